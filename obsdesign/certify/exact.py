@@ -1,0 +1,150 @@
+"""Rational numbers and matrices for exact checks.
+
+The exact scalar type is ``flint.fmpq``; an exact matrix is a 2-D numpy array of dtype
+``object`` holding ``fmpq`` entries, so that formulas such as ``A - L @ C`` can be rebuilt
+in exact arithmetic with ordinary numpy syntax. Never mix ``fmpq`` with ``fractions.Fraction``
+(they do not compare equal); convert with :func:`Q`.
+"""
+
+from __future__ import annotations
+
+import math
+from decimal import Decimal
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+from flint import fmpq
+
+Rational = fmpq
+QMatrix = np.ndarray  # dtype=object, entries fmpq
+
+
+def Q(x: Any) -> fmpq:  # noqa: N802 - Q for the rationals
+    """Convert an int, Fraction, Decimal, finite float, fmpq or "p/q" string to ``fmpq`` exactly."""
+    if isinstance(x, fmpq):
+        return x
+    if isinstance(x, bool):
+        raise TypeError("a boolean is not a number")
+    if isinstance(x, (int, np.integer)):
+        return fmpq(int(x))
+    if isinstance(x, (float, np.floating)):
+        if not math.isfinite(float(x)):
+            raise ValueError(f"not a finite number: {x!r}")
+        fr = Fraction(float(x))
+        return fmpq(fr.numerator, fr.denominator)
+    if isinstance(x, Decimal):
+        if not x.is_finite():
+            raise ValueError(f"not a finite number: {x!r}")
+        fr = Fraction(x)
+        return fmpq(fr.numerator, fr.denominator)
+    if isinstance(x, Fraction):
+        return fmpq(x.numerator, x.denominator)
+    if isinstance(x, str):
+        fr = Fraction(x.strip())
+        return fmpq(fr.numerator, fr.denominator)
+    raise TypeError(f"cannot convert {type(x).__name__} to a rational")
+
+
+def qmat(a: Any) -> QMatrix:
+    """Exact 2-D object array of ``fmpq`` from nested lists / arrays of numbers."""
+    arr = np.array(a, dtype=object)
+    if arr.ndim == 1:
+        arr = arr.reshape(1, -1)
+    if arr.ndim != 2:
+        raise ValueError("expected a matrix")
+    out = np.empty(arr.shape, dtype=object)
+    for idx, v in np.ndenumerate(arr):
+        out[idx] = Q(v)
+    return out
+
+
+def qvec(a: Any) -> QMatrix:
+    """Exact 1-D object array of ``fmpq``."""
+    arr = np.array(a, dtype=object).reshape(-1)
+    return np.array([Q(v) for v in arr], dtype=object)
+
+
+def qeye(n: int) -> QMatrix:
+    """Exact identity matrix."""
+    out = np.full((n, n), fmpq(0), dtype=object)
+    for i in range(n):
+        out[i, i] = fmpq(1)
+    return out
+
+
+def qzeros(shape: tuple[int, ...]) -> QMatrix:
+    """Exact zero array."""
+    return np.full(shape, fmpq(0), dtype=object)
+
+
+def to_float(a: Any) -> np.ndarray | float:
+    """Nearest float64 of an exact scalar or array."""
+    if isinstance(a, fmpq):
+        return _qfloat(a)
+    arr = np.asarray(a, dtype=object)
+    return np.vectorize(_qfloat, otypes=[float])(arr) if arr.size else arr.astype(float)
+
+
+def _qfloat(x: Any) -> float:
+    if isinstance(x, fmpq):
+        return float(Fraction(int(x.p), int(x.q)))  # correctly rounded
+    return float(x)
+
+
+def dyadic(a: Any, bits: int = 24) -> QMatrix | fmpq:
+    """Round floats to the dyadic grid 2^-k·scale and return them exactly.
+
+    The grid step is ``2**-bits`` relative to the largest magnitude of ``a`` (rounded to a
+    power of two), so small entries keep ``bits`` significant bits of the whole matrix and the
+    rationals stay short (fast exact checks). DESIGN.md: "round the solution to a dyadic grid
+    before converting to rationals".
+    """
+    arr = np.asarray(a, dtype=float)
+    if not np.all(np.isfinite(arr)):
+        raise ValueError("cannot round a non-finite number")
+    scale = float(np.max(np.abs(arr))) if arr.size else 0.0
+    e = math.frexp(scale)[1] if scale > 0 else 0
+    k = bits - e  # grid 2^-k
+    def one(v: float) -> fmpq:
+        m = round(v * 2.0**k) if abs(k) < 1000 else round(Fraction(v) * Fraction(2) ** k)
+        return fmpq(int(m), 1) / fmpq(2) ** k if k >= 0 else fmpq(int(m) * 2 ** (-k), 1)
+    if arr.ndim == 0:
+        return one(float(arr))
+    out = np.empty(arr.shape, dtype=object)
+    for idx, v in np.ndenumerate(arr):
+        out[idx] = one(float(v))
+    return out
+
+
+def symmetrize(M: QMatrix) -> QMatrix:
+    """Exact (M + Mᵀ)/2."""
+    return (M + M.T) * fmpq(1, 2)
+
+
+def qstr(a: Any) -> Any:
+    """Exact value(s) as strings like "-187/100" (nested lists for arrays)."""
+    if isinstance(a, fmpq):
+        return str(a)
+    arr = np.asarray(a, dtype=object)
+    if arr.ndim == 0:
+        return str(Q(arr.item()))
+    return [qstr(x) for x in arr] if arr.ndim == 1 else [qstr(row) for row in arr]
+
+
+def qparse(s: Any) -> Any:
+    """Inverse of :func:`qstr`: strings (or nested lists of them) back to ``fmpq`` arrays."""
+    if isinstance(s, str):
+        return Q(s)
+    if isinstance(s, (int, float)):
+        return Q(s)
+    if isinstance(s, list):
+        if s and isinstance(s[0], list):
+            return qmat([[Q(v) for v in row] for row in s])
+        return qvec([Q(v) for v in s])
+    raise ValueError(f"not an exact value: {s!r}")
+
+
+def qmax_abs(M: QMatrix) -> fmpq:
+    """Exact max |entry|."""
+    return max((abs(v) for v in np.asarray(M, dtype=object).flat), default=fmpq(0))

@@ -1,0 +1,106 @@
+"""Outward-rounded bounds for quantities that are not rational (sqrt, log, exp, ...).
+
+mpmath's interval type ``iv.mpf`` rounds every operation outward, so the true value of an
+expression lies in the returned interval. We convert interval ends to exact rationals, so a
+bound reported as "T_max ≥ 1.0899" is a proof. Directions are explicit in every name:
+``*_upper`` returns a rational ≥ the true value, ``*_lower`` one ≤ it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from flint import fmpq
+from mpmath import iv
+from mpmath.libmp import finf, fnan, fninf
+
+from obsdesign.certify.exact import Q
+
+PREC = 113  # bits of the interval endpoints (quad precision); widths far below 1e-30
+
+
+class _prec:
+    """Context manager: run mpmath's interval context at PREC bits, then restore."""
+
+    def __enter__(self) -> None:
+        self.saved = iv.prec
+        iv.prec = PREC
+
+    def __exit__(self, *exc: object) -> None:
+        iv.prec = self.saved
+
+
+def q_to_iv(x: Any) -> Any:
+    """Exact rational → the tightest interval that contains it."""
+    q = Q(x)
+    with _prec():
+        return iv.mpf(int(q.p)) / iv.mpf(int(q.q))
+
+
+def raw_to_q(x: tuple) -> fmpq:
+    """Exact rational value of a finite raw mpmath float (sign, man, exp, bc)."""
+    if x in (finf, fninf, fnan):
+        raise ArithmeticError("interval evaluation did not give a finite enclosure")
+    sign, man, exp, _ = x
+    v = fmpq(int(man) * 2**exp) if exp >= 0 else fmpq(int(man), 2 ** (-exp))
+    return -v if sign else v
+
+
+def bounds(f: Callable[..., Any], *args: Any) -> tuple[fmpq, fmpq]:
+    """Rational (lower, upper) enclosing f(*args), f built from mpmath ``iv`` operations.
+
+    ``args`` are exact rationals (or anything :func:`Q` takes); ``f`` receives intervals.
+    """
+    with _prec():
+        r = f(*[q_to_iv(a) for a in args])
+        r = r if isinstance(r, iv.mpf) else iv.mpf(r)
+        lo, hi = r._mpi_
+    return raw_to_q(lo), raw_to_q(hi)
+
+
+def upper(f: Callable[..., Any], *args: Any) -> fmpq:
+    """A rational ≥ f(*args) (outward rounding)."""
+    return bounds(f, *args)[1]
+
+
+def lower(f: Callable[..., Any], *args: Any) -> fmpq:
+    """A rational ≤ f(*args) (outward rounding)."""
+    return bounds(f, *args)[0]
+
+
+def sqrt_upper(x: Any) -> fmpq:
+    """A rational ≥ √x."""
+    return upper(iv.sqrt, x)
+
+
+def sqrt_lower(x: Any) -> fmpq:
+    """A rational ≤ √x."""
+    return lower(iv.sqrt, x)
+
+
+def log_upper(x: Any) -> fmpq:
+    """A rational ≥ ln x (x > 0)."""
+    return upper(iv.log, x)
+
+
+def log_lower(x: Any) -> fmpq:
+    """A rational ≤ ln x (x > 0)."""
+    return lower(iv.log, x)
+
+
+def round_up(x: Any, digits: int) -> fmpq:
+    """Smallest multiple of 10^-digits that is ≥ x (exact)."""
+    q = Q(x) * fmpq(10) ** digits
+    return fmpq(int(q.ceil())) / fmpq(10) ** digits
+
+
+def round_down(x: Any, digits: int) -> fmpq:
+    """Largest multiple of 10^-digits that is ≤ x (exact)."""
+    q = Q(x) * fmpq(10) ** digits
+    return fmpq(int(q.floor())) / fmpq(10) ** digits
+
+
+def ceil_int(x: Any) -> int:
+    """⌈x⌉ of an exact rational."""
+    return int(Q(x).ceil())

@@ -1,0 +1,70 @@
+"""cvxpy building blocks for LMIs: symmetric-by-construction blocks, strictness margins,
+and a solver call that says why it failed.
+
+Recipe (DESIGN.md): a strict LMI F ≻ 0 is solved as F ⪰ δ_solve·I with a normalization
+(P ⪰ I); only status ``optimal`` is accepted; the solution is then rounded and checked exactly
+by :mod:`obsdesign.certify`. ``optimal_inaccurate`` is "not certified", never "infeasible".
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from obsdesign.errors import SolverError
+
+SOLVERS = ("CLARABEL", "SCS")
+
+
+@dataclass
+class SolveResult:
+    """Outcome of :func:`solve`: ``status`` is cvxpy's status string."""
+
+    status: str
+    solver: str
+    seconds: float
+
+    @property
+    def optimal(self) -> bool:
+        return self.status == "optimal"
+
+    @property
+    def infeasible(self) -> bool:
+        return self.status in ("infeasible", "infeasible_inaccurate")
+
+
+def sym(M: Any) -> Any:
+    """(M + Mᵀ)/2 for a cvxpy expression: use on blocks assembled from products, so that the
+    constraint cvxpy sees is exactly the symmetric matrix the certificate rebuilds."""
+    return (M + M.T) / 2
+
+
+def solve(problem: Any, solvers: tuple[str, ...] = SOLVERS) -> SolveResult:
+    """Solve with the first solver that returns a definite status; fall back on errors."""
+    import cvxpy as cp
+
+    last = ""
+    t0 = time.perf_counter()
+    for name in solvers:
+        if name not in cp.installed_solvers():
+            continue
+        try:
+            problem.solve(solver=name)
+        except cp.error.SolverError as e:
+            last = f"{name}: {e}"
+            continue
+        status = str(problem.status)
+        if status in ("optimal", "infeasible", "unbounded"):
+            return SolveResult(status, name, time.perf_counter() - t0)
+        last = f"{name}: {status}"
+    if last.endswith("inaccurate"):
+        return SolveResult(last.split(": ")[1], last.split(":")[0], time.perf_counter() - t0)
+    raise SolverError(f"no SDP solver succeeded ({last or 'none installed'})")
+
+
+def value(x: Any) -> np.ndarray:
+    """Float value of a cvxpy variable/expression as a numpy array."""
+    return np.asarray(x.value, dtype=float)

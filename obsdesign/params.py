@@ -1,0 +1,136 @@
+"""Design parameters: exact values where certified, floats otherwise, and their JSON form.
+
+In a report, ``parameters`` maps each of the paper's symbols to a float (a matrix is a list of
+rows of floats); the exact form sits beside it under ``parameters["exact"]`` as strings like
+``"-187/100"``. Reading a report back, the exact strings are what the checks use, and
+:meth:`Parameters.consistency` says whether each float still matches its exact value (an
+edited float is caught there).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+from flint import fmpq
+
+from obsdesign.certify.exact import qparse, qstr, to_float
+from obsdesign.errors import InputError
+
+
+def _is_exact(v: Any) -> bool:
+    if isinstance(v, fmpq):
+        return True
+    return isinstance(v, np.ndarray) and v.dtype == object and v.size > 0 and isinstance(
+        v.flat[0], fmpq
+    )
+
+
+def _floats(v: Any) -> Any:
+    if isinstance(v, fmpq):
+        return float(to_float(v))
+    if isinstance(v, np.ndarray):
+        arr = np.asarray(to_float(v), dtype=float) if v.dtype == object else v.astype(float)
+        return arr.tolist()
+    if isinstance(v, (np.floating, np.integer)):
+        return v.item()
+    if isinstance(v, (list, tuple)):
+        return [_floats(x) for x in v]
+    return v
+
+
+class Parameters:
+    """Ordered mapping symbol → value (fmpq / exact object array / float / ndarray / misc)."""
+
+    def __init__(self, values: dict[str, Any] | None = None) -> None:
+        self._v: dict[str, Any] = dict(values or {})
+
+    def __getitem__(self, k: str) -> Any:
+        return self._v[k]
+
+    def __setitem__(self, k: str, v: Any) -> None:
+        self._v[k] = v
+
+    def __contains__(self, k: object) -> bool:
+        return k in self._v
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._v)
+
+    def get(self, k: str, default: Any = None) -> Any:
+        return self._v.get(k, default)
+
+    def items(self) -> Any:
+        return self._v.items()
+
+    def float(self, k: str) -> Any:
+        """Float view of a parameter (numpy array for arrays)."""
+        v = self._v[k]
+        f = _floats(v)
+        return np.asarray(f, dtype=float) if isinstance(f, list) else f
+
+    def is_exact(self, k: str) -> bool:
+        return _is_exact(self._v.get(k))
+
+    def to_json(self) -> dict[str, Any]:
+        out: dict[str, Any] = {}
+        exact: dict[str, Any] = {}
+        for k, v in self._v.items():
+            out[k] = _floats(v)
+            if _is_exact(v):
+                exact[k] = qstr(v)
+        out["exact"] = exact
+        return out
+
+    @classmethod
+    def from_json(cls, d: dict[str, Any]) -> tuple[Parameters, list[str]]:
+        """Parameters from a report's ``parameters`` object, and a list of inconsistencies
+        (a float that no longer matches its exact value)."""
+        if not isinstance(d, dict):
+            raise InputError("report: 'parameters' must be an object")
+        exact = d.get("exact", {})
+        if not isinstance(exact, dict):
+            raise InputError("report: 'parameters.exact' must be an object")
+        vals: dict[str, Any] = {}
+        problems: list[str] = []
+        for k, v in d.items():
+            if k == "exact":
+                continue
+            if k in exact:
+                try:
+                    q = qparse(exact[k])
+                except (ValueError, TypeError, ZeroDivisionError) as e:
+                    raise InputError(f"report: parameters.exact.{k}: not an exact value ({e})") from e
+                vals[k] = q
+                if not _same(_floats(q), v):
+                    problems.append(f"parameter '{k}': float value differs from its exact value")
+            else:
+                vals[k] = np.asarray(v, dtype=float) if _numeric_list(v) else v
+        for k in exact:
+            if k not in d:
+                problems.append(f"parameter '{k}': exact value without a float value")
+        return cls(vals), problems
+
+
+def _numeric_list(v: Any) -> bool:
+    if not isinstance(v, list):
+        return False
+    try:
+        np.asarray(v, dtype=float)
+        return True
+    except (TypeError, ValueError):
+        return False
+
+
+def _same(a: Any, b: Any) -> bool:
+    if isinstance(a, list) or isinstance(b, list):
+        if not (isinstance(a, list) and isinstance(b, list)) or len(a) != len(b):
+            return False
+        return all(_same(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, bool) or isinstance(b, bool):
+        return a == b
+    if not isinstance(b, (int, float)):
+        return False
+    return math.isclose(float(a), float(b), rel_tol=1e-12, abs_tol=1e-300)

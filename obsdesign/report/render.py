@@ -1,0 +1,84 @@
+"""Renderers: rich terminal tables and Markdown."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from obsdesign.certify.claim import ClaimStatus
+from obsdesign.report.model import Report
+
+STYLE = {ClaimStatus.CERTIFIED: "green", ClaimStatus.NUMERICAL: "yellow", ClaimStatus.FAILED: "bold red"}
+
+
+def fmt_value(v: Any, digits: int = 6) -> str:
+    """Compact float rendering of a parameter (matrices row by row)."""
+    if isinstance(v, (int, float, np.floating, np.integer)) and not isinstance(v, bool):
+        return f"{float(v):.{digits}g}"
+    arr = np.asarray(v)
+    if arr.dtype.kind in "fiu" and arr.ndim in (1, 2):
+        if arr.ndim == 1:
+            return "[" + ", ".join(f"{x:.{digits}g}" for x in arr) + "]"
+        return "[" + "; ".join(", ".join(f"{x:.{digits}g}" for x in row) for row in arr) + "]"
+    s = str(v)
+    return s if len(s) < 200 else s[:197] + "..."
+
+
+def _param_rows(report: Report) -> list[tuple[str, str, str]]:
+    rows = []
+    for k in report.parameters:
+        v = report.parameters.float(k) if _numeric(report.parameters[k]) else report.parameters[k]
+        rows.append((k, fmt_value(v), "exact" if report.parameters.is_exact(k) else "float"))
+    return rows
+
+
+def _numeric(v: Any) -> bool:
+    try:
+        np.asarray(v if not isinstance(v, np.ndarray) or v.dtype != object else v.astype(float), dtype=float)
+        return True
+    except (TypeError, ValueError):
+        return False
+
+
+def render_text(report: Report, title: str = "") -> None:
+    """Print a report on the terminal with rich."""
+    from rich.console import Console
+    from rich.table import Table
+
+    console = Console()
+    t = Table(title=title or f"{report.method} — {report.spec_file}", show_lines=False)
+    t.add_column("parameter")
+    t.add_column("value", overflow="fold")
+    t.add_column("form")
+    for k, v, form in _param_rows(report):
+        t.add_row(k, v, form)
+    console.print(t)
+    c = Table(title="claims")
+    for col in ("id", "status", "statement", "check", "detail"):
+        c.add_column(col, overflow="fold")
+    for cl in report.claims:
+        c.add_row(cl.id, f"[{STYLE[cl.status]}]{cl.status.value}[/]", cl.statement, cl.check, cl.detail)
+    console.print(c)
+    for n in report.notes:
+        console.print(f"note: {n}")
+    counts = report.status_counts()
+    console.print(
+        f"claims: {counts['certified']} certified, {counts['numerical']} numerical, "
+        f"{counts['failed']} failed"
+    )
+
+
+def render_markdown(report: Report) -> str:
+    """The report as Markdown."""
+    lines = [f"# obsdesign report: {report.method}", "", f"- spec: `{report.spec_file}`",
+             f"- spec sha256: `{report.spec_sha256}`", f"- tool: {report.tool.get('version', '')}", ""]
+    lines += ["## Parameters", "", "| symbol | value | form |", "| --- | --- | --- |"]
+    lines += [f"| {k} | `{v}` | {f} |" for k, v, f in _param_rows(report)]
+    lines += ["", "## Claims", "", "| id | status | statement | reference | check | detail |",
+              "| --- | --- | --- | --- | --- | --- |"]
+    for c in report.claims:
+        lines.append(f"| {c.id} | **{c.status.value}** | {c.statement} | {c.reference} | {c.check} | {c.detail} |")
+    if report.notes:
+        lines += ["", "## Notes", ""] + [f"- {n}" for n in report.notes]
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,57 @@
+"""Axis-aligned boxes {x : lower <= x <= upper}."""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+
+from obsdesign.certify.exact import qzeros
+from obsdesign.sets.base import ConvexSet
+
+
+@dataclass(frozen=True, eq=False)
+class Box(ConvexSet):
+    """Box with exact bounds ``lower_q``, ``upper_q`` (object arrays of fmpq)."""
+
+    lower_q: np.ndarray
+    upper_q: np.ndarray
+    kind = "box"
+
+    @property
+    def dim(self) -> int:
+        return len(self.lower_q)
+
+    @property
+    def lower(self) -> np.ndarray:
+        return np.array([float(v) for v in self.lower_q])
+
+    @property
+    def upper(self) -> np.ndarray:
+        return np.array([float(v) for v in self.upper_q])
+
+    def contains(self, x: np.ndarray, tol: float = 1e-12) -> np.ndarray | bool:
+        x = np.asarray(x, dtype=float)
+        ok = (x >= self.lower - tol) & (x <= self.upper + tol)
+        return ok.all(axis=-1)
+
+    def bounding_box(self) -> tuple[np.ndarray, np.ndarray]:
+        return self.lower, self.upper
+
+    def vertices_q(self) -> np.ndarray:
+        """All 2^n vertices, exact (rows)."""
+        pts = list(itertools.product(*zip(self.lower_q, self.upper_q, strict=True)))
+        return np.array(pts, dtype=object).reshape(len(pts), self.dim)
+
+    def h_form_q(self) -> tuple[np.ndarray, np.ndarray]:
+        """Exact (G, g) with G x <= g: rows e_i (upper) then -e_i (lower)."""
+        n = self.dim
+        G = qzeros((2 * n, n))
+        g = np.empty(2 * n, dtype=object)
+        for i in range(n):
+            G[i, i] = 1
+            G[n + i, i] = -1
+            g[i] = self.upper_q[i]
+            g[n + i] = -self.lower_q[i]
+        return G, g

@@ -1,0 +1,109 @@
+"""Polytopes in H-form {x : G x <= g}, and symmetric polytopes {x : |Q x| <= 1}.
+
+Vertex enumeration goes through pycddlib: exact with ``cdd.gmp`` (rationals in, rationals
+out) for certificates, float ``cdd`` for speed elsewhere.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+
+import numpy as np
+from flint import fmpq
+
+from obsdesign.certify.exact import Q, to_float
+from obsdesign.sets.base import ConvexSet
+
+
+def _frac(q: fmpq) -> Fraction:
+    return Fraction(int(q.p), int(q.q))
+
+
+def vertices_exact(G_q: np.ndarray, g_q: np.ndarray) -> tuple[np.ndarray, bool]:
+    """Exact vertices of {G x <= g} by cdd.gmp; returns (vertices (k, n) of fmpq, bounded)."""
+    import cdd
+    import cdd.gmp
+
+    rows = [[_frac(g_q[i])] + [-_frac(v) for v in G_q[i]] for i in range(G_q.shape[0])]
+    mat = cdd.gmp.matrix_from_array(rows, rep_type=cdd.RepType.INEQUALITY)
+    gen = cdd.gmp.copy_generators(cdd.gmp.polyhedron_from_matrix(mat))
+    verts, bounded = [], not gen.lin_set
+    for r in gen.array:
+        if r[0] == 0:
+            bounded = False
+        else:
+            verts.append([Q(v) / Q(r[0]) for v in r[1:]])
+    n = G_q.shape[1]
+    return np.array(verts, dtype=object).reshape(len(verts), n), bounded
+
+
+def vertices_float(G: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, bool]:
+    """Float vertices of {G x <= g} by float cdd; returns (vertices, bounded)."""
+    import cdd
+
+    rows = np.hstack([np.asarray(g, float).reshape(-1, 1), -np.asarray(G, float)])
+    mat = cdd.matrix_from_array(rows.tolist(), rep_type=cdd.RepType.INEQUALITY)
+    gen = cdd.copy_generators(cdd.polyhedron_from_matrix(mat))
+    arr = np.array(gen.array, dtype=float).reshape(-1, G.shape[1] + 1)
+    bounded = not gen.lin_set and bool(np.all(arr[:, 0] != 0)) if len(arr) else True
+    verts = arr[arr[:, 0] != 0]
+    return verts[:, 1:] / verts[:, :1], bounded
+
+
+@dataclass(frozen=True, eq=False)
+class Polytope(ConvexSet):
+    """{x : G x <= g} with exact data ``G_q``, ``g_q``."""
+
+    G_q: np.ndarray
+    g_q: np.ndarray
+    kind = "polytope"
+
+    @property
+    def dim(self) -> int:
+        return self.G_q.shape[1]
+
+    @property
+    def G(self) -> np.ndarray:
+        return np.asarray(to_float(self.G_q), dtype=float)
+
+    @property
+    def g(self) -> np.ndarray:
+        return np.asarray(to_float(self.g_q), dtype=float).reshape(-1)
+
+    def h_form_q(self) -> tuple[np.ndarray, np.ndarray]:
+        return self.G_q, self.g_q
+
+    def contains(self, x: np.ndarray, tol: float = 1e-12) -> np.ndarray | bool:
+        x = np.asarray(x, dtype=float)
+        return np.all(x @ self.G.T <= self.g + tol, axis=-1)
+
+    def vertices_q(self) -> np.ndarray:
+        """Exact vertices (cdd.gmp)."""
+        G, g = self.h_form_q()
+        return vertices_exact(G, g)[0]
+
+    def vertices(self) -> np.ndarray:
+        """Float vertices (float cdd)."""
+        return vertices_float(self.G, self.g)[0]
+
+    def bounding_box(self) -> tuple[np.ndarray, np.ndarray]:
+        v = self.vertices()
+        return v.min(axis=0), v.max(axis=0)
+
+
+@dataclass(frozen=True, eq=False)
+class SymmetricPolytope(Polytope):
+    """{x : |Q x| <= 1} (componentwise), i.e. G = [Q; -Q], g = 1."""
+
+    kind = "symmetric-polytope"
+
+    @classmethod
+    def from_Q(cls, Q_q: np.ndarray) -> SymmetricPolytope:
+        G = np.vstack([Q_q, -Q_q])
+        g = np.array([fmpq(1)] * G.shape[0], dtype=object)
+        return cls(G, g)
+
+    @property
+    def Q_q(self) -> np.ndarray:
+        return self.G_q[: self.G_q.shape[0] // 2]

@@ -1,0 +1,41 @@
+"""Simulation results and the standard metrics: sup |e_i|, RMSE per state, final |e|."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+
+@dataclass
+class SimResult:
+    """Trajectories on a common grid ``t`` (sample index or time): plant ``x``, estimate
+    ``xhat`` (both (len(t), n)), outputs ``y``; ``extra`` holds method-specific series and
+    ``info`` method-specific scalar results (printed with the metrics)."""
+
+    t: np.ndarray
+    x: np.ndarray
+    xhat: np.ndarray
+    y: np.ndarray | None = None
+    states: list[str] = field(default_factory=list)
+    extra: dict[str, Any] = field(default_factory=dict)
+    info: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def e(self) -> np.ndarray:
+        return self.xhat - self.x
+
+    def metrics(self) -> dict[str, Any]:
+        return {**metrics(self.e, self.states), **self.info}
+
+
+def metrics(e: np.ndarray, states: list[str] | None = None) -> dict[str, Any]:
+    """sup_k |e_i(k)|, RMSE of each e_i, and the final Euclidean |e|."""
+    e = np.asarray(e, dtype=float)
+    names = states or [f"x{i + 1}" for i in range(e.shape[1])]
+    return {
+        "sup_abs_error": {s: float(np.max(np.abs(e[:, i]))) for i, s in enumerate(names)},
+        "rmse": {s: float(np.sqrt(np.mean(e[:, i] ** 2))) for i, s in enumerate(names)},
+        "final_error_norm": float(np.linalg.norm(e[-1])),
+    }

@@ -1,0 +1,326 @@
+"""A small, safe expression language for nonlinear terms in specs.
+
+Strings like ``x1*x2*(x2+a)*(x2-a)/(1+x2^4)`` over declared variables (states, inputs, time)
+and named parameters. Parsing uses Python's :mod:`ast` with a whitelist: numbers, the declared
+names, ``+ - * / ^ ** %``, unary minus, and calls of the whitelisted functions. Attribute
+access, subscripts, lambdas, comprehensions, keywords, strings and every other construct are
+rejected with a message naming the construct. Spec text is never passed to ``eval``/``exec``
+or ``sympify``: it is compiled into numpy closures walking the checked tree, and into a sympy
+expression built node by node (for exact Jacobians). ``^`` means power.
+
+Functions: sin cos tan exp log sqrt abs tanh atan sinh cosh min max sat sign step heaviside
+floor mod. ``sat(x) = clip(x, -1, 1)``, ``sat(x, r) = clip(x, -r, r)``, ``step(x) =
+heaviside(x) = 1 if x > 0 else 0``, ``mod(a, b) = a - b*floor(a/b)``. Constants ``pi``, ``e``.
+"""
+
+from __future__ import annotations
+
+import ast
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from obsdesign.errors import SpecError
+
+Env = dict[str, Any]
+Fn = Callable[[Env], Any]
+
+
+def _sat(x: Any, r: Any = 1.0) -> Any:
+    return np.clip(x, -r, r)
+
+
+def _step(x: Any) -> Any:
+    return np.where(np.asarray(x) > 0, 1.0, 0.0)
+
+
+def _mod(a: Any, b: Any) -> Any:
+    return a - b * np.floor(a / b)
+
+
+FUNCTIONS: dict[str, tuple[Callable[..., Any], tuple[int, ...]]] = {
+    "sin": (np.sin, (1,)),
+    "cos": (np.cos, (1,)),
+    "tan": (np.tan, (1,)),
+    "exp": (np.exp, (1,)),
+    "log": (np.log, (1,)),
+    "sqrt": (np.sqrt, (1,)),
+    "abs": (np.abs, (1,)),
+    "tanh": (np.tanh, (1,)),
+    "atan": (np.arctan, (1,)),
+    "sinh": (np.sinh, (1,)),
+    "cosh": (np.cosh, (1,)),
+    "min": (np.minimum, (2,)),
+    "max": (np.maximum, (2,)),
+    "sat": (_sat, (1, 2)),
+    "sign": (np.sign, (1,)),
+    "step": (_step, (1,)),
+    "heaviside": (_step, (1,)),
+    "floor": (np.floor, (1,)),
+    "mod": (_mod, (2,)),
+}
+CONSTANTS = {"pi": np.pi, "e": np.e}
+
+_BINOPS: dict[type, Callable[[Any, Any], Any]] = {
+    ast.Add: np.add,
+    ast.Sub: np.subtract,
+    ast.Mult: np.multiply,
+    ast.Div: np.divide,
+    ast.Pow: np.power,
+    ast.BitXor: np.power,
+    ast.Mod: _mod,
+}
+_FORBIDDEN = {
+    ast.Attribute: "attribute access is",
+    ast.Subscript: "subscripts are",
+    ast.Lambda: "lambda is",
+    ast.ListComp: "comprehensions are",
+    ast.GeneratorExp: "comprehensions are",
+    ast.DictComp: "comprehensions are",
+    ast.SetComp: "comprehensions are",
+    ast.Compare: "comparisons are (use step(x))",
+    ast.BoolOp: "boolean operators are",
+    ast.IfExp: "conditional expressions are",
+    ast.NamedExpr: "assignment expressions are",
+    ast.Starred: "starred arguments are",
+    ast.List: "lists are",
+    ast.Tuple: "tuples are",
+    ast.Dict: "dicts are",
+    ast.JoinedStr: "strings are",
+    ast.Await: "await is",
+    ast.Yield: "yield is",
+}
+
+
+@dataclass
+class Expr:
+    """A checked expression: evaluate it vectorized, differentiate it exactly (sympy)."""
+
+    source: str
+    tree: ast.Expression
+    variables: tuple[str, ...]
+    parameters: dict[str, Any]
+    _fn: Fn = field(repr=False, default=lambda env: 0.0)
+
+    def __call__(self, **values: Any) -> Any:
+        """Evaluate with variables given by name (arrays broadcast: a batch at once)."""
+        env: Env = {**CONSTANTS, **{k: float(v) for k, v in self.parameters.items()}}
+        env.update({k: np.asarray(v, dtype=float) for k, v in values.items()})
+        missing = [v for v in self.variables if v not in env and self.uses(v)]
+        if missing:
+            raise KeyError(f"no value for {missing[0]}")
+        return self._fn(env)
+
+    def uses(self, name: str) -> bool:
+        return any(isinstance(n, ast.Name) and n.id == name for n in ast.walk(self.tree))
+
+    def on(self, order: list[str]) -> Callable[[np.ndarray], np.ndarray]:
+        """Callable on an array whose last axis holds ``order`` (shape (..., len(order)))."""
+
+        def f(X: np.ndarray) -> np.ndarray:
+            X = np.asarray(X, dtype=float)
+            out = self(**{name: X[..., i] for i, name in enumerate(order)})
+            return np.broadcast_to(out, X.shape[:-1]).astype(float)
+
+        return f
+
+    def sympy(self) -> Any:
+        """The expression as a sympy object, built node by node (parameters exact)."""
+        return _to_sympy(self.tree.body, self)
+
+    def derivative(self, name: str) -> Callable[..., Any]:
+        """∂/∂name as a vectorized callable of the same variables (exact symbolic derivative)."""
+        import sympy as sp
+
+        d = sp.diff(self.sympy(), sp.Symbol(name))
+        if d.has(sp.Derivative):
+            raise ValueError(f"'{self.source}' is not differentiable in {name}")
+
+        def f(**values: Any) -> Any:
+            env = {k: np.asarray(v, dtype=float) for k, v in values.items()}
+            return _eval_sympy(d, env)
+
+        return f
+
+    def jacobian(self, order: list[str]) -> Callable[[np.ndarray], np.ndarray]:
+        """Gradient w.r.t. ``order`` on arrays of shape (..., len(order)) → (..., len(order))."""
+        parts = [self.derivative(v) for v in order]
+
+        def J(X: np.ndarray) -> np.ndarray:
+            X = np.asarray(X, dtype=float)
+            vals = {name: X[..., i] for i, name in enumerate(order)}
+            return np.stack([np.broadcast_to(p(**vals), X.shape[:-1]) for p in parts], axis=-1)
+
+        return J
+
+
+def parse_expr(
+    text: str,
+    variables: list[str] | tuple[str, ...],
+    parameters: dict[str, Any] | None = None,
+    file: str = "<expr>",
+    key: str = "",
+) -> Expr:
+    """Parse and check ``text``; raise :class:`SpecError` (file, key) on anything not allowed.
+
+    ``parameters`` maps names to exact values (fmpq, int, Decimal, float).
+    """
+    parameters = dict(parameters or {})
+    if not isinstance(text, str):
+        raise SpecError(file, key, "expected an expression string")
+    if len(text) > 10_000:
+        raise SpecError(file, key, "expression is too long")
+    try:
+        tree = ast.parse(text.strip(), mode="eval")
+    except SyntaxError as e:
+        raise SpecError(file, key, f"is not a valid expression ({e.msg})") from None
+    known = set(variables) | set(parameters) | set(CONSTANTS)
+    clash = set(variables) & (set(parameters) | set(FUNCTIONS))
+    if clash:
+        raise SpecError(file, key, f"name {sorted(clash)[0]!r} is both a variable and a parameter/function")
+    fn = _compile(tree.body, known, file, key)
+    return Expr(text, tree, tuple(variables), parameters, fn)
+
+
+def _compile(node: ast.AST, known: set[str], file: str, key: str) -> Fn:
+    def bad(what: str) -> SpecError:
+        return SpecError(file, key, f"{what} not allowed in expressions".replace("(use step(x)) not allowed", "not allowed (use step(x))"))
+
+    for t, what in _FORBIDDEN.items():
+        if isinstance(node, t):
+            raise bad(what)
+    if isinstance(node, ast.Constant):
+        if isinstance(node.value, bool) or not isinstance(node.value, (int, float)):
+            raise bad(f"the constant {node.value!r} is")
+        c = float(node.value)
+        return lambda env: c
+    if isinstance(node, ast.Name):
+        name = node.id
+        if name.startswith("__") or name not in known:
+            if name in FUNCTIONS:
+                raise SpecError(file, key, f"'{name}' is a function: call it, e.g. {name}(x1)")
+            raise SpecError(file, key, f"unknown name '{name}' (known: {', '.join(sorted(known))})")
+        return lambda env: env[name]
+    if isinstance(node, ast.UnaryOp):
+        arg = _compile(node.operand, known, file, key)
+        if isinstance(node.op, ast.USub):
+            return lambda env: -arg(env)
+        if isinstance(node.op, ast.UAdd):
+            return arg
+        raise bad(f"the operator {type(node.op).__name__} is")
+    if isinstance(node, ast.BinOp):
+        op = _BINOPS.get(type(node.op))
+        if op is None:
+            raise bad(f"the operator {type(node.op).__name__} is")
+        left = _compile(node.left, known, file, key)
+        right = _compile(node.right, known, file, key)
+        return lambda env: op(left(env), right(env))
+    if isinstance(node, ast.Call):
+        if not isinstance(node.func, ast.Name):
+            raise bad("calling anything but a named function is")
+        fname = node.func.id
+        if fname not in FUNCTIONS:
+            raise SpecError(file, key, f"unknown function '{fname}' (allowed: {', '.join(sorted(FUNCTIONS))})")
+        if node.keywords:
+            raise bad("keyword arguments are")
+        f, arities = FUNCTIONS[fname]
+        if len(node.args) not in arities:
+            raise SpecError(file, key, f"{fname}() takes {' or '.join(map(str, arities))} argument(s)")
+        args = [_compile(a, known, file, key) for a in node.args]
+        return lambda env: f(*(a(env) for a in args))
+    raise bad(f"the construct {type(node).__name__} is")
+
+
+# -- sympy, built from the checked tree ---------------------------------------------------
+def _to_sympy(node: ast.AST, ex: Expr) -> Any:
+    import sympy as sp
+
+    if isinstance(node, ast.Constant):
+        return sp.nsimplify(node.value) if isinstance(node.value, float) else sp.Integer(node.value)
+    if isinstance(node, ast.Name):
+        if node.id in ex.parameters:
+            from obsdesign.certify.exact import Q
+
+            q = Q(ex.parameters[node.id])
+            return sp.Rational(int(q.p), int(q.q))
+        if node.id == "pi":
+            return sp.pi
+        if node.id == "e":
+            return sp.E
+        return sp.Symbol(node.id)
+    if isinstance(node, ast.UnaryOp):
+        a = _to_sympy(node.operand, ex)
+        return -a if isinstance(node.op, ast.USub) else a
+    if isinstance(node, ast.BinOp):
+        a, b = _to_sympy(node.left, ex), _to_sympy(node.right, ex)
+        op = type(node.op)
+        if op is ast.Add:
+            return a + b
+        if op is ast.Sub:
+            return a - b
+        if op is ast.Mult:
+            return a * b
+        if op is ast.Div:
+            return a / b
+        if op in (ast.Pow, ast.BitXor):
+            return a**b
+        return a - b * sp.floor(a / b)
+    assert isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+    args = [_to_sympy(a, ex) for a in node.args]
+    name = node.func.id
+    table = {
+        "sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "exp": sp.exp, "log": sp.log,
+        "sqrt": sp.sqrt, "abs": sp.Abs, "tanh": sp.tanh, "atan": sp.atan, "sinh": sp.sinh,
+        "cosh": sp.cosh, "min": sp.Min, "max": sp.Max, "sign": sp.sign, "floor": sp.floor,
+    }
+    if name in table:
+        return table[name](*args)
+    if name == "sat":
+        r = args[1] if len(args) == 2 else sp.Integer(1)
+        return sp.Max(-r, sp.Min(r, args[0]))
+    if name in ("step", "heaviside"):
+        return sp.Heaviside(args[0], 0)
+    return args[0] - args[1] * sp.floor(args[0] / args[1])  # mod
+
+
+def _eval_sympy(e: Any, env: dict[str, Any]) -> Any:
+    """Evaluate a sympy expression with numpy by walking its tree (no lambdify/eval)."""
+    import sympy as sp
+
+    if e.is_Symbol:
+        return env[e.name]
+    if e.is_Number or e.is_NumberSymbol:
+        return float(e)
+    args = [_eval_sympy(a, env) for a in e.args]
+    if e.is_Add:
+        out = args[0]
+        for a in args[1:]:
+            out = out + a
+        return out
+    if e.is_Mul:
+        out = args[0]
+        for a in args[1:]:
+            out = out * a
+        return out
+    if e.is_Pow:
+        return np.power(args[0], args[1])
+    fn = {
+        sp.sin: np.sin, sp.cos: np.cos, sp.tan: np.tan, sp.exp: np.exp, sp.log: np.log,
+        sp.tanh: np.tanh, sp.atan: np.arctan, sp.sinh: np.sinh, sp.cosh: np.cosh,
+        sp.Abs: np.abs, sp.sign: np.sign, sp.floor: np.floor,
+    }.get(e.func)
+    if fn is not None:
+        return fn(args[0])
+    if e.func is sp.Heaviside:
+        return np.where(np.asarray(args[0]) > 0, 1.0, 0.0)
+    if e.func is sp.DiracDelta:
+        return np.zeros_like(np.asarray(args[0], dtype=float))
+    if e.func is sp.Min:
+        return np.minimum.reduce(np.broadcast_arrays(*args))
+    if e.func is sp.Max:
+        return np.maximum.reduce(np.broadcast_arrays(*args))
+    if e.func is sp.sec:
+        return 1 / np.cos(args[0])
+    raise ValueError(f"cannot evaluate {e.func} numerically")

@@ -1,0 +1,238 @@
+"""Typed access to a TOML table, with errors that name the file and the key.
+
+Numbers arrive as ``decimal.Decimal`` (TOML floats, parsed with ``parse_float=Decimal``) or
+``int``; :class:`Value` keeps both the exact rational form (``.q``, for certification) and
+float64 (``.f``, for solvers). So ``0.1`` in a spec is exactly 1/10.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from decimal import Decimal
+from typing import Any
+
+import numpy as np
+from flint import fmpq
+
+from obsdesign.certify.exact import Q, to_float
+from obsdesign.errors import SpecError
+
+_MISSING: Any = object()
+
+
+@dataclass(frozen=True)
+class Value:
+    """A number, vector or matrix from a spec: exact (``q``: fmpq or object array) and float."""
+
+    q: Any
+    f: Any
+
+    @classmethod
+    def of(cls, q: Any) -> Value:
+        if isinstance(q, fmpq):
+            return cls(q, float(to_float(q)))
+        arr = np.asarray(q, dtype=object)
+        return cls(arr, np.asarray(to_float(arr), dtype=float).reshape(arr.shape))
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return np.shape(self.f)
+
+
+def _is_number(v: Any) -> bool:
+    return isinstance(v, (int, Decimal)) and not isinstance(v, bool)
+
+
+class Table:
+    """A TOML table with its file name and key path; getters validate and convert."""
+
+    def __init__(self, data: dict[str, Any], file: str, path: str = "") -> None:
+        self.data = data
+        self.file = file
+        self.path = path
+        self._used: set[str] = set()
+
+    # -- plumbing ---------------------------------------------------------------------------
+    def key(self, k: str) -> str:
+        return f"{self.path}.{k}" if self.path else k
+
+    def error(self, k: str, expected: str) -> SpecError:
+        return SpecError(self.file, self.key(k) if k else self.path, expected)
+
+    def has(self, k: str) -> bool:
+        return k in self.data
+
+    def mark(self, *keys: str) -> None:
+        self._used.update(keys)
+
+    def _get(self, k: str, default: Any) -> Any:
+        self._used.add(k)
+        if k in self.data:
+            return self.data[k]
+        if default is _MISSING:
+            raise self.error(k, "is missing")
+        return default
+
+    def done(self, allowed_extra: tuple[str, ...] = ()) -> None:
+        """Reject keys nobody read: a typo must not be silently ignored."""
+        unknown = sorted(set(self.data) - self._used - set(allowed_extra))
+        if unknown:
+            raise self.error(unknown[0], "is not a known key here")
+
+    # -- tables -----------------------------------------------------------------------------
+    def table(self, k: str, required: bool = False) -> Table | None:
+        v = self._get(k, _MISSING if required else None)
+        if v is None:
+            return None
+        if not isinstance(v, dict):
+            raise self.error(k, "expected a table")
+        return Table(v, self.file, self.key(k))
+
+    def tables(self, k: str) -> dict[str, Table]:
+        t = self.table(k)
+        if t is None:
+            return {}
+        out = {}
+        for name, v in t.data.items():
+            if not isinstance(v, dict):
+                raise t.error(name, "expected a table")
+            t.mark(name)
+            out[name] = Table(v, self.file, t.key(name))
+        return out
+
+    # -- scalars ----------------------------------------------------------------------------
+    def str(self, k: str, default: Any = _MISSING, choices: tuple[str, ...] | None = None) -> Any:
+        v = self._get(k, default)
+        if v is default and default is not _MISSING:
+            return v
+        if not isinstance(v, str):
+            raise self.error(k, f"expected a string, got {_tname(v)}")
+        if choices is not None and v not in choices:
+            raise self.error(k, f"expected one of {', '.join(choices)}; got {v!r}")
+        return v
+
+    def bool(self, k: str, default: Any = _MISSING) -> Any:
+        v = self._get(k, default)
+        if v is default and default is not _MISSING:
+            return v
+        if not isinstance(v, bool):
+            raise self.error(k, f"expected true or false, got {_tname(v)}")
+        return v
+
+    def int(self, k: str, default: Any = _MISSING, min: int | None = None) -> Any:
+        v = self._get(k, default)
+        if v is default and default is not _MISSING:
+            return v
+        if not isinstance(v, int) or isinstance(v, bool):
+            raise self.error(k, f"expected an integer, got {_tname(v)}")
+        if min is not None and v < min:
+            raise self.error(k, f"expected an integer >= {min}, got {v}")
+        return v
+
+    def scalar(
+        self,
+        k: str,
+        default: Any = _MISSING,
+        min: Any = None,
+        max: Any = None,
+        strict_min: bool = False,
+        strict_max: bool = False,
+    ) -> Any:
+        """A finite number as :class:`Value`; bounds are checked exactly."""
+        v = self._get(k, default)
+        if v is default and default is not _MISSING:
+            return v if (v is None or isinstance(v, Value)) else Value.of(Q(v))
+        q = self._number(k, v)
+        if min is not None and (q <= Q(min) if strict_min else q < Q(min)):
+            raise self.error(k, f"expected a number {'>' if strict_min else '>='} {min}, got {_show(v)}")
+        if max is not None and (q >= Q(max) if strict_max else q > Q(max)):
+            raise self.error(k, f"expected a number {'<' if strict_max else '<='} {max}, got {_show(v)}")
+        return Value.of(q)
+
+    def _number(self, k: str, v: Any) -> fmpq:
+        if not _is_number(v):
+            raise self.error(k, f"expected a number, got {_tname(v)}")
+        if isinstance(v, Decimal) and not v.is_finite():
+            raise self.error(k, f"expected a finite number, got {v}")
+        return Q(v)
+
+    # -- arrays -----------------------------------------------------------------------------
+    def vector(self, k: str, n: int | None = None, default: Any = _MISSING) -> Any:
+        """A list of numbers (a scalar is accepted when n == 1)."""
+        v = self._get(k, default)
+        if v is default and default is not _MISSING:
+            return v
+        if _is_number(v) and (n is None or n == 1):
+            v = [v]
+        if not isinstance(v, list) or not v or any(isinstance(x, list) for x in v):
+            raise self.error(k, f"expected a non-empty list of numbers{_len(n)}")
+        if n is not None and len(v) != n:
+            raise self.error(k, f"expected {n} numbers, got {len(v)}")
+        return Value.of(np.array([self._number(k, x) for x in v], dtype=object))
+
+    def matrix(
+        self,
+        k: str,
+        rows: int | None = None,
+        cols: int | None = None,
+        default: Any = _MISSING,
+        vector_as: str = "row",
+    ) -> Any:
+        """A list of rows. A flat list is one row (``vector_as='row'``) or one column."""
+        v = self._get(k, default)
+        if v is default and default is not _MISSING:
+            return v
+        if _is_number(v):
+            v = [[v]]
+        if isinstance(v, list) and v and all(_is_number(x) for x in v):
+            v = [v] if vector_as == "row" else [[x] for x in v]
+        if (
+            not isinstance(v, list)
+            or not v
+            or not all(isinstance(r, list) and r for r in v)
+        ):
+            raise self.error(k, f"expected a matrix (a list of rows of numbers){_shape(rows, cols)}")
+        widths = {len(r) for r in v}
+        if len(widths) != 1:
+            raise self.error(k, "expected rows of equal length")
+        arr = np.empty((len(v), len(v[0])), dtype=object)
+        for i, r in enumerate(v):
+            for j, x in enumerate(r):
+                if isinstance(x, list):
+                    raise self.error(k, "expected a matrix of numbers (nested too deep)")
+                arr[i, j] = self._number(k, x)
+        if (rows is not None and arr.shape[0] != rows) or (cols is not None and arr.shape[1] != cols):
+            raise self.error(
+                k, f"expected shape {_dim(rows)}×{_dim(cols)}, got {arr.shape[0]}×{arr.shape[1]}"
+            )
+        return Value.of(arr)
+
+
+def _tname(v: Any) -> str:
+    if isinstance(v, bool):
+        return "a boolean"
+    if isinstance(v, (int, Decimal)):
+        return f"the number {_show(v)}"
+    if isinstance(v, str):
+        return f"the string {v!r}"
+    if isinstance(v, list):
+        return "a list"
+    if isinstance(v, dict):
+        return "a table"
+    return type(v).__name__
+
+
+def _show(v: Any) -> str:
+    return str(v)
+
+
+def _len(n: int | None) -> str:
+    return f" of length {n}" if n is not None else ""
+
+
+def _dim(d: int | None) -> str:
+    return "?" if d is None else str(d)
+
+
+def _shape(r: int | None, c: int | None) -> str:
+    return "" if r is None and c is None else f" of shape {_dim(r)}×{_dim(c)}"

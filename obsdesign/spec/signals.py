@@ -1,0 +1,108 @@
+"""Scenario signals for simulation: zero, constant, windows of impulses, bounded uniform
+random, outliers, explicit sequence. A signal is evaluated on a grid of sample indices
+(discrete time) or sample times (continuous time, held constant between samples)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from obsdesign.spec.reader import Table
+
+KINDS = ("zero", "constant", "windows", "uniform", "outliers", "sequence")
+
+
+@dataclass
+class Window:
+    """Value ``value`` on start <= k <= stop (inclusive)."""
+
+    start: float
+    stop: float
+    value: np.ndarray
+
+
+@dataclass
+class Signal:
+    """One signal of dimension ``dim``; see :data:`KINDS`."""
+
+    kind: str
+    dim: int
+    value: np.ndarray | None = None
+    windows: list[Window] = field(default_factory=list)
+    bound: np.ndarray | None = None
+    amplitude: np.ndarray | None = None
+    rate: float = 0.0
+    values: np.ndarray | None = None
+    seed: int | None = None
+
+    @classmethod
+    def zero(cls, dim: int) -> Signal:
+        return cls("zero", dim)
+
+    def evaluate(self, grid: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        """Values on ``grid`` (sample indices or times), shape (len(grid), dim)."""
+        k = len(grid)
+        out = np.zeros((k, self.dim))
+        if self.seed is not None:
+            rng = np.random.default_rng(self.seed)
+        if self.kind == "constant":
+            out[:] = self.value
+        elif self.kind == "windows":
+            for w in self.windows:
+                out[(grid >= w.start) & (grid <= w.stop)] += w.value
+        elif self.kind == "uniform":
+            out = rng.uniform(-self.bound, self.bound, size=(k, self.dim))
+        elif self.kind == "outliers":
+            base = self.bound if self.bound is not None else np.zeros(self.dim)
+            out = rng.uniform(-base, base, size=(k, self.dim))
+            hit = rng.random(k) < self.rate
+            out[hit] = rng.uniform(-self.amplitude, self.amplitude, size=(int(hit.sum()), self.dim))
+        elif self.kind == "sequence":
+            m = min(k, len(self.values))
+            out[:m] = self.values[:m]
+        return out
+
+
+def parse_signal(t: Table | None, dim: int) -> Signal:
+    """Parse ``[simulate.<name>]`` (``kind`` plus the keys that kind needs)."""
+    if t is None:
+        return Signal.zero(dim)
+    kind = t.str("kind", choices=KINDS)
+    seed = t.int("seed", default=None)
+    s = Signal(kind, dim, seed=seed)
+    if dim == 0 and kind != "zero":
+        raise t.error("kind", "this signal has dimension 0 in [system]; only kind = 'zero' fits")
+    if kind == "constant":
+        s.value = t.vector("value", n=dim).f
+    elif kind == "windows":
+        ws = t._get("windows", None)
+        if not isinstance(ws, list) or not ws or not all(isinstance(w, dict) for w in ws):
+            raise t.error("windows", "expected an array of tables {start, stop, value}")
+        for i, w in enumerate(ws):
+            wt = Table(w, t.file, t.key(f"windows[{i}]"))
+            start = float(wt.scalar("start").f)
+            stop = float(wt.scalar("stop").f)
+            if stop < start:
+                raise wt.error("stop", f"expected stop >= start ({start})")
+            s.windows.append(Window(start, stop, wt.vector("value", n=dim).f))
+            wt.done()
+    elif kind == "uniform":
+        s.bound = _nonneg(t, "bound", dim)
+    elif kind == "outliers":
+        s.amplitude = _nonneg(t, "amplitude", dim)
+        s.rate = float(t.scalar("rate", min=0, max=1).f)
+        s.bound = _nonneg(t, "bound", dim) if t.has("bound") else None
+    elif kind == "sequence":
+        vals = t.matrix("values", cols=dim, vector_as="column" if dim == 1 else "row").f
+        s.values = np.asarray(vals, dtype=float)
+    t.done()
+    return s
+
+
+def _nonneg(t: Table, key: str, dim: int) -> np.ndarray:
+    v = t.vector(key, n=dim) if isinstance(t.data.get(key), list) else t.scalar(key)
+    arr = np.broadcast_to(np.asarray(v.f, dtype=float), (dim,)).copy()
+    if np.any(arr < 0):
+        raise t.error(key, "expected non-negative bounds")
+    return arr
