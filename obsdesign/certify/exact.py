@@ -133,15 +133,20 @@ def qstr(a: Any) -> Any:
 
 
 def qparse(s: Any) -> Any:
-    """Inverse of :func:`qstr`: strings (or nested lists of them) back to ``fmpq`` arrays."""
-    if isinstance(s, str):
-        return Q(s)
-    if isinstance(s, (int, float)):
+    """Inverse of :func:`qstr`: a string (or nested lists of them, any depth) back to ``fmpq``
+    (an object array for lists)."""
+    if isinstance(s, (str, int, float)) and not isinstance(s, bool):
         return Q(s)
     if isinstance(s, list):
-        if s and isinstance(s[0], list):
-            return qmat([[Q(v) for v in row] for row in s])
-        return qvec([Q(v) for v in s])
+        arr = np.array(s, dtype=object)
+        if arr.size == 0 or any(isinstance(v, list) for v in arr.flat):
+            raise ValueError("ragged or empty exact array")
+        out = np.empty(arr.shape, dtype=object)
+        for idx, v in np.ndenumerate(arr):
+            if isinstance(v, bool) or not isinstance(v, (str, int, float)):
+                raise ValueError(f"not an exact value: {v!r}")
+            out[idx] = Q(v)
+        return out
     raise ValueError(f"not an exact value: {s!r}")
 
 
