@@ -93,22 +93,24 @@ def _qfloat(x: Any) -> float:
 
 
 def dyadic(a: Any, bits: int = 24) -> QMatrix | fmpq:
-    """Round floats to the dyadic grid 2^-k·scale and return them exactly.
+    """Round each float to ``bits`` significant bits (a dyadic rational) and return it exactly.
 
-    The grid step is ``2**-bits`` relative to the largest magnitude of ``a`` (rounded to a
-    power of two), so small entries keep ``bits`` significant bits of the whole matrix and the
-    rationals stay short (fast exact checks). DESIGN.md: "round the solution to a dyadic grid
-    before converting to rationals".
+    Rounding keeps the rationals short (fast exact checks) while every entry keeps its own
+    relative accuracy 2^-bits, so badly scaled matrices survive. DESIGN.md: "round the
+    solution to a dyadic grid before converting to rationals".
     """
     arr = np.asarray(a, dtype=float)
     if not np.all(np.isfinite(arr)):
         raise ValueError("cannot round a non-finite number")
-    scale = float(np.max(np.abs(arr))) if arr.size else 0.0
-    e = math.frexp(scale)[1] if scale > 0 else 0
-    k = bits - e  # grid 2^-k
+
     def one(v: float) -> fmpq:
-        m = round(v * 2.0**k) if abs(k) < 1000 else round(Fraction(v) * Fraction(2) ** k)
-        return fmpq(int(m), 1) / fmpq(2) ** k if k >= 0 else fmpq(int(m) * 2 ** (-k), 1)
+        if v == 0.0:
+            return fmpq(0)
+        m, e = math.frexp(v)  # v = m·2^e, 0.5 <= |m| < 1
+        k = bits - e
+        num = round(m * 2.0**bits)
+        return fmpq(num, 2**k) if k >= 0 else fmpq(num * 2 ** (-k))
+
     if arr.ndim == 0:
         return one(float(arr))
     out = np.empty(arr.shape, dtype=object)

@@ -173,7 +173,8 @@ def parse_expr(
     if len(text) > 10_000:
         raise SpecError(file, key, "expression is too long")
     try:
-        tree = ast.parse(text.strip(), mode="eval")
+        # ``^`` is power here; Python's ^ binds looser than * and +, so rewrite it as ** first
+        tree = ast.parse(text.strip().replace("^", "**"), mode="eval")
     except SyntaxError as e:
         raise SpecError(file, key, f"is not a valid expression ({e.msg})") from None
     known = set(variables) | set(parameters) | set(CONSTANTS)

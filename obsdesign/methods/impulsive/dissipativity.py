@@ -1,0 +1,120 @@
+"""QSR data of the nonlinearity (Assumption 1) and the two dissipation rates κ_n, ϖ_o.
+
+Reading of Assumption 1 (eq. (15), impulsive-dissipativity paper 001). Taken literally, (15)
+with Q_i ⪯ 0 "uniformly with respect to ε_j" forces ψ̃_i = 0 whenever ε_i = 0 (put ε_i = 0:
+ψ̃_iᵀ Q_i ψ̃_i ≥ 0), so ψ̃_i may not depend on ε_j at all. obsdesign reads it in *split form*:
+
+    ψ̃_i(ε) = φ_i(ε_i) + c_i(ε),   φ_i(ε_i) = ψ̄_i(z_i + ε_i, z_j) − ψ̄_i(z),
+                                   c_i(ε)   = ψ̄_i(z + ε) − ψ̄_i(z_i + ε_i, z_j),
+
+with the *own part* φ_i (Q_i, S_i, R_i)-dissipative in the sense of (15) for every trajectory
+point z (in the stated region) and the *cross part* bounded linearly, ‖c_i‖ ≤ ℓ_ij ‖ε_j‖.
+The proofs of Lemmas 1-2 go through unchanged with the coupling norms enlarged:
+2ε_nᵀ(Ā_no ε_o + c_n) ≤ 2(‖Ā_no‖ + ℓ_no)‖ε_n‖‖ε_o‖, i.e. λ*_no = ‖Ā_no‖ + ℓ_no and
+λ*_on = ‖Ā_on‖ + ℓ_on. With ℓ_on = ℓ_no = 0 this is the literal reading.
+
+A QSR triple may be multiplied by any θ > 0 and stays valid, but (16) and the ssd LMI are not
+scale invariant; the tool picks θ (rounded to a dyadic rational) to minimize ϖ_o / maximize
+κ_n, unless ``qsr_scaling = "as-given"``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from flint import fmpq
+from scipy.optimize import minimize_scalar
+
+from obsdesign.certify.exact import Q, dyadic, qeye, qzeros, symmetrize, to_float
+
+
+@dataclass
+class QSR:
+    """A supply-rate triple (Q, S, R) of eq. (4)/(15), exact, k×k blocks; ``how`` documents
+    where it came from (given / Lipschitz / sector / derived from a bound in x)."""
+
+    Q: np.ndarray
+    S: np.ndarray
+    R: np.ndarray
+    how: str
+
+    @property
+    def k(self) -> int:
+        return self.Q.shape[0]
+
+    def scaled(self, theta: Any) -> QSR:
+        t = Q(theta)
+        return QSR(self.Q * t, self.S * t, self.R * t, self.how)
+
+    def floats(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return tuple(np.asarray(to_float(x), dtype=float).reshape(self.k, self.k) for x in (self.Q, self.S, self.R))  # type: ignore[return-value]
+
+
+def qsr_lipschitz(ell: Any, k: int) -> QSR:
+    """‖φ(ε)‖ ≤ ℓ‖ε‖  ⇔  ℓ²‖ε‖² − ‖φ‖² ≥ 0  ⇔  (Q, S, R) = (−I, 0, ℓ² I) in (15)."""
+    e = Q(ell)
+    return QSR(-qeye(k), qzeros((k, k)), qeye(k) * (e * e), f"Lipschitz bound ℓ = {e}")
+
+
+def qsr_sector(k1: Any, k2: Any, k: int) -> QSR:
+    """Sector [k1, k2]: (φ − k1 ε)ᵀ(k2 ε − φ) ≥ 0  ⇔  (Q, S, R) = (−I, (k1+k2)/2 I, −k1 k2 I)."""
+    a, b = Q(k1), Q(k2)
+    return QSR(-qeye(k), qeye(k) * ((a + b) / 2), qeye(k) * (-a * b), f"sector [{a}, {b}]")
+
+
+def ssd_matrix(Ablk: Any, qsr: QSR, rate: Any) -> np.ndarray:
+    """N(κ) = [[Ā + Āᵀ + κ I + R, I + Sᵀ], [I + S, Q]], exact.
+
+    Σ(Ā, I, I) is (−R, −Sᵀ, −Q)-ssd(κ) iff N(κ) ⪯ 0: eq. (7) with storage xᵀx, y = x and the
+    supply (−R, −Sᵀ, −Q) (Lemma 1; Lemma 2's proof with κ = −ϖ_o).
+    """
+    A = np.asarray(Ablk, dtype=object)
+    k = A.shape[0]
+    top = np.hstack([A + A.T + qeye(k) * Q(rate) + qsr.R, qeye(k) + qsr.S.T])
+    bot = np.hstack([qeye(k) + qsr.S, qsr.Q])
+    return symmetrize(np.vstack([top, bot]))
+
+
+def best_rate_float(Ablk: np.ndarray, Qm: np.ndarray, S: np.ndarray, R: np.ndarray) -> tuple[float, float]:
+    """Largest κ with N(κ) ⪯ 0 in floats, and the range residual.
+
+    By the generalized Schur complement (Q ⪯ 0): N(κ) ⪯ 0 iff (I − QQ⁺)(I + S) = 0 and
+    Ā + Āᵀ + R − (I + S)ᵀ Q⁺ (I + S) + κ I ⪯ 0, so κ* = −λ_max(Ā + Āᵀ + R − (I+S)ᵀQ⁺(I+S)).
+    For Q ≺ 0 this is −λ_max(M_o) of eq. (16).
+    """
+    k = Ablk.shape[0]
+    B = np.eye(k) + S
+    Qp = np.linalg.pinv(Qm, rcond=1e-12)
+    resid = float(np.linalg.norm((np.eye(k) - Qm @ Qp) @ B)) if k else 0.0
+    Mx = Ablk + Ablk.T + R - B.T @ Qp @ B
+    lam = float(np.linalg.eigvalsh((Mx + Mx.T) / 2).max()) if k else -np.inf
+    return -lam, resid
+
+
+def best_rate(Ablk: np.ndarray, qsr: QSR, optimize: bool) -> tuple[float, fmpq, float]:
+    """(κ*, θ, range residual): the largest ssd rate over the scalings θ·(Q, S, R), θ > 0.
+
+    κ*(θ) is concave in θ (λ_max of an affine-plus-convex matrix function), so a bounded
+    scalar search over log θ finds the optimum. θ is returned as a short dyadic rational.
+    """
+    Qm, S, R = qsr.floats()
+    if not optimize or qsr.k == 0:
+        r, res = best_rate_float(Ablk, Qm, S, R)
+        return r, fmpq(1), res
+
+    def neg(lt: float) -> float:
+        t = float(np.exp(lt))
+        r, res = best_rate_float(Ablk, t * Qm, t * S, t * R)
+        return -r + (1e6 * res if res > 1e-9 else 0.0)
+
+    grid = np.linspace(-12, 12, 49)
+    vals = [neg(g) for g in grid]
+    i = int(np.argmin(vals))
+    lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
+    res = minimize_scalar(neg, bounds=(lo, hi), method="bounded", options={"xatol": 1e-9})
+    theta = dyadic(float(np.exp(res.x)), 24)
+    tf = float(to_float(theta))
+    r, resid = best_rate_float(Ablk, tf * Qm, tf * S, tf * R)
+    return r, theta, resid

@@ -1,0 +1,142 @@
+"""Numerical falsification of Assumption 1 (eq. (15)) on a box of states.
+
+The certificate proves the window *given* the declared nonlinearity data; this pass tries to
+break the declared data by sampling. It draws pairs (x, x̂) in the region (half of them far
+apart, half close together so that derivative-level violations show), maps them to z = T x,
+ẑ = T x̂, ε = ẑ − z, and evaluates, with ψ̄(z) = T ψ(T⁻¹ z):
+
+- own parts (split reading, see :mod:`.dissipativity`): φ_o = ψ̄_o(ẑ_o, z_n) − ψ̄_o(z),
+  φ_n = ψ̄_n(z_o, ẑ_n) − ψ̄_n(z); violation of (15) when ω_i = [φ_i; ε_i]ᵀ[[Q,S],[Sᵀ,R]][φ_i; ε_i] < 0,
+  reported relative to ‖φ_i‖² + ‖ε_i‖²;
+- cross parts: c_o = ψ̄_o(ẑ) − ψ̄_o(ẑ_o, z_n), c_n = ψ̄_n(ẑ) − ψ̄_n(z_o, ẑ_n); violation when
+  ‖c_i‖ > ℓ_ij ‖ε_j‖, reported as ‖c_i‖/‖ε_j‖ − ℓ_ij;
+- with a Lipschitz bound in x (``lipschitz_x``): ‖ψ(x̂) − ψ(x)‖/‖x̂ − x‖ − ℓ.
+
+Mixed points such as T⁻¹(ẑ_o, z_n) are kept only when they lie in the region too (the data
+are claimed on the region). The result is a *numerical* claim: sampling can find a violation
+but never prove there is none.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+Psi = Callable[[np.ndarray], np.ndarray]  # (N, n) -> (N, n)
+
+
+@dataclass
+class Violation:
+    """Worst violation of one inequality: value (> 0 means violated), where, how often."""
+
+    name: str
+    worst: float
+    count: int
+    tested: int
+    x: list[float] = field(default_factory=list)
+    xhat: list[float] = field(default_factory=list)
+
+
+@dataclass
+class Falsification:
+    samples: int
+    items: list[Violation]
+    literal_cross: dict[str, float]  # sup ‖c_i‖/‖ε_j‖ seen: how far the literal reading is off
+
+    @property
+    def violated(self) -> list[Violation]:
+        return [v for v in self.items if v.count > 0]
+
+    def summary(self) -> str:
+        if not self.violated:
+            return f"no violation in {self.samples} sampled pairs"
+        parts = [f"{v.name}: worst {v.worst:.4g} ({v.count}/{v.tested} pairs)" for v in self.violated]
+        return "violated — " + "; ".join(parts)
+
+
+def sample_pairs(rng: np.random.Generator, lo: np.ndarray, hi: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """n pairs in the box [lo, hi]: half independent, half with x̂ − x of size 10^-4..10^-1 of
+    the box width (clipped to the box)."""
+    d = len(lo)
+    x = rng.uniform(lo, hi, size=(n, d))
+    xh = rng.uniform(lo, hi, size=(n, d))
+    k = n // 2
+    scale = 10.0 ** rng.uniform(-4, -1, size=(k, 1)) * (hi - lo)[None, :]
+    direction = rng.normal(size=(k, d))
+    xh[:k] = np.clip(x[:k] + scale * direction, lo, hi)
+    return x, xh
+
+
+def _qsr_value(phi: np.ndarray, e: np.ndarray, Qm: np.ndarray, S: np.ndarray, R: np.ndarray) -> np.ndarray:
+    """ω = φᵀQφ + 2φᵀSε + εᵀRε row-wise (eq. (15))."""
+    return np.einsum("ij,jk,ik->i", phi, Qm, phi) + 2 * np.einsum("ij,jk,ik->i", phi, S, e) + np.einsum(
+        "ij,jk,ik->i", e, R, e
+    )
+
+
+def _worst(name: str, val: np.ndarray, x: np.ndarray, xh: np.ndarray, tol: float) -> Violation:
+    if val.size == 0:
+        return Violation(name, float("-inf"), 0, 0)
+    i = int(np.argmax(val))
+    cnt = int(np.sum(val > tol))
+    return Violation(name, float(val[i]), cnt, int(val.size), x[i].tolist(), xh[i].tolist())
+
+
+def falsify_blocks(
+    psi: Psi, T: np.ndarray, m: int, qsr_o: tuple[np.ndarray, ...], qsr_n: tuple[np.ndarray, ...],
+    ell_on: float, ell_no: float, lo: np.ndarray, hi: np.ndarray, samples: int, seed: int, tol: float = 1e-9,
+) -> Falsification:
+    """Falsification of the split reading of (15) with per-block data (see module doc)."""
+    rng = np.random.default_rng(seed)
+    T = np.asarray(T, dtype=float)
+    Ti = np.linalg.inv(T)
+    x, xh = sample_pairs(rng, lo, hi, samples)
+    z, zh = x @ T.T, xh @ T.T
+
+    def psibar(Z: np.ndarray) -> np.ndarray:
+        return psi(Z @ Ti.T) @ T.T
+
+    def inside(Z: np.ndarray) -> np.ndarray:
+        X = Z @ Ti.T
+        return np.all((X >= lo - 1e-12) & (X <= hi + 1e-12), axis=1)
+
+    mix_o = np.concatenate([zh[:, :m], z[:, m:]], axis=1)  # (ẑ_o, z_n)
+    mix_n = np.concatenate([z[:, :m], zh[:, m:]], axis=1)  # (z_o, ẑ_n)
+    p_z, p_zh, p_mo, p_mn = psibar(z), psibar(zh), psibar(mix_o), psibar(mix_n)
+    eo, en = zh[:, :m] - z[:, :m], zh[:, m:] - z[:, m:]
+    ok_o, ok_n = inside(mix_o), inside(mix_n)
+    items = []
+    lit: dict[str, float] = {}
+    # own parts
+    phi_o = p_mo[:, :m] - p_z[:, :m]
+    w = _qsr_value(phi_o, eo, *qsr_o) / np.maximum(np.sum(phi_o**2, 1) + np.sum(eo**2, 1), 1e-300)
+    items.append(_worst("(15) own part, i = o", -w[ok_o], x[ok_o], xh[ok_o], tol))
+    if T.shape[0] > m:
+        phi_n = p_mn[:, m:] - p_z[:, m:]
+        w = _qsr_value(phi_n, en, *qsr_n) / np.maximum(np.sum(phi_n**2, 1) + np.sum(en**2, 1), 1e-300)
+        items.append(_worst("(15) own part, i = n", -w[ok_n], x[ok_n], xh[ok_n], tol))
+        # cross parts
+        c_o = np.linalg.norm(p_zh[:, :m] - p_mo[:, :m], axis=1)
+        c_n = np.linalg.norm(p_zh[:, m:] - p_mn[:, m:], axis=1)
+        ne_n, ne_o = np.linalg.norm(en, axis=1), np.linalg.norm(eo, axis=1)
+        sel = ok_o & (ne_n > 1e-12)
+        ratio = c_o[sel] / ne_n[sel]
+        lit["o"] = float(ratio.max(initial=0.0))
+        items.append(_worst("cross bound ‖c_o‖ ≤ ℓ_on‖ε_n‖", ratio - ell_on, x[sel], xh[sel], tol))
+        sel = ok_n & (ne_o > 1e-12)
+        ratio = c_n[sel] / ne_o[sel]
+        lit["n"] = float(ratio.max(initial=0.0))
+        items.append(_worst("cross bound ‖c_n‖ ≤ ℓ_no‖ε_o‖", ratio - ell_no, x[sel], xh[sel], tol))
+    return Falsification(samples, items, lit)
+
+
+def falsify_lipschitz_x(psi: Psi, ell: float, lo: np.ndarray, hi: np.ndarray, samples: int, seed: int, tol: float = 1e-9) -> Falsification:
+    """Falsification of ‖ψ(x̂) − ψ(x)‖ ≤ ℓ‖x̂ − x‖ on the region."""
+    rng = np.random.default_rng(seed)
+    x, xh = sample_pairs(rng, lo, hi, samples)
+    d = np.linalg.norm(xh - x, axis=1)
+    sel = d > 1e-12
+    ratio = np.linalg.norm(psi(xh) - psi(x), axis=1)[sel] / d[sel]
+    return Falsification(samples, [_worst("Lipschitz bound of ψ in x", ratio - ell, x[sel], xh[sel], tol)], {})

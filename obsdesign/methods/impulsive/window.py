@@ -1,0 +1,109 @@
+"""Sampling window of Theorems 1-2: γ, β, condition (22), T_max (26b), T_min (26c), ball B.
+
+All functions here take exact rationals and return exact rationals; transcendental values
+(ln, √) go through outward-rounded interval arithmetic, and the reported bounds are rounded
+in the safe direction: T_max down, T_min up, the radius of B up.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from flint import fmpq
+from mpmath import iv
+
+from obsdesign.certify.exact import Q, dyadic, qeye, to_float
+from obsdesign.certify.interval import bounds, round_down, round_up, sqrt_upper
+from obsdesign.certify.psd import check_psd
+
+
+def gamma_of(L_diag: Any) -> tuple[fmpq, fmpq]:
+    """(γ, β): 1 − γ = the largest eigenvalue of the diagonal I − L (text after (18)),
+    β = 1/(1 − γ)² (21c). Requires every eigenvalue of I − L in (0, 1)."""
+    one_minus = max(fmpq(1) - Q(v) for v in np.asarray(L_diag, dtype=object).flat)
+    return fmpq(1) - one_minus, fmpq(1) / (one_minus * one_minus)
+
+
+def norm_upper(X: Any) -> fmpq:
+    """A rational u ≥ ‖X‖₂ (spectral norm), proved by u ≥ 0 and u² I − XᵀX ⪰ 0 exactly."""
+    X = np.asarray(X, dtype=object)
+    if X.size == 0:
+        return fmpq(0)
+    Xf = np.asarray(to_float(X), dtype=float)
+    f = float(np.linalg.norm(Xf, 2))
+    if f == 0.0 and all(v == 0 for v in X.flat):
+        return fmpq(0)
+    u = Q(dyadic(f * (1 + 2.0**-30) + 2.0**-40, 30))
+    for _ in range(40):
+        if norm_bound_holds(X, u):
+            return u
+        u = u * fmpq(1025, 1024) + fmpq(1, 2**30)
+    raise ArithmeticError("could not certify a norm bound")
+
+
+def norm_bound_holds(X: Any, u: Any) -> bool:
+    """Exact check of ‖X‖₂ ≤ u: u ≥ 0 and u² I − XᵀX ⪰ 0."""
+    X = np.asarray(X, dtype=object)
+    u = Q(u)
+    if u < 0:
+        return False
+    if X.size == 0:
+        return True
+    G = X.T @ X
+    return bool(check_psd(qeye(G.shape[0]) * (u * u) - G))
+
+
+def coupling(lam_no: Any, lam_on: Any, beta: Any) -> fmpq:
+    """λ*_no + β λ*_on: the coupling term of (22) and (26b)."""
+    return Q(lam_no) + Q(beta) * Q(lam_on)
+
+
+def kappa_max(kappa_n: Any, lam_no: Any, lam_on: Any, beta: Any) -> fmpq:
+    """Supremum of κ allowed by (22) for i = n: κ < κ_n − λ*_no − β λ*_on."""
+    return Q(kappa_n) - coupling(lam_no, lam_on, beta)
+
+
+def kappa_widest(varpi_o: float, coup: float, gamma: float, alpha: float) -> float:
+    """κ maximizing T_max(κ) − T_min(κ) = c₁/(D₀ + κ) − c₂/κ (26b)-(26c), D₀ = ϖ_o + coupling.
+
+    Stationary point: κ/(D₀ + κ) = √(c₂/c₁), i.e. κ = D₀ r/(1 − r), r = √(c₂/c₁).
+    """
+    c1 = -np.log((1 - gamma) ** 2)
+    c2 = -np.log((alpha - gamma) / alpha)
+    r = np.sqrt(c2 / c1)
+    d0 = varpi_o + coup
+    if r >= 1 or d0 <= 0:
+        return np.inf
+    return d0 * r / (1 - r)
+
+
+def T_max_lower(gamma: Any, varpi_o: Any, kappa: Any, lam_no: Any, lam_on: Any, beta: Any) -> fmpq:
+    """Rational lower bound of T_max = −ln((1−γ)²)/(ϖ_o + κ + λ*_no + β λ*_on) (26b).
+
+    The denominator is exact; requires it > 0."""
+    den = Q(varpi_o) + Q(kappa) + coupling(lam_no, lam_on, beta)
+    if den <= 0:
+        raise ValueError("the denominator of (26b) is not positive")
+    g = Q(gamma)
+    lo, _ = bounds(lambda om, d: -iv.log(om * om) / d, fmpq(1) - g, den)
+    return lo
+
+
+def T_min_upper(alpha: Any, gamma: Any, kappa: Any) -> fmpq:
+    """Rational upper bound of T_min = −ln((α − γ)/α)/κ (26c); requires α > γ, κ > 0."""
+    a, g, k = Q(alpha), Q(gamma), Q(kappa)
+    if not (a > g and k > 0):
+        raise ValueError("(26c) needs α > γ and κ > 0")
+    _, hi = bounds(lambda r, kk: -iv.log(r) / kk, (a - g) / a, k)
+    return hi
+
+
+def radius_upper(alpha: Any, w_bar: Any) -> fmpq:
+    """Rational upper bound of the radius √(α ‖w‖∞) of B (Theorem 2)."""
+    return sqrt_upper(Q(alpha) * Q(w_bar))
+
+
+def safe_window(T_max_lo: fmpq, T_min_hi: fmpq, digits: int) -> tuple[fmpq, fmpq]:
+    """Decimal rounding in the safe direction: T_max down, T_min up."""
+    return round_down(T_max_lo, digits), round_up(T_min_hi, digits)

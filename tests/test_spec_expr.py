@@ -1,0 +1,82 @@
+"""The safe expression language (obsdesign.spec.expr)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from obsdesign.errors import SpecError
+from obsdesign.spec.expr import parse_expr
+
+MU = "x1*x2*(x2+a)*(x2-a)/(1+x2^4)"
+
+
+def test_evaluates_vectorized():
+    e = parse_expr(MU, ["x1", "x2"], {"a": 2})
+    X = np.array([[1.0, 1.0], [2.0, -0.5], [0.0, 3.0]])
+    want = X[:, 0] * X[:, 1] * (X[:, 1] + 2) * (X[:, 1] - 2) / (1 + X[:, 1] ** 4)
+    np.testing.assert_allclose(e.on(["x1", "x2"])(X), want)
+    assert float(e(x1=1.0, x2=1.0)) == pytest.approx(-1.5)
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.floats(-3, 3), st.floats(-3, 3))
+def test_jacobian_matches_finite_differences(a: float, b: float):
+    e = parse_expr("sin(x1)*exp(-x2^2) + tanh(x1*x2) + sqrt(1 + x1^2)", ["x1", "x2"])
+    f, J = e.on(["x1", "x2"]), e.jacobian(["x1", "x2"])
+    x = np.array([a, b])
+    h = 1e-6
+    fd = [(f(x + h * np.eye(2)[i]) - f(x - h * np.eye(2)[i])) / (2 * h) for i in range(2)]
+    np.testing.assert_allclose(J(x), fd, rtol=1e-5, atol=1e-6)
+
+
+def test_functions():
+    e = parse_expr("sat(x1) + sat(x1, 2) + step(x1) + max(x1, 0) + min(x1, 0) + mod(x1, 2) + abs(x1)", ["x1"])
+    x = np.array([[-3.0], [0.5], [3.0]])
+    want = np.clip(x[:, 0], -1, 1) + np.clip(x[:, 0], -2, 2) + (x[:, 0] > 0) + np.maximum(x[:, 0], 0) \
+        + np.minimum(x[:, 0], 0) + np.mod(x[:, 0], 2) + np.abs(x[:, 0])
+    np.testing.assert_allclose(e.on(["x1"])(x), want)
+
+
+def test_caret_is_power_and_parameters_exact():
+    e = parse_expr("a*x1^2", ["x1"], {"a": 3})
+    assert float(e(x1=2.0)) == 12.0
+    import sympy as sp
+
+    assert e.sympy() == 3 * sp.Symbol("x1") ** 2
+
+
+@pytest.mark.parametrize(
+    "text, words",
+    [
+        ("__import__('os').system('true')", "calling anything"),
+        ("__import__('os')", "unknown function"),
+        ("x1.real", "attribute access"),
+        ("(lambda: 1)()", "calling anything"),
+        ("lambda: 1", "lambda"),
+        ("x1[0]", "subscripts"),
+        ("[x1 for x1 in x1]", "comprehensions"),
+        ("open('f')", "unknown function"),
+        ("y + 1", "unknown name"),
+        ("'text'", "constant"),
+        ("x1 if x1 else 0", "conditional"),
+        ("x1 > 0", "comparisons"),
+        ("sin(x=1)", "keyword"),
+        ("sin(x1, x1)", "takes 1"),
+        ("x1 +", "not a valid expression"),
+        ("__builtins__", "unknown name"),
+    ],
+)
+def test_rejects_unsafe_or_bad(text: str, words: str):
+    with pytest.raises(SpecError) as ei:
+        parse_expr(text, ["x1"], file="s.toml", key="nonlinearity.psi")
+    msg = str(ei.value)
+    assert msg.startswith("s.toml: [nonlinearity.psi]") and words in msg
+
+
+def test_nondifferentiable_reported():
+    e = parse_expr("floor(x1)", ["x1"])
+    with pytest.raises(ValueError):
+        e.derivative("x1")
