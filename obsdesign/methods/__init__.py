@@ -14,6 +14,7 @@ if TYPE_CHECKING:
 
 REGISTRY: dict[str, str] = {
     "lyapunov": "obsdesign.methods.lyapunov:METHOD",
+    "impulsive": "obsdesign.methods.impulsive:METHOD",
 }
 
 

@@ -84,7 +84,9 @@ class Coordinates:
         return self.Tinv[:, self.m :]
 
     def floats(self) -> dict[str, np.ndarray]:
-        return {k: np.asarray(to_float(getattr(self, k)), dtype=float) for k in ("T", "Tinv", "Abar")}
+        return {
+            k: np.asarray(to_float(getattr(self, k)), dtype=float) for k in ("T", "Tinv", "Abar")
+        }
 
 
 def transform(A: Any, C: Any, M: Any, source: str = "given") -> Coordinates:
@@ -94,7 +96,11 @@ def transform(A: Any, C: Any, M: Any, source: str = "given") -> Coordinates:
     """
     A = np.asarray(A, dtype=object)
     C = np.asarray(C, dtype=object)
-    M = np.asarray(M, dtype=object).reshape(-1, A.shape[0]) if np.size(M) else np.zeros((0, A.shape[0]), dtype=object)
+    M = (
+        np.asarray(M, dtype=object).reshape(-1, A.shape[0])
+        if np.size(M)
+        else np.zeros((0, A.shape[0]), dtype=object)
+    )
     T = np.vstack([C, M])
     if T.shape[0] != T.shape[1] or qrank(T) < T.shape[0]:
         raise ValueError("T = [C; M] is singular (M must complement the rows of C)")

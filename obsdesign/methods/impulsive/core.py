@@ -16,11 +16,17 @@ from flint import fmpq
 from scipy.optimize import minimize
 
 from obsdesign.certify.claim import Claim, exact_claim
-from obsdesign.certify.exact import Q, dyadic, qeye, to_float
+from obsdesign.certify.exact import Q, dyadic, to_float
 from obsdesign.certify.psd import check_pd, check_psd
 
-from .coordinates import Coordinates, default_coordinates, orthonormal_complement, rational_M, transform
-from .dissipativity import QSR, best_rate, best_rate_float, qsr_lipschitz, ssd_matrix
+from .coordinates import (
+    Coordinates,
+    default_coordinates,
+    orthonormal_complement,
+    rational_M,
+    transform,
+)
+from .dissipativity import QSR, best_rate, qsr_lipschitz, ssd_matrix
 from .window import (
     T_max_lower,
     T_min_upper,
@@ -150,8 +156,12 @@ def optimize_M(p: Problem, seed: int = 0, starts: int = 6) -> np.ndarray:
     best, best_val = M0, float_window(p, M0)
     for s in range(starts):
         x0 = (M0 if s == 0 else M0 + rng.normal(scale=0.5, size=M0.shape)).ravel()
-        res = minimize(lambda v: -float_window(p, v.reshape(n - m, n)), x0, method="Nelder-Mead",
-                       options={"maxiter": 400 * n, "xatol": 1e-6, "fatol": 1e-9})
+        res = minimize(
+            lambda v: -float_window(p, v.reshape(n - m, n)),
+            x0,
+            method="Nelder-Mead",
+            options={"maxiter": 400 * n, "xatol": 1e-6, "fatol": 1e-9},
+        )
         val = -float(res.fun)
         if val > best_val:
             best, best_val = res.x.reshape(n - m, n), val
@@ -170,7 +180,9 @@ def certified_rate(Ablk: np.ndarray, qsr: QSR, theta: fmpq, rate_f: float, lower
             return r
         r = r - Q(dyadic(step, 40))
         step *= 4
-    raise Infeasible("the ssd LMI could not be certified near its float optimum (ill-conditioned data)")
+    raise Infeasible(
+        "the ssd LMI could not be certified near its float optimum (ill-conditioned data)"
+    )
 
 
 def coordinates_for(p: Problem) -> Coordinates:
@@ -191,7 +203,9 @@ def design_window(p: Problem) -> tuple[dict[str, Any], list[str]]:
     if not check_pd(-data.qsr_o.Q):
         raise Infeasible("Lemma 2 needs Q_o ≺ 0; the declared Q_o is not negative definite")
     if data.qsr_n.k and not check_psd(-data.qsr_n.Q):
-        raise Infeasible("Assumption 1 needs Q_n ⪯ 0; the declared Q_n is not negative semidefinite")
+        raise Infeasible(
+            "Assumption 1 needs Q_n ⪯ 0; the declared Q_n is not negative semidefinite"
+        )
     # Lemma 2 / (16): ϖ_o = max eig of M_o (rounded up, certified)
     ko, th_o, _ = best_rate(Af["Ao"], data.qsr_o, p.optimize_scaling)
     lam_Mo = -ko
@@ -199,7 +213,9 @@ def design_window(p: Problem) -> tuple[dict[str, Any], list[str]]:
     # Lemma 1: κ_n = largest ssd rate of Σ(Ā_n, I, I)
     kn_f, th_n, resid = best_rate(Af["An"], data.qsr_n, p.optimize_scaling)
     if not np.isfinite(kn_f) or resid > 1e-7:
-        raise Infeasible("Lemma 1: no κ_n makes Σ(Ā_n, I, I) (−R_n, −S_nᵀ, −Q_n)-ssd (I + S_n ∉ range Q_n)")
+        raise Infeasible(
+            "Lemma 1: no κ_n makes Σ(Ā_n, I, I) (−R_n, −S_nᵀ, −Q_n)-ssd (I + S_n ∉ range Q_n)"
+        )
     kappa_n = certified_rate(co.An, data.qsr_n, th_n, kn_f, True)
     n_no, n_on = norm_upper(co.Ano), norm_upper(co.Aon)
     lam_no, lam_on = n_no + data.ell_no, n_on + data.ell_on
@@ -229,7 +245,9 @@ def design_window(p: Problem) -> tuple[dict[str, Any], list[str]]:
                 f"condition (22) fails for the given κ = {float(kappa):.6g}: it must lie in (0, {float(kmax):.6g})"
             )
     if varpi <= 0:
-        notes.append(f"Assumption 2 (ϖ_o > 0) does not hold: λ_max(M_o) = {lam_Mo:.6g}; the bound (26b) stays valid")
+        notes.append(
+            f"Assumption 2 (ϖ_o > 0) does not hold: λ_max(M_o) = {lam_Mo:.6g}; the bound (26b) stays valid"
+        )
     T_max = T_max_lower(gamma, varpi, kappa, lam_no, lam_on, beta)
     T_min = T_min_upper(p.alpha, gamma, kappa)
     T_max_r, T_min_r = safe_window(T_max, T_min, p.digits)
@@ -274,7 +292,9 @@ def design_window(p: Problem) -> tuple[dict[str, Any], list[str]]:
 class _Claims:
     items: list[Claim] = field(default_factory=list)
 
-    def add(self, id: str, stmt: str, ref: str, check: str, ok: bool, detail: str, margin: Any = 0) -> None:
+    def add(
+        self, id: str, stmt: str, ref: str, check: str, ok: bool, detail: str, margin: Any = 0
+    ) -> None:
         self.items.append(exact_claim(id, stmt, f"{ref}, {REF}", check, margin, ok, detail))
 
 
@@ -291,14 +311,27 @@ def certify_window(p: Problem, P: dict[str, Any]) -> list[Claim]:
         nonsing = True
     except ValueError:
         nonsing = False
-    c.add("T", "T = [C; M] with C from the spec (and M from the spec when given), det T ≠ 0",
-          "eq. (9)", "exact rank", ok_shape and nonsing, "" if ok_shape and nonsing else "T is not [C; M] or is singular")
+    c.add(
+        "T",
+        "T = [C; M] with C from the spec (and M from the spec when given), det T ≠ 0",
+        "eq. (9)",
+        "exact rank",
+        ok_shape and nonsing,
+        "" if ok_shape and nonsing else "T is not [C; M] or is singular",
+    )
     if not (ok_shape and nonsing):
         return c.items
     same = np.asarray(P["Abar"], dtype=object).shape == co.Abar.shape and all(
-        a == b for a, b in zip(np.asarray(P["Abar"], dtype=object).flat, co.Abar.flat, strict=True))
-    c.add("Abar", "Ā = T A T⁻¹ (blocks Ā_o, Ā_on, Ā_no, Ā_n)", "eq. (10c)", "exact rational inverse and product",
-          same, "" if same else "reported Ā differs from T A T⁻¹")
+        a == b for a, b in zip(np.asarray(P["Abar"], dtype=object).flat, co.Abar.flat, strict=True)
+    )
+    c.add(
+        "Abar",
+        "Ā = T A T⁻¹ (blocks Ā_o, Ā_on, Ā_no, Ā_n)",
+        "eq. (10c)",
+        "exact rational inverse and product",
+        same,
+        "" if same else "reported Ā differs from T A T⁻¹",
+    )
     data, derived = blocks_for(p, co)
     for k, v in derived.items():
         if k in P and Q(P[k]) != v:
@@ -306,54 +339,135 @@ def certify_window(p: Problem, P: dict[str, Any]) -> list[Claim]:
     if derived:
         X = {"norm_C": co.T[:m], "norm_M": co.M, "norm_Po": co.Pinv_o, "norm_Pn": co.Pinv_n}
         ok = all(norm_bound_holds(X[k], derived[k]) for k in X)
-        c.add("lipschitz-x-blocks", "own/cross Lipschitz constants ℓ‖·‖‖·‖ of ψ̄ from the bound in x are upper bounds",
-              "split reading of Assumption 1", "exact u²I − XᵀX ⪰ 0 for each norm", ok, "")
+        c.add(
+            "lipschitz-x-blocks",
+            "own/cross Lipschitz constants ℓ‖·‖‖·‖ of ψ̄ from the bound in x are upper bounds",
+            "split reading of Assumption 1",
+            "exact u²I − XᵀX ⪰ 0 for each norm",
+            ok,
+            "",
+        )
     r = check_pd(-data.qsr_o.Q)
     c.add("Q_o-negative-definite", "Q_o ≺ 0", "Lemma 2", "exact LDLᵀ", r.ok, r.detail)
     r = check_psd(-data.qsr_n.Q) if data.qsr_n.k else None
-    c.add("Q_n-negative-semidefinite", "Q_n ⪯ 0", "Assumption 1", "exact LDLᵀ", r is None or r.ok, "" if r is None else r.detail)
+    c.add(
+        "Q_n-negative-semidefinite",
+        "Q_n ⪯ 0",
+        "Assumption 1",
+        "exact LDLᵀ",
+        r is None or r.ok,
+        "" if r is None else r.detail,
+    )
     th_o, th_n = Q(P["theta_o"]), Q(P["theta_n"])
     ok_th = th_o > 0 and th_n > 0
     varpi, kappa_n = Q(P["varpi_o"]), Q(P["kappa_n"])
     r = check_psd(-ssd_matrix(co.Ao, data.qsr_o.scaled(th_o), -varpi)) if ok_th else None
-    c.add("varpi_o", f"Σ(Ā_o, I, I) is (−R_o, −S_oᵀ, −Q_o)-ssd(−ϖ_o), ϖ_o = {float(varpi):.6g} ≥ λ_max(M_o)",
-          "Lemma 2, eq. (16)", "exact LDLᵀ of −N(−ϖ_o) (scaled QSR θ_o > 0)", bool(r), "" if r is None else r.detail)
+    c.add(
+        "varpi_o",
+        f"Σ(Ā_o, I, I) is (−R_o, −S_oᵀ, −Q_o)-ssd(−ϖ_o), ϖ_o = {float(varpi):.6g} ≥ λ_max(M_o)",
+        "Lemma 2, eq. (16)",
+        "exact LDLᵀ of −N(−ϖ_o) (scaled QSR θ_o > 0)",
+        bool(r),
+        "" if r is None else r.detail,
+    )
     r = check_psd(-ssd_matrix(co.An, data.qsr_n.scaled(th_n), kappa_n)) if ok_th else None
-    c.add("kappa_n", f"Σ(Ā_n, I, I) is (−R_n, −S_nᵀ, −Q_n)-ssd(κ_n), κ_n = {float(kappa_n):.6g}",
-          "Lemma 1, eq. (7)", "exact LDLᵀ of −N(κ_n) (scaled QSR θ_n > 0)", bool(r), "" if r is None else r.detail)
+    c.add(
+        "kappa_n",
+        f"Σ(Ā_n, I, I) is (−R_n, −S_nᵀ, −Q_n)-ssd(κ_n), κ_n = {float(kappa_n):.6g}",
+        "Lemma 1, eq. (7)",
+        "exact LDLᵀ of −N(κ_n) (scaled QSR θ_n > 0)",
+        bool(r),
+        "" if r is None else r.detail,
+    )
     lam_no, lam_on = Q(P["lambda_no"]), Q(P["lambda_on"])
     ok = norm_bound_holds(co.Ano, lam_no - data.ell_no)
-    c.add("lambda_no", f"λ*_no = ‖Ā_no‖ + ℓ_no ≤ {float(lam_no):.6g}", "Lemma 1", "exact u²I − XᵀX ⪰ 0", ok, "")
+    c.add(
+        "lambda_no",
+        f"λ*_no = ‖Ā_no‖ + ℓ_no ≤ {float(lam_no):.6g}",
+        "Lemma 1",
+        "exact u²I − XᵀX ⪰ 0",
+        ok,
+        "",
+    )
     ok = norm_bound_holds(co.Aon, lam_on - data.ell_on)
-    c.add("lambda_on", f"λ*_on = ‖Ā_on‖ + ℓ_on ≤ {float(lam_on):.6g}", "Theorem 1", "exact u²I − XᵀX ⪰ 0", ok, "")
+    c.add(
+        "lambda_on",
+        f"λ*_on = ‖Ā_on‖ + ℓ_on ≤ {float(lam_on):.6g}",
+        "Theorem 1",
+        "exact u²I − XᵀX ⪰ 0",
+        ok,
+        "",
+    )
     gamma, beta = gamma_of(p.L)
     ok = Q(P["gamma"]) == gamma and Q(P["beta"]) == beta and 0 < 1 - gamma < 1
-    c.add("gamma-beta", f"1 − γ = λ_max(I − L) = {float(1 - gamma):.6g} ∈ (0, 1), β = 1/(1 − γ)² = {float(beta):.6g}",
-          "eqs. (18), (21c)", "exact", ok, "")
-    c.add("lemma1-iss", f"κ_n > λ*_no ({float(kappa_n):.6g} > {float(lam_no):.6g}): (14b) is ISS w.r.t. ε_o",
-          "Lemma 1", "exact", kappa_n > lam_no, "")
+    c.add(
+        "gamma-beta",
+        f"1 − γ = λ_max(I − L) = {float(1 - gamma):.6g} ∈ (0, 1), β = 1/(1 − γ)² = {float(beta):.6g}",
+        "eqs. (18), (21c)",
+        "exact",
+        ok,
+        "",
+    )
+    c.add(
+        "lemma1-iss",
+        f"κ_n > λ*_no ({float(kappa_n):.6g} > {float(lam_no):.6g}): (14b) is ISS w.r.t. ε_o",
+        "Lemma 1",
+        "exact",
+        kappa_n > lam_no,
+        "",
+    )
     kappa = Q(P["kappa"])
     rhs = coupling(lam_no, lam_on, beta) + kappa
-    c.add("condition-22", f"κ_n > λ*_no + β λ*_on + κ with κ = {float(kappa):.6g} > 0",
-          "Theorem 1, eq. (22)", "exact", bool(kappa > 0 and kappa_n > rhs), f"slack {float(kappa_n - rhs):.6g}")
+    c.add(
+        "condition-22",
+        f"κ_n > λ*_no + β λ*_on + κ with κ = {float(kappa):.6g} > 0",
+        "Theorem 1, eq. (22)",
+        "exact",
+        bool(kappa > 0 and kappa_n > rhs),
+        f"slack {float(kappa_n - rhs):.6g}",
+    )
     T_max, T_min = Q(P["T_max"]), Q(P["T_min"])
     try:
         lo = T_max_lower(gamma, varpi, kappa, lam_no, lam_on, beta)
         ok, det = bool(0 < T_max <= lo), f"T_max = {T_max} ≤ {float(lo):.10g} (outward-rounded)"
     except ValueError as e:
         ok, det = False, str(e)
-    c.add("T_max", f"T_max = {float(T_max):.6g} ≤ −ln((1−γ)²)/(ϖ_o + κ + λ*_no + βλ*_on)", "Theorem 2, eq. (26b); (22) for i = o",
-          "interval arithmetic, rounded down", ok, det)
+    c.add(
+        "T_max",
+        f"T_max = {float(T_max):.6g} ≤ −ln((1−γ)²)/(ϖ_o + κ + λ*_no + βλ*_on)",
+        "Theorem 2, eq. (26b); (22) for i = o",
+        "interval arithmetic, rounded down",
+        ok,
+        det,
+    )
     try:
         hi = T_min_upper(p.alpha, gamma, kappa)
         ok, det = bool(T_min >= hi), f"T_min = {T_min} ≥ {float(hi):.10g} (outward-rounded)"
     except ValueError as e:
         ok, det = False, str(e)
-    c.add("T_min", f"T_min = {float(T_min):.6g} ≥ −ln((α − γ)/α)/κ, α = {float(p.alpha):g} > γ", "Theorem 2, eq. (26c)",
-          "interval arithmetic, rounded up", ok, det)
-    c.add("window", f"T_min < T_max ({float(T_min):.6g} < {float(T_max):.6g})", "Theorem 2, eq. (26a)", "exact",
-          T_min < T_max, "")
+    c.add(
+        "T_min",
+        f"T_min = {float(T_min):.6g} ≥ −ln((α − γ)/α)/κ, α = {float(p.alpha):g} > γ",
+        "Theorem 2, eq. (26c)",
+        "interval arithmetic, rounded up",
+        ok,
+        det,
+    )
+    c.add(
+        "window",
+        f"T_min < T_max ({float(T_min):.6g} < {float(T_max):.6g})",
+        "Theorem 2, eq. (26a)",
+        "exact",
+        T_min < T_max,
+        "",
+    )
     rad = Q(P["ball_radius"])
-    c.add("ball_radius", f"radius of B ≥ √(α‖w‖∞) = √({float(p.alpha):g}·{float(p.w_bar):g})", "Theorem 2",
-          "exact r² ≥ α w̄", bool(rad >= 0 and rad * rad >= Q(p.alpha) * Q(p.w_bar)) and Q(P["w_bar"]) == Q(p.w_bar), "")
+    c.add(
+        "ball_radius",
+        f"radius of B ≥ √(α‖w‖∞) = √({float(p.alpha):g}·{float(p.w_bar):g})",
+        "Theorem 2",
+        "exact r² ≥ α w̄",
+        bool(rad >= 0 and rad * rad >= Q(p.alpha) * Q(p.w_bar)) and Q(P["w_bar"]) == Q(p.w_bar),
+        "",
+    )
     return c.items

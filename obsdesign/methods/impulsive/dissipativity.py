@@ -49,7 +49,10 @@ class QSR:
         return QSR(self.Q * t, self.S * t, self.R * t, self.how)
 
     def floats(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        return tuple(np.asarray(to_float(x), dtype=float).reshape(self.k, self.k) for x in (self.Q, self.S, self.R))  # type: ignore[return-value]
+        return tuple(
+            np.asarray(to_float(x), dtype=float).reshape(self.k, self.k)
+            for x in (self.Q, self.S, self.R)
+        )  # type: ignore[return-value]
 
 
 def qsr_lipschitz(ell: Any, k: int) -> QSR:
@@ -77,7 +80,9 @@ def ssd_matrix(Ablk: Any, qsr: QSR, rate: Any) -> np.ndarray:
     return symmetrize(np.vstack([top, bot]))
 
 
-def best_rate_float(Ablk: np.ndarray, Qm: np.ndarray, S: np.ndarray, R: np.ndarray) -> tuple[float, float]:
+def best_rate_float(
+    Ablk: np.ndarray, Qm: np.ndarray, S: np.ndarray, R: np.ndarray
+) -> tuple[float, float]:
     """Largest κ with N(κ) ⪯ 0 in floats, and the range residual.
 
     By the generalized Schur complement (Q ⪯ 0): N(κ) ⪯ 0 iff (I − QQ⁺)(I + S) = 0 and

@@ -52,11 +52,15 @@ class Falsification:
     def summary(self) -> str:
         if not self.violated:
             return f"no violation in {self.samples} sampled pairs"
-        parts = [f"{v.name}: worst {v.worst:.4g} ({v.count}/{v.tested} pairs)" for v in self.violated]
+        parts = [
+            f"{v.name}: worst {v.worst:.4g} ({v.count}/{v.tested} pairs)" for v in self.violated
+        ]
         return "violated — " + "; ".join(parts)
 
 
-def sample_pairs(rng: np.random.Generator, lo: np.ndarray, hi: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+def sample_pairs(
+    rng: np.random.Generator, lo: np.ndarray, hi: np.ndarray, n: int
+) -> tuple[np.ndarray, np.ndarray]:
     """n pairs in the box [lo, hi]: half independent, half with x̂ − x of size 10^-4..10^-1 of
     the box width (clipped to the box)."""
     d = len(lo)
@@ -69,10 +73,14 @@ def sample_pairs(rng: np.random.Generator, lo: np.ndarray, hi: np.ndarray, n: in
     return x, xh
 
 
-def _qsr_value(phi: np.ndarray, e: np.ndarray, Qm: np.ndarray, S: np.ndarray, R: np.ndarray) -> np.ndarray:
+def _qsr_value(
+    phi: np.ndarray, e: np.ndarray, Qm: np.ndarray, S: np.ndarray, R: np.ndarray
+) -> np.ndarray:
     """ω = φᵀQφ + 2φᵀSε + εᵀRε row-wise (eq. (15))."""
-    return np.einsum("ij,jk,ik->i", phi, Qm, phi) + 2 * np.einsum("ij,jk,ik->i", phi, S, e) + np.einsum(
-        "ij,jk,ik->i", e, R, e
+    return (
+        np.einsum("ij,jk,ik->i", phi, Qm, phi)
+        + 2 * np.einsum("ij,jk,ik->i", phi, S, e)
+        + np.einsum("ij,jk,ik->i", e, R, e)
     )
 
 
@@ -85,8 +93,18 @@ def _worst(name: str, val: np.ndarray, x: np.ndarray, xh: np.ndarray, tol: float
 
 
 def falsify_blocks(
-    psi: Psi, T: np.ndarray, m: int, qsr_o: tuple[np.ndarray, ...], qsr_n: tuple[np.ndarray, ...],
-    ell_on: float, ell_no: float, lo: np.ndarray, hi: np.ndarray, samples: int, seed: int, tol: float = 1e-9,
+    psi: Psi,
+    T: np.ndarray,
+    m: int,
+    qsr_o: tuple[np.ndarray, ...],
+    qsr_n: tuple[np.ndarray, ...],
+    ell_on: float,
+    ell_no: float,
+    lo: np.ndarray,
+    hi: np.ndarray,
+    samples: int,
+    seed: int,
+    tol: float = 1e-9,
 ) -> Falsification:
     """Falsification of the split reading of (15) with per-block data (see module doc)."""
     rng = np.random.default_rng(seed)
@@ -115,7 +133,9 @@ def falsify_blocks(
     items.append(_worst("(15) own part, i = o", -w[ok_o], x[ok_o], xh[ok_o], tol))
     if T.shape[0] > m:
         phi_n = p_mn[:, m:] - p_z[:, m:]
-        w = _qsr_value(phi_n, en, *qsr_n) / np.maximum(np.sum(phi_n**2, 1) + np.sum(en**2, 1), 1e-300)
+        w = _qsr_value(phi_n, en, *qsr_n) / np.maximum(
+            np.sum(phi_n**2, 1) + np.sum(en**2, 1), 1e-300
+        )
         items.append(_worst("(15) own part, i = n", -w[ok_n], x[ok_n], xh[ok_n], tol))
         # cross parts
         c_o = np.linalg.norm(p_zh[:, :m] - p_mo[:, :m], axis=1)
@@ -132,11 +152,15 @@ def falsify_blocks(
     return Falsification(samples, items, lit)
 
 
-def falsify_lipschitz_x(psi: Psi, ell: float, lo: np.ndarray, hi: np.ndarray, samples: int, seed: int, tol: float = 1e-9) -> Falsification:
+def falsify_lipschitz_x(
+    psi: Psi, ell: float, lo: np.ndarray, hi: np.ndarray, samples: int, seed: int, tol: float = 1e-9
+) -> Falsification:
     """Falsification of ‖ψ(x̂) − ψ(x)‖ ≤ ℓ‖x̂ − x‖ on the region."""
     rng = np.random.default_rng(seed)
     x, xh = sample_pairs(rng, lo, hi, samples)
     d = np.linalg.norm(xh - x, axis=1)
     sel = d > 1e-12
     ratio = np.linalg.norm(psi(xh) - psi(x), axis=1)[sel] / d[sel]
-    return Falsification(samples, [_worst("Lipschitz bound of ψ in x", ratio - ell, x[sel], xh[sel], tol)], {})
+    return Falsification(
+        samples, [_worst("Lipschitz bound of ψ in x", ratio - ell, x[sel], xh[sel], tol)], {}
+    )

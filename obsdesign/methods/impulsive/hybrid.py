@@ -41,7 +41,9 @@ class HybridBatch:
     diverged: np.ndarray
 
 
-def draw_intervals(rng: np.random.Generator, runs: int, t_lo: float, t_hi: float, horizon: float) -> np.ndarray:
+def draw_intervals(
+    rng: np.random.Generator, runs: int, t_lo: float, t_hi: float, horizon: float
+) -> np.ndarray:
     """Sampling intervals uniform in [t_lo, t_hi) until each run passes ``horizon``; (runs, K),
     padded with zeros (K = the longest run)."""
     k = int(np.ceil(horizon / t_lo)) + 1
@@ -112,7 +114,15 @@ def simulate_hybrid(
             d = np.stack([f(U[:, 0]), fz(U[:, 1])], axis=1)
             return (h[:, None, None] * d).ravel()
 
-        sol = solve_ivp(rhs, (0.0, 1.0), np.stack([X, Z], 1).ravel(), method="RK45", t_eval=s_eval, rtol=rtol, atol=atol)
+        sol = solve_ivp(
+            rhs,
+            (0.0, 1.0),
+            np.stack([X, Z], 1).ravel(),
+            method="RK45",
+            t_eval=s_eval,
+            rtol=rtol,
+            atol=atol,
+        )
         if sol.status != 0 or sol.y.shape[1] != dense:
             raise ArithmeticError(f"integration failed on interval {k}: {sol.message}")
         U = sol.y.reshape(N, 2, n, dense)
@@ -142,8 +152,15 @@ def simulate_hybrid(
 
 
 def simulate_one_by_one(
-    f: VectorField, T: np.ndarray, L_diag: np.ndarray, x0: np.ndarray, xhat0: np.ndarray,
-    h: np.ndarray, w: np.ndarray, rtol: float = 1e-7, atol: float = 1e-9,
+    f: VectorField,
+    T: np.ndarray,
+    L_diag: np.ndarray,
+    x0: np.ndarray,
+    xhat0: np.ndarray,
+    h: np.ndarray,
+    w: np.ndarray,
+    rtol: float = 1e-7,
+    atol: float = 1e-9,
 ) -> np.ndarray:
     """Reference: one trajectory, one solve_ivp call per interval; returns final ‖ε‖ and state.
 
@@ -173,7 +190,9 @@ class BallReport:
 
     radius: float
     entered: np.ndarray  # (N,) bool: inside B at the end of the horizon
-    settle_time: np.ndarray  # (N,) last time ‖ε‖ > r (0 if never outside), NaN if not inside at the end
+    settle_time: (
+        np.ndarray
+    )  # (N,) last time ‖ε‖ > r (0 if never outside), NaN if not inside at the end
     worst_after: np.ndarray  # (N,) max ‖ε‖ after ``after`` (NaN if no point after)
     after: float
 
