@@ -22,7 +22,9 @@ def _spec(spec: str | Path | Spec) -> Spec:
     return spec if isinstance(spec, Spec) else load_spec(spec)
 
 
-def design(spec: str | Path | Spec, out: str | Path | None = None, progress: Progress | None = None) -> Report:
+def design(
+    spec: str | Path | Spec, out: str | Path | None = None, progress: Progress | None = None
+) -> Report:
     """Design the observer of a spec and certify every claim; write the JSON report to
     ``out`` (atomically) when given. Raises :class:`ObsdesignError` subclasses."""
     t0 = time.perf_counter()
@@ -41,7 +43,11 @@ def design(spec: str | Path | Spec, out: str | Path | None = None, progress: Pro
         parameters=d.parameters,
         claims=claims,
         solver=d.solver,
-        timings={"parse_s": round(t1 - t0, 4), "design_s": round(t2 - t1, 4), "certify_s": round(t3 - t2, 4)},
+        timings={
+            "parse_s": round(t1 - t0, 4),
+            "design_s": round(t2 - t1, 4),
+            "certify_s": round(t3 - t2, 4),
+        },
         notes=d.notes,
     )
     if out is not None:
@@ -111,8 +117,16 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
         raise
     except (KeyError, ValueError, TypeError, IndexError, ZeroDivisionError) as e:
         claims.append(
-            exact_claim("parameters-wellformed", "the report's parameters have the expected form",
-                        "report.parameters", "parse", 0, False, f"{type(e).__name__}: {e}", float_ok=False)
+            exact_claim(
+                "parameters-wellformed",
+                "the report's parameters have the expected form",
+                "report.parameters",
+                "parse",
+                0,
+                False,
+                f"{type(e).__name__}: {e}",
+                float_ok=False,
+            )
         )
     return _replace_claims(rep, claims, time.perf_counter() - t0)
 
@@ -123,7 +137,9 @@ def _replace_claims(rep: Report, claims: list[Claim], seconds: float) -> Report:
     return rep
 
 
-def simulate(spec: str | Path | Spec, report: str | Path | Report | None = None, **kwargs: Any) -> SimResult:
+def simulate(
+    spec: str | Path | Spec, report: str | Path | Report | None = None, **kwargs: Any
+) -> SimResult:
     """Simulate the plant and the designed observer over the spec's ``[simulate]`` scenario.
 
     Uses the parameters of ``report`` when given (after checking its spec hash), else designs.
@@ -134,7 +150,11 @@ def simulate(spec: str | Path | Spec, report: str | Path | Report | None = None,
     if report is None:
         params: Parameters = get_method(sp.method).design(sp).parameters
     else:
-        rep, problems = (Report.from_dict(report.to_dict()) if isinstance(report, Report) else Report.load(report))
+        rep, problems = (
+            Report.from_dict(report.to_dict())
+            if isinstance(report, Report)
+            else Report.load(report)
+        )
         if rep.spec_sha256 != sp.sha256:
             raise InputError(f"{sp.file}: the report was made from another spec (sha256 differs)")
         if problems:
@@ -179,10 +199,21 @@ def check_one(path: Path) -> CheckRow:
         counts = ver.status_counts()
         msg = "; ".join(f"{c.id}: {c.detail}" for c in ver.failed)
         summary = get_method(rep.method).summary(rep.parameters)
-        return CheckRow(str(path), rep.method, code, counts["certified"], counts["numerical"],
-                        counts["failed"], summary, time.perf_counter() - t0, msg)
+        return CheckRow(
+            str(path),
+            rep.method,
+            code,
+            counts["certified"],
+            counts["numerical"],
+            counts["failed"],
+            summary,
+            time.perf_counter() - t0,
+            msg,
+        )
     except ObsdesignError as e:
-        return CheckRow(str(path), "?", e.exit_code, 0, 0, 0, "", time.perf_counter() - t0, e.message)
+        return CheckRow(
+            str(path), "?", e.exit_code, 0, 0, 0, "", time.perf_counter() - t0, e.message
+        )
 
 
 def check(paths: list[str | Path]) -> list[CheckRow]:

@@ -10,7 +10,7 @@ from __future__ import annotations
 import json
 import sys
 from collections.abc import Callable
-from enum import Enum
+from enum import StrEnum
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -26,7 +26,7 @@ app = typer.Typer(
 _state = {"debug": False}
 
 
-class Fmt(str, Enum):
+class Fmt(StrEnum):
     text = "text"
     json = "json"
     md = "md"
@@ -70,9 +70,13 @@ def _main(
 @app.command()
 def design(
     spec: Annotated[Path, typer.Argument(help="Spec file (TOML).")],
-    output: Annotated[Path | None, typer.Option("-o", "--output", help="Write the JSON report here.")] = None,
+    output: Annotated[
+        Path | None, typer.Option("-o", "--output", help="Write the JSON report here.")
+    ] = None,
     fmt: Annotated[Fmt, typer.Option("--format", help="Output format on stdout.")] = Fmt.text,
-    plot: Annotated[Path | None, typer.Option("--plot", help="Write the method's design plot (PNG/SVG).")] = None,
+    plot: Annotated[
+        Path | None, typer.Option("--plot", help="Write the method's design plot (PNG/SVG).")
+    ] = None,
 ) -> None:
     """Design the observer of SPEC, certify every claim, and print (or write) the report."""
 
@@ -105,7 +109,9 @@ def design(
 @app.command()
 def verify(
     report: Annotated[Path, typer.Argument(help="JSON report written by 'design'.")],
-    spec: Annotated[Path | None, typer.Option("--spec", help="Check against this spec (hash must match).")] = None,
+    spec: Annotated[
+        Path | None, typer.Option("--spec", help="Check against this spec (hash must match).")
+    ] = None,
     fmt: Annotated[Fmt, typer.Option("--format")] = Fmt.text,
 ) -> None:
     """Re-check every claim of REPORT independently; exit 0 only if all hold."""
@@ -152,11 +158,14 @@ def check(
 @app.command()
 def simulate(
     spec: Annotated[Path, typer.Argument(help="Spec file with a [simulate] table.")],
-    report: Annotated[Path | None, typer.Option("--report", help="Use this report's parameters.")] = None,
+    report: Annotated[
+        Path | None, typer.Option("--report", help="Use this report's parameters.")
+    ] = None,
     plot: Annotated[Path | None, typer.Option("--plot", help="Write a plot (PNG/SVG).")] = None,
     fmt: Annotated[Fmt, typer.Option("--format")] = Fmt.text,
     option: Annotated[
-        list[str] | None, typer.Option("--option", help="Method simulation option KEY=VALUE (repeatable).")
+        list[str] | None,
+        typer.Option("--option", help="Method simulation option KEY=VALUE (repeatable)."),
     ] = None,
 ) -> None:
     """Run the plant and the designed observer over the spec's scenario; print metrics."""
@@ -287,8 +296,10 @@ def _print_rows(rows: list[Any], fmt: Fmt) -> None:
         print("| spec | method | exit | certified | numerical | failed | result | seconds |")
         print("| --- | --- | --- | --- | --- | --- | --- | --- |")
         for r in rows:
-            print(f"| {r.spec} | {r.method} | {r.code} | {r.certified} | {r.numerical} | {r.failed} | "
-                  f"{r.summary or r.message} | {r.seconds:.2f} |")
+            print(
+                f"| {r.spec} | {r.method} | {r.code} | {r.certified} | {r.numerical} | {r.failed} | "
+                f"{r.summary or r.message} | {r.seconds:.2f} |"
+            )
         return
     from rich.console import Console
     from rich.table import Table
@@ -298,8 +309,16 @@ def _print_rows(rows: list[Any], fmt: Fmt) -> None:
         t.add_column(c, overflow="fold")
     for r in rows:
         verdict = "[green]ok[/]" if r.code == 0 else f"[bold red]exit {r.code}[/]"
-        t.add_row(r.spec, r.method, verdict, str(r.certified), str(r.numerical), str(r.failed),
-                  r.summary if r.code == 0 else r.message, f"{r.seconds:.2f}")
+        t.add_row(
+            r.spec,
+            r.method,
+            verdict,
+            str(r.certified),
+            str(r.numerical),
+            str(r.failed),
+            r.summary if r.code == 0 else r.message,
+            f"{r.seconds:.2f}",
+        )
     Console().print(t)
 
 
@@ -311,13 +330,14 @@ def _print_metrics(m: dict[str, Any]) -> None:
     t.add_column("state")
     t.add_column("sup |e_i|")
     t.add_column("RMSE")
+    t.add_column("sup |x̂_i|")
     for s, v in m["sup_abs_error"].items():
-        t.add_row(s, f"{v:.6g}", f"{m['rmse'][s]:.6g}")
+        t.add_row(s, f"{v:.6g}", f"{m['rmse'][s]:.6g}", f"{m['sup_abs_estimate'][s]:.6g}")
     c = Console()
     c.print(t)
     c.print(f"final |e| = {m['final_error_norm']:.6g}")
     for k, v in m.items():
-        if k not in ("sup_abs_error", "rmse", "final_error_norm", "exit_code"):
+        if k not in ("sup_abs_error", "rmse", "final_error_norm", "sup_abs_estimate", "exit_code"):
             c.print(f"{k}: {v}")
 
 

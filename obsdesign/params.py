@@ -23,8 +23,11 @@ from obsdesign.errors import InputError
 def _is_exact(v: Any) -> bool:
     if isinstance(v, fmpq):
         return True
-    return isinstance(v, np.ndarray) and v.dtype == object and v.size > 0 and isinstance(
-        v.flat[0], fmpq
+    return (
+        isinstance(v, np.ndarray)
+        and v.dtype == object
+        and v.size > 0
+        and isinstance(v.flat[0], fmpq)
     )
 
 
@@ -102,7 +105,9 @@ class Parameters:
                 try:
                     q = qparse(exact[k])
                 except (ValueError, TypeError, ZeroDivisionError) as e:
-                    raise InputError(f"report: parameters.exact.{k}: not an exact value ({e})") from e
+                    raise InputError(
+                        f"report: parameters.exact.{k}: not an exact value ({e})"
+                    ) from e
                 vals[k] = q
                 if not _same(_floats(q), v):
                     problems.append(f"parameter '{k}': float value differs from its exact value")

@@ -33,10 +33,19 @@ def test_jacobian_matches_finite_differences(a: float, b: float):
 
 
 def test_functions():
-    e = parse_expr("sat(x1) + sat(x1, 2) + step(x1) + max(x1, 0) + min(x1, 0) + mod(x1, 2) + abs(x1)", ["x1"])
+    e = parse_expr(
+        "sat(x1) + sat(x1, 2) + step(x1) + max(x1, 0) + min(x1, 0) + mod(x1, 2) + abs(x1)", ["x1"]
+    )
     x = np.array([[-3.0], [0.5], [3.0]])
-    want = np.clip(x[:, 0], -1, 1) + np.clip(x[:, 0], -2, 2) + (x[:, 0] > 0) + np.maximum(x[:, 0], 0) \
-        + np.minimum(x[:, 0], 0) + np.mod(x[:, 0], 2) + np.abs(x[:, 0])
+    want = (
+        np.clip(x[:, 0], -1, 1)
+        + np.clip(x[:, 0], -2, 2)
+        + (x[:, 0] > 0)
+        + np.maximum(x[:, 0], 0)
+        + np.minimum(x[:, 0], 0)
+        + np.mod(x[:, 0], 2)
+        + np.abs(x[:, 0])
+    )
     np.testing.assert_allclose(e.on(["x1"])(x), want)
 
 

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
-from enum import Enum
+from enum import StrEnum
 from typing import Any
 
 
-class ClaimStatus(str, Enum):
+class ClaimStatus(StrEnum):
     """``certified``: an exact check passed. ``numerical``: checked in floats only (with the
     margin), by design of the claim. ``failed``: the check did not pass."""
 

@@ -60,7 +60,9 @@ class Lyapunov(Method):
         if table.has("L"):
             L = table.matrix("L", rows=s.n, cols=s.p, vector_as="column").q
         if s.discrete:
-            rate = table.scalar("lambda", default=None, min=0, max=1, strict_min=True, strict_max=True)
+            rate = table.scalar(
+                "lambda", default=None, min=0, max=1, strict_min=True, strict_max=True
+            )
             if table.has("alpha"):
                 raise table.error("alpha", "is for continuous time; use lambda in discrete time")
         else:
@@ -108,9 +110,7 @@ class Lyapunov(Method):
             rho = float(np.max(eig.real))
             params["max_real_eig"] = rho
             if rho >= 0 and o.rate is None:
-                raise InfeasibleError(
-                    f"A − LC is not Hurwitz: largest real part {rho:.6g} >= 0"
-                )
+                raise InfeasibleError(f"A − LC is not Hurwitz: largest real part {rho:.6g} >= 0")
         best, P_best = best_rate(s.A.q, s.C.q, L, s.discrete, o, rho)
         if o.rate is None:
             rate, P = best, P_best
@@ -261,7 +261,15 @@ def iss_matrix(A: Any, C: Any, L: Any, Dn: Any, P: Any, rate: Any, mu: Any, disc
 def _exact(params: Parameters, k: str, claims: list[Claim]) -> Any:
     if k not in params:
         claims.append(
-            exact_claim(f"{k}-present", f"the report gives {k}", "report", "presence", 0, False, f"{k} missing")
+            exact_claim(
+                f"{k}-present",
+                f"the report gives {k}",
+                "report",
+                "presence",
+                0,
+                False,
+                f"{k} missing",
+            )
         )
         return None
     v = params[k]
@@ -286,7 +294,14 @@ def _decay_claim(s: Any, L: Any, P: Any, rate: Any, margin: Any, suffix: str) ->
     else:
         stmt = f"(A−LC)ᵀP{suffix} + P{suffix}(A−LC) ⪯ −2α{suffix}·P{suffix} with α{suffix} = {rate}"
     return exact_claim(
-        f"decay-lmi{suffix}", stmt, REF, "exact LDLᵀ over Q of the rebuilt matrix", margin, r.ok, r.detail, fl
+        f"decay-lmi{suffix}",
+        stmt,
+        REF,
+        "exact LDLᵀ over Q of the rebuilt matrix",
+        margin,
+        r.ok,
+        r.detail,
+        fl,
     )
 
 
@@ -295,12 +310,20 @@ def _iss_claim(s: Any, L: Any, P: Any, rate: Any, mu: Any) -> Claim:
     r = check_pd(M, 0)
     what = "V(e⁺) ≤ λ²V(e) + μ|v|²" if s.discrete else "V̇ ≤ −2αV + μ|v|²"
     return exact_claim(
-        "iss-gain", f"{what} with μ = {float(Q(mu)):.6g}", REF, "exact LDLᵀ over Q", 0, r.ok, r.detail
+        "iss-gain",
+        f"{what} with μ = {float(Q(mu)):.6g}",
+        REF,
+        "exact LDLᵀ over Q",
+        0,
+        r.ok,
+        r.detail,
     )
 
 
 # -- numerical parts -----------------------------------------------------------------------
-def lyapunov_P(A: np.ndarray, C: np.ndarray, L: np.ndarray, rate: float, discrete: bool) -> np.ndarray:
+def lyapunov_P(
+    A: np.ndarray, C: np.ndarray, L: np.ndarray, rate: float, discrete: bool
+) -> np.ndarray:
     """P solving (A−LC)ᵀP(A−LC) − λ²P = −I (discrete) or
     (A−LC+αI)ᵀP + P(A−LC+αI) = −I (continuous), in floats."""
     from scipy.linalg import solve_continuous_lyapunov, solve_discrete_lyapunov
@@ -381,7 +404,7 @@ def iss_gain(s: Any, L: Any, P: Any, rate: Any) -> fmpq:
     """Smallest μ (rounded up, then certified) with the ISS inequality; Schur complement
     μ ≥ λ_max(LdᵀPLd + LdᵀPAcl S⁻¹ AclᵀPLd) (discrete) or λ_max(LdᵀP S⁻¹ P Ld) (continuous)."""
     A, C, Dn = s.A.f, s.C.f, s.Dn.f
-    Lf, Pf, r = np.asarray(L, float), np.asarray(P, float), float(Q(rate))
+    Lf, Pf, _r = np.asarray(L, float), np.asarray(P, float), float(Q(rate))
     Acl = A - Lf @ C
     Ld = Lf @ Dn
     S = np.asarray(decay_matrix(s.A.q, s.C.q, L, P, rate, s.discrete), dtype=float)
@@ -481,7 +504,7 @@ def design_gain(spec: Spec, progress: Progress | None) -> tuple[np.ndarray, dict
 
 METHOD = Lyapunov()
 
-TEMPLATE = '''\
+TEMPLATE = """\
 # obsdesign spec: Lyapunov-decay linear observer (method "lyapunov").
 # Observer: x̂⁺ = A x̂ + B u + L (y − C x̂ − D u); certify (A−LC)ᵀP(A−LC) ⪯ λ²P exactly.
 title = "my observer"
@@ -509,4 +532,4 @@ seed = 0
 [simulate.noise]
 kind = "uniform"             # zero | constant | windows | uniform | outliers | sequence
 bound = 0.01
-'''
+"""

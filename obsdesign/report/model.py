@@ -44,7 +44,12 @@ def tool_info() -> dict[str, Any]:
         own = metadata.version("obsdesign")
     except metadata.PackageNotFoundError:
         own = "unknown"
-    return {"name": "obsdesign", "version": own, "python": platform.python_version(), "dependencies": versions}
+    return {
+        "name": "obsdesign",
+        "version": own,
+        "python": platform.python_version(),
+        "dependencies": versions,
+    }
 
 
 @dataclass
@@ -123,7 +128,9 @@ class Report:
             if k not in d:
                 raise InputError(f"{file}: key '{k}' is missing (not an obsdesign report?)")
         if str(d["schema_version"]).split(".")[0] != SCHEMA_VERSION.split(".")[0]:
-            raise InputError(f"{file}: schema_version {d['schema_version']} is not supported (expected {SCHEMA_VERSION})")
+            raise InputError(
+                f"{file}: schema_version {d['schema_version']} is not supported (expected {SCHEMA_VERSION})"
+            )
         if not isinstance(d["spec"], str) or not isinstance(d["spec_sha256"], str):
             raise InputError(f"{file}: 'spec' must be the spec text and 'spec_sha256' its hash")
         params, problems = Parameters.from_json(d["parameters"])

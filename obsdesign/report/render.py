@@ -9,7 +9,11 @@ import numpy as np
 from obsdesign.certify.claim import ClaimStatus
 from obsdesign.report.model import Report
 
-STYLE = {ClaimStatus.CERTIFIED: "green", ClaimStatus.NUMERICAL: "yellow", ClaimStatus.FAILED: "bold red"}
+STYLE = {
+    ClaimStatus.CERTIFIED: "green",
+    ClaimStatus.NUMERICAL: "yellow",
+    ClaimStatus.FAILED: "bold red",
+}
 
 
 def fmt_value(v: Any, digits: int = 6) -> str:
@@ -35,7 +39,10 @@ def _param_rows(report: Report) -> list[tuple[str, str, str]]:
 
 def _numeric(v: Any) -> bool:
     try:
-        np.asarray(v if not isinstance(v, np.ndarray) or v.dtype != object else v.astype(float), dtype=float)
+        np.asarray(
+            v if not isinstance(v, np.ndarray) or v.dtype != object else v.astype(float),
+            dtype=float,
+        )
         return True
     except (TypeError, ValueError):
         return False
@@ -58,7 +65,9 @@ def render_text(report: Report, title: str = "") -> None:
     for col in ("id", "status", "statement", "check", "detail"):
         c.add_column(col, overflow="fold")
     for cl in report.claims:
-        c.add_row(cl.id, f"[{STYLE[cl.status]}]{cl.status.value}[/]", cl.statement, cl.check, cl.detail)
+        c.add_row(
+            cl.id, f"[{STYLE[cl.status]}]{cl.status.value}[/]", cl.statement, cl.check, cl.detail
+        )
     console.print(c)
     for n in report.notes:
         console.print(f"note: {n}")
@@ -71,14 +80,27 @@ def render_text(report: Report, title: str = "") -> None:
 
 def render_markdown(report: Report) -> str:
     """The report as Markdown."""
-    lines = [f"# obsdesign report: {report.method}", "", f"- spec: `{report.spec_file}`",
-             f"- spec sha256: `{report.spec_sha256}`", f"- tool: {report.tool.get('version', '')}", ""]
+    lines = [
+        f"# obsdesign report: {report.method}",
+        "",
+        f"- spec: `{report.spec_file}`",
+        f"- spec sha256: `{report.spec_sha256}`",
+        f"- tool: {report.tool.get('version', '')}",
+        "",
+    ]
     lines += ["## Parameters", "", "| symbol | value | form |", "| --- | --- | --- |"]
     lines += [f"| {k} | `{v}` | {f} |" for k, v, f in _param_rows(report)]
-    lines += ["", "## Claims", "", "| id | status | statement | reference | check | detail |",
-              "| --- | --- | --- | --- | --- | --- |"]
+    lines += [
+        "",
+        "## Claims",
+        "",
+        "| id | status | statement | reference | check | detail |",
+        "| --- | --- | --- | --- | --- | --- |",
+    ]
     for c in report.claims:
-        lines.append(f"| {c.id} | **{c.status.value}** | {c.statement} | {c.reference} | {c.check} | {c.detail} |")
+        lines.append(
+            f"| {c.id} | **{c.status.value}** | {c.statement} | {c.reference} | {c.check} | {c.detail} |"
+        )
     if report.notes:
         lines += ["", "## Notes", ""] + [f"- {n}" for n in report.notes]
     return "\n".join(lines) + "\n"

@@ -27,7 +27,12 @@ class SimResult:
         return self.xhat - self.x
 
     def metrics(self) -> dict[str, Any]:
-        return {**metrics(self.e, self.states), **self.info}
+        m = metrics(self.e, self.states)
+        names = self.states or [f"x{i + 1}" for i in range(self.x.shape[1])]
+        m["sup_abs_estimate"] = {
+            s: float(np.max(np.abs(self.xhat[:, i]))) for i, s in enumerate(names)
+        }
+        return {**m, **self.info}
 
 
 def metrics(e: np.ndarray, states: list[str] | None = None) -> dict[str, Any]:

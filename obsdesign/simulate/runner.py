@@ -27,10 +27,16 @@ def signals(spec: Spec, grid: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nd
     sim = spec.simulate
     assert sim is not None
     rng = np.random.default_rng(sim.seed)
-    return sim.u.evaluate(grid, rng), sim.disturbance.evaluate(grid, rng), sim.noise.evaluate(grid, rng)
+    return (
+        sim.u.evaluate(grid, rng),
+        sim.disturbance.evaluate(grid, rng),
+        sim.noise.evaluate(grid, rng),
+    )
 
 
-def run_discrete(spec: Spec, step: Callable[[int, np.ndarray, np.ndarray, np.ndarray], np.ndarray]) -> SimResult:
+def run_discrete(
+    spec: Spec, step: Callable[[int, np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+) -> SimResult:
     """Run a discrete-time observer against the linear plant for ``horizon`` samples."""
     _need(spec)
     s, sim = spec.system, spec.simulate

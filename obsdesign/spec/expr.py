@@ -180,14 +180,22 @@ def parse_expr(
     known = set(variables) | set(parameters) | set(CONSTANTS)
     clash = set(variables) & (set(parameters) | set(FUNCTIONS))
     if clash:
-        raise SpecError(file, key, f"name {sorted(clash)[0]!r} is both a variable and a parameter/function")
+        raise SpecError(
+            file, key, f"name {sorted(clash)[0]!r} is both a variable and a parameter/function"
+        )
     fn = _compile(tree.body, known, file, key)
     return Expr(text, tree, tuple(variables), parameters, fn)
 
 
 def _compile(node: ast.AST, known: set[str], file: str, key: str) -> Fn:
     def bad(what: str) -> SpecError:
-        return SpecError(file, key, f"{what} not allowed in expressions".replace("(use step(x)) not allowed", "not allowed (use step(x))"))
+        return SpecError(
+            file,
+            key,
+            f"{what} not allowed in expressions".replace(
+                "(use step(x)) not allowed", "not allowed (use step(x))"
+            ),
+        )
 
     for t, what in _FORBIDDEN.items():
         if isinstance(node, t):
@@ -223,12 +231,16 @@ def _compile(node: ast.AST, known: set[str], file: str, key: str) -> Fn:
             raise bad("calling anything but a named function is")
         fname = node.func.id
         if fname not in FUNCTIONS:
-            raise SpecError(file, key, f"unknown function '{fname}' (allowed: {', '.join(sorted(FUNCTIONS))})")
+            raise SpecError(
+                file, key, f"unknown function '{fname}' (allowed: {', '.join(sorted(FUNCTIONS))})"
+            )
         if node.keywords:
             raise bad("keyword arguments are")
         f, arities = FUNCTIONS[fname]
         if len(node.args) not in arities:
-            raise SpecError(file, key, f"{fname}() takes {' or '.join(map(str, arities))} argument(s)")
+            raise SpecError(
+                file, key, f"{fname}() takes {' or '.join(map(str, arities))} argument(s)"
+            )
         args = [_compile(a, known, file, key) for a in node.args]
         return lambda env: f(*(a(env) for a in args))
     raise bad(f"the construct {type(node).__name__} is")
@@ -272,9 +284,21 @@ def _to_sympy(node: ast.AST, ex: Expr) -> Any:
     args = [_to_sympy(a, ex) for a in node.args]
     name = node.func.id
     table = {
-        "sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "exp": sp.exp, "log": sp.log,
-        "sqrt": sp.sqrt, "abs": sp.Abs, "tanh": sp.tanh, "atan": sp.atan, "sinh": sp.sinh,
-        "cosh": sp.cosh, "min": sp.Min, "max": sp.Max, "sign": sp.sign, "floor": sp.floor,
+        "sin": sp.sin,
+        "cos": sp.cos,
+        "tan": sp.tan,
+        "exp": sp.exp,
+        "log": sp.log,
+        "sqrt": sp.sqrt,
+        "abs": sp.Abs,
+        "tanh": sp.tanh,
+        "atan": sp.atan,
+        "sinh": sp.sinh,
+        "cosh": sp.cosh,
+        "min": sp.Min,
+        "max": sp.Max,
+        "sign": sp.sign,
+        "floor": sp.floor,
     }
     if name in table:
         return table[name](*args)
@@ -308,9 +332,18 @@ def _eval_sympy(e: Any, env: dict[str, Any]) -> Any:
     if e.is_Pow:
         return np.power(args[0], args[1])
     fn = {
-        sp.sin: np.sin, sp.cos: np.cos, sp.tan: np.tan, sp.exp: np.exp, sp.log: np.log,
-        sp.tanh: np.tanh, sp.atan: np.arctan, sp.sinh: np.sinh, sp.cosh: np.cosh,
-        sp.Abs: np.abs, sp.sign: np.sign, sp.floor: np.floor,
+        sp.sin: np.sin,
+        sp.cos: np.cos,
+        sp.tan: np.tan,
+        sp.exp: np.exp,
+        sp.log: np.log,
+        sp.tanh: np.tanh,
+        sp.atan: np.arctan,
+        sp.sinh: np.sinh,
+        sp.cosh: np.cosh,
+        sp.Abs: np.abs,
+        sp.sign: np.sign,
+        sp.floor: np.floor,
     }.get(e.func)
     if fn is not None:
         return fn(args[0])

@@ -89,9 +89,11 @@ def _system(t: Table) -> System:
     p = C.shape[0]
     B = t.matrix("B", rows=n, vector_as="column") if t.has("B") else Value.of(qzeros((n, 0)))
     m = B.shape[1]
-    D = t.matrix("D", rows=p, cols=m, vector_as="row" if p == 1 else "column") if t.has(
-        "D"
-    ) else Value.of(qzeros((p, m)))
+    D = (
+        t.matrix("D", rows=p, cols=m, vector_as="row" if p == 1 else "column")
+        if t.has("D")
+        else Value.of(qzeros((p, m)))
+    )
     bd_key = "Bd" if t.has("Bd") else "B1"
     if t.has("Bd") and t.has("B1"):
         raise t.error("B1", "give the disturbance input as Bd or B1, not both")
@@ -102,7 +104,11 @@ def _system(t: Table) -> System:
     states = t._get("states", None)
     if states is None:
         states = [f"x{i + 1}" for i in range(n)]
-    elif not (isinstance(states, list) and len(states) == n and all(isinstance(s, str) and s.isidentifier() for s in states)):
+    elif not (
+        isinstance(states, list)
+        and len(states) == n
+        and all(isinstance(s, str) and s.isidentifier() for s in states)
+    ):
         raise t.error("states", f"expected a list of {n} state names (identifiers)")
     params: dict[str, Value] = {}
     pt = t.table("parameters")

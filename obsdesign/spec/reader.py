@@ -144,9 +144,13 @@ class Table:
             return v if (v is None or isinstance(v, Value)) else Value.of(Q(v))
         q = self._number(k, v)
         if min is not None and (q <= Q(min) if strict_min else q < Q(min)):
-            raise self.error(k, f"expected a number {'>' if strict_min else '>='} {min}, got {_show(v)}")
+            raise self.error(
+                k, f"expected a number {'>' if strict_min else '>='} {min}, got {_show(v)}"
+            )
         if max is not None and (q >= Q(max) if strict_max else q > Q(max)):
-            raise self.error(k, f"expected a number {'<' if strict_max else '<='} {max}, got {_show(v)}")
+            raise self.error(
+                k, f"expected a number {'<' if strict_max else '<='} {max}, got {_show(v)}"
+            )
         return Value.of(q)
 
     def _number(self, k: str, v: Any) -> fmpq:
@@ -186,12 +190,10 @@ class Table:
             v = [[v]]
         if isinstance(v, list) and v and all(_is_number(x) for x in v):
             v = [v] if vector_as == "row" else [[x] for x in v]
-        if (
-            not isinstance(v, list)
-            or not v
-            or not all(isinstance(r, list) and r for r in v)
-        ):
-            raise self.error(k, f"expected a matrix (a list of rows of numbers){_shape(rows, cols)}")
+        if not isinstance(v, list) or not v or not all(isinstance(r, list) and r for r in v):
+            raise self.error(
+                k, f"expected a matrix (a list of rows of numbers){_shape(rows, cols)}"
+            )
         widths = {len(r) for r in v}
         if len(widths) != 1:
             raise self.error(k, "expected rows of equal length")
@@ -201,7 +203,9 @@ class Table:
                 if isinstance(x, list):
                     raise self.error(k, "expected a matrix of numbers (nested too deep)")
                 arr[i, j] = self._number(k, x)
-        if (rows is not None and arr.shape[0] != rows) or (cols is not None and arr.shape[1] != cols):
+        if (rows is not None and arr.shape[0] != rows) or (
+            cols is not None and arr.shape[1] != cols
+        ):
             raise self.error(
                 k, f"expected shape {_dim(rows)}×{_dim(cols)}, got {arr.shape[0]}×{arr.shape[1]}"
             )

@@ -47,16 +47,29 @@ def spec_schema() -> dict[str, Any]:
 
     sets = {
         "oneOf": [
-            {"type": "object", "required": ["type", "lower", "upper"],
-             "properties": {"type": {"const": "box"}, "lower": VEC, "upper": VEC}},
-            {"type": "object", "required": ["type", "G", "g"],
-             "description": "{x : G x <= g}, bounded and non-empty",
-             "properties": {"type": {"const": "polytope"}, "G": MAT, "g": VEC}},
-            {"type": "object", "required": ["type", "Q"], "description": "{x : |Q x| <= 1}",
-             "properties": {"type": {"const": "symmetric-polytope"}, "Q": MAT}},
-            {"type": "object", "required": ["type", "E"],
-             "description": "{x : (x-c)' E (x-c) <= 1}, E symmetric positive definite",
-             "properties": {"type": {"const": "ellipsoid"}, "E": MAT, "center": VEC}},
+            {
+                "type": "object",
+                "required": ["type", "lower", "upper"],
+                "properties": {"type": {"const": "box"}, "lower": VEC, "upper": VEC},
+            },
+            {
+                "type": "object",
+                "required": ["type", "G", "g"],
+                "description": "{x : G x <= g}, bounded and non-empty",
+                "properties": {"type": {"const": "polytope"}, "G": MAT, "g": VEC},
+            },
+            {
+                "type": "object",
+                "required": ["type", "Q"],
+                "description": "{x : |Q x| <= 1}",
+                "properties": {"type": {"const": "symmetric-polytope"}, "Q": MAT},
+            },
+            {
+                "type": "object",
+                "required": ["type", "E"],
+                "description": "{x : (x-c)' E (x-c) <= 1}, E symmetric positive definite",
+                "properties": {"type": {"const": "ellipsoid"}, "E": MAT, "center": VEC},
+            },
         ]
     }
     return {
@@ -73,14 +86,20 @@ def spec_schema() -> dict[str, Any]:
                 "required": ["time", "A", "C"],
                 "properties": {
                     "time": {"enum": ["discrete", "continuous"]},
-                    "A": MAT, "B": MAT, "C": MAT, "D": MAT,
+                    "A": MAT,
+                    "B": MAT,
+                    "C": MAT,
+                    "D": MAT,
                     "Bd": {**MAT, "description": "disturbance input (alias B1)"},
                     "B1": MAT,
                     "Dn": {**MAT, "description": "noise input on the output (default identity)"},
                     "sample_time": {**NUM, "exclusiveMinimum": 0},
                     "states": {"type": "array", "items": {"type": "string"}},
-                    "parameters": {"type": "object", "additionalProperties": NUM,
-                                   "description": "named constants for expressions"},
+                    "parameters": {
+                        "type": "object",
+                        "additionalProperties": NUM,
+                        "description": "named constants for expressions",
+                    },
                 },
             },
             "sets": {"type": "object", "additionalProperties": sets},

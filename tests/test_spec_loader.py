@@ -1,0 +1,178 @@
+"""Spec parsing and validation (obsdesign.spec.loader): exact numbers, clear errors."""
+
+from __future__ import annotations
+
+import pytest
+from flint import fmpq
+from typer.testing import CliRunner
+
+from obsdesign.cli import app
+from obsdesign.errors import SpecError
+from obsdesign.sets import Box, Ellipsoid, Polytope, SymmetricPolytope
+from obsdesign.spec import load_spec_text
+
+GOOD = """
+[system]
+time = "discrete"
+A = [[0, 1], [1, 0]]
+C = [[1, 0]]
+[method]
+key = "lyapunov"
+L = [-1.87, 1.874]
+"""
+
+
+def test_decimal_exactness():
+    spec = load_spec_text(GOOD.replace("A = [[0, 1], [1, 0]]", "A = [[0.1, 0.2], [0.1, 0.2]]"))
+    A = spec.system.A.q
+    assert A[0, 0] + A[0, 1] == fmpq(3, 10)  # 0.1 + 0.2 is exactly 3/10
+    assert spec.system.A.f[0, 0] == 0.1
+
+
+def test_sets_and_defaults():
+    text = (
+        GOOD
+        + """
+[sets.X]
+type = "box"
+lower = [-1, -1]
+upper = [1, 1]
+[sets.P]
+type = "polytope"
+G = [[1, 0], [-1, 0], [0, 1], [0, -1]]
+g = [1, 1, 2, 2]
+[sets.S]
+type = "symmetric-polytope"
+Q = [[1, 0], [0, 0.5]]
+[sets.E]
+type = "ellipsoid"
+E = [[2, 0], [0, 1]]
+center = [0.5, 0]
+"""
+    )
+    spec = load_spec_text(text)
+    assert isinstance(spec.sets["X"], Box)
+    assert isinstance(spec.sets["P"], Polytope)
+    assert isinstance(spec.sets["S"], SymmetricPolytope)
+    assert isinstance(spec.sets["E"], Ellipsoid)
+    assert spec.system.Dn.shape == (1, 1) and spec.system.B.shape == (2, 0)
+    assert len(spec.sets["S"].vertices_q()) == 4
+
+
+def _replace(old: str, new: str) -> str:
+    assert old in GOOD
+    return GOOD.replace(old, new)
+
+
+MALFORMED = [
+    ("bad toml", "[system\ntime = 1", "", "not valid TOML"),
+    ("missing system", "[method]\nkey = 'lyapunov'", "system", "missing"),
+    ("missing A", _replace("A = [[0, 1], [1, 0]]\n", ""), "system.A", "missing"),
+    (
+        "non-square A",
+        _replace("A = [[0, 1], [1, 0]]", "A = [[0, 1, 2], [1, 0, 3]]"),
+        "system.A",
+        "square",
+    ),
+    ("C columns", _replace("C = [[1, 0]]", "C = [[1, 0, 0]]"), "system.C", "shape"),
+    ("ragged A", _replace("A = [[0, 1], [1, 0]]", "A = [[0, 1], [1]]"), "system.A", "equal length"),
+    ("nan", _replace("A = [[0, 1], [1, 0]]", "A = [[0, nan], [1, 0]]"), "system.A", "finite"),
+    ("inf", _replace("L = [-1.87, 1.874]", "L = [-inf, 1.874]"), "method.L", "finite"),
+    (
+        "string entry",
+        _replace("A = [[0, 1], [1, 0]]", "A = [[0, '1'], [1, 0]]"),
+        "system.A",
+        "number",
+    ),
+    ("bad time", _replace('time = "discrete"', 'time = "hybrid"'), "system.time", "one of"),
+    ("unknown method", _replace('key = "lyapunov"', 'key = "magic"'), "method.key", "one of"),
+    ("unknown key", GOOD + "gain = 3\n", "method.gain", "not a known key"),
+    ("L shape", _replace("L = [-1.87, 1.874]", "L = [-1.87, 1.874, 3]"), "method.L", "shape"),
+    ("lambda > 1", GOOD + "lambda = 1.5\n", "method.lambda", "< 1"),
+    (
+        "box lower > upper",
+        GOOD + "[sets.X]\ntype='box'\nlower=[1, 0]\nupper=[0, 1]\n",
+        "sets.X.upper",
+        "lower < upper",
+    ),
+    (
+        "unbounded polytope",
+        GOOD + "[sets.P]\ntype='polytope'\nG=[[1, 0]]\ng=[1]\n",
+        "sets.P.G",
+        "unbounded",
+    ),
+    (
+        "empty polytope",
+        GOOD
+        + "[sets.P]\ntype='polytope'\nG=[[1, 0], [-1, 0], [0, 1], [0, -1]]\ng=[-1, -1, 1, 1]\n",
+        "sets.P.G",
+        "empty",
+    ),
+    (
+        "non-symmetric E",
+        GOOD + "[sets.E]\ntype='ellipsoid'\nE=[[1, 1], [0, 1]]\n",
+        "sets.E.E",
+        "symmetric",
+    ),
+    (
+        "indefinite E",
+        GOOD + "[sets.E]\ntype='ellipsoid'\nE=[[1, 0], [0, -1]]\n",
+        "sets.E.E",
+        "positive definite",
+    ),
+    ("bad set type", GOOD + "[sets.E]\ntype='sphere'\n", "sets.E.type", "one of"),
+    (
+        "simulate horizon",
+        GOOD + "[simulate]\nhorizon = 0\nx0=[0,0]\nxhat0=[0,0]\n",
+        "simulate.horizon",
+        ">= 1",
+    ),
+    (
+        "simulate x0",
+        GOOD + "[simulate]\nhorizon = 5\nx0=[0]\nxhat0=[0,0]\n",
+        "simulate.x0",
+        "2 numbers",
+    ),
+    (
+        "signal kind",
+        GOOD + "[simulate]\nhorizon = 5\nx0=[0,0]\nxhat0=[0,0]\n[simulate.noise]\nkind='pink'\n",
+        "simulate.noise.kind",
+        "one of",
+    ),
+    ("unknown top-level", GOOD + "[extra]\na = 1\n", "extra", "not a known key"),
+]
+
+
+@pytest.mark.parametrize("name, text, key, words", MALFORMED, ids=[m[0] for m in MALFORMED])
+def test_malformed_spec_raises_spec_error(name: str, text: str, key: str, words: str):
+    with pytest.raises(SpecError) as ei:
+        load_spec_text(text, "bad.toml")
+    msg = ei.value.message
+    assert msg.startswith("bad.toml:")
+    if key:
+        assert f"[{key}]" in msg
+    assert words in msg
+
+
+@pytest.mark.parametrize("name, text, key, words", MALFORMED, ids=[m[0] for m in MALFORMED])
+def test_malformed_spec_cli_exit_2_no_traceback_no_output(tmp_path, name, text, key, words):
+    spec = tmp_path / "bad.toml"
+    spec.write_text(text)
+    out = tmp_path / "report.json"
+    res = CliRunner().invoke(app, ["design", str(spec), "-o", str(out)])
+    assert res.exit_code == 2, res.output
+    lines = [ln for ln in res.output.strip().splitlines() if ln]
+    assert len(lines) == 1 and "Traceback" not in res.output
+    assert str(spec) in lines[0]
+    assert not out.exists()
+    assert list(tmp_path.iterdir()) == [spec]  # no temp files either
+
+
+def test_expression_injection_rejected_through_spec(tmp_path):
+    # an expression with __import__ in a spec key: the loader-level check lives in methods
+    # that read expressions; here the expression module is exercised with the spec file name.
+    from obsdesign.spec.expr import parse_expr
+
+    with pytest.raises(SpecError) as ei:
+        parse_expr("__import__('os').getcwd()", ["x1"], file="s.toml", key="nonlinearity.psi")
+    assert "s.toml: [nonlinearity.psi]" in ei.value.message
