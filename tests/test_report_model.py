@@ -1,0 +1,103 @@
+"""Report model, JSON round trip, verdicts and atomic writes (obsdesign.report)."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+from flint import fmpq
+
+from obsdesign.certify.claim import Claim, ClaimStatus, exact_claim, numerical_claim
+from obsdesign.certify.exact import qmat
+from obsdesign.errors import InputError
+from obsdesign.params import Parameters
+from obsdesign.report.model import Report, write_atomic
+from obsdesign.report.render import render_markdown
+
+
+def _report(claims: list[Claim]) -> Report:
+    return Report(
+        "lyapunov",
+        "spec text",
+        "s.toml",
+        "0" * 64,
+        Parameters({"P": qmat([[2, 1], [1, 2]]), "lambda": fmpq(191, 200), "it": 3}),
+        claims,
+    )
+
+
+def _c(ok: bool, float_ok: bool | None = None) -> Claim:
+    return exact_claim("c", "s", "ref", "exact", 0, ok, "", float_ok)
+
+
+def test_exit_codes():
+    assert (
+        _report([_c(True), numerical_claim("n", "s", "r", "float", 0, True, "")]).exit_code() == 0
+    )
+    assert _report([_c(True), _c(False)]).exit_code() == 1
+    assert _report([_c(False, float_ok=True)]).exit_code() == 4  # inconclusive
+    assert _report([_c(False, float_ok=True), _c(False, float_ok=False)]).exit_code() == 1
+
+
+def test_json_round_trip_keeps_exact_values():
+    r = _report([_c(True)])
+    d = json.loads(r.to_json())
+    assert d["parameters"]["exact"]["P"] == [["2", "1"], ["1", "2"]]
+    assert d["parameters"]["exact"]["lambda"] == "191/200"
+    assert d["parameters"]["it"] == 3 and "it" not in d["parameters"]["exact"]
+    back, problems = Report.from_dict(d)
+    assert problems == []
+    assert back.parameters["lambda"] == fmpq(191, 200)
+    assert (back.parameters["P"] == r.parameters["P"]).all()
+    assert back.claims[0].status == ClaimStatus.CERTIFIED
+
+
+def test_edited_float_is_reported():
+    d = json.loads(_report([]).to_json())
+    d["parameters"]["lambda"] = 0.9
+    _, problems = Report.from_dict(d)
+    assert problems and "lambda" in problems[0]
+
+
+@pytest.mark.parametrize(
+    "bad",
+    [
+        [],
+        {"schema_version": "1.0"},
+        {
+            "schema_version": "9",
+            "method": "x",
+            "spec": "",
+            "spec_sha256": "",
+            "parameters": {},
+            "claims": [],
+        },
+    ],
+)
+def test_malformed_reports(bad):
+    with pytest.raises(InputError):
+        Report.from_dict(bad)
+
+
+def test_write_atomic_leaves_nothing_on_failure(tmp_path: Path, monkeypatch):
+    target = tmp_path / "r.json"
+    write_atomic(target, "first")
+    assert target.read_text() == "first\n"
+
+    def boom(src, dst):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(os, "replace", boom)
+    with pytest.raises(OSError):
+        write_atomic(target, "second")
+    assert target.read_text() == "first\n"  # old content intact
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.json"]  # no temp file left
+
+
+def test_markdown_renders_claims():
+    md = render_markdown(_report([_c(True), _c(False)]))
+    assert "| c | **certified** |" in md and "**failed**" in md
+    assert np.isfinite(1.0)
