@@ -245,9 +245,12 @@ def design_window(p: Problem) -> tuple[dict[str, Any], list[str]]:
                 f"condition (22) fails for the given κ = {float(kappa):.6g}: it must lie in (0, {float(kmax):.6g})"
             )
     if varpi <= 0:
+        # N(−ϖ) ⪯ N(−ϖ_o) for ϖ ≥ ϖ_o, so ϖ_o = 0 is still certified and keeps (26b) finite
         notes.append(
-            f"Assumption 2 (ϖ_o > 0) does not hold: λ_max(M_o) = {lam_Mo:.6g}; the bound (26b) stays valid"
+            f"Assumption 2 (ϖ_o > 0) does not hold: λ_max(M_o) = {lam_Mo:.6g}; ϖ_o = 0 is used in (26b) "
+            "(sound: the ssd LMI of Lemma 2 holds for every ϖ_o ≥ λ_max(M_o))"
         )
+        varpi = fmpq(0)
     T_max = T_max_lower(gamma, varpi, kappa, lam_no, lam_on, beta)
     T_min = T_min_upper(p.alpha, gamma, kappa)
     T_max_r, T_min_r = safe_window(T_max, T_min, p.digits)
@@ -264,7 +267,7 @@ def design_window(p: Problem) -> tuple[dict[str, Any], list[str]]:
         "theta_n": th_n,
         "varpi_o": varpi,
         "lambda_max_Mo": lam_Mo,
-        "assumption2": bool(varpi > 0),
+        "assumption2": bool(lam_Mo > 0),
         "kappa_n": kappa_n,
         "norm_Ano": n_no,
         "norm_Aon": n_on,

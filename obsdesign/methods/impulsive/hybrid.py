@@ -161,8 +161,10 @@ def simulate_one_by_one(
     w: np.ndarray,
     rtol: float = 1e-7,
     atol: float = 1e-9,
+    final_jump: bool = True,
 ) -> np.ndarray:
-    """Reference: one trajectory, one solve_ivp call per interval; returns final ‖ε‖ and state.
+    """Reference: one trajectory, one solve_ivp call per interval; returns [x; ẑ] at the end
+    (after the last jump unless ``final_jump`` is False).
 
     Used by the benchmark and the tests to check :func:`simulate_hybrid` against it."""
     T = np.asarray(T, dtype=float)
@@ -180,6 +182,8 @@ def simulate_one_by_one(
 
         sol = solve_ivp(rhs, (0.0, hk), np.concatenate([X, Z]), method="RK45", rtol=rtol, atol=atol)
         X, Z = sol.y[:n, -1].copy(), sol.y[n:, -1].copy()
+        if not final_jump and k == len(h) - 1:
+            break
         Z[:m] = Z[:m] - np.asarray(L_diag, dtype=float) * (Z[:m] - (X[:m] + w[k]))
     return np.concatenate([X, Z])
 

@@ -1,0 +1,228 @@
+"""Tests of the impulsive method (paper 001): example numbers, certificate, bad input."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from flint import fmpq
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from obsdesign import api
+from obsdesign.certify.exact import Q, qmat, qvec
+from obsdesign.errors import InfeasibleError, SpecError
+from obsdesign.methods.impulsive.core import (
+    BlockData,
+    Infeasible,
+    Problem,
+    certify_window,
+    design_window,
+)
+from obsdesign.methods.impulsive.dissipativity import best_rate, qsr_lipschitz, qsr_sector
+from obsdesign.methods.impulsive.window import T_max_lower, T_min_upper, gamma_of, norm_upper
+from obsdesign.spec import load_spec
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLE = ROOT / "specs" / "schaum-impulsive-example.toml"
+G_SUP = "1.9822152"  # sup |g|, g(x2) = x2 (x2² − 4)/(1 + x2⁴) = ∂μ/∂x1, rounded up
+
+
+def example_text(**method: str) -> str:
+    txt = EXAMPLE.read_text(encoding="utf-8")
+    for k, v in method.items():
+        lines = txt.splitlines()
+        i = lines.index('key = "impulsive"')
+        lines = [ln for ln in lines if not ln.startswith(f"{k} = ")]
+        i = lines.index('key = "impulsive"')
+        lines.insert(i + 1, f"{k} = {v}")
+        txt = "\n".join(lines) + "\n"
+    return txt
+
+
+def test_example_numbers_and_verify(tmp_path: Path) -> None:
+    """What the tool computes for example (30)-(31) with the shipped reading.
+
+    The paper prints T_min = 0.63, T_max = 1.09; this reading (M = [−3, 1], sector ±sup|g|,
+    κ = the largest κ of (22)) gives T_min = 0.1551, T_max = 0.5396. With Ā_on = 0 and
+    Ā_no = 0, (26b) is −ln 0.04/(ϖ_o + κ) and ϖ_o = 2 sup|g| = 3.9644, so T_max < 0.812 for
+    every κ > 0: no choice of κ reaches the printed 1.09 with this ϖ_o.
+    """
+    out = tmp_path / "r.json"
+    rep = api.design(EXAMPLE, out)
+    p = rep.parameters
+    assert rep.exit_code() == 0
+    assert p["gamma"] == fmpq(4, 5) and p["beta"] == 25
+    assert abs(p.float("varpi_o") - 2 * 1.98221516) < 1e-5
+    assert abs(p.float("kappa_n") - 2.0) < 1e-4
+    assert p["T_min"] == Q("0.1551") and p["T_max"] == Q("0.5396")
+    assert abs(p.float("ball_radius") - np.sqrt(0.3)) < 1e-9
+    assert any("violated" in n for n in rep.notes)  # the falsification pass catches the example
+    ver = api.verify(out)
+    assert ver.exit_code() == 0
+    # tampering with T_max is caught by verify
+    d = json.loads(out.read_text())
+    d["parameters"]["exact"]["T_max"] = "6/10"
+    d["parameters"]["T_max"] = 0.6
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(d))
+    assert api.verify(bad).exit_code() != 0
+
+
+def test_example_with_paper_kappa() -> None:
+    """κ = 0.4923 is what T_min = 0.63 needs (−ln(2.2/3)/0.63); T_max then is 0.7223, not 1.09
+    (the paper's pair needs ϖ_o + λ*_no + βλ*_on ≈ 2.46, we get 3.96)."""
+    rep = api.design(load_spec_text_ex(kappa="0.4923"))
+    p = rep.parameters
+    assert p["T_min"] == Q("0.6301")  # rounded up from 0.630007
+    assert p["T_max"] == Q("0.7222")  # rounded down from 0.72229
+
+
+def load_spec_text_ex(**kw: str):  # noqa: ANN201
+    from obsdesign.spec import load_spec_text
+
+    return load_spec_text(example_text(**kw), "example.toml")
+
+
+def test_example_identity_coordinates_fail_lemma1() -> None:
+    """M = [0, 1] (T = I): Ā_no = b = 3 > κ_n = −2c = 2, Lemma 1 fails (exit 1)."""
+    with pytest.raises(InfeasibleError, match="Lemma 1"):
+        api.design(load_spec_text_ex(M="[[0, 1]]"))
+
+
+def test_widest_kappa_widens() -> None:
+    a = api.design(load_spec_text_ex(kappa='"max"')).parameters
+    b = api.design(load_spec_text_ex(kappa='"widest"')).parameters
+    assert b.float("T_max") - b.float("T_min") >= a.float("T_max") - a.float("T_min")
+
+
+@pytest.mark.parametrize(
+    ("edit", "key"),
+    [
+        ({"L": "[[0.8, 0.1], [0, 0.5]]"}, "method.L"),
+        ({"L": "[1.2]"}, "method.L"),
+        ({"L": "[0]"}, "method.L"),
+        ({"alpha": "0.5"}, "method.alpha"),
+        ({"M": "[[1, 0]]"}, "method.M"),
+        ({"M": '"optimize"'}, "method.M"),
+        ({"kappa": '"huge"'}, "method.kappa"),
+    ],
+)
+def test_bad_method_input(edit: dict[str, str], key: str) -> None:
+    with pytest.raises(SpecError) as e:
+        load_spec_text_ex(**edit)
+    assert key in str(e.value) and "example.toml" in str(e.value)
+
+
+def test_bad_C_rank_and_Q() -> None:
+    from obsdesign.spec import load_spec_text
+
+    txt = EXAMPLE.read_text(encoding="utf-8")
+    bad_c = txt.replace("C = [[1, 0]]", "C = [[0, 0]]")
+    with pytest.raises(SpecError, match="system.C"):
+        load_spec_text(bad_c, "c.toml")
+    bad_q = txt.replace("sector = [-1.9822152, 1.9822152]", "Q = [[1]]\nS = [[0]]\nR = [[1]]")
+    with pytest.raises(SpecError, match="nonlinearity.o"):
+        load_spec_text(bad_q, "q.toml")
+    with pytest.raises(SpecError, match="psi"):
+        load_spec_text(txt.replace('"0"]', '"__import__(1)"]'), "e.toml")
+
+
+def test_empty_window_is_infeasible() -> None:
+    """α just above γ makes T_min huge: T_min ≥ T_max is reported (exit 1)."""
+    with pytest.raises(InfeasibleError, match="empty window"):
+        api.design(load_spec_text_ex(alpha="0.8001"))
+
+
+def test_given_kappa_outside_22() -> None:
+    with pytest.raises(InfeasibleError, match=r"\(22\)"):
+        api.design(load_spec_text_ex(kappa="5"))
+
+
+def test_shipped_specs_check() -> None:
+    rows = api.check([ROOT / "specs" / "impulsive-sector-3state.toml", EXAMPLE])
+    assert api.check_exit_code(rows) == 0
+
+
+# -- the math --------------------------------------------------------------------------------
+def _prob(
+    Ao: float, An: list[list[float]], Aon: float, Ano: float, lo: float, ln: float
+) -> Problem:
+    A = qmat([[Ao, Aon, 0], [Ano, An[0][0], An[0][1]], [0, An[1][0], An[1][1]]])
+    return Problem(
+        A,
+        qmat([[1, 0, 0]]),
+        qvec([Q("0.8")]),
+        Q(3),
+        Q("0.1"),
+        qmat([[0, 1, 0], [0, 0, 1]]),
+        BlockData(qsr_lipschitz(Q(lo), 1), qsr_lipschitz(Q(ln), 2)),
+        "widest",
+    )
+
+
+small = st.floats(-0.5, 0.5, allow_nan=False).map(lambda v: round(v, 3))
+
+
+@settings(max_examples=15, deadline=None)
+@given(
+    small,
+    st.floats(2, 5).map(lambda v: round(v, 3)),
+    small,
+    st.floats(0, 0.3).map(lambda v: round(v, 3)),
+    st.floats(0, 0.3).map(lambda v: round(v, 3)),
+)
+def test_rates_match_closed_form(ao: float, an: float, ano: float, lo: float, ln: float) -> None:
+    """With Lipschitz data and optimal scaling, ϖ_o = 2Ā_o + 2ℓ_o and κ_n = 2a_n − 2ℓ_n
+    (Ā_n = −a_n I + skew) — the certified values are within 1e-4 on the safe side."""
+    p = _prob(ao, [[-an, 0.3], [-0.3, -an]], 0.001, ano, lo, ln)
+    try:
+        P, _ = design_window(p)
+    except Infeasible:
+        return
+    want = max(2 * ao + 2 * lo, 0.0)  # ϖ_o < 0 is raised to 0 (Assumption 2 fails; still sound)
+    assert float(P["varpi_o"]) >= want - 1e-9
+    assert float(P["varpi_o"]) <= want + 1e-4
+    assert float(P["kappa_n"]) <= 2 * an - 2 * ln + 1e-9
+    assert float(P["kappa_n"]) >= 2 * an - 2 * ln - 1e-4
+    assert all(c.ok for c in certify_window(p, P))
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.floats(0.05, 0.95), st.floats(0.1, 5), st.floats(0.01, 3), st.floats(0, 2))
+def test_window_bounds_are_safe(l: float, kap: float, varpi: float, coup: float) -> None:
+    """T_max bound ≤ the float formula (26b), T_min bound ≥ (26c)."""
+    L = qvec([Q(round(l, 4))])
+    g, beta = gamma_of(L)
+    k, v = Q(round(kap, 4)), Q(round(varpi, 4))
+    tmax = T_max_lower(g, v, k, Q(round(coup, 4)), 0, beta)
+    gf = float(g)
+    exact = -np.log((1 - gf) ** 2) / (float(v) + float(k) + round(coup, 4))
+    assert float(tmax) <= exact * (1 + 1e-12) and float(tmax) >= exact * (1 - 1e-9)
+    alpha = Q(gf + 1)
+    tmin = T_min_upper(alpha, g, k)
+    assert float(tmin) >= -np.log(1 / (gf + 1)) / float(k) * (1 - 1e-12)
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.lists(st.floats(-3, 3), min_size=6, max_size=6))
+def test_norm_upper(vals: list[float]) -> None:
+    X = qmat(np.round(np.array(vals).reshape(2, 3), 3).tolist())
+    u = norm_upper(X)
+    f = np.linalg.norm(np.asarray(X, dtype=float), 2)
+    assert f <= float(u) <= f * (1 + 1e-6) + 1e-9
+
+
+def test_sector_scaling_gives_2kmax() -> None:
+    """Sector [k1, k2] with optimal scaling: ϖ_o = 2Ā_o + 2 k2 (the derivative bound)."""
+    r, theta, _ = best_rate(np.array([[0.0]]), qsr_sector(Q(-1), Q("1.5"), 1), True)
+    assert abs(-r - 3.0) < 1e-6 and theta > 0
+    r2, _, _ = best_rate(np.array([[0.0]]), qsr_sector(Q(-1), Q("1.5"), 1), False)
+    assert -r2 >= -r  # as-given scaling is never better
+
+
+def test_load_shipped_example() -> None:
+    s = load_spec(EXAMPLE)
+    assert s.method == "impulsive"
