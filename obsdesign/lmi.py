@@ -9,6 +9,7 @@ by :mod:`obsdesign.certify`. ``optimal_inaccurate`` is "not certified", never "i
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -52,7 +53,9 @@ def solve(problem: Any, solvers: tuple[str, ...] = SOLVERS) -> SolveResult:
         if name not in cp.installed_solvers():
             continue
         try:
-            problem.solve(solver=name)
+            with warnings.catch_warnings():  # "solution may be inaccurate": we read the status
+                warnings.simplefilter("ignore", UserWarning)
+                problem.solve(solver=name)
         except cp.error.SolverError as e:
             last = f"{name}: {e}"
             continue
