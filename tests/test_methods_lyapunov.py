@@ -140,3 +140,23 @@ def test_verify_catches_tampered_P():
     ver = api.verify(rep)
     assert ver.exit_code() == 1
     assert any(c.id == "decay-lmi" and c.status == ClaimStatus.FAILED for c in ver.claims)
+
+
+@settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(2, 4), st.integers(0, 2**31 - 1), st.sampled_from(["discrete", "continuous"]))
+def test_designed_gain_random_observable_systems(n: int, seed: int, time: str):
+    rng = np.random.default_rng(seed)
+    A = rng.standard_normal((n, n)) * 1.2 / np.sqrt(n)
+    C = rng.standard_normal((1, n))
+    fmt = lambda M: (
+        "[" + ", ".join("[" + ", ".join(repr(float(v)) for v in row) + "]" for row in M) + "]"
+    )  # noqa: E731
+    text = f'[system]\ntime = "{time}"\nA = {fmt(A)}\nC = {fmt(C)}\n[method]\nkey = "lyapunov"\nrate_cap = 2\n'
+    rep = api.design(load_spec_text(text))
+    assert all(c.status == ClaimStatus.CERTIFIED for c in rep.claims)
+    L = rep.parameters.float("L")
+    eig = np.linalg.eigvals(A - L @ C)
+    if time == "discrete":
+        assert np.abs(eig).max() <= float(rep.parameters.float("lambda")) + 1e-9
+    else:
+        assert -eig.real.max() >= float(rep.parameters.float("alpha")) - 1e-9
