@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 
 from obsdesign import api
 from obsdesign.certify.exact import Q, qmat, qvec
+from obsdesign.certify.linalg import norm_upper
 from obsdesign.errors import InfeasibleError, SpecError
 from obsdesign.methods.impulsive.core import (
     BlockData,
@@ -22,7 +23,7 @@ from obsdesign.methods.impulsive.core import (
     design_window,
 )
 from obsdesign.methods.impulsive.dissipativity import best_rate, qsr_lipschitz, qsr_sector
-from obsdesign.methods.impulsive.window import T_max_lower, T_min_upper, gamma_of, norm_upper
+from obsdesign.methods.impulsive.window import T_max_lower, T_min_upper, gamma_of
 from obsdesign.spec import load_spec
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -14,30 +14,12 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from flint import fmpq_mat
 
-from obsdesign.certify.exact import Q, dyadic, qmat, to_float
+from obsdesign.certify.exact import dyadic, to_float
+from obsdesign.certify.linalg import qinv, qrank
 
 #: bits of the dyadic grid used to round a float M before it enters exact arithmetic
 M_BITS = 20
-
-
-def qinv(M: Any) -> np.ndarray:
-    """Exact inverse of a square rational matrix (ZeroDivisionError if singular)."""
-    A = np.asarray(M, dtype=object)
-    n = A.shape[0]
-    fm = fmpq_mat(n, n, [Q(v) for v in A.flat])
-    inv = fm.inv()
-    return qmat([[inv[i, j] for j in range(n)] for i in range(n)])
-
-
-def qrank(M: Any) -> int:
-    """Exact rank of a rational matrix."""
-    A = np.asarray(M, dtype=object)
-    r, c = A.shape
-    if r == 0 or c == 0:
-        return 0
-    return int(fmpq_mat(r, c, [Q(v) for v in A.flat]).rank())
 
 
 @dataclass

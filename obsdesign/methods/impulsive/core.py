@@ -17,6 +17,7 @@ from scipy.optimize import minimize
 
 from obsdesign.certify.claim import Claim, exact_claim
 from obsdesign.certify.exact import Q, dyadic, to_float
+from obsdesign.certify.linalg import norm_bound_holds, norm_upper
 from obsdesign.certify.psd import check_pd, check_psd
 
 from .coordinates import (
@@ -34,8 +35,6 @@ from .window import (
     gamma_of,
     kappa_max,
     kappa_widest,
-    norm_bound_holds,
-    norm_upper,
     radius_upper,
     safe_window,
 )

@@ -16,10 +16,10 @@ from flint import fmpq
 
 from obsdesign.certify.claim import Claim, numerical_claim
 from obsdesign.certify.exact import Q, qvec, to_float
+from obsdesign.certify.linalg import qrank
 from obsdesign.certify.psd import check_pd, check_psd
 from obsdesign.errors import InfeasibleError, SpecError
 from obsdesign.methods.base import Design, Method, Progress
-from obsdesign.methods.impulsive.coordinates import qrank
 from obsdesign.methods.impulsive.core import (
     BlockData,
     Infeasible,

@@ -13,9 +13,8 @@ import numpy as np
 from flint import fmpq
 from mpmath import iv
 
-from obsdesign.certify.exact import Q, dyadic, qeye, to_float
+from obsdesign.certify.exact import Q
 from obsdesign.certify.interval import bounds, round_down, round_up, sqrt_upper
-from obsdesign.certify.psd import check_psd
 
 
 def gamma_of(L_diag: Any) -> tuple[fmpq, fmpq]:
@@ -23,35 +22,6 @@ def gamma_of(L_diag: Any) -> tuple[fmpq, fmpq]:
     β = 1/(1 − γ)² (21c). Requires every eigenvalue of I − L in (0, 1)."""
     one_minus = max(fmpq(1) - Q(v) for v in np.asarray(L_diag, dtype=object).flat)
     return fmpq(1) - one_minus, fmpq(1) / (one_minus * one_minus)
-
-
-def norm_upper(X: Any) -> fmpq:
-    """A rational u ≥ ‖X‖₂ (spectral norm), proved by u ≥ 0 and u² I − XᵀX ⪰ 0 exactly."""
-    X = np.asarray(X, dtype=object)
-    if X.size == 0:
-        return fmpq(0)
-    Xf = np.asarray(to_float(X), dtype=float)
-    f = float(np.linalg.norm(Xf, 2))
-    if f == 0.0 and all(v == 0 for v in X.flat):
-        return fmpq(0)
-    u = Q(dyadic(f * (1 + 2.0**-30) + 2.0**-40, 30))
-    for _ in range(40):
-        if norm_bound_holds(X, u):
-            return u
-        u = u * fmpq(1025, 1024) + fmpq(1, 2**30)
-    raise ArithmeticError("could not certify a norm bound")
-
-
-def norm_bound_holds(X: Any, u: Any) -> bool:
-    """Exact check of ‖X‖₂ ≤ u: u ≥ 0 and u² I − XᵀX ⪰ 0."""
-    X = np.asarray(X, dtype=object)
-    u = Q(u)
-    if u < 0:
-        return False
-    if X.size == 0:
-        return True
-    G = X.T @ X
-    return bool(check_psd(qeye(G.shape[0]) * (u * u) - G))
 
 
 def coupling(lam_no: Any, lam_on: Any, beta: Any) -> fmpq:
