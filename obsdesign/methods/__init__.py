@@ -14,7 +14,9 @@ if TYPE_CHECKING:
 
 REGISTRY: dict[str, str] = {
     "lyapunov": "obsdesign.methods.lyapunov:METHOD",
+    "constrained": "obsdesign.methods.constrained:METHOD",
     "impulsive": "obsdesign.methods.impulsive:METHOD",
+    "set-invariant": "obsdesign.methods.setinvariant:METHOD",
 }
 
 

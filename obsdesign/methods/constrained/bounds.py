@@ -1,0 +1,355 @@
+"""Certified quantities of Section 3-4, constrained-redesign paper (000).
+
+Each function returns an exact rational that is either the exact value or a bound in the
+safe direction, and says which: v_max of eq. (13) (upper), v_min of eq. (21) (lower), the
+smallest admissible ε_max for Assumption 3(2) (upper), δ of Assumption 3(4) (upper, as δ²),
+γ of eq. (24) (lower), θ of eq. (22) (rounded up). Square roots go through outward-rounded
+interval arithmetic (``obsdesign.certify.interval``); definiteness through exact LDLᵀ.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+from typing import Any
+
+import flint
+import numpy as np
+from flint import fmpq
+from mpmath import iv
+
+from obsdesign.certify.exact import Q, dyadic, qeye, symmetrize
+from obsdesign.certify.interval import lower, upper
+from obsdesign.certify.psd import check_psd
+from obsdesign.methods.constrained.cmap import ConstraintMap
+from obsdesign.sets import Box, Ellipsoid, Polytope
+from obsdesign.sets.base import ConvexSet
+
+#: above this many vertex pairs, v_max over polytopes falls back to a box bound
+MAX_PAIRS = 4096
+
+
+@dataclass(frozen=True)
+class Bound:
+    """An exact rational ``value`` and whether it is the exact quantity or a safe bound."""
+
+    value: fmpq
+    exact: bool
+    how: str
+
+
+# -- rational helpers ----------------------------------------------------------------------
+def round_sig(x: Any, digits: int, up: bool) -> fmpq:
+    """Round an exact rational to ``digits`` significant decimal digits, up or down."""
+    q = Q(x)
+    if q == 0:
+        return q
+    e = int(np.floor(np.log10(abs(float(q))))) - digits + 1
+    scale = fmpq(10) ** (-e) if e < 0 else fmpq(1, 10**e)
+    t = q * scale
+    k = t.ceil() if up else t.floor()
+    return fmpq(int(k)) / scale
+
+
+def qinv(P: np.ndarray) -> np.ndarray:
+    """Exact inverse of a rational matrix (python-flint ``fmpq_mat``)."""
+    n = P.shape[0]
+    M = flint.fmpq_mat(n, n, [Q(v) for v in P.flat]).inv()
+    out = np.empty((n, n), dtype=object)
+    for i in range(n):
+        for j in range(n):
+            out[i, j] = M[i, j]
+    return out
+
+
+def quad(P: np.ndarray, x: np.ndarray) -> fmpq:
+    """xᵀ P x exactly."""
+    n = len(x)
+    return sum(
+        (x[i] * P[i, j] * x[j] for i in range(n) for j in range(n) if x[i] != 0 and x[j] != 0),
+        fmpq(0),
+    )
+
+
+def quad_lin(g: np.ndarray, x: np.ndarray) -> fmpq:
+    """gᵀ x exactly."""
+    return sum((a * b for a, b in zip(g, x, strict=True)), fmpq(0))
+
+
+def lambda_min_lower(P: np.ndarray) -> fmpq:
+    """A rational ℓ ≤ λ_min(P), proved by P − ℓ I ⪰ 0 (exact LDLᵀ); used in eq. (24)."""
+    lam = float(np.linalg.eigvalsh(np.asarray(P, dtype=float)).min())
+    if lam <= 0:
+        return fmpq(0)
+    for f in (1e-9, 1e-6, 1e-3, 1e-1, 0.5):
+        ell = dyadic(lam * (1 - f), 30)
+        if check_psd(P - qeye(P.shape[0]) * ell):
+            return ell
+    return fmpq(0)
+
+
+def gen_eig_upper(A: np.ndarray, B: np.ndarray) -> fmpq:
+    """A rational κ with A ⪯ κ B (B ≻ 0), proved by κB − A ⪰ 0 exactly: κ ≥ λ_max(B⁻¹A)."""
+    import scipy.linalg as sl
+
+    Af, Bf = np.asarray(A, dtype=float), np.asarray(B, dtype=float)
+    k = float(sl.eigh(Af, Bf, eigvals_only=True).max())
+    k = max(k, 0.0)
+    for f in (1e-9, 1e-6, 1e-3, 1e-1, 1.0):
+        kap = dyadic(k * (1 + f) + 1e-300, 30)
+        if check_psd(symmetrize(B * kap - A)):
+            return kap
+    raise ArithmeticError("could not bound the generalized eigenvalue")
+
+
+# -- sets -----------------------------------------------------------------------------------
+def vertices_q(S: ConvexSet) -> np.ndarray:
+    """Exact vertices of a box or polytope."""
+    if isinstance(S, Box):
+        return S.vertices_q()
+    if isinstance(S, Polytope):
+        return S.vertices_q()
+    raise TypeError(f"no vertices for a {S.kind}")
+
+
+def outer_box_q(S: ConvexSet) -> tuple[np.ndarray, np.ndarray]:
+    """Exact enclosing box of a box or polytope (from its exact vertices)."""
+    if isinstance(S, Box):
+        return S.lower_q, S.upper_q
+    V = vertices_q(S)
+    lo = np.array([min(V[:, j]) for j in range(V.shape[1])], dtype=object)
+    hi = np.array([max(V[:, j]) for j in range(V.shape[1])], dtype=object)
+    return lo, hi
+
+
+def max_phi_over(cm: ConstraintMap, X: ConvexSet) -> list[fmpq]:
+    """b_i = max over X of φ_i, exactly (X box or polytope: φ_i convex, max at a vertex)."""
+    V = vertices_q(X)
+    vals = [cm.phi_q(v) for v in V]
+    return [max(v[i] for v in vals) for i in range(cm.n_c)]
+
+
+# -- v_max (13) ------------------------------------------------------------------------------
+def v_max_bound(
+    P: np.ndarray, rho: Any, mu: Any, X: ConvexSet, Xhat: ConvexSet, w_sq: Any
+) -> Bound:
+    """v_max = max over X × X̂ × D of β(V(x̂ − x), d) with β(v, d) = ρ v + μ |d|², eq. (13).
+
+    β is increasing in v, so v_max = ρ·max V(x̂ − x) + μ·max|d|². V is convex: over polytopes
+    the max is at a vertex of X̂ − X (exact); over an ellipsoid X̂ = {(x−c)ᵀE(x−c) ≤ 1},
+    √V(x̂ − x) ≤ √V(c − x) + √κ with P ⪯ κE (upper bound).
+    """
+    vv = max_V_diff(P, X, Xhat)
+    return Bound(Q(rho) * vv.value + Q(mu) * Q(w_sq), vv.exact, vv.how)
+
+
+def max_V_diff(P: np.ndarray, X: ConvexSet, Xhat: ConvexSet) -> Bound:
+    """max over x ∈ X, x̂ ∈ X̂ of (x̂ − x)ᵀP(x̂ − x): exact or an upper bound."""
+    if isinstance(Xhat, Ellipsoid):
+        kap = gen_eig_upper(P, Xhat.E_q)
+        c = Xhat.center_q
+        best = fmpq(0)
+        for v in vertices_q(X):
+            a = quad(P, c - v)
+            u = upper(lambda a, k: (iv.sqrt(a) + iv.sqrt(k)) ** 2, a, kap)
+            best = max(best, u)
+        return Bound(best, False, "triangle inequality over the ellipsoid X̂ (upper bound)")
+    if isinstance(Xhat, Box) and isinstance(X, Box):
+        lo = Xhat.lower_q - X.upper_q
+        hi = Xhat.upper_q - X.lower_q
+        if 2 ** len(lo) <= MAX_PAIRS:
+            best = max(
+                quad(P, np.array(v, dtype=object))
+                for v in itertools.product(*zip(lo, hi, strict=True))
+            )
+            return Bound(best, True, "exact: vertices of the box X̂ − X")
+        return _box_quad_bound(P, lo, hi)
+    VX, VH = vertices_q(X), vertices_q(Xhat)
+    if len(VX) * len(VH) <= MAX_PAIRS:
+        best = max(quad(P, h - x) for h in VH for x in VX)
+        return Bound(best, True, "exact: vertex pairs of X̂ and X")
+    lx, ux = outer_box_q(X)
+    lh, uh = outer_box_q(Xhat)
+    return _box_quad_bound(P, lh - ux, uh - lx)
+
+
+def _box_quad_bound(P: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> Bound:
+    m = [max(abs(a), abs(b)) for a, b in zip(lo, hi, strict=True)]
+    n = len(m)
+    val = sum((abs(P[i, j]) * m[i] * m[j] for i in range(n) for j in range(n)), fmpq(0))
+    return Bound(val, False, "Σ|P_ij| m_i m_j over the enclosing box (upper bound)")
+
+
+# -- X̂_max ⊆ C_max (Assumption 3(2)) and the choice of ε_max --------------------------------
+def sup_norm_c_over_Xhat_max(
+    cm: ConstraintMap, P: np.ndarray, Pinv: np.ndarray, X: ConvexSet, v_max: Any
+) -> fmpq:
+    """An upper bound of sup |c| over X̂_max = {x + e : x ∈ X, V(e) ≤ v_max}, eq. (15).
+
+    Affine φ: φ_i ≤ a_i = max_X φ_i + √(v_max g_iᵀP⁻¹g_i); |c|² ≤ Σ_classes max (a_i⁺)⁴.
+    Ellipsoid: |x + e|_Q ≤ √(max_X xᵀQx) + √(v_max κ), Q ⪯ κP; |c| ≤ ((that)²/r − 1)⁺².
+    """
+    if cm.affine:
+        return _affine_norm_bound(cm, Pinv, max_phi_over(cm, X), v_max)
+    qx = max(quad(cm.Q_q, v) for v in vertices_q(X))
+    kap = gen_eig_upper(cm.Q_q, P)
+    r = Q(cm.r_q)
+    a = upper(lambda q, v, k, r: (iv.sqrt(q) + iv.sqrt(v * k)) ** 2 / r - 1, qx, v_max, kap, r)
+    return max(a, fmpq(0)) ** 2
+
+
+def _affine_norm_bound(cm: ConstraintMap, Pinv: np.ndarray, b: list[fmpq], v: Any) -> fmpq:
+    """√(Σ_classes max_i (b_i + √(v w_i))⁺⁴) rounded up, w_i = g_iᵀP⁻¹g_i (a rational ≥ it)."""
+    s = _affine_quartic_sum(cm, Pinv, b, v)
+    return upper(iv.sqrt, s) if s > 0 else fmpq(0)
+
+
+def _affine_quartic_sum(cm: ConstraintMap, Pinv: np.ndarray, b: list[fmpq], v: Any) -> fmpq:
+    """Upper bound of Σ_classes max_{i∈class} (b_i + √(v w_i))⁺⁴ (outward rounding)."""
+    G = cm.G_q
+    total = fmpq(0)
+    for cls in cm.classes:
+        worst = fmpq(0)
+        for i in cls:
+            w = quad(Pinv, G[i])
+            a = upper(lambda b, v, w: b + iv.sqrt(v * w), b[i], Q(v), w) if Q(v) > 0 else b[i]
+            worst = max(worst, a)
+        total += worst**4
+    return total
+
+
+def sup_norm_c_over_set(cm: ConstraintMap, S: ConvexSet) -> fmpq:
+    """An upper bound of sup |c| over S (exact at the vertices for boxes/polytopes: |c| is convex)."""
+    if isinstance(S, (Box, Polytope)):
+        best = max(cm.norm_c_sq_q(v) for v in vertices_q(S))
+        return upper(iv.sqrt, best) if best > 0 else fmpq(0)
+    # ellipsoid S = {(x−c)ᵀE(x−c) ≤ 1}: φ_i ≤ g_iᵀc − h_i + √(g_iᵀE⁻¹g_i)
+    assert isinstance(S, Ellipsoid)
+    if cm.affine:
+        b = [p for p in cm.phi_q(S.center_q)]
+        return _affine_norm_bound(cm, qinv(S.E_q), b, fmpq(1))
+    qc = quad(cm.Q_q, S.center_q)
+    kap = gen_eig_upper(cm.Q_q, S.E_q)
+    r = Q(cm.r_q)
+    a = upper(lambda q, k, r: (iv.sqrt(q) + iv.sqrt(k)) ** 2 / r - 1, qc, kap, r)
+    return max(a, fmpq(0)) ** 2
+
+
+# -- v_min (21) ------------------------------------------------------------------------------
+def v_min_condition(
+    cm: ConstraintMap, P: np.ndarray, Pinv: np.ndarray, X: ConvexSet, eps_min: Any, v: Any
+) -> bool:
+    """Sufficient condition, exact/outward rounded: ∀x ∈ X, {x̂ : V(x̂ − x) ≤ v} ⊆ C_min, eq. (21)."""
+    eps = Q(eps_min)
+    if cm.affine:
+        return _affine_quartic_sum(cm, Pinv, max_phi_over(cm, X), v) <= eps * eps
+    qx = max(quad(cm.Q_q, x) for x in vertices_q(X))
+    kap = gen_eig_upper(cm.Q_q, P)
+    r = Q(cm.r_q)
+    lhs = upper(lambda q, v, k: (iv.sqrt(q) + iv.sqrt(v * k)) ** 2, qx, Q(v), kap)
+    rhs = lower(lambda r, e: r * (1 + iv.sqrt(e)), r, eps)
+    return lhs <= rhs
+
+
+def v_min_lower(
+    cm: ConstraintMap, P: np.ndarray, Pinv: np.ndarray, X: ConvexSet, eps_min: Any
+) -> Bound:
+    """A certified lower bound of v_min (eq. (21)): bisection in floats, each candidate
+    rounded down to 8 significant digits and decided by :func:`v_min_condition`."""
+    if not v_min_condition(cm, P, Pinv, X, eps_min, fmpq(0)):
+        return Bound(fmpq(0), False, "X ⊄ int C_min: v_min = 0")
+    hi = 1.0
+    while v_min_condition(cm, P, Pinv, X, eps_min, dyadic(hi, 30)):
+        hi *= 4
+        if hi > 1e300:
+            break
+    lo = 0.0
+    for _ in range(60):
+        mid = (lo + hi) / 2
+        if v_min_condition(cm, P, Pinv, X, eps_min, dyadic(mid, 30)):
+            lo = mid
+        else:
+            hi = mid
+        if hi - lo <= 1e-9 * hi:
+            break
+    v = round_sig(dyadic(lo, 30), 8, up=False) if lo > 0 else fmpq(0)
+    while v > 0 and not v_min_condition(cm, P, Pinv, X, eps_min, v):
+        v = round_sig(v * fmpq(999, 1000), 8, up=False)
+    how = "per-face bound φ_i ≤ max_X φ_i + √(v g_iᵀP⁻¹g_i), at most one face per antipodal class"
+    if not cm.affine:
+        how = "triangle inequality in the Q-norm"
+    return Bound(v, False, f"certified lower bound ({how})")
+
+
+# -- δ (Assumption 3(4)) and γ (24) ----------------------------------------------------------
+def delta_matrix(cm: ConstraintMap) -> np.ndarray:
+    """H with (dc/dx)ᵀ(dc/dx) ⪯ 4 ε_max H on C_max (affine maps).
+
+    dc/dx = diag(2φ⁺) G and at most one face per antipodal class is active, so
+    (dc/dx)ᵀ(dc/dx) = 4 Σ c_i g_i g_iᵀ ⪯ 4 ε_max Σ_classes g_c g_cᵀ with g_c the longest
+    normal of the class (c_i ≤ |c| ≤ ε_max on C_max). For a box H = I.
+    """
+    G = cm.G_q
+    n = G.shape[1]
+    H = np.full((n, n), fmpq(0), dtype=object)
+    for cls in cm.classes:
+        k = max(cls, key=lambda i: quad(qeye(n), G[i]))
+        H = H + np.outer(G[k], G[k])
+    return H
+
+
+def delta_sq_upper(cm: ConstraintMap, eps_max: Any) -> Bound:
+    """A rational ≥ δ² = (sup over C_max of |dc/dx|)², Assumption 3(4).
+
+    Affine: δ² ≤ 4 ε_max λ_max(H) (exact for a box: 4 ε_max). Ellipsoid: |dc/dx| =
+    4 φ⁺|Qx|/r with φ ≤ √ε_max and xᵀQx ≤ r(1 + √ε_max), so δ² ≤ 16 ε_max λ_max(Q)(1 + √ε_max)/r.
+    """
+    e = Q(eps_max)
+    if cm.affine:
+        H = delta_matrix(cm)
+        n = H.shape[0]
+        if cm.kind == "box":
+            return Bound(4 * e, True, "box: δ = 2√ε_max exactly")
+        lam = gen_eig_upper(H, qeye(n))
+        return Bound(4 * e * lam, False, "4 ε_max λ_max(H), H = Σ_classes g gᵀ (upper bound)")
+    n = cm.Q_q.shape[0]
+    lam = gen_eig_upper(cm.Q_q, qeye(n))
+    r = Q(cm.r_q)
+    val = upper(lambda e, l, r: 16 * e * l * (1 + iv.sqrt(e)) / r, e, lam, r)
+    return Bound(val, False, "16 ε_max λ_max(Q)(1 + √ε_max)/r (upper bound)")
+
+
+def delta_sq_valid(cm: ConstraintMap, eps_max: Any, delta_sq: Any) -> tuple[bool, str]:
+    """Exact re-check that ``delta_sq`` bounds δ² (recomputes the bound's ingredients)."""
+    e, d = Q(eps_max), Q(delta_sq)
+    if cm.affine:
+        if e <= 0:
+            return False, "ε_max must be > 0"
+        H = delta_matrix(cm)
+        r = check_psd(qeye(H.shape[0]) * (d / (4 * e)) - H)
+        return r.ok, f"(δ²/(4 ε_max))·I − H ⪰ 0: {r.detail}"
+    ref = delta_sq_upper(cm, e)
+    return d >= ref.value, f"δ² = {float(d):.6g} ≥ bound {float(ref.value):.6g}"
+
+
+def gamma_bound(P: np.ndarray, delta_sq: Any) -> fmpq:
+    """The largest γ allowed by eq. (24), γ ≤ λ_min(P)/δ², rounded down (6 significant digits),
+    with λ_min(P) bounded below exactly. Assumes δ² > 0."""
+    ell = lambda_min_lower(P)
+    return round_sig(ell / Q(delta_sq), 6, up=False)
+
+
+def gamma_ok(P: np.ndarray, gamma: Any, delta_sq: Any) -> tuple[bool, str]:
+    """Exact check of eq. (24): γ δ² ≤ λ_min(P) ⟺ P − γ δ² I ⪰ 0 (LDLᵀ over Q)."""
+    g = Q(gamma)
+    if g <= 0:
+        return False, f"γ = {float(g):g} must be > 0"
+    r = check_psd(P - qeye(P.shape[0]) * (g * Q(delta_sq)))
+    return r.ok, f"P − γδ²·I ⪰ 0: {r.detail}"
+
+
+# -- θ (22) ------------------------------------------------------------------------------------
+def theta_of(v_max: Any, v_min: Any, gamma: Any, eps_min: Any) -> int:
+    """θ = ceil(max(v_max − v_min, 0)/(γ ε_min²)), eq. (22), in exact arithmetic."""
+    num = max(Q(v_max) - Q(v_min), fmpq(0))
+    return int((num / (Q(gamma) * Q(eps_min) ** 2)).ceil())

@@ -1,0 +1,164 @@
+"""Design of the refining map's parameters (Sections 3-4, constrained-redesign paper (000)).
+
+Order: Lyapunov data (P, ρ, μ; Assumption 2) → X̂ → v_max (13) → ε_max (Assumption 3(2)) →
+δ (Assumption 3(4)) → γ (24) → v_min (21) → θ (22), and optionally v̆_max of Section 4.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from flint import fmpq
+
+from obsdesign.certify.exact import Q
+from obsdesign.certify.interval import sqrt_upper
+from obsdesign.errors import InconclusiveError, InfeasibleError
+from obsdesign.methods import lyapunov
+from obsdesign.methods.constrained import bounds as B
+from obsdesign.methods.constrained.lyap import error_input, iss_mu, w_sq_max
+from obsdesign.methods.constrained.options import Options, default_Xhat
+from obsdesign.sets.base import ConvexSet
+from obsdesign.spec.models import Spec
+
+
+@dataclass
+class LyapData:
+    """P, ρ, μ of Assumption 2 (exact) and, when computed, the decay rate λ."""
+
+    P: np.ndarray
+    rho: fmpq
+    mu: fmpq
+    lam: fmpq | None
+
+
+def lyapunov_data(spec: Spec) -> LyapData:
+    """P from the ``lyapunov`` method (certified (A−LC)ᵀP(A−LC) ⪯ λ²P), ρ = λ² (or the given
+    ρ ≥ λ²) and the smallest certified μ; or the user's (P, ρ, μ)."""
+    o: Options = spec.options
+    s = spec.system
+    if o.P is not None:
+        return LyapData(o.P, Q(o.rho), Q(o.mu), None)
+    Acl_f = s.A.f - np.asarray(o.L, dtype=float) @ s.C.f
+    rad = float(np.max(np.abs(np.linalg.eigvals(Acl_f))))
+    if rad >= 1:
+        raise InfeasibleError(
+            f"A − LC is not Schur (spectral radius {rad:.6g} >= 1): no Lyapunov function (Assumption 2)"
+        )
+    if o.lam is None:
+        lo = lyapunov.Options(o.L, None, o.rate_tol, fmpq(10), False, o.margin)
+        lam, P = lyapunov.best_rate(s.A.q, s.C.q, o.L, True, lo, rad)
+    else:
+        lam = o.lam
+        P = lyapunov.certified_P(s.A.q, s.C.q, o.L, True, lam, o.margin)
+        if P is None:
+            if float(lam) <= rad:
+                raise InfeasibleError(
+                    f"no P ≻ 0 gives decay rate λ = {float(lam):g}: A − LC has spectral radius {rad:.6g}"
+                )
+            raise InconclusiveError(
+                f"decay rate λ = {float(lam):g} holds in floats but the exact check failed"
+            )
+    rho = Q(o.rho) if o.rho is not None else lam * lam
+    Acl = s.A.q - o.L @ s.C.q
+    mu = iss_mu(Acl, error_input(s.A.q, s.Bd.q, s.Dn.q, o.L), P, rho)
+    return LyapData(P, rho, mu, lam)
+
+
+def xhat_set(o: Options) -> ConvexSet:
+    """X̂: the given set, or the outer set of C_min (see :func:`default_Xhat`)."""
+    return o.Xhat if o.Xhat is not None else default_Xhat(o.cmap, o.eps_min)
+
+
+def design_params(spec: Spec) -> tuple[dict[str, Any], list[str]]:
+    """Every parameter of the report (exact rationals) and notes on what is exact or a bound."""
+    o: Options = spec.options
+    notes: list[str] = []
+    ld = lyapunov_data(spec)
+    P = ld.P
+    Pinv = B.qinv(P)
+    Xhat = xhat_set(o)
+    W = w_sq_max(o.D_lower, o.D_upper)
+    vmax = B.v_max_bound(P, ld.rho, ld.mu, o.X, Xhat, W)
+    notes.append(f"v_max (13): {vmax.how}")
+    if o.eps_max is None:
+        need = max(
+            B.sup_norm_c_over_Xhat_max(o.cmap, P, Pinv, o.X, vmax.value),
+            B.sup_norm_c_over_set(o.cmap, Xhat),
+        )
+        eps_max = B.round_sig(need, 6, up=True)
+        if eps_max <= o.eps_min:
+            eps_max = B.round_sig(o.eps_min * fmpq(1000001, 1000000), 8, up=True)
+        notes.append(
+            "ε_max: the smallest (6 digits, rounded up) with X̂ ⊆ C_max and X̂_max ⊆ C_max (Assumption 3(1)-(2))"
+        )
+    else:
+        eps_max = o.eps_max
+    dsq = B.delta_sq_upper(o.cmap, eps_max)
+    notes.append(f"δ: {dsq.how}")
+    g_max = B.gamma_bound(P, dsq.value)
+    if o.gamma is None:
+        gamma = g_max
+        if gamma <= 0:
+            raise InfeasibleError(
+                "no γ > 0 satisfies (24): λ_min(P) could not be bounded away from 0"
+            )
+    else:
+        gamma = o.gamma
+        ok, _ = B.gamma_ok(P, gamma, dsq.value)
+        if not ok:
+            msg = (
+                f"γ = {float(gamma):g} exceeds the bound (24) γ ≤ λ_min(P)/δ²: the largest certified γ is "
+                f"{float(g_max):.6g} (λ_min(P) ≥ {float(B.lambda_min_lower(P)):.6g}, δ² ≤ {float(dsq.value):.6g}); "
+                f"γ is {float(gamma / g_max):.3g}× too large"
+            )
+            if not o.gamma_uncertified:
+                raise InfeasibleError(
+                    msg + " (set gamma_uncertified = true to design and simulate with it anyway)"
+                )
+            notes.append("UNCERTIFIED: " + msg)
+    vmin = B.v_min_lower(o.cmap, P, Pinv, o.X, o.eps_min)
+    notes.append(f"v_min (21): {vmin.how}")
+    theta = B.theta_of(vmax.value, vmin.value, gamma, o.eps_min)
+    if theta == 0:
+        notes.append(
+            "Remark 2: v_max ≤ v_min, the estimate never leaves X̂ after a jump: θ = 0, no refining needed"
+        )
+    params: dict[str, Any] = {"L": o.L}
+    if ld.lam is not None:
+        params["lambda"] = ld.lam
+    params.update(
+        {
+            "P": P,
+            "rho": ld.rho,
+            "mu": ld.mu,
+            "gamma": gamma,
+            "gamma_max": g_max,
+            "lambda_min_P": B.lambda_min_lower(P),
+            "delta": sqrt_upper(dsq.value),
+            "delta_sq": dsq.value,
+            "eps_min": o.eps_min,
+            "eps_max": eps_max,
+            "v_max": vmax.value,
+            "v_min": vmin.value,
+            "theta": fmpq(theta),
+        }
+    )
+    if o.X0 is not None and o.Xhat0 is not None:
+        vb = v_max_breve(P, ld.rho, ld.mu, o.X0, o.Xhat0, W)
+        params["v_max_breve"] = vb
+        params["theta_breve"] = fmpq(B.theta_of(min(vb, vmax.value), vmin.value, gamma, o.eps_min))
+        notes.append(
+            "v̆_max (Section 4) = max V(x̂0 − x0) + μ max|w|²/(1 − ρ) over X0 × X̂0; θ̆ uses min(v_max, v̆_max)"
+        )
+    return params, notes
+
+
+def v_max_breve(
+    P: np.ndarray, rho: Any, mu: Any, X0: ConvexSet, Xhat0: ConvexSet, w_sq: Any
+) -> fmpq:
+    """v̆_max = V(e_0,max) + α(d_max)/(1 − ρ) of Section 4 (an upper bound of V along solutions
+    from X0 × X̂0 when β = ρv + μ|d|², by induction: ρ v̆ + μ|d|² ≤ v̆)."""
+    v0 = B.max_V_diff(P, X0, Xhat0).value
+    return v0 + Q(mu) * Q(w_sq) / (1 - Q(rho))

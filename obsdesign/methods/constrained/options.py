@@ -1,0 +1,273 @@
+"""The ``[method]`` and ``[simulate]`` keys of the ``constrained`` method (paper 000)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from flint import fmpq
+
+from obsdesign.certify.exact import Q
+from obsdesign.certify.psd import check_pd
+from obsdesign.methods.constrained.cmap import (
+    KINDS,
+    ConstraintMap,
+    box_map,
+    ellipsoid_map,
+    polytope_map,
+)
+from obsdesign.sets import Box, Ellipsoid, Polytope, vertices_exact
+from obsdesign.sets.base import ConvexSet
+from obsdesign.spec.models import Spec
+from obsdesign.spec.reader import Table
+
+
+@dataclass
+class Options:
+    """Typed ``[method]`` of ``constrained``.
+
+    Lyapunov data: either computed (``lam`` given or best, ρ = ``rho`` or λ²) or given by the
+    user (``P``, ``rho``, ``mu``). Sets: X (box/polytope, from ``[sets]``), X̂ (optional set;
+    default: the outer polytope/ellipsoid of C_min), D (box of w = (d, v)).
+    """
+
+    L: np.ndarray
+    lam: fmpq | None
+    rho: fmpq | None
+    P: np.ndarray | None
+    mu: fmpq | None
+    X_name: str
+    X: ConvexSet
+    Xhat_name: str | None
+    Xhat: ConvexSet | None
+    cmap: ConstraintMap
+    D_lower: np.ndarray
+    D_upper: np.ndarray
+    eps_min: fmpq
+    eps_max: fmpq | None
+    gamma: fmpq | None
+    gamma_uncertified: bool
+    margin: fmpq
+    rate_tol: fmpq
+    X0: ConvexSet | None = None
+    Xhat0: ConvexSet | None = None
+    file: str = ""
+    #: the method's ``[simulate]`` keys (filled by ``parse_simulate``)
+    sim: Any = None
+
+
+@dataclass
+class SimOptions:
+    """Method keys of ``[simulate]``: θ_m values, a simulation-only γ, the saturation level r of (29)."""
+
+    theta_m: list[int] = field(default_factory=list)
+    gamma: fmpq | None = None
+    saturation_r: np.ndarray | None = None
+
+
+def parse_options(table: Table, spec: Spec) -> Options:
+    """Read and validate ``[method]`` (every error names file and key)."""
+    s = spec.system
+    if not s.discrete:
+        raise table.error(
+            "key",
+            'the constrained redesign (paper 000) is for discrete time: set [system] time = "discrete"',
+        )
+    n = s.n
+    L = table.matrix("L", rows=n, cols=s.p, vector_as="column").q
+    P = mu = lam = rho = None
+    if table.has("P"):
+        if table.has("lambda"):
+            raise table.error(
+                "lambda", "give either lambda (P computed) or P, rho, mu (P given), not both"
+            )
+        P = table.matrix("P", rows=n, cols=n).q
+        if any(P[i, j] != P[j, i] for i in range(n) for j in range(n)):
+            raise table.error("P", "expected a symmetric matrix")
+        if not check_pd(P):
+            raise table.error(
+                "P", "expected a positive definite matrix (V(e) = eᵀPe must be positive, eq. (4))"
+            )
+        rho = table.scalar("rho", min=0, max=1, strict_max=True).q
+        mu = table.scalar("mu", min=0).q
+    else:
+        v = table.scalar("lambda", default=None, min=0, max=1, strict_min=True, strict_max=True)
+        lam = None if v is None else v.q
+        r = table.scalar("rho", default=None, min=0, max=1, strict_min=True, strict_max=True)
+        rho = None if r is None else r.q
+        if table.has("mu"):
+            raise table.error(
+                "mu", "mu is computed when P is computed; give P, rho and mu together to set it"
+            )
+        if rho is not None and lam is not None and rho < lam * lam:
+            raise table.error(
+                "rho",
+                f"expected rho >= lambda² = {float(lam * lam):g} (β(v, d) = ρv + μ|d|² needs ρ ≥ λ²)",
+            )
+    X_name, X = _set_ref(table, "X", spec, ("box", "polytope"))
+    Xhat_name, Xhat = (None, None)
+    if table.has("Xhat"):
+        Xhat_name, Xhat = _set_ref(table, "Xhat", spec, ("box", "polytope", "ellipsoid"))
+    X0 = _set_ref(table, "X0", spec, ("box", "polytope"))[1] if table.has("X0") else None
+    Xhat0 = _set_ref(table, "Xhat0", spec, ("box", "polytope"))[1] if table.has("Xhat0") else None
+    if (X0 is None) != (Xhat0 is None):
+        raise table.error(
+            "X0" if X0 is None else "Xhat0",
+            "give both X0 and Xhat0 (initial states and estimates) or neither",
+        )
+    ct = table.table("c", required=True)
+    assert ct is not None
+    cm = parse_cmap(ct, n)
+    nw = s.nd + s.nv
+    dt = table.table("D")
+    if dt is None:
+        if nw:
+            raise table.error(
+                "D",
+                f"is missing: expected a table with lower/upper bounds of w = (d, v) ({nw} numbers)",
+            )
+        Dl = Du = np.zeros(0, dtype=object)
+    else:
+        Dl = dt.vector("lower", n=nw).q
+        Du = dt.vector("upper", n=nw).q
+        if any(not a <= b for a, b in zip(Dl, Du, strict=True)):
+            raise dt.error("upper", "expected lower <= upper in every coordinate")
+        dt.done()
+    eps_min = table.scalar("eps_min", min=0, strict_min=True).q
+    em = table.scalar("eps_max", default=None, min=0, strict_min=True)
+    eps_max = None if em is None else em.q
+    if eps_max is not None and not eps_max > eps_min:
+        raise table.error(
+            "eps_max", f"expected eps_max > eps_min = {float(eps_min):g} (Assumption 3)"
+        )
+    g = table.scalar("gamma", default=None, min=0, strict_min=True)
+    unc = table.bool("gamma_uncertified", default=False)
+    margin = table.scalar("margin", default=fmpq(1, 10**9), min=0).q
+    tol = table.scalar("rate_tol", default=fmpq(1, 10000), min=0, strict_min=True).q
+    table.done()
+    return Options(
+        L,
+        lam,
+        rho,
+        P,
+        mu,
+        X_name,
+        X,
+        Xhat_name,
+        Xhat,
+        cm,
+        Dl,
+        Du,
+        eps_min,
+        eps_max,
+        None if g is None else g.q,
+        unc,
+        margin,
+        tol,
+        X0,
+        Xhat0,
+        spec.file,
+    )
+
+
+def _set_ref(table: Table, key: str, spec: Spec, kinds: tuple[str, ...]) -> tuple[str, ConvexSet]:
+    name = table.str(key)
+    if name not in spec.sets:
+        known = ", ".join(sorted(spec.sets)) or "none"
+        raise table.error(
+            key, f"expected the name of a set in [sets] (known: {known}); got {name!r}"
+        )
+    S = spec.sets[name]
+    if S.kind not in kinds and not (S.kind == "symmetric-polytope" and "polytope" in kinds):
+        raise table.error(
+            key, f"expected a set of type {' or '.join(kinds)}; [sets.{name}] is a {S.kind}"
+        )
+    return name, S
+
+
+def parse_cmap(t: Table, n: int) -> ConstraintMap:
+    """``[method.c]``: the constraint map of Assumption 3 (box (19), ellipsoid (18), polytope)."""
+    kind = t.str("type")
+    if kind not in KINDS:
+        raise t.error(
+            "type",
+            f"expected one of {', '.join(KINDS)} (each gives a convex c, Assumption 3(3)); got {kind!r}",
+        )
+    if kind == "box":
+        lo = t.vector("lower", n=n).q
+        hi = t.vector("upper", n=n).q
+        for i in range(n):
+            if not lo[i] < hi[i]:
+                raise t.error("upper", f"expected lower < upper in every coordinate (index {i})")
+        cm = box_map(lo, hi)
+    elif kind == "polytope":
+        G = t.matrix("G", cols=n).q
+        h = t.vector("h", n=G.shape[0]).q
+        verts, bounded = vertices_exact(G, np.asarray(h, dtype=object))
+        if len(verts) == 0 or not bounded:
+            raise t.error("G", "expected a non-empty bounded polytope {x : G x <= h} for C_0")
+        cm = polytope_map(G, np.asarray(h, dtype=object))
+    else:
+        Qm = t.matrix("Q", rows=n, cols=n).q
+        if any(Qm[i, j] != Qm[j, i] for i in range(n) for j in range(n)):
+            raise t.error("Q", "expected a symmetric matrix")
+        if not check_pd(Qm):
+            raise t.error(
+                "Q",
+                "expected a positive definite Q: otherwise c of eq. (18) is not convex (Assumption 3(3))",
+            )
+        r = t.scalar("r", min=0, strict_min=True).q
+        cm = ellipsoid_map(Qm, r)
+    t.done()
+    return cm
+
+
+def parse_sim(table: Table, spec: Spec) -> SimOptions:
+    """``[simulate]`` keys of this method: theta_m (int or list), gamma, saturation_r."""
+    out = SimOptions()
+    if table.has("theta_m"):
+        v = table.data["theta_m"]
+        vals = v if isinstance(v, list) else [v]
+        if not vals or not all(
+            isinstance(x, int) and not isinstance(x, bool) and x >= 0 for x in vals
+        ):
+            raise table.error("theta_m", "expected a non-negative integer or a list of them")
+        table.mark("theta_m")
+        out.theta_m = [int(x) for x in vals]
+    g = table.scalar("gamma", default=None, min=0, strict_min=True)
+    out.gamma = None if g is None else g.q
+    if table.has("saturation_r"):
+        out.saturation_r = table.vector("saturation_r").f
+        if len(out.saturation_r) not in (1, spec.system.n) or np.any(out.saturation_r <= 0):
+            raise table.error(
+                "saturation_r", f"expected a positive number or {spec.system.n} positive numbers"
+            )
+    return out
+
+
+def default_Xhat(cm: ConstraintMap, eps_min: Any) -> ConvexSet:
+    """X̂ when not given: the outer set of C_min, {φ_i ≤ t} with t ≥ √ε_min rational (a box for
+    the box map, a polytope for a polytope map, an ellipsoid for the ellipsoid map); it contains
+    C_min (Assumption 3(1))."""
+    from obsdesign.certify.interval import sqrt_upper
+
+    t = sqrt_upper(Q(eps_min))
+    t = _short_up(t)
+    if cm.kind == "box":
+        n = cm.dim
+        lo = np.array([-cm.h_q[2 * i] - t for i in range(n)], dtype=object)
+        hi = np.array([cm.h_q[2 * i + 1] + t for i in range(n)], dtype=object)
+        return Box(lo, hi)
+    if cm.affine:
+        return Polytope(cm.G_q, np.array([h + t for h in cm.h_q], dtype=object))
+    return Ellipsoid(
+        cm.Q_q * (1 / (Q(cm.r_q) * (1 + t))), np.array([fmpq(0)] * cm.dim, dtype=object)
+    )
+
+
+def _short_up(t: fmpq) -> fmpq:
+    """A short rational ≥ t (12 significant digits), so the default X̂ prints nicely."""
+    from obsdesign.methods.constrained.bounds import round_sig
+
+    return round_sig(t, 12, up=True)

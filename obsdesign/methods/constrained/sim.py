@@ -1,0 +1,206 @@
+"""Simulation hooks of the constrained redesign (Section 5, Table 1, Fig. 3, paper 000):
+the unmodified observer (2), the modified observer (8)-(10), (23) with step budgets θ_m, and
+the naive saturated observer (29), on the same plant trajectory."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from obsdesign.certify.exact import Q, to_float
+from obsdesign.errors import InputError
+from obsdesign.methods.constrained import bounds as B
+from obsdesign.methods.constrained.claims import _q
+from obsdesign.methods.constrained.design import xhat_set
+from obsdesign.methods.constrained.observer import LinearF, Refiner, Trace, run_observer
+from obsdesign.methods.constrained.options import Options, SimOptions
+from obsdesign.params import Parameters
+from obsdesign.simulate.result import SimResult
+from obsdesign.simulate.runner import signals
+from obsdesign.spec.models import Spec
+
+#: default step budget per sample when θ (22) is astronomically large
+THETA_CAP = 100_000
+
+
+def _exact(params: Parameters, k: str) -> Any:
+    v = params[k]
+    return v if params.is_exact(k) else Q(float(np.asarray(v, dtype=float)))
+
+
+def _ints(v: Any, key: str) -> list[int]:
+    try:
+        vals = [int(x) for x in str(v).replace(";", ",").split(",") if x.strip()]
+    except ValueError:
+        raise InputError(
+            f"--option {key}: expected integers separated by commas, got {v!r}"
+        ) from None
+    if not vals or any(x < 0 for x in vals):
+        raise InputError(f"--option {key}: expected non-negative integers, got {v!r}")
+    return vals
+
+
+def _float(v: Any, key: str) -> float:
+    try:
+        f = float(v)
+    except (TypeError, ValueError):
+        raise InputError(f"--option {key}: expected a number, got {v!r}") from None
+    if not np.isfinite(f) or f <= 0:
+        raise InputError(f"--option {key}: expected a positive number, got {v!r}")
+    return f
+
+
+def simulate(spec: Spec, params: Parameters, **kw: Any) -> SimResult:
+    """Run plant + the three observers; ``kw`` (CLI ``--option``): theta_m (comma list), gamma,
+    saturation_r. Table 1 numbers go to ``info``."""
+    unknown = set(kw) - {"theta_m", "gamma", "saturation_r"}
+    if unknown:
+        raise InputError(
+            f"unknown simulation option(s): {', '.join(sorted(unknown))} (known: theta_m, gamma, saturation_r)"
+        )
+    o: Options = spec.options
+    so: SimOptions = o.sim or SimOptions()
+    s, sm = spec.system, spec.simulate
+    assert sm is not None
+    theta = int(Q(_exact(params, "theta")))
+    thetas = (
+        _ints(kw["theta_m"], "theta_m")
+        if "theta_m" in kw
+        else (so.theta_m or [min(theta, THETA_CAP)])
+    )
+    P = _q(params, "P")
+    Pinv = np.asarray(to_float(B.qinv(P)), dtype=float)  # exact inverse of the exact P, then float
+    gamma_c = Q(_exact(params, "gamma"))
+    if "gamma" in kw:
+        gamma_q = Q(_float(kw["gamma"], "gamma"))
+    elif so.gamma is not None:
+        gamma_q = so.gamma
+    else:
+        gamma_q = gamma_c
+    dsq = Q(_exact(params, "delta_sq"))
+    g_ok, _ = B.gamma_ok(P, gamma_q, dsq)
+    eps_min = float(Q(_exact(params, "eps_min")))
+    eps_max = float(Q(_exact(params, "eps_max")))
+    sat_r = (
+        np.array([_float(kw["saturation_r"], "saturation_r")])
+        if "saturation_r" in kw
+        else so.saturation_r
+    )
+
+    N = int(sm.horizon.f)
+    k = np.arange(N + 1)
+    u, d, v = signals(spec, k)
+    A, Bm, C, D, Bd, Dn = s.A.f, s.B.f, s.C.f, s.D.f, s.Bd.f, s.Dn.f
+    x = np.zeros((N + 1, s.n))
+    x[0] = sm.x0.f
+    for i in range(N):
+        x[i + 1] = A @ x[i] + Bm @ u[i] + Bd @ d[i]
+    y = x @ C.T + u @ D.T + v @ Dn.T
+    F = LinearF(A, Bm, C, D, np.asarray(to_float(o.L), dtype=float))
+    ref = Refiner(o.cmap, Pinv, float(gamma_q), eps_min, eps_max)
+    Pf = np.asarray(to_float(P), dtype=float)
+    Xhat = xhat_set(o)
+
+    traces: dict[str, Trace] = {"unmodified": run_observer(F, u, y, sm.xhat0.f)}
+    for tm in thetas:
+        traces[f"modified θ_m={tm}"] = run_observer(F, u, y, sm.xhat0.f, ref, tm)
+    if sat_r is not None:
+        traces[f"saturated r={_fmt(sat_r)}"] = run_observer(F, u, y, sm.xhat0.f, sat_r=sat_r)
+
+    info: dict[str, Any] = {
+        "theta (22)": theta,
+        "gamma (simulation)": f"{float(gamma_q):.6g}"
+        + (
+            " (certified by (24))"
+            if g_ok
+            else f" (UNCERTIFIED: above the bound (24), certified γ = {float(gamma_c):.4g})"
+        ),
+    }
+    for name, tr in traces.items():
+        info[f"{name}: sup_k |x̂_k|"] = _fmt(tr.sup_k())
+        if name.startswith("modified"):
+            info[f"{name}: sup_k,i |x̂_k,i|"] = _fmt(tr.sup_ki())
+            info[f"{name}: steps (total, max per sample)"] = (
+                f"{int(tr.steps.sum())}, {int(tr.steps.max(initial=0))}"
+            )
+            info[f"{name}: x̂_k in X̂ for all k ≥ 1"] = bool(
+                np.all(Xhat.contains(tr.xhat[1:], tol=1e-9))
+            )
+            info[f"{name}: max V increase over a refining step"] = f"{_v_increase(tr, x, Pf):.3g}"
+        if name.startswith("saturated"):
+            info[f"{name}: final x̂"] = _fmt(tr.xhat[-1])
+    main = next((n for n in traces if n.startswith("modified")), "unmodified")
+    res = SimResult(k.astype(float), x, traces[main].xhat, y, s.states)
+    res.extra = {
+        "estimates": {n: tr.xhat for n, tr in traces.items() if n != main},
+        "traces": traces,
+        "Xhat": Xhat,
+        "refiner": ref,
+    }
+    res.info = info
+    return res
+
+
+def _fmt(a: np.ndarray) -> str:
+    return "[" + ", ".join(f"{float(v):.5g}" for v in np.atleast_1d(a)) + "]"
+
+
+def _v_increase(tr: Trace, x: np.ndarray, P: np.ndarray) -> float:
+    """Largest V(x̂_{k,i+1} − x_{k+1}) − V(x̂_{k,i} − x_{k+1}) over refining steps (Lemma 3: ≤ 0),
+    relative to V(x̂_{k,i} − x_{k+1})."""
+    worst = -np.inf
+    for kk, path in enumerate(tr.iterates):
+        if len(path) < 2:
+            continue
+        E = np.asarray(path) - x[kk + 1]
+        V = np.einsum("ij,jk,ik->i", E, P, E)
+        with np.errstate(invalid="ignore", over="ignore"):
+            inc = np.diff(V) / np.maximum(V[:-1], 1e-300)
+        if inc.size and np.all(np.isfinite(inc)):
+            worst = max(worst, float(inc.max()))
+        elif inc.size:
+            worst = np.inf
+    return worst if worst > -np.inf else 0.0
+
+
+def plot(spec: Spec, res: SimResult, path: Any) -> Any:
+    """Fig. 3 a)-c): error of the unmodified and modified observers, refining steps per sample,
+    and the path of x̂_{k,i} in the plane of the first two states with X̂ and C_min."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from obsdesign.simulate.plot import save_figure
+
+    traces: dict[str, Trace] = res.extra["traces"]
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
+    for name, tr in traces.items():
+        e = tr.xhat - res.x
+        ax[0].plot(res.t, np.linalg.norm(e, axis=1), lw=1, label=name)
+    ax[0].set_yscale("symlog", linthresh=1e-2)
+    ax[0].set_title("a) |e_k|")
+    ax[0].set_xlabel("k")
+    ax[0].legend(fontsize=7)
+    for name, tr in traces.items():
+        if name.startswith("modified"):
+            ax[1].step(res.t[:-1], tr.steps, where="post", lw=1, label=name)
+    ax[1].set_title("b) refining steps per sample")
+    ax[1].set_xlabel("k")
+    ax[1].legend(fontsize=7)
+    mod = [tr for n, tr in traces.items() if n.startswith("modified")]
+    if mod and res.x.shape[1] >= 2:
+        tr = mod[0]
+        pts = np.vstack([np.vstack([tr.xhat[k]] + list(p)) for k, p in enumerate(tr.iterates)])
+        ax[2].plot(pts[:, 0], pts[:, 1], "r.-", lw=0.5, ms=2, label="x̂_{k,i}")
+        ref = res.extra["refiner"]
+        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        gx, gy = np.meshgrid(np.linspace(lo[0], hi[0], 300), np.linspace(lo[1], hi[1], 300))
+        grid = np.zeros((300, 300, res.x.shape[1]))
+        grid[..., 0], grid[..., 1] = gx, gy
+        ax[2].contour(gx, gy, ref.cm.norm_c(grid), levels=[ref.eps_min], colors="b", linewidths=1)
+        ax[2].set_title("c) x̂_{k,i} and C_min (blue)")
+        ax[2].legend(fontsize=7)
+    fig.tight_layout()
+    return save_figure(fig, path)

@@ -1,0 +1,244 @@
+"""The ``constrained`` method on the paper's Section 5 example (paper 000): design, verify,
+Table 1, bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from flint import fmpq
+from typer.testing import CliRunner
+
+from obsdesign import api
+from obsdesign.certify.claim import ClaimStatus
+from obsdesign.cli import app
+from obsdesign.errors import InfeasibleError, SpecError
+from obsdesign.report import Report
+from obsdesign.spec import load_spec_text
+
+SEC5 = "constrained-redesign-sec5.toml"
+
+
+@pytest.fixture(scope="module")
+def sec5_report():
+    from pathlib import Path
+
+    return api.design(Path(__file__).resolve().parents[1] / "specs" / SEC5)
+
+
+def test_sec5_design_certified(sec5_report):
+    rep = sec5_report
+    bad = [c.id for c in rep.claims if c.status != ClaimStatus.CERTIFIED]
+    assert not bad
+    p = rep.parameters
+    # the paper's P and P⁻¹ (printed to 3 digits)
+    P = p.float("P")
+    np.testing.assert_array_equal(np.round(P / 1e5, 3), [[1.259, 1.319], [1.319, 1.381]])
+    np.testing.assert_array_equal(np.round(np.linalg.inv(P), 3), [[0.039, -0.037], [-0.037, 0.036]])
+    for k in ("P", "rho", "mu", "gamma", "delta", "eps_min", "eps_max", "v_max", "v_min", "theta"):
+        assert k in p.to_json()
+    assert p["eps_min"] == fmpq(1, 100)
+    assert p["rho"] == fmpq(955, 1000)
+    # numbers of this design (ρ = λ = 0.955, X = [-1, 1]², D = [-3, 3], X̂ = outer box of C_min)
+    assert p.float("v_max") == pytest.approx(2659567.3, rel=1e-7)  # exact: vertices of X̂ − X
+    assert p.float("v_min") == pytest.approx(0.90753137, rel=1e-7)
+    assert p.float("eps_max") == pytest.approx(140098, rel=1e-5)
+    # δ = 2√ε_max ≈ 748.6. The issue expected ≈ 637: that is 2·(largest single-coordinate
+    # violation over X̂_max); with the Euclidean |c| of (16) both coordinates peak together, so
+    # C_max ⊇ X̂_max needs ε_max ≈ 1.4·10⁵ and δ ≈ 749.
+    assert p.float("delta") == pytest.approx(748.59, rel=1e-4)
+    lam_min = np.linalg.eigvalsh(P).min()
+    assert p.float("gamma") <= lam_min / p.float("delta_sq")
+    assert p.float("gamma") == pytest.approx(2.3965e-5, rel=1e-4)
+    # θ (22) with the certified γ; with the paper's γ = 17 it would be ≈ 1.56·10⁹ (issue: ≈1.5·10⁹)
+    theta = int(p["theta"])
+    assert theta == pytest.approx(1.10977e15, rel=1e-5)
+    assert (p.float("v_max") - p.float("v_min")) / (17 * 1e-4) == pytest.approx(1.564e9, rel=1e-3)
+
+
+def test_sec5_verify_roundtrip(sec5_report):
+    rep2, problems = Report.from_dict(sec5_report.to_dict())
+    assert not problems
+    ver = api.verify(rep2)
+    assert ver.exit_code() == 0
+    assert ver.status_counts()["failed"] == 0
+
+
+def test_sec5_verify_rejects_tampered_theta(sec5_report):
+    d = sec5_report.to_dict()
+    d["parameters"]["theta"] = 1000.0
+    d["parameters"]["exact"]["theta"] = "1000"
+    rep2, _ = Report.from_dict(d)
+    ver = api.verify(rep2)
+    failed = {c.id for c in ver.claims if c.status == ClaimStatus.FAILED}
+    assert "theta-covers" in failed
+
+
+def test_sec5_table1(specs_dir):
+    """Table 1. Unmodified row: reproduced at the printed precision. Modified rows: the literal
+    reading of (20), (23) with the squared box map (19) and the paper's γ = 17 diverges (each
+    step grows like the cube of the violation), so the printed 1.195/1.238, 6.602/4.783 (θ_m = 10)
+    and 9.795/8.366, 11.960/10.358 (θ_m = 3) are NOT reproduced; we assert what we get."""
+    res = api.simulate(specs_dir / SEC5)
+    info = res.info
+    assert info["unmodified: sup_k |x̂_k|"] == "[22.582, 21.61]"  # paper: 22.582 / 21.611
+    tr = res.extra["traces"]["unmodified"]
+    # 22.58179 and 21.61049: the paper's 21.611 is 21.6105 rounded again (double rounding)
+    np.testing.assert_allclose(tr.sup_k(), [22.582, 21.611], atol=6e-4)
+    np.testing.assert_array_equal(np.round(np.round(tr.sup_k(), 4) + 1e-9, 3), [22.582, 21.611])
+    assert "UNCERTIFIED" in info["gamma (simulation)"]
+    for tm in (10, 3):
+        t = res.extra["traces"][f"modified θ_m={tm}"]
+        assert t.sup_k()[0] > 1e7  # diverges (paper: 1.195 for θ_m = 10, 9.795 for θ_m = 3)
+        assert info[f"modified θ_m={tm}: x̂_k in X̂ for all k ≥ 1"] is False
+    # naive saturation (29) with r = 2: stuck at (2, −2) without disturbance
+    sat = res.extra["traces"]["saturated r=[2]"].xhat
+    np.testing.assert_array_equal(sat[1:151], np.tile([2.0, -2.0], (150, 1)))
+    np.testing.assert_array_equal(sat[-1], [2.0, -2.0])
+
+
+def test_sec5_certified_gamma_simulation(specs_dir):
+    """With the certified γ the refining never increases V (Lemma 3) and lowers the peak a little."""
+    res = api.simulate(specs_dir / SEC5, gamma="2.3965e-05")
+    assert "certified" in res.info["gamma (simulation)"]
+    t10 = res.extra["traces"]["modified θ_m=10"]
+    np.testing.assert_allclose(t10.sup_k(), [21.022, 19.986], atol=1e-3)
+    assert float(res.info["modified θ_m=10: max V increase over a refining step"]) <= 1e-9
+
+
+BASE = """
+[system]
+time = "discrete"
+A = [[0, 1], [1, 0]]
+C = [[1, 0]]
+[sets.X]
+type = "box"
+lower = [-1, -1]
+upper = [1, 1]
+[sets.small]
+type = "box"
+lower = [-0.5, -0.5]
+upper = [0.5, 0.5]
+[method]
+key = "constrained"
+L = [-1.87, 1.874]
+lambda = 0.955
+rho = 0.955
+X = "X"
+eps_min = 0.01
+{extra}
+[method.c]
+{c}
+[method.D]
+lower = [-3]
+upper = [3]
+"""
+BOX = 'type = "box"\nlower = [-1.1, -1.1]\nupper = [1.1, 1.1]'
+
+
+def _spec(extra: str = "", c: str = BOX):
+    return load_spec_text(BASE.format(extra=extra, c=c), "bad.toml")
+
+
+def test_bad_eps_order():
+    with pytest.raises(SpecError) as e:
+        _spec("eps_max = 0.005")
+    assert "method.eps_max" in str(e.value) and "bad.toml" in str(e.value)
+
+
+def test_bad_gamma_above_bound_names_the_bound():
+    sp = _spec("gamma = 17")
+    with pytest.raises(InfeasibleError) as e:
+        api.design(sp)
+    assert "2.3965e-05" in str(e.value) and "(24)" in str(e.value)
+
+
+def test_gamma_uncertified_is_failed_claim():
+    sp = _spec("gamma = 17\ngamma_uncertified = true")
+    rep = api.design(sp)
+    st = {c.id: c.status for c in rep.claims}
+    assert st["gamma-bound"] == ClaimStatus.FAILED
+    assert rep.exit_code() == 1
+
+
+def test_bad_nonconvex_c():
+    with pytest.raises(SpecError) as e:
+        _spec(c='type = "ellipsoid"\nQ = [[1, 0], [0, -1]]\nr = 2')
+    assert "method.c.Q" in str(e.value) and "convex" in str(e.value)
+    with pytest.raises(SpecError) as e:
+        _spec(c='type = "sine"')
+    assert "method.c.type" in str(e.value)
+
+
+def test_bad_P_not_positive_definite():
+    text = BASE.format(extra="", c=BOX).replace(
+        "lambda = 0.955\nrho = 0.955", "P = [[1, 2], [2, 1]]\nrho = 0.9\nmu = 1"
+    )
+    with pytest.raises(SpecError) as e:
+        load_spec_text(text, "bad.toml")
+    assert "method.P" in str(e.value)
+
+
+def test_bad_xhat_not_containing_x():
+    """X̂ ⊉ X (hence ⊉ C_min): the inclusion claim fails, exit 1 with the reason."""
+    rep = api.design(_spec('Xhat = "small"'))
+    st = {c.id: c for c in rep.claims}
+    assert st["Cmin-in-Xhat"].status == ClaimStatus.FAILED
+    assert rep.exit_code() == 1
+
+
+def test_bad_c_not_containing_x():
+    rep = api.design(_spec(c='type = "box"\nlower = [-0.9, -0.9]\nupper = [0.9, 0.9]'))
+    st = {c.id: c for c in rep.claims}
+    assert st["X-in-C0"].status == ClaimStatus.FAILED
+
+
+def test_cli_exit_codes(write_spec):
+    r = CliRunner()
+    p = write_spec(BASE.format(extra="eps_max = 0.001", c=BOX))
+    out = r.invoke(app, ["design", str(p)])
+    assert out.exit_code == 2 and "eps_max" in out.output
+    p = write_spec(BASE.format(extra="gamma = 17", c=BOX), "g.toml")
+    out = r.invoke(app, ["design", str(p)])
+    assert out.exit_code == 1 and "Traceback" not in out.output
+
+
+def test_ellipsoid_and_polytope_maps_design():
+    for c in (
+        'type = "ellipsoid"\nQ = [[1, 0], [0, 1]]\nr = 2.5',
+        'type = "polytope"\nG = [[1, 0], [0, 1], [-1, 0], [0, -1], [1, 1]]\nh = [1.1, 1.1, 1.1, 1.1, 2.1]',
+    ):
+        rep = api.design(_spec(c=c))
+        bad = [(x.id, x.detail) for x in rep.claims if x.status != ClaimStatus.CERTIFIED]
+        assert not bad, bad
+        assert int(rep.parameters["theta"]) > 0
+
+
+def test_remark2_theta_zero():
+    """A contracting observer with a small disturbance and a generous C_min: θ = 0 (Remark 2)."""
+    text = """
+[system]
+time = "discrete"
+A = [[0.5, 0], [0, 0.5]]
+C = [[1, 0], [0, 1]]
+[sets.X]
+type = "box"
+lower = [-1, -1]
+upper = [1, 1]
+[method]
+key = "constrained"
+L = [[0.4, 0], [0, 0.4]]
+lambda = 0.2
+X = "X"
+eps_min = 100
+[method.c]
+type = "box"
+lower = [-1, -1]
+upper = [1, 1]
+[method.D]
+lower = [0, 0]
+upper = [0, 0]
+"""
+    rep = api.design(load_spec_text(text, "r2.toml"))
+    assert int(rep.parameters["theta"]) == 0
+    assert any("Remark 2" in n for n in rep.notes)
+    assert rep.exit_code() == 0
