@@ -1,0 +1,157 @@
+"""The iterated convex-hull algorithms of Sections V and VI (Dórea & Pimenta, paper 003).
+
+Both run in float64 on a point cloud ``P`` whose hull is the current polyhedron ``C^i``
+(``Ω``'s vertices are always kept in ``P``, so ``Ω ⊆ C^i`` whatever the hull merges). New
+points are floats, so nothing grows like exact iterated hulls do; the final polyhedron is
+proved exactly by :mod:`.certificate`.
+
+* :func:`general` — Section V, steps 1-9: at the worst breakpoint z^l (max of ε(z^l), LP (9))
+  the image ``Q^i = A·S(z^l) + B1·D + v^l`` of the slice is added, scaled by 1/λ:
+  ``C^{i+1} = Conv(C^i ∪ (1/λ) Q^i)``. Option ``mirror`` also adds ``−(1/λ) Q^i`` (keeps a
+  symmetric start symmetric; converges in fewer iterations on Example 7.2).
+* :func:`symmetric` — Section VI: steps 2-5 become "compute φ_q(0) and ε = max_i(φ_q,i(0) +
+  ξ_i)" (condition (14)), and ``Q^i = A·S(0) + B1·D`` with S(0) = {|Q^i e| <= 1, |C e| <= η̄};
+  converges to C_K^∞(Ω, D, λ).
+
+Stopping: ε^i <= ``lam_stop`` (the paper's rule is λ(1 + Δδ)), or the iteration cap.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from obsdesign.sets import polytope_ops as po
+
+from . import lps
+
+Progress = Callable[[str], None]
+
+
+@dataclass
+class Problem:
+    """Float data of one design: x⁺ = A x + B1 d, z = C e + η, Ω = {G0 e <= 1}, D = conv(Dv)."""
+
+    A: np.ndarray
+    B1: np.ndarray
+    C: np.ndarray
+    G0: np.ndarray
+    Dv: np.ndarray
+    eta: float
+
+    @property
+    def n(self) -> int:
+        return self.A.shape[0]
+
+    @property
+    def p(self) -> int:
+        return self.C.shape[0]
+
+
+@dataclass
+class IterResult:
+    """Outcome of an algorithm run: the last polyhedron and how it got there."""
+
+    G: np.ndarray
+    P: np.ndarray
+    eps: float
+    iterations: int
+    converged: bool
+    history: list[dict[str, float]] = field(default_factory=list)
+
+
+def _drop_inside(img: np.ndarray, G: np.ndarray, tol: float) -> np.ndarray:
+    """Keep only the new points that stick out of {G e <= 1} by more than ``tol``."""
+    if len(img) == 0:
+        return img
+    return img[(img @ G.T).max(axis=1) > 1 + tol]
+
+
+def general(
+    pb: Problem,
+    lam_run: float,
+    lam_stop: float,
+    max_iter: int,
+    mirror: bool = False,
+    start: np.ndarray | None = None,
+    progress: Progress | None = None,
+    drop_tol: float = 1e-10,
+    it0: int = 0,
+    history: list | None = None,
+) -> IterResult:
+    """General algorithm, Section V steps 1-9 (single output). ``start`` is an optional
+    point cloud to start from (it is merged with Ω's vertices)."""
+    c = pb.C.reshape(-1)
+    Vo = po.h_to_v(pb.G0).V
+    P = Vo if start is None else np.vstack([start, Vo])
+    hist = [] if history is None else history
+    Bd = pb.Dv @ pb.B1.T if pb.B1.shape[1] else np.zeros((1, pb.n))
+    eps_l = np.inf
+    st = None
+    for it in range(it0 + 1, it0 + max_iter + 1):
+        st = po.hull(P)
+        P, G = st.V, st.G
+        dl = lps.delta(G, pb.B1, pb.Dv)
+        zs = lps.z_d(P, c, pb.eta)  # step 3
+        phi, slices = lps.phi_at(G, pb.A, P, st.edges, c, pb.eta, zs)  # step 4a
+        er = lps.eps_batch(G, phi, dl)  # step 4b
+        l = int(np.argmax(er.eps))  # step 5
+        eps_l = float(er.eps[l])
+        hist.append({"iteration": it, "facets": len(G), "vertices": len(P), "eps": eps_l})
+        if progress:
+            progress(f"general: iteration {it}, {len(G)} facets, eps = {eps_l:.6f}")
+        if eps_l <= lam_stop:  # step 6
+            return IterResult(G, P, eps_l, it, True, hist)
+        img = slices[l] @ pb.A.T + er.v[l]  # step 7
+        img = po.minkowski_points(img, Bd) / lam_run  # step 8
+        if mirror:
+            img = np.vstack([img, -img])
+        P = np.vstack([P, _drop_inside(img, G, drop_tol)])
+    assert st is not None
+    return IterResult(st.G, st.V, eps_l, it0 + max_iter, False, hist)
+
+
+def symmetric(
+    pb: Problem,
+    lam_run: float,
+    lam_stop: float,
+    max_iter: int,
+    progress: Progress | None = None,
+    drop_tol: float = 1e-10,
+    it0: int = 0,
+    start: np.ndarray | None = None,
+    history: list | None = None,
+) -> IterResult:
+    """Symmetric algorithm of Section VI: condition (14) at z = 0 with v = 0.
+
+    D is symmetrized (D ∪ −D), which only enlarges it: the paper assumes |E d| <= 1."""
+    c = pb.C.reshape(-1) if pb.p == 1 else None
+    Vo = po.h_to_v(pb.G0).V
+    P = np.vstack([Vo, -Vo]) if start is None else np.vstack([start, -start, Vo, -Vo])
+    Dv = np.vstack([pb.Dv, -pb.Dv]) if len(pb.Dv) else pb.Dv
+    Bd = Dv @ pb.B1.T if pb.B1.shape[1] else np.zeros((1, pb.n))
+    hist = [] if history is None else history
+    eps = np.inf
+    st = None
+    for it in range(it0 + 1, it0 + max_iter + 1):
+        st = po.hull(P)
+        P, G = st.V, st.G
+        xi = lps.delta(G, pb.B1, Dv)  # (13)
+        if c is not None:
+            S = po.slice_points(P, st.edges, c, -pb.eta, pb.eta)
+            phi0 = (G @ pb.A @ S.T).max(axis=1)
+        else:
+            phi0, S = lps.phi_slice_general(G, pb.A, pb.C, pb.eta)
+        eps = float((phi0 + xi).max())  # condition (14)
+        hist.append({"iteration": it, "facets": len(G), "vertices": len(P), "eps": eps})
+        if progress:
+            progress(f"symmetric: iteration {it}, {len(G)} facets, eps(14) = {eps:.6f}")
+        if eps <= lam_stop:
+            return IterResult(G, P, eps, it, True, hist)
+        img = po.minkowski_points(S @ pb.A.T, Bd) / lam_run
+        img = np.vstack([img, -img])
+        P = np.vstack([P, _drop_inside(img, G, drop_tol)])
+    assert st is not None
+    return IterResult(st.G, st.V, eps, it0 + max_iter, False, hist)

@@ -1,0 +1,308 @@
+"""Exact certificates for the set-invariant method (paper 003), all in rational arithmetic.
+
+* :func:`omega_contained` — Ω ⊆ {G e <= 1}: every exact vertex of Ω satisfies every row.
+* :func:`theorem31` — Theorem 3.1: for every z^l in Z_d (computed exactly from the exact
+  vertices of {G e <= 1}), ``φ(z^l) + G v^l + δ <= λ 1`` holds exactly for the rational v^l,
+  with φ(z^l) (LP (6)) taken exactly as the max of G A over the slice's exact vertices and
+  δ exactly from D's vertices. Because φ is concave (an LP value in its right-hand side) and
+  the slice's vertices move affinely between consecutive points of Z_d, φ is affine on each
+  segment [z^l, z^{l+1}], so the interpolated law (12) of Proposition 4.1 is certified too.
+* :func:`linear_law` — Proposition 7.1 / linear injection ``v = L z``: for every vertex e of
+  {G e <= 1} and every vertex η of the noise box, ``G (A + L C) e + G L η + δ <= λ 1``.
+
+Float values are used only to pick which entries to evaluate exactly, with a threshold far
+above the float error, so a skipped entry is provably below the bound.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from fractions import Fraction
+from itertools import product
+
+import numpy as np
+from flint import fmpq
+
+from obsdesign.sets import polytope_ops as po
+
+_FILTER = 1e-7  # relative slack of the float prefilter (float error is ~1e-15 relative)
+
+
+@dataclass
+class ExactProblem:
+    """Exact data: A, B1, C (p×n), Ω rows G0 (rhs 1), vertices of Ω and of D, η̄, λ."""
+
+    A: np.ndarray
+    B1: np.ndarray
+    C: np.ndarray
+    G0: np.ndarray
+    Vo: np.ndarray
+    Dv: np.ndarray
+    eta: fmpq
+    lam: fmpq
+
+    @property
+    def n(self) -> int:
+        return self.A.shape[0]
+
+
+def qmatmul(X: np.ndarray, Y: np.ndarray) -> np.ndarray:
+    """Exact product of two fmpq object arrays."""
+    X = np.asarray(X, dtype=object)
+    Y = np.asarray(Y, dtype=object)
+    out = np.empty((X.shape[0], Y.shape[1]), dtype=object)
+    for i in range(X.shape[0]):
+        for j in range(Y.shape[1]):
+            s = fmpq(0)
+            for k in range(X.shape[1]):
+                s += X[i, k] * Y[k, j]
+            out[i, j] = s
+    return out
+
+
+def delta_exact(G: np.ndarray, B1: np.ndarray, Dv: np.ndarray) -> list[fmpq]:
+    """δ_i = max_{d ∈ vert D} G_i B1 d exactly (Section III)."""
+    if B1.shape[1] == 0 or len(Dv) == 0:
+        return [fmpq(0)] * len(G)
+    GB = qmatmul(G, B1)
+    return [max(po.qdot(GB[i], d) for d in Dv) for i in range(len(G))]
+
+
+def omega_contained(G: np.ndarray, Vo: np.ndarray) -> tuple[bool, fmpq]:
+    """Ω ⊆ {G e <= 1} exactly; returns (ok, max over rows and Ω-vertices of G_i e)."""
+    m = max(po.qdot(G[i], v) for i in range(len(G)) for v in Vo)
+    return m <= 1, m
+
+
+def exact_zd(V: np.ndarray, c: np.ndarray, eta: fmpq) -> tuple[list[fmpq], list[fmpq]]:
+    """(Z_d sorted and distinct, c·V per vertex), exactly (Section III)."""
+    cv = [po.qdot(c, v) for v in V]
+    zs = {x - eta for x in cv} | {x + eta for x in cv}
+    return sorted(zs), cv
+
+
+@dataclass
+class Theorem31Result:
+    """Exact outcome of the Theorem 3.1 check."""
+
+    ok: bool
+    factor: fmpq
+    zs: list[fmpq]
+    vs: list[list[fmpq]]
+    eps: list[fmpq]
+    worst: int
+    n_vertices: int
+    exact_lp: int = 0
+    notes: list[str] = field(default_factory=list)
+
+
+class _Slices:
+    """Slices of {G e <= 1} at each z^l: float candidates, exact points on demand.
+
+    For each slab ``|c·e − z| <= η̄`` the candidates are the vertices and edge crossings
+    that the float prefilter cannot exclude (threshold 1e-9 relative, far above the float
+    error); a candidate's exact point is computed only when a row of φ needs it, and only
+    if it exists exactly (vertex inside the slab, or strict crossing). The true maximizer
+    of every needed row is among the candidates within the float tolerance of the float
+    max, so the exact φ_i is exact."""
+
+    def __init__(
+        self, ex: ExactProblem, G: np.ndarray, vrep: po.ExactVRep, zs: list[fmpq], cv: list[fmpq]
+    ):
+        self.G = G
+        self.GA = qmatmul(G, ex.A)
+        self.GAf = po.qfloat(self.GA)
+        self.absGA = np.abs(self.GAf)
+        self.V = vrep.V
+        self.Vf = po.qfloat(vrep.V)
+        self.cv = cv
+        self.cvf = po.qfloat(np.array(cv, dtype=object))
+        self.eta = ex.eta
+        self.zs = zs
+        e = np.array(vrep.edges, dtype=int).reshape(-1, 2)
+        self.ea, self.eb = e[:, 0], e[:, 1]
+        self.emin = np.minimum(self.cvf[self.ea], self.cvf[self.eb])
+        self.emax = np.maximum(self.cvf[self.ea], self.cvf[self.eb])
+        self.tol = 1e-9 * max(1.0, float(np.abs(self.cvf).max()))
+        self.cands: list[list[tuple]] = []
+        self.ptsf: list[np.ndarray] = []
+        for z in zs:
+            lo, hi = float(z - ex.eta), float(z + ex.eta)
+            cand: list[tuple] = []
+            pts = []
+            for j in np.nonzero((self.cvf >= lo - self.tol) & (self.cvf <= hi + self.tol))[0]:
+                cand.append(("v", int(j)))
+                pts.append(self.Vf[j])
+            for side, t in ((0, lo), (1, hi)):
+                if side == 1 and ex.eta == 0:
+                    break
+                for k in np.nonzero((self.emin <= t + self.tol) & (self.emax >= t - self.tol))[0]:
+                    a, b = int(self.ea[k]), int(self.eb[k])
+                    ca, cb = self.cvf[a], self.cvf[b]
+                    w = 0.5 if cb == ca else min(1.0, max(0.0, (t - ca) / (cb - ca)))
+                    cand.append(("e", a, b, side))
+                    pts.append(self.Vf[a] + w * (self.Vf[b] - self.Vf[a]))
+            self.cands.append(cand)
+            self.ptsf.append(np.array(pts).reshape(-1, ex.n))
+        self._cache: dict[tuple, tuple | None] = {}
+
+    def _exact_point(self, l: int, cand: tuple) -> tuple | None:
+        key = (l, cand)
+        if key in self._cache:
+            return self._cache[key]
+        z = self.zs[l]
+        lo, hi = z - self.eta, z + self.eta
+        out = None
+        if cand[0] == "v":
+            j = cand[1]
+            if lo <= self.cv[j] <= hi:
+                out = tuple(self.V[j])
+        else:
+            _, a, b, side = cand
+            t = hi if side else lo
+            da, db = self.cv[a] - t, self.cv[b] - t
+            if (da < 0 < db) or (db < 0 < da):
+                w = (t - self.cv[a]) / (self.cv[b] - self.cv[a])
+                out = tuple(
+                    self.V[a][k] + w * (self.V[b][k] - self.V[a][k]) for k in range(self.V.shape[1])
+                )
+        self._cache[key] = out
+        return out
+
+    def phi_float(self, l: int) -> np.ndarray:
+        return (self.GAf @ self.ptsf[l].T).max(axis=1)
+
+    def phi_exact(self, l: int, rows=None) -> dict[int, fmpq]:
+        """Exact φ_i(z^l) (LP (6)) for the given rows: max of G_i A over the slice vertices."""
+        S = self.ptsf[l]
+        M = self.GAf @ S.T
+        tol = _FILTER * (self.absGA @ np.abs(S).T).max(axis=1) + 1e-300
+        rows = range(len(self.G)) if rows is None else rows
+        out = {}
+        for i in rows:
+            best = None
+            for j in np.nonzero(M[i] >= M[i].max() - tol[i])[0]:
+                p = self._exact_point(l, self.cands[l][j])
+                if p is not None:
+                    val = po.qdot(self.GA[i], p)
+                    best = val if best is None or val > best else best
+            if best is None:
+                raise RuntimeError("empty exact slice (internal error)")
+            out[int(i)] = best
+        return out
+
+
+def exact_lp9(G: np.ndarray, phi: list[fmpq], dl: list[fmpq]) -> tuple[fmpq, list[fmpq]]:
+    """LP (9) solved exactly by cdd.gmp: min ε s.t. φ + G v + δ <= ε 1. Returns (ε, v)."""
+    import cdd
+    import cdd.gmp as cddg
+
+    fr = po._fr
+    n = G.shape[1]
+    rows = [
+        [-fr(dl[i]) - fr(phi[i])] + [-fr(x) for x in G[i]] + [Fraction(1)] for i in range(len(G))
+    ]
+    m = cddg.matrix_from_array(
+        rows,
+        rep_type=cdd.RepType.INEQUALITY,
+        obj_type=cdd.LPObjType.MIN,
+        obj_func=[Fraction(0)] * (n + 1) + [Fraction(1)],
+    )
+    lp = cddg.linprog_from_matrix(m)
+    cddg.linprog_solve(lp)
+    if lp.status != cdd.LPStatusType.OPTIMAL:
+        raise RuntimeError(f"exact LP (9) status {lp.status}")
+    x = lp.primal_solution
+    return po._q(x[n]), [po._q(t) for t in x[:n]]
+
+
+def theorem31(
+    ex: ExactProblem,
+    G: np.ndarray,
+    vs: list[list[fmpq]] | None = None,
+    zs_given: list[fmpq] | None = None,
+    v_solver=None,
+) -> Theorem31Result:
+    """Exact check of Theorem 3.1 for {G e <= 1} (single output).
+
+    With ``vs`` given (verify), every breakpoint of Z_d must be in ``zs_given`` and the check
+    uses the given v^l at the Z_d points. Without (design), v^l comes from the float LP (9)
+    (``v_solver(G, phi, delta) -> EpsResult``), rounded by :func:`po.snap`, and from an exact
+    cdd.gmp LP wherever the rounded v does not pass.
+    """
+    vrep = po.exact_h_to_v(G)
+    c = ex.C[0]
+    zs, cv = exact_zd(vrep.V, c, ex.eta)
+    dl = delta_exact(G, ex.B1, ex.Dv)
+    notes: list[str] = []
+    if vs is not None:
+        assert zs_given is not None
+        pos = {z: i for i, z in enumerate(zs_given)}
+        missing = [z for z in zs if z not in pos]
+        if missing:
+            return Theorem31Result(
+                False,
+                fmpq(10**9),
+                zs,
+                [],
+                [],
+                0,
+                len(vrep.V),
+                0,
+                [f"breakpoint {missing[0]} of Z_d is missing from the injection table"],
+            )
+        vs_use = [vs[pos[z]] for z in zs]
+    sl = _Slices(ex, G, vrep, zs, cv)
+    Gf = po.qfloat(G)
+    dlf = po.qfloat(np.array(dl, dtype=object))
+    if vs is None:
+        phif = np.array([sl.phi_float(l) for l in range(len(zs))])
+        er = v_solver(Gf, phif, dlf)
+        vs_use = [[po.snap(x) for x in er.v[l]] for l in range(len(zs))]
+    absG = np.abs(Gf)
+    eps_l: list[fmpq] = []
+    out_vs: list[list[fmpq]] = []
+    n_exact = 0
+    for l in range(len(zs)):
+        v = vs_use[l]
+        vf = po.qfloat(np.array(v, dtype=object))
+        val = sl.phi_float(l) + Gf @ vf + dlf
+        tol = _FILTER * (np.abs(sl.phi_float(l)) + absG @ np.abs(vf) + np.abs(dlf) + 1.0)
+        thr = min(float(ex.lam), float(val.max()))
+        rows = np.nonzero(val >= thr - tol)[0]
+        ph = sl.phi_exact(l, rows)
+        e = max(ph[i] + po.qdot(G[i], v) + dl[i] for i in ph)
+        if e > ex.lam and vs is None:
+            phall = sl.phi_exact(l)
+            e, v = exact_lp9(G, [phall[i] for i in range(len(G))], dl)
+            n_exact += 1
+        eps_l.append(e)
+        out_vs.append(list(v))
+    worst = int(max(range(len(zs)), key=lambda k: eps_l[k])) if zs else 0
+    factor = eps_l[worst] if zs else fmpq(0)
+    return Theorem31Result(
+        factor <= ex.lam, factor, zs, out_vs, eps_l, worst, len(vrep.V), n_exact, notes
+    )
+
+
+def linear_law(ex: ExactProblem, G: np.ndarray, V: np.ndarray, L: np.ndarray) -> tuple[bool, fmpq]:
+    """Exact check of the linear injection v = L z on {G e <= 1} with vertices V:
+    max over vertices e, noise vertices η (|η_k| = η̄) and rows i of
+    ``G_i (A + L C) e + G_i L η + δ_i`` must be <= λ (proof of Proposition 7.1).
+    Returns (ok, the certified factor)."""
+    M = ex.A + qmatmul(L, ex.C)
+    GM = qmatmul(G, M)
+    GL = qmatmul(G, L)
+    dl = delta_exact(G, ex.B1, ex.Dv)
+    best = None
+    for i in range(len(G)):
+        noise = sum((abs(x) for x in GL[i]), fmpq(0)) * ex.eta
+        m = max(po.qdot(GM[i], v) for v in V) + noise + dl[i]
+        best = m if best is None or m > best else best
+    assert best is not None
+    return best <= ex.lam, best
+
+
+def noise_vertices(p: int, eta: fmpq) -> list[tuple[fmpq, ...]]:
+    """Vertices of the noise box {|η_k| <= η̄}."""
+    return list(product(*[(-eta, eta)] * p))

@@ -1,0 +1,182 @@
+"""Linear output injection v = L z (Proposition 7.1, Dórea & Pimenta, paper 003).
+
+Proposition 7.1 (p = n − 1, η = 0): if the symmetric polyhedron {|Q e| <= 1} satisfies
+condition (15) (= (14)), then ``L = A [Q_I; C]^{-1} [0; −I]`` keeps it λ-contractive, where
+Q_I is "the only non-redundant row of Q in Ω ∩ ker C". That row need not be unique: on
+Example 7.1 two rows tie, and the two choices give different gains. So this module computes
+the whole *admissible set* of linear gains,
+
+    𝓛 = {L : G_i (A + L C) e + G_i L η + δ_i <= λ  for every row i, vertex e, noise vertex η},
+
+a polyhedron in L (the constraints are linear in L), reports it (its vertices when the
+dimension n·p is small), and picks a gain inside it: the max-margin point when 𝓛 has an
+interior, else the average of its vertices (a relative-interior point; every Prop. 7.1
+choice of Q_I lies in 𝓛 by the proposition, so this is in the convex hull of them when they
+span it).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from flint import fmpq
+from scipy.optimize import linprog
+
+from obsdesign.sets import polytope_ops as po
+
+from .certificate import ExactProblem, delta_exact, linear_law, noise_vertices, qmatmul
+
+
+@dataclass
+class GainSet:
+    """The admissible linear gains and the pick."""
+
+    L: np.ndarray | None  # (n, p) fmpq, None if 𝓛 is empty
+    factor: fmpq | None
+    how: str
+    vertices: list[np.ndarray] = field(default_factory=list)  # exact vertices of 𝓛 (small n·p)
+    dimension: int | None = None
+    prop71: list[tuple[int, np.ndarray]] = field(default_factory=list)  # (row index, L)
+    margin: float = 0.0
+
+
+def _constraints(
+    ex: ExactProblem, G: np.ndarray, V: np.ndarray
+) -> tuple[list[list[fmpq]], list[fmpq]]:
+    """Rows a·vec(L) <= b of 𝓛 (vec row-major over L's n×p entries), exactly."""
+    n, p = ex.n, ex.C.shape[0]
+    GA = qmatmul(G, ex.A)
+    dl = delta_exact(G, ex.B1, ex.Dv)
+    etas = noise_vertices(p, ex.eta) if ex.eta != 0 else [tuple([fmpq(0)] * p)]
+    Ce = [[po.qdot(ex.C[k], v) for k in range(p)] for v in V]
+    rows, rhs = [], []
+    seen = set()
+    for i in range(len(G)):
+        for j, v in enumerate(V):
+            base = ex.lam - dl[i] - po.qdot(GA[i], v)
+            for eta in etas:
+                w = [Ce[j][k] + eta[k] for k in range(p)]
+                a = [G[i][r] * w[k] for r in range(n) for k in range(p)]
+                key = (tuple(a), base)
+                if key not in seen:
+                    seen.add(key)
+                    rows.append(a)
+                    rhs.append(base)
+    return rows, rhs
+
+
+def prop71_gains(ex: ExactProblem, G: np.ndarray) -> list[tuple[int, np.ndarray]]:
+    """L = A [Q_I; C]^{-1} [0; −I] for every tying choice of Q_I (Proposition 7.1, p = n−1).
+
+    ker C is one-dimensional, spanned by k; the non-redundant rows of Ω ∩ ker C are those
+    with the largest |G_i k|."""
+    import sympy
+
+    n, p = ex.n, ex.C.shape[0]
+    if p != n - 1:
+        return []
+    Cs = sympy.Matrix([[sympy.Rational(int(x.p), int(x.q)) for x in r] for r in ex.C])
+    ns = Cs.nullspace()
+    if len(ns) != 1:
+        return []
+    k = [fmpq(int(sympy.fraction(x)[0]), int(sympy.fraction(x)[1])) for x in ns[0]]
+    vals = [abs(po.qdot(G[i], k)) for i in range(len(G))]
+    best = max(vals)
+    out = []
+    for i in range(len(G)):
+        if vals[i] == best:
+            M = sympy.Matrix(
+                [[sympy.Rational(int(x.p), int(x.q)) for x in G[i]]]
+                + [list(r) for r in Cs.tolist()]
+            )
+            if M.det() == 0:
+                continue
+            rhs = sympy.zeros(n, p)
+            for r in range(p):
+                rhs[r + 1, r] = -1
+            As = sympy.Matrix([[sympy.Rational(int(x.p), int(x.q)) for x in r] for r in ex.A])
+            Lm = As * M.inv() * rhs
+            L = np.array(
+                [
+                    [fmpq(int(sympy.fraction(x)[0]), int(sympy.fraction(x)[1])) for x in r]
+                    for r in Lm.tolist()
+                ],
+                dtype=object,
+            )
+            if not any(np.array_equal(L, L2) for _, L2 in out) and not any(
+                np.array_equal(L, -L2) for _, L2 in out
+            ):
+                out.append((i, L))
+    return out
+
+
+def admissible_gains(
+    ex: ExactProblem, G: np.ndarray, V: np.ndarray, max_dim_enum: int = 4
+) -> GainSet:
+    """The admissible set 𝓛 of linear gains for {G e <= 1} and a certified pick inside it."""
+    n, p = ex.n, ex.C.shape[0]
+    rows, rhs = _constraints(ex, G, V)
+    Af = po.qfloat(np.array(rows, dtype=object))
+    bf = po.qfloat(np.array(rhs, dtype=object))
+    nl = n * p
+    # max-margin LP: max t s.t. A x + t·‖a‖ <= b, t <= 1
+    norms = np.linalg.norm(Af, axis=1)
+    c = np.zeros(nl + 1)
+    c[-1] = -1.0
+    res = linprog(
+        c,
+        A_ub=np.hstack([Af, norms[:, None]]),
+        b_ub=bf,
+        bounds=[(None, None)] * nl + [(None, 1.0)],
+        method="highs",
+    )
+    prop = prop71_gains(ex, G)
+    if res.status != 0 or res.x[-1] < -1e-9:
+        return GainSet(None, None, "the admissible set of linear gains is empty", prop71=prop)
+    margin = float(res.x[-1])
+    verts: list[np.ndarray] = []
+    dim = None
+    if nl <= max_dim_enum:
+        import cdd
+        import cdd.gmp as cddg
+
+        mat = [[po._fr(rhs[i])] + [-po._fr(x) for x in rows[i]] for i in range(len(rows))]
+        poly = cddg.polyhedron_from_matrix(
+            cddg.matrix_from_array(mat, rep_type=cdd.RepType.INEQUALITY)
+        )
+        gen = cddg.copy_generators(poly)
+        for idx, r in enumerate(gen.array):
+            if r[0] != 0 and idx not in gen.lin_set:
+                verts.append(np.array([po._q(x / r[0]) for x in r[1:]], dtype=object).reshape(n, p))
+        has_dir = bool(gen.lin_set) or any(r[0] == 0 for r in gen.array)
+        if verts and not has_dir:
+            X = np.array([po.qfloat(v).reshape(-1) for v in verts])
+            dim = int(np.linalg.matrix_rank(X - X[0], tol=1e-12)) if len(X) > 1 else 0
+    candidates: list[tuple[np.ndarray, str]] = []
+    if margin > 1e-9:
+        candidates.append(
+            (
+                po.rationalize(res.x[:nl]).reshape(n, p),
+                "max-margin point of the admissible set (it has an interior)",
+            )
+        )
+    if verts:
+        avg = sum((v for v in verts), np.full((n, p), fmpq(0), dtype=object)) * fmpq(1, len(verts))
+        candidates.append(
+            (
+                avg,
+                f"average of the {len(verts)} vertices of the admissible set (a relative-interior point)",
+            )
+        )
+    if prop:
+        avg = sum((L for _, L in prop), np.full((n, p), fmpq(0), dtype=object)) * fmpq(1, len(prop))
+        candidates.append((avg, "average of the Proposition 7.1 gains"))
+        for i, L in prop:
+            candidates.append((L, f"Proposition 7.1 with Q_I = row {i}"))
+    candidates.append((po.rationalize(res.x[:nl]).reshape(n, p), "max-margin LP point"))
+    for L, how in candidates:
+        ok, f = linear_law(ex, G, V, L)
+        if ok:
+            return GainSet(L, f, how, verts, dim, prop, margin)
+    return GainSet(None, None, "no candidate gain passed the exact check", verts, dim, prop, margin)

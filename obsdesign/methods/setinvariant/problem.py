@@ -1,0 +1,118 @@
+"""From a spec to the float and exact data of a set-invariant design (paper 003, Section II-III).
+
+Error dynamics (3): e(k+1) = A e(k) + B1 d(k) + v(z(k)), z(k) = C e(k) + η(k), d ∈ D,
+|η| <= η̄; Ω = {e : G0 e <= 1} is the initial-error polytope (canonical form, right-hand
+side 1, which needs the origin in its interior).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from flint import fmpq
+
+from obsdesign.errors import InfeasibleError
+from obsdesign.sets import Box, Polytope
+from obsdesign.sets import polytope_ops as po
+from obsdesign.spec.models import Spec
+
+from .algorithms import Problem
+from .certificate import ExactProblem
+
+
+@dataclass
+class Data:
+    """Float problem, exact problem and the float vertices of D."""
+
+    fl: Problem
+    ex: ExactProblem
+
+
+def omega_rows(s: Any) -> np.ndarray:
+    """Exact canonical rows (right-hand side 1) of a Box / Polytope set; raises ValueError
+    when the origin is not in the interior."""
+    if isinstance(s, Box):
+        G, g = s.h_form_q()
+    elif isinstance(s, Polytope):
+        G, g = s.G_q, s.g_q
+    else:  # pragma: no cover - filtered by parse_options
+        raise ValueError("expected a box or a polytope")
+    if any(x <= 0 for x in np.asarray(g).reshape(-1)):
+        raise ValueError("the origin must be in the interior (every right-hand side > 0)")
+    return po.canonical(np.asarray(G, dtype=object), np.asarray(g, dtype=object))
+
+
+def disturbance_vertices(s: Any, nd: int) -> np.ndarray:
+    """Exact vertices of D (rows); an empty (0, nd) array when there is no disturbance."""
+    if s is None:
+        return np.zeros((0, nd), dtype=object)
+    if isinstance(s, Box):
+        return np.asarray(s.vertices_q(), dtype=object)
+    return np.asarray(s.vertices_q(), dtype=object).reshape(-1, nd)
+
+
+def build(spec: Spec) -> Data:
+    """Float and exact data of the spec (the options were validated by parse_options)."""
+    o = spec.options
+    s = spec.system
+    G0 = omega_rows(spec.sets[o.omega])
+    Vo = po.exact_h_to_v(G0).V
+    D = o.D
+    Dv = disturbance_vertices(D, s.nd)
+    B1 = np.asarray(s.Bd.q, dtype=object).reshape(s.n, s.nd)
+    ex = ExactProblem(
+        np.asarray(s.A.q, dtype=object),
+        B1,
+        np.asarray(s.C.q, dtype=object),
+        G0,
+        Vo,
+        Dv,
+        o.eta_bar,
+        o.lam,
+    )
+    fl = Problem(
+        s.A.f.astype(float),
+        np.asarray(s.Bd.f, dtype=float).reshape(s.n, s.nd),
+        s.C.f.astype(float),
+        po.qfloat(G0),
+        po.qfloat(Dv).reshape(len(Dv), s.nd),
+        float(o.eta_bar),
+    )
+    return Data(fl, ex)
+
+
+def check_detectable(A: np.ndarray, C: np.ndarray, lam: float) -> None:
+    """PBH test (floats): every mode of A with |μ| > λ must be observable.
+
+    A λ-contractive set needs every unobservable mode to have |μ| <= λ (the injection cannot
+    act on it). Raises InfeasibleError naming the mode: "(C, A) not detectable" when |μ| >= 1,
+    else "unobservable mode faster than λ"."""
+    n = A.shape[0]
+    for mu in np.linalg.eigvals(A):
+        M = np.vstack([A - mu * np.eye(n), C.astype(complex)])
+        sv = np.linalg.svd(M, compute_uv=False)
+        if sv.min() <= 1e-9 * max(1.0, sv.max()):
+            if abs(mu) >= 1:
+                raise InfeasibleError(
+                    f"(C, A) is not detectable: the mode μ = {mu:.6g} (|μ| = {abs(mu):.6g} >= 1) "
+                    "is unobservable, so no bounded set is D-(C,A)-invariant"
+                )
+            if abs(mu) > lam * (1 + 1e-12):
+                raise InfeasibleError(
+                    f"the unobservable mode μ = {mu:.6g} has |μ| = {abs(mu):.6g} > λ = {lam:g}: "
+                    "no polyhedron is λ-contractive (choose λ >= |μ|)"
+                )
+
+
+def necessary_condition(
+    G: np.ndarray, B1: np.ndarray, Dv: np.ndarray, lam: fmpq
+) -> tuple[bool, fmpq]:
+    """Section II: λΩ ⊇ B1·D, i.e. max over D's vertices of G_i B1 d <= λ, exactly."""
+    from .certificate import delta_exact
+
+    if B1.shape[1] == 0 or len(Dv) == 0:
+        return True, fmpq(0)
+    m = max(delta_exact(G, B1, Dv))
+    return m <= lam, m

@@ -1,0 +1,478 @@
+"""Polytope operations for polyhedral set iterations (used by the ``set-invariant`` method).
+
+Every polytope here is written ``{e : G e <= 1}`` with the origin in its interior (the
+canonical form of the Dórea-Pimenta paper, Section III: right-hand side 1). Two modes:
+
+* **float** (design iterations, speed): vertex enumeration and convex hulls through scipy's
+  qhull, using polarity (the vertices of ``{G e <= 1}`` are the facets ``a·x = 1`` of
+  ``conv(rows of G)``), with joggled input (``QJ``) when the default qhull run fails. Every
+  hull is *outward-fixed*: each facet row is rescaled so that every input point satisfies
+  ``G p <= 1``; whatever qhull merged or joggled, the set never shrinks below the points.
+* **exact** (certificates): ``cdd.gmp`` on rationals; vertex enumeration with adjacency
+  (edges), hulls, redundancy removal and the canonical form (rows scaled to right-hand side
+  1, duplicates merged, sorted). Exact data are object arrays of ``flint.fmpq`` like the rest
+  of ``obsdesign.certify``; ``fractions.Fraction`` is used only at the cdd boundary. If only
+  the float ``cdd`` is installed (pycddlib-standalone), :data:`HAVE_GMP` is False and the
+  callers must mark their claims ``numerical``.
+
+Measured facts that shaped this module (issue 4): float cdd canonicalization silently drops
+vertices and can abort with "LP cycling" in 3-D; exact gmp hulls iterated many times grow
+about 10 bits of denominator per iteration. So iterations run in float64 on point clouds
+(the new points are floats, so denominators stay bounded) and only the final polytope is
+converted to rationals and proved.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+from flint import fmpq
+from scipy.spatial import ConvexHull, QhullError
+
+try:  # pragma: no cover - depends on the pycddlib build
+    import cdd
+    import cdd.gmp as cddg
+
+    HAVE_GMP = True
+except ImportError:  # pragma: no cover
+    import cdd
+
+    cddg = None
+    HAVE_GMP = False
+
+
+class PolytopeError(ValueError):
+    """A polytope is empty, unbounded, not full-dimensional or misses the origin."""
+
+
+# =============================================================================== float mode
+
+
+@dataclass
+class VRep:
+    """Vertices ``V`` (rows) and a superset of the edges (index pairs) of a polytope.
+
+    ``edges`` may contain segments through the relative interior of faces (triangulation
+    diagonals); slicing them only adds points of the polytope, never misses a vertex.
+    """
+
+    V: np.ndarray
+    edges: np.ndarray
+
+
+@dataclass
+class HullState:
+    """``conv(points)`` in both forms: extreme points ``V``, edges, and canonical ``G``."""
+
+    V: np.ndarray
+    edges: np.ndarray
+    G: np.ndarray
+
+
+def _qhull(points: np.ndarray) -> ConvexHull:
+    """qhull with default options, then with joggled input if the default run fails."""
+    try:
+        return ConvexHull(points)
+    except QhullError:
+        return ConvexHull(points, qhull_options="QJ")
+
+
+def merge_rows(rows: np.ndarray, tol: float = 1e-10) -> tuple[np.ndarray, np.ndarray]:
+    """Merge rows equal up to ``tol`` (relative); returns (representatives, labels)."""
+    rows = np.asarray(rows, dtype=float)
+    scale = max(1.0, float(np.abs(rows).max())) if rows.size else 1.0
+    key = np.round(rows / (scale * tol)).astype(np.int64)
+    _, first, labels = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    return rows[first], np.asarray(labels).reshape(-1)
+
+
+def outward_fix(G: np.ndarray, P: np.ndarray) -> np.ndarray:
+    """Rescale each row of ``G`` so that ``max_p G_i p = 1`` over the points ``P``.
+
+    After this, every point of ``P`` satisfies ``G p <= 1`` (up to one float rounding), so
+    the polytope contains ``conv(P)``: a vertex qhull merged or dropped cannot shrink it.
+    """
+    m = (np.asarray(G) @ np.asarray(P).T).max(axis=1)
+    if np.any(m <= 0):
+        raise PolytopeError("a facet does not separate the points from the origin")
+    return G / m[:, None]
+
+
+def _edges_from_simplices(simplices: np.ndarray, remap: dict[int, int]) -> np.ndarray:
+    e: set[tuple[int, int]] = set()
+    for s in simplices:
+        idx = [remap[int(k)] for k in s if int(k) in remap]
+        for a in range(len(idx)):
+            for b in range(a + 1, len(idx)):
+                if idx[a] != idx[b]:
+                    e.add((min(idx[a], idx[b]), max(idx[a], idx[b])))
+    return np.array(sorted(e), dtype=int).reshape(-1, 2)
+
+
+def hull(points: np.ndarray) -> HullState:
+    """Convex hull of a point cloud containing the origin in its interior (float).
+
+    Returns the extreme points, the triangulation edges (a superset of the edges) and the
+    canonical, outward-fixed H-form (one row per facet, right-hand side 1).
+    """
+    P = np.asarray(points, dtype=float)
+    n = P.shape[1]
+    if n == 1:
+        lo, hi = float(P.min()), float(P.max())
+        if not lo < 0 < hi:
+            raise PolytopeError("the origin is not interior to the hull")
+        return HullState(np.array([[lo], [hi]]), np.array([[0, 1]]), np.array([[1 / hi], [1 / lo]]))
+    try:
+        h = _qhull(P)
+    except QhullError as exc:
+        raise PolytopeError(f"the points are not full-dimensional ({exc})") from exc
+    eq = h.equations
+    if np.any(eq[:, -1] >= -1e-12):
+        raise PolytopeError("the origin is not interior to the hull")
+    remap = {int(k): i for i, k in enumerate(h.vertices)}
+    V = P[h.vertices]
+    edges = _edges_from_simplices(h.simplices, remap)
+    G, _ = merge_rows(eq[:, :-1] / (-eq[:, -1:]))
+    return HullState(V, edges, outward_fix(G, P))
+
+
+def v_to_h(points: np.ndarray) -> np.ndarray:
+    """Canonical ``G`` with ``conv(points) ⊆ {G e <= 1}`` (float, outward-fixed)."""
+    return hull(points).G
+
+
+def h_to_v(G: np.ndarray) -> VRep:
+    """Vertices and edges of ``{e : G e <= 1}`` (float) by polarity.
+
+    The polar set is ``conv(0, rows of G)``; each of its facets ``a·x = 1`` (not through the
+    origin) is a vertex ``a``; two vertices share an edge iff their polar facets share a
+    ridge. Raises PolytopeError when the polytope is unbounded (the origin lies on the
+    boundary of the polar set).
+    """
+    G = np.asarray(G, dtype=float)
+    n = G.shape[1]
+    if n == 1:
+        pos, neg = G[G[:, 0] > 0, 0], G[G[:, 0] < 0, 0]
+        if not (len(pos) and len(neg)):
+            raise PolytopeError("the polytope is unbounded")
+        return VRep(np.array([[1 / neg.min()], [1 / pos.max()]]), np.array([[0, 1]]))
+    pts = np.vstack([G, np.zeros((1, n))])
+    try:
+        h = _qhull(pts)
+    except QhullError as exc:
+        raise PolytopeError(f"the polytope is unbounded ({exc})") from exc
+    eq = h.equations
+    if np.any(eq[:, -1] >= -1e-12):
+        raise PolytopeError("the polytope is unbounded (its rows do not surround the origin)")
+    V, labels = merge_rows(eq[:, :-1] / (-eq[:, -1:]))
+    e: set[tuple[int, int]] = set()
+    for s, nb in enumerate(h.neighbors):
+        for t in nb:
+            if t >= 0 and labels[s] != labels[t]:
+                a, b = int(labels[s]), int(labels[t])
+                e.add((min(a, b), max(a, b)))
+    return VRep(V, np.array(sorted(e), dtype=int).reshape(-1, 2))
+
+
+def remove_redundant(G: np.ndarray) -> np.ndarray:
+    """Non-redundant rows of ``{G e <= 1}``: the extreme points of ``conv(0, rows of G)``."""
+    G = np.asarray(G, dtype=float)
+    if G.shape[1] == 1:
+        pos, neg = G[G[:, 0] > 0, 0], G[G[:, 0] < 0, 0]
+        return np.array(
+            [[x] for x in ([pos.max()] if len(pos) else []) + ([neg.min()] if len(neg) else [])]
+        )
+    h = _qhull(np.vstack([G, np.zeros((1, G.shape[1]))]))
+    idx = sorted(int(i) for i in h.vertices if i < len(G))
+    R, _ = merge_rows(G[idx])
+    return R
+
+
+def scale(G: np.ndarray, s: float) -> np.ndarray:
+    """``s · {G e <= 1} = {(G / s) e <= 1}`` for ``s > 0``."""
+    return np.asarray(G, dtype=float) / s
+
+
+def linear_image_points(M: np.ndarray, V: np.ndarray) -> np.ndarray:
+    """Generators of the image ``M · conv(V)``: the rows of ``V Mᵀ``."""
+    return np.asarray(V) @ np.asarray(M).T
+
+
+def minkowski_points(P1: np.ndarray, P2: np.ndarray) -> np.ndarray:
+    """All sums ``p + q`` (a superset of the vertices of ``conv(P1) ⊕ conv(P2)``)."""
+    return (P1[:, None, :] + P2[None, :, :]).reshape(-1, P1.shape[1])
+
+
+def slice_points(
+    V: np.ndarray, edges: np.ndarray, c: np.ndarray, lo: float, hi: float
+) -> np.ndarray:
+    """A superset of the vertices of the slice ``P ∩ {lo <= c·e <= hi}`` (float).
+
+    A vertex of a polytope cut by a slab is a vertex inside the slab or the crossing of an
+    edge with one of the two hyperplanes. This is the slice ``{G e <= 1, |C e - z| <= η̄}`` of
+    LP (6) with ``lo = z - η̄``, ``hi = z + η̄``.
+    """
+    cv = V @ c
+    out = [V[(cv >= lo) & (cv <= hi)]]
+    if len(edges):
+        a, b = edges[:, 0], edges[:, 1]
+        for t in {lo, hi}:
+            da, db = cv[a] - t, cv[b] - t
+            cross = da * db < 0
+            if cross.any():
+                aa, bb = a[cross], b[cross]
+                w = (t - cv[aa]) / (cv[bb] - cv[aa])
+                out.append(V[aa] + w[:, None] * (V[bb] - V[aa]))
+    return np.vstack(out)
+
+
+def check_polytope(G: np.ndarray) -> None:
+    """Raise PolytopeError unless ``{G e <= 1}`` is bounded with the origin inside."""
+    h_to_v(G)
+
+
+# =============================================================================== exact mode
+
+
+def _fr(x: Any) -> Fraction:
+    if isinstance(x, fmpq):
+        return Fraction(int(x.p), int(x.q))
+    if isinstance(x, (float, np.floating)):
+        return Fraction(float(x))
+    return Fraction(x)
+
+
+def _q(x: Fraction) -> fmpq:
+    return fmpq(x.numerator, x.denominator)
+
+
+def qarray(rows: Any) -> np.ndarray:
+    """Object array of fmpq from nested numbers (floats taken exactly)."""
+    arr = np.asarray(rows, dtype=object)
+    out = np.empty(arr.shape, dtype=object)
+    for idx, v in np.ndenumerate(arr):
+        out[idx] = v if isinstance(v, fmpq) else _q(_fr(v))
+    return out
+
+
+def qfloat(a: np.ndarray) -> np.ndarray:
+    """Floats of an fmpq array (within an ulp or so; used for prefilters and solvers only)."""
+    arr = np.asarray(a, dtype=object)
+    return np.array([float(x) for x in arr.reshape(-1)], dtype=float).reshape(arr.shape)
+
+
+def snap(x: float, max_den: int = 10**6, tol: float = 1e-12) -> fmpq:
+    """The simplest rational with denominator ``<= max_den`` within ``tol`` (relative) of
+    ``x``, else ``x`` exactly. Recovers values such as 10/9 from float iterations; the exact
+    check afterwards decides, so snapping can never make a false claim pass."""
+    f = Fraction(float(x))
+    s = f.limit_denominator(max_den)
+    if abs(float(s) - float(x)) <= tol * max(1.0, abs(float(x))):
+        return _q(s)
+    return _q(f)
+
+
+def rationalize(M: np.ndarray, bits: int | None = 36) -> np.ndarray:
+    """fmpq array of a float array: :func:`snap` to a simple rational when one is within
+    1e-12, else (``bits`` given) the nearest point of the dyadic grid with ``bits``
+    significant bits relative to the largest entry of the row, else the float exactly.
+
+    Short rationals keep cdd.gmp fast (a 300-facet 3-D polytope: 3 s with full floats);
+    the perturbation (2^-bits relative) is far below the design margins, and the exact check
+    that follows decides anyway."""
+    M = np.asarray(M, dtype=float)
+    M2 = M.reshape(1, -1) if M.ndim < 2 else M.reshape(-1, M.shape[-1])
+    out = np.empty(M2.shape, dtype=object)
+    for i, row in enumerate(M2):
+        s = float(np.abs(row).max()) if row.size else 0.0
+        k = bits - int(np.frexp(s)[1]) if (bits is not None and s > 0) else None
+        for j, v in enumerate(row):
+            f = Fraction(float(v))
+            simple = f.limit_denominator(10**6)
+            if abs(float(simple) - float(v)) <= 1e-12 * max(1.0, abs(float(v))):
+                out[i, j] = _q(simple)
+            elif k is not None:
+                out[i, j] = _q(
+                    Fraction(round(f * 2**k), 2**k)
+                    if k >= 0
+                    else Fraction(round(f / 2 ** (-k)) * 2 ** (-k))
+                )
+            else:
+                out[i, j] = _q(f)
+    return out.reshape(M.shape)
+
+
+def _require_gmp() -> None:
+    if not HAVE_GMP:  # pragma: no cover
+        raise PolytopeError("cdd.gmp is not available: exact polytope operations are disabled")
+
+
+@dataclass
+class ExactVRep:
+    """Exact vertices ``V`` ((k, n) fmpq object array) and edges (index pairs)."""
+
+    V: np.ndarray
+    edges: list[tuple[int, int]]
+
+
+def exact_h_to_v(G: np.ndarray, g: np.ndarray | None = None) -> ExactVRep:
+    """Exact vertices and edges of ``{e : G e <= g}`` (``g`` defaults to 1) by cdd.gmp.
+
+    Raises PolytopeError if it is empty, unbounded (ray or line) or not full-dimensional.
+    """
+    _require_gmp()
+    G = np.asarray(G, dtype=object)
+    k, n = G.shape
+    gg = [Fraction(1)] * k if g is None else [_fr(x) for x in np.asarray(g).reshape(-1)]
+    rows = [[gg[i]] + [-_fr(x) for x in G[i]] for i in range(k)]
+    p = cddg.polyhedron_from_matrix(cddg.matrix_from_array(rows, rep_type=cdd.RepType.INEQUALITY))
+    gen = cddg.copy_generators(p)
+    if gen.lin_set:
+        raise PolytopeError("the polyhedron is unbounded (it contains a line)")
+    if not gen.array:
+        raise PolytopeError("the polyhedron is empty")
+    if any(r[0] == 0 for r in gen.array):
+        raise PolytopeError("the polyhedron is unbounded (it has a ray)")
+    if len(gen.array) < n + 1:
+        raise PolytopeError("the polyhedron is not full-dimensional")
+    V = np.array([[_q(x / r[0]) for x in r[1:]] for r in gen.array], dtype=object).reshape(-1, n)
+    adj = cddg.copy_adjacency(p)
+    edges = sorted({(min(i, j), max(i, j)) for i, s in enumerate(adj) for j in s})
+    return ExactVRep(V, edges)
+
+
+def exact_v_to_h(P: np.ndarray) -> np.ndarray:
+    """Exact canonical H-form of ``conv(P)`` (rows with right-hand side 1) by cdd.gmp."""
+    _require_gmp()
+    rows = [[Fraction(1)] + [_fr(x) for x in p] for p in np.asarray(P, dtype=object)]
+    p = cddg.polyhedron_from_matrix(cddg.matrix_from_array(rows, rep_type=cdd.RepType.GENERATOR))
+    ineq = cddg.copy_inequalities(p)
+    if ineq.lin_set:
+        raise PolytopeError("the points are not full-dimensional")
+    out = []
+    for r in ineq.array:  # b + a·x >= 0  ->  (-a / b)·x <= 1
+        if r[0] <= 0:
+            raise PolytopeError("the origin is not interior to the hull")
+        out.append([_q(-x / r[0]) for x in r[1:]])
+    return canonical(np.array(out, dtype=object))
+
+
+def canonical(G: np.ndarray, g: np.ndarray | None = None) -> np.ndarray:
+    """Canonical exact form: rows divided by their right-hand side (which must be > 0, i.e.
+    the origin is interior), duplicates merged, rows sorted lexicographically."""
+    G = np.asarray(G, dtype=object)
+    if g is not None:
+        gv = [x if isinstance(x, fmpq) else _q(_fr(x)) for x in np.asarray(g).reshape(-1)]
+        if any(x <= 0 for x in gv):
+            raise PolytopeError("the origin is not in the interior (a right-hand side is <= 0)")
+        G = np.array(
+            [[G[i, j] / gv[i] for j in range(G.shape[1])] for i in range(G.shape[0])], dtype=object
+        )
+    uniq = sorted({tuple(_fr(x) for x in r) for r in G})
+    return np.array([[_q(x) for x in r] for r in uniq], dtype=object).reshape(len(uniq), G.shape[1])
+
+
+def exact_remove_redundant(G: np.ndarray) -> np.ndarray:
+    """Exact non-redundant rows of ``{G e <= 1}`` (cdd.gmp redundancy removal), canonical."""
+    _require_gmp()
+    G = canonical(G)
+    rows = [[Fraction(1)] + [-_fr(x) for x in r] for r in G]
+    red = cddg.redundant_rows(cddg.matrix_from_array(rows, rep_type=cdd.RepType.INEQUALITY))
+    keep = [i for i in range(len(G)) if i not in red]
+    return G[keep]
+
+
+def exact_outward_fix(G: np.ndarray, P: np.ndarray) -> tuple[np.ndarray, int]:
+    """Divide each exact row by ``max_p G_i p`` where that exceeds 1, so every point of
+    ``P`` satisfies ``G p <= 1`` exactly. Returns (rows, number of rows rescaled)."""
+    G = np.array(G, dtype=object)
+    P = np.asarray(P, dtype=object)
+    fixed = 0
+    for i in range(G.shape[0]):
+        m = max(qdot(G[i], p) for p in P)
+        if m > 1:
+            G[i] = np.array([x / m for x in G[i]], dtype=object)
+            fixed += 1
+    return G, fixed
+
+
+def qdot(a: Any, b: Any) -> fmpq:
+    """Exact dot product of two fmpq vectors."""
+    s = fmpq(0)
+    for x, y in zip(a, b, strict=True):
+        s += x * y
+    return s
+
+
+class ExactSlicer:
+    """Exact slices ``P ∩ {lo <= c·e <= hi}`` of one polytope for many slabs.
+
+    A float prefilter (threshold 1e-9 relative, far above the float error of ``c·V``)
+    selects the candidate vertices and edges; membership and crossings are then decided and
+    computed exactly, so the result is the exact superset of the slice's vertices."""
+
+    def __init__(self, V: np.ndarray, edges: list[tuple[int, int]], c: np.ndarray) -> None:
+        self.V = np.asarray(V, dtype=object)
+        self.cv = [qdot(c, v) for v in self.V]
+        self.cvf = qfloat(np.array(self.cv, dtype=object)) if len(self.cv) else np.zeros(0)
+        e = np.array(edges, dtype=int).reshape(-1, 2)
+        self.ea, self.eb = e[:, 0], e[:, 1]
+        self.emin = np.minimum(self.cvf[self.ea], self.cvf[self.eb]) if len(e) else np.zeros(0)
+        self.emax = np.maximum(self.cvf[self.ea], self.cvf[self.eb]) if len(e) else np.zeros(0)
+        self.tol = 1e-9 * max(1.0, float(np.abs(self.cvf).max()) if len(self.cvf) else 1.0)
+
+    def points(self, lo: fmpq, hi: fmpq) -> list[tuple[fmpq, ...]]:
+        lof, hif, tol, cv, V = float(lo), float(hi), self.tol, self.cv, self.V
+        n = V.shape[1]
+        cand = np.nonzero((self.cvf >= lof - tol) & (self.cvf <= hif + tol))[0]
+        pts = [tuple(V[j]) for j in cand if lo <= cv[j] <= hi]
+        for t, tf in {(lo, lof), (hi, hif)}:
+            for idx in np.nonzero((self.emin <= tf + tol) & (self.emax >= tf - tol))[0]:
+                a, b = int(self.ea[idx]), int(self.eb[idx])
+                da, db = cv[a] - t, cv[b] - t
+                if (da < 0 < db) or (db < 0 < da):
+                    w = (t - cv[a]) / (cv[b] - cv[a])
+                    pts.append(tuple(V[a][k] + w * (V[b][k] - V[a][k]) for k in range(n)))
+        return pts
+
+
+def exact_slice_points(
+    V: np.ndarray, edges: list[tuple[int, int]], cv: list[fmpq], lo: fmpq, hi: fmpq
+) -> list[tuple[fmpq, ...]]:
+    """Exact superset of the vertices of ``P ∩ {lo <= c·e <= hi}``, ``cv[j] = c·V[j]``."""
+    pts = [tuple(V[j]) for j in range(len(V)) if lo <= cv[j] <= hi]
+    for t in {lo, hi}:
+        for a, b in edges:
+            da, db = cv[a] - t, cv[b] - t
+            if (da < 0 < db) or (db < 0 < da):
+                w = (t - cv[a]) / (cv[b] - cv[a])
+                pts.append(tuple(V[a][k] + w * (V[b][k] - V[a][k]) for k in range(V.shape[1])))
+    return pts
+
+
+def exact_vertices_of_slice(
+    G: np.ndarray, C: np.ndarray, lo: np.ndarray, hi: np.ndarray
+) -> np.ndarray:
+    """Exact vertices of ``{G e <= 1, lo <= C e <= hi}`` (any number of outputs) by cdd.gmp,
+    with the equalities ``C e = lo`` written as linearities when ``lo == hi``."""
+    _require_gmp()
+    G = np.asarray(G, dtype=object)
+    C = np.asarray(C, dtype=object)
+    n = G.shape[1]
+    rows = [[Fraction(1)] + [-_fr(x) for x in r] for r in G]
+    lin = []
+    for k in range(C.shape[0]):
+        if lo[k] == hi[k]:
+            lin.append(len(rows))
+            rows.append([-_fr(lo[k])] + [_fr(x) for x in C[k]])
+        else:
+            rows.append([_fr(hi[k])] + [-_fr(x) for x in C[k]])
+            rows.append([-_fr(lo[k])] + [_fr(x) for x in C[k]])
+    m = cddg.matrix_from_array(rows, rep_type=cdd.RepType.INEQUALITY, lin_set=lin)
+    gen = cddg.copy_generators(cddg.polyhedron_from_matrix(m))
+    if gen.lin_set or any(r[0] == 0 for r in gen.array):
+        raise PolytopeError("the slice is unbounded")
+    return np.array([[_q(x / r[0]) for x in r[1:]] for r in gen.array], dtype=object).reshape(-1, n)
