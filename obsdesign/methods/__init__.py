@@ -17,7 +17,6 @@ REGISTRY: dict[str, str] = {
     "constrained": "obsdesign.methods.constrained:METHOD",
     "impulsive": "obsdesign.methods.impulsive:METHOD",
     "set-invariant": "obsdesign.methods.setinvariant:METHOD",
-    "set-invariant": "obsdesign.methods.setinvariant:METHOD",
 }
 
 
