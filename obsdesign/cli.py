@@ -302,8 +302,9 @@ def _print_rows(rows: list[Any], fmt: Fmt) -> None:
                 f"{r.summary or r.message} | {r.seconds:.2f} |"
             )
         return
-    from rich.console import Console
     from rich.table import Table
+
+    from obsdesign.report.render import console
 
     t = Table(title="obsdesign check")
     for c in ("spec", "method", "verdict", "cert.", "num.", "failed", "result", "s"):
@@ -320,12 +321,13 @@ def _print_rows(rows: list[Any], fmt: Fmt) -> None:
             r.summary if r.code == 0 else r.message,
             f"{r.seconds:.2f}",
         )
-    Console().print(t)
+    console().print(t)
 
 
 def _print_metrics(m: dict[str, Any]) -> None:
-    from rich.console import Console
     from rich.table import Table
+
+    from obsdesign.report.render import console
 
     t = Table(title="simulation metrics")
     t.add_column("state")
@@ -334,7 +336,7 @@ def _print_metrics(m: dict[str, Any]) -> None:
     t.add_column("sup |x̂_i|")
     for s, v in m["sup_abs_error"].items():
         t.add_row(s, f"{v:.6g}", f"{m['rmse'][s]:.6g}", f"{m['sup_abs_estimate'][s]:.6g}")
-    c = Console()
+    c = console()
     c.print(t)
     c.print(f"final |e| = {m['final_error_norm']:.6g}")
     for k, v in m.items():

@@ -48,19 +48,28 @@ def _numeric(v: Any) -> bool:
         return False
 
 
+def console() -> Any:
+    """A rich console; when stdout is not a terminal (CI logs, pipes) use 160 columns rather
+    than rich's default 80, so tables stay readable."""
+    import sys
+
+    from rich.console import Console
+
+    return Console() if sys.stdout.isatty() else Console(width=160)
+
+
 def render_text(report: Report, title: str = "") -> None:
     """Print a report on the terminal with rich."""
-    from rich.console import Console
     from rich.table import Table
 
-    console = Console()
+    out = console()
     t = Table(title=title or f"{report.method} — {report.spec_file}", show_lines=False)
     t.add_column("parameter")
     t.add_column("value", overflow="fold")
     t.add_column("form")
     for k, v, form in _param_rows(report):
         t.add_row(k, v, form)
-    console.print(t)
+    out.print(t)
     c = Table(title="claims")
     for col in ("id", "status", "statement", "check", "detail"):
         c.add_column(col, overflow="fold")
@@ -68,11 +77,11 @@ def render_text(report: Report, title: str = "") -> None:
         c.add_row(
             cl.id, f"[{STYLE[cl.status]}]{cl.status.value}[/]", cl.statement, cl.check, cl.detail
         )
-    console.print(c)
+    out.print(c)
     for n in report.notes:
-        console.print(f"note: {n}")
+        out.print(f"note: {n}")
     counts = report.status_counts()
-    console.print(
+    out.print(
         f"claims: {counts['certified']} certified, {counts['numerical']} numerical, "
         f"{counts['failed']} failed"
     )
