@@ -13,13 +13,13 @@ import itertools
 from dataclasses import dataclass
 from typing import Any
 
-import flint
 import numpy as np
 from flint import fmpq
 from mpmath import iv
 
 from obsdesign.certify.exact import Q, dyadic, qeye, symmetrize
 from obsdesign.certify.interval import lower, upper
+from obsdesign.certify.linalg import qinv
 from obsdesign.certify.psd import check_psd
 from obsdesign.methods.constrained.cmap import ConstraintMap
 from obsdesign.sets import Box, Ellipsoid, Polytope
@@ -49,17 +49,6 @@ def round_sig(x: Any, digits: int, up: bool) -> fmpq:
     t = q * scale
     k = t.ceil() if up else t.floor()
     return fmpq(int(k)) / scale
-
-
-def qinv(P: np.ndarray) -> np.ndarray:
-    """Exact inverse of a rational matrix (python-flint ``fmpq_mat``)."""
-    n = P.shape[0]
-    M = flint.fmpq_mat(n, n, [Q(v) for v in P.flat]).inv()
-    out = np.empty((n, n), dtype=object)
-    for i in range(n):
-        for j in range(n):
-            out[i, j] = M[i, j]
-    return out
 
 
 def quad(P: np.ndarray, x: np.ndarray) -> fmpq:

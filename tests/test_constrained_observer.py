@@ -1,0 +1,104 @@
+"""Runtime pieces of paper 000: the maps c (18)/(19), M (20), G (23), the θ_m loop, the
+vectorized batch and the saturation (29)."""
+
+from __future__ import annotations
+
+import numpy as np
+from flint import fmpq
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from obsdesign.certify.exact import Q, qeye, qmat
+from obsdesign.methods.constrained.cmap import (
+    antipodal_classes,
+    box_map,
+    ellipsoid_map,
+    polytope_map,
+)
+from obsdesign.methods.constrained.observer import LinearF, Refiner, run_observer, sat
+
+MAPS = [
+    box_map([-1, -2], [1, 2]),
+    polytope_map(
+        qmat([[1, 0], [0, 1], [-1, 0], [0, -1], [1, 1]]),
+        np.array([Q(v) for v in (1, 1, 1, 1, 1.5)], dtype=object),
+    ),
+    ellipsoid_map(qmat([[2, 0.5], [0.5, 1]]), Q(3)),
+]
+
+
+def test_box_map_matches_eq19():
+    cm = MAPS[0]
+    x = np.array([1.5, -2.5])
+    # (c̲_1, c̄_1, c̲_2, c̄_2) = (0, 0.5², 0.5², 0)
+    np.testing.assert_allclose(cm.c(x), [0, 0.25, 0.25, 0])
+    assert cm.classes == [[0, 1], [2, 3]]
+    assert cm.norm_c_sq_q(np.array([fmpq(3, 2), fmpq(-5, 2)], dtype=object)) == fmpq(1, 16) * 2
+
+
+def test_antipodal_classes():
+    G = qmat([[1, 0], [0, 1], [-2, 0], [0, -1], [1, 1], [-1, -1]])
+    assert antipodal_classes(G) == [[0, 2], [1, 3], [4, 5]]
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2), st.floats(-4, 4), st.floats(-4, 4))
+def test_jtc_is_gradient_of_half_norm_squared(i, a, b):
+    """(dc/dx)ᵀ c = ∇(|c|²/2): checked by central differences."""
+    cm = MAPS[i]
+    x = np.array([a, b])
+    g = cm.jtc(x)
+    h = 1e-6
+    num = np.array(
+        [(np.sum(cm.c(x + h * e) ** 2) - np.sum(cm.c(x - h * e) ** 2)) / (4 * h) for e in np.eye(2)]
+    )
+    np.testing.assert_allclose(g, num, rtol=1e-4, atol=1e-6)
+
+
+def test_G_is_eq23():
+    cm = MAPS[0]
+    Pinv = np.array([[0.5, 0.1], [0.1, 0.25]])
+    ref = Refiner(cm, Pinv, 0.2, 0.01, 4.0)
+    inside = np.array([1.05, 0.0])  # |c| = 0.0025 ≤ ε_min: identity
+    np.testing.assert_array_equal(ref.G(inside), inside)
+    far = np.array([10.0, 0.0])  # |c| = 81 > ε_max: identity (outside C_max)
+    np.testing.assert_array_equal(ref.G(far), far)
+    mid = np.array([2.0, 0.0])  # |c| = 1: x̂ − γ P⁻¹ (dc/dx)ᵀ c, (dc/dx)ᵀc = (2·1³, 0)
+    np.testing.assert_allclose(ref.G(mid), mid - 0.2 * Pinv @ np.array([2.0, 0.0]))
+    y, steps = ref.refine(mid, 1000)
+    assert cm.norm_c(y) <= 0.01 and 0 < steps < 1000
+    y3, s3 = ref.refine(mid, 3)
+    assert s3 == 3 and cm.norm_c(y3) > 0.01
+
+
+def test_batch_matches_loop():
+    rng = np.random.default_rng(0)
+    for cm in MAPS:
+        ref = Refiner(cm, np.array([[0.3, 0.05], [0.05, 0.2]]), 0.05, 0.01, 50.0)
+        X = rng.uniform(-4, 4, (200, 2))
+        Y, steps, sup = ref.refine_batch(X, 25)
+        for j in range(len(X)):
+            path: list[np.ndarray] = []
+            y, s = ref.refine(X[j], 25, path)
+            np.testing.assert_allclose(Y[j], y, rtol=1e-12, atol=1e-12)
+            assert steps[j] == s
+            np.testing.assert_allclose(sup[j], np.max(np.abs(np.vstack([X[j]] + path)), axis=0))
+
+
+def test_saturated_observer_eq29():
+    A = np.array([[0.0, 1], [1, 0]])
+    C = np.array([[1.0, 0]])
+    F = LinearF(A, np.zeros((2, 0)), C, np.zeros((1, 0)), np.array([[-1.87], [1.874]]))
+    N = 50
+    y = np.tile([-1.0], (N + 1, 1))
+    u = np.zeros((N + 1, 0))
+    tr = run_observer(F, u, y, np.array([1.0, 1.0]), sat_r=2.0)
+    np.testing.assert_array_equal(tr.xhat[1:], np.tile([2.0, -2.0], (N, 1)))
+    np.testing.assert_array_equal(sat(np.array([3.0, -5.0, 0.5]), 1.0), [1.0, -1.0, 0.5])
+
+
+def test_ellipsoid_map_values():
+    cm = ellipsoid_map(qeye(2), Q(2))
+    x = np.array([2.0, 0.0])  # xᵀx/r − 1 = 1 → c = 1
+    np.testing.assert_allclose(cm.c(x), [1.0])
+    np.testing.assert_allclose(cm.jtc(x), 4 * 1 * x / 2)
