@@ -1,0 +1,355 @@
+"""The set-invariant method (paper 003, Dórea & Pimenta): Examples 7.1 and 7.2, the laws,
+bad input, and property tests (Proposition 4.1) on random systems."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from flint import fmpq
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from obsdesign import api
+from obsdesign.certify.claim import ClaimStatus
+from obsdesign.errors import InfeasibleError, SpecError
+from obsdesign.methods.setinvariant import laws
+from obsdesign.spec import load_spec_text
+
+
+@pytest.fixture(scope="module")
+def rep71(tmp_path_factory):
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    out = tmp_path_factory.mktemp("r") / "r71.json"
+    rep = api.design(root / "specs" / "dorea-pimenta-7-1.toml", out)
+    return rep, out
+
+
+@pytest.fixture(scope="module")
+def rep72(tmp_path_factory):
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    out = tmp_path_factory.mktemp("r") / "r72.json"
+    rep = api.design(root / "specs" / "dorea-pimenta-7-2.toml", out)
+    return rep, out
+
+
+def _rows_up_to_sign(G: np.ndarray) -> set[tuple[float, ...]]:
+    out = set()
+    for r in np.round(G, 4):
+        r = r + 0.0
+        if r[np.flatnonzero(r)[0]] < 0:
+            r = -r
+        out.add(tuple(float(x) + 0.0 for x in r))
+    return out
+
+
+def test_example_71_Q2_iterations_and_vertices(rep71):
+    rep, _ = rep71
+    assert all(c.status == ClaimStatus.CERTIFIED for c in rep.claims)
+    p = rep.parameters
+    assert p["iterations"] == 2
+    # the first check of (14) gives 2.4, the second passes with 0.9
+    assert np.allclose(p["history_eps"], [2.4, 0.9])
+    Q2 = np.array([[-0.4412, 0.5588], [-0.8333, 0.1667], [0.9, 0.0]])
+    assert _rows_up_to_sign(p.float("G")) == _rows_up_to_sign(Q2)
+    # exact rows: 15/34, 19/34, 5/6, 1/6, 9/10 and exact factor 9/10
+    assert {abs(x) for x in np.asarray(p["G"]).reshape(-1)} == {
+        fmpq(15, 34),
+        fmpq(19, 34),
+        fmpq(5, 6),
+        fmpq(1, 6),
+        fmpq(9, 10),
+        fmpq(0),
+    }
+    assert p["contractivity"] == fmpq(9, 10)
+
+
+def test_example_71_linear_gains(rep71):
+    """Two rows of Q² tie in Ω ∩ ker C: the Prop. 7.1 gains are the ends of the admissible
+    segment L = [−0.7, l2], l2 ∈ [−7/15, 7/85] (≈ [−0.4667, 0.0824]); the paper's
+    L = [−0.7, −0.2212] lies inside and certifies."""
+    rep, _ = rep71
+    p = rep.parameters
+    L = np.asarray(p["L"]).reshape(-1)
+    assert L[0] == fmpq(-7, 10)
+    V = np.asarray(p["L_admissible_vertices"])
+    ends = sorted(V[:, 1])
+    assert ends == [fmpq(-7, 15), fmpq(7, 85)]
+    assert all(v == fmpq(-7, 10) for v in V[:, 0])
+    assert ends[0] < L[1] < ends[1]
+    user = next(c for c in rep.claims if c.id == "linear-law-user")
+    assert user.status == ClaimStatus.CERTIFIED
+    assert any("Proposition 7.1 with Q_I" in n for n in rep.notes)
+
+
+def test_example_71_verify_and_simulate(rep71, tmp_path):
+    rep, out = rep71
+    v = api.verify(out)
+    assert v.exit_code() == 0
+    from pathlib import Path
+
+    from obsdesign.spec import load_spec
+
+    spec = load_spec(Path(__file__).resolve().parents[1] / "specs" / "dorea-pimenta-7-1.toml")
+    res = api.simulate(spec, out)
+    assert res.info["error_in_polyhedron"] and res.info["admissible_scenario"]
+    assert res.info["max_gauge"] <= 1 + 1e-9
+    from obsdesign.methods import get_method
+
+    png = get_method("set-invariant").plot_simulation(spec, res, tmp_path / "fig1.png")
+    assert png.exists() and png.stat().st_size > 1000
+    # the paper's linear gain gives a trajectory in the polyhedron too
+    res2 = api.simulate(spec, out, law="linear")
+    assert res2.info["error_in_polyhedron"]
+
+
+def test_verify_rejects_tampered_breakpoint(rep71, tmp_path):
+    _, out = rep71
+    d = json.loads(out.read_text())
+    v = d["parameters"]["exact"]["v_breakpoints"]
+    v[0][0] = "3"  # a worse injection at the first breakpoint
+    d["parameters"]["v_breakpoints"][0][0] = 3.0
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(d))
+    rep = api.verify(bad)
+    assert rep.exit_code() != 0
+    assert any(c.id == "theorem-3.1" and c.status == ClaimStatus.FAILED for c in rep.claims)
+
+
+def test_example_72_symmetric_fails_general_certifies(rep72, tmp_path):
+    """C_K^∞ meets (14) but max ε(z) ≈ 1.06 > 1 (Fig. 2); the general algorithm then gives
+    a polyhedron whose certified factor is <= λ = 1."""
+    rep, out = rep72
+    p = rep.parameters
+    assert (
+        1.06 < p["symmetric_contractivity"] < 1.065
+    )  # paper: "ε(z) > 1 for some z", Fig. 2 ≈ 1.06
+    assert p["converged"] is True
+    assert p["contractivity"] <= 1
+    assert all(c.status == ClaimStatus.CERTIFIED for c in rep.claims)
+    assert api.verify(out).exit_code() == 0
+    from pathlib import Path
+
+    from obsdesign.methods import get_method
+    from obsdesign.spec import load_spec
+
+    spec = load_spec(Path(__file__).resolve().parents[1] / "specs" / "dorea-pimenta-7-2.toml")
+    png = get_method("set-invariant").plot_design(spec, rep.parameters, tmp_path / "fig2.png")
+    assert png.stat().st_size > 1000
+
+
+# -- bad input ------------------------------------------------------------------------------
+BASE = """
+[system]
+time = "{time}"
+A = {A}
+B1 = {B1}
+C = {C}
+
+[sets.omega]
+{omega}
+
+[method]
+key = "set-invariant"
+omega = "omega"
+disturbance = {{ type = "box", lower = [-0.1], upper = [0.1] }}
+eta_bar = {eta}
+lambda = {lam}
+algorithm = "{alg}"
+max_iterations = {maxit}
+"""
+
+
+def spec_text(**kw: object) -> str:
+    d = dict(
+        time="discrete",
+        A="[[0.7, 0.7], [-0.7, 0.7]]",
+        B1="[1, 1]",
+        C="[[1, 1]]",
+        omega='type = "symmetric-polytope"\nQ = [[1, 0], [0, 1]]',
+        eta="0",
+        lam="0.9",
+        alg="symmetric",
+        maxit="50",
+    )
+    d.update({k: str(v) for k, v in kw.items()})
+    return BASE.format(**d)
+
+
+@pytest.mark.parametrize(
+    "kw,key",
+    [
+        ({"lam": "0"}, "method.lambda"),
+        ({"lam": "-0.5"}, "method.lambda"),
+        ({"lam": "1.1"}, "method.lambda"),
+        ({"omega": 'type = "polytope"\nG = [[1, 0], [-1, 0]]\ng = [1, 1]'}, "sets.omega.G"),
+        (
+            {
+                "omega": 'type = "polytope"\nG = [[1, 0], [-1, 0], [0, 1], [0, -1]]\ng = [1, -2, 1, 1]'
+            },
+            "sets.omega.G",
+        ),
+        (
+            {
+                "omega": 'type = "polytope"\nG = [[1, 0], [-1, 0], [0, 1], [0, -1]]\ng = [2, -1, 1, 1]'
+            },
+            "method.omega",
+        ),
+        ({"time": "continuous"}, "system.time"),
+        (
+            {
+                "C": "[[1, 0], [0, 1], [1, 1]]",
+                "A": "[[0.5, 0, 0], [0, 0.5, 0], [0, 0, 0.5]]",
+                "B1": "[1, 1, 1]",
+                "omega": 'type = "box"\nlower = [-1, -1, -1]\nupper = [1, 1, 1]',
+            },
+            "system.C",
+        ),
+        ({"eta": "-1"}, "method.eta_bar"),
+    ],
+)
+def test_bad_input_names_the_key(kw, key):
+    with pytest.raises(SpecError) as e:
+        load_spec_text(spec_text(**kw), "bad.toml")
+    assert e.value.exit_code == 2
+    assert f"[{key}]" in e.value.message
+
+
+def test_multi_output_needs_p_equal_n_minus_1_and_no_noise():
+    three = dict(
+        A="[[0.5, 0.1, 0], [0, 0.5, 0], [0, 0, 0.5]]",
+        B1="[1, 1, 1]",
+        C="[[1, 0, 0], [0, 1, 0]]",
+        omega='type = "box"\nlower = [-1, -1, -1]\nupper = [1, 1, 1]',
+    )
+    with pytest.raises(SpecError, match="Proposition 7.1"):
+        load_spec_text(spec_text(eta="0.1", **three), "bad.toml")
+    with pytest.raises(SpecError, match="symmetric"):
+        load_spec_text(spec_text(alg="general", **three), "bad.toml")
+    # p = n − 1 = 2 with η̄ = 0: symmetric algorithm and a linear law (Proposition 7.1)
+    rep = api.design(load_spec_text(spec_text(**three), "ok.toml"))
+    assert rep.exit_code() == 0
+    assert any(c.id == "linear-law" and c.status == ClaimStatus.CERTIFIED for c in rep.claims)
+
+
+def test_not_detectable_exit_1():
+    # the mode 1.2 of e2 is not seen by C = [1, 0]
+    sp = load_spec_text(spec_text(A="[[0.5, 0], [0, 1.2]]", C="[[1, 0]]"), "nd.toml")
+    with pytest.raises(InfeasibleError, match="not detectable"):
+        api.design(sp)
+    sp = load_spec_text(spec_text(A="[[0.5, 0], [0, 0.95]]", C="[[1, 0]]"), "slow.toml")
+    with pytest.raises(InfeasibleError, match="λ"):
+        api.design(sp)
+
+
+def test_necessary_condition_and_not_converged():
+    # algorithm "none" checks Ω itself: λΩ does not contain B1·D = ±0.5·(1, 1) -> failed claim
+    t = spec_text(alg="none").replace("lower = [-0.1], upper = [0.1]", "lower = [-1], upper = [1]")
+    rep = api.design(load_spec_text(t, "none.toml"))
+    nec = next(c for c in rep.claims if c.id == "necessary-condition")
+    assert nec.status == ClaimStatus.FAILED and "Section II" in nec.statement
+    assert rep.exit_code() == 1
+    # iteration cap: not converged, the last polyhedron is reported, exit 1
+    rep = api.design(load_spec_text(spec_text(alg="general", maxit=1), "cap.toml"))
+    assert rep.parameters["converged"] is False and "G" in rep.parameters
+    assert rep.exit_code() == 1
+
+
+# -- property tests (Proposition 4.1) ------------------------------------------------------
+def _fmt(M: np.ndarray) -> str:
+    return (
+        "["
+        + ", ".join("[" + ", ".join(repr(float(v)) for v in r) + "]" for r in np.atleast_2d(M))
+        + "]"
+    )
+
+
+@st.composite
+def systems(draw):
+    n = draw(st.sampled_from([2, 3]))
+    seed = draw(st.integers(0, 10**6))
+    rng = np.random.default_rng(seed)
+    A = rng.normal(size=(n, n))
+    A *= rng.uniform(0.4, 1.2) / max(abs(np.linalg.eigvals(A)))
+    A = np.round(A, 3)
+    C = np.round(rng.normal(size=(1, n)), 3)
+    B1 = np.round(rng.normal(size=(n, 1)) * 0.1, 3)
+    b = float(np.round(rng.uniform(0.1, 1.0), 2))
+    eta = float(np.round(rng.uniform(0, 0.05), 3))
+    return A, B1, C, b, eta, seed
+
+
+@settings(max_examples=6, deadline=None, suppress_health_check=list(HealthCheck))
+@given(systems())
+def test_property_error_stays_in_polyhedron(sys_):
+    """Every certified design keeps e(k) in {G e <= 1} for random admissible d, η over 200
+    steps (interpolated law (12)), and e(k) → 0 with d = η = 0 (time-varying law (10))."""
+    _check_system(sys_)
+
+
+def test_property_body_runs_on_a_certified_design():
+    """The property test's body on a fixed system that certifies (so it cannot pass vacuously)."""
+    A = np.array([[0.7, 0.7], [-0.7, 0.7]])
+    B1 = np.array([[0.1], [0.2]])
+    C = np.array([[1.0, 0.5]])
+    assert _check_system((A, B1, C, 0.5, 0.02, 7))
+
+
+def _check_system(sys_) -> bool:
+    """Design, and if certified simulate; returns whether the simulation part ran."""
+    A, B1, C, b, eta, seed = sys_
+    n = A.shape[0]
+    text = f"""
+[system]
+time = "discrete"
+A = {_fmt(A)}
+B1 = {_fmt(B1.T)[1:-1]}
+C = {_fmt(C)}
+[sets.omega]
+type = "box"
+lower = {[-1.0] * n}
+upper = {[1.0] * n}
+[method]
+key = "set-invariant"
+omega = "omega"
+disturbance = {{ type = "box", lower = [{-b}], upper = [{b}] }}
+eta_bar = {eta}
+lambda = 0.9
+algorithm = "general"
+mirror = true
+delta_tol = 0.001
+max_iterations = 25
+"""
+    try:
+        sp = load_spec_text(text, "prop.toml")
+        rep = api.design(sp)
+    except InfeasibleError:
+        return False
+    if rep.exit_code() != 0:
+        assert rep.parameters["converged"] is False  # only a non-converged run may fail
+        return False
+    p = rep.parameters
+    G = p.float("G").reshape(-1, n)
+    z = p.float("breakpoints").reshape(-1)
+    v = p.float("v_breakpoints").reshape(len(z), n)
+    rng = np.random.default_rng(seed)
+    from obsdesign.sets import polytope_ops as po
+
+    V = po.h_to_v(G).V
+    law = laws.PiecewiseAffineLaw(z, v, 0.9)
+    for _ in range(3):
+        e0 = V[rng.integers(len(V))] * rng.uniform(0.3, 1.0)
+        d = rng.choice([-b, b], size=(200, 1)) * rng.uniform(0.5, 1, size=(200, 1))
+        et = rng.uniform(-eta, eta, size=(200, 1))
+        e = laws.simulate_error(A, B1, C, law, e0, d, et)
+        assert (e @ G.T).max() <= 1 + 1e-7
+    tv = laws.PiecewiseAffineLaw(z, v, 0.9, "time-varying")
+    e = laws.simulate_error(A, B1, C, tv, V[0], np.zeros((200, 1)), np.zeros((200, 1)))
+    assert (e @ G.T).max() <= 1 + 1e-7
+    assert np.abs(e[-1]).max() < 1e-6
+    return True
