@@ -101,18 +101,18 @@ def outward_fix(G: np.ndarray, P: np.ndarray) -> np.ndarray:
     return G / m[:, None]
 
 
-def _edges_from_simplices(simplices: np.ndarray, remap: dict[int, int]) -> np.ndarray:
-    e: set[tuple[int, int]] = set()
-    for s in simplices:
-        idx = [remap[int(k)] for k in s if int(k) in remap]
-        for a in range(len(idx)):
-            for b in range(a + 1, len(idx)):
-                if idx[a] != idx[b]:
-                    e.add((min(idx[a], idx[b]), max(idx[a], idx[b])))
-    return np.array(sorted(e), dtype=int).reshape(-1, 2)
+def _edges_from_simplices(simplices: np.ndarray, remap: np.ndarray) -> np.ndarray:
+    """All pairs of vertices that share a simplex of the triangulation (vectorized);
+    ``remap`` maps point indices to vertex indices (-1 for non-vertices)."""
+    S = remap[np.asarray(simplices, dtype=int)]
+    k = S.shape[1]
+    pairs = [np.sort(S[:, [a, b]], axis=1) for a in range(k) for b in range(a + 1, k)]
+    E = np.vstack(pairs) if pairs else np.zeros((0, 2), dtype=int)
+    E = E[(E[:, 0] >= 0) & (E[:, 0] != E[:, 1])]
+    return np.unique(E, axis=0) if len(E) else E.reshape(0, 2)
 
 
-def hull(points: np.ndarray) -> HullState:
+def hull(points: np.ndarray, with_edges: bool = True) -> HullState:
     """Convex hull of a point cloud containing the origin in its interior (float).
 
     Returns the extreme points, the triangulation edges (a superset of the edges) and the
@@ -132,16 +132,17 @@ def hull(points: np.ndarray) -> HullState:
     eq = h.equations
     if np.any(eq[:, -1] >= -1e-12):
         raise PolytopeError("the origin is not interior to the hull")
-    remap = {int(k): i for i, k in enumerate(h.vertices)}
+    remap = np.full(len(P), -1, dtype=int)
+    remap[h.vertices] = np.arange(len(h.vertices))
     V = P[h.vertices]
-    edges = _edges_from_simplices(h.simplices, remap)
+    edges = _edges_from_simplices(h.simplices, remap) if with_edges else np.zeros((0, 2), dtype=int)
     G, _ = merge_rows(eq[:, :-1] / (-eq[:, -1:]))
     return HullState(V, edges, outward_fix(G, P))
 
 
 def v_to_h(points: np.ndarray) -> np.ndarray:
     """Canonical ``G`` with ``conv(points) ⊆ {G e <= 1}`` (float, outward-fixed)."""
-    return hull(points).G
+    return hull(points, with_edges=False).G
 
 
 def h_to_v(G: np.ndarray) -> VRep:
@@ -168,13 +169,14 @@ def h_to_v(G: np.ndarray) -> VRep:
     if np.any(eq[:, -1] >= -1e-12):
         raise PolytopeError("the polytope is unbounded (its rows do not surround the origin)")
     V, labels = merge_rows(eq[:, :-1] / (-eq[:, -1:]))
-    e: set[tuple[int, int]] = set()
-    for s, nb in enumerate(h.neighbors):
-        for t in nb:
-            if t >= 0 and labels[s] != labels[t]:
-                a, b = int(labels[s]), int(labels[t])
-                e.add((min(a, b), max(a, b)))
-    return VRep(V, np.array(sorted(e), dtype=int).reshape(-1, 2))
+    nb = np.asarray(h.neighbors)
+    src = np.repeat(np.arange(len(nb)), nb.shape[1])
+    dst = nb.reshape(-1)
+    ok = dst >= 0
+    E = np.sort(np.stack([labels[src[ok]], labels[dst[ok]]], axis=1), axis=1)
+    E = E[E[:, 0] != E[:, 1]]
+    edges = np.unique(E, axis=0) if len(E) else np.zeros((0, 2), dtype=int)
+    return VRep(V, edges.astype(int))
 
 
 def remove_redundant(G: np.ndarray) -> np.ndarray:
@@ -476,3 +478,71 @@ def exact_vertices_of_slice(
     if gen.lin_set or any(r[0] == 0 for r in gen.array):
         raise PolytopeError("the slice is unbounded")
     return np.array([[_q(x / r[0]) for x in r[1:]] for r in gen.array], dtype=object).reshape(-1, n)
+
+
+def _incidence_rank(G: np.ndarray, rows: set[int], n: int) -> int:
+    if len(rows) < n:
+        return len(rows)
+    from flint import fmpq_mat
+
+    return fmpq_mat([list(G[i]) for i in sorted(rows)]).rank()
+
+
+def exact_hull(P: np.ndarray) -> tuple[np.ndarray, ExactVRep]:
+    """Exact hull of the exact points ``P`` (origin interior) by one cdd.gmp V→H run.
+
+    Returns the canonical rows ``G`` (right-hand side 1) and the exact vertices with their
+    edges (cdd's input adjacency). Points that turn out not to be vertices (on a face but
+    not extreme) are dropped and the hull recomputed, so that the edges are true edges.
+    Building the H-form from the vertices keeps degenerate vertices (more than n facets)
+    single, where an H-form rounded from floats would split them into clusters.
+    """
+    _require_gmp()
+    P = np.asarray(P, dtype=object)
+    n = P.shape[1]
+    for _ in range(3):
+        rows = [[Fraction(1)] + [_fr(x) for x in p] for p in P]
+        poly = cddg.polyhedron_from_matrix(
+            cddg.matrix_from_array(rows, rep_type=cdd.RepType.GENERATOR)
+        )
+        ineq = cddg.copy_inequalities(poly)
+        if ineq.lin_set:
+            raise PolytopeError("the points are not full-dimensional")
+        G = []
+        for r in ineq.array:
+            if r[0] <= 0:
+                raise PolytopeError("the origin is not interior to the hull")
+            G.append([_q(-x / r[0]) for x in r[1:]])
+        Gq = np.array(G, dtype=object).reshape(len(G), n)
+        inc = cddg.copy_input_incidence(poly)
+        keep = [j for j in range(len(P)) if _incidence_rank(Gq, inc[j], n) == n]
+        if len(keep) == len(P):
+            adj = cddg.copy_input_adjacency(poly)
+            edges = sorted({(min(i, j), max(i, j)) for i, s in enumerate(adj) for j in s})
+            order = sorted(range(len(Gq)), key=lambda i: tuple(_fr(x) for x in Gq[i]))
+            return Gq[order], ExactVRep(P, edges)
+        P = P[keep]
+    raise PolytopeError("could not isolate the vertices of the hull")  # pragma: no cover
+
+
+def exact_check_forms(G: np.ndarray, V: np.ndarray) -> tuple[bool, str, ExactVRep | None]:
+    """Do ``{G e <= 1}`` and ``conv(V)`` describe the same polytope, exactly?
+
+    Holds iff the exact hull of ``V`` (cdd.gmp V→H) has exactly the rows of ``G`` (both in
+    canonical form) and every point of ``V`` is a vertex. Then ``V`` with the hull's
+    adjacency is the exact vertex representation of ``{G e <= 1}``."""
+    try:
+        H, vrep = exact_hull(V)
+    except PolytopeError as e:
+        return False, str(e), None
+    if len(vrep.V) != len(V):
+        return False, f"{len(V) - len(vrep.V)} of the reported vertices are not vertices", None
+    a = {tuple(_fr(x) for x in r) for r in H}
+    b = {tuple(_fr(x) for x in r) for r in np.asarray(G, dtype=object)}
+    if a != b:
+        return (
+            False,
+            f"the hull of V has {len(a - b)} facet(s) not in G and G has {len(b - a)} row(s) not facets of conv(V)",
+            None,
+        )
+    return True, f"{len(V)} exact vertices, {len(H)} facets (V- and H-forms agree)", vrep

@@ -222,6 +222,7 @@ def theorem31(
     vs: list[list[fmpq]] | None = None,
     zs_given: list[fmpq] | None = None,
     v_solver=None,
+    vrep: po.ExactVRep | None = None,
 ) -> Theorem31Result:
     """Exact check of Theorem 3.1 for {G e <= 1} (single output).
 
@@ -230,7 +231,8 @@ def theorem31(
     (``v_solver(G, phi, delta) -> EpsResult``), rounded by :func:`po.snap`, and from an exact
     cdd.gmp LP wherever the rounded v does not pass.
     """
-    vrep = po.exact_h_to_v(G)
+    if vrep is None:
+        vrep = po.exact_h_to_v(G)
     c = ex.C[0]
     zs, cv = exact_zd(vrep.V, c, ex.eta)
     dl = delta_exact(G, ex.B1, ex.Dv)

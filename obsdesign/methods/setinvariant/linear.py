@@ -70,44 +70,42 @@ def prop71_gains(ex: ExactProblem, G: np.ndarray) -> list[tuple[int, np.ndarray]
     """L = A [Q_I; C]^{-1} [0; −I] for every tying choice of Q_I (Proposition 7.1, p = n−1).
 
     ker C is one-dimensional, spanned by k; the non-redundant rows of Ω ∩ ker C are those
-    with the largest |G_i k|."""
-    import sympy
+    with the largest |G_i k| (rows i and −i give the same L, counted once)."""
+    from flint import fmpq_mat
 
     n, p = ex.n, ex.C.shape[0]
     if p != n - 1:
         return []
-    Cs = sympy.Matrix([[sympy.Rational(int(x.p), int(x.q)) for x in r] for r in ex.C])
-    ns = Cs.nullspace()
-    if len(ns) != 1:
+    # kernel vector of C: solve with one free coordinate set to 1
+    k = None
+    for j in range(n):
+        cols = [c for c in range(n) if c != j]
+        M = fmpq_mat([[ex.C[r][c] for c in cols] for r in range(p)])
+        if M.det() != 0:
+            rhs = fmpq_mat([[-ex.C[r][j]] for r in range(p)])
+            sol = M.solve(rhs)
+            k = [fmpq(0)] * n
+            k[j] = fmpq(1)
+            for t, c in enumerate(cols):
+                k[c] = sol[t, 0]
+            break
+    if k is None:
         return []
-    k = [fmpq(int(sympy.fraction(x)[0]), int(sympy.fraction(x)[1])) for x in ns[0]]
     vals = [abs(po.qdot(G[i], k)) for i in range(len(G))]
     best = max(vals)
-    out = []
+    Am = fmpq_mat([[x for x in r] for r in ex.A])
+    rhs = fmpq_mat(n, p, [fmpq(-1) if r == c + 1 else fmpq(0) for r in range(n) for c in range(p)])
+    out: list[tuple[int, np.ndarray]] = []
     for i in range(len(G)):
-        if vals[i] == best:
-            M = sympy.Matrix(
-                [[sympy.Rational(int(x.p), int(x.q)) for x in G[i]]]
-                + [list(r) for r in Cs.tolist()]
-            )
-            if M.det() == 0:
-                continue
-            rhs = sympy.zeros(n, p)
-            for r in range(p):
-                rhs[r + 1, r] = -1
-            As = sympy.Matrix([[sympy.Rational(int(x.p), int(x.q)) for x in r] for r in ex.A])
-            Lm = As * M.inv() * rhs
-            L = np.array(
-                [
-                    [fmpq(int(sympy.fraction(x)[0]), int(sympy.fraction(x)[1])) for x in r]
-                    for r in Lm.tolist()
-                ],
-                dtype=object,
-            )
-            if not any(np.array_equal(L, L2) for _, L2 in out) and not any(
-                np.array_equal(L, -L2) for _, L2 in out
-            ):
-                out.append((i, L))
+        if vals[i] != best:
+            continue
+        M = fmpq_mat([[x for x in G[i]]] + [[x for x in r] for r in ex.C])
+        if M.det() == 0:
+            continue
+        Lm = Am * M.solve(rhs)
+        L = np.array([[Lm[r, c] for c in range(p)] for r in range(n)], dtype=object)
+        if not any(np.array_equal(L, L2) for _, L2 in out):
+            out.append((i, L))
     return out
 
 

@@ -166,23 +166,33 @@ class SetInvariant(Method):
         history: list[dict[str, float]] = []
         single = s.p == 1
 
-        def exact_stage(G: np.ndarray) -> tuple[np.ndarray, ce.Theorem31Result | None]:
-            Gq = po.rationalize(G)
-            Gq, _ = po.exact_outward_fix(Gq, ex.Vo)
-            Gq = po.exact_remove_redundant(Gq)
+        Vo_f = po.qfloat(ex.Vo)
+        vreps: dict[int, po.ExactVRep] = {}
+
+        def exact_stage(P: np.ndarray) -> tuple[np.ndarray, ce.Theorem31Result | None]:
+            """Exact polytope from the float vertices P: Ω's vertices exactly, the others
+            snapped (po.snap); one exact hull gives G and the edges (po.exact_hull)."""
+            near = (
+                np.array([np.abs(Vo_f - p).max(axis=1).min() <= 1e-9 for p in P])
+                if len(P)
+                else np.zeros(0, bool)
+            )
+            Pq = np.vstack([ex.Vo, po.rationalize(P[~near])]) if (~near).any() else ex.Vo
+            Gq, vrep = po.exact_hull(Pq)
+            vreps[id(Gq)] = vrep
             if not single:
                 return Gq, None
-            return Gq, ce.theorem31(ex, Gq, v_solver=lps.eps_batch)
+            return Gq, ce.theorem31(ex, Gq, v_solver=lps.eps_batch, vrep=vrep)
 
         converged = True
         sym_eps_max = None
         if o.algorithm == "none":
-            G, it = fl.G0, 1
-            Gq, res = exact_stage(G)
+            it = 1
+            Gq, res = exact_stage(Vo_f)
         elif o.algorithm == "symmetric":
             r = al.symmetric(fl, lam, lam * (1 + dd), o.max_iterations, progress, history=history)
-            it, converged, G = r.iterations, r.converged, r.G
-            Gq, res = exact_stage(G)
+            it, converged = r.iterations, r.converged
+            Gq, res = exact_stage(r.P)
             if converged and single and res is not None and not res.ok:
                 zs, epsz = lps.epsilon_profile(r.G, fl.A, fl.B1, fl.C[0], fl.Dv, fl.eta)
                 sym_eps_max = float(np.max(epsz))
@@ -208,8 +218,8 @@ class SetInvariant(Method):
                         it0=it,
                         history=history,
                     )
-                    it, converged, G = r.iterations, r.converged, r.G
-                    Gq, res = exact_stage(G)
+                    it, converged = r.iterations, r.converged
+                    Gq, res = exact_stage(r.P)
                     notes.append(
                         f"general algorithm (Section V) continued from C_K^∞: {it} iterations in all"
                     )
@@ -225,8 +235,8 @@ class SetInvariant(Method):
                 progress=progress,
                 history=history,
             )
-            it, converged, G = r.iterations, r.converged, r.G
-            Gq, res = exact_stage(G)
+            it, converged = r.iterations, r.converged
+            Gq, res = exact_stage(r.P)
         # strict: the certified factor must be <= λ; continue with the scaled hull if needed
         if (
             single
@@ -249,14 +259,15 @@ class SetInvariant(Method):
                     lam * (1 - 1e-12),
                     o.max_iterations,
                     o.mirror,
-                    start=po.qfloat(po.exact_h_to_v(Gq).V),
+                    start=po.qfloat(vreps[id(Gq)].V),
                     progress=progress,
                     it0=it,
                     history=history,
                 )
-                it, converged, G = r.iterations, r.converged, r.G
-                Gq, res = exact_stage(G)
+                it, converged = r.iterations, r.converged
+                Gq, res = exact_stage(r.P)
         params["G"] = Gq
+        params["V"] = vreps[id(Gq)].V
         params["lambda"] = o.lam
         params["iterations"] = it
         params["converged"] = bool(converged)
@@ -279,7 +290,7 @@ class SetInvariant(Method):
                     f"{res.exact_lp} breakpoint injections came from the exact (cdd.gmp) LP (9)"
                 )
         # linear law (Proposition 7.1 / any admissible L)
-        V = po.exact_h_to_v(Gq).V
+        V = vreps[id(Gq)].V
         if o.linear_law and s.p == s.n - 1:
             gs = admissible_gains(ex, Gq, V)
             if gs.L is not None:
@@ -343,23 +354,23 @@ class SetInvariant(Method):
                     f"report λ = {lam_r}, spec λ = {o.lam}",
                 )
             )
-        try:
-            vrep = po.exact_h_to_v(G)
-            bounded, detail = True, f"{len(vrep.V)} exact vertices, {len(G)} facets"
-        except po.PolytopeError as e:
-            bounded, detail = False, str(e)
+        Vr = _exact_param(params, "V", claims)
+        if Vr is None:
+            return claims
+        Vr = np.asarray(Vr, dtype=object).reshape(-1, s.n)
+        bounded, detail, vrep = po.exact_check_forms(G, Vr)
         claims.append(
             exact_claim(
-                "polyhedron-bounded",
-                "{e : G e <= 1} is a bounded polytope with the origin in its interior",
+                "polyhedron-forms",
+                "{e : G e <= 1} = conv(V): a bounded polytope with the origin inside, given by its facets G and vertices V",
                 f"{REF}, Section III",
-                "exact vertex enumeration (cdd.gmp)",
+                "exact hull of V (cdd.gmp) has exactly the rows of G; every point of V is a vertex",
                 0,
                 bounded,
                 detail,
             )
         )
-        if not bounded:
+        if not bounded or vrep is None:
             return claims
         ok, m = ce.omega_contained(G, ex.Vo)
         claims.append(
@@ -406,7 +417,7 @@ class SetInvariant(Method):
                     )
                 )
                 return claims
-            res = ce.theorem31(ex, G, vs=vs, zs_given=zs)
+            res = ce.theorem31(ex, G, vs=vs, zs_given=zs, vrep=vrep)
             # float twin of the same inequality (exit 4 vs 1 when the exact check fails)
             flo = bool(float(res.factor) <= float(ex.lam) * (1 + 1e-9)) if res.eps else False
             det = (
@@ -549,7 +560,7 @@ class SetInvariant(Method):
     def summary(self, params: Parameters) -> str:
         out = f"{params.get('facets')} facets, {params.get('iterations')} iterations"
         if "contractivity" in params:
-            out += f", certified factor {params.float('contractivity'):.6g}"
+            out += f", certified factor {params.float('contractivity'):.9g}"
         if "L" in params:
             out += f", linear L = {np.round(params.float('L').reshape(-1), 4).tolist()}"
         return out
