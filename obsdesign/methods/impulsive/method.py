@@ -280,8 +280,8 @@ class Impulsive(Method):
         return TEMPLATE
 
     def options_schema(self) -> dict[str, Any]:
-        num = {"type": "number"}
-        mat = {"type": "array", "items": {"anyOf": [num, {"type": "array", "items": num}]}}
+        from obsdesign.spec.schema import MAT as mat
+        from obsdesign.spec.schema import NUM as num
         return {
             "type": "object",
             "required": ["key", "L", "alpha", "noise_bound"],
