@@ -41,6 +41,16 @@ class ConstraintMap:
     Q_q: np.ndarray | None = None
     r_q: Any = None
     classes: list[list[int]] = field(default_factory=list)
+    _f: dict[str, Any] = field(default_factory=dict, repr=False)
+
+    def __post_init__(self) -> None:
+        # float views, computed once (the runtime evaluates c millions of times)
+        if self.affine:
+            self._f["G"] = np.asarray(to_float(self.G_q), dtype=float)
+            self._f["h"] = np.asarray(to_float(self.h_q), dtype=float).reshape(-1)
+        else:
+            self._f["Q"] = np.asarray(to_float(self.Q_q), dtype=float)
+            self._f["r"] = float(Q(self.r_q))
 
     # -- float views ------------------------------------------------------------------------
     @property
@@ -57,19 +67,19 @@ class ConstraintMap:
 
     @property
     def G(self) -> np.ndarray:
-        return np.asarray(to_float(self.G_q), dtype=float)
+        return self._f["G"]
 
     @property
     def h(self) -> np.ndarray:
-        return np.asarray(to_float(self.h_q), dtype=float).reshape(-1)
+        return self._f["h"]
 
     @property
     def Qf(self) -> np.ndarray:
-        return np.asarray(to_float(self.Q_q), dtype=float)
+        return self._f["Q"]
 
     @property
     def r(self) -> float:
-        return float(Q(self.r_q))
+        return self._f["r"]
 
     # -- float evaluation (vectorized over leading axes) ------------------------------------
     def phi(self, x: np.ndarray) -> np.ndarray:
