@@ -17,7 +17,7 @@ SPEC = ROOT / "specs" / "constrained-redesign-sec5.toml"
 def _system(n: int, seed: int = 0):
     """x⁺ = A x with ‖A‖_∞ = 1, y = x (C = I), A − LC = K of spectral radius 0.9; box map
     r = ±1.1, ε_min = 0.01, and a small γ so that refining runs its full θ_m budget."""
-    from obsdesign.certify.exact import Q, qmat
+    from obsdesign.certify.exact import Q
     from obsdesign.methods.constrained.cmap import box_map
     from obsdesign.methods.constrained.observer import LinearF, Refiner
 
@@ -31,7 +31,6 @@ def _system(n: int, seed: int = 0):
     M = rng.standard_normal((n, n))
     Pinv = np.linalg.inv(M @ M.T + np.eye(n))
     cm = box_map([Q(-1.1)] * n, [Q(1.1)] * n)
-    del qmat
     return A, F, Refiner(cm, Pinv, 1e-4, 0.01, 1e12)
 
 

@@ -9,7 +9,7 @@ import numpy as np
 from flint import fmpq
 
 from obsdesign.certify.claim import Claim, exact_claim
-from obsdesign.certify.exact import Q, dyadic
+from obsdesign.certify.exact import Q, dyadic, to_float
 from obsdesign.certify.interval import sqrt_upper
 from obsdesign.certify.psd import check_pd, check_psd
 from obsdesign.methods import lyapunov
@@ -41,7 +41,6 @@ def _c(
 
 
 REQUIRED = (
-    "L",
     "P",
     "rho",
     "mu",
@@ -59,7 +58,6 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     """All claims of item 7 of the issue (decay LMI, P ≻ 0, (5), inclusions, δ, (24), v_max,
     v_min, θ), each recomputed from spec + parameters."""
     o: Options = spec.options
-    s = spec.system
     missing = [k for k in REQUIRED if k not in params]
     if missing:
         return [
@@ -72,7 +70,19 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
                 f"missing: {', '.join(missing)}",
             )
         ]
-    L, P, rho, mu = _q(params, "L"), _q(params, "P"), Q(_q(params, "rho")), Q(_q(params, "mu"))
+    if o.L is not None and "L" not in params:
+        return [
+            _c(
+                "parameters-present",
+                "the report gives L",
+                "report",
+                "presence",
+                False,
+                "missing: L",
+            )
+        ]
+    L = _q(params, "L") if o.L is not None else None
+    P, rho, mu = _q(params, "P"), Q(_q(params, "rho")), Q(_q(params, "mu"))
     gamma, dsq = Q(_q(params, "gamma")), Q(_q(params, "delta_sq"))
     eps_min, eps_max = Q(_q(params, "eps_min")), Q(_q(params, "eps_max"))
     v_max, v_min, theta = Q(_q(params, "v_max")), Q(_q(params, "v_min")), Q(_q(params, "theta"))
@@ -117,45 +127,10 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         )
     r = check_pd(P, o.margin)
     out.append(_c("P-positive-definite", "P ≻ 0", "eq. (4)", "exact LDLᵀ over Q", r.ok, r.detail))
-    Acl = s.A.q - L @ s.C.q
-    if "lambda" in params:
-        lam = Q(_q(params, "lambda"))
-        M = lyapunov.decay_matrix(s.A.q, s.C.q, L, P, lam, True)
-        r = check_pd(M, o.margin)
-        out.append(
-            _c(
-                "decay-lmi",
-                f"(A−LC)ᵀP(A−LC) ⪯ λ²P with λ = {float(lam):.6g}",
-                "Section 5",
-                "exact LDLᵀ over Q of the rebuilt matrix",
-                r.ok,
-                r.detail,
-            )
-        )
-        if o.rho is None and rho != lam * lam:
-            out.append(
-                _c(
-                    "rho-is-lambda-squared",
-                    "ρ = λ²",
-                    "Remark 1",
-                    "exact equality",
-                    False,
-                    f"ρ = {rho}",
-                )
-            )
-    Bw = error_input(s.A.q, s.Bd.q, s.Dn.q, L)
-    r = check_psd(iss_matrix(Acl, Bw, P, rho, mu))
-    ok = r.ok and rho < 1
-    out.append(
-        _c(
-            "iss-bound",
-            f"V(e⁺) ≤ ρV(e) + μ|w|² with ρ = {float(rho):.6g}, μ = {float(mu):.6g}",
-            "Assumption 2, eq. (5)-(6)",
-            "exact LDLᵀ over Q (linear error dynamics)",
-            ok,
-            r.detail + ("" if rho < 1 else "; ρ must be < 1"),
-        )
-    )
+    if o.model is not None and o.model.nonlinear:
+        out.append(_iss_sampled(spec, params, P, rho, mu, v_max))
+    else:
+        out += _linear_claims(spec, params, L, P, rho, mu)
     out += _convexity(o.cmap)
     out.append(
         _c(
@@ -256,6 +231,80 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
             )
         )
     return out
+
+
+def _linear_claims(
+    spec: Spec, params: Parameters, L: Any, P: Any, rho: Any, mu: Any
+) -> list[Claim]:
+    """Decay LMI and inequality (5) for the linear error dynamics, exactly."""
+    o: Options = spec.options
+    s = spec.system
+    out: list[Claim] = []
+    Acl = s.A.q - L @ s.C.q
+    if "lambda" in params:
+        lam = Q(_q(params, "lambda"))
+        M = lyapunov.decay_matrix(s.A.q, s.C.q, L, P, lam, True)
+        r = check_pd(M, o.margin)
+        out.append(
+            _c(
+                "decay-lmi",
+                f"(A−LC)ᵀP(A−LC) ⪯ λ²P with λ = {float(lam):.6g}",
+                "Section 5",
+                "exact LDLᵀ over Q of the rebuilt matrix",
+                r.ok,
+                r.detail,
+            )
+        )
+        if o.rho is None and rho != lam * lam:
+            out.append(
+                _c(
+                    "rho-is-lambda-squared",
+                    "ρ = λ²",
+                    "Remark 1",
+                    "exact equality",
+                    False,
+                    f"ρ = {rho}",
+                )
+            )
+    Bw = error_input(s.A.q, s.Bd.q, s.Dn.q, L)
+    r = check_psd(iss_matrix(Acl, Bw, P, rho, mu))
+    ok = r.ok and rho < 1
+    out.append(
+        _c(
+            "iss-bound",
+            f"V(e⁺) ≤ ρV(e) + μ|w|² with ρ = {float(rho):.6g}, μ = {float(mu):.6g}",
+            "Assumption 2, eq. (5)-(6)",
+            "exact LDLᵀ over Q (linear error dynamics)",
+            ok,
+            r.detail + ("" if rho < 1 else "; ρ must be < 1"),
+        )
+    )
+    return out
+
+
+def _iss_sampled(spec: Spec, params: Parameters, P: Any, rho: Any, mu: Any, v_max: Any) -> Claim:
+    """Inequality (5) for expression-defined f, h, F: sampled (numerical claim)."""
+    from obsdesign.certify.claim import numerical_claim
+    from obsdesign.methods.constrained.nonlinear import check_iss_samples
+    from obsdesign.methods.constrained.observer import LinearF
+
+    o: Options = spec.options
+    s = spec.system
+    F = o.model.F
+    if F is None:
+        F = LinearF(s.A.f, s.B.f, s.C.f, s.D.f, np.asarray(to_float(o.L), dtype=float))
+    Pf = np.asarray(to_float(P), dtype=float)
+    ok, _, det = check_iss_samples(spec, o.model, F, Pf, float(rho), float(mu), float(v_max))
+    ok = ok and rho < 1
+    return numerical_claim(
+        "iss-bound",
+        f"V(Δ(x, e, u, w)) ≤ ρV(e) + μ|w|² with ρ = {float(rho):.6g}, μ = {float(mu):.6g}",
+        f"Assumption 2, eq. (5)-(6), {REF}",
+        "sampled in float64 (expression-defined f, h, F): not a proof",
+        0,
+        ok,
+        det,
+    )
 
 
 def _convexity(cm: ConstraintMap) -> list[Claim]:

@@ -125,7 +125,7 @@ def design_params(spec: Spec) -> tuple[dict[str, Any], list[str]]:
         notes.append(
             "Remark 2: v_max ≤ v_min, the estimate never leaves X̂ after a jump: θ = 0, no refining needed"
         )
-    params: dict[str, Any] = {"L": o.L}
+    params: dict[str, Any] = {} if o.L is None else {"L": o.L}
     if ld.lam is not None:
         params["lambda"] = ld.lam
     params.update(

@@ -60,7 +60,7 @@ class Constrained(Method):
         mat = {"type": "array", "items": {"anyOf": [num, vec]}}
         return {
             "type": "object",
-            "required": ["key", "L", "X", "c", "eps_min"],
+            "required": ["key", "X", "c", "eps_min"],
             "additionalProperties": False,
             "properties": {
                 "key": {"const": self.key},
@@ -93,6 +93,10 @@ class Constrained(Method):
                     "required": ["type"],
                 },
                 "D": {"type": "object", "properties": {"lower": vec, "upper": vec}},
+                "U": {"type": "object", "properties": {"lower": vec, "upper": vec}},
+                "f": {"type": "array", "items": {"type": "string"}},
+                "h": {"type": "array", "items": {"type": "string"}},
+                "F": {"type": "array", "items": {"type": "string"}},
             },
         }
 
@@ -128,6 +132,11 @@ eps_min = 0.01               # C_min = {|c| ≤ ε_min}
 # gamma = 1e-5               # default: the largest γ allowed by (24), γ ≤ λ_min(P)/δ²
 # gamma_uncertified = false  # true: accept a γ above (24) (claims fail, simulation allowed)
 # X0 = "X0"  Xhat0 = "Xhat0"  # optional: v̆_max of Section 4 from initial-condition sets
+# Nonlinear plant/observer (then give P, rho, mu; (5) is checked on samples, "numerical"):
+# f = ["x2", "0.5*sin(x1)"]        # x⁺ = f(x, u, d): states x1.., inputs u1.., d1..
+# h = ["x1 + v1"]                  # y = h(x, u, v): noise v1..
+# F = ["x2_hat + 0.2*(y1 - x1_hat)", "0.5*sin(x1_hat)"]   # x̂⁺ = F(x̂, u, y)
+# [method.U]  lower = [...]  upper = [...]   # input bounds (needed with expressions and inputs)
 
 [method.c]                   # the constraint map c of Assumption 3
 type = "box"                 # box (eq. 19) | polytope (G x ≤ h) | ellipsoid (eq. 18: Q, r)

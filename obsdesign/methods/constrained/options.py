@@ -32,7 +32,7 @@ class Options:
     default: the outer polytope/ellipsoid of C_min), D (box of w = (d, v)).
     """
 
-    L: np.ndarray
+    L: np.ndarray | None
     lam: fmpq | None
     rho: fmpq | None
     P: np.ndarray | None
@@ -55,6 +55,10 @@ class Options:
     file: str = ""
     #: the method's ``[simulate]`` keys (filled by ``parse_simulate``)
     sim: Any = None
+    #: expression-defined f, h, F (nonlinear.Model); None entries mean linear
+    model: Any = None
+    U_lower: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    U_upper: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 @dataclass
@@ -75,7 +79,19 @@ def parse_options(table: Table, spec: Spec) -> Options:
             'the constrained redesign (paper 000) is for discrete time: set [system] time = "discrete"',
         )
     n = s.n
-    L = table.matrix("L", rows=n, cols=s.p, vector_as="column").q
+    from obsdesign.methods.constrained.nonlinear import parse_model
+
+    model = parse_model(table, spec)
+    if model.F is None or table.has("L"):
+        L = table.matrix("L", rows=n, cols=s.p, vector_as="column").q
+    else:
+        L = None
+    if model.nonlinear and not table.has("P"):
+        raise table.error(
+            "P",
+            "is missing: with f, h or F expressions give the Lyapunov data P, rho and mu (Assumption 2); "
+            "inequality (5) is then checked on samples",
+        )
     P = mu = lam = rho = None
     if table.has("P"):
         if table.has("lambda"):
@@ -134,6 +150,19 @@ def parse_options(table: Table, spec: Spec) -> Options:
         if any(not a <= b for a, b in zip(Dl, Du, strict=True)):
             raise dt.error("upper", "expected lower <= upper in every coordinate")
         dt.done()
+    Ul = Uh = np.zeros(0)
+    ut = table.table("U")
+    if ut is not None:
+        Ul = ut.vector("lower", n=s.m).f
+        Uh = ut.vector("upper", n=s.m).f
+        if np.any(Ul > Uh):
+            raise ut.error("upper", "expected lower <= upper in every coordinate")
+        ut.done()
+    elif model.nonlinear and s.m:
+        raise table.error(
+            "U",
+            f"is missing: expected a table with lower/upper bounds of the input u ({s.m} numbers)",
+        )
     eps_min = table.scalar("eps_min", min=0, strict_min=True).q
     em = table.scalar("eps_max", default=None, min=0, strict_min=True)
     eps_max = None if em is None else em.q
@@ -146,7 +175,7 @@ def parse_options(table: Table, spec: Spec) -> Options:
     margin = table.scalar("margin", default=fmpq(1, 10**9), min=0).q
     tol = table.scalar("rate_tol", default=fmpq(1, 10000), min=0, strict_min=True).q
     table.done()
-    return Options(
+    o = Options(
         L,
         lam,
         rho,
@@ -169,6 +198,8 @@ def parse_options(table: Table, spec: Spec) -> Options:
         Xhat0,
         spec.file,
     )
+    o.model, o.U_lower, o.U_upper = model, Ul, Uh
+    return o
 
 
 def _set_ref(table: Table, key: str, spec: Spec, kinds: tuple[str, ...]) -> tuple[str, ConvexSet]:

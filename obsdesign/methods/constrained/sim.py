@@ -91,13 +91,19 @@ def simulate(spec: Spec, params: Parameters, **kw: Any) -> SimResult:
     N = int(sm.horizon.f)
     k = np.arange(N + 1)
     u, d, v = signals(spec, k)
-    A, Bm, C, D, Bd, Dn = s.A.f, s.B.f, s.C.f, s.D.f, s.Bd.f, s.Dn.f
+    from obsdesign.methods.constrained.nonlinear import Model, plant_f, plant_h
+
+    model = o.model if o.model is not None else Model(None, None, None)
+    f, h = plant_f(spec, model), plant_h(spec, model)
     x = np.zeros((N + 1, s.n))
     x[0] = sm.x0.f
     for i in range(N):
-        x[i + 1] = A @ x[i] + Bm @ u[i] + Bd @ d[i]
-    y = x @ C.T + u @ D.T + v @ Dn.T
-    F = LinearF(A, Bm, C, D, np.asarray(to_float(o.L), dtype=float))
+        x[i + 1] = f(x[i], u[i], d[i])
+    y = h(x, u, v)
+    if model.F is not None:
+        F: Any = model.F
+    else:
+        F = LinearF(s.A.f, s.B.f, s.C.f, s.D.f, np.asarray(to_float(o.L), dtype=float))
     ref = Refiner(o.cmap, Pinv, float(gamma_q), eps_min, eps_max)
     Pf = np.asarray(to_float(P), dtype=float)
     Xhat = xhat_set(o)
