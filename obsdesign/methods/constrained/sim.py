@@ -149,7 +149,7 @@ def simulate(spec: Spec, params: Parameters, **kw: Any) -> SimResult:
 
 
 def _fmt(a: np.ndarray) -> str:
-    return "[" + ", ".join(f"{float(v):.5g}" for v in np.atleast_1d(a)) + "]"
+    return "[" + ", ".join(f"{float(v):.6g}" for v in np.atleast_1d(a)) + "]"
 
 
 def _v_increase(tr: Trace, x: np.ndarray, P: np.ndarray) -> float:
