@@ -353,3 +353,10 @@ max_iterations = 25
     assert (e @ G.T).max() <= 1 + 1e-7
     assert np.abs(e[-1]).max() < 1e-6
     return True
+
+
+def test_template_designs():
+    from obsdesign.methods import get_method
+
+    rep = api.design(load_spec_text(get_method("set-invariant").template(), "template.toml"))
+    assert rep.exit_code() == 0

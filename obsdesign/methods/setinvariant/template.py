@@ -1,6 +1,6 @@
 """Commented spec template of the set-invariant method (``obsdesign init set-invariant``)."""
 
-TEMPLATE = """\\
+TEMPLATE = """\
 # obsdesign spec: set-invariant estimator (method "set-invariant", Dórea & Pimenta).
 # Error e = x − x̂ obeys e⁺ = A e + B1 d + v(z), z = C e + η, d ∈ D, |η| <= eta_bar.
 # The design finds a D-(C,A)-λ-contractive polyhedron {G e <= 1} containing Ω and the
@@ -17,15 +17,10 @@ C = [[1, 1]]                  # one output (or p = n − 1 outputs: linear law, 
 type = "symmetric-polytope"   # |Q e| <= 1 ; or type = "polytope" with G, g ; or "box"
 Q = [[1, 0], [0, 1]]
 
-[sets.D]                      # disturbance set (box or polytope)
-type = "box"
-lower = [-1]
-upper = [1]
-
 [method]
 key = "set-invariant"
 omega = "omega"
-disturbance = "D"
+disturbance = { type = "box", lower = [-1], upper = [1] }   # D (dimension = columns of B1)
 eta_bar = 0                   # measurement-noise bound |η| <= eta_bar
 lambda = 0.9                  # contraction rate, 0 < λ <= 1 (1: invariance)
 algorithm = "symmetric"       # symmetric (Section VI) | general (Section V) | none (check Ω)
