@@ -112,7 +112,22 @@ def outer_box_q(S: ConvexSet) -> tuple[np.ndarray, np.ndarray]:
 
 
 def max_phi_over(cm: ConstraintMap, X: ConvexSet) -> list[fmpq]:
-    """b_i = max over X of φ_i, exactly (X box or polytope: φ_i convex, max at a vertex)."""
+    """b_i = max over X of φ_i (X box or polytope: φ_i convex, max at a vertex).
+
+    Exact, except for the ellipsoid map over a box with more than MAX_PAIRS vertices, where
+    max xᵀQx ≤ Σ|Q_ij| m_i m_j (an upper bound, the safe direction for every use here).
+    Affine φ over a box: the closed form Σ_j max(g_ij l_j, g_ij u_j) − h_i.
+    """
+    if isinstance(X, Box):
+        lo, hi = X.lower_q, X.upper_q
+        if cm.affine:
+            G, h = cm.G_q, cm.h_q
+            return [
+                sum((max(G[i, j] * lo[j], G[i, j] * hi[j]) for j in range(len(lo))), fmpq(0)) - h[i]
+                for i in range(cm.n_c)
+            ]
+        if 2 ** len(lo) > MAX_PAIRS:
+            return [_box_quad_bound(cm.Q_q, lo, hi).value / Q(cm.r_q) - 1]
     V = vertices_q(X)
     vals = [cm.phi_q(v) for v in V]
     return [max(v[i] for v in vals) for i in range(cm.n_c)]
@@ -209,6 +224,11 @@ def _affine_quartic_sum(cm: ConstraintMap, Pinv: np.ndarray, b: list[fmpq], v: A
 
 def sup_norm_c_over_set(cm: ConstraintMap, S: ConvexSet) -> fmpq:
     """An upper bound of sup |c| over S (exact at the vertices for boxes/polytopes: |c| is convex)."""
+    if isinstance(S, Box) and 2**S.dim > MAX_PAIRS:
+        b = max_phi_over(cm, S)  # per-face maxima: |c|² ≤ Σ_classes max (b_i⁺)⁴
+        if not cm.affine:
+            return max(b[0], fmpq(0)) ** 2
+        return _affine_norm_bound(cm, qinv(qeye(S.dim)), b, fmpq(0))
     if isinstance(S, (Box, Polytope)):
         best = max(cm.norm_c_sq_q(v) for v in vertices_q(S))
         return upper(iv.sqrt, best) if best > 0 else fmpq(0)

@@ -379,6 +379,17 @@ def _cmin_in_xhat(cm: ConstraintMap, eps_min: fmpq, Xhat: ConvexSet) -> tuple[bo
     from obsdesign.certify.interval import upper
 
     t = sqrt_upper(eps_min)
+    if cm.kind == "box" and isinstance(Xhat, (Box, Polytope)):
+        # the outer set of C_min is the box [r̲ − t, r̄ + t]: compare face by face (closed form)
+        n = cm.dim
+        lo = np.array([-cm.h_q[2 * i] - t for i in range(n)], dtype=object)
+        hi = np.array([cm.h_q[2 * i + 1] + t for i in range(n)], dtype=object)
+        G, g = Xhat.h_form_q()
+        worst = max(
+            sum((max(G[j, i] * lo[i], G[j, i] * hi[i]) for i in range(n)), fmpq(0)) - g[j]
+            for j in range(G.shape[0])
+        )
+        return worst <= 0, f"max over the outer box of C_min of (H x − k) = {float(worst):.6g}"
     if cm.affine:
         V, bounded = vertices_exact(cm.G_q, np.array([h + t for h in cm.h_q], dtype=object))
         if not bounded or len(V) == 0:

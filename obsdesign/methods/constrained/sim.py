@@ -21,7 +21,7 @@ from obsdesign.simulate.runner import signals
 from obsdesign.spec.models import Spec
 
 #: default step budget per sample when θ (22) is astronomically large
-THETA_CAP = 100_000
+THETA_CAP = 10_000
 
 
 def _exact(params: Parameters, k: str) -> Any:
@@ -116,6 +116,12 @@ def simulate(spec: Spec, params: Parameters, **kw: Any) -> SimResult:
 
     info: dict[str, Any] = {
         "theta (22)": theta,
+        "theta_m": ", ".join(map(str, thetas))
+        + (
+            f" (θ capped at {THETA_CAP}: pass theta_m to choose)"
+            if not so.theta_m and "theta_m" not in kw and theta > THETA_CAP
+            else ""
+        ),
         "gamma (simulation)": f"{float(gamma_q):.6g}"
         + (
             " (certified by (24))"
