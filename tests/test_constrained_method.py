@@ -242,3 +242,67 @@ upper = [0, 0]
     assert int(rep.parameters["theta"]) == 0
     assert any("Remark 2" in n for n in rep.notes)
     assert rep.exit_code() == 0
+
+
+def test_large_box_uses_closed_forms():
+    """n = 13: 2¹³ vertices exceed the vertex budget; the per-face closed forms keep it fast."""
+    n = 13
+    rng = np.random.default_rng(13)
+    A = rng.uniform(-1, 1, (n, n))
+    A /= np.abs(A).sum(axis=1).max()
+    K = rng.uniform(-1, 1, (n, n))
+    K *= 0.5 / np.max(np.abs(np.linalg.eigvals(K)))
+
+    def v(a):
+        return "[" + ", ".join(f"{x:.6f}" for x in a) + "]"
+
+    def m(M):
+        return "[" + ", ".join(v(r) for r in M) + "]"
+
+    text = f"""
+[system]
+time = "discrete"
+A = {m(A)}
+C = {m(np.eye(n))}
+[sets.X]
+type = "box"
+lower = {v(-np.ones(n))}
+upper = {v(np.ones(n))}
+[method]
+key = "constrained"
+L = {m(A - K)}
+lambda = 0.6
+X = "X"
+eps_min = 0.05
+[method.c]
+type = "box"
+lower = {v(-1.5 * np.ones(n))}
+upper = {v(1.5 * np.ones(n))}
+[method.D]
+lower = {v(-0.1 * np.ones(n))}
+upper = {v(0.1 * np.ones(n))}
+"""
+    rep = api.design(load_spec_text(text, "n13.toml"))
+    assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
+    assert any("upper bound" in n for n in rep.notes)
+
+
+def test_v_max_breve_and_tampered_gamma(specs_dir):
+    text = (specs_dir / SEC5).read_text()
+    text = text.replace(
+        "[method]",
+        '[sets.X0]\ntype = "box"\nlower = [-1, -1]\nupper = [-0.9, -0.9]\n'
+        '[sets.Xhat0]\ntype = "box"\nlower = [0.9, 0.9]\nupper = [1, 1]\n[method]',
+        1,
+    ).replace("eps_min = 0.01", 'eps_min = 0.01\nX0 = "X0"\nXhat0 = "Xhat0"')
+    rep = api.design(load_spec_text(text, "breve.toml"))
+    assert rep.exit_code() == 0
+    # v̆_max = V(e0,max) + μ·9/(1 − ρ) ≈ 2.11e6 + 4.9e6 > v_max: θ̆ = θ (the paper's caveat)
+    assert rep.parameters.float("v_max_breve") == pytest.approx(7.008e6, rel=1e-3)
+    assert int(rep.parameters["theta_breve"]) == int(rep.parameters["theta"])
+    d = rep.to_dict()
+    d["parameters"]["gamma"] = 17.0
+    d["parameters"]["exact"]["gamma"] = "17"
+    ver = api.verify(Report.from_dict(d)[0])
+    failed = {c.id for c in ver.claims if c.status == ClaimStatus.FAILED}
+    assert "gamma-bound" in failed and ver.exit_code() == 1
