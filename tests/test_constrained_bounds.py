@@ -63,13 +63,19 @@ def test_lambda_min_and_gen_eig(n, seed):
 
 
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(st.integers(2, 3), st.integers(0, 2**31 - 1), st.floats(0.05, 1.0), st.floats(0.001, 0.5))
-def test_v_min_is_sound(n, seed, pad, eps):
+@given(
+    st.integers(2, 3),
+    st.integers(0, 2**31 - 1),
+    st.floats(0.05, 1.0),
+    st.floats(0.001, 0.5),
+    st.sampled_from(["euclidean", "max"]),
+)
+def test_v_min_is_sound(n, seed, pad, eps, norm):
     """Every x̂ with V(x̂ − x) ≤ v_min, x ∈ X, is in C_min (eq. (21))."""
     rng = np.random.default_rng(seed)
     P = _rand_P(rng, n)
     X = _box(-np.ones(n), np.ones(n))
-    cm = box_map([-1 - pad] * n, [1 + pad] * n)
+    cm = box_map([-1 - pad] * n, [1 + pad] * n, norm)
     eps_q = Q(round(eps, 6))
     vb = B.v_min_lower(cm, P, qinv(P), X, eps_q)
     Pf = np.asarray(to_float(P), float)
@@ -77,8 +83,10 @@ def test_v_min_is_sound(n, seed, pad, eps):
     xs[:8] = rng.choice([-1.0, 1.0], (8, n))  # vertices matter most
     pts = xs + _ellipsoid_samples(rng, Pf, float(vb.value), 200)
     assert np.all(cm.norm_c(pts) <= float(eps_q) * (1 + 1e-9))
-    # and it is not absurdly conservative: 1.5·v_min leaves C_min somewhere, or v_min is large
     assert B.v_min_condition(cm, P, qinv(P), X, eps_q, vb.value)
+    if norm == "max":  # exact: slightly above v_min some point of some ellipsoid leaves C_min
+        assert vb.exact
+        assert not B.v_min_condition(cm, P, qinv(P), X, eps_q, vb.value * fmpq(1001, 1000))
 
 
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])

@@ -306,3 +306,20 @@ def test_v_max_breve_and_tampered_gamma(specs_dir):
     ver = api.verify(Report.from_dict(d)[0])
     failed = {c.id for c in ver.claims if c.status == ClaimStatus.FAILED}
     assert "gamma-bound" in failed and ver.exit_code() == 1
+
+
+def test_sec5_max_norm_matches_issue_estimate(specs_dir):
+    """With |c| the max-norm, C_min/C_max are boxes, v_min has an exact closed form, and
+    δ = 643.47, γ = 3.2434e-5 (the issue's estimate: δ ≈ 637, γ ≈ 3.3e-5)."""
+    text = (
+        (specs_dir / SEC5)
+        .read_text()
+        .replace('type = "box"\nlower = [-1.1', 'type = "box"\nnorm = "max"\nlower = [-1.1')
+    )
+    rep = api.design(load_spec_text(text, "max.toml"))
+    assert rep.exit_code() == 0
+    p = rep.parameters
+    assert p.float("delta") == pytest.approx(643.47, rel=1e-4)
+    assert p.float("gamma") == pytest.approx(3.24344e-5, rel=1e-5)
+    assert p.float("v_min") == pytest.approx(1.0270701, rel=1e-7)
+    assert any("exact closed form" in n for n in rep.notes)

@@ -21,7 +21,15 @@ def _vec(v) -> str:
     return "[" + ", ".join(f"{x:.6f}" for x in v) + "]"
 
 
-def random_spec(n: int, seed: int, r_pad: float, eps_min: float, wbound: float, rad: float = 0.8):
+def random_spec(
+    n: int,
+    seed: int,
+    r_pad: float,
+    eps_min: float,
+    wbound: float,
+    rad: float = 0.8,
+    norm: str = "euclidean",
+):
     """x⁺ = A x with ‖A‖_∞ ≤ 1 (so X = [−1, 1]ⁿ is invariant, Assumption 1), y = x + v
     (C = I), L = A − K with K of spectral radius ``rad``, λ = rad + 0.1."""
     rng = np.random.default_rng(seed)
@@ -52,6 +60,7 @@ X = "X"
 eps_min = {eps_min:.6f}
 [method.c]
 type = "box"
+norm = "{norm}"
 lower = {_vec(-r * np.ones(n))}
 upper = {_vec(r * np.ones(n))}
 [method.D]
@@ -77,9 +86,10 @@ bound = {_vec(wbound * np.ones(n))}
     st.floats(0.05, 0.5),
     st.sampled_from([0.0, 0.05, 0.3]),
     st.sampled_from([0.5, 0.8]),
+    st.sampled_from(["euclidean", "max"]),
 )
-def test_theorem1_invariance_and_lemma3(n, seed, r_pad, eps_min, wbound, rad):
-    check_run(n, seed, r_pad, eps_min, wbound, rad)
+def test_theorem1_invariance_and_lemma3(n, seed, r_pad, eps_min, wbound, rad, norm):
+    check_run(n, seed, r_pad, eps_min, wbound, rad, norm)
 
 
 def test_refining_is_exercised():
@@ -88,9 +98,9 @@ def test_refining_is_exercised():
     assert steps.sum() > 1000
 
 
-def check_run(n, seed, r_pad, eps_min, wbound, rad):
+def check_run(n, seed, r_pad, eps_min, wbound, rad, norm="euclidean"):
     """Design, simulate with θ_m = θ, and check (25a), (25b) and Lemma 3 (A.1a)."""
-    sp, _ = random_spec(n, seed, r_pad, eps_min, wbound, rad)
+    sp, _ = random_spec(n, seed, r_pad, eps_min, wbound, rad, norm)
     rep = api.design(sp)
     assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
     p = rep.parameters

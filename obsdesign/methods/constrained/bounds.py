@@ -209,7 +209,9 @@ def _affine_norm_bound(cm: ConstraintMap, Pinv: np.ndarray, b: list[fmpq], v: An
 
 
 def _affine_quartic_sum(cm: ConstraintMap, Pinv: np.ndarray, b: list[fmpq], v: Any) -> fmpq:
-    """Upper bound of Σ_classes max_{i∈class} (b_i + √(v w_i))⁺⁴ (outward rounding)."""
+    """Upper bound of |c|² over {x + e : x ∈ X, V(e) ≤ v} given b_i = max_X φ_i:
+    Σ_classes max_{i∈class} (b_i + √(v w_i))⁺⁴ (Euclidean |c|), or the max over classes
+    (max-norm |c|), with outward rounding."""
     G = cm.G_q
     total = fmpq(0)
     for cls in cm.classes:
@@ -218,7 +220,7 @@ def _affine_quartic_sum(cm: ConstraintMap, Pinv: np.ndarray, b: list[fmpq], v: A
             w = quad(Pinv, G[i])
             a = upper(lambda b, v, w: b + iv.sqrt(v * w), b[i], Q(v), w) if Q(v) > 0 else b[i]
             worst = max(worst, a)
-        total += worst**4
+        total = max(total, worst**4) if cm.norm == "max" else total + worst**4
     return total
 
 
@@ -284,9 +286,16 @@ def v_min_lower(
     v = round_sig(dyadic(lo, 30), 8, up=False) if lo > 0 else fmpq(0)
     while v > 0 and not v_min_condition(cm, P, Pinv, X, eps_min, v):
         v = round_sig(v * fmpq(999, 1000), 8, up=False)
-    how = "per-face bound φ_i ≤ max_X φ_i + √(v g_iᵀP⁻¹g_i), at most one face per antipodal class"
     if not cm.affine:
-        how = "triangle inequality in the Q-norm"
+        return Bound(v, False, "certified lower bound (triangle inequality in the Q-norm)")
+    if cm.norm == "max" or len(cm.classes) == 1:
+        # C_min = {φ_i ≤ √ε_min} exactly: the per-face condition is necessary and sufficient
+        return Bound(
+            v,
+            True,
+            "exact closed form per face, max_X φ_i + √(v g_iᵀP⁻¹g_i) ≤ √ε_min (rounded down to 8 digits)",
+        )
+    how = "per-face bound φ_i ≤ max_X φ_i + √(v g_iᵀP⁻¹g_i), at most one face per antipodal class"
     return Bound(v, False, f"certified lower bound ({how})")
 
 

@@ -41,6 +41,9 @@ class ConstraintMap:
     Q_q: np.ndarray | None = None
     r_q: Any = None
     classes: list[list[int]] = field(default_factory=list)
+    #: the norm |c| of eq. (16): "euclidean" (the paper's |·|) or "max" (then C_ε is the
+    #: polytope {φ_i ≤ √ε} for affine maps); Lemma 3 holds for both, since |c|₂ ≥ |c|_∞
+    norm: str = "euclidean"
     _f: dict[str, Any] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
@@ -94,7 +97,9 @@ class ConstraintMap:
         return np.maximum(self.phi(x), 0.0) ** 2
 
     def norm_c(self, x: np.ndarray) -> np.ndarray:
-        """|c(x)|, the Euclidean norm used in the sets C_ε of eq. (16)."""
+        """|c(x)|, the norm used in the sets C_ε of eq. (16) (Euclidean or max)."""
+        if self.norm == "max":
+            return np.max(self.c(x), axis=-1)
         return np.linalg.norm(self.c(x), axis=-1)
 
     def jtc(self, x: np.ndarray) -> np.ndarray:
@@ -128,7 +133,7 @@ class ConstraintMap:
         out = fmpq(0)
         for p in self.phi_q(x):
             if p > 0:
-                out += p**4
+                out = max(out, p**4) if self.norm == "max" else out + p**4
         return out
 
 
@@ -162,7 +167,7 @@ def _negative_multiple(a: np.ndarray, b: np.ndarray) -> bool:
     return bool(s < 0 and all(b[t] == s * a[t] for t in range(len(a))))
 
 
-def box_map(lower: np.ndarray, upper: np.ndarray) -> ConstraintMap:
+def box_map(lower: np.ndarray, upper: np.ndarray, norm: str = "euclidean") -> ConstraintMap:
     """The box map of eq. (19): rows −e_i (φ = r̲_i − x_i) then +e_i (φ = x_i − r̄_i)."""
     n = len(lower)
     G = qzeros((2 * n, n))
@@ -172,12 +177,14 @@ def box_map(lower: np.ndarray, upper: np.ndarray) -> ConstraintMap:
         h[2 * i] = -Q(lower[i])
         G[2 * i + 1, i] = fmpq(1)
         h[2 * i + 1] = Q(upper[i])
-    return ConstraintMap("box", G_q=G, h_q=h, classes=[[2 * i, 2 * i + 1] for i in range(n)])
+    return ConstraintMap(
+        "box", G_q=G, h_q=h, classes=[[2 * i, 2 * i + 1] for i in range(n)], norm=norm
+    )
 
 
-def polytope_map(G: np.ndarray, h: np.ndarray) -> ConstraintMap:
+def polytope_map(G: np.ndarray, h: np.ndarray, norm: str = "euclidean") -> ConstraintMap:
     """One component c_i = max(g_iᵀx − h_i, 0)² per face of {G x ≤ h}."""
-    return ConstraintMap("polytope", G_q=G, h_q=h, classes=antipodal_classes(G))
+    return ConstraintMap("polytope", G_q=G, h_q=h, classes=antipodal_classes(G), norm=norm)
 
 
 def ellipsoid_map(Qm: np.ndarray, r: Any) -> ConstraintMap:

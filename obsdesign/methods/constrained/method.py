@@ -83,6 +83,7 @@ class Constrained(Method):
                     "type": "object",
                     "properties": {
                         "type": {"enum": ["box", "polytope", "ellipsoid"]},
+                        "norm": {"enum": ["euclidean", "max"]},
                         "lower": vec,
                         "upper": vec,
                         "G": mat,
@@ -140,6 +141,7 @@ eps_min = 0.01               # C_min = {|c| ≤ ε_min}
 
 [method.c]                   # the constraint map c of Assumption 3
 type = "box"                 # box (eq. 19) | polytope (G x ≤ h) | ellipsoid (eq. 18: Q, r)
+# norm = "euclidean"         # |c| in C_ε = {|c| ≤ ε}: "euclidean" (paper) or "max" (box-shaped C_ε)
 lower = [-1.1, -1.1]
 upper = [1.1, 1.1]
 

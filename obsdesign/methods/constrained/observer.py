@@ -81,7 +81,7 @@ class Refiner:
                 p = G @ x - h
                 np.maximum(p, 0.0, out=p)
                 p2 = p * p
-                nc2 = float(p2 @ p2)
+                nc2 = float(p2.max()) ** 2 if cm.norm == "max" else float(p2 @ p2)
                 if not (lo2 < nc2 <= hi2):
                     break
                 x = x - Pg @ (G.T @ (2.0 * p2 * p))

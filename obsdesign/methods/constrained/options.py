@@ -225,20 +225,21 @@ def parse_cmap(t: Table, n: int) -> ConstraintMap:
             "type",
             f"expected one of {', '.join(KINDS)} (each gives a convex c, Assumption 3(3)); got {kind!r}",
         )
+    norm = t.str("norm", default="euclidean", choices=("euclidean", "max"))
     if kind == "box":
         lo = t.vector("lower", n=n).q
         hi = t.vector("upper", n=n).q
         for i in range(n):
             if not lo[i] < hi[i]:
                 raise t.error("upper", f"expected lower < upper in every coordinate (index {i})")
-        cm = box_map(lo, hi)
+        cm = box_map(lo, hi, norm)
     elif kind == "polytope":
         G = t.matrix("G", cols=n).q
         h = t.vector("h", n=G.shape[0]).q
         verts, bounded = vertices_exact(G, np.asarray(h, dtype=object))
         if len(verts) == 0 or not bounded:
             raise t.error("G", "expected a non-empty bounded polytope {x : G x <= h} for C_0")
-        cm = polytope_map(G, np.asarray(h, dtype=object))
+        cm = polytope_map(G, np.asarray(h, dtype=object), norm)
     else:
         Qm = t.matrix("Q", rows=n, cols=n).q
         if any(Qm[i, j] != Qm[j, i] for i in range(n) for j in range(n)):
