@@ -72,7 +72,7 @@ def load_spec_text(text: str, file: str = "<spec>") -> Spec:
     st = root.table("simulate")
     if st is not None:
         spec.simulate = _simulate(st, system)
-        method.parse_simulate(st, spec)
+        spec.simulate.options = method.parse_simulate(st, spec)
         st.done()
     root.done()
     return spec

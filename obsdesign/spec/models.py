@@ -68,6 +68,8 @@ class SimulateSpec:
     noise: Signal
     seed: int
     table: Table
+    #: what the method's ``parse_simulate`` returned for its own ``[simulate]`` keys
+    options: Any = None
 
 
 @dataclass
