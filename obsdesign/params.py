@@ -139,3 +139,43 @@ def _same(a: Any, b: Any) -> bool:
     if not isinstance(b, (int, float)):
         return False
     return math.isclose(float(a), float(b), rel_tol=1e-12, abs_tol=1e-300)
+
+
+def exact_param(params: Parameters, k: str, claims: list[Any], accept_float: bool = True) -> Any:
+    """The exact value of parameter ``k`` for a certificate, or None after appending a failed
+    claim saying why (missing; or float-only when ``accept_float`` is False). A float-only
+    value, when accepted, is taken at its exact binary value."""
+    from obsdesign.certify.claim import exact_claim
+    from obsdesign.certify.exact import Q, dyadic
+
+    if k not in params:
+        claims.append(
+            exact_claim(
+                f"{k}-present",
+                f"the report gives {k}",
+                "report",
+                "presence",
+                0,
+                False,
+                f"{k} missing",
+            )
+        )
+        return None
+    v = params[k]
+    if _is_exact(v):
+        return v
+    if not accept_float:
+        claims.append(
+            exact_claim(
+                f"{k}-exact",
+                f"{k} is given exactly",
+                "report",
+                "presence of the exact value",
+                0,
+                False,
+                f"{k} has no exact value in the report",
+            )
+        )
+        return None
+    arr = np.asarray(v, dtype=float)
+    return Q(float(arr)) if arr.ndim == 0 else dyadic(arr, 60)

@@ -28,7 +28,7 @@ from obsdesign.certify.exact import Q, dyadic, qeye, symmetrize
 from obsdesign.certify.psd import check_pd
 from obsdesign.errors import InconclusiveError, InfeasibleError, SolverError
 from obsdesign.methods.base import Design, Method, Progress
-from obsdesign.params import Parameters
+from obsdesign.params import Parameters, exact_param
 from obsdesign.spec.models import Spec
 from obsdesign.spec.reader import Table
 
@@ -147,9 +147,9 @@ class Lyapunov(Method):
         o: Options = spec.options
         name = "lambda" if s.discrete else "alpha"
         claims: list[Claim] = []
-        L = _exact(params, "L", claims)
-        P = _exact(params, "P", claims)
-        rate = _exact(params, name, claims)
+        L = exact_param(params, "L", claims)
+        P = exact_param(params, "P", claims)
+        rate = exact_param(params, name, claims)
         if L is None or P is None or rate is None:
             return claims
         if o.L is not None and not np.array_equal(np.asarray(L), np.asarray(o.L)):
@@ -179,13 +179,13 @@ class Lyapunov(Method):
         claims.append(_pd_claim("P-positive-definite", "P ≻ 0", P, o.margin))
         claims.append(_decay_claim(s, L, P, rate, o.margin, ""))
         if "P_best" in params and f"{name}_best" in params:
-            Pb = _exact(params, "P_best", claims)
-            rb = _exact(params, f"{name}_best", claims)
+            Pb = exact_param(params, "P_best", claims)
+            rb = exact_param(params, f"{name}_best", claims)
             if Pb is not None and rb is not None:
                 claims.append(_pd_claim("P_best-positive-definite", "P_best ≻ 0", Pb, o.margin))
                 claims.append(_decay_claim(s, L, Pb, rb, o.margin, "_best"))
         if o.iss_gain:
-            mu = _exact(params, "mu", claims)
+            mu = exact_param(params, "mu", claims)
             if mu is not None:
                 claims.append(_iss_claim(s, L, P, rate, mu))
         return claims
@@ -209,6 +209,7 @@ class Lyapunov(Method):
     def options_schema(self) -> dict[str, Any]:
         from obsdesign.spec.schema import MAT as mat
         from obsdesign.spec.schema import NUM as num
+
         return {
             "type": "object",
             "required": ["key"],
@@ -256,28 +257,6 @@ def iss_matrix(A: Any, C: Any, L: Any, Dn: Any, P: Any, rate: Any, mu: Any, disc
         off = -(P @ Ld)
         low = qeye(k) * Q(mu)
     return symmetrize(np.block([[S, off], [off.T, low]]))
-
-
-def _exact(params: Parameters, k: str, claims: list[Claim]) -> Any:
-    if k not in params:
-        claims.append(
-            exact_claim(
-                f"{k}-present",
-                f"the report gives {k}",
-                "report",
-                "presence",
-                0,
-                False,
-                f"{k} missing",
-            )
-        )
-        return None
-    v = params[k]
-    if isinstance(v, fmpq) or (isinstance(v, np.ndarray) and v.dtype == object):
-        return v
-    # a float-only parameter is taken at its exact binary value
-    arr = np.asarray(v, dtype=float)
-    return Q(float(arr)) if arr.ndim == 0 else dyadic(arr, 60)
 
 
 def _pd_claim(id: str, what: str, P: Any, margin: Any) -> Claim:
