@@ -69,6 +69,36 @@ def _drop_inside(img: np.ndarray, G: np.ndarray, tol: float) -> np.ndarray:
     return img[(img @ G.T).max(axis=1) > 1 + tol]
 
 
+def _eps_screened(
+    G: np.ndarray,
+    phi: np.ndarray,
+    dl: np.ndarray,
+    zs: np.ndarray,
+    prev: tuple[np.ndarray, np.ndarray] | None,
+    lam_stop: float,
+) -> lps.EpsResult:
+    """ε(z^l) of LP (9), solving the LP only where needed.
+
+    For any v, max_i(φ_i + δ_i + G_i v) >= ε(z) (LP (9) is a minimum over v), so the
+    previous iteration's injections, interpolated at the new z^l, give upper bounds. Where the
+    bound is <= the stopping level the LP is skipped (that z cannot be the worst violator,
+    and the bound is reported as its ε); the LP is solved at the other z^l. The worst z and
+    the stopping decision are therefore the same as with all LPs solved."""
+    if prev is None or len(prev[0]) < 2:
+        return lps.eps_batch(G, phi, dl)
+    zp, vp = prev
+    vi = np.stack([np.interp(zs, zp, vp[:, k]) for k in range(vp.shape[1])], axis=1)
+    ub = (phi + dl[None, :] + vi @ G.T).max(axis=1)
+    need = np.nonzero(ub > lam_stop)[0]
+    eps, v = ub.copy(), vi
+    if len(need):
+        er = lps.eps_batch(G, phi[need], dl)
+        better = er.eps < ub[need]
+        eps[need] = np.where(better, er.eps, ub[need])
+        v[need] = np.where(better[:, None], er.v, vi[need])
+    return lps.EpsResult(eps, v)
+
+
 def general(
     pb: Problem,
     lam_run: float,
@@ -90,13 +120,15 @@ def general(
     Bd = pb.Dv @ pb.B1.T if pb.B1.shape[1] else np.zeros((1, pb.n))
     eps_l = np.inf
     st = None
+    prev: tuple[np.ndarray, np.ndarray] | None = None
     for it in range(it0 + 1, it0 + max_iter + 1):
         st = po.hull(P)
         P, G = st.V, st.G
         dl = lps.delta(G, pb.B1, pb.Dv)
         zs = lps.z_d(P, c, pb.eta)  # step 3
         phi, slices = lps.phi_at(G, pb.A, P, st.edges, c, pb.eta, zs)  # step 4a
-        er = lps.eps_batch(G, phi, dl)  # step 4b
+        er = _eps_screened(G, phi, dl, zs, prev, lam_stop)  # step 4b
+        prev = (zs, er.v)
         l = int(np.argmax(er.eps))  # step 5
         eps_l = float(er.eps[l])
         hist.append({"iteration": it, "facets": len(G), "vertices": len(P), "eps": eps_l})
