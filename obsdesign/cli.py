@@ -76,7 +76,10 @@ def design(
     ] = None,
     fmt: Annotated[Fmt, typer.Option("--format", help="Output format on stdout.")] = Fmt.text,
     plot: Annotated[
-        Path | None, typer.Option("--plot", help="Write the method's design plot (PNG/SVG).")
+        Path | None,
+        typer.Option(
+            "--plot", "--plot-epsilon", help="Write the method's design plot (PNG/SVG), e.g. ε(z)."
+        ),
     ] = None,
 ) -> None:
     """Design the observer of SPEC, certify every claim, and print (or write) the report."""
