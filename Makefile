@@ -5,7 +5,7 @@ PY     := $(VENV)/bin/python
 SUDO   := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 DEBS   := libcdd-dev libgmp-dev
 
-.PHONY: install run test test-slow bench lint clean
+.PHONY: install run test test-slow bench bench-quick lint clean
 
 install: $(VENV)/.installed
 
@@ -30,6 +30,9 @@ test-slow: install
 
 bench: install
 	$(PY) benchmarks/run.py
+
+bench-quick: install
+	OBSDESIGN_BENCH_QUICK=1 $(PY) benchmarks/run.py
 
 lint: install
 	$(VENV)/bin/ruff check obsdesign tests benchmarks

@@ -227,9 +227,12 @@ def primitives() -> None:
 
 
 def main() -> None:
+    import os
+
     examples()
     primitives()
-    paper_test()
+    # `make bench-quick` sets OBSDESIGN_BENCH_QUICK: 5 random systems instead of 20 (~10 min)
+    paper_test(5 if os.environ.get("OBSDESIGN_BENCH_QUICK") else 20)
 
 
 if __name__ == "__main__":
