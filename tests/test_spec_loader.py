@@ -64,6 +64,34 @@ def _replace(old: str, new: str) -> str:
     return GOOD.replace(old, new)
 
 
+IMPULSIVE = """
+[system]
+time = "continuous"
+A = [[0, 0.01], [1, -3]]
+C = [[1, 0]]
+[nonlinearity]
+psi = ["PSI", "0"]
+[nonlinearity.o]
+sector = [-0.2, 0.2]
+[nonlinearity.n]
+sector = [0, 0.3]
+[method]
+key = "impulsive"
+L = [0.8]
+alpha = 3
+noise_bound = 0.1
+M = [[0, 1]]
+"""
+
+
+def _expr(psi: str) -> str:
+    return IMPULSIVE.replace("PSI", psi.replace('"', "'"))
+
+
+def test_impulsive_base_spec_is_valid():
+    load_spec_text(_expr("0.2*sin(x1)"), "ok.toml")
+
+
 MALFORMED = [
     ("bad toml", "[system\ntime = 1", "", "not valid TOML"),
     ("missing system", "[method]\nkey = 'lyapunov'", "system", "missing"),
@@ -140,6 +168,15 @@ MALFORMED = [
         "one of",
     ),
     ("unknown top-level", GOOD + "[extra]\na = 1\n", "extra", "not a known key"),
+    (
+        "expr __import__",
+        _expr("__import__('os').system('true')"),
+        "nonlinearity.psi[0]",
+        "not allowed",
+    ),
+    ("expr attribute", _expr("x1.__class__"), "nonlinearity.psi[0]", "attribute access"),
+    ("expr lambda", _expr("(lambda: 0)"), "nonlinearity.psi[0]", "lambda"),
+    ("expr unknown name", _expr("open"), "nonlinearity.psi[0]", "unknown name"),
 ]
 
 
