@@ -1,7 +1,10 @@
 """Polytopes in H-form {x : G x <= g}, and symmetric polytopes {x : |Q x| <= 1}.
 
 Vertex enumeration goes through pycddlib: exact with ``cdd.gmp`` (rationals in, rationals
-out) for certificates, float ``cdd`` for speed elsewhere.
+out) for certificates, float ``cdd`` for speed elsewhere. Whether exact cdd is available is
+decided by one switch, :data:`obsdesign.sets.polytope_ops.HAVE_GMP` (read at call time, so a
+test can turn it off); without it :func:`vertices_exact` raises and :func:`check_polytope_q`
+decides boundedness and emptiness with HiGHS LPs instead.
 """
 
 from __future__ import annotations
@@ -13,6 +16,7 @@ import numpy as np
 from flint import fmpq
 
 from obsdesign.certify.exact import Q, to_float
+from obsdesign.sets import polytope_ops as po
 from obsdesign.sets.base import ConvexSet
 
 
@@ -21,7 +25,12 @@ def _frac(q: fmpq) -> Fraction:
 
 
 def vertices_exact(G_q: np.ndarray, g_q: np.ndarray) -> tuple[np.ndarray, bool]:
-    """Exact vertices of {G x <= g} by cdd.gmp; returns (vertices (k, n) of fmpq, bounded)."""
+    """Exact vertices of {G x <= g} by cdd.gmp; returns (vertices (k, n) of fmpq, bounded).
+
+    Raises :class:`~obsdesign.sets.polytope_ops.PolytopeError` when cdd.gmp is not available
+    (:data:`~obsdesign.sets.polytope_ops.HAVE_GMP` is False)."""
+    if not po.HAVE_GMP:
+        raise po.PolytopeError("cdd.gmp is not available: exact vertex enumeration is disabled")
     import cdd
     import cdd.gmp
 
@@ -49,6 +58,39 @@ def vertices_float(G: np.ndarray, g: np.ndarray) -> tuple[np.ndarray, bool]:
     bounded = not gen.lin_set and bool(np.all(arr[:, 0] != 0)) if len(arr) else True
     verts = arr[arr[:, 0] != 0]
     return verts[:, 1:] / verts[:, :1], bounded
+
+
+def check_polytope_q(G_q: np.ndarray, g_q: np.ndarray) -> tuple[bool, bool, bool]:
+    """(non-empty, bounded, exact) for {G x <= g}.
+
+    With cdd.gmp (:data:`~obsdesign.sets.polytope_ops.HAVE_GMP`) this is decided exactly by
+    vertex enumeration (``exact`` True). Without it, by HiGHS LPs in float64 (``exact`` False):
+    non-empty when ``G x <= g`` is feasible, bounded when ``±x_k`` is bounded above on it for
+    every coordinate k. A set empty or unbounded only within float rounding may be misjudged.
+    """
+    if po.HAVE_GMP:
+        verts, bounded = vertices_exact(G_q, g_q)
+        # a line or ray means non-empty (cdd gives no vertex for a polyhedron with a line)
+        return len(verts) > 0 or not bounded, bounded and len(verts) > 0, True
+    from scipy.optimize import linprog
+
+    G = np.asarray(to_float(G_q), dtype=float).reshape(len(g_q), -1)
+    g = np.asarray(to_float(np.asarray(g_q, dtype=object)), dtype=float).reshape(-1)
+    n = G.shape[1]
+    free = [(None, None)] * n
+    feas = linprog(np.zeros(n), A_ub=G, b_ub=g, bounds=free, method="highs")
+    if feas.status == 2:
+        return False, True, False
+    if feas.status != 0:
+        return True, False, False
+    for k in range(n):
+        for sgn in (1.0, -1.0):
+            c = np.zeros(n)
+            c[k] = -sgn  # maximize sgn * x_k
+            r = linprog(c, A_ub=G, b_ub=g, bounds=free, method="highs")
+            if r.status != 0:  # 3: unbounded (anything else: treat as not proven bounded)
+                return True, False, False
+    return True, True, False
 
 
 @dataclass(frozen=True, eq=False)

@@ -18,8 +18,9 @@ import numpy as np
 from obsdesign.certify.exact import qeye, qzeros
 from obsdesign.certify.psd import check_pd
 from obsdesign.errors import InputError, SpecError
-from obsdesign.sets import Box, Ellipsoid, Polytope, SymmetricPolytope, vertices_exact
+from obsdesign.sets import Box, Ellipsoid, Polytope, SymmetricPolytope
 from obsdesign.sets.base import ConvexSet
+from obsdesign.sets.polytope import check_polytope_q
 from obsdesign.spec.models import SimulateSpec, Spec, System
 from obsdesign.spec.reader import Table, Value
 from obsdesign.spec.signals import parse_signal
@@ -155,11 +156,11 @@ def _set(t: Table, n: int) -> ConvexSet:
 
 
 def _check_polytope(t: Table, s: Polytope, key: str) -> None:
-    """Non-empty and bounded, decided exactly (cdd.gmp)."""
-    verts, bounded = vertices_exact(s.G_q, s.g_q)
-    if len(verts) == 0 and bounded:
+    """Non-empty and bounded: decided exactly with cdd.gmp, else by float LPs (HiGHS)."""
+    nonempty, bounded, _exact = check_polytope_q(s.G_q, s.g_q)
+    if not nonempty:
         raise t.error(key, "describes an empty set")
-    if not bounded or len(verts) == 0:
+    if not bounded:
         raise t.error(key, "describes an unbounded set (expected a bounded polytope)")
 
 

@@ -38,7 +38,7 @@ from obsdesign.spec.reader import Table
 
 from . import algorithms as al
 from . import certificate as ce
-from . import laws, lps
+from . import laws, lps, numerical
 from .linear import admissible_gains
 from .problem import build, check_detectable, necessary_condition
 
@@ -158,6 +158,7 @@ class SetInvariant(Method):
         t0 = time.perf_counter()
         data = build(spec)
         fl, ex = data.fl, data.ex
+        exact_mode = ex is not None  # False without cdd.gmp: float-only, numerical claims
         lam = float(o.lam)
         dd = float(o.delta_tol)
         check_detectable(fl.A, fl.C, lam)
@@ -166,12 +167,17 @@ class SetInvariant(Method):
         history: list[dict[str, float]] = []
         single = s.p == 1
 
-        Vo_f = po.qfloat(ex.Vo)
-        vreps: dict[int, po.ExactVRep] = {}
+        Vo_f = po.qfloat(ex.Vo) if ex is not None else numerical.omega_vertices(fl)
+        vreps: dict[int, Any] = {}
 
-        def exact_stage(P: np.ndarray) -> tuple[np.ndarray, ce.Theorem31Result | None]:
+        def exact_stage(P: np.ndarray) -> tuple[np.ndarray, Any]:
             """Exact polytope from the float vertices P: Ω's vertices exactly, the others
-            snapped (po.snap); one exact hull gives G and the edges (po.exact_hull)."""
+            snapped (po.snap); one exact hull gives G and the edges (po.exact_hull).
+            Without cdd.gmp: the float hull and Theorem 3.1 in float64 (numerical.py)."""
+            if ex is None:
+                Gf, resf, vrf = numerical.float_stage(fl, P, lam)
+                vreps[id(Gf)] = vrf
+                return Gf, resf
             near = (
                 np.array([np.abs(Vo_f - p).max(axis=1).min() <= 1e-9 for p in P])
                 if len(P)
@@ -278,12 +284,13 @@ class SetInvariant(Method):
             )
         if res is not None:
             params["contractivity"] = res.factor
-            params["breakpoints"] = np.array(res.zs, dtype=object)
-            params["v_breakpoints"] = np.array(res.vs, dtype=object).reshape(len(res.zs), s.n)
+            dt = object if exact_mode else float
+            params["breakpoints"] = np.array(res.zs, dtype=dt)
+            params["v_breakpoints"] = np.array(res.vs, dtype=dt).reshape(len(res.zs), s.n)
             if len(res.zs) > 1:
-                Ls, ws = laws.pieces(res.zs, res.vs)
-                params["L_pieces"] = np.array(Ls, dtype=object)
-                params["w_pieces"] = np.array(ws, dtype=object)
+                Ls, ws = laws.pieces(list(res.zs), [list(v) for v in res.vs])
+                params["L_pieces"] = np.array(Ls, dtype=dt)
+                params["w_pieces"] = np.array(ws, dtype=dt)
             params["vertices"] = res.n_vertices
             if res.exact_lp:
                 notes.append(
@@ -292,7 +299,11 @@ class SetInvariant(Method):
         # linear law (Proposition 7.1 / any admissible L)
         V = vreps[id(Gq)].V
         if o.linear_law and s.p == s.n - 1:
-            gs = admissible_gains(ex, Gq, V)
+            gs = (
+                admissible_gains(ex, Gq, V)
+                if ex is not None
+                else numerical.float_gains(fl, lam, Gq, V)
+            )
             if gs.L is not None:
                 params["L"] = gs.L
                 params["L_factor"] = gs.factor
@@ -322,12 +333,13 @@ class SetInvariant(Method):
         params["history_facets"] = [h["facets"] for h in history]
         params["history_eps"] = [h["eps"] for h in history]
         solver = {
-            "name": "HiGHS (scipy) LPs + qhull hulls; cdd.gmp exact",
+            "name": "HiGHS (scipy) LPs + qhull hulls; "
+            + ("cdd.gmp exact" if exact_mode else "float64 only (no cdd.gmp)"),
             "status": "converged" if converged else "not converged",
             "seconds": round(time.perf_counter() - t0, 4),
         }
-        if not po.HAVE_GMP:  # pragma: no cover
-            notes.append("cdd.gmp is not installed: claims cannot be certified")
+        if not exact_mode:
+            notes.append(numerical.NOTE)
         return Design(params, solver, notes)
 
     # -- certificate ------------------------------------------------------------------------
@@ -336,6 +348,8 @@ class SetInvariant(Method):
         s = spec.system
         data = build(spec)
         ex = data.ex
+        if ex is None:  # no cdd.gmp: the same claims in float64, status numerical
+            return numerical.certify(spec, params, data.fl, REF)
         claims: list[Claim] = []
         G = _exact_param(params, "G", claims)
         if G is None:
@@ -605,7 +619,7 @@ def _parse_disturbance(table: Table, spec: Spec) -> tuple[str | None, Any]:
     """``disturbance``: the name of a set in [sets] (when its dimension is n) or an inline
     table ``{type = "box", lower, upper}`` / ``{type = "polytope", G, g}`` of dimension
     = columns of B1 (the [sets] loader requires state dimension)."""
-    from obsdesign.sets.polytope import vertices_exact
+    from obsdesign.sets.polytope import check_polytope_q
 
     s = spec.system
     if not table.has("disturbance"):
@@ -636,8 +650,8 @@ def _parse_disturbance(table: Table, spec: Spec) -> tuple[str | None, Any]:
             Gd = t.matrix("G", cols=s.nd)
             gd = t.vector("g", n=Gd.shape[0])
             D = Polytope(Gd.q, np.asarray(gd.q, dtype=object))
-            verts, bounded = vertices_exact(D.G_q, D.g_q)
-            if not bounded or len(verts) == 0:
+            nonempty, bounded, _exact = check_polytope_q(D.G_q, D.g_q)
+            if not (nonempty and bounded):
                 raise t.error("G", "expected a bounded, non-empty polytope D")
         t.done()
         name = "disturbance"

@@ -24,10 +24,10 @@ from .certificate import ExactProblem
 
 @dataclass
 class Data:
-    """Float problem, exact problem and the float vertices of D."""
+    """Float problem and exact problem (``ex`` is None without cdd.gmp: float-only mode)."""
 
     fl: Problem
-    ex: ExactProblem
+    ex: ExactProblem | None
 
 
 def omega_rows(s: Any) -> np.ndarray:
@@ -53,11 +53,34 @@ def disturbance_vertices(s: Any, nd: int) -> np.ndarray:
     return np.asarray(s.vertices_q(), dtype=object).reshape(-1, nd)
 
 
+def disturbance_vertices_float(s: Any, nd: int) -> np.ndarray:
+    """Float vertices of D (float cdd for a polytope); (0, nd) when there is none."""
+    if s is None:
+        return np.zeros((0, nd))
+    if isinstance(s, Box):
+        return po.qfloat(np.asarray(s.vertices_q(), dtype=object)).reshape(-1, nd)
+    from obsdesign.sets.polytope import vertices_float
+
+    return vertices_float(s.G, s.g)[0].reshape(-1, nd)
+
+
 def build(spec: Spec) -> Data:
     """Float and exact data of the spec (the options were validated by parse_options)."""
     o = spec.options
     s = spec.system
     G0 = omega_rows(spec.sets[o.omega])
+    if not po.HAVE_GMP:  # float-only mode: no exact problem (claims are numerical)
+        return Data(
+            Problem(
+                s.A.f.astype(float),
+                np.asarray(s.Bd.f, dtype=float).reshape(s.n, s.nd),
+                s.C.f.astype(float),
+                po.qfloat(G0),
+                disturbance_vertices_float(o.D, s.nd),
+                float(o.eta_bar),
+            ),
+            None,
+        )
     Vo = po.exact_h_to_v(G0).V
     D = o.D
     Dv = disturbance_vertices(D, s.nd)

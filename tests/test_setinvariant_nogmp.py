@@ -1,0 +1,110 @@
+"""Float-only mode of ``set-invariant`` (issue 4 item 1): without ``cdd.gmp`` the design runs
+and every claim is ``numerical``, never ``certified``. The switch is
+``obsdesign.sets.polytope_ops.HAVE_GMP``; here it is turned off with monkeypatch."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from obsdesign import api
+from obsdesign.certify.claim import ClaimStatus
+from obsdesign.errors import SpecError
+from obsdesign.methods.setinvariant import numerical
+from obsdesign.sets import polytope_ops as po
+from obsdesign.sets.polytope import check_polytope_q, vertices_exact
+from obsdesign.spec import load_spec, load_spec_text
+
+SPEC71 = Path(__file__).resolve().parents[1] / "specs" / "dorea-pimenta-7-1.toml"
+Q2 = np.array([[-0.4412, 0.5588], [-0.8333, 0.1667], [0.9, 0.0]])
+
+
+@pytest.fixture
+def nogmp(monkeypatch):
+    monkeypatch.setattr(po, "HAVE_GMP", False)
+
+
+def _rows_up_to_sign(G: np.ndarray) -> set[tuple[float, ...]]:
+    out = set()
+    for r in np.asarray(G, dtype=float):
+        r = r if (r[np.nonzero(np.abs(r) > 1e-12)[0][0]] > 0) else -r
+        out.add(tuple(np.round(r, 4) + 0.0))
+    return out
+
+
+def test_example_71_without_gmp_is_numerical(nogmp, tmp_path):
+    out = tmp_path / "r71.json"
+    rep = api.design(SPEC71, out)
+    assert rep.exit_code() == 0
+    ids = {c.id for c in rep.claims}
+    assert {"polyhedron-forms", "omega-contained", "theorem-3.1", "linear-law-user"} <= ids
+    assert all(c.status == ClaimStatus.NUMERICAL for c in rep.claims)
+    assert any("cdd.gmp is not installed" in n for n in rep.notes)
+    # same polyhedron as the exact design: Q² of the paper, 2 iterations, factor 0.9
+    assert rep.parameters["iterations"] == 2
+    assert _rows_up_to_sign(rep.parameters.float("G")) == _rows_up_to_sign(Q2)
+    assert abs(rep.parameters.float("contractivity") - 0.9) <= 1e-9
+    # no fake exact values in the report
+    assert "G" not in json.loads(out.read_text())["parameters"]["exact"]
+    # verify (still without gmp) re-checks in floats: numerical again
+    ver = api.verify(out)
+    assert ver.exit_code() == 0
+    assert all(c.status == ClaimStatus.NUMERICAL for c in ver.claims)
+    assert {c.id for c in ver.claims} == ids
+
+
+def test_tampered_G_is_caught_without_gmp(nogmp, tmp_path):
+    out = tmp_path / "r71.json"
+    api.design(SPEC71, out)
+    d = json.loads(out.read_text())
+    d["parameters"]["G"][0] = [1.1 * x for x in d["parameters"]["G"][0]]  # shrink one facet
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(d))
+    rep = api.verify(bad)
+    assert rep.exit_code() != 0
+    assert any(c.id == "polyhedron-forms" and c.status == ClaimStatus.FAILED for c in rep.claims)
+    # a worse injection at a breakpoint fails Theorem 3.1 (in floats)
+    d = json.loads(out.read_text())
+    d["parameters"]["v_breakpoints"][0][0] = 3.0
+    bad.write_text(json.dumps(d))
+    rep = api.verify(bad)
+    assert any(c.id == "theorem-3.1" and c.status == ClaimStatus.FAILED for c in rep.claims)
+
+
+def test_loader_without_gmp_checks_polytopes_by_lp(nogmp):
+    spec = load_spec(SPEC71)  # loads (Ω checked by LPs)
+    G, g = spec.sets["omega"].h_form_q()
+    assert check_polytope_q(G, g) == (True, True, False)
+    with pytest.raises(po.PolytopeError):
+        vertices_exact(G, g)
+    text = SPEC71.read_text()
+    with pytest.raises(SpecError, match="unbounded"):
+        load_spec_text(text.replace("Q = [[1, 0], [0, 1]]", "Q = [[1, 0]]"))
+    empty = text.replace(
+        'type = "symmetric-polytope"\nQ = [[1, 0], [0, 1]]',
+        'type = "polytope"\nG = [[1, 0], [-1, 0], [0, 1], [0, -1]]\ng = [-1, -1, 1, 1]',
+    )
+    with pytest.raises(SpecError, match="empty"):
+        load_spec_text(empty)
+
+
+def test_with_gmp_claims_are_certified_again(monkeypatch, tmp_path):
+    if not po.HAVE_GMP:  # pragma: no cover - depends on the pycddlib build
+        pytest.skip("cdd.gmp is not installed")
+    monkeypatch.setattr(po, "HAVE_GMP", False)
+    out = tmp_path / "r71.json"
+    api.design(SPEC71, out)
+    monkeypatch.undo()
+    assert po.HAVE_GMP
+    rep = api.design(SPEC71)
+    assert rep.exit_code() == 0
+    assert all(c.status == ClaimStatus.CERTIFIED for c in rep.claims)
+    assert not any("cdd.gmp is not installed" in n for n in rep.notes)
+    # a float-only report does not pass the exact verify: G has no exact value
+    ver = api.verify(out)
+    assert ver.exit_code() != 0
+    assert not any(c.status == ClaimStatus.CERTIFIED for c in ver.claims)
+    assert numerical.TOL <= 1e-9
