@@ -5,7 +5,7 @@ PY     := $(VENV)/bin/python
 SUDO   := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 DEBS   := libcdd-dev libgmp-dev
 
-.PHONY: install run test test-slow bench bench-quick lint clean
+.PHONY: install run test test-slow test-explore bench bench-quick lint clean
 
 install: $(VENV)/.installed
 
@@ -24,6 +24,9 @@ run: install
 
 test: install
 	$(PY) -m pytest -q
+
+test-explore: install
+	HYPOTHESIS_PROFILE=explore $(PY) -m pytest -q
 
 test-slow: install
 	$(PY) -m pytest -q -m slow

@@ -100,6 +100,16 @@ def _eps_block(G: np.ndarray, phi: np.ndarray, dlt: np.ndarray) -> EpsResult:
     b_ub = (-dlt[None, :] - phi).reshape(-1)
     cost = np.concatenate([np.zeros(nz * n), np.ones(nz)])
     res = linprog(cost, A_ub=A_ub, b_ub=b_ub, bounds=(None, None), method="highs")
+    if res.status != 0 and nz > 1:
+        # HiGHS occasionally reports "Solve error" on a large block LP (seen on a random
+        # 3-state system): the blocks are independent, so split and retry
+        half = nz // 2
+        a, b = _eps_block(G, phi[:half], dlt), _eps_block(G, phi[half:], dlt)
+        return EpsResult(np.concatenate([a.eps, b.eps]), np.vstack([a.v, b.v]))
+    for method in ("highs-ds", "highs-ipm"):
+        if res.status == 0:
+            break
+        res = linprog(cost, A_ub=A_ub, b_ub=b_ub, bounds=(None, None), method=method)
     if res.status != 0:
         raise SolverError(f"HiGHS failed on LP (9): {res.message}")
     v = res.x[: nz * n].reshape(nz, n)
