@@ -148,9 +148,12 @@ def test_designed_gain_random_observable_systems(n: int, seed: int, time: str):
     rng = np.random.default_rng(seed)
     A = rng.standard_normal((n, n)) * 1.2 / np.sqrt(n)
     C = rng.standard_normal((1, n))
-    fmt = lambda M: (
-        "[" + ", ".join("[" + ", ".join(repr(float(v)) for v in row) + "]" for row in M) + "]"
-    )  # noqa: E731
+
+    def fmt(M):
+        return (
+            "[" + ", ".join("[" + ", ".join(repr(float(v)) for v in row) + "]" for row in M) + "]"
+        )  # noqa: E731
+
     text = f'[system]\ntime = "{time}"\nA = {fmt(A)}\nC = {fmt(C)}\n[method]\nkey = "lyapunov"\nrate_cap = 2\n'
     rep = api.design(load_spec_text(text))
     assert all(c.status == ClaimStatus.CERTIFIED for c in rep.claims)

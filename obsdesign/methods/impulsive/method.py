@@ -282,6 +282,7 @@ class Impulsive(Method):
     def options_schema(self) -> dict[str, Any]:
         from obsdesign.spec.schema import MAT as mat
         from obsdesign.spec.schema import NUM as num
+
         return {
             "type": "object",
             "required": ["key", "L", "alpha", "noise_bound"],
