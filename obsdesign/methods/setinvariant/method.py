@@ -30,7 +30,7 @@ from flint import fmpq
 from obsdesign.certify.claim import Claim, exact_claim
 from obsdesign.errors import InfeasibleError
 from obsdesign.methods.base import Design, Method, Progress
-from obsdesign.params import Parameters
+from obsdesign.params import Parameters, exact_param
 from obsdesign.sets import Box, Polytope
 from obsdesign.sets import polytope_ops as po
 from obsdesign.spec.models import Spec
@@ -351,7 +351,7 @@ class SetInvariant(Method):
         if ex is None:  # no cdd.gmp: the same claims in float64, status numerical
             return numerical.certify(spec, params, data.fl, REF)
         claims: list[Claim] = []
-        G = _exact_param(params, "G", claims)
+        G = exact_param(params, "G", claims, accept_float=False)
         if G is None:
             return claims
         G = np.asarray(G, dtype=object).reshape(-1, s.n)
@@ -368,7 +368,7 @@ class SetInvariant(Method):
                     f"report λ = {lam_r}, spec λ = {o.lam}",
                 )
             )
-        Vr = _exact_param(params, "V", claims)
+        Vr = exact_param(params, "V", claims, accept_float=False)
         if Vr is None:
             return claims
         Vr = np.asarray(Vr, dtype=object).reshape(-1, s.n)
@@ -499,7 +499,7 @@ class SetInvariant(Method):
             )
         for key, label in (("L", "designed"), ("L_user", "given in the spec")):
             if key in params:
-                L = _exact_param(params, key, claims)
+                L = exact_param(params, key, claims, accept_float=False)
                 if L is None:
                     continue
                 L = np.asarray(L, dtype=object).reshape(s.n, s.p)
@@ -672,37 +672,6 @@ def _short(x: Any) -> str:
     """``"p/q ≈ "`` when the exact value is short enough to print, else ``"≈ "``."""
     t = str(x)
     return f"{t} ≈ " if len(t) <= 24 else "≈ "
-
-
-def _exact_param(params: Parameters, k: str, claims: list[Claim]) -> Any:
-    if k not in params:
-        claims.append(
-            exact_claim(
-                f"{k}-present",
-                f"the report gives {k}",
-                "report",
-                "presence",
-                0,
-                False,
-                f"{k} missing",
-            )
-        )
-        return None
-    v = params[k]
-    if isinstance(v, fmpq) or (isinstance(v, np.ndarray) and v.dtype == object):
-        return v
-    claims.append(
-        exact_claim(
-            f"{k}-exact",
-            f"{k} is given exactly",
-            "report",
-            "presence of the exact value",
-            0,
-            False,
-            f"{k} has no exact value in the report",
-        )
-    )
-    return None
 
 
 def infeasible(msg: str) -> InfeasibleError:
