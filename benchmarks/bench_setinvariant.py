@@ -106,7 +106,7 @@ def examples() -> None:
 def paper_test(count: int = 20) -> None:
     from obsdesign import api
     from obsdesign.errors import ObsdesignError
-    from obsdesign.spec import load_spec_text
+    from obsdesign.api import load_spec_text
 
     rows = []
     disagree = 0

@@ -43,7 +43,7 @@ def check(*args: Any, **kwargs: Any) -> Any:
 
 
 def load_spec(*args: Any, **kwargs: Any) -> Any:
-    """See :func:`obsdesign.spec.load_spec`."""
-    from obsdesign.spec import load_spec as _load
+    """See :func:`obsdesign.api.load_spec`."""
+    from obsdesign.api import load_spec as _load
 
     return _load(*args, **kwargs)

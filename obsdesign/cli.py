@@ -86,21 +86,12 @@ def design(
 
     def body() -> int:
         from obsdesign import api
-        from obsdesign.methods import get_method
 
         progress = _progress() if fmt == Fmt.text else None
         rep = api.design(spec, output, progress=progress)
         _print_report(rep, fmt)
         if plot is not None:
-            from obsdesign.spec import load_spec
-
-            sp = load_spec(spec)
-            m = get_method(rep.method)
-            plotter = getattr(m, "plot_design", None)
-            if plotter is None:
-                _err(f"method '{rep.method}' has no design plot")
-                return 2
-            plotter(sp, rep.parameters, plot)
+            api.plot_design(spec, rep.parameters, plot)
             if fmt == Fmt.text:
                 print(f"plot written to {plot}")
         if output is not None and fmt == Fmt.text:
@@ -140,16 +131,11 @@ def check(
     def body() -> int:
         from obsdesign import api
 
-        rows = []
-        files = api.spec_files(list(paths))
-        if not files:
-            from obsdesign.errors import InputError
-
-            raise InputError(f"no spec files (*.toml) in {', '.join(map(str, paths))}")
-        for f in files:
+        def each(f: Path) -> None:
             if fmt == Fmt.text:
                 sys.stderr.write(f"checking {f} ...\n")
-            rows.append(api.check_one(f))
+
+        rows = api.check(list(paths), on_start=each)
         if fmt == Fmt.json:
             print(json.dumps([r.__dict__ for r in rows], indent=2))
         else:
@@ -176,26 +162,16 @@ def simulate(
 
     def body() -> int:
         from obsdesign import api
-        from obsdesign.spec import load_spec
 
-        kwargs = _kv(option or [])
-        sp = load_spec(spec)
-        res = api.simulate(sp, report, **kwargs)
+        sp = api.load_spec(spec)
+        res = api.simulate(sp, report, options=_kv(option or []))
         m = res.metrics()
         if fmt == Fmt.json:
             print(json.dumps(m, indent=2, default=_jsonable))
         else:
             _print_metrics(m)
         if plot is not None:
-            from obsdesign.methods import get_method
-
-            plotter = getattr(get_method(sp.method), "plot_simulation", None)
-            if plotter is not None:
-                plotter(sp, res, plot)
-            else:
-                from obsdesign.simulate.plot import plot_result
-
-                plot_result(res, plot, title=sp.title or sp.file)
+            api.plot_simulation(sp, res, plot)
             if fmt == Fmt.text:
                 print(f"plot written to {plot}")
         return int(res.info.get("exit_code", 0))
@@ -208,9 +184,9 @@ def schema() -> None:
     """Print the JSON schema of the spec format."""
 
     def body() -> int:
-        from obsdesign.spec.schema import spec_schema
+        from obsdesign import api
 
-        print(json.dumps(spec_schema(), indent=2, ensure_ascii=False))
+        print(json.dumps(api.schema(), indent=2, ensure_ascii=False))
         return 0
 
     _run(body)
@@ -221,12 +197,9 @@ def init(method: Annotated[str, typer.Argument(help="Method key.")]) -> None:
     """Print a commented template spec for METHOD."""
 
     def body() -> int:
-        from obsdesign.errors import InputError
-        from obsdesign.methods import get_method, method_keys
+        from obsdesign import api
 
-        if method not in method_keys():
-            raise InputError(f"unknown method '{method}' (known: {', '.join(method_keys())})")
-        sys.stdout.write(get_method(method).template())
+        sys.stdout.write(api.template(method))
         return 0
 
     _run(body)
@@ -237,11 +210,10 @@ def methods() -> None:
     """List the design methods."""
 
     def body() -> int:
-        from obsdesign.methods import get_method, method_keys
+        from obsdesign import api
 
-        for k in method_keys():
-            m = get_method(k)
-            print(f"{k:15s} {m.title}  (paper {m.paper})")
+        for m in api.methods():
+            print(f"{m.key:15s} {m.title}  ({m.paper})")
         return 0
 
     _run(body)

@@ -77,6 +77,34 @@ class Parameters:
     def is_exact(self, k: str) -> bool:
         return _is_exact(self._v.get(k))
 
+    def exact(self, k: str, claims: list[Any], accept_float: bool = True) -> Any:
+        """The exact value of parameter ``k`` for a certificate, or None after appending a
+        failed claim saying why (missing; or float-only when ``accept_float`` is False). A
+        float-only value, when accepted, is taken at its exact binary value."""
+        return exact_param(self, k, claims, accept_float)
+
+    def require(self, keys: tuple[str, ...] | list[str], claims: list[Any]) -> bool:
+        """True when every key is present; else one failed claim per missing key."""
+        from obsdesign.certify.claim import exact_claim
+
+        ok = True
+        for k in keys:
+            if k not in self._v:
+                ok = False
+                claims.append(
+                    exact_claim(
+                        f"{k}-present",
+                        f"the report gives {k}",
+                        "report",
+                        "presence",
+                        0,
+                        False,
+                        f"{k} missing",
+                        False,
+                    )
+                )
+        return ok
+
     def to_json(self) -> dict[str, Any]:
         out: dict[str, Any] = {}
         exact: dict[str, Any] = {}

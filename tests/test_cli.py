@@ -122,7 +122,7 @@ def test_schema_and_init():
     res = runner.invoke(app, ["init", "lyapunov"])
     assert res.exit_code == 0 and 'key = "lyapunov"' in res.output
     # the template is itself a valid spec
-    from obsdesign.spec import load_spec_text
+    from obsdesign.api import load_spec_text
 
     load_spec_text(res.output, "template.toml")
     assert runner.invoke(app, ["init", "nope"]).exit_code == 2

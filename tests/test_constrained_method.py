@@ -9,11 +9,11 @@ from flint import fmpq
 from typer.testing import CliRunner
 
 from obsdesign import api
+from obsdesign.api import load_spec_text
 from obsdesign.certify.claim import ClaimStatus
 from obsdesign.cli import app
 from obsdesign.errors import InfeasibleError, SpecError
 from obsdesign.report import Report
-from obsdesign.spec import load_spec_text
 
 SEC5 = "constrained-redesign-sec5.toml"
 

@@ -7,23 +7,23 @@ import numpy as np
 import pytest
 
 from obsdesign import api
+from obsdesign.api import load_spec_text
 from obsdesign.certify.claim import ClaimStatus
 from obsdesign.errors import SpecError
-from obsdesign.spec import load_spec_text
 
 NL = """
 [system]
 time = "discrete"
 A = [[0, 1], [0, 0]]
 C = [[1, 0]]
+f = ["x2", "0.5*sin(x1)"]
+h = ["x1 + v1"]
 [sets.X]
 type = "box"
 lower = [-1, -1]
 upper = [1, 1]
 [method]
 key = "constrained"
-f = ["x2", "0.5*sin(x1)"]
-h = ["x1 + v1"]
 F = ["x2_hat + 0.2*(y1 - x1_hat)", "0.5*sin(x1_hat)"]
 P = [[1, 0], [0, 2.4]]
 rho = {rho}
@@ -83,4 +83,4 @@ def test_bad_expression_rejected():
     text = NL.format(rho=0.81, gamma=0.001).replace('"0.5*sin(x1)"]', '"__import__(1)"]')
     with pytest.raises(SpecError) as e:
         load_spec_text(text, "nl.toml")
-    assert "method.f" in str(e.value)
+    assert "system.f" in str(e.value)

@@ -8,8 +8,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from obsdesign import api
+from obsdesign.api import load_spec_text
 from obsdesign.methods.constrained.design import xhat_set
-from obsdesign.spec import load_spec_text
 
 
 def _fmt(M) -> str:

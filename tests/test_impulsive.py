@@ -12,6 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from obsdesign import api
+from obsdesign.api import load_spec
 from obsdesign.certify.exact import Q, qmat, qvec
 from obsdesign.certify.linalg import norm_upper
 from obsdesign.errors import InfeasibleError, SpecError
@@ -24,7 +25,6 @@ from obsdesign.methods.impulsive.core import (
 )
 from obsdesign.methods.impulsive.dissipativity import best_rate, qsr_lipschitz, qsr_sector
 from obsdesign.methods.impulsive.window import T_max_lower, T_min_upper, gamma_of
-from obsdesign.spec import load_spec
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "specs" / "schaum-impulsive-example.toml"
@@ -82,7 +82,7 @@ def test_example_with_paper_kappa() -> None:
 
 
 def load_spec_text_ex(**kw: str):  # noqa: ANN201
-    from obsdesign.spec import load_spec_text
+    from obsdesign.api import load_spec_text
 
     return load_spec_text(example_text(**kw), "example.toml")
 
@@ -118,7 +118,7 @@ def test_bad_method_input(edit: dict[str, str], key: str) -> None:
 
 
 def test_bad_C_rank_and_Q() -> None:
-    from obsdesign.spec import load_spec_text
+    from obsdesign.api import load_spec_text
 
     txt = EXAMPLE.read_text(encoding="utf-8")
     bad_c = txt.replace("C = [[1, 0]]", "C = [[0, 0]]")

@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 from obsdesign import api
+from obsdesign.api import load_spec_text
 from obsdesign.certify.exact import Q, qmat, qvec
 from obsdesign.errors import InputError
 from obsdesign.methods import get_method
 from obsdesign.methods.impulsive.core import LipschitzX, Problem, certify_window, design_window
-from obsdesign.spec import load_spec_text
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC3 = ROOT / "specs" / "impulsive-sector-3state.toml"

@@ -9,9 +9,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from obsdesign import api
+from obsdesign.api import load_spec_text
 from obsdesign.certify.claim import ClaimStatus
 from obsdesign.errors import InfeasibleError
-from obsdesign.spec import load_spec_text
 
 
 def test_paper_P_and_Pinv(specs_dir):

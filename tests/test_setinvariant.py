@@ -12,10 +12,10 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from obsdesign import api
+from obsdesign.api import load_spec_text
 from obsdesign.certify.claim import ClaimStatus
 from obsdesign.errors import InfeasibleError, SpecError
 from obsdesign.methods.setinvariant import laws
-from obsdesign.spec import load_spec_text
 
 
 @pytest.fixture(scope="module")
@@ -93,7 +93,7 @@ def test_example_71_verify_and_simulate(rep71, tmp_path):
     assert v.exit_code() == 0
     from pathlib import Path
 
-    from obsdesign.spec import load_spec
+    from obsdesign.api import load_spec
 
     spec = load_spec(Path(__file__).resolve().parents[1] / "specs" / "dorea-pimenta-7-1.toml")
     res = api.simulate(spec, out)
@@ -135,8 +135,8 @@ def test_example_72_symmetric_fails_general_certifies(rep72, tmp_path):
     assert api.verify(out).exit_code() == 0
     from pathlib import Path
 
+    from obsdesign.api import load_spec
     from obsdesign.methods import get_method
-    from obsdesign.spec import load_spec
 
     spec = load_spec(Path(__file__).resolve().parents[1] / "specs" / "dorea-pimenta-7-2.toml")
     png = get_method("set-invariant").plot_design(spec, rep.parameters, tmp_path / "fig2.png")

@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 
 from obsdesign import api
+from obsdesign.api import load_spec, load_spec_text
 from obsdesign.certify.claim import ClaimStatus
 from obsdesign.errors import SpecError
 from obsdesign.methods.setinvariant import numerical
 from obsdesign.sets import polytope_ops as po
 from obsdesign.sets.polytope import check_polytope_q, vertices_exact
-from obsdesign.spec import load_spec, load_spec_text
 
 SPEC71 = Path(__file__).resolve().parents[1] / "specs" / "dorea-pimenta-7-1.toml"
 Q2 = np.array([[-0.4412, 0.5588], [-0.8333, 0.1667], [0.9, 0.0]])

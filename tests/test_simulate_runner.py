@@ -8,9 +8,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.linalg import expm
 
+from obsdesign.api import load_spec_text
 from obsdesign.simulate.linear import simulate_linear_observer
 from obsdesign.simulate.result import metrics
-from obsdesign.spec import load_spec_text
 
 BASE = """
 [system]

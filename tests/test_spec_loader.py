@@ -6,10 +6,10 @@ import pytest
 from flint import fmpq
 from typer.testing import CliRunner
 
+from obsdesign.api import load_spec_text
 from obsdesign.cli import app
 from obsdesign.errors import SpecError
 from obsdesign.sets import Box, Ellipsoid, Polytope, SymmetricPolytope
-from obsdesign.spec import load_spec_text
 
 GOOD = """
 [system]
@@ -69,7 +69,6 @@ IMPULSIVE = """
 time = "continuous"
 A = [[0, 0.01], [1, -3]]
 C = [[1, 0]]
-[nonlinearity]
 psi = ["PSI", "0"]
 [nonlinearity.o]
 sector = [-0.2, 0.2]
@@ -171,12 +170,12 @@ MALFORMED = [
     (
         "expr __import__",
         _expr("__import__('os').system('true')"),
-        "nonlinearity.psi[0]",
+        "system.psi[0]",
         "not allowed",
     ),
-    ("expr attribute", _expr("x1.__class__"), "nonlinearity.psi[0]", "attribute access"),
-    ("expr lambda", _expr("(lambda: 0)"), "nonlinearity.psi[0]", "lambda"),
-    ("expr unknown name", _expr("open"), "nonlinearity.psi[0]", "unknown name"),
+    ("expr attribute", _expr("x1.__class__"), "system.psi[0]", "attribute access"),
+    ("expr lambda", _expr("(lambda: 0)"), "system.psi[0]", "lambda"),
+    ("expr unknown name", _expr("open"), "system.psi[0]", "unknown name"),
 ]
 
 

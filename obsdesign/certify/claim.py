@@ -97,3 +97,92 @@ def numerical_claim(
         detail=detail,
         float_ok=passed,
     )
+
+
+class Claims(list[Claim]):
+    """The claim toolkit: collects claims built from keyword arguments.
+
+    ``exact(...)`` records a claim decided by an exact check (certified or failed),
+    ``numerical(...)`` one checked in floats only (numerical or failed), ``matches(...)`` the
+    exact comparison of a reported value with the value the spec fixes (a mismatch is a failed
+    claim naming the key). Each returns the claim it added.
+    """
+
+    def exact(
+        self,
+        *,
+        id: str,
+        statement: str,
+        reference: str,
+        check: str,
+        passed: bool,
+        margin: Any = 0,
+        detail: str = "",
+        float_ok: bool | None = None,
+    ) -> Claim:
+        c = exact_claim(id, statement, reference, check, margin, passed, detail, float_ok)
+        self.append(c)
+        return c
+
+    def numerical(
+        self,
+        *,
+        id: str,
+        statement: str,
+        reference: str,
+        check: str,
+        passed: bool,
+        margin: Any = 0,
+        detail: str = "",
+    ) -> Claim:
+        c = numerical_claim(id, statement, reference, check, margin, passed, detail)
+        self.append(c)
+        return c
+
+    def failed(self, *, id: str, statement: str, reference: str, detail: str) -> Claim:
+        """A claim that cannot be checked at all (missing or malformed data): failed."""
+        return self.exact(
+            id=id,
+            statement=statement,
+            reference=reference,
+            check="presence",
+            passed=False,
+            detail=detail,
+            float_ok=False,
+        )
+
+    def matches(self, key: str, reported: Any, expected: Any, where: str) -> bool:
+        """Exact comparison of a value the report carries with the one the spec fixes.
+
+        Adds a failed claim ``<key>-matches-spec`` when they differ (nothing when they agree)
+        and returns whether they agree. ``where`` names the spec key (``[method].L``)."""
+        same = _exact_equal(reported, expected)
+        if not same:
+            self.exact(
+                id=f"{key}-matches-spec",
+                statement=f"the reported {key} is the one the spec fixes ({where})",
+                reference=f"spec {where}",
+                check="exact equality",
+                passed=False,
+                detail=f"the report's {key} differs from the spec's {where}",
+                float_ok=False,
+            )
+        return same
+
+
+def _exact_equal(a: Any, b: Any) -> bool:
+    import numpy as np
+
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        A, B = np.asarray(a, dtype=object), np.asarray(b, dtype=object)
+        if A.shape != B.shape:
+            return False
+        return all(_exact_equal(x, y) for x, y in zip(A.flat, B.flat, strict=True))
+    if isinstance(a, (list, tuple)) or isinstance(b, (list, tuple)):
+        return _exact_equal(np.asarray(a, dtype=object), np.asarray(b, dtype=object))
+    try:
+        from obsdesign.certify.exact import Q
+
+        return bool(Q(a) == Q(b))
+    except (TypeError, ValueError):
+        return bool(a == b)

@@ -1,11 +1,13 @@
 """Spec files: TOML → typed, validated models with exact numbers.
 
-``load_spec(path)`` is the entry point; every error it raises is a :class:`SpecError` naming
-the file, the TOML key and what was expected.
+``read_spec(path)`` parses and validates the generic parts (system, sets, simulate scenario)
+and keeps ``[method]`` raw; it knows no method. :func:`obsdesign.api.load_spec` binds the
+method. Every error is a :class:`SpecError` naming the file, the TOML key and what was
+expected.
 """
 
-from obsdesign.spec.loader import load_spec, load_spec_text
+from obsdesign.spec.loader import read_spec, read_spec_text
 from obsdesign.spec.models import Spec, System
 from obsdesign.spec.reader import Table, Value
 
-__all__ = ["Spec", "System", "Table", "Value", "load_spec", "load_spec_text"]
+__all__ = ["Spec", "System", "Table", "Value", "read_spec", "read_spec_text"]

@@ -21,16 +21,19 @@ from obsdesign.errors import InputError, SpecError
 from obsdesign.sets import Box, Ellipsoid, Polytope, SymmetricPolytope
 from obsdesign.sets.base import ConvexSet
 from obsdesign.sets.polytope import check_polytope_q
+from obsdesign.spec.expr import parse_expr
 from obsdesign.spec.models import SimulateSpec, Spec, System
 from obsdesign.spec.reader import Table, Value
 from obsdesign.spec.signals import parse_signal
 
-TOP_KEYS = ("title", "description", "reference", "system", "sets", "method", "simulate")
+#: top-level tables kept raw for the method to read
+EXTRA_TABLES = ("nonlinearity",)
 SET_TYPES = ("box", "polytope", "symmetric-polytope", "ellipsoid")
 
 
-def load_spec(path: str | Path) -> Spec:
-    """Read, parse and validate the spec at ``path``."""
+def read_spec(path: str | Path) -> Spec:
+    """Read, parse and validate the generic parts of the spec at ``path`` (no method bound:
+    see :func:`obsdesign.api.load_spec`)."""
     p = Path(path)
     try:
         raw = p.read_bytes()
@@ -42,11 +45,14 @@ def load_spec(path: str | Path) -> Spec:
         text = raw.decode("utf-8")
     except UnicodeDecodeError:
         raise SpecError(str(p), "", "is not UTF-8 text") from None
-    return load_spec_text(text, str(p))
+    return read_spec_text(text, str(p))
 
 
-def load_spec_text(text: str, file: str = "<spec>") -> Spec:
-    """Parse and validate spec text; ``file`` is used in error messages."""
+def read_spec_text(text: str, file: str = "<spec>") -> Spec:
+    """Parse and validate the generic parts of spec text; ``file`` is used in error messages.
+
+    Returns a :class:`Spec` whose ``method_table`` (and ``simulate.table``) are raw: the API
+    binds the method, which reads its own keys."""
     try:
         data = tomllib.loads(text, parse_float=Decimal)
     except tomllib.TOMLDecodeError as e:
@@ -56,39 +62,67 @@ def load_spec_text(text: str, file: str = "<spec>") -> Spec:
     title = root.str("title", default="")
     root.str("description", default="")
     root.str("reference", default="")
-    system = _system(root.table("system", required=True))  # type: ignore[arg-type]
+    st = root.table("system", required=True)
+    assert st is not None
+    system = _system(st)
     sets = {name: _set(t, system.n) for name, t in root.tables("sets").items()}
-
     mt = root.table("method", required=True)
     assert mt is not None
-    from obsdesign.methods import get_method, method_keys
-
     key = mt.str("key")
-    if key not in method_keys():
-        raise mt.error("key", f"expected one of {', '.join(method_keys())}; got {key!r}")
-    method = get_method(key)
-    extra = {name: t for name in method.extra_tables if (t := root.table(name)) is not None}
-    spec = Spec(file, text, sha, title, system, sets, key, None, None, extra)
-    spec.options = method.parse_options(mt, spec)
-    st = root.table("simulate")
-    if st is not None:
-        spec.simulate = _simulate(st, system)
-        spec.simulate.options = method.parse_simulate(st, spec)
-        st.done()
+    _old_spelling(root, mt)
+    tables = {name: t for name in EXTRA_TABLES if (t := root.table(name)) is not None}
+    spec = Spec(file, text, sha, title, system, sets, key, None, None, tables, mt)
+    sim = root.table("simulate")
+    if sim is not None:
+        spec.simulate = _simulate(sim, system)
     root.done()
     return spec
+
+
+def _old_spelling(root: Table, mt: Table) -> None:
+    """A spec in the spelling before the one plant model: say where the key lives now."""
+    for k in ("f", "h"):
+        if mt.has(k):
+            raise mt.error(k, f"has moved: the plant's {k} is now [system] {k}")
+    nl = root.data.get("nonlinearity")
+    if isinstance(nl, dict) and "psi" in nl:
+        raise SpecError(root.file, "nonlinearity.psi", "has moved: ψ is now [system] psi")
 
 
 # -- [system] -----------------------------------------------------------------------------
 def _system(t: Table) -> System:
     time = t.str("time", choices=("discrete", "continuous"))
-    A = t.matrix("A")
-    n = A.shape[0]
-    if A.shape[1] != n:
+    has_f = t.has("f")
+    A = t.matrix("A") if (t.has("A") or not has_f) else None
+    if A is not None and A.shape[1] != A.shape[0]:
         raise t.error("A", f"expected a square matrix, got {A.shape[0]}×{A.shape[1]}")
-    C = t.matrix("C", cols=n)
-    p = C.shape[0]
-    B = t.matrix("B", rows=n, vector_as="column") if t.has("B") else Value.of(qzeros((n, 0)))
+    states = t._get("states", None)
+    if A is not None:
+        n = A.shape[0]
+    elif isinstance(states, list) and states:
+        n = len(states)
+    else:
+        n = _expr_count(t, "f")
+    if states is None:
+        states = [f"x{i + 1}" for i in range(n)]
+    elif not (
+        isinstance(states, list)
+        and len(states) == n
+        and all(isinstance(s, str) and s.isidentifier() for s in states)
+        and len(set(states)) == n
+    ):
+        raise t.error("states", f"expected a list of {n} distinct state names (identifiers)")
+    C = t.matrix("C", cols=n) if (t.has("C") or not t.has("h")) else None
+    p = C.shape[0] if C is not None else _expr_count(t, "h")
+    if t.has("B"):
+        B = t.matrix("B", rows=n, vector_as="column")
+    else:
+        m = t.int("inputs", default=None, min=0) if t.has("inputs") else None
+        if m is None:
+            m = _expr_count(t, "u") if t.has("u") else 0
+        B = Value.of(qzeros((n, m)))
+    if t.has("B") and t.has("inputs"):
+        raise t.error("inputs", "give the number of inputs by B or by inputs, not both")
     m = B.shape[1]
     D = (
         t.matrix("D", rows=p, cols=m, vector_as="row" if p == 1 else "column")
@@ -98,19 +132,14 @@ def _system(t: Table) -> System:
     bd_key = "Bd" if t.has("Bd") else "B1"
     if t.has("Bd") and t.has("B1"):
         raise t.error("B1", "give the disturbance input as Bd or B1, not both")
-    Bd = t.matrix(bd_key, rows=n, vector_as="column") if t.has(bd_key) else Value.of(qzeros((n, 0)))
+    if t.has(bd_key):
+        Bd = t.matrix(bd_key, rows=n, vector_as="column")
+    else:
+        nd = t.int("disturbances", default=0, min=0)
+        Bd = Value.of(qzeros((n, nd)))
     t.mark("B1", "Bd")
     Dn = t.matrix("Dn", rows=p, vector_as="column") if t.has("Dn") else Value.of(qeye(p))
     sample_time = t.scalar("sample_time", default=None, min=0, strict_min=True)
-    states = t._get("states", None)
-    if states is None:
-        states = [f"x{i + 1}" for i in range(n)]
-    elif not (
-        isinstance(states, list)
-        and len(states) == n
-        and all(isinstance(s, str) and s.isidentifier() for s in states)
-    ):
-        raise t.error("states", f"expected a list of {n} state names (identifiers)")
     params: dict[str, Value] = {}
     pt = t.table("parameters")
     if pt is not None:
@@ -118,12 +147,50 @@ def _system(t: Table) -> System:
             if not k.isidentifier():
                 raise pt.error(k, "expected an identifier as parameter name")
             params[k] = pt.scalar(k)
+    sys = System(
+        time, A, B, C, D, Bd, Dn, sample_time, list(states), params, n_states=n, n_outputs=p
+    )
+    if has_f and t.has("psi"):
+        raise t.error(
+            "psi", "give the plant as f (whole right-hand side) or as A x + psi, not both"
+        )
+    if t.has("psi") and A is None:
+        raise t.error("psi", "is the additive term of A x + psi: A is missing")
+    exact = sys.exact_parameters()
+    x_u_d_t = [*sys.states, *sys.inputs, *sys.disturbances, "t"]
+    sys.f = _exprs(t, "f", n, x_u_d_t, exact)
+    sys.psi = _exprs(t, "psi", n, x_u_d_t, exact)
+    sys.h = _exprs(t, "h", p, [*sys.states, *sys.inputs, *sys.noises, "t"], exact)
+    sys.u_signal = _exprs(t, "u", m, ["t"], exact)
     t.done()
-    return System(time, A, B, C, D, Bd, Dn, sample_time, list(states), params)
+    return sys
+
+
+def _expr_count(t: Table, k: str) -> int:
+    raw = t.data.get(k)
+    if isinstance(raw, str):
+        return 1
+    if not isinstance(raw, list) or not raw:
+        raise t.error(k, "expected a non-empty list of expression strings")
+    return len(raw)
+
+
+def _exprs(t: Table, k: str, length: int, variables: list[str], params: dict[str, Any]) -> Any:
+    """``k = ["expr", ...]`` with ``length`` entries over ``variables``, or None when absent."""
+    if not t.has(k):
+        return None
+    raw = t._get(k, None)
+    if isinstance(raw, str):
+        raw = [raw]
+    if not isinstance(raw, list) or len(raw) != length or not all(isinstance(e, str) for e in raw):
+        raise t.error(k, f"expected a list of {length} expression strings")
+    return [parse_expr(e, variables, params, t.file, t.key(f"{k}[{i}]")) for i, e in enumerate(raw)]
 
 
 # -- [sets.NAME] --------------------------------------------------------------------------
 def _set(t: Table, n: int) -> ConvexSet:
+    """One ``[sets.NAME]``; its dimension is the state dimension unless ``dim`` says."""
+    n = t.int("dim", default=n, min=1)
     kind = t.str("type", choices=SET_TYPES)
     s: ConvexSet
     if kind == "box":

@@ -6,36 +6,47 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from obsdesign.sets.base import ConvexSet
+from obsdesign.spec.expr import Expr
 from obsdesign.spec.reader import Table, Value
 from obsdesign.spec.signals import Signal
 
 
 @dataclass
 class System:
-    """``[system]``: x⁺ = A x + B u + Bd d (or ẋ = ...), y = C x + D u + Dn v.
+    """``[system]``: the one home of the plant.
 
-    ``d`` is the disturbance input, ``v`` the measurement noise. Unused inputs have zero
-    columns.
+    Linear data: x⁺ = A x + B u + Bd d (or ẋ = ...), y = C x + D u + Dn v; ``d`` is the
+    disturbance input, ``v`` the measurement noise; unused inputs have zero columns.
+    Expressions (vectors of :class:`~obsdesign.spec.expr.Expr` over :attr:`variables`):
+    ``f`` the whole right-hand side (x⁺ or ẋ), or ``psi`` an additive term
+    (x⁺ or ẋ = A x + B u + Bd d + ψ); ``h`` the whole output map; ``u_signal`` an open-loop
+    input u(t). A and C are None when only expressions describe the plant.
     """
 
     time: str
-    A: Value
+    A: Value | None
     B: Value
-    C: Value
+    C: Value | None
     D: Value
     Bd: Value
     Dn: Value
     sample_time: Value | None
     states: list[str]
     parameters: dict[str, Value] = field(default_factory=dict)
+    f: list[Expr] | None = None
+    psi: list[Expr] | None = None
+    h: list[Expr] | None = None
+    u_signal: list[Expr] | None = None
+    n_states: int = 0
+    n_outputs: int = 0
 
     @property
     def n(self) -> int:
-        return self.A.shape[0]
+        return self.A.shape[0] if self.A is not None else self.n_states
 
     @property
     def p(self) -> int:
-        return self.C.shape[0]
+        return self.C.shape[0] if self.C is not None else self.n_outputs
 
     @property
     def m(self) -> int:
@@ -52,6 +63,31 @@ class System:
     @property
     def discrete(self) -> bool:
         return self.time == "discrete"
+
+    @property
+    def linear(self) -> bool:
+        """A and C given and no expression in the plant."""
+        return self.A is not None and self.C is not None and not (self.f or self.psi or self.h)
+
+    @property
+    def inputs(self) -> list[str]:
+        return [f"u{i + 1}" for i in range(self.m)]
+
+    @property
+    def disturbances(self) -> list[str]:
+        return [f"d{i + 1}" for i in range(self.nd)]
+
+    @property
+    def noises(self) -> list[str]:
+        return [f"v{i + 1}" for i in range(self.nv)]
+
+    @property
+    def variables(self) -> list[str]:
+        """Variables of ``f`` / ``psi`` / ``h``: states, u1.., d1.., v1.., t."""
+        return [*self.states, *self.inputs, *self.disturbances, *self.noises, "t"]
+
+    def exact_parameters(self) -> dict[str, Any]:
+        return {k: v.q for k, v in self.parameters.items()}
 
 
 @dataclass
@@ -74,7 +110,13 @@ class SimulateSpec:
 
 @dataclass
 class Spec:
-    """A whole spec file, validated. ``options`` is the method's own typed options object."""
+    """A whole spec file, validated in its generic parts.
+
+    The spec layer knows no method: ``method_table`` is the raw ``[method]`` table and
+    ``tables`` the raw top-level tables a method may read (``nonlinearity``). The API binds the
+    method (:func:`obsdesign.api.bind`), which fills ``options`` (the method's typed options)
+    and ``simulate.options``.
+    """
 
     file: str
     text: str
@@ -86,6 +128,7 @@ class Spec:
     options: Any
     simulate: SimulateSpec | None
     tables: dict[str, Table] = field(default_factory=dict)
+    method_table: Table | None = None
 
     def set(self, name: str) -> ConvexSet:
         return self.sets[name]

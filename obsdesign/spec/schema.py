@@ -16,6 +16,13 @@ MAT: dict[str, Any] = {
 }
 
 
+DIM: dict[str, Any] = {
+    "type": "integer",
+    "minimum": 1,
+    "description": "dimension of the set (default: the number of states)",
+}
+
+
 def _signal() -> dict[str, Any]:
     return {
         "type": "object",
@@ -41,34 +48,46 @@ def _signal() -> dict[str, Any]:
     }
 
 
-def spec_schema() -> dict[str, Any]:
-    """The JSON schema (draft 2020-12) of a spec file, method sections included."""
-    from obsdesign.methods import get_method, method_keys
+EXPR: dict[str, Any] = {"type": "string", "format": "obsdesign-expression"}
+EXPRS: dict[str, Any] = {
+    "anyOf": [EXPR, {"type": "array", "items": EXPR, "minItems": 1}],
+    "description": "expressions in the safe expression language, one per component",
+}
+
+
+def spec_schema(
+    method_schemas: list[dict[str, Any]], simulate_keys: dict[str, Any] | None = None
+) -> dict[str, Any]:
+    """The JSON schema (draft 2020-12) of a spec file.
+
+    ``method_schemas`` are the methods' ``[method]`` schemas and ``simulate_keys`` the union of
+    their own ``[simulate]`` keys; the caller (the API) collects them, so this layer imports no
+    method."""
 
     sets = {
         "oneOf": [
             {
                 "type": "object",
                 "required": ["type", "lower", "upper"],
-                "properties": {"type": {"const": "box"}, "lower": VEC, "upper": VEC},
+                "properties": {"type": {"const": "box"}, "lower": VEC, "upper": VEC, "dim": DIM},
             },
             {
                 "type": "object",
                 "required": ["type", "G", "g"],
                 "description": "{x : G x <= g}, bounded and non-empty",
-                "properties": {"type": {"const": "polytope"}, "G": MAT, "g": VEC},
+                "properties": {"type": {"const": "polytope"}, "G": MAT, "g": VEC, "dim": DIM},
             },
             {
                 "type": "object",
                 "required": ["type", "Q"],
                 "description": "{x : |Q x| <= 1}",
-                "properties": {"type": {"const": "symmetric-polytope"}, "Q": MAT},
+                "properties": {"type": {"const": "symmetric-polytope"}, "Q": MAT, "dim": DIM},
             },
             {
                 "type": "object",
                 "required": ["type", "E"],
                 "description": "{x : (x-c)' E (x-c) <= 1}, E symmetric positive definite",
-                "properties": {"type": {"const": "ellipsoid"}, "E": MAT, "center": VEC},
+                "properties": {"type": {"const": "ellipsoid"}, "E": MAT, "center": VEC, "dim": DIM},
             },
         ]
     }
@@ -83,7 +102,8 @@ def spec_schema() -> dict[str, Any]:
             "reference": {"type": "string"},
             "system": {
                 "type": "object",
-                "required": ["time", "A", "C"],
+                "required": ["time"],
+                "description": "the plant: linear data (A, C, ...), expressions (f or psi, h), or both",
                 "properties": {
                     "time": {"enum": ["discrete", "continuous"]},
                     "A": MAT,
@@ -95,6 +115,26 @@ def spec_schema() -> dict[str, Any]:
                     "Dn": {**MAT, "description": "noise input on the output (default identity)"},
                     "sample_time": {**NUM, "exclusiveMinimum": 0},
                     "states": {"type": "array", "items": {"type": "string"}},
+                    "inputs": {
+                        "type": "integer",
+                        "minimum": 0,
+                        "description": "number of inputs when B is absent",
+                    },
+                    "disturbances": {
+                        "type": "integer",
+                        "minimum": 0,
+                        "description": "number of disturbance inputs when Bd is absent",
+                    },
+                    "f": {
+                        **EXPRS,
+                        "description": "x⁺ or ẋ as expressions of states, u1.., d1.., t",
+                    },
+                    "psi": {
+                        **EXPRS,
+                        "description": "additive term: x⁺ or ẋ = A x + B u + Bd d + ψ",
+                    },
+                    "h": {**EXPRS, "description": "y as expressions of states, u1.., v1.., t"},
+                    "u": {**EXPRS, "description": "open-loop input u(t) as expressions of t"},
                     "parameters": {
                         "type": "object",
                         "additionalProperties": NUM,
@@ -103,7 +143,12 @@ def spec_schema() -> dict[str, Any]:
                 },
             },
             "sets": {"type": "object", "additionalProperties": sets},
-            "method": {"oneOf": [get_method(k).options_schema() for k in method_keys()]},
+            "nonlinearity": {
+                "type": "object",
+                "description": "bound data of the plant's nonlinearity (sector, QSR, Lipschitz); "
+                "read by the methods that use it",
+            },
+            "method": {"oneOf": method_schemas},
             "simulate": {
                 "type": "object",
                 "required": ["horizon", "x0", "xhat0"],
@@ -116,6 +161,7 @@ def spec_schema() -> dict[str, Any]:
                     "u": _signal(),
                     "disturbance": _signal(),
                     "noise": _signal(),
+                    **(simulate_keys or {}),
                 },
             },
         },

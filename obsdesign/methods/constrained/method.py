@@ -134,8 +134,7 @@ eps_min = 0.01               # C_min = {|c| ≤ ε_min}
 # gamma_uncertified = false  # true: accept a γ above (24) (claims fail, simulation allowed)
 # X0 = "X0"  Xhat0 = "Xhat0"  # optional: v̆_max of Section 4 from initial-condition sets
 # Nonlinear plant/observer (then give P, rho, mu; (5) is checked on samples, "numerical"):
-# f = ["x2", "0.5*sin(x1)"]        # x⁺ = f(x, u, d): states x1.., inputs u1.., d1..
-# h = ["x1 + v1"]                  # y = h(x, u, v): noise v1..
+# the plant's f and h go in [system] (f = ["x2", "0.5*sin(x1)"], h = ["x1 + v1"]);
 # F = ["x2_hat + 0.2*(y1 - x1_hat)", "0.5*sin(x1_hat)"]   # x̂⁺ = F(x̂, u, y)
 # [method.U]  lower = [...]  upper = [...]   # input bounds (needed with expressions and inputs)
 

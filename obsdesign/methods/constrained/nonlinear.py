@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from obsdesign.errors import SpecError
 from obsdesign.spec.expr import Expr, parse_expr
 from obsdesign.spec.models import Spec
 from obsdesign.spec.reader import Table
@@ -95,11 +96,15 @@ class Model:
 
 
 def parse_model(table: Table, spec: Spec) -> Model:
-    """Read the optional ``f``, ``h``, ``F`` keys of ``[method]``."""
+    """The plant's ``f``, ``h`` from ``[system]`` and the observer map ``F`` of ``[method]``."""
     nm = names(spec)
     s = spec.system
-    f = parse_vector(table, "f", s.n, nm.x + nm.u + nm.d, spec)
-    h = parse_vector(table, "h", s.p, nm.x + nm.u + nm.v, spec)
+    if s.psi is not None:
+        raise SpecError(
+            spec.file, "system.psi", "is not used by the constrained method: give f instead"
+        )
+    f = None if s.f is None else VectorExpr(s.f, nm.x + nm.u + nm.d)
+    h = None if s.h is None else VectorExpr(s.h, nm.x + nm.u + nm.v)
     F = parse_vector(table, "F", s.n, nm.xhat + nm.u + nm.y, spec)
     return Model(f, h, F)
 

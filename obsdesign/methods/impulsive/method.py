@@ -31,7 +31,6 @@ from obsdesign.methods.impulsive.core import (
 from obsdesign.methods.impulsive.dissipativity import QSR, qsr_lipschitz, qsr_sector
 from obsdesign.methods.impulsive.falsify import Falsification, falsify_blocks, falsify_lipschitz_x
 from obsdesign.params import Parameters
-from obsdesign.spec.expr import parse_expr
 from obsdesign.spec.models import Spec
 from obsdesign.spec.reader import Table
 
@@ -134,17 +133,10 @@ class Impulsive(Method):
         table.done()
         nl = spec.tables.get("nonlinearity")
         if nl is None:
-            raise SpecError(
-                spec.file, "nonlinearity", "is missing (psi and the data of Assumption 1)"
-            )
-        params = {k: v.q for k, v in s.parameters.items()}
-        psi_raw = nl._get("psi", None)
-        if not isinstance(psi_raw, list) or len(psi_raw) != n:
-            raise nl.error("psi", f"expected a list of {n} expression strings (one per state)")
-        psi = [
-            parse_expr(e, s.states, params, spec.file, nl.key(f"psi[{i}]"))
-            for i, e in enumerate(psi_raw)
-        ]
+            raise SpecError(spec.file, "nonlinearity", "is missing (the data of Assumption 1)")
+        if s.psi is None:
+            raise SpecError(spec.file, "system.psi", "is missing (ẋ = A x + ψ(x), eq. (1a))")
+        psi = s.psi
         data: BlockData | LipschitzX
         if nl.has("lipschitz_x"):
             if nl.has("o") or nl.has("n"):
@@ -402,11 +394,11 @@ time = "continuous"
 A = [[0, 0], [3, -1]]          # ẋ = A x + ψ(x)
 C = [[1, 0]]                   # y_k = C x(t_k) + w_k, rank C = m < n
 states = ["x1", "x2"]
+psi = ["x1*x2*(x2^2 - a^2)/(1 + x2^4)", "0"]   # ẋ = A x + ψ(x), safe expression language
 [system.parameters]
 a = 2
 
 [nonlinearity]
-psi = ["x1*x2*(x2^2 - a^2)/(1 + x2^4)", "0"]   # ψ(x), safe expression language
 # Data of Assumption 1 (15): either a Lipschitz constant of ψ in x (then M may be optimized) ...
 # lipschitz_x = 0.1
 # ... or per block in z = T x (split reading: own part QSR + cross Lipschitz constant):
