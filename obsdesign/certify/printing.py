@@ -1,0 +1,90 @@
+"""Numbers printed inside claim statements: exact, or rounded in the direction that keeps the
+statement true.
+
+A statement "x ≤ U" may print U rounded *up*, "x ≥ L" may print L rounded *down*; a value
+that the statement asserts equality of is printed exactly (as a fraction) — see the soundness
+rule of the method contract. Every function returns a decimal string whose exact value is
+on the safe side of ``q`` (tested by parsing the string back and comparing exactly).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from flint import fmpq, fmpz
+
+from obsdesign.certify.exact import Q
+
+
+def _scaled(q: fmpq, digits: int) -> tuple[int, fmpq]:
+    """Exponent e with 10^(digits-1) ≤ |q|/10^e < 10^digits (q ≠ 0) and the scaled value."""
+    a = abs(q)
+    e = len(str(int(a.floor()))) - digits if a >= 1 else -digits
+    while a / fmpq(10) ** e >= fmpq(10) ** digits if e >= 0 else a * fmpq(10) ** (-e) >= 10**digits:
+        e += 1
+    while e > -400 and (a / fmpq(10) ** e if e >= 0 else a * fmpq(10) ** (-e)) < 10 ** (digits - 1):
+        e -= 1
+    s = q / fmpq(10) ** e if e >= 0 else q * fmpq(10) ** (-e)
+    return e, s
+
+
+def _show(m: fmpz | int, e: int) -> str:
+    m = int(m)
+    if m == 0:
+        return "0"
+    sign = "-" if m < 0 else ""
+    digits = str(abs(m))
+    exp10 = e + len(digits) - 1
+    if exp10 > 12 or exp10 < -6:
+        body = digits.rstrip("0")
+        mant = body[0] + ("." + body[1:] if len(body) > 1 else "")
+        return f"{sign}{mant}e{exp10}"
+    if e >= 0:
+        return sign + digits + "0" * e
+    k = -e
+    if len(digits) <= k:
+        digits = "0" * (k - len(digits) + 1) + digits
+    whole, frac = digits[:-k], digits[-k:].rstrip("0")
+    return sign + whole + ("." + frac if frac else "")
+
+
+def fmt_up(x: Any, digits: int = 6) -> str:
+    """``x`` rounded up (towards +∞) to ``digits`` significant digits, as a decimal string."""
+    q = Q(x)
+    if q == 0:
+        return "0"
+    e, s = _scaled(q, digits)
+    return _show(s.ceil(), e)
+
+
+def fmt_down(x: Any, digits: int = 6) -> str:
+    """``x`` rounded down (towards −∞) to ``digits`` significant digits, as a decimal string."""
+    q = Q(x)
+    if q == 0:
+        return "0"
+    e, s = _scaled(q, digits)
+    return _show(s.floor(), e)
+
+
+def fmt_exact(x: Any) -> str:
+    """``x`` exactly: a finite decimal when it has one with at most 30 digits, else p/q."""
+    q = Q(x)
+    den = int(q.q)
+    k = 0
+    while den % 10 == 0 or den % 2 == 0 or den % 5 == 0:
+        if den % 10 == 0:
+            den //= 10
+        elif den % 2 == 0:
+            den //= 2
+        else:
+            den //= 5
+        k += 1
+    if den == 1:
+        for e in range(0, 40):
+            m = q * fmpq(10) ** e
+            if m.q == 1:
+                s = _show(m.p, -e)
+                if len(s) <= 32:
+                    return s
+                break
+    return str(q)
