@@ -1,0 +1,299 @@
+"""Design of the stubborn observer: the λ search and the optimized selection of K, R, W.
+
+Slides "Stubborn observers for linear and nonlinear systems" (Astolfi, Alessandri, Zaccarian,
+WUDS 2017): LMIs (1)-(3) (continuous time) and (7)-(9) (discrete time), K = P⁻¹X; the
+"optimized parameter selection": first the best λ, then λ at a fraction of it with W ⪰ I,
+P ⪰ I, then one criterion (size of R, size of K through X, or the L2 gain).
+
+Recipe (DESIGN.md, Exactness): each strict LMI F ≺ 0 is solved as F ⪯ −δ·I (δ the margin),
+Clarabel, only status ``optimal`` is accepted; P, U, W, Y, R and the gain K itself are rounded
+to dyadic rationals and X is rebuilt exactly as X = P K, so the certificate checks the LMIs
+with the reported gain.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from flint import fmpq
+
+from obsdesign.certify.exact import Q, dyadic, symmetrize, to_float
+from obsdesign.errors import InconclusiveError, InfeasibleError, SolverError
+from obsdesign.lmi import solve
+from obsdesign.methods.base import SolverResult, SolverStatus
+from obsdesign.methods.stubborn import claims as _claims
+from obsdesign.methods.stubborn.detect import detectability
+from obsdesign.methods.stubborn.options import Options
+from obsdesign.spec.models import Spec
+
+#: bits of the dyadic rounding of the solution (relative per entry)
+BITS = 40
+#: the λ search stops at these caps (continuous: λ ≤ LAMBDA_CAP; discrete: λ ≥ 1/LAMBDA_CAP)
+LAMBDA_CAP = 1e6
+
+
+@dataclass
+class Plant:
+    """The linear data the LMIs use (floats for the solver)."""
+
+    A: np.ndarray
+    C: np.ndarray
+    Bd: np.ndarray
+    discrete: bool
+
+    @classmethod
+    def of(cls, spec: Spec) -> Plant:
+        s = spec.system
+        return cls(
+            np.asarray(s.A.f, float),
+            np.asarray(s.C.f, float),
+            np.asarray(s.Bd.f, float),
+            s.discrete,
+        )
+
+
+def _problem(pl: Plant, o: Options, lam: float, criterion: str | None, margin: float) -> Any:
+    """cvxpy problem of LMIs (1)-(3) / (7)-(9) at a fixed λ, normalized P ⪰ I, W ⪰ I.
+
+    ``criterion`` None: feasibility; ``R``: minimize λ_max(R); ``K``: minimize ‖X‖₂;
+    ``l2``: minimize g with the bounded real lemma (g = γ², γ the L2 gain d → e).
+    Full mode adds ‖X‖₂ ≤ gain_bound (then ‖K‖₂ = ‖P⁻¹X‖₂ ≤ gain_bound)."""
+    import cvxpy as cp
+
+    A, C = pl.A, pl.C
+    n, p = A.shape[0], C.shape[0]
+    P = cp.Variable((n, n), symmetric=True)
+    u = cp.Variable(p)
+    w = cp.Variable(p)
+    Y = cp.Variable((p, n))
+    R = cp.Variable((p, p), symmetric=True)
+    Kf = None if o.K is None else np.asarray(to_float(o.K), float)
+    X = P @ Kf if Kf is not None else cp.Variable((n, p))
+    U, W = cp.diag(u), cp.diag(w)
+    G = P @ A - X @ C
+    S = W @ C + Y
+
+    def sym(M: Any) -> Any:
+        return (M + M.T) / 2
+
+    if not pl.discrete:
+        M1 = cp.bmat([[G + G.T + lam * P - C.T @ R @ C, X + C.T @ U], [X.T + U @ C, -2 * U]])
+        M2 = cp.bmat([[G + G.T, X + S.T], [X.T + S, -2 * W]])
+    else:
+        M1 = cp.bmat([[-lam * P - C.T @ R @ C, C.T @ U, G.T], [U @ C, -2 * U, X.T], [G, X, -P]])
+        M2 = cp.bmat([[-P, S.T, G.T], [S, -2 * W, X.T], [G, X, -P]])
+    m = margin
+    cons = [
+        sym(M1) << -m * np.eye(M1.shape[0]),
+        sym(M2) << -m * np.eye(M2.shape[0]),
+        P >> np.eye(n),
+        w >= 1,
+        u >= m,
+        R >> m * np.eye(p),
+    ]
+    for i in range(p):
+        Mi = cp.bmat(
+            [[P, Y[i : i + 1, :].T], [Y[i : i + 1, :], cp.reshape(w[i], (1, 1), order="C")]]
+        )
+        cons.append(sym(Mi) >> m * np.eye(n + 1))
+    if o.K is None:
+        gb = float(o.gain_bound)
+        cons.append(cp.bmat([[gb * np.eye(n), X], [X.T, gb * np.eye(p)]]) >> 0)
+    obj: Any = cp.Minimize(0)
+    extra: dict[str, Any] = {}
+    if criterion == "R":
+        obj = cp.Minimize(cp.lambda_max(R))
+    elif criterion == "K":
+        t = cp.Variable()
+        cons.append(cp.bmat([[t * np.eye(n), X], [X.T, t * np.eye(p)]]) >> 0)
+        obj = cp.Minimize(t)
+    elif criterion == "l2":
+        g = cp.Variable()
+        Bd = pl.Bd
+        k = Bd.shape[1]
+        PB = P @ Bd
+        if not pl.discrete:
+            M3 = cp.bmat([[G + G.T + np.eye(n), PB], [PB.T, -g * np.eye(k)]])
+        else:
+            M3 = cp.bmat(
+                [
+                    [-P + np.eye(n), np.zeros((n, k)), G.T],
+                    [np.zeros((k, n)), -g * np.eye(k), PB.T],
+                    [G, PB, -P],
+                ]
+            )
+        cons.append(sym(M3) << -m * np.eye(M3.shape[0]))
+        obj = cp.Minimize(g)
+        extra["g"] = g
+    prob = cp.Problem(obj, cons)
+    return prob, dict(P=P, X=X, u=u, w=w, Y=Y, R=R, **extra)
+
+
+def feasible(pl: Plant, o: Options, lam: float) -> tuple[bool, str]:
+    """Whether the solver finds LMIs (1)-(3) / (7)-(9) feasible at λ (status, for the report)."""
+    prob, _ = _problem(pl, o, lam, None, float(o.margin))
+    try:
+        r = solve(prob)
+    except SolverError as e:
+        return False, f"solver failure ({e.message})"
+    return r.optimal, r.status
+
+
+def search_lambda(pl: Plant, o: Options) -> tuple[float, float, str]:
+    """The best λ to a relative tolerance: (certifiable side, other side, status there).
+
+    Continuous time: the largest λ > 0 (feasibility is monotone: a smaller λ only relaxes
+    (1)); doubling from 1 brackets it, bisection refines until hi − lo ≤ tol·lo. Discrete
+    time: the smallest λ ∈ (0, 1) (a larger λ relaxes (7)); bisection on (0, 1)."""
+    tol = float(o.lambda_tol)
+    if not pl.discrete:
+        lo, hi = 0.0, 1.0
+        ok, st = feasible(pl, o, hi)
+        while ok:
+            lo, hi = hi, 2 * hi
+            if hi > LAMBDA_CAP:
+                return lo, float("inf"), "feasible up to the cap"
+            ok, st = feasible(pl, o, hi)
+        if lo == 0.0:
+            lo = 1e-6
+            if not feasible(pl, o, lo)[0]:
+                return 0.0, lo, st
+            lo, hi = _bisect(pl, o, lo, hi, tol, up=True)
+            return lo, hi, st
+        lo, hi = _bisect(pl, o, lo, hi, tol, up=True)
+        return lo, hi, feasible(pl, o, hi)[1]
+    top = 1 - 1e-6
+    if not feasible(pl, o, top)[0]:
+        return 1.0, top, "infeasible"
+    bot = 1 / LAMBDA_CAP
+    if feasible(pl, o, bot)[0]:
+        return bot, 0.0, "feasible down to the cap"
+    hi, lo = _bisect(pl, o, top, bot, tol, up=False)
+    return hi, lo, feasible(pl, o, lo)[1]
+
+
+def _bisect(
+    pl: Plant, o: Options, good: float, bad: float, tol: float, up: bool
+) -> tuple[float, float]:
+    while abs(bad - good) > tol * abs(good):
+        mid = (good + bad) / 2
+        if feasible(pl, o, mid)[0]:
+            good = mid
+        else:
+            bad = mid
+    return good, bad
+
+
+def _chosen(o: Options, best: fmpq, discrete: bool) -> fmpq:
+    """λ from the best rate: fraction·λ_max (continuous), 1 − fraction·(1 − λ_best)
+    (discrete: the decay margin 1 − λ is the fraction of the best one)."""
+    return o.fraction * best if not discrete else 1 - o.fraction * (1 - best)
+
+
+def design_params(
+    spec: Spec, progress: Any = None
+) -> tuple[dict[str, Any], SolverResult, list[str]]:
+    """Full-stubborn or redesign: λ search, criterion step, rounding, exact self-check."""
+    o: Options = spec.options
+    pl = Plant.of(spec)
+    t0 = time.perf_counter()
+    notes: list[str] = []
+    vals: dict[str, Any] = {}
+    if o.lam is not None:
+        lam_q = o.lam
+        if not feasible(pl, o, float(lam_q))[0]:
+            _infeasible(spec, pl, o, f"at the given λ = {float(lam_q):g}")
+    else:
+        if progress:
+            progress("searching the best λ")
+        good, bad, st = search_lambda(pl, o)
+        if good == (0.0 if not pl.discrete else 1.0):
+            _infeasible(spec, pl, o, "for every λ tried")
+        best = dyadic(good, 20)
+        if (not pl.discrete and best > Q(good)) or (pl.discrete and best < Q(good)):
+            best = Q(good)
+        vals["lambda_max"] = best
+        other = Q(bad) if np.isfinite(bad) else None
+        if other is not None:
+            vals["lambda_bracket"] = np.array([best, other], dtype=object)
+        lam_q = _chosen(o, best, pl.discrete)
+        notes.append(
+            f"best λ {'≈' if other is not None else '≥'} {float(best):.6g}"
+            + (f" (solver: feasible there, {st} at {float(bad):.6g})" if other is not None else "")
+            + f"; λ = {'fraction·λ_max' if not pl.discrete else '1 − fraction·(1 − λ_best)'}"
+        )
+    if progress:
+        progress(f"criterion '{o.criterion}' at λ = {float(lam_q):.6g}")
+    margin = float(o.margin)
+    last = ""
+    for attempt in range(4):
+        prob, v = _problem(pl, o, float(lam_q), o.criterion, margin)
+        r = solve(prob)
+        if not r.optimal:
+            if attempt == 0 and r.infeasible:
+                _infeasible(spec, pl, o, f"at λ = {float(lam_q):g} with the criterion step")
+            last = f"solver status {r.status}"
+            margin *= 10
+            continue
+        cand = _round(v, o, lam_q)
+        cand.update({k: x for k, x in vals.items()})
+        cand["criterion"] = o.criterion
+        bad_ids = [c.id for c in _claims.lmi_claims(spec, cand) if not c.ok]
+        if not bad_ids:
+            notes.append(f"solver margin {margin:g}")
+            sr = SolverResult(
+                f"cvxpy/{r.solver}", SolverStatus.OPTIMAL, "", time.perf_counter() - t0
+            )
+            return cand, sr, notes
+        last = f"exact check failed: {', '.join(bad_ids)}"
+        margin *= 10
+    raise InconclusiveError(f"stubborn: no candidate certified ({last})")
+
+
+def _round(v: dict[str, Any], o: Options, lam_q: fmpq) -> dict[str, Any]:
+    """Dyadic rounding; K rounded itself, X rebuilt exactly as P K."""
+    P = symmetrize(dyadic((v["P"].value + v["P"].value.T) / 2, BITS))
+    Xf = np.asarray(v["X"].value, float)
+    if o.K is None:
+        K = dyadic(np.linalg.solve(np.asarray(to_float(P), float), Xf), BITS)
+    else:
+        K = np.asarray(o.K, dtype=object)
+    X = P @ K
+    R = symmetrize(dyadic((v["R"].value + v["R"].value.T) / 2, BITS))
+    U = dyadic(np.asarray(v["u"].value, float).reshape(-1), BITS)
+    W = dyadic(np.asarray(v["w"].value, float).reshape(-1), BITS)
+    Y = dyadic(np.asarray(v["Y"].value, float), BITS)
+    out: dict[str, Any] = {"K": K, "P": P, "X": X, "U": U, "W": W, "Y": Y, "R": R, "lambda": lam_q}
+    if "g" in v:
+        g = Q(float(v["g"].value))
+        out["gamma2"] = dyadic(float(g) * (1 + 1e-6) + 1e-9, BITS)
+    return out
+
+
+def _infeasible(spec: Spec, pl: Plant, o: Options, where: str) -> None:
+    """Say why: (C, A) not detectable (Proposition: the LMIs are feasible iff it is), or the
+    bounds of the design (gain bound, given K, given λ)."""
+    det = detectability(pl.A, pl.C, pl.discrete)
+    if det.verdict is False:
+        raise InfeasibleError(
+            f"stubborn: (C, A) is not detectable ({det.detail}); LMIs {_refs(pl)} are infeasible"
+        )
+    if det.verdict is None:
+        raise InconclusiveError(
+            f"stubborn: LMIs {_refs(pl)} infeasible {where}, and detectability of (C, A) is "
+            f"numerically inconclusive ({det.detail})"
+        )
+    if o.K is not None:
+        why = "the given K does not allow it (redesign: X = P K)"
+    elif o.lam is not None:
+        why = f"try a smaller λ or a larger gain_bound (now {float(o.gain_bound):g})"
+    else:
+        why = f"(C, A) is detectable: raise gain_bound (now {float(o.gain_bound):g})"
+    raise InfeasibleError(f"stubborn: LMIs {_refs(pl)} infeasible {where}: {why}")
+
+
+def _refs(pl: Plant) -> str:
+    return "(7)-(9)" if pl.discrete else "(1)-(3)"

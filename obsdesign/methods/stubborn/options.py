@@ -1,0 +1,147 @@
+"""The ``[method]`` and ``[simulate]`` keys of the ``stubborn`` method (paper 002: Astolfi,
+Alessandri, Zaccarian, "Stubborn observers for linear and nonlinear systems", WUDS 2017)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from flint import fmpq
+
+from obsdesign.spec.models import Spec
+from obsdesign.spec.reader import Table
+
+#: design criteria of the slides' "optimized parameter selection" (steps 2-4)
+CRITERIA = ("R", "K", "l2")
+MODES = ("full", "redesign", "high-gain")
+
+#: stated defaults (docs/methods/stubborn.md, "Choices where the paper is ambiguous")
+DEFAULT_FRACTION = fmpq(1, 2)
+DEFAULT_GAIN_BOUND = fmpq(100)
+DEFAULT_MARGIN = fmpq(1, 10**6)
+DEFAULT_LAMBDA_TOL = fmpq(1, 1000)
+
+
+@dataclass
+class Options:
+    """Typed ``[method]`` of ``stubborn``.
+
+    mode: ``full`` (design K, λ, R, W: LMIs (1)-(3) or (7)-(9) with X free), ``redesign``
+    (K given: X = P K, LMIs in P) or ``high-gain`` (second part of the slides).
+    K: the given gain (redesign; for high-gain the Hurwitz coefficients k_1..k_n).
+    lam: a fixed λ (no search) or None; fraction: λ = fraction·λ_max (continuous time) or
+    1 − λ = fraction·(1 − λ_best) (discrete time). gain_bound: ‖X‖₂ ≤ gain_bound with P ⪰ I
+    (hence ‖K‖₂ ≤ gain_bound) in full mode. criterion: R (min λ_max(R)), K (min ‖X‖₂),
+    l2 (min the L2 gain from d to e, bounded real lemma on A − KC with Bd).
+    margin: strictness margin of the solver (LMIs are certified strict, exactly).
+    """
+
+    mode: str
+    K: np.ndarray | None
+    lam: fmpq | None
+    fraction: fmpq
+    gain_bound: fmpq
+    criterion: str
+    margin: fmpq
+    lambda_tol: fmpq
+    # high-gain redesign
+    lipschitz: fmpq | None = None
+    ell: fmpq | None = None
+    epsilon: fmpq | None = None
+
+
+@dataclass
+class SimOptions:
+    """Method keys of ``[simulate]``: outlier study settings and the saturation initial state.
+
+    noise_std: standard deviation of the Gaussian measurement noise; outlier_rate:
+    probability that a sample carries an outlier; amplitudes: maximal absolute values of the
+    outliers (uniform in [−a, a]); runs: Monte Carlo runs per amplitude; sigma0: σ̄(0)
+    (None: max_i w_i (C e(0))_i², so that the injection starts unsaturated)."""
+
+    noise_std: float = 0.05
+    outlier_rate: float = 0.01
+    amplitudes: tuple[float, ...] = (0.1, 1.0, 10.0, 100.0, 1000.0)
+    runs: int = 100
+    sigma0: float | None = None
+
+
+def parse_options(table: Table, spec: Spec) -> Options:
+    """Read and validate ``[method]`` (every error names file and key)."""
+    s = spec.system
+    mode_default = "redesign" if table.has("K") else "full"
+    mode = table.str("mode", default=mode_default, choices=MODES)
+    n = s.n
+    lip = ell = eps = None
+    if mode == "high-gain":
+        if s.p != 1:
+            raise table.error("mode", "the high-gain redesign needs one output y = x1")
+        K = table.vector("K", n=n).q
+        lip = table.scalar("lipschitz", min=0).q
+        e = table.scalar("ell", default=None, min=1)
+        ell = None if e is None else e.q
+        ep = table.scalar("epsilon", default=None, min=0, strict_min=True)
+        eps = None if ep is None else ep.q
+        lam_v = table.scalar("lambda", default=fmpq(1), min=0, strict_min=True)
+        table.done()
+        return Options(
+            mode,
+            np.asarray(K, dtype=object).reshape(n, 1),
+            lam_v.q,
+            DEFAULT_FRACTION,
+            DEFAULT_GAIN_BOUND,
+            "R",
+            DEFAULT_MARGIN,
+            DEFAULT_LAMBDA_TOL,
+            lip,
+            ell,
+            eps,
+        )
+    if s.A is None or s.C is None:
+        raise table.error("mode", "full and redesign modes need the linear model A, C in [system]")
+    K = None
+    if mode == "redesign":
+        if not table.has("K"):
+            raise table.error("K", "is missing: the stubborn redesign keeps a given gain K")
+        K = table.matrix("K", rows=n, cols=s.p, vector_as="column").q
+    elif table.has("K"):
+        raise table.error("K", "full-stubborn mode designs K; use mode = 'redesign' to give it")
+    if s.discrete:
+        lv = table.scalar("lambda", default=None, min=0, max=1, strict_min=True, strict_max=True)
+    else:
+        lv = table.scalar("lambda", default=None, min=0, strict_min=True)
+    frac = table.scalar(
+        "lambda_fraction", default=DEFAULT_FRACTION, min=0, max=1, strict_min=True
+    ).q
+    if lv is not None and table.has("lambda_fraction"):
+        raise table.error("lambda_fraction", "give lambda (fixed) or lambda_fraction, not both")
+    gb = table.scalar("gain_bound", default=DEFAULT_GAIN_BOUND, min=0, strict_min=True).q
+    if mode == "redesign" and table.has("gain_bound"):
+        raise table.error("gain_bound", "the redesign keeps the given K: no gain bound to set")
+    crit = table.str("criterion", default="R", choices=CRITERIA)
+    if crit == "K" and mode == "redesign":
+        raise table.error("criterion", "criterion 'K' sizes the designed gain: full mode only")
+    if crit == "l2" and s.nd == 0:
+        raise table.error("criterion", "criterion 'l2' needs a disturbance input: give [system] Bd")
+    margin = table.scalar("margin", default=DEFAULT_MARGIN, min=0, strict_min=True).q
+    tol = table.scalar("lambda_tol", default=DEFAULT_LAMBDA_TOL, min=0, strict_min=True).q
+    table.done()
+    return Options(mode, K, None if lv is None else lv.q, frac, gb, crit, margin, tol)
+
+
+def parse_sim(table: Table, spec: Spec) -> SimOptions:
+    """The method's own ``[simulate]`` keys (the outlier model of the study)."""
+    o = SimOptions()
+    if table.has("noise_std"):
+        o.noise_std = float(table.scalar("noise_std", min=0).f)
+    if table.has("outlier_rate"):
+        o.outlier_rate = float(table.scalar("outlier_rate", min=0, max=1).f)
+    if table.has("amplitudes"):
+        o.amplitudes = tuple(float(a) for a in table.vector("amplitudes").f)
+        if any(a < 0 for a in o.amplitudes):
+            raise table.error("amplitudes", "expected non-negative outlier amplitudes")
+    if table.has("runs"):
+        o.runs = table.int("runs", min=1)
+    if table.has("sigma0"):
+        o.sigma0 = float(table.scalar("sigma0", min=0).f)
+    return o
