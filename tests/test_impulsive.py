@@ -16,13 +16,9 @@ from obsdesign.api import load_spec
 from obsdesign.certify.exact import Q, qmat, qvec
 from obsdesign.certify.linalg import norm_upper
 from obsdesign.errors import InfeasibleError, SpecError
-from obsdesign.methods.impulsive.core import (
-    BlockData,
-    Infeasible,
-    Problem,
-    certify_window,
-    design_window,
-)
+from obsdesign.methods.impulsive.claims import certify_window
+from obsdesign.methods.impulsive.core import BlockData, Infeasible, Problem
+from obsdesign.methods.impulsive.design import design_window
 from obsdesign.methods.impulsive.dissipativity import best_rate, qsr_lipschitz, qsr_sector
 from obsdesign.methods.impulsive.window import T_max_lower, T_min_upper, gamma_of
 

@@ -7,7 +7,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from obsdesign.certify.exact import Q, qmat, qvec
-from obsdesign.methods.impulsive.core import Infeasible, LipschitzX, Problem, design_window
+from obsdesign.methods.impulsive.core import Infeasible, LipschitzX, Problem
+from obsdesign.methods.impulsive.design import design_window
 from obsdesign.methods.impulsive.hybrid import (
     ball_report,
     draw_intervals,

@@ -12,7 +12,9 @@ from obsdesign.api import load_spec_text
 from obsdesign.certify.exact import Q, qmat, qvec
 from obsdesign.errors import InputError
 from obsdesign.methods import get_method
-from obsdesign.methods.impulsive.core import LipschitzX, Problem, certify_window, design_window
+from obsdesign.methods.impulsive.claims import certify_window
+from obsdesign.methods.impulsive.core import LipschitzX, Problem
+from obsdesign.methods.impulsive.design import design_window
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC3 = ROOT / "specs" / "impulsive-sector-3state.toml"

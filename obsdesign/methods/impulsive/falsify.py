@@ -13,16 +13,21 @@ apart, half close together so that derivative-level violations show), maps them 
 - with a Lipschitz bound in x (``lipschitz_x``): ‖ψ(x̂) − ψ(x)‖/‖x̂ − x‖ − ℓ.
 
 Mixed points such as T⁻¹(ẑ_o, z_n) are kept only when they lie in the region too (the data
-are claimed on the region). The result is a *numerical* claim: sampling can find a violation
-but never prove there is none.
+are claimed on the region). A value of ψ that is NaN or ±inf at a sampled point, and a NaN or
+±inf value of an inequality, is a violation (reported with the point that produced it). The
+result is a *numerical* claim: sampling can find a violation but never prove there is none.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from obsdesign.spec.models import Spec
 
 Psi = Callable[[np.ndarray], np.ndarray]  # (N, n) -> (N, n)
 
@@ -53,7 +58,9 @@ class Falsification:
         if not self.violated:
             return f"no violation in {self.samples} sampled pairs"
         parts = [
-            f"{v.name}: worst {v.worst:.4g} ({v.count}/{v.tested} pairs)" for v in self.violated
+            f"{v.name}: worst {v.worst:.4g} ({v.count}/{v.tested} pairs"
+            + (f", at x = {_pt(v.x)}, x̂ = {_pt(v.xhat)})" if v.x else ")")
+            for v in self.violated
         ]
         return "violated — " + "; ".join(parts)
 
@@ -84,12 +91,26 @@ def _qsr_value(
     )
 
 
+def _pt(v: list[float]) -> str:
+    return "(" + ", ".join(f"{a:.4g}" for a in v) + ")"
+
+
 def _worst(name: str, val: np.ndarray, x: np.ndarray, xh: np.ndarray, tol: float) -> Violation:
+    """Worst value of one inequality (> tol violates; NaN and ±inf violate too, and a
+    non-finite value is reported first, with its point)."""
     if val.size == 0:
         return Violation(name, float("-inf"), 0, 0)
-    i = int(np.argmax(val))
-    cnt = int(np.sum(val > tol))
+    bad = ~np.isfinite(val)
+    cnt = int(np.sum(bad | (val > tol)))
+    i = int(np.argmax(bad)) if bad.any() else int(np.argmax(val))
     return Violation(name, float(val[i]), cnt, int(val.size), x[i].tolist(), xh[i].tolist())
+
+
+def _finite(psi_x: np.ndarray, psi_xh: np.ndarray, x: np.ndarray, xh: np.ndarray) -> Violation:
+    """ψ must be finite at every sampled point (NaN / ±inf is a violation)."""
+    bad = ~(np.all(np.isfinite(psi_x), axis=1) & np.all(np.isfinite(psi_xh), axis=1))
+    val = np.where(bad, np.nan, -1.0)
+    return _worst("ψ finite on the region", val, x, xh, 0.0)
 
 
 def falsify_blocks(
@@ -107,6 +128,24 @@ def falsify_blocks(
     tol: float = 1e-9,
 ) -> Falsification:
     """Falsification of the split reading of (15) with per-block data (see module doc)."""
+    with np.errstate(all="ignore"):
+        return _falsify_blocks(psi, T, m, qsr_o, qsr_n, ell_on, ell_no, lo, hi, samples, seed, tol)
+
+
+def _falsify_blocks(
+    psi: Psi,
+    T: np.ndarray,
+    m: int,
+    qsr_o: tuple[np.ndarray, ...],
+    qsr_n: tuple[np.ndarray, ...],
+    ell_on: float,
+    ell_no: float,
+    lo: np.ndarray,
+    hi: np.ndarray,
+    samples: int,
+    seed: int,
+    tol: float,
+) -> Falsification:
     rng = np.random.default_rng(seed)
     T = np.asarray(T, dtype=float)
     Ti = np.linalg.inv(T)
@@ -125,7 +164,7 @@ def falsify_blocks(
     p_z, p_zh, p_mo, p_mn = psibar(z), psibar(zh), psibar(mix_o), psibar(mix_n)
     eo, en = zh[:, :m] - z[:, :m], zh[:, m:] - z[:, m:]
     ok_o, ok_n = inside(mix_o), inside(mix_n)
-    items = []
+    items = [_finite(psi(x), psi(xh), x, xh)]
     lit: dict[str, float] = {}
     # own parts
     phi_o = p_mo[:, :m] - p_z[:, :m]
@@ -143,11 +182,11 @@ def falsify_blocks(
         ne_n, ne_o = np.linalg.norm(en, axis=1), np.linalg.norm(eo, axis=1)
         sel = ok_o & (ne_n > 1e-12)
         ratio = c_o[sel] / ne_n[sel]
-        lit["o"] = float(ratio.max(initial=0.0))
+        lit["o"] = float(np.nanmax(ratio, initial=0.0))
         items.append(_worst("cross bound ‖c_o‖ ≤ ℓ_on‖ε_n‖", ratio - ell_on, x[sel], xh[sel], tol))
         sel = ok_n & (ne_o > 1e-12)
         ratio = c_n[sel] / ne_o[sel]
-        lit["n"] = float(ratio.max(initial=0.0))
+        lit["n"] = float(np.nanmax(ratio, initial=0.0))
         items.append(_worst("cross bound ‖c_n‖ ≤ ℓ_no‖ε_o‖", ratio - ell_no, x[sel], xh[sel], tol))
     return Falsification(samples, items, lit)
 
@@ -156,11 +195,46 @@ def falsify_lipschitz_x(
     psi: Psi, ell: float, lo: np.ndarray, hi: np.ndarray, samples: int, seed: int, tol: float = 1e-9
 ) -> Falsification:
     """Falsification of ‖ψ(x̂) − ψ(x)‖ ≤ ℓ‖x̂ − x‖ on the region."""
-    rng = np.random.default_rng(seed)
-    x, xh = sample_pairs(rng, lo, hi, samples)
-    d = np.linalg.norm(xh - x, axis=1)
-    sel = d > 1e-12
-    ratio = np.linalg.norm(psi(xh) - psi(x), axis=1)[sel] / d[sel]
-    return Falsification(
-        samples, [_worst("Lipschitz bound of ψ in x", ratio - ell, x[sel], xh[sel], tol)], {}
+    with np.errstate(all="ignore"):
+        rng = np.random.default_rng(seed)
+        x, xh = sample_pairs(rng, lo, hi, samples)
+        px, pxh = psi(x), psi(xh)
+        d = np.linalg.norm(xh - x, axis=1)
+        sel = d > 1e-12
+        ratio = np.linalg.norm(pxh - px, axis=1)[sel] / d[sel]
+        items = [
+            _finite(px, pxh, x, xh),
+            _worst("Lipschitz bound of ψ in x", ratio - ell, x[sel], xh[sel], tol),
+        ]
+    return Falsification(samples, items, {})
+
+
+def run_falsification(spec: Spec, T: Any) -> Falsification:
+    """Falsification pass of Assumption 1 (15) on the spec's ``[nonlinearity.falsify]`` box,
+    in the coordinates z = T x of the design (``T`` exact or float, n×n)."""
+    from obsdesign.certify.exact import to_float
+
+    from .core import LipschitzX
+    from .plant import psi_callable
+
+    o = spec.options
+    fz = o.falsify
+    assert fz is not None
+    psi = psi_callable(spec)
+    data = o.problem.data
+    if isinstance(data, LipschitzX):
+        return falsify_lipschitz_x(psi, float(data.ell), fz.lower, fz.upper, fz.samples, fz.seed)
+    Tf = np.asarray(to_float(np.asarray(T, dtype=object)), dtype=float)
+    return falsify_blocks(
+        psi,
+        Tf,
+        o.problem.m,
+        data.qsr_o.floats(),
+        data.qsr_n.floats(),
+        float(data.ell_on),
+        float(data.ell_no),
+        fz.lower,
+        fz.upper,
+        fz.samples,
+        fz.seed,
     )

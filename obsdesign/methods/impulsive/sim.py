@@ -14,7 +14,6 @@ B = {‖ε‖ ≤ √(α‖w‖∞)} and the last time it was outside.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -25,6 +24,8 @@ from obsdesign.methods.impulsive.hybrid import (
     pad_to_horizon,
     simulate_hybrid,
 )
+from obsdesign.methods.impulsive.options import SimOptions
+from obsdesign.methods.impulsive.plant import plant_field
 from obsdesign.params import Parameters
 from obsdesign.simulate.result import SimResult
 from obsdesign.spec.models import Spec
@@ -45,16 +46,25 @@ def read_intervals(path: Path) -> np.ndarray:
     return vals
 
 
-def simulate_spec(spec: Spec, params: Parameters, **kwargs: Any) -> SimResult:
-    """Run the three scenarios; ``kwargs`` (strings from the CLI): runs, seed."""
-    from obsdesign.methods.impulsive.method import plant_field
-
+def simulate_spec(
+    spec: Spec,
+    params: Parameters,
+    runs: int | None = None,
+    seed: int | None = None,
+    sampling_file: Path | None = None,
+    rtol: float | None = None,
+) -> SimResult:
+    """Run the three scenarios. ``runs``, ``seed``, ``sampling_file``, ``rtol`` (typed values
+    of ``simulate --option``, validated by the API) override the spec's ``[simulate]``."""
     o = spec.options
     sim = spec.simulate
     if sim is None:
         raise InputError(f"{spec.file}: no [simulate] table")
-    runs = int(kwargs.get("runs", o.runs))
-    seed = int(kwargs.get("seed", sim.seed))
+    so: SimOptions = sim.options if isinstance(sim.options, SimOptions) else SimOptions()
+    runs = so.runs if runs is None else int(runs)
+    seed = sim.seed if seed is None else int(seed)
+    sampling_file = so.sampling_file if sampling_file is None else Path(sampling_file)
+    rtol = so.rtol if rtol is None else float(rtol)
     horizon = float(sim.horizon.f)
     T = np.asarray(params.float("T"), dtype=float)
     Ld = np.array([float(v) for v in o.problem.L])
@@ -62,14 +72,12 @@ def simulate_spec(spec: Spec, params: Parameters, **kwargs: Any) -> SimResult:
     t_lo, t_hi = params.float("T_min"), params.float("T_max")
     radius = params.float("ball_radius")
     rng = np.random.default_rng(seed)
-    if o.sampling_file is not None:
-        h = read_intervals(o.sampling_file)
+    if sampling_file is not None:
+        h = read_intervals(sampling_file)
         runs = 1
         H = pad_to_horizon(h[None, :], horizon)
         if H.shape[1] == 0 or np.sum(H) < horizon * 0.999:
-            raise InputError(
-                f"{o.sampling_file}: the intervals do not cover the horizon {horizon:g}"
-            )
+            raise InputError(f"{sampling_file}: the intervals do not cover the horizon {horizon:g}")
     else:
         H = draw_intervals(rng, runs, t_lo, t_hi, horizon)
     K = H.shape[1]
@@ -78,9 +86,9 @@ def simulate_spec(spec: Spec, params: Parameters, **kwargs: Any) -> SimResult:
     f = plant_field(spec)
     x0 = np.tile(sim.x0.f, (runs, 1))
     xh0 = np.tile(sim.xhat0.f, (runs, 1))
-    noisy = simulate_hybrid(f, T, Ld, x0, xh0, H, W, rtol=o.rtol)
-    clean = simulate_hybrid(f, T, Ld, x0, xh0, H, np.zeros_like(W), rtol=o.rtol)
-    open_ = simulate_hybrid(f, T, np.zeros(m), x0[:1], xh0[:1], H[:1], W[:1], rtol=o.rtol)
+    noisy = simulate_hybrid(f, T, Ld, x0, xh0, H, W, rtol=rtol)
+    clean = simulate_hybrid(f, T, Ld, x0, xh0, H, np.zeros_like(W), rtol=rtol)
+    open_ = simulate_hybrid(f, T, np.zeros(m), x0[:1], xh0[:1], H[:1], W[:1], rtol=rtol)
     after = horizon / 2
     br = ball_report(noisy, radius, after)
     used = H[H > 0]
@@ -124,7 +132,6 @@ def plot_simulation(spec: Spec, res: SimResult, path: str | Path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from obsdesign.methods.impulsive.method import plant_field
     from obsdesign.simulate.plot import save_figure
 
     ex = res.extra

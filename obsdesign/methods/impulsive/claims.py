@@ -1,0 +1,323 @@
+"""Certificate of the impulsive observer: every claim rebuilt from the spec and the report's
+exact parameters (Schaum, Feketa, Meurer, Moreno, "Robust nonlinear observer design based on
+impulsive dissipativity", MTNS 2020).
+
+Binding to the spec (soundness rule of the method contract): A, C, L (hence γ, β), α, the
+noise bound, M and κ when the spec gives them, and the data of Assumption 1 (QSR triples and
+cross constants, or ``lipschitz_x``) are read from the spec; the report's copies (``gamma``,
+``beta``, ``alpha``, ``w_bar``, ``kappa``, ``ell_no``, ``ell_on``, the C and M rows of ``T``,
+``theta_*`` under ``qsr_scaling = "as-given"``) are compared exactly. From the report the
+checks take only what the design computed: T's free rows, Ā, θ_o, θ_n, ϖ_o, κ_n, λ*_no, λ*_on,
+κ, T_min, T_max, the radius of B and the four norm bounds of ``lipschitz_x`` data.
+
+Numbers printed in statements are exact (:func:`fmt_exact`) or rounded in the direction that
+keeps the statement true (:func:`fmt_up` for upper bounds, :func:`fmt_down` for lower bounds).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from flint import fmpq
+
+from obsdesign.certify.claim import Claim, Claims
+from obsdesign.certify.exact import Q
+from obsdesign.certify.linalg import norm_bound_holds
+from obsdesign.certify.printing import fmt_down, fmt_exact, fmt_up
+from obsdesign.certify.psd import check_pd, check_psd
+from obsdesign.params import Parameters
+from obsdesign.spec.models import Spec
+
+from .coordinates import transform
+from .core import NORM_KEYS, REF, BlockData, LipschitzX, Problem, blocks_from_norms, norm_matrices
+from .dissipativity import ssd_matrix
+from .window import T_max_lower, T_min_upper, coupling, gamma_of
+
+#: exact parameters every report carries (checked by the API before :func:`certify`)
+PARAM_KEYS = (
+    "T",
+    "Abar",
+    "theta_o",
+    "theta_n",
+    "varpi_o",
+    "kappa_n",
+    "ell_no",
+    "ell_on",
+    "lambda_no",
+    "lambda_on",
+    "gamma",
+    "beta",
+    "kappa",
+    "T_min",
+    "T_max",
+    "alpha",
+    "w_bar",
+    "ball_radius",
+)
+
+
+def certify(spec: Spec, params: Parameters) -> list[Claim]:
+    """Every claim of Lemmas 1-2 and Theorems 1-2 (eqs. (9), (10c), (16), (18), (21c), (22),
+    (26a)-(26c)) rebuilt from the spec and the report's exact parameters, plus the numerical
+    falsification claim of Assumption 1 (eq. (15)) when the spec asks for it
+    (``on_violation = "fail"``).
+
+    ``spec``: the bound spec; ``params``: the report's parameters (exact values required)."""
+    from .falsify import run_falsification
+
+    o = spec.options
+    p: Problem = o.problem
+    c = Claims()
+    keys = PARAM_KEYS + (NORM_KEYS if isinstance(p.data, LipschitzX) else ())
+    P: dict[str, Any] = {k: params.exact(k, c, accept_float=False) for k in keys}
+    if any(v is None for v in P.values()):
+        return c
+    P["M_source"] = str(params.get("M_source", "given"))
+    certify_window(p, P, c)
+    t_ok = any(x.id == "T" and x.ok for x in c)
+    if o.falsify is not None and o.falsify.on_violation == "fail" and t_ok:
+        fr = run_falsification(spec, P["T"])
+        c.numerical(
+            id="assumption1-falsification",
+            statement="Assumption 1 (split reading) holds at every sampled pair of the region",
+            reference=f"Assumption 1, eq. (15), {REF}",
+            check=f"sampling, {fr.samples} pairs; NaN or ±inf counts as a violation "
+            "(cannot prove, only falsify)",
+            passed=not fr.violated,
+            detail=fr.summary(),
+        )
+    return c
+
+
+def _ref(where: str) -> str:
+    return f"{where}, {REF}"
+
+
+def certify_window(p: Problem, P: dict[str, Any], c: Claims | None = None) -> Claims:
+    """The claims of the window: T and Ā (eqs. (9), (10c)), Q_o ≺ 0, Q_n ⪯ 0 (Assumption 1,
+    Lemma 2), ϖ_o (Lemma 2, eq. (16)), κ_n (Lemma 1, eq. (7)), λ*_no, λ*_on, γ and β (eqs.
+    (18), (21c)), Lemma 1's ISS condition, condition (22), T_max (26b), T_min (26c), the window
+    (26a) and the radius of B (Theorem 2).
+
+    ``p``: what the spec fixes; ``P``: the report's exact parameters by key; ``c``: the claim
+    list to extend (a new one when None). Returns the claim list."""
+    c = Claims() if c is None else c
+    T = np.asarray(P["T"], dtype=object)
+    n, m = p.A.shape[0], p.m
+    ok_shape = T.shape == (n, n) and all(T[i, j] == p.C[i, j] for i in range(m) for j in range(n))
+    M = p.given_M
+    if M is not None and ok_shape:
+        ok_shape = all(T[m + i, j] == M[i, j] for i in range(n - m) for j in range(n))
+    co = None
+    if ok_shape:
+        try:
+            co = transform(p.A, p.C, T[m:], P.get("M_source", "given"))
+        except ValueError:
+            co = None
+    c.exact(
+        id="T",
+        statement="T = [C; M] with C from the spec (and M from the spec when given), det T ≠ 0",
+        reference=_ref("eq. (9)"),
+        check="exact equality with the spec, exact rank",
+        passed=co is not None,
+        detail="" if co is not None else "T is not [C; M] of the spec, or is singular",
+    )
+    if co is None:
+        return c
+    Ab = np.asarray(P["Abar"], dtype=object)
+    same = Ab.shape == co.Abar.shape and all(
+        a == b for a, b in zip(Ab.flat, co.Abar.flat, strict=True)
+    )
+    c.exact(
+        id="Abar",
+        statement="Ā = T A T⁻¹ (blocks Ā_o, Ā_on, Ā_no, Ā_n)",
+        reference=_ref("eq. (10c)"),
+        check="exact rational inverse and product",
+        passed=same,
+        detail="" if same else "reported Ā differs from T A T⁻¹",
+    )
+    # -- data of Assumption 1, from the spec (and the reported norm bounds for lipschitz_x) --
+    data: BlockData
+    if isinstance(p.data, LipschitzX):
+        X = norm_matrices(co)
+        nb = {k: Q(P[k]) for k in NORM_KEYS}
+        bad = [k for k in NORM_KEYS if not norm_bound_holds(X[k], nb[k])]
+        c.exact(
+            id="lipschitz-x-blocks",
+            statement=(
+                f"‖C‖ ≤ {fmt_up(nb['norm_C'])}, ‖M‖ ≤ {fmt_up(nb['norm_M'])}, "
+                f"‖P_o‖ ≤ {fmt_up(nb['norm_Po'])}, ‖P_n‖ ≤ {fmt_up(nb['norm_Pn'])}: the own and "
+                "cross Lipschitz constants ℓ‖·‖‖·‖ of ψ̄ derived from lipschitz_x are upper bounds"
+            ),
+            reference=_ref("split reading of Assumption 1"),
+            check="exact u²I − XᵀX ⪰ 0 for each norm",
+            passed=not bad,
+            detail=f"not an upper bound: {', '.join(bad)}" if bad else "",
+        )
+        data = blocks_from_norms(p.data.ell, nb, m, n)
+        where = "[nonlinearity].lipschitz_x (derived)"
+    else:
+        data = p.data
+        where = "[nonlinearity.{}].cross"
+    c.matches("ell_no", P["ell_no"], data.ell_no, where.format("n"))
+    c.matches("ell_on", P["ell_on"], data.ell_on, where.format("o"))
+    c.matches("alpha", P["alpha"], p.alpha, "[method].alpha")
+    c.matches("w_bar", P["w_bar"], p.w_bar, "[method].noise_bound")
+    if p.given_kappa is not None:
+        c.matches("kappa", P["kappa"], p.given_kappa, "[method].kappa")
+    if not p.optimize_scaling:
+        c.matches("theta_o", P["theta_o"], 1, '[method].qsr_scaling = "as-given"')
+        c.matches("theta_n", P["theta_n"], 1, '[method].qsr_scaling = "as-given"')
+    r = check_pd(-data.qsr_o.Q)
+    c.exact(
+        id="Q_o-negative-definite",
+        statement="Q_o ≺ 0",
+        reference=_ref("Lemma 2"),
+        check="exact LDLᵀ",
+        passed=r.ok,
+        detail=r.detail,
+    )
+    r = check_psd(-data.qsr_n.Q)
+    c.exact(
+        id="Q_n-negative-semidefinite",
+        statement="Q_n ⪯ 0",
+        reference=_ref("Assumption 1"),
+        check="exact LDLᵀ",
+        passed=r.ok,
+        detail=r.detail,
+    )
+    th_o, th_n = Q(P["theta_o"]), Q(P["theta_n"])
+    varpi, kappa_n = Q(P["varpi_o"]), Q(P["kappa_n"])
+    ok, det = _ssd(co.Ao, data.qsr_o, th_o, -varpi, "θ_o")
+    c.exact(
+        id="varpi_o",
+        statement=(
+            f"Σ(Ā_o, I, I) is (−R_o, −S_oᵀ, −Q_o)-ssd(−ϖ_o) with ϖ_o ≤ {fmt_up(varpi)}, "
+            "so ϖ_o ≥ λ_max(M_o)"
+        ),
+        reference=_ref("Lemma 2, eq. (16)"),
+        check="exact LDLᵀ of −N(−ϖ_o) (QSR scaled by θ_o > 0)",
+        passed=ok,
+        detail=det,
+    )
+    ok, det = _ssd(co.An, data.qsr_n, th_n, kappa_n, "θ_n")
+    c.exact(
+        id="kappa_n",
+        statement=(f"Σ(Ā_n, I, I) is (−R_n, −S_nᵀ, −Q_n)-ssd(κ_n) with κ_n ≥ {fmt_down(kappa_n)}"),
+        reference=_ref("Lemma 1, eq. (7)"),
+        check="exact LDLᵀ of −N(κ_n) (QSR scaled by θ_n > 0)",
+        passed=ok,
+        detail=det,
+    )
+    lam_no, lam_on = Q(P["lambda_no"]), Q(P["lambda_on"])
+    for key, blk, lam, ell, ref in (
+        ("lambda_no", co.Ano, lam_no, data.ell_no, "Lemma 1"),
+        ("lambda_on", co.Aon, lam_on, data.ell_on, "Theorem 1"),
+    ):
+        sub = key.split("_")[1]
+        u = lam - Q(ell)
+        c.exact(
+            id=key,
+            statement=f"λ*_{sub} = ‖Ā_{sub}‖ + ℓ_{sub} ≤ {fmt_up(lam)}",
+            reference=_ref(ref),
+            check="exact u²I − XᵀX ⪰ 0 with u = λ*_" + sub + " − ℓ_" + sub + " ≥ 0",
+            passed=norm_bound_holds(blk, u),
+            margin=u,
+            detail="" if u >= 0 else f"λ*_{sub} − ℓ_{sub} = {fmt_exact(u)} < 0",
+        )
+    gamma, beta = gamma_of(p.L)
+    ok = Q(P["gamma"]) == gamma and Q(P["beta"]) == beta and 0 < 1 - gamma < 1
+    c.exact(
+        id="gamma-beta",
+        statement=(
+            f"1 − γ = λ_max(I − L) = {fmt_exact(1 - gamma)} ∈ (0, 1), "
+            f"β = 1/(1 − γ)² = {fmt_exact(beta)}"
+        ),
+        reference=_ref("eqs. (18), (21c)"),
+        check="exact, from the spec's L",
+        passed=ok,
+        detail="" if ok else "the report's γ or β differs from the value of the spec's L",
+    )
+    slack = kappa_n - lam_no
+    c.exact(
+        id="lemma1-iss",
+        statement=(f"κ_n > λ*_no (κ_n − λ*_no ≥ {fmt_down(slack)}): (14b) is ISS w.r.t. ε_o"),
+        reference=_ref("Lemma 1"),
+        check="exact",
+        passed=slack > 0,
+        margin=slack,
+    )
+    kappa = Q(P["kappa"])
+    slack = kappa_n - coupling(lam_no, lam_on, beta) - kappa
+    c.exact(
+        id="condition-22",
+        statement=(
+            f"κ_n > λ*_no + β λ*_on + κ and κ > 0 (κ ≥ {fmt_down(kappa)}, "
+            f"κ_n − λ*_no − β λ*_on − κ ≥ {fmt_down(slack)})"
+        ),
+        reference=_ref("Theorem 1, eq. (22)"),
+        check="exact",
+        passed=kappa > 0 and slack > 0,
+        margin=slack,
+    )
+    T_max, T_min = Q(P["T_max"]), Q(P["T_min"])
+    try:
+        lo = T_max_lower(gamma, varpi, kappa, lam_no, lam_on, beta)
+        ok, det = 0 < T_max <= lo, f"T_max = {T_max} ≤ {float(lo):.10g} (outward-rounded)"
+    except ValueError as e:
+        ok, det = False, str(e)
+    c.exact(
+        id="T_max",
+        statement=f"T_max = {fmt_exact(T_max)} ≤ −ln((1−γ)²)/(ϖ_o + κ + λ*_no + βλ*_on)",
+        reference=_ref("Theorem 2, eq. (26b); (22) for i = o"),
+        check="interval arithmetic, rounded down",
+        passed=bool(ok),
+        detail=det,
+    )
+    try:
+        hi = T_min_upper(p.alpha, gamma, kappa)
+        ok, det = T_min >= hi, f"T_min = {T_min} ≥ {float(hi):.10g} (outward-rounded)"
+    except ValueError as e:
+        ok, det = False, str(e)
+    c.exact(
+        id="T_min",
+        statement=(
+            f"T_min = {fmt_exact(T_min)} ≥ −ln((α − γ)/α)/κ, "
+            f"α = {fmt_exact(p.alpha)} > γ = {fmt_exact(gamma)}"
+        ),
+        reference=_ref("Theorem 2, eq. (26c)"),
+        check="interval arithmetic, rounded up",
+        passed=bool(ok),
+        detail=det,
+    )
+    c.exact(
+        id="window",
+        statement=f"T_min < T_max ({fmt_exact(T_min)} < {fmt_exact(T_max)})",
+        reference=_ref("Theorem 2, eq. (26a)"),
+        check="exact",
+        passed=T_min < T_max,
+        margin=T_max - T_min,
+    )
+    rad = Q(P["ball_radius"])
+    aw = Q(p.alpha) * Q(p.w_bar)
+    c.exact(
+        id="ball_radius",
+        statement=(
+            f"radius of B: r_B ≥ √(α‖w‖∞) = √({fmt_exact(p.alpha)}·{fmt_exact(p.w_bar)}), "
+            f"r_B ≤ {fmt_up(rad)}"
+        ),
+        reference=_ref("Theorem 2"),
+        check="exact r_B ≥ 0 and r_B² ≥ α w̄",
+        passed=rad >= 0 and rad * rad >= aw,
+        margin=rad * rad - aw,
+    )
+    return c
+
+
+def _ssd(Ablk: np.ndarray, qsr: Any, theta: fmpq, rate: fmpq, name: str) -> tuple[bool, str]:
+    """N(rate) ⪯ 0 of eq. (7) with the QSR triple scaled by θ > 0 (Lemmas 1-2), exact."""
+    if not theta > 0:
+        return False, f"{name} = {theta} is not positive"
+    r = check_psd(-ssd_matrix(Ablk, qsr.scaled(theta), rate))
+    return r.ok, r.detail

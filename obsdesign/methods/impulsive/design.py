@@ -1,0 +1,291 @@
+"""Design of the impulsive observer: coordinates, rates, κ and the sampling window (paper 001).
+
+Order of Schaum, Feketa, Meurer, Moreno, "Robust nonlinear observer design based on impulsive
+dissipativity" (MTNS 2020): coordinates (9)-(10) → κ_n (Lemma 1) and ϖ_o (Lemma 2, (16)) →
+γ, β (18), (21c) → λ*_on, λ*_no → κ from (22) → T_max (26b), T_min (26c) → radius of B
+(Theorem 2). Floats choose (M, the QSR scalings θ, the rates); everything reported is exact
+and is certified again, from the spec and these numbers only, by :mod:`.claims`.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+from flint import fmpq
+from scipy.optimize import minimize
+
+from obsdesign.certify.exact import Q, dyadic, to_float
+from obsdesign.certify.linalg import norm_upper
+from obsdesign.certify.psd import check_pd, check_psd
+from obsdesign.errors import InfeasibleError
+from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
+from obsdesign.params import Parameters
+from obsdesign.spec.models import Spec
+
+from .coordinates import (
+    Coordinates,
+    default_coordinates,
+    orthonormal_complement,
+    rational_M,
+    transform,
+)
+from .core import BlockData, Infeasible, LipschitzX, Problem, blocks_from_norms, norm_bounds
+from .dissipativity import QSR, best_rate, ssd_matrix
+from .window import (
+    T_max_lower,
+    T_min_upper,
+    coupling,
+    gamma_of,
+    kappa_max,
+    kappa_widest,
+    radius_upper,
+    safe_window,
+)
+
+
+def design(spec: Spec, progress: Progress | None = None) -> Design:
+    """The window [T_min, T_max] of Theorem 2 (eqs. (26a)-(26c)) for the spec, with every
+    intermediate quantity exact, plus the falsification pass of Assumption 1 (eq. (15)) when
+    ``[nonlinearity.falsify]`` asks for it.
+
+    ``spec``: a bound spec (``spec.options`` is :class:`.options.Options`); ``progress``:
+    optional callback for status lines. Raises :class:`InfeasibleError` naming the failing
+    condition (Lemma 1, (22), empty window)."""
+    from .falsify import run_falsification
+
+    o = spec.options
+    t0 = time.perf_counter()
+    if progress:
+        progress("coordinates, κ_n, ϖ_o, κ and the window (26b)-(26c)")
+    try:
+        vals, notes = design_window(o.problem)
+    except Infeasible as e:
+        raise InfeasibleError(str(e)) from None
+    params = Parameters(vals)
+    if o.falsify is not None:
+        if progress:
+            progress(f"falsification of Assumption 1 on {o.falsify.samples} sampled pairs")
+        fr = run_falsification(spec, vals["T"])
+        params["falsification"] = fr.summary()
+        if fr.violated and o.falsify.on_violation == "warn":
+            notes.append(
+                "WARNING: Assumption 1 as declared is violated on the falsification region — "
+                f"{fr.summary()}; literal reading (cross terms) sup ‖c_o‖/‖ε_n‖ = "
+                f"{fr.literal_cross.get('o', 0):.4g}, sup ‖c_n‖/‖ε_o‖ = "
+                f"{fr.literal_cross.get('n', 0):.4g}. The window is certified only *given* the "
+                "declared data."
+            )
+    solver = SolverResult(
+        "eigenvalue formulas (generalized Schur complement) + exact LDLᵀ",
+        SolverStatus.CLOSED_FORM,
+        seconds=time.perf_counter() - t0,
+    )
+    return Design(params, solver, notes)
+
+
+# -- float evaluation (used by the M search) -------------------------------------------------
+def float_window(p: Problem, Mf: np.ndarray) -> float:
+    """Window width T_max − T_min of (26b)-(26c) in floats for a float M (``lipschitz_x``
+    data); a negative score measures how far (22) is from holding. Used only to choose M.
+
+    ``p``: the problem; ``Mf``: a float (n−m)×n complement of the rows of C."""
+    A, C = (np.asarray(to_float(x), dtype=float) for x in (p.A, p.C))
+    ell = float(p.data.ell)  # type: ignore[union-attr]
+    T = np.vstack([C, Mf])
+    if abs(np.linalg.det(T)) < 1e-9:
+        return -1e6
+    Ti = np.linalg.inv(T)
+    Ab = T @ A @ Ti
+    m = p.m
+
+    def n2(X: np.ndarray) -> float:
+        return float(np.linalg.norm(X, 2)) if X.size else 0.0
+
+    nC, nM, nPo, nPn = n2(C), n2(Mf), n2(Ti[:, :m]), n2(Ti[:, m:])
+    Ao, Aon, Ano, An = Ab[:m, :m], Ab[:m, m:], Ab[m:, :m], Ab[m:, m:]
+    varpi = float(np.linalg.eigvalsh(Ao + Ao.T).max()) + 2 * nC * ell * nPo
+    kap_n = -float(np.linalg.eigvalsh(An + An.T).max()) - 2 * nM * ell * nPn
+    g, beta = (float(v) for v in gamma_of(p.L))
+    coup = n2(Ano) + nM * ell * nPo + beta * (n2(Aon) + nC * ell * nPn)
+    kmax = kap_n - coup
+    if kmax <= 0:
+        return kmax - 10.0
+    kap = _kappa_float(p, max(varpi, 0.0), coup, g, kmax)
+    tmax = -np.log((1 - g) ** 2) / (max(varpi, 0.0) + kap + coup)
+    tmin = -np.log((float(p.alpha) - g) / float(p.alpha)) / kap
+    return tmax - tmin
+
+
+def _kappa_float(p: Problem, varpi: float, coup: float, g: float, kmax: float) -> float:
+    if p.kappa == "max":
+        return kmax * (1 - 1e-6)
+    if p.kappa == "widest":
+        return min(kappa_widest(varpi, coup, g, float(p.alpha)), kmax * (1 - 1e-6))
+    return float(p.kappa)
+
+
+def optimize_M(p: Problem, seed: int = 0, starts: int = 6) -> np.ndarray:
+    """Search M (float) maximizing the window width T_max − T_min of (26b)-(26c)
+    (Nelder-Mead from the orthonormal complement and ``starts`` − 1 random starts drawn with
+    ``seed``). Only meaningful when the nonlinearity data transform with T (``lipschitz_x``).
+
+    ``p``: the problem. Returns the best float M found."""
+    C = np.asarray(to_float(p.C), dtype=float)
+    n, m = C.shape[1], C.shape[0]
+    M0 = orthonormal_complement(C)
+    rng = np.random.default_rng(seed)
+    best, best_val = M0, float_window(p, M0)
+    for s in range(starts):
+        x0 = (M0 if s == 0 else M0 + rng.normal(scale=0.5, size=M0.shape)).ravel()
+        res = minimize(
+            lambda v: -float_window(p, v.reshape(n - m, n)),
+            x0,
+            method="Nelder-Mead",
+            options={"maxiter": 400 * n, "xatol": 1e-6, "fatol": 1e-9},
+        )
+        val = -float(res.fun)
+        if val > best_val:
+            best, best_val = res.x.reshape(n - m, n), val
+    return best
+
+
+# -- exact rounding of the two rates --------------------------------------------------------
+def certified_rate(Ablk: np.ndarray, qsr: QSR, theta: fmpq, rate_f: float) -> fmpq:
+    """A dyadic rate r just below ``rate_f`` with N(r) ⪯ 0 proved exactly (the ssd LMI of
+    eq. (7), Lemma 1; Lemma 2 with r = −ϖ_o): κ_n is rounded down, ϖ_o up.
+
+    ``Ablk``: the exact diagonal block Ā_n or Ā_o; ``qsr``: its data of Assumption 1;
+    ``theta``: the scaling of the QSR triple; ``rate_f``: the float optimum."""
+    q = qsr.scaled(theta)
+    step = 2.0**-30 * max(1.0, abs(rate_f))
+    r = Q(dyadic(rate_f - step, 40))
+    for _ in range(60):
+        if check_psd(-ssd_matrix(Ablk, q, r)):
+            return r
+        r = r - Q(dyadic(step, 40))
+        step *= 4
+    raise Infeasible(
+        "the ssd LMI could not be certified near its float optimum (ill-conditioned data)"
+    )
+
+
+def coordinates_for(p: Problem) -> Coordinates:
+    """T = [C; M] of eq. (9): the spec's M, the orthonormal complement of the rows of C, or
+    the M that widens the window (``optimize``), rounded to exact rationals.
+
+    ``p``: the problem."""
+    if isinstance(p.M, str):
+        if p.M == "orthonormal":
+            return default_coordinates(p.A, p.C)
+        return transform(p.A, p.C, rational_M(optimize_M(p)), "optimized")
+    return transform(p.A, p.C, p.M, "given")
+
+
+def design_window(p: Problem) -> tuple[dict[str, Any], list[str]]:
+    """All parameters of the design (Lemmas 1-2, eqs. (16), (18), (21c), (22), (26b),
+    (26c), Theorem 2), exact, and notes; raises :class:`Infeasible` with the failing
+    inequality and its numbers.
+
+    ``p``: the problem (what the spec fixes)."""
+    notes: list[str] = []
+    co = coordinates_for(p)
+    derived: dict[str, fmpq] = {}
+    data: BlockData
+    if isinstance(p.data, LipschitzX):
+        derived = norm_bounds(co)
+        data = blocks_from_norms(p.data.ell, derived, p.m, p.A.shape[0])
+    else:
+        data = p.data
+    Af = {k: np.asarray(to_float(getattr(co, k)), dtype=float) for k in ("Ao", "An")}
+    if not check_pd(-data.qsr_o.Q):
+        raise Infeasible("Lemma 2 needs Q_o ≺ 0; the declared Q_o is not negative definite")
+    if not check_psd(-data.qsr_n.Q):
+        raise Infeasible(
+            "Assumption 1 needs Q_n ⪯ 0; the declared Q_n is not negative semidefinite"
+        )
+    # Lemma 2 / (16): ϖ_o = max eig of M_o (rounded up, certified)
+    ko, th_o, _ = best_rate(Af["Ao"], data.qsr_o, p.optimize_scaling)
+    lam_Mo = -ko
+    varpi = -certified_rate(co.Ao, data.qsr_o, th_o, ko)
+    # Lemma 1: κ_n = largest ssd rate of Σ(Ā_n, I, I)
+    kn_f, th_n, resid = best_rate(Af["An"], data.qsr_n, p.optimize_scaling)
+    if not np.isfinite(kn_f) or resid > 1e-7:
+        raise Infeasible(
+            "Lemma 1: no κ_n makes Σ(Ā_n, I, I) (−R_n, −S_nᵀ, −Q_n)-ssd (I + S_n ∉ range Q_n)"
+        )
+    kappa_n = certified_rate(co.An, data.qsr_n, th_n, kn_f)
+    n_no, n_on = norm_upper(co.Ano), norm_upper(co.Aon)
+    lam_no, lam_on = n_no + data.ell_no, n_on + data.ell_on
+    gamma, beta = gamma_of(p.L)
+    if not kappa_n > lam_no:
+        raise Infeasible(
+            f"Lemma 1 fails: κ_n = {float(kappa_n):.6g} ≤ λ*_no = ‖Ā_no‖ + ℓ_no = "
+            f"{float(lam_no):.6g} (short by {float(lam_no - kappa_n):.4g}); try another M"
+        )
+    kmax = kappa_max(kappa_n, lam_no, lam_on, beta)
+    if kmax <= 0:
+        raise Infeasible(
+            f"condition (22) fails for every κ > 0: κ_n = {float(kappa_n):.6g} ≤ λ*_no + β λ*_on = "
+            f"{float(lam_no):.6g} + {float(beta):.6g}·{float(lam_on):.6g} = "
+            f"{float(coupling(lam_no, lam_on, beta)):.6g} (short by {float(-kmax):.4g})"
+        )
+    vp = max(float(varpi), 0.0)
+    if p.given_kappa is None:
+        kf = _kappa_float(p, vp, float(coupling(lam_no, lam_on, beta)), float(gamma), float(kmax))
+        kappa = Q(dyadic(kf, 30))
+        while kappa >= kmax:
+            kappa = kappa * fmpq(1023, 1024)
+    else:
+        kappa = p.given_kappa
+        if not (0 < kappa < kmax):
+            raise Infeasible(
+                f"condition (22) fails for the given κ = {float(kappa):.6g}: it must lie in "
+                f"(0, {float(kmax):.6g})"
+            )
+    if varpi <= 0:
+        # N(−ϖ) ⪯ N(−ϖ_o) for ϖ ≥ ϖ_o, so ϖ_o = 0 is still certified and keeps (26b) finite
+        notes.append(
+            f"Assumption 2 (ϖ_o > 0) does not hold: λ_max(M_o) = {lam_Mo:.6g}; ϖ_o = 0 is used "
+            "in (26b) (sound: the ssd LMI of Lemma 2 holds for every ϖ_o ≥ λ_max(M_o))"
+        )
+        varpi = fmpq(0)
+    T_max = T_max_lower(gamma, varpi, kappa, lam_no, lam_on, beta)
+    T_min = T_min_upper(p.alpha, gamma, kappa)
+    T_max_r, T_min_r = safe_window(T_max, T_min, p.digits)
+    if not T_min_r < T_max_r:
+        raise Infeasible(
+            f"empty window: T_min = {float(T_min):.6g} ≥ T_max = {float(T_max):.6g} "
+            f"(κ = {float(kappa):.6g}); a larger α, a smaller γ (L closer to I) or another κ/M "
+            "may help"
+        )
+    params: dict[str, Any] = {
+        "T": co.T,
+        "M_source": co.source,
+        "Abar": co.Abar,
+        "theta_o": th_o,
+        "theta_n": th_n,
+        "varpi_o": varpi,
+        "lambda_max_Mo": lam_Mo,
+        "assumption2": bool(lam_Mo > 0),
+        "kappa_n": kappa_n,
+        "norm_Ano": n_no,
+        "norm_Aon": n_on,
+        "ell_no": Q(data.ell_no),
+        "ell_on": Q(data.ell_on),
+        "lambda_no": lam_no,
+        "lambda_on": lam_on,
+        "gamma": gamma,
+        "beta": beta,
+        "kappa_max": kmax,
+        "kappa": kappa,
+        "T_min": T_min_r,
+        "T_max": T_max_r,
+        "alpha": Q(p.alpha),
+        "w_bar": Q(p.w_bar),
+        "ball_radius": radius_upper(p.alpha, p.w_bar),
+    }
+    params.update(derived)
+    notes.append(f"M from {co.source}; QSR o: {data.qsr_o.how}; n: {data.qsr_n.how}")
+    return params, notes

@@ -1,0 +1,261 @@
+"""The ``[method]``, ``[nonlinearity]`` and ``[simulate]`` keys of the ``impulsive`` method
+(Schaum, Feketa, Meurer, Moreno, "Robust nonlinear observer design based on impulsive
+dissipativity", MTNS 2020).
+
+The plant is ẋ = A x + ψ(x) with ψ from ``[system] psi``; ``[nonlinearity]`` holds only the
+data of Assumption 1 (``lipschitz_x``, or ``[nonlinearity.o]`` / ``[nonlinearity.n]``) and the
+optional falsification box ``[nonlinearity.falsify]``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from flint import fmpq
+
+from obsdesign.certify.exact import Q, qvec
+from obsdesign.certify.linalg import qrank
+from obsdesign.certify.psd import check_pd, check_psd
+from obsdesign.errors import SpecError
+from obsdesign.spec.models import Spec
+from obsdesign.spec.reader import Table
+
+from .core import BlockData, LipschitzX, Problem
+from .dissipativity import QSR, qsr_lipschitz, qsr_sector
+
+
+@dataclass
+class FalsifySpec:
+    """``[nonlinearity.falsify]``: the box [lower, upper] in x, the number of sampled pairs, the
+    seed, and what a violation does (``fail``: a failed numerical claim; ``warn``: a note)."""
+
+    lower: np.ndarray
+    upper: np.ndarray
+    samples: int
+    seed: int
+    on_violation: str
+
+
+@dataclass
+class Options:
+    """Typed ``[method]`` + ``[nonlinearity]`` of ``impulsive``: the exact problem and the
+    optional falsification pass."""
+
+    problem: Problem
+    falsify: FalsifySpec | None
+
+
+@dataclass
+class SimOptions:
+    """The method's own ``[simulate]`` keys: ``runs`` (sampling sequences), ``sampling_file``
+    (intervals from a file, one run), ``rtol`` (RK45 relative tolerance)."""
+
+    runs: int = 20
+    sampling_file: Path | None = None
+    rtol: float = 1e-7
+
+
+def parse_options(table: Table, spec: Spec) -> Options:
+    """Read and validate ``[method]`` and ``[nonlinearity]`` (every error names file and key).
+
+    ``table``: the ``[method]`` table; ``spec``: the spec (its ``[system]`` and raw tables)."""
+    s = spec.system
+    if s.discrete:
+        raise SpecError(spec.file, "system.time", 'the impulsive method needs time = "continuous"')
+    for key, v in (("f", s.f), ("h", s.h), ("u", s.u_signal)):
+        if v is not None:
+            raise SpecError(
+                spec.file,
+                f"system.{key}",
+                "is not used by the impulsive method: the plant is ẋ = A x + psi(x), "
+                "y_k = C x(t_k) + w_k",
+            )
+    n, m = s.n, s.p
+    if not m < n:
+        raise SpecError(
+            spec.file, "system.C", f"expected fewer outputs than states (m = {m}, n = {n})"
+        )
+    if qrank(s.C.q) < m:
+        raise SpecError(spec.file, "system.C", f"expected rank(C) = m = {m} (full row rank)")
+    if s.m or s.nd:
+        raise SpecError(
+            spec.file, "system.B", "the impulsive method has no inputs or disturbances (B, Bd)"
+        )
+    L = _diag_gain(table, m)
+    gamma = fmpq(1) - max(fmpq(1) - v for v in L)
+    alpha = table.scalar("alpha", min=0, strict_min=True).q
+    if not alpha > gamma:
+        raise table.error(
+            "alpha", f"expected α > γ = {float(gamma):g} (Theorem 2), got {float(alpha):g}"
+        )
+    w_bar = table.scalar("noise_bound", min=0).q
+    Mv: Any = "orthonormal"
+    if table.has("M"):
+        if isinstance(table.data["M"], str):
+            Mv = table.str("M", choices=("orthonormal", "optimize"))
+        else:
+            Mv = table.matrix("M", rows=n - m, cols=n).q
+            if qrank(np.vstack([s.C.q, Mv])) < n:
+                raise table.error(
+                    "M", "expected T = [C; M] invertible (M must complement the rows of C)"
+                )
+    kappa: Any = "max"
+    if table.has("kappa") and isinstance(table.data["kappa"], str):
+        kappa = table.str("kappa", choices=("max", "widest"))
+    elif table.has("kappa"):
+        kappa = table.scalar("kappa", min=0, strict_min=True).q
+    scaling = table.str("qsr_scaling", default="optimize", choices=("optimize", "as-given"))
+    digits = table.int("digits", default=4, min=1)
+    table.done()
+    nl = spec.tables.get("nonlinearity")
+    if nl is None:
+        raise SpecError(spec.file, "nonlinearity", "is missing (the data of Assumption 1)")
+    if s.psi is None:
+        raise SpecError(spec.file, "system.psi", "is missing (ẋ = A x + ψ(x), eq. (1a))")
+    if any(e.uses("t") for e in s.psi):
+        raise SpecError(spec.file, "system.psi", "expected ψ(x) without t (eq. (1a))")
+    data = _assumption1(nl, table, Mv, m, n)
+    fz = _falsify(nl, n)
+    nl.done()
+    prob = Problem(s.A.q, s.C.q, L, alpha, w_bar, Mv, data, kappa, scaling == "optimize", digits)
+    return Options(prob, fz)
+
+
+def _assumption1(nl: Table, table: Table, Mv: Any, m: int, n: int) -> BlockData | LipschitzX:
+    """The data of Assumption 1: ``lipschitz_x`` or the two blocks in z = T x."""
+    if nl.has("lipschitz_x"):
+        if nl.has("o") or nl.has("n"):
+            raise nl.error(
+                "lipschitz_x",
+                "give either lipschitz_x or the tables [nonlinearity.o] / [nonlinearity.n], "
+                "not both",
+            )
+        return LipschitzX(nl.scalar("lipschitz_x", min=0).q)
+    if isinstance(Mv, str):
+        raise table.error(
+            "M",
+            "per-block data ([nonlinearity.o], [nonlinearity.n]) are in the coordinates "
+            "z = T x, so M must be given as a matrix (or use nonlinearity.lipschitz_x)",
+        )
+    to, tn = nl.table("o", required=True), nl.table("n", required=True)
+    assert to is not None and tn is not None
+    q_o, l_on = _block(to, m)
+    q_n, l_no = _block(tn, n - m)
+    if not check_pd(-q_o.Q):
+        raise to.error(
+            "Q" if to.has("Q") else "sector",
+            "expected Q_o negative definite (Lemma 2 needs Q_o ≺ 0)",
+        )
+    if not check_psd(-q_n.Q):
+        raise tn.error("Q", "expected Q_n negative semidefinite (Assumption 1 needs Q_n ⪯ 0)")
+    return BlockData(q_o, q_n, l_on, l_no)
+
+
+def _falsify(nl: Table, n: int) -> FalsifySpec | None:
+    ft = nl.table("falsify")
+    if ft is None:
+        return None
+    lo, hi = ft.vector("lower", n=n), ft.vector("upper", n=n)
+    if not all(lo.q[i] < hi.q[i] for i in range(n)):
+        raise ft.error("upper", "expected lower < upper in every coordinate")
+    fz = FalsifySpec(
+        lo.f,
+        hi.f,
+        ft.int("samples", default=20000, min=10),
+        ft.int("seed", default=0, min=0),
+        ft.str("on_violation", default="fail", choices=("fail", "warn")),
+    )
+    ft.done()
+    return fz
+
+
+def parse_simulate(table: Table, spec: Spec) -> SimOptions:
+    """The method's ``[simulate]`` keys (``runs``, ``sampling_file`` relative to the spec's
+    folder, ``rtol``) as :class:`SimOptions`; never mutates the spec.
+
+    ``table``: the ``[simulate]`` table; ``spec``: the spec (for the file's folder)."""
+    runs = table.int("runs", default=20, min=1)
+    sf = None
+    if table.has("sampling_file"):
+        p = Path(table.str("sampling_file"))
+        sf = p if p.is_absolute() else Path(spec.file).resolve().parent / p
+    rtol = float(table.scalar("rtol", default=fmpq(1, 10**7), min=0, strict_min=True).f)
+    return SimOptions(runs, sf, rtol)
+
+
+def _diag_gain(table: Table, m: int) -> np.ndarray:
+    """L as its diagonal: a list of m numbers, or an m×m matrix that must be diagonal; every
+    eigenvalue of I − L must lie in (0, 1) (text after (18))."""
+    raw = table.data.get("L")
+    if isinstance(raw, list) and raw and isinstance(raw[0], list):
+        Lm = table.matrix("L", rows=m, cols=m).q
+        if any(Lm[i, j] != 0 for i in range(m) for j in range(m) if i != j):
+            raise table.error("L", "expected a diagonal correction gain L (eq. (11b))")
+        d = qvec([Lm[i, i] for i in range(m)])
+    else:
+        d = table.vector("L", n=m).q
+    for i, v in enumerate(d):
+        if not (0 < 1 - v < 1):
+            raise table.error(
+                "L",
+                f"expected every eigenvalue of I − L in (0, 1), i.e. 0 < L_ii < 1; "
+                f"L[{i}] = {float(v):g}",
+            )
+    return np.asarray(d, dtype=object)
+
+
+def _block(t: Table, k: int) -> tuple[QSR, fmpq]:
+    """One block of Assumption 1: exactly one of ``sector = [k1, k2]``, ``lipschitz = ℓ`` or
+    ``Q``, ``S``, ``R`` (k×k), plus ``cross`` (ℓ_ij of the split reading, default 0)."""
+    given = [key for key in ("sector", "lipschitz", "Q") if t.has(key)]
+    if len(given) != 1:
+        raise t.error("", "expected exactly one of sector = [k1, k2], lipschitz = ℓ, or Q/S/R")
+    if given[0] == "sector":
+        v = t.vector("sector", n=2).q
+        if not v[0] <= v[1]:
+            raise t.error("sector", "expected k1 ≤ k2")
+        q = qsr_sector(v[0], v[1], k)
+    elif given[0] == "lipschitz":
+        q = qsr_lipschitz(t.scalar("lipschitz", min=0).q, k)
+    else:
+        Qm, S, R = (t.matrix(key, rows=k, cols=k).q for key in ("Q", "S", "R"))
+        for key, X in (("Q", Qm), ("R", R)):
+            if any(X[i, j] != X[j, i] for i in range(k) for j in range(k)):
+                raise t.error(key, "expected a symmetric matrix")
+        q = QSR(Qm, S, R, "given (Q, S, R)")
+    cross = t.scalar("cross", default=fmpq(0), min=0).q
+    t.done()
+    return q, Q(cross)
+
+
+def options_schema(key: str) -> dict[str, Any]:
+    """JSON schema of the ``[method]`` table of ``impulsive``."""
+    from obsdesign.spec.schema import MAT, NUM
+
+    return {
+        "type": "object",
+        "required": ["key", "L", "alpha", "noise_bound"],
+        "additionalProperties": False,
+        "properties": {
+            "key": {"const": key},
+            "L": MAT,
+            "alpha": {**NUM, "exclusiveMinimum": 0},
+            "noise_bound": {**NUM, "minimum": 0},
+            "M": {"anyOf": [MAT, {"enum": ["orthonormal", "optimize"]}]},
+            "kappa": {"anyOf": [{**NUM, "exclusiveMinimum": 0}, {"enum": ["max", "widest"]}]},
+            "qsr_scaling": {"enum": ["optimize", "as-given"]},
+            "digits": {"type": "integer", "minimum": 1},
+        },
+    }
+
+
+def simulate_schema() -> dict[str, Any]:
+    """JSON-schema properties of the method's own ``[simulate]`` keys."""
+    return {
+        "runs": {"type": "integer", "minimum": 1},
+        "sampling_file": {"type": "string"},
+        "rtol": {"type": "number", "exclusiveMinimum": 0},
+    }
