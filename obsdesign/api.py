@@ -4,16 +4,27 @@ from __future__ import annotations
 
 import hashlib
 import time
+import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from obsdesign.certify.claim import Claim, ClaimStatus, exact_claim
-from obsdesign.errors import EXIT_OK, InputError, ObsdesignError, SpecError
+from obsdesign.errors import (
+    EXIT_BAD_INPUT,
+    EXIT_OK,
+    EXIT_SOLVER,
+    InputError,
+    ObsdesignError,
+    SpecError,
+)
+from obsdesign.limits import max_states_for
 from obsdesign.methods import get_method, method_keys
 from obsdesign.methods.base import Method, Progress
 from obsdesign.params import Parameters
-from obsdesign.report.model import Report, write_atomic
+from obsdesign.report.model import TOP_KEYS, Report, check_output, write_atomic
 from obsdesign.simulate.result import SimResult
 from obsdesign.spec import Spec, read_spec, read_spec_text
 
@@ -45,6 +56,14 @@ def bind(spec: Spec) -> Spec:
         )
     m = get_method(spec.method)
     s = spec.system
+    cap = max_states_for(m.key, getattr(m, "max_states", None))
+    if s.n > cap:
+        raise SpecError(
+            spec.file,
+            "system",
+            f"has {s.n} states, above method '{m.key}''s practical limit of {cap} "
+            f"(--limit max_states=N to try anyway)",
+        )
     if m.needs_linear:
         for k, v in (("A", s.A), ("C", s.C)):
             if v is None:
@@ -83,18 +102,62 @@ def _did_you_mean(word: str, known: list[str]) -> str:
     return f" (did you mean '{m[0]}'?)" if m else ""
 
 
+@contextmanager
+def captured_warnings(notes: list[str]) -> Iterator[None]:
+    """Turn Python warnings (numpy RuntimeWarning, scipy LinAlgWarning, ...) raised inside
+    the block into report notes instead of letting them reach stderr (one note per distinct
+    message)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            yield
+        finally:
+            seen: set[str] = set()
+            for w in caught:
+                text = f"warning: {w.category.__name__}: {w.message}"
+                if text not in seen and text not in notes:
+                    seen.add(text)
+                    notes.append(text)
+
+
 def design(
-    spec: str | Path | Spec, out: str | Path | None = None, progress: Progress | None = None
+    spec: str | Path | Spec,
+    out: str | Path | None = None,
+    progress: Progress | None = None,
+    force: bool = False,
 ) -> Report:
     """Design the observer of a spec and certify every claim; write the JSON report to
-    ``out`` (atomically) when given. Raises :class:`ObsdesignError` subclasses."""
+    ``out`` (atomically) when given. Raises :class:`ObsdesignError` subclasses.
+
+    ``out`` is checked before anything runs (:func:`obsdesign.report.model.check_output`:
+    never the spec itself, a symbolic link, a non-regular or a write-protected file unless
+    ``force``). The report is written whatever the verdict, so ``out`` never keeps a stale
+    report: its ``verdict`` says ``ok``, ``failed`` or ``inconclusive``; a design that stops
+    with an error (exit 1, 3 or 4 raised before any claim) writes a report with
+    ``"verdict": "error"`` and the error, which ``verify`` reports as such. Bad input (exit 2)
+    writes nothing and leaves ``out`` untouched."""
+    if out is not None:
+        check_output(out, force, inputs=(Path(spec),) if isinstance(spec, (str, Path)) else ())
     t0 = time.perf_counter()
     sp = _spec(spec)
     t1 = time.perf_counter()
     m = get_method(sp.method)
-    d = m.design(sp, progress)
+    notes: list[str] = []
+    try:
+        with captured_warnings(notes):
+            d = m.design(sp, progress)
+    except ObsdesignError as e:
+        if out is not None and e.exit_code != EXIT_BAD_INPUT:
+            _write_error_report(sp, out, e.exit_code, e.message, force)
+        raise
+    except Exception as e:
+        if out is not None:
+            msg = f"internal failure: {type(e).__name__}: {e}"
+            _write_error_report(sp, out, EXIT_SOLVER, msg, force)
+        raise
     t2 = time.perf_counter()
-    claims = certify(sp, d.parameters)
+    with captured_warnings(notes):
+        claims = certify(sp, d.parameters)
     t3 = time.perf_counter()
     report = Report(
         method=sp.method,
@@ -109,35 +172,111 @@ def design(
             "design_s": round(t2 - t1, 4),
             "certify_s": round(t3 - t2, 4),
         },
-        notes=d.notes,
+        notes=[*d.notes, *notes],
     )
+    report.verdict = report.computed_verdict()
     if out is not None:
-        write_atomic(out, report.to_json())
+        write_atomic(out, report.to_json(), force)
     return report
 
 
+def _write_error_report(sp: Spec, out: str | Path, code: int, message: str, force: bool) -> None:
+    rep = Report(
+        method=sp.method,
+        spec=sp.text,
+        spec_file=sp.file,
+        spec_sha256=sp.sha256,
+        parameters=Parameters(),
+        claims=[],
+        verdict="error",
+        error={"exit_code": code, "message": message},
+    )
+    write_atomic(out, rep.to_json(), force)
+
+
+class _TrackedParameters(Parameters):
+    """Parameters that record which keys the checks read (the rest are "not verified")."""
+
+    def __init__(self, values: dict[str, Any]) -> None:
+        super().__init__(values)
+        self.read: set[str] = set()
+
+    def __getitem__(self, k: str) -> Any:
+        self.read.add(k)
+        return super().__getitem__(k)
+
+    def get(self, k: str, default: Any = None) -> Any:
+        self.read.add(k)
+        return super().get(k, default)
+
+    def float(self, k: str) -> Any:
+        self.read.add(k)
+        return super().float(k)
+
+    def is_exact(self, k: str) -> bool:
+        self.read.add(k)
+        return super().is_exact(k)
+
+    def items(self) -> Any:
+        self.read.update(self._v)
+        return super().items()
+
+    def __iter__(self) -> Iterator[str]:
+        self.read.update(self._v)
+        return super().__iter__()
+
+
+#: claims only ``verify`` makes (never in a design report)
+VERIFY_ONLY = ("spec-hash", "parameters-consistent", "report-verdict")
+
+
 def verify(report: str | Path | Report, spec: str | Path | None = None) -> Report:
-    """Re-check every claim of a report from the spec and the parameters alone.
+    """Re-check a report from the spec and the parameters alone, and compare it with what
+    the report claims.
 
     The spec is the one embedded in the report, or ``spec`` when given; either way its
-    sha256 must equal the report's ``spec_sha256``. Stored statuses are ignored: the returned
-    report carries freshly computed claims.
+    sha256 must equal the report's ``spec_sha256``. The returned report carries the freshly
+    computed claims, plus a failed claim for every difference from the report:
+
+    - **claims**: the claim list is recomputed and compared with the report's, claim by
+      claim on (id, statement, status): a claim the report omits (``report-omits:<id>``), a
+      claim it adds (``report-adds:<id>``) and a claim whose statement or status differs
+      (``report-alters:<id>``) each fail, naming the claim. Reference, check, margin and
+      detail are replaced by the recomputed ones (not compared).
+    - **verdict**: the report's ``verdict`` must be the one its recomputed claims give
+      (``report-verdict``). A report of a design that stopped with an error (``"verdict":
+      "error"``) is reported as that error (a failed ``design-completed`` claim).
+    - **parameters**: the exact value is authoritative; each float beside an exact value
+      must be the nearest double to it (bit for bit), else ``parameters-consistent`` fails.
+      Parameters that no check reads are kept but listed in ``Report.unverified`` and shown
+      as "not verified" (they are informational: no claim depends on them).
+    - **notes** of the report are not verified: they are kept, each prefixed with
+      "not verified (from the report):". Unknown top-level keys are ignored with a note.
     """
     t0 = time.perf_counter()
     if isinstance(report, Report):
-        rep, problems = Report.from_dict(report.to_dict())
+        d = report.to_dict()
+        if report.raw_parameters is not None:  # as read: floats compared bit for bit
+            d["parameters"] = report.raw_parameters
+        rep, problems = Report.from_dict(d)
+        rep.extra_keys = list(report.extra_keys)
     else:
         rep, problems = Report.load(report)
     if spec is not None:
+        from obsdesign.limits import read_input
+
         p = Path(spec)
+        raw = read_input(p, "spec")
         try:
-            text = p.read_bytes().decode("utf-8")
-        except OSError as e:
-            raise InputError(f"{p}: cannot read spec ({e.strerror})") from None
+            text = raw.decode("utf-8")
+        except UnicodeDecodeError:
+            raise SpecError(str(p), "", "is not UTF-8 text") from None
         file = str(p)
     else:
         text, file = rep.spec, rep.spec_file or "<embedded spec>"
     sha = hashlib.sha256(text.encode("utf-8")).hexdigest()
+    old_claims, old_notes = rep.claims, rep.notes
+    rep.notes = [f"not verified (from the report): {n}" for n in old_notes]
     if sha != rep.spec_sha256:
         where = f"spec {file}" if spec is not None else "the embedded spec"
         claims = [
@@ -158,22 +297,160 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
     sp = load_spec_text(text, file)
     if sp.method != rep.method:
         raise InputError(f"report: method '{rep.method}' but the spec says '{sp.method}'")
+    if rep.error is not None:
+        return _replace_claims(rep, [_error_claim(rep)], time.perf_counter() - t0)
     claims: list[Claim] = []
+    problems = [
+        *problems,
+        *(q for q in _float_problems(rep) if not any(q.split(":")[0] in o for o in problems)),
+    ]
     if problems:
         claims.append(
             exact_claim(
                 "parameters-consistent",
-                "every float parameter equals its exact value",
+                "every float parameter is the nearest double to its exact value",
                 "report.parameters",
-                "comparison",
+                "comparison (the exact value is authoritative)",
                 0,
                 False,
                 "; ".join(problems),
                 float_ok=False,
             )
         )
-    claims += certify(sp, rep.parameters)
+    tracked = _TrackedParameters(dict(rep.parameters.items()))
+    tracked.read.clear()
+    notes: list[str] = []
+    with captured_warnings(notes):
+        fresh = certify(sp, tracked)
+    claims += fresh
+    claims += compare_claims(old_claims, fresh)
+    rep.unverified = [k for k in rep.parameters if k not in tracked.read]
+    if rep.verdict:
+        got = _verdict_of(fresh)
+        if rep.verdict != got:
+            claims.append(
+                exact_claim(
+                    "report-verdict",
+                    f"the report's verdict '{rep.verdict}' is the one its claims give",
+                    "report.verdict",
+                    "comparison",
+                    0,
+                    False,
+                    f"the recomputed claims give '{got}'",
+                    float_ok=False,
+                )
+            )
+    unknown = sorted(set(rep.extra_keys) - set(TOP_KEYS))
+    if unknown:
+        notes.append(f"ignored report keys (not part of a report): {', '.join(unknown)}")
+    if rep.unverified:
+        notes.append(
+            "not verified (no check reads them; informational only): " + ", ".join(rep.unverified)
+        )
+    rep.notes += notes
     return _replace_claims(rep, claims, time.perf_counter() - t0)
+
+
+def _verdict_of(claims: list[Claim]) -> str:
+    r = Report("", "", "", "", Parameters(), claims)
+    return r.computed_verdict()
+
+
+def _error_claim(rep: Report) -> Claim:
+    err = rep.error or {}
+    code = int(err.get("exit_code", 1))
+    return exact_claim(
+        "design-completed",
+        "the design completed",
+        "report.error",
+        "the report records an error",
+        0,
+        False,
+        f"the report records a design that stopped with exit {code}: {err.get('message', '')}",
+        float_ok=code == 4,
+    )
+
+
+def _float_problems(rep: Report) -> list[str]:
+    """Every float beside an exact value must be the nearest double to it, bit for bit."""
+    raw = rep.raw_parameters
+    if not isinstance(raw, dict):
+        return []
+    exact = raw.get("exact", {})
+    canon = rep.parameters.to_json()
+    out = []
+    for k in exact if isinstance(exact, dict) else ():
+        if k in raw and k in canon and not _same_floats(raw[k], canon[k]):
+            out.append(
+                f"parameter '{k}': the float is not the nearest double to the exact value "
+                f"(the exact value is authoritative)"
+            )
+    return out
+
+
+def _same_floats(a: Any, b: Any) -> bool:
+    if isinstance(a, list) and isinstance(b, list):
+        return len(a) == len(b) and all(_same_floats(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, bool) or isinstance(b, bool) or isinstance(a, list) or isinstance(b, list):
+        return False
+    if not isinstance(a, (int, float)) or not isinstance(b, (int, float)):
+        return False
+    return float(a) == float(b)
+
+
+def compare_claims(reported: list[Claim], fresh: list[Claim]) -> list[Claim]:
+    """Failed claims for every difference between the report's claim list and the
+    recomputed one, compared on (id, statement, status); claims with the same id are paired
+    in order. Claims only ``verify`` makes (:data:`VERIFY_ONLY`) must not be in a report."""
+    out: list[Claim] = []
+    by_id: dict[str, list[Claim]] = {}
+    for c in fresh:
+        by_id.setdefault(c.id, []).append(c)
+    seen: dict[str, int] = {}
+    for c in reported:
+        i = seen.get(c.id, 0)
+        seen[c.id] = i + 1
+        mine = by_id.get(c.id, [])
+        if i >= len(mine) or c.id in VERIFY_ONLY:
+            out.append(
+                _diff_claim(
+                    f"report-adds:{c.id}",
+                    f"the report lists claim '{c.id}' ({c.status.value}: {c.statement!r}), "
+                    f"which the recomputation does not make",
+                )
+            )
+            continue
+        f = mine[i]
+        what = []
+        if c.statement != f.statement:
+            what.append(f"statement {c.statement!r} vs recomputed {f.statement!r}")
+        if c.status != f.status:
+            what.append(f"status {c.status.value} vs recomputed {f.status.value}")
+        if what:
+            out.append(_diff_claim(f"report-alters:{c.id}", "; ".join(what)))
+    for cid, mine in by_id.items():
+        for f in mine[seen.get(cid, 0) :]:
+            out.append(
+                _diff_claim(
+                    f"report-omits:{cid}",
+                    f"the recomputation makes claim '{cid}' ({f.status.value}), "
+                    f"which the report does not list",
+                )
+            )
+    return out
+
+
+def _diff_claim(cid: str, detail: str) -> Claim:
+    return exact_claim(
+        cid,
+        "the report's claim list is the recomputed one",
+        "report.claims",
+        "comparison of id, statement and status",
+        0,
+        False,
+        detail,
+        float_ok=False,
+    )
 
 
 def certify(spec: Spec, params: Parameters) -> list[Claim]:

@@ -91,7 +91,7 @@ def test_write_atomic_leaves_nothing_on_failure(tmp_path: Path, monkeypatch):
         raise OSError("disk full")
 
     monkeypatch.setattr(os, "replace", boom)
-    with pytest.raises(OSError):
+    with pytest.raises(InputError, match="disk full"):
         write_atomic(target, "second")
     assert target.read_text() == "first\n"  # old content intact
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.json"]  # no temp file left

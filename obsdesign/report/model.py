@@ -5,7 +5,9 @@ from __future__ import annotations
 import json
 import os
 import platform
+import stat
 import tempfile
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from importlib import metadata
 from pathlib import Path
@@ -15,11 +17,12 @@ from obsdesign.certify.claim import Claim, ClaimStatus
 from obsdesign.errors import EXIT_INCONCLUSIVE, EXIT_INFEASIBLE, EXIT_OK, InputError
 from obsdesign.params import Parameters
 
-SCHEMA_VERSION = "1.0"
+SCHEMA_VERSION = "1.1"
 TOP_KEYS = (
     "schema_version",
     "tool",
     "method",
+    "verdict",
     "spec",
     "spec_file",
     "spec_sha256",
@@ -28,7 +31,12 @@ TOP_KEYS = (
     "solver",
     "timings",
     "notes",
+    "error",
+    "unverified_parameters",
 )
+#: ``verdict`` of a report: what ``design`` concluded (``error``: the design stopped with an
+#: error before any claim was made; ``error`` then holds its exit code and message)
+VERDICTS = {EXIT_OK: "ok", EXIT_INFEASIBLE: "failed", EXIT_INCONCLUSIVE: "inconclusive"}
 DEPS = ("numpy", "scipy", "cvxpy", "clarabel", "pycddlib", "python-flint", "mpmath")
 
 
@@ -67,6 +75,16 @@ class Report:
     notes: list[str] = field(default_factory=list)
     tool: dict[str, Any] = field(default_factory=tool_info)
     schema_version: str = SCHEMA_VERSION
+    #: ``ok`` / ``failed`` / ``inconclusive`` (from the claims) or ``error`` (see ``error``)
+    verdict: str = ""
+    #: for ``verdict == "error"``: ``{"exit_code": int, "message": str}``
+    error: dict[str, Any] | None = None
+    #: set by ``verify``: parameters no check reads (shown as "not verified")
+    unverified: list[str] = field(default_factory=list)
+    #: the report's ``parameters`` object as read (``verify`` compares its floats exactly)
+    raw_parameters: dict[str, Any] | None = field(default=None, repr=False)
+    #: top-level keys of the JSON that are not report keys (``verify`` notes them)
+    extra_keys: list[str] = field(default_factory=list)
 
     # -- verdict ----------------------------------------------------------------------------
     @property
@@ -75,7 +93,10 @@ class Report:
 
     def exit_code(self) -> int:
         """0 when every claim holds; 4 when every failed claim still holds in floats
-        (inconclusive); 1 otherwise."""
+        (inconclusive); 1 otherwise. A report of a design that stopped with an error has
+        that error's exit code."""
+        if self.error is not None:
+            return int(self.error.get("exit_code", EXIT_INFEASIBLE))
         bad = self.failed
         if not bad:
             return EXIT_OK
@@ -90,11 +111,18 @@ class Report:
         return out
 
     # -- JSON -------------------------------------------------------------------------------
+    def computed_verdict(self) -> str:
+        """The verdict the claims give (``error`` for an error report)."""
+        if self.error is not None:
+            return "error"
+        return VERDICTS.get(self.exit_code(), "failed")
+
     def to_dict(self) -> dict[str, Any]:
-        return {
+        d = {
             "schema_version": self.schema_version,
             "tool": self.tool,
             "method": self.method,
+            "verdict": self.verdict or self.computed_verdict(),
             "spec": self.spec,
             "spec_file": self.spec_file,
             "spec_sha256": self.spec_sha256,
@@ -104,6 +132,11 @@ class Report:
             "timings": self.timings,
             "notes": self.notes,
         }
+        if self.error is not None:
+            d["error"] = self.error
+        if self.unverified:
+            d["unverified_parameters"] = self.unverified
+        return d
 
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), indent=2, ensure_ascii=False)
@@ -111,19 +144,29 @@ class Report:
     @classmethod
     def load(cls, path: str | Path) -> tuple[Report, list[str]]:
         """Read a report; returns it and the list of float/exact inconsistencies found."""
+        from obsdesign.limits import read_input
+
         p = Path(path)
+        raw = read_input(p, "report")
         try:
-            d = json.loads(p.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise InputError(f"{p}: no such report file") from None
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+            d = json.loads(raw.decode("utf-8"))
+        except (UnicodeDecodeError, json.JSONDecodeError) as e:
             raise InputError(f"{p}: not a readable JSON report ({e})") from None
+        except RecursionError:
+            raise InputError(f"{p}: JSON nested too deeply") from None
+        except ValueError as e:  # an integer beyond Python's int-string limit
+            raise InputError(f"{p}: a number is too long ({e})") from None
         return cls.from_dict(d, str(p))
 
     @classmethod
     def from_dict(cls, d: Any, file: str = "<report>") -> tuple[Report, list[str]]:
+        from obsdesign.limits import data_problem
+
         if not isinstance(d, dict):
             raise InputError(f"{file}: a report is a JSON object")
+        bad = data_problem(d, exact_strings=True)
+        if bad is not None:
+            raise InputError(f"{file}: [{bad[0]}] {bad[1]}")
         for k in ("schema_version", "method", "spec", "spec_sha256", "parameters", "claims"):
             if k not in d:
                 raise InputError(f"{file}: key '{k}' is missing (not an obsdesign report?)")
@@ -133,6 +176,21 @@ class Report:
             )
         if not isinstance(d["spec"], str) or not isinstance(d["spec_sha256"], str):
             raise InputError(f"{file}: 'spec' must be the spec text and 'spec_sha256' its hash")
+        verdict = d.get("verdict", "")
+        if verdict not in ("", "error", *VERDICTS.values()):
+            raise InputError(f"{file}: unknown verdict {verdict!r}")
+        err = d.get("error")
+        if verdict == "error" or err is not None:
+            if not (
+                verdict == "error"
+                and isinstance(err, dict)
+                and isinstance(err.get("exit_code"), int)
+                and not isinstance(err.get("exit_code"), bool)
+                and isinstance(err.get("message"), str)
+            ):
+                raise InputError(
+                    f"{file}: an error report has verdict 'error' and error.exit_code/message"
+                )
         params, problems = Parameters.from_json(d["parameters"])
         try:
             claims = [Claim.from_dict(c) for c in d["claims"]]
@@ -151,24 +209,104 @@ class Report:
                 notes=list(d.get("notes", [])),
                 tool=dict(d.get("tool", {})),
                 schema_version=str(d["schema_version"]),
+                verdict=str(verdict),
+                error=dict(err) if isinstance(err, dict) else None,
+                raw_parameters=d["parameters"],
+                extra_keys=sorted(str(k) for k in d if k not in TOP_KEYS),
             ),
             problems,
         )
 
 
-def write_atomic(path: str | Path, text: str) -> Path:
-    """Write text to ``path`` through a temp file in the same folder and an atomic rename, so
-    that a reader never sees a half-written file and a failure leaves no file behind."""
+def check_output(path: str | Path, force: bool = False, inputs: tuple[Path, ...] = ()) -> None:
+    """Refuse (:class:`InputError`, one line) an output path that would destroy something:
+    one of ``inputs`` (the spec itself), a symbolic link, an existing file that is not a
+    regular file (device, FIFO, socket), or a write-protected file, unless ``force``; a
+    directory always. Nothing is written or created here."""
     p = Path(path)
-    p.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=p.parent, prefix=f".{p.name}.", suffix=".tmp")
     try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-            if not text.endswith("\n"):
-                f.write("\n")
-        os.replace(tmp, p)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+        lst = os.lstat(p)
+    except FileNotFoundError:
+        parent = p.parent
+        if parent.exists() and not parent.is_dir():
+            raise InputError(f"{p}: cannot write ({parent} is not a directory)") from None
+        return
+    except OSError as e:
+        raise InputError(f"{p}: cannot write ({e.strerror})") from None
+    for i in inputs:
+        try:
+            same = os.path.samefile(p, i)
+        except OSError:
+            same = False
+        if same and not force:
+            raise InputError(f"{p}: is the input file itself; refusing to overwrite it (--force)")
+    if stat.S_ISLNK(lst.st_mode) and not force:
+        raise InputError(
+            f"{p}: is a symbolic link; refusing to replace it (--force writes through it)"
+        )
+    try:
+        st = os.stat(p)
+    except OSError as e:  # a dangling link with --force: written as a new file
+        if force and stat.S_ISLNK(lst.st_mode):
+            return
+        raise InputError(f"{p}: cannot write ({e.strerror})") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise InputError(f"{p}: is a directory")
+    if not stat.S_ISREG(st.st_mode) and not force:
+        raise InputError(
+            f"{p}: is not a regular file (device, FIFO or socket); refusing to replace it "
+            f"(--force writes into it)"
+        )
+    if stat.S_ISREG(st.st_mode) and not os.access(p, os.W_OK) and not force:
+        raise InputError(f"{p}: is write-protected; refusing to replace it (--force)")
+
+
+def _umask_mode() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
+def write_via(path: str | Path, writer: Callable[[Path], Any], force: bool = False) -> Path:
+    """Write ``path`` by calling ``writer(tmp)`` on a temp file in the same folder (same
+    suffix) and renaming it atomically, so that a reader never sees a half-written file and
+    a failure leaves no file behind. The new file gets the mode of the file it replaces, or
+    the umask's normal mode (0666 & ~umask). With ``force``, a symbolic link is written
+    through (its target replaced) and a non-regular file (FIFO, device) is written into
+    directly. Every OS error is an :class:`InputError` naming the path and the reason."""
+    p = Path(path)
+    try:
+        if force and p.is_symlink():
+            p = Path(os.path.realpath(p))
+        if force and p.exists() and not p.is_file() and not p.is_dir():
+            writer(p)  # a FIFO or a device: write into it, never replace it
+            return p
+        p.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            mode = stat.S_IMODE(os.stat(p).st_mode)
+        except FileNotFoundError:
+            mode = _umask_mode()
+        fd, tmp = tempfile.mkstemp(dir=p.parent, prefix=f".{p.name}.", suffix=p.suffix or ".tmp")
+        os.close(fd)
+        try:
+            writer(Path(tmp))
+            os.chmod(tmp, mode)
+            os.replace(tmp, p)
+        finally:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+    except OSError as e:
+        raise InputError(f"{path}: cannot write ({e.strerror or e})") from None
     return p
+
+
+def write_atomic(path: str | Path, text: str, force: bool = False) -> Path:
+    """Write text to ``path`` atomically (see :func:`write_via`)."""
+    if not text.endswith("\n"):
+        text += "\n"
+
+    def w(tmp: Path) -> None:
+        with open(tmp, "w", encoding="utf-8") as f:
+            f.write(text)
+
+    return write_via(path, w, force)

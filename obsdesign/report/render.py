@@ -33,8 +33,18 @@ def _param_rows(report: Report) -> list[tuple[str, str, str]]:
     rows = []
     for k in report.parameters:
         v = report.parameters.float(k) if _numeric(report.parameters[k]) else report.parameters[k]
-        rows.append((k, fmt_value(v), "exact" if report.parameters.is_exact(k) else "float"))
+        form = "exact" if report.parameters.is_exact(k) else "float"
+        if k in report.unverified:
+            form = "not verified"
+        rows.append((k, fmt_value(v), form))
     return rows
+
+
+def esc(text: Any) -> str:
+    """Text with rich markup escaped: ``[system.A]`` prints as it is."""
+    from rich.markup import escape
+
+    return escape(str(text))
 
 
 def _numeric(v: Any) -> bool:
@@ -63,23 +73,29 @@ def render_text(report: Report, title: str = "") -> None:
     from rich.table import Table
 
     out = console()
-    t = Table(title=title or f"{report.method} — {report.spec_file}", show_lines=False)
+    t = Table(title=esc(title or f"{report.method} — {report.spec_file}"), show_lines=False)
     t.add_column("parameter")
     t.add_column("value", overflow="fold")
     t.add_column("form")
     for k, v, form in _param_rows(report):
-        t.add_row(k, v, form)
+        t.add_row(esc(k), esc(v), form)
     out.print(t)
     c = Table(title="claims")
     for col in ("id", "status", "statement", "check", "detail"):
         c.add_column(col, overflow="fold")
     for cl in report.claims:
         c.add_row(
-            cl.id, f"[{STYLE[cl.status]}]{cl.status.value}[/]", cl.statement, cl.check, cl.detail
+            esc(cl.id),
+            f"[{STYLE[cl.status]}]{cl.status.value}[/]",
+            esc(cl.statement),
+            esc(cl.check),
+            esc(cl.detail),
         )
     out.print(c)
+    if report.error is not None:
+        out.print(f"design stopped: {esc(report.error.get('message', ''))}", markup=True)
     for n in report.notes:
-        out.print(f"note: {n}")
+        out.print(f"note: {esc(n)}")
     counts = report.status_counts()
     out.print(
         f"claims: {counts['certified']} certified, {counts['numerical']} numerical, "

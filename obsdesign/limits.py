@@ -1,0 +1,234 @@
+"""Input limits: every size a spec or report may have, checked before the expensive step.
+
+One number, one file or one expression must never hang the tool, exhaust memory or hit
+Python's recursion limit. Each limit has a default (``docs/reliability.md`` lists them) and
+can be changed for one run with ``obsdesign --limit KEY=VALUE`` (or :func:`set_limits`).
+
+Checked where the input enters:
+
+- files (spec, report): a regular file (``stat`` before ``open``, so a FIFO or /dev/zero is
+  refused at once) of at most ``max_file_bytes``;
+- numbers: at most ``max_digits`` significant digits and a decimal exponent within
+  ``±max_exponent``, checked on the text / ``Decimal`` before any conversion to a rational;
+- TOML and JSON nesting: at most ``max_depth`` levels (walked iteratively);
+- expressions: at most ``max_expr_chars`` characters and ``max_expr_depth`` levels of the
+  syntax tree (walked iteratively, before anything recursive runs);
+- state dimension: at most ``max_states`` (the method's own ``max_states`` when it declares
+  one, else the default);
+- simulation memory: ``runs × steps × states`` doubles estimated before allocating, at most
+  ``max_sim_bytes``.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import stat
+from collections.abc import Iterator
+from dataclasses import dataclass, fields, replace
+from decimal import Decimal
+from pathlib import Path
+from typing import Any
+
+from obsdesign.errors import InputError
+
+
+@dataclass(frozen=True)
+class Limits:
+    """The limits in force (see the module docstring)."""
+
+    max_file_bytes: int = 16 * 1024 * 1024
+    max_digits: int = 1000
+    max_exponent: int = 1000
+    max_depth: int = 32
+    max_expr_chars: int = 10_000
+    max_expr_depth: int = 200
+    max_states: int = 100
+    max_sim_bytes: int = 2 * 1024**3
+
+
+_current = Limits()
+_overridden: set[str] = set()
+
+#: per-method practical state-dimension limits (a method may declare ``max_states`` itself)
+METHOD_MAX_STATES: dict[str, int] = {"set-invariant": 12}
+
+
+def limits() -> Limits:
+    """The limits in force."""
+    return _current
+
+
+def set_limits(**values: int) -> Limits:
+    """Change limits (``set_limits(max_digits=5000)``); returns the previous ones."""
+    global _current
+    old = _current
+    known = {f.name for f in fields(Limits)}
+    for k in values:
+        if k not in known:
+            raise InputError(f"--limit {k}: unknown limit (known: {', '.join(sorted(known))})")
+    _current = replace(_current, **values)
+    _overridden.update(values)
+    return old
+
+
+def reset_limits(old: Limits | None = None) -> None:
+    """Back to ``old`` (or to the defaults)."""
+    global _current
+    _current = old if old is not None else Limits()
+    if old is None:
+        _overridden.clear()
+
+
+def max_states_for(key: str, declared: int | None = None) -> int:
+    """The state-dimension limit of method ``key``: ``--limit max_states`` when given, else
+    the method's declared ``max_states``, else :data:`METHOD_MAX_STATES`, else the default."""
+    if "max_states" in _overridden:
+        return _current.max_states
+    return int(declared or METHOD_MAX_STATES.get(key, _current.max_states))
+
+
+def parse_limit(text: str) -> tuple[str, int]:
+    """``KEY=VALUE`` of ``--limit`` (VALUE a positive integer, ``16M``/``2G`` allowed)."""
+    if "=" not in text:
+        raise InputError(f"--limit expects KEY=VALUE, got {text!r}")
+    k, v = (s.strip() for s in text.split("=", 1))
+    mult = {"k": 1024, "m": 1024**2, "g": 1024**3}.get(v[-1:].lower(), 1)
+    num = v[:-1] if mult != 1 else v
+    if not num.isdigit() or len(num) > 18 or int(num) <= 0:
+        raise InputError(f"--limit {k}: expected a positive integer, got {v!r}")
+    if k not in {f.name for f in fields(Limits)}:
+        known = ", ".join(sorted(f.name for f in fields(Limits)))
+        raise InputError(f"--limit {k}: unknown limit (known: {known})")
+    return k, int(num) * mult
+
+
+# -- files ----------------------------------------------------------------------------------
+def read_input(path: str | Path, what: str) -> bytes:
+    """The bytes of an input file: a regular file (symlinks followed) of at most
+    ``max_file_bytes``. Anything else is an :class:`InputError` naming the path; checked
+    with ``stat`` before ``open`` so a FIFO, a device or /dev/zero is refused at once."""
+    p = Path(path)
+    lim = _current.max_file_bytes
+    try:
+        st = os.stat(p)
+    except FileNotFoundError:
+        raise InputError(f"{p}: no such {what} file") from None
+    except OSError as e:
+        raise InputError(f"{p}: cannot read {what} ({e.strerror})") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise InputError(f"{p}: is a directory, not a {what} file")
+    if not stat.S_ISREG(st.st_mode):
+        raise InputError(f"{p}: is not a regular file (refusing to read a {what} from it)")
+    if st.st_size > lim:
+        raise InputError(
+            f"{p}: {what} file is {st.st_size} bytes, above the limit of {lim} bytes "
+            f"(--limit max_file_bytes=N)"
+        )
+    try:
+        with open(p, "rb") as f:
+            data = f.read(lim + 1)
+    except OSError as e:
+        raise InputError(f"{p}: cannot read {what} ({e.strerror})") from None
+    if len(data) > lim:
+        raise InputError(f"{p}: {what} file is above the limit of {lim} bytes")
+    return data
+
+
+# -- numbers --------------------------------------------------------------------------------
+def decimal_problem(d: Decimal) -> str | None:
+    """Why a Decimal is too big to convert to a rational (None when it is fine)."""
+    if not d.is_finite():
+        return None
+    t = d.as_tuple()
+    digits = len(t.digits)
+    exp = int(t.exponent)  # type: ignore[arg-type]
+    lim = _current
+    if digits > lim.max_digits:
+        return f"has {digits} digits, above the limit of {lim.max_digits} (--limit max_digits=N)"
+    adjusted = exp + digits - 1
+    if abs(exp) > lim.max_exponent + lim.max_digits or abs(adjusted) > lim.max_exponent:
+        return (
+            f"has decimal exponent {adjusted}, outside ±{lim.max_exponent} (--limit max_exponent=N)"
+        )
+    return None
+
+
+def int_problem(v: int) -> str | None:
+    """Why an int has too many digits (None when it is fine); no decimal conversion made."""
+    bits = abs(v).bit_length()
+    if bits * 0.30103 > _current.max_digits + 1:
+        return f"has about {int(bits * 0.30103)} digits, above the limit of {_current.max_digits} (--limit max_digits=N)"
+    return None
+
+
+_NUM = re.compile(
+    r"^\s*[+-]?(?:(\d+)(?:\.(\d*))?|\.(\d+))(?:[eE]([+-]?\d+))?\s*$"  # decimal
+)
+_FRAC = re.compile(r"^\s*[+-]?(\d+)\s*/\s*[+-]?(\d+)\s*$")
+
+
+def number_text_problem(s: str) -> str | None:
+    """Why the text of an exact number ("p/q" or a decimal) is too big to convert (None when
+    fine or when it is not a number at all: the converter then says so)."""
+    lim = _current
+    if len(s) > 4 * (lim.max_digits + 20):
+        return f"is {len(s)} characters long, above the limit for a number (--limit max_digits=N)"
+    m = _FRAC.match(s)
+    if m:
+        for g in m.groups():
+            if len(g.lstrip("0")) > lim.max_digits:
+                return f"has more than {lim.max_digits} digits (--limit max_digits=N)"
+        return None
+    m = _NUM.match(s.replace("_", ""))
+    if not m:
+        return None
+    ip, fp, fp2, ex = m.groups()
+    digits = len((ip or "") + (fp or "") + (fp2 or "")) if (ip or fp or fp2) else 0
+    if digits > lim.max_digits:
+        return f"has {digits} digits, above the limit of {lim.max_digits} (--limit max_digits=N)"
+    if ex is not None:
+        if len(ex.lstrip("+-").lstrip("0")) > 9 or abs(int(ex)) > lim.max_exponent + digits:
+            return (
+                f"has decimal exponent {ex}, outside ±{lim.max_exponent} (--limit max_exponent=N)"
+            )
+    return None
+
+
+# -- nesting --------------------------------------------------------------------------------
+def walk(data: Any) -> Iterator[tuple[str, Any, int]]:
+    """Every (key path, value, depth) of nested dicts/lists, iteratively (no recursion)."""
+    stack: list[tuple[str, Any, int]] = [("", data, 0)]
+    while stack:
+        path, v, depth = stack.pop()
+        yield path, v, depth
+        if isinstance(v, dict):
+            for k, x in v.items():
+                stack.append((f"{path}.{k}" if path else str(k), x, depth + 1))
+        elif isinstance(v, list):
+            for i, x in enumerate(v):
+                stack.append((f"{path}[{i}]", x, depth + 1))
+
+
+def data_problem(data: Any, exact_strings: bool = False) -> tuple[str, str] | None:
+    """The first (key path, reason) where parsed TOML/JSON data breaks a limit: nesting
+    depth, digits or exponent of a number (Decimal or int), and, with ``exact_strings``,
+    the text of a string that reads as a number."""
+    lim = _current
+    for path, v, depth in walk(data):
+        if depth > lim.max_depth:
+            return path.split("[")[0] or "(top)", (
+                f"is nested more than {lim.max_depth} levels deep (--limit max_depth=N)"
+            )
+        why: str | None = None
+        if isinstance(v, bool):
+            continue
+        if isinstance(v, Decimal):
+            why = decimal_problem(v)
+        elif isinstance(v, int):
+            why = int_problem(v)
+        elif exact_strings and isinstance(v, str):
+            why = number_text_problem(v)
+        if why:
+            return path or "(top)", why
+    return None

@@ -1,0 +1,165 @@
+"""`verify` compares what the report claims (issue 11 item 6): the recomputed claim list,
+the verdict, the parameters (float = nearest double of the exact value) and the notes."""
+
+from __future__ import annotations
+
+import copy
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import pytest
+from typer.testing import CliRunner
+
+from obsdesign import api
+from obsdesign.cli import app
+from obsdesign.report.model import Report
+
+SPEC = Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+runner = CliRunner()
+
+
+@pytest.fixture(scope="module")
+def good() -> dict[str, Any]:
+    return json.loads(api.design(SPEC).to_json())
+
+
+def _verify(d: dict[str, Any]) -> Report:
+    return api.verify(Report.from_dict(copy.deepcopy(d))[0])
+
+
+def _failed(rep: Report) -> set[str]:
+    return {c.id for c in rep.failed}
+
+
+def test_untouched_report_verifies(good):
+    rep = _verify(good)
+    assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
+    assert rep.unverified == ["rho"]  # design information no check reads
+    assert good["verdict"] == "ok"
+
+
+def test_added_claim_fails(good):
+    d = copy.deepcopy(good)
+    d["claims"].append({**d["claims"][0], "id": "one-is-two", "statement": "1 = 2"})
+    rep = _verify(d)
+    assert _failed(rep) == {"report-adds:one-is-two"}
+    assert rep.exit_code() == 1
+
+
+def test_duplicated_claim_fails(good):
+    d = copy.deepcopy(good)
+    d["claims"].append(copy.deepcopy(d["claims"][0]))
+    assert _failed(_verify(d)) == {f"report-adds:{d['claims'][0]['id']}"}
+
+
+def test_removed_claim_fails(good):
+    d = copy.deepcopy(good)
+    gone = d["claims"].pop(1)
+    assert _failed(_verify(d)) == {f"report-omits:{gone['id']}"}
+
+
+def test_all_claims_removed_fails(good):
+    d = copy.deepcopy(good)
+    ids = {c["id"] for c in d["claims"]}
+    d["claims"] = []
+    rep = _verify(d)
+    assert _failed(rep) == {f"report-omits:{i}" for i in ids}
+    assert rep.exit_code() == 1
+
+
+def test_altered_statement_fails(good):
+    d = copy.deepcopy(good)
+    c = d["claims"][0]
+    c["statement"] = c["statement"] + " (and more)"
+    assert _failed(_verify(d)) == {f"report-alters:{c['id']}"}
+
+
+def test_altered_status_fails(good):
+    d = copy.deepcopy(good)
+    c = d["claims"][0]
+    c["status"] = "numerical"
+    assert _failed(_verify(d)) == {f"report-alters:{c['id']}"}
+
+
+def test_verify_only_claim_in_report_fails(good):
+    d = copy.deepcopy(good)
+    d["claims"].append({**d["claims"][0], "id": "parameters-consistent"})
+    assert _failed(_verify(d)) == {"report-adds:parameters-consistent"}
+
+
+def test_altered_verdict_fails(good):
+    d = copy.deepcopy(good)
+    d["verdict"] = "failed"
+    assert _failed(_verify(d)) == {"report-verdict"}
+
+
+def test_extra_parameter_is_not_verified(good):
+    d = copy.deepcopy(good)
+    d["parameters"]["certified_by"] = "NASA"
+    d["parameters"]["gain"] = 1.5
+    d["parameters"]["exact"]["gain"] = "3/2"
+    rep = _verify(d)
+    assert rep.exit_code() == 0
+    assert {"certified_by", "gain"} <= set(rep.unverified)
+    res = runner.invoke(app, ["verify", "-", "--format", "json"], input="")
+    assert res.exit_code == 2  # '-' is not a file
+
+
+def test_extra_parameter_flagged_in_text_output(good, tmp_path: Path):
+    d = copy.deepcopy(good)
+    d["parameters"]["gain"] = 1.5
+    d["parameters"]["exact"]["gain"] = "3/2"
+    p = tmp_path / "r.json"
+    p.write_text(json.dumps(d))
+    res = runner.invoke(app, ["verify", str(p)])
+    assert res.exit_code == 0
+    row = next(line for line in res.output.splitlines() if " gain " in line)
+    assert "not verified" in row and "exact" not in row
+    j = json.loads(runner.invoke(app, ["verify", str(p), "--format", "json"]).output)
+    assert "gain" in j["unverified_parameters"]
+
+
+def test_injected_note_is_flagged(good):
+    d = copy.deepcopy(good)
+    d["notes"] = ["all claims independently audited by a third party"]
+    rep = _verify(d)
+    assert rep.exit_code() == 0
+    assert rep.notes[0].startswith("not verified (from the report): all claims")
+    assert not any(n.startswith("all claims") for n in rep.notes)
+
+
+def test_float_one_ulp_off_fails(good):
+    d = copy.deepcopy(good)
+    x = d["parameters"]["P"][0][0]
+    d["parameters"]["P"][0][0] = math.nextafter(x, math.inf)
+    rep = _verify(d)
+    assert _failed(rep) == {"parameters-consistent"}
+    assert "nearest double" in rep.failed[0].detail and "'P'" in rep.failed[0].detail
+
+
+def test_unknown_top_level_key_is_noted(good):
+    d = copy.deepcopy(good)
+    d["signature"] = "trust me"
+    rep = _verify(d)
+    assert rep.exit_code() == 0
+    assert any("signature" in n for n in rep.notes)
+
+
+def test_error_report_verifies_as_failed(good):
+    d = copy.deepcopy(good)
+    d.update(verdict="error", error={"exit_code": 1, "message": "not detectable"}, claims=[])
+    d["parameters"] = {"exact": {}}
+    rep = _verify(d)
+    assert _failed(rep) == {"design-completed"} and rep.exit_code() == 1
+    assert "not detectable" in rep.failed[0].detail
+
+
+def test_bad_verdict_value_is_refused(good, tmp_path: Path):
+    d = copy.deepcopy(good)
+    d["verdict"] = "great"
+    p = tmp_path / "r.json"
+    p.write_text(json.dumps(d))
+    res = runner.invoke(app, ["verify", str(p)])
+    assert res.exit_code == 2 and "verdict" in res.output
