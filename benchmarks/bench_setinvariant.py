@@ -45,10 +45,15 @@ C = {fmt(C)}
 type = "box"
 lower = {[-1.0] * n}
 upper = {[1.0] * n}
+[sets.D]
+type = "box"
+dim = 1
+lower = [-1]
+upper = [1]
 [method]
 key = "set-invariant"
 omega = "omega"
-disturbance = {{ type = "box", lower = [-1], upper = [1] }}
+disturbance = "D"
 eta_bar = 0.01
 lambda = {lam}
 algorithm = "general"
@@ -105,8 +110,8 @@ def examples() -> None:
 
 def paper_test(count: int = 20) -> None:
     from obsdesign import api
-    from obsdesign.errors import ObsdesignError
     from obsdesign.api import load_spec_text
+    from obsdesign.errors import ObsdesignError
 
     rows = []
     disagree = 0

@@ -154,10 +154,16 @@ C = {C}
 [sets.omega]
 {omega}
 
+[sets.D]
+type = "box"
+dim = 1
+lower = [-0.1]
+upper = [0.1]
+
 [method]
 key = "set-invariant"
 omega = "omega"
-disturbance = {{ type = "box", lower = [-0.1], upper = [0.1] }}
+disturbance = "D"
 eta_bar = {eta}
 lambda = {lam}
 algorithm = "{alg}"
@@ -249,7 +255,7 @@ def test_not_detectable_exit_1():
 
 def test_necessary_condition_and_not_converged():
     # algorithm "none" checks Ω itself: λΩ does not contain B1·D = ±0.5·(1, 1) -> failed claim
-    t = spec_text(alg="none").replace("lower = [-0.1], upper = [0.1]", "lower = [-1], upper = [1]")
+    t = spec_text(alg="none").replace("lower = [-0.1]\nupper = [0.1]", "lower = [-1]\nupper = [1]")
     rep = api.design(load_spec_text(t, "none.toml"))
     nec = next(c for c in rep.claims if c.id == "necessary-condition")
     assert nec.status == ClaimStatus.FAILED and "Section II" in nec.statement
@@ -316,10 +322,15 @@ C = {_fmt(C)}
 type = "box"
 lower = {[-1.0] * n}
 upper = {[1.0] * n}
+[sets.D]
+type = "box"
+dim = 1
+lower = [{-b}]
+upper = [{b}]
 [method]
 key = "set-invariant"
 omega = "omega"
-disturbance = {{ type = "box", lower = [{-b}], upper = [{b}] }}
+disturbance = "D"
 eta_bar = {eta}
 lambda = 0.9
 algorithm = "general"

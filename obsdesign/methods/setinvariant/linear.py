@@ -109,6 +109,33 @@ def prop71_gains(ex: ExactProblem, G: np.ndarray) -> list[tuple[int, np.ndarray]
     return out
 
 
+def gain_vertices(
+    ex: ExactProblem,
+    G: np.ndarray,
+    V: np.ndarray,
+    constraints: tuple[list[list[fmpq]], list[fmpq]] | None = None,
+) -> tuple[list[np.ndarray], bool]:
+    """Exact vertices of the admissible set 𝓛 of linear gains (proof of Proposition 7.1),
+    by cdd.gmp vertex enumeration, and whether 𝓛 has directions (lines or rays).
+
+    ``ex``: exact problem; ``G``: facets of the polyhedron (rhs 1); ``V``: its vertices;
+    ``constraints``: the rows of 𝓛 when already computed."""
+    import cdd
+    import cdd.gmp as cddg
+
+    n, p = ex.n, ex.C.shape[0]
+    rows, rhs = constraints if constraints is not None else _constraints(ex, G, V)
+    mat = [[po._fr(rhs[i])] + [-po._fr(x) for x in rows[i]] for i in range(len(rows))]
+    poly = cddg.polyhedron_from_matrix(cddg.matrix_from_array(mat, rep_type=cdd.RepType.INEQUALITY))
+    gen = cddg.copy_generators(poly)
+    verts: list[np.ndarray] = []
+    for idx, r in enumerate(gen.array):
+        if r[0] != 0 and idx not in gen.lin_set:
+            verts.append(np.array([po._q(x / r[0]) for x in r[1:]], dtype=object).reshape(n, p))
+    has_dir = bool(gen.lin_set) or any(r[0] == 0 for r in gen.array)
+    return verts, has_dir
+
+
 def admissible_gains(
     ex: ExactProblem, G: np.ndarray, V: np.ndarray, max_dim_enum: int = 4
 ) -> GainSet:
@@ -136,18 +163,7 @@ def admissible_gains(
     verts: list[np.ndarray] = []
     dim = None
     if nl <= max_dim_enum:
-        import cdd
-        import cdd.gmp as cddg
-
-        mat = [[po._fr(rhs[i])] + [-po._fr(x) for x in rows[i]] for i in range(len(rows))]
-        poly = cddg.polyhedron_from_matrix(
-            cddg.matrix_from_array(mat, rep_type=cdd.RepType.INEQUALITY)
-        )
-        gen = cddg.copy_generators(poly)
-        for idx, r in enumerate(gen.array):
-            if r[0] != 0 and idx not in gen.lin_set:
-                verts.append(np.array([po._q(x / r[0]) for x in r[1:]], dtype=object).reshape(n, p))
-        has_dir = bool(gen.lin_set) or any(r[0] == 0 for r in gen.array)
+        verts, has_dir = gain_vertices(ex, G, V, (rows, rhs))
         if verts and not has_dir:
             X = np.array([po.qfloat(v).reshape(-1) for v in verts])
             dim = int(np.linalg.matrix_rank(X - X[0], tol=1e-12)) if len(X) > 1 else 0

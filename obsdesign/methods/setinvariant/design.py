@@ -1,0 +1,248 @@
+"""Design of a set-invariant estimator (Dórea & Pimenta, "Design of set-invariant estimators
+for linear discrete-time systems"): iterations → final polytope → exact parameters.
+
+The iterations run in float64 (:mod:`.algorithms`, Sections V and VI); the final point cloud
+is proved once (:func:`final_stage`: exact hull, Theorem 3.1 at every z of Z_d) and
+:func:`polytope_params` derives every reported quantity from that polytope (injection table
+of Proposition 4.1, admissible linear gains of Proposition 7.1). Without ``cdd.gmp`` the same
+stages run in float64 (:mod:`.numerical`) and every claim is numerical.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
+from obsdesign.params import Parameters
+from obsdesign.sets import polytope_ops as po
+from obsdesign.spec.models import Spec
+
+from . import algorithms as al
+from . import certificate as ce
+from . import laws, lps, numerical
+from .linear import admissible_gains
+from .options import Options
+from .problem import Data, build, check_detectable
+
+
+@dataclass
+class Stage:
+    """A proved polytope: facets ``G`` (rhs 1), its vertex representation, and the Theorem 3.1
+    result (None for p > 1)."""
+
+    G: np.ndarray
+    vrep: Any
+    res: Any
+
+
+def final_stage(data: Data, P: np.ndarray, single: bool, lam: float) -> Stage:
+    """The polytope conv(Ω's vertices ∪ P), proved: Ω's vertices exactly, the other points
+    snapped (po.snap), one exact hull (cdd.gmp) for G and the edges, then Theorem 3.1 at every
+    z^l of Z_d with v^l from LP (9) (Section III, eq. (6), (9)). Without cdd.gmp: the float
+    hull and Theorem 3.1 in float64 (numerical.float_stage).
+
+    ``data``: float and exact problem; ``P``: float points (rows); ``single``: one output;
+    ``lam``: λ (float, for the float-only stage)."""
+    fl, ex = data.fl, data.ex
+    if ex is None:
+        Gf, resf, vrf = numerical.float_stage(fl, P, lam)
+        return Stage(Gf, vrf, resf)
+    Vo_f = po.qfloat(ex.Vo)
+    P = np.asarray(P, dtype=float).reshape(-1, fl.n)
+    near = np.array([np.abs(Vo_f - p).max(axis=1).min() <= 1e-9 for p in P], dtype=bool)
+    Pq = np.vstack([ex.Vo, po.rationalize(P[~near])]) if (~near).any() else ex.Vo
+    Gq, vrep = po.exact_hull(Pq)
+    if not single:
+        return Stage(Gq, vrep, None)
+    return Stage(Gq, vrep, ce.theorem31(ex, Gq, v_solver=lps.eps_batch, vrep=vrep))
+
+
+@dataclass
+class _Run:
+    """What the iterations produced: the proved stage, iteration count, notes, history."""
+
+    stage: Stage
+    iterations: int
+    converged: bool
+    notes: list[str] = field(default_factory=list)
+    history: list[dict[str, float]] = field(default_factory=list)
+    extra: dict[str, Any] = field(default_factory=dict)
+
+
+def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
+    """The algorithm of the spec: symmetric C_K^∞ (Section VI; condition (14)), general
+    (Section V; stopping rule ε^i ≤ λ(1 + Δδ)) or none (Ω itself); the symmetric-to-general
+    fallback (Example 7.2) and the strict continuation until the certified factor is ≤ λ."""
+    o: Options = spec.options
+    fl = data.fl
+    single = spec.system.p == 1
+    lam, dd = float(o.lam), float(o.delta_tol)
+    run = _Run(Stage(np.zeros((0, fl.n)), None, None), 0, True)
+    hist = run.history
+    sym_failed = False
+    if o.algorithm == "none":
+        run.iterations = 1
+        run.stage = final_stage(data, np.zeros((0, fl.n)), single, lam)
+    elif o.algorithm == "symmetric":
+        r = al.symmetric(fl, lam, lam * (1 + dd), o.max_iterations, progress, history=hist)
+        run.iterations, run.converged = r.iterations, r.converged
+        run.stage = final_stage(data, r.P, single, lam)
+        res = run.stage.res
+        if r.converged and single and res is not None and not res.ok:
+            sym_failed = True
+            _, epsz = lps.epsilon_profile(r.G, fl.A, fl.B1, fl.C[0], fl.Dv, fl.eta)
+            sym_eps = float(np.max(epsz))
+            run.extra.update(
+                symmetric_G=run.stage.G,
+                symmetric_iterations=r.iterations,
+                symmetric_contractivity=sym_eps,
+            )
+            msg = (
+                f"the symmetric C_K^∞ meets condition (14) after {r.iterations} iterations but "
+                f"not Theorem 3.1: max ε(z) = {sym_eps:.6g} > λ = {lam:g}"
+            )
+            run.notes.append(msg)
+            if progress:
+                progress(msg)
+            if o.fallback == "general":
+                r = al.general(
+                    fl, lam / (1 + dd), lam, o.max_iterations, o.mirror,
+                    start=r.P, progress=progress, it0=r.iterations, history=hist,
+                )  # fmt: skip
+                run.iterations, run.converged = r.iterations, r.converged
+                run.stage = final_stage(data, r.P, single, lam)
+                run.notes.append(
+                    f"general algorithm (Section V) continued from C_K^∞: {r.iterations} "
+                    "iterations in all"
+                )
+    else:
+        lam_run = lam / (1 + dd) if o.strict else lam
+        lam_stop = lam if o.strict else lam * (1 + dd)
+        r = al.general(
+            fl, lam_run, lam_stop, o.max_iterations, o.mirror, progress=progress, history=hist
+        )
+        run.iterations, run.converged = r.iterations, r.converged
+        run.stage = final_stage(data, r.P, single, lam)
+    res = run.stage.res
+    if single and o.strict and run.converged and res is not None and not res.ok:
+        if o.algorithm != "none" and float(res.factor) <= lam * (1 + 2 * dd):
+            if not sym_failed or o.fallback == "general":
+                run.notes.append(
+                    f"certified factor {float(res.factor):.9g} > λ: iterating with the hull "
+                    "scaled by λ/(1 + Δδ) until the certified factor is <= λ"
+                )
+                V0 = po.qfloat(run.stage.vrep.V) if data.ex is not None else run.stage.vrep.V
+                r = al.general(
+                    fl, lam / (1 + dd), lam * (1 - 1e-12), o.max_iterations, o.mirror,
+                    start=V0, progress=progress, it0=run.iterations, history=hist,
+                )  # fmt: skip
+                run.iterations, run.converged = r.iterations, r.converged
+                run.stage = final_stage(data, r.P, single, lam)
+    return run
+
+
+def polytope_params(spec: Spec, data: Data, stage: Stage, notes: list[str]) -> Parameters:
+    """Every reported quantity derived from a proved polytope: G, V, the certified factor and
+    the injection table of Proposition 4.1 (breakpoints = Z_d, v^l, and the interpolation (12)
+    L^j, w^j) for one output, and the admissible linear gains of Proposition 7.1 (p = n − 1).
+
+    ``spec``: the bound spec; ``data``: its float/exact problem; ``stage``: the polytope;
+    ``notes``: report notes (appended to)."""
+    o: Options = spec.options
+    s = spec.system
+    exact = data.ex is not None
+    G, V, res = stage.G, stage.vrep.V, stage.res
+    params = Parameters()
+    params["G"] = G
+    params["V"] = V
+    params["lambda"] = o.lam
+    params["facets"] = len(G)
+    params["vertices"] = len(V)
+    if res is not None:
+        dt = object if exact else float
+        params["contractivity"] = res.factor
+        params["breakpoints"] = np.array(res.zs, dtype=dt)
+        params["v_breakpoints"] = np.array(res.vs, dtype=dt).reshape(len(res.zs), s.n)
+        if len(res.zs) > 1:
+            Ls, ws = laws.pieces(list(res.zs), [list(v) for v in res.vs])
+            params["L_pieces"] = np.array(Ls, dtype=dt)
+            params["w_pieces"] = np.array(ws, dtype=dt)
+        if res.exact_lp:
+            notes.append(
+                f"{res.exact_lp} breakpoint injections came from the exact (cdd.gmp) LP (9)"
+            )
+    if o.linear_law and s.p == s.n - 1:
+        gs = (
+            admissible_gains(data.ex, G, V)
+            if data.ex is not None
+            else numerical.float_gains(data.fl, float(o.lam), G, V)
+        )
+        if gs.L is not None:
+            params["L"] = gs.L
+            params["L_factor"] = gs.factor
+            if gs.vertices:
+                params["L_admissible_vertices"] = np.array(
+                    [v.reshape(-1) for v in gs.vertices], dtype=object
+                )
+            notes.append(f"linear law v = L z: {gs.how}")
+            if len(gs.vertices) > 1:
+                vs_txt = "; ".join(
+                    str(np.asarray(po.qfloat(v)).round(4).reshape(-1).tolist()) for v in gs.vertices
+                )
+                notes.append(
+                    f"admissible linear gains: the convex hull of {len(gs.vertices)} vertices "
+                    f"({vs_txt}); dimension {gs.dimension}"
+                )
+            for i, Lp in gs.prop71:
+                Lf = np.asarray(po.qfloat(Lp)).round(4).reshape(-1).tolist()
+                notes.append(f"Proposition 7.1 with Q_I = row {i} of G gives L = {Lf}")
+        else:
+            notes.append(f"no linear law: {gs.how}")
+    if o.L is not None:
+        params["L_user"] = o.L
+    return params
+
+
+def design(spec: Spec, progress: Progress | None = None) -> Design:
+    """Design for a bound spec: the algorithm of Section V or VI, the exact final stage, the
+    injection table (Proposition 4.1) and linear gains (Proposition 7.1).
+
+    ``spec``: the bound spec; ``progress``: optional callback for progress lines. Raises
+    InfeasibleError when (C, A) has a mode faster than λ that the output cannot see
+    (Section II)."""
+    o: Options = spec.options
+    t0 = time.perf_counter()
+    data = build(spec)
+    check_detectable(data.fl.A, data.fl.C, float(o.lam))
+    run = _iterate(spec, data, progress)
+    notes = list(run.notes)
+    params = polytope_params(spec, data, run.stage, notes)
+    params["iterations"] = run.iterations
+    params["converged"] = bool(run.converged)
+    for k, v in run.extra.items():
+        params[k] = v
+    if spec.system.p != 1 and "L" not in params and run.history:
+        params["contractivity_14"] = run.history[-1]["eps"]
+    params["history_facets"] = [h["facets"] for h in run.history]
+    params["history_eps"] = [h["eps"] for h in run.history]
+    if not run.converged:
+        notes.append(
+            f"NOT CONVERGED after {run.iterations} iterations (max_iterations = "
+            f"{o.max_iterations}); the last polyhedron is reported"
+        )
+    name = "HiGHS (scipy) LPs + qhull hulls; " + (
+        "cdd.gmp exact" if data.ex is not None else "float64 only (no cdd.gmp)"
+    )
+    solver = SolverResult(
+        name,
+        SolverStatus.OPTIMAL if run.converged else SolverStatus.FAILED,
+        f"{'converged' if run.converged else 'not converged'} after {run.iterations} iterations",
+        time.perf_counter() - t0,
+    )
+    if data.ex is None:
+        notes.append(numerical.NOTE)
+    return Design(params, solver, notes)
