@@ -1,0 +1,226 @@
+"""The certificate of the ``lyapunov`` method: every claim recomputed from the spec and the
+report's parameters, in exact arithmetic.
+
+Decay LMI and ISS inequality: eq. (4)-(7), Section 5 of Astolfi, Bernard, Postoyan, Marconi,
+"Redesign of discrete-time nonlinear observers with state estimate constraints guaranteed in
+prescribed convex set", NOLCOS 2019 (maths in :mod:`obsdesign.lyap`). What the spec fixes (L,
+the asked rate, rate_tol, margin, iss_gain) is read from the spec; the report's copies of L and
+of the rate are compared with it exactly.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from obsdesign import lyap
+from obsdesign.certify.claim import Claim, Claims
+from obsdesign.certify.exact import Q
+from obsdesign.certify.printing import fmt_exact, fmt_up
+from obsdesign.certify.psd import check_pd
+from obsdesign.methods.lyapunov.design import rate_name
+from obsdesign.methods.lyapunov.options import Options
+from obsdesign.params import Parameters
+from obsdesign.spec.models import Spec
+
+REF = lyap.REF
+
+
+def certify(spec: Spec, params: Parameters) -> list[Claim]:
+    """Every claim of a ``lyapunov`` report: P ≻ 0 and the decay LMI at the reported rate and
+    at the best rate (eq. (4)-(6)), the best rate's bracket, and the ISS gain μ (eq. (5)-(7));
+    Section 5 of the constrained-redesign paper (Astolfi et al., NOLCOS 2019).
+
+    :param spec: the bound spec; :param params: the report's parameters.
+    Returns the claims (a missing or float-only parameter is a failed claim)."""
+    s = spec.system
+    o: Options = spec.options
+    name = rate_name(s.discrete)
+    c = Claims()
+    need = ["L", "P", name, "P_best", f"{name}_best", f"{name}_bracket", f"{name}_bracket_kind"]
+    if o.iss_gain:
+        need.append("mu")
+    if not params.require(need, c):
+        return list(c)
+    L = params.exact("L", c)
+    P = params.exact("P", c)
+    rate = params.exact(name, c)
+    Pb = params.exact("P_best", c)
+    best = params.exact(f"{name}_best", c)
+    other = params.exact(f"{name}_bracket", c)
+    mu = params.exact("mu", c) if o.iss_gain else None
+    if any(v is None for v in (L, P, rate, Pb, best, other)) or (o.iss_gain and mu is None):
+        return list(c)
+    if o.L is not None:
+        c.matches("L", L, o.L, "[method].L")
+        L = o.L
+    if o.rate is not None:
+        c.matches(name, rate, o.rate, f"[method].{name}")
+        rate = o.rate
+    rate, best, other = Q(rate), Q(best), Q(other)
+    A, C = s.A.q, s.C.q
+    pd_claim(c, "P-positive-definite", "P ≻ 0", P, o.margin)
+    decay_claim(c, A, C, L, P, rate, s.discrete, o.margin, "")
+    pd_claim(c, "P_best-positive-definite", "P_best ≻ 0", Pb, o.margin)
+    decay_claim(c, A, C, L, Pb, best, s.discrete, o.margin, "_best")
+    bracket_claim(c, A, C, L, best, other, str(params[f"{name}_bracket_kind"]), s.discrete, o)
+    if o.iss_gain:
+        iss_claim(c, A, C, L, s.Bd.q, s.Dn.q, P, rate, mu, s.discrete)
+    return list(c)
+
+
+def pd_claim(c: Claims, id: str, what: str, P: np.ndarray, margin: Any) -> Claim:
+    """P − margin·I ≻ 0 exactly: V(e) = eᵀPe of eq. (4) (constrained-redesign paper, Astolfi
+    et al., NOLCOS 2019) is a Lyapunov function candidate.
+
+    :param c: the claim list; :param id: claim id; :param what: statement; :param P: exact
+    matrix; :param margin: δ."""
+    r = check_pd(P, margin)
+    return c.exact(
+        id=id,
+        statement=what,
+        reference=REF,
+        check="exact LDLᵀ over Q",
+        passed=r.ok,
+        margin=margin,
+        detail=r.detail,
+    )
+
+
+def decay_claim(
+    c: Claims,
+    A: np.ndarray,
+    C: np.ndarray,
+    L: np.ndarray,
+    P: np.ndarray,
+    rate: Any,
+    discrete: bool,
+    margin: Any,
+    suffix: str,
+) -> Claim:
+    """The decay LMI λ²P − (A−LC)ᵀP(A−LC) ⪰ margin·I (continuous: −((A−LC)ᵀP + P(A−LC) +
+    2αP) ⪰ margin·I), rebuilt from the spec's A, C and checked exactly: eq. (4)-(6) with
+    w = 0, Section 5 of the constrained-redesign paper (Astolfi et al., NOLCOS 2019).
+
+    :param c: the claim list; :param A, C, L, P: exact matrices; :param rate: λ or α;
+    :param discrete: time domain; :param margin: δ; :param suffix: "" or "_best"."""
+    M = lyap.decay_matrix(A, C, L, P, rate, discrete)
+    r = check_pd(M, margin)
+    fl = bool(np.linalg.eigvalsh(np.asarray(M, dtype=float)).min() > float(margin))
+    x = fmt_exact(rate)
+    if discrete:
+        stmt = f"(A−LC)ᵀP{suffix}(A−LC) ⪯ λ{suffix}²·P{suffix} with λ{suffix} = {x}"
+    else:
+        stmt = f"(A−LC)ᵀP{suffix} + P{suffix}(A−LC) ⪯ −2α{suffix}·P{suffix} with α{suffix} = {x}"
+    return c.exact(
+        id=f"decay-lmi{suffix}",
+        statement=stmt,
+        reference=REF,
+        check="exact LDLᵀ over Q of the rebuilt matrix",
+        passed=r.ok,
+        margin=margin,
+        detail=r.detail,
+        float_ok=fl,
+    )
+
+
+def bracket_claim(
+    c: Claims,
+    A: np.ndarray,
+    C: np.ndarray,
+    L: np.ndarray,
+    best: Any,
+    other: Any,
+    kind: str,
+    discrete: bool,
+    o: Options,
+) -> Claim:
+    """The best rate is best to within ``rate_tol``: the other end of its bracket lies within
+    the tolerance, beyond it (λ_bracket < λ_best, α_bracket > α_best), not beyond a rate the
+    spec asks for, and is of the reported kind — ``infeasible``: no P ≻ 0 satisfies the decay
+    LMI of eq. (4)-(6) there (some eigenvalue z of A − LC has |z| ≥ λ, resp. Re z ≥ −α; exact
+    Routh test, :func:`obsdesign.lyap.rate_feasible`); ``not-certifiable``: the rate is
+    feasible (same exact test), so the bracket only bounds what this tool certifies. Section 5
+    of the constrained-redesign paper (Astolfi et al., NOLCOS 2019).
+
+    :param c: the claim list; :param A, C, L: exact plant and gain; :param best: the
+    certified best rate; :param other: the bracket's other end; :param kind: its kind;
+    :param discrete: time domain; :param o: the spec's options (rate_tol, asked rate)."""
+    sym, name = ("λ", "lambda") if discrete else ("α", "alpha")
+    best, other, tol = Q(best), Q(other), Q(o.rate_tol)
+    width = best - other if discrete else other - best
+    problems = []
+    if not 0 < width <= tol:
+        problems.append(
+            f"|{sym}_best − {sym}_bracket| = {fmt_exact(abs(best - other))} is not in (0, rate_tol]"
+        )
+    if o.rate is not None and (best > o.rate if discrete else best < o.rate):
+        problems.append(
+            f"{sym}_best = {fmt_exact(best)} is worse than the asked {fmt_exact(o.rate)}"
+        )
+    feasible = lyap.rate_feasible(lyap.closed_loop(A, C, L), other, discrete)
+    if kind == lyap.INFEASIBLE:
+        if feasible:
+            problems.append(f"{sym} = {fmt_exact(other)} is feasible (exact Routh test)")
+        why = f"no P ≻ 0 gives {sym} = {fmt_exact(other)} (A − LC has an eigenvalue " + (
+            "of modulus ≥ λ)" if discrete else "with real part ≥ −α)"
+        )
+    elif kind == lyap.NOT_CERTIFIABLE:
+        if not feasible:
+            problems.append(f"{sym} = {fmt_exact(other)} is infeasible, not merely uncertified")
+        why = f"{sym} = {fmt_exact(other)} is feasible but was not certified (best among certified rates)"
+    else:
+        problems.append(f"unknown bracket kind {kind!r}")
+        why = f"{sym} = {fmt_exact(other)} is {kind}"
+    return c.exact(
+        id=f"{name}_best-bracket",
+        statement=f"{sym}_best = {fmt_exact(best)} is best to within {fmt_exact(tol)}: {why}",
+        reference=REF,
+        check="exact Routh test of the characteristic polynomial "
+        + ("of (A−LC)/λ after the Möbius map" if discrete else "of A−LC+αI")
+        + "; exact comparison of the bracket width with rate_tol",
+        passed=not problems,
+        detail="; ".join(problems)
+        or f"bracket [{fmt_exact(min(best, other))}, {fmt_exact(max(best, other))}], {kind}",
+    )
+
+
+def iss_claim(
+    c: Claims,
+    A: np.ndarray,
+    C: np.ndarray,
+    L: np.ndarray,
+    Bd: np.ndarray,
+    Dn: np.ndarray,
+    P: np.ndarray,
+    rate: Any,
+    mu: Any,
+    discrete: bool,
+) -> Claim:
+    """The ISS inequality V(e⁺) ≤ λ²V(e) + μ|w|² (continuous: V̇ ≤ −2αV + μ|w|²) for
+    w = (d, v) entering as B_w = [−Bd, L Dn]: eq. (5) with β(v, w) = ρv + μ|w|², eq. (6)-(7),
+    Section 5 of the constrained-redesign paper (Astolfi et al., NOLCOS 2019); the block
+    matrix is checked ≻ 0 exactly. μ is printed exactly, and rounded up beside it.
+
+    :param c: the claim list; :param A, C, L, Bd, Dn, P: exact matrices; :param rate: λ or
+    α; :param mu: the ISS gain; :param discrete: time domain."""
+    Acl = lyap.closed_loop(A, C, L)
+    Bw = lyap.error_input(Bd, Dn, L)
+    M = lyap.iss_matrix(Acl, Bw, P, lyap.decay_factor(rate, discrete), mu, discrete)
+    r = check_pd(M, 0)
+    if Bd.shape[1] and Dn.shape[1]:
+        sig, tail = "w", ", w = (d, v)"
+    else:
+        sig, tail = ("d" if Bd.shape[1] else "v"), ""
+    what = f"V(e⁺) ≤ λ²V(e) + μ|{sig}|²" if discrete else f"V̇ ≤ −2αV + μ|{sig}|²"
+    m = fmt_exact(mu)
+    shown = m if len(m) <= 16 else f"{Q(mu)} ≤ {fmt_up(mu, 6)}"
+    return c.exact(
+        id="iss-gain",
+        statement=f"{what}{tail} with μ = {shown}",
+        reference=REF,
+        check="exact LDLᵀ over Q",
+        passed=r.ok,
+        detail=r.detail,
+    )
