@@ -55,7 +55,7 @@ class Plant:
         )
 
 
-def _problem(pl: Plant, o: Options, lam: float, criterion: str | None, margin: float) -> Any:
+def _problem(pl: Plant, o: Options, lam: Any, criterion: str | None, margin: float) -> Any:
     """cvxpy problem of LMIs (1)-(3) / (7)-(9) at a fixed λ, normalized P ⪰ I, W ⪰ I.
 
     ``criterion`` None: feasibility; ``R``: minimize λ_max(R); ``K``: minimize ‖X‖₂;
@@ -132,14 +132,31 @@ def _problem(pl: Plant, o: Options, lam: float, criterion: str | None, margin: f
     return prob, dict(P=P, X=X, u=u, w=w, Y=Y, R=R, **extra)
 
 
+class Feasibility:
+    """Feasibility of LMIs (1)-(3) / (7)-(9) as a function of λ: one cvxpy problem with λ as a
+    parameter (canonicalized once, re-solved for each λ of the search)."""
+
+    def __init__(self, pl: Plant, o: Options) -> None:
+        import cvxpy as cp
+
+        self.lam = cp.Parameter(nonneg=True)
+        self.prob, _ = _problem(pl, o, self.lam, None, float(o.margin))
+        self.calls = 0
+
+    def __call__(self, lam: float) -> tuple[bool, str]:
+        """Whether the solver finds the LMIs feasible at λ, and its status."""
+        self.lam.value = lam
+        self.calls += 1
+        try:
+            r = solve(self.prob, ("CLARABEL",))
+        except SolverError as e:
+            return False, f"solver failure ({e.message})"
+        return r.optimal, r.status
+
+
 def feasible(pl: Plant, o: Options, lam: float) -> tuple[bool, str]:
     """Whether the solver finds LMIs (1)-(3) / (7)-(9) feasible at λ (status, for the report)."""
-    prob, _ = _problem(pl, o, lam, None, float(o.margin))
-    try:
-        r = solve(prob)
-    except SolverError as e:
-        return False, f"solver failure ({e.message})"
-    return r.optimal, r.status
+    return Feasibility(pl, o)(lam)
 
 
 def search_lambda(pl: Plant, o: Options) -> tuple[float, float, str]:
@@ -149,6 +166,11 @@ def search_lambda(pl: Plant, o: Options) -> tuple[float, float, str]:
     (1)); doubling from 1 brackets it, bisection refines until hi − lo ≤ tol·lo. Discrete
     time: the smallest λ ∈ (0, 1) (a larger λ relaxes (7)); bisection on (0, 1)."""
     tol = float(o.lambda_tol)
+    feas = Feasibility(pl, o)
+
+    def feasible(_pl: Plant, _o: Options, lam: float) -> tuple[bool, str]:
+        return feas(lam)
+
     if not pl.discrete:
         lo, hi = 0.0, 1.0
         ok, st = feasible(pl, o, hi)
@@ -161,9 +183,9 @@ def search_lambda(pl: Plant, o: Options) -> tuple[float, float, str]:
             lo = 1e-6
             if not feasible(pl, o, lo)[0]:
                 return 0.0, lo, st
-            lo, hi = _bisect(pl, o, lo, hi, tol, up=True)
+            lo, hi = _bisect(feas, lo, hi, tol)
             return lo, hi, st
-        lo, hi = _bisect(pl, o, lo, hi, tol, up=True)
+        lo, hi = _bisect(feas, lo, hi, tol)
         return lo, hi, feasible(pl, o, hi)[1]
     top = 1 - 1e-6
     if not feasible(pl, o, top)[0]:
@@ -171,16 +193,16 @@ def search_lambda(pl: Plant, o: Options) -> tuple[float, float, str]:
     bot = 1 / LAMBDA_CAP
     if feasible(pl, o, bot)[0]:
         return bot, 0.0, "feasible down to the cap"
-    hi, lo = _bisect(pl, o, top, bot, tol, up=False)
+    hi, lo = _bisect(feas, top, bot, tol)
     return hi, lo, feasible(pl, o, lo)[1]
 
 
-def _bisect(
-    pl: Plant, o: Options, good: float, bad: float, tol: float, up: bool
-) -> tuple[float, float]:
+def _bisect(feas: Feasibility, good: float, bad: float, tol: float) -> tuple[float, float]:
+    """Bisection between a feasible λ (good) and an infeasible one (bad) until
+    |bad − good| ≤ tol·|good|."""
     while abs(bad - good) > tol * abs(good):
         mid = (good + bad) / 2
-        if feasible(pl, o, mid)[0]:
+        if feas(mid)[0]:
             good = mid
         else:
             bad = mid

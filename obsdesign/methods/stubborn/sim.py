@@ -1,0 +1,328 @@
+"""Simulation of the stubborn observer, batched over Monte Carlo runs and observers.
+
+The error e = x − x̂ of every observer x̂' = A x̂ + B u + K sat_σ(y − ŷ) obeys
+ė = A e − K sat_σ(C e + ν) (discrete: e⁺ = ...), independent of u, so the plant is simulated
+once and the observers' errors are integrated together as arrays of shape
+(observers, amplitudes, runs, n): one numpy step advances every run (vectorized across runs).
+
+Observers (slides, Examples 1-3 tables): the stubborn observer (adaptive saturation
+σ̄' = −λσ̄ + e_yᵀRe_y, σ_i = √(σ̄/w_i); discrete σ̄⁺ = λσ̄ + e_yᵀRe_y), the Luenberger observer
+with the same K (no saturation), and two constant-saturation observers whose levels are the
+mean and the max of the stubborn observer's σ_i(t) over a nominal run (noise, no outliers).
+
+Outlier model (docs/methods/stubborn.md): ν_k = n_k + o_k per output channel, n_k Gaussian
+N(0, noise_std²), o_k = 0 except with probability outlier_rate per sample, then uniform in
+[−a, a] (a: the outlier maximal absolute value). In continuous time ν is held over each step
+dt (the measurement is sampled every dt).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from obsdesign.errors import InputError
+from obsdesign.methods.stubborn.options import SimOptions
+from obsdesign.params import Parameters
+from obsdesign.simulate.result import SimResult
+from obsdesign.spec.models import Spec
+
+OBSERVERS = ("luenberger", "mean-constant-sat", "max-constant-sat", "stubborn")
+
+
+@dataclass
+class Gains:
+    """Float data of the error dynamics: A, C, K, λ, R, w (σ_i = √(σ̄/w_i))."""
+
+    A: np.ndarray
+    C: np.ndarray
+    K: np.ndarray
+    lam: float
+    R: np.ndarray
+    w: np.ndarray
+    discrete: bool
+
+    @classmethod
+    def of(cls, spec: Spec, params: Parameters) -> Gains:
+        s = spec.system
+        n, p = s.n, s.p
+        return cls(
+            np.asarray(s.A.f, float),
+            np.asarray(s.C.f, float),
+            np.asarray(params.float("K"), float).reshape(n, p),
+            float(params.float("lambda")),
+            np.asarray(params.float("R"), float).reshape(p, p),
+            np.asarray(params.float("W"), float).reshape(p),
+            s.discrete,
+        )
+
+
+def run_errors(
+    g: Gains,
+    e0: np.ndarray,
+    nu: Any,
+    steps: int,
+    dt: float,
+    levels: np.ndarray,
+    adaptive: np.ndarray,
+    sigma0: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Integrate the errors of a batch of observers.
+
+    e0: (..., n) initial errors (broadcast); nu(k0, k1) -> (k1 − k0, ..., p) the output noise
+    of steps k0..k1−1; levels (..., p): constant saturation levels (inf: Luenberger);
+    adaptive (...,) bool: the stubborn observer's adaptive level instead. Continuous time:
+    Heun's method with ν held over each step. Returns the sums of e_i² over the grid
+    (for the RMSE, (..., n)), the final e and the trajectory of σ̄ of the first batch entry
+    is not kept here (see :func:`single_run`)."""
+    e = np.broadcast_to(e0, adaptive.shape + (g.A.shape[0],)).astype(float).copy()
+    sb = np.where(adaptive, sigma0, 0.0)
+    sq = e**2
+    AT, CT, KT = g.A.T, g.C.T, g.K.T
+    ad = adaptive[..., None]
+
+    def inject(e: np.ndarray, sb: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        ey = e @ CT + v
+        sig = np.sqrt(np.maximum(sb, 0.0)[..., None] / g.w)
+        lev = np.where(ad, sig, levels)
+        return np.clip(ey, -lev, lev) @ KT, ey
+
+    chunk = 2000
+    for k0 in range(0, steps, chunk):
+        k1 = min(steps, k0 + chunk)
+        V = nu(k0, k1)
+        for k in range(k1 - k0):
+            v = V[k]
+            q, ey = inject(e, sb, v)
+            ry = np.einsum("...i,ij,...j->...", ey, g.R, ey)
+            if g.discrete:
+                e = e @ AT - q
+                sb = np.where(adaptive, g.lam * sb + ry, 0.0)
+            else:
+                de1 = e @ AT - q
+                ds1 = -g.lam * sb + ry
+                e2 = e + dt * de1
+                s2 = np.maximum(sb + dt * ds1, 0.0)
+                q2, ey2 = inject(e2, s2, v)
+                ry2 = np.einsum("...i,ij,...j->...", ey2, g.R, ey2)
+                e = e + dt / 2 * (de1 + e2 @ AT - q2)
+                sb = np.where(
+                    adaptive, np.maximum(sb + dt / 2 * (ds1 - g.lam * s2 + ry2), 0.0), 0.0
+                )
+            sq += e**2
+    return sq, e, sb
+
+
+def _grid(spec: Spec) -> tuple[int, float]:
+    sim = spec.simulate
+    assert sim is not None
+    if spec.system.discrete:
+        return int(sim.horizon.f), 1.0
+    dt = float(sim.dt.f)
+    return int(round(float(sim.horizon.f) / dt)), dt
+
+
+def default_sigma0(g: Gains, e0: np.ndarray) -> float:
+    """σ̄(0) = max_i w_i (C e(0))_i²: every σ_i(0) ≥ |(C e(0))_i| (unsaturated start)."""
+    ey = g.C @ e0
+    return float(np.max(g.w * ey**2)) if ey.size else 0.0
+
+
+def noise_fn(
+    rng: np.random.Generator, shape: tuple[int, ...], p: int, so: SimOptions, amps: np.ndarray
+) -> Any:
+    """ν of the outlier model for a batch ``shape`` (..., runs); ``amps`` broadcasts to it."""
+
+    def nu(k0: int, k1: int) -> np.ndarray:
+        m = k1 - k0
+        v = rng.normal(0.0, so.noise_std, size=(m, *shape, p))
+        hit = rng.random(size=(m, *shape, p)) < so.outlier_rate
+        a = np.broadcast_to(amps, shape)[..., None]
+        o = rng.uniform(-1.0, 1.0, size=(m, *shape, p)) * a
+        return v + np.where(hit, o, 0.0)
+
+    return nu
+
+
+def sigma_levels(
+    g: Gains, e0: np.ndarray, so: SimOptions, steps: int, dt: float, seed: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Nominal run of the stubborn observer (noise, no outliers): σ_i(t), its mean and max."""
+    rng = np.random.default_rng(seed)
+    p = g.C.shape[0]
+    nom = SimOptions(so.noise_std, 0.0, (0.0,), 1, so.sigma0)
+    nu = noise_fn(rng, (), p, nom, np.zeros(()))
+    V = nu(0, steps)
+    s0 = so.sigma0 if so.sigma0 is not None else default_sigma0(g, e0)
+    sig = np.empty((steps, p))
+    e, sb = e0.astype(float), s0
+    for k in range(steps):  # one run: plain loop, keeps σ(t)
+        _, e, sb = run_errors(
+            g, e, lambda a, b, V=V, k=k: V[k : k + 1], 1, dt, np.zeros(p), np.array(True), sb
+        )
+        sig[k] = np.sqrt(max(float(sb), 0.0) / g.w)
+    return sig, sig.mean(axis=0), sig.max(axis=0)
+
+
+def study(spec: Spec, params: Parameters, runs: int | None = None) -> dict[str, Any]:
+    """The outlier study: medians over Monte Carlo runs of the RMSE of each state, for each
+    observer and each outlier amplitude (slides, Examples 1-3 tables)."""
+    so: SimOptions = spec.simulate.options or SimOptions()
+    g = Gains.of(spec, params)
+    sim = spec.simulate
+    e0 = np.asarray(sim.x0.f, float) - np.asarray(sim.xhat0.f, float)
+    steps, dt = _grid(spec)
+    runs = runs or so.runs
+    p = g.C.shape[0]
+    _, mean_l, max_l = sigma_levels(g, e0, so, steps, dt, sim.seed)
+    amps = np.asarray(so.amplitudes, float)
+    no, na = len(OBSERVERS), len(amps)
+    shape = (na, runs)
+    levels = np.empty((no, na, runs, p))
+    levels[0] = np.inf
+    levels[1] = mean_l
+    levels[2] = max_l
+    levels[3] = np.inf
+    adaptive = np.zeros((no, na, runs), bool)
+    adaptive[3] = True
+    s0 = so.sigma0 if so.sigma0 is not None else default_sigma0(g, e0)
+    rng = np.random.default_rng(sim.seed + 1)
+    base = noise_fn(rng, shape, p, so, amps[:, None])
+
+    def nu(k0: int, k1: int) -> np.ndarray:
+        return base(k0, k1)[:, None]  # same noise for every observer
+
+    sq, _, _ = run_errors(g, e0, nu, steps, dt, levels, adaptive, s0)
+    rmse = np.sqrt(sq / (steps + 1))  # (observers, amplitudes, runs, n)
+    med = np.median(rmse, axis=2)
+    names = spec.system.states
+    table = {
+        ob: {
+            f"{a:g}": {names[i]: float(med[j, k, i]) for i in range(len(names))}
+            for k, a in enumerate(amps)
+        }
+        for j, ob in enumerate(OBSERVERS)
+    }
+    return {
+        "median_rmse": table,
+        "constant_levels": {"mean": mean_l.tolist(), "max": max_l.tolist()},
+        "runs": runs,
+        "amplitudes": amps.tolist(),
+        "rmse": rmse,
+    }
+
+
+def format_table(st: dict[str, Any], states: list[str]) -> str:
+    """The study as a text table like the slides' (medians of the RMSEs)."""
+    amps = [f"{a:g}" for a in st["amplitudes"]]
+    head = f"{'observer':20s}" + "".join(f"{'a=' + a:>{12 * len(states)}s}" for a in amps)
+    sub = f"{'':20s}" + "".join(f"{s:>12s}" for _ in amps for s in states)
+    rows = [head, sub]
+    for ob, byamp in st["median_rmse"].items():
+        rows.append(f"{ob:20s}" + "".join(f"{byamp[a][s]:12.4g}" for a in amps for s in states))
+    return "\n".join(rows)
+
+
+def single_run(spec: Spec, params: Parameters, observer: str = "stubborn") -> SimResult:
+    """One run: plant, the chosen observer, σ(t); noise from the spec's [simulate.noise]
+    (through Dn) when given, else the outlier model with amplitude 10 (the slides' runs)."""
+    so: SimOptions = spec.simulate.options or SimOptions()
+    s = spec.system
+    sim = spec.simulate
+    g = Gains.of(spec, params)
+    steps, dt = _grid(spec)
+    n, p = s.n, s.p
+    rng = np.random.default_rng(sim.seed)
+    t = np.arange(steps + 1) * dt
+    if sim.noise.kind != "zero":
+        v = sim.noise.evaluate(np.arange(steps + 1) if s.discrete else t, rng)
+        V = v @ np.asarray(s.Dn.f, float).T
+    else:
+        V = noise_fn(rng, (), p, so, np.asarray(10.0))(0, steps + 1)
+    x = _plant(spec, steps, dt, rng)
+    e0 = x[0] - np.asarray(sim.xhat0.f, float)
+    s0 = so.sigma0 if so.sigma0 is not None else default_sigma0(g, e0)
+    E = np.empty((steps + 1, n))
+    S = np.empty(steps + 1)
+    E[0], S[0] = e0, s0
+    adaptive = np.array(observer == "stubborn")
+    lev = np.full(p, np.inf)
+    e, sb = e0, s0
+    for k in range(steps):
+        _, e, sb = run_errors(g, e, lambda a, b, k=k: V[k : k + 1], 1, dt, lev, adaptive, sb)
+        E[k + 1], S[k + 1] = e, sb
+    xhat = x - E
+    y = x @ np.asarray(s.C.f, float).T + V
+    sig = np.sqrt(np.maximum(S, 0)[:, None] / g.w)
+    return SimResult(
+        t,
+        x,
+        xhat,
+        y,
+        list(s.states),
+        extra={"sigma_bar": S, "sigma": sig},
+        info={"observer": observer},
+    )
+
+
+def _plant(spec: Spec, steps: int, dt: float, rng: np.random.Generator) -> np.ndarray:
+    """Plant trajectory x (steps+1, n): ẋ = A x + B u(t) + Bd d (RK4, u from [system] u or
+    [simulate.u], d from [simulate.disturbance] held over each step); x⁺ = ... in discrete time."""
+    s = spec.system
+    sim = spec.simulate
+    A, B, Bd = (np.asarray(M.f, float) for M in (s.A, s.B, s.Bd))
+    grid = np.arange(steps + 1) * (1.0 if s.discrete else dt)
+    D = sim.disturbance.evaluate(np.arange(steps + 1) if s.discrete else grid, rng)
+    if s.u_signal is not None:
+        fs = [ex.on(["t"]) for ex in s.u_signal]
+
+        def u(tt: float) -> np.ndarray:
+            return np.array([float(f(np.array([tt]))) for f in fs])
+    else:
+        Uv = sim.u.evaluate(np.arange(steps + 1) if s.discrete else grid, rng)
+
+        def u(tt: float) -> np.ndarray:
+            return Uv[min(int(round(tt / (1.0 if s.discrete else dt))), steps)]
+
+    x = np.empty((steps + 1, s.n))
+    x[0] = np.asarray(sim.x0.f, float)
+    for k in range(steps):
+        tk, xk, d = grid[k], x[k], Bd @ D[k]
+        if s.discrete:
+            x[k + 1] = A @ xk + B @ u(tk) + d
+            continue
+
+        def f(tt: float, z: np.ndarray, d: np.ndarray = d) -> np.ndarray:
+            return A @ z + B @ u(tt) + d
+
+        k1 = f(tk, xk)
+        k2 = f(tk + dt / 2, xk + dt / 2 * k1)
+        k3 = f(tk + dt / 2, xk + dt / 2 * k2)
+        k4 = f(tk + dt, xk + dt * k3)
+        x[k + 1] = xk + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return x
+
+
+def simulate(
+    spec: Spec, params: Parameters, study: str = "none", runs: int = 0, observer: str = "stubborn"
+) -> SimResult:
+    """``simulate``: one run (default) or the outlier study (``--option study=outliers``)."""
+    if spec.options.mode == "high-gain":
+        from obsdesign.methods.stubborn.highgain import simulate as hg
+
+        return hg(spec, params, observer=observer)
+    if spec.system.A is None:
+        raise InputError("stubborn simulation needs the linear model")
+    res = single_run(spec, params, observer if observer != "standard" else "luenberger")
+    if study == "outliers":
+        st = _study(spec, params, runs or None)
+        res.info["outlier_study"] = "\n" + format_table(st, spec.system.states)
+        res.info["constant_sat_levels"] = st["constant_levels"]
+        res.info["runs"] = st["runs"]
+        res.extra["study"] = st
+    return res
+
+
+_study = study
