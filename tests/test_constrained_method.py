@@ -98,7 +98,7 @@ def test_sec5_table1(specs_dir):
 
 def test_sec5_certified_gamma_simulation(specs_dir):
     """With the certified γ the refining never increases V (Lemma 3) and lowers the peak a little."""
-    res = api.simulate(specs_dir / SEC5, gamma="2.3965e-05")
+    res = api.simulate(specs_dir / SEC5, options={"gamma": "2.3965e-05"})
     assert "certified" in res.info["gamma (simulation)"]
     t10 = res.extra["traces"]["modified θ_m=10"]
     np.testing.assert_allclose(t10.sup_k(), [21.022, 19.986], atol=1e-3)

@@ -1,5 +1,15 @@
-"""The certificate of the constrained redesign (paper 000): every claim is rebuilt from the
-spec and the reported parameters, in exact arithmetic (or outward-rounded intervals)."""
+"""The certificate of the constrained redesign (Astolfi, Bernard, Postoyan, Marconi, "Redesign
+of discrete-time nonlinear observers with state estimate constraints guaranteed in prescribed
+convex set", NOLCOS 2019): every claim is rebuilt from the spec and the reported parameters, in
+exact arithmetic (or outward-rounded intervals).
+
+Binding: whatever the spec fixes (L, λ, ρ, P, μ, ε_min, ε_max, γ when given, the sets X, X̂,
+X0, X̂0, D, the map c, the margin) is read from the spec; where the report also carries it,
+it is compared exactly (a failed ``<key>-matches-spec`` claim otherwise). The report may carry
+no parameter that no claim checks (``parameters-expected``). Numbers printed in statements are
+exact or rounded in the direction that keeps the statement true
+(:mod:`obsdesign.certify.printing`).
+"""
 
 from __future__ import annotations
 
@@ -7,44 +17,35 @@ from typing import Any
 
 import numpy as np
 from flint import fmpq
+from mpmath import iv
 
-from obsdesign.certify.claim import Claim, exact_claim
-from obsdesign.certify.exact import Q, dyadic, to_float
-from obsdesign.certify.interval import sqrt_upper
+from obsdesign import lyap
+from obsdesign.certify.claim import Claim, Claims
+from obsdesign.certify.exact import Q, qeye, to_float
+from obsdesign.certify.interval import sqrt_upper, upper
+from obsdesign.certify.printing import fmt_down, fmt_exact, fmt_up
 from obsdesign.certify.psd import check_pd, check_psd
-from obsdesign.methods import lyapunov
 from obsdesign.methods.constrained import bounds as B
 from obsdesign.methods.constrained.cmap import ConstraintMap
 from obsdesign.methods.constrained.design import v_max_breve, xhat_set
-from obsdesign.methods.constrained.lyap import error_input, iss_matrix, w_sq_max
+from obsdesign.methods.constrained.lyap import w_sq_max
 from obsdesign.methods.constrained.options import Options
 from obsdesign.params import Parameters
 from obsdesign.sets import Box, Ellipsoid, Polytope, vertices_exact
 from obsdesign.sets.base import ConvexSet
 from obsdesign.spec.models import Spec
 
-REF = "constrained-redesign paper (000)"
+REF = "constrained-redesign paper (Astolfi et al., NOLCOS 2019)"
 
-
-def _q(params: Parameters, k: str) -> Any:
-    v = params[k]
-    if isinstance(v, fmpq) or (isinstance(v, np.ndarray) and v.dtype == object):
-        return v
-    arr = np.asarray(v, dtype=float)
-    return Q(float(arr)) if arr.ndim == 0 else dyadic(arr, 60)
-
-
-def _c(
-    id: str, stmt: str, ref: str, check: str, ok: bool, detail: str, float_ok: bool | None = None
-) -> Claim:
-    return exact_claim(id, stmt, f"{ref}, {REF}", check, 0, ok, detail, float_ok)
-
-
+#: parameters every report of this method carries (checked generically by the API)
 REQUIRED = (
     "P",
     "rho",
     "mu",
     "gamma",
+    "gamma_max",
+    "lambda_min_P",
+    "delta",
     "delta_sq",
     "eps_min",
     "eps_max",
@@ -54,237 +55,288 @@ REQUIRED = (
 )
 
 
+def expected_params(o: Options) -> set[str]:
+    """The parameters a design of these options reports, each checked by a claim: the
+    Lyapunov data (eq. (4)-(6)), v_max (eq. (13)), ε_max, δ, γ (eq. (24)), v_min (eq. (21)),
+    θ (eq. (22)), and v̆_max, θ̆ of Section 4 (constrained-redesign paper, Astolfi et al.,
+    NOLCOS 2019).
+
+    :param o: the method's options."""
+    keys = set(REQUIRED)
+    if o.L is not None:
+        keys.add("L")
+    if o.P is None:
+        keys.add("lambda")
+    if o.X0 is not None:
+        keys |= {"v_max_breve", "theta_breve"}
+    return keys
+
+
+def _ref(where: str) -> str:
+    return f"{where}, {REF}"
+
+
+def _is_int(q: fmpq) -> bool:
+    return q.q == 1
+
+
+def _int_or_exact(q: fmpq) -> str:
+    """An integer printed in full, anything else exactly (θ, θ̆ of eq. (22))."""
+    return str(int(q.p)) if q.q == 1 else fmt_exact(q)
+
+
 def certify(spec: Spec, params: Parameters) -> list[Claim]:
-    """All claims of item 7 of the issue (decay LMI, P ≻ 0, (5), inclusions, δ, (24), v_max,
-    v_min, θ), each recomputed from spec + parameters."""
+    """Every claim of the constrained redesign (Astolfi et al., NOLCOS 2019), recomputed from
+    spec + parameters: Lyapunov data (eq. (4)-(6), Assumption 2), convexity of c and the
+    inclusions of Assumption 3, v_max (eq. (13)), X̂_max ⊆ C_max (eq. (15)), δ (Assumption
+    3(4)), γ (eq. (24)), v_min (eq. (21)), θ (eq. (22)) and v̆_max, θ̆ (Section 4).
+
+    :param spec: the bound spec (the source of everything it fixes);
+    :param params: the report's parameters. Returns the claims (a missing parameter is a
+    failed claim, never an exception)."""
     o: Options = spec.options
-    missing = [k for k in REQUIRED if k not in params]
-    if missing:
-        return [
-            _c(
-                "parameters-present",
-                "the report gives every parameter",
-                "report",
-                "presence",
-                False,
-                f"missing: {', '.join(missing)}",
-            )
-        ]
-    if o.L is not None and "L" not in params:
-        return [
-            _c(
-                "parameters-present",
-                "the report gives L",
-                "report",
-                "presence",
-                False,
-                "missing: L",
-            )
-        ]
-    L = _q(params, "L") if o.L is not None else None
-    P, rho, mu = _q(params, "P"), Q(_q(params, "rho")), Q(_q(params, "mu"))
-    gamma, dsq = Q(_q(params, "gamma")), Q(_q(params, "delta_sq"))
-    eps_min, eps_max = Q(_q(params, "eps_min")), Q(_q(params, "eps_max"))
-    v_max, v_min, theta = Q(_q(params, "v_max")), Q(_q(params, "v_min")), Q(_q(params, "theta"))
-    out: list[Claim] = []
-    same = np.array_equal(np.asarray(L), np.asarray(o.L))
-    out.append(
-        _c(
-            "L-matches-spec",
-            "the gain L is the spec's",
-            "spec [method].L",
-            "exact equality",
-            same,
-            "" if same else "the report's L differs from the spec's",
+    c = Claims()
+    val = {k: params.exact(k, c) for k in REQUIRED}
+    extra = sorted(k for k in params if k not in expected_params(o))
+    if extra:
+        c.failed(
+            id="parameters-expected",
+            statement="the report carries only parameters this design computes",
+            reference="report.parameters",
+            detail=f"unexpected: {', '.join(extra)}",
         )
-    )
+    if any(v is None for v in val.values()):
+        return c
+
+    # -- what the spec fixes: read from the spec, the report's copy compared exactly ------
+    L = o.L
+    if L is not None:
+        Lr = params.exact("L", c)
+        if Lr is not None:
+            c.matches("L", Lr, L, "[method].L")
+    P, rho, mu = val["P"], Q(val["rho"]), Q(val["mu"])
+    lam = None
     if o.P is not None:
-        same = np.array_equal(np.asarray(P), np.asarray(o.P)) and rho == o.rho and mu == o.mu
-        out.append(
-            _c(
-                "lyapunov-data-matches-spec",
-                "P, ρ, μ are the spec's",
-                "spec [method]",
-                "exact equality",
-                same,
-                "" if same else "P, rho or mu differ from the spec",
-            )
-        )
-    if (
-        eps_min != o.eps_min
-        or (o.eps_max is not None and eps_max != o.eps_max)
-        or (o.gamma is not None and gamma != o.gamma)
-    ):
-        out.append(
-            _c(
-                "values-match-spec",
-                "ε_min, ε_max, γ are the spec's where given",
-                "spec [method]",
-                "exact equality",
-                False,
-                "a reported value differs from the spec",
-            )
-        )
-    r = check_pd(P, o.margin)
-    out.append(_c("P-positive-definite", "P ≻ 0", "eq. (4)", "exact LDLᵀ over Q", r.ok, r.detail))
-    if o.model is not None and o.model.nonlinear:
-        out.append(_iss_sampled(spec, params, P, rho, mu, v_max))
+        c.matches("P", P, o.P, "[method].P")
+        c.matches("rho", rho, o.rho, "[method].rho")
+        c.matches("mu", mu, o.mu, "[method].mu")
+        P, rho, mu = o.P, Q(o.rho), Q(o.mu)
     else:
-        out += _linear_claims(spec, params, L, P, rho, mu)
-    out += _convexity(o.cmap)
-    out.append(
-        _c(
-            "eps-order",
-            f"ε_max = {float(eps_max):.6g} > ε_min = {float(eps_min):.6g} > 0",
-            "Assumption 3",
-            "exact comparison",
-            eps_max > eps_min > 0,
-            "",
-        )
+        if o.lam is not None:
+            lam = Q(o.lam)
+            if "lambda" in params:
+                c.matches("lambda", params.exact("lambda", c), lam, "[method].lambda")
+        else:
+            lr = params.exact("lambda", c)
+            lam = None if lr is None else Q(lr)
+        if o.rho is not None:
+            c.matches("rho", rho, o.rho, "[method].rho")
+            rho = Q(o.rho)
+    eps_min = Q(o.eps_min)
+    c.matches("eps_min", val["eps_min"], eps_min, "[method].eps_min")
+    eps_max = Q(val["eps_max"])
+    if o.eps_max is not None:
+        c.matches("eps_max", eps_max, o.eps_max, "[method].eps_max")
+        eps_max = Q(o.eps_max)
+    gamma = Q(val["gamma"])
+    if o.gamma is not None:
+        c.matches("gamma", gamma, o.gamma, "[method].gamma")
+        gamma = Q(o.gamma)
+    dsq, delta = Q(val["delta_sq"]), Q(val["delta"])
+    v_max, v_min, theta = Q(val["v_max"]), Q(val["v_min"]), Q(val["theta"])
+
+    # -- Assumption 2: P, the decay LMI, inequality (5) -----------------------------------
+    r = check_pd(P, o.margin)
+    c.exact(
+        id="P-positive-definite",
+        statement="P ≻ 0",
+        reference=_ref("eq. (4)"),
+        check="exact LDLᵀ over Q",
+        passed=r.ok,
+        detail=r.detail,
     )
+    if o.model is not None and o.model.nonlinear:
+        _iss_sampled(c, spec, P, rho, mu, v_max)
+    else:
+        _linear_claims(c, spec, P, rho, mu, lam)
+    _convexity(c, o.cmap)
+    c.exact(
+        id="eps-order",
+        statement=f"ε_max = {fmt_exact(eps_max)} > ε_min = {fmt_exact(eps_min)} > 0",
+        reference=_ref("Assumption 3"),
+        check="exact comparison",
+        passed=eps_max > eps_min > 0,
+    )
+
+    # -- Assumption 3(1)-(2): inclusions ---------------------------------------------------
     Xhat = xhat_set(o)
-    out += _inclusions(o, Xhat, eps_min, eps_max)
+    _inclusions(c, o, Xhat, eps_min, eps_max)
     Pinv = B.qinv(P)
     W = w_sq_max(o.D_lower, o.D_upper)
     vb = B.v_max_bound(P, rho, mu, o.X, Xhat, W)
-    out.append(
-        _c(
-            "v_max-bound",
-            f"v_max = {float(v_max):.8g} ≥ max β(V(x̂ − x), d) over X × X̂ × D",
-            "eq. (13)",
-            f"recomputed: {float(vb.value):.8g} ({vb.how})",
-            v_max >= vb.value,
-            "",
-        )
+    c.exact(
+        id="v_max-bound",
+        statement=f"max over X × X̂ × D of β(V(x̂ − x), w) ≤ v_max ≤ {fmt_up(v_max, 8)}",
+        reference=_ref("eq. (13)"),
+        check=f"exact rational comparison with the recomputed bound ({vb.how})",
+        passed=v_max >= vb.value,
+        detail=f"recomputed bound ≤ {fmt_up(vb.value, 10)}",
     )
     sup = B.sup_norm_c_over_Xhat_max(o.cmap, P, Pinv, o.X, v_max)
-    out.append(
-        _c(
-            "Xhat_max-in-Cmax",
-            "X̂_max ⊆ C_max",
-            "Assumption 3(2), eq. (15)",
-            "sup |c| over X̂_max bounded by per-face support functions (outward rounding)",
-            sup <= eps_max,
-            f"sup |c| ≤ {float(sup):.6g} vs ε_max = {float(eps_max):.6g}",
-        )
+    c.exact(
+        id="Xhat_max-in-Cmax",
+        statement="X̂_max ⊆ C_max",
+        reference=_ref("Assumption 3(2), eq. (15)"),
+        check="sup |c| over X̂_max bounded by per-face support functions (outward rounding)",
+        passed=sup <= eps_max,
+        detail=f"sup |c| over X̂_max ≤ {fmt_up(sup, 10)}",
     )
+
+    # -- δ (Assumption 3(4)), γ (24) -------------------------------------------------------
     ok, det = B.delta_sq_valid(o.cmap, eps_max, dsq)
-    if "delta" in params:
-        ok = ok and Q(_q(params, "delta")) ** 2 >= dsq
-    out.append(
-        _c(
-            "delta-bound",
-            f"sup over C_max of |dc/dx| ≤ δ, δ² = {float(dsq):.6g}",
-            "Assumption 3(4)",
-            "exact",
-            ok,
-            det,
-        )
+    c.exact(
+        id="delta-bound",
+        statement=f"sup over C_max of |dc/dx|² ≤ δ² ≤ {fmt_up(dsq, 8)}",
+        reference=_ref("Assumption 3(4)"),
+        check="exact: δ² ≥ the bound recomputed from ε_max, and the reported δ has δ·δ ≥ δ²",
+        passed=ok and delta >= 0 and delta * delta >= dsq,
+        detail=det,
+    )
+    ell = Q(val["lambda_min_P"])
+    r = check_psd(P - qeye(P.shape[0]) * ell)
+    c.exact(
+        id="lambda_min-bound",
+        statement=f"λ_min(P) ≥ {fmt_down(ell, 8)}",
+        reference=_ref("eq. (24)"),
+        check="exact LDLᵀ of P − λ_min_P·I",
+        passed=r.ok,
+        detail=f"P − λ_min_P·I ⪰ 0: {r.detail}",
     )
     ok, det = B.gamma_ok(P, gamma, dsq)
-    out.append(
-        _c(
-            "gamma-bound",
-            f"γ = {float(gamma):.6g} ≤ λ_min(P)/δ²",
-            "Theorem 1, eq. (24)",
-            "exact LDLᵀ of P − γδ²I",
-            ok,
-            det + ("" if ok else f"; largest certified γ ≈ {float(B.gamma_bound(P, dsq)):.6g}"),
-            float_ok=False,
-        )
+    c.exact(
+        id="gamma-bound",
+        statement=f"γ δ² ≤ λ_min(P) with γ = {fmt_down(gamma, 8)}",
+        reference=_ref("Theorem 1, eq. (24)"),
+        check="exact LDLᵀ of P − γδ²I",
+        passed=ok,
+        detail=det,
     )
-    ok = B.v_min_condition(o.cmap, P, Pinv, o.X, eps_min, v_min) and v_min >= 0
-    out.append(
-        _c(
-            "v_min-bound",
-            f"V(x̂ − x) ≤ v_min = {float(v_min):.8g}, x ∈ X ⟹ x̂ ∈ C_min",
-            "eq. (21)",
-            "per-face support functions, exact/outward rounding",
-            ok,
-            "",
-        )
+    gmax = Q(val["gamma_max"])
+    ok, det = B.gamma_ok(P, gmax, dsq)
+    c.exact(
+        id="gamma_max-bound",
+        statement=f"γ_max δ² ≤ λ_min(P) with γ_max = {fmt_down(gmax, 8)}",
+        reference=_ref("Theorem 1, eq. (24)"),
+        check="exact LDLᵀ of P − γ_max δ²I",
+        passed=ok,
+        detail=det,
+    )
+
+    # -- v_min (21), θ (22) ----------------------------------------------------------------
+    ok = v_min >= 0 and B.v_min_condition(o.cmap, P, Pinv, o.X, eps_min, v_min)
+    c.exact(
+        id="v_min-bound",
+        statement=f"x ∈ X, V(x̂ − x) ≤ {fmt_down(v_min, 8)} ⟹ x̂ ∈ C_min",
+        reference=_ref("eq. (21)"),
+        check="per-face support functions, exact/outward rounding",
+        passed=ok,
     )
     need = max(v_max - v_min, fmpq(0)) / (gamma * eps_min**2)
-    out.append(
-        _c(
-            "theta-covers",
-            f"θ = {int(theta)} ≥ (v_max − v_min)/(γ ε_min²) = {float(need):.6g}",
-            "eq. (22)",
-            "exact rational comparison",
-            theta >= need and theta == int(theta),
-            "",
-        )
+    c.exact(
+        id="theta-covers",
+        statement=f"θ = {_int_or_exact(theta)} ≥ (v_max − v_min)/(γ ε_min²)",
+        reference=_ref("eq. (22)"),
+        check="exact rational comparison; θ an integer",
+        passed=theta >= need and _is_int(theta),
+        detail=f"(v_max − v_min)/(γ ε_min²) ≤ {fmt_up(need, 10)}",
     )
-    if "v_max_breve" in params and o.X0 is not None and o.Xhat0 is not None:
-        vbr = Q(_q(params, "v_max_breve"))
-        ref = v_max_breve(P, rho, mu, o.X0, o.Xhat0, W)
-        tb = Q(_q(params, "theta_breve"))
-        need_b = max(min(vbr, v_max) - v_min, fmpq(0)) / (gamma * eps_min**2)
-        out.append(
-            _c(
-                "v_max_breve",
-                f"v̆_max = {float(vbr):.6g} bounds V along solutions from X0 × X̂0; θ̆ = {int(tb)}",
-                "Section 4",
-                "exact rational comparison",
-                vbr >= ref and tb >= need_b and rho < 1,
-                "",
-            )
-        )
-    return out
+    if o.X0 is not None and o.Xhat0 is not None:
+        _breve(c, params, o, P, rho, mu, W, v_max, v_min, gamma, eps_min)
+    return c
 
 
-def _linear_claims(
-    spec: Spec, params: Parameters, L: Any, P: Any, rho: Any, mu: Any
-) -> list[Claim]:
-    """Decay LMI and inequality (5) for the linear error dynamics, exactly."""
+def _breve(
+    c: Claims,
+    params: Parameters,
+    o: Options,
+    P: Any,
+    rho: fmpq,
+    mu: fmpq,
+    W: fmpq,
+    v_max: fmpq,
+    v_min: fmpq,
+    gamma: fmpq,
+    eps_min: fmpq,
+) -> None:
+    """v̆_max and θ̆ of Section 4 (constrained-redesign paper, Astolfi et al., NOLCOS 2019)."""
+    vr, tr = params.exact("v_max_breve", c), params.exact("theta_breve", c)
+    if vr is None or tr is None:
+        return
+    vbr, tb = Q(vr), Q(tr)
+    ref = v_max_breve(P, rho, mu, o.X0, o.Xhat0, W)
+    c.exact(
+        id="v_max_breve-bound",
+        statement=f"V(x̂_k − x_k) ≤ v̆_max ≤ {fmt_up(vbr, 8)} for all k along solutions from X0 × X̂0",
+        reference=_ref("Section 4"),
+        check="exact: v̆_max ≥ max V(x̂0 − x0) over X0 × X̂0 + μ max|w|²/(1 − ρ), ρ < 1",
+        passed=vbr >= ref and rho < 1,
+        detail=f"recomputed bound ≤ {fmt_up(ref, 10)}",
+    )
+    need = max(min(vbr, v_max) - v_min, fmpq(0)) / (gamma * eps_min**2)
+    c.exact(
+        id="theta_breve-covers",
+        statement=f"θ̆ = {_int_or_exact(tb)} ≥ (min(v_max, v̆_max) − v_min)/(γ ε_min²)",
+        reference=_ref("Section 4, eq. (22)"),
+        check="exact rational comparison; θ̆ an integer",
+        passed=tb >= need and _is_int(tb),
+        detail=f"(min(v_max, v̆_max) − v_min)/(γ ε_min²) ≤ {fmt_up(need, 10)}",
+    )
+
+
+def _linear_claims(c: Claims, spec: Spec, P: Any, rho: fmpq, mu: fmpq, lam: fmpq | None) -> None:
+    """Decay LMI (Section 5) and inequality (5) (eq. (5)-(6)) for the linear error dynamics
+    e⁺ = (A − LC)e + B_w w, exactly (constrained-redesign paper, Astolfi et al., NOLCOS 2019).
+    With λ (P computed), ρ = λ² unless the spec gives ρ."""
     o: Options = spec.options
     s = spec.system
-    out: list[Claim] = []
-    Acl = s.A.q - L @ s.C.q
-    if "lambda" in params:
-        lam = Q(_q(params, "lambda"))
-        M = lyapunov.decay_matrix(s.A.q, s.C.q, L, P, lam, True)
-        r = check_pd(M, o.margin)
-        out.append(
-            _c(
-                "decay-lmi",
-                f"(A−LC)ᵀP(A−LC) ⪯ λ²P with λ = {float(lam):.6g}",
-                "Section 5",
-                "exact LDLᵀ over Q of the rebuilt matrix",
-                r.ok,
-                r.detail,
-            )
+    A, C, L = s.A.q, s.C.q, o.L
+    if o.P is None and lam is not None:
+        r = check_pd(lyap.decay_matrix(A, C, L, P, lam, True), o.margin)
+        c.exact(
+            id="decay-lmi",
+            statement=f"(A−LC)ᵀP(A−LC) ⪯ λ²P with λ = {fmt_up(lam, 10)}",
+            reference=_ref("Section 5"),
+            check="exact LDLᵀ over Q of λ²P − (A−LC)ᵀP(A−LC) − margin·I",
+            passed=r.ok,
+            detail=r.detail,
         )
-        if o.rho is None and rho != lam * lam:
-            out.append(
-                _c(
-                    "rho-is-lambda-squared",
-                    "ρ = λ²",
-                    "Remark 1",
-                    "exact equality",
-                    False,
-                    f"ρ = {rho}",
-                )
+        if o.rho is None:
+            c.exact(
+                id="rho-is-lambda-squared",
+                statement="ρ = λ²",
+                reference=_ref("eq. (6), Remark 1"),
+                check="exact equality",
+                passed=rho == lam * lam,
+                detail="" if rho == lam * lam else "the report's ρ is not λ²",
             )
-    Bw = error_input(s.A.q, s.Bd.q, s.Dn.q, L)
-    r = check_psd(iss_matrix(Acl, Bw, P, rho, mu))
-    ok = r.ok and rho < 1
-    out.append(
-        _c(
-            "iss-bound",
-            f"V(e⁺) ≤ ρV(e) + μ|w|² with ρ = {float(rho):.6g}, μ = {float(mu):.6g}",
-            "Assumption 2, eq. (5)-(6)",
-            "exact LDLᵀ over Q (linear error dynamics)",
-            ok,
-            r.detail + ("" if rho < 1 else "; ρ must be < 1"),
-        )
+    Acl = lyap.closed_loop(A, C, L)
+    Bw = lyap.error_input(s.Bd.q, s.Dn.q, L)
+    r = check_psd(lyap.iss_matrix(Acl, Bw, P, rho, mu))
+    c.exact(
+        id="iss-bound",
+        statement=(
+            f"V(e⁺) ≤ ρV(e) + μ|w|² with ρ = {fmt_up(rho, 10)}, μ = {fmt_up(mu, 10)}, ρ < 1"
+        ),
+        reference=_ref("Assumption 2, eq. (5)-(6)"),
+        check="exact LDLᵀ over Q (linear error dynamics)",
+        passed=r.ok and rho < 1,
+        detail=r.detail + ("" if rho < 1 else "; ρ must be < 1"),
     )
-    return out
 
 
-def _iss_sampled(spec: Spec, params: Parameters, P: Any, rho: Any, mu: Any, v_max: Any) -> Claim:
-    """Inequality (5) for expression-defined f, h, F: sampled (numerical claim)."""
-    from obsdesign.certify.claim import numerical_claim
+def _iss_sampled(c: Claims, spec: Spec, P: Any, rho: fmpq, mu: fmpq, v_max: fmpq) -> None:
+    """Inequality (5) (Assumption 2, constrained-redesign paper, Astolfi et al., NOLCOS 2019)
+    for expression-defined f, h, F: sampled (a numerical claim, not a proof)."""
     from obsdesign.methods.constrained.nonlinear import check_iss_samples
     from obsdesign.methods.constrained.observer import LinearF
 
@@ -295,124 +347,124 @@ def _iss_sampled(spec: Spec, params: Parameters, P: Any, rho: Any, mu: Any, v_ma
         F = LinearF(s.A.f, s.B.f, s.C.f, s.D.f, np.asarray(to_float(o.L), dtype=float))
     Pf = np.asarray(to_float(P), dtype=float)
     ok, _, det = check_iss_samples(spec, o.model, F, Pf, float(rho), float(mu), float(v_max))
-    ok = ok and rho < 1
-    return numerical_claim(
-        "iss-bound",
-        f"V(Δ(x, e, u, w)) ≤ ρV(e) + μ|w|² with ρ = {float(rho):.6g}, μ = {float(mu):.6g}",
-        f"Assumption 2, eq. (5)-(6), {REF}",
-        "sampled in float64 (expression-defined f, h, F): not a proof",
-        0,
-        ok,
-        det,
+    c.numerical(
+        id="iss-bound",
+        statement=(
+            f"V(Δ(x, e, u, w)) ≤ ρV(e) + μ|w|² with ρ = {fmt_exact(rho)}, μ = {fmt_exact(mu)}"
+            " on the samples"
+        ),
+        reference=_ref("Assumption 2, eq. (5)-(6)"),
+        check="sampled in float64 (expression-defined f, h, F): not a proof",
+        passed=ok and rho < 1,
+        detail=det,
     )
 
 
-def _convexity(cm: ConstraintMap) -> list[Claim]:
+def _convexity(c: Claims, cm: ConstraintMap) -> None:
+    """Assumption 3(3): c convex (Lemma 1: ellipsoid map (18) with Q ≻ 0; Lemma 2: affine φ)."""
     if cm.affine:
-        return [
-            _c(
-                "c-convex",
-                "each c_i = max(g_iᵀx − h_i, 0)² is convex",
-                "Assumption 3(3), Lemma 2",
-                "by construction (affine φ_i)",
-                True,
-                f"{cm.n_c} components",
-            )
-        ]
-    r = check_pd(cm.Q_q)
-    return [
-        _c(
-            "c-convex",
-            "c = max(xᵀQx/r − 1, 0)² is convex (Q ≻ 0)",
-            "Assumption 3(3), Lemma 1",
-            "exact LDLᵀ of Q",
-            r.ok,
-            r.detail,
+        c.exact(
+            id="c-convex",
+            statement="each c_i = max(g_iᵀx − h_i, 0)² is convex",
+            reference=_ref("Assumption 3(3), Lemma 2"),
+            check="by construction (affine φ_i)",
+            passed=True,
+            detail=f"{cm.n_c} components",
         )
-    ]
+        return
+    r = check_pd(cm.Q_q)
+    c.exact(
+        id="c-convex",
+        statement="c = max(xᵀQx/r − 1, 0)² is convex (Q ≻ 0)",
+        reference=_ref("Assumption 3(3), Lemma 1"),
+        check="exact LDLᵀ of Q",
+        passed=r.ok,
+        detail=r.detail,
+    )
 
 
-def _inclusions(o: Options, Xhat: ConvexSet, eps_min: fmpq, eps_max: fmpq) -> list[Claim]:
+def _inclusions(c: Claims, o: Options, Xhat: ConvexSet, eps_min: fmpq, eps_max: fmpq) -> None:
     """Assumption 3(1): X ⊂ C_0 ⊂ C_min ⊂ X̂ ⊂ C_max."""
     cm = o.cmap
-    out = []
-    b = B.max_phi_over(cm, o.X)
-    worst = max(b)
-    out.append(
-        _c(
-            "X-in-C0",
-            "X ⊂ C_0 = {c = 0}",
-            "Assumption 3(1)",
-            "exact: φ_i at the vertices of X",
-            worst <= 0,
-            f"max φ over X = {float(worst):.6g}",
-        )
+    worst = max(B.max_phi_over(cm, o.X))
+    c.exact(
+        id="X-in-C0",
+        statement="X ⊂ C_0 = {c = 0}",
+        reference=_ref("Assumption 3(1)"),
+        check="exact: φ_i at the vertices of X",
+        passed=worst <= 0,
+        detail=f"max φ over X = {fmt_exact(worst)}",
     )
-    ok, det = _cmin_in_xhat(cm, eps_min, Xhat)
-    out.append(
-        _c(
-            "Cmin-in-Xhat",
-            "C_min ⊂ X̂",
-            "Assumption 3(1)",
-            "exact: the outer set {φ_i ≤ t}, t ≥ √ε_min, lies in X̂",
-            ok,
-            det,
-        )
+    ok, det = cmin_in_xhat(cm, eps_min, Xhat)
+    c.exact(
+        id="Cmin-in-Xhat",
+        statement="C_min ⊂ X̂",
+        reference=_ref("Assumption 3(1)"),
+        check="exact: the outer set {φ_i ≤ t}, t ≥ √ε_min, lies in X̂",
+        passed=ok,
+        detail=det,
     )
     sup = B.sup_norm_c_over_set(cm, Xhat)
-    out.append(
-        _c(
-            "Xhat-in-Cmax",
-            "X̂ ⊂ C_max",
-            "Assumption 3(1)",
-            "sup |c| over X̂ (vertices / support function)",
-            sup <= eps_max,
-            f"sup |c| over X̂ ≤ {float(sup):.6g}",
-        )
+    c.exact(
+        id="Xhat-in-Cmax",
+        statement="X̂ ⊂ C_max",
+        reference=_ref("Assumption 3(1)"),
+        check="sup |c| over X̂ (vertices / support function) ≤ ε_max",
+        passed=sup <= eps_max,
+        detail=f"sup |c| over X̂ ≤ {fmt_up(sup, 10)}",
     )
-    return out
 
 
-def _cmin_in_xhat(cm: ConstraintMap, eps_min: fmpq, Xhat: ConvexSet) -> tuple[bool, str]:
-    from mpmath import iv
+def cmin_in_xhat(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet) -> tuple[bool, str]:
+    """Assumption 3(1), C_min ⊂ X̂ (constrained-redesign paper, Astolfi et al., NOLCOS 2019),
+    through the outer set of C_min: {φ_i ≤ t} with a rational t ≥ √ε_min (each |c_i| ≤ |c|),
+    i.e. the box [r̲ − t, r̄ + t] for the box map (19), a polytope for a polytope map, the
+    ellipsoid {xᵀQx ≤ r(1 + t)} for the ellipsoid map (18). Every face / vertex is checked.
 
-    from obsdesign.certify.interval import upper
-
-    t = sqrt_upper(eps_min)
+    :param cm: the map c; :param eps_min: ε_min; :param Xhat: the set X̂.
+    Returns (holds, detail)."""
+    t = sqrt_upper(Q(eps_min))
     if cm.kind == "box" and isinstance(Xhat, (Box, Polytope)):
-        # the outer set of C_min is the box [r̲ − t, r̄ + t]: compare face by face (closed form)
+        # the outer set is a box: max of each face of X̂ over it, in closed form
         n = cm.dim
-        lo = np.array([-cm.h_q[2 * i] - t for i in range(n)], dtype=object)
-        hi = np.array([cm.h_q[2 * i + 1] + t for i in range(n)], dtype=object)
+        lo = [-cm.h_q[2 * i] - t for i in range(n)]
+        hi = [cm.h_q[2 * i + 1] + t for i in range(n)]
         G, g = Xhat.h_form_q()
-        worst = max(
+        faces = [
             sum((max(G[j, i] * lo[i], G[j, i] * hi[i]) for i in range(n)), fmpq(0)) - g[j]
             for j in range(G.shape[0])
-        )
-        return worst <= 0, f"max over the outer box of C_min of (H x − k) = {float(worst):.6g}"
+        ]
+        worst = max(faces)
+        return worst <= 0, f"max over the outer box of C_min of (H x − k) ≤ {fmt_up(worst, 10)}"
     if cm.affine:
         V, bounded = vertices_exact(cm.G_q, np.array([h + t for h in cm.h_q], dtype=object))
         if not bounded or len(V) == 0:
             return False, "the outer set of C_min is unbounded"
-        bad = [v for v in V if not _contains_q(Xhat, v)]
+        bad = [v for v in V if not contains_q(Xhat, v)]
         return not bad, f"{len(V)} vertices checked" + (f"; {len(bad)} outside X̂" if bad else "")
-    # ellipsoid c: outer set {xᵀQx ≤ r(1 + t)}
-    R = Q(cm.r_q) * (1 + t)
+    R = Q(cm.r_q) * (1 + t)  # ellipsoid map: the outer set {xᵀQx ≤ r(1 + t)}
     if isinstance(Xhat, Ellipsoid):
-        if any(c != 0 for c in Xhat.center_q):
+        if any(x != 0 for x in Xhat.center_q):
             return False, "X̂ ellipsoid must be centred at 0 for this check"
         r = check_psd(cm.Q_q * (1 / R) - Xhat.E_q)
-        return r.ok, f"E_X̂ ⪯ Q/(r(1+√ε_min)): {r.detail}"
+        return r.ok, f"E_X̂ ⪯ Q/(r(1+t)): {r.detail}"
     G, g = Xhat.h_form_q()  # type: ignore[attr-defined]
     Qinv = B.qinv(cm.Q_q)
-    for j in range(G.shape[0]):
-        s = upper(lambda R, w: iv.sqrt(R * w), R, B.quad(Qinv, G[j]))
-        if s > g[j]:
-            return False, f"face {j}: support {float(s):.6g} > {float(g[j]):.6g}"
-    return True, "support function of the outer ellipsoid below every face of X̂"
+    bad_faces = [
+        j
+        for j in range(G.shape[0])
+        if upper(lambda R, w: iv.sqrt(R * w), R, B.quad(Qinv, G[j])) > g[j]
+    ]
+    if bad_faces:
+        return False, f"faces {bad_faces}: support of the outer ellipsoid above the face"
+    return True, f"support function of the outer ellipsoid below all {G.shape[0]} faces of X̂"
 
 
-def _contains_q(S: ConvexSet, v: np.ndarray) -> bool:
+def contains_q(S: ConvexSet, v: np.ndarray) -> bool:
+    """Whether the exact point v lies in the box / polytope / ellipsoid S (every coordinate,
+    face or the quadratic form, exactly): the vertex test of C_min ⊂ X̂, Assumption 3(1).
+
+    :param S: the set; :param v: an exact point."""
     if isinstance(S, Box):
         return all(lo <= x <= hi for lo, x, hi in zip(S.lower_q, v, S.upper_q, strict=True))
     if isinstance(S, Polytope):

@@ -1,4 +1,5 @@
-"""Design of the refining map's parameters (Sections 3-4, constrained-redesign paper (000)).
+"""Design of the refining map's parameters (Sections 3-4 of Astolfi, Bernard, Postoyan,
+Marconi, NOLCOS 2019, the constrained-redesign paper).
 
 Order: Lyapunov data (P, ρ, μ; Assumption 2) → X̂ → v_max (13) → ε_max (Assumption 3(2)) →
 δ (Assumption 3(4)) → γ (24) → v_min (21) → θ (22), and optionally v̆_max of Section 4.
@@ -12,15 +13,19 @@ from typing import Any
 import numpy as np
 from flint import fmpq
 
+from obsdesign import lyap
 from obsdesign.certify.exact import Q
 from obsdesign.certify.interval import sqrt_upper
 from obsdesign.errors import InconclusiveError, InfeasibleError
-from obsdesign.methods import lyapunov
+from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
 from obsdesign.methods.constrained import bounds as B
-from obsdesign.methods.constrained.lyap import error_input, iss_mu, w_sq_max
+from obsdesign.methods.constrained.lyap import w_sq_max
 from obsdesign.methods.constrained.options import Options, default_Xhat
+from obsdesign.params import Parameters
 from obsdesign.sets.base import ConvexSet
 from obsdesign.spec.models import Spec
+
+REF = "Astolfi, Bernard, Postoyan, Marconi, NOLCOS 2019 (constrained-redesign paper)"
 
 
 @dataclass
@@ -34,12 +39,19 @@ class LyapData:
 
 
 def lyapunov_data(spec: Spec) -> LyapData:
-    """P from the ``lyapunov`` method (certified (A−LC)ᵀP(A−LC) ⪯ λ²P), ρ = λ² (or the given
-    ρ ≥ λ²) and the smallest certified μ; or the user's (P, ρ, μ)."""
+    """Assumption 2 and Section 5 of the constrained-redesign paper (Astolfi et al., NOLCOS
+    2019): V(e) = eᵀPe (eq. (4)) with P solving (A−LC)ᵀP(A−LC) − λ²P = −I, certified exactly
+    ((A−LC)ᵀP(A−LC) ⪯ λ²P); β(v, w) = ρv + μ|w|² (eq. (6)) with ρ = λ² or the spec's ρ ≥ λ²,
+    and the smallest certified μ of eq. (5). The user's (P, ρ, μ) when the spec gives them.
+
+    :param spec: the bound spec (``[method]`` L, lambda, rho, P, mu, margin, rate_tol).
+    Raises :class:`InfeasibleError` when A − LC is not Schur or λ is below its spectral
+    radius, :class:`InconclusiveError` when λ holds in floats but not exactly."""
     o: Options = spec.options
     s = spec.system
     if o.P is not None:
         return LyapData(o.P, Q(o.rho), Q(o.mu), None)
+    A, C = s.A.q, s.C.q
     Acl_f = s.A.f - np.asarray(o.L, dtype=float) @ s.C.f
     rad = float(np.max(np.abs(np.linalg.eigvals(Acl_f))))
     if rad >= 1:
@@ -47,11 +59,11 @@ def lyapunov_data(spec: Spec) -> LyapData:
             f"A − LC is not Schur (spectral radius {rad:.6g} >= 1): no Lyapunov function (Assumption 2)"
         )
     if o.lam is None:
-        lo = lyapunov.Options(o.L, None, o.rate_tol, fmpq(10), False, o.margin)
-        lam, P = lyapunov.best_rate(s.A.q, s.C.q, o.L, True, lo, rad)
+        br = lyap.best_rate(A, C, o.L, True, tol=o.rate_tol, margin=o.margin)
+        lam, P = br.best, br.P
     else:
         lam = o.lam
-        P = lyapunov.certified_P(s.A.q, s.C.q, o.L, True, lam, o.margin)
+        P = lyap.certified_P(A, C, o.L, True, lam, o.margin)
         if P is None:
             if float(lam) <= rad:
                 raise InfeasibleError(
@@ -61,18 +73,49 @@ def lyapunov_data(spec: Spec) -> LyapData:
                 f"decay rate λ = {float(lam):g} holds in floats but the exact check failed"
             )
     rho = Q(o.rho) if o.rho is not None else lam * lam
-    Acl = s.A.q - o.L @ s.C.q
-    mu = iss_mu(Acl, error_input(s.A.q, s.Bd.q, s.Dn.q, o.L), P, rho)
+    Acl = lyap.closed_loop(A, C, o.L)
+    mu = lyap.iss_mu(Acl, lyap.error_input(s.Bd.q, s.Dn.q, o.L), P, rho)
     return LyapData(P, rho, mu, lam)
 
 
+def design(spec: Spec, progress: Progress | None = None) -> Design:
+    """The whole design of Sections 3-4 of the constrained-redesign paper (Astolfi et al.,
+    NOLCOS 2019): see :func:`design_params`; the solver is the Lyapunov equation (closed form)
+    certified exactly, then exact rational bounds.
+
+    :param spec: the bound spec; :param progress: optional message callback."""
+    import time
+
+    if progress:
+        progress("Lyapunov data, v_max, ε_max, δ, γ, v_min, θ")
+    t0 = time.perf_counter()
+    vals, notes = design_params(spec)
+    o: Options = spec.options
+    name = (
+        "user-given Lyapunov data (P, ρ, μ) + exact rational bounds"
+        if o.P is not None
+        else "Lyapunov equation (scipy) certified exactly + exact rational bounds"
+    )
+    solver = SolverResult(name, SolverStatus.CLOSED_FORM, seconds=time.perf_counter() - t0)
+    return Design(Parameters(vals), solver, notes)
+
+
 def xhat_set(o: Options) -> ConvexSet:
-    """X̂: the given set, or the outer set of C_min (see :func:`default_Xhat`)."""
+    """X̂ of Assumption 3(1) (constrained-redesign paper, Astolfi et al., NOLCOS 2019): the
+    spec's set, or the outer set of C_min (see :func:`default_Xhat`).
+
+    :param o: the method's options."""
     return o.Xhat if o.Xhat is not None else default_Xhat(o.cmap, o.eps_min)
 
 
 def design_params(spec: Spec) -> tuple[dict[str, Any], list[str]]:
-    """Every parameter of the report (exact rationals) and notes on what is exact or a bound."""
+    """Every parameter of the report (exact rationals) and notes on what is exact or a bound.
+
+    Constrained-redesign paper (Astolfi et al., NOLCOS 2019): Lyapunov data (Assumption 2,
+    eq. (4)-(6)) → X̂ → v_max (eq. (13)) → ε_max (Assumption 3(2), eq. (15)) → δ (Assumption
+    3(4)) → γ (eq. (24)) → v_min (eq. (21)) → θ (eq. (22)), and v̆_max, θ̆ of Section 4.
+
+    :param spec: the bound spec. Raises :class:`InfeasibleError` when γ violates (24)."""
     o: Options = spec.options
     notes: list[str] = []
     ld = lyapunov_data(spec)
@@ -158,7 +201,11 @@ def design_params(spec: Spec) -> tuple[dict[str, Any], list[str]]:
 def v_max_breve(
     P: np.ndarray, rho: Any, mu: Any, X0: ConvexSet, Xhat0: ConvexSet, w_sq: Any
 ) -> fmpq:
-    """v̆_max = V(e_0,max) + α(d_max)/(1 − ρ) of Section 4 (an upper bound of V along solutions
-    from X0 × X̂0 when β = ρv + μ|d|², by induction: ρ v̆ + μ|d|² ≤ v̆)."""
+    """v̆_max = V(e_0,max) + α(d_max)/(1 − ρ), Section 4 of the constrained-redesign paper
+    (Astolfi et al., NOLCOS 2019): an upper bound of V along solutions from X0 × X̂0 when
+    β = ρv + μ|d|², by induction (ρ v̆ + μ|d|² ≤ v̆).
+
+    :param P, rho, mu: Lyapunov data; :param X0, Xhat0: initial-state / estimate sets;
+    :param w_sq: max |w|² over D."""
     v0 = B.max_V_diff(P, X0, Xhat0).value
     return v0 + Q(mu) * Q(w_sq) / (1 - Q(rho))

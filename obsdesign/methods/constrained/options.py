@@ -10,6 +10,7 @@ from flint import fmpq
 
 from obsdesign.certify.exact import Q
 from obsdesign.certify.psd import check_pd
+from obsdesign.errors import SpecError
 from obsdesign.methods.constrained.cmap import (
     KINDS,
     ConstraintMap,
@@ -53,8 +54,6 @@ class Options:
     X0: ConvexSet | None = None
     Xhat0: ConvexSet | None = None
     file: str = ""
-    #: the method's ``[simulate]`` keys (filled by ``parse_simulate``)
-    sim: Any = None
     #: expression-defined f, h, F (nonlinear.Model); None entries mean linear
     model: Any = None
     U_lower: np.ndarray = field(default_factory=lambda: np.zeros(0))
@@ -63,7 +62,9 @@ class Options:
 
 @dataclass
 class SimOptions:
-    """Method keys of ``[simulate]``: θ_m values, a simulation-only γ, the saturation level r of (29)."""
+    """Method keys of ``[simulate]`` (Section 5, Table 1 of the constrained-redesign paper,
+    Astolfi et al., NOLCOS 2019): the step budgets θ_m (one modified observer each), a
+    simulation-only γ, and the saturation level r of the naive observer (29)."""
 
     theta_m: list[int] = field(default_factory=list)
     gamma: fmpq | None = None
@@ -71,8 +72,21 @@ class SimOptions:
 
 
 def parse_options(table: Table, spec: Spec) -> Options:
-    """Read and validate ``[method]`` (every error names file and key)."""
+    """Read and validate ``[method]`` (every error names file and key).
+
+    Assumptions 1-3 of the constrained-redesign paper (Astolfi et al., NOLCOS 2019): the sets
+    X, X̂, the map c (eq. (18)/(19)/polytope), ε_min < ε_max, the Lyapunov data of eq. (4)-(6).
+
+    :param table: the raw ``[method]`` table; :param spec: the spec (its ``[system]`` and
+    ``[sets]`` are already parsed). Returns the typed :class:`Options`."""
     s = spec.system
+    for old in ("f", "h"):
+        if table.has(old):
+            raise table.error(
+                old,
+                f"has moved: the plant's {old} lives in [system] ({old} = [...]); "
+                "only the observer map F stays in [method]",
+            )
     if not s.discrete:
         raise table.error(
             "key",
@@ -82,6 +96,14 @@ def parse_options(table: Table, spec: Spec) -> Options:
     from obsdesign.methods.constrained.nonlinear import parse_model
 
     model = parse_model(table, spec)
+    for k, v, expr in (("A", s.A, model.f), ("C", s.C, model.h)):
+        if v is None and (expr is None or model.F is None):
+            raise SpecError(
+                spec.file,
+                f"system.{k}",
+                "is missing: the linear plant/observer needs A and C "
+                "(give f, h in [system] and F in [method] for an expression-defined one)",
+            )
     if model.F is None or table.has("L"):
         L = table.matrix("L", rows=n, cols=s.p, vector_as="column").q
     else:
@@ -256,7 +278,12 @@ def parse_cmap(t: Table, n: int) -> ConstraintMap:
 
 
 def parse_sim(table: Table, spec: Spec) -> SimOptions:
-    """``[simulate]`` keys of this method: theta_m (int or list), gamma, saturation_r."""
+    """``[simulate]`` keys of this method: theta_m (int or list), gamma, saturation_r
+    (Section 5 / Table 1 and eq. (29) of the constrained-redesign paper, Astolfi et al.,
+    NOLCOS 2019).
+
+    :param table: the raw ``[simulate]`` table; :param spec: the spec (for n). Returns the
+    options; the spec is not modified."""
     out = SimOptions()
     if table.has("theta_m"):
         v = table.data["theta_m"]
@@ -303,3 +330,76 @@ def _short_up(t: fmpq) -> fmpq:
     from obsdesign.methods.constrained.bounds import round_sig
 
     return round_sig(t, 12, up=True)
+
+
+def options_schema(key: str) -> dict[str, Any]:
+    """JSON schema of ``[method]`` (the shared NUM / VEC / MAT / EXPRS fragments)."""
+    from obsdesign.spec.schema import EXPRS, MAT, NUM, VEC
+
+    bounds = {
+        "type": "object",
+        "required": ["lower", "upper"],
+        "additionalProperties": False,
+        "properties": {"lower": VEC, "upper": VEC},
+    }
+    return {
+        "type": "object",
+        "required": ["key", "X", "c", "eps_min"],
+        "additionalProperties": False,
+        "properties": {
+            "key": {"const": key},
+            "L": MAT,
+            "lambda": {**NUM, "exclusiveMinimum": 0, "exclusiveMaximum": 1},
+            "rho": {**NUM, "minimum": 0, "exclusiveMaximum": 1},
+            "P": MAT,
+            "mu": {**NUM, "minimum": 0},
+            "X": {"type": "string"},
+            "Xhat": {"type": "string"},
+            "X0": {"type": "string"},
+            "Xhat0": {"type": "string"},
+            "eps_min": {**NUM, "exclusiveMinimum": 0},
+            "eps_max": {**NUM, "exclusiveMinimum": 0},
+            "gamma": {**NUM, "exclusiveMinimum": 0},
+            "gamma_uncertified": {"type": "boolean"},
+            "margin": {**NUM, "minimum": 0},
+            "rate_tol": {**NUM, "exclusiveMinimum": 0},
+            "c": {
+                "type": "object",
+                "required": ["type"],
+                "additionalProperties": False,
+                "properties": {
+                    "type": {"enum": list(KINDS)},
+                    "norm": {"enum": ["euclidean", "max"]},
+                    "lower": VEC,
+                    "upper": VEC,
+                    "G": MAT,
+                    "h": VEC,
+                    "Q": MAT,
+                    "r": {**NUM, "exclusiveMinimum": 0},
+                },
+            },
+            "D": bounds,
+            "U": bounds,
+            "F": {**EXPRS, "description": "observer map x̂⁺ = F(x̂, u, y) (x1_hat…, u1…, y1…)"},
+        },
+    }
+
+
+def simulate_schema() -> dict[str, Any]:
+    """JSON-schema properties of the method's own ``[simulate]`` keys."""
+    from obsdesign.spec.schema import NUM, VEC
+
+    return {
+        "theta_m": {
+            "anyOf": [
+                {"type": "integer", "minimum": 0},
+                {"type": "array", "items": {"type": "integer", "minimum": 0}, "minItems": 1},
+            ],
+            "description": "refining steps per sample (one modified observer per value)",
+        },
+        "gamma": {**NUM, "exclusiveMinimum": 0, "description": "simulation-only γ"},
+        "saturation_r": {
+            "anyOf": [NUM, VEC],
+            "description": "level r of the saturated observer (29)",
+        },
+    }

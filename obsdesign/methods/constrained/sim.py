@@ -11,7 +11,6 @@ import numpy as np
 from obsdesign.certify.exact import Q, to_float
 from obsdesign.errors import InputError
 from obsdesign.methods.constrained import bounds as B
-from obsdesign.methods.constrained.claims import _q
 from obsdesign.methods.constrained.design import xhat_set
 from obsdesign.methods.constrained.observer import LinearF, Refiner, Trace, run_observer
 from obsdesign.methods.constrained.options import Options, SimOptions
@@ -25,55 +24,63 @@ THETA_CAP = 10_000
 
 
 def _exact(params: Parameters, k: str) -> Any:
-    v = params[k]
-    return v if params.is_exact(k) else Q(float(np.asarray(v, dtype=float)))
+    """Parameter ``k`` exactly (a float-only value at its exact binary value)."""
+    v = params.exact(k, [])
+    if v is None:
+        raise InputError(f"report: parameter {k!r} is missing")
+    return v
 
 
-def _ints(v: Any, key: str) -> list[int]:
+def theta_list(text: str) -> list[int]:
+    """``--option theta_m=10,3``: step budgets θ_m (non-negative integers, comma separated).
+
+    :param text: the option's text. Raises :class:`InputError` naming the key."""
     try:
-        vals = [int(x) for x in str(v).replace(";", ",").split(",") if x.strip()]
+        vals = [int(x) for x in str(text).replace(";", ",").split(",") if x.strip()]
     except ValueError:
         raise InputError(
-            f"--option {key}: expected integers separated by commas, got {v!r}"
+            f"--option theta_m: expected integers separated by commas, got {text!r}"
         ) from None
     if not vals or any(x < 0 for x in vals):
-        raise InputError(f"--option {key}: expected non-negative integers, got {v!r}")
+        raise InputError(f"--option theta_m: expected non-negative integers, got {text!r}")
     return vals
 
 
-def _float(v: Any, key: str) -> float:
-    try:
-        f = float(v)
-    except (TypeError, ValueError):
-        raise InputError(f"--option {key}: expected a number, got {v!r}") from None
-    if not np.isfinite(f) or f <= 0:
+def _positive(v: float, key: str) -> float:
+    if not v > 0:
         raise InputError(f"--option {key}: expected a positive number, got {v!r}")
-    return f
+    return float(v)
 
 
-def simulate(spec: Spec, params: Parameters, **kw: Any) -> SimResult:
-    """Run plant + the three observers; ``kw`` (CLI ``--option``): theta_m (comma list), gamma,
-    saturation_r. Table 1 numbers go to ``info``."""
-    unknown = set(kw) - {"theta_m", "gamma", "saturation_r"}
-    if unknown:
-        raise InputError(
-            f"unknown simulation option(s): {', '.join(sorted(unknown))} (known: theta_m, gamma, saturation_r)"
-        )
+def simulate(
+    spec: Spec,
+    params: Parameters,
+    theta_m: str | None = None,
+    gamma: float | None = None,
+    saturation_r: float | None = None,
+) -> SimResult:
+    """Run the plant and three observers on one trajectory: the unmodified observer (2), the
+    modified observer (8)-(10) with G of eq. (23) and a budget θ_m per sample, and the naive
+    saturated observer (29) (Section 5, Table 1, Fig. 3 of the constrained-redesign paper,
+    Astolfi et al., NOLCOS 2019). Table 1 numbers go to ``info``.
+
+    :param spec: the bound spec (its ``[simulate]`` and method options);
+    :param params: the design's parameters (P, γ, θ, ε_min, ε_max, δ²);
+    :param theta_m: ``--option theta_m`` (comma list), overrides ``[simulate] theta_m``;
+    :param gamma: ``--option gamma``, a simulation-only γ (reported UNCERTIFIED above (24));
+    :param saturation_r: ``--option saturation_r``, the level r of (29)."""
     o: Options = spec.options
-    so: SimOptions = o.sim or SimOptions()
     s, sm = spec.system, spec.simulate
     assert sm is not None
+    so: SimOptions = sm.options if isinstance(sm.options, SimOptions) else SimOptions()
     theta = int(Q(_exact(params, "theta")))
-    thetas = (
-        _ints(kw["theta_m"], "theta_m")
-        if "theta_m" in kw
-        else (so.theta_m or [min(theta, THETA_CAP)])
-    )
-    P = _q(params, "P")
+    from_option = theta_m is not None
+    thetas = theta_list(theta_m) if theta_m is not None else (so.theta_m or [min(theta, THETA_CAP)])
+    P = _exact(params, "P")
     Pinv = np.asarray(to_float(B.qinv(P)), dtype=float)  # exact inverse of the exact P, then float
     gamma_c = Q(_exact(params, "gamma"))
-    if "gamma" in kw:
-        gamma_q = Q(_float(kw["gamma"], "gamma"))
+    if gamma is not None:
+        gamma_q = Q(_positive(gamma, "gamma"))
     elif so.gamma is not None:
         gamma_q = so.gamma
     else:
@@ -83,8 +90,8 @@ def simulate(spec: Spec, params: Parameters, **kw: Any) -> SimResult:
     eps_min = float(Q(_exact(params, "eps_min")))
     eps_max = float(Q(_exact(params, "eps_max")))
     sat_r = (
-        np.array([_float(kw["saturation_r"], "saturation_r")])
-        if "saturation_r" in kw
+        np.array([_positive(saturation_r, "saturation_r")])
+        if saturation_r is not None
         else so.saturation_r
     )
 
@@ -119,7 +126,7 @@ def simulate(spec: Spec, params: Parameters, **kw: Any) -> SimResult:
         "theta_m": ", ".join(map(str, thetas))
         + (
             f" (θ capped at {THETA_CAP}: pass theta_m to choose)"
-            if not so.theta_m and "theta_m" not in kw and theta > THETA_CAP
+            if not so.theta_m and not from_option and theta > THETA_CAP
             else ""
         ),
         "gamma (simulation)": f"{float(gamma_q):.6g}"
@@ -177,8 +184,12 @@ def _v_increase(tr: Trace, x: np.ndarray, P: np.ndarray) -> float:
 
 
 def plot(spec: Spec, res: SimResult, path: Any) -> Any:
-    """Fig. 3 a)-c): error of the unmodified and modified observers, refining steps per sample,
-    and the path of x̂_{k,i} in the plane of the first two states with X̂ and C_min."""
+    """Fig. 3 a)-c) of the constrained-redesign paper (Astolfi et al., NOLCOS 2019): error of
+    the unmodified and modified observers, refining steps per sample, and the path of x̂_{k,i}
+    in the plane of the first two states with C_min.
+
+    :param spec: the bound spec; :param res: what :func:`simulate` returned; :param path: the
+    image file to write."""
     import matplotlib
 
     matplotlib.use("Agg")
