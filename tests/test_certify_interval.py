@@ -1,24 +1,119 @@
-"""Outward-rounded bounds (obsdesign.certify.interval)."""
+"""Outward-rounded bounds (obsdesign.certify.interval), checked in EXACT arithmetic.
+
+Every direction test compares with an independent oracle built from exact rationals only
+(Taylor series of exp with a rigorous remainder, squared back with outward rounding), never with
+floats: a bound that is wrong by 1e-34 (a swapped ``log_upper`` / ``log_lower``) is caught.
+"""
 
 from __future__ import annotations
 
 import math
 
+import pytest
 from flint import fmpq
 from hypothesis import given
 from hypothesis import strategies as st
 from mpmath import iv
 
+from obsdesign.certify import interval
 from obsdesign.certify.interval import (
+    PREC,
     bounds,
     ceil_int,
+    exp_lower,
+    exp_upper,
     log_lower,
     log_upper,
+    lower,
+    q_to_iv,
+    raw_to_q,
     round_down,
     round_up,
     sqrt_lower,
     sqrt_upper,
+    upper,
 )
+
+F = fmpq
+BITS = 600  # the oracle rounds outward to BITS significant bits
+
+
+def _scale(q: fmpq) -> fmpq:
+    e = int(q.p).bit_length() - int(q.q).bit_length()
+    return F(2) ** (BITS - e)
+
+
+def _floor(q: fmpq) -> fmpq:
+    s = _scale(q)
+    return F(int((q * s).floor())) / s
+
+
+def _ceil(q: fmpq) -> fmpq:
+    s = _scale(q)
+    return F(int((q * s).ceil())) / s
+
+
+def exp_enclosure(r: fmpq) -> tuple[fmpq, fmpq]:
+    """Exact rationals lo ≤ e^r ≤ hi (relative width < 2^-500 for |r| ≤ 40), no floats.
+
+    e^s for |s| ≤ 1/2 by its Taylor polynomial of degree 90 with the remainder bound
+    |R| ≤ 2 |s|^91 / 91!, then e^r = (e^s)^(2^m) squared with outward rounding.
+    """
+    m = 0
+    while abs(r) / 2**m > F(1, 2):
+        m += 1
+    s = r / 2**m
+    term, total = F(1), F(1)
+    for k in range(1, 91):
+        term = term * s / k
+        total += term
+    rem = 2 * abs(s) ** 91 / math.factorial(91)
+    lo, hi = _floor(total - rem), _ceil(total + rem)
+    assert lo > 0
+    for _ in range(m):
+        lo, hi = _floor(lo * lo), _ceil(hi * hi)
+    return lo, hi
+
+
+def test_oracle_is_sound_on_known_values():
+    lo, hi = exp_enclosure(F(0))
+    assert lo <= 1 <= hi
+    lo, hi = exp_enclosure(F(1))  # e = 2.718281828459045235360287471352662497757…
+    e39 = F(2718281828459045235360287471352662497757, 10**39)  # e truncated to 39 decimals
+    assert e39 < lo and hi < e39 + F(1, 10**39)
+    assert hi - lo < F(1, 2**500)
+
+
+rationals = st.builds(F, st.integers(1, 10**9), st.integers(1, 10**6))
+
+
+@given(rationals)
+def test_log_bounds_direction_exact(x: fmpq):
+    lo, hi = log_lower(x), log_upper(x)
+    # lo ≤ ln x  ⟸  e^lo ≤ x ;  ln x ≤ hi  ⟸  x ≤ e^hi   (exact comparisons)
+    assert exp_enclosure(lo)[1] <= x, "log_lower is above ln x"
+    assert x <= exp_enclosure(hi)[0], "log_upper is below ln x"
+    assert hi - lo <= F(1, 2**100) * (1 + abs(hi))
+    if x != 1:  # ln x is irrational: both bounds are strict
+        assert lo < hi
+
+
+@given(st.builds(F, st.integers(-40 * 10**6, 40 * 10**6), st.just(10**6)))
+def test_exp_bounds_direction_exact(r: fmpq):
+    lo, hi = exp_lower(r), exp_upper(r)
+    olo, ohi = exp_enclosure(r)
+    assert lo <= olo and ohi <= hi
+    assert lo > 0 and hi - lo <= F(1, 2**100) * hi
+
+
+def test_log_and_exp_known_points():
+    assert log_lower(1) <= 0 <= log_upper(1)
+    for x in (F(3), F(1, 3), F(10**30), F(1, 10**30), F(2**200 + 1, 2**200)):
+        lo, hi = log_lower(x), log_upper(x)
+        assert exp_enclosure(lo)[1] < x < exp_enclosure(hi)[0]
+    for r in (F(-30), F(1, 7), F(25)):
+        assert exp_lower(r) < exp_enclosure(r)[0] and exp_enclosure(r)[1] < exp_upper(r)
+    assert exp_lower(0) <= 1 <= exp_upper(0)
 
 
 @given(st.integers(1, 10**9), st.integers(1, 10**6))
@@ -29,15 +124,66 @@ def test_sqrt_bounds_bracket(p: int, q: int):
     assert hi - lo < fmpq(1, 10**20) * (1 + hi)
 
 
-def test_log_bounds():
-    lo, hi = log_lower(fmpq(3)), log_upper(fmpq(3))
-    assert lo <= hi and float(lo) <= math.log(3) <= float(hi)
+def test_sqrt_strict_on_non_squares():
+    for x in (F(2), F(1, 3), F(10**40 + 1), F(7, 10**40)):
+        lo, hi = sqrt_lower(x), sqrt_upper(x)
+        assert lo * lo < x < hi * hi
+    assert sqrt_lower(F(9, 4)) <= F(3, 2) <= sqrt_upper(F(9, 4))
 
 
-def test_composite_expression():
-    lo, hi = bounds(lambda a, b: iv.log(a) / b + iv.sqrt(b), fmpq(25), fmpq(1, 7))
-    val = math.log(25) * 7 + math.sqrt(1 / 7)
-    assert float(lo) <= val <= float(hi)
+def test_precision_is_113_bits_and_restored():
+    assert PREC == 113
+    lo, hi = sqrt_lower(2), sqrt_upper(2)
+    assert hi - lo == F(1, 2**112)  # one ulp of a 113-bit float in [1, 2)
+    for v in (lo, hi):
+        assert 2**112 % int(v.q) == 0 and int(v.p).bit_length() <= 113
+    saved = iv.prec
+    iv.prec = 30
+    try:
+        log_upper(5)
+        assert iv.prec == 30  # restored after the call
+        with interval._prec():
+            assert iv.prec == PREC
+        assert iv.prec == 30
+    finally:
+        iv.prec = saved
+
+
+def test_q_to_iv_encloses_the_rational():
+    for x in (F(1, 3), F(-(10**50) - 1, 3), F(2**300 + 1, 2**301), F(0), F(7)):
+        lo, hi = q_to_iv(x)._mpi_
+        assert raw_to_q(lo) <= x <= raw_to_q(hi)
+    lo, hi = q_to_iv(F(7))._mpi_
+    assert raw_to_q(lo) == raw_to_q(hi) == 7
+    assert q_to_iv("1/4")._mpi_[0] == q_to_iv(0.25)._mpi_[1]
+
+
+def test_raw_to_q_values():
+    from mpmath.libmp import finf, fnan, fninf, from_int, from_rational
+
+    assert raw_to_q(from_int(12)) == 12
+    assert raw_to_q(from_int(-12)) == -12
+    assert raw_to_q(from_int(3 * 2**70)) == 3 * 2**70
+    assert raw_to_q(from_rational(3, 8, 53)) == F(3, 8)
+    assert raw_to_q(from_rational(-5, 64, 53)) == F(-5, 64)
+    for bad in (finf, fninf, fnan):
+        with pytest.raises(ArithmeticError, match="did not give a finite enclosure"):
+            raw_to_q(bad)
+
+
+def test_generic_bounds():
+    assert bounds(lambda a: 2, 3) == (2, 2)  # a constant becomes an interval
+    assert lower(lambda a: -a, 3) == -3 and upper(lambda a: -a, 3) == -3
+    lo, hi = bounds(lambda a, b: a / b, 1, 3)
+    assert lo < F(1, 3) < hi
+    with pytest.raises(ArithmeticError):
+        log_upper(0)
+    with pytest.raises(ArithmeticError):
+        lower(iv.log, 0)
+    # a composite expression, checked exactly: e^(1/7) * 25 via the oracle
+    lo, hi = bounds(lambda a, b: iv.exp(a) * b, F(1, 7), F(25))
+    olo, ohi = exp_enclosure(F(1, 7))
+    assert lo <= 25 * olo and 25 * ohi <= hi
 
 
 def test_rounding_directions():
@@ -46,4 +192,16 @@ def test_rounding_directions():
     assert round_up(fmpq(-1, 3), 2) == fmpq(-33, 100)
     assert round_down(fmpq(-1, 3), 2) == fmpq(-34, 100)
     assert round_up(fmpq(1, 2), 1) == fmpq(1, 2)
-    assert ceil_int(fmpq(7, 2)) == 4 and ceil_int(fmpq(4)) == 4
+    assert round_down(fmpq(1, 2), 1) == fmpq(1, 2)
+    assert round_up(fmpq(12345, 1), -2) == 12400 and round_down(fmpq(12345), -2) == 12300
+    assert round_up(0.1, 0) == 1 and round_down(0.1, 0) == 0
+    assert ceil_int(fmpq(7, 2)) == 4 and ceil_int(fmpq(4)) == 4 and ceil_int(-0.5) == 0
+    assert isinstance(ceil_int(F(1, 2)), int)
+
+
+@given(st.builds(F, st.integers(-(10**12), 10**12), st.integers(1, 10**6)), st.integers(0, 8))
+def test_rounding_property(x: fmpq, d: int):
+    up, down = round_up(x, d), round_down(x, d)
+    step = F(1, 10**d)
+    assert down <= x <= up and up - down <= step and (up * 10**d).q == 1
+    assert (down * 10**d).q == 1

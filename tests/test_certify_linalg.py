@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from flint import fmpq
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from obsdesign.certify.exact import qeye, qmat
+from obsdesign.certify.exact import Q, dyadic, qeye, qmat
 from obsdesign.certify.linalg import norm_bound_holds, norm_upper, qinv, qrank
+
+F = fmpq
 
 
 @settings(max_examples=30, deadline=None)
@@ -23,6 +26,31 @@ def test_inverse_and_rank(n: int, seed: int):
         assert (M @ qinv(M) == qeye(n)).all()
 
 
+def test_inverse_known_answers():
+    inv = qinv(qmat([[2, 1], [1, 1]]))
+    assert (inv == qmat([[1, -1], [-1, 2]])).all()
+    assert all(isinstance(v, fmpq) for v in inv.flat)
+    # float input is inverted exactly (0.1 is its binary value)
+    inv = qinv([[0.1]])
+    assert inv[0, 0] == 1 / Q(0.1)
+    inv = qinv([[F(1, 3), 0], [0, 4]])
+    assert (inv == qmat([[3, 0], [0, F(1, 4)]])).all()
+    with pytest.raises(ZeroDivisionError):
+        qinv(qmat([[1, 2], [2, 4]]))
+
+
+def test_rank_known_answers():
+    assert qrank([[1, 2, 3], [2, 4, 6]]) == 1
+    assert qrank([[1, 2, 3], [2, 4, 7]]) == 2
+    assert qrank(qmat([[1, 1], [1, 1 + F(1, 2**80)]])) == 2  # float rank would say 1
+    assert qrank([[1.0, 1.0], [1.0, 1.0 + 2.0**-52]]) == 2
+    assert qrank(np.empty((0, 3), dtype=object)) == 0
+    assert qrank(np.empty((3, 0), dtype=object)) == 0
+    assert qrank([[0, 0], [0, 0]]) == 0
+    assert qrank([[0, 0, 1]]) == 1
+    assert isinstance(qrank([[1]]), int)
+
+
 @settings(max_examples=30, deadline=None)
 @given(st.integers(1, 5), st.integers(1, 5), st.integers(0, 2**31 - 1))
 def test_norm_upper_is_a_tight_proved_bound(r: int, c: int, seed: int):
@@ -30,11 +58,81 @@ def test_norm_upper_is_a_tight_proved_bound(r: int, c: int, seed: int):
     Xq = qmat(X)
     u = norm_upper(Xq)
     assert norm_bound_holds(Xq, u)
+    assert norm_bound_holds(X, u)  # float input: converted exactly, same answer
     f = np.linalg.norm(X, 2)
     assert f <= float(u) <= f * (1 + 1e-6) + 1e-9
     assert not norm_bound_holds(Xq, u * fmpq(999, 1000)) or f < 1e-9
 
 
-def test_norm_of_zero_and_empty():
+def test_norm_bound_known_answers():
+    X = qmat([[3, 0], [0, 4]])  # ‖X‖ = 4
+    assert norm_bound_holds(X, 4)
+    assert not norm_bound_holds(X, 4 - F(1, 10**40))
+    assert norm_bound_holds(X, F(9, 2))
+    X = qmat([[1, 1], [0, 0]])  # ‖X‖ = √2
+    assert norm_bound_holds(X, F(99, 70)) and not norm_bound_holds(X, F(140, 99))
+    X = qmat([[1, 2, 2]])  # a non-square matrix, ‖X‖ = 3 (Gram is 3x3)
+    assert norm_bound_holds(X, 3) and not norm_bound_holds(X, 3 - F(1, 10**30))
+    assert norm_bound_holds(X.T, 3) and not norm_bound_holds(X.T, 3 - F(1, 10**30))
+    # a negative u is never a bound, not even of the zero matrix (callers pass λ − ℓ)
+    assert not norm_bound_holds(qmat([[0, 0]]), -F(1, 10**30))
+    assert not norm_bound_holds(qmat([[0, 0]]), -1)
+    assert not norm_bound_holds(np.empty((0, 2), dtype=object), -1)
+    assert not norm_bound_holds(qmat([[1]]), -1)  # |−1| ≥ 1 would pass u² ≥ 1
+    assert not norm_bound_holds(qmat([[F(1, 2)]]), -1)
+    assert norm_bound_holds(qmat([[0, 0]]), 0)
+    assert norm_bound_holds(np.empty((0, 2), dtype=object), 0)
+    assert norm_bound_holds(qmat([[1]]), 1) and not norm_bound_holds(qmat([[1]]), F(1, 2))
+    assert norm_bound_holds(qmat([[F(1, 2)]]), 1)
+    # u given as a float or a string is exact as well
+    assert norm_bound_holds([[0.1]], 0.1) and not norm_bound_holds([[0.1]], "0.1")
+    assert isinstance(norm_bound_holds(qmat([[1]]), 1), bool)
+
+
+def test_norm_upper_known_values():
+    """The schedule of the first candidate: f(1 + 2^-30) + 2^-40 on a 30-bit dyadic grid."""
+    assert norm_upper(qmat([[1]])) == 1 + F(1, 2**29)
+    assert norm_upper(qmat([[2**-50]])) == F(1, 2**40) + F(1, 2**50)
     assert norm_upper(qmat([[0, 0]])) == 0
     assert norm_upper(np.empty((0, 2), dtype=object)) == 0
+    # a nonzero matrix whose float image is zero still gets a proved positive bound
+    tiny = qmat([[F(1, 10**400)]])
+    u = norm_upper(tiny)
+    assert u == F(1, 2**40) and norm_bound_holds(tiny, u)
+    assert norm_upper([[3.0, 0.0], [0.0, -4.0]]) >= 4
+
+
+def _schedule(u0: fmpq, steps: int) -> list[fmpq]:
+    out = [u0]
+    for _ in range(steps):
+        out.append(out[-1] * F(1025, 1024) + F(1, 2**30))
+    return out
+
+
+def test_norm_upper_recovers_from_a_low_float_estimate(monkeypatch):
+    """When the float norm is too low, the candidate grows by 1025/1024 (+2^-30) per step."""
+    monkeypatch.setattr(np.linalg, "norm", lambda *a, **k: 0.98)
+    u = norm_upper(qmat([[1]]))
+    sched = _schedule(Q(dyadic(0.98 * (1 + 2.0**-30) + 2.0**-40, 30)), 39)
+    first = next(i for i, v in enumerate(sched) if v >= 1)
+    assert u == sched[first] and u >= 1 and sched[first - 1] < 1
+
+
+def test_norm_upper_gives_up_after_40_candidates(monkeypatch):
+    X = qmat([[1]])
+    # find a float estimate whose 40th candidate (index 39) is < 1 but whose 41st is ≥ 1
+    lo, hi = 0.9, 1.0
+    for _ in range(60):
+        mid = (lo + hi) / 2
+        s = _schedule(Q(dyadic(mid * (1 + 2.0**-30) + 2.0**-40, 30)), 40)
+        if s[39] < 1:
+            lo = mid
+        else:
+            hi = mid
+    s = _schedule(Q(dyadic(lo * (1 + 2.0**-30) + 2.0**-40, 30)), 40)
+    assert s[39] < 1 <= s[40]
+    monkeypatch.setattr(np.linalg, "norm", lambda *a, **k: lo)
+    with pytest.raises(ArithmeticError, match="could not certify a norm bound"):
+        norm_upper(X)
+    monkeypatch.setattr(np.linalg, "norm", lambda *a, **k: hi)
+    assert norm_upper(X) >= 1

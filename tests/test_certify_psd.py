@@ -1,42 +1,224 @@
-"""Exact PD/PSD tests (obsdesign.certify.psd)."""
+"""Exact PD/PSD tests (obsdesign.certify.psd): a known-answer table and negative cases.
+
+Every case has an answer known exactly (by hand: determinants, eigenvalues of small rational
+matrices); the table includes the broken-certificate cases of issue 15 (zero pivot with a
+nonzero off-diagonal, the skipped elimination, float input, asymmetry) and margins exactly at
+the boundary of definiteness.
+"""
 
 from __future__ import annotations
 
+from fractions import Fraction
+
 import numpy as np
+import pytest
 from flint import fmpq
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from obsdesign.certify.exact import qeye, qmat
-from obsdesign.certify.psd import check_pd, check_psd, ldl_pivots
+from obsdesign.certify.psd import PSDResult, check_pd, check_psd, ldl_pivots
+
+F = fmpq
+THIRD_FLOAT = 1 / 3  # 0.333…3148 < 1/3 exactly
+
+# (name, matrix, psd, pd): exact answers.
+TABLE = [
+    ("zero-diag-swap [[0,1],[1,0]] (eigenvalues ±1)", [[0, 1], [1, 0]], False, False),
+    ("zero first pivot, coupling [[0,1],[1,5]] (det -1)", [[0, 1], [1, 5]], False, False),
+    ("needs elimination [[2,2],[2,1]] (det -2)", [[2, 2], [2, 1]], False, False),
+    ("needs elimination [[1,2],[2,1]] (det -3)", [[1, 2], [2, 1]], False, False),
+    (
+        "float input [[3.0,1.0],[1.0,fl(1/3)]] (det = 3 fl(1/3) - 1 < 0)",
+        [[3.0, 1.0], [1.0, THIRD_FLOAT]],
+        False,
+        False,
+    ),
+    ("exact [[3,1],[1,1/3]] (singular PSD)", [[3, 1], [1, F(1, 3)]], True, False),
+    ("singular 3x3 [[1,1,0],[1,1,0],[0,0,2]]", [[1, 1, 0], [1, 1, 0], [0, 0, 2]], True, False),
+    ("zero after one step, coupled rest (det -1)", [[1, 1, 1], [1, 1, 0], [1, 0, 1]], False, False),
+    ("rank one [[1,2],[2,4]]", [[1, 2], [2, 4]], True, False),
+    ("rank one [[4,2],[2,1]]", [[4, 2], [2, 1]], True, False),
+    ("zero 2x2", [[0, 0], [0, 0]], True, False),
+    ("[[0]]", [[0]], True, False),
+    ("[[-1]]", [[-1]], False, False),
+    ("[[1]]", [[1]], True, True),
+    ("[[0,0],[0,1]] (PSD, zero leading pivot)", [[0, 0], [0, 1]], True, False),
+    ("[[1,0],[0,0]]", [[1, 0], [0, 0]], True, False),
+    ("[[1,0],[0,-1/10^30]]", [[1, 0], [0, F(-1, 10**30)]], False, False),
+    ("[[2,1],[1,2]] (eigenvalues 1, 3)", [[2, 1], [1, 2]], True, True),
+    ("[[4,2,2],[2,5,1],[2,1,6]]", [[4, 2, 2], [2, 5, 1], [2, 1, 6]], True, True),
+    ("[[1,1],[1,1+2^-60]] (PD, float-singular)", [[1, 1], [1, 1 + F(1, 2**60)]], True, True),
+    ("[[1,1],[1,1-2^-60]] (indefinite)", [[1, 1], [1, 1 - F(1, 2**60)]], False, False),
+    ("diag(2, 0, 3) singular", [[2, 0, 0], [0, 0, 0], [0, 0, 3]], True, False),
+    ("diag(3, -1/7, 2)", [[3, 0, 0], [0, F(-1, 7), 0], [0, 0, 2]], False, False),
+    # det = 5x - 7 with leading minors 3, 5: x = 7/5 is singular PSD of rank 2
+    (
+        "rank 2 [[3,1,1],[1,2,-1],[1,-1,7/5]]",
+        [[3, 1, 1], [1, 2, -1], [1, -1, F(7, 5)]],
+        True,
+        False,
+    ),
+    (
+        "negative only after elimination [[1,1,0],[1,2,1],[0,1,1/2]] (det -1/2)",
+        [[1, 1, 0], [1, 2, 1], [0, 1, F(1, 2)]],
+        False,
+        False,
+    ),
+]
 
 
-def test_pd_identity_and_margin():
-    assert check_pd(qeye(4)).ok
-    assert check_pd(qeye(4), fmpq(1, 2)).ok
-    assert not check_pd(qeye(4), 1).ok  # I - I = 0 is not PD
+def _det(M: np.ndarray) -> fmpq:
+    from flint import fmpq_mat
+
+    n = M.shape[0]
+    return fmpq_mat(n, n, list(M.flat)).det()
 
 
-def test_psd_singular_is_psd_not_pd():
+@pytest.mark.parametrize(("name", "M", "psd", "pd"), TABLE, ids=[t[0] for t in TABLE])
+def test_known_answers(name: str, M: list, psd: bool, pd: bool):
+    r_psd, r_pd = check_psd(M), check_pd(M)
+    assert r_psd.ok is psd, (name, r_psd)
+    assert r_pd.ok is pd, (name, r_pd)
+    assert bool(r_psd) is psd and bool(r_pd) is pd
+    # the same answers for the exact transpose-symmetric input given as fmpq
+    Mq = qmat(M)
+    assert check_psd(Mq).ok is psd and check_pd(Mq).ok is pd
+    # and an independent exact oracle: the leading minors / all principal minors
+    assert _pd_by_minors(Mq) is pd
+    assert _psd_by_principal_minors(Mq) is psd
+
+
+def _pd_by_minors(M: np.ndarray) -> bool:
+    n = M.shape[0]
+    return all(_det(M[:k, :k]) > 0 for k in range(1, n + 1))
+
+
+def _psd_by_principal_minors(M: np.ndarray) -> bool:
+    from itertools import combinations
+
+    n = M.shape[0]
+    for k in range(1, n + 1):
+        for S in combinations(range(n), k):
+            if _det(M[np.ix_(S, S)]) < 0:
+                return False
+    return True
+
+
+def test_details_and_pivots():
+    r = check_psd([[0, 1], [1, 0]])
+    assert r == PSDResult(False, 0.0, "zero pivot with a nonzero off-diagonal entry")
+    r = check_psd([[2, 2], [2, 1]])
+    assert r.min_pivot == -1.0
+    assert r.detail == "negative diagonal -1 after elimination"
+    r = check_psd([[1, 1, 0], [1, 1, 0], [0, 0, 2]])
+    assert r == PSDResult(True, 0.0, "PSD, rank 2")
+    assert check_psd([[0, 0], [0, 0]]).detail == "PSD, rank 0"
+    r = check_psd([[2, 0], [0, 3]])
+    assert r == PSDResult(True, 2.0, "PSD (full rank)")
+    r = check_psd([[5, 0, 0], [0, 3, 0], [0, 0, 4]])
+    assert r.min_pivot == 3.0 and r.ok
+    r = check_psd(np.empty((0, 0), dtype=object))
+    assert r == PSDResult(True, 0.0, "PSD (full rank)")
+    r = check_pd(np.empty((0, 0), dtype=object))
+    assert r == PSDResult(True, float("inf"), "empty matrix")
+    r = check_pd([[2, 1], [1, 2]])
+    assert r == PSDResult(True, 1.5, "all 2 LDLᵀ pivots > 0 (min 1.5)")
+    r = check_pd([[1, 0, 0], [0, 1, 0], [0, 0, 0]])
+    assert r == PSDResult(False, 0.0, "LDLᵀ pivot 2 = 0 <= 0")
+    r = check_pd([[1, 2], [2, 1]])
+    assert r == PSDResult(False, -3.0, "LDLᵀ pivot 1 = -3 <= 0")
+    r = check_pd([[-2]])
+    assert r == PSDResult(False, -2.0, "LDLᵀ pivot 0 = -2 <= 0")
+
+
+def test_ldl_pivots_exact():
+    assert ldl_pivots([[2, 1], [1, 2]]) == [F(2), F(3, 2)]
+    assert ldl_pivots([[4, 2, 2], [2, 5, 1], [2, 1, 6]]) == [F(4), F(4), F(5)]
+    # stops at the first non-positive pivot (no division by zero)
+    assert ldl_pivots([[0, 1], [1, 0]]) == [F(0)]
+    assert ldl_pivots([[1, 1, 5], [1, 1, 2], [5, 2, 9]]) == [F(1), F(0)]
+    assert ldl_pivots([[1, 2], [2, 1]]) == [F(1), F(-3)]
+    # [[2,2],[2,1]]: the elimination step cannot be skipped
+    assert ldl_pivots([[2, 2], [2, 1]]) == [F(2), F(-1)]
+    # a zero in column k must not stop the update of later columns
+    assert ldl_pivots([[1, 0, 1], [0, 1, 1], [1, 1, 3]]) == [F(1), F(1), F(1)]
+    assert ldl_pivots([[2, 0, 2], [0, 1, 0], [2, 0, 3]]) == [F(2), F(1), F(1)]
+    assert ldl_pivots(np.empty((0, 0), dtype=object)) == []
+
+
+@pytest.mark.parametrize("check", [check_psd, check_pd])
+def test_asymmetric_rejected(check):
+    for M in ([[2, 1], [0, 2]], [[2, 0], [1, 2]], [[1, 0, 0], [0, 1, 0], [0, F(1, 10**40), 1]]):
+        r = check(M)
+        assert not r.ok and "not symmetric" in r.detail, r
+        assert np.isnan(r.min_pivot)
+    r = check([[1, 0, 0], [0, 1, 2], [0, 3, 1]])
+    assert r.detail == "not symmetric at (1, 2)"
+    r = check([[1, 5, 0], [6, 1, 2], [0, 2, 1]])
+    assert r.detail == "not symmetric at (0, 1)"
+    # float asymmetry below float resolution of the entries is still asymmetry
+    r = check([[1.0, 0.1], [0.1 + 2**-56, 1.0]])
+    assert not r.ok
+
+
+@pytest.mark.parametrize("check", [check_psd, check_pd])
+def test_not_square(check):
+    with pytest.raises(ValueError, match="square"):
+        check([[1, 2, 3], [4, 5, 6]])
+    with pytest.raises(ValueError, match="square"):
+        check([1, 2])
+    with pytest.raises(ValueError, match="square"):
+        ldl_pivots([[1, 2]])
+
+
+def test_float_input_is_decided_exactly():
+    M = [[3.0, 1.0], [1.0, THIRD_FLOAT]]
+    assert not check_psd(M).ok
+    assert not check_psd(np.array(M)).ok
+    assert not check_pd(np.array(M)).ok
+    assert ldl_pivots(np.array(M))[-1] < 0
+    # mixed: first entry exact, the rest float
+    Mix = [[F(3), 1.0], [1.0, THIRD_FLOAT]]
+    assert not check_psd(Mix).ok and not check_pd(Mix).ok
+    # Fractions, strings and numpy integers are converted exactly as well
+    assert check_psd([[Fraction(3), 1], [1, Fraction(1, 3)]]).ok
+    assert check_psd([["3", "1"], ["1", "1/3"]]).ok
+    assert not check_pd([["3", "1"], ["1", "1/3"]]).ok
+    assert check_pd(np.array([[2, 1], [1, 2]], dtype=np.int64)).ok
+    assert ldl_pivots([["3", "1"], ["1", "1/3"]]) == [F(3), F(0)]
+
+
+def test_margins_at_the_boundary():
+    M = qmat([[2, 1], [1, 2]])  # eigenvalues 1 and 3
+    assert check_psd(M, 1).ok  # M - I = [[1,1],[1,1]] singular PSD
+    assert not check_pd(M, 1).ok
+    tiny = F(1, 2**80)
+    assert not check_psd(M, 1 + tiny).ok  # the smallest false δ region starts right above 1
+    assert check_pd(M, 1 - tiny).ok
+    assert check_psd(M, 1 - tiny).ok
+    assert not check_pd(M, 1 + tiny).ok
+    assert check_psd(M, F(-5)).ok and check_pd(M, -5).ok
+    assert check_psd(M, "1").ok and not check_psd(M, "1.0000000001").ok
+    assert check_pd(M, 0.5).ok and check_pd(M, "0.999").ok
+    # margin 1 on I: 0 is PSD, not PD; on I/2: indefinite
+    assert check_psd(qeye(3), 1).ok and not check_pd(qeye(3), 1).ok
+    assert not check_psd(qeye(3) * F(1, 2), 1).ok
+    assert not check_pd(qeye(3) * F(1, 2), 1).ok
+    assert check_pd(qeye(4)).ok and check_pd(qeye(4), F(1, 2)).ok
+    # rational eigenvalue 1/3 of [[2/3, 1/3],[1/3, 2/3]] (eigenvalues 1/3, 1)
+    N = qmat([[F(2, 3), F(1, 3)], [F(1, 3), F(2, 3)]])
+    assert check_psd(N, F(1, 3)).ok and not check_pd(N, F(1, 3)).ok
+    assert not check_psd(N, F(1, 3) + F(1, 10**50)).ok
+    # 1x1 with margin 1: the margin must be subtracted
+    assert not check_psd([[F(1, 2)]], 1).ok and not check_pd([[F(1, 2)]], 1).ok
+    assert check_psd([[1]], 1).ok and not check_pd([[1]], 1).ok
+
+
+def test_singular_psd_is_psd_not_pd():
     M = qmat([[1, 1, 0], [1, 1, 0], [0, 0, 2]])
     assert check_psd(M).ok
     assert not check_pd(M).ok
-
-
-def test_indefinite():
-    M = qmat([[1, 2], [2, 1]])
-    assert not check_psd(M).ok
-    assert not check_pd(M).ok
-
-
-def test_zero_pivot_with_nonzero_coupling_is_not_psd():
-    M = qmat([[0, 1], [1, 5]])
-    assert not check_psd(M).ok
-
-
-def test_asymmetric_rejected():
-    r = check_pd(qmat([[2, 1], [0, 2]]))
-    assert not r.ok and "symmetric" in r.detail
 
 
 def test_badly_scaled_20x20():
@@ -46,17 +228,18 @@ def test_badly_scaled_20x20():
     M = S @ (B @ B.T + 1e-3 * np.eye(20)) @ S
     Mq = qmat(M)  # every float exactly
     Mq = (Mq + Mq.T) * fmpq(1, 2)
-    assert check_pd(Mq).ok
-    # subtract a tiny multiple of e1 e1ᵀ beyond the smallest pivot: becomes indefinite
+    assert check_pd(Mq).ok and check_psd(Mq).ok
     piv = ldl_pivots(Mq)
     assert all(p > 0 for p in piv)
     bad = Mq.copy()
     bad[19, 19] -= piv[-1] * 2
-    assert not check_pd(bad).ok
+    assert not check_pd(bad).ok and not check_psd(bad).ok
+    edge = Mq.copy()
+    edge[19, 19] -= piv[-1]  # exactly singular now
+    assert check_psd(edge).ok and not check_pd(edge).ok
 
 
 def test_exactness_beats_floats():
-    # [[1, 1], [1, 1 + 2^-60]] is PD; in float64 it rounds to a singular matrix
     eps = fmpq(1, 2**60)
     M = qmat([[1, 1], [1, 1]])
     M[1, 1] += eps
@@ -75,6 +258,19 @@ def test_random_gram_matrices(n: int, seed: int):
     v = rng.integers(-3, 4, size=n)
     N = M - qmat(np.outer(v, v)) * (1 + int(np.abs(v).sum() > 0) * 1000)
     if np.any(v):
-        # subtracting a large rank-one term makes it indefinite unless v is orthogonal to range
         ev = np.linalg.eigvalsh(np.asarray(N, dtype=float))
         assert check_psd(N).ok == bool(ev.min() >= -1e-9)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(1, 5), st.integers(1, 5), st.integers(0, 2**31 - 1))
+def test_random_low_rank_against_minors(n: int, r: int, seed: int):
+    """Low-rank Gram matrices minus a tiny shift: compare with the exact principal-minor test."""
+    rng = np.random.default_rng(seed)
+    B = qmat(rng.integers(-3, 4, size=(n, r)))
+    M = B @ B.T
+    assert check_psd(M).ok and _psd_by_principal_minors(M)
+    shift = F(int(rng.integers(-2, 3)), 7)
+    N = M - qeye(n) * shift
+    assert check_psd(N).ok is _psd_by_principal_minors(N)
+    assert check_pd(N).ok is _pd_by_minors(N)

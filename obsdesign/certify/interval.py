@@ -43,7 +43,7 @@ def raw_to_q(x: tuple) -> fmpq:
     if x in (finf, fninf, fnan):
         raise ArithmeticError("interval evaluation did not give a finite enclosure")
     sign, man, exp, _ = x
-    v = fmpq(int(man) * 2**exp) if exp >= 0 else fmpq(int(man), 2 ** (-exp))
+    v = fmpq(int(man)) * fmpq(2) ** int(exp)
     return -v if sign else v
 
 
@@ -53,8 +53,7 @@ def bounds(f: Callable[..., Any], *args: Any) -> tuple[fmpq, fmpq]:
     ``args`` are exact rationals (or anything :func:`Q` takes); ``f`` receives intervals.
     """
     with _prec():
-        r = f(*[q_to_iv(a) for a in args])
-        r = r if isinstance(r, iv.mpf) else iv.mpf(r)
+        r = iv.mpf(f(*[q_to_iv(a) for a in args]))  # a constant result becomes an interval
         lo, hi = r._mpi_
     return raw_to_q(lo), raw_to_q(hi)
 
@@ -87,6 +86,16 @@ def log_upper(x: Any) -> fmpq:
 def log_lower(x: Any) -> fmpq:
     """A rational ≤ ln x (x > 0)."""
     return lower(iv.log, x)
+
+
+def exp_upper(x: Any) -> fmpq:
+    """A rational ≥ eˣ."""
+    return upper(iv.exp, x)
+
+
+def exp_lower(x: Any) -> fmpq:
+    """A rational ≤ eˣ."""
+    return lower(iv.exp, x)
 
 
 def round_up(x: Any, digits: int) -> fmpq:

@@ -30,8 +30,12 @@ def qrank(M: Any) -> int:
 
 
 def norm_bound_holds(X: Any, u: Any) -> bool:
-    """Exact check of ‖X‖₂ ≤ u: u ≥ 0 and u² I − XᵀX ⪰ 0."""
-    X = np.asarray(X, dtype=object)
+    """Exact check of ‖X‖₂ ≤ u: u ≥ 0 and u² I − XᵀX ⪰ 0.
+
+    ``X`` (any numbers, floats by their exact binary value) and ``u`` are converted to
+    rationals first; a negative ``u`` is never a norm bound (callers pass differences such as
+    λ − ℓ, which may be negative)."""
+    X = qmat(X)
     u = Q(u)
     if u < 0:
         return False
@@ -43,7 +47,7 @@ def norm_bound_holds(X: Any, u: Any) -> bool:
 
 def norm_upper(X: Any) -> fmpq:
     """A rational u ≥ ‖X‖₂ (spectral norm), proved by u ≥ 0 and u² I − XᵀX ⪰ 0 exactly."""
-    X = np.asarray(X, dtype=object)
+    X = qmat(X)
     if X.size == 0:
         return fmpq(0)
     Xf = np.asarray(to_float(X), dtype=float)

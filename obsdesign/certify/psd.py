@@ -35,12 +35,12 @@ class PSDResult:
 
 
 def _as_q(M: Any) -> np.ndarray:
+    """Square exact matrix: every entry converted to ``fmpq`` exactly (floats by their binary
+    value), so that no decision is ever taken in floating point, whatever the input mixes."""
     arr = np.asarray(M, dtype=object)
     if arr.ndim != 2 or arr.shape[0] != arr.shape[1]:
         raise ValueError("expected a square matrix")
-    if arr.size and not isinstance(arr.flat[0], fmpq):
-        arr = qmat(arr)
-    return arr
+    return qmat(arr)
 
 
 def _symmetric(arr: np.ndarray) -> str:
