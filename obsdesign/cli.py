@@ -7,14 +7,31 @@ traceback.
 
 from __future__ import annotations
 
-import json
+import os
+import signal
 import sys
-from collections.abc import Callable
-from enum import StrEnum
-from pathlib import Path
-from typing import Annotated, Any
 
-import typer
+
+def _early_interrupt(signum: int, frame: object) -> None:  # pragma: no cover - timing
+    """Ctrl-C while the heavy modules load: one line, exit 130, no traceback."""
+    sys.stderr.write("obsdesign: interrupted\n")
+    os._exit(130)
+
+
+# installed before the heavy imports below (typer, rich, then numpy/scipy in the commands);
+# main() restores Python's handler once the command runs, so cleanup code still runs
+if signal.getsignal(signal.SIGINT) is signal.default_int_handler and os.path.basename(
+    sys.argv[0]
+) in ("obsdesign", "cli.py"):
+    signal.signal(signal.SIGINT, _early_interrupt)
+
+import json  # noqa: E402
+from collections.abc import Callable  # noqa: E402
+from enum import StrEnum  # noqa: E402
+from pathlib import Path  # noqa: E402
+from typing import Annotated, Any  # noqa: E402
+
+import typer  # noqa: E402
 
 app = typer.Typer(
     name="obsdesign",
@@ -25,6 +42,20 @@ app = typer.Typer(
     rich_markup_mode=None,  # plain click help: rendering help through rich costs ~150 ms
 )
 _state = {"debug": False}
+#: plot formats (matplotlib's savefig, by the file suffix)
+PLOT_SUFFIXES = (
+    ".png",
+    ".svg",
+    ".svgz",
+    ".pdf",
+    ".eps",
+    ".ps",
+    ".jpg",
+    ".jpeg",
+    ".tif",
+    ".tiff",
+    ".webp",
+)
 
 
 class Fmt(StrEnum):
@@ -50,6 +81,8 @@ def _run(fn: Callable[[], int]) -> None:
         raise typer.Exit(e.exit_code) from None
     except typer.Exit:
         raise
+    except BrokenPipeError:
+        _quiet_broken_pipe()
     except KeyboardInterrupt:
         _err("interrupted")
         raise typer.Exit(130) from None
@@ -58,14 +91,69 @@ def _run(fn: Callable[[], int]) -> None:
             raise
         _err(f"internal failure: {type(e).__name__}: {e} (run with --debug for the traceback)")
         raise typer.Exit(EXIT_SOLVER) from None
+    try:
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _quiet_broken_pipe()
     raise typer.Exit(code)
+
+
+def _quiet_broken_pipe() -> None:
+    """The reader of stdout went away (``obsdesign schema | head -1``): stop quietly with
+    exit 141, as a process killed by SIGPIPE would (stdout is pointed at /dev/null so that
+    Python's own flush at exit does not complain)."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
+    raise typer.Exit(141) from None
+
+
+def _check_plot(path: Path | None, force: bool, inputs: tuple[Path, ...] = ()) -> None:
+    """Refuse a plot path before any work: an unknown format or a path that
+    :func:`obsdesign.report.model.check_output` refuses (exit 2)."""
+    if path is None:
+        return
+    from obsdesign.errors import InputError
+    from obsdesign.report.model import check_output
+
+    if path.suffix.lower() not in PLOT_SUFFIXES:
+        raise InputError(
+            f"{path}: unknown plot format {path.suffix or '(no suffix)'!r} "
+            f"(expected one of {', '.join(PLOT_SUFFIXES)})"
+        )
+    check_output(path, force, inputs)
+
+
+def _write_plot(path: Path, draw: Callable[[Path], Any], force: bool) -> None:
+    from obsdesign.report.model import write_via
+
+    write_via(path, draw, force)
 
 
 @app.callback()
 def _main(
     debug: Annotated[bool, typer.Option("--debug", help="Show tracebacks on errors.")] = False,
+    limit: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--limit",
+            help="Change an input limit for this run, KEY=VALUE (repeatable), e.g. "
+            "max_digits=5000, max_file_bytes=64M; see docs/reliability.md.",
+        ),
+    ] = None,
 ) -> None:
     _state["debug"] = debug
+    if limit:
+        from obsdesign.errors import ObsdesignError
+        from obsdesign.limits import parse_limit, set_limits
+
+        try:
+            set_limits(**dict(parse_limit(x) for x in limit))
+        except ObsdesignError as e:
+            _err(e.message)
+            raise typer.Exit(e.exit_code) from None
 
 
 @app.command()
@@ -81,17 +169,33 @@ def design(
             "--plot", "--plot-epsilon", help="Write the method's design plot (PNG/SVG), e.g. ε(z)."
         ),
     ] = None,
+    force: Annotated[
+        bool,
+        typer.Option(
+            "--force",
+            help="Write -o/--plot even over the spec itself, through a symbolic link, into a "
+            "non-regular file or over a write-protected file.",
+        ),
+    ] = False,
 ) -> None:
-    """Design the observer of SPEC, certify every claim, and print (or write) the report."""
+    """Design the observer of SPEC, certify every claim, and print (or write) the report.
+
+    The report at -o is written whatever the verdict (its "verdict" says ok, failed,
+    inconclusive, or error when the design stopped with an error), so it is never stale;
+    bad input (exit 2) writes nothing."""
 
     def body() -> int:
         from obsdesign import api
+        from obsdesign.report.model import check_output
 
+        if output is not None:
+            check_output(output, force, (spec,))
+        _check_plot(plot, force, (spec,) + ((output,) if output is not None else ()))
         progress = _progress() if fmt == Fmt.text else None
-        rep = api.design(spec, output, progress=progress)
+        rep = api.design(spec, output, progress=progress, force=force)
         _print_report(rep, fmt)
         if plot is not None:
-            api.plot_design(spec, rep.parameters, plot)
+            _write_plot(plot, lambda tmp: api.plot_design(spec, rep.parameters, tmp), force)
             if fmt == Fmt.text:
                 print(f"plot written to {plot}")
         if output is not None and fmt == Fmt.text:
@@ -157,12 +261,16 @@ def simulate(
         list[str] | None,
         typer.Option("--option", help="Method simulation option KEY=VALUE (repeatable)."),
     ] = None,
+    force: Annotated[
+        bool, typer.Option("--force", help="Write --plot even where it is refused by default.")
+    ] = False,
 ) -> None:
     """Run the plant and the designed observer over the spec's scenario; print metrics."""
 
     def body() -> int:
         from obsdesign import api
 
+        _check_plot(plot, force, (spec,) + ((report,) if report is not None else ()))
         sp = api.load_spec(spec)
         res = api.simulate(sp, report, options=_kv(option or []))
         m = res.metrics()
@@ -171,7 +279,7 @@ def simulate(
         else:
             _print_metrics(m)
         if plot is not None:
-            api.plot_simulation(sp, res, plot)
+            _write_plot(plot, lambda tmp: api.plot_simulation(sp, res, tmp), force)
             if fmt == Fmt.text:
                 print(f"plot written to {plot}")
         return int(res.info.get("exit_code", 0))
@@ -321,7 +429,13 @@ def _print_metrics(m: dict[str, Any]) -> None:
 
 def main() -> None:
     """Console-script entry point."""
-    app()
+    if signal.getsignal(signal.SIGINT) is _early_interrupt:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        app()
+    except KeyboardInterrupt:  # pragma: no cover - Ctrl-C outside a command body
+        _err("interrupted")
+        sys.exit(130)
 
 
 if __name__ == "__main__":

@@ -257,7 +257,8 @@ def check_output(path: str | Path, force: bool = False, inputs: tuple[Path, ...]
             f"{p}: is not a regular file (device, FIFO or socket); refusing to replace it "
             f"(--force writes into it)"
         )
-    if stat.S_ISREG(st.st_mode) and not os.access(p, os.W_OK) and not force:
+    protected = not os.access(p, os.W_OK) or not st.st_mode & 0o222  # (root ignores access)
+    if stat.S_ISREG(st.st_mode) and protected and not force:
         raise InputError(f"{p}: is write-protected; refusing to replace it (--force)")
 
 

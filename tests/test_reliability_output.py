@@ -1,0 +1,175 @@
+"""Output files (issue 11 item 1): never destroy a user's file, never leave a stale report,
+every OS error on output is exit 2 with the path and the reason; broken pipes are quiet."""
+
+from __future__ import annotations
+
+import errno
+import json
+import os
+import shutil
+import stat
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from obsdesign.cli import app
+
+SPEC = Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+runner = CliRunner()
+
+
+@pytest.fixture
+def spec(tmp_path: Path) -> Path:
+    p = tmp_path / "s.toml"
+    shutil.copy(SPEC, p)
+    return p
+
+
+def _refused(res, *words: str) -> None:
+    assert res.exit_code == 2, res.output
+    err = res.output.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("obsdesign: error:"), res.output
+    for w in words:
+        assert w in err[0]
+
+
+def test_output_is_the_spec_itself(spec: Path):
+    before = spec.read_bytes()
+    _refused(runner.invoke(app, ["design", str(spec), "-o", str(spec)]), "input file itself")
+    assert spec.read_bytes() == before
+
+
+def test_output_through_symlink_to_spec(spec: Path, tmp_path: Path):
+    link = tmp_path / "r.json"
+    link.symlink_to(spec)
+    before = spec.read_bytes()
+    _refused(runner.invoke(app, ["design", str(spec), "-o", str(link)]))
+    assert spec.read_bytes() == before and link.is_symlink()
+
+
+def test_output_symlink_elsewhere(spec: Path, tmp_path: Path):
+    target = tmp_path / "t.json"
+    target.write_text("keep")
+    link = tmp_path / "r.json"
+    link.symlink_to(target)
+    _refused(runner.invoke(app, ["design", str(spec), "-o", str(link)]), "symbolic link")
+    assert target.read_text() == "keep" and link.is_symlink()
+    # with --force the link is written through: the link stays, its target gets the report
+    assert runner.invoke(app, ["design", str(spec), "-o", str(link), "--force"]).exit_code == 0
+    assert link.is_symlink() and json.loads(target.read_text())["verdict"] == "ok"
+
+
+def test_output_fifo_and_directory(spec: Path, tmp_path: Path):
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    _refused(runner.invoke(app, ["design", str(spec), "-o", str(fifo)]), "not a regular file")
+    assert stat.S_ISFIFO(os.lstat(fifo).st_mode)
+    d = tmp_path / "dir"
+    d.mkdir()
+    _refused(runner.invoke(app, ["design", str(spec), "-o", str(d)]), "is a directory")
+    _refused(runner.invoke(app, ["design", str(spec), "-o", str(d), "--force"]), "directory")
+
+
+def test_output_dev_null_is_not_replaced(spec: Path):
+    _refused(runner.invoke(app, ["design", str(spec), "-o", os.devnull]), "not a regular file")
+    assert stat.S_ISCHR(os.stat(os.devnull).st_mode)
+    res = runner.invoke(app, ["design", str(spec), "-o", os.devnull, "--force"])
+    assert res.exit_code == 0 and stat.S_ISCHR(os.stat(os.devnull).st_mode)
+
+
+def test_output_write_protected(spec: Path, tmp_path: Path):
+    ro = tmp_path / "ro.json"
+    ro.write_text("keep")
+    ro.chmod(0o444)
+    _refused(runner.invoke(app, ["design", str(spec), "-o", str(ro)]), "write-protected")
+    assert ro.read_text() == "keep"
+
+
+def test_plot_unknown_format_and_spec(spec: Path, tmp_path: Path):
+    out = tmp_path / "r.json"
+    _refused(
+        runner.invoke(app, ["design", str(spec), "-o", str(out), "--plot", "x.txt"]),
+        "plot format",
+    )
+    assert not out.exists()  # refused before anything is written
+    _refused(runner.invoke(app, ["simulate", str(spec), "--plot", str(spec)]), "plot format")
+
+
+def test_report_mode_follows_umask(spec: Path, tmp_path: Path):
+    old = os.umask(0o022)
+    try:
+        out = tmp_path / "r.json"
+        assert runner.invoke(app, ["design", str(spec), "-o", str(out)]).exit_code == 0
+        assert stat.S_IMODE(out.stat().st_mode) == 0o644
+    finally:
+        os.umask(old)
+
+
+def test_failed_design_replaces_stale_report(spec: Path, tmp_path: Path):
+    out = tmp_path / "r.json"
+    assert runner.invoke(app, ["design", str(spec), "-o", str(out)]).exit_code == 0
+    # a gain that makes A − LC unstable: the design stops with exit 1
+    bad = tmp_path / "bad.toml"
+    bad.write_text(spec.read_text().replace("L = [-1.87, 1.874]", "L = [5, 5]"))
+    res = runner.invoke(app, ["design", str(bad), "-o", str(out)])
+    assert res.exit_code == 1
+    d = json.loads(out.read_text())
+    assert d["verdict"] == "error" and d["error"]["exit_code"] == 1
+    ver = runner.invoke(app, ["verify", str(out), "--format", "json"])
+    assert ver.exit_code == 1
+    assert [c["id"] for c in json.loads(ver.output)["claims"]] == ["design-completed"]
+    # failed claims (not an error): the verdict says failed
+    slow = tmp_path / "slow.toml"
+    slow.write_text(spec.read_text().replace("lambda = 0.955", "lambda = 0.9"))
+    res = runner.invoke(app, ["design", str(slow), "-o", str(out)])
+    assert res.exit_code in (1, 4)
+    assert json.loads(out.read_text())["verdict"] in ("error", "failed", "inconclusive")
+
+
+def test_bad_input_leaves_output_untouched(spec: Path, tmp_path: Path):
+    out = tmp_path / "r.json"
+    out.write_text("old")
+    bad = tmp_path / "bad.toml"
+    bad.write_text(spec.read_text().replace('key = "lyapunov"', 'key = "lyapunovv"'))
+    res = runner.invoke(app, ["design", str(bad), "-o", str(out)])
+    assert res.exit_code == 2 and out.read_text() == "old"
+
+
+@pytest.mark.parametrize("err", [errno.EROFS, errno.EPERM, errno.ENOSPC])
+def test_os_errors_on_output_are_exit_2(spec: Path, tmp_path: Path, monkeypatch, err: int):
+    out = tmp_path / "r.json"
+
+    def boom(src, dst):
+        raise OSError(err, os.strerror(err))
+
+    monkeypatch.setattr(os, "replace", boom)
+    res = runner.invoke(app, ["design", str(spec), "-o", str(out)])
+    _refused(res, str(out), os.strerror(err))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]  # no temp file left
+    res = runner.invoke(app, ["simulate", str(spec), "--plot", str(tmp_path / "p.png")])
+    assert res.exit_code == 2 and os.strerror(err) in res.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
+
+
+def test_output_in_missing_folder_under_a_file(spec: Path, tmp_path: Path):
+    _refused(
+        runner.invoke(app, ["design", str(spec), "-o", str(spec / "r.json")]),
+        "Not a directory",
+    )
+
+
+def test_broken_pipe_is_quiet(tmp_path: Path):
+    exe = Path(sys.executable).parent / "obsdesign"
+    r = subprocess.run(
+        f"'{exe}' schema | head -c 10; exit ${{PIPESTATUS[0]}}",
+        shell=True,
+        executable="/bin/bash",
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert r.stdout == '{\n  "$sche'[:10] or len(r.stdout) == 10
+    assert r.stderr == "" and r.returncode in (0, 141)
