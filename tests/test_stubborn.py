@@ -1,0 +1,302 @@
+"""The ``stubborn`` method (paper 002: Astolfi, Alessandri, Zaccarian, stubborn observers):
+design + exact certificate of LMIs (1)-(3) / (7)-(9), tamper tests per claim id, the outlier
+study's qualitative result, bad input."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from flint import fmpq
+from typer.testing import CliRunner
+
+from obsdesign import api
+from obsdesign.certify.claim import ClaimStatus
+from obsdesign.certify.exact import Q, qparse, qstr, to_float
+from obsdesign.cli import app
+from obsdesign.errors import InfeasibleError, SpecError
+from obsdesign.report import Report
+
+SPECS = Path(__file__).resolve().parents[1] / "specs"
+EX1 = SPECS / "astolfi-stubborn-example1.toml"
+EX3 = SPECS / "astolfi-stubborn-example3.toml"
+EX4 = SPECS / "astolfi-stubborn-example4.toml"
+
+
+@pytest.fixture(scope="module")
+def ex1() -> Report:
+    return api.design(EX1)
+
+
+@pytest.fixture(scope="module")
+def ex4() -> Report:
+    return api.design(EX4)
+
+
+def _certified(rep: Report) -> None:
+    bad = [(c.id, c.detail) for c in rep.claims if c.status != ClaimStatus.CERTIFIED]
+    assert not bad
+
+
+def test_example1_design_certified(ex1: Report) -> None:
+    _certified(ex1)
+    ids = {c.id for c in ex1.claims}
+    assert ids == {
+        "gain-relation", "P-positive", "U-positive", "W-positive", "R-positive",
+        "lambda-range", "lambda-choice", "lmi-regional", "lmi-global", "lmi-sector",
+    }  # fmt: skip
+    p = ex1.parameters
+    for k in ("K", "P", "X", "U", "W", "Y", "R", "lambda", "lambda_max", "criterion"):
+        assert k in p
+    # λ = fraction·λ_max exactly (fraction 1/2 from the spec)
+    assert p["lambda"] == fmpq(1, 2) * p["lambda_max"]
+    # X = P K exactly, K = P⁻¹X
+    assert (p["P"] @ p["K"] == p["X"]).all()
+    # with ‖X‖₂ ≤ 100 and P ⪰ I the best λ of Example 1 is ≈ 7.5 (bracket within 0.1 %)
+    lo, hi = (float(x) for x in to_float(p["lambda_bracket"]))
+    assert 7.3 < lo < hi <= lo * 1.001 + 1e-12
+    K = p.float("K").ravel()
+    assert np.linalg.norm(K) <= 100
+    assert (
+        max(
+            np.linalg.eigvals(
+                p.float("P") @ np.zeros((2, 2)) + np.array([[0, 1], [-1, 0]]) - np.outer(K, [1, 1])
+            ).real
+        )
+        < 0
+    )
+
+
+def test_example1_verify_cli(ex1: Report, tmp_path: Path) -> None:
+    out = tmp_path / "ex1.json"
+    out.write_text(ex1.to_json())
+    r = CliRunner().invoke(app, ["verify", str(out)])
+    assert r.exit_code == 0, r.output
+
+
+def test_example4_discrete_l2(ex4: Report) -> None:
+    _certified(ex4)
+    p = ex4.parameters
+    assert "l2-gain" in {c.id for c in ex4.claims}
+    lam, best = p["lambda"], p["lambda_max"]
+    assert 0 < best < lam < 1
+    assert 1 - lam == fmpq(1, 2) * (1 - best)  # discrete: 1 − λ = fraction·(1 − λ_best)
+    A = np.array([[1, 1, 0, 0], [0, 1, 0, 0], [0, 0, 1, 1], [0, 0, 0, 1.0]])
+    C = np.array([[1, 0, 0, 0], [0, 0, 1, 0.0]])
+    assert max(abs(np.linalg.eigvals(A - p.float("K") @ C))) < 1
+
+
+# -- tamper tests: every claim id must fail when its quantity is made false ----------------
+def _set(d: dict[str, Any], key: str, value: Any) -> None:
+    d["parameters"]["exact"][key] = qstr(value)
+    f = to_float(value)
+    d["parameters"][key] = f if isinstance(f, float) else np.asarray(f).tolist()
+
+
+def _get(d: dict[str, Any], key: str) -> Any:
+    return qparse(d["parameters"]["exact"][key])
+
+
+def _failed(d: dict[str, Any]) -> set[str]:
+    rep, problems = Report.from_dict(json.loads(json.dumps(d)))
+    assert not problems
+    ver = api.verify(rep)
+    assert ver.exit_code() != 0 or not any(c.status == ClaimStatus.FAILED for c in ver.claims)
+    # the method's own recomputed claims (verify adds report-alters:<id> / report-verdict when
+    # the stored claims differ from the recomputed ones)
+    return {
+        c.id
+        for c in ver.claims
+        if c.status == ClaimStatus.FAILED and not c.id.startswith("report-")
+    }
+
+
+TINY = fmpq(1, 2**80)
+
+
+def _tampered(rep: Report, name: str) -> dict[str, Any]:
+    d = rep.to_dict()
+    P, K, Y, u, w = (_get(d, k) for k in ("P", "K", "Y", "U", "W"))
+    if name == "gain-relation":
+        X = _get(d, "X")
+        X[0, 0] += TINY
+        _set(d, "X", X)
+    elif name == "P-positive":  # P singular (det = 0): the smallest change that breaks P ≻ 0
+        P[0, 0] = P[0, 1] * P[1, 0] / P[1, 1]
+        _set(d, "P", P)
+        _set(d, "X", P @ K)
+    elif name == "U-positive":
+        u[0] = fmpq(0)
+        _set(d, "U", u)
+    elif name == "W-positive":
+        w[0] = fmpq(0)
+        _set(d, "W", w)
+    elif name == "R-positive":
+        _set(d, "R", _get(d, "R") * 0)
+    elif name == "lambda-range":  # λ = 0 with λ_max = 0 (so that λ = fraction·λ_max holds)
+        _set(d, "lambda", fmpq(0))
+        _set(d, "lambda_max", fmpq(0))
+    elif name == "lambda-choice":
+        _set(d, "lambda", _get(d, "lambda") + TINY)
+    elif name == "lmi-regional":  # λ just above the largest λ for which (1) holds
+        lam = _lambda_star(d) * (1 + fmpq(1, 10**9))
+        _set(d, "lambda", lam)
+        _set(d, "lambda_max", 2 * lam)
+    elif name == "lmi-global":  # −Y keeps (3) (quadratic in Y) and breaks (2)
+        _set(d, "Y", -Y)
+    elif name == "lmi-sector":  # Y_1 scaled just past Y_1 P⁻¹ Y_1ᵀ = w_1
+        q = (Y @ _inv2(P) @ Y.T)[0, 0]
+        c = Q(float(np.sqrt(float(w[0] / q)))) * (1 + fmpq(1, 10**9))
+        assert c * c * q > w[0]
+        _set(d, "Y", Y * c)
+    else:
+        raise AssertionError(name)
+    return d
+
+
+def _inv2(P: np.ndarray) -> np.ndarray:
+    a, b, c, e = P[0, 0], P[0, 1], P[1, 0], P[1, 1]
+    det = a * e - b * c
+    return np.array([[e / det, -b / det], [-c / det, a / det]], dtype=object)
+
+
+def _lambda_star(d: dict[str, Any]) -> fmpq:
+    """The largest λ with LMI (1) for the reported P, X, U, R (float generalized eigenvalue):
+    M1(λ) = M1(0) + λ·diag(P, 0) ≺ 0 iff λ < λ* (computed on the Schur complement)."""
+    from obsdesign.methods.stubborn import lmis
+
+    A = np.array([[0, 1], [-1, 0.0]])
+    C = np.array([[1, 1.0]])
+    P, X, u, R = (np.asarray(to_float(_get(d, k)), float) for k in ("P", "X", "U", "R"))
+    M0 = lmis.regional(A, C, P, X, u.reshape(-1), R, 0.0, False).astype(float)
+    S = M0[:2, :2] - M0[:2, 2:] @ np.linalg.inv(M0[2:, 2:]) @ M0[2:, :2]
+    L = np.linalg.cholesky(P)
+    Li = np.linalg.inv(L)
+    return Q(float(np.linalg.eigvalsh(-Li @ S @ Li.T).min()))
+
+
+EXPECTED = {
+    "gain-relation": {"gain-relation"},
+    # a singular P breaks every LMI that carries P (all three here)
+    "P-positive": {"P-positive", "lmi-sector", "lmi-global", "lmi-regional"},
+    "U-positive": {"U-positive", "lmi-regional"},
+    "W-positive": {"W-positive", "lmi-global", "lmi-sector"},
+    "R-positive": {"R-positive", "lmi-regional"},
+    "lambda-range": {"lambda-range"},
+    "lambda-choice": {"lambda-choice"},
+    "lmi-regional": {"lmi-regional"},
+    "lmi-global": {"lmi-global"},
+    "lmi-sector": {"lmi-sector"},
+}
+
+
+@pytest.mark.parametrize("name", sorted(EXPECTED))
+def test_tamper_each_claim(ex1: Report, name: str) -> None:
+    assert _failed(_tampered(ex1, name)) == EXPECTED[name]
+
+
+def test_tamper_verify_cli_exit_1(ex1: Report, tmp_path: Path) -> None:
+    out = tmp_path / "t.json"
+    out.write_text(json.dumps(_tampered(ex1, "lmi-regional")))
+    r = CliRunner().invoke(app, ["verify", str(out)])
+    assert r.exit_code == 1, r.output
+
+
+def test_tamper_l2_gain(ex4: Report) -> None:
+    d = ex4.to_dict()
+    g = _get(d, "gamma2")
+    _set(d, "gamma2", g * fmpq(9, 10))
+    assert _failed(d) == {"l2-gain"}
+
+
+def test_tamper_discrete_lambda_range(ex4: Report) -> None:
+    d = ex4.to_dict()
+    _set(d, "lambda", fmpq(1))
+    _set(d, "lambda_max", fmpq(1))
+    assert _failed(d) == {"lambda-range"}
+
+
+def test_missing_parameter(ex1: Report) -> None:
+    d = ex1.to_dict()
+    del d["parameters"]["Y"]
+    del d["parameters"]["exact"]["Y"]
+    assert _failed(d) == {"Y-present"}
+
+
+# -- what the spec fixes is read from the spec ---------------------------------------------
+PAPER_K1 = """
+[system]
+time = "continuous"
+A = [[0, 1], [-1, 0]]
+C = [[1, 1]]
+[method]
+key = "stubborn"
+K = [-11.9944, 20.4153]
+lambda = 2
+"""
+
+
+def test_redesign_with_paper_gain_and_spec_binding() -> None:
+    sp = api.load_spec_text(PAPER_K1, "k.toml")
+    rep = api.design(sp)
+    _certified(rep)
+    p = rep.parameters
+    assert p["lambda"] == 2
+    assert (p["K"] == np.array([[Q("-11.9944")], [Q("20.4153")]], dtype=object)).all()
+    d = rep.to_dict()
+    K = _get(d, "K")
+    K[0, 0] += TINY
+    _set(d, "K", K)  # X stays P·K_spec: only the comparison with the spec's K fails
+    assert _failed(d) == {"K-matches-spec"}
+    d = rep.to_dict()
+    _set(d, "lambda", fmpq(2) - TINY)
+    assert _failed(d) == {"lambda-matches-spec"}
+    d = rep.to_dict()
+    d["parameters"]["criterion"] = "K"
+    assert _failed(d) == {"criterion-matches-spec"}
+
+
+def test_defaults_only_system_and_key() -> None:
+    text = '[system]\ntime = "continuous"\nA = [[0, 1], [-2, -1]]\nC = [[1, 0]]\n[method]\nkey = "stubborn"\nlambda_tol = 0.05\n'
+    rep = api.design(api.load_spec_text(text, "d.toml"))
+    _certified(rep)
+    assert rep.parameters["criterion"] == "R"
+
+
+def test_undetectable_exit_1_names_detectability() -> None:
+    text = '[system]\ntime = "continuous"\nA = [[1, 0], [0, -1]]\nC = [[0, 1]]\n[method]\nkey = "stubborn"\nlambda = 1\n'
+    with pytest.raises(InfeasibleError, match="not detectable"):
+        api.design(api.load_spec_text(text, "u.toml"))
+
+
+@pytest.mark.parametrize(
+    "extra, key",
+    [
+        ('criterion = "nope"', "criterion"),
+        ("lambda = -1", "lambda"),
+        ('criterion = "l2"', "criterion"),
+        ("gain_bound = 0", "gain_bound"),
+    ],
+)
+def test_bad_input(extra: str, key: str) -> None:
+    text = f'[system]\ntime = "continuous"\nA = [[0, 1], [-1, 0]]\nC = [[1, 1]]\n[method]\nkey = "stubborn"\n{extra}\n'
+    with pytest.raises(SpecError, match=key):
+        api.load_spec_text(text, "b.toml")
+
+
+# -- the outlier study: the slides' qualitative result ------------------------------------
+@pytest.mark.parametrize("spec", [EX1, EX3])
+def test_outlier_study_qualitative(spec: Path) -> None:
+    rep = api.design(spec) if spec != EX1 else None
+    sp = api.load_spec(spec)
+    res = api.simulate(sp, rep, options={"study": "outliers", "runs": "24"})
+    med = res.extra["study"]["median_rmse"]
+    for a in ("100", "1000"):
+        for s in ("x1", "x2"):
+            assert med["luenberger"][a][s] >= 5 * med["stubborn"][a][s], (a, s)
+    for a in ("0.1", "1"):
+        for s in ("x1", "x2"):
+            assert med["stubborn"][a][s] <= 2 * med["luenberger"][a][s], (a, s)
