@@ -298,7 +298,7 @@ def _round(v: dict[str, Any], o: Options, lam_q: fmpq) -> dict[str, Any]:
 def _infeasible(spec: Spec, pl: Plant, o: Options, where: str) -> None:
     """Say why: (C, A) not detectable (Proposition: the LMIs are feasible iff it is), or the
     bounds of the design (gain bound, given K, given λ)."""
-    det = detectability(pl.A, pl.C, pl.discrete)
+    det = detectability(spec.system.A.q, spec.system.C.q, pl.discrete)
     if det.verdict is False:
         raise InfeasibleError(
             f"stubborn: (C, A) is not detectable ({det.detail}); LMIs {_refs(pl)} are infeasible"

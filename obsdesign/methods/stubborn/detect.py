@@ -1,8 +1,8 @@
 """Detectability of (C, A) for the "not detectable" diagnosis (Proposition of the slides:
 LMIs (1)-(3) are feasible iff (C, A) is detectable).
 
-Uses the exact test of :mod:`obsdesign.certify.detect` when that module exists; until then a
-float PBH test: (C, A) is detectable iff rank [A − μI; C] = n for every eigenvalue μ of A with
+Uses the exact test of :mod:`obsdesign.certify.detect` (exact over Q: unobservable restriction,
+Routh / Schur–Cohn) when that module is present; without it, a float PBH test: (C, A) is detectable iff rank [A − μI; C] = n for every eigenvalue μ of A with
 Re μ ≥ 0 (continuous) or |μ| ≥ 1 (discrete). The test is *inconclusive* (verdict None, exit 4
 upstream) when an eigenvalue is within ``tol`` of the stability boundary or the smallest
 singular value of [A − μI; C] is between ``tol`` and ``1e3·tol`` (relative to the data).
@@ -28,6 +28,8 @@ def detectability(A: np.ndarray, C: np.ndarray, discrete: bool, tol: float = 1e-
     exact = _exact(A, C, discrete)
     if exact is not None:
         return exact
+    A = np.asarray(A, dtype=float) if np.asarray(A).dtype != object else _f(A)
+    C = np.asarray(C, dtype=float) if np.asarray(C).dtype != object else _f(C)
     n = A.shape[0]
     scale = max(1.0, float(np.linalg.norm(A)), float(np.linalg.norm(C)))
     inconclusive = []
@@ -52,16 +54,16 @@ def detectability(A: np.ndarray, C: np.ndarray, discrete: bool, tol: float = 1e-
 
 
 def _exact(A: np.ndarray, C: np.ndarray, discrete: bool) -> Detectability | None:
+    """The exact test of :mod:`obsdesign.certify.detect` (Kalman/Hautus over Q), when present."""
     try:
-        from obsdesign.certify import detect  # type: ignore[attr-defined]
+        from obsdesign.certify.detect import detectability as exact_detectability
     except ImportError:
         return None
-    fn = getattr(detect, "is_detectable", None)
-    if fn is None:
-        return None
-    try:
-        r = fn(A, C, discrete=discrete)
-    except TypeError:
-        return None
-    ok = bool(getattr(r, "ok", r))
-    return Detectability(ok, str(getattr(r, "detail", "exact test")))
+    r = exact_detectability(A, C, "discrete" if discrete else "continuous")
+    return Detectability(bool(r.detectable), f"exact: {r.reason}")
+
+
+def _f(M: np.ndarray) -> np.ndarray:
+    from obsdesign.certify.exact import to_float
+
+    return np.asarray(to_float(M), dtype=float)

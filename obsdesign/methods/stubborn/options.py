@@ -20,6 +20,10 @@ DEFAULT_FRACTION = fmpq(1, 2)
 DEFAULT_GAIN_BOUND = fmpq(100)
 DEFAULT_MARGIN = fmpq(1, 10**6)
 DEFAULT_LAMBDA_TOL = fmpq(1, 1000)
+#: high-gain: ε of σ' = −ℓλσ + ℓ(λ + ε)e_y² (the slides prove some ε* exists, give no formula)
+DEFAULT_EPSILON = fmpq(1)
+#: high-gain: ℓ = this factor times the bound ℓ* ≥ 2L|P| when the spec gives no ℓ
+ELL_FACTOR = fmpq(11, 10)
 
 
 @dataclass
@@ -48,6 +52,8 @@ class Options:
     lipschitz: fmpq | None = None
     ell: fmpq | None = None
     epsilon: fmpq | None = None
+    #: high-gain: φ̂ = φ(clip(x̂, −state_bound, state_bound)) (bounded outside X); None: no clip
+    state_bound: np.ndarray | None = None
 
 
 @dataclass
@@ -64,6 +70,13 @@ class SimOptions:
     amplitudes: tuple[float, ...] = (0.1, 1.0, 10.0, 100.0, 1000.0)
     runs: int = 100
     sigma0: float | None = None
+    #: high-gain scenario: an impulsive outlier (held over one step dt) and a window of
+    #: high-frequency noise (uniform in [−hf_amplitude, hf_amplitude], new every step)
+    impulse_time: float | None = None
+    impulse_value: float = 0.0
+    hf_start: float = 0.0
+    hf_stop: float = 0.0
+    hf_amplitude: float = 0.0
 
 
 def parse_options(table: Table, spec: Spec) -> Options:
@@ -80,9 +93,11 @@ def parse_options(table: Table, spec: Spec) -> Options:
         lip = table.scalar("lipschitz", min=0).q
         e = table.scalar("ell", default=None, min=1)
         ell = None if e is None else e.q
-        ep = table.scalar("epsilon", default=None, min=0, strict_min=True)
-        eps = None if ep is None else ep.q
+        eps = table.scalar("epsilon", default=DEFAULT_EPSILON, min=0, strict_min=True).q
         lam_v = table.scalar("lambda", default=fmpq(1), min=0, strict_min=True)
+        sb = table.vector("state_bound", n=n).f if table.has("state_bound") else None
+        if sb is not None and np.any(sb <= 0):
+            raise table.error("state_bound", "expected positive bounds")
         table.done()
         return Options(
             mode,
@@ -96,6 +111,7 @@ def parse_options(table: Table, spec: Spec) -> Options:
             lip,
             ell,
             eps,
+            sb,
         )
     if s.A is None or s.C is None:
         raise table.error("mode", "full and redesign modes need the linear model A, C in [system]")
@@ -144,4 +160,11 @@ def parse_sim(table: Table, spec: Spec) -> SimOptions:
         o.runs = table.int("runs", min=1)
     if table.has("sigma0"):
         o.sigma0 = float(table.scalar("sigma0", min=0).f)
+    if table.has("impulse_time"):
+        o.impulse_time = float(table.scalar("impulse_time", min=0).f)
+        o.impulse_value = float(table.scalar("impulse_value").f)
+    if table.has("hf_start") or table.has("hf_stop"):
+        o.hf_start = float(table.scalar("hf_start", min=0).f)
+        o.hf_stop = float(table.scalar("hf_stop", min=0).f)
+        o.hf_amplitude = float(table.scalar("hf_amplitude", min=0).f)
     return o

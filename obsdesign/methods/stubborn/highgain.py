@@ -1,0 +1,304 @@
+"""Stubborn redesign of high-gain observers (second part of the stubborn-observer slides,
+Astolfi, Alessandri, Zaccarian, WUDS 2017).
+
+Plant in triangular form ẋ_i = x_{i+1} + φ_i(x_1..x_i, u), ẋ_n = φ_n(x, u, d), y = x_1 + ν,
+given by ``[system] f`` (or A x + ψ). High-gain observer with gain ℓ and Hurwitz coefficients
+K = (k_1..k_n): x̂_i' = x̂_{i+1} + φ̂_i(x̂) + k_i ℓ^i sat_σ̄(y − x̂_1); stubborn saturation
+σ' = −ℓλσ + ℓ(λ + ε)(y − ŷ)², σ̄ = √σ. Design (slides, "Scaled error dynamics"): P solves
+P(A − KC) + (A − KC)ᵀP = −I, and convergence holds for ℓ > ℓ* = 2L|P| (L the Lipschitz bound of
+the scaled Δ_φ, given by the user).
+
+Certified exactly: P solves the Lyapunov equation (rational solution of the linear system),
+P ≻ 0 (hence A − KC is Hurwitz), 2L|P| ≤ ℓ* (ℓ*·I − 2L P ⪰ 0) and ℓ > 2L|P| (ℓ I − 2L P ≻ 0,
+|P| = λ_max(P) for P ≻ 0). ε is the user's (default 1): the slides prove that some ε* exists
+but give no formula, so ε > ε* is not claimed.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+from flint import fmpq, fmpq_mat
+
+from obsdesign.certify.claim import Claim, Claims
+from obsdesign.certify.exact import Q, qeye, qmat, qzeros, to_float
+from obsdesign.certify.printing import fmt_exact, fmt_up
+from obsdesign.certify.psd import check_pd, check_psd
+from obsdesign.methods.base import SolverResult, SolverStatus
+from obsdesign.methods.stubborn.options import ELL_FACTOR, Options, SimOptions
+from obsdesign.params import Parameters
+from obsdesign.simulate.result import SimResult
+from obsdesign.spec.models import Spec
+
+PAPER = "stubborn-observer slides (Astolfi, Alessandri, Zaccarian, WUDS 2017), high-gain part"
+
+
+def chain(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The high-gain A (ones on the superdiagonal) and C = (1, 0, …, 0), exact."""
+    A = qzeros((n, n))
+    for i in range(n - 1):
+        A[i, i + 1] = fmpq(1)
+    C = qzeros((1, n))
+    C[0, 0] = fmpq(1)
+    return A, C
+
+
+def lyapunov_exact(Ac: np.ndarray) -> np.ndarray:
+    """The exact rational solution P of P Ac + Acᵀ P = −I (Ac Hurwitz: unique), by solving the
+    n² × n² linear system (I ⊗ Acᵀ + Acᵀ ⊗ I) vec P = −vec I over Q."""
+    n = Ac.shape[0]
+    N = n * n
+    M = fmpq_mat(N, N)
+    rhs = fmpq_mat(N, 1)
+    for i in range(n):
+        for j in range(n):
+            r = i * n + j  # equation (i, j): Σ_k P_ik Ac_kj + Σ_k Ac_ki P_kj = −δ_ij
+            for k in range(n):
+                M[r, i * n + k] += Ac[k, j]
+                M[r, k * n + j] += Ac[k, i]
+            rhs[r, 0] = fmpq(-1) if i == j else fmpq(0)
+    sol = M.solve(rhs)
+    P = qzeros((n, n))
+    for i in range(n):
+        for j in range(n):
+            P[i, j] = sol[i * n + j, 0]
+    return P
+
+
+def _norm_bound(P: np.ndarray) -> fmpq:
+    """A rational t ≥ λ_max(P) = |P| proved by t·I − P ⪰ 0 (exact)."""
+    n = P.shape[0]
+    lam = float(np.linalg.eigvalsh(np.asarray(to_float(P), float)).max())
+    t = Q(fmt_up(lam * (1 + 1e-12) + 1e-300, 12))
+    while not check_psd(qeye(n) * t - P).ok:
+        t *= fmpq(1000001, 1000000)
+    return t
+
+
+def design_params(
+    spec: Spec, progress: Any = None
+) -> tuple[dict[str, Any], SolverResult, list[str]]:
+    """ℓ* ≥ 2L|P| (exact bound) and ℓ = the spec's ℓ or ELL_FACTOR·ℓ* (rounded up to 3 digits)."""
+    from obsdesign.errors import InfeasibleError
+
+    t0 = time.perf_counter()
+    o: Options = spec.options
+    n = spec.system.n
+    A, C = chain(n)
+    K = np.asarray(o.K, dtype=object)
+    Ac = A - K @ C
+    P = lyapunov_exact(Ac)
+    if not check_pd(P).ok:
+        raise InfeasibleError(
+            "stubborn high-gain: A − KC is not Hurwitz (the Lyapunov equation has no P ≻ 0): "
+            "choose k_1..k_n with a Hurwitz polynomial sⁿ + k_1 sⁿ⁻¹ + … + k_n"
+        )
+    t = _norm_bound(P)
+    ell_star = 2 * o.lipschitz * t
+    ell = o.ell if o.ell is not None else max(fmpq(1), Q(fmt_up(ELL_FACTOR * ell_star, 3)))
+    vals = {
+        "K": K,
+        "P": P,
+        "ell_star": ell_star,
+        "ell": ell,
+        "lambda": o.lam,
+        "epsilon": o.epsilon,
+    }
+    notes = [
+        f"ℓ* = 2L|P| ≤ {fmt_up(ell_star, 6)} (L = {fmt_exact(o.lipschitz)}); ℓ = {fmt_exact(ell)}",
+        "ε is the user's choice (default 1): the slides give no formula for ε*",
+    ]
+    sr = SolverResult(
+        "exact Lyapunov equation (python-flint)",
+        SolverStatus.CLOSED_FORM,
+        "",
+        time.perf_counter() - t0,
+    )
+    return vals, sr, notes
+
+
+def certify(spec: Spec, params: Parameters) -> list[Claim]:
+    """High-gain claims, recomputed from spec (K, L, λ, ε, ℓ when given) and parameters."""
+    o: Options = spec.options
+    n = spec.system.n
+    c = Claims()
+    vals = {k: params.exact(k, c) for k in ("K", "P", "ell", "ell_star", "lambda", "epsilon")}
+    if any(v is None for v in vals.values()):
+        return c
+    K = np.asarray(o.K, dtype=object)
+    c.matches("K", qmat(np.asarray(vals["K"], dtype=object).reshape(n, 1)), K, "[method].K")
+    c.matches("lambda", vals["lambda"], o.lam, "[method].lambda")
+    c.matches("epsilon", vals["epsilon"], o.epsilon, "[method].epsilon")
+    if o.ell is not None:
+        c.matches("ell", vals["ell"], o.ell, "[method].ell")
+    P = qmat(np.asarray(vals["P"], dtype=object).reshape(n, n))
+    A, C = chain(n)
+    Ac = A - K @ C
+    E = P @ Ac + Ac.T @ P + qeye(n)
+    ok = all(x == 0 for x in E.flat)
+    c.exact(
+        id="lyapunov-equation",
+        statement="P(A − KC) + (A − KC)ᵀP = −I with K = (k_1..k_n) of [method].K",
+        reference=f"{PAPER}, scaled error dynamics",
+        check="exact matrix equation",
+        passed=ok,
+        detail="holds exactly" if ok else "residual ≠ 0",
+        float_ok=ok,
+    )
+    r = check_pd(P)
+    c.exact(
+        id="P-positive",
+        statement="P ≻ 0 (with the Lyapunov equation: A − KC is Hurwitz)",
+        reference=f"{PAPER}, scaled error dynamics",
+        check="exact LDLᵀ",
+        passed=r.ok,
+        detail=r.detail,
+    )
+    L = o.lipschitz
+    ell, ell_star = Q(vals["ell"]), Q(vals["ell_star"])
+    r = check_psd(qeye(n) * ell_star - P * (2 * L))
+    c.exact(
+        id="ell-star-bound",
+        statement=f"ℓ* = 2L|P| ≤ {fmt_up(ell_star, 8)} (L = {fmt_exact(L)} from [method].lipschitz)",
+        reference=f"{PAPER}, convergence for ℓ > ℓ* = 2L|P|",
+        check="exact LDLᵀ of ℓ*·I − 2L·P (⪰ 0)",
+        passed=r.ok,
+        detail=r.detail,
+    )
+    r = check_pd(qeye(n) * ell - P * (2 * L))
+    c.exact(
+        id="ell-bound",
+        statement=f"ℓ = {fmt_exact(ell)} > 2L|P| (the high-gain observer converges)",
+        reference=f"{PAPER}, convergence for ℓ > ℓ* = 2L|P|",
+        check="exact LDLᵀ of ℓ·I − 2L·P (≻ 0; |P| = λ_max(P) for P ≻ 0)",
+        passed=r.ok,
+        detail=r.detail,
+    )
+    return c
+
+
+# -- simulation ----------------------------------------------------------------------------
+def _rhs(spec: Spec) -> Any:
+    """Vectorized plant right-hand side F(x (..., n), u (m,), d (nd,), t) from f or A x + ψ."""
+    s = spec.system
+    order = [*s.states, *s.inputs, *s.disturbances, "t"]
+    if s.f is not None:
+        fs = [e.on(order) for e in s.f]
+        lin = None
+    else:
+        fs = [e.on(order) for e in (s.psi or [])]
+        lin = (np.asarray(s.A.f, float), np.asarray(s.B.f, float), np.asarray(s.Bd.f, float))
+
+    def F(x: np.ndarray, u: np.ndarray, d: np.ndarray, t: float) -> np.ndarray:
+        shp = x.shape[:-1]
+        Z = np.concatenate(
+            [
+                x,
+                np.broadcast_to(u, (*shp, len(u))),
+                np.broadcast_to(d, (*shp, len(d))),
+                np.full((*shp, 1), t),
+            ],
+            axis=-1,
+        )
+        out = np.stack([f(Z) for f in fs], axis=-1) if fs else np.zeros_like(x)
+        if lin is not None:
+            A, B, Bd = lin
+            out = out + x @ A.T + u @ B.T + d @ Bd.T
+        return out
+
+    return F
+
+
+def simulate(spec: Spec, params: Parameters, observer: str = "stubborn") -> SimResult:
+    """Plant, standard and stubborn high-gain observers (Heun, step dt); ν: the spec's
+    impulsive outlier and high-frequency noise window. Reports |x̂ − x| of both."""
+    s = spec.system
+    sim = spec.simulate
+    so: SimOptions = sim.options or SimOptions()
+    n = s.n
+    dt = float(sim.dt.f)
+    steps = int(round(float(sim.horizon.f) / dt))
+    t = np.arange(steps + 1) * dt
+    rng = np.random.default_rng(sim.seed)
+    F = _rhs(spec)
+    ell = float(params.float("ell"))
+    k = np.asarray(params.float("K"), float).reshape(n)
+    gain = k * ell ** np.arange(1, n + 1)
+    lam, eps = float(params.float("lambda")), float(params.float("epsilon"))
+    o: Options = spec.options
+    bound = o.state_bound
+    nu = np.zeros(steps + 1)
+    if so.impulse_time is not None:
+        nu[int(round(so.impulse_time / dt))] += so.impulse_value
+    win = (t >= so.hf_start) & (t < so.hf_stop)
+    nu[win] += rng.uniform(-so.hf_amplitude, so.hf_amplitude, size=int(win.sum()))
+    fu = [e.on(["t"]) for e in s.u_signal] if s.u_signal is not None else []
+
+    def u_at(tt: float) -> np.ndarray:
+        return np.array([float(f(np.array([tt]))) for f in fu]) if fu else np.zeros(s.m)
+
+    d0 = np.zeros(s.nd)
+    x = np.empty((steps + 1, n))
+    xh = np.empty((steps + 1, 2, n))  # observers: standard, stubborn
+    sig = np.empty(steps + 1)
+    x[0] = np.asarray(sim.x0.f, float)
+    xh[0] = np.asarray(sim.xhat0.f, float)
+    ey0 = x[0, 0] - xh[0, 0, 0]
+    sg = so.sigma0 if so.sigma0 is not None else ey0**2
+    sig[0] = sg
+    stub = np.array([False, True])
+
+    def obs(
+        xhat: np.ndarray, sg: float, y: float, u: np.ndarray, tt: float
+    ) -> tuple[np.ndarray, float]:
+        xc = np.clip(xhat, -bound, bound) if bound is not None else xhat
+        ey = y - xhat[:, 0]
+        lev = np.sqrt(max(sg, 0.0))
+        inj = np.where(stub, np.clip(ey, -lev, lev), ey)
+        dx = F(xc, u, d0, tt) + inj[:, None] * gain
+        ds = -ell * lam * sg + ell * (lam + eps) * ey[1] ** 2
+        return dx, ds
+
+    for i in range(steps):
+        ti, u = t[i], u_at(t[i])
+        u2 = u_at(t[i] + dt)
+        y = x[i, 0] + nu[i]
+        f1 = F(x[i], u, d0, ti)
+        x2 = x[i] + dt * f1
+        x[i + 1] = x[i] + dt / 2 * (f1 + F(x2, u2, d0, ti + dt))
+        a, sa = obs(xh[i], sg, y, u, ti)
+        xb, sb_ = xh[i] + dt * a, max(sg + dt * sa, 0.0)
+        b, sbb = obs(xb, sb_, x2[0] + nu[i], u2, ti + dt)
+        xh[i + 1] = xh[i] + dt / 2 * (a + b)
+        sg = max(sg + dt / 2 * (sa + sbb), 0.0)
+        sig[i + 1] = sg
+    pick = 0 if observer in ("standard", "luenberger") else 1
+    err = np.linalg.norm(xh - x[:, None, :], axis=-1)
+    after = t >= (so.impulse_time or 0.0)
+    info = {
+        "observer": "standard high-gain" if pick == 0 else "stubborn high-gain",
+        "sup_error_after_impulse": {
+            "standard": float(err[after, 0].max()),
+            "stubborn": float(err[after, 1].max()),
+        },
+        "rmse_error_norm": {
+            "standard": float(np.sqrt(np.mean(err[:, 0] ** 2))),
+            "stubborn": float(np.sqrt(np.mean(err[:, 1] ** 2))),
+        },
+    }
+    return SimResult(
+        t,
+        x,
+        xh[:, pick, :],
+        x[:, 0] + nu,
+        list(s.states),
+        extra={
+            "xhat_standard": xh[:, 0],
+            "xhat_stubborn": xh[:, 1],
+            "sigma": sig,
+            "error_norm": err,
+        },
+        info=info,
+    )
