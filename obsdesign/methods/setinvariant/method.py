@@ -32,8 +32,8 @@ class SetInvariant(Method):
     key = "set-invariant"
     title = "Set-invariant estimator (D-(C,A)-λ-contractive polyhedron)"
     paper = (
-        "Dórea, Pimenta, Design of set-invariant estimators for linear discrete-time systems "
-        "(paper 003)"
+        "C. E. T. Dórea, A. C. C. Pimenta, Design of set-invariant estimators for linear "
+        "discrete-time systems, IEEE CDC-ECC 2005"
     )
     Options = Options
     SimOptions = None
