@@ -17,6 +17,7 @@ REGISTRY: dict[str, str] = {
     "constrained": "obsdesign.methods.constrained:METHOD",
     "impulsive": "obsdesign.methods.impulsive:METHOD",
     "set-invariant": "obsdesign.methods.setinvariant:METHOD",
+    "search-space": "obsdesign.methods.searchspace:METHOD",
     "stubborn": "obsdesign.methods.stubborn:METHOD",
 }
 

@@ -1,0 +1,346 @@
+"""The certificate of the search-space observer: every inequality of Lemma 1, Lemma 2 and
+Theorem 1 (Hernández & García, "An alternative approach to the state observation problem for
+Lipschitz continuous systems with controls"), recomputed from the spec and the reported
+parameters, in exact arithmetic or with outward rounding.
+
+What the spec fixes (E, D, U, α, γ⋆ or ε⋆, γ₀, and κ, K, L_f, L_h, f_sup when given) is read
+from the spec and, where the report carries it too, compared exactly. The γ and ε schedules
+are checked entry by entry, all of them.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from flint import fmpq
+
+from obsdesign.certify import interval as ivq
+from obsdesign.certify.claim import Claim, Claims
+from obsdesign.certify.exact import Q
+from obsdesign.certify.printing import fmt_down, fmt_exact, fmt_up
+from obsdesign.methods.searchspace import bounds
+from obsdesign.methods.searchspace.design import (
+    SCHEDULE_RTOL,
+    exp_lower,
+    exp_upper,
+    interval_bound,
+)
+from obsdesign.methods.searchspace.options import Options
+from obsdesign.params import Parameters
+from obsdesign.spec.models import Spec
+
+PAPER = "Hernández & García (paper 004)"
+SCALARS = ("L_f", "L_h", "f_sup", "kappa", "gamma_star", "eps_star", "dT", "K", "dtau")
+LISTS = ("gamma_schedule", "eps_schedule")
+_SYM = {"L_f": "L_f^E", "L_h": "L_h^E", "f_sup": "‖f_u‖_E"}
+_WHAT = {
+    "L_f": "a Lipschitz constant of f(·, u) on E, uniformly in u ∈ U",
+    "L_h": "a Lipschitz constant of h on E",
+    "f_sup": "a bound of |f(x, u)| over x ∈ E, u ∈ U",
+}
+
+
+def _vector(v: Any, name: str) -> list[fmpq]:
+    arr = np.asarray(v, dtype=object)
+    if arr.ndim != 1 or arr.size == 0 or not all(isinstance(x, fmpq) for x in arr):
+        raise ValueError(f"{name} must be a non-empty list of exact numbers")
+    return list(arr)
+
+
+def certify(spec: Spec, params: Parameters) -> list[Claim]:
+    """All claims of the method (see the module docstring); never trusts a stored status."""
+    o: Options = spec.options
+    s = spec.system
+    c = Claims()
+    v: dict[str, Any] = {}
+    for k in (*SCALARS, *LISTS):
+        v[k] = params.exact(k, c, accept_float=False)
+    if any(x is None for x in v.values()):
+        return c
+    gam = _vector(v["gamma_schedule"], "gamma_schedule")
+    eps = _vector(v["eps_schedule"], "eps_schedule")
+    L_f, L_h, F, kappa = v["L_f"], v["L_h"], v["f_sup"], v["kappa"]
+    g_star, dT, dtau = v["gamma_star"], v["dT"], v["dtau"]
+    K = v["K"]
+
+    # what the spec fixes, compared exactly
+    for k in ("L_f", "L_h", "f_sup", "kappa"):
+        if getattr(o, k) is not None:
+            c.matches(k, v[k], getattr(o, k), f"[method].{k}")
+    expected_gs = o.gamma_star if o.gamma_star is not None else kappa * o.eps_star
+    where = "[method].gamma_star" if o.gamma_star is not None else "κ·[method].eps_star"
+    c.matches("gamma_star", g_star, expected_gs, where)
+    if o.K is not None:
+        c.matches("K", K, fmpq(o.K), "[method].K")
+    c.matches("gamma0", gam[0], o.gamma0, "[method].gamma0")
+
+    if s.m > 0:
+        _input_range(c, spec)
+    _d_in_e(c, o)
+    for k in ("L_h", "L_f", "f_sup"):
+        _constant(c, spec, k, v[k])
+    c.exact(
+        id="kappa-range",
+        statement=f"L_h^E < κ < 2 L_h^E with κ = {fmt_exact(kappa)}, L_h^E = {fmt_exact(L_h)}",
+        reference=f"Theorem 1, {PAPER}",
+        check="exact rational comparison",
+        passed=bool(L_h < kappa < 2 * L_h),
+        margin=min(kappa - L_h, 2 * L_h - kappa),
+        detail="" if L_h < kappa < 2 * L_h else _by("κ leaves (L_h, 2L_h)", kappa, L_h, 2 * L_h),
+        float_ok=float(L_h) < float(kappa) < 2 * float(L_h),
+    )
+    c.exact(
+        id="gamma0-above-star",
+        statement=f"γ₀ = {fmt_exact(o.gamma0)} ≥ γ⋆ = {fmt_exact(g_star)}",
+        reference=f"Theorem 1, hypothesis 2, {PAPER}",
+        check="exact rational comparison",
+        passed=bool(o.gamma0 >= g_star),
+        margin=o.gamma0 - g_star,
+        detail="" if o.gamma0 >= g_star else f"γ₀ is below γ⋆ by {fmt_up(g_star - o.gamma0)}",
+        float_ok=float(o.gamma0) >= float(g_star),
+    )
+    rule = o.alpha * g_star / (2 * L_h * F)
+    c.exact(
+        id="dT-rule",
+        statement=f"ΔT = α γ⋆ / (2 L_h^E ‖f_u‖_E) = {fmt_exact(dT)} with α = {fmt_exact(o.alpha)}",
+        reference=f"Theorem 1, {PAPER}",
+        check="exact rational equality",
+        passed=bool(dT == rule),
+        margin=dT - rule,
+        detail="" if dT == rule else f"the rule gives {fmt_exact(rule)}",
+        float_ok=float(dT) == float(rule),
+    )
+    g_min = min([*gam, g_star])
+    lemma1 = g_min / (2 * L_h * F)
+    c.exact(
+        id="lemma1-discarding",
+        statement=(
+            f"ΔT = {fmt_exact(dT)} < γ_i / (2 L_h^E ‖f_u‖_E) for every i: the smallest γ is "
+            f"{fmt_exact(g_min)} and γ_i ≥ γ⋆ afterwards"
+        ),
+        reference=f"Lemma 1 (discarding), {PAPER}",
+        check="exact rational comparison at min(γ schedule ∪ {γ⋆})",
+        passed=bool(dT < lemma1),
+        margin=lemma1 - dT,
+        detail="" if dT < lemma1 else f"ΔT exceeds γ/(2 L_h ‖f_u‖) = {fmt_down(lemma1)} (α ≥ 1?)",
+        float_ok=float(dT) < float(lemma1),
+    )
+    k_int = K.q == 1 and K >= 1
+    c.exact(
+        id="dtau-rule",
+        statement=f"Δτ = K ΔT = {fmt_exact(dtau)} with the integer K = {fmt_exact(K)} ≥ 1",
+        reference=f"Theorem 1, {PAPER}",
+        check="exact rational equality",
+        passed=bool(k_int and dtau == K * dT),
+        margin=dtau - K * dT,
+        detail="" if (k_int and dtau == K * dT) else "Δτ ≠ KΔT or K is not a positive integer",
+        float_ok=float(dtau) == float(K) * float(dT),
+    )
+    ratio = kappa / L_h
+    if o.K is None:
+        if ratio > 1:
+            hi = ivq.log_upper(ratio)
+            ok = bool(k_int and ((K + 1) * dT * L_f >= hi or K == 1 and dT * L_f >= hi))
+        else:
+            hi, ok = None, bool(K == 1)
+        c.exact(
+            id="K-rule",
+            statement=(
+                f"K = {fmt_exact(K)} is the largest integer with K ΔT < log(κ/L_h^E)/L_f^E "
+                "(at least 1, the paper's max{·, 1})"
+            ),
+            reference=f"Theorem 1, hypothesis 1, {PAPER}",
+            check="(K+1)·ΔT·L_f ≥ upper bound of log(κ/L_h) (outward rounding, 113 bits)",
+            passed=ok,
+            margin=0 if hi is None else (K + 1) * dT * L_f - hi,
+            detail="" if ok else "a larger K also keeps Lemma 2's horizon",
+            float_ok=ok,
+        )
+    if ratio > 1:
+        lo = ivq.log_lower(ratio)
+        ok2 = bool(L_f * dtau < lo)
+        stmt_bound = f" (log(κ/L_h^E)/L_f^E ≥ {fmt_down(lo / L_f, 8)})"
+    else:
+        lo, ok2, stmt_bound = fmpq(0), False, ""
+    c.exact(
+        id="lemma2-consistency",
+        statement=f"Δτ = {fmt_exact(dtau)} < log(κ/L_h^E)/L_f^E{stmt_bound}",
+        reference=f"Lemma 2 (consistency) with γ_i/ε_i = κ, Theorem 1, {PAPER}",
+        check="L_f·Δτ < lower bound of log(κ/L_h) (outward rounding, 113 bits)",
+        passed=ok2,
+        margin=lo - L_f * dtau,
+        detail=""
+        if ok2
+        else (
+            f"L_f Δτ exceeds log(κ/L_h) by at least {fmt_down(L_f * dtau - ivq.log_upper(ratio)) if ratio > 1 else 'κ ≤ L_h'}"
+            + (" (K = 1 already too long: decrease α or γ⋆)" if K == 1 else "")
+        ),
+        float_ok=ok2,
+    )
+    _schedule(c, gam, g_star, L_f, dtau)
+    ok_eps = len(eps) == len(gam) and all(e == g / kappa for e, g in zip(eps, gam, strict=False))
+    c.exact(
+        id="eps-schedule",
+        statement=f"ε_i = γ_i/κ for each of the {len(gam)} entries of the schedule",
+        reference=f"Theorem 1, hypothesis 3, {PAPER}",
+        check="exact rational equality, entry by entry",
+        passed=ok_eps,
+        detail="" if ok_eps else _first_bad_eps(eps, gam, kappa),
+        float_ok=ok_eps,
+    )
+    es = v["eps_star"]
+    c.exact(
+        id="eps-star",
+        statement=f"ε⋆ = γ⋆/κ = {fmt_exact(es)}",
+        reference=f"Theorem 1, {PAPER}",
+        check="exact rational equality",
+        passed=bool(es == g_star / kappa),
+        margin=es - g_star / kappa,
+        detail="" if es == g_star / kappa else f"γ⋆/κ = {fmt_exact(g_star / kappa)}",
+        float_ok=float(es) == float(g_star) / float(kappa),
+    )
+    return c
+
+
+def _by(what: str, x: fmpq, lo: fmpq, hi: fmpq) -> str:
+    gap = lo - x if x <= lo else x - hi
+    return f"{what} by {fmt_up(gap)} (κ = {fmt_exact(x)})"
+
+
+def _first_bad_eps(eps: list[fmpq], gam: list[fmpq], kappa: fmpq) -> str:
+    if len(eps) != len(gam):
+        return f"{len(eps)} ε entries for {len(gam)} γ entries"
+    for i, (e, g) in enumerate(zip(eps, gam, strict=True)):
+        if e != g / kappa:
+            return f"ε_{i} = {fmt_exact(e)} but γ_{i}/κ = {fmt_exact(g / kappa)}"
+    return ""
+
+
+def _schedule(c: Claims, gam: list[fmpq], g_star: fmpq, L_f: fmpq, dtau: fmpq) -> None:
+    """γ_{i+1} = max(γ_i e^{L_f Δτ}/2, γ⋆) for every listed entry, rounded up by at most
+    SCHEDULE_RTOL; the list ends at γ⋆, which the rule keeps fixed (e^{L_f Δτ}/2 ≤ 1)."""
+    x = L_f * dtau
+    e_hi, e_lo = exp_upper(x), exp_lower(x)
+    bad = ""
+    for i in range(len(gam) - 1):
+        g, nxt = gam[i], gam[i + 1]
+        low = max(g * e_hi / 2, g_star)
+        high = max(g * e_lo / 2 * (1 + SCHEDULE_RTOL), g_star)
+        if not (low <= nxt <= high):
+            bad = (
+                f"γ_{i + 1} = {fmt_exact(nxt)} is not max(γ_{i} e^(L_f Δτ)/2, γ⋆) ∈ "
+                f"[{fmt_down(low, 15)}, {fmt_up(high, 15)}]"
+            )
+            break
+    if not bad and gam[-1] != g_star:
+        bad = f"the schedule ends at {fmt_exact(gam[-1])}, not at γ⋆ = {fmt_exact(g_star)}"
+    if not bad and e_hi > 2:
+        bad = "e^(L_f Δτ)/2 > 1: γ⋆ is not a fixed point of the rule (Δτ too long)"
+    c.exact(
+        id="gamma-schedule",
+        statement=(
+            f"each of the {len(gam)} entries follows γ_(i+1) = max(γ_i e^(L_f Δτ)/2, γ⋆) "
+            "(rounded up by at most 1e-12 relative), the last is γ⋆ and stays γ⋆ "
+            "(e^(L_f Δτ)/2 ≤ 1)"
+        ),
+        reference=f"Theorem 1, hypothesis 2, {PAPER}",
+        check="every entry against outward-rounded bounds of e^(L_f Δτ) (113 bits)",
+        passed=not bad,
+        detail=bad,
+        float_ok=not bad,
+    )
+
+
+def _input_range(c: Claims, spec: Spec) -> None:
+    o: Options = spec.options
+    s = spec.system
+    assert o.U is not None and s.u_signal is not None
+    stmt = f"u(t) ∈ U = {_box(o.U.lower, o.U.upper)}"
+    if o.horizon is None:
+        c.failed(
+            id="input-range",
+            statement=stmt + " over the horizon of interest",
+            reference=f"Remark 2.5 / footnote 7, {PAPER}",
+            detail="no horizon: give [method].horizon or [simulate].horizon",
+        )
+        return
+    t1 = o.t0 + o.horizon
+    ok, excess, used = bounds.range_inside(
+        s.u_signal, "t", o.t0, t1, list(o.U.lower), list(o.U.upper), budget=4096
+    )
+    c.exact(
+        id="input-range",
+        statement=stmt + f" for every t ∈ [{fmt_exact(o.t0)}, {fmt_exact(t1)}]",
+        reference=f"Remark 2.5 (the fixed input u), {PAPER}",
+        check=f"interval enclosures of u on {used} sub-intervals of the horizon (outward rounding)",
+        passed=ok,
+        detail="" if ok else f"an enclosure leaves U by up to {excess:.3g} (not proved)",
+        float_ok=ok,
+    )
+
+
+def _box(lo: Any, hi: Any) -> str:
+    return " × ".join(f"[{fmt_exact(a)}, {fmt_exact(b)}]" for a, b in zip(lo, hi, strict=True))
+
+
+def _d_in_e(c: Claims, o: Options) -> None:
+    ok = all(
+        e_lo <= d_lo and d_hi <= e_hi
+        for d_lo, d_hi, e_lo, e_hi in zip(o.D.lower, o.D.upper, o.E.lower, o.E.upper, strict=True)
+    )
+    c.exact(
+        id="D-in-E",
+        statement=f"D = {_box(o.D.lower, o.D.upper)} ⊆ E = {_box(o.E.lower, o.E.upper)}",
+        reference=f"Lemma 1 (D ⊂ E), {PAPER}",
+        check="exact comparison of the box bounds",
+        passed=ok,
+        detail="" if ok else f"D ({o.D_where}) is not inside E ({o.E_where})",
+        float_ok=ok,
+    )
+
+
+def _constant(c: Claims, spec: Spec, k: str, val: fmpq) -> None:
+    o: Options = spec.options
+    b = interval_bound(k, spec)
+    given = getattr(o, k) is not None
+    proved = b.finite and Q(b.upper) <= val
+    est = f"sampled lower estimate {b.lower_est:.6g}" + (
+        f", interval bound {fmt_up(b.upper, 8)}" if b.finite else ", no finite interval bound"
+    )
+    stmt = f"{fmt_exact(val)} is {_WHAT[k]} ({_SYM[k]} ≤ {fmt_exact(val)})" + (
+        " (given in the spec)" if given else ""
+    )
+    check = f"interval arithmetic with outward rounding on {b.boxes} sub-boxes of E" + (
+        " × U" if (k != "L_h" and o.U is not None) else ""
+    )
+    if proved or not given or b.lower_est > float(val):
+        c.exact(
+            id=f"{k}-bound",
+            statement=stmt,
+            reference=f"Lemmas 1-2, Theorem 1, {PAPER}",
+            check=check,
+            passed=proved,
+            margin=(val - Q(b.upper)) if b.finite else "inf",
+            detail=est
+            if proved
+            else (
+                f"{est}: the value is below "
+                + (
+                    "a sampled difference quotient"
+                    if b.lower_est > float(val)
+                    else "the interval bound"
+                )
+            ),
+            float_ok=b.finite and float(val) >= b.upper,
+        )
+    else:
+        c.numerical(
+            id=f"{k}-bound",
+            statement=stmt,
+            reference=f"Lemmas 1-2, Theorem 1, {PAPER}",
+            check="given by the user: not proved; compared with a sampled lower estimate",
+            passed=True,
+            margin=float(val) - b.lower_est,
+            detail=est,
+        )

@@ -1,0 +1,220 @@
+"""Design of the search-space observer: the constants on E and the parameter rules.
+
+Hernández & García, "An alternative approach to the state observation problem for Lipschitz
+continuous systems with controls" (paper 004):
+
+- constants: certified upper bounds of L_h^E, L_f^E, ‖f_u‖_E (:mod:`.bounds`), rounded up to
+  ``digits`` significant digits, or the user's values;
+- Theorem 1: L_h < κ < 2 L_h (default κ = 3/2·L_h), ΔT = α γ⋆ / (2 L_h ‖f_u‖) (Lemma 1 at
+  γ⋆), Δτ = K ΔT with K the largest integer with K ΔT < log(κ/L_h)/L_f (Lemma 2 with
+  γ_i/ε_i = κ; the paper's printed formula for K lost its α and L_f in extraction, see
+  docs), γ_{i+1} = max(γ_i e^{L_f Δτ}/2, γ⋆), ε_i = γ_i/κ, ε⋆ = γ⋆/κ.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from flint import fmpq
+from mpmath import iv
+
+from obsdesign.certify import interval as ivq
+from obsdesign.certify.exact import Q
+from obsdesign.certify.printing import fmt_up
+from obsdesign.errors import InfeasibleError
+from obsdesign.methods.searchspace import bounds
+from obsdesign.methods.searchspace.options import Options
+from obsdesign.spec.models import Spec
+
+#: the γ schedule is rounded up to this many significant digits (a coarser grid still covers)
+SCHEDULE_DIGITS = 14
+#: an entry may exceed max(γ_i e^{L_f Δτ}/2, γ⋆) by at most this relative amount
+SCHEDULE_RTOL = fmpq(1, 10**12)
+MAX_SCHEDULE = 100_000
+
+
+@dataclass
+class Constants:
+    """The three constants (exact, as used by the rules) and how they were obtained."""
+
+    L_f: fmpq
+    L_h: fmpq
+    f_sup: fmpq
+    bound_L_f: bounds.Bound | None
+    bound_L_h: bounds.Bound | None
+    bound_f_sup: bounds.Bound | None
+
+
+def round_up_q(x: float | fmpq, digits: int) -> fmpq:
+    """The decimal with ``digits`` significant digits just above ``x`` (exact)."""
+    return Q(fmt_up(Q(x), digits))
+
+
+_CACHE: dict[tuple[str, str, int, float], bounds.Bound] = {}
+
+
+def _compute(kind: str, spec: Spec, budget: int, rtol: float) -> bounds.Bound:
+    s = spec.system
+    o: Options = spec.options
+    names = [*s.states, *s.inputs]
+    lo = [*o.E.lower, *(o.U.lower if o.U is not None else [])]
+    hi = [*o.E.upper, *(o.U.upper if o.U is not None else [])]
+    if kind == "L_f":
+        return bounds.lipschitz(s.f, names, s.states, lo, hi, budget, rtol)
+    if kind == "f_sup":
+        return bounds.sup_norm(s.f, names, lo, hi, budget, rtol)
+    return bounds.lipschitz(s.h, s.states, s.states, o.E.lower, o.E.upper, budget, rtol)
+
+
+def interval_bound(kind: str, spec: Spec) -> bounds.Bound:
+    """Certified bound of ``kind`` ∈ {L_f, L_h, f_sup} on E (× U). A deterministic function of
+    the spec text, so it is cached per text (design and certify compute it once)."""
+    o: Options = spec.options
+    key = (kind, spec.text, o.bound_boxes, o.bound_rtol)
+    if key not in _CACHE:
+        if len(_CACHE) > 256:
+            _CACHE.clear()
+        _CACHE[key] = _compute(kind, spec, o.bound_boxes, o.bound_rtol)
+    return _CACHE[key]
+
+
+def constants(spec: Spec) -> Constants:
+    """L_f, L_h, ‖f_u‖ on E: the user's values where given, else the certified interval
+    bounds rounded up to ``digits`` significant digits."""
+    o: Options = spec.options
+    vals: dict[str, fmpq] = {}
+    bs: dict[str, bounds.Bound | None] = {}
+    for k in ("L_f", "L_h", "f_sup"):
+        given = getattr(o, k)
+        b = interval_bound(k, spec)
+        bs[k] = b
+        if given is not None:
+            vals[k] = given
+        else:
+            if not b.finite:
+                raise InfeasibleError(
+                    f"{_NAMES[k]} has no finite interval bound on E ({b.boxes} sub-boxes): "
+                    + (
+                        "h is not Lipschitz there (a jump?)"
+                        if k == "L_h"
+                        else "f is not Lipschitz/bounded there"
+                    )
+                    + f"; give [method].{k} to use your own value"
+                )
+            vals[k] = round_up_q(b.upper, o.digits)
+            if vals[k] == 0:
+                vals[k] = fmpq(1, 10**o.digits)
+    return Constants(vals["L_f"], vals["L_h"], vals["f_sup"], bs["L_f"], bs["L_h"], bs["f_sup"])
+
+
+_NAMES = {"L_f": "L_f^E", "L_h": "L_h^E", "f_sup": "‖f_u‖_E"}
+
+
+def exp_upper(x: fmpq) -> fmpq:
+    """A rational ≥ e^x."""
+    return ivq.upper(iv.exp, x)
+
+
+def exp_lower(x: fmpq) -> fmpq:
+    """A rational ≤ e^x."""
+    return ivq.lower(iv.exp, x)
+
+
+def dT_rule(alpha: fmpq, gamma_star: fmpq, L_h: fmpq, f_sup: fmpq) -> fmpq:
+    """ΔT = α γ⋆ / (2 L_h^E ‖f_u‖_E) (Theorem 1; Lemma 1 at γ = γ⋆ when α < 1)."""
+    return alpha * gamma_star / (2 * L_h * f_sup)
+
+
+def K_rule(kappa: fmpq, L_h: fmpq, L_f: fmpq, dT: fmpq) -> int:
+    """K of Theorem 1 (hypothesis 1): the largest integer with K ΔT < log(κ/L_h)/L_f, so that
+    Δτ = KΔT keeps Lemma 2's consistency horizon; at least 1 (the paper's max{·, 1})."""
+    if kappa <= L_h:
+        return 1
+    lo = ivq.log_lower(kappa / L_h)
+    k = int((lo / (L_f * dT)).ceil()) - 1
+    return max(k, 1)
+
+
+def schedule(gamma0: fmpq, gamma_star: fmpq, L_f: fmpq, dtau: fmpq) -> list[fmpq]:
+    """γ_{i+1} = max(γ_i e^{L_f Δτ}/2, γ⋆) (Theorem 1, hypothesis 2), each entry rounded up
+    to SCHEDULE_DIGITS significant digits, listed until it reaches γ⋆ (constant after).
+    Stops early (without reaching γ⋆) when e^{L_f Δτ}/2 ≥ 1 or after MAX_SCHEDULE entries."""
+    r = exp_upper(L_f * dtau) / 2
+    out = [gamma0]
+    g = gamma0
+    while g != gamma_star and len(out) < MAX_SCHEDULE:
+        if r >= 1:
+            break
+        nxt = g * r
+        g = gamma_star if nxt <= gamma_star else round_up_q(nxt, SCHEDULE_DIGITS)
+        out.append(g)
+    return out
+
+
+def rules(
+    c: Constants, o: Options, kappa: fmpq | None = None, K: int | None = None
+) -> dict[str, Any]:
+    """Every parameter of Theorem 1 from the constants and the options (exact)."""
+    L_f, L_h, F = c.L_f, c.L_h, c.f_sup
+    kappa = kappa if kappa is not None else (o.kappa if o.kappa is not None else L_h * 3 / 2)
+    gamma_star = o.gamma_star if o.gamma_star is not None else kappa * o.eps_star
+    dT = dT_rule(o.alpha, gamma_star, L_h, F)
+    K = K if K is not None else (o.K if o.K is not None else K_rule(kappa, L_h, L_f, dT))
+    dtau = K * dT
+    gam = schedule(o.gamma0, gamma_star, L_f, dtau)
+    return params_from(L_f, L_h, F, kappa, gamma_star, dT, K, dtau, gam)
+
+
+def params_from(
+    L_f: fmpq,
+    L_h: fmpq,
+    F: fmpq,
+    kappa: fmpq,
+    gamma_star: fmpq,
+    dT: fmpq,
+    K: int,
+    dtau: fmpq,
+    gam: list[fmpq],
+) -> dict[str, Any]:
+    """The report's parameters (JSON keys of the issue) from their exact values."""
+    return {
+        "L_f": L_f,
+        "L_h": L_h,
+        "f_sup": F,
+        "kappa": kappa,
+        "gamma_star": gamma_star,
+        "eps_star": gamma_star / kappa,
+        "dT": dT,
+        "K": fmpq(K),
+        "dtau": dtau,
+        "gamma_schedule": np.array(gam, dtype=object),
+        "eps_schedule": np.array([g / kappa for g in gam], dtype=object),
+    }
+
+
+def design_params(spec: Spec) -> tuple[dict[str, Any], list[str]]:
+    """Constants and parameter rules; notes on tightness and on what the user gave."""
+    o: Options = spec.options
+    c = constants(spec)
+    vals = rules(c, o)
+    notes = []
+    for k, b in (("L_f", c.bound_L_f), ("L_h", c.bound_L_h), ("f_sup", c.bound_f_sup)):
+        given = getattr(o, k) is not None
+        if b is not None:
+            t = b.tightness
+            notes.append(
+                f"{k}: {'given ' + str(getattr(o, k)) + '; ' if given else ''}interval bound "
+                f"{fmt_up(b.upper, 6) if b.finite else '∞'} on {b.boxes} sub-boxes, sampled lower "
+                f"estimate {b.lower_est:.6g} (bound/estimate {t:.4g})"
+            )
+    n_sw = len(vals["gamma_schedule"]) - 1
+    notes.append(
+        f"schedule: γ reaches γ⋆ after {n_sw} switches (t = {float(n_sw * vals['dtau']):.4g}); "
+        f"{o.K and 'K given' or 'K from Lemma 2'}"
+    )
+    if math.isclose(float(vals["kappa"]), float(c.L_h) * 1.5) and o.kappa is None:
+        notes.append("κ = 3/2·L_h (default; [method].kappa sets it)")
+    return vals, notes

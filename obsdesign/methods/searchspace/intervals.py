@@ -1,0 +1,545 @@
+"""Outward-rounded interval arithmetic with Clarke-gradient enclosures on a spec expression.
+
+Used for the constants of the search-space method (Hernández & García, "An alternative
+approach to the state observation problem for Lipschitz continuous systems with controls"):
+L_f^E, L_h^E and ‖f_u‖_E of Lemma 1, Lemma 2 and Theorem 1.
+
+An :class:`I` holds float endpoints ``lo ≤ hi``; every operation returns an interval that
+contains the exact result of the operation on every pair of points of its operands:
+
+- ``+ − ×`` use error-free transformations (TwoSum, Dekker's TwoProduct) to decide the sign of
+  the rounding error, so an exact result stays exact (1·u is [u, u], not one ulp wider) and an
+  inexact one moves one ulp outward; ``÷`` and ``sqrt`` check exactness with rationals and
+  otherwise widen by one ulp (both are correctly rounded in IEEE 754);
+- ``exp log sin cos tan`` come from mpmath's interval context and ``atan tanh sinh cosh``
+  from python-flint ``arb`` balls at the end points (monotone functions), converted to
+  floats with directed rounding.
+
+:func:`evaluate` walks the checked expression tree (:class:`obsdesign.spec.expr.Expr`) and
+returns a :class:`Dual`: an interval enclosure of the value and of every partial derivative
+with respect to chosen variables. For non-smooth primitives the derivative enclosure contains
+Clarke's generalized gradient (``abs``: [−1, 1]·∇a where a may vanish; ``max``/``min``: the
+hull of the gradients of the operands that may be active), so by Clarke's mean-value theorem
+the magnitude of the enclosure bounds the Lipschitz constant on a convex box. A discontinuity
+(``step``, ``sign``, ``floor`` where they jump) gives an unbounded derivative: the function is
+not Lipschitz on that box. Two patterns are recognized exactly: ``X*step(X)`` (= max(X, 0),
+the paper's y = x₁·[x₁ > 0]) and ``X - floor(X)`` / ``mod(X, c)`` (the sawtooth input).
+"""
+
+from __future__ import annotations
+
+import ast
+import math
+from dataclasses import dataclass
+from fractions import Fraction
+from typing import Any
+
+from mpmath import iv
+from mpmath.libmp import to_float
+
+INF = math.inf
+_SPLIT = 134217729.0  # 2^27 + 1 (Veltkamp)
+
+
+def _down(x: float) -> float:
+    return math.nextafter(x, -INF)
+
+
+def _up(x: float) -> float:
+    return math.nextafter(x, INF)
+
+
+def _two_sum(a: float, b: float) -> tuple[float, float]:
+    s = a + b
+    bb = s - a
+    return s, (a - (s - bb)) + (b - bb)
+
+
+def _split(a: float) -> tuple[float, float]:
+    c = _SPLIT * a
+    hi = c - (c - a)
+    return hi, a - hi
+
+
+def _two_prod(a: float, b: float) -> tuple[float, float]:
+    p = a * b
+    if not math.isfinite(p) or p == 0.0 or abs(a) > 1e150 or abs(b) > 1e150:
+        return p, (0.0 if (p == 0.0 and (a == 0.0 or b == 0.0)) else math.nan)
+    if abs(p) < 1e-280:
+        return p, math.nan  # near underflow: treat as inexact
+    ah, al = _split(a)
+    bh, bl = _split(b)
+    err = ((ah * bh - p) + ah * bl + al * bh) + al * bl
+    return p, err
+
+
+def _round(p: float, err: float) -> tuple[float, float]:
+    """Directed bounds of a value p + err (err exact, or nan: unknown sign)."""
+    if not math.isfinite(p):
+        return (-INF if p != INF else _down(INF), INF if p != -INF else _up(-INF))
+    if err == 0.0:
+        return p, p
+    if err > 0.0:
+        return p, _up(p)
+    if err < 0.0:
+        return _down(p), p
+    return _down(p), _up(p)
+
+
+def add_lo(a: float, b: float) -> float:
+    return _round(*_two_sum(a, b))[0]
+
+
+def add_hi(a: float, b: float) -> float:
+    return _round(*_two_sum(a, b))[1]
+
+
+def mul_lo(a: float, b: float) -> float:
+    if a == 0.0 or b == 0.0:
+        return 0.0
+    return _round(*_two_prod(a, b))[0]
+
+
+def mul_hi(a: float, b: float) -> float:
+    if a == 0.0 or b == 0.0:
+        return 0.0
+    return _round(*_two_prod(a, b))[1]
+
+
+def sqrt_hi(x: float) -> float:
+    """A float ≥ √x (x ≥ 0)."""
+    s = math.sqrt(x)
+    return s if _two_prod(s, s) == (x, 0.0) else _up(s)
+
+
+def sqrt_lo(x: float) -> float:
+    s = math.sqrt(x)
+    return s if _two_prod(s, s) == (x, 0.0) else max(0.0, _down(s))
+
+
+@dataclass(frozen=True, slots=True)
+class I:  # noqa: E742 - I for "interval"
+    """A closed interval [lo, hi] of reals with float endpoints (possibly infinite)."""
+
+    lo: float
+    hi: float
+
+    @staticmethod
+    def point(x: float) -> I:
+        return I(x, x)
+
+    @staticmethod
+    def of_q(q: Any) -> I:
+        """The tightest float interval around an exact rational (fmpq, Fraction, int)."""
+        fr = Fraction(int(q.p), int(q.q)) if hasattr(q, "p") else Fraction(q)
+        f = float(fr)
+        if Fraction(f) == fr:
+            return I(f, f)
+        return I(f if Fraction(f) < fr else _down(f), f if Fraction(f) > fr else _up(f))
+
+    @staticmethod
+    def entire() -> I:
+        return I(-INF, INF)
+
+    @property
+    def finite(self) -> bool:
+        return math.isfinite(self.lo) and math.isfinite(self.hi)
+
+    @property
+    def mag(self) -> float:
+        """max |x| over the interval."""
+        return max(abs(self.lo), abs(self.hi))
+
+    @property
+    def mid(self) -> float:
+        return 0.5 * (self.lo + self.hi) if self.finite else 0.0
+
+    def contains0(self) -> bool:
+        return self.lo <= 0.0 <= self.hi
+
+    def hull(self, o: I) -> I:
+        return I(min(self.lo, o.lo), max(self.hi, o.hi))
+
+    def __add__(self, o: I) -> I:
+        return I(add_lo(self.lo, o.lo), add_hi(self.hi, o.hi))
+
+    def __neg__(self) -> I:
+        return I(-self.hi, -self.lo)
+
+    def __sub__(self, o: I) -> I:
+        return self + (-o)
+
+    def __mul__(self, o: I) -> I:
+        if self.lo == self.hi == 0.0 or o.lo == o.hi == 0.0:
+            return I(0.0, 0.0)
+        if not (self.finite and o.finite):
+            return _mul_inf(self, o)
+        los = [mul_lo(a, b) for a in (self.lo, self.hi) for b in (o.lo, o.hi)]
+        his = [mul_hi(a, b) for a in (self.lo, self.hi) for b in (o.lo, o.hi)]
+        return I(min(los), max(his))
+
+    def __truediv__(self, o: I) -> I:
+        if o.contains0():
+            return I.entire()
+        if not (self.finite and o.finite):
+            return I.entire()
+        qs = [(a / b, a, b) for a in (self.lo, self.hi) for b in (o.lo, o.hi)]
+        lo = min(_div_lo(q, a, b) for q, a, b in qs)
+        hi = max(_div_hi(q, a, b) for q, a, b in qs)
+        return I(lo, hi)
+
+    def sqr(self) -> I:
+        m = self.mag
+        lo = 0.0 if self.contains0() else min(abs(self.lo), abs(self.hi))
+        return I(mul_lo(lo, lo), mul_hi(m, m))
+
+    def abs(self) -> I:
+        if self.contains0():
+            return I(0.0, self.mag)
+        return I(min(abs(self.lo), abs(self.hi)), self.mag)
+
+
+def _mul_inf(a: I, b: I) -> I:
+    vals = []
+    for x in (a.lo, a.hi):
+        for y in (b.lo, b.hi):
+            vals.append(0.0 if (x == 0.0 or y == 0.0) else x * y)
+    return I(min(vals), max(vals))
+
+
+def _div_exact(q: float, a: float, b: float) -> bool:
+    return math.isfinite(q) and Fraction(q) * Fraction(b) == Fraction(a)
+
+
+def _div_lo(q: float, a: float, b: float) -> float:
+    return q if _div_exact(q, a, b) else _down(q)
+
+
+def _div_hi(q: float, a: float, b: float) -> float:
+    return q if _div_exact(q, a, b) else _up(q)
+
+
+# -- transcendental functions -----------------------------------------------------------
+def _iv_call(fn: Any, x: I) -> I:
+    """Apply an mpmath interval function with outward conversion of the end points."""
+    if not x.finite:
+        return I.entire()
+    saved = iv.prec
+    iv.prec = 60
+    try:
+        r = fn(iv.mpf([x.lo, x.hi]))
+        lo, hi = r._mpi_
+    finally:
+        iv.prec = saved
+    lo_f = to_float(lo, rnd="f")
+    hi_f = to_float(hi, rnd="c")
+    return I(_down(lo_f), _up(hi_f))
+
+
+def _arb_point(fn: str, x: float) -> tuple[float, float]:
+    """Rigorous float bounds of fn(x) at one point, from a python-flint arb ball."""
+    from flint import arb
+
+    if not math.isfinite(x):
+        return (-INF, INF)
+    b = getattr(arb(x), fn)()
+    return _down(float(b.lower())), _up(float(b.upper()))
+
+
+def _monotone(fn: str, x: I) -> I:
+    """Increasing function: [f(lo)↓, f(hi)↑]."""
+    if not x.finite:
+        return I.entire()
+    return I(_arb_point(fn, x.lo)[0], _arb_point(fn, x.hi)[1])
+
+
+def exp(x: I) -> I:
+    return _iv_call(iv.exp, x)
+
+
+def log(x: I) -> I:
+    if x.hi <= 0.0:
+        raise ArithmeticError("log of a non-positive interval")
+    if x.lo <= 0.0:
+        return I(-INF, _iv_call(iv.log, I(x.hi, x.hi)).hi)
+    return _iv_call(iv.log, x)
+
+
+def sin(x: I) -> I:
+    return _iv_call(iv.sin, x) if x.finite else I(-1.0, 1.0)
+
+
+def cos(x: I) -> I:
+    return _iv_call(iv.cos, x) if x.finite else I(-1.0, 1.0)
+
+
+def tan(x: I) -> I:
+    return _iv_call(iv.tan, x)
+
+
+def sqrt(x: I) -> I:
+    if x.hi < 0.0:
+        raise ArithmeticError("sqrt of a negative interval")
+    lo = 0.0 if x.lo <= 0.0 else sqrt_lo(x.lo)
+    return I(lo, sqrt_hi(x.hi) if math.isfinite(x.hi) else INF)
+
+
+def cosh(x: I) -> I:
+    a = x.abs()
+    return _monotone("cosh", a)
+
+
+# -- values with derivative enclosures (forward mode) --------------------------------------
+@dataclass(frozen=True, slots=True)
+class Dual:
+    """Interval value ``v`` and enclosures ``g`` of the partial derivatives (a tuple, one per
+    differentiation variable; empty when derivatives are not asked for)."""
+
+    v: I
+    g: tuple[I, ...]
+
+
+ZERO = I(0.0, 0.0)
+ONE = I(1.0, 1.0)
+
+
+def _const(v: I, nd: int) -> Dual:
+    return Dual(v, (ZERO,) * nd)
+
+
+def _scale(g: tuple[I, ...], s: I) -> tuple[I, ...]:
+    return tuple(s * gi if not (gi.lo == gi.hi == 0.0) else ZERO for gi in g)
+
+
+def _gadd(a: tuple[I, ...], b: tuple[I, ...]) -> tuple[I, ...]:
+    return tuple(x + y for x, y in zip(a, b, strict=True))
+
+
+def _ghull(a: tuple[I, ...], b: tuple[I, ...]) -> tuple[I, ...]:
+    return tuple(x.hull(y) for x, y in zip(a, b, strict=True))
+
+
+def d_add(a: Dual, b: Dual) -> Dual:
+    return Dual(a.v + b.v, _gadd(a.g, b.g))
+
+
+def d_neg(a: Dual) -> Dual:
+    return Dual(-a.v, tuple(-x for x in a.g))
+
+
+def d_mul(a: Dual, b: Dual) -> Dual:
+    return Dual(a.v * b.v, _gadd(_scale(a.g, b.v), _scale(b.g, a.v)))
+
+
+def d_div(a: Dual, b: Dual) -> Dual:
+    v = a.v / b.v
+    if not a.g:
+        return Dual(v, ())
+    den = b.v.sqr()
+    g = tuple((ga * b.v - gb * a.v) / den for ga, gb in zip(a.g, b.g, strict=True))
+    return Dual(v, g)
+
+
+def d_max(a: Dual, b: Dual) -> Dual:
+    v = I(max(a.v.lo, b.v.lo), max(a.v.hi, b.v.hi))
+    if a.v.hi < b.v.lo:
+        return Dual(v, b.g)
+    if b.v.hi < a.v.lo:
+        return Dual(v, a.g)
+    return Dual(v, _ghull(a.g, b.g))
+
+
+def d_min(a: Dual, b: Dual) -> Dual:
+    return d_neg(d_max(d_neg(a), d_neg(b)))
+
+
+def d_abs(a: Dual) -> Dual:
+    if a.v.lo > 0.0:
+        return Dual(a.v, a.g)
+    if a.v.hi < 0.0:
+        return d_neg(a)
+    return Dual(a.v.abs(), tuple(I(-x.mag, x.mag) for x in a.g))
+
+
+def d_step(a: Dual, sign: bool = False) -> Dual:
+    """step(a) = [a > 0] (or sign(a)): constant where a keeps its sign; a jump (unbounded
+    derivative) where the box meets the switching point a = 0."""
+    nd = len(a.g)
+    if a.v.lo > 0.0:
+        return _const(ONE, nd)
+    if a.v.hi < 0.0 or (a.v.hi <= 0.0 and not sign):
+        return _const(I(-1.0, -1.0) if sign else ZERO, nd)
+    if sign and a.v.lo == a.v.hi == 0.0:
+        return _const(ZERO, nd)
+    v = I(-1.0 if (sign and a.v.lo < 0.0) else 0.0, 1.0 if a.v.hi > 0.0 else 0.0)
+    g = tuple(ZERO if (x.lo == x.hi == 0.0) else I.entire() for x in a.g)
+    return Dual(v, g)
+
+
+def d_floor(a: Dual) -> Dual:
+    lo, hi = math.floor(a.v.lo), math.floor(a.v.hi) if math.isfinite(a.v.hi) else INF
+    if not math.isfinite(a.v.lo):
+        lo = -INF
+    v = I(float(lo), float(hi))
+    jump = lo != hi
+    return Dual(v, tuple(I.entire() if (jump and not (x.lo == x.hi == 0.0)) else ZERO for x in a.g))
+
+
+def d_frac(a: Dual) -> Dual:
+    """a − floor(a) ∈ [0, 1): exact where floor(a) is constant."""
+    if a.v.finite and math.floor(a.v.lo) == math.floor(a.v.hi):
+        k = float(math.floor(a.v.lo))
+        return Dual(a.v - I(k, k), a.g)
+    jump = tuple(I.entire() if not (x.lo == x.hi == 0.0) else ZERO for x in a.g)
+    return Dual(I(0.0, 1.0), jump)
+
+
+def d_pow_int(a: Dual, k: int) -> Dual:
+    if k == 0:
+        return _const(ONE, len(a.g))
+    if k < 0:
+        return d_div(_const(ONE, len(a.g)), d_pow_int(a, -k))
+    v = _pow_int(a.v, k)
+    if not a.g:
+        return Dual(v, ())
+    dv = I(float(k), float(k)) * _pow_int(a.v, k - 1)
+    return Dual(v, _scale(a.g, dv))
+
+
+def _pow_int(x: I, k: int) -> I:
+    if k == 0:
+        return ONE
+    if k == 1:
+        return x
+    if k % 2 == 0:
+        h = _pow_int(x, k // 2)
+        return h.sqr()
+    return x * _pow_int(x, k - 1)
+
+
+def d_fn(a: Dual, name: str) -> Dual:
+    """Smooth unary functions: value and chain rule f'(a)·∇a."""
+    v: I
+    if name == "exp":
+        v = exp(a.v)
+        d = v
+    elif name == "log":
+        v = log(a.v)
+        d = ONE / a.v
+    elif name == "sqrt":
+        v = sqrt(a.v)
+        d = ONE / (I(2.0, 2.0) * v) if v.lo > 0.0 else I.entire()
+    elif name == "sin":
+        v, d = sin(a.v), cos(a.v)
+    elif name == "cos":
+        v, d = cos(a.v), -sin(a.v)
+    elif name == "tan":
+        v = tan(a.v)
+        d = ONE + v.sqr()
+    elif name == "atan":
+        v = _monotone("atan", a.v)
+        d = ONE / (ONE + a.v.sqr())
+    elif name == "tanh":
+        v = _monotone("tanh", a.v)
+        d = ONE - v.sqr()
+        d = I(max(0.0, d.lo), min(1.0, d.hi))
+    elif name == "sinh":
+        v, d = _monotone("sinh", a.v), cosh(a.v)
+    elif name == "cosh":
+        v, d = cosh(a.v), _monotone("sinh", a.v)
+    else:  # pragma: no cover - guarded by the caller
+        raise ValueError(name)
+    return Dual(v, _scale(a.g, d) if a.g else ())
+
+
+def _same(a: ast.AST, b: ast.AST) -> bool:
+    return ast.dump(a) == ast.dump(b)
+
+
+def _is_call(node: ast.AST, *names: str) -> bool:
+    return isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id in names
+
+
+_CONSTS = {"pi": I(_down(math.pi), _up(math.pi)), "e": I(_down(math.e), _up(math.e))}
+
+
+def evaluate(node: ast.AST, env: dict[str, Dual], params: dict[str, I], nd: int) -> Dual:
+    """Enclosure of the expression ``node`` (value and ``nd`` partial derivatives) over the
+    box given by ``env`` (variable → Dual) and ``params`` (name → interval)."""
+    if isinstance(node, ast.Expression):
+        node = node.body
+    if isinstance(node, ast.Constant):
+        c = float(node.value)
+        # a decimal literal is within half an ulp of its double: widen unless integral
+        v = I(c, c) if (c == int(c) and abs(c) < 2**53) else I(_down(c), _up(c))
+        return _const(v, nd)
+    if isinstance(node, ast.Name):
+        if node.id in env:
+            return env[node.id]
+        if node.id in params:
+            return _const(params[node.id], nd)
+        return _const(_CONSTS[node.id], nd)
+    if isinstance(node, ast.UnaryOp):
+        a = evaluate(node.operand, env, params, nd)
+        return d_neg(a) if isinstance(node.op, ast.USub) else a
+    if isinstance(node, ast.BinOp):
+        op = type(node.op)
+        left, right = node.left, node.right
+        if op is ast.Mult:
+            for x, s in ((left, right), (right, left)):
+                if _is_call(s, "step", "heaviside") and _same(s.args[0], x):
+                    a = evaluate(x, env, params, nd)
+                    return d_max(a, _const(ZERO, nd))  # X*step(X) = max(X, 0)
+        if op is ast.Sub and _is_call(right, "floor") and _same(right.args[0], left):
+            return d_frac(evaluate(left, env, params, nd))
+        a = evaluate(left, env, params, nd)
+        if op in (ast.Pow, ast.BitXor):
+            if isinstance(right, ast.Constant) and float(right.value) == int(right.value):
+                return d_pow_int(a, int(right.value))
+            b = evaluate(right, env, params, nd)
+            if a.v.lo <= 0.0:
+                raise ArithmeticError("non-integer power of a base that may be ≤ 0")
+            return d_fn(d_mul(b, d_fn(a, "log")), "exp")
+        b = evaluate(right, env, params, nd)
+        if op is ast.Add:
+            return d_add(a, b)
+        if op is ast.Sub:
+            return d_add(a, d_neg(b))
+        if op is ast.Mult:
+            return d_mul(a, b)
+        if op is ast.Div:
+            return d_div(a, b)
+        if op is ast.Mod:
+            return _mod(a, b, nd)
+        raise ValueError(f"operator {op.__name__}")
+    if isinstance(node, ast.Call) and isinstance(node.func, ast.Name):
+        name = node.func.id
+        args = [evaluate(x, env, params, nd) for x in node.args]
+        if name in ("exp", "log", "sqrt", "sin", "cos", "tan", "atan", "tanh", "sinh", "cosh"):
+            return d_fn(args[0], name)
+        if name == "abs":
+            return d_abs(args[0])
+        if name == "max":
+            return d_max(args[0], args[1])
+        if name == "min":
+            return d_min(args[0], args[1])
+        if name == "sat":
+            r = args[1] if len(args) == 2 else _const(ONE, nd)
+            return d_max(d_neg(r), d_min(r, args[0]))
+        if name in ("step", "heaviside"):
+            return d_step(args[0])
+        if name == "sign":
+            return d_step(args[0], sign=True)
+        if name == "floor":
+            return d_floor(args[0])
+        if name == "mod":
+            return _mod(args[0], args[1], nd)
+    raise ValueError(f"cannot enclose {ast.dump(node)[:60]}")
+
+
+def _mod(a: Dual, b: Dual, nd: int) -> Dual:
+    """mod(a, b) = a − b·floor(a/b) for a constant b > 0: b·frac(a/b)."""
+    if not (b.v.lo > 0.0 and all(x.lo == x.hi == 0.0 for x in b.g)):
+        raise ArithmeticError("mod(a, b) is enclosed only for a constant b > 0")
+    q = d_div(a, b)
+    return d_mul(d_frac(q), b)

@@ -1,0 +1,351 @@
+"""search-space method (Hernández & García, paper 004): the example's certified numbers, and
+for every claim id a tampered report (or spec) that makes exactly that claim fail."""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from flint import fmpq
+from typer.testing import CliRunner
+
+from obsdesign import api
+from obsdesign.certify import interval as ivq
+from obsdesign.certify.claim import ClaimStatus
+from obsdesign.certify.exact import Q
+from obsdesign.cli import app
+from obsdesign.methods.searchspace import design as D
+from obsdesign.params import Parameters
+
+ROOT = Path(__file__).resolve().parents[1]
+SPEC = ROOT / "specs" / "hernandez-garcia-example.toml"
+TEXT = SPEC.read_text(encoding="utf-8")
+
+
+@pytest.fixture(scope="module")
+def example():
+    sp = api.load_spec(SPEC)
+    rep = api.design(sp)
+    return sp, rep
+
+
+def test_example_numbers_exact(example):
+    sp, rep = example
+    p = rep.parameters
+    assert all(c.status == ClaimStatus.CERTIFIED for c in rep.claims), [
+        (c.id, c.detail) for c in rep.failed
+    ]
+    assert p["L_f"] == 1 and p["L_h"] == 1
+    assert p["f_sup"] == fmpq(353554, 100000)  # 2.5·√2 = 3.5355339… rounded up to 6 digits
+    assert p["kappa"] == fmpq(3, 2)
+    assert p["dT"] == fmpq(9, 10) * fmpq(1, 20) / (2 * p["f_sup"]) == fmpq(1125, 176777)
+    assert p["K"] == 63  # 63·ΔT = 0.40093 < log 1.5 = 0.405465 < 64·ΔT
+    assert p["eps_star"] == fmpq(1, 30)
+    g = list(p["gamma_schedule"])
+    assert len(g) == 12 and g[0] == 1 and g[-1] == fmpq(1, 20)
+    assert all(a > b for a, b in zip(g, g[1:], strict=False))
+    ids = [c.id for c in rep.claims]
+    assert ids == [
+        "input-range",
+        "D-in-E",
+        "L_h-bound",
+        "L_f-bound",
+        "f_sup-bound",
+        "kappa-range",
+        "gamma0-above-star",
+        "dT-rule",
+        "lemma1-discarding",
+        "dtau-rule",
+        "K-rule",
+        "lemma2-consistency",
+        "gamma-schedule",
+        "eps-schedule",
+        "eps-star",
+    ]
+
+
+def test_verify_roundtrip(example, tmp_path):
+    _, rep = example
+    out = tmp_path / "r.json"
+    out.write_text(rep.to_json())
+    ver = api.verify(out)
+    assert ver.exit_code() == 0
+    assert [(c.id, c.statement, c.status) for c in ver.claims] == [
+        (c.id, c.statement, c.status) for c in rep.claims
+    ]
+
+
+def test_printed_numbers_are_true(example):
+    """Every number printed in a statement is exact or rounded to the safe side."""
+    sp, rep = example
+    p = rep.parameters
+    st = {c.id: c.statement for c in rep.claims}
+    m = re.search(r"log\(κ/L_h\^E\)/L_f\^E ≥ ([0-9.]+)", st["lemma2-consistency"])
+    assert m and Q(m.group(1)) <= ivq.log_lower(p["kappa"] / p["L_h"]) / p["L_f"]
+    m = re.search(r"‖f_u‖_E\) = ([0-9/]+)", st["dT-rule"])
+    assert m and Q(m.group(1)) == p["dT"]
+    m = re.search(r"\(‖f_u‖_E ≤ ([0-9.]+)\)", st["f_sup-bound"])
+    assert m and Q(m.group(1)) == p["f_sup"]
+    m = re.search(r"ε⋆ = γ⋆/κ = ([0-9/]+)", st["eps-star"])
+    assert m and Q(m.group(1)) == p["eps_star"]
+
+
+# -- tampering -------------------------------------------------------------------------------
+def _consistent(sp, **over):
+    """Parameters from the rules with some inputs overridden (consistently downstream)."""
+    o = sp.options
+    c = D.constants(sp)
+    c = dataclasses.replace(c, **{k: v for k, v in over.items() if k in ("L_f", "L_h", "f_sup")})
+    if "gamma_star" in over or "gamma0" in over:
+        o = dataclasses.replace(
+            o,
+            gamma_star=over.get("gamma_star", o.gamma_star),
+            gamma0=over.get("gamma0", o.gamma0),
+        )
+    return D.rules(c, o, kappa=over.get("kappa"), K=over.get("K"))
+
+
+def _report_with(rep, vals: dict, tmp_path: Path) -> Path:
+    d = rep.to_dict()
+    vals = {k: np.array(v, dtype=object) if isinstance(v, list) else v for k, v in vals.items()}
+    d["parameters"] = Parameters(vals).to_json()
+    out = tmp_path / "tampered.json"
+    out.write_text(json.dumps(d))
+    return out
+
+
+def _failed(path: Path) -> set[str]:
+    """The method's own failed claims after verify (verify adds report-alters:<id> /
+    report-verdict when the stored claims differ from the recomputed ones); exit code 1."""
+    ver = api.verify(path)
+    assert ver.exit_code() == 1, [(c.id, c.float_ok) for c in ver.failed]
+    return {c.id for c in ver.failed if not c.id.startswith("report-")}
+
+
+def _reschedule(vals: dict, o) -> dict:
+    """Recompute Δτ-dependent entries after a change of dT / K / dtau."""
+    gam = D.schedule(o.gamma0, vals["gamma_star"], vals["L_f"], vals["dtau"])
+    v = dict(vals)
+    v["gamma_schedule"] = gam
+    v["eps_schedule"] = [g / v["kappa"] for g in gam]
+    return D.params_from(
+        v["L_f"],
+        v["L_h"],
+        v["f_sup"],
+        v["kappa"],
+        v["gamma_star"],
+        v["dT"],
+        int(v["K"]),
+        v["dtau"],
+        gam,
+    )
+
+
+ULP_BELOW_1 = fmpq(1) - fmpq(1, 2**53)
+
+
+def test_tamper_L_h(example, tmp_path):
+    sp, rep = example
+    assert _failed(_report_with(rep, _consistent(sp, L_h=ULP_BELOW_1), tmp_path)) == {"L_h-bound"}
+
+
+def test_tamper_L_f(example, tmp_path):
+    sp, rep = example
+    assert _failed(_report_with(rep, _consistent(sp, L_f=ULP_BELOW_1), tmp_path)) == {"L_f-bound"}
+
+
+def test_tamper_f_sup(example, tmp_path):
+    sp, rep = example
+    below = Q("3.53553390593273")  # < 2.5·√2 = 3.5355339059327376…
+    assert _failed(_report_with(rep, _consistent(sp, f_sup=below), tmp_path)) == {"f_sup-bound"}
+
+
+def test_tamper_kappa(example, tmp_path):
+    sp, rep = example
+    assert _failed(_report_with(rep, _consistent(sp, kappa=fmpq(2)), tmp_path)) == {"kappa-range"}
+
+
+def test_tamper_gamma_star(example, tmp_path):
+    sp, rep = example
+    v = _consistent(sp, gamma_star=fmpq(1, 20) + fmpq(1, 2**60))
+    assert _failed(_report_with(rep, v, tmp_path)) == {"gamma_star-matches-spec"}
+
+
+def test_tamper_gamma0(example, tmp_path):
+    sp, rep = example
+    v = _consistent(sp, gamma0=fmpq(1) + fmpq(1, 2**60))
+    assert _failed(_report_with(rep, v, tmp_path)) == {"gamma0-matches-spec"}
+
+
+def test_tamper_dT(example, tmp_path):
+    sp, rep = example
+    v = _consistent(sp)
+    v["dT"] += fmpq(1, 2**80)
+    v["dtau"] = v["K"] * v["dT"]
+    assert _failed(_report_with(rep, _reschedule(v, sp.options), tmp_path)) == {"dT-rule"}
+
+
+def test_tamper_dtau(example, tmp_path):
+    sp, rep = example
+    v = _consistent(sp)
+    v["dtau"] -= fmpq(1, 2**80)
+    assert _failed(_report_with(rep, _reschedule(v, sp.options), tmp_path)) == {"dtau-rule"}
+
+
+def test_tamper_K_smaller_is_not_the_rule(example, tmp_path):
+    sp, rep = example
+    v = _consistent(sp, K=62)
+    assert _failed(_report_with(rep, v, tmp_path)) == {"K-rule"}
+
+
+def test_tamper_K_larger_breaks_lemma2(example, tmp_path):
+    sp, rep = example
+    v = _consistent(sp, K=64)
+    assert _failed(_report_with(rep, v, tmp_path)) == {"lemma2-consistency"}
+
+
+def test_tamper_schedule_entry(example, tmp_path):
+    sp, rep = example
+    v = _consistent(sp)
+    g = list(v["gamma_schedule"])
+    x = v["L_f"] * v["dtau"]
+    g[3] = g[2] * D.exp_lower(x) / 2 - fmpq(1, 2**80)  # below γ_2 e^{L_f Δτ}/2
+    v["gamma_schedule"] = g
+    v["eps_schedule"] = [a / v["kappa"] for a in g]
+    assert _failed(_report_with(rep, v, tmp_path)) == {"gamma-schedule"}
+
+
+def test_tamper_schedule_truncated(example, tmp_path):
+    sp, rep = example
+    v = _consistent(sp)
+    v["gamma_schedule"] = list(v["gamma_schedule"])[:-1]
+    v["eps_schedule"] = list(v["eps_schedule"])[:-1]
+    assert _failed(_report_with(rep, v, tmp_path)) == {"gamma-schedule"}
+
+
+def test_tamper_eps_entry(example, tmp_path):
+    sp, rep = example
+    v = _consistent(sp)
+    e = list(v["eps_schedule"])
+    e[5] += fmpq(1, 2**80)
+    v["eps_schedule"] = e
+    assert _failed(_report_with(rep, v, tmp_path)) == {"eps-schedule"}
+
+
+def test_tamper_eps_star(example, tmp_path):
+    sp, rep = example
+    v = _consistent(sp)
+    v["eps_star"] += fmpq(1, 2**80)
+    assert _failed(_report_with(rep, v, tmp_path)) == {"eps-star"}
+
+
+def test_tampered_report_cli_exit_1(example, tmp_path):
+    sp, rep = example
+    path = _report_with(rep, _consistent(sp, K=64), tmp_path)
+    r = CliRunner().invoke(app, ["verify", str(path)])
+    assert r.exit_code == 1, r.output
+
+
+# -- spec-level: conditions that cannot all hold --------------------------------------------
+def _design_failed(text: str, tmp_path: Path) -> set[str]:
+    p = tmp_path / "s.toml"
+    p.write_text(text, encoding="utf-8")
+    rep = api.design(p)
+    out = tmp_path / "r.json"
+    out.write_text(rep.to_json())
+    assert api.verify(out).exit_code() == 1
+    return {c.id for c in rep.failed}
+
+
+def test_input_outside_U(tmp_path):
+    text = TEXT.replace("lower = [0]\nupper = [1]", "lower = [0]\nupper = [0.99]")
+    assert _design_failed(text, tmp_path) == {"input-range"}
+
+
+def test_D_outside_E(tmp_path):
+    text = TEXT.replace("lower = [0, -2]\nupper = [0, 2]", "lower = [0, -2]\nupper = [0, 2.6]")
+    assert _design_failed(text, tmp_path) == {"D-in-E"}
+
+
+def test_alpha_one_breaks_lemma1(tmp_path):
+    text = TEXT.replace("alpha = 0.9 ", "alpha = 1 ")
+    assert _design_failed(text, tmp_path) == {"lemma1-discarding"}
+
+
+def test_gamma0_below_gamma_star(tmp_path):
+    text = TEXT.replace("gamma0 = 1 ", "gamma0 = 0.0499 ")
+    assert _design_failed(text, tmp_path) == {"gamma0-above-star"}
+
+
+def test_given_constants(tmp_path):
+    """User-given constants: proved when the interval bound is below them; a value below a
+    sampled difference quotient fails; the report must carry the spec's value."""
+    text = TEXT.replace("gamma0 = 1 ", "gamma0 = 1\nL_h = 1\nL_f = 1.5 ")
+    p = tmp_path / "s.toml"
+    p.write_text(text, encoding="utf-8")
+    sp = api.load_spec(p)
+    rep = api.design(sp)
+    assert rep.exit_code() == 0
+    assert rep.parameters["L_f"] == fmpq(3, 2)
+    assert "given" in next(c.statement for c in rep.claims if c.id == "L_f-bound")
+    v = _consistent(sp, L_h=fmpq(1) + fmpq(1, 2**52))
+    assert _failed(_report_with(rep, v, tmp_path)) == {"L_h-matches-spec"}
+    bad = TEXT.replace("gamma0 = 1 ", "gamma0 = 1\nL_h = 0.9 ")
+    failed = _design_failed(bad, tmp_path)
+    assert failed == {"L_h-bound"}
+
+
+def test_kappa_outside_range_and_K_one_too_long(tmp_path):
+    """κ ≥ 2 L_h: the paper's conditions cannot all hold; say which and by how much."""
+    text = TEXT.replace("# kappa = 1.5 ", "kappa = 2.5 ")
+    p = tmp_path / "s.toml"
+    p.write_text(text, encoding="utf-8")
+    rep = api.design(p)
+    bad = {c.id: c.detail for c in rep.failed}
+    # κ/L_h > 2 also makes e^{L_f Δτ}/2 ≥ 1 possible: here the schedule cannot decrease
+    assert set(bad) == {"kappa-range", "gamma-schedule"}
+    assert "by 0.5" in bad["kappa-range"]
+    # γ⋆ so large that even K = 1 exceeds Lemma 2's horizon
+    text = TEXT.replace("# kappa = 1.5 ", "kappa = 1.001 ").replace("alpha = 0.9 ", "alpha = 0.99 ")
+    text = text.replace("gamma_star = 0.05 ", "gamma_star = 0.5 ")
+    p.write_text(text, encoding="utf-8")
+    rep = api.design(p)
+    assert {c.id for c in rep.failed} == {"lemma2-consistency"}
+    assert rep.parameters["K"] == 1
+    assert "K = 1 already too long" in rep.failed[0].detail
+
+
+def test_bad_inputs(tmp_path):
+    from obsdesign.errors import SpecError
+
+    p = tmp_path / "s.toml"
+    p.write_text(TEXT.replace('f = ["u1*x2", "-u1*x1"]', 'f = ["u1*x2 + t", "-u1*x1"]'))
+    with pytest.raises(SpecError, match="time enters through u"):
+        api.load_spec(p)
+    p.write_text(TEXT.replace("gamma_star = 0.05 ", "eps_star = 0.05\ngamma_star = 0.05 "))
+    with pytest.raises(SpecError, match="exactly one of gamma_star and eps_star"):
+        api.load_spec(p)
+    p.write_text(TEXT.replace("lower = [0, -2]\nupper = [0, 2]", "lower = [0, 2]\nupper = [0, -2]"))
+    with pytest.raises(SpecError, match="lower <= upper"):
+        api.load_spec(p)
+
+
+def test_eps_star_spelling(tmp_path):
+    text = TEXT.replace("gamma_star = 0.05 ", "eps_star = 0.04 ")
+    p = tmp_path / "s.toml"
+    p.write_text(text, encoding="utf-8")
+    rep = api.design(p)
+    assert rep.exit_code() == 0
+    assert rep.parameters["gamma_star"] == fmpq(3, 2) * fmpq(1, 25)
+    assert rep.parameters["eps_star"] == fmpq(1, 25)
+
+
+def test_copy_is_untouched(example):
+    """Tampering helpers work on copies: the module fixture stays certified."""
+    sp, rep = example
+    assert copy.deepcopy(rep).exit_code() == 0
