@@ -131,6 +131,11 @@ def test_example_72_symmetric_fails_general_certifies(rep72, tmp_path):
     )  # paper: "ε(z) > 1 for some z", Fig. 2 ≈ 1.06
     assert p["converged"] is True
     assert p["contractivity"] <= 1
+    # reproduced: 3 symmetric + 30 general checks, 56 facets, 30 vertices, factor 0.999999654
+    assert (p["iterations"], p["facets"], p["vertices"]) == (33, 56, 30)
+    assert len(np.asarray(p["G"]).reshape(-1, 3)) == 56 and len(np.asarray(p["V"])) == 30
+    assert fmpq(999999653, 10**9) < p["contractivity"] < fmpq(999999654, 10**9)
+    assert p["symmetric_iterations"] == 3 and len(np.asarray(p["symmetric_G"])) == 70
     assert all(c.status == ClaimStatus.CERTIFIED for c in rep.claims)
     assert api.verify(out).exit_code() == 0
     from pathlib import Path

@@ -108,3 +108,54 @@ def test_with_gmp_claims_are_certified_again(monkeypatch, tmp_path):
     assert ver.exit_code() != 0
     assert not any(c.status == ClaimStatus.CERTIFIED for c in ver.claims)
     assert numerical.TOL <= 1e-9
+
+
+def _float_failed(d: dict, tmp_path: Path) -> set[str]:
+    """Failed ids of the float certificate; verify (still without gmp) must exit 1."""
+    from obsdesign.report.model import Report
+
+    rep, problems = Report.from_dict(d)
+    assert not problems, problems
+    spec = load_spec_text(rep.spec, rep.spec_file)
+    ids = {c.id for c in api.certify(spec, rep.parameters) if not c.ok}
+    path = tmp_path / "t.json"
+    path.write_text(json.dumps(d))
+    assert api.verify(path).exit_code() == 1
+    return ids
+
+
+def test_float_backend_checks_the_spec_L(nogmp, tmp_path):
+    """Issue 15 item 1 without gmp: the report's L_user replaced by the designed gain."""
+    from obsdesign.certify.exact import Q
+
+    spec = load_spec_text(SPEC71.read_text().replace("L = [-0.7, -0.2212]", "L = [0.5, 0.5]"))
+    out = tmp_path / "r.json"
+    rep = api.design(spec, out)
+    assert {c.id for c in rep.failed} == {"linear-law-user"}
+    d = json.loads(out.read_text())
+    L = d["parameters"]["L"]
+    d["parameters"]["L_user"] = L
+    d["parameters"]["exact"]["L_user"] = [[str(Q(x)) for x in r] for r in L]
+    assert _float_failed(d, tmp_path) == {"linear-law-user", "L_user-matches-spec"}
+
+
+def test_float_backend_checks_the_whole_table(nogmp, tmp_path):
+    """Issue 15 item 2 without gmp: an extra breakpoint z = 1/3 with v = (100, 100)."""
+    from obsdesign.methods.setinvariant import laws
+
+    out = tmp_path / "r.json"
+    api.design(SPEC71, out)
+    d = json.loads(out.read_text())
+    p = d["parameters"]
+    zs, vs = list(p["breakpoints"]), [list(v) for v in p["v_breakpoints"]]
+    k = next(i for i, z in enumerate(zs) if z > 1 / 3)
+    zs.insert(k, 1 / 3)
+    vs.insert(k, [100.0, 100.0])
+    Ls, ws = laws.pieces(zs, vs)
+    p["breakpoints"], p["v_breakpoints"] = zs, vs
+    p["L_pieces"], p["w_pieces"] = Ls, ws
+    assert _float_failed(d, tmp_path) == {"injection-table"}
+    # a tampered segment
+    d = json.loads(out.read_text())
+    d["parameters"]["w_pieces"][1][0] += 1e-6
+    assert _float_failed(d, tmp_path) == {"injection-table"}
