@@ -374,7 +374,24 @@ max_iterations = {maxit}
 
 
 def test_template_designs():
-    from obsdesign.methods import get_method
-
-    rep = api.design(load_spec_text(get_method("set-invariant").template(), "template.toml"))
+    rep = api.design(load_spec_text(api.template("set-invariant"), "template.toml"))
     assert rep.exit_code() == 0
+
+
+def test_template_options_uncommented_still_load():
+    """Every commented-out key of the template is valid when uncommented (one at a time and
+    all together) and validates against ``obsdesign schema``."""
+    import re
+    import tomllib
+
+    import jsonschema
+
+    text = api.template("set-invariant")
+    lines = text.splitlines()
+    opts = [i for i, ln in enumerate(lines) if re.match(r"^# [A-Za-z_]+ = ", ln)]
+    assert len(opts) >= 5
+    variants = [[i] for i in opts] + [opts]
+    for idx in variants:
+        t = "\n".join(ln[2:] if i in idx else ln for i, ln in enumerate(lines))
+        jsonschema.validate(tomllib.loads(t), api.schema())
+        load_spec_text(t, "template.toml")

@@ -15,6 +15,7 @@ import numpy as np
 from obsdesign.errors import InputError
 from obsdesign.params import Parameters
 from obsdesign.sets import Box
+from obsdesign.sets import polytope_ops as po
 from obsdesign.simulate.runner import run_discrete
 from obsdesign.spec.models import Spec
 
@@ -35,10 +36,12 @@ def make_law(spec: Spec, params: Parameters, law: str | None) -> Any:
         v = params.float("v_breakpoints").reshape(len(z), s.n)
         return laws.PiecewiseAffineLaw(z, v, lam, law)
     if law == "linear":
-        key = "L" if "L" in params else "L_user" if "L_user" in params else None
-        if key is None:
-            raise InputError("the report has no linear gain L")
-        return laws.LinearLaw(params.float(key).reshape(s.n, s.p))
+        # the designed L, else the spec's [method].L (never the report's copy of it)
+        if "L" in params:
+            return laws.LinearLaw(params.float("L").reshape(s.n, s.p))
+        if spec.options.L is None:
+            raise InputError("the report has no linear gain L and the spec gives none")
+        return laws.LinearLaw(po.qfloat(spec.options.L).reshape(s.n, s.p))
     if law == "online-lp":
         d = build(spec).fl
         return laws.OnlineLPLaw(params.float("G").reshape(-1, s.n), d.A, d.B1, d.C[0], d.Dv, d.eta)
@@ -56,7 +59,9 @@ def _admissible(spec: Spec, d: np.ndarray, v: np.ndarray) -> bool:
 
 
 def simulate(spec: Spec, params: Parameters, law: str | None = None, **kwargs: Any) -> Any:
-    """Run the spec's scenario with the designed law; kwargs: ``law`` (string)."""
+    """Run the spec's scenario with the injection law ``law`` (interpolated eq. (12),
+    time-varying eq. (10), online-lp LP (9), linear v = L z; default: the table for one
+    output, else L)."""
     if kwargs:
         raise InputError(f"unknown simulation option(s): {', '.join(sorted(kwargs))} (known: law)")
     s = spec.system
