@@ -20,7 +20,7 @@ from obsdesign.errors import (
     ObsdesignError,
     SpecError,
 )
-from obsdesign.limits import max_states_for
+from obsdesign.limits import limits, max_states_for
 from obsdesign.methods import get_method, method_keys
 from obsdesign.methods.base import Method, Progress
 from obsdesign.params import Parameters
@@ -507,8 +507,10 @@ def simulate(
     kwargs = {**get_method(sp.method).parse_sim_options(options or {}), **kwargs}
     if sp.simulate is None:
         raise InputError(f"{sp.file}: [simulate] is missing: nothing to simulate")
+    check_sim_memory(sp, kwargs)
     if report is None:
-        params: Parameters = get_method(sp.method).design(sp).parameters
+        with captured_warnings([]):
+            params: Parameters = get_method(sp.method).design(sp).parameters
     else:
         rep, problems = (
             Report.from_dict(report.to_dict())
@@ -520,7 +522,39 @@ def simulate(
         if problems:
             raise InputError(f"report: {problems[0]}")
         params = rep.parameters
-    return get_method(sp.method).simulate(sp, params, **kwargs)
+    notes: list[str] = []
+    with captured_warnings(notes):
+        res = get_method(sp.method).simulate(sp, params, **kwargs)
+    if notes:
+        res.info["warnings"] = notes
+    return res
+
+
+def check_sim_memory(sp: Spec, kwargs: dict[str, Any]) -> None:
+    """Refuse a simulation whose trajectories would not fit: ``runs × steps × states``
+    doubles (plant, estimate, error and output per step) estimated before anything is
+    allocated, against ``max_sim_bytes`` (:mod:`obsdesign.limits`). ``runs`` is the
+    ``--option runs`` value, else the spec's, else 1; steps are the horizon (discrete time)
+    or horizon / dt (continuous time)."""
+    sim = sp.simulate
+    assert sim is not None
+    runs = kwargs.get("runs")
+    if runs is None:
+        runs = getattr(sim.options, "runs", None) or getattr(sp.options, "runs", None) or 1
+    horizon = float(sim.horizon.f)
+    if sp.system.discrete or sim.dt is None:
+        steps = horizon
+    else:
+        steps = horizon / max(float(sim.dt.f), 1e-300)
+    width = 4 * sp.system.n + sp.system.p + sp.system.m + 2
+    need = 8.0 * float(runs) * (steps + 1.0) * width
+    cap = limits().max_sim_bytes
+    if need > cap:
+        raise InputError(
+            f"{sp.file}: simulating {int(runs)} run(s) × {steps:.3g} steps × {sp.system.n} "
+            f"states needs about {need / 2**30:.3g} GiB, above the limit of "
+            f"{cap / 2**30:.3g} GiB (fewer runs, a shorter horizon, or --limit max_sim_bytes=N)"
+        )
 
 
 @dataclass
@@ -539,21 +573,31 @@ class CheckRow:
 
 
 def spec_files(paths: list[str | Path]) -> list[Path]:
-    """Expand folders to their ``*.toml`` files (sorted); keep files as given."""
+    """Expand folders to their ``*.toml`` files, subfolders included (sorted; hidden
+    folders skipped); keep files as given."""
     out: list[Path] = []
     for p in map(Path, paths):
         if p.is_dir():
-            out += sorted(p.glob("*.toml"))
+            out += sorted(
+                f
+                for f in p.rglob("*.toml")
+                if not any(part.startswith(".") for part in f.relative_to(p).parts[:-1])
+            )
         else:
             out.append(p)
     return out
 
 
 def check_one(path: Path) -> CheckRow:
-    """Design, serialize, reload and verify one spec."""
+    """Design, serialize, reload and verify one spec. Always returns a row: an error of any
+    kind (bad input, solver failure, an internal error) becomes that row's exit code and
+    message, so one spec never loses the others' rows (KeyboardInterrupt still stops)."""
     t0 = time.perf_counter()
+    method_key = "?"
     try:
-        rep = design(path)
+        sp = load_spec(path)
+        method_key = sp.method
+        rep = design(sp)
         ver = verify(Report.from_dict(rep.to_dict())[0])
         code = ver.exit_code()
         counts = ver.status_counts()
@@ -572,12 +616,25 @@ def check_one(path: Path) -> CheckRow:
         )
     except ObsdesignError as e:
         return CheckRow(
-            str(path), "?", e.exit_code, 0, 0, 0, "", time.perf_counter() - t0, e.message
+            str(path), method_key, e.exit_code, 0, 0, 0, "", time.perf_counter() - t0, e.message
+        )
+    except Exception as e:  # noqa: BLE001 - one row per spec, whatever happened in it
+        return CheckRow(
+            str(path),
+            method_key,
+            EXIT_SOLVER,
+            0,
+            0,
+            0,
+            "",
+            time.perf_counter() - t0,
+            f"internal failure: {type(e).__name__}: {e}",
         )
 
 
 def check(paths: list[str | Path], on_start: Any = None) -> list[CheckRow]:
-    """Design and verify every spec under ``paths``; ``on_start(path)`` is called before each."""
+    """Design and verify every spec under ``paths`` (folders recursively, see
+    :func:`spec_files`); ``on_start(path)`` is called before each. One row per spec."""
     files = spec_files(paths)
     if not files:
         raise InputError(f"no spec files (*.toml) in {', '.join(map(str, paths))}")

@@ -230,7 +230,10 @@ def check(
     paths: Annotated[list[Path], typer.Argument(help="Spec files or folders of *.toml.")],
     fmt: Annotated[Fmt, typer.Option("--format")] = Fmt.text,
 ) -> None:
-    """Design and verify every spec; one row per spec; non-zero exit if any fails."""
+    """Design and verify every spec; one row per spec; non-zero exit if any fails.
+
+    Folders are searched recursively for *.toml (hidden folders skipped). Every spec gets a
+    row whatever happens in it: its exit code and message (an internal error is exit 3)."""
 
     def body() -> int:
         from obsdesign import api
@@ -380,14 +383,13 @@ def _print_rows(rows: list[Any], fmt: Fmt) -> None:
         print("| spec | method | exit | certified | numerical | failed | result | seconds |")
         print("| --- | --- | --- | --- | --- | --- | --- | --- |")
         for r in rows:
-            print(
-                f"| {r.spec} | {r.method} | {r.code} | {r.certified} | {r.numerical} | {r.failed} | "
-                f"{r.summary or r.message} | {r.seconds:.2f} |"
-            )
+            cells = [r.spec, r.method, r.code, r.certified, r.numerical, r.failed]
+            cells += [r.summary or r.message, f"{r.seconds:.2f}"]
+            print("| " + " | ".join(_md_cell(c) for c in cells) + " |")
         return
     from rich.table import Table
 
-    from obsdesign.report.render import console
+    from obsdesign.report.render import console, esc
 
     t = Table(title="obsdesign check")
     for c in ("spec", "method", "verdict", "cert.", "num.", "failed", "result", "s"):
@@ -395,22 +397,27 @@ def _print_rows(rows: list[Any], fmt: Fmt) -> None:
     for r in rows:
         verdict = "[green]ok[/]" if r.code == 0 else f"[bold red]exit {r.code}[/]"
         t.add_row(
-            r.spec,
-            r.method,
+            esc(r.spec),
+            esc(r.method),
             verdict,
             str(r.certified),
             str(r.numerical),
             str(r.failed),
-            r.summary if r.code == 0 else r.message,
+            esc(r.summary if r.code == 0 else r.message),
             f"{r.seconds:.2f}",
         )
     console().print(t)
 
 
+def _md_cell(v: Any) -> str:
+    """A Markdown table cell: pipes escaped, one line."""
+    return str(v).replace("|", "\\|").replace("\n", " ")
+
+
 def _print_metrics(m: dict[str, Any]) -> None:
     from rich.table import Table
 
-    from obsdesign.report.render import console
+    from obsdesign.report.render import console, esc
 
     t = Table(title="simulation metrics")
     t.add_column("state")
@@ -418,13 +425,13 @@ def _print_metrics(m: dict[str, Any]) -> None:
     t.add_column("RMSE")
     t.add_column("sup |x̂_i|")
     for s, v in m["sup_abs_error"].items():
-        t.add_row(s, f"{v:.6g}", f"{m['rmse'][s]:.6g}", f"{m['sup_abs_estimate'][s]:.6g}")
+        t.add_row(esc(s), f"{v:.6g}", f"{m['rmse'][s]:.6g}", f"{m['sup_abs_estimate'][s]:.6g}")
     c = console()
     c.print(t)
     c.print(f"final |e| = {m['final_error_norm']:.6g}")
     for k, v in m.items():
         if k not in ("sup_abs_error", "rmse", "final_error_norm", "sup_abs_estimate", "exit_code"):
-            c.print(f"{k}: {v}")
+            c.print(esc(f"{k}: {v}"))
 
 
 def main() -> None:

@@ -8,6 +8,8 @@ Checked where the input enters:
 
 - files (spec, report): a regular file (``stat`` before ``open``, so a FIFO or /dev/zero is
   refused at once) of at most ``max_file_bytes``;
+- values: a spec holds at most ``max_values`` comma-separated values (counted on the text
+  before the TOML parser runs: a 2000×2000 matrix is refused in milliseconds);
 - numbers: at most ``max_digits`` significant digits and a decimal exponent within
   ``±max_exponent``, checked on the text / ``Decimal`` before any conversion to a rational;
 - TOML and JSON nesting: at most ``max_depth`` levels (walked iteratively);
@@ -24,7 +26,9 @@ from __future__ import annotations
 import os
 import re
 import stat
+import sys
 from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, fields, replace
 from decimal import Decimal
 from pathlib import Path
@@ -38,6 +42,7 @@ class Limits:
     """The limits in force (see the module docstring)."""
 
     max_file_bytes: int = 16 * 1024 * 1024
+    max_values: int = 250_000
     max_digits: int = 1000
     max_exponent: int = 1000
     max_depth: int = 32
@@ -165,6 +170,7 @@ def int_problem(v: int) -> str | None:
 _NUM = re.compile(
     r"^\s*[+-]?(?:(\d+)(?:\.(\d*))?|\.(\d+))(?:[eE]([+-]?\d+))?\s*$"  # decimal
 )
+_NUMBERISH = re.compile(r"^[\s0-9+\-./eE_]*$")
 _FRAC = re.compile(r"^\s*[+-]?(\d+)\s*/\s*[+-]?(\d+)\s*$")
 
 
@@ -172,6 +178,8 @@ def number_text_problem(s: str) -> str | None:
     """Why the text of an exact number ("p/q" or a decimal) is too big to convert (None when
     fine or when it is not a number at all: the converter then says so)."""
     lim = _current
+    if not _NUMBERISH.match(s):
+        return None
     if len(s) > 4 * (lim.max_digits + 20):
         return f"is {len(s)} characters long, above the limit for a number (--limit max_digits=N)"
     m = _FRAC.match(s)
@@ -193,6 +201,23 @@ def number_text_problem(s: str) -> str | None:
                 f"has decimal exponent {ex}, outside ±{lim.max_exponent} (--limit max_exponent=N)"
             )
     return None
+
+
+@contextmanager
+def int_digits() -> Iterator[None]:
+    """Let the parsers read integers up to ``max_digits`` digits when that is above Python's
+    int-string limit (4300 by default); the digit count is then checked by the walker."""
+    get = getattr(sys, "get_int_max_str_digits", None)
+    old = get() if get is not None else 0
+    need = _current.max_digits + 1
+    if get is None or old == 0 or old >= need:
+        yield
+        return
+    sys.set_int_max_str_digits(need)
+    try:
+        yield
+    finally:
+        sys.set_int_max_str_digits(old)
 
 
 # -- nesting --------------------------------------------------------------------------------

@@ -144,18 +144,22 @@ class Report:
     @classmethod
     def load(cls, path: str | Path) -> tuple[Report, list[str]]:
         """Read a report; returns it and the list of float/exact inconsistencies found."""
-        from obsdesign.limits import read_input
+        from obsdesign.limits import int_digits, limits, read_input
 
         p = Path(path)
         raw = read_input(p, "report")
         try:
-            d = json.loads(raw.decode("utf-8"))
+            with int_digits():
+                d = json.loads(raw.decode("utf-8"))
         except (UnicodeDecodeError, json.JSONDecodeError) as e:
             raise InputError(f"{p}: not a readable JSON report ({e})") from None
         except RecursionError:
             raise InputError(f"{p}: JSON nested too deeply") from None
-        except ValueError as e:  # an integer beyond Python's int-string limit
-            raise InputError(f"{p}: a number is too long ({e})") from None
+        except ValueError:  # an integer beyond Python's int-string limit
+            raise InputError(
+                f"{p}: has a number with more than {max(4300, limits().max_digits)} digits "
+                f"(--limit max_digits=N)"
+            ) from None
         return cls.from_dict(d, str(p))
 
     @classmethod
@@ -164,7 +168,9 @@ class Report:
 
         if not isinstance(d, dict):
             raise InputError(f"{file}: a report is a JSON object")
-        bad = data_problem(d, exact_strings=True)
+        bad = data_problem(d)
+        if bad is None and isinstance(d.get("parameters"), dict):
+            bad = data_problem({"parameters": d["parameters"]}, exact_strings=True)
         if bad is not None:
             raise InputError(f"{file}: [{bad[0]}] {bad[1]}")
         for k in ("schema_version", "method", "spec", "spec_sha256", "parameters", "claims"):

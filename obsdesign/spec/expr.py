@@ -16,6 +16,7 @@ heaviside(x) = 1 if x > 0 else 0``, ``mod(a, b) = a - b*floor(a/b)``. Constants 
 from __future__ import annotations
 
 import ast
+import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -167,16 +168,34 @@ def parse_expr(
 
     ``parameters`` maps names to exact values (fmpq, int, Decimal, float).
     """
+    from obsdesign.limits import limits
+
     parameters = dict(parameters or {})
     if not isinstance(text, str):
         raise SpecError(file, key, "expected an expression string")
-    if len(text) > 10_000:
-        raise SpecError(file, key, "expression is too long")
+    lim = limits()
+    if len(text) > lim.max_expr_chars:
+        raise SpecError(
+            file,
+            key,
+            f"expression is {len(text)} characters long, above the limit of "
+            f"{lim.max_expr_chars} (--limit max_expr_chars=N)",
+        )
+    depth = nesting_depth(text)
+    if depth > lim.max_expr_depth:
+        raise SpecError(file, key, _too_deep(depth))
     try:
         # ``^`` is power here; Python's ^ binds looser than * and +, so rewrite it as ** first
         tree = ast.parse(text.strip().replace("^", "**"), mode="eval")
     except SyntaxError as e:
         raise SpecError(file, key, f"is not a valid expression ({e.msg})") from None
+    except (RecursionError, MemoryError):  # a backstop: nesting_depth bounds the depth first
+        raise SpecError(file, key, _too_deep(depth)) from None
+    except ValueError as e:  # e.g. an integer literal beyond the int-string limit
+        raise SpecError(file, key, f"is not a valid expression ({e})") from None
+    tree_depth = _tree_depth(tree)
+    if tree_depth > lim.max_expr_depth:
+        raise SpecError(file, key, _too_deep(tree_depth))
     known = set(variables) | set(parameters) | set(CONSTANTS)
     clash = set(variables) & (set(parameters) | set(FUNCTIONS))
     if clash:
@@ -185,6 +204,105 @@ def parse_expr(
         )
     fn = _compile(tree.body, known, file, key)
     return Expr(text, tree, tuple(variables), parameters, fn)
+
+
+def _too_deep(depth: int) -> str:
+    from obsdesign.limits import limits
+
+    return (
+        f"expression nests {depth} levels deep, above the limit of {limits().max_expr_depth} "
+        f"(--limit max_expr_depth=N)"
+    )
+
+
+_TOKEN = re.compile(
+    r"\s*(?:(\d+\.?\d*(?:[eE][+-]?\d+)?|\.\d+(?:[eE][+-]?\d+)?)|([A-Za-z_]\w*)|(\*\*|[-+*/%^(),]))"
+)
+_PREC = {"+": 1, "-": 1, "*": 2, "/": 2, "%": 2, "u": 3, "**": 4, "^": 4}
+
+
+def nesting_depth(text: str) -> int:
+    """The depth of the syntax tree ``text`` would parse to (operators by precedence, ``**``
+    right-associative, unary signs, calls and parentheses), computed iteratively with an
+    operator-precedence scan, so that a 4000-long ``-`` or ``**`` chain is measured without
+    recursion before :func:`ast.parse` sees it. Text it cannot tokenize gets the depth of
+    what came before (``ast.parse`` then reports the syntax error)."""
+    vals: list[int] = []  # depth of each pending operand
+    ops: list[str] = []  # operators, "(" and "call("
+    marks: list[int] = []  # len(vals) at each open parenthesis
+    prev = "start"  # kind of the previous token: start, name, value, op, open, comma
+
+    def apply(op: str) -> None:
+        if op == "u":
+            vals.append((vals.pop() if vals else 0) + 1)
+        else:
+            b = vals.pop() if vals else 0
+            a = vals.pop() if vals else 0
+            vals.append(max(a, b) + 1)
+
+    def unwind() -> None:
+        while ops and ops[-1] in _PREC:
+            apply(ops.pop())
+
+    pos, deepest = 0, 0
+    while pos < len(text):
+        m = _TOKEN.match(text, pos)
+        if m is None or m.end() == pos:
+            break
+        pos = m.end()
+        num, name, op = m.groups()
+        if num is not None or name is not None:
+            vals.append(1)
+            prev = "name" if name is not None else "value"
+        elif op == "(":
+            ops.append("call(" if prev == "name" else "(")
+            marks.append(len(vals))
+            prev = "open"
+        elif op == ",":
+            unwind()
+            prev = "comma"
+        elif op == ")":
+            unwind()
+            if ops:
+                kind = ops.pop()
+                mark = marks.pop()
+                args = vals[mark:]
+                del vals[mark:]
+                if kind == "call(" and vals:
+                    vals.pop()  # the function name
+                vals.append(max(args, default=0) + (1 if kind == "call(" else 0))
+            prev = "value"
+        elif op in _PREC:
+            if op in "+-" and prev in ("start", "op", "open", "comma"):
+                ops.append("u")
+            else:
+                p = _PREC[op]
+                right = op in ("**", "^")
+                while (
+                    ops
+                    and ops[-1] in _PREC
+                    and (_PREC[ops[-1]] > p or (_PREC[ops[-1]] == p and not right))
+                ):
+                    apply(ops.pop())
+                ops.append(op)
+            prev = "op"
+        deepest = max(deepest, len(ops), max(vals, default=0))
+    while ops:
+        top = ops.pop()
+        if top in _PREC:
+            apply(top)
+    return max(deepest, max(vals, default=0))
+
+
+def _tree_depth(tree: ast.AST) -> int:
+    """Depth of a parsed tree, walked with an explicit stack (no recursion)."""
+    deepest = 0
+    stack: list[tuple[ast.AST, int]] = [(tree, 1)]
+    while stack:
+        node, d = stack.pop()
+        deepest = max(deepest, d)
+        stack.extend((c, d + 1) for c in ast.iter_child_nodes(node))
+    return deepest
 
 
 def _compile(node: ast.AST, known: set[str], file: str, key: str) -> Fn:
@@ -203,6 +321,8 @@ def _compile(node: ast.AST, known: set[str], file: str, key: str) -> Fn:
     if isinstance(node, ast.Constant):
         if isinstance(node.value, bool) or not isinstance(node.value, (int, float)):
             raise bad(f"the constant {node.value!r} is")
+        if isinstance(node.value, int) and node.value.bit_length() > 1024:
+            raise SpecError(file, key, "has an integer constant beyond the float range")
         c = float(node.value)
         return lambda env: c
     if isinstance(node, ast.Name):
@@ -278,7 +398,7 @@ def _to_sympy(node: ast.AST, ex: Expr) -> Any:
         if op is ast.Div:
             return a / b
         if op in (ast.Pow, ast.BitXor):
-            return a**b
+            return _sympy_pow(a, b)
         return a - b * sp.floor(a / b)
     assert isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
     args = [_to_sympy(a, ex) for a in node.args]
@@ -308,6 +428,23 @@ def _to_sympy(node: ast.AST, ex: Expr) -> Any:
     if name in ("step", "heaviside"):
         return sp.Heaviside(args[0], 0)
     return args[0] - args[1] * sp.floor(args[0] / args[1])  # mod
+
+
+def _sympy_pow(a: Any, b: Any) -> Any:
+    """``a**b``, except that a constant power whose exact value would have more than 10^4
+    bits (``9**9**9``) is taken in floating point (inf when it overflows): sympy would
+    otherwise compute the huge integer exactly and never return."""
+    import math
+
+    import sympy as sp
+
+    if getattr(a, "is_Number", False) and getattr(b, "is_Number", False):
+        fa, fb = abs(float(a)), abs(float(b))
+        size = fb * abs(math.log2(fa)) if fa not in (0.0, 1.0) and math.isfinite(fa) else 0.0
+        if not math.isfinite(fb) or size > 10_000:
+            with np.errstate(all="ignore"):
+                return sp.Float(float(np.power(float(a), float(b))))
+    return a**b
 
 
 def _eval_sympy(e: Any, env: dict[str, Any]) -> Any:

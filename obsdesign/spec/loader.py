@@ -8,6 +8,7 @@ upper, E symmetric positive definite); every error names the file and the TOML k
 from __future__ import annotations
 
 import hashlib
+import re
 import tomllib
 from decimal import Decimal
 from pathlib import Path
@@ -17,7 +18,8 @@ import numpy as np
 
 from obsdesign.certify.exact import qeye, qzeros
 from obsdesign.certify.psd import check_pd
-from obsdesign.errors import InputError, SpecError
+from obsdesign.errors import SpecError
+from obsdesign.limits import data_problem, int_digits, limits, read_input
 from obsdesign.sets import Box, Ellipsoid, Polytope, SymmetricPolytope
 from obsdesign.sets.base import ConvexSet
 from obsdesign.sets.polytope import check_polytope_q
@@ -35,12 +37,7 @@ def read_spec(path: str | Path) -> Spec:
     """Read, parse and validate the generic parts of the spec at ``path`` (no method bound:
     see :func:`obsdesign.api.load_spec`)."""
     p = Path(path)
-    try:
-        raw = p.read_bytes()
-    except FileNotFoundError:
-        raise InputError(f"{p}: no such spec file") from None
-    except OSError as e:
-        raise InputError(f"{p}: cannot read ({e.strerror})") from None
+    raw = read_input(p, "spec")  # a regular file within the size limit, or InputError
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError:
@@ -53,10 +50,7 @@ def read_spec_text(text: str, file: str = "<spec>") -> Spec:
 
     Returns a :class:`Spec` whose ``method_table`` (and ``simulate.table``) are raw: the API
     binds the method, which reads its own keys."""
-    try:
-        data = tomllib.loads(text, parse_float=Decimal)
-    except tomllib.TOMLDecodeError as e:
-        raise SpecError(file, "", f"is not valid TOML ({e})") from None
+    data = _parse_toml(text, file)
     sha = hashlib.sha256(text.encode("utf-8")).hexdigest()
     root = Table(data, file)
     title = root.str("title", default="")
@@ -79,6 +73,53 @@ def read_spec_text(text: str, file: str = "<spec>") -> Spec:
     return spec
 
 
+def _parse_toml(text: str, file: str) -> dict[str, Any]:
+    """TOML → data (floats as Decimal), within the limits (:mod:`obsdesign.limits`): size,
+    nesting depth, digits and exponent of every number, checked before any number is turned
+    into a rational. Errors name the file and the key (or the line)."""
+    lim = limits()
+    if len(text) > lim.max_file_bytes:
+        raise SpecError(file, "", f"is above the limit of {lim.max_file_bytes} bytes")
+    commas = text.count(",")
+    if commas >= lim.max_values:
+        raise SpecError(
+            file,
+            "",
+            f"holds about {commas + 1} values, above the limit of {lim.max_values} "
+            f"(--limit max_values=N)",
+        )
+    try:
+        with int_digits():
+            data = tomllib.loads(text, parse_float=Decimal)
+    except tomllib.TOMLDecodeError as e:
+        raise SpecError(file, "", f"is not valid TOML ({e})") from None
+    except RecursionError:
+        raise SpecError(
+            file, "", f"is nested more than {lim.max_depth} levels deep (--limit max_depth=N)"
+        ) from None
+    except ValueError:  # an integer beyond Python's int-string limit (4300 digits)
+        raise SpecError(file, _long_number_line(text), _too_many_digits()) from None
+    bad = data_problem(data)
+    if bad is not None:
+        raise SpecError(file, bad[0], bad[1])
+    return data
+
+
+def _too_many_digits() -> str:
+    return f"has a number with more than {limits().max_digits} digits (--limit max_digits=N)"
+
+
+def _long_number_line(text: str) -> str:
+    """'line N (key K)' of the first run of digits longer than the digit limit."""
+    m = re.search(r"\d[\d_]{" + str(limits().max_digits) + ",}", text)
+    if m is None:
+        return ""
+    line_no = text.count("\n", 0, m.start()) + 1
+    line = text.splitlines()[line_no - 1]
+    k = re.match(r"\s*([A-Za-z0-9_.\"'-]+)\s*=", line)
+    return f"line {line_no}" + (f", key {k.group(1)}" if k else "")
+
+
 def _old_spelling(root: Table, mt: Table) -> None:
     """A spec in the spelling before the one plant model: say where the key lives now."""
     for k in ("f", "h"):
@@ -92,6 +133,7 @@ def _old_spelling(root: Table, mt: Table) -> None:
 # -- [system] -----------------------------------------------------------------------------
 def _system(t: Table) -> System:
     time = t.str("time", choices=("discrete", "continuous"))
+    _check_dimension(t)
     has_f = t.has("f")
     A = t.matrix("A") if (t.has("A") or not has_f) else None
     if A is not None and A.shape[1] != A.shape[0]:
@@ -164,6 +206,19 @@ def _system(t: Table) -> System:
     sys.u_signal = _exprs(t, "u", m, ["t"], exact)
     t.done()
     return sys
+
+
+def _check_dimension(t: Table) -> None:
+    """Refuse a state dimension above every method's limit before any number is converted
+    (the method's own, lower limit is checked when it is bound)."""
+    cap = limits().max_states
+    for k in ("A", "states", "f"):
+        raw = t.data.get(k)
+        if isinstance(raw, list) and len(raw) > cap:
+            raise t.error(
+                k,
+                f"gives {len(raw)} states, above the limit of {cap} (--limit max_states=N)",
+            )
 
 
 def _expr_count(t: Table, k: str) -> int:

@@ -16,6 +16,7 @@ from flint import fmpq
 
 from obsdesign.certify.exact import Q, to_float
 from obsdesign.errors import SpecError
+from obsdesign.limits import decimal_problem, int_problem
 
 _MISSING: Any = object()
 
@@ -158,6 +159,9 @@ class Table:
             raise self.error(k, f"expected a number, got {_tname(v)}")
         if isinstance(v, Decimal) and not v.is_finite():
             raise self.error(k, f"expected a finite number, got {v}")
+        why = decimal_problem(v) if isinstance(v, Decimal) else int_problem(v)
+        if why:  # checked before the conversion to a rational (which could take forever)
+            raise self.error(k, why)
         return Q(v)
 
     # -- arrays -----------------------------------------------------------------------------

@@ -1,0 +1,255 @@
+"""Input limits (issue 11 items 3, 5, 7): one number, one file, one expression or one
+nesting never hangs the tool, exhausts memory or hits RecursionError; every case is exit 2
+with one line naming the file (and the key where there is one), fast."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import time
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from obsdesign.cli import app
+from obsdesign.limits import reset_limits, set_limits
+
+ROOT = Path(__file__).resolve().parents[1]
+SPEC = ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+TEXT = SPEC.read_text()
+runner = CliRunner()
+
+
+@pytest.fixture(autouse=True)
+def _default_limits():
+    reset_limits()
+    yield
+    reset_limits()
+
+
+def _edit(old: str, new: str) -> str:
+    assert old in TEXT
+    return TEXT.replace(old, new, 1)
+
+
+def _matrix(n: int) -> str:
+    return "[" + ",".join("[" + ",".join(["0.5"] * n) + "]" for _ in range(n)) + "]"
+
+
+#: (case, spec text, words the one-line error must contain)
+SPEC_CASES = [
+    (
+        "margin 1e-999999999",
+        _edit("lambda = 0.955", "lambda = 1e-999999999"),
+        ["lambda", "exponent"],
+    ),
+    (
+        "A entry 1e-999999999",
+        _edit("A = [[0, 1], [1, 0]]", "A = [[0, 1e-999999999], [1, 0]]"),
+        ["system.A", "exponent"],
+    ),
+    ("1e999999999", _edit("lambda = 0.955", "lambda = 1e999999999"), ["lambda", "exponent"]),
+    (
+        "5000-digit integer",
+        _edit("A = [[0, 1], [1, 0]]", "A = [[0, " + "9" * 5000 + "], [1, 0]]"),
+        ["line", "key A", "digits"],
+    ),
+    (
+        "2000-digit integer",
+        _edit("A = [[0, 1], [1, 0]]", "A = [[0, " + "9" * 2000 + "], [1, 0]]"),
+        ["system.A", "digits"],
+    ),
+    (
+        "2000-digit decimal",
+        _edit("lambda = 0.955", "lambda = 0." + "9" * 2000),
+        ["lambda", "digits"],
+    ),
+    (
+        "TOML nested 1000 levels",
+        TEXT + "\n[extra]\nx = " + "[" * 1000 + "]" * 1000 + "\n",
+        ["nested"],
+    ),
+    (
+        "TOML nested 40 levels",
+        TEXT + "\n[extra]\nx = " + "[" * 40 + "1" + "]" * 40 + "\n",
+        ["extra.x", "nested"],
+    ),
+    (
+        "TOML tables nested 40 levels",
+        TEXT + "\n[" + ".".join(["t"] * 40) + "]\nx = 1\n",
+        ["nested"],
+    ),
+    (
+        "300-state A",
+        _edit("A = [[0, 1], [1, 0]]", "A = " + _matrix(300)),
+        ["system.A", "300 states", "max_states"],
+    ),
+    (
+        "2000×2000 A",
+        _edit("A = [[0, 1], [1, 0]]", "A = " + _matrix(2000)),
+        ["values", "max_values"],
+    ),
+]
+
+
+@pytest.mark.parametrize("case,text,words", SPEC_CASES, ids=[c[0] for c in SPEC_CASES])
+def test_spec_limit_table(tmp_path: Path, case: str, text: str, words: list[str]):
+    spec = tmp_path / "s.toml"
+    spec.write_text(text)
+    out = tmp_path / "r.json"
+    t0 = time.perf_counter()
+    res = runner.invoke(app, ["design", str(spec), "-o", str(out)])
+    seconds = time.perf_counter() - t0
+    assert res.exit_code == 2, res.output
+    line = res.output.strip()
+    assert "\n" not in line and line.startswith(f"obsdesign: error: {spec}")
+    for w in words:
+        assert w in line, line
+    assert "Traceback" not in res.output and not out.exists()
+    assert seconds < 10  # the real figure is in benchmarks/bench_reliability.py
+
+
+EXPRESSIONS = [
+    ("3999-long unary minus chain", "-" * 3999 + "x1", "levels deep"),
+    ("2**2**… chain", "**".join(["2"] * 2000), "levels deep"),
+    ("3000-term sum", "+".join(["x1"] * 3000), "levels deep"),
+    ("overlong expression", "x1+" * 5000 + "x1", "characters long"),
+    ("huge integer constant", "x1*" + "9" * 400, "float range"),
+    ("syntax error", "x1 +* 2", "not a valid expression"),
+]
+
+
+@pytest.mark.parametrize("case,expr,words", EXPRESSIONS, ids=[c[0] for c in EXPRESSIONS])
+def test_expression_limit_table(tmp_path: Path, case: str, expr: str, words: str):
+    spec = tmp_path / "s.toml"
+    spec.write_text(_edit("C = [[1, 0]]", f'C = [[1, 0]]\npsi = ["{expr}", "0"]'))
+    res = runner.invoke(app, ["design", str(spec)])
+    assert res.exit_code == 2, res.output
+    assert "system.psi[0]" in res.output and words in res.output
+    assert "Traceback" not in res.output and "RecursionError" not in res.output
+
+
+def test_constant_power_tower_does_not_hang():
+    from obsdesign.spec.expr import parse_expr
+
+    t0 = time.perf_counter()
+    e = parse_expr("x1*2**2**2**2**2**2 + 0*9**9**9", ["x1"])
+    e.sympy()
+    assert time.perf_counter() - t0 < 10
+
+
+def test_limits_are_overridable(tmp_path: Path):
+    spec = tmp_path / "s.toml"
+    spec.write_text(_edit("lambda = 0.955", "lambda = 0." + "9" * 2000))
+    assert runner.invoke(app, ["design", str(spec)]).exit_code == 2
+    res = runner.invoke(app, ["--limit", "max_digits=3000", "design", str(spec)])
+    assert res.exit_code != 2, res.output  # read (then it is a design question)
+    reset_limits()
+    res = runner.invoke(app, ["--limit", "max_dgits=3", "design", str(spec)])
+    assert res.exit_code == 2 and "unknown limit" in res.output
+    res = runner.invoke(app, ["--limit", "max_digits=-3", "design", str(spec)])
+    assert res.exit_code == 2 and "positive integer" in res.output
+
+
+def test_max_states_override_message(tmp_path: Path):
+    set_limits(max_states=1)
+    spec = tmp_path / "s.toml"
+    spec.write_text(TEXT)
+    res = runner.invoke(app, ["design", str(spec)])
+    assert res.exit_code == 2 and "max_states" in res.output
+
+
+# -- files ----------------------------------------------------------------------------------
+def test_spec_symlink_to_dev_zero_is_refused_fast(tmp_path: Path):
+    link = tmp_path / "s.toml"
+    link.symlink_to("/dev/zero")
+    t0 = time.perf_counter()
+    res = runner.invoke(app, ["design", str(link)])
+    assert res.exit_code == 2 and "not a regular file" in res.output
+    assert time.perf_counter() - t0 < 5
+
+
+def test_spec_fifo_and_directory_are_refused(tmp_path: Path):
+    fifo = tmp_path / "f.toml"
+    os.mkfifo(fifo)
+    res = runner.invoke(app, ["design", str(fifo)])  # must not block on open()
+    assert res.exit_code == 2 and "not a regular file" in res.output
+    res = runner.invoke(app, ["design", str(tmp_path)])
+    assert res.exit_code == 2 and "directory" in res.output
+
+
+def test_file_size_limit(tmp_path: Path):
+    spec = tmp_path / "s.toml"
+    spec.write_text(TEXT + "\n# " + "x" * 5000 + "\n")
+    set_limits(max_file_bytes=4096)
+    res = runner.invoke(app, ["design", str(spec)])
+    assert res.exit_code == 2 and "max_file_bytes" in res.output
+    rep = tmp_path / "r.json"
+    rep.write_text("{}" + " " * 5000)
+    res = runner.invoke(app, ["verify", str(rep)])
+    assert res.exit_code == 2 and "max_file_bytes" in res.output
+
+
+@pytest.fixture(scope="module")
+def report_text(tmp_path_factory) -> str:
+    out = tmp_path_factory.mktemp("rep") / "r.json"
+    reset_limits()
+    assert runner.invoke(app, ["design", str(SPEC), "-o", str(out)]).exit_code == 0
+    return out.read_text()
+
+
+REPORT_CASES = [
+    (
+        "exact 1e999999999",
+        lambda d: d["parameters"]["exact"].__setitem__("lambda", "1e999999999"),
+        "exponent",
+    ),
+    (
+        "exact 1e-999999999",
+        lambda d: d["parameters"]["exact"].__setitem__("lambda", "1e-999999999"),
+        "exponent",
+    ),
+    (
+        "exact 5000-digit fraction",
+        lambda d: d["parameters"]["exact"].__setitem__("lambda", "9" * 5000 + "/7"),
+        "max_digits",
+    ),
+    ("float 5000-digit integer", None, "digits"),
+    ("JSON nested 100000 levels", None, "nested"),
+]
+
+
+@pytest.mark.parametrize("case,edit,words", REPORT_CASES, ids=[c[0] for c in REPORT_CASES])
+def test_report_limit_table(tmp_path: Path, report_text: str, case: str, edit, words: str):
+    p = tmp_path / "r.json"
+    if case.startswith("float"):
+        p.write_text(report_text.replace('"lambda": 0.955', '"lambda": ' + "9" * 5000, 1))
+    elif case.startswith("JSON"):
+        d = json.loads(report_text)
+        p.write_text(json.dumps(d)[:-1] + ', "x": ' + "[" * 100000 + "]" * 100000 + "}")
+    else:
+        d = json.loads(report_text)
+        edit(d)
+        p.write_text(json.dumps(d))
+    t0 = time.perf_counter()
+    res = runner.invoke(app, ["verify", str(p)])
+    assert res.exit_code == 2, res.output
+    assert words in res.output and str(p) in res.output and "Traceback" not in res.output
+    assert time.perf_counter() - t0 < 10
+
+
+def test_simulation_memory_estimate(tmp_path: Path):
+    spec = tmp_path / "s.toml"
+    spec.write_text(_edit("horizon = 300", "horizon = 100000000000"))
+    res = runner.invoke(app, ["simulate", str(spec)])
+    assert res.exit_code == 2 and "GiB" in res.output and "max_sim_bytes" in res.output
+
+
+def test_shipped_specs_stay_within_the_limits(tmp_path: Path):
+    from obsdesign.spec import read_spec
+
+    for f in sorted((ROOT / "specs").glob("*.toml")):
+        shutil.copy(f, tmp_path / f.name)
+        read_spec(tmp_path / f.name)  # no limit error
