@@ -1,0 +1,476 @@
+"""Soundness of the impulsive certificate (issue 15): every claim fails when its quantity is
+false by the smallest margin, statements print true numbers, and the spec binds the checks.
+
+Each tamper changes report parameters consistently (exact value and its nearest double, as
+``Parameters.to_json`` writes them) and asserts the exact set of failed claim ids of the
+method (``api.certify``), then that ``obsdesign verify`` of the forged report exits 1.
+Thresholds are exact closed forms for example (30)-(31) of the paper (Schaum, Feketa,
+Meurer, Moreno, MTNS 2020) with M = [−3, 1]: Ā = [[0, 0], [0, −1]], so with the sector
+±k of ψ̃_o, N(−ϖ) ⪯ 0 ⇔ ϖ ≥ θ_o k² + 1/θ_o, and with ψ̃_n = 0, N(κ) ⪯ 0 ⇔ κ ≤ 2 − 1/θ_n.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import mpmath
+import numpy as np
+import pytest
+from flint import fmpq
+from typer.testing import CliRunner
+
+from obsdesign import api
+from obsdesign.certify.exact import Q, qmat
+from obsdesign.cli import app
+from obsdesign.methods.impulsive.core import BlockData
+from obsdesign.methods.impulsive.dissipativity import QSR
+from obsdesign.params import Parameters
+from obsdesign.report.model import Report
+from obsdesign.spec.models import Spec
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLE = ROOT / "specs" / "schaum-impulsive-example.toml"
+SPEC3 = ROOT / "specs" / "impulsive-sector-3state.toml"
+K = Q("1.9822152")  # the sector ±k of ψ̃_o in the shipped example
+TINY = fmpq(1, 2**100)
+runner = CliRunner()
+
+LIPSCHITZ = """title = "impulsive, lipschitz_x data"
+[system]
+time = "continuous"
+A = [[0.2, 0.005], [0.5, -3]]
+C = [[1, 0]]
+states = ["x1", "x2"]
+psi = ["0.005*sin(x2)", "0"]
+[nonlinearity]
+lipschitz_x = 0.005
+[nonlinearity.falsify]
+lower = [-2, -2]
+upper = [2, 2]
+samples = 2000
+on_violation = "fail"
+[method]
+key = "impulsive"
+L = [0.8]
+alpha = 3
+noise_bound = 0.1
+kappa = "widest"
+"""
+
+
+def example_text(**method: str) -> str:
+    """The shipped example with ``[method]`` keys replaced or added."""
+    lines = EXAMPLE.read_text(encoding="utf-8").splitlines()
+    for k, v in method.items():
+        lines = [ln for ln in lines if not ln.startswith(f"{k} = ")]
+        i = lines.index('key = "impulsive"')
+        lines.insert(i + 1, f"{k} = {v}")
+    return "\n".join(lines) + "\n"
+
+
+_CACHE: dict[str, tuple[Spec, Report]] = {}
+
+
+def designed(name: str) -> tuple[Spec, Report]:
+    """(spec, report) of a named variant, designed once per session."""
+    if name not in _CACHE:
+        text = {
+            "example": EXAMPLE.read_text(encoding="utf-8"),
+            "kappa": example_text(kappa="0.4923"),
+            "as-given": example_text(qsr_scaling='"as-given"'),
+            "lipschitz": LIPSCHITZ,
+            "3state": SPEC3.read_text(encoding="utf-8"),
+            "cross": SPEC3.read_text(encoding="utf-8")
+            .replace("sector = [-0.2, 0.2]", "sector = [-0.2, 0.2]\ncross = 0.05")
+            .replace("sector = [0, 0.3]", "sector = [0, 0.3]\ncross = 0.05"),
+        }[name]
+        spec = api.load_spec_text(text, f"{name}.toml")
+        rep = api.design(spec)
+        assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
+        _CACHE[name] = (spec, rep)
+    return _CACHE[name]
+
+
+def _with(params: Parameters, changes: dict[str, Any]) -> Parameters:
+    """A copy of ``params`` with ``changes`` (exact values), round-tripped through the JSON
+    form so that every float is the nearest double of its exact value."""
+    new = Parameters(dict(params.items()))
+    for k, v in changes.items():
+        new[k] = v
+    back, problems = Parameters.from_json(json.loads(json.dumps(new.to_json())))
+    assert not problems
+    return back
+
+
+def failed_ids(spec: Spec, params: Parameters) -> set[str]:
+    return {c.id for c in api.certify(spec, params) if not c.ok}
+
+
+def forged_verify_exit(tmp_path: Path, rep: Report, params: Parameters, spec: Spec) -> int:
+    """Exit code of ``obsdesign verify`` on a forged report: the tampered parameters with the
+    claims recomputed for them but every status written as certified (what a forger writes)."""
+    d = json.loads(rep.to_json())
+    d["parameters"] = json.loads(json.dumps(params.to_json()))
+    claims = []
+    for c in api.certify(spec, params):
+        cd = c.to_dict()
+        cd["status"] = "certified"
+        claims.append(cd)
+    d["claims"] = claims
+    path = tmp_path / "forged.json"
+    path.write_text(json.dumps(d), encoding="utf-8")
+    res = runner.invoke(app, ["verify", str(path)])
+    return res.exit_code
+
+
+def _mat(params: Parameters, key: str, i: int, j: int, delta: fmpq) -> np.ndarray:
+    X = np.array(params[key], dtype=object, copy=True)
+    X[i, j] = X[i, j] + delta
+    return X
+
+
+def _varpi_star(p: Parameters) -> fmpq:
+    th = Q(p["theta_o"])
+    return th * K * K + 1 / th
+
+
+def _kappa_star(p: Parameters) -> fmpq:
+    return 2 - 1 / Q(p["theta_n"])
+
+
+def _tmax_true(p: Parameters) -> Any:
+    with mpmath.workdps(100):
+        g = mpmath.mpf(1) - mpmath.mpf(4) / 5
+        den = sum(
+            mpmath.mpf(int(Q(p[k]).p)) / int(Q(p[k]).q) for k in ("varpi_o", "kappa", "lambda_no")
+        ) + 25 * mpmath.mpf(int(Q(p["lambda_on"]).p)) / int(Q(p["lambda_on"]).q)
+        return -mpmath.log(g * g) / den
+
+
+def _tmin_true(p: Parameters) -> Any:
+    with mpmath.workdps(100):
+        k = mpmath.mpf(int(Q(p["kappa"]).p)) / int(Q(p["kappa"]).q)
+        return -mpmath.log((3 - mpmath.mpf(4) / 5) / 3) / k
+
+
+def _above(x: Any) -> fmpq:
+    """A rational strictly above the irrational ``x`` by at most 1e-60 (far below the width
+    of the 113-bit enclosures, so any widening of a check by more than that is caught)."""
+    with mpmath.workdps(100):
+        return fmpq(int(mpmath.ceil(x * mpmath.mpf(10) ** 60)), 10**60)
+
+
+def _below(x: Any) -> fmpq:
+    """A rational strictly below the irrational ``x`` by at most 1e-60."""
+    with mpmath.workdps(100):
+        return fmpq(int(mpmath.floor(x * mpmath.mpf(10) ** 60)), 10**60)
+
+
+def _sqrt(x: Any) -> Any:
+    with mpmath.workdps(100):
+        return mpmath.sqrt(mpmath.mpf(x))
+
+
+Tamper = Callable[[Parameters], dict[str, Any]]
+
+# (variant, name, tamper, exact set of failed claim ids)
+TAMPERS: list[tuple[str, str, Tamper, set[str]]] = [
+    ("example", "T", lambda p: {"T": _mat(p, "T", 1, 0, TINY)}, {"T"}),
+    ("example", "Abar", lambda p: {"Abar": _mat(p, "Abar", 1, 1, TINY)}, {"Abar"}),
+    (
+        "example",
+        "varpi_o below ϖ* = θk² + 1/θ",
+        lambda p: {"varpi_o": _varpi_star(p) - TINY},
+        {"varpi_o"},
+    ),
+    (
+        "example",
+        "kappa_n above κ* = 2 − 1/θ_n",
+        lambda p: {"kappa_n": _kappa_star(p) + TINY},
+        {"kappa_n"},
+    ),
+    ("example", "lambda_no < ‖Ā_no‖ + ℓ_no = 0", lambda p: {"lambda_no": -TINY}, {"lambda_no"}),
+    ("example", "lambda_on < ‖Ā_on‖ + ℓ_on = 0", lambda p: {"lambda_on": -TINY}, {"lambda_on"}),
+    (
+        "cross",
+        "lambda_no < ‖Ā_no‖ + ℓ_no = 1 + 0.05",
+        lambda p: {"lambda_no": 1 + Q("0.05") - TINY},
+        {"lambda_no"},
+    ),
+    (
+        "cross",
+        "lambda_on < ‖Ā_on‖ + ℓ_on = 0.01 + 0.05",
+        lambda p: {"lambda_on": Q("0.06") - TINY},
+        {"lambda_on"},
+    ),
+    (
+        "cross",
+        "ell_no (cross given)",
+        lambda p: {"ell_no": Q("0.05") - TINY},
+        {"ell_no-matches-spec"},
+    ),
+    ("example", "gamma", lambda p: {"gamma": fmpq(4, 5) + TINY}, {"gamma-beta"}),
+    ("example", "beta", lambda p: {"beta": 25 - TINY}, {"gamma-beta"}),
+    (
+        "example",
+        "kappa_n = λ*_no (Lemma 1 and (22) fail together)",
+        lambda p: {"kappa_n": fmpq(0)},
+        {"lemma1-iss", "condition-22"},
+    ),
+    (
+        "example",
+        "kappa_n = λ*_no + βλ*_on + κ",
+        lambda p: {"kappa_n": Q(p["kappa"])},
+        {"condition-22"},
+    ),
+    ("example", "T_max above (26b)", lambda p: {"T_max": _above(_tmax_true(p))}, {"T_max"}),
+    ("example", "T_min below (26c)", lambda p: {"T_min": _below(_tmin_true(p))}, {"T_min"}),
+    ("example", "T_min = T_max", lambda p: {"T_min": Q(p["T_max"])}, {"window"}),
+    (
+        "example",
+        "ball_radius² < α w̄",
+        lambda p: {"ball_radius": _below(_sqrt("0.3"))},
+        {"ball_radius"},
+    ),
+    (
+        "example",
+        "denominator of (26b) = 0 (ValueError must fail T_max)",
+        lambda p: {"varpi_o": -Q(p["kappa"])},
+        {"varpi_o", "T_max"},
+    ),
+    ("example", "alpha", lambda p: {"alpha": 3 + TINY}, {"alpha-matches-spec"}),
+    ("example", "w_bar", lambda p: {"w_bar": fmpq(1, 10) + TINY}, {"w_bar-matches-spec"}),
+    ("example", "ell_no", lambda p: {"ell_no": TINY}, {"ell_no-matches-spec"}),
+    ("example", "ell_on", lambda p: {"ell_on": TINY}, {"ell_on-matches-spec"}),
+    ("kappa", "kappa given", lambda p: {"kappa": Q("0.4923") + TINY}, {"kappa-matches-spec"}),
+    ("as-given", "theta_o", lambda p: {"theta_o": 1 + TINY}, {"theta_o-matches-spec"}),
+    ("as-given", "theta_n", lambda p: {"theta_n": 1 + TINY}, {"theta_n-matches-spec"}),
+    (
+        "lipschitz",
+        "norm_C below ‖C‖ = 1 (ℓ_on changed consistently)",
+        lambda p: {
+            "norm_C": 1 - TINY,
+            "ell_on": (1 - TINY) * Q("0.005") * Q(p["norm_Pn"]),
+        },
+        {"lipschitz-x-blocks"},
+    ),
+]
+
+
+@pytest.mark.parametrize(
+    ("variant", "name", "tamper", "expected"), TAMPERS, ids=[t[1] for t in TAMPERS]
+)
+def test_tamper_fails_exactly_that_claim(
+    tmp_path: Path, variant: str, name: str, tamper: Tamper, expected: set[str]
+) -> None:
+    spec, rep = designed(variant)
+    assert failed_ids(spec, rep.parameters) == set()
+    params = _with(rep.parameters, tamper(rep.parameters))
+    assert failed_ids(spec, params) == expected
+    assert forged_verify_exit(tmp_path, rep, params, spec) == 1
+
+
+def test_thresholds_are_tight() -> None:
+    """The closed-form thresholds used above are the certified values' neighbours: the design
+    sits on the safe side of each, within 1e-6 (so the tampers are the smallest false ones)."""
+    _, rep = designed("example")
+    p = rep.parameters
+    assert _varpi_star(p) <= Q(p["varpi_o"]) <= _varpi_star(p) + fmpq(1, 10**6)
+    assert _kappa_star(p) - fmpq(1, 10**6) <= Q(p["kappa_n"]) <= _kappa_star(p)
+    spec, _ = designed("example")
+    # ... and the thresholds themselves still certify (exact boundary of the LMI)
+    at = _with(p, {"varpi_o": _varpi_star(p), "kappa_n": _kappa_star(p)})
+    assert failed_ids(spec, at) == set()
+
+
+def test_every_claim_id_has_a_tamper() -> None:
+    covered = set().union(*(t[3] for t in TAMPERS)) | {
+        "Q_o-negative-definite",
+        "Q_n-negative-semidefinite",
+        "assumption1-falsification",
+    }
+    seen: set[str] = set()
+    for v in ("example", "kappa", "lipschitz", "3state"):
+        seen |= {c.id for c in designed(v)[1].claims}
+    assert seen <= covered, seen - covered
+
+
+def test_claim_ids_of_the_example() -> None:
+    """Known answer: the claim list of the shipped example, in order (a deleted claim fails)."""
+    _, rep = designed("example")
+    assert [c.id for c in rep.claims] == [
+        "T",
+        "Abar",
+        "Q_o-negative-definite",
+        "Q_n-negative-semidefinite",
+        "varpi_o",
+        "kappa_n",
+        "lambda_no",
+        "lambda_on",
+        "gamma-beta",
+        "lemma1-iss",
+        "condition-22",
+        "T_max",
+        "T_min",
+        "window",
+        "ball_radius",
+    ]
+    assert all(c.status.value == "certified" for c in rep.claims)
+
+
+def _with_data(spec: Spec, **kw: Any) -> Spec:
+    """A copy of a bound spec whose Assumption 1 data are replaced (bypassing the loader's own
+    checks, to test the certificate's)."""
+    import copy
+
+    sp = copy.copy(spec)
+    sp.options = copy.deepcopy(spec.options)
+    d: BlockData = sp.options.problem.data
+    for k, v in kw.items():
+        setattr(d, k, v)
+    return sp
+
+
+def test_singular_Q_o_fails_only_its_claim() -> None:
+    """Q_o = 0 (⪯ 0 but not ≺ 0) with S_o = −1/θ_o, R_o = 0: N(−ϖ_o) = diag(−ϖ_o, 0) ⪯ 0 still
+    holds, so exactly Q_o-negative-definite fails (check_psd in place of check_pd would pass)."""
+    spec, rep = designed("example")
+    th = Q(rep.parameters["theta_o"])
+    q = QSR(qmat([[0]]), qmat([[-1 / th]]), qmat([[0]]), "test")
+    assert failed_ids(_with_data(spec, qsr_o=q), rep.parameters) == {"Q_o-negative-definite"}
+
+
+def test_positive_Q_n_fails_its_claim() -> None:
+    """Q_n = 2⁻¹⁰⁰ > 0: Q_n ⪯ 0 fails; N(κ_n) has θ_n Q_n in its corner, so kappa_n fails with
+    it (Q_n ⪯ 0 is implied by N(κ_n) ⪯ 0: no tamper can fail it alone)."""
+    spec, rep = designed("example")
+    q = QSR(qmat([[TINY]]), qmat([[0]]), qmat([[0]]), "test")
+    got = failed_ids(_with_data(spec, qsr_n=q), rep.parameters)
+    assert got == {"Q_n-negative-semidefinite", "kappa_n"}
+
+
+def test_negative_theta_is_not_a_scaling() -> None:
+    """A QSR triple may be scaled by θ > 0 only. With Q_n = 0, S_n = 2²⁰, R_n = 2²², the
+    scaling θ_n = −2⁻²⁰ makes I + θS_n = 0 and θR_n = −4, so N(κ) ⪯ 0 would "hold" for κ = 3:
+    the claim must fail on θ_n ≤ 0 alone (the LMI does not catch it here)."""
+    spec, rep = designed("example")
+    q = QSR(qmat([[0]]), qmat([[2**20]]), qmat([[2**22]]), "test")
+    params = _with(rep.parameters, {"theta_n": -fmpq(1, 2**20), "kappa_n": fmpq(3)})
+    assert failed_ids(_with_data(spec, qsr_n=q), params) == {"kappa_n"}
+    params = _with(rep.parameters, {"theta_n": fmpq(0)})
+    assert failed_ids(spec, params) == {"kappa_n"}
+
+
+def test_float_only_parameter_is_not_certified() -> None:
+    spec, rep = designed("example")
+    p = Parameters(dict(rep.parameters.items()))
+    p["varpi_o"] = float(p.float("varpi_o"))
+    ids = [c.id for c in api.certify(spec, p) if not c.ok]
+    assert ids == ["varpi_o-exact"]
+
+
+# -- statements print true numbers ---------------------------------------------------------
+NUM = r"(-?[0-9.]+(?:e-?[0-9]+)?|-?[0-9]+/[0-9]+)"
+
+
+def _num(stmt: str, pattern: str) -> fmpq:
+    m = re.search(pattern.replace("NUM", NUM), stmt)
+    assert m, (pattern, stmt)
+    return Q(m.group(1))
+
+
+def _check_statements(rep: Report) -> None:
+    p = {k: Q(v) for k, v in rep.parameters.items() if isinstance(v, fmpq)}
+    st = {c.id: c.statement for c in rep.claims}
+    assert _num(st["varpi_o"], r"ϖ_o ≤ NUM") >= p["varpi_o"]
+    assert _num(st["kappa_n"], r"κ_n ≥ NUM") <= p["kappa_n"]
+    assert _num(st["lambda_no"], r"ℓ_no ≤ NUM") >= p["lambda_no"]
+    assert _num(st["lambda_on"], r"ℓ_on ≤ NUM") >= p["lambda_on"]
+    g, b = p["gamma"], p["beta"]
+    assert _num(st["gamma-beta"], r"λ_max\(I − L\) = NUM") == 1 - g
+    assert _num(st["gamma-beta"], r"β = 1/\(1 − γ\)² = NUM") == b
+    assert _num(st["lemma1-iss"], r"κ_n − λ\*_no ≥ NUM") <= p["kappa_n"] - p["lambda_no"]
+    assert _num(st["condition-22"], r"κ ≥ NUM") <= p["kappa"]
+    slack = p["kappa_n"] - p["lambda_no"] - b * p["lambda_on"] - p["kappa"]
+    assert _num(st["condition-22"], r"− κ ≥ NUM") <= slack
+    assert _num(st["T_max"], r"T_max = NUM") == p["T_max"]
+    assert _num(st["T_min"], r"T_min = NUM") == p["T_min"]
+    assert _num(st["T_min"], r"α = NUM") == p["alpha"]
+    assert _num(st["window"], r"\(NUM <") == p["T_min"]
+    assert _num(st["ball_radius"], r"r_B ≤ NUM") >= p["ball_radius"]
+    if "lipschitz-x-blocks" in st:
+        for sym, k in (("C", "norm_C"), ("M", "norm_M"), ("P_o", "norm_Po"), ("P_n", "norm_Pn")):
+            assert _num(st["lipschitz-x-blocks"], rf"‖{sym}‖ ≤ NUM") >= p[k]
+
+
+@pytest.mark.parametrize("variant", ["example", "kappa", "lipschitz", "3state", "cross"])
+def test_printed_numbers_are_true(variant: str) -> None:
+    _check_statements(designed(variant)[1])
+
+
+def test_issue15_reproduction_lambda_no_printed_up() -> None:
+    """A[1][0] = 1.0000004, T = I: ‖Ā_no‖ = 1.0000004 exactly; the statement must not print
+    "≤ 1" (it printed f"{x:.6g}" before)."""
+    txt = (
+        EXAMPLE.read_text(encoding="utf-8")
+        .replace("A = [[0, 0], [3, -1]]", "A = [[0, 0], [1.0000004, -1]]")
+        .replace("M = [[-3, 1]]", "M = [[0, 1]]")
+    )
+    rep = api.design(api.load_spec_text(txt, "repro.toml"))
+    assert rep.exit_code() == 0
+    _check_statements(rep)
+    st = {c.id: c.statement for c in rep.claims}
+    assert _num(st["lambda_no"], r"ℓ_no ≤ NUM") >= Q("1.0000004")
+    assert not st["lambda_no"].endswith("≤ 1")
+
+
+# -- falsification: NaN and inf are violations (issue 11 item 2) ---------------------------
+@pytest.mark.parametrize("psi", ['["0*9**9**9", "0"]', '["x1**1e308", "0"]'])
+def test_falsification_nan_inf_is_a_violation(psi: str) -> None:
+    txt = (
+        EXAMPLE.read_text(encoding="utf-8")
+        .replace('psi = ["x1*x2*(x2^2 - a^2)/(1 + x2^4)", "0"]', f"psi = {psi}")
+        .replace('on_violation = "warn"', 'on_violation = "fail"')
+        .replace("samples = 20000", "samples = 200")
+    )
+    rep = api.design(api.load_spec_text(txt, "nan.toml"))
+    assert rep.exit_code() == 1
+    bad = [c for c in rep.claims if not c.ok]
+    assert [c.id for c in bad] == ["assumption1-falsification"]
+    assert "ψ finite on the region" in bad[0].detail and "at x = (" in bad[0].detail
+
+
+def test_falsification_lipschitz_x_nan() -> None:
+    txt = LIPSCHITZ.replace('psi = ["0.005*sin(x2)", "0"]', 'psi = ["0*9**9**9", "0"]')
+    rep = api.design(api.load_spec_text(txt, "nan.toml"))
+    assert [c.id for c in rep.claims if not c.ok] == ["assumption1-falsification"]
+
+
+def test_falsification_passes_on_the_3state_spec() -> None:
+    _, rep = designed("3state")
+    c = next(c for c in rep.claims if c.id == "assumption1-falsification")
+    assert c.status.value == "numerical" and "no violation" in c.detail
+
+
+# -- shipped numbers (issue 8: no printed number changes) ----------------------------------
+def test_shipped_numbers() -> None:
+    p = designed("example")[1].parameters
+    assert (p["T_min"], p["T_max"]) == (Q("0.1551"), Q("0.5396"))
+    assert p["gamma"] == fmpq(4, 5) and p["beta"] == 25 and p["kappa_n"] <= 2
+    assert abs(p.float("varpi_o") - 2 * 1.98221516) < 1e-5
+    p3 = designed("3state")[1].parameters
+    assert (p3["T_min"], p3["T_max"]) == (Q("0.4176"), Q("1.3452"))
+    s = api.method("impulsive").summary(p)
+    assert "T_min = 0.1551" in s and "T_max = 0.5396" in s
+
+
+def test_simulate_option_errors_exit_2(tmp_path: Path) -> None:
+    spec = tmp_path / "s.toml"
+    spec.write_text(SPEC3.read_text(encoding="utf-8"), encoding="utf-8")
+    for opt in ("runs=abc", "runs=0", "nosuchkey=1", "rtol=abc"):
+        res = runner.invoke(app, ["simulate", str(spec), "--option", opt])
+        assert res.exit_code == 2, (opt, res.output)
