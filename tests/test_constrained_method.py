@@ -3,6 +3,9 @@ Table 1, bad input."""
 
 from __future__ import annotations
 
+import re
+from pathlib import Path
+
 import numpy as np
 import pytest
 from flint import fmpq
@@ -20,8 +23,6 @@ SEC5 = "constrained-redesign-sec5.toml"
 
 @pytest.fixture(scope="module")
 def sec5_report():
-    from pathlib import Path
-
     return api.design(Path(__file__).resolve().parents[1] / "specs" / SEC5)
 
 
@@ -105,38 +106,31 @@ def test_sec5_certified_gamma_simulation(specs_dir):
     assert float(res.info["modified θ_m=10: max V increase over a refining step"]) <= 1e-9
 
 
-BASE = """
-[system]
-time = "discrete"
-A = [[0, 1], [1, 0]]
-C = [[1, 0]]
-[sets.X]
-type = "box"
-lower = [-1, -1]
-upper = [1, 1]
-[sets.small]
-type = "box"
-lower = [-0.5, -0.5]
-upper = [0.5, 0.5]
-[method]
-key = "constrained"
-L = [-1.87, 1.874]
-lambda = 0.955
-rho = 0.955
-X = "X"
-eps_min = 0.01
-{extra}
-[method.c]
-{c}
-[method.D]
-lower = [-3]
-upper = [3]
-"""
+TSPECS = Path(__file__).resolve().parent / "specs"
 BOX = 'type = "box"\nlower = [-1.1, -1.1]\nupper = [1.1, 1.1]'
 
 
+def spec_text(name: str = "box") -> str:
+    """A shared test spec, ``tests/specs/constrained-<name>.toml``."""
+    return (TSPECS / f"constrained-{name}.toml").read_text(encoding="utf-8")
+
+
+def variant(name: str = "box", *, add: str = "", c: str | None = None, replace: tuple = ()) -> str:
+    """A test spec with ``add`` lines put into [method], the [method.c] body replaced by ``c``
+    and each (old, new) of ``replace`` applied (each old text must occur)."""
+    text = spec_text(name)
+    if add:
+        text = text.replace('key = "constrained"\n', f'key = "constrained"\n{add}\n', 1)
+    if c is not None:
+        text = re.sub(r"\[method\.c\]\n.*?\n\n", f"[method.c]\n{c}\n\n", text, count=1, flags=re.S)
+    for old, new in replace:
+        assert old in text, old
+        text = text.replace(old, new, 1)
+    return text
+
+
 def _spec(extra: str = "", c: str = BOX):
-    return load_spec_text(BASE.format(extra=extra, c=c), "bad.toml")
+    return load_spec_text(variant(add=extra, c=c), "bad.toml")
 
 
 def test_bad_eps_order():
@@ -170,8 +164,8 @@ def test_bad_nonconvex_c():
 
 
 def test_bad_P_not_positive_definite():
-    text = BASE.format(extra="", c=BOX).replace(
-        "lambda = 0.955\nrho = 0.955", "P = [[1, 2], [2, 1]]\nrho = 0.9\nmu = 1"
+    text = variant(
+        replace=[("lambda = 0.955\nrho = 0.955", "P = [[1, 2], [2, 1]]\nrho = 0.9\nmu = 1")]
     )
     with pytest.raises(SpecError) as e:
         load_spec_text(text, "bad.toml")
@@ -194,10 +188,10 @@ def test_bad_c_not_containing_x():
 
 def test_cli_exit_codes(write_spec):
     r = CliRunner()
-    p = write_spec(BASE.format(extra="eps_max = 0.001", c=BOX))
+    p = write_spec(variant(add="eps_max = 0.001"))
     out = r.invoke(app, ["design", str(p)])
     assert out.exit_code == 2 and "eps_max" in out.output
-    p = write_spec(BASE.format(extra="gamma = 17", c=BOX), "g.toml")
+    p = write_spec(variant(add="gamma = 17"), "g.toml")
     out = r.invoke(app, ["design", str(p)])
     assert out.exit_code == 1 and "Traceback" not in out.output
 
@@ -215,29 +209,7 @@ def test_ellipsoid_and_polytope_maps_design():
 
 def test_remark2_theta_zero():
     """A contracting observer with a small disturbance and a generous C_min: θ = 0 (Remark 2)."""
-    text = """
-[system]
-time = "discrete"
-A = [[0.5, 0], [0, 0.5]]
-C = [[1, 0], [0, 1]]
-[sets.X]
-type = "box"
-lower = [-1, -1]
-upper = [1, 1]
-[method]
-key = "constrained"
-L = [[0.4, 0], [0, 0.4]]
-lambda = 0.2
-X = "X"
-eps_min = 100
-[method.c]
-type = "box"
-lower = [-1, -1]
-upper = [1, 1]
-[method.D]
-lower = [0, 0]
-upper = [0, 0]
-"""
+    text = spec_text("fast")
     rep = api.design(load_spec_text(text, "r2.toml"))
     assert int(rep.parameters["theta"]) == 0
     assert any("Remark 2" in n for n in rep.notes)
@@ -246,43 +218,10 @@ upper = [0, 0]
 
 def test_large_box_uses_closed_forms():
     """n = 13: 2¹³ vertices exceed the vertex budget; the per-face closed forms keep it fast."""
-    n = 13
-    rng = np.random.default_rng(13)
-    A = rng.uniform(-1, 1, (n, n))
-    A /= np.abs(A).sum(axis=1).max()
-    K = rng.uniform(-1, 1, (n, n))
-    K *= 0.5 / np.max(np.abs(np.linalg.eigvals(K)))
+    from test_constrained_properties import random_spec
 
-    def v(a):
-        return "[" + ", ".join(f"{x:.6f}" for x in a) + "]"
-
-    def m(M):
-        return "[" + ", ".join(v(r) for r in M) + "]"
-
-    text = f"""
-[system]
-time = "discrete"
-A = {m(A)}
-C = {m(np.eye(n))}
-[sets.X]
-type = "box"
-lower = {v(-np.ones(n))}
-upper = {v(np.ones(n))}
-[method]
-key = "constrained"
-L = {m(A - K)}
-lambda = 0.6
-X = "X"
-eps_min = 0.05
-[method.c]
-type = "box"
-lower = {v(-1.5 * np.ones(n))}
-upper = {v(1.5 * np.ones(n))}
-[method.D]
-lower = {v(-0.1 * np.ones(n))}
-upper = {v(0.1 * np.ones(n))}
-"""
-    rep = api.design(load_spec_text(text, "n13.toml"))
+    sp, _ = random_spec(13, seed=13, r_pad=0.5, eps_min=0.05, wbound=0.1, rad=0.5)
+    rep = api.design(sp)
     assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
     assert any("upper bound" in n for n in rep.notes)
 

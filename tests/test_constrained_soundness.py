@@ -1,0 +1,587 @@
+"""Soundness of the constrained certificate (issue 15; Astolfi et al., NOLCOS 2019): for every
+claim id a tampered report (float and exact value changed consistently, by the smallest margin
+that makes the claim false) makes exactly that claim fail, and ``obsdesign verify`` exits 1;
+the boundary value itself passes. Claims decided by the spec alone fail on a spec changed by
+the smallest margin. Printed numbers in statements are checked to be true as printed."""
+
+from __future__ import annotations
+
+import copy
+import json
+import re
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from flint import fmpq
+from test_constrained_method import spec_text, variant
+from test_constrained_nonlinear import NL
+from typer.testing import CliRunner
+
+from obsdesign import api
+from obsdesign.certify.claim import Claims, ClaimStatus
+from obsdesign.certify.exact import Q, qeye, qparse, qstr, to_float
+from obsdesign.certify.psd import check_pd, check_psd
+from obsdesign.cli import app
+from obsdesign.lyap import closed_loop, decay_matrix, error_input, iss_matrix
+from obsdesign.methods.constrained import bounds as B
+from obsdesign.methods.constrained import claims as CL
+from obsdesign.methods.constrained.cmap import box_map, ellipsoid_map, polytope_map
+from obsdesign.methods.constrained.design import xhat_set
+from obsdesign.methods.constrained.lyap import w_sq_max
+from obsdesign.report import Report
+from obsdesign.sets import Box, Ellipsoid, Polytope
+
+TINY = fmpq(1, 10**30)
+runner = CliRunner()
+
+
+def _design(text: str, name: str = "t.toml") -> Report:
+    return api.design(api.load_spec_text(text, name))
+
+
+@pytest.fixture(scope="module")
+def sec5() -> Report:
+    """λ = 0.955 and ρ = 0.955 given (the shipped Section 5 design without [simulate])."""
+    rep = _design(spec_text())
+    assert rep.exit_code() == 0
+    return rep
+
+
+@pytest.fixture(scope="module")
+def best_rate() -> Report:
+    """λ omitted (the best certified rate), ρ = 0.955 given."""
+    rep = _design(variant(replace=[("lambda = 0.955\n", "")]))
+    assert rep.exit_code() == 0
+    return rep
+
+
+@pytest.fixture(scope="module")
+def rho_lam2() -> Report:
+    """λ = 0.955 given, ρ omitted: ρ = λ²."""
+    rep = _design(variant(replace=[("rho = 0.955\n", "")]))
+    assert rep.exit_code() == 0
+    return rep
+
+
+@pytest.fixture(scope="module")
+def breve() -> Report:
+    """Section 4: initial sets X0, X̂0 give v̆_max and θ̆."""
+    text = variant(
+        add='X0 = "X0"\nXhat0 = "Xhat0"',
+        replace=[
+            (
+                "[method]",
+                '[sets.X0]\ntype = "box"\nlower = [-1, -1]\nupper = [-0.9, -0.9]\n\n'
+                '[sets.Xhat0]\ntype = "box"\nlower = [0.9, 0.9]\nupper = [1, 1]\n\n[method]',
+            )
+        ],
+    )
+    rep = _design(text)
+    assert rep.exit_code() == 0
+    return rep
+
+
+@pytest.fixture(scope="module")
+def big_xhat() -> Report:
+    """A fast observer with a large X̂: X̂ ⊂ C_max is the inclusion that fixes ε_max."""
+    rep = _design(spec_text("fast").replace("eps_min = 100", 'eps_min = 0.01\nXhat = "big"'))
+    assert rep.exit_code() == 0
+    return rep
+
+
+@pytest.fixture(scope="module")
+def given() -> dict[str, Report]:
+    """Designs whose ε_max, γ, or (P, ρ, μ) the spec fixes."""
+    return {
+        "eps_max": _design(variant(add="eps_max = 140098")),
+        "gamma": _design(variant(add="gamma = 0.00002")),
+        "nl": _design(NL),
+    }
+
+
+# -- helpers -------------------------------------------------------------------------------
+def tamper(rep: Report, **new: Any) -> dict[str, Any]:
+    """The report as a dict with parameters replaced (exact strings and floats together);
+    a value None removes the parameter."""
+    d = json.loads(rep.to_json())
+    for k, v in new.items():
+        if v is None:
+            d["parameters"].pop(k)
+            d["parameters"]["exact"].pop(k, None)
+            continue
+        ex = qstr(v) if not isinstance(v, str) else v
+        d["parameters"]["exact"][k] = ex
+        d["parameters"][k] = _floats(ex)
+    return d
+
+
+def _floats(ex: Any) -> Any:
+    if isinstance(ex, list):
+        return [_floats(x) for x in ex]
+    return float(to_float(qparse(ex)))
+
+
+def failed_ids(d: dict[str, Any]) -> set[str]:
+    rep, problems = Report.from_dict(copy.deepcopy(d))
+    assert not problems, problems
+    ver = api.verify(rep)
+    # the method's recomputed claims (verify adds report-alters:<id> / report-verdict when the
+    # tampered report's stored claims no longer match)
+    return {
+        c.id
+        for c in ver.claims
+        if c.status == ClaimStatus.FAILED and not c.id.startswith("report-")
+    }
+
+
+def cli_verify_exit(d: dict[str, Any], tmp_path: Path) -> int:
+    p = tmp_path / "tampered.json"
+    p.write_text(json.dumps(d), encoding="utf-8")
+    return runner.invoke(app, ["verify", str(p)]).exit_code
+
+
+def p_exact(rep: Report, k: str) -> Any:
+    return rep.parameters[k]
+
+
+def bisect(ok: fmpq, bad: fmpq, holds: Any, steps: int = 110) -> tuple[fmpq, fmpq]:
+    """Exact bisection: ``holds(ok)`` and not ``holds(bad)``; returns a bracket of width
+    |ok − bad|/2^steps with the same property (the smallest false margin the test can find)."""
+    assert holds(ok) and not holds(bad)
+    for _ in range(steps):
+        mid = (ok + bad) / 2
+        if holds(mid):
+            ok = mid
+        else:
+            bad = mid
+    return ok, bad
+
+
+def assert_only(rep: Report, tmp_path: Path, ids: set[str], ok: dict, bad: dict) -> None:
+    """``ok`` (the boundary) verifies; ``bad`` fails exactly ``ids`` and the CLI exits 1."""
+    assert failed_ids(tamper(rep, **ok)) == set()
+    d = tamper(rep, **bad)
+    assert failed_ids(d) == ids
+    assert cli_verify_exit(d, tmp_path) == 1
+
+
+# -- spec-fixed values: the report's copy must equal the spec's ------------------------------
+@pytest.mark.parametrize(
+    "fixture, key, delta",
+    [
+        ("sec5", "L", None),
+        ("sec5", "lambda", TINY),
+        ("sec5", "rho", -TINY),
+        ("sec5", "eps_min", TINY),
+        ("eps_max", "eps_max", -TINY),
+        ("gamma", "gamma", -TINY),
+        ("nl", "P", None),
+        ("nl", "rho", -TINY),
+        ("nl", "mu", TINY),
+    ],
+)
+def test_spec_fixed_value_tampered(request, given, tmp_path, fixture, key, delta) -> None:
+    rep = given[fixture] if fixture in given else request.getfixturevalue(fixture)
+    v = p_exact(rep, key)
+    if delta is None:  # a matrix: move its first entry by 10⁻³⁰
+        w = v.copy()
+        w.flat[0] = w.flat[0] + TINY
+        if key == "P":
+            w[1, 0] = w[0, 1]  # keep it symmetric; the (0, 0) entry moved
+    else:
+        w = v + delta
+    d = tamper(rep, **{key: w})
+    assert failed_ids(d) == {f"{key}-matches-spec"}
+    assert cli_verify_exit(d, tmp_path) == 1
+
+
+@pytest.mark.parametrize(
+    "fixture, key, value",
+    [
+        ("sec5", "rho", fmpq(1, 2)),
+        ("sec5", "eps_min", fmpq(1, 2)),
+        ("eps_max", "eps_max", fmpq(1)),
+        ("gamma", "gamma", fmpq(17)),
+        ("nl", "mu", fmpq(0)),
+    ],
+)
+def test_spec_fixed_value_far_off(request, given, fixture, key, value) -> None:
+    """A report copy far from the spec's value: still only the comparison fails, because
+    every check uses the spec's value (a check that used the report's would fail too)."""
+    rep = given[fixture] if fixture in given else request.getfixturevalue(fixture)
+    assert failed_ids(tamper(rep, **{key: value})) == {f"{key}-matches-spec"}
+
+
+def test_unexpected_and_missing_parameters(sec5, tmp_path) -> None:
+    d = tamper(sec5, v_max_breve=fmpq(1))  # no X0 in the spec: nothing would check it
+    assert failed_ids(d) == {"parameters-expected"}
+    assert cli_verify_exit(d, tmp_path) == 1
+    assert failed_ids(tamper(sec5, theta=None)) == {"theta-present"}
+    assert failed_ids(tamper(sec5, lambda_min_P=None)) == {"lambda_min_P-present"}
+
+
+# -- claims decided from the report's computed values ----------------------------------------
+def test_decay_lmi(best_rate, tmp_path) -> None:
+    sp = api.load_spec_text(variant(replace=[("lambda = 0.955\n", "")]), "t.toml")
+    s, o = sp.system, sp.options
+    P, lam = p_exact(best_rate, "P"), p_exact(best_rate, "lambda")
+    assert 0.95 < float(lam) < 0.951  # ρ(A − LC) = 0.95
+
+    def holds(x: fmpq) -> bool:
+        return bool(check_pd(decay_matrix(s.A.q, s.C.q, o.L, P, x, True), o.margin))
+
+    ok, bad = bisect(lam, fmpq(9, 10), holds)
+    assert_only(best_rate, tmp_path, {"decay-lmi"}, {"lambda": ok}, {"lambda": bad})
+
+
+def test_rho_is_lambda_squared(rho_lam2, tmp_path) -> None:
+    rho = p_exact(rho_lam2, "rho")
+    assert rho == fmpq(191, 200) ** 2
+    d = tamper(rho_lam2, rho=rho - TINY)
+    assert failed_ids(d) == {"rho-is-lambda-squared"}
+    assert cli_verify_exit(d, tmp_path) == 1
+
+
+def test_iss_bound(sec5, tmp_path) -> None:
+    sp = api.load_spec_text(spec_text(), "t.toml")
+    s, o = sp.system, sp.options
+    P, rho, mu = (p_exact(sec5, k) for k in ("P", "rho", "mu"))
+    Acl, Bw = closed_loop(s.A.q, s.C.q, o.L), error_input(s.Bd.q, s.Dn.q, o.L)
+
+    def holds(m: fmpq) -> bool:
+        return bool(check_psd(iss_matrix(Acl, Bw, P, rho, m)))
+
+    ok, bad = bisect(mu, fmpq(0), holds)
+    assert_only(sec5, tmp_path, {"iss-bound"}, {"mu": ok}, {"mu": bad})
+
+
+def test_iss_bound_needs_rho_below_one(best_rate, tmp_path) -> None:
+    """λ = 1, ρ = λ² = 1 and every other parameter recomputed consistently for ρ = 1
+    (the report's λ and ρ are design outputs when the spec gives neither): inequality (5)
+    holds, but β must contract (ρ < 1), so exactly iss-bound fails."""
+    from obsdesign.methods.constrained.design import design_params
+
+    text = variant(replace=[("lambda = 0.955\n", ""), ("rho = 0.955\n", "")])
+    sp = api.load_spec_text(text, "t.toml")
+    rep = api.design(sp)
+    assert rep.exit_code() == 0
+    o = sp.options
+    o.P, o.rho, o.mu = rep.parameters["P"], fmpq(1), rep.parameters["mu"]
+    vals, _ = design_params(sp)
+    vals.pop("L")
+    d = tamper(rep, **{**vals, "lambda": fmpq(1), "rho": fmpq(1)})
+    assert failed_ids(d) == {"iss-bound"}
+    assert cli_verify_exit(d, tmp_path) == 1
+
+
+def test_P_not_positive_definite(sec5, tmp_path) -> None:
+    """P − ℓI with ℓ just above λ_min(P): singular-to-indefinite, and every claim that needs
+    P ≻ 0 (or its inverse) fails with it."""
+    P = p_exact(sec5, "P")
+    ell = p_exact(sec5, "lambda_min_P")
+
+    def holds(x: fmpq) -> bool:
+        return bool(check_pd(P - qeye(2) * x, fmpq(1, 10**9)))
+
+    _, bad = bisect(ell, ell * 2, holds)
+    d = tamper(sec5, P=P - qeye(2) * bad)
+    assert failed_ids(d) == {
+        "P-positive-definite",
+        "lambda_min-bound",
+        "gamma-bound",
+        "gamma_max-bound",
+        "v_min-bound",
+        "Xhat_max-in-Cmax",
+        "decay-lmi",
+        "iss-bound",
+    }
+    assert cli_verify_exit(d, tmp_path) == 1
+
+
+def test_v_max_bound(sec5, tmp_path) -> None:
+    sp = api.load_spec_text(spec_text(), "t.toml")
+    o = sp.options
+    P, rho, mu = (p_exact(sec5, k) for k in ("P", "rho", "mu"))
+    ref = B.v_max_bound(P, rho, mu, o.X, xhat_set(o), w_sq_max(o.D_lower, o.D_upper)).value
+    assert p_exact(sec5, "v_max") == ref  # exact for boxes
+    assert_only(sec5, tmp_path, {"v_max-bound"}, {"v_max": ref}, {"v_max": ref - TINY})
+
+
+def test_Xhat_max_in_Cmax(sec5, tmp_path) -> None:
+    sp = api.load_spec_text(spec_text(), "t.toml")
+    o = sp.options
+    P = p_exact(sec5, "P")
+    sup = B.sup_norm_c_over_Xhat_max(o.cmap, P, B.qinv(P), o.X, p_exact(sec5, "v_max"))
+    assert_only(sec5, tmp_path, {"Xhat_max-in-Cmax"}, {"eps_max": sup}, {"eps_max": sup - TINY})
+
+
+def test_Xhat_in_Cmax(big_xhat, tmp_path) -> None:
+    text = spec_text("fast").replace("eps_min = 100", 'eps_min = 0.01\nXhat = "big"')
+    o = api.load_spec_text(text, "t.toml").options
+    sup = B.sup_norm_c_over_set(o.cmap, xhat_set(o))
+    assert 114.55 < float(sup) < 114.56  # 81·√2
+    assert_only(big_xhat, tmp_path, {"Xhat-in-Cmax"}, {"eps_max": sup}, {"eps_max": sup - TINY})
+
+
+def test_eps_order(sec5, tmp_path) -> None:
+    """ε_max = ε_min: C_max = C_min cannot contain X̂ ⊇ C_min either, so the two inclusions
+    into C_max fail with the order."""
+    d = tamper(sec5, eps_max=fmpq(1, 100))
+    assert failed_ids(d) == {"eps-order", "Xhat-in-Cmax", "Xhat_max-in-Cmax"}
+    assert cli_verify_exit(d, tmp_path) == 1
+
+
+def test_delta_bound(sec5, tmp_path) -> None:
+    dsq = p_exact(sec5, "delta_sq")
+    assert dsq == 4 * p_exact(sec5, "eps_max")  # box map: δ = 2√ε_max exactly
+    assert_only(sec5, tmp_path, {"delta-bound"}, {"delta_sq": dsq}, {"delta_sq": dsq - TINY})
+    # the reported δ must satisfy δ² ≥ δ²-bound
+    delta = p_exact(sec5, "delta")
+    ok, bad = bisect(delta, fmpq(0), lambda x: x * x >= dsq)
+    assert_only(sec5, tmp_path, {"delta-bound"}, {"delta": ok}, {"delta": bad})
+
+
+@pytest.mark.parametrize("key, cid", [("gamma", "gamma-bound"), ("gamma_max", "gamma_max-bound")])
+def test_gamma_bounds(sec5, tmp_path, key, cid) -> None:
+    P, dsq = p_exact(sec5, "P"), p_exact(sec5, "delta_sq")
+    g = p_exact(sec5, key)
+    ok, bad = bisect(g, g * 2, lambda x: B.gamma_ok(P, x, dsq)[0])
+    assert_only(sec5, tmp_path, {cid}, {key: ok}, {key: bad})
+
+
+def test_lambda_min_bound(sec5, tmp_path) -> None:
+    P, ell = p_exact(sec5, "P"), p_exact(sec5, "lambda_min_P")
+    ok, bad = bisect(ell, ell * 2, lambda x: bool(check_psd(P - qeye(2) * x)))
+    assert_only(sec5, tmp_path, {"lambda_min-bound"}, {"lambda_min_P": ok}, {"lambda_min_P": bad})
+
+
+def test_v_min_bound(sec5, tmp_path) -> None:
+    sp = api.load_spec_text(spec_text(), "t.toml")
+    o = sp.options
+    P = p_exact(sec5, "P")
+    Pinv = B.qinv(P)
+    v = p_exact(sec5, "v_min")
+
+    def holds(x: fmpq) -> bool:
+        return B.v_min_condition(o.cmap, P, Pinv, o.X, o.eps_min, x)
+
+    ok, bad = bisect(v, v * 2, holds, steps=60)
+    assert_only(sec5, tmp_path, {"v_min-bound"}, {"v_min": ok}, {"v_min": bad})
+
+
+def test_theta_covers(sec5, tmp_path) -> None:
+    t = p_exact(sec5, "theta")
+    assert t == 1109771083252742
+    assert_only(sec5, tmp_path, {"theta-covers"}, {"theta": t}, {"theta": t - 1})
+    # a non-integer θ above the bound is refused too (θ counts steps)
+    assert failed_ids(tamper(sec5, theta=t + fmpq(1, 2))) == {"theta-covers"}
+
+
+def test_breve_claims(breve, tmp_path) -> None:
+    p = breve.parameters
+    vb, tb, vmax = p["v_max_breve"], p["theta_breve"], p["v_max"]
+    assert float(vb) == pytest.approx(7.008e6, rel=1e-3) and vb > vmax
+    assert tb == p["theta"]
+    # v̆_max: the recomputed bound is the boundary (exact arithmetic)
+    sp = api.load_spec_text(breve.spec, "t.toml")  # the embedded spec: its X0, X̂0, D fix the bound
+    o = sp.options
+    from obsdesign.methods.constrained.design import v_max_breve
+
+    ref = v_max_breve(p["P"], p["rho"], p["mu"], o.X0, o.Xhat0, w_sq_max(o.D_lower, o.D_upper))
+    assert_only(
+        breve, tmp_path, {"v_max_breve-bound"}, {"v_max_breve": ref}, {"v_max_breve": ref - TINY}
+    )
+    # θ̆ = ceil of its quotient: one less fails (kills max → min in the θ̆ check)
+    assert_only(
+        breve, tmp_path, {"theta_breve-covers"}, {"theta_breve": tb}, {"theta_breve": tb - 1}
+    )
+
+
+# -- claims decided by the spec: the smallest change of a set ------------------------------
+def test_X_in_C0(tmp_path, write_spec) -> None:
+    ok = _design(variant(replace=[("upper = [1, 1]", "upper = [1, 1.1]")]))
+    assert ok.exit_code() == 0
+    text = variant(replace=[("upper = [1, 1]", "upper = [1, 1.1000000000000000001]")])
+    rep = _design(text)
+    assert {c.id for c in rep.failed} == {"X-in-C0"}
+    out = tmp_path / "r.json"
+    out.write_text(rep.to_json())
+    assert runner.invoke(app, ["verify", str(out)]).exit_code == 1
+
+
+def test_Cmin_in_Xhat_spec(tmp_path) -> None:
+    """X̂ with one face on the outer box of C_min (the default X̂), rounded up at 40 decimals:
+    certified; rounded down (inside by < 10⁻⁴⁰): exactly Cmin-in-Xhat fails."""
+    from obsdesign.certify.interval import sqrt_upper
+
+    edge = fmpq(11, 10) + sqrt_upper(fmpq(1, 100))
+    for j, up in enumerate((True, False)):
+        face = _dec(edge, up)
+        text = variant(
+            add='Xhat = "Xh"',
+            replace=[
+                (
+                    "[method]",
+                    f'[sets.Xh]\ntype = "box"\nlower = [-2, -2]\nupper = [2, {face}]\n\n[method]',
+                )
+            ],
+        )
+        rep = _design(text, f"xh{j}.toml")
+        assert {c.id for c in rep.failed} == (set() if up else {"Cmin-in-Xhat"})
+    out = tmp_path / "r.json"
+    out.write_text(rep.to_json())
+    assert runner.invoke(app, ["verify", str(out)]).exit_code == 1
+
+
+def _dec(q: fmpq, up: bool, digits: int = 40) -> str:
+    """A decimal literal of q rounded up or down at ``digits`` places (q > 0)."""
+    s = (q * 10**digits).ceil() if up else (q * 10**digits).floor()
+    txt = str(int(s)).rjust(digits + 1, "0")
+    return f"{txt[:-digits]}.{txt[-digits:]}"
+
+
+def test_c_convex_fails_for_an_indefinite_Q() -> None:
+    """The parser refuses such a Q (exit 2); the claim itself must fail too."""
+    c = Claims()
+    CL._convexity(c, ellipsoid_map(np.array([[Q(1), Q(0)], [Q(0), Q(-1)]], dtype=object), Q(2)))
+    assert [(x.id, x.status) for x in c] == [("c-convex", ClaimStatus.FAILED)]
+    c = Claims()
+    CL._convexity(c, ellipsoid_map(np.array([[Q(1), Q(0)], [Q(0), Q(1)]], dtype=object), Q(2)))
+    assert [(x.id, x.status) for x in c] == [("c-convex", ClaimStatus.CERTIFIED)]
+
+
+# -- C_min ⊂ X̂: every branch, every face, the boundary exact --------------------------------
+EPS = fmpq(1, 100)
+
+
+def _t() -> fmpq:
+    from obsdesign.certify.interval import sqrt_upper
+
+    return sqrt_upper(EPS)
+
+
+def _faces(k: list[fmpq]) -> Polytope:
+    G = np.array([[1, 0], [0, 1], [-1, 0], [0, -1]], dtype=object)
+    return Polytope(np.vectorize(Q, otypes=[object])(G), np.array(k, dtype=object))
+
+
+def _box_cm():
+    lo = np.array([Q(-1), Q(-1)], dtype=object)
+    hi = np.array([Q(1), Q(1)], dtype=object)
+    return box_map(lo, hi, "euclidean")
+
+
+def _poly_cm():
+    G = np.vectorize(Q, otypes=[object])(np.array([[1, 0], [0, 1], [-1, 0], [0, -1]]))
+    return polytope_map(G, np.array([Q(1)] * 4, dtype=object), "euclidean")
+
+
+@pytest.mark.parametrize("cm_kind", ["box", "polytope"])
+@pytest.mark.parametrize("face", range(4))
+def test_cmin_in_xhat_affine_every_face(cm_kind: str, face: int) -> None:
+    """Outer set of C_min = the box [−1 − t, 1 + t]²; X̂ exactly that box passes, X̂ with one
+    face (any of the four) moved in by 10⁻³⁰ fails — as a polytope and as a box."""
+    cm = _box_cm() if cm_kind == "box" else _poly_cm()
+    e = 1 + _t()
+    assert CL.cmin_in_xhat(cm, EPS, _faces([e] * 4))[0]
+    k = [e] * 4
+    k[face] = e - TINY
+    assert not CL.cmin_in_xhat(cm, EPS, _faces(k))[0]
+    lo = [-k[2], -k[3]]
+    hi = [k[0], k[1]]
+    box = Box(np.array(lo, dtype=object), np.array(hi, dtype=object))
+    assert not CL.cmin_in_xhat(cm, EPS, box)[0]
+    assert CL.cmin_in_xhat(cm, EPS, Box(np.array([-e, -e]), np.array([e, e])))[0]
+
+
+def test_cmin_in_xhat_polytope_map_in_ellipsoid() -> None:
+    """Vertices (±(1+t), ±(1+t)) of the outer set against X̂ = {xᵀEx ≤ 1}, E = I/(2(1+t)²)."""
+    cm = _poly_cm()
+    e = 1 + _t()
+    E = qeye(2) * (1 / (2 * e * e))
+    zero = np.array([Q(0), Q(0)], dtype=object)
+    assert CL.cmin_in_xhat(cm, EPS, Ellipsoid(E, zero))[0]
+    assert not CL.cmin_in_xhat(cm, EPS, Ellipsoid(E * (1 + TINY), zero))[0]
+
+
+def test_contains_q_checks_every_coordinate_and_face() -> None:
+    """v = (1, 2) on every face of the box [1, 1] × [2, 2]: moving any one face or coordinate
+    bound by 10⁻³⁰ excludes it (kills all → any and loops over only some faces)."""
+    v = np.array([Q(1), Q(2)], dtype=object)
+    assert CL.contains_q(Box(np.array([Q(1), Q(2)]), np.array([Q(1), Q(2)])), v)
+    for j in range(2):
+        lo, hi = [Q(1), Q(2)], [Q(1), Q(2)]
+        hi[j] -= TINY
+        assert not CL.contains_q(Box(np.array(lo), np.array(hi)), v)
+        lo, hi = [Q(1), Q(2)], [Q(1), Q(2)]
+        lo[j] += TINY
+        assert not CL.contains_q(Box(np.array(lo), np.array(hi)), v)
+    k = [Q(1), Q(2), Q(-1), Q(-2)]
+    assert CL.contains_q(_faces(k), v)
+    for j in range(4):
+        kj = list(k)
+        kj[j] -= TINY
+        assert not CL.contains_q(_faces(kj), v)
+    E = qeye(2) * fmpq(1, 5)  # |v|² = 5
+    zero = np.array([Q(0), Q(0)], dtype=object)
+    assert CL.contains_q(Ellipsoid(E, zero), v)
+    assert not CL.contains_q(Ellipsoid(E * (1 + TINY), zero), v)
+
+
+@pytest.mark.parametrize("face", range(4))
+def test_cmin_in_xhat_ellipsoid_map(face: int) -> None:
+    """Ellipsoid map (18), Q = I, r = 2: outer set {|x|² ≤ R}, R = 2(1 + t). X̂ = {xᵀEx ≤ 1}
+    passes at E = I/R and fails at E(1 + 10⁻³⁰); X̂ a square with one face just below √R
+    fails, every face at 1.4833 > √2.2 passes (kills r(1 + t) → r/(1 + t))."""
+    cm = ellipsoid_map(qeye(2), Q(2))
+    R = 2 * (1 + _t())
+    zero = np.array([Q(0), Q(0)], dtype=object)
+    assert CL.cmin_in_xhat(cm, EPS, Ellipsoid(qeye(2) * (1 / R), zero))[0]
+    assert not CL.cmin_in_xhat(cm, EPS, Ellipsoid(qeye(2) * ((1 + TINY) / R), zero))[0]
+    ok = Q("14833/10000")
+    assert ok * ok > R
+    assert CL.cmin_in_xhat(cm, EPS, _faces([ok] * 4))[0]
+    low = Q("14832/10000")  # √2.2 = 1.48324 > 1.4832; r/(1+t) would give √1.818 = 1.348
+    assert low * low < R
+    k = [ok] * 4
+    k[face] = low
+    assert not CL.cmin_in_xhat(cm, EPS, _faces(k))[0]
+
+
+# -- printed numbers are true as printed ------------------------------------------------------
+NUM = r"(-?[0-9.]+(?:e-?[0-9]+)?)"
+
+
+def _num(statement: str, label: str) -> fmpq:
+    m = re.search(re.escape(label) + r"\s*=?\s*" + NUM, statement)
+    assert m, (label, statement)
+    return qparse(m.group(1))
+
+
+def test_printed_numbers_are_true(sec5) -> None:
+    sp = api.load_spec_text(spec_text(), "t.toml")
+    s, o = sp.system, sp.options
+    st = {c.id: c.statement for c in sec5.claims}
+    p = sec5.parameters
+    P = p["P"]
+    # iss-bound: the printed ρ, μ satisfy (5) exactly
+    rho, mu = _num(st["iss-bound"], "ρ ="), _num(st["iss-bound"], "μ =")
+    Acl, Bw = closed_loop(s.A.q, s.C.q, o.L), error_input(s.Bd.q, s.Dn.q, o.L)
+    assert check_psd(iss_matrix(Acl, Bw, P, rho, mu)) and rho < 1
+    # decay-lmi with the printed λ
+    lam = _num(st["decay-lmi"], "λ =")
+    assert check_psd(decay_matrix(s.A.q, s.C.q, o.L, P, lam, True))
+    # γ, γ_max (printed down): P − γδ²I ⪰ 0 with the printed values; λ_min(P) ≥ printed
+    dsq = p["delta_sq"]
+    assert B.gamma_ok(P, _num(st["gamma-bound"], "γ ="), dsq)[0]
+    assert B.gamma_ok(P, _num(st["gamma_max-bound"], "γ_max ="), dsq)[0]
+    assert check_psd(P - qeye(2) * _num(st["lambda_min-bound"], "λ_min(P) ≥"))
+    # δ² bound printed up; v_max printed up; v_min printed down; θ exact
+    assert _num(st["delta-bound"], "δ² ≤") >= dsq
+    assert _num(st["v_max-bound"], "v_max ≤") >= p["v_max"]
+    vm = _num(st["v_min-bound"], "V(x̂ − x) ≤")
+    assert vm <= p["v_min"] and B.v_min_condition(o.cmap, P, B.qinv(P), o.X, o.eps_min, vm)
+    assert _num(st["theta-covers"], "θ =") == p["theta"]
+    assert st["eps-order"] == "ε_max = 140098 > ε_min = 0.01 > 0"
