@@ -159,3 +159,62 @@ def test_float_backend_checks_the_whole_table(nogmp, tmp_path):
     d = json.loads(out.read_text())
     d["parameters"]["w_pieces"][1][0] += 1e-6
     assert _float_failed(d, tmp_path) == {"injection-table"}
+
+
+NODIST = """
+[system]
+time = "discrete"
+A = [[0.7, 0.7], [-0.7, 0.7]]
+C = [[1, 1]]
+[sets.omega]
+type = "symmetric-polytope"
+Q = [[1, 0], [0, 1]]
+[method]
+key = "set-invariant"
+omega = "omega"
+lambda = 0.9
+"""
+
+
+def _tamper_float(d: dict, how: str) -> None:
+    p = d["parameters"]
+    if how == "omega-contained":  # shrink by 1e-6 (no disturbance: only Ω ⊆ C breaks)
+        s = 1 - 1e-6
+        p["G"] = [[x / s for x in r] for r in p["G"]]
+        for k in ("V", "v_breakpoints", "w_pieces"):
+            p[k] = [[x * s for x in r] for r in p[k]]
+        p["breakpoints"] = [x * s for x in p["breakpoints"]]
+    elif how == "injection-table":  # reversed order of the table
+        p["breakpoints"] = p["breakpoints"][::-1]
+        p["v_breakpoints"] = p["v_breakpoints"][::-1]
+    elif how == "contractivity-value":
+        p["contractivity"] *= 1 - 1e-6
+    elif how == "linear-law":
+        p["L"][1][0] = 0.0823529 + 1e-6  # beyond 7/85
+    elif how == "polyhedron-forms":
+        p["V"][0] = [x * (1 + 1e-6) for x in p["V"][0]]
+
+
+@pytest.mark.parametrize(
+    "claim,spec",
+    [
+        ("omega-contained", NODIST),
+        ("injection-table", None),
+        ("contractivity-value", None),
+        ("linear-law", None),
+        ("polyhedron-forms", None),
+    ],
+)
+def test_float_backend_tamper_per_claim(nogmp, tmp_path, claim, spec):
+    out = tmp_path / "r.json"
+    api.design(load_spec_text(spec) if spec else SPEC71, out)
+    d = json.loads(out.read_text())
+    _tamper_float(d, claim)
+    if claim == "injection-table":  # the reversed table: L^j, w^j of the reversed order
+        from obsdesign.methods.setinvariant import laws
+
+        Ls, ws = laws.pieces(d["parameters"]["breakpoints"], d["parameters"]["v_breakpoints"])
+        d["parameters"]["L_pieces"], d["parameters"]["w_pieces"] = Ls, ws
+    if claim == "linear-law":
+        d["parameters"].pop("L_factor", None)
+    assert _float_failed(d, tmp_path) == {claim}

@@ -453,3 +453,14 @@ def test_disturbance_set_dimension_is_checked() -> None:
     text = SPEC71.read_text().replace('disturbance = "D"\n', "")
     with pytest.raises(SpecError, match=r"\[sets.D\] with dim = 1"):
         api.load_spec_text(text, "none.toml")
+
+
+def test_injection_table_shape(base71: dict[str, Any]) -> None:
+    L = exact(base71, "L_pieces")
+    assert failed_certify(put(base71, L_pieces=L.reshape(2, -1))) == {"injection-table"}
+
+
+def test_linear_gains_vertex_listed_twice(base71: dict[str, Any]) -> None:
+    Vs = exact(base71, "L_admissible_vertices")
+    d = put(base71, L_admissible_vertices=np.vstack([Vs, Vs[:1]]))
+    assert failed_certify(d) == {"linear-gains-vertices"}

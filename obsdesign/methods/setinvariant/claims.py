@@ -168,9 +168,11 @@ class ExactBackend:
         return len(zs) == len(zd) and all(a == b for a, b in zip(zs, zd, strict=True))
 
     def same(self, a: Any, b: Any) -> bool:
-        A = np.asarray(a, dtype=object).reshape(-1)
-        B = np.asarray(b, dtype=object).reshape(-1)
-        return A.shape == B.shape and all(x == y for x, y in zip(A, B, strict=True))
+        """Exact equality, shapes included."""
+        A, B = np.asarray(a, dtype=object), np.asarray(b, dtype=object)
+        if A.shape != B.shape:
+            return False
+        return all(x == y for x, y in zip(A.reshape(-1), B.reshape(-1), strict=True))
 
     def linear(self, G: np.ndarray, V: np.ndarray, L: np.ndarray) -> tuple[bool, Any]:
         return ce.linear_law(self.ex, G, V, L)
@@ -268,8 +270,8 @@ class FloatBackend:
         )
 
     def same(self, a: Any, b: Any) -> bool:
-        A = np.asarray(a, dtype=float).reshape(-1)
-        B = np.asarray(b, dtype=float).reshape(-1)
+        """Equality within the relative tolerance, shapes included."""
+        A, B = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
         return A.shape == B.shape and bool(
             np.all(np.abs(A - B) <= numerical.TOL * np.maximum(1.0, np.abs(B)))
         )
