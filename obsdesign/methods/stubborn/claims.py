@@ -1,10 +1,12 @@
 """Claims of the stubborn observer, each recomputed from the spec and the reported parameters.
 
-Exact: P ≻ 0, U, W diagonal ≻ 0, R ≻ 0, λ in range, X = P K, and LMIs (1)-(3) (continuous) or
-(7)-(9) (discrete) of the slides (Astolfi, Alessandri, Zaccarian, "Stubborn observers for
-linear and nonlinear systems", WUDS 2017) by exact LDLᵀ (:func:`check_pd`) of the rebuilt
-block matrices. What the spec fixes (K in redesign mode, λ or its fraction, the criterion,
-the gain bound) is read from the spec and compared exactly with the report's copy.
+Exact: P ≻ 0, U, W diagonal ≻ 0, R ≻ 0, λ in range, X = P K, ‖K‖₂ ≤ gain bound, and LMIs
+(1)-(3) (continuous) or (7)-(9) (discrete) of the slides (Astolfi, Alessandri, Zaccarian,
+"Stubborn observers for linear and nonlinear systems", WUDS 2017) by exact LDLᵀ
+(:func:`check_pd`) of the rebuilt block matrices; the same checks on the second certificate at
+λ_max (the best λ is certified, not only estimated). What the spec fixes (K in redesign mode, λ
+or its fraction, the criterion, the gain bound) is read from the spec and compared exactly with
+the report's copy.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ from flint import fmpq
 from obsdesign.certify.claim import Claim, Claims
 from obsdesign.certify.exact import Q, qmat
 from obsdesign.certify.printing import fmt_exact, fmt_up
-from obsdesign.certify.psd import check_pd
+from obsdesign.certify.psd import PSDResult, check_pd, check_psd
 from obsdesign.methods.stubborn import lmis
 from obsdesign.methods.stubborn.options import Options
 from obsdesign.params import Parameters
@@ -27,8 +29,7 @@ PAPER = "stubborn-observer slides (Astolfi, Alessandri, Zaccarian, WUDS 2017)"
 
 
 def _mat(v: Any, shape: tuple[int, int]) -> np.ndarray:
-    M = qmat(np.asarray(v, dtype=object).reshape(shape))
-    return M
+    return qmat(np.asarray(v, dtype=object).reshape(shape))
 
 
 def _vec(v: Any, n: int) -> np.ndarray:
@@ -38,35 +39,109 @@ def _vec(v: Any, n: int) -> np.ndarray:
     return np.array([Q(x) for x in arr], dtype=object)
 
 
-def lmi_claims(spec: Spec, params: dict[str, Any] | Parameters) -> list[Claim]:
-    """Every claim of a linear-mode design (full-stubborn or redesign)."""
+def _scalar(v: Any) -> fmpq:
+    return v if isinstance(v, fmpq) else Q(np.asarray(v, dtype=object).reshape(-1)[0])
+
+
+def _sign(v: np.ndarray) -> PSDResult:
+    m = min(v)
+    return PSDResult(bool(m > 0), float(m), f"min = {float(m):.6g}")
+
+
+def point_checks(
+    spec: Spec,
+    P: np.ndarray,
+    K: np.ndarray,
+    u: np.ndarray,
+    w: np.ndarray,
+    Y: np.ndarray,
+    R: np.ndarray,
+    lam: fmpq,
+) -> dict[str, PSDResult]:
+    """The exact checks of one point of LMIs (1)-(3) / (7)-(9) with X = P K (K the gain that is
+    reported, so the LMIs are checked in the original variables): P ≻ 0, u, w > 0, R ≻ 0, λ in
+    range, the three LMIs, and ‖K‖₂ ≤ gain_bound in full mode."""
+    o: Options = spec.options
+    s = spec.system
+    A, C, disc = s.A.q, s.C.q, s.discrete
+    X = P @ K
+    out = {
+        "P-positive": check_pd(P),
+        "U-positive": _sign(u),
+        "W-positive": _sign(w),
+        "R-positive": check_pd(R),
+        "lambda-range": PSDResult(bool(lam > 0 and (lam < 1 or not disc)), float(lam), ""),
+        "lmi-regional": check_pd(-lmis.regional(A, C, P, X, u, R, lam, disc)),
+        "lmi-global": check_pd(-lmis.global_(A, C, P, X, w, Y, disc)),
+    }
+    bad = [
+        f"i = {i + 1}: {r.detail}"
+        for i in range(s.p)
+        if not (r := check_pd(lmis.sector(P, Y, w, i)))
+    ]
+    out["lmi-sector"] = PSDResult(not bad, 0.0, "; ".join(bad) or f"{s.p} block(s), all pivots > 0")
+    if o.K is None:
+        p = K.shape[1]
+        G = np.full((p, p), fmpq(0), dtype=object)
+        for i in range(p):
+            G[i, i] = o.gain_bound * o.gain_bound
+        out["gain-bound"] = check_psd(G - K.T @ K)
+    return out
+
+
+def point_failures(spec: Spec, cand: dict[str, Any], with_l2: bool) -> list[str]:
+    """Names of the failed exact checks of a rounded candidate (the design's self-check)."""
+    res = point_checks(
+        spec, cand["P"], cand["K"], cand["U"], cand["W"], cand["Y"], cand["R"], cand["lambda"]
+    )
+    bad = [k for k, r in res.items() if not r.ok]
+    if with_l2:
+        s = spec.system
+        X = cand["P"] @ cand["K"]
+        M = lmis.l2_gain(s.A.q, s.C.q, s.Bd.q, cand["P"], X, cand["gamma2"], s.discrete)
+        if not check_pd(-M).ok:
+            bad.append("l2-gain")
+    return bad
+
+
+def _read_point(pr: Parameters, c: Claims, spec: Spec, suffix: str) -> dict[str, Any] | None:
+    s = spec.system
+    n, p = s.n, s.p
+    keys = ["K", "P", "U", "W", "Y", "R"]
+    vals = {k: pr.exact(k + suffix, c) for k in keys}
+    if any(v is None for v in vals.values()):
+        return None
+    return {
+        "K": _mat(vals["K"], (n, p)),
+        "P": _mat(vals["P"], (n, n)),
+        "U": _vec(vals["U"], p),
+        "W": _vec(vals["W"], p),
+        "Y": _mat(vals["Y"], (p, n)),
+        "R": _mat(vals["R"], (p, p)),
+    }
+
+
+def lmi_claims(
+    spec: Spec, params: dict[str, Any] | Parameters, full_check: bool = True
+) -> list[Claim]:
+    """Every claim of a linear-mode design (full-stubborn or redesign); ``full_check`` False
+    skips the λ_max certificate and bracket."""
     pr = params if isinstance(params, Parameters) else Parameters(params)
     o: Options = spec.options
     s = spec.system
     n, p = s.n, s.p
-    A, C = s.A.q, s.C.q
     disc = s.discrete
     c = Claims()
-    keys = ["K", "P", "X", "U", "W", "Y", "R", "lambda"]
-    vals = {k: pr.exact(k, c) for k in keys}
-    if any(v is None for v in vals.values()):
+    pt = _read_point(pr, c, spec, "")
+    Xr = pr.exact("X", c)
+    lam = pr.exact("lambda", c)
+    if pt is None or Xr is None or lam is None:
         return c
-    P = _mat(vals["P"], (n, n))
-    Xr = _mat(vals["X"], (n, p))
-    u = _vec(vals["U"], p)
-    w = _vec(vals["W"], p)
-    Y = _mat(vals["Y"], (p, n))
-    R = _mat(vals["R"], (p, p))
-    lam = (
-        Q(np.asarray(vals["lambda"], dtype=object).reshape(-1)[0])
-        if not isinstance(vals["lambda"], fmpq)
-        else vals["lambda"]
-    )
+    lam = _scalar(lam)
+    Xr = _mat(Xr, (n, p))
     if o.K is not None:
-        K = np.asarray(o.K, dtype=object)
-        c.matches("K", _mat(vals["K"], (n, p)), K, "[method].K")
-    else:
-        K = _mat(vals["K"], (n, p))
+        c.matches("K", pt["K"], np.asarray(o.K, dtype=object), "[method].K")
+        pt["K"] = np.asarray(o.K, dtype=object)
     crit = pr.get("criterion")
     if crit is not None and crit != o.criterion:
         c.failed(
@@ -75,6 +150,11 @@ def lmi_claims(spec: Spec, params: dict[str, Any] | Parameters) -> list[Claim]:
             reference="spec [method].criterion",
             detail=f"report says {crit!r}, the spec {o.criterion!r}",
         )
+    if o.K is None and "gain_bound" in pr:
+        gb = pr.exact("gain_bound", c)
+        if gb is not None:
+            c.matches("gain_bound", gb, o.gain_bound, "[method].gain_bound")
+    P, K = pt["P"], pt["K"]
     X = P @ K
     eq = all(X[i, j] == Xr[i, j] for i in range(n) for j in range(p))
     c.exact(
@@ -86,100 +166,99 @@ def lmi_claims(spec: Spec, params: dict[str, Any] | Parameters) -> list[Claim]:
         detail="X = P K" if eq else "the reported X differs from P K",
         float_ok=eq,
     )
-    r = check_pd(P)
-    c.exact(
-        id="P-positive",
-        statement="P ≻ 0",
-        reference=f"{PAPER}, Theorem",
-        check="exact LDLᵀ",
-        passed=r.ok,
-        detail=r.detail,
-    )
-    ok_u = all(x > 0 for x in u)
-    c.exact(
-        id="U-positive",
-        statement="U = diag(u) ≻ 0 (sector multiplier)",
-        reference=f"{PAPER}, global sector condition",
-        check="exact sign of each entry",
-        passed=ok_u,
-        detail=f"min u_i = {float(min(u)):.6g}",
-    )
-    ok_w = all(x > 0 for x in w)
-    c.exact(
-        id="W-positive",
-        statement="W = diag(w) ≻ 0 (σ_i = √(σ̄/w_i))",
-        reference=f"{PAPER}, regional sector condition",
-        check="exact sign of each entry",
-        passed=ok_w,
-        detail=f"min w_i = {float(min(w)):.6g}",
-    )
-    r = check_pd(R)
-    c.exact(
-        id="R-positive",
-        statement="R = Rᵀ ≻ 0",
-        reference=f"{PAPER}, adaptive saturation law",
-        check="exact LDLᵀ",
-        passed=r.ok,
-        detail=r.detail,
-    )
-    in_range = lam > 0 and (lam < 1 or not disc)
-    c.exact(
-        id="lambda-range",
-        statement=f"λ = {fmt_exact(lam)} " + ("∈ (0, 1)" if disc else "> 0"),
-        reference=f"{PAPER}, adaptive saturation law",
-        check="exact comparison",
-        passed=in_range,
-        detail="",
-    )
-    _lambda_choice(c, o, pr, lam, disc)
+    res = point_checks(spec, P, K, pt["U"], pt["W"], pt["Y"], pt["R"], lam)
     eqs = ("(7)", "(8)", "(9)") if disc else ("(1)", "(2)", "(3)")
-    M1 = lmis.regional(A, C, P, X, u, R, lam, disc)
-    r = check_pd(-M1)
-    c.exact(
-        id="lmi-regional",
-        statement=f"LMI {eqs[0]} holds strictly at λ = {fmt_exact(lam)} with K = P⁻¹X",
-        reference=f"{PAPER}, eq. {eqs[0]}",
-        check="exact LDLᵀ of −M (all pivots > 0)",
-        passed=r.ok,
-        detail=r.detail,
-    )
-    M2 = lmis.global_(A, C, P, X, w, Y, disc)
-    r = check_pd(-M2)
-    c.exact(
-        id="lmi-global",
-        statement=f"LMI {eqs[1]} holds strictly",
-        reference=f"{PAPER}, eq. {eqs[1]}",
-        check="exact LDLᵀ of −M (all pivots > 0)",
-        passed=r.ok,
-        detail=r.detail,
-    )
-    bad = []
-    for i in range(p):
-        ri = check_pd(lmis.sector(P, Y, w, i))
-        if not ri.ok:
-            bad.append(f"i = {i + 1}: {ri.detail}")
-    c.exact(
-        id="lmi-sector",
-        statement=f"LMI {eqs[2]} holds (strictly) for every output i = 1..{p}",
-        reference=f"{PAPER}, eq. {eqs[2]}",
-        check="exact LDLᵀ of each [[P, Y_iᵀ], [Y_i, w_i]]",
-        passed=not bad,
-        detail="; ".join(bad) or f"{p} block(s), all pivots > 0",
-    )
+    text = {
+        "P-positive": ("P ≻ 0", "Theorem", "exact LDLᵀ"),
+        "U-positive": ("U = diag(u) ≻ 0 (sector multiplier)", "global sector condition", "exact sign of each entry"),
+        "W-positive": ("W = diag(w) ≻ 0 (σ_i = √(σ̄/w_i))", "regional sector condition", "exact sign of each entry"),
+        "R-positive": ("R = Rᵀ ≻ 0", "adaptive saturation law", "exact LDLᵀ"),
+        "lambda-range": (f"λ = {fmt_exact(lam)} " + ("∈ (0, 1)" if disc else "> 0"), "adaptive saturation law", "exact comparison"),
+        "lmi-regional": (f"LMI {eqs[0]} holds strictly at λ = {fmt_exact(lam)} with K = P⁻¹X", f"eq. {eqs[0]}", "exact LDLᵀ of −M (all pivots > 0)"),
+        "lmi-global": (f"LMI {eqs[1]} holds strictly", f"eq. {eqs[1]}", "exact LDLᵀ of −M (all pivots > 0)"),
+        "lmi-sector": (f"LMI {eqs[2]} holds (strictly) for every output i = 1..{p}", f"eq. {eqs[2]}", "exact LDLᵀ of each [[P, Y_iᵀ], [Y_i, w_i]]"),
+        "gain-bound": (f"‖K‖₂ ≤ {fmt_exact(o.gain_bound)} ([method].gain_bound)", "optimized parameter selection (the bound that makes the best λ finite)", "exact LDLᵀ of bound²·I − KᵀK (⪰ 0)"),
+    }  # fmt: skip
+    for cid, r in res.items():
+        st, ref, chk = text[cid]
+        c.exact(
+            id=cid,
+            statement=st,
+            reference=f"{PAPER}, {ref}",
+            check=chk,
+            passed=r.ok,
+            detail=r.detail,
+        )
+    _lambda_choice(c, o, pr, lam, disc)
     if o.criterion == "l2":
         g = pr.exact("gamma2", c)
         if g is not None:
-            M3 = lmis.l2_gain(A, C, s.Bd.q, P, X, Q(g), disc)
+            M3 = lmis.l2_gain(s.A.q, s.C.q, s.Bd.q, P, X, _scalar(g), disc)
             r = check_pd(-M3)
             c.exact(
                 id="l2-gain",
-                statement=f"the L2 gain from d to e of the Luenberger part (gain K) is ≤ √γ², "
-                f"γ² ≤ {fmt_up(g, 8)}",
+                statement="the L2 gain from d to e of the Luenberger part (gain K) is ≤ γ with "
+                f"γ² ≤ {fmt_up(_scalar(g), 8)}",
                 reference=f"{PAPER}, criterion 4 (bounded real lemma)",
                 check="exact LDLᵀ of the bounded-real-lemma matrix",
                 passed=r.ok,
                 detail=r.detail,
             )
+    if full_check and o.lam is None:
+        c += lambda_max_claims(spec, pr)
+    return c
+
+
+def lambda_max_claims(spec: Spec, pr: Parameters) -> list[Claim]:
+    """The best λ: certified at λ_max (a second certificate P, K, U, W, Y, R ``*_at_max``), and
+    bracketed: λ_other within lambda_tol of λ_max where the solver does not find the LMIs
+    feasible (re-solved here: numerical)."""
+    from obsdesign.methods.stubborn.design import Feasibility, Plant
+
+    o: Options = spec.options
+    disc = spec.system.discrete
+    c = Claims()
+    lm = pr.exact("lambda_max", c)
+    pt = _read_point(pr, c, spec, "_at_max")
+    if lm is None or pt is None:
+        return c
+    lm = _scalar(lm)
+    res = point_checks(spec, pt["P"], pt["K"], pt["U"], pt["W"], pt["Y"], pt["R"], lm)
+    bad = [f"{k}: {r.detail}" for k, r in res.items() if not r.ok]
+    eqs = "(7)-(9)" if disc else "(1)-(3)"
+    c.exact(
+        id="lambda-max-certified",
+        statement=f"LMIs {eqs} hold at λ_max = {fmt_exact(lm)} (P, K, U, W, Y, R _at_max; with "
+        + ("‖K‖₂ ≤ gain bound)" if o.K is None else "the given K)"),
+        reference=f"{PAPER}, optimized parameter selection (first maximize λ)",
+        check="exact LDLᵀ of every LMI and positivity condition at λ_max",
+        passed=not bad,
+        detail="; ".join(bad) or "all checks passed",
+    )
+    if "lambda_bracket" not in pr:
+        return c
+    br = pr.exact("lambda_bracket", c)
+    if br is None:
+        return c
+    arr = np.asarray(br, dtype=object).reshape(-1)
+    lo, hi = Q(arr[0]), Q(arr[-1])
+    close = arr.size == 2 and abs(hi - lo) <= o.lambda_tol * abs(lo)
+    side = (hi < lo) if disc else (hi > lo)
+    ok_hi, st_hi = Feasibility(Plant.of(spec), o)(float(hi))
+    word = "smallest" if disc else "largest"
+    c.numerical(
+        id="lambda-max-bracket",
+        statement=f"the {word} λ with LMIs {eqs} feasible is within a relative "
+        f"{fmt_exact(o.lambda_tol)} of λ_max = {fmt_exact(lo)}: the solver does not find them "
+        f"feasible at {fmt_exact(hi)}",
+        reference=f"{PAPER}, optimized parameter selection (first maximize λ)",
+        check="exact bracket width and side; feasibility SDP re-solved at the far end (Clarabel)",
+        passed=bool(close and side and lo == lm and not ok_hi),
+        detail=f"at the far end: {st_hi}"
+        + ("" if close else "; bracket wider than lambda_tol")
+        + ("" if side else "; far end on the wrong side")
+        + ("" if lo == lm else "; the bracket does not start at λ_max"),
+    )
     return c
 
 
@@ -191,7 +270,7 @@ def _lambda_choice(c: Claims, o: Options, pr: Parameters, lam: fmpq, disc: bool)
     lm = pr.exact("lambda_max", c)
     if lm is None:
         return
-    lm = Q(lm)
+    lm = _scalar(lm)
     want = o.fraction * lm if not disc else 1 - o.fraction * (1 - lm)
     ok = want == lam
     rule = "λ = fraction·λ_max" if not disc else "1 − λ = fraction·(1 − λ_best)"

@@ -100,7 +100,7 @@ def _problem(pl: Plant, o: Options, lam: Any, criterion: str | None, margin: flo
         )
         cons.append(sym(Mi) >> m * np.eye(n + 1))
     if o.K is None:
-        gb = float(o.gain_bound)
+        gb = float(o.gain_bound) * (1 - 1e-6)  # strictly inside: the claim checks ‖K‖₂ ≤ bound
         cons.append(cp.bmat([[gb * np.eye(n), X], [X.T, gb * np.eye(p)]]) >> 0)
     obj: Any = cp.Minimize(0)
     extra: dict[str, Any] = {}
@@ -133,22 +133,32 @@ def _problem(pl: Plant, o: Options, lam: Any, criterion: str | None, margin: flo
 
 
 class Feasibility:
-    """Feasibility of LMIs (1)-(3) / (7)-(9) as a function of λ: one cvxpy problem with λ as a
-    parameter (canonicalized once, re-solved for each λ of the search)."""
+    """Feasibility of LMIs (1)-(3) / (7)-(9) as a function of λ.
 
-    def __init__(self, pl: Plant, o: Options) -> None:
+    ``fresh`` False (the λ search): one cvxpy problem with λ as a parameter, canonicalized once.
+    ``fresh`` True: the problem built afresh with λ a constant; this is what ``verify``
+    re-solves at the bracket's far end, and the design confirms that end the same way (near
+    the boundary the parametrized problem and the fresh one can disagree)."""
+
+    def __init__(self, pl: Plant, o: Options, fresh: bool = True) -> None:
         import cvxpy as cp
 
-        self.lam = cp.Parameter(nonneg=True)
-        self.prob, _ = _problem(pl, o, self.lam, None, float(o.margin))
+        self.pl, self.o, self.fresh = pl, o, fresh
         self.calls = 0
+        if not fresh:
+            self.lam = cp.Parameter(nonneg=True)
+            self.prob, _ = _problem(pl, o, self.lam, None, float(o.margin))
 
     def __call__(self, lam: float) -> tuple[bool, str]:
         """Whether the solver finds the LMIs feasible at λ, and its status."""
-        self.lam.value = lam
         self.calls += 1
+        if self.fresh:
+            prob, _ = _problem(self.pl, self.o, float(lam), None, float(self.o.margin))
+        else:
+            self.lam.value = lam
+            prob = self.prob
         try:
-            r = solve(self.prob, ("CLARABEL",))
+            r = solve(prob, ("CLARABEL",))
         except SolverError as e:
             return False, f"solver failure ({e.message})"
         return r.optimal, r.status
@@ -165,8 +175,8 @@ def search_lambda(pl: Plant, o: Options) -> tuple[float, float, str]:
     Continuous time: the largest λ > 0 (feasibility is monotone: a smaller λ only relaxes
     (1)); doubling from 1 brackets it, bisection refines until hi − lo ≤ tol·lo. Discrete
     time: the smallest λ ∈ (0, 1) (a larger λ relaxes (7)); bisection on (0, 1)."""
-    tol = float(o.lambda_tol)
-    feas = Feasibility(pl, o)
+    tol = float(o.lambda_tol) / 2  # half the tolerance: _certified_best may step back tol/8 ×3
+    feas = Feasibility(pl, o, fresh=False)
 
     def feasible(_pl: Plant, _o: Options, lam: float) -> tuple[bool, str]:
         return feas(lam)
@@ -197,6 +207,22 @@ def search_lambda(pl: Plant, o: Options) -> tuple[float, float, str]:
     return hi, lo, feasible(pl, o, lo)[1]
 
 
+def confirm_far_end(pl: Plant, o: Options, good: float, bad: float) -> tuple[float, float, str]:
+    """Make the far end of the bracket one that a fresh problem does not find feasible (the
+    check ``verify`` repeats): while it does, slide the bracket [good, bad] outwards by its
+    width (at most 40 times)."""
+    fresh = Feasibility(pl, o, fresh=True)
+    w = bad - good
+    for _ in range(40):
+        ok, st = fresh(bad)
+        if not ok:
+            return good, bad, st
+        good, bad = bad, bad + w
+        if (pl.discrete and bad <= 0) or (not pl.discrete and bad > LAMBDA_CAP):
+            break
+    return good, float("inf") if not pl.discrete else 0.0, "no far end confirmed"
+
+
 def _bisect(feas: Feasibility, good: float, bad: float, tol: float) -> tuple[float, float]:
     """Bisection between a feasible λ (good) and an infeasible one (bad) until
     |bad − good| ≤ tol·|good|."""
@@ -225,7 +251,7 @@ def design_params(
     notes: list[str] = []
     vals: dict[str, Any] = {}
     if o.lam is not None:
-        lam_q = o.lam
+        lam_q = o.lam  # a rate the user asks for is checked directly, before any search
         if not feasible(pl, o, float(lam_q))[0]:
             _infeasible(spec, pl, o, f"at the given λ = {float(lam_q):g}")
     else:
@@ -234,45 +260,87 @@ def design_params(
         good, bad, st = search_lambda(pl, o)
         if good == (0.0 if not pl.discrete else 1.0):
             _infeasible(spec, pl, o, "for every λ tried")
-        best = dyadic(good, 20)
-        if (not pl.discrete and best > Q(good)) or (pl.discrete and best < Q(good)):
-            best = Q(good)
+        if np.isfinite(bad) and bad != 0.0:
+            good, bad, st = confirm_far_end(pl, o, good, bad)
+        best, cert = _certified_best(spec, pl, o, good)
         vals["lambda_max"] = best
-        other = Q(bad) if np.isfinite(bad) else None
+        for k in POINT_KEYS:
+            vals[f"{k}_at_max"] = cert[k]
+        other = Q(bad) if np.isfinite(bad) and bad != 0.0 else None
         if other is not None:
             vals["lambda_bracket"] = np.array([best, other], dtype=object)
         lam_q = _chosen(o, best, pl.discrete)
         notes.append(
-            f"best λ {'≈' if other is not None else '≥'} {float(best):.6g}"
-            + (f" (solver: feasible there, {st} at {float(bad):.6g})" if other is not None else "")
+            f"best λ {'≈' if other is not None else '≥'} {float(best):.6g} (certified there"
+            + (f"; solver: {st} at {float(bad):.6g})" if other is not None else ", search cap)")
             + f"; λ = {'fraction·λ_max' if not pl.discrete else '1 − fraction·(1 − λ_best)'}"
         )
     if progress:
         progress(f"criterion '{o.criterion}' at λ = {float(lam_q):.6g}")
+    cand, margin, solver = _certify_point(spec, pl, o, lam_q, o.criterion)
+    if cand is None:
+        raise InconclusiveError(
+            f"stubborn: no candidate certified at λ = {float(lam_q):g} ({solver})"
+        )
+    cand.update(vals)
+    cand["criterion"] = o.criterion
+    if o.K is None:
+        cand["gain_bound"] = o.gain_bound
+    notes.append(f"solver margin {margin:g}")
+    sr = SolverResult(f"cvxpy/{solver}", SolverStatus.OPTIMAL, "", time.perf_counter() - t0)
+    return cand, sr, notes
+
+
+#: the matrices of one certified point of LMIs (1)-(3) / (7)-(9)
+POINT_KEYS = ("K", "P", "U", "W", "Y", "R")
+
+
+def _certified_best(spec: Spec, pl: Plant, o: Options, good: float) -> tuple[fmpq, dict[str, Any]]:
+    """A certified point at (or just inside) the solver's best λ: λ_max rounded to 20 bits
+    towards the feasible side, then stepped back by tol/8 (up to 3 times) until the rounded
+    solution passes the exact checks. The bracket [λ_max, λ_other] stays within lambda_tol."""
+    step = float(o.lambda_tol) / 8 * abs(good)
+    for i in range(4):
+        g = good - i * step if not pl.discrete else good + i * step
+        best = dyadic(g, 20)
+        if (not pl.discrete and best > Q(g)) or (pl.discrete and best < Q(g)):
+            best = Q(g)
+        cand, _, _ = _certify_point(spec, pl, o, best, None, attempts=2)
+        if cand is not None:
+            return best, cand
+    raise InconclusiveError(
+        f"stubborn: the solver's best λ ≈ {good:.6g} could not be certified exactly"
+    )
+
+
+def _certify_point(
+    spec: Spec, pl: Plant, o: Options, lam_q: fmpq, criterion: str | None, attempts: int = 4
+) -> tuple[dict[str, Any] | None, float, str]:
+    """Solve at λ (with the criterion, or feasibility), round, check exactly; raise the solver
+    margin ×10 on failure. Returns (candidate or None, margin, solver name or last problem)."""
     margin = float(o.margin)
     last = ""
-    for attempt in range(4):
-        prob, v = _problem(pl, o, float(lam_q), o.criterion, margin)
-        r = solve(prob)
+    for attempt in range(attempts):
+        prob, v = _problem(pl, o, float(lam_q), criterion, margin)
+        try:
+            r = solve(prob, ("CLARABEL",))
+        except SolverError as e:
+            last = e.message
+            margin *= 10
+            continue
         if not r.optimal:
-            if attempt == 0 and r.infeasible:
+            if attempt == 0 and r.infeasible and criterion is not None:
                 _infeasible(spec, pl, o, f"at λ = {float(lam_q):g} with the criterion step")
             last = f"solver status {r.status}"
             margin *= 10
             continue
         cand = _round(v, o, lam_q)
-        cand.update({k: x for k, x in vals.items()})
-        cand["criterion"] = o.criterion
-        bad_ids = [c.id for c in _claims.lmi_claims(spec, cand) if not c.ok]
-        if not bad_ids:
-            notes.append(f"solver margin {margin:g}")
-            sr = SolverResult(
-                f"cvxpy/{r.solver}", SolverStatus.OPTIMAL, "", time.perf_counter() - t0
-            )
-            return cand, sr, notes
-        last = f"exact check failed: {', '.join(bad_ids)}"
+        bad = _claims.point_failures(spec, cand, criterion == "l2")
+        if not bad:
+            return cand, margin, r.solver
+        last = f"exact check failed: {', '.join(bad)}"
         margin *= 10
-    raise InconclusiveError(f"stubborn: no candidate certified ({last})")
+    return None, margin, last
 
 
 def _round(v: dict[str, Any], o: Options, lam_q: fmpq) -> dict[str, Any]:
