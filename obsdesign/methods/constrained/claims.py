@@ -212,25 +212,19 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         passed=r.ok,
         detail=f"P − λ_min_P·I ⪰ 0: {r.detail}",
     )
-    ok, det = B.gamma_ok(P, gamma, dsq)
-    c.exact(
-        id="gamma-bound",
-        statement=f"γ δ² ≤ λ_min(P) with γ = {fmt_down(gamma, 8)}",
-        reference=_ref("Theorem 1, eq. (24)"),
-        check="exact LDLᵀ of P − γδ²I",
-        passed=ok,
-        detail=det,
-    )
-    gmax = Q(val["gamma_max"])
-    ok, det = B.gamma_ok(P, gmax, dsq)
-    c.exact(
-        id="gamma_max-bound",
-        statement=f"γ_max δ² ≤ λ_min(P) with γ_max = {fmt_down(gmax, 8)}",
-        reference=_ref("Theorem 1, eq. (24)"),
-        check="exact LDLᵀ of P − γ_max δ²I",
-        passed=ok,
-        detail=det,
-    )
+    for cid, label, g in (
+        ("gamma-bound", "γ", gamma),
+        ("gamma_max-bound", "γ_max", Q(val["gamma_max"])),
+    ):
+        ok, det = B.gamma_ok(P, g, dsq)
+        c.exact(
+            id=cid,
+            statement=f"{label} δ² ≤ λ_min(P) with {label} = {fmt_down(g, 8)}",
+            reference=_ref("Theorem 1, eq. (24)"),
+            check=f"exact LDLᵀ of P − {label}δ²I",
+            passed=ok,
+            detail=det,
+        )
 
     # -- v_min (21), θ (22) ----------------------------------------------------------------
     ok = v_min >= 0 and B.v_min_condition(o.cmap, P, Pinv, o.X, eps_min, v_min)

@@ -112,19 +112,18 @@ def parse_model(table: Table, spec: Spec) -> Model:
 def plant_f(spec: Spec, model: Model) -> Any:
     """x⁺ = f(x, u, d) (vectorized): the expression, or A x + B u + Bd d."""
     s = spec.system
-    if model.f is not None:
-        return model.f
-    A, B, Bd = s.A.f, s.B.f, s.Bd.f
-    return lambda x, u, d: x @ A.T + u @ B.T + d @ Bd.T
+    return model.f if model.f is not None else _affine(s.A.f, s.B.f, s.Bd.f)
 
 
 def plant_h(spec: Spec, model: Model) -> Any:
     """y = h(x, u, v) (vectorized): the expression, or C x + D u + Dn v."""
     s = spec.system
-    if model.h is not None:
-        return model.h
-    C, D, Dn = s.C.f, s.D.f, s.Dn.f
-    return lambda x, u, v: x @ C.T + u @ D.T + v @ Dn.T
+    return model.h if model.h is not None else _affine(s.C.f, s.D.f, s.Dn.f)
+
+
+def _affine(M: np.ndarray, N: np.ndarray, K: np.ndarray) -> Any:
+    """(x, a, b) ↦ M x + N a + K b on row-stacked arrays."""
+    return lambda x, a, b: x @ M.T + a @ N.T + b @ K.T
 
 
 def check_iss_samples(

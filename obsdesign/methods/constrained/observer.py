@@ -86,17 +86,13 @@ class Refiner:
                     break
                 x = x - Pg @ (G.T @ (2.0 * p2 * p))
                 steps += 1
-                if path is not None:
-                    path.append(x)
-                if not np.all(np.isfinite(x)):
+                if _record(path, x):
                     break
             return x, steps
         while steps < theta_m and bool(self.active(x)):
             x = x + self.M(x)
             steps += 1
-            if path is not None:
-                path.append(x)
-            if not np.all(np.isfinite(x)):
+            if _record(path, x):
                 break
         return x, steps
 
@@ -200,3 +196,11 @@ def run_batch(
             x1, steps[:, k], _ = refiner.refine_batch(x1, theta_m)
         out[:, k + 1] = x1
     return out, steps
+
+
+def _record(path: list | None, x: np.ndarray) -> bool:
+    """Append the iterate x̂_{k,i} to ``path`` (when kept); True when it is no longer finite
+    (the refining loop then stops)."""
+    if path is not None:
+        path.append(x)
+    return not bool(np.all(np.isfinite(x)))
