@@ -231,9 +231,8 @@ def _iv_call(fn: Any, x: I) -> I:
         lo, hi = r._mpi_
     finally:
         iv.prec = saved
-    lo_f = to_float(lo, rnd="f")
-    hi_f = to_float(hi, rnd="c")
-    return I(_down(lo_f), _up(hi_f))
+    # mpmath's enclosure is rigorous; converting its end points with floor/ceiling keeps it so
+    return I(to_float(lo, rnd="f"), to_float(hi, rnd="c"))
 
 
 def _arb_point(fn: str, x: float) -> tuple[float, float]:
@@ -463,16 +462,21 @@ def _is_call(node: ast.AST, *names: str) -> bool:
 _CONSTS = {"pi": I(_down(math.pi), _up(math.pi)), "e": I(_down(math.e), _up(math.e))}
 
 
-def evaluate(node: ast.AST, env: dict[str, Dual], params: dict[str, I], nd: int) -> Dual:
+def evaluate(
+    node: ast.AST, env: dict[str, Dual], params: dict[str, I], nd: int, src: str | None = None
+) -> Dual:
     """Enclosure of the expression ``node`` (value and ``nd`` partial derivatives) over the
-    box given by ``env`` (variable → Dual) and ``params`` (name → interval)."""
+    box given by ``env`` (variable → Dual) and ``params`` (name → interval). ``src`` is the
+    text the tree was parsed from: a decimal literal is then taken at its exact value."""
     if isinstance(node, ast.Expression):
         node = node.body
     if isinstance(node, ast.Constant):
         c = float(node.value)
-        # a decimal literal is within half an ulp of its double: widen unless integral
-        v = I(c, c) if (c == int(c) and abs(c) < 2**53) else I(_down(c), _up(c))
-        return _const(v, nd)
+        seg = ast.get_source_segment(src, node) if src is not None else None
+        try:
+            return _const(I.of_q(Fraction(seg)), nd) if seg is not None else _lit(c, nd)
+        except (ValueError, ZeroDivisionError):
+            return _lit(c, nd)
     if isinstance(node, ast.Name):
         if node.id in env:
             return env[node.id]
@@ -480,7 +484,7 @@ def evaluate(node: ast.AST, env: dict[str, Dual], params: dict[str, I], nd: int)
             return _const(params[node.id], nd)
         return _const(_CONSTS[node.id], nd)
     if isinstance(node, ast.UnaryOp):
-        a = evaluate(node.operand, env, params, nd)
+        a = evaluate(node.operand, env, params, nd, src)
         return d_neg(a) if isinstance(node.op, ast.USub) else a
     if isinstance(node, ast.BinOp):
         op = type(node.op)
@@ -488,19 +492,19 @@ def evaluate(node: ast.AST, env: dict[str, Dual], params: dict[str, I], nd: int)
         if op is ast.Mult:
             for x, s in ((left, right), (right, left)):
                 if _is_call(s, "step", "heaviside") and _same(s.args[0], x):
-                    a = evaluate(x, env, params, nd)
+                    a = evaluate(x, env, params, nd, src)
                     return d_max(a, _const(ZERO, nd))  # X*step(X) = max(X, 0)
         if op is ast.Sub and _is_call(right, "floor") and _same(right.args[0], left):
-            return d_frac(evaluate(left, env, params, nd))
-        a = evaluate(left, env, params, nd)
+            return d_frac(evaluate(left, env, params, nd, src))
+        a = evaluate(left, env, params, nd, src)
         if op in (ast.Pow, ast.BitXor):
             if isinstance(right, ast.Constant) and float(right.value) == int(right.value):
                 return d_pow_int(a, int(right.value))
-            b = evaluate(right, env, params, nd)
+            b = evaluate(right, env, params, nd, src)
             if a.v.lo <= 0.0:
                 raise ArithmeticError("non-integer power of a base that may be ≤ 0")
             return d_fn(d_mul(b, d_fn(a, "log")), "exp")
-        b = evaluate(right, env, params, nd)
+        b = evaluate(right, env, params, nd, src)
         if op is ast.Add:
             return d_add(a, b)
         if op is ast.Sub:
@@ -514,7 +518,7 @@ def evaluate(node: ast.AST, env: dict[str, Dual], params: dict[str, I], nd: int)
         raise ValueError(f"operator {op.__name__}")
     if isinstance(node, ast.Call) and isinstance(node.func, ast.Name):
         name = node.func.id
-        args = [evaluate(x, env, params, nd) for x in node.args]
+        args = [evaluate(x, env, params, nd, src) for x in node.args]
         if name in ("exp", "log", "sqrt", "sin", "cos", "tan", "atan", "tanh", "sinh", "cosh"):
             return d_fn(args[0], name)
         if name == "abs":
@@ -535,6 +539,11 @@ def evaluate(node: ast.AST, env: dict[str, Dual], params: dict[str, I], nd: int)
         if name == "mod":
             return _mod(args[0], args[1], nd)
     raise ValueError(f"cannot enclose {ast.dump(node)[:60]}")
+
+
+def _lit(c: float, nd: int) -> Dual:
+    """A literal known only as its double: the decimal is within half an ulp of it."""
+    return _const(I(c, c) if (c == int(c) and abs(c) < 2**53) else I(_down(c), _up(c)), nd)
 
 
 def _mod(a: Dual, b: Dual, nd: int) -> Dual:

@@ -1,0 +1,481 @@
+"""The concatenated ε-γ observer of Hernández & García ("An alternative approach to the state
+observation problem for Lipschitz continuous systems with controls", Definitions 5-7), run on a
+grid of hypercube centres with every live centre flowed at once.
+
+- **Cells.** A hypercube of radius ε (footnote 2: radius = diam/2) has half-side ε/√n, so
+  every point of the cell is within Euclidean distance ε of its centre. Level i uses the fixed
+  grid of centres 2 s_i ℤⁿ with s_i = ε_i/√n.
+- **Flow.** Between samples all live centres are advanced together by a fixed-step RK4
+  (chunks of centres, so the only per-centre memory is the state itself); the step count is
+  chosen and checked by step doubling (error control) at every switch.
+- **Discarding** (Definition 6): at t_k a centre is dropped when |y_k − h(x̄)| > γ_i.
+- **Refinement at the switches** (Definition 7 and the consistency part of Theorem 1's proof).
+  ``refine = "recover"`` (default, sound): by Lemma 2's estimate (2) the true state at τ_{i+1}
+  lies in the Euclidean ball of radius η = ε_i e^{L_f Δτ} (+ the flow error estimate) around
+  some surviving centre; the new level's grid cells that meet one of these balls are taken
+  (duplicates merge: the grid is fixed) and a cell is kept only when |h(c) − y(τ_{i+1})| ≤
+  L_h ε_{i+1}, which every cell that contains a point of h⁻¹(y(τ_{i+1})) satisfies — this is
+  the paper's ∩ (h⁻¹(y))_ε without computing h⁻¹. Guarantee: the cell that contains the
+  true state is never dropped, as long as L_f, L_h are Lipschitz constants on a set that
+  contains the trajectories and the cells around them and the flow error stays below its
+  estimate. ``refine = "paper"`` is Definition 7 literally, D_{i+1} = [(X + G_ε) ∪ X] ∩
+  (h⁻¹(y))_ε with G_ε = {±ε/√n}ⁿ: the 2ⁿ children cover the *cube* of radius 2ε, not the
+  *ball* of radius η that (2) gives, so for n ≥ 2 it can lose the true state, and it grows
+  without bound (only exact duplicates merge).
+- **Estimate**: the centroid of the live centres; the error of footnote 9 (the largest
+  coordinate-wise distance between a live centre and the true state) is reported beside the
+  centroid's error and an observable bound (spread of the centres + the current cell radius).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from obsdesign.errors import InfeasibleError
+from obsdesign.methods.searchspace.options import Options, SimOptions
+from obsdesign.params import Parameters
+from obsdesign.simulate.result import SimResult
+from obsdesign.spec.models import Spec
+
+CHUNK = 1 << 15
+#: relative/absolute inflation of every radius used in a covering test (float rounding)
+INFLATE = 1e-9
+
+
+class ConsistencyLost(InfeasibleError):
+    """Every centre was discarded: the message says which bound was violated."""
+
+
+class MemoryCap(InfeasibleError):
+    """The search space needs more live centres than the cap allows."""
+
+
+@dataclass
+class Plant:
+    """Vectorized f, h, u of a spec: ``rhs(X, t)`` on (N, n) arrays, ``out(X)`` → (N, p)."""
+
+    spec: Spec
+    states: list[str] = field(init=False)
+    inputs: list[str] = field(init=False)
+
+    def __post_init__(self) -> None:
+        s = self.spec.system
+        self.states = list(s.states)
+        self.inputs = list(s.inputs)
+        self._cache: dict[float, dict[str, float]] = {}
+        names = {*s.variables, *(v for ex in (*s.f, *s.h) for v in ex.variables)}
+        self._zeros = {v: 0.0 for v in names}
+
+    def u(self, t: float) -> dict[str, float]:
+        """u(t) by name (the last few times are cached: RK4 asks each time twice)."""
+        s = self.spec.system
+        if not self.inputs:
+            return {}
+        hit = self._cache.get(t)
+        if hit is None:
+            if len(self._cache) > 8:
+                self._cache.clear()
+            hit = {n: float(ex(t=t)) for n, ex in zip(self.inputs, s.u_signal, strict=True)}
+            self._cache[t] = hit
+        return hit
+
+    def rhs(self, X: np.ndarray, t: float, out: np.ndarray | None = None) -> np.ndarray:
+        """f(X, u(t)) for every row of X (eq. (1))."""
+        env: dict[str, Any] = dict(self._zeros)  # every variable given: Expr skips its name search
+        env.update({n: X[:, i] for i, n in enumerate(self.states)})
+        env.update(self.u(t))
+        env["t"] = t
+        out = np.empty_like(X) if out is None else out
+        for i, ex in enumerate(self.spec.system.f):
+            out[:, i] = ex(**env)
+        return out
+
+    def out(self, X: np.ndarray) -> np.ndarray:
+        """h(X) for every row of X."""
+        env: dict[str, Any] = dict(self._zeros)
+        env.update({n: X[..., i] for i, n in enumerate(self.states)})
+        return np.stack(
+            [np.broadcast_to(ex(**env), X.shape[:-1]) for ex in self.spec.system.h], axis=-1
+        )
+
+
+def rk4(plant: Plant, X: np.ndarray, t: float, dt: float, nsub: int) -> np.ndarray:
+    """Advance every row of X from t to t + dt by ``nsub`` classical RK4 steps, in chunks of
+    CHUNK rows (temporaries are per chunk: no per-centre memory beyond the state)."""
+    h = dt / nsub
+    out = np.empty_like(X)
+    for a in range(0, X.shape[0], CHUNK):
+        x = X[a : a + CHUNK].copy()
+        acc = np.empty_like(x)
+        xt = np.empty_like(x)
+        k = np.empty_like(x)
+        tt = t
+        for _ in range(nsub):
+            plant.rhs(x, tt, k)
+            np.multiply(k, h / 6, out=acc)
+            acc += x
+            np.multiply(k, h / 2, out=xt)
+            xt += x
+            plant.rhs(xt, tt + h / 2, k)
+            acc += (h / 3) * k
+            np.multiply(k, h / 2, out=xt)
+            xt += x
+            plant.rhs(xt, tt + h / 2, k)
+            acc += (h / 3) * k
+            np.multiply(k, h, out=xt)
+            xt += x
+            plant.rhs(xt, tt + h, k)
+            acc += (h / 6) * k
+            x, acc = acc, x
+            tt += h
+        out[a : a + CHUNK] = x
+    return out
+
+
+def flow_error(plant: Plant, X: np.ndarray, t: float, dt: float, nsub: int) -> float:
+    """Step-doubling estimate of the RK4 error over one sample interval (max over the rows)."""
+    if X.shape[0] == 0:
+        return 0.0
+    a = rk4(plant, X, t, dt, nsub)
+    b = rk4(plant, X, t, dt, 2 * nsub)
+    return float(np.max(np.linalg.norm(a - b, axis=1))) * 16 / 15
+
+
+def cover_box(lo: np.ndarray, hi: np.ndarray, s: float) -> np.ndarray:
+    """Centres of the grid 2sℤⁿ whose cells [c − s, c + s] meet the box [lo, hi] (the ε-cover
+    F_ε(D) of Definition 5 on a fixed grid, not necessarily minimal)."""
+    axes = [
+        np.arange(
+            math.ceil((a - s) / (2 * s) - INFLATE), math.floor((b + s) / (2 * s) + INFLATE) + 1
+        )
+        for a, b in zip(lo, hi, strict=True)
+    ]
+    grid = np.array(list(itertools.product(*axes)), dtype=np.int64).reshape(-1, len(lo))
+    return grid * (2 * s)
+
+
+def recover(C: np.ndarray, eta: float, s: float, cap: int) -> np.ndarray:
+    """Centres of the grid 2sℤⁿ whose cells meet some ball B(c, η), c a row of C (merged:
+    each cell once). Raises :class:`MemoryCap` when more than ``cap`` cells are needed."""
+    n = C.shape[1]
+    eta = eta * (1 + INFLATE) + INFLATE * s
+    R = math.ceil((eta + s) / (2 * s) + 0.5)
+    offs = np.array(list(itertools.product(range(-R, R + 1), repeat=n)), dtype=np.int64)
+    base = np.rint(C / (2 * s)).astype(np.int64)
+    step = max(1, (1 << 20) // len(offs))
+    keys: list[np.ndarray] = []
+    total = 0
+    for a in range(0, C.shape[0], step):
+        idx = base[a : a + step, None, :] + offs[None, :, :]
+        g = idx * (2 * s)
+        d = np.maximum(np.abs(C[a : a + step, None, :] - g) - s, 0.0)
+        hit = np.einsum("ijk,ijk->ij", d, d) <= eta * eta
+        kept = np.unique(idx[hit], axis=0)
+        keys.append(kept)
+        total += len(kept)
+        if total > 4 * cap:  # merge early to keep memory bounded
+            keys = [np.unique(np.concatenate(keys), axis=0)]
+            total = len(keys[0])
+            if total > cap:
+                break
+    allk = np.unique(np.concatenate(keys), axis=0) if keys else np.zeros((0, n), np.int64)
+    if len(allk) > cap:
+        raise MemoryCap(
+            f"the refinement needs at least {len(allk):,} live centres, above the memory cap "
+            f"max_centres = {cap:,}; dropping any of them could drop the cell of the true state, "
+            "so the observer stops: raise max_centres, or start from a smaller D or a larger γ₀"
+        )
+    return allk * (2 * s)
+
+
+def paper_children(C: np.ndarray, s: float) -> np.ndarray:
+    """Definition 7 literally: X ∪ (X + G_ε), G_ε = {±ε/√n}ⁿ = {±s}ⁿ (exact duplicates merged)."""
+    n = C.shape[1]
+    G = np.array(list(itertools.product((-s, s), repeat=n)))
+    kids = np.concatenate([C, (C[:, None, :] + G[None, :, :]).reshape(-1, n)])
+    key = np.round(kids / (s * 1e-6)).astype(np.int64)
+    _, first = np.unique(key, axis=0, return_index=True)
+    return kids[np.sort(first)]
+
+
+@dataclass
+class Run:
+    """What the observer recorded at every sample."""
+
+    t: list[float] = field(default_factory=list)
+    x: list[np.ndarray] = field(default_factory=list)
+    y: list[np.ndarray] = field(default_factory=list)
+    xhat: list[np.ndarray] = field(default_factory=list)
+    live: list[int] = field(default_factory=list)
+    err9: list[np.ndarray] = field(default_factory=list)
+    near: list[float] = field(default_factory=list)
+    bound: list[float] = field(default_factory=list)
+    gamma: list[float] = field(default_factory=list)
+    stored: list[tuple[float, np.ndarray]] = field(default_factory=list)
+    switches: list[float] = field(default_factory=list)
+
+
+def _options(spec: Spec, kw: dict[str, Any]) -> SimOptions:
+    base = spec.simulate.options if spec.simulate and spec.simulate.options else SimOptions()
+    vals = {k: v for k, v in kw.items() if v is not None and hasattr(base, k)}
+    return SimOptions(**{**base.__dict__, **vals})
+
+
+def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) -> SimResult:
+    """Run the plant from [simulate] x0 and the concatenated ε-γ observer over the horizon."""
+    so = _options(spec, kw)
+    o: Options = spec.options
+    assert spec.simulate is not None
+    plant = Plant(spec)
+    n = spec.system.n
+    dT = params.float("dT")
+    K = int(round(params.float("K")))
+    gam = [float(g) for g in params.float("gamma_schedule")]
+    eps = [float(e) for e in params.float("eps_schedule")]
+    L_f, L_h = params.float("L_f"), params.float("L_h")
+    t0 = float(o.t0)
+    N = int(math.floor(float(spec.simulate.horizon.f) / dT + 1e-9))
+    x0 = np.asarray(spec.simulate.x0.f, dtype=float).reshape(1, n)
+    E_lo, E_hi = o.E.lo, o.E.hi
+    nsub = so.substeps or 1
+    bar = _progress(progress, N)
+
+    t = t0
+    x = x0.copy()
+    y = plant.out(x)[0]
+    i = 0
+    s = eps[0] / math.sqrt(n)
+    C = cover_box(o.D.lo, o.D.hi, s)
+    C = C[_consistent(plant, C, y, L_h * eps[0])]
+    if len(C) > so.max_centres:
+        raise MemoryCap(
+            f"the ε₀-cover of D needs {len(C):,} centres, above max_centres = {so.max_centres:,}"
+        )
+    run = Run()
+    tau = t0
+    steps = 0
+    flow_err = 0.0
+    left_E: float | None = None
+    t_start = time.perf_counter()
+    if not len(C):
+        raise ConsistencyLost(_diagnose(run, x0[0], o, "the output filter at t₀", None))
+    _record(run, t, x[0], y, C, eps[0], 0.0, L_f, gam[0], so, 0)
+    if so.substeps == 0:
+        nsub, flow_err = _auto_substeps(plant, C, t, dT, nsub, eps[0])
+    for k in range(1, N + 1):
+        t_next = t0 + k * dT
+        # the plant's state rides along as the last row (same RK4 steps as the centres)
+        XC = rk4(plant, np.concatenate([C, x]), t, dT, nsub)
+        steps += len(C) * nsub
+        C, x = XC[:-1], XC[-1:]
+        t = t_next
+        y = plant.out(x)[0]
+        if left_E is None and not (np.all(x[0] >= E_lo) and np.all(x[0] <= E_hi)):
+            left_E = t
+        keep = np.all(np.abs(plant.out(C) - y) <= gam[min(i, len(gam) - 1)], axis=1)
+        if not keep.any():
+            raise ConsistencyLost(
+                _diagnose(
+                    run,
+                    x[0],
+                    o,
+                    f"discarding at t = {t:.6g} (γ = {gam[min(i, len(gam) - 1)]:.6g})",
+                    (C, eps[min(i, len(eps) - 1)], L_f, t - tau, left_E, flow_err),
+                )
+            )
+        C = C[keep]
+        if k % K == 0:  # switch τ_{i+1}: refine (Definition 7)
+            survivors, since = C, t - tau
+            e_old = eps[min(i, len(eps) - 1)]
+            i += 1
+            e_new = eps[min(i, len(eps) - 1)]
+            s = e_new / math.sqrt(n)
+            if so.refine == "paper":
+                C = paper_children(C, s)
+                if len(C) > so.max_centres:
+                    raise MemoryCap(
+                        f"Definition 7 taken literally needs {len(C):,} centres at t = {t:.4g}, "
+                        f"above max_centres = {so.max_centres:,} (it grows without bound: "
+                        'use refine = "recover")'
+                    )
+            else:
+                eta = e_old * math.exp(L_f * K * dT) + K * flow_err
+                C = recover(C, eta, s, so.max_centres)
+            C = C[_consistent(plant, C, y, L_h * e_new)]
+            run.switches.append(t)
+            tau = t
+            if not len(C):
+                raise ConsistencyLost(
+                    _diagnose(
+                        run,
+                        x[0],
+                        o,
+                        f"the refinement at τ = {t:.6g}",
+                        (survivors, e_old, L_f, since, left_E, flow_err),
+                    )
+                )
+            if so.substeps == 0:
+                nsub, fe = _auto_substeps(plant, C, t, dT, nsub, e_new)
+                flow_err = max(flow_err, fe)
+        e_cur = eps[min(i, len(eps) - 1)]
+        _record(run, t, x[0], y, C, e_cur, t - tau, L_f, gam[min(i, len(gam) - 1)], so, k)
+        if bar is not None:
+            bar(k, len(C))
+    secs = time.perf_counter() - t_start
+    if bar is not None:
+        bar(None, 0)
+    return _result(spec, run, params, steps, secs, nsub, flow_err, left_E, so)
+
+
+def _consistent(plant: Plant, C: np.ndarray, y: np.ndarray, r: float) -> np.ndarray:
+    """Cells that may contain a point of h⁻¹(y): |h(c) − y| ≤ L_h ε (componentwise, inflated
+    for float rounding) — the ∩ (h⁻¹(y))_ε of Definition 7 without h⁻¹."""
+    if len(C) == 0:
+        return np.zeros(0, dtype=bool)
+    return np.all(np.abs(plant.out(C) - y) <= r * (1 + INFLATE) + 1e-12, axis=1)
+
+
+def _auto_substeps(
+    plant: Plant, C: np.ndarray, t: float, dT: float, nsub: int, eps: float
+) -> tuple[int, float]:
+    """Smallest RK4 step count (doubling from ``nsub``) whose step-doubling error estimate over
+    one sample is below 1e-4·ε on a subset of the centres; returns it and the estimate."""
+    sub = C[:: max(1, len(C) // 256)]
+    err = flow_error(plant, sub, t, dT, nsub)
+    while err > 1e-4 * eps and nsub < 256:
+        nsub *= 2
+        err = flow_error(plant, sub, t, dT, nsub)
+    return nsub, err
+
+
+def _record(
+    run: Run,
+    t: float,
+    x: np.ndarray,
+    y: np.ndarray,
+    C: np.ndarray,
+    eps: float,
+    since: float,
+    L_f: float,
+    gamma: float,
+    so: SimOptions,
+    k: int,
+) -> None:
+    c = C.mean(axis=0)
+    run.t.append(t)
+    run.x.append(x.copy())
+    run.y.append(np.asarray(y, dtype=float).copy())
+    run.xhat.append(c)
+    run.live.append(len(C))
+    run.err9.append(np.max(np.abs(C - x), axis=0))
+    run.near.append(float(np.sqrt(np.min(np.einsum("ij,ij->i", C - x, C - x)))))
+    spread = float(np.max(np.linalg.norm(C - c, axis=1)))
+    run.bound.append(spread + eps * math.exp(L_f * since))
+    run.gamma.append(gamma)
+    if k % so.store_every == 0:
+        sub = C if len(C) <= 4000 else C[:: len(C) // 4000 + 1]
+        run.stored.append((t, sub.copy()))
+
+
+def _diagnose(run: Run, x: np.ndarray, o: Options, where: str, ctx: Any) -> str:
+    """'consistency lost': which assumption or bound failed, from the true trajectory."""
+    msg = [f"consistency lost: every centre was discarded by {where}."]
+    x0 = run.x[0] if run.x else x
+    if not (np.all(x0 >= o.D.lo - 1e-12) and np.all(x0 <= o.D.hi + 1e-12)):
+        msg.append(f"x0 = {np.round(x0, 6).tolist()} is not in D = {o.D.describe()}.")
+    if ctx is not None:
+        C, eps, L_f, since, left_E, flow_err = ctx
+        if left_E is not None:
+            msg.append(
+                f"The true state left E at t = {left_E:.6g}: the constants on E do not apply."
+            )
+        bound = eps * math.exp(L_f * since) + flow_err
+        d = float(np.min(np.linalg.norm(C - x, axis=1))) if len(C) else math.inf
+        if d > bound:
+            msg.append(
+                f"Lemma 2's estimate (2) is violated: the nearest centre is {d:.4g} from the true "
+                f"state, above ε e^(L_f (t − τ)) = {bound:.4g} (L_f is not a Lipschitz constant "
+                "along the trajectory, or the flow error exceeded its estimate)."
+            )
+        else:
+            msg.append(
+                f"The nearest centre is within (2)'s bound ({d:.4g} ≤ {bound:.4g}) but its output "
+                "differs by more than γ: L_h is not a Lipschitz constant of h there, or Lemma 2's "
+                "horizon Δτ < log(κ/L_h)/L_f does not hold."
+            )
+    return " ".join(msg)
+
+
+def _progress(on: bool, N: int) -> Any:
+    if not on:
+        return None
+    from rich.progress import BarColumn, Progress, TextColumn
+
+    p = Progress(TextColumn("observer"), BarColumn(), TextColumn("{task.fields[live]} centres"))
+    task = p.add_task("run", total=N, live=0)
+    p.start()
+
+    def update(k: int | None, live: int) -> None:
+        if k is None:
+            p.stop()
+            return
+        p.update(task, completed=k, live=live)
+
+    return update
+
+
+def _result(
+    spec: Spec,
+    run: Run,
+    params: Parameters,
+    steps: int,
+    secs: float,
+    nsub: int,
+    flow_err: float,
+    left_E: float | None,
+    so: SimOptions,
+) -> SimResult:
+    x = np.array(run.x)
+    xhat = np.array(run.xhat)
+    err9 = np.array(run.err9)
+    final = float(np.linalg.norm(xhat[-1] - x[-1]))
+    info = {
+        "eps_star": params.float("eps_star"),
+        "final_error": final,
+        "final_error_fn9": err9[-1].tolist(),
+        "final_bound": run.bound[-1],
+        "final_true_cell": run.near[-1],
+        "final_live": run.live[-1],
+        "max_live": int(max(run.live)),
+        "switches": len(run.switches),
+        "centre_steps": int(steps),
+        "centre_steps_per_s": steps / secs if secs > 0 else math.inf,
+        "rk4_substeps": nsub,
+        "flow_error_estimate": flow_err,
+        "refine": so.refine,
+    }
+    if left_E is not None:
+        info["left_E_at"] = left_E
+    return SimResult(
+        t=np.array(run.t),
+        x=x,
+        xhat=xhat,
+        y=np.array(run.y),
+        states=list(spec.system.states),
+        extra={
+            "live": np.array(run.live),
+            "err_fn9": err9,
+            "true_cell": np.array(run.near),
+            "bound": np.array(run.bound),
+            "gamma": np.array(run.gamma),
+            "switches": np.array(run.switches),
+            "stored": run.stored,
+        },
+        info=info,
+    )

@@ -1,0 +1,148 @@
+"""The vectorized ε-γ observer of the search-space method (paper 004): consistency (the true
+state's cell is never dropped), the final error, shrinking at the switches, the memory cap, the
+literal Definition 7 and the "consistency lost" diagnosis."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from obsdesign import api
+from obsdesign.cli import app
+from obsdesign.methods.searchspace.sim import ConsistencyLost, MemoryCap, cover_box, recover
+
+ROOT = Path(__file__).resolve().parents[1]
+SPEC = ROOT / "specs" / "hernandez-garcia-example.toml"
+PEND = ROOT / "specs" / "hernandez-garcia-pendulum.toml"
+TEXT = SPEC.read_text(encoding="utf-8")
+
+
+def _load(text: str, tmp_path: Path):
+    p = tmp_path / "s.toml"
+    p.write_text(text, encoding="utf-8")
+    sp = api.load_spec(p)
+    return sp, api.design(sp)
+
+
+@pytest.fixture(scope="module")
+def example():
+    sp = api.load_spec(SPEC)
+    rep = api.design(sp)
+    return sp, rep, api.simulate(sp, rep)
+
+
+def _level_bounds(res, rep):
+    """ε_i e^{L_f (t − τ_i)} at every sample (the radius Lemma 2 guarantees)."""
+    p = rep.parameters
+    eps = [float(e) for e in p.float("eps_schedule")]
+    L_f, dtau = p.float("L_f"), p.float("dtau")
+    t0 = res.t[0]
+    i = np.floor((res.t - t0) / dtau + 1e-9).astype(int)
+    since = res.t - t0 - i * dtau
+    return np.array([eps[min(j, len(eps) - 1)] for j in i]) * np.exp(L_f * since)
+
+
+def test_true_cell_is_never_dropped(example):
+    """Consistency (Lemma 2 / Theorem 1): at every sample a live centre lies within
+    ε_i e^{L_f (t − τ_i)} of the true state."""
+    sp, rep, res = example
+    near = res.extra["true_cell"]
+    assert np.all(near <= _level_bounds(res, rep) * (1 + 1e-9))
+
+
+def test_final_error_at_most_eps_star(example):
+    """After the schedule reached γ⋆, right after each switch the true state is inside a
+    live cell of radius ε⋆; at the end the true cell's error is ≤ ε⋆ e^{L_f (t − τ)}."""
+    sp, rep, res = example
+    eps_star = rep.parameters.float("eps_star")
+    t, near = res.t, res.extra["true_cell"]
+    reached = rep.parameters.float("dtau") * (len(rep.parameters["gamma_schedule"]) - 1)
+    for s in res.extra["switches"]:
+        if s >= reached - 1e-9:
+            k = int(np.argmin(np.abs(t - s)))
+            assert near[k] <= eps_star
+    assert res.info["final_true_cell"] <= _level_bounds(res, rep)[-1]
+    assert res.info["max_live"] <= 1300  # the issue's figure for a sound re-covering
+
+
+def test_centroid_error_after_informative_phase(tmp_path):
+    """y = x1·[x1 > 0] is informative while x1 > 0 (t < 6.7 here): at t = 5 the centroid's
+    error is below ε⋆ = 1/30 (over [6.7, 12] the output is 0 and it stays ≈ 0.05)."""
+    sp, rep = _load(TEXT.replace("horizon = 12", "horizon = 5"), tmp_path)
+    res = api.simulate(sp, rep)
+    assert res.info["final_error"] <= rep.parameters.float("eps_star")
+
+
+def test_search_space_shrinks_at_switches(example):
+    """Figs. 3-5: in the informative phase the search space's extent (footnote 9's error)
+    falls at most switches and by a factor > 20 overall."""
+    sp, rep, res = example
+    t, ext = res.t, res.extra["err_fn9"].max(axis=1)
+    sw = [s for s in res.extra["switches"] if 1.5 < s < 6.1]
+    at = [ext[int(np.argmin(np.abs(t - s)))] for s in sw]
+    falls = sum(b < a for a, b in zip(at, at[1:], strict=False))
+    assert falls >= 0.7 * (len(at) - 1)
+    assert at[-1] < at[0] / 20
+
+
+def test_pendulum_final_error(tmp_path):
+    sp = api.load_spec(PEND)
+    rep = api.design(sp)
+    assert rep.exit_code() == 0
+    res = api.simulate(sp, rep)
+    assert res.info["final_error"] <= rep.parameters.float("eps_star")
+    assert np.all(res.extra["true_cell"] <= _level_bounds(res, rep) * (1 + 1e-9))
+
+
+def test_memory_cap_fails_with_explanation(example):
+    sp, rep, _ = example
+    with pytest.raises(MemoryCap, match="dropping any of them could drop the cell"):
+        api.simulate(sp, rep, max_centres=12)
+
+
+def test_definition_7_literally_grows(example):
+    sp, rep, _ = example
+    with pytest.raises(MemoryCap, match="grows without bound"):
+        api.simulate(sp, rep, refine="paper", max_centres=3000)
+
+
+def test_consistency_lost_is_diagnosed(tmp_path):
+    """x0 outside D with an informative output: every centre is dropped at t₀; the message
+    says which assumption failed. (With the example's output a state outside D can be
+    recovered: the search space dilates while y = 0.)"""
+    text = TEXT.replace("x0 = [0, 1]", "x0 = [1.5, 0]").replace('["x1*step(x1)"]', '["x1"]')
+    sp, rep = _load(text, tmp_path)
+    with pytest.raises(ConsistencyLost, match=r"consistency lost.*x0 = \[1\.5, 0\.0\] is not in D"):
+        api.simulate(sp, rep)
+
+
+def test_cli_simulate_option_and_cap(tmp_path):
+    r = CliRunner().invoke(app, ["simulate", str(SPEC), "--option", "max_centres=12"])
+    assert r.exit_code == 1
+    assert "memory cap" in r.output
+    r = CliRunner().invoke(app, ["simulate", str(SPEC), "--option", "refine=literal"])
+    assert r.exit_code == 2
+
+
+def test_recover_covers_every_ball_point():
+    """Sound re-covering: every point within η of a centre lies in a returned cell."""
+    rng = np.random.default_rng(1)
+    C = rng.uniform(-1, 1, size=(40, 2))
+    eta, s = 0.3, 0.1
+    cells = recover(C, eta, s, cap=10**6)
+    for c in C:
+        for _ in range(50):
+            d = rng.normal(size=2)
+            p = c + eta * rng.uniform() ** 0.5 * d / np.linalg.norm(d)
+            assert np.any(np.all(np.abs(cells - p) <= s + 1e-12, axis=1))
+    # merged: each cell once
+    assert len(np.unique(np.round(cells / s).astype(int), axis=0)) == len(cells)
+
+
+def test_cover_box_degenerate_side():
+    C = cover_box(np.array([0.0, -2.0]), np.array([0.0, 2.0]), 1 / math.sqrt(2) * 2 / 3)
+    assert np.all(C[:, 0] == 0) and C[:, 1].min() <= -2 + 0.48 and C[:, 1].max() >= 2 - 0.48
