@@ -333,3 +333,21 @@ def test_outlier_study_qualitative(spec: Path) -> None:
     for a in ("0.1", "1"):
         for s in ("x1", "x2"):
             assert med["stubborn"][a][s] <= 2 * med["luenberger"][a][s], (a, s)
+
+
+def test_template_designs_and_verifies(tmp_path: Path) -> None:
+    runner = CliRunner()
+    res = runner.invoke(app, ["init", "stubborn"])
+    assert res.exit_code == 0
+    spec = tmp_path / "t.toml"
+    spec.write_text(res.output)
+    out = tmp_path / "t.json"
+    r = runner.invoke(app, ["design", str(spec), "-o", str(out), "--format", "json"])
+    assert r.exit_code == 0, r.output
+    assert runner.invoke(app, ["verify", str(out), "--format", "json"]).exit_code == 0
+
+
+def test_schema_lists_stubborn_keys() -> None:
+    sch = json.dumps(api.schema())
+    for k in ("lambda_fraction", "gain_bound", "lipschitz", "outlier_rate"):
+        assert k in sch

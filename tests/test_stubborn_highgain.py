@@ -1,0 +1,124 @@
+"""The ``stubborn`` method's high-gain redesign (second part of the stubborn-observer slides,
+Astolfi, Alessandri, Zaccarian, WUDS 2017) on the forced Duffing oscillator: exact P, ℓ*, ℓ,
+tamper tests per claim id, and the outlier rejection of the stubborn high-gain observer."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from flint import fmpq
+
+from obsdesign import api
+from obsdesign.certify.claim import ClaimStatus
+from obsdesign.certify.exact import Q, qparse, qstr, to_float
+from obsdesign.report import Report
+
+DUFFING = Path(__file__).resolve().parents[1] / "specs" / "astolfi-stubborn-duffing.toml"
+TINY = fmpq(1, 2**80)
+
+
+@pytest.fixture(scope="module")
+def rep() -> Report:
+    return api.design(DUFFING)
+
+
+def test_duffing_design_known_answer(rep: Report) -> None:
+    assert {c.id: c.status for c in rep.claims} == {
+        "lyapunov-equation": ClaimStatus.CERTIFIED,
+        "P-positive": ClaimStatus.CERTIFIED,
+        "ell-star-bound": ClaimStatus.CERTIFIED,
+        "ell-bound": ClaimStatus.CERTIFIED,
+    }
+    p = rep.parameters
+    # K = (2, 1): P(A − KC) + (A − KC)ᵀP = −I has P = [[1/2, −1/2], [−1/2, 3/2]] (by hand)
+    P = p["P"]
+    assert [[P[i, j] for j in range(2)] for i in range(2)] == [
+        [fmpq(1, 2), fmpq(-1, 2)],
+        [fmpq(-1, 2), fmpq(3, 2)],
+    ]
+    # |P| = 1 + 1/√2, ℓ* = 2·16·|P| = 54.6274…; ℓ = 1.1·ℓ* rounded up to 3 digits = 60.1
+    assert p["ell"] == Q("60.1")
+    lmax = 1 + np.sqrt(0.5)
+    assert 32 * lmax <= float(p["ell_star"]) <= 32 * lmax * (1 + 1e-9)
+    assert p["lambda"] == 1 and p["epsilon"] == 1
+
+
+def _set(d: dict[str, Any], key: str, value: Any) -> None:
+    d["parameters"]["exact"][key] = qstr(value)
+    f = to_float(value)
+    d["parameters"][key] = f if isinstance(f, float) else np.asarray(f).tolist()
+
+
+def _failed(d: dict[str, Any]) -> set[str]:
+    r, problems = Report.from_dict(json.loads(json.dumps(d)))
+    assert not problems
+    ver = api.verify(r)
+    assert ver.exit_code() == 1
+    return {
+        c.id
+        for c in ver.claims
+        if c.status == ClaimStatus.FAILED and not c.id.startswith("report-")
+    }
+
+
+def _bound(rep: Report) -> fmpq:
+    """A rational just below 2L|P| = 32 (1 + 1/√2) (checked exactly: (b/32 − 1)² < 1/2)."""
+    b = Q(32 * (1 + np.sqrt(0.5)) * (1 - 1e-12))
+    assert (b / 32 - 1) ** 2 < fmpq(1, 2)
+    return b
+
+
+@pytest.mark.parametrize(
+    "name, expected",
+    [
+        ("lyapunov-equation", {"lyapunov-equation"}),
+        ("P-positive", {"P-positive", "lyapunov-equation"}),
+        ("ell-bound", {"ell-bound"}),
+        ("ell-star-bound", {"ell-star-bound"}),
+        ("K", {"K-matches-spec"}),
+        ("epsilon", {"epsilon-matches-spec"}),
+        ("lambda", {"lambda-matches-spec"}),
+    ],
+)
+def test_tamper(rep: Report, name: str, expected: set[str]) -> None:
+    d = rep.to_dict()
+    P = qparse(d["parameters"]["exact"]["P"])
+    if name == "lyapunov-equation":
+        P[0, 1] += TINY
+        P[1, 0] += TINY
+        _set(d, "P", P)
+    elif name == "P-positive":  # singular P
+        P[0, 0] = P[0, 1] * P[1, 0] / P[1, 1]
+        _set(d, "P", P)
+    elif name == "ell-bound":
+        _set(d, "ell", _bound(rep))
+    elif name == "ell-star-bound":
+        _set(d, "ell_star", _bound(rep))
+    elif name == "K":  # the report's K is compared with the spec's; the equation uses the spec's
+        _set(d, "K", np.array([[fmpq(2) + TINY], [fmpq(1)]], dtype=object))
+    else:
+        _set(d, name, fmpq(1) + TINY)
+    assert _failed(d) == expected
+
+
+def test_stubborn_high_gain_rejects_the_impulsive_outlier(rep: Report) -> None:
+    res = api.simulate(api.load_spec(DUFFING), rep)
+    sup = res.info["sup_error_after_impulse"]
+    assert sup["stubborn"] * 3 <= sup["standard"]
+    err = res.extra["error_norm"]
+    t = res.t
+    # before the outlier both observers converge (no noise on [0, 2))
+    k = np.searchsorted(t, 1.9)
+    assert err[k, 0] < 1e-6 and err[k, 1] < 1e-6
+
+
+def test_not_hurwitz_is_infeasible() -> None:
+    from obsdesign.errors import InfeasibleError
+
+    text = DUFFING.read_text().replace("K = [2, 1]", "K = [-1, 1]")
+    with pytest.raises(InfeasibleError, match="Hurwitz"):
+        api.design(api.load_spec_text(text, "d.toml"))
