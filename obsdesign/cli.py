@@ -18,8 +18,8 @@ def _early_interrupt(signum: int, frame: object) -> None:  # pragma: no cover - 
     os._exit(130)
 
 
-# installed before the heavy imports below (typer, rich, then numpy/scipy in the commands);
-# main() restores Python's handler once the command runs, so cleanup code still runs
+# installed before the heavy imports below (typer, rich); _run() restores Python's handler
+# when the command body starts, so that cleanup code (temp files) runs on Ctrl-C
 if signal.getsignal(signal.SIGINT) is signal.default_int_handler and os.path.basename(
     sys.argv[0]
 ) in ("obsdesign", "cli.py"):
@@ -73,6 +73,9 @@ def _run(fn: Callable[[], int]) -> None:
     from obsdesign.errors import EXIT_SOLVER, ObsdesignError
 
     try:
+        # from here on Ctrl-C raises KeyboardInterrupt (handled below, cleanup runs)
+        if signal.getsignal(signal.SIGINT) is _early_interrupt:
+            signal.signal(signal.SIGINT, signal.default_int_handler)
         code = fn()
     except ObsdesignError as e:
         if _state["debug"]:
@@ -186,16 +189,20 @@ def design(
 
     def body() -> int:
         from obsdesign import api
+        from obsdesign.errors import InputError
         from obsdesign.report.model import check_output
 
         if output is not None:
             check_output(output, force, (spec,))
         _check_plot(plot, force, (spec,) + ((output,) if output is not None else ()))
         progress = _progress() if fmt == Fmt.text else None
-        rep = api.design(spec, output, progress=progress, force=force)
+        sp = api.load_spec(spec)
+        if plot is not None and api.method(sp.method).plot_design is None:
+            raise InputError(f"--plot: method '{sp.method}' has no design plot")
+        rep = api.design(sp, output, progress=progress, force=force)
         _print_report(rep, fmt)
         if plot is not None:
-            _write_plot(plot, lambda tmp: api.plot_design(spec, rep.parameters, tmp), force)
+            _write_plot(plot, lambda tmp: api.plot_design(sp, rep.parameters, tmp), force)
             if fmt == Fmt.text:
                 print(f"plot written to {plot}")
         if output is not None and fmt == Fmt.text:
@@ -436,8 +443,6 @@ def _print_metrics(m: dict[str, Any]) -> None:
 
 def main() -> None:
     """Console-script entry point."""
-    if signal.getsignal(signal.SIGINT) is _early_interrupt:
-        signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
         app()
     except KeyboardInterrupt:  # pragma: no cover - Ctrl-C outside a command body

@@ -173,3 +173,21 @@ def test_broken_pipe_is_quiet(tmp_path: Path):
     )
     assert r.stdout == '{\n  "$sche'[:10] or len(r.stdout) == 10
     assert r.stderr == "" and r.returncode in (0, 141)
+
+
+@pytest.mark.parametrize("delay", [0.5, 1.5])
+def test_ctrl_c_is_one_line_no_traceback(delay: float):
+    import signal
+    import time
+
+    exe = Path(sys.executable).parent / "obsdesign"
+    specs = Path(__file__).resolve().parents[1] / "specs"
+    p = subprocess.Popen(
+        [str(exe), "check", str(specs)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    time.sleep(delay)
+    p.send_signal(signal.SIGINT)
+    _, err = p.communicate(timeout=120)
+    assert p.returncode == 130, err
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err
+    assert err.strip().splitlines()[-1].endswith("interrupted")
