@@ -262,3 +262,50 @@ def test_sec5_max_norm_matches_issue_estimate(specs_dir):
     assert p.float("gamma") == pytest.approx(3.24344e-5, rel=1e-5)
     assert p.float("v_min") == pytest.approx(1.0270701, rel=1e-7)
     assert any("exact closed form" in n for n in rep.notes)
+
+
+def test_parse_simulate_returns_options_and_leaves_the_spec(specs_dir):
+    from obsdesign.methods.constrained.options import SimOptions
+
+    sp = api.load_spec(specs_dir / SEC5)
+    so = sp.simulate.options
+    assert isinstance(so, SimOptions)
+    assert so.theta_m == [10, 3] and so.gamma == 17
+    np.testing.assert_array_equal(so.saturation_r, [2.0])
+    assert not hasattr(sp.options, "sim")
+    m = api.method("constrained")
+    again = m.parse_simulate(sp.simulate.table, sp)
+    assert again == so and sp.simulate.options is so
+
+
+def test_simulate_options_validated_centrally(specs_dir, tmp_path):
+    m = api.method("constrained")
+    assert m.parse_sim_options({"theta_m": "10,3", "gamma": "17"}) == {
+        "theta_m": "10,3",
+        "gamma": 17.0,
+    }
+    r = CliRunner()
+    spec = str(specs_dir / SEC5)
+    out = r.invoke(app, ["simulate", spec, "--option", "thetam=3"])
+    assert out.exit_code == 2 and "theta_m" in out.output
+    out = r.invoke(app, ["simulate", spec, "--option", "gamma=abc"])
+    assert out.exit_code == 2 and "gamma" in out.output
+    out = r.invoke(app, ["simulate", spec, "--option", "theta_m=1,x"])
+    assert out.exit_code == 2 and "theta_m" in out.output
+    res = api.simulate(specs_dir / SEC5, options={"theta_m": "2", "saturation_r": "3"})
+    assert set(res.extra["traces"]) == {"unmodified", "modified θ_m=2", "saturated r=[3]"}
+
+
+def test_old_spelling_of_f_h_in_method_is_refused():
+    for key in ("f", "h"):
+        text = variant(add=f'{key} = ["x2", "x1"]')
+        with pytest.raises(SpecError) as e:
+            load_spec_text(text, "old.toml")
+        assert f"method.{key}" in str(e.value) and "[system]" in str(e.value)
+
+
+def test_linear_observer_needs_A_and_C():
+    text = variant(replace=[("A = [[0, 1], [1, 0]]\n", "")])
+    with pytest.raises(SpecError) as e:
+        load_spec_text(text.replace("[system]\n", '[system]\nstates = ["x1", "x2"]\n'), "a.toml")
+    assert "system.A" in str(e.value)
