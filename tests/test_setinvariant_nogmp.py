@@ -218,3 +218,63 @@ def test_float_backend_tamper_per_claim(nogmp, tmp_path, claim, spec):
     if claim == "linear-law":
         d["parameters"].pop("L_factor", None)
     assert _float_failed(d, tmp_path) == {claim}
+
+
+def test_float_backend_necessary_condition(nogmp):
+    text = api.template("set-invariant").replace('algorithm = "symmetric"', 'algorithm = "none"')
+    rep = api.design(load_spec_text(text, "none.toml"))
+    assert {c.id for c in rep.failed} == {"necessary-condition", "theorem-3.1"}
+
+
+def test_float_backend_checks_gain_vertices(monkeypatch, tmp_path):
+    """A report made with cdd.gmp, verified without it: each listed gain vertex must be
+    admissible and a vertex of the admissible set (in float64)."""
+    from obsdesign.certify.exact import Q
+
+    out = tmp_path / "r.json"
+    api.design(SPEC71, out)
+    monkeypatch.setattr(po, "HAVE_GMP", False)
+    base = json.loads(out.read_text())
+    from obsdesign.report.model import Report
+
+    rep, _ = Report.from_dict(base)
+    claims = api.certify(load_spec(SPEC71), rep.parameters)
+    assert all(c.status == ClaimStatus.NUMERICAL for c in claims)
+    assert "linear-gains-vertices" in {c.id for c in claims}
+    for l2 in ("7/85 + 1/1000000", "7/85 - 1/1000000"):  # outside; inside but not a vertex
+        d = json.loads(out.read_text())
+        V = d["parameters"]["exact"]["L_admissible_vertices"]
+        i = next(k for k, r in enumerate(V) if r[1] == "7/85")
+        q = Q(7) / 85 + (Q(1) if "+" in l2 else Q(-1)) / 10**6
+        V[i][1] = str(q)
+        d["parameters"]["L_admissible_vertices"][i][1] = float(q)
+        assert _float_failed(d, tmp_path) == {"linear-gains-vertices"}
+
+
+def test_float_backend_gain_vertex_of_the_arrangement(monkeypatch, tmp_path):
+    """An intersection of two constraint lines of the admissible set that violates a third
+    constraint is not admissible (it passes the vertex test alone)."""
+    from itertools import combinations
+
+    from obsdesign.certify.exact import Q
+    from obsdesign.methods.setinvariant.problem import build
+
+    out = tmp_path / "r.json"
+    api.design(SPEC71, out)
+    monkeypatch.setattr(po, "HAVE_GMP", False)
+    d = json.loads(out.read_text())
+    p = d["parameters"]
+    G, V = np.array(p["G"]), np.array(p["V"])
+    Af, bf = numerical.gain_constraints(build(load_spec(SPEC71)).fl, 0.9, G, V)
+    for i, j in combinations(range(len(Af)), 2):
+        M = Af[[i, j]]
+        if abs(np.linalg.det(M)) < 1e-6:
+            continue
+        x = np.linalg.solve(M, bf[[i, j]])
+        if (bf - Af @ x).min() < -1e-3:
+            break
+    else:
+        raise AssertionError("no infeasible arrangement vertex")
+    p["L_admissible_vertices"][0] = [float(t) for t in x]
+    p["exact"]["L_admissible_vertices"][0] = [str(Q(float(t))) for t in x]
+    assert _float_failed(d, tmp_path) == {"linear-gains-vertices"}
