@@ -1,17 +1,43 @@
-"""The lyapunov method: the paper's P (constrained-redesign paper, Section 5) and properties."""
+"""The lyapunov method: the paper's P (constrained-redesign paper, Section 5), the bracketed
+best rate, the claims bound to the spec, and a tamper test for every claim id."""
 
 from __future__ import annotations
+
+import json
+import re
+import tomllib
+from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 import pytest
 from flint import fmpq
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from typer.testing import CliRunner
 
-from obsdesign import api
+from obsdesign import api, lyap
 from obsdesign.api import load_spec_text
 from obsdesign.certify.claim import ClaimStatus
+from obsdesign.certify.exact import Q, qmat
+from obsdesign.certify.psd import check_pd
+from obsdesign.cli import app
 from obsdesign.errors import InfeasibleError
+from obsdesign.params import Parameters
+
+ROOT = Path(__file__).resolve().parents[1]
+SEC5 = ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+runner = CliRunner()
+EPS = fmpq(1, 2**60)
+
+IDS = [
+    "P-positive-definite",
+    "decay-lmi",
+    "P_best-positive-definite",
+    "decay-lmi_best",
+    "lambda_best-bracket",
+    "iss-gain",
+]
 
 
 def test_paper_P_and_Pinv(specs_dir):
@@ -28,6 +54,326 @@ def test_paper_P_and_Pinv(specs_dir):
     best = float(rep.parameters.float("lambda_best"))
     assert 0.95 < best <= 0.95 + 1e-4 + 1e-9
     assert "mu" in rep.parameters
+
+
+def test_shipped_spec_key_results_exact() -> None:
+    """specs/constrained-redesign-sec5-lyapunov.toml: every number as before the package
+    split (P, λ, P_best, λ_best, μ), plus the bracket; the exact claim list."""
+    rep = api.design(SEC5)
+    ex = json.loads(rep.to_json())["parameters"]["exact"]
+    assert ex["L"] == [["-187/100"], ["937/500"]]
+    assert ex["P"] == [
+        ["1056385108643/8388608", "553027016185/4194304"],
+        ["553027016185/4194304", "579147225817/4194304"],
+    ]
+    assert ex["lambda"] == "191/200"
+    assert ex["P_best"] == [
+        ["529058895159/32768", "278434182085/16384"],
+        ["278434182085/16384", "586140837409/32768"],
+    ]
+    assert ex["lambda_best"] == "47503/50000"
+    assert ex["lambda_bracket"] == "19/20"
+    assert rep.parameters["lambda_bracket_kind"] == "infeasible"
+    assert ex["mu"] == "256225184"
+    assert [c.id for c in rep.claims] == IDS
+    assert all(c.status == ClaimStatus.CERTIFIED for c in rep.claims)
+    st = {c.id: c.statement for c in rep.claims}
+    assert st["decay-lmi"] == "(A−LC)ᵀP(A−LC) ⪯ λ²·P with λ = 0.955"
+    assert st["decay-lmi_best"] == "(A−LC)ᵀP_best(A−LC) ⪯ λ_best²·P_best with λ_best = 0.95006"
+    # was "μ = 2.56225e+08", below the certified μ: now exact
+    assert st["iss-gain"] == "V(e⁺) ≤ λ²V(e) + μ|v|² with μ = 256225184"
+    assert st["lambda_best-bracket"].startswith("λ_best = 0.95006 is best to within 0.0001: ")
+    assert rep.solver["status"] == "closed_form"
+    assert api.method("lyapunov").summary(rep.parameters) == (
+        "lambda = 0.955, best = 0.95006, mu = 2.562e+08"
+    )
+
+
+_NUM = re.compile(r"(λ_best|α_best|λ|α|μ) = ([-0-9./e+]+)(?: ≤ ([-0-9.e+]+))?")
+
+
+@pytest.mark.parametrize(
+    "extra",
+    [
+        "",
+        "\n[system]\ntime = 'continuous'\nA = [[0, 1], [-2, -0.1]]\nC = [[1, 0]]\n"
+        "[method]\nkey = 'lyapunov'\nL = [3, 2]\nalpha = 0.5\niss_gain = true\n",
+        "\n[system]\ntime = 'discrete'\nA = [[0, 1], [-0.5, 0.3]]\nC = [[1, 0]]\n"
+        "Bd = [[0.1], [0.2]]\n[method]\nkey = 'lyapunov'\nL = [0.5, 0.1]\nlambda = 0.9\n"
+        "iss_gain = true\n",
+    ],
+)
+def test_printed_numbers_are_exact_or_safe(extra: str) -> None:
+    """Every number printed in a statement is the exact value, or (μ) an upper bound."""
+    rep = api.design(SEC5 if not extra else load_spec_text(extra, "x.toml"))
+    key = {"λ": "lambda", "α": "alpha", "λ_best": "lambda_best", "α_best": "alpha_best"}
+    seen = 0
+    for c in rep.claims:
+        for sym, val, up in _NUM.findall(c.statement):
+            seen += 1
+            if sym == "μ":
+                mu = Q(rep.parameters["mu"])
+                assert Q(val) == mu and (not up or Q(up) >= mu), c.statement
+            elif "gives" not in c.statement.split(f"{sym} = {val}")[0]:
+                assert Q(val) == Q(rep.parameters[key[sym]]), c.statement
+    assert seen >= 4
+
+
+def test_asked_rate_just_above_the_spectral_radius() -> None:
+    """ρ(A − LC) = 0.9999999 and λ = 0.99999991: checked directly (was refused: "no decay
+    rate below 1 certifies"); the best rate is the asked one, bracketed by 0.99999."""
+    text = """
+[system]
+time = "discrete"
+A = [[0.9999999, 0], [0, 0.5]]
+C = [[0, 1]]
+[method]
+key = "lyapunov"
+L = [0, 0]
+lambda = 0.99999991
+"""
+    rep = api.design(load_spec_text(text))
+    assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
+    p = rep.parameters
+    assert p["lambda"] == fmpq(99999991, 10**8) == p["lambda_best"]
+    assert p["lambda_bracket"] == fmpq(99999, 100000)
+    assert p["lambda_bracket_kind"] == "infeasible"
+
+
+def test_best_never_worse_than_the_asked_rate(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A certifier that fails on (0.6, 0.99) except at the asked 0.955: the design reports
+    λ_best ≤ 0.955 (was: a best rate worse than a certified asked rate)."""
+    real = lyap.certified_P
+
+    def flaky(A, C, L, discrete, rate, margin, bits=lyap.BITS):  # noqa: ANN001, ANN202
+        if fmpq(6, 10) < rate < fmpq(99, 100) and rate != fmpq(955, 1000):
+            return None
+        return real(A, C, L, discrete, rate, margin, bits)
+
+    monkeypatch.setattr(lyap, "certified_P", flaky)
+    rep = api.design(SEC5)
+    assert rep.parameters["lambda_best"] <= fmpq(955, 1000)
+    assert rep.exit_code() == 0
+
+
+def test_template_with_every_key_line_uncommented() -> None:
+    text = api.template("lyapunov")
+    lines = [re.sub(r"^# (\w+ = )", r"\1", ln) for ln in text.splitlines()]
+    full = "\n".join(lines) + "\n"
+    tomllib.loads(full)
+    assert "Bd = " in full and "\n# Bd" not in full
+    rep = api.design(load_spec_text(full, "template-uncommented.toml"))
+    assert rep.exit_code() == 0
+    assert "w = (d, v)" in {c.id: c.statement for c in rep.claims}["iss-gain"]
+
+
+# -- tamper tests: every claim id fails alone, by the smallest margin -----------------------
+CONT = """
+[system]
+time = "continuous"
+A = [[-10, 0], [0, -1]]
+C = [[1, 1]]
+[method]
+key = "lyapunov"
+L = [0, 0]
+alpha = 0.5
+margin = 0.01
+"""
+
+
+def _edge(ok: Callable[[fmpq], bool], good: fmpq, bad: fmpq) -> fmpq:
+    """The failing end of a bisection to 60 bits: ok(good), not ok(result), and the result
+    within |bad − good|·2⁻⁶⁰ of a passing value."""
+    assert ok(good) and not ok(bad)
+    for _ in range(60):
+        mid = (good + bad) / 2
+        if ok(mid):
+            good = mid
+        else:
+            bad = mid
+    return bad
+
+
+def _decay_ok(spec, name: str, rate_key: str):  # noqa: ANN001, ANN202
+    s = spec.system
+    o = spec.options
+
+    def ok(P: np.ndarray, rate: fmpq) -> bool:
+        M = lyap.decay_matrix(s.A.q, s.C.q, o.L, P, rate, s.discrete)
+        return bool(check_pd(M, o.margin))
+
+    return ok
+
+
+def _tamper_decay(p: Parameters, spec, pkey: str, rkey: str) -> None:  # noqa: ANN001
+    """P − t·e₁e₁ᵀ with t just past the edge of the decay LMI."""
+    P0, rate = (
+        p[pkey],
+        Q(p[rkey] if spec.options.rate is None or rkey != "lambda" else spec.options.rate),
+    )
+    ok = _decay_ok(spec, pkey, rkey)
+    E = qmat([[1, 0], [0, 0]])
+
+    def at(t: fmpq) -> np.ndarray:
+        return P0 - E * t
+
+    t = _edge(lambda t: ok(at(t), rate), fmpq(0), fmpq(1000))
+    p[pkey] = at(t)
+
+
+def _tamper_rate_edge(p: Parameters, spec) -> None:  # noqa: ANN001
+    ok = _decay_ok(spec, "P", "lambda")
+    p["lambda"] = _edge(lambda r: ok(p["P"], r), Q(p["lambda"]), fmpq(0))
+
+
+def _tamper_mu_edge(p: Parameters, spec) -> None:  # noqa: ANN001
+    s, o = spec.system, spec.options
+    Acl = lyap.closed_loop(s.A.q, s.C.q, o.L)
+    Bw = lyap.error_input(s.Bd.q, s.Dn.q, o.L)
+    rho = lyap.decay_factor(o.rate, True)
+
+    def ok(mu: fmpq) -> bool:
+        return bool(check_pd(lyap.iss_matrix(Acl, Bw, p["P"], rho, mu, True)))
+
+    p["mu"] = _edge(ok, Q(p["mu"]), fmpq(0))
+
+
+def _set(key: str, f: Callable) -> Callable:  # noqa: ANN001
+    def t(p: Parameters, spec) -> None:  # noqa: ANN001
+        p[key] = f(p[key], spec)
+
+    return t
+
+
+def _diag_first(v: fmpq) -> Callable:
+    def f(P: np.ndarray, spec) -> np.ndarray:  # noqa: ANN001
+        Q2 = P.copy()
+        Q2[0, 0] = v
+        return Q2
+
+    return f
+
+
+TAMPERS: list[tuple[str, str, Callable, set[str]]] = [
+    # without iss_gain: the ISS block contains the decay matrix (its edge breaks μ too)
+    ("decay-lmi", "noiss", lambda p, s: _tamper_decay(p, s, "P", "lambda"), {"decay-lmi"}),
+    (
+        "decay-lmi_best",
+        "sec5",
+        lambda p, s: _tamper_decay(p, s, "P_best", "lambda_best"),
+        {"decay-lmi_best"},
+    ),
+    ("decay-lmi by lambda", "best", _tamper_rate_edge, {"decay-lmi"}),
+    ("P-positive-definite", "cont", _set("P", _diag_first(fmpq(1, 100))), {"P-positive-definite"}),
+    (
+        "P_best-positive-definite",
+        "cont",
+        _set("P_best", _diag_first(fmpq(1, 100))),
+        {"P_best-positive-definite"},
+    ),
+    (
+        "bracket end feasible",
+        "sec5",
+        _set("lambda_bracket", lambda v, s: v + EPS),
+        {"lambda_best-bracket"},
+    ),
+    (
+        "bracket too wide",
+        "sec5",
+        _set(
+            "lambda_bracket",
+            lambda v, s: Q(s.options.rate_tol) * -1 + EPS * -1 + fmpq(47503, 50000),
+        ),
+        {"lambda_best-bracket"},
+    ),
+    (
+        "bracket kind",
+        "sec5",
+        _set("lambda_bracket_kind", lambda v, s: "not-certifiable"),
+        {"lambda_best-bracket"},
+    ),
+    (
+        "best worse than asked",
+        "wide",
+        _set("lambda_best", lambda v, s: fmpq(955, 1000) + EPS),
+        {"lambda_best-bracket"},
+    ),
+    (
+        "alpha bracket end feasible",
+        "cont",
+        _set("alpha_bracket", lambda v, s: fmpq(1) - EPS),
+        {"alpha_best-bracket"},
+    ),
+    ("iss-gain", "sec5", _tamper_mu_edge, {"iss-gain"}),
+    (
+        "L-matches-spec",
+        "sec5",
+        _set("L", lambda L, s: L + qmat([[EPS], [0]])),
+        {"L-matches-spec"},
+    ),
+    ("lambda-matches-spec", "sec5", _set("lambda", lambda v, s: v + EPS), {"lambda-matches-spec"}),
+    # far off: the checks must use the spec's rate, not the report's
+    (
+        "lambda-matches-spec far",
+        "sec5",
+        _set("lambda", lambda v, s: fmpq(1, 2)),
+        {"lambda-matches-spec"},
+    ),
+    (
+        "bracket on the wrong side",
+        "sec5",
+        lambda p, s: (
+            p.__setitem__("lambda_bracket_kind", "not-certifiable"),
+            p.__setitem__("lambda_bracket", Q(p["lambda_best"]) + EPS),
+        ),
+        {"lambda_best-bracket"},
+    ),
+]
+
+
+def _case_spec(which: str, tmp_path: Path) -> Path:
+    if which == "sec5":
+        return SEC5
+    text = {
+        "noiss": SEC5.read_text().replace("iss_gain = true", "iss_gain = false"),
+        "best": SEC5.read_text()
+        .replace("lambda = 0.955\n", "")
+        .replace("iss_gain = true", "iss_gain = false"),
+        "wide": SEC5.read_text().replace("rate_tol = 0.0001", "rate_tol = 0.1"),
+        "cont": CONT,
+    }[which]
+    path = tmp_path / f"{which}.toml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+@pytest.mark.parametrize(
+    ("name", "which", "tamper", "expected"), TAMPERS, ids=[t[0] for t in TAMPERS]
+)
+def test_tamper_fails_exactly_that_claim(
+    name: str, which: str, tamper: Callable, expected: set[str], tmp_path: Path
+) -> None:
+    path = _case_spec(which, tmp_path)
+    rep = api.design(path)
+    assert rep.exit_code() == 0
+    spec = api.load_spec(path)
+    tamper(rep.parameters, spec)
+    failed = {c.id for c in api.certify(spec, rep.parameters) if not c.ok}
+    assert failed == expected
+    # the same report through the CLI: exit 1 and the recomputed claim failed
+    out = tmp_path / "tampered.json"
+    out.write_text(rep.to_json(), encoding="utf-8")
+    res = runner.invoke(app, ["verify", str(out), "--format", "json"])
+    assert res.exit_code == 1
+    fresh = {c["id"]: c["status"] for c in json.loads(res.output)["claims"]}
+    assert all(fresh.get(i) == "failed" for i in expected)
+
+
+def test_missing_mu_fails_when_the_spec_asks_for_it() -> None:
+    rep = api.design(SEC5)
+    p = Parameters({k: v for k, v in rep.parameters.items() if k != "mu"})
+    failed = {c.id for c in api.certify(api.load_spec(SEC5), p) if not c.ok}
+    assert failed == {"mu-present"}
 
 
 def _spec(A, C, L, extra=""):

@@ -39,8 +39,6 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     name = rate_name(s.discrete)
     c = Claims()
     need = ["L", "P", name, "P_best", f"{name}_best", f"{name}_bracket", f"{name}_bracket_kind"]
-    if o.iss_gain:
-        need.append("mu")
     if not params.require(need, c):
         return list(c)
     L = params.exact("L", c)

@@ -1,0 +1,195 @@
+"""The shared Lyapunov maths (obsdesign/lyap.py): known answers in exact arithmetic."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from flint import fmpq
+
+from obsdesign import lyap
+from obsdesign.certify.exact import qeye, qmat
+from obsdesign.certify.psd import check_pd, check_psd
+from obsdesign.errors import InconclusiveError, InfeasibleError
+from obsdesign.lyap import (
+    INFEASIBLE,
+    best_rate,
+    certified_P,
+    closed_loop,
+    decay_matrix,
+    error_input,
+    iss_matrix,
+    iss_mu,
+    rate_feasible,
+)
+
+# Section 5 of the constrained-redesign paper: eig(A − LC) = 0.95, 0.92 exactly
+A5 = qmat([[0, 1], [1, 0]])
+C5 = qmat([[1, 0]])
+L5 = qmat([["-187/100"], ["937/500"]])
+TOL = fmpq(1, 10000)
+MARGIN = fmpq(1, 10**9)
+TINY = fmpq(1, 10**30)
+
+
+def test_decay_matrix_known_answer_discrete() -> None:
+    """λ²P − AclᵀPAcl with P = I, λ = 1/2: Acl = [[187/100, 1], [−437/500, 0]]."""
+    Acl = closed_loop(A5, C5, L5)
+    assert Acl.tolist() == [[fmpq(187, 100), 1], [fmpq(-437, 500), 0]]
+    M = decay_matrix(A5, C5, L5, qeye(2), fmpq(1, 2), True)
+    a, b = fmpq(187, 100), fmpq(-437, 500)
+    assert M.tolist() == [
+        [fmpq(1, 4) - a * a - b * b, -a],
+        [-a, fmpq(1, 4) - 1],
+    ]
+
+
+def test_decay_matrix_known_answer_continuous() -> None:
+    """−(AclᵀP + PAcl + 2αP) with Acl = [[−1, 2], [0, −3]], P = I, α = 1/2."""
+    A = qmat([[-1, 2], [0, -3]])
+    M = decay_matrix(A, qmat([[1, 0]]), qmat([[0], [0]]), qeye(2), fmpq(1, 2), False)
+    assert M.tolist() == [[1, -2], [-2, 5]]
+
+
+def test_decay_matrix_fails_below_the_spectral_radius() -> None:
+    """Kills λ²P − AclᵀPAcl → λ²P + AclᵀPAcl: a P certified at 0.955 fails at 0.9."""
+    P = certified_P(A5, C5, L5, True, fmpq(955, 1000), MARGIN)
+    assert P is not None
+    assert check_pd(decay_matrix(A5, C5, L5, P, fmpq(955, 1000), True), MARGIN)
+    assert not check_pd(decay_matrix(A5, C5, L5, P, fmpq(9, 10), True))
+    assert not check_pd(decay_matrix(A5, C5, L5, P, fmpq(95, 100), True))
+
+
+@pytest.mark.parametrize(
+    ("M", "rate", "discrete", "expected"),
+    [
+        ([[0, 1], [1, 0]], fmpq(1), True, False),  # eigenvalues ±1: on the unit circle
+        ([[0, 1], [1, 0]], fmpq(1) + TINY, True, True),
+        ([["187/100", 1], ["-437/500", 0]], fmpq(19, 20), True, False),  # ρ = 0.95 exactly
+        ([["187/100", 1], ["-437/500", 0]], fmpq(19, 20) + TINY, True, True),
+        ([[0, "-1/2"], ["1/2", 0]], fmpq(1, 2), True, False),  # ±i/2
+        ([[0, "-1/2"], ["1/2", 0]], fmpq(1, 2) + TINY, True, True),
+        ([["-1/2"]], fmpq(1, 2), True, False),  # eigenvalue −λ: the Möbius degree drops
+        ([["-1/2"]], fmpq(1, 2) + TINY, True, True),
+        ([["1/2", 1], [0, "1/2"]], fmpq(1, 2) + TINY, True, True),  # Jordan block
+        ([["1/2", 1], [0, "1/2"]], fmpq(1, 2), True, False),
+        ([[0]], fmpq(0), True, False),  # λ = 0 never certifies (strict LMI)
+        ([[-1, 0], [0, -2]], fmpq(1), False, False),  # max Re = −1
+        ([[-1, 0], [0, -2]], fmpq(1) - TINY, False, True),
+        ([[-1, 5], [-5, -1]], fmpq(1), False, False),  # −1 ± 5i
+        ([[-1, 5], [-5, -1]], fmpq(1) - TINY, False, True),
+        ([[1, 0], [0, -3]], fmpq(1, 10), False, False),
+    ],
+)
+def test_rate_feasible_known_answers(M: list, rate: fmpq, discrete: bool, expected: bool) -> None:
+    assert rate_feasible(qmat(M), rate, discrete) is expected
+
+
+def test_rate_feasible_agrees_with_eigenvalues() -> None:
+    rng = np.random.default_rng(7)
+    for _ in range(200):
+        n = int(rng.integers(1, 5))
+        M = np.round(rng.standard_normal((n, n)) * 8) / 8
+        e = np.linalg.eigvals(M)
+        for r in (0.5, 1.0, 1.5):
+            if abs(np.abs(e).max() - r) > 1e-9:
+                assert rate_feasible(qmat(M), fmpq(int(2 * r), 2), True) == (np.abs(e).max() < r)
+            if abs(e.real.max() + r) > 1e-9:
+                assert rate_feasible(qmat(M), fmpq(int(2 * r), 2), False) == (e.real.max() + r < 0)
+
+
+def test_error_input_and_iss_matrix_known_answer() -> None:
+    """B_w = [−Bd, L Dn]; the scalar ISS block [[ρp − a²p, −abp], [−abp, μ − b²p]]."""
+    Bd, Dn, L = qmat([[2]]), qmat([[3]]), qmat([[5]])
+    assert error_input(Bd, Dn, L).tolist() == [[-2, 15]]
+    assert error_input(qmat(np.zeros((1, 0))), Dn, L).tolist() == [[15]]
+    assert error_input(qmat(np.zeros((1, 0))), qmat(np.zeros((1, 0))), L).shape == (1, 0)
+    a, b, p, rho, mu = fmpq(1, 2), fmpq(3), fmpq(2), fmpq(1, 3), fmpq(7)
+    M = iss_matrix(qmat([[a]]), qmat([[b]]), qmat([[p]]), rho, mu, True)
+    assert M.tolist() == [[rho * p - a * a * p, -a * b * p], [-a * b * p, mu - b * b * p]]
+    Mc = iss_matrix(qmat([[-a]]), qmat([[b]]), qmat([[p]]), rho, mu, False)
+    assert Mc.tolist() == [[2 * a * p - rho * p, -p * b], [-p * b, mu]]
+
+
+@pytest.mark.parametrize("discrete", [True, False])
+def test_iss_mu_is_certified_and_near_the_infimum(discrete: bool) -> None:
+    """Scalar: μ* = b²p + (abp)²/(ρp − a²p) (discrete), p²b²/((2a − ρ)p) (continuous, ȧ = −a)."""
+    a, b, p, rho = fmpq(1, 2), fmpq(3), fmpq(2), fmpq(1, 2)
+    Acl = qmat([[a if discrete else -a]])
+    Bw, P = qmat([[b]]), qmat([[p]])
+    if discrete:
+        mu_star = b * b * p + (a * b * p) ** 2 / (rho * p - a * a * p)
+    else:
+        mu_star = (p * b) ** 2 / ((2 * a - rho) * p)
+    mu = iss_mu(Acl, Bw, P, rho, discrete, strict=True)
+    assert mu_star < mu <= mu_star * fmpq(11, 10) + fmpq(1, 10**6)
+    assert check_pd(iss_matrix(Acl, Bw, P, rho, mu, discrete))
+    assert not check_psd(iss_matrix(Acl, Bw, P, rho, mu_star - TINY, discrete))
+
+
+def test_best_rate_shipped_section5() -> None:
+    """Same search as before the bracket existed: λ_best = 0.95006 (P_best unchanged); the
+    other end 0.95 = ρ(A − LC) is proved infeasible."""
+    br = best_rate(A5, C5, L5, True, tol=TOL, margin=MARGIN)
+    assert br.best == fmpq(47503, 50000)
+    assert br.other == fmpq(19, 20) and br.kind == INFEASIBLE
+    assert (
+        br.P.tolist()
+        == qmat(
+            [
+                ["529058895159/32768", "278434182085/16384"],
+                ["278434182085/16384", "586140837409/32768"],
+            ]
+        ).tolist()
+    )
+
+
+def test_best_rate_known_rate_finer_than_the_grid() -> None:
+    """ρ = 0.9999999 lies above the grid's last point 0.99999: the known (asked) certified
+    rate 0.99999991 is the best, bracketed by 0.99999 (infeasible)."""
+    A = qmat([["9999999/10000000", 0], [0, "1/2"]])
+    C, L = qmat([[0, 1]]), qmat([[0], [0]])
+    lam = fmpq(99999991, 10**8)
+    P = certified_P(A, C, L, True, lam, MARGIN)
+    assert P is not None
+    br = best_rate(A, C, L, True, tol=TOL, margin=MARGIN, known=(lam, P))
+    assert br.best == lam and br.other == fmpq(99999, 100000) and br.kind == INFEASIBLE
+    # without the known rate, finer candidates 1 − 10⁻ᵏ are tried
+    br = best_rate(A, C, L, True, tol=TOL, margin=MARGIN)
+    assert fmpq(9999999, 10**7) < br.best < 1 and br.best - br.other <= TOL
+
+
+def test_best_rate_never_worse_than_a_known_rate(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A non-monotone certifier (fails on (0.6, 0.99)) must not push the result above the
+    known certified rate 0.955."""
+    real = lyap.certified_P
+    known_P = real(A5, C5, L5, True, fmpq(955, 1000), MARGIN)
+
+    def flaky(A, C, L, discrete, rate, margin, bits=lyap.BITS):  # noqa: ANN001, ANN202
+        if fmpq(6, 10) < rate < fmpq(99, 100) and rate != fmpq(955, 1000):
+            return None
+        return real(A, C, L, discrete, rate, margin, bits)
+
+    monkeypatch.setattr(lyap, "certified_P", flaky)
+    br = best_rate(A5, C5, L5, True, tol=TOL, margin=MARGIN, known=(fmpq(955, 1000), known_P))
+    assert br.best <= fmpq(955, 1000)
+    assert br.other < br.best
+
+
+def test_best_rate_continuous_bracket() -> None:
+    """Acl = [[−3, 1], [−4, −0.1]]: eigenvalues −1.55 ± i·1.3775…; α_best within 1e-4 below
+    an α proved infeasible."""
+    A = qmat([[0, 1], ["-2", "-1/10"]])
+    C, L = qmat([[1, 0]]), qmat([[3], [2]])
+    br = best_rate(A, C, L, False, tol=TOL, margin=MARGIN)
+    assert br.kind == INFEASIBLE and 0 < br.other - br.best <= TOL
+    assert br.best < fmpq(155, 100) <= br.other
+    assert not rate_feasible(closed_loop(A, C, L), br.other, False)
+
+
+def test_best_rate_not_schur_and_not_certifiable() -> None:
+    with pytest.raises(InfeasibleError, match="not Schur"):
+        best_rate(qmat([[2]]), qmat([[1]]), qmat([[0]]), True, tol=TOL, margin=MARGIN)
+    # Schur (ρ = 1 − 10⁻²⁰), but no rate < 1 certifies with 40-bit P
+    A = qmat([[1 - fmpq(1, 10**20)]])
+    with pytest.raises(InconclusiveError):
+        best_rate(A, qmat([[1]]), qmat([[0]]), True, tol=TOL, margin=MARGIN)
