@@ -236,6 +236,28 @@ def test_decay_lmi(best_rate, tmp_path) -> None:
     assert_only(best_rate, tmp_path, {"decay-lmi"}, {"lambda": ok}, {"lambda": bad})
 
 
+def test_lambda_bracket(best_rate, tmp_path) -> None:
+    """Best λ: ρ(A − LC) = 0.95 exactly, so λ_infeasible = 0.95 is proved infeasible and
+    0.95 + 10⁻³⁰ is not; the bracket may be at most rate_tol = 10⁻⁴ wide."""
+    lam, other = p_exact(best_rate, "lambda"), p_exact(best_rate, "lambda_infeasible")
+    assert other == fmpq(19, 20) and 0 < lam - other <= fmpq(1, 10**4)
+    assert_only(
+        best_rate,
+        tmp_path,
+        {"lambda-bracket"},
+        {"lambda_infeasible": other},
+        {"lambda_infeasible": other + TINY},
+    )
+    tol = fmpq(1, 10**4)
+    assert_only(
+        best_rate,
+        tmp_path,
+        {"lambda-bracket"},
+        {"lambda_infeasible": lam - tol},
+        {"lambda_infeasible": lam - tol - TINY},
+    )
+
+
 def test_rho_is_lambda_squared(rho_lam2, tmp_path) -> None:
     rho = p_exact(rho_lam2, "rho")
     assert rho == fmpq(191, 200) ** 2
@@ -271,7 +293,7 @@ def test_iss_bound_needs_rho_below_one(best_rate, tmp_path) -> None:
     o.P, o.rho, o.mu = rep.parameters["P"], fmpq(1), rep.parameters["mu"]
     vals, _ = design_params(sp)
     vals.pop("L")
-    d = tamper(rep, **{**vals, "lambda": fmpq(1), "rho": fmpq(1)})
+    d = tamper(rep, **{**vals, "lambda": fmpq(1), "rho": fmpq(1), "lambda_infeasible": None})
     assert failed_ids(d) == {"iss-bound"}
     assert cli_verify_exit(d, tmp_path) == 1
 

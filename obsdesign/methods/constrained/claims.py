@@ -67,6 +67,8 @@ def expected_params(o: Options) -> set[str]:
         keys.add("L")
     if o.P is None:
         keys.add("lambda")
+        if o.lam is None:
+            keys.add("lambda_infeasible")
     if o.X0 is not None:
         keys |= {"v_max_breve", "theta_breve"}
     return keys
@@ -159,6 +161,8 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         _iss_sampled(c, spec, P, rho, mu, v_max)
     else:
         _linear_claims(c, spec, P, rho, mu, lam)
+        if o.P is None and o.lam is None and lam is not None and "lambda_infeasible" in params:
+            _lambda_bracket(c, spec, params, lam)
     _convexity(c, o.cmap)
     c.exact(
         id="eps-order",
@@ -325,6 +329,32 @@ def _linear_claims(c: Claims, spec: Spec, P: Any, rho: fmpq, mu: fmpq, lam: fmpq
         check="exact LDLᵀ over Q (linear error dynamics)",
         passed=r.ok and rho < 1,
         detail=r.detail + ("" if rho < 1 else "; ρ must be < 1"),
+    )
+
+
+def _lambda_bracket(c: Claims, spec: Spec, params: Parameters, lam: fmpq) -> None:
+    """Best λ, bracketed (Section 5 of the constrained-redesign paper, Astolfi et al., NOLCOS
+    2019): at λ_infeasible no P ≻ 0 makes λ²P − (A−LC)ᵀP(A−LC) ≻ 0 (exact Routh test of the
+    spectral radius), and λ − λ_infeasible ≤ rate_tol."""
+    o: Options = spec.options
+    s = spec.system
+    other = params.exact("lambda_infeasible", c)
+    if other is None:
+        return
+    other = Q(other)
+    feasible = lyap.rate_feasible(lyap.closed_loop(s.A.q, s.C.q, o.L), other, True)
+    width = lam - other
+    c.exact(
+        id="lambda-bracket",
+        statement=(
+            f"no P ≻ 0 has (A−LC)ᵀP(A−LC) ≺ λ²P at λ = {fmt_exact(other)}: the certified λ "
+            f"is best to within {fmt_exact(o.rate_tol)}"
+        ),
+        reference=_ref("Section 5"),
+        check="exact Routh test (Acl/λ Schur ⟺ some P ≻ 0); exact bracket width",
+        passed=not feasible and 0 <= width <= Q(o.rate_tol),
+        detail=f"bracket width {fmt_up(width, 6)}"
+        + ("; λ_infeasible is feasible" if feasible else ""),
     )
 
 

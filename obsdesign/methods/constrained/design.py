@@ -36,6 +36,9 @@ class LyapData:
     rho: fmpq
     mu: fmpq
     lam: fmpq | None
+    #: best-rate search: the other end of the bracket and whether it is proved infeasible
+    lam_other: fmpq | None = None
+    other_kind: str = ""
 
 
 def lyapunov_data(spec: Spec) -> LyapData:
@@ -58,9 +61,11 @@ def lyapunov_data(spec: Spec) -> LyapData:
         raise InfeasibleError(
             f"A − LC is not Schur (spectral radius {rad:.6g} >= 1): no Lyapunov function (Assumption 2)"
         )
+    bracket: tuple[fmpq | None, str] = (None, "")
     if o.lam is None:
         br = lyap.best_rate(A, C, o.L, True, tol=o.rate_tol, margin=o.margin)
         lam, P = br.best, br.P
+        bracket = (br.other, br.kind)
     else:
         lam = o.lam
         P = lyap.certified_P(A, C, o.L, True, lam, o.margin)
@@ -75,7 +80,7 @@ def lyapunov_data(spec: Spec) -> LyapData:
     rho = Q(o.rho) if o.rho is not None else lam * lam
     Acl = lyap.closed_loop(A, C, o.L)
     mu = lyap.iss_mu(Acl, lyap.error_input(s.Bd.q, s.Dn.q, o.L), P, rho)
-    return LyapData(P, rho, mu, lam)
+    return LyapData(P, rho, mu, lam, *bracket)
 
 
 def design(spec: Spec, progress: Progress | None = None) -> Design:
@@ -171,6 +176,17 @@ def design_params(spec: Spec) -> tuple[dict[str, Any], list[str]]:
     params: dict[str, Any] = {} if o.L is None else {"L": o.L}
     if ld.lam is not None:
         params["lambda"] = ld.lam
+    if ld.lam_other is not None and ld.other_kind == lyap.INFEASIBLE:
+        params["lambda_infeasible"] = ld.lam_other
+        notes.append(
+            "λ: the best certified rate; no P ≻ 0 exists at λ_infeasible (exact Routh test), "
+            f"bracket width ≤ rate_tol = {o.rate_tol}"
+        )
+    elif ld.lam_other is not None:
+        notes.append(
+            f"λ: the best certified rate to within rate_tol; λ = {float(ld.lam_other):.6g} is "
+            "feasible but could not be certified"
+        )
     params.update(
         {
             "P": P,
