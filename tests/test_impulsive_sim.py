@@ -114,3 +114,24 @@ def test_simulate_option_overrides(tmp_path: Path) -> None:
     rep = api.design(spec)
     res = api.simulate(spec, rep, options={"runs": "2", "seed": "5"})
     assert res.info["runs"] == 2
+
+
+def test_simulation_memory_is_checked_before_allocating(tmp_path: Path) -> None:
+    """runs × samples × states is estimated first: 100,000 runs over the 3-state spec's
+    horizon would need ≈ 10 GiB, refused at once (exit 2), not after allocating."""
+    import time
+
+    from typer.testing import CliRunner
+
+    from obsdesign.cli import app
+
+    spec = tmp_path / "s.toml"
+    spec.write_text(SPEC3.read_text(encoding="utf-8"), encoding="utf-8")
+    rep = tmp_path / "r.json"
+    assert CliRunner().invoke(app, ["design", str(spec), "-o", str(rep)]).exit_code == 0
+    t0 = time.perf_counter()
+    res = CliRunner().invoke(
+        app, ["simulate", str(spec), "--report", str(rep), "--option", "runs=100000"]
+    )
+    assert res.exit_code == 2 and "GiB" in res.output
+    assert time.perf_counter() - t0 < 5

@@ -84,6 +84,9 @@ def designed(name: str) -> tuple[Spec, Report]:
             "as-given": example_text(qsr_scaling='"as-given"'),
             "lipschitz": LIPSCHITZ,
             "3state": SPEC3.read_text(encoding="utf-8"),
+            "stable-o": SPEC3.read_text(encoding="utf-8").replace(
+                "A = [[0, 0.01, 0]", "A = [[-5, 0.01, 0]"
+            ),
             "cross": SPEC3.read_text(encoding="utf-8")
             .replace("sector = [-0.2, 0.2]", "sector = [-0.2, 0.2]\ncross = 0.05")
             .replace("sector = [0, 0.3]", "sector = [0, 0.3]\ncross = 0.05"),
@@ -213,6 +216,12 @@ TAMPERS: list[tuple[str, str, Tamper, set[str]]] = [
         lambda p: {"ell_no": Q("0.05") - TINY},
         {"ell_no-matches-spec"},
     ),
+    (
+        "stable-o",
+        "varpi_o < 0 where the LMI would allow it (Assumption 2 fails, ϖ_o = 0 is used)",
+        lambda p: {"varpi_o": -TINY},
+        {"varpi_o"},
+    ),
     ("example", "gamma", lambda p: {"gamma": fmpq(4, 5) + TINY}, {"gamma-beta"}),
     ("example", "beta", lambda p: {"beta": 25 - TINY}, {"gamma-beta"}),
     (
@@ -294,7 +303,7 @@ def test_every_claim_id_has_a_tamper() -> None:
         "assumption1-falsification",
     }
     seen: set[str] = set()
-    for v in ("example", "kappa", "lipschitz", "3state"):
+    for v in ("example", "kappa", "lipschitz", "3state", "stable-o"):
         seen |= {c.id for c in designed(v)[1].claims}
     assert seen <= covered, seen - covered
 
@@ -407,7 +416,9 @@ def _check_statements(rep: Report) -> None:
             assert _num(st["lipschitz-x-blocks"], rf"‖{sym}‖ ≤ NUM") >= p[k]
 
 
-@pytest.mark.parametrize("variant", ["example", "kappa", "lipschitz", "3state", "cross"])
+@pytest.mark.parametrize(
+    "variant", ["example", "kappa", "lipschitz", "3state", "cross", "stable-o"]
+)
 def test_printed_numbers_are_true(variant: str) -> None:
     _check_statements(designed(variant)[1])
 

@@ -190,10 +190,12 @@ def certify_window(p: Problem, P: dict[str, Any], c: Claims | None = None) -> Cl
     th_o, th_n = Q(P["theta_o"]), Q(P["theta_n"])
     varpi, kappa_n = Q(P["varpi_o"]), Q(P["kappa_n"])
     ok, det = _ssd(co.Ao, data.qsr_o, th_o, -varpi, "θ_o")
+    if varpi < 0:  # Assumption 2 reads ϖ_o > 0; the design raises a negative λ_max(M_o) to 0
+        ok, det = False, f"ϖ_o = {fmt_exact(varpi)} < 0 (the tool uses ϖ_o ≥ 0 in (26b))"
     c.exact(
         id="varpi_o",
         statement=(
-            f"Σ(Ā_o, I, I) is (−R_o, −S_oᵀ, −Q_o)-ssd(−ϖ_o) with ϖ_o ≤ {fmt_up(varpi)}, "
+            f"Σ(Ā_o, I, I) is (−R_o, −S_oᵀ, −Q_o)-ssd(−ϖ_o) with 0 ≤ ϖ_o ≤ {fmt_up(varpi)}, "
             "so ϖ_o ≥ λ_max(M_o)"
         ),
         reference=_ref("Lemma 2, eq. (16)"),

@@ -46,6 +46,23 @@ def read_intervals(path: Path) -> np.ndarray:
     return vals
 
 
+def check_memory(runs: int, samples: int, n: int, dense: int = 8) -> None:
+    """Refuse (:class:`InputError`) a simulation whose arrays would exceed the
+    ``max_sim_bytes`` limit: two batches of ``runs`` trajectories with ``samples`` intervals
+    of ``dense`` points, each point holding t, x, ẑ (n each) and flags, as float64."""
+    from obsdesign.limits import limits
+
+    need = 2 * runs * (samples * dense + 1) * (2 * n + 3) * 8 + runs * samples * 8 * 3
+    cap = limits().max_sim_bytes
+    if need > cap:
+        raise InputError(
+            f"the simulation would need about {need / 2**30:.1f} GiB "
+            f"({runs} runs × {samples} samples × {n} states); the limit is "
+            f"{cap / 2**30:.1f} GiB (fewer runs, a shorter horizon, or "
+            "obsdesign --limit max_sim_bytes=...)"
+        )
+
+
 def simulate_spec(
     spec: Spec,
     params: Parameters,
@@ -72,13 +89,18 @@ def simulate_spec(
     t_lo, t_hi = params.float("T_min"), params.float("T_max")
     radius = params.float("ball_radius")
     rng = np.random.default_rng(seed)
+    n = spec.system.n
     if sampling_file is not None:
         h = read_intervals(sampling_file)
         runs = 1
+        check_memory(1, h.size, n)
         H = pad_to_horizon(h[None, :], horizon)
         if H.shape[1] == 0 or np.sum(H) < horizon * 0.999:
             raise InputError(f"{sampling_file}: the intervals do not cover the horizon {horizon:g}")
     else:
+        if not 0 < t_lo <= t_hi:
+            raise InputError(f"report: expected 0 < T_min ≤ T_max, got {t_lo:g}, {t_hi:g}")
+        check_memory(runs, int(np.ceil(horizon / t_lo)) + 1, n)
         H = draw_intervals(rng, runs, t_lo, t_hi, horizon)
     K = H.shape[1]
     Dn = spec.system.Dn.f
