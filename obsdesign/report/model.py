@@ -210,10 +210,10 @@ class Report:
                 spec_sha256=d["spec_sha256"],
                 parameters=params,
                 claims=claims,
-                solver=dict(d.get("solver", {})),
-                timings=dict(d.get("timings", {})),
-                notes=list(d.get("notes", [])),
-                tool=dict(d.get("tool", {})),
+                solver=_typed(d, "solver", dict, file),
+                timings=_typed(d, "timings", dict, file),
+                notes=_notes(d, file),
+                tool=_typed(d, "tool", dict, file),
                 schema_version=str(d["schema_version"]),
                 verdict=str(verdict),
                 error=dict(err) if isinstance(err, dict) else None,
@@ -222,6 +222,20 @@ class Report:
             ),
             problems,
         )
+
+
+def _typed(d: dict[str, Any], key: str, kind: type, file: str) -> Any:
+    v = d.get(key, kind())
+    if not isinstance(v, kind):
+        raise InputError(f"{file}: '{key}' must be a JSON {'object' if kind is dict else 'list'}")
+    return kind(v)
+
+
+def _notes(d: dict[str, Any], file: str) -> list[str]:
+    v = _typed(d, "notes", list, file)
+    if not all(isinstance(n, str) for n in v):
+        raise InputError(f"{file}: 'notes' must be a list of strings")
+    return v
 
 
 def check_output(path: str | Path, force: bool = False, inputs: tuple[Path, ...] = ()) -> None:
