@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 from flint import fmpq, fmpq_mat, fmpq_poly
 
+from obsdesign.certify.detect import hurwitz_stable, schur_stable
 from obsdesign.certify.exact import Q, dyadic, qeye, symmetrize
 from obsdesign.certify.psd import check_pd, check_psd
 from obsdesign.errors import InconclusiveError, InfeasibleError
@@ -170,35 +171,12 @@ def _charpoly(M: np.ndarray) -> fmpq_poly:
     return fmpq_mat(n, n, [Q(x) for x in M.flat]).charpoly()
 
 
-def _routh_hurwitz(p: fmpq_poly) -> bool:
-    """True iff every root of p lies in the open left half-plane: the exact Routh array has
-    every first-column entry > 0 (after making the leading coefficient positive)."""
-    c = [Q(x) for x in reversed(p.coeffs())]  # highest degree first
-    n = len(c) - 1
-    if n < 0 or c[0] == 0:
-        return False
-    if c[0] < 0:
-        c = [-x for x in c]
-    m = n // 2 + 1
-    rows = [c[0::2], c[1::2]]
-    rows = [r + [fmpq(0)] * (m - len(r)) for r in rows]
-    for i in range(1, n + 1):
-        a, b = rows[i - 1], rows[i]
-        if b[0] <= 0:
-            return False
-        if i < n:
-            rows.append(
-                [(b[0] * a[j + 1] - a[0] * b[j + 1]) / b[0] for j in range(m - 1)] + [fmpq(0)]
-            )
-    return True
-
-
 def rate_feasible(Acl: np.ndarray, rate: Any, discrete: bool) -> bool:
     """Whether some P ≻ 0 makes :func:`decay_matrix` ≻ 0 at ``rate``, decided exactly.
 
-    Discrete: iff every eigenvalue z of Acl has |z| < λ (Acl/λ Schur), tested by the Routh
-    array of the Möbius transform (1−s)ⁿ p((1+s)/(1−s)) of p(z) = det(zI − Acl/λ); continuous:
-    iff Acl + αI is Hurwitz (Routh array of det(sI − Acl − αI)). Necessity: for Acl v = z v,
+    Discrete: iff every eigenvalue z of Acl has |z| < λ, i.e. det(zI − Acl/λ) is Schur stable
+    (exact Schur–Cohn test); continuous: iff Acl + αI is Hurwitz (exact Routh test) — both from
+    :mod:`obsdesign.certify.detect`. Necessity: for Acl v = z v,
     v* (λ²P − AclᵀPAcl) v = (λ² − |z|²) v*Pv (and −2(Re z + α) v*Pv in continuous time);
     sufficiency: the Lyapunov equation. This decides the decay LMI of eq. (4)-(6), Section 5 of
     the constrained-redesign paper (Astolfi et al., NOLCOS 2019), for a fixed gain.
@@ -211,15 +189,25 @@ def rate_feasible(Acl: np.ndarray, rate: Any, discrete: bool) -> bool:
     if discrete:
         if r <= 0:
             return False
-        p = _charpoly(Acl * (1 / r))
-        one_plus, one_minus = fmpq_poly([1, 1]), fmpq_poly([1, -1])
-        coeffs = [Q(x) for x in p.coeffs()] + [fmpq(0)] * (n + 1 - len(p.coeffs()))
-        m = fmpq_poly([0])
-        for k, ck in enumerate(coeffs):
-            if ck != 0:
-                m += ck * one_plus**k * one_minus ** (n - k)
-        return m.degree() == n and _routh_hurwitz(m)
-    return _routh_hurwitz(_charpoly(Acl + qeye(n) * r))
+        return schur_stable(_charpoly(Acl * (1 / r)))[0]
+    return hurwitz_stable(_charpoly(Acl + qeye(n) * r))[0]
+
+
+def stability_test(discrete: bool) -> str:
+    """The name of the exact test behind :func:`rate_feasible` (for messages and claims).
+
+    :param discrete: time domain (Schur–Cohn, Section 5 setting of the constrained-redesign
+    paper) or continuous (Routh)."""
+    return "exact Schur–Cohn test" if discrete else "exact Routh test"
+
+
+def as_qarray(M: fmpq_mat) -> np.ndarray:
+    """An ``fmpq_mat`` as an exact object array (the form the functions here take).
+
+    :param M: a flint rational matrix."""
+    return np.array(
+        [[M[i, j] for j in range(M.ncols())] for i in range(M.nrows())], dtype=object
+    ).reshape(M.nrows(), M.ncols())
 
 
 # -- P from the Lyapunov equation, certified -----------------------------------------------
@@ -354,7 +342,7 @@ def best_rate(
     if lo >= edge:
         what = "Schur" if discrete else "Hurwitz"
         lim = f"spectral radius {bound:.6g}" if discrete else f"largest real part {bound:.6g}"
-        raise InfeasibleError(f"A − LC is not {what}: {lim} (exact Routh test)")
+        raise InfeasibleError(f"A − LC is not {what}: {lim} ({stability_test(discrete)})")
     known_r = None if known is None else Q(known[0]) * sign
     hi, P = edge - grid, None
     if hi > lo:

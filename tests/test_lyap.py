@@ -68,7 +68,7 @@ def test_decay_matrix_fails_below_the_spectral_radius() -> None:
         ([["187/100", 1], ["-437/500", 0]], fmpq(19, 20) + TINY, True, True),
         ([[0, "-1/2"], ["1/2", 0]], fmpq(1, 2), True, False),  # ±i/2
         ([[0, "-1/2"], ["1/2", 0]], fmpq(1, 2) + TINY, True, True),
-        ([["-1/2"]], fmpq(1, 2), True, False),  # eigenvalue −λ: the Möbius degree drops
+        ([["-1/2"]], fmpq(1, 2), True, False),  # eigenvalue −λ on the circle
         ([["-1/2"]], fmpq(1, 2) + TINY, True, True),
         ([["1/2", 1], [0, "1/2"]], fmpq(1, 2) + TINY, True, True),  # Jordan block
         ([["1/2", 1], [0, "1/2"]], fmpq(1, 2), True, False),

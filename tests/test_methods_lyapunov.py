@@ -509,3 +509,28 @@ def test_designed_gain_random_observable_systems(n: int, seed: int, time: str):
         assert np.abs(eig).max() <= float(rep.parameters.float("lambda")) + 1e-9
     else:
         assert -eig.real.max() >= float(rep.parameters.float("alpha")) - 1e-9
+
+
+def test_designed_gain_exact_detectability_reasons() -> None:
+    """(C, A) with the unobservable mode 0.9: λ = 0.8 is proved impossible for every L (exit 1,
+    naming the mode); λ = 0.95 designs and certifies; continuous, unstable unobservable mode 1/2:
+    not detectable (exact test)."""
+    base = """
+[system]
+time = "discrete"
+A = [[0.5, 0], [0, 0.9]]
+C = [[1, 0]]
+[method]
+key = "lyapunov"
+"""
+    with pytest.raises(InfeasibleError, match="unobservable mode") as ei:
+        api.design(load_spec_text(base + "lambda = 0.8\n"))
+    assert ei.value.exit_code == 1
+    rep = api.design(load_spec_text(base + "lambda = 0.95\n"))
+    assert rep.exit_code() == 0
+    assert rep.parameters["lambda_best"] <= fmpq(95, 100)
+    cont = base.replace('"discrete"', '"continuous"').replace(
+        "[[0.5, 0], [0, 0.9]]", "[[-1, 0], [0, 0.5]]"
+    )
+    with pytest.raises(InfeasibleError, match="not detectable"):
+        api.design(load_spec_text(cont))

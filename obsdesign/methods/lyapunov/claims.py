@@ -138,7 +138,7 @@ def bracket_claim(
     the tolerance, beyond it (λ_bracket < λ_best, α_bracket > α_best), not beyond a rate the
     spec asks for, and is of the reported kind — ``infeasible``: no P ≻ 0 satisfies the decay
     LMI of eq. (4)-(6) there (some eigenvalue z of A − LC has |z| ≥ λ, resp. Re z ≥ −α; exact
-    Routh test, :func:`obsdesign.lyap.rate_feasible`); ``not-certifiable``: the rate is
+    Schur–Cohn / Routh test, :func:`obsdesign.lyap.rate_feasible`); ``not-certifiable``: the rate is
     feasible (same exact test), so the bracket only bounds what this tool certifies. Section 5
     of the constrained-redesign paper (Astolfi et al., NOLCOS 2019).
 
@@ -160,7 +160,9 @@ def bracket_claim(
     feasible = lyap.rate_feasible(lyap.closed_loop(A, C, L), other, discrete)
     if kind == lyap.INFEASIBLE:
         if feasible:
-            problems.append(f"{sym} = {fmt_exact(other)} is feasible (exact Routh test)")
+            problems.append(
+                f"{sym} = {fmt_exact(other)} is feasible ({lyap.stability_test(discrete)})"
+            )
         why = f"no P ≻ 0 gives {sym} = {fmt_exact(other)} (A − LC has an eigenvalue " + (
             "of modulus ≥ λ)" if discrete else "with real part ≥ −α)"
         )
@@ -175,8 +177,8 @@ def bracket_claim(
         id=f"{name}_best-bracket",
         statement=f"{sym}_best = {fmt_exact(best)} is best to within {fmt_exact(tol)}: {why}",
         reference=REF,
-        check="exact Routh test of the characteristic polynomial "
-        + ("of (A−LC)/λ after the Möbius map" if discrete else "of A−LC+αI")
+        check=lyap.stability_test(discrete)
+        + (" of det(zI − (A−LC)/λ)" if discrete else " of det(sI − (A−LC) − αI)")
         + "; exact comparison of the bracket width with rate_tol",
         passed=not problems,
         detail="; ".join(problems)

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from obsdesign import lyap
+from obsdesign.certify.detect import detectability, unobservable_restriction
 from obsdesign.certify.exact import dyadic
 from obsdesign.certify.printing import fmt_exact
 from obsdesign.errors import InconclusiveError, InfeasibleError, SolverError
@@ -72,17 +73,19 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
                 raise InfeasibleError(
                     f"no P ≻ 0 gives decay rate {sym} = {fmt_exact(o.rate)}: A − LC has an "
                     f"eigenvalue {'of modulus ≥ λ' if s.discrete else 'with real part ≥ −α'} "
-                    f"(exact Routh test; {lim})"
+                    f"({lyap.stability_test(s.discrete)}; {lim})"
                 )
             raise InconclusiveError(
-                f"decay rate {sym} = {fmt_exact(o.rate)} is feasible (exact Routh test) but the "
+                f"decay rate {sym} = {fmt_exact(o.rate)} is feasible "
+                f"({lyap.stability_test(s.discrete)}) but the "
                 f"rounded Lyapunov-equation P fails the exact check with margin "
                 f"{fmt_exact(o.margin)} (too close to the limit: {lim})"
             )
         known = (o.rate, P)
     elif not lyap.rate_feasible(Acl, 1 if s.discrete else 0, s.discrete):
         raise InfeasibleError(
-            f"A − LC is not {'Schur' if s.discrete else 'Hurwitz'}: {lim} (exact Routh test)"
+            f"A − LC is not {'Schur' if s.discrete else 'Hurwitz'}: {lim} "
+            f"({lyap.stability_test(s.discrete)})"
             + ("" if o.L is None else " (the given L does not stabilize the error)")
         )
     br = lyap.best_rate(
@@ -100,7 +103,7 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
         rho = lyap.decay_factor(rate, s.discrete)
         params["mu"] = lyap.iss_mu(Acl, Bw, P, rho, s.discrete, strict=True)
     why = (
-        "no P ≻ 0 exists there (exact Routh test)"
+        f"no P ≻ 0 exists there ({lyap.stability_test(s.discrete)})"
         if br.kind == lyap.INFEASIBLE
         else "feasible, but the rounded Lyapunov-equation P fails the exact check there"
     )
@@ -120,6 +123,9 @@ def design_gain(
     Discrete: [[λ²P, (PA − XC)ᵀ], [PA − XC, P]] ⪰ δ I, the Schur complement of the decay LMI
     eq. (4)-(6) (Section 5, constrained-redesign paper, Astolfi et al., NOLCOS 2019);
     continuous: −(AᵀP + PA − CᵀXᵀ − XC + 2αP) ⪰ δ I. Normalization I ⪯ P ⪯ t·I, minimal t.
+    (C, A) is tested for detectability exactly first (exit 1 with the reason when it is not;
+    an asked rate that an unobservable mode forbids is also exit 1); a solver that then finds
+    no gain makes the run inconclusive (exit 4), never "infeasible".
 
     :param spec: the bound spec; :param o: its options; :param progress: callback."""
     import cvxpy as cp
@@ -169,18 +175,33 @@ def design_gain(
         best = (Lc, res.solver, rate)
         return True
 
+    time = "discrete" if s.discrete else "continuous"
+    det = detectability(s.A.q, s.C.q, time)
+    what = "Schur" if s.discrete else "Hurwitz"
+    if not det.detectable:
+        raise InfeasibleError(f"no gain L makes A − LC {what}: (C, A) is {det.reason}")
     if o.rate is not None:
+        # the unobservable modes are eigenvalues of A − LC for every L (exact)
+        _, Au = unobservable_restriction(s.A.q, s.C.q)
+        if Au.nrows() and not lyap.rate_feasible(lyap.as_qarray(Au), o.rate, s.discrete):
+            raise InfeasibleError(
+                f"no gain L gives decay rate {fmt_exact(o.rate)}: an unobservable mode of "
+                f"(C, A) (a root of {Au.charpoly()}) is an eigenvalue of A − LC for every L "
+                f"and fails the rate ({lyap.stability_test(s.discrete)})"
+            )
         # design with some slack (2 %) so the rounded gain certifies robustly at the asked rate
         slack = float(o.rate) * (0.98 if s.discrete else 1.02)
         if not feasible(slack) and not feasible(float(o.rate)):
-            raise InfeasibleError(
-                f"the LMI for L is infeasible at rate {fmt_exact(o.rate)}"
-                + (" ((C, A) not detectable?)" if s.discrete else "")
+            raise InconclusiveError(
+                f"the LMI solver found no gain at rate {fmt_exact(o.rate)}, although (C, A) "
+                f"allows it ({det.reason})"
             )
     elif s.discrete:
         lo, hi = 0.0, 1.0 - tol
         if not feasible(hi):
-            raise InfeasibleError("no gain L makes A − LC Schur: (C, A) is not detectable")
+            raise InconclusiveError(
+                f"the LMI solver found no gain with λ ≤ {1.0 - tol:g} ({det.reason})"
+            )
         while hi - lo > tol:
             mid = (lo + hi) / 2
             if progress:
@@ -193,7 +214,7 @@ def design_gain(
     else:
         lo, hi = 0.0, float(o.rate_cap)
         if not feasible(tol):
-            raise InfeasibleError("no gain L makes A − LC Hurwitz: (C, A) is not detectable")
+            raise InconclusiveError(f"the LMI solver found no gain with α ≥ {tol:g} ({det.reason})")
         lo = tol
         if feasible(hi):
             lo = hi
