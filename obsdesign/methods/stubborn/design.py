@@ -14,6 +14,7 @@ with the reported gain.
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -132,36 +133,40 @@ def _problem(pl: Plant, o: Options, lam: Any, criterion: str | None, margin: flo
     return prob, dict(P=P, X=X, u=u, w=w, Y=Y, R=R, **extra)
 
 
+def solve_cold(prob: Any) -> tuple[bool, str]:
+    """Clarabel without warm start (cvxpy's default warm start reuses the solver object of the
+    previous λ, so the answer near the boundary would depend on the search's history; cold, the
+    same λ always gives the same answer, here and in ``verify``). Returns (optimal, status)."""
+    import cvxpy as cp
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)
+            prob.solve(solver="CLARABEL", warm_start=False)
+    except cp.error.SolverError as e:
+        return False, f"solver failure ({e})"
+    return prob.status == "optimal", str(prob.status)
+
+
 class Feasibility:
-    """Feasibility of LMIs (1)-(3) / (7)-(9) as a function of λ.
+    """Feasibility of LMIs (1)-(3) / (7)-(9) as a function of λ: one cvxpy problem with λ as a
+    parameter (canonicalized once), each λ solved cold (:func:`solve_cold`), so the answer
+    at a λ does not depend on the λs solved before (``verify`` re-solves the bracket's far
+    end with a new object and gets the search's answer)."""
 
-    ``fresh`` False (the λ search): one cvxpy problem with λ as a parameter, canonicalized once.
-    ``fresh`` True: the problem built afresh with λ a constant; this is what ``verify``
-    re-solves at the bracket's far end, and the design confirms that end the same way (near
-    the boundary the parametrized problem and the fresh one can disagree)."""
-
-    def __init__(self, pl: Plant, o: Options, fresh: bool = True) -> None:
+    def __init__(self, pl: Plant, o: Options) -> None:
         import cvxpy as cp
 
-        self.pl, self.o, self.fresh = pl, o, fresh
+        self.pl, self.o = pl, o
         self.calls = 0
-        if not fresh:
-            self.lam = cp.Parameter(nonneg=True)
-            self.prob, _ = _problem(pl, o, self.lam, None, float(o.margin))
+        self.lam = cp.Parameter(nonneg=True)
+        self.prob, _ = _problem(pl, o, self.lam, None, float(o.margin))
 
     def __call__(self, lam: float) -> tuple[bool, str]:
         """Whether the solver finds the LMIs feasible at λ, and its status."""
         self.calls += 1
-        if self.fresh:
-            prob, _ = _problem(self.pl, self.o, float(lam), None, float(self.o.margin))
-        else:
-            self.lam.value = lam
-            prob = self.prob
-        try:
-            r = solve(prob, ("CLARABEL",))
-        except SolverError as e:
-            return False, f"solver failure ({e.message})"
-        return r.optimal, r.status
+        self.lam.value = float(lam)
+        return solve_cold(self.prob)
 
 
 def feasible(pl: Plant, o: Options, lam: float) -> tuple[bool, str]:
@@ -176,7 +181,7 @@ def search_lambda(pl: Plant, o: Options) -> tuple[float, float, str]:
     (1)); doubling from 1 brackets it, bisection refines until hi − lo ≤ tol·lo. Discrete
     time: the smallest λ ∈ (0, 1) (a larger λ relaxes (7)); bisection on (0, 1)."""
     tol = float(o.lambda_tol) / 2  # half the tolerance: _certified_best may step back tol/8 ×3
-    feas = Feasibility(pl, o, fresh=False)
+    feas = Feasibility(pl, o)
 
     def feasible(_pl: Plant, _o: Options, lam: float) -> tuple[bool, str]:
         return feas(lam)
@@ -205,22 +210,6 @@ def search_lambda(pl: Plant, o: Options) -> tuple[float, float, str]:
         return bot, 0.0, "feasible down to the cap"
     hi, lo = _bisect(feas, top, bot, tol)
     return hi, lo, feasible(pl, o, lo)[1]
-
-
-def confirm_far_end(pl: Plant, o: Options, good: float, bad: float) -> tuple[float, float, str]:
-    """Make the far end of the bracket one that a fresh problem does not find feasible (the
-    check ``verify`` repeats): while it does, slide the bracket [good, bad] outwards by its
-    width (at most 40 times)."""
-    fresh = Feasibility(pl, o, fresh=True)
-    w = bad - good
-    for _ in range(40):
-        ok, st = fresh(bad)
-        if not ok:
-            return good, bad, st
-        good, bad = bad, bad + w
-        if (pl.discrete and bad <= 0) or (not pl.discrete and bad > LAMBDA_CAP):
-            break
-    return good, float("inf") if not pl.discrete else 0.0, "no far end confirmed"
 
 
 def _bisect(feas: Feasibility, good: float, bad: float, tol: float) -> tuple[float, float]:
@@ -260,8 +249,6 @@ def design_params(
         good, bad, st = search_lambda(pl, o)
         if good == (0.0 if not pl.discrete else 1.0):
             _infeasible(spec, pl, o, "for every λ tried")
-        if np.isfinite(bad) and bad != 0.0:
-            good, bad, st = confirm_far_end(pl, o, good, bad)
         best, cert = _certified_best(spec, pl, o, good)
         vals["lambda_max"] = best
         for k in POINT_KEYS:
@@ -278,6 +265,16 @@ def design_params(
     if progress:
         progress(f"criterion '{o.criterion}' at λ = {float(lam_q):.6g}")
     cand, margin, solver = _certify_point(spec, pl, o, lam_q, o.criterion)
+    if cand is None and o.criterion != "l2":
+        # the criterion step did not give a certifiable optimum: fall back on the certified
+        # feasibility point at the same λ (the criterion is then not optimized; said in notes)
+        why = solver
+        cand, margin, solver = _certify_point(spec, pl, o, lam_q, None)
+        if cand is not None:
+            notes.append(
+                f"criterion '{o.criterion}' step not certified ({why}): the reported point is "
+                "the certified feasibility solution at this λ (criterion not optimized)"
+            )
     if cand is None:
         raise InconclusiveError(
             f"stubborn: no candidate certified at λ = {float(lam_q):g} ({solver})"
