@@ -464,3 +464,41 @@ def test_linear_gains_vertex_listed_twice(base71: dict[str, Any]) -> None:
     Vs = exact(base71, "L_admissible_vertices")
     d = put(base71, L_admissible_vertices=np.vstack([Vs, Vs[:1]]))
     assert failed_certify(d) == {"linear-gains-vertices"}
+
+
+def test_phi_is_the_max_over_the_slice_even_for_near_ties() -> None:
+    """LP (6) φ_i(z) = max over the slice of G_i A e: two slice points whose values differ by
+    2·10⁻¹⁰ relative (inside the float prefilter's tolerance, so both are evaluated exactly)
+    must give the larger one."""
+    q = fmpq
+    eps = q(1, 10**10)
+    G = np.array([[q(1), q(0)], [q(-1), q(0)], [q(0), q(1)], [q(0), q(-1)]], dtype=object)
+    ex = ce.ExactProblem(
+        A=np.array([[q(1), eps], [q(0), q(1)]], dtype=object),
+        B1=np.zeros((2, 0), dtype=object),
+        C=np.array([[q(1), q(0)]], dtype=object),
+        G0=G,
+        Vo=np.zeros((0, 2), dtype=object),
+        Dv=np.zeros((0, 0), dtype=object),
+        eta=q(0),
+        lam=q(1),
+    )
+    vrep = ce.po.exact_h_to_v(G)
+    zs, cv = ce.exact_zd(vrep.V, ex.C[0], ex.eta)
+    assert zs == [q(-1), q(1)]
+    sl = ce._Slices(ex, G, vrep, [q(1, 2)], cv)
+    phi = sl.phi_exact(0)
+    # the slice at z = 1/2 is {1/2} × [−1, 1]: row (1, 0) A e = 1/2 + 10⁻¹⁰ e₂, max at e₂ = 1
+    assert phi[0] == q(1, 2) + eps
+    assert phi[1] == -q(1, 2) + eps
+    assert phi[2] == 1 and phi[3] == 1
+
+
+def test_zd_includes_both_noise_shifts() -> None:
+    """Z_d = {c·v ± η̄ : v vertex} (Section III): with η̄ = 1/10 on the unit box, 4 points."""
+    q = fmpq
+    V = np.array([[q(a), q(b)] for a in (-1, 1) for b in (-1, 1)], dtype=object)
+    c = np.array([q(1), q(0)], dtype=object)
+    zs, cv = ce.exact_zd(V, c, q(1, 10))
+    assert zs == [q(-11, 10), q(-9, 10), q(9, 10), q(11, 10)]
+    assert sorted(set(cv)) == [q(-1), q(1)]
