@@ -351,3 +351,49 @@ def test_schema_lists_stubborn_keys() -> None:
     sch = json.dumps(api.schema())
     for k in ("lambda_fraction", "gain_bound", "lipschitz", "outlier_rate"):
         assert k in sch
+
+
+def test_printed_numbers_are_true(ex1: Report, ex4: Report) -> None:
+    """Numbers printed in statements: λ exactly, γ² rounded up (the statement 'γ² ≤ v' holds)."""
+    import re
+
+    def num(stmt: str, before: str) -> fmpq:
+        m = re.search(re.escape(before) + r"\s*(-?[0-9./e+-]+)", stmt)
+        assert m, stmt
+        return Q(m.group(1))
+
+    for rep in (ex1, ex4):
+        by = {c.id: c.statement for c in rep.claims}
+        assert num(by["lambda-range"], "λ =") == rep.parameters["lambda"]
+        assert num(by["lambda-max-certified"], "λ_max =") == rep.parameters["lambda_max"]
+    g = num({c.id: c.statement for c in ex4.claims}["l2-gain"], "γ² ≤")
+    assert g >= ex4.parameters["gamma2"]
+
+
+def test_study_option_via_cli_json(tmp_path: Path) -> None:
+    text = EX1.read_text().replace("runs = 100", "runs = 3").replace("horizon = 10", "horizon = 2")
+    f = tmp_path / "s.toml"
+    f.write_text(text)
+    r = CliRunner().invoke(
+        app, ["simulate", str(f), "--option", "study=outliers", "--format", "json"]
+    )
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.output)
+    assert "outlier_study" in out and "stubborn" in out["outlier_study"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("i", [1, 2, 3, 4])
+def test_outlier_study_long(i: int) -> None:
+    """The shipped specs' study (100 runs each): stubborn ≥ 5× better than Luenberger at
+    amplitudes ≥ 100 and within 2× at ≤ 1, every state."""
+    sp = api.load_spec(SPECS / f"astolfi-stubborn-example{i}.toml")
+    rep = api.design(sp)
+    _certified(rep)
+    res = api.simulate(sp, rep, options={"study": "outliers"})
+    med = res.extra["study"]["median_rmse"]
+    for s in sp.system.states:
+        for a in ("100", "1000"):
+            assert med["luenberger"][a][s] >= 5 * med["stubborn"][a][s], (a, s)
+        for a in ("0.1", "1"):
+            assert med["stubborn"][a][s] <= 2 * med["luenberger"][a][s], (a, s)

@@ -122,3 +122,13 @@ def test_not_hurwitz_is_infeasible() -> None:
     text = DUFFING.read_text().replace("K = [2, 1]", "K = [-1, 1]")
     with pytest.raises(InfeasibleError, match="Hurwitz"):
         api.design(api.load_spec_text(text, "d.toml"))
+
+
+def test_printed_bound_is_true(rep: Report) -> None:
+    import re
+
+    by = {c.id: c.statement for c in rep.claims}
+    m = re.search(r"≤\s*([0-9.]+)", by["ell-star-bound"])
+    assert m and Q(m.group(1)) >= rep.parameters["ell_star"]
+    m = re.search(r"ℓ = ([0-9./]+)", by["ell-bound"])
+    assert m and Q(m.group(1)) == rep.parameters["ell"]
