@@ -188,6 +188,9 @@ def design(
     bad input (exit 2) writes nothing."""
 
     def body() -> int:
+        from obsdesign.limits import precheck_spec
+
+        precheck_spec(spec)  # before the heavy imports: an oversized spec is refused at once
         from obsdesign import api
         from obsdesign.errors import InputError
         from obsdesign.report.model import check_output
@@ -223,6 +226,11 @@ def verify(
     """Re-check every claim of REPORT independently; exit 0 only if all hold."""
 
     def body() -> int:
+        from obsdesign.limits import precheck_spec, read_input
+
+        read_input(report, "report")  # before the heavy imports (regular file, size)
+        if spec is not None:
+            precheck_spec(spec)
         from obsdesign import api
 
         rep = api.verify(report, spec)
@@ -278,6 +286,9 @@ def simulate(
     """Run the plant and the designed observer over the spec's scenario; print metrics."""
 
     def body() -> int:
+        from obsdesign.limits import precheck_spec
+
+        precheck_spec(spec)  # before the heavy imports
         from obsdesign import api
 
         _check_plot(plot, force, (spec,) + ((report,) if report is not None else ()))

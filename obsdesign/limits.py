@@ -42,7 +42,7 @@ class Limits:
     """The limits in force (see the module docstring)."""
 
     max_file_bytes: int = 16 * 1024 * 1024
-    max_values: int = 250_000
+    max_values: int = 50_000
     max_digits: int = 1000
     max_exponent: int = 1000
     max_depth: int = 32
@@ -138,6 +138,19 @@ def read_input(path: str | Path, what: str) -> bytes:
     if len(data) > lim:
         raise InputError(f"{p}: {what} file is above the limit of {lim} bytes")
     return data
+
+
+def precheck_spec(path: str | Path) -> None:
+    """The cheap checks of a spec file (regular file, size, value count), with nothing but
+    the standard library loaded: the CLI runs them before importing numpy and the solvers,
+    so that an oversized spec is refused in milliseconds."""
+    data = read_input(path, "spec")
+    commas = data.count(b",")
+    if commas >= _current.max_values:
+        raise InputError(
+            f"{path}: holds about {commas + 1} values, above the limit of "
+            f"{_current.max_values} (--limit max_values=N)"
+        )
 
 
 # -- numbers --------------------------------------------------------------------------------

@@ -187,7 +187,7 @@ CASES: list[tuple[str, str, Callable[[Path], list[str]], int, list[str]]] = [
             str(_spec(t, _sub(LYAP, "A = [[0, 1], [1, 0]]", "A = " + _matrix(300)))),
         ],
         2,
-        ["300 states"],
+        ["max_values"],
     ),
     (
         "5",

@@ -82,9 +82,14 @@ SPEC_CASES = [
         ["nested"],
     ),
     (
+        "150-state A",
+        _edit("A = [[0, 1], [1, 0]]", "A = " + _matrix(150)),
+        ["system.A", "150 states", "max_states"],
+    ),
+    (
         "300-state A",
         _edit("A = [[0, 1], [1, 0]]", "A = " + _matrix(300)),
-        ["system.A", "300 states", "max_states"],
+        ["values", "max_values"],
     ),
     (
         "2000×2000 A",

@@ -181,7 +181,7 @@ def parse_expr(
             f"expression is {len(text)} characters long, above the limit of "
             f"{lim.max_expr_chars} (--limit max_expr_chars=N)",
         )
-    depth = nesting_depth(text)
+    depth = nesting_depth(text, stop=lim.max_expr_depth)
     if depth > lim.max_expr_depth:
         raise SpecError(file, key, _too_deep(depth))
     try:
@@ -221,16 +221,19 @@ _TOKEN = re.compile(
 _PREC = {"+": 1, "-": 1, "*": 2, "/": 2, "%": 2, "u": 3, "**": 4, "^": 4}
 
 
-def nesting_depth(text: str) -> int:
+def nesting_depth(text: str, stop: int | None = None) -> int:
     """The depth of the syntax tree ``text`` would parse to (operators by precedence, ``**``
     right-associative, unary signs, calls and parentheses), computed iteratively with an
     operator-precedence scan, so that a 4000-long ``-`` or ``**`` chain is measured without
     recursion before :func:`ast.parse` sees it. Text it cannot tokenize gets the depth of
-    what came before (``ast.parse`` then reports the syntax error)."""
+    what came before (``ast.parse`` then reports the syntax error). With ``stop``, returns as
+    soon as the depth exceeds it."""
     vals: list[int] = []  # depth of each pending operand
     ops: list[str] = []  # operators, "(" and "call("
     marks: list[int] = []  # len(vals) at each open parenthesis
     prev = "start"  # kind of the previous token: start, name, value, op, open, comma
+
+    top = [0]  # the deepest operand built so far
 
     def apply(op: str) -> None:
         if op == "u":
@@ -239,6 +242,7 @@ def nesting_depth(text: str) -> int:
             b = vals.pop() if vals else 0
             a = vals.pop() if vals else 0
             vals.append(max(a, b) + 1)
+        top[0] = max(top[0], vals[-1])
 
     def unwind() -> None:
         while ops and ops[-1] in _PREC:
@@ -271,6 +275,7 @@ def nesting_depth(text: str) -> int:
                 if kind == "call(" and vals:
                     vals.pop()  # the function name
                 vals.append(max(args, default=0) + (1 if kind == "call(" else 0))
+                top[0] = max(top[0], vals[-1])
             prev = "value"
         elif op in _PREC:
             if op in "+-" and prev in ("start", "op", "open", "comma"):
@@ -286,12 +291,14 @@ def nesting_depth(text: str) -> int:
                     apply(ops.pop())
                 ops.append(op)
             prev = "op"
-        deepest = max(deepest, len(ops), max(vals, default=0))
+        deepest = max(deepest, len(ops), top[0])
+        if stop is not None and deepest > stop:
+            return deepest
     while ops:
-        top = ops.pop()
-        if top in _PREC:
-            apply(top)
-    return max(deepest, max(vals, default=0))
+        op = ops.pop()
+        if op in _PREC:
+            apply(op)
+    return max(deepest, top[0], max(vals, default=0))
 
 
 def _tree_depth(tree: ast.AST) -> int:
