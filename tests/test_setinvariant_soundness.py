@@ -502,3 +502,21 @@ def test_zd_includes_both_noise_shifts() -> None:
     zs, cv = ce.exact_zd(V, c, q(1, 10))
     assert zs == [q(-11, 10), q(-9, 10), q(9, 10), q(11, 10)]
     assert sorted(set(cv)) == [q(-1), q(1)]
+
+
+def test_disturbance_name_must_be_a_polyhedron_in_sets() -> None:
+    text = SPEC71.read_text()
+    with pytest.raises(SpecError, match=r"\[method.disturbance\] expected the name of a set"):
+        api.load_spec_text(text.replace('disturbance = "D"', 'disturbance = "nope"'), "n.toml")
+    ell = text.replace(
+        'type = "box"\ndim = 1\nlower = [-1]\nupper = [1]', 'type = "ellipsoid"\ndim = 1\nE = [[1]]'
+    )
+    with pytest.raises(SpecError, match=r"\[method.disturbance\] expected a box or"):
+        api.load_spec_text(ell, "e.toml")
+    # a polytope D of dimension 1 is accepted and designs the same polyhedron
+    poly = text.replace(
+        'type = "box"\ndim = 1\nlower = [-1]\nupper = [1]',
+        'type = "polytope"\ndim = 1\nG = [[1], [-1]]\ng = [1, 1]',
+    )
+    rep = api.design(api.load_spec_text(poly, "p.toml"))
+    assert rep.exit_code() == 0 and rep.parameters["contractivity"] == fmpq(9, 10)
