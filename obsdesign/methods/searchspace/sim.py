@@ -252,7 +252,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
     i = 0
     s = eps[0] / math.sqrt(n)
     C = cover_box(o.D.lo, o.D.hi, s)
-    C = C[_consistent(plant, C, y, L_h * eps[0])]
+    C = C[_consistent(plant, C, y, L_h * eps[0]) & _meets(C, s, E_lo, E_hi)]
     if len(C) > so.max_centres:
         raise MemoryCap(
             f"the ε₀-cover of D needs {len(C):,} centres, above max_centres = {so.max_centres:,}"
@@ -307,7 +307,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
             else:
                 eta = e_old * math.exp(L_f * K * dT) + K * flow_err
                 C = recover(C, eta, s, so.max_centres)
-            C = C[_consistent(plant, C, y, L_h * e_new)]
+            C = C[_consistent(plant, C, y, L_h * e_new) & _meets(C, s, E_lo, E_hi)]
             run.switches.append(t)
             tau = t
             if not len(C):
@@ -339,6 +339,13 @@ def _consistent(plant: Plant, C: np.ndarray, y: np.ndarray, r: float) -> np.ndar
     if len(C) == 0:
         return np.zeros(0, dtype=bool)
     return np.all(np.abs(plant.out(C) - y) <= r * (1 + INFLATE) + 1e-12, axis=1)
+
+
+def _meets(C: np.ndarray, s: float, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Cells [c − s, c + s] that meet the box E: the true state stays in E (the paper's
+    ambient-space assumption), so a cell outside E cannot hold it."""
+    pad = s * (1 + INFLATE) + INFLATE
+    return np.all((C + pad >= lo) & (C - pad <= hi), axis=1)
 
 
 def _auto_substeps(
