@@ -520,3 +520,51 @@ def test_disturbance_name_must_be_a_polyhedron_in_sets() -> None:
     )
     rep = api.design(api.load_spec_text(poly, "p.toml"))
     assert rep.exit_code() == 0 and rep.parameters["contractivity"] == fmpq(9, 10)
+
+
+def test_multi_output_needs_its_linear_law(tmp_path: Path) -> None:
+    """p = n − 1 = 2 outputs: the linear law is the only injection; a report without L (or
+    with L just outside the admissible set) fails linear-law."""
+    text = """
+[system]
+time = "discrete"
+A = [[0.5, 0.1, 0], [0, 0.5, 0], [0, 0, 0.5]]
+B1 = [1, 1, 1]
+C = [[1, 0, 0], [0, 1, 0]]
+[sets.omega]
+type = "box"
+lower = [-1, -1, -1]
+upper = [1, 1, 1]
+[sets.D]
+type = "box"
+dim = 1
+lower = [-0.1]
+upper = [0.1]
+[method]
+key = "set-invariant"
+omega = "omega"
+disturbance = "D"
+lambda = 0.9
+"""
+    out = tmp_path / "m.json"
+    rep = api.design(api.load_spec_text(text, "m.toml"), out)
+    assert rep.exit_code() == 0
+    d = json.loads(out.read_text())
+    base = copy.deepcopy(d)
+    for k in ("L", "L_factor", "L_admissible_vertices"):
+        d["parameters"].pop(k, None)
+        d["parameters"]["exact"].pop(k, None)
+    assert failed_certify(d) == {"linear-law"}
+    # the designed L scaled until its factor exceeds λ
+    spec = api.load_spec_text(text, "m.toml")
+    ex = build(spec).ex
+    G, V, L = exact(base, "G"), exact(base, "V"), exact(base, "L")
+    s = fmpq(2)
+    for _ in range(60):
+        ok, f = ce.linear_law(ex, G, V, L * s)
+        if not ok:
+            break
+        s *= 2
+    assert not ok
+    d = put(base, L=L * s, L_factor=f)
+    assert failed_certify(d) == {"linear-law"}
