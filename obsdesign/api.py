@@ -61,8 +61,8 @@ def bind(spec: Spec) -> Spec:
         raise SpecError(
             spec.file,
             "system",
-            f"has {s.n} states, above method '{m.key}''s practical limit of {cap} "
-            f"(--limit max_states=N to try anyway)",
+            f"has {s.n} states, above the practical limit of method '{m.key}' "
+            f"({cap} states; --limit max_states=N to try anyway)",
         )
     if m.needs_linear:
         for k, v in (("A", s.A), ("C", s.C)):
@@ -82,13 +82,30 @@ def bind(spec: Spec) -> Spec:
 
 
 def load_spec(path: str | Path) -> Spec:
-    """Read a spec file and bind its method (see :func:`bind`)."""
-    return bind(read_spec(path))
+    """Read a spec file and bind its method (see :func:`bind`). Warnings raised while
+    reading (numpy, scipy) are kept in ``spec.warnings`` rather than printed."""
+    notes: list[str] = []
+    with captured_warnings(notes):
+        sp = bind(read_spec(path))
+    _keep_warnings(sp, notes)
+    return sp
 
 
 def load_spec_text(text: str, file: str = "<spec>") -> Spec:
     """Parse spec text and bind its method (see :func:`bind`)."""
-    return bind(read_spec_text(text, file))
+    notes: list[str] = []
+    with captured_warnings(notes):
+        sp = bind(read_spec_text(text, file))
+    _keep_warnings(sp, notes)
+    return sp
+
+
+def _keep_warnings(sp: Spec, notes: list[str]) -> None:
+    if notes:
+        try:
+            sp.warnings = [*getattr(sp, "warnings", []), *notes]  # type: ignore[attr-defined]
+        except AttributeError:  # a slotted Spec: nothing to keep them in
+            pass
 
 
 def _spec(spec: str | Path | Spec) -> Spec:
@@ -159,6 +176,7 @@ def design(
     with captured_warnings(notes):
         claims = certify(sp, d.parameters)
     t3 = time.perf_counter()
+    notes = [*getattr(sp, "warnings", []), *notes]
     report = Report(
         method=sp.method,
         spec=sp.text,

@@ -26,6 +26,7 @@ if signal.getsignal(signal.SIGINT) is signal.default_int_handler and os.path.bas
     signal.signal(signal.SIGINT, _early_interrupt)
 
 import json  # noqa: E402
+import warnings  # noqa: E402
 from collections.abc import Callable  # noqa: E402
 from enum import StrEnum  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -76,7 +77,14 @@ def _run(fn: Callable[[], int]) -> None:
         # from here on Ctrl-C raises KeyboardInterrupt (handled below, cleanup runs)
         if signal.getsignal(signal.SIGINT) is _early_interrupt:
             signal.signal(signal.SIGINT, signal.default_int_handler)
-        code = fn()
+        # the API turns warnings into report notes; any other stray warning (numpy, scipy)
+        # is not printed unless --debug
+        with warnings.catch_warnings(record=True) as stray:
+            warnings.simplefilter("always")
+            code = fn()
+        if _state["debug"]:
+            for w in stray:
+                _err(f"warning: {w.category.__name__}: {w.message}")
     except ObsdesignError as e:
         if _state["debug"]:
             raise
