@@ -88,3 +88,35 @@ def test_undetectable_cli_exit_1(tmp_path) -> None:
     r = CliRunner().invoke(app, ["design", str(f), "-o", str(tmp_path / "r.json")])
     assert r.exit_code == 1
     assert "not detectable" in r.output
+
+
+def test_discrete_redesign_certified_and_gas() -> None:
+    """Discrete time, K given (deadbeat-like gain of a double integrator): LMIs (7)-(9) in P;
+    the noise-free error of the stubborn observer converges."""
+    text = (
+        '[system]\ntime = "discrete"\nA = [[1, 1], [0, 1]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "stubborn"\nK = [1.5, 0.5]\nlambda_tol = 0.05\n'
+    )
+    sp = api.load_spec_text(text, "d.toml")
+    rep = api.design(sp)
+    bad = [
+        c.id
+        for c in rep.claims
+        if c.status == ClaimStatus.FAILED
+        or (c.status == ClaimStatus.NUMERICAL and c.id != "lambda-max-bracket")
+    ]
+    assert not bad
+    assert "gain-bound" not in {c.id for c in rep.claims}  # redesign: K is the spec's
+    g = sim.Gains.of(sp, rep.parameters)
+    e0 = np.array([3.0, -2.0])
+    _, e, _ = sim.run_errors(
+        g,
+        e0,
+        lambda k0, k1: np.zeros((k1 - k0, 1)),
+        400,
+        1.0,
+        np.full(1, np.inf),
+        np.array(True),
+        sim.default_sigma0(g, e0),
+    )
+    assert np.linalg.norm(e) <= 1e-6 * np.linalg.norm(e0)

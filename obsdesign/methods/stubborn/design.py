@@ -340,19 +340,27 @@ def _certify_point(
     return None, margin, last
 
 
+def _snap(M: Any) -> np.ndarray:
+    """Entries below 10⁻¹² of the largest set to 0 (solver noise; the exact check decides)."""
+    a = np.array(M, dtype=float)
+    a[np.abs(a) < 1e-12 * max(float(np.abs(a).max(initial=0.0)), 1e-300)] = 0.0
+    return a
+
+
 def _round(v: dict[str, Any], o: Options, lam_q: fmpq) -> dict[str, Any]:
-    """Dyadic rounding; K rounded itself, X rebuilt exactly as P K."""
-    P = symmetrize(dyadic((v["P"].value + v["P"].value.T) / 2, BITS))
+    """Dyadic rounding (40 bits); K rounded itself and X rebuilt exactly as P K (DESIGN.md
+    recipe: check the LMIs in the original variables with the reported gain)."""
+    P = symmetrize(dyadic(_snap((v["P"].value + v["P"].value.T) / 2), BITS))
     Xf = np.asarray(v["X"].value, float)
     if o.K is None:
-        K = dyadic(np.linalg.solve(np.asarray(to_float(P), float), Xf), BITS)
+        K = dyadic(_snap(np.linalg.solve(np.asarray(to_float(P), float), Xf)), BITS)
     else:
         K = np.asarray(o.K, dtype=object)
     X = P @ K
-    R = symmetrize(dyadic((v["R"].value + v["R"].value.T) / 2, BITS))
+    R = symmetrize(dyadic(_snap((v["R"].value + v["R"].value.T) / 2), BITS))
     U = dyadic(np.asarray(v["u"].value, float).reshape(-1), BITS)
     W = dyadic(np.asarray(v["w"].value, float).reshape(-1), BITS)
-    Y = dyadic(np.asarray(v["Y"].value, float), BITS)
+    Y = dyadic(_snap(np.asarray(v["Y"].value, float)), BITS)
     out: dict[str, Any] = {"K": K, "P": P, "X": X, "U": U, "W": W, "Y": Y, "R": R, "lambda": lam_q}
     if "g" in v:
         g = Q(float(v["g"].value))

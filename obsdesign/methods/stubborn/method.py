@@ -50,6 +50,23 @@ class Stubborn(Method):
         ),
     )
 
+    def summary(self, params: Parameters) -> str:
+        """The summary fields, matrices printed compactly (rows separated by ';', 4 digits)."""
+        import numpy as np
+
+        out = []
+        for f in self.summary_fields:
+            if f.param not in params:
+                continue
+            v = np.asarray(params.float(f.param), dtype=float)
+            if v.ndim == 0:
+                out.append(f"{f.label} = {float(v):.6g}")
+            else:
+                rows = np.atleast_2d(v) if v.ndim == 2 else v.reshape(1, -1)
+                txt = "; ".join(", ".join(f"{x:.4g}" for x in r) for r in rows)
+                out.append(f"{f.label} = [{txt}]")
+        return ", ".join(out)
+
     def parse_options(self, table: Table, spec: Spec) -> _opts.Options:
         return _opts.parse_options(table, spec)
 
