@@ -138,6 +138,19 @@ def rk4(plant: Plant, X: np.ndarray, t: float, dt: float, nsub: int) -> np.ndarr
     return out
 
 
+def observer_step(
+    plant: Plant, C: np.ndarray, x: np.ndarray, t: float, dT: float, nsub: int, gamma: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """One sample of the ε-γ observer (Definition 6): flow the live centres C and the plant
+    state x (1 × n, riding along as the last row) from t to t + ΔT, measure y = h(x), and mark
+    the centres to keep, |y − h(c)| ≤ γ. Returns (flowed C, keep mask, x, y)."""
+    XC = rk4(plant, np.concatenate([C, x]), t, dT, nsub)
+    C, x = XC[:-1], XC[-1:]
+    y = plant.out(x)[0]
+    keep = np.all(np.abs(plant.out(C) - y) <= gamma, axis=1)
+    return C, keep, x, y
+
+
 def flow_error(plant: Plant, X: np.ndarray, t: float, dt: float, nsub: int) -> float:
     """Step-doubling estimate of the RK4 error over one sample interval (max over the rows)."""
     if X.shape[0] == 0:
@@ -270,15 +283,11 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
         nsub, flow_err = _auto_substeps(plant, C, t, dT, nsub, eps[0])
     for k in range(1, N + 1):
         t_next = t0 + k * dT
-        # the plant's state rides along as the last row (same RK4 steps as the centres)
-        XC = rk4(plant, np.concatenate([C, x]), t, dT, nsub)
         steps += len(C) * nsub
-        C, x = XC[:-1], XC[-1:]
+        C, keep, x, y = observer_step(plant, C, x, t, dT, nsub, gam[min(i, len(gam) - 1)])
         t = t_next
-        y = plant.out(x)[0]
         if left_E is None and not (np.all(x[0] >= E_lo) and np.all(x[0] <= E_hi)):
             left_E = t
-        keep = np.all(np.abs(plant.out(C) - y) <= gam[min(i, len(gam) - 1)], axis=1)
         if not keep.any():
             raise ConsistencyLost(
                 _diagnose(
