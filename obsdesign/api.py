@@ -539,6 +539,11 @@ def simulate(
             raise InputError(f"{sp.file}: the report was made from another spec (sha256 differs)")
         if problems:
             raise InputError(f"report: {problems[0]}")
+        if rep.error is not None:
+            raise InputError(
+                f"report: records a design that stopped with an error "
+                f"({rep.error.get('message', '')}): no parameters to simulate"
+            )
         params = rep.parameters
     notes: list[str] = []
     with captured_warnings(notes):

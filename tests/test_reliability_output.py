@@ -191,3 +191,12 @@ def test_ctrl_c_is_one_line_no_traceback(delay: float):
     assert p.returncode == 130, err
     assert "Traceback" not in err and "KeyboardInterrupt" not in err
     assert err.strip().splitlines()[-1].endswith("interrupted")
+
+
+def test_simulate_refuses_an_error_report(spec: Path, tmp_path: Path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(spec.read_text().replace("L = [-1.87, 1.874]", "L = [5, 5]"))
+    out = tmp_path / "r.json"
+    assert runner.invoke(app, ["design", str(bad), "-o", str(out)]).exit_code == 1
+    res = runner.invoke(app, ["simulate", str(bad), "--report", str(out)])
+    _refused(res, "stopped with an error")
