@@ -127,9 +127,9 @@ def three_state() -> None:
         per <= 64,
     )
     print(
-        f"    (state {state} B/centre, float64, not counted; the peak holds the flowed copy "
-        f"that replaces the state ({state} B), then the output values and the keep mask; RK4 "
-        "temporaries are per chunk of 32,768 centres, no per-centre bookkeeping)"
+        f"    (state {state} B/centre, float64, not counted: RK4 updates it in place with "
+        "temporaries per chunk of 32,768 centres; the peak holds the output values h(c) and "
+        "the keep mask; no per-centre bookkeeping)"
     )
     del Cn, keep
 

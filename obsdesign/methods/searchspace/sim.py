@@ -105,11 +105,14 @@ class Plant:
         )
 
 
-def rk4(plant: Plant, X: np.ndarray, t: float, dt: float, nsub: int) -> np.ndarray:
+def rk4(
+    plant: Plant, X: np.ndarray, t: float, dt: float, nsub: int, inplace: bool = False
+) -> np.ndarray:
     """Advance every row of X from t to t + dt by ``nsub`` classical RK4 steps, in chunks of
-    CHUNK rows (temporaries are per chunk: no per-centre memory beyond the state)."""
+    CHUNK rows (temporaries are per chunk: no per-centre memory beyond the state; with
+    ``inplace`` the result overwrites X)."""
     h = dt / nsub
-    out = np.empty_like(X)
+    out = X if inplace else np.empty_like(X)
     for a in range(0, X.shape[0], CHUNK):
         x = X[a : a + CHUNK].copy()
         acc = np.empty_like(x)
@@ -141,11 +144,11 @@ def rk4(plant: Plant, X: np.ndarray, t: float, dt: float, nsub: int) -> np.ndarr
 def observer_step(
     plant: Plant, C: np.ndarray, x: np.ndarray, t: float, dT: float, nsub: int, gamma: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """One sample of the ε-γ observer (Definition 6): flow the live centres C and the plant
-    state x (1 × n, riding along as the last row) from t to t + ΔT, measure y = h(x), and mark
-    the centres to keep, |y − h(c)| ≤ γ. Returns (flowed C, keep mask, x, y)."""
-    XC = rk4(plant, np.concatenate([C, x]), t, dT, nsub)
-    C, x = XC[:-1], XC[-1:]
+    """One sample of the ε-γ observer (Definition 6): flow the live centres C (in place) and the
+    plant state x (1 × n, same RK4 steps) from t to t + ΔT, measure y = h(x), and mark the
+    centres to keep, |y − h(c)| ≤ γ. Returns (flowed C, keep mask, x, y)."""
+    C = rk4(plant, C, t, dT, nsub, inplace=True)
+    x = rk4(plant, x, t, dT, nsub)
     y = plant.out(x)[0]
     keep = np.all(np.abs(plant.out(C) - y) <= gamma, axis=1)
     return C, keep, x, y
