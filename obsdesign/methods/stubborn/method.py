@@ -135,6 +135,11 @@ class Stubborn(Method):
             "amplitudes": {"type": "array", "items": {**num, "minimum": 0}},
             "runs": {"type": "integer", "minimum": 1},
             "sigma0": {**num, "minimum": 0},
+            "impulse_time": {**num, "minimum": 0},
+            "impulse_value": num,
+            "hf_start": {**num, "minimum": 0},
+            "hf_stop": {**num, "minimum": 0},
+            "hf_amplitude": {**num, "minimum": 0},
         }
 
 
