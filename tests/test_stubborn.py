@@ -399,3 +399,67 @@ def test_outlier_study_long(i: int) -> None:
             assert med["luenberger"][a][s] >= 5 * med["stubborn"][a][s], (a, s)
         for a in ("0.1", "1"):
             assert med["stubborn"][a][s] <= 2 * med["luenberger"][a][s], (a, s)
+
+
+# -- the LMI formulas against the slides' He(Z) forms, written independently ----------------
+def _q(rows: list[list[Any]]) -> np.ndarray:
+    from obsdesign.certify.exact import qmat
+
+    return qmat(rows)
+
+
+def _he_blocks(Z: list[list[np.ndarray]]) -> np.ndarray:
+    M = np.block(Z)
+    return M + M.T
+
+
+def test_lmi_formulas_match_the_slides() -> None:
+    from obsdesign.methods.stubborn import lmis
+
+    h = fmpq(1, 2)
+    A = _q([[0, 1], [-1, fmpq(1, 10)]])
+    C = _q([[1, 1]])
+    P = _q([[3, 1], [1, 2]])
+    X = _q([[fmpq(1, 3)], [-2]])
+    u = np.array([fmpq(5, 7)], dtype=object)
+    w = np.array([fmpq(9, 4)], dtype=object)
+    Y = _q([[fmpq(-1, 5), fmpq(2, 3)]])
+    R = _q([[fmpq(11, 3)]])
+    lam = fmpq(3, 2)
+    U, W = _q([[u[0]]]), _q([[w[0]]])
+    Z0 = np.zeros((2, 1), dtype=object) * fmpq(0)
+    G = P @ A - X @ C
+    # (1): He[[PA − XC + ½(λP − CᵀRC), X], [UC, −U]]
+    want1 = _he_blocks([[G + h * (lam * P - C.T @ R @ C), X], [U @ C, -U]])
+    assert (lmis.regional(A, C, P, X, u, R, lam, False) == want1).all()
+    # (2): He[[PA − XC, X], [WC + Y, −W]]
+    want2 = _he_blocks([[G, X], [W @ C + Y, -W]])
+    assert (lmis.global_(A, C, P, X, w, Y, False) == want2).all()
+    # (7): He[[−½(λP + CᵀRC), 0, 0], [UC, −U, 0], [PA − XC, X, −½P]]
+    Z22 = np.full((2, 2), fmpq(0), dtype=object)
+    want7 = _he_blocks(
+        [
+            [-h * (lam * P + C.T @ R @ C), Z0, Z22],
+            [U @ C, -U, Z0.T],
+            [G, X, -h * P],
+        ]
+    )
+    assert (lmis.regional(A, C, P, X, u, R, lam, True) == want7).all()
+    # (8): He[[−½P, 0, 0], [WC + Y, −W, 0], [PA − XC, X, −½P]]
+    want8 = _he_blocks([[-h * P, Z0, Z22], [W @ C + Y, -W, Z0.T], [G, X, -h * P]])
+    assert (lmis.global_(A, C, P, X, w, Y, True) == want8).all()
+    # (3) / (9): [[P, Y_1ᵀ], [Y_1, w_1]]
+    assert (lmis.sector(P, Y, w, 0) == np.block([[P, Y.T], [Y, W]])).all()
+
+
+def test_l2_formula_known_answer() -> None:
+    """ė = −e + d has L2 gain exactly 1: the bounded-real-lemma matrix certifies γ² = 1 + 2⁻²⁰
+    (P = 1) and no P gives γ² = 1 (det = −(P − 1)² ≤ 0)."""
+    from obsdesign.certify.psd import check_pd
+    from obsdesign.methods.stubborn import lmis
+
+    A, C, Bd = _q([[-1]]), _q([[0]]), _q([[1]])
+    X = _q([[0]])
+    assert check_pd(-lmis.l2_gain(A, C, Bd, _q([[1]]), X, 1 + fmpq(1, 2**20), False)).ok
+    for p in (fmpq(1, 2), fmpq(1), fmpq(2)):
+        assert not check_pd(-lmis.l2_gain(A, C, Bd, _q([[p]]), X, fmpq(1), False)).ok
