@@ -268,7 +268,7 @@ C = [[1, 1]]
 [method]
 key = "stubborn"
 K = [-11.9944, 20.4153]
-lambda = 2
+lambda = 5
 """
 
 
@@ -277,7 +277,7 @@ def test_redesign_with_paper_gain_and_spec_binding() -> None:
     rep = api.design(sp)
     _certified(rep)
     p = rep.parameters
-    assert p["lambda"] == 2
+    assert p["lambda"] == 5
     assert (p["K"] == np.array([[Q("-11.9944")], [Q("20.4153")]], dtype=object)).all()
     d = rep.to_dict()
     K = _get(d, "K")
@@ -285,11 +285,21 @@ def test_redesign_with_paper_gain_and_spec_binding() -> None:
     _set(d, "K", K)  # X stays P·K_spec: only the comparison with the spec's K fails
     assert _failed(d) == {"K-matches-spec"}
     d = rep.to_dict()
-    _set(d, "lambda", fmpq(2) - TINY)
+    _set(d, "lambda", fmpq(5) - TINY)
     assert _failed(d) == {"lambda-matches-spec"}
     d = rep.to_dict()
     d["parameters"]["criterion"] = "K"
     assert _failed(d) == {"criterion-matches-spec"}
+
+
+def test_paper_gain_example3_redesign() -> None:
+    """The slides' Example 3 gain K = (−6.7510, 11.7510) certifies LMIs (1)-(3) at λ = 3.7
+    (its best λ ≈ 3.77; the slides' K, R, W triple is feasible up to λ ≈ 3.74)."""
+    text = PAPER_K1.replace("[-1, 0]]", "[0, 0.1]]").replace(
+        "K = [-11.9944, 20.4153]", "K = [-6.7510, 11.7510]"
+    )
+    rep = api.design(api.load_spec_text(text.replace("lambda = 5", "lambda = 3.7"), "k3.toml"))
+    _certified(rep)
 
 
 def test_defaults_only_system_and_key() -> None:
