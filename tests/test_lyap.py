@@ -193,3 +193,14 @@ def test_best_rate_not_schur_and_not_certifiable() -> None:
     A = qmat([[1 - fmpq(1, 10**20)]])
     with pytest.raises(InconclusiveError):
         best_rate(A, qmat([[1]]), qmat([[0]]), True, tol=TOL, margin=MARGIN)
+
+
+def test_certified_P_checks_the_decay_matrix() -> None:
+    """λ = 0.95 + 10⁻¹⁰ is feasible, and the rounded Lyapunov-equation P is ≻ 0, but the
+    rounding breaks the decay LMI: no P is returned (not certifiable)."""
+    lam = fmpq(19, 20) + fmpq(1, 10**10)
+    assert rate_feasible(closed_loop(A5, C5, L5), lam, True)
+    assert certified_P(A5, C5, L5, True, lam, MARGIN) is None
+    Pf = lyap.lyapunov_P(*(np.asarray(x, dtype=float) for x in (A5, C5, L5)), float(lam), True)
+    P = lyap.symmetrize(lyap.dyadic(Pf, lyap.BITS))
+    assert check_pd(P, MARGIN)

@@ -22,7 +22,7 @@ from obsdesign.certify.claim import ClaimStatus
 from obsdesign.certify.exact import Q, qmat
 from obsdesign.certify.psd import check_pd
 from obsdesign.cli import app
-from obsdesign.errors import InfeasibleError
+from obsdesign.errors import InconclusiveError, InfeasibleError
 from obsdesign.params import Parameters
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -534,3 +534,13 @@ key = "lyapunov"
     )
     with pytest.raises(InfeasibleError, match="not detectable"):
         api.design(load_spec_text(cont))
+
+
+def test_asked_rate_feasible_but_not_certifiable_is_inconclusive() -> None:
+    """λ = 0.9500000001 > ρ = 0.95: feasible (exact test) but the 40-bit P fails: exit 4."""
+    text = SEC5.read_text().replace("lambda = 0.955", "lambda = 0.9500000001")
+    with pytest.raises(InconclusiveError, match="feasible") as ei:
+        api.design(load_spec_text(text, "x.toml"))
+    assert ei.value.exit_code == 4
+    with pytest.raises(InfeasibleError, match="exact Schur–Cohn test"):
+        api.design(load_spec_text(SEC5.read_text().replace("lambda = 0.955", "lambda = 0.95")))
