@@ -202,7 +202,8 @@ def stability_test(discrete: bool) -> str:
 
 
 def as_qarray(M: fmpq_mat) -> np.ndarray:
-    """An ``fmpq_mat`` as an exact object array (the form the functions here take).
+    """An ``fmpq_mat`` as an exact object array (the form the functions here take), e.g. the
+    unobservable restriction A_u whose modes bound every rate of eq. (4)-(6).
 
     :param M: a flint rational matrix."""
     return np.array(
