@@ -173,16 +173,18 @@ def test_polynomial_test_details():
     ok, why = hurwitz_stable(poly(1, 4, 6, 4, F(51, 10)))  # Routh 1, 4, 5, -2/25
     assert not ok and why == "Routh array: first-column entry 3 is -2/25 <= 0"
     for bad in (schur_stable, hurwitz_stable):
-        with pytest.raises(ValueError, match="zero polynomial"):
+        with pytest.raises(ValueError, match=r"^the zero polynomial has no roots to test$"):
             bad(fmpq_poly([]))
 
 
 def test_shapes_and_errors():
-    with pytest.raises(ValueError, match="A must be square"):
+    with pytest.raises(ValueError, match=r"^A must be square, got 2x3$"):
         detectability([[1, 2, 3], [4, 5, 6]], [[1, 0, 0]])
-    with pytest.raises(ValueError, match="C must have 2 columns"):
+    with pytest.raises(ValueError, match=r"^C must have 2 columns \(A is 2x2\), got 3$"):
         detectability([[1, 0], [0, 1]], [[1, 0, 0]])
-    with pytest.raises(ValueError, match="time must be 'discrete' or 'continuous'"):
+    with pytest.raises(
+        ValueError, match=r"^time must be 'discrete' or 'continuous', not 'sampled'$"
+    ):
         detectability([[1]], [[1]], "sampled")
     # no output at all: everything is unobservable
     r = detectability([[F(1, 2), 0], [0, F(-1, 3)]], np.empty((0, 2), dtype=object))
@@ -361,3 +363,34 @@ def test_n20_is_fast():
         s = detectability(A.T, C[:, ::-1].copy(), kind)
         assert s.unobservable_dim <= n
     assert time.perf_counter() - t < 5.0
+
+
+def test_reasons_defaults_and_small_sizes():
+    A, C = [[-2, 0], [0, 0.5]], [[0, 1]]
+    assert detectability(A, C).reason == (
+        "not detectable: rank of the observability matrix 1 < 2; the unobservable modes "
+        "(roots of x + 2) do not all satisfy |z| < 1 (Schur–Cohn step 0: |a0| = 2 >= |a_d| = 1, "
+        "so a root has |z| >= 1)"
+    )
+    assert detectability(A, C, "continuous").reason == (
+        "detectable: rank of the observability matrix 1 < 2; the unobservable modes "
+        "(roots of x + 2) all satisfy Re s < 0 (Routh array: all 1 first-column entries after "
+        "a_d are > 0)"
+    )
+    assert not is_detectable(A, C) and is_detectable(A, C, "continuous")  # default: discrete
+    assert is_detectable([[F(1, 2), 0], [0, 3]], [[0, 1]])
+    # several Schur–Cohn steps are counted
+    assert schur_stable(poly(1, F(-3, 2), F(11, 16), F(-3, 32))) == (
+        True,
+        "Schur–Cohn: all 3 steps with |a0| < |a_d|",
+    )
+    ok, why = schur_stable(poly(1, 0, 0, F(1, 2), F(-1, 4), 1))  # a0 = 1 at step 0
+    assert not ok and why.startswith("Schur–Cohn step 0:")
+    ok, why = schur_stable(poly(1, F(1, 10), F(1, 10), 5, F(1, 10)))  # fails at a later step
+    assert not ok and why.startswith("Schur–Cohn step ") and not why.startswith("Schur–Cohn step 0")
+    # 1×1 and 0×0 systems
+    assert is_observable([[2]], [[1]]) and not is_observable([[2]], [[0]])
+    r = detectability([[F(1, 2)]], [[0]])
+    assert (r.observable, r.detectable, r.unobservable_dim) == (False, True, 1)
+    r = detectability(np.empty((0, 0), dtype=object), np.empty((1, 0), dtype=object))
+    assert (r.observable, r.detectable, r.unobservable_dim) == (True, True, 0)

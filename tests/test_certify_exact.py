@@ -11,7 +11,7 @@ from flint import fmpq
 from hypothesis import given
 from hypothesis import strategies as st
 
-from obsdesign.certify.exact import Q, dyadic, qmat, qparse, qstr, to_float
+from obsdesign.certify.exact import Q, dyadic, qmat, qparse, qstr, qvec, to_float
 
 
 def test_decimal_is_exact():
@@ -49,3 +49,107 @@ def test_dyadic_close_and_exact_grid(xs):
     assert np.all(np.abs(back - arr) <= np.abs(arr) * 2.0**-30)
     for v in q:
         assert int(v.q) & (int(v.q) - 1) == 0  # denominator is a power of two
+
+
+# ------------------------------------------------------------ known answers, every branch
+
+F = fmpq
+
+
+def test_Q_every_input_type():
+    assert Q(np.int64(-7)) == -7 and isinstance(Q(np.int64(-7)), fmpq)
+    assert Q(np.float32(0.1)) == Q(float(np.float32(0.1)))
+    assert Q(0.5) == F(1, 2) and Q(-0.1) == -Q(0.1)
+    assert Q(2.0**-1074) == F(1, 2**1074)
+    assert Q(" 1/3 ") == F(1, 3) and Q("0.1") == F(1, 10) and Q("1e-3") == F(1, 1000)
+    assert Q(Decimal("-2.5")) == F(-5, 2)
+    x = F(2, 7)
+    assert Q(x) is x
+    for bad in (float("inf"), float("-inf"), np.float64("nan")):
+        with pytest.raises(ValueError, match=r"^not a finite number: "):
+            Q(bad)
+    with pytest.raises(ValueError, match=r"^not a finite number: "):
+        Q(Decimal("nan"))
+    with pytest.raises(TypeError, match=r"^a boolean is not a number$"):
+        Q(False)
+    with pytest.raises(TypeError, match=r"^cannot convert list to a rational$"):
+        Q([1])
+    with pytest.raises(TypeError, match=r"^cannot convert complex to a rational$"):
+        Q(1j)
+
+
+def test_qmat_qvec_qeye_qzeros():
+    m = qmat([1, 2.5])
+    assert m.shape == (1, 2) and m[0, 1] == F(5, 2) and m.dtype == object
+    assert all(isinstance(v, fmpq) for v in m.flat)
+    m = qmat([[F(1, 3), "2/3"], [0.25, 4]])
+    assert m.shape == (2, 2) and (m == np.array([[F(1, 3), F(2, 3)], [F(1, 4), F(4)]])).all()
+    for bad in (np.zeros((2, 2, 2)), 5):
+        with pytest.raises(ValueError, match=r"^expected a matrix$"):
+            qmat(bad)
+    v = qvec([[1, 2], [3, 0.5]])
+    assert v.shape == (4,) and v[3] == F(1, 2) and v.dtype == object
+    assert all(isinstance(x, fmpq) for x in v)
+    from obsdesign.certify.exact import qeye, qzeros
+
+    eye = qeye(3)
+    assert eye.shape == (3, 3) and eye.dtype == object
+    assert all(eye[i, j] == (1 if i == j else 0) for i in range(3) for j in range(3))
+    assert all(isinstance(x, fmpq) for x in eye.flat)
+    z = qzeros((2, 3))
+    assert z.shape == (2, 3) and all(x == 0 and isinstance(x, fmpq) for x in z.flat)
+
+
+def test_to_float_correctly_rounded():
+    assert to_float(F(1, 3)) == 1 / 3 and isinstance(to_float(F(1, 3)), float)
+    big = F(3**40, 7**20)  # needs correct rounding, not float(p) / float(q)
+    from fractions import Fraction as Fr
+
+    assert to_float(big) == float(Fr(3**40, 7**20))
+    a = to_float(qmat([[F(1, 2), F(-3)]]))
+    assert a.dtype == float and a.tolist() == [[0.5, -3.0]]
+    e = to_float(np.empty((0, 2), dtype=object))
+    assert e.shape == (0, 2) and e.dtype == float
+    mixed = to_float(np.array([1, 2.5, F(1, 4)], dtype=object))
+    assert mixed.tolist() == [1.0, 2.5, 0.25] and mixed.dtype == float
+
+
+def test_dyadic_known_values():
+    assert dyadic(1 / 3, 4) == F(11, 32)
+    assert dyadic(1 / 3) == F(11184811, 2**25)  # default 24 bits
+    assert dyadic(1e10, 4) == 9 * 2**30
+    assert dyadic(2.0**40, 10) == 2**40
+    assert dyadic(-0.75, 1) == -1  # round half to even on the 1-bit grid
+    assert dyadic(0.0) == 0 and isinstance(dyadic(0.0), fmpq)
+    assert dyadic(3.0, 2) == 3 and dyadic(5.0, 2) == 4
+    arr = dyadic(np.array([[0.1, -0.2]]), 8)
+    assert arr.shape == (1, 2) and arr[0, 0] == F(205, 2048) and arr[0, 1] == F(-205, 1024)
+    with pytest.raises(ValueError, match=r"^cannot round a non-finite number$"):
+        dyadic([1.0, float("inf")])
+
+
+def test_symmetrize_qstr_qparse_qmax_abs():
+    from obsdesign.certify.exact import qmax_abs, symmetrize
+
+    S = symmetrize(qmat([[1, 2], [0, 3]]))
+    assert (S == qmat([[1, 1], [1, 3]])).all()
+    assert qstr(F(-187, 100)) == "-187/100" and qstr(5) == "5"
+    assert qstr(np.array(F(1, 3), dtype=object)) == "1/3"
+    assert qstr(qmat([[1, F(1, 2)]])) == [["1", "1/2"]]
+    assert qstr(qvec([1, F(-1, 2)])) == ["1", "-1/2"]
+    assert qparse("3/4") == F(3, 4) and qparse(2) == 2 and qparse(0.5) == F(1, 2)
+    p = qparse([["1/2", 3], [0.25, "-1"]])
+    assert p.shape == (2, 2) and p[1, 0] == F(1, 4) and all(isinstance(v, fmpq) for v in p.flat)
+    for bad in (True, None, {"a": 1}, [], [[1, 2], [3]], [1, True], [1, None], [[1], [[2]]]):
+        with pytest.raises(ValueError):
+            qparse(bad)
+    with pytest.raises(ValueError, match=r"^ragged or empty exact array$"):
+        qparse([])
+    with pytest.raises(ValueError, match=r"^not an exact value: "):
+        qparse([1, None])
+    with pytest.raises(ValueError, match=r"^not an exact value: "):
+        qparse(True)
+    assert qmax_abs(qmat([[1, -3], [2, 0]])) == 3
+    assert qmax_abs(np.empty((0,), dtype=object)) == 0 and isinstance(
+        qmax_abs(np.empty((0,), dtype=object)), fmpq
+    )

@@ -57,11 +57,8 @@ def _to_fmat(M: Any) -> fmpq_mat:
 def _to_zmat(M: fmpq_mat) -> fmpz_mat:
     """D·M with D the least common denominator of M's entries: an integer matrix with the same
     row space and kernel (and, for A, the same Krylov row spaces: C (D A)^k = D^k C A^k)."""
-    r, c = M.nrows(), M.ncols()
-    D = 1
-    for v in M.entries():
-        D = math.lcm(D, int(v.q))
-    return fmpz_mat(r, c, [int(v.p) * (D // int(v.q)) for v in M.entries()])
+    D = math.lcm(*[int(v.q) for v in M.entries()])
+    return fmpz_mat(M.nrows(), M.ncols(), [int(v.p) * (D // int(v.q)) for v in M.entries()])
 
 
 def observable_rowspace(A: Any, C: Any) -> fmpq_mat:
@@ -78,7 +75,7 @@ def observable_rowspace(A: Any, C: Any) -> fmpq_mat:
     for _ in range(n):
         entries += block.entries()
         block = block * Az
-    rows = len(entries) // n if n else 0
+    rows = Cf.nrows() * n
     if rows == 0:
         return fmpq_mat(0, n)
     R, den, rank = fmpz_mat(rows, n, entries).rref()

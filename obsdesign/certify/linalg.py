@@ -12,21 +12,14 @@ from obsdesign.certify.psd import check_psd
 
 
 def qinv(M: Any) -> np.ndarray:
-    """Exact inverse of a square rational matrix (ZeroDivisionError if singular)."""
-    A = np.asarray(M, dtype=object)
-    n = A.shape[0]
-    fm = fmpq_mat(n, n, [Q(v) for v in A.flat])
-    inv = fm.inv()
-    return qmat([[inv[i, j] for j in range(n)] for i in range(n)])
+    """Exact inverse of a square rational matrix (ZeroDivisionError if singular, ValueError if
+    not square)."""
+    return qmat(fmpq_mat(qmat(M).tolist()).inv().tolist())
 
 
 def qrank(M: Any) -> int:
-    """Exact rank of a rational matrix."""
-    A = np.asarray(M, dtype=object)
-    r, c = A.shape
-    if r == 0 or c == 0:
-        return 0
-    return int(fmpq_mat(r, c, [Q(v) for v in A.flat]).rank())
+    """Exact rank of a rational matrix (0 for an empty one)."""
+    return int(fmpq_mat(qmat(M).tolist()).rank())
 
 
 def norm_bound_holds(X: Any, u: Any) -> bool:
@@ -42,7 +35,7 @@ def norm_bound_holds(X: Any, u: Any) -> bool:
     if X.size == 0:
         return True
     G = X.T @ X
-    return bool(check_psd(qeye(G.shape[0]) * (u * u) - G))
+    return bool(check_psd(qeye(len(G)) * (u * u) - G))
 
 
 def norm_upper(X: Any) -> fmpq:
@@ -50,8 +43,7 @@ def norm_upper(X: Any) -> fmpq:
     X = qmat(X)
     if X.size == 0:
         return fmpq(0)
-    Xf = np.asarray(to_float(X), dtype=float)
-    f = float(np.linalg.norm(Xf, 2))
+    f = float(np.linalg.norm(to_float(X), 2))
     if f == 0.0 and all(v == 0 for v in X.flat):
         return fmpq(0)
     u = Q(dyadic(f * (1 + 2.0**-30) + 2.0**-40, 30))

@@ -1,0 +1,164 @@
+"""The claim model and builder (obsdesign.certify.claim): statuses, serialization, matches."""
+
+from __future__ import annotations
+
+import numpy as np
+from flint import fmpq
+
+from obsdesign.certify.claim import (
+    Claim,
+    Claims,
+    ClaimStatus,
+    exact_claim,
+    numerical_claim,
+)
+from obsdesign.certify.exact import qmat
+
+F = fmpq
+
+
+def test_status_values_and_ok():
+    assert [s.value for s in ClaimStatus] == ["certified", "numerical", "failed"]
+    c = exact_claim("a", "s", "r", "chk", 0, True, "d")
+    assert c.status is ClaimStatus.CERTIFIED and c.ok
+    assert exact_claim("a", "s", "r", "chk", 0, False, "d").ok is False
+    n = numerical_claim("b", "s", "r", "chk", 0, True, "d")
+    assert n.status is ClaimStatus.NUMERICAL and n.ok
+    assert numerical_claim("b", "s", "r", "chk", 0, False, "d").ok is False
+
+
+def test_exact_and_numerical_claim_fields():
+    c = exact_claim("id1", "stmt", "ref", "check", F(1, 3), True, "det", float_ok=False)
+    assert c == Claim(
+        id="id1",
+        statement="stmt",
+        reference="ref",
+        check="check",
+        margin="1/3",
+        status=ClaimStatus.CERTIFIED,
+        detail="det",
+        float_ok=False,
+        extra={},
+    )
+    assert exact_claim("i", "s", "r", "c", 0, True, "d").float_ok is None
+    n = numerical_claim("id2", "stmt", "ref", "check", 0.5, False, "det")
+    assert n == Claim(
+        id="id2",
+        statement="stmt",
+        reference="ref",
+        check="check",
+        margin="0.5",
+        status=ClaimStatus.FAILED,
+        detail="det",
+        float_ok=False,
+        extra={},
+    )
+    assert numerical_claim("i", "s", "r", "c", 0, True, "d").float_ok is True
+
+
+def test_to_dict_and_back():
+    c = exact_claim("id1", "stmt", "ref", "check", 2, True, "det", float_ok=True)
+    d = c.to_dict()
+    assert d == {
+        "id": "id1",
+        "statement": "stmt",
+        "reference": "ref",
+        "check": "check",
+        "margin": "2",
+        "status": "certified",
+        "detail": "det",
+        "float_ok": True,
+    }
+    assert isinstance(d["status"], str) and type(d["status"]) is str
+    assert Claim.from_dict(d) == c
+    c.extra["x"] = [1, 2]
+    d = c.to_dict()
+    assert d["extra"] == {"x": [1, 2]}
+    assert Claim.from_dict(d) == c
+    minimal = {
+        "id": 5,
+        "statement": "s",
+        "reference": "r",
+        "check": "c",
+        "margin": 0,
+        "status": "failed",
+    }
+    m = Claim.from_dict(minimal)
+    assert m == Claim("5", "s", "r", "c", "0", ClaimStatus.FAILED, "", None, {})
+    assert m.detail == "" and m.float_ok is None and m.extra == {}
+
+
+def test_claims_builder():
+    cs = Claims()
+    a = cs.exact(id="a", statement="s", reference="r", check="c", passed=True)
+    assert a.status is ClaimStatus.CERTIFIED and a.margin == "0" and a.detail == ""
+    assert a.float_ok is None
+    b = cs.exact(
+        id="b",
+        statement="s",
+        reference="r",
+        check="c",
+        passed=False,
+        margin=F(1, 2),
+        detail="d",
+        float_ok=True,
+    )
+    assert (b.status, b.margin, b.detail, b.float_ok) == (ClaimStatus.FAILED, "1/2", "d", True)
+    n = cs.numerical(id="n", statement="s", reference="r", check="c", passed=True)
+    assert n.status is ClaimStatus.NUMERICAL and n.margin == "0" and n.detail == ""
+    n2 = cs.numerical(
+        id="n2", statement="s", reference="r", check="c", passed=False, margin=3, detail="dd"
+    )
+    assert (n2.status, n2.margin, n2.detail) == (ClaimStatus.FAILED, "3", "dd")
+    f = cs.failed(id="f", statement="s", reference="r", detail="missing")
+    assert f == Claim("f", "s", "r", "presence", "0", ClaimStatus.FAILED, "missing", False, {})
+    assert list(cs) == [a, b, n, n2, f]
+    assert [c.id for c in cs] == ["a", "b", "n", "n2", "f"]
+
+
+def test_matches_equal_adds_nothing():
+    cs = Claims()
+    assert cs.matches("L", [[F(1, 2)], ["-1/3"]], qmat([[0.5], [F(-1, 3)]]), "[method].L") is True
+    assert cs.matches("lam", "9/10", F(9, 10), "[method].lambda") is True
+    assert cs.matches("lam", 0.5, "1/2", "[method].lambda") is True
+    assert cs.matches("mode", "abc", "abc", "[method].mode") is True
+    assert cs.matches("xs", (1, 2), [F(1), F(2)], "[x]") is True
+    assert len(cs) == 0
+
+
+def test_matches_differs_adds_a_failed_claim():
+    cs = Claims()
+    assert (
+        cs.matches(
+            "L", [[F(1, 2)], [F(-1, 3)]], [[F(1, 2)], [F(-1, 3) + F(1, 10**40)]], "[method].L"
+        )
+        is False
+    )
+    (c,) = cs
+    assert c == Claim(
+        id="L-matches-spec",
+        statement="the reported L is the one the spec fixes ([method].L)",
+        reference="spec [method].L",
+        check="exact equality",
+        margin="0",
+        status=ClaimStatus.FAILED,
+        detail="the report's L differs from the spec's [method].L",
+        float_ok=False,
+        extra={},
+    )
+    assert cs.matches("lam", 0.9, "9/10", "[method].lambda") is False  # 0.9 is binary
+    assert cs.matches("mode", "abc", "abd", "[method].mode") is False
+    assert cs.matches("shape", [[1, 2]], [[1], [2]], "[x]") is False
+    assert cs.matches("len", [1, 2], [1, 2, 3], "[x]") is False
+    assert cs.matches("arr", np.array([1, 2], dtype=object), [1, 3], "[x]") is False
+    assert cs.matches("scalar-vs-list", 1, [1], "[x]") is False
+    assert [c.id for c in cs] == [
+        "L-matches-spec",
+        "lam-matches-spec",
+        "mode-matches-spec",
+        "shape-matches-spec",
+        "len-matches-spec",
+        "arr-matches-spec",
+        "scalar-vs-list-matches-spec",
+    ]
+    assert all(c.status is ClaimStatus.FAILED for c in cs)

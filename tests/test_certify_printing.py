@@ -1,0 +1,119 @@
+"""Safe-direction printing of numbers in claim statements (obsdesign.certify.printing).
+
+Every printed string is parsed back exactly and compared with the value: ``fmt_up`` is ≥ it,
+``fmt_down`` ≤ it, ``fmt_exact`` equal, with the stated number of significant digits.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+import pytest
+from flint import fmpq
+from hypothesis import given
+from hypothesis import strategies as st
+
+from obsdesign.certify.printing import fmt_down, fmt_exact, fmt_up
+
+F = fmpq
+
+
+def parse(s: str) -> fmpq:
+    fr = Fraction(s)
+    return F(fr.numerator, fr.denominator)
+
+
+KNOWN = [
+    # (value, digits, fmt_up, fmt_down)
+    (F(1, 3), 6, "0.333334", "0.333333"),
+    (F(-1, 3), 6, "-0.333333", "-0.333334"),
+    (F(2, 3), 2, "0.67", "0.66"),
+    (F(123456789), 6, "123457000", "123456000"),
+    (F(10**13 + 1), 3, "1.01e13", "1e13"),
+    (F(-(10**13) - 1), 3, "-1e13", "-1.01e13"),
+    (F(1, 10**7) + F(1, 10**12), 2, "1.1e-7", "1e-7"),
+    (F(1, 10**7), 2, "1e-7", "1e-7"),
+    (F(1), 6, "1", "1"),
+    (F(100), 6, "100", "100"),
+    (F(1, 10**6), 6, "0.000001", "0.000001"),
+    (F(1, 10**500), 3, "1e-400", "0"),  # below the 1e-400 floor: still on the safe side
+    (F(385360653, 536870912), 5, "0.7178", "0.71779"),  # issue 15: μ printed as 0.71779
+    (F(999999), 3, "1000000", "999000"),
+    (F(1999, 2), 3, "1000", "999"),
+    (F(-5, 10**8), 2, "-5e-8", "-5e-8"),
+    (F(12345678901234), 20, "1.2345678901234e13", "1.2345678901234e13"),
+    (F(1, 7), 1, "0.2", "0.1"),
+    (F(10**12), 3, "1000000000000", "1000000000000"),
+    (F(123, 10**6), 2, "0.00013", "0.00012"),
+    (F(0), 3, "0", "0"),
+    (F(1000001, 1000), 4, "1001", "1000"),
+    (F(-999, 1000), 2, "-0.99", "-1"),
+]
+
+
+@pytest.mark.parametrize(("q", "digits", "up", "down"), KNOWN)
+def test_known_strings(q: fmpq, digits: int, up: str, down: str):
+    assert fmt_up(q, digits) == up
+    assert fmt_down(q, digits) == down
+    assert parse(up) >= q >= parse(down)
+
+
+def test_default_digits_and_inputs():
+    assert fmt_up(F(1, 3)) == "0.333334" and fmt_down(F(1, 3)) == "0.333333"
+    assert fmt_up("1/3", 2) == "0.34" and fmt_down(0.1, 3) == "0.1"
+    assert fmt_up(0.1, 20) == "0.10000000000000000556"  # the float's exact binary value
+
+
+EXACT = [
+    (F(1, 4), "0.25"),
+    (F(1, 3), "1/3"),
+    (F(5), "5"),
+    (F(-187, 100), "-1.87"),
+    (F(1, 2**40), "1/1099511627776"),
+    (F(3, 10**45), "3/" + "1" + "0" * 45),
+    (F(10**20), "1e20"),
+    (F(0), "0"),
+    (F(1, 2**20), "9.5367431640625e-7"),
+    (F(7, 5**10), "7.168e-7"),
+    (F(10**31 + 1), "10000000000000000000000000000001"),
+    (F(-3, 8), "-0.375"),
+    (F(1, 6), "1/6"),
+    (F(1, 10), "0.1"),
+    (F(3, 50), "0.06"),
+    (F(7, 20), "0.35"),
+    (F(123456789, 1000), "123456.789"),
+    (F(1, 5**13), "8.192e-10"),
+]
+
+
+@pytest.mark.parametrize(("q", "s"), EXACT)
+def test_fmt_exact_known(q: fmpq, s: str):
+    assert fmt_exact(q) == s
+    assert parse(s) == q
+
+
+finite = st.builds(
+    lambda p, q, e: F(p, q) * F(10) ** e,
+    st.integers(-(10**9), 10**9),
+    st.integers(1, 10**6),
+    st.integers(-30, 30),
+)
+
+
+@given(finite, st.integers(1, 12))
+def test_safe_direction_and_tight(q: fmpq, digits: int):
+    up, down = parse(fmt_up(q, digits)), parse(fmt_down(q, digits))
+    assert down <= q <= up
+    if q != 0:
+        # one unit in the last of `digits` significant digits
+        assert up - down <= abs(q) * F(10) ** (1 - digits) * 10
+        assert up - q <= abs(q) * F(10) ** (1 - digits)
+        assert q - down <= abs(q) * F(10) ** (1 - digits)
+    for s in (fmt_up(q, digits), fmt_down(q, digits)):
+        mant = s.lstrip("-").split("e")[0].replace(".", "").strip("0")
+        assert len(mant) <= digits
+
+
+@given(finite)
+def test_exact_roundtrip(q: fmpq):
+    assert parse(fmt_exact(q)) == q
