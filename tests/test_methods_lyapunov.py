@@ -176,7 +176,7 @@ C = [[1, 1]]
 [method]
 key = "lyapunov"
 L = [0, 0]
-alpha = 0.5
+alpha = 0.9
 margin = 0.01
 """
 
@@ -205,14 +205,11 @@ def _decay_ok(spec, name: str, rate_key: str):  # noqa: ANN001, ANN202
     return ok
 
 
-def _tamper_decay(p: Parameters, spec, pkey: str, rkey: str) -> None:  # noqa: ANN001
-    """P − t·e₁e₁ᵀ with t just past the edge of the decay LMI."""
-    P0, rate = (
-        p[pkey],
-        Q(p[rkey] if spec.options.rate is None or rkey != "lambda" else spec.options.rate),
-    )
+def _tamper_decay(p: Parameters, spec, pkey: str, rkey: str, row: int = 0) -> None:  # noqa: ANN001
+    """P − t·eᵢeᵢᵀ (i = row) with t just past the edge of the decay LMI."""
+    P0, rate = p[pkey], Q(p[rkey])  # the untampered rate (equal to the spec's when it asks one)
     ok = _decay_ok(spec, pkey, rkey)
-    E = qmat([[1, 0], [0, 0]])
+    E = qmat([[1 - row, 0], [0, row]])
 
     def at(t: fmpq) -> np.ndarray:
         return P0 - E * t
@@ -312,6 +309,13 @@ TAMPERS: list[tuple[str, str, Callable, set[str]]] = [
         {"L-matches-spec"},
     ),
     ("lambda-matches-spec", "sec5", _set("lambda", lambda v, s: v + EPS), {"lambda-matches-spec"}),
+    ("alpha-matches-spec", "cont", _set("alpha", lambda v, s: v + EPS), {"alpha-matches-spec"}),
+    (
+        "decay-lmi continuous",
+        "cont",
+        lambda p, s: _tamper_decay(p, s, "P", "alpha", row=1),
+        {"decay-lmi"},
+    ),
     # far off: the checks must use the spec's rate, not the report's
     (
         "lambda-matches-spec far",
