@@ -1,0 +1,139 @@
+"""Known answers and direction tests of the search-space interval kernel (exact oracles, not
+floats): every enclosure contains the exact value, exact results stay exact, non-Lipschitz
+primitives give unbounded derivatives, and the Lipschitz / sup bounds are valid and tight on
+functions with known constants."""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+
+import numpy as np
+import pytest
+from flint import fmpq
+from hypothesis import given
+from hypothesis import strategies as st
+
+from obsdesign.methods.searchspace import bounds as B
+from obsdesign.methods.searchspace.intervals import (
+    ONE,
+    ZERO,
+    Dual,
+    I,
+    add_hi,
+    add_lo,
+    d_abs,
+    d_frac,
+    d_max,
+    d_step,
+    evaluate,
+    mul_hi,
+    mul_lo,
+    sqrt_hi,
+    sqrt_lo,
+)
+from obsdesign.spec.expr import parse_expr
+
+floats = st.floats(min_value=-1e6, max_value=1e6, allow_nan=False).filter(lambda x: x != 0)
+
+
+@given(floats, floats)
+def test_add_mul_directed(a, b):
+    s, p = Fraction(a) + Fraction(b), Fraction(a) * Fraction(b)
+    assert Fraction(add_lo(a, b)) <= s <= Fraction(add_hi(a, b))
+    assert Fraction(mul_lo(a, b)) <= p <= Fraction(mul_hi(a, b))
+    # one ulp at most
+    assert add_hi(a, b) <= math.nextafter(a + b, math.inf)
+    assert mul_lo(a, b) >= math.nextafter(a * b, -math.inf)
+
+
+def test_exact_results_stay_exact():
+    assert mul_lo(1.0, 0.75) == mul_hi(1.0, 0.75) == 0.75
+    assert add_lo(0.5, 0.25) == add_hi(0.5, 0.25) == 0.75
+    assert sqrt_lo(4.0) == sqrt_hi(4.0) == 2.0
+    assert Fraction(sqrt_lo(2.0)) ** 2 < 2 < Fraction(sqrt_hi(2.0)) ** 2
+    x = I.of_q(fmpq(1, 10))
+    assert Fraction(x.lo) < Fraction(1, 10) < Fraction(x.hi)
+
+
+def test_interval_ops_known_answers():
+    z = I(-1.0, 2.0)
+    assert z.sqr() == I(0.0, 4.0)
+    assert z.abs() == I(0.0, 2.0)
+    assert (I(1.0, 2.0) / I(0.5, 1.0)) == I(1.0, 4.0)
+    assert (I(1.0, 2.0) / z).lo == -math.inf
+    assert (z * I(-3.0, 1.0)) == I(-6.0, 3.0)
+
+
+def _d(lo: float, hi: float) -> Dual:
+    return Dual(I(lo, hi), (ONE,))
+
+
+def test_clarke_rules():
+    assert d_abs(_d(-1.0, 1.0)).g == (I(-1.0, 1.0),)
+    assert d_abs(_d(1.0, 2.0)).g == (ONE,)
+    assert d_max(_d(-1.0, 1.0), Dual(ZERO, (ZERO,))).g == (I(0.0, 1.0),)
+    assert d_max(_d(1.0, 2.0), Dual(ZERO, (ZERO,))).g == (ONE,)
+    assert d_step(_d(-1.0, 1.0)).g[0].hi == math.inf  # a jump: not Lipschitz
+    assert d_step(_d(0.5, 1.0)).g == (ZERO,) and d_step(_d(0.5, 1.0)).v == ONE
+    assert d_step(_d(-1.0, 0.0)).v == ZERO  # step(0) = 0: no jump inside [-1, 0]
+    assert d_frac(_d(0.2, 0.7)).v.lo >= 0.2 - 1e-15 and d_frac(_d(0.2, 0.7)).g == (ONE,)
+    assert d_frac(_d(0.5, 1.5)).v == I(0.0, 1.0)
+
+
+def _enc(text: str, box: dict[str, tuple[float, float]]):
+    ex = parse_expr(text, list(box))
+    env = {k: Dual(I(*v), tuple(ONE if j == k else ZERO for j in box)) for k, v in box.items()}
+    return evaluate(ex.tree, env, {}, len(box), ex.source)
+
+
+def test_patterns_and_literals():
+    d = _enc("x1*step(x1)", {"x1": (-1.0, 1.0)})
+    assert d.v == I(0.0, 1.0) and d.g == (I(0.0, 1.0),)
+    assert _enc("t/3 - floor(t/3)", {"t": (0.0, 9.0)}).v == I(0.0, 1.0)
+    assert _enc("0.5*x", {"x": (-1.0, 1.0)}).v == I(-0.5, 0.5)  # 0.5 exact, 0.1 would widen
+    v = _enc("0.1*x", {"x": (1.0, 1.0)}).v
+    assert Fraction(v.lo) <= Fraction(1, 10) <= Fraction(v.hi) and v.lo < v.hi
+    assert _enc("x*step(y)", {"x": (1.0, 2.0), "y": (-1.0, 1.0)}).g[1].hi == math.inf
+
+
+@pytest.mark.parametrize(
+    ("f", "true_L", "slack"),
+    [
+        ("sin(x1) + 0.5*x2", math.sqrt(1.25), 1.01),
+        ("abs(x1 - x2)", math.sqrt(2), 1.0 + 1e-12),
+        # the box enclosure of co{(1, 0), (0, 1)} contains (1, 1): √2 near the diagonal
+        ("max(x1, x2)", 1.0, math.sqrt(2) * (1 + 1e-12)),
+    ],
+)
+def test_lipschitz_valid_and_tight(f, true_L, slack):
+    ex = [parse_expr(f, ["x1", "x2"])]
+    b = B.lipschitz(ex, ["x1", "x2"], ["x1", "x2"], [-1, -1], [1, 1], 60, 1e-3)
+    assert b.upper >= true_L * (1 - 1e-12)  # never below the true constant
+    assert b.lower_est <= true_L * (1 + 1e-6)
+    assert b.upper <= true_L * slack
+
+
+def test_lipschitz_of_a_jump_is_infinite():
+    ex = [parse_expr("step(x1)", ["x1"])]
+    b = B.lipschitz(ex, ["x1"], ["x1"], [-1], [1], 50, 1e-3)
+    assert not b.finite
+
+
+def test_sup_norm_and_range():
+    ex = [parse_expr("x1*x2", ["x1", "x2"]), parse_expr("x1", ["x1", "x2"])]
+    b = B.sup_norm(ex, ["x1", "x2"], [-1, -2], [1, 2], 100, 1e-6)
+    assert b.upper >= math.sqrt(5) and b.upper <= math.sqrt(5) * (1 + 1e-12)
+    u = [parse_expr("0.5*sin(t)", ["t"])]
+    ok, _, _ = B.range_inside(u, "t", 0, 8, [fmpq(-1, 2)], [fmpq(1, 2)], 64)
+    assert ok
+    ok, excess, _ = B.range_inside(u, "t", 0, 8, [fmpq(-1, 2)], [fmpq(49, 100)], 64)
+    assert not ok and excess > 0
+
+
+def test_norm_upper_is_an_upper_bound():
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        A = rng.normal(size=(3, 3))
+        J = [[I(v, v) for v in row] for row in A]
+        assert B.norm_upper_iv(J) >= np.linalg.norm(A, 2) * (1 - 1e-12)
