@@ -156,9 +156,12 @@ def test_error_report_verifies_as_failed(good):
     assert "not detectable" in rep.failed[0].detail
 
 
-def test_bad_verdict_value_is_refused(good, tmp_path: Path):
+@pytest.mark.parametrize("verdict", ["great", "", None, 0])
+def test_bad_verdict_value_is_refused(good, tmp_path: Path, verdict):
     d = copy.deepcopy(good)
-    d["verdict"] = "great"
+    d["verdict"] = verdict
+    if verdict is None:
+        del d["verdict"]
     p = tmp_path / "r.json"
     p.write_text(json.dumps(d))
     res = runner.invoke(app, ["verify", str(p)])

@@ -182,9 +182,12 @@ class Report:
             )
         if not isinstance(d["spec"], str) or not isinstance(d["spec_sha256"], str):
             raise InputError(f"{file}: 'spec' must be the spec text and 'spec_sha256' its hash")
-        verdict = d.get("verdict", "")
-        if verdict not in ("", "error", *VERDICTS.values()):
+        verdict = d.get("verdict")
+        if verdict is None and _version(d["schema_version"]) >= (1, 1):
+            raise InputError(f"{file}: key 'verdict' is missing")
+        if verdict is not None and verdict not in ("error", *VERDICTS.values()):
             raise InputError(f"{file}: unknown verdict {verdict!r}")
+        verdict = verdict or ""
         err = d.get("error")
         if verdict == "error" or err is not None:
             if not (
@@ -222,6 +225,13 @@ class Report:
             ),
             problems,
         )
+
+
+def _version(v: Any) -> tuple[int, ...]:
+    try:
+        return tuple(int(x) for x in str(v).split(".")[:2])
+    except ValueError:
+        return (0,)
 
 
 def _typed(d: dict[str, Any], key: str, kind: type, file: str) -> Any:
