@@ -49,7 +49,9 @@ def _vector(v: Any, name: str) -> list[fmpq]:
 
 
 def certify(spec: Spec, params: Parameters) -> list[Claim]:
-    """All claims of the method (see the module docstring); never trusts a stored status."""
+    """Every inequality of Lemma 1, Lemma 2 and Theorem 1, the constants on E and the input
+    range, recomputed from ``spec`` and the report's ``params`` (see the module docstring);
+    never trusts a stored status."""
     o: Options = spec.options
     s = spec.system
     c = Claims()

@@ -49,7 +49,10 @@ class Constants:
 
 
 def round_up_q(x: float | fmpq, digits: int) -> fmpq:
-    """The decimal with ``digits`` significant digits just above ``x`` (exact)."""
+    """The decimal with ``digits`` significant digits just above ``x`` (exact): a rounded-up
+    constant is still a Lipschitz constant / bound for Lemmas 1-2 and Theorem 1.
+
+    ``x``: the value; ``digits``: significant digits."""
     return Q(fmt_up(Q(x), digits))
 
 
@@ -70,8 +73,11 @@ def _compute(kind: str, spec: Spec, budget: int, rtol: float) -> bounds.Bound:
 
 
 def interval_bound(kind: str, spec: Spec) -> bounds.Bound:
-    """Certified bound of ``kind`` ∈ {L_f, L_h, f_sup} on E (× U). A deterministic function of
-    the spec text, so it is cached per text (design and certify compute it once)."""
+    """Certified bound of ``kind`` ∈ {L_f, L_h, f_sup} on E (× U): L_f^E, L_h^E, ‖f_u‖_E of
+    Lemma 1, Lemma 2 and Theorem 1. A deterministic function of the spec text, so it is cached
+    per text (design and certify compute it once).
+
+    ``kind``: which constant; ``spec``: the bound spec."""
     o: Options = spec.options
     key = (kind, spec.text, o.bound_boxes, o.bound_rtol)
     if key not in _CACHE:
@@ -82,8 +88,10 @@ def interval_bound(kind: str, spec: Spec) -> bounds.Bound:
 
 
 def constants(spec: Spec) -> Constants:
-    """L_f, L_h, ‖f_u‖ on E: the user's values where given, else the certified interval
-    bounds rounded up to ``digits`` significant digits."""
+    """L_f^E, L_h^E, ‖f_u‖_E (Lemma 1, Lemma 2, Theorem 1) on E: the user's values where given,
+    else the certified interval bounds rounded up to ``digits`` significant digits.
+
+    ``spec``: the bound spec (its options give E, U, the budget and the given values)."""
     o: Options = spec.options
     vals: dict[str, fmpq] = {}
     bs: dict[str, bounds.Bound | None] = {}
@@ -114,12 +122,16 @@ _NAMES = {"L_f": "L_f^E", "L_h": "L_h^E", "f_sup": "‖f_u‖_E"}
 
 
 def exp_upper(x: fmpq) -> fmpq:
-    """A rational ≥ e^x."""
+    """A rational ≥ e^x (113-bit outward rounding), for γ_i e^{L_f Δτ}/2 of Theorem 1.
+
+    ``x``: an exact rational."""
     return ivq.upper(iv.exp, x)
 
 
 def exp_lower(x: fmpq) -> fmpq:
-    """A rational ≤ e^x."""
+    """A rational ≤ e^x (113-bit outward rounding), for γ_i e^{L_f Δτ}/2 of Theorem 1.
+
+    ``x``: an exact rational."""
     return ivq.lower(iv.exp, x)
 
 
@@ -179,7 +191,11 @@ def params_from(
     dtau: fmpq,
     gam: list[fmpq],
 ) -> dict[str, Any]:
-    """The report's parameters (JSON keys of the issue) from their exact values."""
+    """The report's parameters from their exact values: the constants, κ, γ⋆, ε⋆ = γ⋆/κ, ΔT,
+    K, Δτ and the schedules γ_i, ε_i = γ_i/κ of Theorem 1 (hypotheses 1-3).
+
+    ``L_f``, ``L_h``, ``F`` (= ‖f_u‖_E), ``kappa``, ``gamma_star``, ``dT``, ``K``, ``dtau``:
+    exact values; ``gam``: the γ schedule."""
     return {
         "L_f": L_f,
         "L_h": L_h,
@@ -196,7 +212,10 @@ def params_from(
 
 
 def design_params(spec: Spec) -> tuple[dict[str, Any], list[str]]:
-    """Constants and parameter rules; notes on tightness and on what the user gave."""
+    """Constants and the parameter rules of Theorem 1 (with Lemma 1 and Lemma 2); notes on the
+    tightness of each constant and on what the user gave.
+
+    ``spec``: the bound spec."""
     o: Options = spec.options
     c = constants(spec)
     vals = rules(c, o)
