@@ -473,3 +473,17 @@ def test_l2_formula_known_answer() -> None:
     assert check_pd(-lmis.l2_gain(A, C, Bd, _q([[1]]), X, 1 + fmpq(1, 2**20), False)).ok
     for p in (fmpq(1, 2), fmpq(1), fmpq(2)):
         assert not check_pd(-lmis.l2_gain(A, C, Bd, _q([[p]]), X, fmpq(1), False)).ok
+
+
+def test_r_bound_instead_of_gain_bound() -> None:
+    """r_bound alone (no gain bound) also makes the best λ finite; R ⪯ r_bound·I is certified
+    and a reported R just above the bound fails exactly that claim."""
+    text = EX1.read_text().replace("gain_bound = 100", "r_bound = 100\nlambda_tol = 0.01")
+    rep = api.design(api.load_spec_text(text, "r.toml"))
+    _certified(rep)
+    ids = {c.id for c in rep.claims}
+    assert "r-bound" in ids and "gain-bound" not in ids
+    assert rep.parameters["r_bound"] == 100
+    d = rep.to_dict()
+    _set(d, "R", np.array([[fmpq(100) + TINY]], dtype=object))
+    assert _failed(d) == {"r-bound"}

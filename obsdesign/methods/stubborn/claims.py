@@ -60,7 +60,7 @@ def point_checks(
 ) -> dict[str, PSDResult]:
     """The exact checks of one point of LMIs (1)-(3) / (7)-(9) with X = P K (K the gain that is
     reported, so the LMIs are checked in the original variables): P ≻ 0, u, w > 0, R ≻ 0, λ in
-    range, the three LMIs, and ‖K‖₂ ≤ gain_bound in full mode."""
+    range, the three LMIs, ‖K‖₂ ≤ gain_bound in full mode, R ⪯ r_bound·I when given."""
     o: Options = spec.options
     s = spec.system
     A, C, disc = s.A.q, s.C.q, s.discrete
@@ -80,13 +80,18 @@ def point_checks(
         if not (r := check_pd(lmis.sector(P, Y, w, i)))
     ]
     out["lmi-sector"] = PSDResult(not bad, 0.0, "; ".join(bad) or f"{s.p} block(s), all pivots > 0")
-    if o.K is None:
-        p = K.shape[1]
-        G = np.full((p, p), fmpq(0), dtype=object)
-        for i in range(p):
-            G[i, i] = o.gain_bound * o.gain_bound
-        out["gain-bound"] = check_psd(G - K.T @ K)
+    if o.K is None and o.gain_bound is not None:
+        out["gain-bound"] = check_psd(_scaled_eye(K.shape[1], o.gain_bound**2) - K.T @ K)
+    if o.r_bound is not None:
+        out["r-bound"] = check_psd(_scaled_eye(R.shape[0], o.r_bound) - R)
     return out
+
+
+def _scaled_eye(p: int, c: fmpq) -> np.ndarray:
+    G = np.full((p, p), fmpq(0), dtype=object)
+    for i in range(p):
+        G[i, i] = c
+    return G
 
 
 def point_failures(spec: Spec, cand: dict[str, Any], with_l2: bool) -> list[str]:
@@ -150,10 +155,11 @@ def lmi_claims(
             reference="spec [method].criterion",
             detail=f"report says {crit!r}, the spec {o.criterion!r}",
         )
-    if o.K is None and "gain_bound" in pr:
-        gb = pr.exact("gain_bound", c)
-        if gb is not None:
-            c.matches("gain_bound", gb, o.gain_bound, "[method].gain_bound")
+    for key, fixed in (("gain_bound", o.gain_bound), ("r_bound", o.r_bound)):
+        if key in pr:
+            v = pr.exact(key, c)
+            if v is not None:
+                c.matches(key, v, fixed, f"[method].{key}")
     P, K = pt["P"], pt["K"]
     X = P @ K
     eq = all(X[i, j] == Xr[i, j] for i in range(n) for j in range(p))
@@ -177,7 +183,8 @@ def lmi_claims(
         "lmi-regional": (f"LMI {eqs[0]} holds strictly at λ = {fmt_exact(lam)} with K = P⁻¹X", f"eq. {eqs[0]}", "exact LDLᵀ of −M (all pivots > 0)"),
         "lmi-global": (f"LMI {eqs[1]} holds strictly", f"eq. {eqs[1]}", "exact LDLᵀ of −M (all pivots > 0)"),
         "lmi-sector": (f"LMI {eqs[2]} holds (strictly) for every output i = 1..{p}", f"eq. {eqs[2]}", "exact LDLᵀ of each [[P, Y_iᵀ], [Y_i, w_i]]"),
-        "gain-bound": (f"‖K‖₂ ≤ {fmt_exact(o.gain_bound)} ([method].gain_bound)", "optimized parameter selection (the bound that makes the best λ finite)", "exact LDLᵀ of bound²·I − KᵀK (⪰ 0)"),
+        "r-bound": (f"R ⪯ {fmt_exact(o.r_bound or 0)}·I ([method].r_bound)", "optimized parameter selection (the bound that makes the best λ finite)", "exact LDLᵀ of r_bound·I − R (⪰ 0)"),
+        "gain-bound": (f"‖K‖₂ ≤ {fmt_exact(o.gain_bound or 0)} ([method].gain_bound)", "optimized parameter selection (the bound that makes the best λ finite)", "exact LDLᵀ of bound²·I − KᵀK (⪰ 0)"),
     }  # fmt: skip
     for cid, r in res.items():
         st, ref, chk = text[cid]
@@ -229,7 +236,7 @@ def lambda_max_claims(spec: Spec, pr: Parameters) -> list[Claim]:
     c.exact(
         id="lambda-max-certified",
         statement=f"LMIs {eqs} hold at λ_max = {fmt_exact(lm)} (P, K, U, W, Y, R _at_max; with "
-        + ("‖K‖₂ ≤ gain bound)" if o.K is None else "the given K)"),
+        + ("the spec's bounds)" if o.K is None or o.r_bound is not None else "the given K)"),
         reference=f"{PAPER}, optimized parameter selection (first maximize λ)",
         check="exact LDLᵀ of every LMI and positivity condition at λ_max",
         passed=not bad,

@@ -61,7 +61,8 @@ def _problem(pl: Plant, o: Options, lam: Any, criterion: str | None, margin: flo
 
     ``criterion`` None: feasibility; ``R``: minimize λ_max(R); ``K``: minimize ‖X‖₂;
     ``l2``: minimize g with the bounded real lemma (g = γ², γ the L2 gain d → e).
-    Full mode adds ‖X‖₂ ≤ gain_bound (then ‖K‖₂ = ‖P⁻¹X‖₂ ≤ gain_bound)."""
+    Full mode adds ‖X‖₂ ≤ gain_bound (then ‖K‖₂ = ‖P⁻¹X‖₂ ≤ gain_bound); r_bound adds
+    R ⪯ r_bound·I."""
     import cvxpy as cp
 
     A, C = pl.A, pl.C
@@ -100,9 +101,11 @@ def _problem(pl: Plant, o: Options, lam: Any, criterion: str | None, margin: flo
             [[P, Y[i : i + 1, :].T], [Y[i : i + 1, :], cp.reshape(w[i], (1, 1), order="C")]]
         )
         cons.append(sym(Mi) >> m * np.eye(n + 1))
-    if o.K is None:
+    if o.K is None and o.gain_bound is not None:
         gb = float(o.gain_bound) * (1 - 1e-6)  # strictly inside: the claim checks ‖K‖₂ ≤ bound
         cons.append(cp.bmat([[gb * np.eye(n), X], [X.T, gb * np.eye(p)]]) >> 0)
+    if o.r_bound is not None:
+        cons.append(R << float(o.r_bound) * (1 - 1e-6) * np.eye(p))
     obj: Any = cp.Minimize(0)
     extra: dict[str, Any] = {}
     if criterion == "R":
@@ -281,8 +284,10 @@ def design_params(
         )
     cand.update(vals)
     cand["criterion"] = o.criterion
-    if o.K is None:
+    if o.K is None and o.gain_bound is not None:
         cand["gain_bound"] = o.gain_bound
+    if o.r_bound is not None:
+        cand["r_bound"] = o.r_bound
     notes.append(f"solver margin {margin:g}")
     sr = SolverResult(f"cvxpy/{solver}", SolverStatus.OPTIMAL, "", time.perf_counter() - t0)
     return cand, sr, notes
@@ -383,10 +388,14 @@ def _infeasible(spec: Spec, pl: Plant, o: Options, where: str) -> None:
         )
     if o.K is not None:
         why = "the given K does not allow it (redesign: X = P K)"
-    elif o.lam is not None:
-        why = f"try a smaller λ or a larger gain_bound (now {float(o.gain_bound):g})"
     else:
-        why = f"(C, A) is detectable: raise gain_bound (now {float(o.gain_bound):g})"
+        bounds = ", ".join(
+            f"{k} (now {float(v):g})"
+            for k, v in (("gain_bound", o.gain_bound), ("r_bound", o.r_bound))
+            if v is not None
+        )
+        first = "try a smaller λ or raise " if o.lam is not None else "(C, A) is detectable: raise "
+        why = first + bounds
     raise InfeasibleError(f"stubborn: LMIs {_refs(pl)} infeasible {where}: {why}")
 
 

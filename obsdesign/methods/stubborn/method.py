@@ -118,6 +118,7 @@ class Stubborn(Method):
                 "lambda": {**num, "exclusiveMinimum": 0},
                 "lambda_fraction": {**num, "exclusiveMinimum": 0, "maximum": 1},
                 "gain_bound": {**num, "exclusiveMinimum": 0},
+                "r_bound": {**num, "exclusiveMinimum": 0},
                 "criterion": {"enum": list(_opts.CRITERIA)},
                 "margin": {**num, "exclusiveMinimum": 0},
                 "lambda_tol": {**num, "exclusiveMinimum": 0},

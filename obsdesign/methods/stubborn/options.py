@@ -35,7 +35,8 @@ class Options:
     K: the given gain (redesign; for high-gain the Hurwitz coefficients k_1..k_n).
     lam: a fixed λ (no search) or None; fraction: λ = fraction·λ_max (continuous time) or
     1 − λ = fraction·(1 − λ_best) (discrete time). gain_bound: ‖X‖₂ ≤ gain_bound with P ⪰ I
-    (hence ‖K‖₂ ≤ gain_bound) in full mode. criterion: R (min λ_max(R)), K (min ‖X‖₂),
+    (hence ‖K‖₂ ≤ gain_bound) in full mode (default 100, none when only r_bound is given).
+    r_bound: R ⪯ r_bound·I (optional). criterion: R (min λ_max(R)), K (min ‖X‖₂),
     l2 (min the L2 gain from d to e, bounded real lemma on A − KC with Bd).
     margin: strictness margin of the solver (LMIs are certified strict, exactly).
     """
@@ -44,7 +45,7 @@ class Options:
     K: np.ndarray | None
     lam: fmpq | None
     fraction: fmpq
-    gain_bound: fmpq
+    gain_bound: fmpq | None
     criterion: str
     margin: fmpq
     lambda_tol: fmpq
@@ -54,6 +55,9 @@ class Options:
     epsilon: fmpq | None = None
     #: high-gain: φ̂ = φ(clip(x̂, −state_bound, state_bound)) (bounded outside X); None: no clip
     state_bound: np.ndarray | None = None
+    #: R ⪯ r_bound·I in every solve (the other way to make the best λ finite); with it the gain
+    #: bound is off unless given too
+    r_bound: fmpq | None = None
 
 
 @dataclass
@@ -131,7 +135,10 @@ def parse_options(table: Table, spec: Spec) -> Options:
     ).q
     if lv is not None and table.has("lambda_fraction"):
         raise table.error("lambda_fraction", "give lambda (fixed) or lambda_fraction, not both")
-    gb = table.scalar("gain_bound", default=DEFAULT_GAIN_BOUND, min=0, strict_min=True).q
+    rb = table.scalar("r_bound", default=None, min=0, strict_min=True)
+    gb_default = None if rb is not None else DEFAULT_GAIN_BOUND
+    gbv = table.scalar("gain_bound", default=gb_default, min=0, strict_min=True)
+    gb = None if gbv is None else gbv.q
     if mode == "redesign" and table.has("gain_bound"):
         raise table.error("gain_bound", "the redesign keeps the given K: no gain bound to set")
     crit = table.str("criterion", default="R", choices=CRITERIA)
@@ -142,7 +149,9 @@ def parse_options(table: Table, spec: Spec) -> Options:
     margin = table.scalar("margin", default=DEFAULT_MARGIN, min=0, strict_min=True).q
     tol = table.scalar("lambda_tol", default=DEFAULT_LAMBDA_TOL, min=0, strict_min=True).q
     table.done()
-    return Options(mode, K, None if lv is None else lv.q, frac, gb, crit, margin, tol)
+    o = Options(mode, K, None if lv is None else lv.q, frac, gb, crit, margin, tol)
+    o.r_bound = None if rb is None else rb.q
+    return o
 
 
 def parse_sim(table: Table, spec: Spec) -> SimOptions:
