@@ -82,7 +82,7 @@ def bind(spec: Spec) -> Spec:
 
 
 def load_spec(path: str | Path) -> Spec:
-    """Read a spec file and bind its method (see :func:`bind`). Warnings raised while
+    """Read the spec file at ``path`` and bind its method (see :func:`bind`). Warnings raised while
     reading (numpy, scipy) are kept in ``spec.warnings`` rather than printed."""
     notes: list[str] = []
     with captured_warnings(notes):
@@ -92,7 +92,8 @@ def load_spec(path: str | Path) -> Spec:
 
 
 def load_spec_text(text: str, file: str = "<spec>") -> Spec:
-    """Parse spec text and bind its method (see :func:`bind`)."""
+    """Parse spec ``text`` and bind its method (see :func:`bind`); ``file`` names it in
+    error messages."""
     notes: list[str] = []
     with captured_warnings(notes):
         sp = bind(read_spec_text(text, file))
@@ -143,8 +144,9 @@ def design(
     progress: Progress | None = None,
     force: bool = False,
 ) -> Report:
-    """Design the observer of a spec and certify every claim; write the JSON report to
-    ``out`` (atomically) when given. Raises :class:`ObsdesignError` subclasses.
+    """Design the observer of ``spec`` (a path or a Spec) and certify every claim; write the
+    JSON report to ``out`` (atomically) when given; ``progress(message)`` is called as the
+    design advances. Raises :class:`ObsdesignError` subclasses.
 
     ``out`` is checked before anything runs (:func:`obsdesign.report.model.check_output`:
     never the spec itself, a symbolic link, a non-regular or a write-protected file unless
@@ -417,8 +419,8 @@ def _same_floats(a: Any, b: Any) -> bool:
 
 
 def compare_claims(reported: list[Claim], fresh: list[Claim]) -> list[Claim]:
-    """Failed claims for every difference between the report's claim list and the
-    recomputed one, compared on (id, statement, status); claims with the same id are paired
+    """Failed claims for every difference between the report's claim list (``reported``) and
+    the recomputed one (``fresh``), compared on (id, statement, status); claims with the same id are paired
     in order. Claims only ``verify`` makes (:data:`VERIFY_ONLY`) must not be in a report."""
     out: list[Claim] = []
     by_id: dict[str, list[Claim]] = {}
@@ -554,7 +556,8 @@ def simulate(
 
 
 def check_sim_memory(sp: Spec, kwargs: dict[str, Any]) -> None:
-    """Refuse a simulation whose trajectories would not fit: ``runs × steps × states``
+    """Refuse a simulation of the bound spec ``sp`` with the typed ``kwargs`` of ``simulate``
+    whose trajectories would not fit: ``runs × steps × states``
     doubles (plant, estimate, error and output per step) estimated before anything is
     allocated, against ``max_sim_bytes`` (:mod:`obsdesign.limits`). ``runs`` is the
     ``--option runs`` value, else the spec's, else 1; steps are the horizon (discrete time)
@@ -596,7 +599,7 @@ class CheckRow:
 
 
 def spec_files(paths: list[str | Path]) -> list[Path]:
-    """Expand folders to their ``*.toml`` files, subfolders included (sorted; hidden
+    """Expand the folders among ``paths`` to their ``*.toml`` files, subfolders included (sorted; hidden
     folders skipped); keep files as given."""
     out: list[Path] = []
     for p in map(Path, paths):
@@ -612,7 +615,7 @@ def spec_files(paths: list[str | Path]) -> list[Path]:
 
 
 def check_one(path: Path) -> CheckRow:
-    """Design, serialize, reload and verify one spec. Always returns a row: an error of any
+    """Design, serialize, reload and verify the spec at ``path``. Always returns a row: an error of any
     kind (bad input, solver failure, an internal error) becomes that row's exit code and
     message, so one spec never loses the others' rows (KeyboardInterrupt still stops)."""
     t0 = time.perf_counter()
@@ -697,7 +700,8 @@ def schema() -> dict[str, Any]:
 
 
 def plot_design(spec: str | Path | Spec, params: Parameters, path: str | Path) -> Any:
-    """The method's design plot (InputError when the method has none)."""
+    """The method's design plot of ``spec`` with ``params`` (a report's parameters), written
+    to ``path`` (InputError when the method has none)."""
     sp = _spec(spec)
     m = get_method(sp.method)
     if m.plot_design is None:
@@ -706,7 +710,8 @@ def plot_design(spec: str | Path | Spec, params: Parameters, path: str | Path) -
 
 
 def plot_simulation(spec: str | Path | Spec, result: SimResult, path: str | Path) -> Any:
-    """The method's simulation plot, or the generic one (estimation error over time)."""
+    """The method's simulation plot of ``spec`` and ``result`` written to ``path``, or the
+    generic one (estimation error over time)."""
     sp = _spec(spec)
     m = get_method(sp.method)
     if m.plot_simulation is not None:
