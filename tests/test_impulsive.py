@@ -105,6 +105,7 @@ def test_widest_kappa_widens() -> None:
         ({"M": "[[1, 0]]"}, "method.M"),
         ({"M": '"optimize"'}, "method.M"),
         ({"kappa": '"huge"'}, "method.kappa"),
+        ({"digits": "100000"}, "method.digits"),
     ],
 )
 def test_bad_method_input(edit: dict[str, str], key: str) -> None:
@@ -125,6 +126,14 @@ def test_bad_C_rank_and_Q() -> None:
         load_spec_text(bad_q, "q.toml")
     with pytest.raises(SpecError, match="psi"):
         load_spec_text(txt.replace('"0"]', '"__import__(1)"]'), "e.toml")
+
+
+def test_falsification_samples_capped() -> None:
+    from obsdesign.api import load_spec_text
+
+    txt = EXAMPLE.read_text(encoding="utf-8").replace("samples = 20000", "samples = 100000000")
+    with pytest.raises(SpecError, match="nonlinearity.falsify.samples"):
+        load_spec_text(txt, "s.toml")
 
 
 def test_empty_window_is_infeasible() -> None:

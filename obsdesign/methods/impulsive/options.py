@@ -26,6 +26,10 @@ from obsdesign.spec.reader import Table
 from .core import BlockData, LipschitzX, Problem
 from .dissipativity import QSR, qsr_lipschitz, qsr_sector
 
+#: most decimals of T_min / T_max (``digits``) and most sampled pairs of the falsification
+MAX_DIGITS = 30
+MAX_SAMPLES = 1_000_000
+
 
 @dataclass
 class FalsifySpec:
@@ -109,6 +113,8 @@ def parse_options(table: Table, spec: Spec) -> Options:
         kappa = table.scalar("kappa", min=0, strict_min=True).q
     scaling = table.str("qsr_scaling", default="optimize", choices=("optimize", "as-given"))
     digits = table.int("digits", default=4, min=1)
+    if digits > MAX_DIGITS:
+        raise table.error("digits", f"expected at most {MAX_DIGITS} decimals, got {digits}")
     table.done()
     nl = spec.tables.get("nonlinearity")
     if nl is None:
@@ -161,10 +167,13 @@ def _falsify(nl: Table, n: int) -> FalsifySpec | None:
     lo, hi = ft.vector("lower", n=n), ft.vector("upper", n=n)
     if not all(lo.q[i] < hi.q[i] for i in range(n)):
         raise ft.error("upper", "expected lower < upper in every coordinate")
+    samples = ft.int("samples", default=20000, min=10)
+    if samples > MAX_SAMPLES:
+        raise ft.error("samples", f"expected at most {MAX_SAMPLES} sampled pairs, got {samples}")
     fz = FalsifySpec(
         lo.f,
         hi.f,
-        ft.int("samples", default=20000, min=10),
+        samples,
         ft.int("seed", default=0, min=0),
         ft.str("on_violation", default="fail", choices=("fail", "warn")),
     )
@@ -247,7 +256,7 @@ def options_schema(key: str) -> dict[str, Any]:
             "M": {"anyOf": [MAT, {"enum": ["orthonormal", "optimize"]}]},
             "kappa": {"anyOf": [{**NUM, "exclusiveMinimum": 0}, {"enum": ["max", "widest"]}]},
             "qsr_scaling": {"enum": ["optimize", "as-given"]},
-            "digits": {"type": "integer", "minimum": 1},
+            "digits": {"type": "integer", "minimum": 1, "maximum": MAX_DIGITS},
         },
     }
 
