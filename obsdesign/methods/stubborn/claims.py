@@ -95,7 +95,9 @@ def _scaled_eye(p: int, c: fmpq) -> np.ndarray:
 
 
 def point_failures(spec: Spec, cand: dict[str, Any], with_l2: bool) -> list[str]:
-    """Names of the failed exact checks of a rounded candidate (the design's self-check)."""
+    """Names of the failed exact checks of a rounded candidate (the design's self-check): LMIs
+    (1)-(3) / (7)-(9) and positivity via :func:`point_checks`, plus the bounded-real-lemma LMI
+    when ``with_l2``."""
     res = point_checks(
         spec, cand["P"], cand["K"], cand["U"], cand["W"], cand["Y"], cand["R"], cand["lambda"]
     )
@@ -129,8 +131,9 @@ def _read_point(pr: Parameters, c: Claims, spec: Spec, suffix: str) -> dict[str,
 def lmi_claims(
     spec: Spec, params: dict[str, Any] | Parameters, full_check: bool = True
 ) -> list[Claim]:
-    """Every claim of a linear-mode design (full-stubborn or redesign); ``full_check`` False
-    skips the λ_max certificate and bracket."""
+    """Every claim of a linear-mode design (full-stubborn or redesign): the slides' Theorem
+    (LMIs (1)-(3) / (7)-(9) with K = P⁻¹X) and the optimized parameter selection, recomputed
+    from ``spec`` and ``params``; ``full_check`` False skips the λ_max certificate and bracket."""
     pr = params if isinstance(params, Parameters) else Parameters(params)
     o: Options = spec.options
     s = spec.system

@@ -137,7 +137,8 @@ def _problem(pl: Plant, o: Options, lam: Any, criterion: str | None, margin: flo
 
 
 def solve_cold(prob: Any) -> tuple[bool, str]:
-    """Clarabel without warm start (cvxpy's default warm start reuses the solver object of the
+    """Solve one LMI problem of the λ search (LMIs (1)-(3) / (7)-(9)) with Clarabel without warm
+    start (cvxpy's default warm start reuses the solver object of the
     previous λ, so the answer near the boundary would depend on the search's history; cold, the
     same λ always gives the same answer, here and in ``verify``). Returns (optimal, status)."""
     import cvxpy as cp
@@ -236,7 +237,10 @@ def _chosen(o: Options, best: fmpq, discrete: bool) -> fmpq:
 def design_params(
     spec: Spec, progress: Any = None
 ) -> tuple[dict[str, Any], SolverResult, list[str]]:
-    """Full-stubborn or redesign: λ search, criterion step, rounding, exact self-check."""
+    """Full-stubborn or redesign (slides' Theorem, LMIs (1)-(3) / (7)-(9), K = P⁻¹X): the λ
+    search ("first maximize λ"), λ at the fraction, the criterion step (min R, min K through X,
+    or the L2 gain), rounding and the exact self-check. ``spec``: the bound spec;
+    ``progress``: optional callback for status lines. Returns (parameters, solver info, notes)."""
     o: Options = spec.options
     pl = Plant.of(spec)
     t0 = time.perf_counter()

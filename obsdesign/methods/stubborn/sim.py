@@ -69,14 +69,16 @@ def run_errors(
     adaptive: np.ndarray,
     sigma0: float,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Integrate the errors of a batch of observers.
+    """Integrate the errors of a batch of observers: the error dynamics of the stubborn-observer
+    slides (Astolfi, Alessandri, Zaccarian, WUDS 2017), ė = Ae − K sat_σ(Ce + ν),
+    σ̄' = −λσ̄ + e_yᵀRe_y (discrete: e⁺ = …, σ̄⁺ = λσ̄ + e_yᵀRe_y), σ_i = √(σ̄/w_i).
 
     e0: (..., n) initial errors (broadcast); nu(k0, k1) -> (k1 − k0, ..., p) the output noise
     of steps k0..k1−1; levels (..., p): constant saturation levels (inf: Luenberger);
     adaptive (...,) bool: the stubborn observer's adaptive level instead. Continuous time:
-    Heun's method with ν held over each step. Returns the sums of e_i² over the grid
-    (for the RMSE, (..., n)), the final e and the trajectory of σ̄ of the first batch entry
-    is not kept here (see :func:`single_run`)."""
+    Heun's method with ν held over each step. Returns the sums of e_i² over the grid points
+    0..steps (for the RMSE, shape (..., n)), the final e and the final σ̄ (trajectories are
+    not kept: :func:`single_run` steps one at a time to record them)."""
     e = np.broadcast_to(e0, adaptive.shape + (g.A.shape[0],)).astype(float).copy()
     sb = np.where(adaptive, sigma0, 0.0)
     sq = e**2
