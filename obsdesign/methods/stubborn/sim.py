@@ -314,6 +314,12 @@ def simulate(
     if spec.options.mode == "high-gain":
         from obsdesign.methods.stubborn.highgain import simulate as hg
 
+        if study != "none":
+            raise InputError(
+                "--option study=outliers: the outlier study is for the linear modes (full, "
+                "redesign); the high-gain scenario is the spec's impulse and noise window"
+            )
+
         return hg(spec, params, observer=observer)
     if spec.system.A is None:
         raise InputError("stubborn simulation needs the linear model")
