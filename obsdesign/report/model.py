@@ -9,7 +9,6 @@ import stat
 import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from importlib import metadata
 from pathlib import Path
 from typing import Any
 
@@ -41,23 +40,32 @@ DEPS = ("numpy", "scipy", "cvxpy", "clarabel", "pycddlib", "python-flint", "mpma
 
 
 def tool_info() -> dict[str, Any]:
-    """Tool and dependency versions, recorded in every report."""
-    versions: dict[str, str] = {}
-    for d in DEPS:
+    """Tool and dependency versions, recorded in every report (computed once per process:
+    importlib.metadata costs milliseconds per package; a fresh copy is returned)."""
+    global _TOOL_INFO
+    if _TOOL_INFO is None:
+        from importlib import metadata
+
+        versions: dict[str, str] = {}
+        for d in DEPS:
+            try:
+                versions[d] = metadata.version(d)
+            except metadata.PackageNotFoundError:
+                versions[d] = "not installed"
         try:
-            versions[d] = metadata.version(d)
+            own = metadata.version("obsdesign")
         except metadata.PackageNotFoundError:
-            versions[d] = "not installed"
-    try:
-        own = metadata.version("obsdesign")
-    except metadata.PackageNotFoundError:
-        own = "unknown"
-    return {
-        "name": "obsdesign",
-        "version": own,
-        "python": platform.python_version(),
-        "dependencies": versions,
-    }
+            own = "unknown"
+        _TOOL_INFO = {
+            "name": "obsdesign",
+            "version": own,
+            "python": platform.python_version(),
+            "dependencies": versions,
+        }
+    return {**_TOOL_INFO, "dependencies": dict(_TOOL_INFO["dependencies"])}
+
+
+_TOOL_INFO: dict[str, Any] | None = None
 
 
 @dataclass

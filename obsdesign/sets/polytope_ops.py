@@ -26,22 +26,47 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from flint import fmpq
-from scipy.spatial import ConvexHull, QhullError
 
-try:  # pragma: no cover - depends on the pycddlib build
-    import cdd
-    import cdd.gmp as cddg
+if TYPE_CHECKING:
+    from scipy.spatial import ConvexHull
 
-    HAVE_GMP = True
-except ImportError:  # pragma: no cover
-    import cdd
+# scipy.spatial (qhull) and pycddlib are imported on first use, not with this module (issue
+# 12 item 3: `import obsdesign.api` must not pay for them when the method does not use them).
+# ``HAVE_GMP``, ``cdd`` and ``cddg`` are module attributes resolved on first access
+# (:func:`__getattr__`); a value set from outside (monkeypatch) is kept.
+_CDD_LOADED = False
 
-    cddg = None
-    HAVE_GMP = False
+
+def _load_cdd() -> None:
+    """Import pycddlib once and set ``cdd``, ``cddg`` (None without the gmp build) and
+    ``HAVE_GMP`` (unless already set, e.g. by a test)."""
+    global _CDD_LOADED
+    if _CDD_LOADED:
+        return
+    g = globals()
+    try:  # pragma: no cover - depends on the pycddlib build
+        import cdd as _cdd
+        import cdd.gmp as _cddg
+
+        have = True
+    except ImportError:  # pragma: no cover
+        import cdd as _cdd
+
+        _cddg, have = None, False
+    g["cdd"], g["cddg"] = _cdd, _cddg
+    g.setdefault("HAVE_GMP", have)
+    _CDD_LOADED = True
+
+
+def __getattr__(name: str) -> Any:
+    if name in ("cdd", "cddg", "HAVE_GMP"):
+        _load_cdd()
+        return globals()[name]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 class PolytopeError(ValueError):
@@ -72,12 +97,22 @@ class HullState:
     G: np.ndarray
 
 
+class _QhullFailed(Exception):
+    """qhull failed with and without joggled input (message: qhull's)."""
+
+
 def _qhull(points: np.ndarray) -> ConvexHull:
-    """qhull with default options, then with joggled input if the default run fails."""
+    """qhull with default options, then with joggled input if the default run fails
+    (raises :class:`_QhullFailed` when both fail). scipy.spatial is imported here."""
+    from scipy.spatial import ConvexHull, QhullError
+
     try:
         return ConvexHull(points)
     except QhullError:
-        return ConvexHull(points, qhull_options="QJ")
+        try:
+            return ConvexHull(points, qhull_options="QJ")
+        except QhullError as exc:
+            raise _QhullFailed(str(exc)) from exc
 
 
 def merge_rows(rows: np.ndarray, tol: float = 1e-10) -> tuple[np.ndarray, np.ndarray]:
@@ -127,7 +162,7 @@ def hull(points: np.ndarray, with_edges: bool = True) -> HullState:
         return HullState(np.array([[lo], [hi]]), np.array([[0, 1]]), np.array([[1 / hi], [1 / lo]]))
     try:
         h = _qhull(P)
-    except QhullError as exc:
+    except _QhullFailed as exc:
         raise PolytopeError(f"the points are not full-dimensional ({exc})") from exc
     eq = h.equations
     if np.any(eq[:, -1] >= -1e-12):
@@ -163,7 +198,7 @@ def h_to_v(G: np.ndarray) -> VRep:
     pts = np.vstack([G, np.zeros((1, n))])
     try:
         h = _qhull(pts)
-    except QhullError as exc:
+    except _QhullFailed as exc:
         raise PolytopeError(f"the polytope is unbounded ({exc})") from exc
     eq = h.equations
     if np.any(eq[:, -1] >= -1e-12):
@@ -307,9 +342,13 @@ def rationalize(M: np.ndarray, bits: int | None = 36) -> np.ndarray:
     return out.reshape(M.shape)
 
 
-def _require_gmp() -> None:
-    if not HAVE_GMP:  # pragma: no cover
+def _require_gmp() -> tuple[Any, Any]:
+    """(cdd, cdd.gmp), imported on first use; PolytopeError without the gmp build."""
+    _load_cdd()
+    g = globals()
+    if not g["HAVE_GMP"]:  # pragma: no cover
         raise PolytopeError("cdd.gmp is not available: exact polytope operations are disabled")
+    return g["cdd"], g["cddg"]
 
 
 @dataclass
@@ -325,7 +364,7 @@ def exact_h_to_v(G: np.ndarray, g: np.ndarray | None = None) -> ExactVRep:
 
     Raises PolytopeError if it is empty, unbounded (ray or line) or not full-dimensional.
     """
-    _require_gmp()
+    cdd, cddg = _require_gmp()
     G = np.asarray(G, dtype=object)
     k, n = G.shape
     gg = [Fraction(1)] * k if g is None else [_fr(x) for x in np.asarray(g).reshape(-1)]
@@ -348,7 +387,7 @@ def exact_h_to_v(G: np.ndarray, g: np.ndarray | None = None) -> ExactVRep:
 
 def exact_v_to_h(P: np.ndarray) -> np.ndarray:
     """Exact canonical H-form of ``conv(P)`` (rows with right-hand side 1) by cdd.gmp."""
-    _require_gmp()
+    cdd, cddg = _require_gmp()
     rows = [[Fraction(1)] + [_fr(x) for x in p] for p in np.asarray(P, dtype=object)]
     p = cddg.polyhedron_from_matrix(cddg.matrix_from_array(rows, rep_type=cdd.RepType.GENERATOR))
     ineq = cddg.copy_inequalities(p)
@@ -379,7 +418,7 @@ def canonical(G: np.ndarray, g: np.ndarray | None = None) -> np.ndarray:
 
 def exact_remove_redundant(G: np.ndarray) -> np.ndarray:
     """Exact non-redundant rows of ``{G e <= 1}`` (cdd.gmp redundancy removal), canonical."""
-    _require_gmp()
+    cdd, cddg = _require_gmp()
     G = canonical(G)
     rows = [[Fraction(1)] + [-_fr(x) for x in r] for r in G]
     red = cddg.redundant_rows(cddg.matrix_from_array(rows, rep_type=cdd.RepType.INEQUALITY))
@@ -460,7 +499,7 @@ def exact_vertices_of_slice(
 ) -> np.ndarray:
     """Exact vertices of ``{G e <= 1, lo <= C e <= hi}`` (any number of outputs) by cdd.gmp,
     with the equalities ``C e = lo`` written as linearities when ``lo == hi``."""
-    _require_gmp()
+    cdd, cddg = _require_gmp()
     G = np.asarray(G, dtype=object)
     C = np.asarray(C, dtype=object)
     n = G.shape[1]
@@ -497,7 +536,7 @@ def exact_hull(P: np.ndarray) -> tuple[np.ndarray, ExactVRep]:
     Building the H-form from the vertices keeps degenerate vertices (more than n facets)
     single, where an H-form rounded from floats would split them into clusters.
     """
-    _require_gmp()
+    cdd, cddg = _require_gmp()
     P = np.asarray(P, dtype=object)
     n = P.shape[1]
     for _ in range(3):
