@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from flint import fmpq
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from obsdesign import lyap
 from obsdesign.certify.exact import qeye, qmat
@@ -204,3 +206,36 @@ def test_certified_P_checks_the_decay_matrix() -> None:
     Pf = lyap.lyapunov_P(*(np.asarray(x, dtype=float) for x in (A5, C5, L5)), float(lam), True)
     P = lyap.symmetrize(lyap.dyadic(Pf, lyap.BITS))
     assert check_pd(P, MARGIN)
+
+
+@settings(max_examples=20, deadline=None)
+@given(
+    st.integers(1, 4),
+    st.integers(0, 2**31 - 1),
+    st.sampled_from([True, False]),
+    st.sampled_from([fmpq(1, 100), fmpq(1, 1000), fmpq(3, 10000)]),
+)
+def test_best_rate_bracket_property(n: int, seed: int, discrete: bool, tol: fmpq) -> None:
+    """For random stable error dynamics: the best rate certifies, the other end lies within
+    tol on the far side, and an "infeasible" end is below ρ (above −max Re eig) exactly."""
+    rng = np.random.default_rng(seed)
+    M = rng.standard_normal((n, n))
+    e = np.linalg.eigvals(M)
+    if discrete:
+        M *= rng.uniform(0.05, 0.95) / max(np.abs(e).max(), 1e-9)
+    else:
+        M -= (e.real.max() + rng.uniform(0.05, 3.0)) * np.eye(n)
+    A = qmat(np.round(M * 2**20) / 2**20)
+    C, L = qmat(np.ones((1, n))), qmat(np.zeros((n, 1)))
+    br = best_rate(A, C, L, discrete, tol=tol, margin=MARGIN)
+    assert check_pd(decay_matrix(A, C, L, br.P, br.best, discrete), MARGIN)
+    width = br.best - br.other if discrete else br.other - br.best
+    assert 0 < width <= tol
+    feasible = rate_feasible(A, br.other, discrete)
+    assert feasible == (br.kind != INFEASIBLE)
+    ef = np.linalg.eigvals(np.asarray(A, dtype=float))
+    bound = np.abs(ef).max() if discrete else -ef.real.max()
+    if br.kind == INFEASIBLE:
+        assert (
+            (float(br.other) <= bound + 1e-12) if discrete else (float(br.other) >= bound - 1e-12)
+        )
