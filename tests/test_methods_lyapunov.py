@@ -360,6 +360,7 @@ def test_tamper_fails_exactly_that_claim(
     path = _case_spec(which, tmp_path)
     rep = api.design(path)
     assert rep.exit_code() == 0
+    assert api.verify(rep).exit_code() == 0  # untampered: verifies (statements deterministic)
     spec = api.load_spec(path)
     tamper(rep.parameters, spec)
     failed = {c.id for c in api.certify(spec, rep.parameters) if not c.ok}
