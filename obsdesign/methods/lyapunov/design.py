@@ -59,11 +59,11 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     if s.discrete:
         bound = float(np.max(np.abs(eig)))
         params["rho"] = bound
-        lim = f"spectral radius {bound:.6g}"
+        lim = f"spectral radius ≈ {bound:.6g}"
     else:
         bound = float(np.max(eig.real))
         params["max_real_eig"] = bound
-        lim = f"largest real part {bound:.6g}"
+        lim = f"largest real part ≈ {bound:.6g}"
     known = None
     if o.rate is not None:
         # the asked rate first, directly: no search can make it fail
