@@ -349,3 +349,27 @@ def test_copy_is_untouched(example):
     """Tampering helpers work on copies: the module fixture stays certified."""
     sp, rep = example
     assert copy.deepcopy(rep).exit_code() == 0
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "failed"),
+    [
+        ("gamma0 = 1 ", "gamma0 = 0.05 ", set()),  # γ₀ = γ⋆ is allowed (≥)
+        ("gamma0 = 1 ", "gamma0 = 0.04999999999 ", {"gamma0-above-star"}),
+        ("lower = [0, -2]\nupper = [0, 2]", "lower = [0, -2.5]\nupper = [0, 2.5]", set()),
+        (
+            "lower = [0, -2]\nupper = [0, 2]",
+            "lower = [0, -2.5]\nupper = [0, 2.50000000001]",
+            {"D-in-E"},
+        ),
+        ("alpha = 0.9 ", "alpha = 0.99999999999 ", set()),
+    ],
+)
+def test_spec_boundaries(tmp_path, old, new, failed):
+    """The inequalities at their boundaries: allowed equality passes, the smallest step past
+    it fails exactly that claim."""
+    assert old in TEXT
+    p = tmp_path / "s.toml"
+    p.write_text(TEXT.replace(old, new), encoding="utf-8")
+    rep = api.design(p)
+    assert {c.id for c in rep.failed} == failed

@@ -146,3 +146,10 @@ def test_recover_covers_every_ball_point():
 def test_cover_box_degenerate_side():
     C = cover_box(np.array([0.0, -2.0]), np.array([0.0, 2.0]), 1 / math.sqrt(2) * 2 / 3)
     assert np.all(C[:, 0] == 0) and C[:, 1].min() <= -2 + 0.48 and C[:, 1].max() >= 2 - 0.48
+
+
+def test_plot_writes_figs_3_to_5(tmp_path):
+    sp, rep = _load(TEXT.replace("horizon = 12", "horizon = 1"), tmp_path)
+    res = api.simulate(sp, rep, store_every=5)
+    out = api.plot_simulation(sp, res, tmp_path / "figs.png")
+    assert Path(out).stat().st_size > 10_000
