@@ -153,3 +153,12 @@ def test_plot_writes_figs_3_to_5(tmp_path):
     res = api.simulate(sp, rep, store_every=5)
     out = api.plot_simulation(sp, res, tmp_path / "figs.png")
     assert Path(out).stat().st_size > 10_000
+
+
+def test_consistency_lost_names_L_h(tmp_path):
+    """A given L_h below h's Lipschitz constant (its claim fails; simulate runs anyway): the
+    refinement's output filter drops the true cell and the diagnosis names L_h."""
+    sp, rep = _load(TEXT.replace("gamma0 = 1 ", "gamma0 = 1\nL_h = 0.3 "), tmp_path)
+    assert {c.id for c in rep.failed} == {"L_h-bound"}
+    with pytest.raises(ConsistencyLost, match="L_h is not a Lipschitz constant of h"):
+        api.simulate(sp, rep)

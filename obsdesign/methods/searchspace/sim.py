@@ -416,7 +416,13 @@ def _diagnose(run: Run, x: np.ndarray, o: Options, where: str, ctx: Any) -> str:
             )
         bound = eps * math.exp(L_f * since) + flow_err
         d = float(np.min(np.linalg.norm(C - x, axis=1))) if len(C) else math.inf
-        if d > bound:
+        if "refinement" in where and d <= bound:
+            msg.append(
+                f"The nearest survivor was within (2)'s bound ({d:.4g} ≤ {bound:.4g}), so a "
+                "re-covered cell held the true state and failed |h(c) − y(τ)| ≤ L_h ε: L_h is "
+                "not a Lipschitz constant of h there (a given L_h too small?)."
+            )
+        elif d > bound:
             msg.append(
                 f"Lemma 2's estimate (2) is violated: the nearest centre is {d:.4g} from the true "
                 f"state, above ε e^(L_f (t − τ)) = {bound:.4g} (L_f is not a Lipschitz constant "
