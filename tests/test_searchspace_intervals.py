@@ -137,3 +137,11 @@ def test_norm_upper_is_an_upper_bound():
         A = rng.normal(size=(3, 3))
         J = [[I(v, v) for v in row] for row in A]
         assert B.norm_upper_iv(J) >= np.linalg.norm(A, 2) * (1 - 1e-12)
+
+
+def test_domain_errors_bound_nothing():
+    """sqrt at 0 is not Lipschitz and log(0) is unbounded: +∞, never an exception."""
+    b = B.lipschitz([parse_expr("sqrt(x1)", ["x1"])], ["x1"], ["x1"], [0], [1], 20, 1e-3)
+    assert not b.finite
+    b = B.sup_norm([parse_expr("log(x1)", ["x1"])], ["x1"], [0], [1], 20, 1e-3)
+    assert not b.finite and b.lower_est < math.inf

@@ -163,6 +163,7 @@ def branch_and_bound(
     largest bound (along its relatively widest side) until that bound is within ``rtol`` of
     the best sampled value ``lower_of`` or ``budget`` sub-boxes were evaluated."""
     widths0 = [iv.hi - iv.lo for iv in box]
+    upper_of = _safe(upper_of)
     ub0 = upper_of(box)
     lb = lower_of(box)
     heap: list[tuple[float, int, Box]] = [(-ub0, 0, box)]
@@ -181,6 +182,19 @@ def branch_and_bound(
             heapq.heappush(heap, (-upper_of(child), count, child))
             lb = max(lb, lower_of(child))
     return Bound(-heap[0][0], lb, count)
+
+
+def _safe(upper_of: Callable[[Box], float]) -> Callable[[Box], float]:
+    """An enclosure that cannot be computed on a box (log or sqrt of a box reaching 0, a
+    non-integer power of a base that may be negative, …) bounds nothing: +∞."""
+
+    def f(b: Box) -> float:
+        try:
+            return upper_of(b)
+        except (ArithmeticError, ValueError):
+            return math.inf
+
+    return f
 
 
 def _box(E_lo: Sequence[Any], E_hi: Sequence[Any]) -> Box:
@@ -206,11 +220,12 @@ def _eval(exprs: Sequence[Expr], names: Sequence[str], X: np.ndarray) -> np.ndar
     """Float values of the expressions at the rows of X (every variable of an expression is
     given, unused ones as 0, so the expression skips its name search)."""
     out = []
-    for ex in exprs:
-        env = {v: 0.0 for v in ex.variables}
-        env.update({n: X[..., i] for i, n in enumerate(names)})
-        r = ex(**env)
-        out.append(np.broadcast_to(np.asarray(r, dtype=float), X.shape[:-1]))
+    with np.errstate(all="ignore"):
+        for ex in exprs:
+            env = {v: 0.0 for v in ex.variables}
+            env.update({n: X[..., i] for i, n in enumerate(names)})
+            r = ex(**env)
+            out.append(np.broadcast_to(np.asarray(r, dtype=float), X.shape[:-1]))
     return np.stack(out, axis=-1)
 
 
@@ -229,7 +244,9 @@ def sup_norm(
         return sqrt_hi(_sum_hi([mul_hi(d.v.mag, d.v.mag) for d in vs]))
 
     def lower_of(b: Box) -> float:
-        return float(np.max(np.linalg.norm(_eval(exprs, names, _samples(b)), axis=-1)))
+        v = np.linalg.norm(_eval(exprs, names, _samples(b)), axis=-1)
+        v = v[np.isfinite(v)]
+        return float(v.max()) if v.size else 0.0
 
     return branch_and_bound(_box(lo, hi), upper_of, lower_of, budget, rtol)
 
@@ -293,7 +310,10 @@ def range_inside(
     HI = [Fraction(int(q.p), int(q.q)) for q in hi]
 
     def excess(b: Box) -> float:
-        vs = _enclose(exprs, [var], b, ())
+        try:
+            vs = _enclose(exprs, [var], b, ())
+        except (ArithmeticError, ValueError):
+            return math.inf
         worst = 0.0
         for d, a, z in zip(vs, LO, HI, strict=True):
             if not d.v.finite:
