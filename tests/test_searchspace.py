@@ -373,3 +373,19 @@ def test_spec_boundaries(tmp_path, old, new, failed):
     p.write_text(TEXT.replace(old, new), encoding="utf-8")
     rep = api.design(p)
     assert {c.id for c in rep.failed} == failed
+
+
+def test_spec_fixed_kappa_and_K_are_bound(tmp_path):
+    """κ and K given in the spec: a report with another (consistently recomputed) value fails
+    exactly the comparison with the spec."""
+    text = TEXT.replace("# kappa = 1.5 ", "kappa = 1.5\nK = 50 ")
+    p = tmp_path / "s.toml"
+    p.write_text(text, encoding="utf-8")
+    sp = api.load_spec(p)
+    rep = api.design(sp)
+    assert rep.exit_code() == 0 and rep.parameters["K"] == 50
+    assert "K-rule" not in {c.id for c in rep.claims}
+    v = _consistent(sp, kappa=fmpq(8, 5))
+    assert _failed(_report_with(rep, v, tmp_path)) == {"kappa-matches-spec"}
+    v = _consistent(sp, K=49)
+    assert _failed(_report_with(rep, v, tmp_path)) == {"K-matches-spec"}
