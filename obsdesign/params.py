@@ -85,25 +85,11 @@ class Parameters:
 
     def require(self, keys: tuple[str, ...] | list[str], claims: list[Any]) -> bool:
         """True when every key is present; else one failed claim per missing key."""
-        from obsdesign.certify.claim import exact_claim
+        from obsdesign.certify.claim import missing_claim
 
-        ok = True
-        for k in keys:
-            if k not in self._v:
-                ok = False
-                claims.append(
-                    exact_claim(
-                        f"{k}-present",
-                        f"the report gives {k}",
-                        "report",
-                        "presence",
-                        0,
-                        False,
-                        f"{k} missing",
-                        False,
-                    )
-                )
-        return ok
+        missing = [k for k in keys if k not in self._v]
+        claims.extend(missing_claim(k) for k in missing)
+        return not missing
 
     def to_json(self) -> dict[str, Any]:
         out: dict[str, Any] = {}
@@ -173,21 +159,11 @@ def exact_param(params: Parameters, k: str, claims: list[Any], accept_float: boo
     """The exact value of parameter ``k`` for a certificate, or None after appending a failed
     claim saying why (missing; or float-only when ``accept_float`` is False). A float-only
     value, when accepted, is taken at its exact binary value."""
-    from obsdesign.certify.claim import exact_claim
+    from obsdesign.certify.claim import exact_claim, missing_claim
     from obsdesign.certify.exact import Q, dyadic
 
     if k not in params:
-        claims.append(
-            exact_claim(
-                f"{k}-present",
-                f"the report gives {k}",
-                "report",
-                "presence",
-                0,
-                False,
-                f"{k} missing",
-            )
-        )
+        claims.append(missing_claim(k))
         return None
     v = params[k]
     if _is_exact(v):

@@ -60,6 +60,19 @@ class Claim:
         )
 
 
+def _claim(
+    status: ClaimStatus,
+    id: str,
+    statement: str,
+    reference: str,
+    check: str,
+    margin: Any,
+    detail: str,
+    float_ok: bool | None,
+) -> Claim:
+    return Claim(id, statement, reference, check, str(margin), status, detail, float_ok)
+
+
 def exact_claim(
     id: str,
     statement: str,
@@ -71,31 +84,29 @@ def exact_claim(
     float_ok: bool | None = None,
 ) -> Claim:
     """A claim decided by an exact check: certified when it passed, failed otherwise."""
-    return Claim(
-        id=id,
-        statement=statement,
-        reference=reference,
-        check=check,
-        margin=str(margin),
-        status=ClaimStatus.CERTIFIED if passed else ClaimStatus.FAILED,
-        detail=detail,
-        float_ok=float_ok,
-    )
+    status = ClaimStatus.CERTIFIED if passed else ClaimStatus.FAILED
+    return _claim(status, id, statement, reference, check, margin, detail, float_ok)
 
 
 def numerical_claim(
     id: str, statement: str, reference: str, check: str, margin: Any, passed: bool, detail: str
 ) -> Claim:
     """A claim checked in floating point only: numerical when it passed, failed otherwise."""
-    return Claim(
-        id=id,
-        statement=statement,
-        reference=reference,
-        check=check,
-        margin=str(margin),
-        status=ClaimStatus.NUMERICAL if passed else ClaimStatus.FAILED,
-        detail=detail,
-        float_ok=passed,
+    status = ClaimStatus.NUMERICAL if passed else ClaimStatus.FAILED
+    return _claim(status, id, statement, reference, check, margin, detail, passed)
+
+
+def missing_claim(key: str) -> Claim:
+    """The failed claim for a parameter a report must carry but does not."""
+    return exact_claim(
+        f"{key}-present",
+        f"the report gives {key}",
+        "report",
+        "presence",
+        0,
+        False,
+        f"{key} missing",
+        False,
     )
 
 

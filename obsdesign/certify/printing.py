@@ -48,22 +48,22 @@ def _show(m: fmpz | int, e: int) -> str:
     return sign + whole + ("." + frac if frac else "")
 
 
-def fmt_up(x: Any, digits: int = 6) -> str:
-    """``x`` rounded up (towards +∞) to ``digits`` significant digits, as a decimal string."""
+def _fmt(x: Any, digits: int, up: bool) -> str:
     q = Q(x)
     if q == 0:
         return "0"
     e, s = _scaled(q, digits)
-    return _show(s.ceil(), e)
+    return _show(s.ceil() if up else s.floor(), e)
+
+
+def fmt_up(x: Any, digits: int = 6) -> str:
+    """``x`` rounded up (towards +∞) to ``digits`` significant digits, as a decimal string."""
+    return _fmt(x, digits, True)
 
 
 def fmt_down(x: Any, digits: int = 6) -> str:
     """``x`` rounded down (towards −∞) to ``digits`` significant digits, as a decimal string."""
-    q = Q(x)
-    if q == 0:
-        return "0"
-    e, s = _scaled(q, digits)
-    return _show(s.floor(), e)
+    return _fmt(x, digits, False)
 
 
 def fmt_exact(x: Any) -> str:
