@@ -159,14 +159,3 @@ def test_python_api_one_liner():
     assert r.returncode == 0 and r.stdout.strip() == "certified"
 
 
-@pytest.mark.parametrize("method", ["lyapunov", "constrained", "impulsive", "set-invariant"])
-def test_every_template_designs_and_verifies(tmp_path: Path, method: str):
-    res = runner.invoke(app, ["init", method])
-    assert res.exit_code == 0
-    spec = tmp_path / "t.toml"
-    spec.write_text(res.output)
-    out = tmp_path / "t.json"
-    assert (
-        runner.invoke(app, ["design", str(spec), "-o", str(out), "--format", "json"]).exit_code == 0
-    )
-    assert runner.invoke(app, ["verify", str(out), "--format", "json"]).exit_code == 0
