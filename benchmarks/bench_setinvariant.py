@@ -7,8 +7,9 @@
    Ω = {|e|∞ <= 1}, D = {|d| <= 1} through B1 with entries ~ N(0, 0.05²), η̄ = 0.01.
    λ rule: A is drawn with spectral radius ρ(A) in [0.5, 0.95] and λ = (1 + ρ(A))/2, halfway
    between the contraction the open loop gives (v = 0) and 1. General algorithm with
-   mirrored images, Δδ = 1e-3, at most 60 iterations. Targets: all converge (the paper
-   reports all of its 20 did), median design time < 2 s, exact verify <= 3× design.
+   mirrored images, Δδ = 1e-3, at most 60 iterations, the default time_limit (30 s).
+   Targets (issue 12 item 2): every system certified or refused with a reason in < 60 s;
+   median (design + exact certify in one process) <= 1.5× the float-only design.
 4. Polytope primitives vs the obvious alternatives: vertex enumeration and hull vs scipy's
    qhull (target within 2×), redundancy removal vs one HiGHS LP per row (no slower), exact
    certificate check (n <= 4, a few hundred facets) under 1 s.
@@ -108,58 +109,79 @@ def examples() -> None:
         )
 
 
+def _float_design(sp) -> float:
+    """Seconds of the same design with the exact stages switched off (float64 only: the
+    iterations plus the float final stage), the baseline of issue 12 item 2."""
+    from obsdesign.methods import get_method
+    from obsdesign.sets import polytope_ops as po
+
+    saved = po.HAVE_GMP
+    po.HAVE_GMP = False
+    try:
+        return _timed(get_method("set-invariant").design, sp)[1]
+    finally:
+        po.HAVE_GMP = saved
+
+
 def paper_test(count: int = 20) -> None:
+    """Issue 12 item 2: each system certified or refused with a reason in < 60 s (design +
+    exact certify in one process, the design's exact hull and Theorem 3.1 reused, then an
+    independent verify of the JSON report that recomputes everything); the median of
+    (design + certify) / float-only design <= 1.5."""
+    import tempfile
+
     from obsdesign import api
     from obsdesign.api import load_spec_text
     from obsdesign.errors import ObsdesignError
+    from obsdesign.methods.setinvariant import memo
 
     rows = []
-    disagree = 0
+    disagree = refused = 0
+    worst = 0.0
     for seed in range(count):
         A, B1, C, lam = random_system(seed)
         sp = load_spec_text(_spec_text(A, B1, C, lam), f"random-{seed}.toml")
+        tf = _float_design(sp)
+        h0 = memo.STATS["hits"]
+        t0 = time.perf_counter()
         try:
-            rep, td = _timed(api.design, sp)
+            rep = api.design(sp)
         except ObsdesignError as e:
-            print(f"  seed {seed:2d} n={A.shape[0]} λ={lam:.4f}: {e.message}")
+            t = time.perf_counter() - t0
+            refused += 1
+            worst = max(worst, t)
+            print(
+                f"  seed {seed:2d} n={A.shape[0]} λ={lam:.4f}: refused after {t:.1f} s: {e.message}"
+            )
             continue
-        from obsdesign.methods import get_method
-
-        m = get_method("set-invariant")
-        claims, tv = _timed(m.certify, sp, rep.parameters)
+        td = time.perf_counter() - t0
+        with tempfile.TemporaryDirectory() as d:
+            out = Path(d) / "r.json"
+            out.write_text(rep.to_json())
+            ver, tv = _timed(api.verify, out)
         p = rep.parameters
-        ok = all(c.ok for c in claims)
-        hist = p["history_eps"]
+        ok = rep.exit_code() == 0
         if p["converged"] and not ok:
             disagree += 1
-        rows.append(
-            (
-                seed,
-                A.shape[0],
-                lam,
-                p["iterations"],
-                p["facets"],
-                p["converged"],
-                ok,
-                td,
-                tv,
-                hist[-1],
-            )
-        )
+        if ver.exit_code() != rep.exit_code():
+            disagree += 1
+        worst = max(worst, td, tv)
+        rows.append((seed, td, tf, tv, ok))
         print(
-            f"  seed {seed:2d} n={A.shape[0]} λ={lam:.4f}: {p['iterations']:3d} iterations, {p['facets']:4d} facets, "
-            f"converged {p['converged']}, certified {ok}, design {td:6.2f} s, exact verify {tv:6.2f} s "
-            f"(ratio {tv / td:4.2f}), last ε {hist[-1]:.5f}"
+            f"  seed {seed:2d} n={A.shape[0]} λ={lam:.4f}: {p['iterations']:3d} iterations, "
+            f"{p['facets']:4d} facets, {'certified' if ok else 'NOT certified'}; float-only design "
+            f"{tf:6.2f} s, design + certify {td:6.2f} s (ratio {td / tf:4.2f}, "
+            f"{memo.STATS['hits'] - h0} exact checks reused), independent verify {tv:6.2f} s"
         )
-    conv = sum(r[5] for r in rows)
-    cert = sum(r[6] for r in rows)
-    med = statistics.median(r[7] for r in rows) if rows else float("nan")
-    ratio = max((r[8] / r[7] for r in rows if r[6]), default=float("nan"))
+    cert = sum(r[4] for r in rows)
+    med = statistics.median(r[1] / r[2] for r in rows) if rows else float("nan")
+    medt = statistics.median(r[1] for r in rows) if rows else float("nan")
+    print(f"random systems: {cert}/{count} certified, {refused} refused with a reason")
     print(
-        f"random systems: {conv}/{count} converged, {cert}/{count} certified (paper: all 20 converged)"
+        f"slowest system (design + certify, or verify, or refusal): {worst:.1f} s (target < 60 s)"
     )
-    print(f"median design time: {med:.3f} s (target < 2 s)")
-    print(f"max exact-verify / design time: {ratio:.2f} (target <= 3)")
+    print(f"median (design + certify) / float-only design: {med:.2f} (target <= 1.5)")
+    print(f"median design + certify: {medt:.3f} s")
     print(f"float design vs exact certificate disagreements: {disagree} (target 0)")
 
 

@@ -18,6 +18,7 @@ Stopping: ε^i <= ``lam_stop`` (the paper's rule is λ(1 + Δδ)), or the iterat
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -60,6 +61,8 @@ class IterResult:
     iterations: int
     converged: bool
     history: list[dict[str, float]] = field(default_factory=list)
+    #: stopped at the time budget (``deadline``), not at the iteration cap
+    timed_out: bool = False
 
 
 def _drop_inside(img: np.ndarray, G: np.ndarray, tol: float) -> np.ndarray:
@@ -110,9 +113,12 @@ def general(
     drop_tol: float = 1e-10,
     it0: int = 0,
     history: list | None = None,
+    deadline: float | None = None,
 ) -> IterResult:
     """General algorithm, Section V steps 1-9 (single output). ``start`` is an optional
-    point cloud to start from (it is merged with Ω's vertices)."""
+    point cloud to start from (it is merged with Ω's vertices); ``deadline``: a
+    ``time.perf_counter()`` value after which the run stops, not converged, with
+    ``timed_out`` set."""
     c = pb.C.reshape(-1)
     Vo = po.h_to_v(pb.G0).V
     P = Vo if start is None else np.vstack([start, Vo])
@@ -136,6 +142,8 @@ def general(
             progress(f"general: iteration {it}, {len(G)} facets, eps = {eps_l:.6f}")
         if eps_l <= lam_stop:  # step 6
             return IterResult(G, P, eps_l, it, True, hist)
+        if deadline is not None and time.perf_counter() > deadline:
+            return IterResult(G, P, eps_l, it, False, hist, timed_out=True)
         img = slices[l] @ pb.A.T + er.v[l]  # step 7
         img = po.minkowski_points(img, Bd) / lam_run  # step 8
         if mirror:
@@ -155,8 +163,10 @@ def symmetric(
     it0: int = 0,
     start: np.ndarray | None = None,
     history: list | None = None,
+    deadline: float | None = None,
 ) -> IterResult:
-    """Symmetric algorithm of Section VI: condition (14) at z = 0 with v = 0.
+    """Symmetric algorithm of Section VI: condition (14) at z = 0 with v = 0 (``deadline``
+    as in :func:`general`).
 
     D is symmetrized (D ∪ −D), which only enlarges it: the paper assumes |E d| <= 1."""
     c = pb.C.reshape(-1) if pb.p == 1 else None
@@ -182,6 +192,8 @@ def symmetric(
             progress(f"symmetric: iteration {it}, {len(G)} facets, eps(14) = {eps:.6f}")
         if eps <= lam_stop:
             return IterResult(G, P, eps, it, True, hist)
+        if deadline is not None and time.perf_counter() > deadline:
+            return IterResult(G, P, eps, it, False, hist, timed_out=True)
         img = po.minkowski_points(S @ pb.A.T, Bd) / lam_run
         img = np.vstack([img, -img])
         P = np.vstack([P, _drop_inside(img, G, drop_tol)])

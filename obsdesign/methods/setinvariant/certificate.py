@@ -69,8 +69,16 @@ def delta_exact(G: np.ndarray, B1: np.ndarray, Dv: np.ndarray) -> list[fmpq]:
 
 
 def omega_contained(G: np.ndarray, Vo: np.ndarray) -> tuple[bool, fmpq]:
-    """Ω ⊆ {G e <= 1} exactly; returns (ok, max over rows and Ω-vertices of G_i e)."""
-    m = max(po.qdot(G[i], v) for i in range(len(G)) for v in Vo)
+    """Ω ⊆ {G e <= 1} exactly; returns (ok, max over rows and Ω-vertices of G_i e).
+
+    A float prefilter picks the pairs within :data:`_FILTER` × max |G||V| of the float max
+    (far above the float error of any entry), so the exact max over those pairs is the
+    exact max."""
+    Gf, Vf = po.qfloat(G), po.qfloat(Vo)
+    M = Gf @ Vf.T
+    tol = _FILTER * float((np.abs(Gf) @ np.abs(Vf).T).max()) + 1e-300
+    cand = np.argwhere(M >= M.max() - tol)
+    m = max(po.qdot(G[i], Vo[j]) for i, j in cand)
     return m <= 1, m
 
 

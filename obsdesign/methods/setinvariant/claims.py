@@ -30,7 +30,7 @@ from obsdesign.sets import polytope_ops as po
 from obsdesign.spec.models import Spec
 
 from . import certificate as ce
-from . import laws, lps, numerical
+from . import laws, lps, memo, numerical
 from .options import Options
 from .problem import build, necessary_condition
 
@@ -138,9 +138,12 @@ class ExactBackend:
 
     exact = True
 
-    def __init__(self, ex: ce.ExactProblem) -> None:
+    def __init__(self, ex: ce.ExactProblem, params: Parameters | None = None) -> None:
         self.ex = ex
         self.lam = ex.lam
+        #: the design's record of its exact checks is used only for the object it returned
+        #: (:mod:`.memo`); None: recompute everything
+        self.params = params
 
     def read(self, params: Parameters, key: str, c: Claims) -> Any:
         """The exact value of a reported parameter (a float-only one is a failed claim)."""
@@ -150,6 +153,10 @@ class ExactBackend:
         return np.asarray(x, dtype=object).reshape(-1, cols)
 
     def forms(self, G: np.ndarray, V: np.ndarray) -> tuple[bool, str, Any]:
+        if self.params is not None:
+            hit = memo.recall(self.params, "forms", memo.fingerprint(G, V))
+            if hit is not None:
+                return hit
         return po.exact_check_forms(G, V)
 
     def omega(self, G: np.ndarray) -> tuple[bool, Any]:
@@ -162,6 +169,11 @@ class ExactBackend:
         return ce.exact_zd(vrep.V, self.ex.C[0], self.ex.eta)[0]
 
     def theorem31(self, G: np.ndarray, vrep: Any, zs: list[Any], vs: list[list[Any]]) -> Any:
+        if self.params is not None:
+            key = (memo.problem_key(self.ex), memo.fingerprint(G, vrep.V, zs, vs))
+            hit = memo.recall(self.params, "theorem31", key)
+            if hit is not None:
+                return hit
         return ce.theorem31(self.ex, G, vs=vs, zs_given=zs, vrep=vrep)
 
     def same_points(self, zs: list[Any], zd: list[Any]) -> bool:
@@ -366,7 +378,7 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     s = spec.system
     data = build(spec)
     b: ExactBackend | FloatBackend = (
-        ExactBackend(data.ex) if data.ex is not None else FloatBackend(data.fl, o.lam)
+        ExactBackend(data.ex, params) if data.ex is not None else FloatBackend(data.fl, o.lam)
     )
     emit = _Emit(b, o)
     c = emit.c

@@ -10,12 +10,14 @@ stages run in float64 (:mod:`.numerical`) and every claim is numerical.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from obsdesign.errors import SolverError
 from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
 from obsdesign.params import Parameters
 from obsdesign.sets import polytope_ops as po
@@ -23,7 +25,7 @@ from obsdesign.spec.models import Spec
 
 from . import algorithms as al
 from . import certificate as ce
-from . import laws, lps, numerical
+from . import laws, lps, memo, numerical
 from .linear import admissible_gains
 from .options import Options
 from .problem import Data, build, check_detectable
@@ -73,6 +75,17 @@ class _Run:
     extra: dict[str, Any] = field(default_factory=dict)
 
 
+def _budget(r: al.IterResult, o: Options) -> None:
+    """Stop the design when the iterations ran out of time (``[method] time_limit``): a
+    SolverError (exit 3) saying how far they got, instead of running for minutes."""
+    if r.timed_out:
+        raise SolverError(
+            f"not converged within {o.time_limit:g} s ([method] time_limit) / {r.iterations} "
+            f"iterations: last ε = {r.eps:.6g} > λ = {float(o.lam):g} with {len(r.G)} facets "
+            "(raise time_limit, or a larger λ or Δδ)"
+        )
+
+
 def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
     """The algorithm of the spec: symmetric C_K^∞ (Section VI; condition (14)), general
     (Section V; stopping rule ε^i ≤ λ(1 + Δδ)) or none (Ω itself); the symmetric-to-general
@@ -81,6 +94,7 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
     fl = data.fl
     single = spec.system.p == 1
     lam, dd = float(o.lam), float(o.delta_tol)
+    dl = time.perf_counter() + o.time_limit  # the budget of the float iterations
     run = _Run(Stage(np.zeros((0, fl.n)), None, None), 0, True)
     hist = run.history
     sym_failed = False
@@ -88,7 +102,10 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
         run.iterations = 1
         run.stage = final_stage(data, np.zeros((0, fl.n)), single, lam)
     elif o.algorithm == "symmetric":
-        r = al.symmetric(fl, lam, lam * (1 + dd), o.max_iterations, progress, history=hist)
+        r = al.symmetric(
+            fl, lam, lam * (1 + dd), o.max_iterations, progress, history=hist, deadline=dl
+        )
+        _budget(r, o)
         run.iterations, run.converged = r.iterations, r.converged
         run.stage = final_stage(data, r.P, single, lam)
         res = run.stage.res
@@ -112,7 +129,9 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
                 r = al.general(
                     fl, lam / (1 + dd), lam, o.max_iterations, o.mirror,
                     start=r.P, progress=progress, it0=r.iterations, history=hist,
+                    deadline=dl,
                 )  # fmt: skip
+                _budget(r, o)
                 run.iterations, run.converged = r.iterations, r.converged
                 run.stage = final_stage(data, r.P, single, lam)
                 run.notes.append(
@@ -123,8 +142,10 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
         lam_run = lam / (1 + dd) if o.strict else lam
         lam_stop = lam if o.strict else lam * (1 + dd)
         r = al.general(
-            fl, lam_run, lam_stop, o.max_iterations, o.mirror, progress=progress, history=hist
-        )
+            fl, lam_run, lam_stop, o.max_iterations, o.mirror, progress=progress, history=hist,
+            deadline=dl,
+        )  # fmt: skip
+        _budget(r, o)
         run.iterations, run.converged = r.iterations, r.converged
         run.stage = final_stage(data, r.P, single, lam)
     res = run.stage.res
@@ -139,7 +160,9 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
                 r = al.general(
                     fl, lam / (1 + dd), lam * (1 - 1e-12), o.max_iterations, o.mirror,
                     start=V0, progress=progress, it0=run.iterations, history=hist,
+                    deadline=dl,
                 )  # fmt: skip
+                _budget(r, o)
                 run.iterations, run.converged = r.iterations, r.converged
                 run.stage = final_stage(data, r.P, single, lam)
     return run
@@ -245,4 +268,27 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     )
     if data.ex is None:
         notes.append(numerical.NOTE)
+    else:
+        _record(data, run.stage, params)
     return Design(params, solver, notes)
+
+
+def _record(data: Data, stage: Stage, params: Parameters) -> None:
+    """Hand the exact facts the final stage proved to ``certify`` of this very ``params``
+    object (:mod:`.memo`): conv(V) = {G e <= 1} with every point of V a vertex (the last
+    exact hull ran on exactly V), and Theorem 3.1's exact maximum for the reported v^l at
+    Z_d. Keyed by the exact inputs, so a changed parameter or spec recomputes."""
+    if stage.vrep is None:
+        return
+    rec = memo.Recorder()
+    G, V = stage.G, stage.vrep.V
+    rec.put("forms", memo.fingerprint(G, V), (True, po.forms_detail(len(V), len(G)), stage.vrep))
+    res = stage.res
+    if res is not None:
+        key = memo.fingerprint(G, V, list(res.zs), [list(v) for v in res.vs])
+        rec.put(
+            "theorem31",
+            (memo.problem_key(data.ex), key),
+            dataclasses.replace(res, exact_lp=0, notes=[]),
+        )
+    memo.attach(params, rec)

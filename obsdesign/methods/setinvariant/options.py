@@ -34,7 +34,9 @@ class Options:
     ``delta_tol``: Δδ of the stopping rule; ``max_iterations``; ``mirror``: also add the
     mirrored images (general algorithm); ``strict``: the certified factor must be ≤ λ;
     ``fallback``: what follows a symmetric C_K^∞ that fails Theorem 3.1; ``L``: a linear gain
-    to certify (n×p, exact); ``linear_law``: compute the admissible linear gains (p = n − 1).
+    to certify (n×p, exact); ``linear_law``: compute the admissible linear gains (p = n − 1);
+    ``time_limit``: seconds the float iterations may run (default :data:`TIME_LIMIT`) before
+    the design stops with "not converged within N s / K iterations" (exit 3).
     """
 
     omega: str
@@ -50,6 +52,12 @@ class Options:
     fallback: str
     L: np.ndarray | None
     linear_law: bool
+    time_limit: float = 30.0
+
+
+#: default time budget of the float iterations, in seconds (``[method] time_limit``); the
+#: exact final stage comes after it
+TIME_LIMIT = 30.0
 
 
 def _spec_error(spec: Spec, key: str, expected: str) -> SpecError:
@@ -135,6 +143,9 @@ def parse_options(table: Table, spec: Spec) -> Options:
     fallback = table.str("fallback", default="general", choices=FALLBACKS)
     L = table.matrix("L", rows=s.n, cols=s.p, vector_as="column").q if table.has("L") else None
     linear_law = table.bool("linear_law", default=True)
+    time_limit = float(
+        table.scalar("time_limit", default=fmpq(int(TIME_LIMIT)), min=0, strict_min=True).q
+    )
     if s.p != 1:
         if s.p != s.n - 1:
             raise _spec_error(
@@ -171,6 +182,7 @@ def parse_options(table: Table, spec: Spec) -> Options:
         fallback=fallback,
         L=L,
         linear_law=linear_law,
+        time_limit=time_limit,
     )
 
 
@@ -199,5 +211,10 @@ def options_schema(key: str) -> dict[str, Any]:
             "fallback": {"enum": list(FALLBACKS)},
             "L": mat,
             "linear_law": {"type": "boolean"},
+            "time_limit": {
+                **num,
+                "exclusiveMinimum": 0,
+                "description": "seconds the float iterations may run (default 30)",
+            },
         },
     }

@@ -1,0 +1,186 @@
+"""The set-invariant design hands its exact hull and Theorem 3.1 result to ``certify`` of
+the same Parameters object (issue 12 item 2, :mod:`obsdesign.methods.setinvariant.memo`);
+``verify`` (a report read from JSON, in this process or another) recomputes everything; a
+tampered parameter or spec never hits; the time budget stops the iterations with a reason."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from flint import fmpq
+
+from obsdesign import api
+from obsdesign.certify.claim import ClaimStatus
+from obsdesign.errors import SolverError
+from obsdesign.methods.setinvariant import memo
+from obsdesign.params import Parameters
+from obsdesign.report.model import Report
+
+ROOT = Path(__file__).resolve().parents[1]
+SPEC71 = ROOT / "specs" / "dorea-pimenta-7-1.toml"
+
+# a random 3-state system of benchmarks/bench_setinvariant.py (seed 2): one output, noise,
+# a disturbance, the general algorithm
+RANDOM = """
+[system]
+time = "discrete"
+A = [[0.0536, -0.1483, -0.1172], [-0.6924, 0.5104, 0.3245], [-0.0923, 0.2195, 0.0798]]
+B1 = [-0.0396, 0.0227, -0.005]
+C = [[0.9776, -0.3106, -0.3288]]
+[sets.omega]
+type = "box"
+lower = [-1.0, -1.0, -1.0]
+upper = [1.0, 1.0, 1.0]
+[sets.D]
+type = "box"
+dim = 1
+lower = [-1]
+upper = [1]
+[method]
+key = "set-invariant"
+omega = "omega"
+disturbance = "D"
+eta_bar = 0.01
+lambda = 0.8979
+algorithm = "general"
+mirror = true
+delta_tol = 0.001
+max_iterations = 60
+"""
+
+
+def _summary(claims: list) -> list[tuple]:
+    return [(c.id, c.status, c.statement, c.detail, str(c.margin)) for c in claims]
+
+
+def _hits() -> int:
+    return memo.STATS["hits"]
+
+
+@pytest.fixture(scope="module")
+def designed() -> tuple:
+    sp = api.load_spec_text(RANDOM, "random-2.toml")
+    rep = api.design(sp)
+    assert rep.exit_code() == 0
+    return sp, rep
+
+
+def test_design_records_and_certify_hits(designed: tuple) -> None:
+    sp, rep = designed
+    h0 = _hits()
+    hit = api.certify(sp, rep.parameters)
+    assert _hits() == h0 + 2  # forms and Theorem 3.1
+    fresh = api.certify(sp, Parameters(dict(rep.parameters.items())))  # another object
+    assert _hits() == h0 + 2
+    assert _summary(hit) == _summary(fresh)
+    assert all(c.status == ClaimStatus.CERTIFIED for c in hit)
+    assert _summary(hit) == _summary(rep.claims)
+
+
+def test_verify_recomputes_in_process(designed: tuple, tmp_path: Path) -> None:
+    sp, rep = designed
+    out = tmp_path / "r.json"
+    out.write_text(rep.to_json())
+    h0 = _hits()
+    for src in (out, rep, Report.load(out)[0]):
+        v = api.verify(src)
+        assert v.exit_code() == 0
+    assert _hits() == h0  # no lookup of a report read back, or of verify's tracked copy
+
+
+def test_verify_in_a_new_process(tmp_path: Path) -> None:
+    out = tmp_path / "r.json"
+    api.design(SPEC71, out)
+    exe = Path(sys.executable).parent / "obsdesign"
+    r = subprocess.run([str(exe), "verify", str(out)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout + r.stderr
+
+
+def _tamper_same_object(rep: Report, key: str, i: int, delta: fmpq) -> None:
+    """Change one entry of ``key`` in the design's own Parameters object (exact and float
+    consistently: the array holds fmpq, floats are derived)."""
+    a = np.array(rep.parameters[key], dtype=object, copy=True)
+    flat = a.reshape(-1)
+    flat[i] = flat[i] + delta
+    rep.parameters[key] = a
+
+
+@pytest.mark.parametrize(
+    ("key", "claim"),
+    [("G", "polyhedron-forms"), ("v_breakpoints", "theorem-3.1")],
+)
+def test_tampered_parameter_never_hits(key: str, claim: str) -> None:
+    sp = api.load_spec_text(RANDOM, "random-2.toml")
+    rep = api.design(sp)
+    if key == "v_breakpoints":  # push the worst breakpoint's v above λ
+        i = 0
+        delta = fmpq(1)
+    else:
+        i, delta = 0, fmpq(1, 10**6)
+    _tamper_same_object(rep, key, i, delta)
+    h0, m0 = memo.STATS["hits"], memo.STATS["misses"]
+    claims = api.certify(sp, rep.parameters)
+    failed = {c.id for c in claims if c.status == ClaimStatus.FAILED}
+    assert claim in failed
+    if key == "G":
+        assert _hits() == h0  # the forms lookup missed and nothing after it ran
+    else:
+        assert _hits() == h0 + 1  # forms (untouched) hits, Theorem 3.1 misses
+        assert memo.STATS["misses"] == m0 + 1
+
+
+def test_changed_spec_never_hits(designed: tuple) -> None:
+    sp, rep = designed
+    other = api.load_spec_text(RANDOM.replace("lambda = 0.8979", "lambda = 0.8978"), "b.toml")
+    h0, m0 = _hits(), memo.STATS["misses"]
+    claims = api.certify(other, rep.parameters)
+    assert _hits() == h0 + 1  # forms does not depend on the spec; Theorem 3.1 does
+    assert memo.STATS["misses"] == m0 + 1
+    assert "lambda-matches-spec" in {c.id for c in claims if c.status == ClaimStatus.FAILED}
+
+
+def test_fingerprint_is_exact() -> None:
+    a = np.array([[fmpq(1, 3), fmpq(2)]], dtype=object)
+    b = np.array([[fmpq(1, 3), fmpq(2)]], dtype=object)
+    c = np.array([[fmpq(1, 3) + fmpq(1, 10**30), fmpq(2)]], dtype=object)
+    assert memo.fingerprint(a) == memo.fingerprint(b)
+    assert memo.fingerprint(a) != memo.fingerprint(c)
+    assert memo.fingerprint(a) != memo.fingerprint(a.reshape(2, 1))
+    assert memo.fingerprint([fmpq(1, 2)]) != memo.fingerprint([0.5])
+    assert memo.fingerprint(np.array([0.1])) != memo.fingerprint(np.array([0.1 + 2**-56]))
+
+
+def test_record_dropped_with_its_object() -> None:
+    p = Parameters({"x": 1})
+    rec = memo.Recorder()
+    rec.put("k", ("a",), 42)
+    memo.attach(p, rec)
+    assert memo.recall(p, "k", ("a",)) == 42
+    assert memo.recall(Parameters({"x": 1}), "k", ("a",)) is None
+    i = id(p)
+    del p
+    assert i not in memo._MEMO
+
+
+# seed 0 of the benchmark: converges in 2 iterations
+SEED0 = (
+    RANDOM.replace(
+        "A = [[0.0536, -0.1483, -0.1172], [-0.6924, 0.5104, 0.3245], [-0.0923, 0.2195, 0.0798]]",
+        "A = [[0.0752, -0.079, 0.3832], [0.0628, -0.3205, 0.2163], [0.7802, 0.5666, -0.421]]",
+    )
+    .replace("B1 = [-0.0396, 0.0227, -0.005]", "B1 = [-0.0109, -0.0623, -0.0366]")
+    .replace("C = [[0.9776, -0.3106, -0.3288]]", "C = [[-0.6233, 0.0413, -2.325]]")
+    .replace("lambda = 0.8979", "lambda = 0.9604")
+)
+
+
+def test_time_budget_refuses_with_reason() -> None:
+    sp = api.load_spec_text(SEED0.replace("max_iterations = 60", "time_limit = 1e-9"), "t.toml")
+    with pytest.raises(SolverError, match=r"not converged within 1e-09 s .* / 1 iterations"):
+        api.design(sp)
+    rep = api.design(api.load_spec_text(SEED0, "s0.toml"))  # the default budget: converges
+    assert rep.exit_code() == 0 and rep.parameters["iterations"] == 2
