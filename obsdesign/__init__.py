@@ -9,7 +9,27 @@ The heavy modules (numpy, cvxpy, scipy) load on first use, so ``obsdesign --help
 
 from __future__ import annotations
 
+import os as _os
+import signal as _signal
+import sys as _sys
 from typing import Any
+
+
+def _early_interrupt(signum: int, frame: object) -> None:  # pragma: no cover - timing
+    """Ctrl-C while the command line starts (imports of typer, rich, numpy): one line,
+    exit 130, no traceback. :func:`obsdesign.cli._run` restores Python's handler when a
+    command body starts, so that cleanup code (temporary files) runs on Ctrl-C."""
+    _sys.stderr.write("obsdesign: interrupted\n")
+    _os._exit(130)
+
+
+# Installed here, the first obsdesign code the console script runs (``from obsdesign.cli
+# import main`` imports this package first), so only Python's own start-up (a few ms before
+# any obsdesign code) can still show a traceback on Ctrl-C.
+if _signal.getsignal(_signal.SIGINT) is _signal.default_int_handler and _os.path.basename(
+    _sys.argv[0] if _sys.argv else ""
+) in ("obsdesign", "cli.py"):
+    _signal.signal(_signal.SIGINT, _early_interrupt)
 
 __version__ = "0.1.0"
 

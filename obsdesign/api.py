@@ -7,7 +7,7 @@ import time
 import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -596,6 +596,9 @@ class CheckRow:
     summary: str
     seconds: float
     message: str = ""
+    #: the verified claims, each ``{"id", "status", "statement", "detail"}`` (empty when the
+    #: spec stopped before any claim): the JUnit XML of ``check --junit`` has one testcase each
+    claims: list[dict[str, Any]] = field(default_factory=list)
 
 
 def spec_files(paths: list[str | Path]) -> list[Path]:
@@ -629,6 +632,10 @@ def check_one(path: Path) -> CheckRow:
         counts = ver.status_counts()
         msg = "; ".join(f"{c.id}: {c.detail}" for c in ver.failed)
         summary = get_method(rep.method).summary(ver.parameters)
+        claims = [
+            {"id": c.id, "status": c.status.value, "statement": c.statement, "detail": c.detail}
+            for c in ver.claims
+        ]
         return CheckRow(
             str(path),
             rep.method,
@@ -639,6 +646,7 @@ def check_one(path: Path) -> CheckRow:
             summary,
             time.perf_counter() - t0,
             msg,
+            claims,
         )
     except ObsdesignError as e:
         return CheckRow(

@@ -11,15 +11,12 @@ import os
 import signal
 import sys
 
+# obsdesign/__init__.py (imported before this module) installs the early Ctrl-C handler
+from obsdesign import _early_interrupt
 
-def _early_interrupt(signum: int, frame: object) -> None:  # pragma: no cover - timing
-    """Ctrl-C while the heavy modules load: one line, exit 130, no traceback."""
-    sys.stderr.write("obsdesign: interrupted\n")
-    os._exit(130)
-
-
-# installed before the heavy imports below (typer, rich); _run() restores Python's handler
-# when the command body starts, so that cleanup code (temp files) runs on Ctrl-C
+# installed before the heavy imports below (typer, rich) when the package's own check did
+# not (``python obsdesign/cli.py``); _run() restores Python's handler when the command body
+# starts, so that cleanup code (temp files) runs on Ctrl-C
 if signal.getsignal(signal.SIGINT) is signal.default_int_handler and os.path.basename(
     sys.argv[0]
 ) in ("obsdesign", "cli.py"):
@@ -34,15 +31,42 @@ from typing import Annotated, Any  # noqa: E402
 
 import typer  # noqa: E402
 
+
+def _usage_name(self: Any) -> str:
+    """Usage-line name of an argument as click writes it (SPEC, [SPEC], PATH...): typer ≥ 0.2x
+    writes a required argument as {SPEC}, which reads like a placeholder to substitute."""
+    name = self.metavar or self.display_name_raw
+    if not self.required:
+        name = f"[{name}]"
+    if self.nargs != 1 and not name.endswith("..."):
+        name += "..."
+    return name
+
+
+def _arg_type(self: Any, ctx: Any) -> str | None:
+    """No ``<path>`` / ``<list[Path]>`` after an argument that has a metavar (SPEC, PATH...):
+    the metavar and the help say what it is."""
+    return None if self.metavar else _ARG_TYPE(self, ctx)
+
+
+if hasattr(typer.core.TyperArgument, "_usage_display_name"):
+    typer.core.TyperArgument._usage_display_name = _usage_name  # type: ignore[method-assign]
+_ARG_TYPE = typer.core.TyperArgument.display_type_rich
+typer.core.TyperArgument.display_type_rich = _arg_type  # type: ignore[method-assign]
+
 app = typer.Typer(
     name="obsdesign",
     help="Observer design with exact certificates: design, verify, simulate, check.",
     no_args_is_help=True,
     pretty_exceptions_enable=False,
-    add_completion=False,
+    # `obsdesign --install-completion` / `--show-completion` (bash, zsh, fish, PowerShell)
+    add_completion=True,
     rich_markup_mode=None,  # plain click help: rendering help through rich costs ~150 ms
 )
-_state = {"debug": False}
+_state = {"debug": False, "quiet": False}
+#: ``-`` in place of a spec (or report) path: read it from standard input
+STDIN = "-"
+STDIN_NAME = "<stdin>"
 #: plot formats (matplotlib's savefig, by the file suffix)
 PLOT_SUFFIXES = (
     ".png",
@@ -67,6 +91,94 @@ class Fmt(StrEnum):
 
 def _err(msg: str) -> None:
     sys.stderr.write(f"obsdesign: error: {msg}\n")
+
+
+# options shared by the commands that print results
+QuietOpt = Annotated[
+    bool,
+    typer.Option(
+        "-q",
+        "--quiet",
+        help="Print only the one-line verdict (verify, check) or nothing (design, simulate); "
+        "no progress. Errors still go to stderr; --format json still prints the JSON.",
+    ),
+]
+WidthOpt = Annotated[
+    int | None,
+    typer.Option(
+        "--width",
+        metavar="COLUMNS",
+        min=40,
+        help="Width of text tables (default: the terminal's; else $COLUMNS; else 100).",
+    ),
+]
+
+
+def _setup(quiet: bool = False, width: int | None = None) -> None:
+    """Apply -q/--quiet and --width for this command."""
+    _state["quiet"] = quiet
+    if width is not None:
+        from obsdesign.report.render import set_width
+
+        set_width(width)
+
+
+def _is_stdin(path: Path | None) -> bool:
+    return path is not None and str(path) == STDIN
+
+
+def _inputs(*paths: Path | None) -> tuple[Path, ...]:
+    """The input files among ``paths`` (stdin and None left out), for the output checks."""
+    return tuple(p for p in paths if p is not None and not _is_stdin(p))
+
+
+def _read_stdin(what: str) -> str:
+    """Standard input as text, within ``max_file_bytes`` (``-`` in place of a path)."""
+    from obsdesign.errors import InputError
+    from obsdesign.limits import limits
+
+    lim = limits().max_file_bytes
+    data = sys.stdin.buffer.read(lim + 1)
+    if len(data) > lim:
+        raise InputError(
+            f"{STDIN_NAME}: {what} is above the limit of {lim} bytes (--limit max_file_bytes=N)"
+        )
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise InputError(f"{STDIN_NAME}: {what} is not UTF-8 text") from None
+
+
+def _precheck(spec: Path) -> None:
+    """The cheap checks of a spec file before the heavy imports (none for stdin)."""
+    if not _is_stdin(spec):
+        from obsdesign.limits import precheck_spec
+
+        precheck_spec(spec)
+
+
+def _load_spec(spec: Path) -> Any:
+    """The bound spec at ``spec``, or read from stdin for ``-`` (file name ``<stdin>``)."""
+    from obsdesign import api
+
+    if not _is_stdin(spec):
+        return api.load_spec(spec)
+    from obsdesign.errors import InputError
+    from obsdesign.limits import limits
+
+    text = _read_stdin("spec")
+    if text.count(",") >= limits().max_values:
+        raise InputError(
+            f"{STDIN_NAME}: holds about {text.count(',') + 1} values, above the limit of "
+            f"{limits().max_values} (--limit max_values=N)"
+        )
+    return api.load_spec_text(text, STDIN_NAME)
+
+
+def _say(text: str) -> None:
+    """An informational line on stdout (text format), unless --quiet."""
+    if not _state["quiet"]:
+        print(text)
 
 
 def _run(fn: Callable[[], int]) -> None:
@@ -143,13 +255,31 @@ def _write_plot(path: Path, draw: Callable[[Path], Any], force: bool) -> None:
     write_via(path, draw, force)
 
 
+def _version(value: bool) -> None:
+    if value:
+        from obsdesign import __version__
+
+        print(f"obsdesign {__version__}")
+        raise typer.Exit(0)
+
+
 @app.callback()
 def _main(
+    version: Annotated[
+        bool,
+        typer.Option(
+            "--version",
+            callback=_version,
+            is_eager=True,
+            help="Print the version and exit.",
+        ),
+    ] = False,
     debug: Annotated[bool, typer.Option("--debug", help="Show tracebacks on errors.")] = False,
     limit: Annotated[
         list[str] | None,
         typer.Option(
             "--limit",
+            metavar="KEY=VALUE",
             help="Change an input limit for this run, KEY=VALUE (repeatable), e.g. "
             "max_digits=5000, max_file_bytes=64M; see docs/reliability.md.",
         ),
@@ -169,15 +299,25 @@ def _main(
 
 @app.command()
 def design(
-    spec: Annotated[Path, typer.Argument(help="Spec file (TOML).")],
+    spec: Annotated[
+        Path,
+        typer.Argument(metavar="SPEC", help="Spec file (TOML); - reads it from stdin."),
+    ],
     output: Annotated[
-        Path | None, typer.Option("-o", "--output", help="Write the JSON report here.")
+        Path | None,
+        typer.Option("-o", "--output", metavar="FILE", help="Write the JSON report here."),
     ] = None,
-    fmt: Annotated[Fmt, typer.Option("--format", help="Output format on stdout.")] = Fmt.text,
+    fmt: Annotated[
+        Fmt,
+        typer.Option("--format", help="Output format on stdout (json: the report only)."),
+    ] = Fmt.text,
     plot: Annotated[
         Path | None,
         typer.Option(
-            "--plot", "--plot-epsilon", help="Write the method's design plot (PNG/SVG), e.g. ε(z)."
+            "--plot",
+            "--plot-epsilon",
+            metavar="FILE",
+            help="Write the method's design plot (PNG/SVG), e.g. ε(z).",
         ),
     ] = None,
     force: Annotated[
@@ -188,6 +328,8 @@ def design(
             "non-regular file or over a write-protected file.",
         ),
     ] = False,
+    quiet: QuietOpt = False,
+    width: WidthOpt = None,
 ) -> None:
     """Design the observer of SPEC, certify every claim, and print (or write) the report.
 
@@ -196,28 +338,28 @@ def design(
     bad input (exit 2) writes nothing."""
 
     def body() -> int:
-        from obsdesign.limits import precheck_spec
-
-        precheck_spec(spec)  # before the heavy imports: an oversized spec is refused at once
+        _setup(quiet, width)
+        _precheck(spec)  # before the heavy imports: an oversized spec is refused at once
         from obsdesign import api
         from obsdesign.errors import InputError
         from obsdesign.report.model import check_output
 
         if output is not None:
-            check_output(output, force, (spec,))
-        _check_plot(plot, force, (spec,) + ((output,) if output is not None else ()))
-        progress = _progress() if fmt == Fmt.text else None
-        sp = api.load_spec(spec)
+            check_output(output, force, _inputs(spec))
+        _check_plot(plot, force, _inputs(spec, output))
+        progress = _progress() if fmt == Fmt.text and not quiet else None
+        sp = _load_spec(spec)
         if plot is not None and api.method(sp.method).plot_design is None:
             raise InputError(f"--plot: method '{sp.method}' has no design plot")
         rep = api.design(sp, output, progress=progress, force=force)
-        _print_report(rep, fmt)
+        if not quiet or fmt == Fmt.json:
+            _print_report(rep, fmt)
         if plot is not None:
             _write_plot(plot, lambda tmp: api.plot_design(sp, rep.parameters, tmp), force)
             if fmt == Fmt.text:
-                print(f"plot written to {plot}")
+                _say(f"plot written to {plot}")
         if output is not None and fmt == Fmt.text:
-            print(f"report written to {output}")
+            _say(f"report written to {output}")
         return rep.exit_code()
 
     _run(body)
@@ -225,24 +367,44 @@ def design(
 
 @app.command()
 def verify(
-    report: Annotated[Path, typer.Argument(help="JSON report written by 'design'.")],
+    report: Annotated[
+        Path,
+        typer.Argument(
+            metavar="REPORT",
+            help="JSON report written by 'design'; - reads it from stdin.",
+        ),
+    ],
     spec: Annotated[
-        Path | None, typer.Option("--spec", help="Check against this spec (hash must match).")
+        Path | None,
+        typer.Option("--spec", metavar="SPEC", help="Check against this spec (hash must match)."),
     ] = None,
-    fmt: Annotated[Fmt, typer.Option("--format")] = Fmt.text,
+    fmt: Annotated[Fmt, typer.Option("--format", help="Output format on stdout.")] = Fmt.text,
+    quiet: QuietOpt = False,
+    width: WidthOpt = None,
 ) -> None:
-    """Re-check every claim of REPORT independently; exit 0 only if all hold."""
+    """Re-check every claim of REPORT independently; exit 0 only if all hold.
+
+    The last line (text and md) is the verdict, e.g. "verified: 8 claims certified,
+    0 failed"."""
 
     def body() -> int:
+        _setup(quiet, width)
         from obsdesign.limits import precheck_spec, read_input
 
-        read_input(report, "report")  # before the heavy imports (regular file, size)
+        if not _is_stdin(report):
+            read_input(report, "report")  # before the heavy imports (regular file, size)
         if spec is not None:
             precheck_spec(spec)
         from obsdesign import api
+        from obsdesign.report.render import verdict_line
 
-        rep = api.verify(report, spec)
-        _print_report(rep, fmt)
+        rep = api.verify(_read_report(report), spec)
+        if not quiet or fmt == Fmt.json:
+            _print_report(rep, fmt)
+        if fmt == Fmt.md and not quiet:
+            print(f"\n**{verdict_line(rep)}**")
+        elif fmt != Fmt.json:
+            print(verdict_line(rep))
         return rep.exit_code()
 
     _run(body)
@@ -250,26 +412,54 @@ def verify(
 
 @app.command()
 def check(
-    paths: Annotated[list[Path], typer.Argument(help="Spec files or folders of *.toml.")],
-    fmt: Annotated[Fmt, typer.Option("--format")] = Fmt.text,
+    paths: Annotated[
+        list[Path],
+        typer.Argument(metavar="PATH...", help="Spec files or folders of *.toml."),
+    ],
+    fmt: Annotated[Fmt, typer.Option("--format", help="Output format on stdout.")] = Fmt.text,
+    junit: Annotated[
+        Path | None,
+        typer.Option(
+            "--junit",
+            metavar="FILE",
+            help="Also write a JUnit XML report (one testcase per spec and per claim).",
+        ),
+    ] = None,
+    quiet: QuietOpt = False,
+    width: WidthOpt = None,
 ) -> None:
     """Design and verify every spec; one row per spec; non-zero exit if any fails.
 
     Folders are searched recursively for *.toml (hidden folders skipped). Every spec gets a
-    row whatever happens in it: its exit code and message (an internal error is exit 3)."""
+    row whatever happens in it: its exit code and message (an internal error is exit 3).
+    The last line (text and md) is the verdict, e.g. "checked: 13 specs, 13 ok, 0 failed;
+    95 claims certified, 0 failed"."""
 
     def body() -> int:
+        _setup(quiet, width)
         from obsdesign import api
 
+        if junit is not None:
+            from obsdesign.report.model import check_output
+
+            check_output(junit, False, _inputs(*paths))
+
         def each(f: Path) -> None:
-            if fmt == Fmt.text:
+            if fmt == Fmt.text and not quiet:
                 sys.stderr.write(f"checking {f} ...\n")
 
         rows = api.check(list(paths), on_start=each)
+        if junit is not None:
+            from obsdesign.junit import write_junit
+
+            write_junit(junit, rows)
         if fmt == Fmt.json:
-            print(json.dumps([r.__dict__ for r in rows], indent=2))
+            print(json.dumps([r.__dict__ for r in rows], indent=2, default=_jsonable))
         else:
-            _print_rows(rows, fmt)
+            if not quiet:
+                _print_rows(rows, fmt)
+            line = _check_verdict(rows)
+            print(f"\n**{line}**" if fmt == Fmt.md and not quiet else line)
         return api.check_exit_code(rows)
 
     _run(body)
@@ -277,48 +467,76 @@ def check(
 
 @app.command()
 def simulate(
-    spec: Annotated[Path, typer.Argument(help="Spec file with a [simulate] table.")],
+    spec: Annotated[
+        Path,
+        typer.Argument(
+            metavar="SPEC",
+            help="Spec file with a [simulate] table; - reads it from stdin.",
+        ),
+    ],
     report: Annotated[
-        Path | None, typer.Option("--report", help="Use this report's parameters.")
+        Path | None,
+        typer.Option("--report", metavar="REPORT", help="Use this report's parameters."),
     ] = None,
-    plot: Annotated[Path | None, typer.Option("--plot", help="Write a plot (PNG/SVG).")] = None,
-    fmt: Annotated[Fmt, typer.Option("--format")] = Fmt.text,
+    plot: Annotated[
+        Path | None,
+        typer.Option("--plot", metavar="FILE", help="Write a plot (PNG/SVG)."),
+    ] = None,
+    fmt: Annotated[Fmt, typer.Option("--format", help="Output format on stdout.")] = Fmt.text,
     option: Annotated[
         list[str] | None,
-        typer.Option("--option", help="Method simulation option KEY=VALUE (repeatable)."),
+        typer.Option(
+            "--option",
+            metavar="KEY=VALUE",
+            help="Method simulation option KEY=VALUE (repeatable).",
+        ),
     ] = None,
     force: Annotated[
-        bool, typer.Option("--force", help="Write --plot even where it is refused by default.")
+        bool,
+        typer.Option("--force", help="Write --plot even where it is refused by default."),
     ] = False,
+    quiet: QuietOpt = False,
+    width: WidthOpt = None,
 ) -> None:
     """Run the plant and the designed observer over the spec's scenario; print metrics."""
 
     def body() -> int:
-        from obsdesign.limits import precheck_spec
-
-        precheck_spec(spec)  # before the heavy imports
+        _setup(quiet, width)
+        _precheck(spec)  # before the heavy imports
         from obsdesign import api
 
-        _check_plot(plot, force, (spec,) + ((report,) if report is not None else ()))
-        sp = api.load_spec(spec)
+        _check_plot(plot, force, _inputs(spec, report))
+        sp = _load_spec(spec)
         res = api.simulate(sp, report, options=_kv(option or []))
         m = res.metrics()
         if fmt == Fmt.json:
             print(json.dumps(m, indent=2, default=_jsonable))
-        else:
+        elif fmt == Fmt.md and not quiet:
+            sys.stdout.write(_metrics_markdown(m))
+        elif not quiet:
             _print_metrics(m)
         if plot is not None:
             _write_plot(plot, lambda tmp: api.plot_simulation(sp, res, tmp), force)
             if fmt == Fmt.text:
-                print(f"plot written to {plot}")
+                _say(f"plot written to {plot}")
         return int(res.info.get("exit_code", 0))
 
     _run(body)
 
 
+class JsonFmt(StrEnum):
+    json = "json"
+
+
 @app.command()
-def schema() -> None:
-    """Print the JSON schema of the spec format."""
+def schema(
+    fmt: Annotated[
+        JsonFmt, typer.Option("--format", help="Output format (JSON schema only).")
+    ] = JsonFmt.json,
+) -> None:
+    """Print the JSON schema of the spec format (draft 2020-12).
+
+    Expression-valued keys carry "format": "obsdesign-expression"."""
 
     def body() -> int:
         from obsdesign import api
@@ -330,8 +548,19 @@ def schema() -> None:
 
 
 @app.command()
-def init(method: Annotated[str, typer.Argument(help="Method key.")]) -> None:
-    """Print a commented template spec for METHOD."""
+def init(
+    method: Annotated[
+        str,
+        typer.Argument(
+            metavar="METHOD",
+            help="Method key (see 'obsdesign methods').",
+            show_default=False,
+        ),
+    ],
+) -> None:
+    """Print a commented template spec (TOML) for METHOD, e.g. obsdesign init lyapunov > my.toml.
+
+    Every commented line "# key = value" is a valid alternative once uncommented."""
 
     def body() -> int:
         from obsdesign import api
@@ -343,14 +572,35 @@ def init(method: Annotated[str, typer.Argument(help="Method key.")]) -> None:
 
 
 @app.command()
-def methods() -> None:
-    """List the design methods."""
+def methods(
+    fmt: Annotated[Fmt, typer.Option("--format", help="Output format on stdout.")] = Fmt.text,
+) -> None:
+    """List the design methods (--format json also gives the obsdesign version)."""
 
     def body() -> int:
-        from obsdesign import api
+        from obsdesign import __version__, api
 
-        for m in api.methods():
-            print(f"{m.key:15s} {m.title}  ({m.paper})")
+        ms = api.methods()
+        if fmt == Fmt.json:
+            rows = [
+                {
+                    "key": m.key,
+                    "title": m.title,
+                    "paper": m.paper,
+                    "needs_linear": m.needs_linear,
+                    "extra_tables": list(m.extra_tables),
+                }
+                for m in ms
+            ]
+            print(json.dumps({"version": __version__, "methods": rows}, indent=2))
+        elif fmt == Fmt.md:
+            print("| key | title | paper |")
+            print("| --- | --- | --- |")
+            for m in ms:
+                print(f"| {_md_cell(m.key)} | {_md_cell(m.title)} | {_md_cell(m.paper)} |")
+        else:
+            for m in ms:
+                print(f"{m.key:15s} {m.title}  ({m.paper})")
         return 0
 
     _run(body)
@@ -435,6 +685,63 @@ def _print_rows(rows: list[Any], fmt: Fmt) -> None:
     console().print(t)
 
 
+def _check_verdict(rows: list[Any]) -> str:
+    """The one-line verdict of ``check``."""
+    ok = sum(r.code == 0 for r in rows)
+    cert = sum(r.certified for r in rows)
+    num = sum(r.numerical for r in rows)
+    fail = sum(r.failed for r in rows)
+    claims = f"{cert} claim{'s' if cert != 1 else ''} certified"
+    if num:
+        claims += f", {num} numerical"
+    head = "checked" if ok == len(rows) else "NOT all checked"
+    return (
+        f"{head}: {len(rows)} spec{'s' if len(rows) != 1 else ''}, {ok} ok, "
+        f"{len(rows) - ok} failed; {claims}, {fail} failed"
+    )
+
+
+def _read_report(report: Path) -> Any:
+    """The report path, or for ``-`` the report read from stdin (a Report)."""
+    if not _is_stdin(report):
+        return report
+    from obsdesign.errors import InputError
+    from obsdesign.limits import int_digits
+    from obsdesign.report.model import Report
+
+    text = _read_stdin("report")
+    try:
+        with int_digits():
+            d = json.loads(text)
+    except json.JSONDecodeError as e:
+        raise InputError(f"{STDIN_NAME}: not a readable JSON report ({e})") from None
+    except RecursionError:
+        raise InputError(f"{STDIN_NAME}: JSON nested too deeply") from None
+    return Report.from_dict(d, STDIN_NAME)[0]
+
+
+def _metrics_markdown(m: dict[str, Any]) -> str:
+    lines = [
+        "| state | sup \\|e_i\\| | RMSE | sup \\|x̂_i\\| |",
+        "| --- | --- | --- | --- |",
+    ]
+    for st, v in m["sup_abs_error"].items():
+        lines.append(
+            f"| {_md_cell(st)} | {v:.6g} | {m['rmse'][st]:.6g} | {m['sup_abs_estimate'][st]:.6g} |"
+        )
+    lines += ["", f"final \\|e\\| = {m['final_error_norm']:.6g}"]
+    for k, v in m.items():
+        if k not in (
+            "sup_abs_error",
+            "rmse",
+            "final_error_norm",
+            "sup_abs_estimate",
+            "exit_code",
+        ):
+            lines.append(f"- {_md_cell(k)}: {_md_cell(v)}")
+    return "\n".join(lines) + "\n"
+
+
 def _md_cell(v: Any) -> str:
     """A Markdown table cell: pipes escaped, one line."""
     return str(v).replace("|", "\\|").replace("\n", " ")
@@ -456,7 +763,13 @@ def _print_metrics(m: dict[str, Any]) -> None:
     c.print(t)
     c.print(f"final |e| = {m['final_error_norm']:.6g}")
     for k, v in m.items():
-        if k not in ("sup_abs_error", "rmse", "final_error_norm", "sup_abs_estimate", "exit_code"):
+        if k not in (
+            "sup_abs_error",
+            "rmse",
+            "final_error_norm",
+            "sup_abs_estimate",
+            "exit_code",
+        ):
             c.print(esc(f"{k}: {v}"))
 
 

@@ -58,14 +58,55 @@ def _numeric(v: Any) -> bool:
         return False
 
 
-def console() -> Any:
-    """A rich console; when stdout is not a terminal (CI logs, pipes) use 160 columns rather
-    than rich's default 80, so tables stay readable."""
+#: ``--width N`` of the command line (None: see :func:`width`)
+_WIDTH: dict[str, int | None] = {"width": None}
+#: width of tables when stdout is not a terminal and COLUMNS is not set (CI logs, pipes)
+DEFAULT_WIDTH = 100
+#: below this width the claims table puts check and detail under the statement
+NARROW = 120
+
+
+def set_width(n: int | None) -> None:
+    """Fix the width of rendered tables (``--width N``); None restores the default."""
+    _WIDTH["width"] = n
+
+
+def width() -> int | None:
+    """The table width: ``--width`` if given, else ``COLUMNS`` if set to a positive number,
+    else the terminal's width (None: rich asks the terminal) when stdout is a terminal, else
+    :data:`DEFAULT_WIDTH` columns."""
+    import os
     import sys
 
+    if _WIDTH["width"] is not None:
+        return _WIDTH["width"]
+    env = os.environ.get("COLUMNS", "").strip()
+    if env.isdigit() and int(env) > 0:
+        return int(env)
+    return None if sys.stdout.isatty() else DEFAULT_WIDTH
+
+
+def console() -> Any:
+    """A rich console of :func:`width` columns."""
     from rich.console import Console
 
-    return Console() if sys.stdout.isatty() else Console(width=160)
+    return Console(width=width())
+
+
+def verdict_line(report: Report, verb: str = "verified") -> str:
+    """The one-line verdict printed last by ``verify``: ``verified: 8 claims certified,
+    0 failed`` (numerical claims named when there are any; ``NOT verified`` when a claim
+    failed or the design stopped with an error)."""
+    n = report.status_counts()
+    ok = report.exit_code() == 0
+    parts = [f"{n['certified']} claim{'s' if n['certified'] != 1 else ''} certified"]
+    if n["numerical"]:
+        parts.append(f"{n['numerical']} numerical")
+    parts.append(f"{n['failed']} failed")
+    head = verb if ok else f"NOT {verb}"
+    if report.error is not None:
+        head += f" (design stopped with exit {report.error.get('exit_code', '?')})"
+    return f"{head}: {', '.join(parts)}"
 
 
 def render_text(report: Report, title: str = "") -> None:
@@ -81,16 +122,32 @@ def render_text(report: Report, title: str = "") -> None:
         t.add_row(esc(k), esc(v), form)
     out.print(t)
     c = Table(title="claims")
-    for col in ("id", "status", "statement", "check", "detail"):
-        c.add_column(col, overflow="fold")
-    for cl in report.claims:
-        c.add_row(
-            esc(cl.id),
-            f"[{STYLE[cl.status]}]{cl.status.value}[/]",
-            esc(cl.statement),
-            esc(cl.check),
-            esc(cl.detail),
-        )
+    # claim ids never break mid-word: their column is as wide as the longest id (up to 32
+    # characters); the prose columns wrap at spaces. Below NARROW columns the check and
+    # the detail go under the statement (two columns), so nothing is cropped at 80.
+    id_w = min(max((len(cl.id) for cl in report.claims), default=2), 32)
+    if out.width < NARROW:
+        c.add_column("id / status", overflow="fold", min_width=id_w)
+        c.add_column("statement / check / detail", overflow="fold")
+        for cl in report.claims:
+            c.add_row(
+                f"{esc(cl.id)}\n[{STYLE[cl.status]}]{cl.status.value}[/]",
+                f"{esc(cl.statement)}\n[dim]check:[/] {esc(cl.check)}"
+                f"\n[dim]detail:[/] {esc(cl.detail)}",
+            )
+    else:
+        c.add_column("id", overflow="fold", min_width=id_w)
+        c.add_column("status", no_wrap=True, min_width=9)
+        for col in ("statement", "check", "detail"):
+            c.add_column(col, overflow="fold")
+        for cl in report.claims:
+            c.add_row(
+                esc(cl.id),
+                f"[{STYLE[cl.status]}]{cl.status.value}[/]",
+                esc(cl.statement),
+                esc(cl.check),
+                esc(cl.detail),
+            )
     out.print(c)
     if report.error is not None:
         out.print(f"design stopped: {esc(report.error.get('message', ''))}", markup=True)

@@ -71,14 +71,23 @@ class Table:
         if k in self.data:
             return self.data[k]
         if default is _MISSING:
-            raise self.error(k, "is missing")
+            import difflib
+
+            close = difflib.get_close_matches(k, sorted(set(self.data) - self._used), n=1)
+            hint = f" (is '{close[0]}' a misspelling of it?)" if close else ""
+            raise self.error(k, f"is missing{hint}")
         return default
 
     def done(self, allowed_extra: tuple[str, ...] = ()) -> None:
         """Reject keys nobody read: a typo must not be silently ignored."""
         unknown = sorted(set(self.data) - self._used - set(allowed_extra))
         if unknown:
-            raise self.error(unknown[0], "is not a known key here")
+            import difflib
+
+            known = sorted((self._used | set(allowed_extra)) - set(self.data))
+            close = difflib.get_close_matches(unknown[0], known, n=1, cutoff=0.6)
+            hint = f" (did you mean '{close[0]}'?)" if close else ""
+            raise self.error(unknown[0], f"is not a known key here{hint}")
 
     # -- tables -----------------------------------------------------------------------------
     def table(self, k: str, required: bool = False) -> Table | None:

@@ -1,0 +1,199 @@
+"""Command-line conventions (issue 14 item 2): --version, -q, ``-`` for stdin, --format on
+every printing command with nothing but JSON on stdout, "did you mean", the one-line verdict
+of verify and check, readable --help, table width."""
+
+from __future__ import annotations
+
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from obsdesign import __version__
+from obsdesign.cli import app
+from obsdesign.methods import method_keys
+
+SPEC = """title = "one state"
+[system]
+time = "discrete"
+A = [[0.5, 0.1], [0, 0.8]]
+C = [[1, 0]]
+[method]
+key = "lyapunov"
+lambda = 0.9
+[simulate]
+horizon = 20
+x0 = [1, -1]
+xhat0 = [0, 0]
+"""
+runner = CliRunner()
+
+
+def _run(*args: str, input: str | None = None) -> tuple[int, str, str]:
+    r = runner.invoke(app, list(args), input=input)
+    return r.exit_code, r.stdout, r.stderr
+
+
+@pytest.fixture()
+def spec(tmp_path: Path) -> Path:
+    p = tmp_path / "s.toml"
+    p.write_text(SPEC)
+    return p
+
+
+@pytest.fixture(autouse=True)
+def _no_columns(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv("COLUMNS", raising=False)
+    from obsdesign.report import render
+
+    render.set_width(None)
+
+
+def test_version_and_methods_json():
+    code, out, _ = _run("--version")
+    assert code == 0 and out.strip() == f"obsdesign {__version__}"
+    code, out, _ = _run("methods", "--format", "json")
+    d = json.loads(out)
+    assert d["version"] == __version__
+    assert [m["key"] for m in d["methods"]] == method_keys()
+    code, out, _ = _run("methods", "--format", "md")
+    assert out.splitlines()[0] == "| key | title | paper |" and len(out.splitlines()) == 2 + len(
+        method_keys()
+    )
+
+
+def test_stdin_spec_quiet_and_verdict(tmp_path: Path):
+    out_json = tmp_path / "r.json"
+    code, out, _ = _run("design", "-", "-q", "-o", str(out_json), input=SPEC)
+    assert code == 0 and out == ""  # quiet: nothing on stdout
+    d = json.loads(out_json.read_text())
+    assert d["spec_file"] == "<stdin>" and d["verdict"] == "ok"
+    n = len(d["claims"])
+    code, out, _ = _run("verify", str(out_json))
+    assert code == 0
+    assert out.rstrip().splitlines()[-1] == f"verified: {n} claims certified, 0 failed"
+    code, out, _ = _run("verify", str(out_json), "-q")
+    assert out == f"verified: {n} claims certified, 0 failed\n"
+    # a report from stdin
+    code, out, _ = _run("verify", "-", "-q", input=out_json.read_text())
+    assert code == 0 and out == f"verified: {n} claims certified, 0 failed\n"
+    # tampered: the verdict says so and the exit code is 1
+    d["parameters"]["exact"]["L"][0][0] = "7"
+    d["parameters"]["L"][0][0] = 7.0
+    code, out, _ = _run("verify", "-", "-q", input=json.dumps(d))
+    assert code == 1 and out.startswith("NOT verified: ")
+
+
+def test_stdin_output_checks_still_refuse(tmp_path: Path):
+    target = tmp_path / "t.json"
+    target.write_text("{}")
+    link = tmp_path / "link.json"
+    link.symlink_to(target)
+    code, _, err = _run("design", "-", "-o", str(link), input=SPEC)
+    assert code == 2 and "symbolic link" in err
+    assert target.read_text() == "{}"
+    target.chmod(0o444)  # write-protected (mode bits count even for root)
+    code, _, err = _run("design", "-", "-o", str(target), input=SPEC)
+    assert code == 2 and "write-protected" in err
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ("design", "{spec}", "--format", "json"),
+        ("verify", "{report}", "--format", "json"),
+        ("check", "{spec}", "--format", "json"),
+        ("simulate", "{spec}", "--format", "json"),
+        ("methods", "--format", "json"),
+        ("schema", "--format", "json"),
+    ],
+)
+def test_json_only_on_stdout(args: tuple[str, ...], spec: Path, tmp_path: Path):
+    report = tmp_path / "r.json"
+    assert _run("design", str(spec), "-q", "-o", str(report))[0] == 0
+    argv = [a.format(spec=spec, report=report) for a in args]
+    code, out, _ = _run(*argv)
+    assert code == 0
+    json.loads(out)  # the whole of stdout is one JSON document
+
+
+def test_check_verdict_line_and_md(spec: Path, tmp_path: Path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(SPEC.replace("lambda = 0.9", "lamda = 0.9"))
+    code, out, _ = _run("check", str(spec), "-q")
+    assert code == 0
+    assert re.fullmatch(r"checked: 1 spec, 1 ok, 0 failed; \d+ claims certified, 0 failed\n", out)
+    code, out, _ = _run("check", str(spec), str(bad), "--format", "md")
+    assert code == 2
+    assert out.rstrip().splitlines()[-1].startswith("**NOT all checked: 2 specs, 1 ok, 1 failed;")
+
+
+def test_did_you_mean(tmp_path: Path):
+    # an unknown key next to an optional one
+    code, _, err = _run("design", "-", input=SPEC.replace("[simulate]", "[simulat]"))
+    assert code == 2 and "(did you mean 'simulate'?)" in err
+    code, _, err = _run(
+        "design", "-", input=SPEC.replace("lambda = 0.9", "lambda = 0.9\nrate_tl = 1")
+    )
+    assert code == 2 and "[method.rate_tl]" in err and "(did you mean 'rate_tol'?)" in err
+    # a misspelt required key
+    si = runner.invoke(app, ["init", "set-invariant"]).stdout
+    assert re.search(r"^lambda = ", si, re.M)
+    code, _, err = _run("design", "-", input=re.sub(r"^lambda = ", "lamda = ", si, flags=re.M))
+    assert code == 2 and "[method.lambda] is missing (is 'lamda' a misspelling of it?)" in err
+    code, _, err = _run("init", "lyapunv")
+    assert code == 2 and "did you mean 'lyapunov'" in err
+
+
+def test_help_metavars_readable():
+    for cmd in ("design", "verify", "check", "simulate", "schema", "init", "methods", "--help"):
+        out = runner.invoke(app, [cmd, "--help"] if cmd != "--help" else ["--help"]).stdout
+        for bad in ("{", "<list[", "<path>", "<str>"):
+            assert bad not in out, (cmd, bad)
+    assert (
+        "Usage: obsdesign check [OPTIONS] PATH..." in runner.invoke(app, ["check", "--help"]).stdout
+    )
+    assert "--install-completion" in runner.invoke(app, ["--help"]).stdout
+
+
+@pytest.mark.parametrize("width", [80, 100, 160])
+def test_width_and_unbroken_ids(width: int, spec: Path, tmp_path: Path):
+    report = tmp_path / "r.json"
+    assert _run("design", str(spec), "-q", "-o", str(report))[0] == 0
+    ids = [c["id"] for c in json.loads(report.read_text())["claims"]]
+    code, out, _ = _run("verify", str(report), "--width", str(width))
+    lines = out.splitlines()
+    assert max(len(x) for x in lines) <= width
+    cells = {c.strip() for line in lines for c in re.split(r"[│┃]", line)}
+    for cid in ids:
+        assert cid in cells, cid  # each id whole in one cell, never broken
+
+
+def test_default_width_not_a_terminal(spec: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch):
+    report = tmp_path / "r.json"
+    assert _run("design", str(spec), "-q", "-o", str(report))[0] == 0
+    out = _run("verify", str(report))[1]
+    assert max(len(x) for x in out.splitlines()) == 100  # not a terminal: 100 columns
+    monkeypatch.setenv("COLUMNS", "90")
+    out = _run("verify", str(report))[1]
+    assert max(len(x) for x in out.splitlines()) == 90
+
+
+def test_early_interrupt_handler_installed_by_the_package():
+    code = (
+        "import sys, signal; sys.argv[0] = '/x/bin/obsdesign'; import obsdesign; "
+        "print(signal.getsignal(signal.SIGINT) is obsdesign._early_interrupt)"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert r.stdout.strip() == "True"
+    r = subprocess.run(
+        [sys.executable, "-c", code.replace("/x/bin/obsdesign", "python")],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert r.stdout.strip() == "False"  # a library import leaves Ctrl-C alone
