@@ -1,0 +1,246 @@
+"""Running independent tasks in this process or on Dask (``dask.distributed``).
+
+:func:`run_tasks` maps a picklable function over a list of items and returns the results in
+the items' order, whatever order they finish in:
+
+- in-process (the default): one after the other;
+- on a Dask ``LocalCluster`` of ``workers`` processes (one thread each) that it starts and
+  stops itself;
+- on an existing Dask cluster (``scheduler="tcp://HOST:PORT"``, started with ``dask
+  scheduler`` and ``dask worker tcp://HOST:PORT``), or on a ``dask.distributed.Client`` the
+  caller passes (then the caller owns it).
+
+A worker that dies while running a task costs a retry on another worker (Dask reschedules
+the tasks of a lost worker; ``distributed.scheduler.allowed-failures``, 3 by default), not a
+result: a task that kills every worker it runs on becomes the result ``lost(item, message)``.
+The limits in force here (``--limit``) are applied in the workers for each task, so a
+distributed run refuses exactly what the serial run refuses. Ctrl-C cancels the tasks and
+stops the cluster this module started.
+
+Dask is an extra (``pip install 'obsdesign[distributed]'``); without it, asking for workers
+is an :class:`InputError` that says how to install it (exit 2).
+"""
+
+from __future__ import annotations
+
+import logging
+import sys
+import uuid
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
+from typing import Any, TypeVar
+
+from obsdesign.errors import InputError
+
+T = TypeVar("T")
+R = TypeVar("R")
+
+#: what to run to get Dask
+INSTALL_HINT = (
+    "Dask is not installed: pip install 'obsdesign[distributed]' "
+    "(or pip install 'dask[distributed]'), or run without --workers/--scheduler"
+)
+
+
+def dask_available() -> bool:
+    """Whether ``dask.distributed`` can be imported."""
+    try:
+        import dask.distributed  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def _require_dask() -> None:
+    if not dask_available():
+        raise InputError(INSTALL_HINT)
+
+
+def check_workers(workers: int | None, scheduler: str | None) -> None:
+    """Refuse (exit 2) a bad ``--workers``/``--scheduler`` pair, or Dask missing, before any
+    work starts."""
+    if workers is not None and scheduler is not None:
+        raise InputError("--workers and --scheduler exclude each other (a scheduler has its own)")
+    if workers is not None and workers < 1:
+        raise InputError(f"--workers: expected a positive number of processes, got {workers}")
+    if scheduler is not None and "://" not in scheduler:
+        raise InputError(
+            f"--scheduler: expected an address such as tcp://HOST:8786, got {scheduler!r}"
+        )
+    if workers is not None or scheduler is not None:
+        _require_dask()
+
+
+@contextmanager
+def dask_client(
+    workers: int | None = None, scheduler: str | None = None, client: Any = None
+) -> Iterator[Any]:
+    """A ``dask.distributed.Client``: ``client`` as given (not closed here), else one
+    connected to ``scheduler``, else one on a new ``LocalCluster`` of ``workers`` processes
+    with one thread each. What this function starts, it closes (also on Ctrl-C)."""
+    if client is not None:
+        yield client
+        return
+    _require_dask()
+    from dask.distributed import Client, LocalCluster
+
+    logging.getLogger("distributed").setLevel(logging.ERROR)
+    if scheduler is not None:
+        try:
+            c = Client(scheduler, timeout="10s")
+        except OSError as e:
+            raise InputError(f"--scheduler {scheduler}: cannot connect ({e})") from None
+        try:
+            yield c
+        finally:
+            c.close()
+        return
+    cluster = LocalCluster(
+        n_workers=workers or 1,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=None,
+        silence_logs=logging.ERROR,
+    )
+    try:
+        c = Client(cluster)
+        try:
+            yield c
+        finally:
+            c.close()
+    finally:
+        cluster.close()
+
+
+def _limits_state() -> tuple[Any, tuple[str, ...]]:
+    from obsdesign import limits as lim
+
+    return lim.limits(), tuple(sorted(lim._overridden))
+
+
+def _call(fn: Callable[[T], R], state: tuple[Any, tuple[str, ...]], item: T) -> R:
+    """Run ``fn(item)`` in a worker with the caller's limits in force (restored after)."""
+    from obsdesign import limits as lim
+
+    values, overridden = state
+    old = lim.limits()
+    old_over = set(lim._overridden)
+    lim.reset_limits()
+    if overridden:
+        lim.set_limits(**{k: getattr(values, k) for k in overridden})
+    try:
+        return fn(item)
+    finally:
+        lim.reset_limits(old)
+        lim._overridden.clear()
+        lim._overridden.update(old_over)
+
+
+def run_tasks(
+    fn: Callable[[T], R],
+    items: Sequence[T],
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    client: Any = None,
+    on_result: Callable[[int, R], None] | None = None,
+    lost: Callable[[T, str], R] | None = None,
+) -> list[R]:
+    """``[fn(x) for x in items]``, in this process or on Dask (see the module docstring).
+
+    ``on_result(i, result)`` is called as each result arrives (in completion order: for a
+    progress bar); the returned list is in the items' order. ``fn`` should not raise (return
+    a result that records the failure); if it does, or if its task kills the workers it runs
+    on, the result is ``lost(item, message)`` (the exception is raised when ``lost`` is
+    None)."""
+    items = list(items)
+    results: list[Any] = [None] * len(items)
+    if workers is None and scheduler is None and client is None:
+        for i, it in enumerate(items):
+            r = fn(it)
+            results[i] = r
+            if on_result is not None:
+                on_result(i, r)
+        return results
+    check_workers(workers, scheduler)
+    from dask.distributed import as_completed
+
+    state = _limits_state()
+    tag = uuid.uuid4().hex[:12]
+    with dask_client(workers, scheduler, client) as c:
+        futures = [
+            c.submit(_call, fn, state, it, key=f"obsdesign-{tag}-{i}", pure=False)
+            for i, it in enumerate(items)
+        ]
+        index = {f.key: i for i, f in enumerate(futures)}
+        try:
+            for fut in as_completed(futures):
+                i = index[fut.key]
+                try:
+                    r = fut.result()
+                except Exception as e:  # noqa: BLE001 - KilledWorker, or fn raised
+                    if lost is None:
+                        raise
+                    name = type(e).__name__
+                    if name == "KilledWorker":
+                        msg = f"internal failure: the task killed every worker it ran on ({e})"
+                    else:
+                        msg = f"internal failure: {name}: {e}"
+                    r = lost(items[i], msg)
+                results[i] = r
+                if on_result is not None:
+                    on_result(i, r)
+        except BaseException:
+            c.cancel(futures)
+            raise
+    return results
+
+
+@contextmanager
+def progress_bar(total: int, label: str, quiet: bool = False) -> Iterator[Callable[[bool], None]]:
+    """A rich progress bar on stderr (rows done / total, failures, ETA); yields
+    ``advance(failed)``, called once per finished row. Nothing is shown with ``quiet``."""
+    if quiet or total <= 0:
+        yield lambda failed: None
+        return
+    from rich.console import Console
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+
+    bar = Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("failures {task.fields[failures]}"),
+        TimeElapsedColumn(),
+        TextColumn("ETA"),
+        TimeRemainingColumn(),
+        console=Console(file=sys.stderr),
+        transient=False,
+    )
+    task = bar.add_task(label, total=total, failures=0)
+    failures = 0
+
+    def advance(failed: bool) -> None:
+        nonlocal failures
+        failures += bool(failed)
+        bar.update(task, advance=1, failures=failures)
+
+    with bar:
+        yield advance
+
+
+__all__ = [
+    "INSTALL_HINT",
+    "check_workers",
+    "dask_available",
+    "dask_client",
+    "progress_bar",
+    "run_tasks",
+]

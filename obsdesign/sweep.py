@@ -1,0 +1,764 @@
+"""Design-space sweeps: a grid over dotted spec keys, one designed and verified spec per point.
+
+A grid is a list of axes, each written ``KEY=VALUES`` (the ``--set`` of ``obsdesign
+sweep``), KEY a dotted spec key (``method.lambda``, ``simulate.noise.bound``) and VALUES
+
+- ``a:b:n``: ``n`` values from ``a`` to ``b`` evenly spaced (both ends included);
+- ``a:b:n:log``: ``n`` values from ``a`` to ``b`` evenly spaced in log scale (``a, b > 0``);
+- ``[v1, v2, ...]``: these TOML values (a bare word is a string: ``[clarabel, scs]``); to
+  sweep arrays, give a list of arrays (``method.L=[[-1.87, 1.874], [-1.8, 1.9]]``);
+- ``v``: one value (a fixed change applied to every point).
+
+The grid is the product of the axes (the last axis varies fastest); point ``i`` is row
+``i``. Each point's spec is the spec's TOML text with the values written in place as
+decimals (``0.93``, ``0.0031622776601684``: linear values exactly when they have at most 15
+significant digits, log values rounded to 15), so the spec of every point is exact and
+self-contained: the design certifies that text. The key's line is replaced (a trailing
+comment kept), or added to its table when absent; the edit is checked by parsing the new
+text and comparing it with the old one with only that key changed.
+
+Every point is designed, serialized, reloaded and verified (as ``obsdesign check`` does),
+and simulated with ``simulate=True``. A point that fails (bad input, infeasible, solver
+failure, an internal error) is a row with its exit code and message, never a lost row.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+import sys
+import time
+import tomllib
+import types
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from decimal import Decimal, localcontext
+from fractions import Fraction
+from itertools import product
+from pathlib import Path
+from typing import Any
+
+from obsdesign.errors import EXIT_BAD_INPUT, EXIT_OK, EXIT_SOLVER, InputError, ObsdesignError
+
+#: at most this many points in one sweep (a typo such as 1:2:1000000000 is refused at once)
+MAX_POINTS = 100_000
+#: significant digits of the values written into the spec (linear values that need more are
+#: rounded; log values always are)
+DIGITS = 15
+#: output formats by suffix
+OUTPUT_SUFFIXES = (".csv", ".jsonl", ".parquet")
+#: columns that differ between two runs of the same sweep (wall-clock times)
+TIMING_COLUMNS = ("design_s", "verify_s", "simulate_s", "seconds")
+
+_KEY_RE = re.compile(r"^[A-Za-z0-9_-]+(\.[A-Za-z0-9_-]+)*$")
+_NUM = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
+_RANGE_RE = re.compile(rf"^({_NUM}):({_NUM}):(\d+)(?::(lin|log))?$")
+_HEADER_RE = re.compile(r"^\s*\[\s*([^\[\]#]+?)\s*\]\s*(?:#.*)?$")
+_AOT_RE = re.compile(r"^\s*\[\[")
+
+
+# -- axes and grid --------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Axis:
+    """One swept key and its values (TOML literals, as written into the spec)."""
+
+    key: str
+    values: tuple[str, ...]
+
+
+def parse_axis(text: str) -> Axis:
+    """``KEY=VALUES`` (see the module docstring) as an :class:`Axis`; :class:`InputError`
+    naming the ``--set`` on any mistake."""
+    if "=" not in text:
+        raise InputError(f"--set expects KEY=VALUES (e.g. method.lambda=0.9:0.99:10), got {text!r}")
+    key, spec = (s.strip() for s in text.split("=", 1))
+    if not _KEY_RE.match(key):
+        raise InputError(f"--set {text!r}: {key!r} is not a dotted spec key (e.g. method.lambda)")
+    if not spec:
+        raise InputError(f"--set {key}: no value")
+    m = _RANGE_RE.match(spec)
+    if m:
+        return Axis(
+            key,
+            tuple(_range_values(key, m.group(1), m.group(2), int(m.group(3)), m.group(4) == "log")),
+        )
+    if spec.startswith("["):
+        items = _split_list(key, spec)
+        if not items:
+            raise InputError(f"--set {key}: the list of values is empty")
+        return Axis(key, tuple(_literal(key, it) for it in items))
+    return Axis(key, (_literal(key, spec),))
+
+
+def _range_values(key: str, a_text: str, b_text: str, n: int, log: bool) -> list[str]:
+    if n < 1:
+        raise InputError(f"--set {key}: the number of values must be at least 1, got {n}")
+    if n > MAX_POINTS:
+        raise InputError(f"--set {key}: {n} values, above the limit of {MAX_POINTS} points")
+    for t in (a_text, b_text):
+        digits = len(t.lstrip("+-").split("e")[0].split("E")[0].replace(".", "").lstrip("0"))
+        if digits > 50:
+            raise InputError(f"--set {key}: {t!r} has more than 50 significant digits")
+        exp = re.search(r"[eE]([+-]?\d+)$", t)
+        if exp and abs(int(exp.group(1))) > 300:
+            raise InputError(f"--set {key}: the exponent of {t!r} is out of range (±300)")
+    a, b = Decimal(a_text), Decimal(b_text)
+    as_int = all("." not in t and "e" not in t.lower() for t in (a_text, b_text))
+    prec = max(DIGITS, len(a.as_tuple().digits), len(b.as_tuple().digits))
+    out: list[Decimal] = []
+    if log:
+        if a <= 0 or b <= 0:
+            raise InputError(f"--set {key}: a log range needs positive ends, got {a_text}:{b_text}")
+        for i in range(n):
+            if i == 0 or n == 1:
+                out.append(a)
+            elif i == n - 1:
+                out.append(b)
+            else:
+                with localcontext() as ctx:
+                    ctx.prec = prec + 25
+                    v = (a.ln() + (b.ln() - a.ln()) * i / (n - 1)).exp()
+                with localcontext() as ctx:
+                    ctx.prec = prec
+                    out.append(+v)
+    else:
+        fa, fb = Fraction(a), Fraction(b)
+        for i in range(n):
+            q = fa if n == 1 else fa + (fb - fa) * Fraction(i, n - 1)
+            with localcontext() as ctx:
+                ctx.prec = prec
+                out.append(Decimal(q.numerator) / Decimal(q.denominator))
+    return [_decimal_text(v, as_int) for v in out]
+
+
+def _decimal_text(v: Decimal, as_int: bool) -> str:
+    """A TOML number for ``v``: plain decimal digits (no exponent), an integer only when the
+    range's ends were integers."""
+    s = format(v.normalize(), "f")
+    if s in ("-0", "-0.0"):
+        s = "0"
+    if "." not in s and not as_int:
+        s += ".0"
+    return s
+
+
+def _split_list(key: str, spec: str) -> list[str]:
+    """The top-level items of ``[a, b, c]`` (brackets, braces and quotes respected)."""
+    if not spec.endswith("]"):
+        raise InputError(f"--set {key}: a list of values must end with ']': {spec!r}")
+    body = spec[1:-1]
+    items, depth, quote, cur = [], 0, "", []
+    for ch in body:
+        if quote:
+            cur.append(ch)
+            if ch == quote:
+                quote = ""
+            continue
+        if ch in "\"'":
+            quote = ch
+        elif ch in "[{":
+            depth += 1
+        elif ch in "]}":
+            depth -= 1
+            if depth < 0:
+                raise InputError(f"--set {key}: unbalanced brackets in {spec!r}")
+        elif ch == "," and depth == 0:
+            items.append("".join(cur).strip())
+            cur = []
+            continue
+        cur.append(ch)
+    if quote or depth:
+        raise InputError(f"--set {key}: unbalanced brackets or quotes in {spec!r}")
+    last = "".join(cur).strip()
+    if last or items:
+        items.append(last)
+    if any(not it for it in items):
+        raise InputError(f"--set {key}: empty item in {spec!r}")
+    return items
+
+
+def _literal(key: str, text: str) -> str:
+    """``text`` as a TOML value literal: as written when it is one, else a quoted string
+    (a bare word). A number is written as given (its decimal text is the exact value)."""
+    try:
+        tomllib.loads(f"x = {text}")
+        return text
+    except tomllib.TOMLDecodeError:
+        pass
+    if re.match(r"^[A-Za-z_][A-Za-z0-9_.+-]*$", text):
+        return json.dumps(text)
+    raise InputError(f"--set {key}: {text!r} is not a TOML value")
+
+
+def grid_points(axes: Sequence[Axis]) -> list[dict[str, str]]:
+    """The product of the axes, the last varying fastest: one ``{key: literal}`` per point."""
+    keys = [a.key for a in axes]
+    if len(set(keys)) != len(keys):
+        dup = sorted({k for k in keys if keys.count(k) > 1})
+        raise InputError(f"--set: key {dup[0]} is given twice")
+    total = math.prod(len(a.values) for a in axes)
+    if total > MAX_POINTS:
+        raise InputError(f"--set: the grid has {total} points, above the limit of {MAX_POINTS}")
+    return [dict(zip(keys, vals, strict=True)) for vals in product(*(a.values for a in axes))]
+
+
+def parse_grid(grid: Sequence[str] | dict[str, Any]) -> list[Axis]:
+    """Axes from ``--set`` texts, or from a dict ``{key: "a:b:n" | [values] | value}``
+    (values may be Python numbers: written with ``repr``, i.e. the shortest decimal)."""
+    if isinstance(grid, dict):
+        texts = []
+        for k, v in grid.items():
+            if isinstance(v, (list, tuple)):
+                v = "[" + ", ".join(_py_literal(x) for x in v) + "]"
+            elif not isinstance(v, str):
+                v = _py_literal(v)
+            texts.append(f"{k}={v}")
+        grid = texts
+    if not grid:
+        raise InputError("sweep: no --set KEY=VALUES given (nothing to sweep)")
+    return [parse_axis(t) for t in grid]
+
+
+def _py_literal(x: Any) -> str:
+    if isinstance(x, bool):
+        return "true" if x else "false"
+    if isinstance(x, (int, float, Decimal, Fraction)):
+        if isinstance(x, float) and not math.isfinite(x):
+            raise InputError(f"sweep: {x!r} is not a finite number")
+        if isinstance(x, Fraction):
+            x = Decimal(x.numerator) / Decimal(x.denominator)
+        return repr(x) if isinstance(x, float) else str(x)
+    if isinstance(x, (list, tuple)):
+        return "[" + ", ".join(_py_literal(y) for y in x) + "]"
+    return json.dumps(str(x))
+
+
+# -- editing the spec text --------------------------------------------------------------------
+def _sections(lines: list[str]) -> list[tuple[str | None, int, int]]:
+    """``(table, first_line, end_line)`` of each section: the root (None) and every
+    ``[table]`` header; array-of-tables sections are named ``[[...]]`` (never matched)."""
+    out: list[tuple[str | None, int, int]] = []
+    name: str | None = None
+    start = 0
+    in_ml = False
+    for i, line in enumerate(lines):
+        if line.count('"""') % 2 == 1 or line.count("'''") % 2 == 1:
+            in_ml = not in_ml
+            continue
+        if in_ml:
+            continue
+        if _AOT_RE.match(line):
+            out.append((name, start, i))
+            name, start = "[[...]]", i + 1
+            continue
+        m = _HEADER_RE.match(line)
+        if m:
+            out.append((name, start, i))
+            name, start = re.sub(r"\s*\.\s*", ".", m.group(1).strip()), i + 1
+    out.append((name, start, len(lines)))
+    return out
+
+
+def _value_span(lines: list[str], i: int, col: int) -> tuple[int, str]:
+    """The last line of the value that starts at ``lines[i][col:]`` and the comment after it
+    (when the value is on one line)."""
+    rest = lines[i][col:]
+    for m in re.finditer("#", rest):
+        try:
+            tomllib.loads("x = " + rest[: m.start()])
+            return i, rest[m.start() :]
+        except tomllib.TOMLDecodeError:
+            continue
+    for j in range(i, len(lines)):
+        try:
+            tomllib.loads("x = " + "\n".join([rest, *lines[i + 1 : j + 1]]))
+            return j, ""
+        except tomllib.TOMLDecodeError:
+            continue
+    return i, ""
+
+
+def set_key(text: str, key: str, literal: str, file: str = "<spec>") -> str:
+    """The TOML ``text`` with dotted ``key`` set to the TOML ``literal``: the key's line is
+    replaced (its trailing comment kept), or the key is added at the end of its deepest
+    existing table. The result is parsed and compared with the original: exactly that key
+    changed, or :class:`InputError`."""
+    parts = key.split(".")
+    lines = text.split("\n")
+    secs = _sections(lines)
+    done = False
+    for j in range(len(parts) - 1, -1, -1):
+        table = ".".join(parts[:j]) if j else None
+        rest = parts[j:]
+        pat = re.compile(r"^(\s*)" + r"\s*\.\s*".join(re.escape(p) for p in rest) + r"\s*=\s*")
+        for name, a, b in secs:
+            if name != table:
+                continue
+            for i in range(a, b):
+                m = pat.match(lines[i])
+                if m:
+                    last, comment = _value_span(lines, i, m.end())
+                    new = f"{lines[i][: m.end()]}{literal}" + (f"  {comment}" if comment else "")
+                    lines[i : last + 1] = [new]
+                    done = True
+                    break
+            if done:
+                break
+        if done:
+            break
+    if not done:
+        for j in range(len(parts) - 1, -1, -1):
+            table = ".".join(parts[:j]) if j else None
+            hit = [(a, b) for name, a, b in secs if name == table]
+            if not hit:
+                continue
+            a, b = hit[0]
+            at = b
+            while at > a and not lines[at - 1].strip():
+                at -= 1
+            lines.insert(at, f"{'.'.join(parts[j:])} = {literal}")
+            done = True
+            break
+    new_text = "\n".join(lines)
+    if not done:
+        new_text = f"{'.'.join(parts)} = {literal}\n" + text
+    _check_edit(text, new_text, parts, literal, file)
+    return new_text
+
+
+def _check_edit(old: str, new: str, parts: list[str], literal: str, file: str) -> None:
+    key = ".".join(parts)
+    try:
+        before = tomllib.loads(old)
+    except tomllib.TOMLDecodeError as e:
+        raise InputError(f"{file}: is not valid TOML ({e})") from None
+    try:
+        after = tomllib.loads(new)
+    except tomllib.TOMLDecodeError as e:
+        raise InputError(f"{file}: cannot set {key} = {literal} ({e})") from None
+    want = tomllib.loads(f"x = {literal}")["x"]
+    d = before
+    for p in parts[:-1]:
+        nxt = d.get(p) if isinstance(d, dict) else None
+        if nxt is None:
+            nxt = {}
+            d[p] = nxt
+        if not isinstance(nxt, dict):
+            raise InputError(f"{file}: cannot set {key}: {p} is not a table")
+        d = nxt
+    d[parts[-1]] = want
+    if before != after:
+        raise InputError(
+            f"{file}: cannot set {key} in the spec text (an inline table or an array of "
+            f"tables holds it: write it as a [table] key)"
+        )
+
+
+def point_text(text: str, values: dict[str, str], file: str = "<spec>") -> str:
+    """The spec text of one grid point (every key of ``values`` set)."""
+    for k, lit in values.items():
+        text = set_key(text, k, lit, file)
+    return text
+
+
+# -- one point --------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class PointTask:
+    """Everything a worker needs for one point (the spec travels as text: no shared files)."""
+
+    index: int
+    values: dict[str, str]
+    text: str
+    file: str
+    simulate: bool = False
+    sim_options: dict[str, str] = field(default_factory=dict)
+
+
+_VERDICTS = {0: "ok", 1: "failed", 2: "bad input", 3: "error", 4: "inconclusive"}
+
+
+def _value(lit: str) -> Any:
+    v = tomllib.loads(f"x = {lit}")["x"]
+    return v if isinstance(v, (int, float, str, bool)) else lit
+
+
+def _row_head(task: PointTask) -> dict[str, Any]:
+    return {"point": task.index, **{k: _value(v) for k, v in task.values.items()}}
+
+
+def failure_row(task: PointTask, code: int, message: str, method: str = "") -> dict[str, Any]:
+    """The row of a point that stopped with exit ``code``."""
+    return {
+        **_row_head(task),
+        "verdict": _VERDICTS.get(code, "error"),
+        "exit_code": code,
+        "message": message,
+        "method": method,
+    }
+
+
+def run_point(task: PointTask) -> dict[str, Any]:
+    """Design, serialize, reload and verify one point (and simulate it when asked): its
+    row. Never raises (but KeyboardInterrupt): an error is the row's exit code and message."""
+    from obsdesign import api
+    from obsdesign.report.model import Report
+
+    t0 = time.perf_counter()
+    method = ""
+    name = f"{task.file}[point {task.index}]"
+    try:
+        text = point_text(task.text, task.values, name)
+        sp = api.load_spec_text(text, name)
+        method = sp.method
+        rep = api.design(sp)
+        t1 = time.perf_counter()
+        ver = api.verify(Report.from_dict(rep.to_dict())[0])
+        t2 = time.perf_counter()
+        code = ver.exit_code()
+        counts = ver.status_counts()
+        row = {
+            **_row_head(task),
+            "verdict": _VERDICTS.get(code, "error"),
+            "exit_code": code,
+            "message": "; ".join(f"{c.id}: {c.detail}" for c in ver.failed),
+            "method": method,
+            "certified": counts["certified"],
+            "numerical": counts["numerical"],
+            "failed": counts["failed"],
+        }
+        m = api.method(method)
+        for f in m.summary_fields:
+            if f.param in ver.parameters:
+                row[f.param] = _scalar(ver.parameters, f.param)
+        row["design_s"] = round(t1 - t0, 4)
+        row["verify_s"] = round(t2 - t1, 4)
+        if task.simulate:
+            try:
+                res = api.simulate(sp, rep, options=dict(task.sim_options))
+                row.update(_flat_metrics(res.metrics()))
+                sim_code = int(res.info.get("exit_code", 0) or 0)
+            except ObsdesignError as e:
+                sim_code = e.exit_code
+                row["message"] = "; ".join(
+                    x for x in (row["message"], f"simulate: {e.message}") if x
+                )
+            row["simulate_s"] = round(time.perf_counter() - t2, 4)
+            if sim_code > row["exit_code"]:
+                row["exit_code"] = sim_code
+                row["verdict"] = _VERDICTS.get(sim_code, "error")
+        row["seconds"] = round(time.perf_counter() - t0, 4)
+        return row
+    except ObsdesignError as e:
+        row = failure_row(task, e.exit_code, e.message, method)
+    except Exception as e:  # noqa: BLE001 - one row per point, whatever happened in it
+        row = failure_row(task, EXIT_SOLVER, f"internal failure: {type(e).__name__}: {e}", method)
+    row["seconds"] = round(time.perf_counter() - t0, 4)
+    return row
+
+
+def _scalar(params: Any, key: str) -> Any:
+    try:
+        return float(params.float(key))
+    except (TypeError, ValueError):
+        v = params[key]
+        return v if isinstance(v, (int, str, bool)) else json.dumps(v, default=str)
+
+
+def _flat_metrics(m: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for k, v in m.items():
+        if k == "exit_code":
+            continue
+        name = f"{prefix}{k}"
+        if isinstance(v, dict):
+            out.update(_flat_metrics(v, name + "."))
+        elif isinstance(v, (bool, int, float, str)) or v is None:
+            out[name] = v
+        else:
+            try:
+                out[name] = float(v)
+            except (TypeError, ValueError):
+                out[name] = json.dumps(v, default=str)
+    return out
+
+
+# -- the sweep --------------------------------------------------------------------------------
+def _spec_source(spec: Any) -> tuple[str, str]:
+    """(text, file name) of a spec path or :class:`obsdesign.spec.Spec`."""
+    if isinstance(spec, (str, Path)):
+        from obsdesign.limits import read_input
+
+        p = Path(spec)
+        raw = read_input(p, "spec")
+        try:
+            return raw.decode("utf-8"), str(p)
+        except UnicodeDecodeError:
+            raise InputError(f"{p}: is not UTF-8 text") from None
+    return spec.text, spec.file
+
+
+def plan(
+    spec: Any,
+    grid: Sequence[str] | dict[str, Any],
+    simulate: bool = False,
+    options: dict[str, str] | None = None,
+) -> tuple[list[Axis], list[PointTask]]:
+    """The axes and one task per grid point; bad input that concerns every point (a bad
+    ``--set``, a key that cannot be written, a spec without ``[simulate]`` for
+    ``simulate=True``) is an :class:`InputError` here, before any work."""
+    axes = parse_grid(grid)
+    text, file = _spec_source(spec)
+    points = grid_points(axes)
+    point_text(text, points[0], file)  # every point edits the same lines: check once
+    if simulate:
+        try:
+            doc = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as e:
+            raise InputError(f"{file}: is not valid TOML ({e})") from None
+        if "simulate" not in doc and not any(k.startswith("simulate.") for k in points[0]):
+            raise InputError(f"{file}: [simulate] is missing: nothing to simulate (--simulate)")
+    tasks = [
+        PointTask(i, p, text, file, simulate, dict(options or {})) for i, p in enumerate(points)
+    ]
+    return axes, tasks
+
+
+def sweep_rows(
+    spec: Any,
+    grid: Sequence[str] | dict[str, Any],
+    *,
+    simulate: bool = False,
+    options: dict[str, str] | None = None,
+    client: Any = None,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    on_row: Callable[[dict[str, Any]], None] | None = None,
+) -> list[dict[str, Any]]:
+    """One row per grid point, in grid order (see the module docstring); ``on_row(row)`` is
+    called as each row arrives (completion order)."""
+    from obsdesign.distributed import run_tasks
+
+    _, tasks = plan(spec, grid, simulate, options)
+
+    def lost(task: PointTask, message: str) -> dict[str, Any]:
+        return failure_row(task, EXIT_SOLVER, message)
+
+    return run_tasks(
+        run_point,
+        tasks,
+        workers=workers,
+        scheduler=scheduler,
+        client=client,
+        on_result=(lambda i, r: on_row(r)) if on_row is not None else None,
+        lost=lost,
+    )
+
+
+def columns(rows: Sequence[dict[str, Any]]) -> list[str]:
+    """Every column of ``rows``, in order of first appearance (timings last)."""
+    cols: dict[str, None] = {}
+    for r in rows:
+        for k in r:
+            cols.setdefault(k, None)
+    head = [c for c in cols if c not in TIMING_COLUMNS]
+    return head + [c for c in TIMING_COLUMNS if c in cols]
+
+
+def to_frame(rows: list[dict[str, Any]]) -> Any:
+    """A pandas DataFrame of ``rows`` (columns as :func:`columns`), or ``rows`` themselves
+    when pandas is not installed."""
+    try:
+        import pandas as pd
+    except ImportError:
+        return rows
+    return pd.DataFrame(rows, columns=columns(rows))
+
+
+def sweep(
+    spec: Any,
+    grid: Sequence[str] | dict[str, Any],
+    client: Any = None,
+    *,
+    simulate: bool = False,
+    options: dict[str, str] | None = None,
+    workers: int | None = None,
+    scheduler: str | None = None,
+) -> Any:
+    """Sweep ``spec`` (a path or a Spec) over ``grid`` (``["method.lambda=0.9:0.99:10"]`` or
+    ``{"method.lambda": [0.9, 0.95]}``): a pandas DataFrame with one row per point (a list of
+    dicts without pandas). ``client`` (a ``dask.distributed.Client``), ``workers`` (a
+    LocalCluster) or ``scheduler`` run the points on Dask; the rows are the same."""
+    rows = sweep_rows(
+        spec,
+        grid,
+        simulate=simulate,
+        options=options,
+        client=client,
+        workers=workers,
+        scheduler=scheduler,
+    )
+    return to_frame(rows)
+
+
+def exit_code(rows: Sequence[dict[str, Any]]) -> int:
+    """The worst row's exit code (0 when every point passed)."""
+    return max((int(r.get("exit_code", EXIT_OK)) for r in rows), default=EXIT_OK)
+
+
+# -- output ---------------------------------------------------------------------------------
+def check_output_path(path: Path, force: bool, inputs: tuple[Path, ...]) -> None:
+    """Refuse an output path before any work: unknown suffix, Parquet without pyarrow, or a
+    path :func:`obsdesign.report.model.check_output` refuses."""
+    from obsdesign.report.model import check_output
+
+    suf = path.suffix.lower()
+    if suf not in OUTPUT_SUFFIXES:
+        raise InputError(
+            f"{path}: unknown table format {path.suffix or '(no suffix)'!r} "
+            f"(expected one of {', '.join(OUTPUT_SUFFIXES)})"
+        )
+    if suf == ".parquet":
+        try:
+            import pyarrow  # noqa: F401
+        except ImportError:
+            raise InputError(f"{path}: Parquet needs pyarrow (pip install pyarrow)") from None
+    check_output(path, force, inputs)
+
+
+def _cell(v: Any) -> Any:
+    if isinstance(v, float) and not math.isfinite(v):
+        return str(v)
+    return v
+
+
+def write_table(path: Path, rows: list[dict[str, Any]], force: bool = False) -> None:
+    """Write ``rows`` to ``path`` atomically (CSV, JSON Lines or Parquet by suffix)."""
+    from obsdesign.report.model import write_via
+
+    cols = columns(rows)
+    suf = path.suffix.lower()
+
+    def w(tmp: Path) -> None:
+        if suf == ".csv":
+            import csv
+
+            with open(tmp, "w", encoding="utf-8", newline="") as f:
+                wr = csv.DictWriter(f, fieldnames=cols, restval="")
+                wr.writeheader()
+                for r in rows:
+                    wr.writerow({k: ("" if v is None else v) for k, v in r.items()})
+        elif suf == ".jsonl":
+            with open(tmp, "w", encoding="utf-8") as f:
+                for r in rows:
+                    f.write(json.dumps({k: _cell(v) for k, v in r.items()}, ensure_ascii=False))
+                    f.write("\n")
+        else:
+            import pyarrow as pa
+            import pyarrow.parquet as pq
+
+            data = {c: [_parquet_cell(r.get(c)) for r in rows] for c in cols}
+            pq.write_table(pa.table(data), str(tmp))
+
+    write_via(path, w, force)
+
+
+def _parquet_cell(v: Any) -> Any:
+    return v
+
+
+def plot_sweep(
+    rows: list[dict[str, Any]], axes: list[Axis], y: str, path: Path, x: str | None = None
+) -> None:
+    """Plot column ``y`` against the swept key ``x`` (the first axis by default), one line
+    per value of the other axes; failed points are left out (gaps)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    keys = [a.key for a in axes]
+    x = x or keys[0]
+    others = [k for k in keys if k != x]
+    groups: dict[tuple[Any, ...], list[tuple[float, float]]] = {}
+    for r in rows:
+        g = tuple(r.get(k) for k in others)
+        try:
+            xv = float(r[x])
+            yv = float(r[y]) if r.get(y) is not None and r.get("exit_code") in (0, 4) else math.nan
+        except (TypeError, ValueError, KeyError):
+            continue
+        groups.setdefault(g, []).append((xv, yv))
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    try:
+        for g, pts in groups.items():
+            pts.sort()
+            label = ", ".join(f"{k} = {v}" for k, v in zip(others, g, strict=True)) or None
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], marker="o", label=label)
+        ax.set_xlabel(x)
+        ax.set_ylabel(y)
+        if len(groups) > 1:
+            ax.legend(fontsize="small")
+        ax.grid(True, alpha=0.3)
+        fig.tight_layout()
+        fig.savefig(path, format=path.suffix.lstrip(".").lower() or "png")
+    finally:
+        plt.close(fig)
+
+
+def expected_columns(text: str, axes: list[Axis], simulate: bool) -> set[str] | None:
+    """The columns a sweep of the spec ``text`` will have (swept keys, verdict, counts, the
+    method's summary parameters, timings), or None when unknown beforehand (``simulate``:
+    the metrics depend on the method)."""
+    if simulate:
+        return None
+    try:
+        key = tomllib.loads(text).get("method", {}).get("key")
+        from obsdesign import api
+
+        m = api.method(str(key))
+    except (tomllib.TOMLDecodeError, AttributeError, ObsdesignError):
+        return None
+    fixed = {"point", "verdict", "exit_code", "message", "method", "certified", "numerical"}
+    fixed |= {"failed", *TIMING_COLUMNS}
+    return fixed | {a.key for a in axes} | {f.param for f in m.summary_fields}
+
+
+def check_plot_column(rows: list[dict[str, Any]], axes: list[Axis], y: str, x: str | None) -> None:
+    """--y must be a column of the table and --x a swept key (after the run: columns
+    depend on the method)."""
+    keys = [a.key for a in axes]
+    if x is not None and x not in keys:
+        raise InputError(f"--x {x}: not a swept key (swept: {', '.join(keys)})")
+    cols = columns(rows)
+    if y not in cols:
+        raise InputError(f"--y {y}: not a column of the table (columns: {', '.join(cols)})")
+
+
+# `obsdesign.sweep(spec, grid, client=None)` is this module's `sweep`: importing the module
+# makes it the package attribute `obsdesign.sweep`, so the module itself is callable.
+class _CallableModule(types.ModuleType):
+    def __call__(self, *args: Any, **kwargs: Any) -> Any:
+        return sweep(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule
+
+__all__ = [
+    "Axis",
+    "EXIT_BAD_INPUT",
+    "PointTask",
+    "columns",
+    "exit_code",
+    "grid_points",
+    "parse_axis",
+    "parse_grid",
+    "plan",
+    "point_text",
+    "run_point",
+    "set_key",
+    "sweep",
+    "sweep_rows",
+    "to_frame",
+    "write_table",
+]
