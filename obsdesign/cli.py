@@ -495,6 +495,17 @@ def simulate(
         bool,
         typer.Option("--force", help="Write --plot even where it is refused by default."),
     ] = False,
+    runs: Annotated[
+        int | None,
+        typer.Option(
+            "--runs",
+            metavar="N",
+            min=1,
+            help="Monte Carlo runs (same as --option runs=N, for methods with a runs option): "
+            "initial errors from [simulate] initial_error, signals from seeds spawned from "
+            "[simulate] seed; prints quantiles of the per-run metrics.",
+        ),
+    ] = None,
     quiet: QuietOpt = False,
     width: WidthOpt = None,
 ) -> None:
@@ -507,7 +518,10 @@ def simulate(
 
         _check_plot(plot, force, _inputs(spec, report))
         sp = _load_spec(spec)
-        res = api.simulate(sp, report, options=_kv(option or []))
+        opts = _kv(option or [])
+        if runs is not None:
+            opts["runs"] = str(runs)
+        res = api.simulate(sp, report, options=opts)
         m = res.metrics()
         if fmt == Fmt.json:
             print(json.dumps(m, indent=2, default=_jsonable))

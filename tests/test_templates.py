@@ -1,0 +1,55 @@
+"""Every method's template (``obsdesign init KEY``) is a valid spec, and stays valid TOML when
+ANY one of its commented ``# key = value`` lines is uncommented alone (issue 14 item 3)."""
+
+from __future__ import annotations
+
+import re
+import tomllib
+
+import pytest
+
+from obsdesign import api
+from obsdesign.methods import method_keys
+
+#: a commented assignment: "# key = value", "#   key.sub = value  # note"
+COMMENTED = re.compile(r"^(\s*)#\s?(\s*[A-Za-z_][\w.-]*\s*=\s*\S.*)$")
+
+
+def commented_lines(text: str) -> list[int]:
+    """Indices of the lines that look like a commented ``key = value``."""
+    return [i for i, line in enumerate(text.splitlines()) if COMMENTED.match(line)]
+
+
+def uncomment(text: str, i: int) -> str:
+    lines = text.splitlines()
+    m = COMMENTED.match(lines[i])
+    assert m is not None
+    lines[i] = m.group(1) + m.group(2)
+    return "\n".join(lines) + "\n"
+
+
+def test_pattern_finds_commented_assignments_only():
+    text = '# a comment\n# f = ["x2"]      # note\n#   rate_cap = 10\n# [sets.X0]\n#: doc\nx = 1\n'
+    assert commented_lines(text) == [1, 2]
+    assert uncomment(text, 1).splitlines()[1] == 'f = ["x2"]      # note'
+
+
+@pytest.mark.parametrize("key", method_keys())
+def test_template_loads_as_a_spec(key: str):
+    sp = api.load_spec_text(api.template(key), f"template:{key}")
+    assert sp.method == key
+
+
+@pytest.mark.parametrize("key", method_keys())
+def test_any_single_comment_line_uncommented_is_valid_toml(key: str):
+    text = api.template(key)
+    tomllib.loads(text)
+    idx = commented_lines(text)
+    assert idx, f"{key}: the template shows no optional key"
+    bad = []
+    for i in idx:
+        try:
+            tomllib.loads(uncomment(text, i))
+        except tomllib.TOMLDecodeError as e:
+            bad.append(f"line {i + 1}: {text.splitlines()[i]!r}: {e}")
+    assert not bad, f"{key}: " + "; ".join(bad)
