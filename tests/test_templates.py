@@ -5,11 +5,14 @@ from __future__ import annotations
 
 import re
 import tomllib
+from pathlib import Path
 
+import jsonschema
 import pytest
 
 from obsdesign import api
 from obsdesign.methods import method_keys
+from obsdesign.spec.schema import expression_keys
 
 #: a commented assignment: "# key = value", "#   key.sub = value  # note"
 COMMENTED = re.compile(r"^(\s*)#\s?(\s*[A-Za-z_][\w.-]*\s*=\s*\S.*)$")
@@ -53,3 +56,23 @@ def test_any_single_comment_line_uncommented_is_valid_toml(key: str):
         except tomllib.TOMLDecodeError as e:
             bad.append(f"line {i + 1}: {text.splitlines()[i]!r}: {e}")
     assert not bad, f"{key}: " + "; ".join(bad)
+
+
+SPECS = sorted((Path(__file__).resolve().parents[1] / "specs").glob("*.toml"))
+
+
+@pytest.mark.parametrize("path", SPECS, ids=[p.name for p in SPECS])
+def test_shipped_specs_validate_against_the_schema(path: Path):
+    jsonschema.validate(tomllib.loads(path.read_text(encoding="utf-8")), api.schema())
+
+
+def test_schema_marks_expression_keys_and_covers_nonlinearity():
+    sch = api.schema()
+    assert expression_keys(sch) == ["method.F", "system.f", "system.h", "system.psi", "system.u"]
+    nl = sch["properties"]["nonlinearity"]
+    assert set(nl["properties"]) == {"lipschitz_x", "o", "n", "falsify"}
+    assert nl["additionalProperties"] is False
+    bad = tomllib.loads(api.template("impulsive"))
+    bad.setdefault("nonlinearity", {})["lipschitz_y"] = 1
+    with pytest.raises(jsonschema.ValidationError):
+        jsonschema.validate(bad, sch)

@@ -55,6 +55,76 @@ EXPRS: dict[str, Any] = {
 }
 
 
+def _nonlinearity() -> dict[str, Any]:
+    """``[nonlinearity]``: bound data of the plant's nonlinearity ψ (the expressions live in
+    ``[system] psi``). Read by the ``impulsive`` method (Assumption 1 of the impulsive-observer
+    paper): ``lipschitz_x``, or the blocks ``[nonlinearity.o]`` / ``[nonlinearity.n]`` in
+    z = T x (each: ``sector = [a, b]``, ``lipschitz``, or a QSR triple ``Q``, ``S``, ``R``; and
+    ``cross``), and the optional falsification box ``[nonlinearity.falsify]``."""
+    block = {
+        "type": "object",
+        "additionalProperties": False,
+        "description": "one of sector, lipschitz or (Q, S, R); cross: the coupling constant",
+        "properties": {
+            "sector": {**VEC, "minItems": 2, "maxItems": 2, "description": "[a, b]"},
+            "lipschitz": {**NUM, "minimum": 0},
+            "Q": MAT,
+            "S": MAT,
+            "R": MAT,
+            "cross": {**NUM, "minimum": 0},
+        },
+    }
+    return {
+        "type": "object",
+        "additionalProperties": False,
+        "description": "bound data of the plant's nonlinearity ψ ([system] psi): a Lipschitz "
+        "constant, or sector / QSR data per block; read by the methods that declare it "
+        "(impulsive)",
+        "properties": {
+            "lipschitz_x": {**NUM, "minimum": 0, "description": "|ψ(x) − ψ(x')| ≤ ℓ|x − x'|"},
+            "o": {**block, "description": "the output block of z = T x (Assumption 1)"},
+            "n": {**block, "description": "the other block of z = T x (Assumption 1)"},
+            "falsify": {
+                "type": "object",
+                "required": ["lower", "upper"],
+                "additionalProperties": False,
+                "description": "sample pairs in the box [lower, upper] to look for a "
+                "violation of the bound (a numerical check, not a certificate)",
+                "properties": {
+                    "lower": VEC,
+                    "upper": VEC,
+                    "samples": {"type": "integer", "minimum": 10},
+                    "seed": {"type": "integer", "minimum": 0},
+                    "on_violation": {"enum": ["fail", "warn"]},
+                },
+            },
+        },
+    }
+
+
+def expression_keys(schema: dict[str, Any]) -> list[str]:
+    """The dotted keys of ``schema`` whose values are expressions (``"format":
+    "obsdesign-expression"``), e.g. ``system.f`` or ``method.F``."""
+    out: set[str] = set()
+
+    def walk(node: Any, path: list[str]) -> None:
+        if isinstance(node, dict):
+            if node.get("format") == "obsdesign-expression":
+                out.add(".".join(path))
+            for k, v in node.items():
+                if k == "properties" and isinstance(v, dict):
+                    for name, sub in v.items():
+                        walk(sub, [*path, name])
+                elif k in ("anyOf", "oneOf", "allOf") and isinstance(v, list):
+                    for sub in v:
+                        walk(sub, path)
+                elif k in ("items", "additionalProperties") and isinstance(v, dict):
+                    walk(v, path)
+
+    walk(schema, [])
+    return sorted(out)
+
+
 def spec_schema(
     method_schemas: list[dict[str, Any]], simulate_keys: dict[str, Any] | None = None
 ) -> dict[str, Any]:
@@ -143,11 +213,7 @@ def spec_schema(
                 },
             },
             "sets": {"type": "object", "additionalProperties": sets},
-            "nonlinearity": {
-                "type": "object",
-                "description": "bound data of the plant's nonlinearity (sector, QSR, Lipschitz); "
-                "read by the methods that use it",
-            },
+            "nonlinearity": _nonlinearity(),
             "method": {"oneOf": method_schemas},
             "simulate": {
                 "type": "object",

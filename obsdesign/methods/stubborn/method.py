@@ -125,6 +125,10 @@ class Stubborn(Method):
                 "lipschitz": {**num, "minimum": 0},
                 "ell": {**num, "minimum": 1},
                 "epsilon": {**num, "exclusiveMinimum": 0},
+                "state_bound": {
+                    **vec,
+                    "description": "high-gain mode: the estimate is clipped to |x̂_i| ≤ state_bound_i inside φ",
+                },
             },
         }
 
