@@ -104,8 +104,8 @@ def test_claims_builder():
         float_ok=True,
     )
     assert (b.status, b.margin, b.detail, b.float_ok) == (ClaimStatus.FAILED, "1/2", "d", True)
-    n = cs.numerical(id="n", statement="s", reference="r", check="c", passed=True)
-    assert n.status is ClaimStatus.NUMERICAL and n.margin == "0" and n.detail == ""
+    n = cs.numerical(id="n", statement="sn", reference="rn", check="cn", passed=True)
+    assert n == Claim("n", "sn", "rn", "cn", "0", ClaimStatus.NUMERICAL, "", True, {})
     n2 = cs.numerical(
         id="n2", statement="s", reference="r", check="c", passed=False, margin=3, detail="dd"
     )
@@ -152,7 +152,28 @@ def test_matches_differs_adds_a_failed_claim():
     assert cs.matches("len", [1, 2], [1, 2, 3], "[x]") is False
     assert cs.matches("arr", np.array([1, 2], dtype=object), [1, 3], "[x]") is False
     assert cs.matches("scalar-vs-list", 1, [1], "[x]") is False
-    assert [c.id for c in cs] == [
+    # an array against a scalar, mixed float/string lists (no common string dtype)
+    assert cs.matches("a1", np.array([1], dtype=object), 1, "[x]") is False
+    assert cs.matches("a2", np.array([1, 2], dtype=object), 1, "[x]") is False
+    assert cs.matches("a3", 1, np.array([1], dtype=object), "[x]") is False
+    assert cs.matches("m1", [0.1, "1/3"], ["1/10", "1/3"], "[x]") is False
+    assert cs.matches("m2", ["1/10", "1/3"], [0.1, "1/3"], "[x]") is False
+    assert cs.matches("m3", (0.1, "1/3"), ("1/10", "1/3"), "[x]") is False
+    assert cs.matches("m4", [0.5, "1/3"], ["1/2", "1/3"], "[x]") is True
+    exact_strings = np.array(["1/10", "1/3"], dtype=object)
+    assert cs.matches("m5", [0.1, "1/3"], exact_strings, "[x]") is False
+    assert cs.matches("m6", exact_strings, [0.1, "1/3"], "[x]") is False
+    assert [c.id for c in cs][-8:] == [
+        "a1-matches-spec",
+        "a2-matches-spec",
+        "a3-matches-spec",
+        "m1-matches-spec",
+        "m2-matches-spec",
+        "m3-matches-spec",
+        "m5-matches-spec",
+        "m6-matches-spec",
+    ]
+    assert [c.id for c in cs][:7] == [
         "L-matches-spec",
         "lam-matches-spec",
         "mode-matches-spec",

@@ -153,3 +153,17 @@ def test_symmetrize_qstr_qparse_qmax_abs():
     assert qmax_abs(np.empty((0,), dtype=object)) == 0 and isinstance(
         qmax_abs(np.empty((0,), dtype=object)), fmpq
     )
+
+
+def test_mixed_and_empty_inputs_stay_exact():
+    # a float next to a string must keep its binary value (no common string dtype)
+    v = qvec([0.1, "1/3"])
+    assert v[0] == Q(0.1) and v[0] != F(1, 10) and v[1] == F(1, 3)
+    e = qvec([])
+    assert e.shape == (0,) and e.dtype == object
+    assert dyadic(np.array([F(1, 3)], dtype=object), 4)[0] == F(11, 32)
+    assert dyadic([F(-3, 4)], 1)[0] == -1
+    p = qparse([1, 2])  # plain ints are exact values
+    assert p.tolist() == [F(1), F(2)] and all(isinstance(x, fmpq) for x in p)
+    assert qparse([[3], [4]]).shape == (2, 1)
+    assert qparse([0.1])[0] == Q(0.1)

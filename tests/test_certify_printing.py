@@ -117,3 +117,22 @@ def test_safe_direction_and_tight(q: fmpq, digits: int):
 @given(finite)
 def test_exact_roundtrip(q: fmpq):
     assert parse(fmt_exact(q)) == q
+
+
+def test_fmt_exact_huge_denominators():
+    # no float conversion of the denominator anywhere (2^1100 overflows a float)
+    for q in (F(1, 2**1100), F(3, 10**400), F(7, 5**500)):
+        s = fmt_exact(q)
+        assert parse(s) == q and "/" in s
+    assert fmt_exact(F(1, 11)) == "1/11" and fmt_exact(F(1, 22)) == "1/22"
+
+
+def test_fmt_exact_length_limits():
+    """A decimal is used when it needs at most 39 decimals and 32 characters, else p/q."""
+    assert fmt_exact(F(1, 10**39)) == "1e-39"
+    assert fmt_exact(F(1, 10**40)) == "1/1" + "0" * 40
+    s32 = fmt_exact(F(1234567890123456789012345678901, 10**20))
+    assert s32 == "12345678901.23456789012345678901" and len(s32) == 32
+    q33 = F(12345678901234567890123456789012, 10**21)
+    s33 = fmt_exact(q33)
+    assert s33 == str(q33) and "/" in s33 and parse(s33) == q33
