@@ -28,7 +28,7 @@ from flint import fmpq, fmpq_mat, fmpq_poly
 
 from obsdesign.certify.detect import hurwitz_stable, schur_stable
 from obsdesign.certify.exact import Q, dyadic, qeye, symmetrize
-from obsdesign.certify.psd import check_pd, check_psd
+from obsdesign.certify.psd import check_pd_fast, check_psd, to_fmpq_mat
 from obsdesign.errors import InconclusiveError, InfeasibleError
 
 #: reference printed in claims that check these formulas
@@ -51,6 +51,41 @@ def closed_loop(A: np.ndarray, C: np.ndarray, L: np.ndarray) -> np.ndarray:
     return A - L @ C
 
 
+def fmat(M: Any) -> fmpq_mat:
+    """An exact object array (or any matrix :func:`obsdesign.certify.exact.Q` converts) as a
+    flint ``fmpq_mat``: products of n = 100 matrices run in C instead of n³ Python ``fmpq``
+    operations (the Lyapunov maths of Section 5, constrained-redesign paper, at scale).
+
+    :param M: the matrix."""
+    return to_fmpq_mat(M)
+
+
+def as_array(M: fmpq_mat) -> np.ndarray:
+    """An ``fmpq_mat`` back as an exact object array (see :func:`fmat`).
+
+    :param M: the flint matrix."""
+    r, c = M.nrows(), M.ncols()
+    return np.array(M.entries(), dtype=object).reshape(r, c)
+
+
+def _sym(M: fmpq_mat) -> fmpq_mat:
+    return (M + M.transpose()) * fmpq(1, 2)
+
+
+def decay_fmat(Acl: Any, P: Any, rate: Any, discrete: bool) -> fmpq_mat:
+    """:func:`decay_matrix` for a given Acl = A − LC, as an ``fmpq_mat`` (exact, fast):
+    λ²P − AclᵀPAcl (discrete, eq. (5)-(6) with w = 0, constrained-redesign paper, Astolfi et
+    al., NOLCOS 2019) or −(AclᵀP + PAcl + 2αP) (continuous).
+
+    :param Acl: the error dynamics matrix; :param P: symmetric n×n; :param rate: λ or α;
+    :param discrete: time domain."""
+    Am, Pm = fmat(Acl), fmat(P)
+    r = Q(rate)
+    if discrete:
+        return _sym(Pm * (r * r) - Am.transpose() * Pm * Am)
+    return _sym(-(Am.transpose() * Pm + Pm * Am + Pm * (2 * r)))
+
+
 def decay_matrix(
     A: np.ndarray, C: np.ndarray, L: np.ndarray, P: np.ndarray, rate: Any, discrete: bool
 ) -> np.ndarray:
@@ -59,14 +94,11 @@ def decay_matrix(
     Discrete: λ² P − Aclᵀ P Acl, i.e. eq. (5) with w = 0 and β(v, 0) = ρ v, ρ = λ² (eq. (6));
     continuous: −(Aclᵀ P + P Acl + 2α P), i.e. V̇ ≤ −2α V. Section 5 of the
     constrained-redesign paper (Astolfi et al., NOLCOS 2019) certifies its P this way.
+    Computed through :func:`decay_fmat` (flint), returned as an object array.
 
     :param A, C, L: plant and gain (exact); :param P: symmetric n×n (exact);
     :param rate: λ (discrete) or α (continuous); :param discrete: time domain."""
-    Acl = closed_loop(A, C, L)
-    r = Q(rate)
-    if discrete:
-        return symmetrize(P * (r * r) - Acl.T @ P @ Acl)
-    return symmetrize(-(Acl.T @ P + P @ Acl + P * (2 * r)))
+    return as_array(decay_fmat(fmat(A) - fmat(L) * fmat(C), P, rate, discrete))
 
 
 def error_input(Bd: np.ndarray, Dn: np.ndarray, L: np.ndarray) -> np.ndarray:
@@ -99,19 +131,23 @@ def iss_matrix(
     matrix; :param rho: decay factor of V (λ² discrete, 2α continuous); :param mu: ISS gain."""
     k = Bw.shape[1]
     r = Q(rho)
+    Am, Pm = fmat(Acl), fmat(P)
     if discrete:
-        S = symmetrize(P * r - Acl.T @ P @ Acl)
+        S = _sym(Pm * r - Am.transpose() * Pm * Am)
     else:
-        S = symmetrize(-(Acl.T @ P + P @ Acl + P * r))
+        S = _sym(-(Am.transpose() * Pm + Pm * Am + Pm * r))
     if k == 0:
-        return S
+        return as_array(S)
+    Bm = fmat(Bw)
     if discrete:
-        off = -(Acl.T @ P @ Bw)
-        low = qeye(k) * Q(mu) - Bw.T @ P @ Bw
+        off = -(Am.transpose() * Pm * Bm)
+        low = fmpq_mat(k, k, [Q(mu) if i == j else fmpq(0) for i in range(k) for j in range(k)])
+        low = low - Bm.transpose() * Pm * Bm
     else:
-        off = -(P @ Bw)
-        low = qeye(k) * Q(mu)
-    return symmetrize(np.block([[S, off], [off.T, low]]))
+        off = -(Pm * Bm)
+        low = fmpq_mat(k, k, [Q(mu) if i == j else fmpq(0) for i in range(k) for j in range(k)])
+    S_, off_, low_ = as_array(S), as_array(off), as_array(low)
+    return symmetrize(np.block([[S_, off_], [off_.T, low_]]))
 
 
 def decay_factor(rate: Any, discrete: bool) -> fmpq:
@@ -147,15 +183,14 @@ def iss_mu(
         return fmpq(0)
     Af, Bf, Pf = (np.asarray(M, dtype=float) for M in (Acl, Bw, P))
     r = Q(rho)
+    S = np.asarray(iss_matrix(Acl, Bw[:, :0], P, r, 0, discrete), dtype=float)
     if discrete:
-        S = np.asarray(symmetrize(P * r - Acl.T @ P @ Acl), dtype=float)
         G = Bf.T @ Pf @ Bf + Bf.T @ Pf @ Af @ np.linalg.solve(S, Af.T @ Pf @ Bf)
     else:
-        S = np.asarray(symmetrize(-(Acl.T @ P + P @ Acl + P * r)), dtype=float)
         G = Bf.T @ Pf @ np.linalg.solve(S, Pf @ Bf)
     mu_f = float(np.linalg.eigvalsh((G + G.T) / 2).max())
     mu = dyadic(mu_f * (1 + 1e-9) + 1e-12, 30)
-    check = check_pd if strict else check_psd
+    check = check_pd_fast if strict else check_psd
     for _ in range(80):
         if check(iss_matrix(Acl, Bw, P, r, mu, discrete)):
             return mu
@@ -167,38 +202,101 @@ def iss_mu(
 
 # -- exact stability tests (the infeasible end of a rate bracket) ---------------------------
 def _charpoly(M: np.ndarray) -> fmpq_poly:
-    n = M.shape[0]
-    return fmpq_mat(n, n, [Q(x) for x in M.flat]).charpoly()
+    return fmat(M).charpoly()
 
 
-def rate_feasible(Acl: np.ndarray, rate: Any, discrete: bool) -> bool:
-    """Whether some P ≻ 0 makes :func:`decay_matrix` ≻ 0 at ``rate``, decided exactly.
+#: significant bits of the rounded Lyapunov solution used as an inertia certificate
+INERTIA_BITS = 60
 
-    Discrete: iff every eigenvalue z of Acl has |z| < λ, i.e. det(zI − Acl/λ) is Schur stable
-    (exact Schur–Cohn test); continuous: iff Acl + αI is Hurwitz (exact Routh test) — both from
-    :mod:`obsdesign.certify.detect`. Necessity: for Acl v = z v,
-    v* (λ²P − AclᵀPAcl) v = (λ² − |z|²) v*Pv (and −2(Re z + α) v*Pv in continuous time);
-    sufficiency: the Lyapunov equation. This decides the decay LMI of eq. (4)-(6), Section 5 of
-    the constrained-redesign paper (Astolfi et al., NOLCOS 2019), for a fixed gain.
 
-    :param Acl: A − LC (exact); :param rate: λ or α (exact); :param discrete: time domain."""
+def _lyap_solution(Acl: np.ndarray, rate: float, discrete: bool) -> np.ndarray | None:
+    """Float X with λ²X − AclᵀXAcl = I (continuous: −((Acl+αI)ᵀX + X(Acl+αI)) = I), whatever
+    the stability of Acl (an unstable Acl gives an indefinite X); None when scipy fails."""
+    from scipy.linalg import solve_continuous_lyapunov, solve_discrete_lyapunov
+
+    Af = np.asarray(Acl, dtype=float)
+    n = Af.shape[0]
+    try:
+        with np.errstate(all="ignore"):
+            if discrete:
+                X = solve_discrete_lyapunov((Af / rate).T, np.eye(n) / rate**2)
+            else:
+                X = solve_continuous_lyapunov((Af + rate * np.eye(n)).T, -np.eye(n))
+    except (np.linalg.LinAlgError, ValueError):
+        return None
+    if not np.all(np.isfinite(X)):
+        return None
+    return (X + X.T) / 2
+
+
+def rate_feasibility(Acl: np.ndarray, rate: Any, discrete: bool) -> tuple[bool, str]:
+    """Whether some P ≻ 0 makes :func:`decay_matrix` ≻ 0 at ``rate``, decided exactly, and how.
+
+    Feasible iff every eigenvalue z of Acl has |z| < λ (discrete) / Re z < −α (continuous).
+    Decided by the first proof that goes through:
+
+    1. *Lyapunov inertia certificate* (cheap at n = 100): X solves the Lyapunov equation with
+       right-hand side I in floats and is rounded to a dyadic rational X; if the exact
+       decay matrix D(X) ≻ 0 (:func:`obsdesign.certify.psd.check_pd_fast`), then X ≻ 0 proves
+       the rate feasible (X is a certificate), and X ⊁ 0 proves it infeasible: were Acl/λ
+       Schur (Acl + αI Hurwitz), the equation λ²Y − AclᵀYAcl = D(X) would have the unique
+       solution Y = Σ_k (Acl/λ)ᵀᵏ (D(X)/λ²) (Acl/λ)ᵏ ≻ 0 (continuous: ∫ e^{Bᵀt} D(X) e^{Bt} dt,
+       B = Acl + αI), and Y = X.
+    2. Otherwise the exact Schur–Cohn test of det(zI − Acl/λ) (continuous: Routh test of
+       det(sI − Acl − αI)), from :mod:`obsdesign.certify.detect` (slow beyond n ≈ 20).
+
+    Necessity of the eigenvalue condition: for Acl v = z v, v*(λ²P − AclᵀPAcl)v =
+    (λ² − |z|²) v*Pv. This decides the decay LMI of eq. (4)-(6), Section 5 of the
+    constrained-redesign paper (Astolfi et al., NOLCOS 2019), for a fixed gain.
+
+    :param Acl: A − LC (exact); :param rate: λ or α (exact); :param discrete: time domain.
+    Returns (verdict, the proof used)."""
     r = Q(rate)
     n = Acl.shape[0]
     if n == 0:
-        return True
+        return True, "empty matrix"
+    if discrete and r <= 0:
+        return False, "λ ≤ 0"
+    X = _lyap_solution(Acl, float(r), discrete)
+    if X is not None and np.any(X != 0):
+        Xq = symmetrize(dyadic(X, INERTIA_BITS))
+        if check_pd_fast(decay_fmat(Acl, Xq, r, discrete)):
+            pd = check_pd_fast(Xq)
+            return pd.ok, "exact Lyapunov inertia certificate (D(X) ≻ 0, X " + (
+                "≻ 0)" if pd.ok else "⊁ 0)"
+            )
     if discrete:
-        if r <= 0:
-            return False
-        return schur_stable(_charpoly(Acl * (1 / r)))[0]
-    return hurwitz_stable(_charpoly(Acl + qeye(n) * r))[0]
+        return schur_stable(_charpoly(Acl * (1 / r)))[0], stability_test(True)
+    return hurwitz_stable(_charpoly(Acl + qeye(n) * r))[0], stability_test(False)
+
+
+def rate_feasible(Acl: np.ndarray, rate: Any, discrete: bool) -> bool:
+    """Whether some P ≻ 0 makes :func:`decay_matrix` ≻ 0 at ``rate``, decided exactly
+    (:func:`rate_feasibility` without the proof's name): eq. (4)-(6), Section 5 of the
+    constrained-redesign paper (Astolfi et al., NOLCOS 2019), for a fixed gain.
+
+    :param Acl: A − LC (exact); :param rate: λ or α (exact); :param discrete: time domain."""
+    return rate_feasibility(Acl, rate, discrete)[0]
 
 
 def stability_test(discrete: bool) -> str:
-    """The name of the exact test behind :func:`rate_feasible` (for messages and claims).
+    """The name of the exact polynomial test behind :func:`rate_feasible` when the inertia
+    certificate does not decide (for messages and claims).
 
     :param discrete: time domain (Schur–Cohn, Section 5 setting of the constrained-redesign
     paper) or continuous (Routh)."""
     return "exact Schur–Cohn test" if discrete else "exact Routh test"
+
+
+def feasibility_check(discrete: bool) -> str:
+    """The ``check`` wording of :func:`rate_feasibility` (both proofs it may use).
+
+    :param discrete: time domain (eq. (4)-(6), constrained-redesign paper)."""
+    poly = "det(zI − (A−LC)/λ)" if discrete else "det(sI − (A−LC) − αI)"
+    return (
+        "exact Lyapunov inertia certificate (dyadic X with D(X) ≻ 0; X ≻ 0 iff feasible), "
+        f"else {stability_test(discrete)} of {poly}"
+    )
 
 
 def as_qarray(M: fmpq_mat) -> np.ndarray:
@@ -206,9 +304,7 @@ def as_qarray(M: fmpq_mat) -> np.ndarray:
     unobservable restriction A_u whose modes bound every rate of eq. (4)-(6).
 
     :param M: a flint rational matrix."""
-    return np.array(
-        [[M[i, j] for j in range(M.ncols())] for i in range(M.nrows())], dtype=object
-    ).reshape(M.nrows(), M.ncols())
+    return as_array(M)
 
 
 # -- P from the Lyapunov equation, certified -----------------------------------------------
@@ -231,6 +327,17 @@ def lyapunov_P(
     return (P + P.T) / 2
 
 
+def _float_P(A: np.ndarray, C: np.ndarray, L: np.ndarray, discrete: bool, r: fmpq) -> Any:
+    Af, Cf, Lf = (np.asarray(x, dtype=float) for x in (A, C, L))
+    try:
+        Pf = lyapunov_P(Af, Cf, Lf, float(r), discrete)
+    except (np.linalg.LinAlgError, ValueError):
+        return None
+    if not np.all(np.isfinite(Pf)):
+        return None
+    return Pf
+
+
 def certified_P(
     A: np.ndarray,
     C: np.ndarray,
@@ -244,25 +351,47 @@ def certified_P(
     P − margin·I ≻ 0 and :func:`decay_matrix` − margin·I ≻ 0 exactly, or None.
 
     Eq. (4)-(6) and Section 5 of the constrained-redesign paper (Astolfi et al., NOLCOS 2019).
+    One Lyapunov equation (scipy) and two exact checks
+    (:func:`obsdesign.certify.psd.check_pd_fast`); no SDP.
 
     :param A, C, L: exact plant and gain; :param discrete: time domain; :param rate: λ or α
     (exact); :param margin: δ of the strict checks; :param bits: rounding of P."""
     r = Q(rate)
     if (discrete and r <= 0) or A.shape[0] == 0:
         return None
-    Af, Cf, Lf = (np.asarray(x, dtype=float) for x in (A, C, L))
-    try:
-        Pf = lyapunov_P(Af, Cf, Lf, float(r), discrete)
-    except (np.linalg.LinAlgError, ValueError):
-        return None
-    if not np.all(np.isfinite(Pf)):
+    Pf = _float_P(A, C, L, discrete, r)
+    if Pf is None:
         return None
     P = symmetrize(dyadic(Pf, bits))
-    if not check_pd(P, margin):
+    if not check_pd_fast(P, margin):
         return None
-    if not check_pd(decay_matrix(A, C, L, P, r, discrete), margin):
+    if not check_pd_fast(decay_fmat(closed_loop(A, C, L), P, r, discrete), margin):
         return None
     return P
+
+
+def _predict_certified(
+    A: np.ndarray, C: np.ndarray, L: np.ndarray, discrete: bool, r: fmpq, margin: Any
+) -> bool:
+    """Float forecast of :func:`certified_P` (a guess that steers the search, never a proof):
+    both matrices' smallest eigenvalues exceed the margin by a clear relative gap."""
+    Pf = _float_P(A, C, L, discrete, r)
+    if Pf is None:
+        return False
+    Acl = np.asarray(A, dtype=float) - np.asarray(L, dtype=float) @ np.asarray(C, dtype=float)
+    rf = float(r)
+    if discrete:
+        M = rf * rf * Pf - Acl.T @ Pf @ Acl
+    else:
+        M = -(Acl.T @ Pf + Pf @ Acl + 2 * rf * Pf)
+    M = (M + M.T) / 2
+    m = float(margin)
+    gap = 1e-6
+    wp = np.linalg.eigvalsh(Pf)
+    wm = np.linalg.eigvalsh(M)
+    return bool(
+        wp[0] - m > gap * abs(wp[-1]) and wm[0] - m > gap * max(abs(wm[-1]), abs(wm[0]), 1.0)
+    )
 
 
 # -- the best rate, bracketed --------------------------------------------------------------
@@ -273,13 +402,15 @@ class RateBracket:
     ``best`` (λ or α) is certified with ``P``; ``other`` is the closest rate on the other side
     that was ``kind`` = ``"infeasible"`` (proved by :func:`rate_feasible`: no P ≻ 0 exists)
     or ``"not-certifiable"`` (feasible, but the rounded Lyapunov-equation P failed the exact
-    check with the margin); |best − other| ≤ tol unless the search stopped on the grid."""
+    check with the margin); |best − other| ≤ tol unless the search stopped on the grid.
+    ``exact_checks`` counts the exact :func:`certified_P` calls the search made."""
 
     best: fmpq
     P: np.ndarray
     other: fmpq
     kind: str
     tol: fmpq
+    exact_checks: int = 0
 
 
 def _grid(tol: fmpq) -> fmpq:
@@ -290,6 +421,10 @@ def _grid(tol: fmpq) -> fmpq:
 def _snap(x: fmpq, grid: fmpq, up: bool) -> fmpq:
     q = x / grid
     return (fmpq(int(q.ceil())) if up else fmpq(int(q.floor()))) * grid
+
+
+#: the most exact :func:`certified_P` calls one :func:`best_rate` search may make
+MAX_EXACT_CHECKS = 40
 
 
 def best_rate(
@@ -310,26 +445,68 @@ def best_rate(
     NOLCOS 2019, Section 5) is searched on a decimal grid of step tol/10. The bracket starts
     from the spectral bound: the grid point just beyond ρ(Acl) (resp. −max Re eig(Acl)) proved
     infeasible by :func:`rate_feasible`, and the certified end 1 − grid (resp. grid), or finer
-    candidates when those fail. Each midpoint is decided exactly; a midpoint that fails is the
-    new infeasible / not-certifiable end. ``known`` = (rate, P), a rate already certified
-    (the user's), keeps the result at least as good: the search never reports a worse rate.
+    candidates when those fail. Each midpoint is decided by :func:`certified_P`; a midpoint
+    that fails is the new infeasible / not-certifiable end. ``known`` = (rate, P), a rate
+    already certified (the user's), keeps the result at least as good: the search never reports
+    a worse rate.
+
+    Cost: every step is one Lyapunov equation, no SDP. A float forecast
+    (:func:`_predict_certified`) stands in for the exact check at the midpoints it calls
+    clearly certified; the exact check runs at the midpoints it calls failed and at the final
+    certified end. If that final check fails, the search is rerun with exact checks at every
+    midpoint, so the result is always that of the all-exact bisection. At most
+    :data:`MAX_EXACT_CHECKS` exact checks (then :class:`InconclusiveError`).
 
     :param A, C, L: exact plant and gain; :param discrete: time domain; :param tol: bracket
     width; :param margin: δ of the checks; :param known: a certified (rate, P);
     :param progress: callback for messages. Raises :class:`InfeasibleError` when Acl is not
     Schur / Hurwitz (exact) and :class:`InconclusiveError` when it is but nothing certifies."""
+    try:
+        return _best_rate(A, C, L, discrete, tol, margin, known, progress, forecast=True)
+    except _ForecastWrong:
+        return _best_rate(A, C, L, discrete, tol, margin, known, progress, forecast=False)
+
+
+class _ForecastWrong(Exception):
+    """The float forecast called a rate certified that the exact check refuses."""
+
+
+def _best_rate(
+    A: np.ndarray,
+    C: np.ndarray,
+    L: np.ndarray,
+    discrete: bool,
+    tol: Any,
+    margin: Any,
+    known: tuple[Any, np.ndarray] | None,
+    progress: Callable[[str], None] | None,
+    forecast: bool,
+) -> RateBracket:
     Acl = closed_loop(A, C, L)
     tol_q = Q(tol)
     grid = _grid(tol_q)
     eig = np.linalg.eigvals(np.asarray(Acl, dtype=float))
     # r-space: r = λ (discrete) or r = −α (continuous); smaller r is better in both
     sign = 1 if discrete else -1
+    checks = 0
+    pending = object()  # a forecast "certified", exact check deferred
 
     def rate(r: fmpq) -> fmpq:
         return r * sign
 
-    def cert(r: fmpq) -> np.ndarray | None:
+    def exact(r: fmpq) -> np.ndarray | None:
+        nonlocal checks
+        checks += 1
+        if checks > MAX_EXACT_CHECKS:
+            raise InconclusiveError(
+                f"best-rate search: more than {MAX_EXACT_CHECKS} exact checks without a bracket"
+            )
         return certified_P(A, C, L, discrete, rate(r), margin)
+
+    def cert(r: fmpq) -> Any:
+        if forecast and _predict_certified(A, C, L, discrete, rate(r), margin):
+            return pending
+        return exact(r)
 
     def feasible(r: fmpq) -> bool:
         return rate_feasible(Acl, rate(r), discrete)
@@ -380,4 +557,8 @@ def best_rate(
             lo, lo_kind = mid, (NOT_CERTIFIABLE if feasible(mid) else INFEASIBLE)
     if known_r is not None and known_r < hi:
         hi, P = known_r, known[1]  # type: ignore[index]
-    return RateBracket(rate(hi), P, rate(lo), lo_kind, tol_q)
+    if P is pending:
+        P = exact(hi)
+        if P is None:
+            raise _ForecastWrong
+    return RateBracket(rate(hi), P, rate(lo), lo_kind, tol_q, checks)
