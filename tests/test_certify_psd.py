@@ -17,7 +17,17 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from obsdesign.certify.exact import qeye, qmat
-from obsdesign.certify.psd import PSDResult, check_pd, check_psd, ldl_pivots
+from obsdesign.certify.psd import (
+    FAST_CHECK,
+    PSDResult,
+    _fraction_free,
+    _gershgorin_certificate,
+    check_pd,
+    check_pd_fast,
+    check_psd,
+    ldl_pivots,
+    to_fmpq_mat,
+)
 
 F = fmpq
 THIRD_FLOAT = 1 / 3  # 0.333…3148 < 1/3 exactly
@@ -84,6 +94,12 @@ def test_known_answers(name: str, M: list, psd: bool, pd: bool):
     # the same answers for the exact transpose-symmetric input given as fmpq
     Mq = qmat(M)
     assert check_psd(Mq).ok is psd and check_pd(Mq).ok is pd
+    # the fast test, and each of its two proofs on its own, give the same exact verdict
+    assert check_pd_fast(M).ok is pd and check_pd_fast(Mq).ok is pd
+    Fm = to_fmpq_mat(Mq)
+    assert _fraction_free(Fm).ok is pd
+    g = _gershgorin_certificate(Fm, np.array(Mq.tolist(), dtype=float))
+    assert g is None or g.ok is pd
     # and an independent exact oracle: the leading minors / all principal minors
     assert _pd_by_minors(Mq) is pd
     assert _psd_by_principal_minors(Mq) is psd
@@ -274,3 +290,88 @@ def test_random_low_rank_against_minors(n: int, r: int, seed: int):
     N = M - qeye(n) * shift
     assert check_psd(N).ok is _psd_by_principal_minors(N)
     assert check_pd(N).ok is _pd_by_minors(N)
+
+
+# ------------------------------------------------------------ check_pd_fast (issue 12)
+
+
+def test_pd_fast_paths_and_details():
+    r = check_pd_fast([[2, 1], [1, 2]])
+    assert r.ok and r.min_pivot == 1.0
+    assert r.detail == (
+        "M = RᵀR + S with S strictly diagonally dominant (exact), n = 2; float λ_min ≈ 1"
+    )
+    r = check_pd_fast([[1, 2], [2, 1]])
+    assert r == PSDResult(
+        False, -1.0, "vᵀMv = -1 <= 0 for a rational v (float eigenvector, checked exactly)"
+    )
+    # entries beyond the float range: the exact fraction-free path decides
+    big = F(10) ** 400
+    r = check_pd_fast([[big, 0], [0, 1]])
+    assert r == PSDResult(
+        True, 1.0, "fraction-free LDLᵀ: all 2 leading principal minors > 0 (min pivot 1)"
+    )
+    r = check_pd_fast([[big, 0], [0, -1]])
+    assert r == PSDResult(False, -1.0, "fraction-free LDLᵀ: pivot 1 = -1 <= 0 (leading minor ≤ 0)")
+    r = check_pd_fast([[0, 1], [1, big]])
+    assert r == PSDResult(False, 0.0, "leading principal minor 1 is 0 (fraction-free LDLᵀ)")
+    r = check_pd_fast([[big, 1, 0], [1, 1, 0], [0, 0, -3]])
+    assert not r.ok and r.detail.startswith("fraction-free LDLᵀ: pivot 2 = -3 <= 0")
+    # PD by a margin of 2^-60 only: no float certificate, the exact path decides
+    r = check_pd_fast([[1, 1], [1, 1 + F(1, 2**60)]])
+    assert r.ok and r.detail.startswith("fraction-free LDLᵀ: all 2 leading principal minors > 0")
+    assert r.min_pivot == float(F(1, 2**60))
+    assert "fraction-free" in FAST_CHECK and "diagonally dominant" in FAST_CHECK
+
+
+def test_pd_fast_inputs_margins_and_errors():
+    from flint import fmpq_mat, fmpz_mat
+
+    M = [[2, 1], [1, 2]]
+    assert check_pd_fast(fmpz_mat(M)).ok and check_pd_fast(fmpq_mat(M)).ok
+    assert to_fmpq_mat(fmpq_mat(M)) == fmpq_mat(M)
+    assert to_fmpq_mat(fmpz_mat(M)) == fmpq_mat(M)
+    assert to_fmpq_mat([[0.1]])[0, 0] == Fraction(0.1).numerator / F(Fraction(0.1).denominator)
+    with pytest.raises(ValueError, match=r"^expected a matrix$"):
+        to_fmpq_mat([1, 2])
+    with pytest.raises(ValueError, match=r"^expected a square matrix$"):
+        check_pd_fast([[1, 2, 3], [4, 5, 6]])
+    r = check_pd_fast([[1, 0, 0], [0, 1, 2], [0, 3, 1]])
+    assert r.detail == "not symmetric at (1, 2)" and not r.ok and np.isnan(r.min_pivot)
+    assert not check_pd_fast([[2, 1], [0, 2]]).ok
+    assert check_pd_fast(np.empty((0, 0), dtype=object)) == PSDResult(
+        True, float("inf"), "empty matrix"
+    )
+    # margins exactly at the boundary (eigenvalues 1 and 3)
+    assert not check_pd_fast(M, 1).ok
+    assert check_pd_fast(M, 1 - F(1, 2**80)).ok
+    assert not check_pd_fast(M, 1 + F(1, 2**80)).ok
+    assert check_pd_fast(M, "1/2").ok and not check_pd_fast(M, 3).ok
+    assert not check_pd_fast([[F(1, 2)]], 1).ok and check_pd_fast([[2]], 1).ok
+    # float input decided exactly
+    assert not check_pd_fast([[3.0, 1.0], [1.0, THIRD_FLOAT]]).ok
+    with pytest.raises(ValueError, match=r"^not a finite number: inf$"):
+        check_pd_fast([[np.inf, 0.0], [0.0, 1.0]])
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(1, 12), st.integers(0, 2**31 - 1), st.integers(-3, 3))
+def test_pd_fast_agrees_with_ldl(n: int, seed: int, shift: int):
+    rng = np.random.default_rng(seed)
+    r = int(rng.integers(1, n + 1))
+    B = qmat(rng.integers(-3, 4, size=(n, r)))
+    M = B @ B.T - qeye(n) * F(shift, 5)  # often singular or nearly so
+    assert check_pd_fast(M).ok is check_pd(M).ok
+
+
+def test_pd_fast_large():
+    rng = np.random.default_rng(7)
+    n = 60
+    B = rng.standard_normal((n, n))
+    M = qmat(B @ B.T + np.eye(n))
+    M = (M + M.T) * F(1, 2)
+    r = check_pd_fast(M)
+    assert r.ok and r.detail.startswith("M = RᵀR + S")
+    bad = M.copy()
+    bad[0, 0] = -F(1)
+    assert not check_pd_fast(bad).ok

@@ -222,6 +222,8 @@ def _gershgorin_certificate(F: Any, Mf: np.ndarray) -> PSDResult | None:
         if not np.all(np.isfinite(v)):
             return None
         z, k = _dyadic_int(v)
+        if not any(z):  # v = 0 proves nothing
+            return None
         vq = fmpq_mat(n, 1, [fmpq(t) for t in z])
         val = (vq.transpose() * F * vq)[0, 0]
         if val <= 0:
@@ -286,8 +288,11 @@ def check_pd_fast(M: Any, margin: Any = 0) -> PSDResult:
     m = Q(margin)
     if m != 0:
         F = F - m * type(F)(n, n, [fmpq(int(i == j)) for i in range(n) for j in range(n)])
-    with np.errstate(all="ignore"):
-        Mf = np.array([float(x) for x in F.entries()], dtype=float).reshape(n, n)
+    try:
+        with np.errstate(all="ignore"):
+            Mf = np.array([float(x) for x in F.entries()], dtype=float).reshape(n, n)
+    except OverflowError:  # an entry beyond the float range: no float guide, exact path only
+        Mf = np.full((n, n), np.inf)
     if np.all(np.isfinite(Mf)):
         r = _gershgorin_certificate(F, Mf)
         if r is not None:
