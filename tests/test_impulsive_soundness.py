@@ -87,6 +87,7 @@ def designed(name: str) -> tuple[Spec, Report]:
             "stable-o": SPEC3.read_text(encoding="utf-8").replace(
                 "A = [[0, 0.01, 0]", "A = [[-5, 0.01, 0]"
             ),
+            "square": example_text(noise_bound="0.12"),
             "cross": SPEC3.read_text(encoding="utf-8")
             .replace("sector = [-0.2, 0.2]", "sector = [-0.2, 0.2]\ncross = 0.05")
             .replace("sector = [0, 0.3]", "sector = [0, 0.3]\ncross = 0.05"),
@@ -183,6 +184,8 @@ Tamper = Callable[[Parameters], dict[str, Any]]
 # (variant, name, tamper, exact set of failed claim ids)
 TAMPERS: list[tuple[str, str, Tamper, set[str]]] = [
     ("example", "T", lambda p: {"T": _mat(p, "T", 1, 0, TINY)}, {"T"}),
+    ("example", "T (C row)", lambda p: {"T": _mat(p, "T", 0, 1, TINY)}, {"T"}),
+    ("lipschitz", "T (C row, M free)", lambda p: {"T": _mat(p, "T", 0, 0, TINY)}, {"T"}),
     ("example", "Abar", lambda p: {"Abar": _mat(p, "Abar", 1, 1, TINY)}, {"Abar"}),
     (
         "example",
@@ -236,6 +239,12 @@ TAMPERS: list[tuple[str, str, Tamper, set[str]]] = [
         lambda p: {"kappa_n": Q(p["kappa"])},
         {"condition-22"},
     ),
+    (
+        "example",
+        "kappa = 0 ((22) needs κ > 0, (26c) is undefined)",
+        lambda p: {"kappa": fmpq(0)},
+        {"condition-22", "T_min"},
+    ),
     ("example", "T_max above (26b)", lambda p: {"T_max": _above(_tmax_true(p))}, {"T_max"}),
     ("example", "T_min below (26c)", lambda p: {"T_min": _below(_tmin_true(p))}, {"T_min"}),
     ("example", "T_min = T_max", lambda p: {"T_min": Q(p["T_max"])}, {"window"}),
@@ -243,6 +252,18 @@ TAMPERS: list[tuple[str, str, Tamper, set[str]]] = [
         "example",
         "ball_radius² < α w̄",
         lambda p: {"ball_radius": _below(_sqrt("0.3"))},
+        {"ball_radius"},
+    ),
+    (
+        "example",
+        "ball_radius negative (r_B² ≥ α w̄ but r_B < 0)",
+        lambda p: {"ball_radius": -_above(_sqrt("0.3"))},
+        {"ball_radius"},
+    ),
+    (
+        "square",
+        "ball_radius² = α w̄ − 2⁻¹⁰⁰·…",
+        lambda p: {"ball_radius": fmpq(3, 5) - TINY},
         {"ball_radius"},
     ),
     (
@@ -294,6 +315,12 @@ def test_thresholds_are_tight() -> None:
     # ... and the thresholds themselves still certify (exact boundary of the LMI)
     at = _with(p, {"varpi_o": _varpi_star(p), "kappa_n": _kappa_star(p)})
     assert failed_ids(spec, at) == set()
+
+
+def test_ball_radius_on_the_boundary_certifies() -> None:
+    """α w̄ = 3 · 0.12 = 0.36 = 0.6²: r_B = 0.6 exactly is a true bound (≥, not >)."""
+    spec, rep = designed("square")
+    assert failed_ids(spec, _with(rep.parameters, {"ball_radius": fmpq(3, 5)})) == set()
 
 
 def test_every_claim_id_has_a_tamper() -> None:
