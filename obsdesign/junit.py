@@ -1,7 +1,9 @@
 """JUnit XML of ``obsdesign check --junit FILE``, so CI systems show failed claims natively.
 
 One ``<testsuite>`` per spec, holding one ``<testcase>`` for the spec itself (``design and
-verify``: its exit code; a spec that stopped with an error is an ``<error>`` here) and one per
+verify``: its exit code; bad input (exit 2) or a solver/internal failure (exit 3) is an
+``<error>``, an infeasible design or failed claim (exit 1) or an inconclusive one (exit 4) a
+``<failure>``) and one per
 verified claim (a failed claim is a ``<failure>`` with the claim's statement and detail; a
 numerical claim passes, with a ``<system-out>`` line saying it is not exact). The format is
 the common subset of the JUnit XML read by GitHub Actions reporters, GitLab CI
@@ -51,7 +53,7 @@ def junit_tree(rows: list[Any], name: str = "obsdesign check") -> ET.ElementTree
         )
         n += 1
         if r.code != 0:
-            kind = "error" if r.code in _ERROR_CODES or not r.claims else "failure"
+            kind = "error" if r.code in _ERROR_CODES else "failure"
             el = ET.SubElement(
                 case,
                 kind,
