@@ -16,7 +16,7 @@ $(VENV)/.debs:
 
 $(VENV)/.installed: $(VENV)/.debs pyproject.toml
 	$(PY) -m pip install -q --upgrade pip
-	$(PY) -m pip install -q -e '.[dev,control]'
+	$(PY) -m pip install -q -e '.[dev,distributed,parquet,control]'
 	@touch $@
 
 run: install

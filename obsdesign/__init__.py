@@ -62,6 +62,14 @@ def check(*args: Any, **kwargs: Any) -> Any:
     return api.check(*args, **kwargs)
 
 
+def sweep(*args: Any, **kwargs: Any) -> Any:
+    """See :func:`obsdesign.api.sweep` (once :mod:`obsdesign.sweep` is imported, this name is
+    that module, which is callable with the same arguments)."""
+    from obsdesign import api
+
+    return api.sweep(*args, **kwargs)
+
+
 def load_spec(*args: Any, **kwargs: Any) -> Any:
     """See :func:`obsdesign.api.load_spec`."""
     from obsdesign.api import load_spec as _load

@@ -666,18 +666,64 @@ def check_one(path: Path) -> CheckRow:
         )
 
 
-def check(paths: list[str | Path], on_start: Any = None) -> list[CheckRow]:
+def check(
+    paths: list[str | Path],
+    on_start: Any = None,
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    client: Any = None,
+    on_row: Any = None,
+) -> list[CheckRow]:
     """Design and verify every spec under ``paths`` (folders recursively, see
-    :func:`spec_files`); ``on_start(path)`` is called before each. One row per spec."""
+    :func:`spec_files`); ``on_start(path)`` is called before each (in-process runs only).
+    One row per spec, in file order. ``workers`` (a Dask LocalCluster of that many
+    processes), ``scheduler`` (an existing Dask scheduler's address; its workers must see
+    the same files) or ``client`` (a ``dask.distributed.Client``) run the specs on Dask
+    (:mod:`obsdesign.distributed`): the rows are the serial run's (but ``seconds``).
+    ``on_row(row)`` is called as each row arrives."""
     files = spec_files(paths)
     if not files:
         raise InputError(f"no spec files (*.toml) in {', '.join(map(str, paths))}")
-    rows = []
-    for f in files:
-        if on_start is not None:
-            on_start(f)
-        rows.append(check_one(f))
-    return rows
+    if workers is None and scheduler is None and client is None:
+        rows = []
+        for f in files:
+            if on_start is not None:
+                on_start(f)
+            rows.append(check_one(f))
+            if on_row is not None:
+                on_row(rows[-1])
+        return rows
+    from obsdesign.distributed import run_tasks
+
+    def lost(f: Path, message: str) -> CheckRow:
+        return CheckRow(str(f), "?", EXIT_SOLVER, 0, 0, 0, "", 0.0, message)
+
+    return run_tasks(
+        check_one,
+        files,
+        workers=workers,
+        scheduler=scheduler,
+        client=client,
+        on_result=(lambda i, r: on_row(r)) if on_row is not None else None,
+        lost=lost,
+    )
+
+
+def sweep(
+    spec: str | Path | Spec,
+    grid: list[str] | dict[str, Any],
+    client: Any = None,
+    **kwargs: Any,
+) -> Any:
+    """Design and verify ``spec`` at every point of ``grid`` (``["method.lambda=0.9:0.99:10"]``
+    or ``{"method.lambda": [0.9, 0.95]}``): a pandas DataFrame with one row per point (a list
+    of dicts without pandas). ``client`` (a ``dask.distributed.Client``) runs the points on
+    Dask; ``kwargs``: ``simulate``, ``options``, ``workers``, ``scheduler`` (see
+    :func:`obsdesign.sweep.sweep`)."""
+    from obsdesign.sweep import sweep as _sweep
+
+    return _sweep(spec, grid, client, **kwargs)
 
 
 def check_exit_code(rows: list[CheckRow]) -> int:
@@ -744,6 +790,7 @@ __all__ = [
     "plot_simulation",
     "schema",
     "simulate",
+    "sweep",
     "template",
     "verify",
 ]

@@ -410,6 +410,26 @@ def verify(
     _run(body)
 
 
+# Dask options (issue 13; obsdesign.distributed)
+WorkersOpt = Annotated[
+    int | None,
+    typer.Option(
+        "--workers",
+        metavar="N",
+        help="Run on a Dask LocalCluster of N worker processes (needs obsdesign[distributed]); "
+        "the output is the serial run's.",
+    ),
+]
+SchedulerOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--scheduler",
+        metavar="tcp://HOST:PORT",
+        help="Run on an existing Dask cluster (see docs/sweeps.md: dask scheduler, dask worker).",
+    ),
+]
+
+
 @app.command()
 def check(
     paths: Annotated[
@@ -427,6 +447,8 @@ def check(
     ] = None,
     quiet: QuietOpt = False,
     width: WidthOpt = None,
+    workers: WorkersOpt = None,
+    scheduler: SchedulerOpt = None,
 ) -> None:
     """Design and verify every spec; one row per spec; non-zero exit if any fails.
 
@@ -448,7 +470,10 @@ def check(
             if fmt == Fmt.text and not quiet:
                 sys.stderr.write(f"checking {f} ...\n")
 
-        rows = api.check(list(paths), on_start=each)
+        if workers is None and scheduler is None:
+            rows = api.check(list(paths), on_start=each)
+        else:
+            rows = _check_distributed(list(paths), workers, scheduler, quiet)
         if junit is not None:
             from obsdesign.junit import write_junit
 
@@ -465,13 +490,176 @@ def check(
     _run(body)
 
 
+def _check_distributed(
+    paths: list[Path], workers: int | None, scheduler: str | None, quiet: bool
+) -> list[Any]:
+    """``check`` on Dask, with a progress bar on stderr (unless --quiet)."""
+    from obsdesign import api
+    from obsdesign.distributed import check_workers, progress_bar
+
+    check_workers(workers, scheduler)
+    n = len(api.spec_files(list(paths)))
+    with progress_bar(n, "check", quiet) as advance:
+        return api.check(
+            list(paths), workers=workers, scheduler=scheduler, on_row=lambda r: advance(r.code != 0)
+        )
+
+
+@app.command()
+def sweep(
+    spec: Annotated[
+        Path, typer.Argument(metavar="SPEC", help="Spec file (TOML); - reads it from stdin.")
+    ],
+    sets: Annotated[
+        list[str],
+        typer.Option(
+            "--set",
+            metavar="KEY=VALUES",
+            help="A swept spec key (repeatable): a:b:n (linear), a:b:n:log, [v1, v2, ...] "
+            "or one value; e.g. method.lambda=0.90:0.99:10.",
+        ),
+    ],
+    simulate: Annotated[
+        bool, typer.Option("--simulate", help="Also simulate every point (metrics columns).")
+    ] = False,
+    option: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--option", metavar="KEY=VALUE", help="Simulation option KEY=VALUE (repeatable)."
+        ),
+    ] = None,
+    output: Annotated[
+        Path | None,
+        typer.Option(
+            "-o",
+            "--output",
+            metavar="FILE",
+            help="Write the table (.csv, .jsonl, .parquet), atomically at the end.",
+        ),
+    ] = None,
+    plot: Annotated[
+        Path | None,
+        typer.Option("--plot", metavar="FILE", help="Plot --y against a swept key (PNG/SVG)."),
+    ] = None,
+    y: Annotated[
+        str | None, typer.Option("--y", metavar="COLUMN", help="The plotted column.")
+    ] = None,
+    x: Annotated[
+        str | None,
+        typer.Option("--x", metavar="KEY", help="The swept key on the x axis (the first one)."),
+    ] = None,
+    fmt: Annotated[Fmt, typer.Option("--format", help="Output format on stdout.")] = Fmt.text,
+    workers: WorkersOpt = None,
+    scheduler: SchedulerOpt = None,
+    force: Annotated[
+        bool, typer.Option("--force", help="Write -o/--plot even where refused by default.")
+    ] = False,
+    quiet: QuietOpt = False,
+    width: WidthOpt = None,
+) -> None:
+    """Design and verify SPEC at every point of a grid of spec keys; one row per point.
+
+    Every point gets a row whatever happens in it (its exit code and message); the exit code
+    is the worst row's. See docs/sweeps.md."""
+
+    def body() -> int:
+        _setup(quiet, width)
+        _precheck(spec)
+        import types
+
+        from obsdesign import sweep as sw
+        from obsdesign.distributed import check_workers, progress_bar
+        from obsdesign.errors import InputError
+
+        check_workers(workers, scheduler)
+        if output is not None:
+            sw.check_output_path(output, force, _inputs(spec))
+        if plot is not None and y is None:
+            raise InputError("--plot needs --y COLUMN (the plotted column)")
+        if plot is None and (y is not None or x is not None):
+            raise InputError("--y/--x choose what --plot draws: give --plot FILE")
+        _check_plot(plot, force, _inputs(spec, output))
+        src: Any = spec
+        if _is_stdin(spec):
+            src = types.SimpleNamespace(text=_read_stdin("spec"), file=STDIN_NAME)
+        axes = sw.parse_grid(sets)
+        _, tasks = sw.plan(src, sets, simulate, _kv(option or []))
+        if plot is not None:
+            cols = sw.expected_columns(tasks[0].text, axes, simulate)
+            if x is not None and x not in [a.key for a in axes]:
+                raise InputError(f"--x {x}: not a swept key")
+            if cols is not None and y not in cols:
+                raise InputError(f"--y {y}: not a column of this sweep ({', '.join(sorted(cols))})")
+        with progress_bar(len(tasks), "sweep", quiet) as advance:
+            rows = sw.sweep_rows(
+                src,
+                sets,
+                simulate=simulate,
+                options=_kv(option or []),
+                workers=workers,
+                scheduler=scheduler,
+                on_row=lambda r: advance(r["exit_code"] != 0),
+            )
+        if output is not None:
+            sw.write_table(output, rows, force)
+        if plot is not None:
+            sw.check_plot_column(rows, axes, y or "", x)
+            _write_plot(plot, lambda tmp: sw.plot_sweep(rows, axes, y or "", tmp, x), force)
+        if fmt == Fmt.json:
+            print(json.dumps(rows, indent=2, ensure_ascii=False, default=_jsonable))
+            return sw.exit_code(rows)
+        if output is None and not quiet:
+            _print_sweep(rows, fmt)
+        ok = sum(r["exit_code"] == 0 for r in rows)
+        line = f"swept: {len(rows)} points, {ok} ok, {len(rows) - ok} not ok"
+        if rows and ok < len(rows):
+            line += f" (worst exit {sw.exit_code(rows)})"
+        print(f"\n**{line}**" if fmt == Fmt.md and not quiet else line)
+        if output is not None and fmt == Fmt.text:
+            _say(f"table written to {output}")
+        if plot is not None and fmt == Fmt.text:
+            _say(f"plot written to {plot}")
+        return sw.exit_code(rows)
+
+    _run(body)
+
+
+def _print_sweep(rows: list[dict[str, Any]], fmt: Fmt) -> None:
+    from obsdesign.sweep import TIMING_COLUMNS, columns
+
+    cols = [c for c in columns(rows) if c not in ("method", *TIMING_COLUMNS)]
+    if fmt == Fmt.md:
+        print("| " + " | ".join(cols) + " |")
+        print("|" + " --- |" * len(cols))
+        for r in rows:
+            print("| " + " | ".join(_md_cell(r.get(c, "")) for c in cols) + " |")
+        return
+    from rich.table import Table
+
+    from obsdesign.report.render import console, esc
+
+    t = Table(title="obsdesign sweep")
+    for c in cols:
+        t.add_column(esc(c), overflow="fold")
+    for r in rows:
+        t.add_row(*(esc(_sweep_cell(r.get(c))) for c in cols))
+    console().print(t)
+
+
+def _sweep_cell(v: Any) -> str:
+    if v is None:
+        return ""
+    if isinstance(v, float):
+        return format(v, ".6g")
+    return str(v)
+
+
 @app.command()
 def simulate(
     spec: Annotated[
         Path,
         typer.Argument(
-            metavar="SPEC",
-            help="Spec file with a [simulate] table; - reads it from stdin.",
+            metavar="SPEC", help="Spec file with a [simulate] table; - reads it from stdin."
         ),
     ],
     report: Annotated[

@@ -336,7 +336,11 @@ def _check_edit(old: str, new: str, parts: list[str], literal: str, file: str) -
     try:
         after = tomllib.loads(new)
     except tomllib.TOMLDecodeError as e:
-        raise InputError(f"{file}: cannot set {key} = {literal} ({e})") from None
+        raise InputError(
+            f"{file}: cannot set {key} = {literal} ({e}"
+            + ("; an inline table holds it: write it as a [table]" if "immutable" in str(e) else "")
+            + ")"
+        ) from None
     want = tomllib.loads(f"x = {literal}")["x"]
     d = before
     for p in parts[:-1]:

@@ -1,0 +1,211 @@
+"""Sweeps and checks on Dask (issue 13): the same rows as the serial run, every point exactly
+once when a worker dies mid-sweep, lost tasks as rows, the caller's limits in force in the
+workers, Ctrl-C stops the cluster and leaves no file.
+
+One LocalCluster (2 worker processes) is shared by the module: starting one costs seconds."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("dask.distributed")
+
+from typer.testing import CliRunner  # noqa: E402
+
+from obsdesign import api  # noqa: E402
+from obsdesign import sweep as sw  # noqa: E402
+from obsdesign.cli import app  # noqa: E402
+from obsdesign.distributed import run_tasks  # noqa: E402
+from obsdesign.limits import reset_limits, set_limits  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+SPECS = ROOT / "specs"
+SPEC = SPECS / "constrained-redesign-sec5-lyapunov.toml"
+#: the fast shipped specs (the whole folder is the slow test below)
+FAST = [
+    SPECS / "constrained-redesign-sec5-lyapunov.toml",
+    SPECS / "hernandez-garcia-example.toml",
+    SPECS / "schaum-impulsive-example.toml",
+    SPECS / "astolfi-stubborn-duffing.toml",
+]
+GRID12 = ["method.lambda=0.94:0.99:6", "method.rate_tol=[0.0001, 0.001]"]
+
+
+@pytest.fixture(scope="module")
+def client():
+    import dask
+    from dask.distributed import Client, LocalCluster
+
+    # a task may be on one dying worker and be retried once; the second death marks it lost
+    with dask.config.set({"distributed.scheduler.allowed-failures": 1}):
+        cluster = LocalCluster(
+            n_workers=2,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            silence_logs=40,
+        )
+        c = Client(cluster)
+        try:
+            yield c
+        finally:
+            c.close()
+            cluster.close()
+
+
+def _strip(rows: list[dict]) -> list[dict]:
+    """Rows without the wall-clock columns (the only ones two runs may differ in)."""
+    return [{k: v for k, v in r.items() if k not in sw.TIMING_COLUMNS} for r in rows]
+
+
+@pytest.fixture(scope="module")
+def serial12() -> list[dict]:
+    return sw.sweep_rows(SPEC, GRID12)
+
+
+def test_twelve_point_sweep_is_the_serial_table(client, serial12):
+    rows = sw.sweep_rows(SPEC, GRID12, client=client)
+    assert len(rows) == 12
+    assert _strip(rows) == _strip(serial12)
+    assert [r["exit_code"] for r in rows] == [1] * 4 + [0] * 8  # λ ≤ 0.95 infeasible
+    assert sw.columns(rows) == sw.columns(serial12)
+    # the DataFrame too (column order included)
+    pd = pytest.importorskip("pandas")
+    a = sw.to_frame(rows).drop(columns=list(sw.TIMING_COLUMNS), errors="ignore")
+    b = sw.to_frame(serial12).drop(columns=list(sw.TIMING_COLUMNS), errors="ignore")
+    pd.testing.assert_frame_equal(a, b)
+
+
+def test_a_worker_killed_mid_sweep_costs_a_retry_not_a_row(client, serial12):
+    pids = client.run(os.getpid)
+    seen: list[int] = []
+    killed: list[int] = []
+
+    def on_row(row: dict) -> None:
+        seen.append(row["point"])
+        if not killed:
+            busy = [w for w, keys in client.processing().items() if keys and w in pids]
+            victim = pids[busy[0]] if busy else next(iter(pids.values()))
+            os.kill(victim, signal.SIGKILL)
+            killed.append(victim)
+
+    rows = sw.sweep_rows(SPEC, GRID12, client=client, on_row=on_row)
+    assert killed
+    assert sorted(seen) == list(range(12))  # every point reported exactly once
+    assert [r["point"] for r in rows] == list(range(12))
+    assert _strip(rows) == _strip(serial12)
+    client.wait_for_workers(2, timeout=60)  # the nanny restarted it
+    assert killed[0] not in client.run(os.getpid).values()
+
+
+def test_a_task_that_kills_every_worker_is_a_row_not_a_hang(client):
+    def die_on_3(x: int) -> int:
+        if x == 3:
+            os._exit(1)
+        return x * x
+
+    out = run_tasks(die_on_3, list(range(6)), client=client, lost=lambda x, msg: (x, msg))
+    assert out[:3] == [0, 1, 4] and out[4:] == [16, 25]
+    assert out[3][0] == 3 and "killed every worker" in out[3][1]
+    client.wait_for_workers(2, timeout=60)
+
+
+def test_the_callers_limits_hold_in_the_workers(client):
+    grid = ["method.lambda=[0.97, 0.97" + "0" * 40 + "1]"]  # 43 digits
+    old = set_limits(max_digits=40)
+    try:
+        serial = sw.sweep_rows(SPEC, grid)
+        dist = sw.sweep_rows(SPEC, grid, client=client)
+    finally:
+        reset_limits(old)
+    assert [r["exit_code"] for r in serial] == [0, 2]
+    assert "digits" in serial[1]["message"]
+    assert _strip(dist) == _strip(serial)
+    # and the workers are back to their own limits afterwards
+    assert [r["exit_code"] for r in sw.sweep_rows(SPEC, grid, client=client)] == [0, 0]
+
+
+def _check_rows(rows: list) -> list[dict]:
+    return [{k: v for k, v in r.__dict__.items() if k != "seconds"} for r in rows]
+
+
+def test_check_on_dask_equals_serial_on_the_fast_specs(client):
+    serial = api.check(FAST)
+    dist = api.check(FAST, client=client)
+    assert [r.spec for r in dist] == [str(f) for f in FAST]
+    assert _check_rows(dist) == _check_rows(serial)
+    assert all(r.code == 0 for r in dist)
+
+
+@pytest.mark.slow
+def test_cli_check_workers_2_on_specs_equals_serial():
+    runner = CliRunner()
+    a = runner.invoke(app, ["check", str(SPECS), "--format", "json"])
+    b = runner.invoke(app, ["check", str(SPECS), "--format", "json", "--workers", "2", "-q"])
+    assert a.exit_code == b.exit_code == 0, (a.stderr, b.stderr)
+    import json
+
+    ra, rb = json.loads(a.stdout), json.loads(b.stdout)
+    for r in ra + rb:
+        r.pop("seconds")
+    assert ra == rb and len(ra) == len(list(SPECS.glob("*.toml")))
+
+
+def test_cli_sweep_workers_2_writes_the_serial_table(tmp_path: Path, serial12):
+    out = tmp_path / "t.jsonl"
+    r = CliRunner().invoke(
+        app, ["sweep", str(SPEC), *sum((["--set", g] for g in GRID12), []), "--workers", "2",
+              "-o", str(out), "-q"],
+    )  # fmt: skip
+    assert r.exit_code == 1, r.stderr
+    import json
+
+    rows = [json.loads(x) for x in out.read_text(encoding="utf-8").splitlines()]
+    assert _strip(rows) == _strip(serial12)
+
+
+def test_ctrl_c_stops_the_cluster_it_started_and_writes_nothing(tmp_path: Path):
+    psutil = pytest.importorskip("psutil")
+    out = tmp_path / "t.csv"
+    exe = Path(sys.executable).parent / "obsdesign"
+    cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "obsdesign.cli"]
+    p = subprocess.Popen(
+        [*cmd, "sweep", str(SPEC), "--set", "method.lambda=0.96:0.99:3000", "--workers", "2",
+         "-o", str(out), "-q"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        proc = psutil.Process(p.pid)
+        deadline = time.monotonic() + 60
+        kids: list = []
+        while time.monotonic() < deadline:  # the two worker processes are up
+            kids = proc.children(recursive=True)
+            if sum("dask" in _name(k) for k in kids) >= 2:
+                break
+            time.sleep(0.2)
+        assert sum("dask" in _name(k) for k in kids) >= 2, kids
+        time.sleep(3)  # tasks running
+        p.send_signal(signal.SIGINT)
+        _, err = p.communicate(timeout=60)
+    finally:
+        if p.poll() is None:
+            p.kill()
+    assert p.returncode == 130, err
+    assert "interrupted" in err
+    assert not out.exists() and not any(tmp_path.iterdir())
+    gone, alive = psutil.wait_procs(kids, timeout=20)
+    assert not alive, alive
+
+
+def _name(proc) -> str:
+    try:
+        return proc.name() + " " + " ".join(proc.cmdline())
+    except Exception:  # noqa: BLE001 - gone already
+        return ""

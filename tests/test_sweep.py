@@ -1,0 +1,277 @@
+"""Sweeps (issue 13), in-process: grid parsing with exact known answers, the spec-text edit
+(only the swept key changes), one row per point whatever happens in it, the worst row's exit
+code, the table formats, the CLI's refusals before any work. The Dask runs are in
+tests/test_distributed.py."""
+
+from __future__ import annotations
+
+import csv
+import json
+import tomllib
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from obsdesign import sweep as sw
+from obsdesign.cli import app
+from obsdesign.errors import InputError
+
+ROOT = Path(__file__).resolve().parents[1]
+SPEC = ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+runner = CliRunner()
+
+
+# -- grid ----------------------------------------------------------------------------------
+def test_linear_range_is_exact_decimals():
+    a = sw.parse_axis("method.lambda=0.90:0.99:10")
+    assert a.key == "method.lambda"
+    assert a.values == tuple(
+        f"0.{k}" for k in ("9", "91", "92", "93", "94", "95", "96", "97", "98", "99")
+    )
+
+
+def test_integer_ends_give_integers_and_thirds_are_rounded_to_15_digits():
+    assert sw.parse_axis("simulate.horizon=100:300:3").values == ("100", "200", "300")
+    assert sw.parse_axis("k=0:1:4").values == ("0", "0.333333333333333", "0.666666666666667", "1")
+    assert sw.parse_axis("k=0.0:1:3").values == ("0.0", "0.5", "1.0")
+    assert sw.parse_axis("k=2.5:7:1").values == ("2.5",)
+
+
+def test_log_range_hits_the_decades_exactly():
+    v = sw.parse_axis("simulate.noise.bound=1e-3:1:7:log").values
+    assert v == ("0.001", "0.00316227766016838", "0.01", "0.0316227766016838", "0.1",
+                 "0.316227766016838", "1.0")  # fmt: skip
+
+
+def test_lists_and_single_values():
+    assert sw.parse_axis("method.solver=[clarabel, scs]").values == ('"clarabel"', '"scs"')
+    assert sw.parse_axis("method.L=[[-1.87, 1.874], [-1.8, 1.9]]").values == (
+        "[-1.87, 1.874]",
+        "[-1.8, 1.9]",
+    )
+    assert sw.parse_axis("method.iss_gain=false").values == ("false",)
+    assert sw.parse_axis('x=[1, 2.50, "a,b"]').values == ("1", "2.50", '"a,b"')
+
+
+@pytest.mark.parametrize(
+    "text, where",
+    [
+        ("method.lambda", "KEY=VALUES"),
+        ("method..lambda=1", "not a dotted spec key"),
+        ("x=1:2:0", "at least 1"),
+        ("x=1:2:1000001", "above the limit"),
+        ("x=0:1:3:log", "positive ends"),
+        ("x=[1, 2", "end with ']'"),
+        ("x=[]", "empty"),
+        ("x=[1,,2]", "empty item"),
+        ("x=1e400:1:2", "exponent"),
+        ("x=a b", "not a TOML value"),
+    ],
+)
+def test_bad_axes_are_bad_input(text: str, where: str):
+    with pytest.raises(InputError, match=where):
+        sw.parse_axis(text)
+
+
+def test_grid_is_the_product_last_axis_fastest_and_limited():
+    axes = sw.parse_grid(["a.x=[1, 2]", "a.y=[3, 4, 5]"])
+    pts = sw.grid_points(axes)
+    assert pts == [{"a.x": x, "a.y": y} for x in "12" for y in "345"]
+    with pytest.raises(InputError, match="given twice"):
+        sw.grid_points(sw.parse_grid(["a.x=1", "a.x=2"]))
+    with pytest.raises(InputError, match="limit"):
+        sw.grid_points(sw.parse_grid(["a.x=0:1:1000", "a.y=0:1:1000"]))
+    assert [a.values for a in sw.parse_grid({"a.x": [0.1, 2], "a.y": "1:2:2", "a.z": 3})] == [
+        ("0.1", "2"),
+        ("1", "2"),
+        ("3",),
+    ]
+
+
+# -- editing the spec text -----------------------------------------------------------------
+def _changed(old: str, new: str) -> dict:
+    a, b = tomllib.loads(old), tomllib.loads(new)
+    return {k: (a.get(k), b.get(k)) for k in set(a) | set(b) if a.get(k) != b.get(k)}
+
+
+def test_set_key_replaces_only_that_line_and_keeps_its_comment():
+    text = '[method]\nkey = "lyapunov"\nlambda = 0.955  # the paper\nrate_tol = 1e-4\n'
+    new = sw.set_key(text, "method.lambda", "0.97")
+    assert new == '[method]\nkey = "lyapunov"\nlambda = 0.97  # the paper\nrate_tol = 1e-4\n'
+
+
+def test_set_key_adds_a_missing_key_to_its_table_and_replaces_multiline_values():
+    text = '[system]\nA = [[0, 1],\n     [1, 0]]  \n\n[simulate]\nhorizon = 3\n\n[simulate.noise]\nkind = "none"\n'
+    new = sw.set_key(text, "system.A", "[[0, 2], [1, 0]]")
+    assert tomllib.loads(new)["system"]["A"] == [[0, 2], [1, 0]]
+    new = sw.set_key(text, "simulate.noise.bound", "0.5")
+    assert tomllib.loads(new)["simulate"]["noise"] == {"kind": "none", "bound": 0.5}
+    new = sw.set_key(text, "simulate.dt", "0.01")
+    assert tomllib.loads(new)["simulate"] == {"horizon": 3, "dt": 0.01, "noise": {"kind": "none"}}
+    new = sw.set_key(text, "method.lambda", "0.9")  # no [method]: a new dotted root key
+    assert tomllib.loads(new)["method"] == {"lambda": 0.9}
+
+
+def test_set_key_refuses_what_it_cannot_write_exactly():
+    text = '[simulate]\nnoise = { kind = "none" }\n'
+    with pytest.raises(InputError, match="inline table"):
+        sw.set_key(text, "simulate.noise.bound", "0.5")
+    with pytest.raises(InputError, match="cannot set method.key.x"):
+        sw.set_key("[method]\nkey = 1\n", "method.key.x", "2")
+
+
+def test_point_text_of_the_shipped_spec_changes_exactly_the_swept_keys():
+    text = SPEC.read_text(encoding="utf-8")
+    new = sw.point_text(text, {"method.lambda": "0.97", "simulate.horizon": "200"})
+    assert _changed(text, new) == {
+        "method": (
+            tomllib.loads(text)["method"],
+            {**tomllib.loads(text)["method"], "lambda": 0.97},
+        ),
+        "simulate": (
+            tomllib.loads(text)["simulate"],
+            {**tomllib.loads(text)["simulate"], "horizon": 200},
+        ),
+    }
+    assert "lambda = 0.97\n" in new  # the decimal as written: the spec stays exact
+
+
+# -- running points ------------------------------------------------------------------------
+def test_mixed_good_and_bad_points_each_get_their_row_and_exit_code():
+    # 0.94, 0.95: infeasible (exit 1: spectral radius 0.95); 0.96: ok; 1.5: bad input (exit 2)
+    rows = sw.sweep_rows(SPEC, ["method.lambda=[0.94, 0.95, 0.96, 1.5, 0.99]"])
+    assert [r["point"] for r in rows] == [0, 1, 2, 3, 4]
+    assert [r["method.lambda"] for r in rows] == [0.94, 0.95, 0.96, 1.5, 0.99]
+    assert [r["exit_code"] for r in rows] == [1, 1, 0, 2, 0]
+    assert [r["verdict"] for r in rows] == ["failed", "failed", "ok", "bad input", "ok"]
+    assert "spectral radius" in rows[0]["message"]
+    assert "[point 3]" in rows[3]["message"] and "lambda" in rows[3]["message"]
+    ok = rows[2]
+    assert (ok["certified"], ok["numerical"], ok["failed"], ok["message"]) == (6, 0, 0, "")
+    assert ok["lambda"] == 0.96 and 0.95 < ok["lambda_best"] < 0.951 and ok["mu"] > 0
+    assert sw.exit_code(rows) == 2
+    assert sw.exit_code([rows[2], rows[4]]) == 0
+
+
+def test_simulated_points_carry_the_metrics():
+    rows = sw.sweep_rows(SPEC, ["method.lambda=[0.96, 0.99]"], simulate=True)
+    assert all(r["exit_code"] == 0 for r in rows)
+    for r in rows:
+        assert r["rmse.x1"] > 0 and r["final_error_norm"] >= 0 and r["simulate_s"] >= 0
+    # same gain L, same scenario: the trajectories do not depend on λ
+    assert rows[0]["rmse.x1"] == rows[1]["rmse.x1"]
+
+
+def test_simulate_without_a_simulate_table_is_bad_input_before_any_work(tmp_path: Path):
+    text = SPEC.read_text(encoding="utf-8").split("[simulate]")[0]
+    p = tmp_path / "s.toml"
+    p.write_text(text, encoding="utf-8")
+    with pytest.raises(InputError, match=r"\[simulate\] is missing"):
+        sw.plan(p, ["method.lambda=0.97"], simulate=True)
+
+
+def test_api_sweep_returns_a_dataframe():
+    pd = pytest.importorskip("pandas")
+    from obsdesign import api
+
+    df = api.sweep(SPEC, {"method.lambda": [0.96, 0.98]})
+    assert isinstance(df, pd.DataFrame)
+    assert list(df["method.lambda"]) == [0.96, 0.98]
+    assert list(df.columns[:4]) == ["point", "method.lambda", "verdict", "exit_code"]
+    import obsdesign
+
+    assert list(obsdesign.sweep(SPEC, ["method.lambda=0.97"])["exit_code"]) == [0]
+
+
+# -- the command line ------------------------------------------------------------------------
+def test_cli_sweep_writes_csv_jsonl_and_plot(tmp_path: Path):
+    out = tmp_path / "t.csv"
+    png = tmp_path / "p.png"
+    r = runner.invoke(
+        app,
+        [
+            "sweep", str(SPEC), "--set", "method.lambda=0.95:0.99:5",
+            "--set", "method.rate_tol=[0.0001, 0.001]",
+            "-o", str(out), "--plot", str(png), "--y", "mu", "--quiet",
+        ],
+    )  # fmt: skip
+    assert r.exit_code == 1, r.output  # λ = 0.95 is infeasible: the worst row
+    with open(out, encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 10 and rows[0]["method.lambda"] == "0.95"
+    assert [x["exit_code"] for x in rows] == ["1", "1"] + ["0"] * 8
+    assert png.stat().st_size > 1000
+    assert "swept: 10 points, 8 ok, 2 not ok (worst exit 1)" in r.output
+    jl = tmp_path / "t.jsonl"
+    r = runner.invoke(app, ["sweep", str(SPEC), "--set", "method.lambda=[0.97]", "-o", str(jl)])
+    assert r.exit_code == 0, r.output
+    lines = jl.read_text(encoding="utf-8").splitlines()
+    assert len(lines) == 1 and json.loads(lines[0])["certified"] == 6
+
+
+def test_cli_sweep_format_json_prints_only_data(tmp_path: Path):
+    r = runner.invoke(
+        app, ["sweep", str(SPEC), "--set", "method.lambda=[0.96,0.98]", "--format", "json"]
+    )
+    assert r.exit_code == 0
+    rows = json.loads(r.stdout)
+    assert [x["method.lambda"] for x in rows] == [0.96, 0.98]
+
+
+def test_cli_sweep_parquet(tmp_path: Path):
+    pq = pytest.importorskip("pyarrow.parquet")
+    out = tmp_path / "t.parquet"
+    r = runner.invoke(
+        app, ["sweep", str(SPEC), "--set", "method.lambda=[0.94, 0.97]", "-o", str(out), "-q"]
+    )
+    assert r.exit_code == 1
+    t = pq.read_table(out).to_pylist()
+    assert [x["exit_code"] for x in t] == [1, 0] and t[1]["certified"] == 6
+
+
+@pytest.mark.parametrize(
+    "extra, msg",
+    [
+        (["-o", "{spec}"], "unknown table format"),
+        (["-o", "{tmp}/t.xlsx"], "unknown table format"),
+        (["--plot", "{tmp}/p.png"], "--plot needs --y"),
+        (["--y", "mu"], "give --plot"),
+        (["--plot", "{tmp}/p.png", "--y", "nope"], "--y nope: not a column"),
+        (["--workers", "0"], "positive number"),
+        (["--workers", "2", "--scheduler", "tcp://h:1"], "exclude each other"),
+        (["--scheduler", "localhost"], "tcp://HOST"),
+        (["--set", "method.lambda=1"], "given twice"),
+    ],
+)
+def test_cli_sweep_refuses_before_any_work(tmp_path: Path, extra: list[str], msg: str):
+    spec = tmp_path / "s.toml"
+    spec.write_text(SPEC.read_text(encoding="utf-8"), encoding="utf-8")
+    before = spec.read_bytes()
+    args = [a.format(spec=spec, tmp=tmp_path) for a in extra]
+    r = runner.invoke(app, ["sweep", str(spec), "--set", "method.lambda=0.97", *args])
+    assert r.exit_code == 2, r.output
+    assert msg in r.stderr
+    assert spec.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
+
+
+def test_cli_sweep_refuses_the_spec_itself_as_output(tmp_path: Path):
+    spec = tmp_path / "s.csv"  # a spec whose name looks like a table
+    spec.write_text(SPEC.read_text(encoding="utf-8"), encoding="utf-8")
+    r = runner.invoke(app, ["sweep", str(spec), "--set", "method.lambda=0.97", "-o", str(spec)])
+    assert r.exit_code == 2 and "input file itself" in r.stderr
+    assert spec.read_text(encoding="utf-8") == SPEC.read_text(encoding="utf-8")
+
+
+def test_workers_without_dask_say_how_to_install_it(monkeypatch: pytest.MonkeyPatch):
+    import obsdesign.distributed as dist
+
+    monkeypatch.setattr(dist, "dask_available", lambda: False)
+    for cmd in (
+        ["sweep", str(SPEC), "--set", "method.lambda=0.97", "--workers", "2"],
+        ["check", str(SPEC), "--workers", "2"],
+    ):
+        r = runner.invoke(app, cmd)
+        assert r.exit_code == 2
+        assert "pip install 'obsdesign[distributed]'" in r.stderr
