@@ -62,12 +62,15 @@ def check(*args: Any, **kwargs: Any) -> Any:
     return api.check(*args, **kwargs)
 
 
-def sweep(*args: Any, **kwargs: Any) -> Any:
-    """See :func:`obsdesign.api.sweep` (once :mod:`obsdesign.sweep` is imported, this name is
-    that module, which is callable with the same arguments)."""
-    from obsdesign import api
+def __getattr__(name: str) -> Any:
+    """``obsdesign.sweep``: the module :mod:`obsdesign.sweep`, imported on first use and
+    callable as :func:`obsdesign.api.sweep` (``obsdesign.sweep(spec, grid, client=None)``).
+    A function of that name here would be replaced by the submodule on its import."""
+    if name == "sweep":
+        import importlib
 
-    return api.sweep(*args, **kwargs)
+        return importlib.import_module("obsdesign.sweep")
+    raise AttributeError(f"module 'obsdesign' has no attribute {name!r}")
 
 
 def load_spec(*args: Any, **kwargs: Any) -> Any:

@@ -611,7 +611,8 @@ def sweep(
         if output is None and not quiet:
             _print_sweep(rows, fmt)
         ok = sum(r["exit_code"] == 0 for r in rows)
-        line = f"swept: {len(rows)} points, {ok} ok, {len(rows) - ok} not ok"
+        pts = f"{len(rows)} point{'' if len(rows) == 1 else 's'}"
+        line = f"swept: {pts}, {ok} ok, {len(rows) - ok} not ok"
         if rows and ok < len(rows):
             line += f" (worst exit {sw.exit_code(rows)})"
         print(f"\n**{line}**" if fmt == Fmt.md and not quiet else line)
