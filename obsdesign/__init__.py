@@ -78,3 +78,17 @@ def load_spec(*args: Any, **kwargs: Any) -> Any:
     from obsdesign.api import load_spec as _load
 
     return _load(*args, **kwargs)
+
+
+def spec_from_statespace(*args: Any, **kwargs: Any) -> Any:
+    """See :func:`obsdesign.interop.spec_from_statespace` (needs ``obsdesign[control]``)."""
+    from obsdesign.interop import spec_from_statespace as _from
+
+    return _from(*args, **kwargs)
+
+
+def observer_statespace(*args: Any, **kwargs: Any) -> Any:
+    """See :func:`obsdesign.interop.observer_statespace` (needs ``obsdesign[control]``)."""
+    from obsdesign.interop import observer_statespace as _obs
+
+    return _obs(*args, **kwargs)

@@ -774,6 +774,55 @@ def init(
     _run(body)
 
 
+@app.command("import")
+def import_mat(
+    mat: Annotated[
+        Path, typer.Argument(metavar="FILE.mat", help="MATLAB .mat file (scipy.io.loadmat).")
+    ],
+    a: Annotated[str, typer.Option("--A", metavar="NAME", help="Variable holding A.")] = "A",
+    c: Annotated[str, typer.Option("--C", metavar="NAME", help="Variable holding C.")] = "C",
+    b: Annotated[
+        str | None, typer.Option("--B", metavar="NAME", help="Variable holding B (optional).")
+    ] = None,
+    d: Annotated[
+        str | None, typer.Option("--D", metavar="NAME", help="Variable holding D (optional).")
+    ] = None,
+    bd: Annotated[
+        str | None,
+        typer.Option("--Bd", metavar="NAME", help="Variable holding the disturbance input Bd."),
+    ] = None,
+    dt: Annotated[
+        float | None,
+        typer.Option(
+            "--dt", metavar="SECONDS", help="Sample time: discrete time (default: continuous)."
+        ),
+    ] = None,
+    dt_var: Annotated[
+        str | None,
+        typer.Option("--dt-var", metavar="NAME", help="Variable holding the sample time."),
+    ] = None,
+    method: Annotated[
+        str, typer.Option("--method", metavar="KEY", help="[method] key of the spec.")
+    ] = "lyapunov",
+) -> None:
+    """Print a spec (TOML) built from the matrices of a MATLAB .mat file, e.g.
+    obsdesign import plant.mat --A A --C C --dt 0.1 > spec.toml.
+
+    Floats are written by their shortest repr (the spec reads back as the same doubles).
+    Add the method's options to the printed [method] table (see obsdesign init KEY)."""
+
+    def body() -> int:
+        from obsdesign import api
+        from obsdesign.interop import spec_text_from_mat
+
+        api.method(method)  # an unknown key: "did you mean"
+        names = {"A": a, "C": c, "B": b, "D": d, "Bd": bd}
+        sys.stdout.write(spec_text_from_mat(mat, names, method, dt=dt, dt_name=dt_var))
+        return 0
+
+    _run(body)
+
+
 @app.command()
 def methods(
     fmt: Annotated[Fmt, typer.Option("--format", help="Output format on stdout.")] = Fmt.text,

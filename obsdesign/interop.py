@@ -1,0 +1,330 @@
+"""python-control and MATLAB interop (the optional extra ``obsdesign[control]``).
+
+- :func:`spec_from_statespace` / :func:`spec_text_from_statespace`: a ``control.StateSpace``
+  (or ``(A, B, C, D, dt)`` matrices) → a spec. ``dt = 0`` is continuous time; ``dt > 0``
+  discrete time with ``sample_time = dt``; ``dt = True`` (discrete, unspecified period)
+  discrete time without a sample time. Every float is written as its shortest ``repr``
+  (the decimal that reads back as the same double; the spec means that decimal exactly).
+- :func:`observer_statespace`: the designed observer of a report as a ``control.StateSpace``
+  (inputs ``u[i]`` then ``y[j]``, states and outputs ``xhat[i]``) for the linear observers:
+  ``lyapunov`` (x̂⁺ = A x̂ + B u + L(y − C x̂ − D u)), ``set-invariant`` with its linear law
+  (x̂⁺ = A x̂ + B u − L(y − C x̂ − D u), the sign of eq. (3) of the set-invariant paper) and the
+  Luenberger part of ``stubborn`` (x̂⁺ = A x̂ + B u + K(y − C x̂ − D u), without its
+  saturation). The piecewise-affine injection of ``set-invariant`` (eq. (10)/(12), one
+  output) is a ``control.NonlinearIOSystem``. The other methods' observers (constrained:
+  projection onto X̂; impulsive: sampled, hybrid; search-space: set-valued) are not offered.
+- :func:`spec_text_from_mat`: matrices from a MATLAB ``.mat`` file (``scipy.io.loadmat``) →
+  spec text (``obsdesign import FILE.mat --A A --C C ...``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from obsdesign.errors import InputError
+
+#: methods whose designed observer is linear (a control.StateSpace)
+LINEAR = ("lyapunov", "set-invariant", "stubborn")
+
+
+def _control() -> Any:
+    try:
+        import control
+    except ImportError:  # pragma: no cover - the extra is not installed
+        raise InputError(
+            "python-control is not installed: pip install 'obsdesign[control]'"
+        ) from None
+    return control
+
+
+# -- TOML writing ---------------------------------------------------------------------------
+def _num(x: Any) -> str:
+    """A number as TOML: integers as they are, floats by their shortest repr (exact decimal)."""
+    if isinstance(x, (bool, np.bool_)):
+        return "true" if x else "false"
+    if isinstance(x, (int, np.integer)):
+        return str(int(x))
+    f = float(x)
+    if not math.isfinite(f):
+        raise InputError(f"cannot write the non-finite number {f!r} into a spec")
+    if f == int(f) and abs(f) < 2**53:
+        return str(int(f))
+    return repr(f)
+
+
+def _value(v: Any) -> str:
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
+    if isinstance(v, (bool, np.bool_, int, float, np.integer, np.floating)):
+        return _num(v)
+    arr = np.asarray(v)
+    if arr.ndim == 0:
+        return _value(arr.item())
+    if arr.dtype.kind in "fiub":
+        if arr.ndim == 1:
+            return "[" + ", ".join(_num(x) for x in arr) + "]"
+        return "[" + ", ".join(_value(row) for row in arr) + "]"
+    return "[" + ", ".join(_value(x) for x in v) + "]"
+
+
+def _table(name: str, data: Mapping[str, Any]) -> list[str]:
+    """``[name]`` with its plain keys first, then its sub-tables."""
+    lines = [f"[{name}]"]
+    subs = []
+    for k, v in data.items():
+        if isinstance(v, Mapping):
+            subs.append((k, v))
+        elif v is not None:
+            lines.append(f"{k} = {_value(v)}")
+    out = lines + [""]
+    for k, v in subs:
+        out += _table(f"{name}.{k}", v)
+    return out
+
+
+# -- StateSpace → spec -----------------------------------------------------------------------
+def _matrices(sys: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, Any]:
+    if isinstance(sys, tuple):
+        A, B, C, D, dt = (*sys, 0)[:5] if len(sys) == 4 else sys
+    else:
+        A, B, C, D, dt = sys.A, sys.B, sys.C, sys.D, getattr(sys, "dt", 0)
+    A = np.atleast_2d(np.asarray(A, dtype=float))
+    C = np.atleast_2d(np.asarray(C, dtype=float))
+    n = A.shape[0]
+    B = np.asarray(B, dtype=float).reshape(n, -1) if np.size(B) else np.zeros((n, 0))
+    D = (
+        np.asarray(D, dtype=float).reshape(C.shape[0], -1)
+        if np.size(D)
+        else np.zeros((C.shape[0], 0))
+    )
+    if A.shape != (n, n) or C.shape[1] != n:
+        raise InputError(f"state-space shapes do not fit: A {A.shape}, C {C.shape}")
+    return A, B, C, D, dt
+
+
+def spec_text_from_statespace(
+    sys: Any,
+    method: str = "lyapunov",
+    *,
+    title: str | None = None,
+    states: list[str] | None = None,
+    sets: Mapping[str, Mapping[str, Any]] | None = None,
+    nonlinearity: Mapping[str, Any] | None = None,
+    simulate: Mapping[str, Any] | None = None,
+    Bd: Any = None,
+    **options: Any,
+) -> str:
+    """Spec text (TOML) of the plant ``sys`` (a ``control.StateSpace``, or a tuple
+    ``(A, B, C, D[, dt])``) with ``[method] key = method`` and the method's ``options``
+    (``lambda=0.9``, ``L=[[...]]``; a key that is not a Python name: ``**{"rate-x": 1}``).
+
+    ``dt``: 0 (or None) continuous; True discrete without a sample time; > 0 discrete with
+    ``sample_time = dt``. ``B`` and ``D`` are written when they are not all zero. ``sets``,
+    ``nonlinearity`` and ``simulate`` are written as tables (nested mappings → sub-tables),
+    ``Bd`` as the disturbance input. Floats are written by their shortest repr, so the spec
+    reads back as the same doubles."""
+    A, B, C, D, dt = _matrices(sys)
+    if dt is None or (dt is not True and float(dt) == 0):
+        time, sample_time = "continuous", None
+    elif dt is True:
+        time, sample_time = "discrete", None
+    elif float(dt) > 0:
+        time, sample_time = "discrete", float(dt)
+    else:
+        raise InputError(f"dt must be 0, True or positive, got {dt!r}")
+    system: dict[str, Any] = {"time": time, "A": A, "C": C}
+    if B.size and np.any(B != 0):
+        system["B"] = B
+        if D.size and np.any(D != 0):
+            system["D"] = D
+    elif B.shape[1]:
+        system["inputs"] = B.shape[1]
+    if Bd is not None:
+        system["Bd"] = np.asarray(Bd, dtype=float).reshape(A.shape[0], -1)
+    if sample_time is not None:
+        system["sample_time"] = sample_time
+    if states is not None:
+        system["states"] = list(states)
+    head = [f"title = {_value(title)}", ""] if title else []
+    lines = head + _table("system", system)
+    for name, s in (sets or {}).items():
+        lines += _table(f"sets.{name}", s)
+    if nonlinearity:
+        lines += _table("nonlinearity", nonlinearity)
+    lines += _table("method", {"key": method, **options})
+    if simulate:
+        lines += _table("simulate", simulate)
+    return "\n".join(lines).rstrip("\n") + "\n"
+
+
+def spec_from_statespace(sys: Any, method: str = "lyapunov", **options: Any) -> Any:
+    """The bound :class:`obsdesign.spec.Spec` of :func:`spec_text_from_statespace` (file name
+    ``<statespace>``); its ``text`` is the TOML."""
+    from obsdesign.api import load_spec_text
+
+    return load_spec_text(spec_text_from_statespace(sys, method, **options), "<statespace>")
+
+
+# -- report → observer ------------------------------------------------------------------------
+def _names(prefix: str, k: int) -> list[str]:
+    return [f"{prefix}[{i}]" for i in range(k)]
+
+
+def observer_statespace(report: Any, law: str | None = None) -> Any:
+    """The designed observer of ``report`` (a :class:`obsdesign.report.model.Report` or a path
+    to one) as a python-control system with inputs ``u[0..m-1]``, ``y[0..p-1]`` and outputs
+    (and states) ``xhat[0..n-1]``: a ``control.StateSpace`` for the linear observers
+    (:data:`LINEAR`), a ``control.NonlinearIOSystem`` for set-invariant's piecewise-affine
+    injection (``law="interpolated"`` or ``"time-varying"``; the default for one output when
+    the report has a breakpoint table is still the linear law when it has one: pass ``law``
+    to choose). Continuous-time plants give continuous-time observers, discrete ones
+    discrete (``dt`` = ``sample_time``, else True)."""
+    from obsdesign.api import load_spec_text
+    from obsdesign.report.model import Report
+
+    ct = _control()
+    if not isinstance(report, Report):
+        report = Report.load(report)[0]
+    if report.error is not None:
+        raise InputError("the report records a design that stopped with an error: no observer")
+    sp = load_spec_text(report.spec, report.spec_file or "<report>")
+    s, params = sp.system, report.parameters
+    n, p = s.n, s.p
+    A, C = np.asarray(s.A.f, float), np.asarray(s.C.f, float)
+    B = np.asarray(s.B.f, float).reshape(n, -1)
+    m = B.shape[1]
+    D = np.asarray(s.D.f, float).reshape(p, m) if m else np.zeros((p, 0))
+    if s.discrete:
+        dt: Any = float(s.sample_time.f) if getattr(s, "sample_time", None) is not None else True
+    else:
+        dt = 0
+    inputs, outputs = _names("u", m) + _names("y", p), _names("xhat", n)
+    name = f"obsdesign-{report.method}"
+
+    def linear(G: np.ndarray, sign: float) -> Any:
+        # x̂' = A x̂ + B u + sign·G (y − C x̂ − D u)
+        G = np.asarray(G, float).reshape(n, p)
+        Ao = A - sign * G @ C
+        Bo = np.hstack([B - sign * G @ D, sign * G])
+        return ct.ss(
+            Ao,
+            Bo,
+            np.eye(n),
+            np.zeros((n, m + p)),
+            dt,
+            inputs=inputs,
+            outputs=outputs,
+            states=outputs,
+            name=name,
+        )
+
+    if report.method == "lyapunov":
+        return linear(params.float("L"), +1.0)
+    if report.method == "stubborn":
+        return linear(params.float("K"), +1.0)
+    if report.method == "set-invariant":
+        use = law or ("linear" if "L" in params or sp.options.L is not None else "interpolated")
+        if use == "linear":
+            from obsdesign.methods.setinvariant.sim import make_law
+
+            return linear(make_law(sp, params, "linear").L, -1.0)
+        return _setinvariant_nonlinear(ct, sp, params, use, A, B, C, D, dt, inputs, outputs, name)
+    raise InputError(
+        f"method '{report.method}': its observer is not linear (constrained: projection onto "
+        f"X̂; impulsive: sampled and hybrid; search-space: set-valued) and is not offered as "
+        f"a python-control system; observers are offered for {', '.join(LINEAR)}"
+    )
+
+
+def _setinvariant_nonlinear(
+    ct: Any,
+    sp: Any,
+    params: Any,
+    law: str,
+    A: Any,
+    B: Any,
+    C: Any,
+    D: Any,
+    dt: Any,
+    inputs: list[str],
+    outputs: list[str],
+    name: str,
+) -> Any:
+    """set-invariant's piecewise-affine injection (eq. (12) interpolated, eq. (10)
+    time-varying) as a discrete-time ``control.NonlinearIOSystem``: x̂⁺ = A x̂ + B u − v(z),
+    z = y − C x̂ − D u (k = t / dt for the time-varying law)."""
+    from obsdesign.methods.setinvariant.sim import make_law
+
+    f = make_law(sp, params, law)
+    m = B.shape[1]
+    step = float(dt) if dt not in (True, 0) else 1.0
+
+    def update(t: float, x: np.ndarray, w: np.ndarray, prm: Any) -> np.ndarray:
+        u, y = w[:m], w[m:]
+        z = y - C @ x - D @ u
+        return A @ x + B @ u - np.asarray(f(float(z[0]), int(round(t / step))), float)
+
+    return ct.nlsys(
+        update,
+        lambda t, x, w, prm: x,
+        states=outputs,
+        inputs=inputs,
+        outputs=outputs,
+        dt=dt if dt is not None else True,
+        name=name,
+    )
+
+
+# -- MATLAB .mat → spec ------------------------------------------------------------------------
+def spec_text_from_mat(
+    path: str | Path,
+    names: Mapping[str, str | None],
+    method: str = "lyapunov",
+    dt: float | None = None,
+    dt_name: str | None = None,
+) -> str:
+    """Spec text from the matrices of a MATLAB ``.mat`` file: ``names`` maps ``A``, ``B``,
+    ``C``, ``D``, ``Bd`` to variable names in the file (``None``: absent). The sample time is
+    ``dt`` or the scalar variable ``dt_name`` (none: continuous time)."""
+    from scipy.io import loadmat
+
+    from obsdesign.limits import read_input
+
+    read_input(path, "MATLAB")  # a regular file within the size limit
+    try:
+        data = loadmat(str(path))
+    except Exception as e:  # noqa: BLE001 - scipy raises several kinds on a bad file
+        raise InputError(f"{path}: not a readable .mat file ({type(e).__name__}: {e})") from None
+
+    def var(key: str) -> np.ndarray | None:
+        v = names.get(key)
+        if v is None:
+            return None
+        if v not in data:
+            known = ", ".join(sorted(k for k in data if not k.startswith("__")))
+            raise InputError(f"{path}: no variable '{v}' for {key} (variables: {known})")
+        arr = np.asarray(data[v])
+        if arr.dtype.kind not in "fiu":
+            raise InputError(f"{path}: variable '{v}' ({key}) is not a real numeric matrix")
+        return arr.astype(float)
+
+    A, C = var("A"), var("C")
+    if A is None or C is None:
+        raise InputError("--A and --C are required")
+    n = A.shape[0]
+    B, D, Bd = var("B"), var("D"), var("Bd")
+    if dt_name is not None:
+        t = var_dt = data.get(dt_name)
+        if t is None:
+            raise InputError(f"{path}: no variable '{dt_name}' for the sample time")
+        dt = float(np.asarray(var_dt).reshape(-1)[0])
+    Bm = B if B is not None else np.zeros((n, 0))
+    Dm = D if D is not None else np.zeros((C.shape[0], Bm.shape[1]))
+    return spec_text_from_statespace(
+        (A, Bm, C, Dm, dt if dt else 0), method, Bd=Bd, title=f"imported from {Path(path).name}"
+    )

@@ -1,0 +1,164 @@
+"""python-control interop (obsdesign/interop.py, issue 14 item 4): StateSpace → spec →
+design → observer StateSpace, whose simulated error decays at the certified rate; the
+MATLAB .mat import."""
+
+from __future__ import annotations
+
+import json
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import obsdesign
+from obsdesign import api
+from obsdesign.cli import app
+from obsdesign.errors import InputError
+from obsdesign.interop import (
+    observer_statespace,
+    spec_from_statespace,
+    spec_text_from_statespace,
+)
+
+control = pytest.importorskip("control")
+ROOT = Path(__file__).resolve().parents[1]
+A_D = [[0.5, 0.1], [0.30000000000000004, 0.8]]  # 0.1 + 0.2: its repr reads back bit for bit
+A_C = [[0.0, 1.0], [-2.0, -0.5]]
+
+
+def _plant_with_state(sys: object) -> object:
+    """The plant with outputs y (named y[j]) and x (named x[i]) for interconnection."""
+    n, p, m = sys.nstates, sys.noutputs, sys.ninputs
+    C2 = np.vstack([sys.C, np.eye(n)])
+    D2 = np.vstack([sys.D, np.zeros((n, m))])
+    return control.ss(
+        sys.A,
+        sys.B,
+        C2,
+        D2,
+        sys.dt,
+        inputs=[f"u[{i}]" for i in range(m)],
+        outputs=[f"y[{j}]" for j in range(p)] + [f"x[{i}]" for i in range(n)],
+        name="plant",
+    )
+
+
+def _errors(sys: object, obs: object, T: np.ndarray, x0: list[float], xh0: list[float]):
+    """x − x̂ along the interconnection of the plant and the observer (u(t) = sin t)."""
+    n = sys.nstates
+    plant = _plant_with_state(sys)
+    joint = control.interconnect(
+        [plant, obs],
+        inplist=["u[0]"],
+        outlist=[f"x[{i}]" for i in range(n)] + [f"xhat[{i}]" for i in range(n)],
+    )
+    U = np.sin(T).reshape(1, -1)
+    r = control.input_output_response(joint, T, U, X0=[*x0, *xh0])
+    out = np.asarray(r.outputs)
+    return out[:n] - out[n:]
+
+
+def test_toml_writes_exact_reprs():
+    sys = control.ss(A_D, [[0], [1]], [[1, 0]], [[0]], 0.1)
+    text = spec_text_from_statespace(sys, "lyapunov", **{"lambda": 0.9})
+    d = tomllib.loads(text)
+    assert d["system"]["A"] == A_D  # the same doubles, bit for bit
+    assert d["system"]["sample_time"] == 0.1 and d["system"]["time"] == "discrete"
+    assert "0.30000000000000004" in text
+    assert d["method"] == {"key": "lyapunov", "lambda": 0.9}
+    assert "D" not in d["system"]  # an all-zero D is left out
+    cont = tomllib.loads(spec_text_from_statespace(control.ss(A_C, [[0], [1]], [[1, 0]], 0)))
+    assert cont["system"]["time"] == "continuous" and "sample_time" not in cont["system"]
+    disc = tomllib.loads(spec_text_from_statespace(control.ss(A_D, [[0], [1]], [[1, 0]], 0, True)))
+    assert disc["system"]["time"] == "discrete" and "sample_time" not in disc["system"]
+
+
+def test_discrete_round_trip_error_decays_at_the_certified_rate():
+    sys = control.ss(A_D, [[0], [1]], [[1, 0]], [[0]], 0.1)
+    sp = obsdesign.spec_from_statespace(sys, "lyapunov", **{"lambda": 0.9})
+    rep = api.design(sp)
+    assert rep.exit_code() == 0
+    lam = float(rep.parameters.float("lambda"))
+    P = np.asarray(rep.parameters.float("P"), float)
+    L = np.asarray(rep.parameters.float("L"), float).reshape(2, 1)
+    obs = rep.observer_statespace()
+    assert isinstance(obs, control.StateSpace) and obs.dt == 0.1
+    np.testing.assert_array_equal(obs.A, np.asarray(A_D) - L @ np.array([[1.0, 0.0]]))
+    T = np.arange(0, 61) * 0.1
+    e = _errors(sys, obs, T, [1.0, -1.0], [0.0, 0.0])
+    V = np.einsum("ik,ij,jk->k", e, P, e)
+    k = np.arange(len(T))
+    # V(e_k) ≤ λ^{2k} V(e_0): the certified decay (float slack only)
+    assert np.all(V <= lam ** (2 * k) * V[0] * (1 + 1e-9) + 1e-300)
+    assert np.linalg.norm(e[:, -1]) < 1e-2 * np.linalg.norm(e[:, 0])
+
+
+def test_continuous_round_trip_error_decays_at_the_certified_rate():
+    sys = control.ss(A_C, [[0], [1]], [[1, 0]], [[0]])
+    rep = api.design(spec_from_statespace(sys, "lyapunov"))  # alpha designed (best)
+    assert rep.exit_code() == 0
+    alpha = float(rep.parameters.float("alpha"))
+    P = np.asarray(rep.parameters.float("P"), float)
+    obs = observer_statespace(rep)
+    assert isinstance(obs, control.StateSpace) and obs.dt == 0
+    T = np.linspace(0, 8, 401)
+    e = _errors(sys, obs, T, [1.0, 0.5], [0.0, 0.0])
+    V = np.einsum("ik,ij,jk->k", e, P, e)
+    # V(e(t)) ≤ e^{−2αt} V(e(0)), with the ODE solver's relative tolerance as slack
+    assert np.all(V <= np.exp(-2 * alpha * T) * V[0] * (1 + 1e-4) + 1e-9 * V[0])
+    assert V[-1] < np.exp(-2 * alpha * T[-1]) * V[0] * 1.01
+
+
+def test_set_invariant_linear_and_piecewise_observers():
+    rep = api.design(api.load_spec(ROOT / "specs" / "dorea-pimenta-7-1.toml"))
+    assert rep.exit_code() == 0
+    sp = api.load_spec(ROOT / "specs" / "dorea-pimenta-7-1.toml")
+    A, B, C = sp.system.A.f, sp.system.B.f, sp.system.C.f
+    obs = observer_statespace(rep, law="linear")
+    L = np.asarray(rep.parameters.float("L"), float).reshape(2, 1)
+    np.testing.assert_allclose(obs.A, A + L @ C, rtol=0, atol=1e-15)  # x̂⁺ = A x̂ − L z
+    nl = observer_statespace(rep, law="interpolated")
+    assert isinstance(nl, control.NonlinearIOSystem) and not isinstance(nl, control.StateSpace)
+    from obsdesign.methods.setinvariant.sim import make_law
+
+    f = make_law(sp, rep.parameters, "interpolated")
+    xh, y = np.array([0.3, -0.2]), np.array([0.5])
+    w = np.concatenate([np.zeros(B.shape[1]), y])
+    z = y - C @ xh
+    want = A @ xh - np.asarray(f(float(z[0]), 0), float)
+    np.testing.assert_allclose(nl._rhs(0, xh, w), want, rtol=0, atol=1e-15)
+
+
+def test_methods_without_a_linear_observer_say_so():
+    rep = api.design(api.load_spec(ROOT / "specs" / "constrained-redesign-sec5.toml"))
+    with pytest.raises(InputError, match="not linear"):
+        observer_statespace(rep)
+
+
+def test_mat_import_round_trip(tmp_path: Path):
+    from scipy.io import savemat
+
+    A = np.array(A_D)
+    mat = tmp_path / "plant.mat"
+    savemat(
+        mat, {"Ad": A, "Bd_in": np.array([[0.0], [1.0]]), "Cm": np.array([[1.0, 0.0]]), "Ts": 0.1}
+    )
+    r = CliRunner().invoke(
+        app, ["import", str(mat), "--A", "Ad", "--B", "Bd_in", "--C", "Cm", "--dt-var", "Ts"]
+    )
+    assert r.exit_code == 0, r.stderr
+    d = tomllib.loads(r.stdout)
+    assert d["system"]["A"] == A_D and d["system"]["sample_time"] == 0.1
+    assert d["system"]["B"] == [[0], [1]] and d["method"] == {"key": "lyapunov"}
+    spec = tmp_path / "spec.toml"
+    spec.write_text(r.stdout.replace('key = "lyapunov"', 'key = "lyapunov"\nlambda = 0.9'))
+    out = CliRunner().invoke(app, ["design", str(spec), "--format", "json"])
+    assert out.exit_code == 0 and json.loads(out.stdout)["verdict"] == "ok"
+    bad = CliRunner().invoke(app, ["import", str(mat), "--A", "A", "--C", "Cm"])
+    assert bad.exit_code == 2 and "no variable 'A'" in bad.stderr and "Ad" in bad.stderr
+    bad = CliRunner().invoke(
+        app, ["import", str(mat), "--A", "Ad", "--C", "Cm", "--method", "lyapunv"]
+    )
+    assert bad.exit_code == 2 and "did you mean 'lyapunov'" in bad.stderr
