@@ -455,7 +455,7 @@ def check(
     Folders are searched recursively for *.toml (hidden folders skipped). Every spec gets a
     row whatever happens in it: its exit code and message (an internal error is exit 3).
     The last line (text and md) is the verdict, e.g. "checked: 13 specs, 13 ok, 0 failed;
-    95 claims certified, 0 failed"."""
+    151 claims certified, 5 numerical, 0 failed"."""
 
     def body() -> int:
         _setup(quiet, width)
