@@ -267,7 +267,7 @@ def certify_window(p: Problem, P: dict[str, Any], c: Claims | None = None) -> Cl
     try:
         lo = T_max_lower(gamma, varpi, kappa, lam_no, lam_on, beta)
         ok, det = 0 < T_max <= lo, f"T_max = {T_max} ≤ {float(lo):.10g} (outward-rounded)"
-    except ValueError as e:
+    except (ValueError, ArithmeticError) as e:
         ok, det = False, str(e)
     c.exact(
         id="T_max",
@@ -280,7 +280,7 @@ def certify_window(p: Problem, P: dict[str, Any], c: Claims | None = None) -> Cl
     try:
         hi = T_min_upper(p.alpha, gamma, kappa)
         ok, det = T_min >= hi, f"T_min = {T_min} ≥ {float(hi):.10g} (outward-rounded)"
-    except ValueError as e:
+    except (ValueError, ArithmeticError) as e:
         ok, det = False, str(e)
     c.exact(
         id="T_min",
