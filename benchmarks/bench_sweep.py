@@ -29,6 +29,13 @@ def _strip(rows: list[dict]) -> list[dict]:
     return [{k: v for k, v in r.items() if k not in TIMING_COLUMNS} for r in rows]
 
 
+def _burn(n: int) -> int:
+    s = 0
+    for i in range(n):
+        s += i * i
+    return s
+
+
 def main() -> None:
     import dask
     from dask.distributed import Client, LocalCluster
@@ -70,6 +77,18 @@ def main() -> None:
              f"{sp:.2f}x", ">= 1.6x", sp >= 1.6 and same)  # fmt: skip
         cold = t_serial / (t_dist + t_start + t_warm)
         line("  speed-up incl. cluster start and worker imports", f"{cold:.2f}x", "(report)", None)
+
+        # what the machine gives 2 processes now: the same pure-Python CPU work, serial vs
+        # the 2 workers (with other processes running, this bounds the speed-up above)
+        work = [2_000_000] * 8
+        t0 = time.perf_counter()
+        run_tasks(_burn, work)
+        t_b1 = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        run_tasks(_burn, work, client=client)
+        t_b2 = time.perf_counter() - t0
+        line("  machine's 2-process capacity now (pure CPU work)", f"{t_b1 / t_b2:.2f}x",
+             "(report; ~2x idle)", None)  # fmt: skip
 
         m = 400
         run_tasks(abs, list(range(20)), client=client)

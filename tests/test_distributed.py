@@ -209,3 +209,47 @@ def _name(proc) -> str:
         return proc.name() + " " + " ".join(proc.cmdline())
     except Exception:  # noqa: BLE001 - gone already
         return ""
+
+
+@pytest.mark.slow
+def test_an_existing_scheduler_runs_the_sweep_and_a_dead_address_is_bad_input(
+    tmp_path: Path, serial12
+):
+    import json
+
+    bindir = Path(sys.executable).parent
+    sched_file = tmp_path / "scheduler.json"
+    common = ["--no-dashboard"]
+    sched = subprocess.Popen(
+        [str(bindir / "dask"), "scheduler", "--scheduler-file", str(sched_file), "--port", "0",
+         *common],
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+    )  # fmt: skip
+    worker = None
+    try:
+        deadline = time.monotonic() + 60
+        while not sched_file.exists() and time.monotonic() < deadline:
+            time.sleep(0.2)
+        time.sleep(0.5)
+        address = json.loads(sched_file.read_text())["address"]
+        worker = subprocess.Popen(
+            [str(bindir / "dask"), "worker", address, "--nworkers", "2", "--nthreads", "1",
+             *common],
+            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+        )  # fmt: skip
+        out = tmp_path / "t.jsonl"
+        args = ["sweep", str(SPEC), *sum((["--set", g] for g in GRID12), [])]
+        r = CliRunner().invoke(app, [*args, "--scheduler", address, "-o", str(out), "-q"])
+        assert r.exit_code == 1, r.stderr
+        rows = [json.loads(x) for x in out.read_text(encoding="utf-8").splitlines()]
+        assert _strip(rows) == _strip(serial12)
+    finally:
+        for p in (worker, sched):
+            if p is not None:
+                p.send_signal(signal.SIGINT)
+                try:
+                    p.wait(timeout=20)
+                except subprocess.TimeoutExpired:
+                    p.kill()
+    r = CliRunner().invoke(app, [*args, "--scheduler", "tcp://127.0.0.1:9", "-q"])
+    assert r.exit_code == 2 and "cannot connect" in r.stderr
