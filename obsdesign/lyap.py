@@ -45,10 +45,47 @@ NOT_CERTIFIABLE = "not-certifiable"
 
 # -- exact matrices ------------------------------------------------------------------------
 def closed_loop(A: np.ndarray, C: np.ndarray, L: np.ndarray) -> np.ndarray:
-    """Acl = A − L C, the error dynamics matrix of eq. (3) for a linear observer (exact).
+    """Acl = A − L C, the error dynamics matrix of eq. (3) for a linear observer (exact;
+    the product runs in flint).
 
     :param A: n×n state matrix; :param C: p×n output matrix; :param L: n×p gain."""
-    return A - L @ C
+    if A.shape[0] == 0 or C.shape[0] == 0:
+        return A - L @ C
+    return as_array(fmat(A) - fmat(L) * fmat(C))
+
+
+#: the prime of :func:`observable_mod_p` (2⁶¹ − 1, a Mersenne prime)
+PRIME = 2**61 - 1
+
+
+def observable_mod_p(A: Any, C: Any) -> bool:
+    """A fast proof that (C, A) is observable (True), or no conclusion (False).
+
+    With D_A, D_C the common denominators, the integer blocks C_z A_z^k = D_C D_A^k C A^k span
+    the same row space as the observability matrix [C; CA; …; CA^{n−1}]; their rank modulo the
+    prime :data:`PRIME` is at most the rank over Q (a minor that is nonzero mod p is nonzero),
+    so rank n mod p proves the Kalman rank condition. False means only "not proved" (the
+    exact test of :mod:`obsdesign.certify.detect` then decides). The observer of Section 5 of
+    the constrained-redesign paper (Astolfi et al., NOLCOS 2019) needs (C, A) detectable.
+
+    :param A: n×n matrix; :param C: p×n matrix (exact or floats, converted exactly)."""
+    from flint import nmod_mat
+
+    Af, Cf = fmat(A), fmat(C)
+    n = Af.nrows()
+    if n == 0:
+        return True
+    if Cf.nrows() == 0:
+        return False
+    Az, _ = Af.numer_denom()
+    Cz, _ = Cf.numer_denom()
+    Am = nmod_mat(n, n, [int(v) % PRIME for v in Az.entries()], PRIME)
+    block = nmod_mat(Cf.nrows(), n, [int(v) % PRIME for v in Cz.entries()], PRIME)
+    rows: list[Any] = []
+    for _ in range(n):
+        rows += block.entries()
+        block = block * Am
+    return nmod_mat(len(rows) // n, n, [int(v) for v in rows], PRIME).rank() == n
 
 
 def fmat(M: Any) -> fmpq_mat:

@@ -1,5 +1,6 @@
-"""Design of the ``lyapunov`` method: the gain (given or by an LMI), the certified P at the
-asked rate, the best rate with its bracket, the ISS gain μ.
+"""Design of the ``lyapunov`` method: the gain (given, or designed by a Riccati equation, by
+pole placement or by an LMI), the certified P at the asked rate, the best rate with its
+bracket, the ISS gain μ.
 
 The Lyapunov function is the linear case of eq. (4)-(7), Section 5 of Astolfi, Bernard,
 Postoyan, Marconi, "Redesign of discrete-time nonlinear observers with state estimate
@@ -9,10 +10,13 @@ constraints guaranteed in prescribed convex set", NOLCOS 2019; the maths is in
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
+from flint import fmpq_mat
 
 from obsdesign import lyap
-from obsdesign.certify.detect import detectability, unobservable_restriction
+from obsdesign.certify.detect import Detectability, detectability, unobservable_restriction
 from obsdesign.certify.exact import dyadic
 from obsdesign.certify.printing import fmt_exact
 from obsdesign.errors import InconclusiveError, InfeasibleError, SolverError
@@ -44,11 +48,16 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     s = spec.system
     A, C = s.A.q, s.C.q
     notes: list[str] = []
-    solver = SolverResult("scipy Lyapunov equation", SolverStatus.CLOSED_FORM)
+    solver = SolverResult(
+        "scipy Lyapunov equation",
+        SolverStatus.CLOSED_FORM,
+        "L given; P from one Lyapunov equation per rate, checked exactly",
+        extra={"gain_design": "given"},
+    )
     if o.L is None:
-        Lf, solver = design_gain(spec, o, progress)
+        Lf, solver, how = design_gain(spec, o, progress)
         L = dyadic(Lf, lyap.BITS)
-        notes.append("L designed by the LMI in (P, X = P L); certified with the rounded L")
+        notes.append(f"L designed by {how}; certified with L rounded to {lyap.BITS} bits")
     else:
         L = o.L
     Acl = lyap.closed_loop(A, C, L)
@@ -69,29 +78,33 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
         # the asked rate first, directly: no search can make it fail
         P = lyap.certified_P(A, C, L, s.discrete, o.rate, o.margin)
         if P is None:
-            if not lyap.rate_feasible(Acl, o.rate, s.discrete):
+            ok, how = lyap.rate_feasibility(Acl, o.rate, s.discrete)
+            if not ok:
                 raise InfeasibleError(
                     f"no P ≻ 0 gives decay rate {sym} = {fmt_exact(o.rate)}: A − LC has an "
                     f"eigenvalue {'of modulus ≥ λ' if s.discrete else 'with real part ≥ −α'} "
-                    f"({lyap.stability_test(s.discrete)}; {lim})"
+                    f"({how}; {lim})"
                 )
             raise InconclusiveError(
                 f"decay rate {sym} = {fmt_exact(o.rate)} is feasible "
-                f"({lyap.stability_test(s.discrete)}) but the "
+                f"({how}) but the "
                 f"rounded Lyapunov-equation P fails the exact check with margin "
                 f"{fmt_exact(o.margin)} (too close to the limit: {lim})"
             )
         known = (o.rate, P)
-    elif not lyap.rate_feasible(Acl, 1 if s.discrete else 0, s.discrete):
-        raise InfeasibleError(
-            f"A − LC is not {'Schur' if s.discrete else 'Hurwitz'}: {lim} "
-            f"({lyap.stability_test(s.discrete)})"
-            + ("" if o.L is None else " (the given L does not stabilize the error)")
-        )
+    elif bound >= 1 - 1e-6 if s.discrete else bound >= -1e-6:
+        # (a float bound clearly inside: the certified best rate below proves Schur / Hurwitz)
+        ok, how = lyap.rate_feasibility(Acl, 1 if s.discrete else 0, s.discrete)
+        if not ok:
+            raise InfeasibleError(
+                f"A − LC is not {'Schur' if s.discrete else 'Hurwitz'}: {lim} ({how})"
+                + ("" if o.L is None else " (the given L does not stabilize the error)")
+            )
     br = lyap.best_rate(
         A, C, L, s.discrete, tol=o.rate_tol, margin=o.margin, known=known, progress=progress
     )
     rate, P = (br.best, br.P) if known is None else known
+    solver.extra["best_rate_exact_checks"] = br.exact_checks
     params["P"] = P
     params[name] = rate
     params["P_best"] = br.P
@@ -103,7 +116,7 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
         rho = lyap.decay_factor(rate, s.discrete)
         params["mu"] = lyap.iss_mu(Acl, Bw, P, rho, s.discrete, strict=True)
     why = (
-        f"no P ≻ 0 exists there ({lyap.stability_test(s.discrete)})"
+        "no P ≻ 0 exists there (proved exactly, see the bracket claim)"
         if br.kind == lyap.INFEASIBLE
         else "feasible, but the rounded Lyapunov-equation P fails the exact check there"
     )
@@ -115,19 +128,200 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     return Design(params, solver, notes)
 
 
+#: default Riccati weights (the Kalman-filter reading: process noise covariance Q, output
+#: noise covariance R)
+DEFAULT_WEIGHTS = "Q = I (n×n), R = I (p×p)"
+#: slack of a designed gain below an asked rate (the rounded gain then certifies robustly)
+SLACK_DISCRETE, SLACK_CONTINUOUS = 0.98, 1.02
+
+
+def default_poles(n: int, discrete: bool, target: float | None) -> np.ndarray:
+    """The stated default poles of ``design = "place"``: discrete t·(0.2 + 0.4·i/n),
+    continuous −t − (1 + i/n), i = 0 … n−1, with t the asked rate with 2 % slack (1 in
+    discrete time, 0 in continuous time when no rate is asked): n distinct real poles inside
+    the asked decay region (Section 5 of the constrained-redesign paper asks only for
+    A − LC Schur).
+
+    :param n: state dimension; :param discrete: time domain; :param target: the asked rate."""
+    i = np.arange(n, dtype=float)
+    if discrete:
+        t = 1.0 if target is None else target * SLACK_DISCRETE
+        return t * (0.2 + 0.4 * i / n)
+    t = 0.0 if target is None else target * SLACK_CONTINUOUS
+    return -t - (1.0 + i / n)
+
+
+def riccati_gain(
+    A: np.ndarray,
+    C: np.ndarray,
+    discrete: bool,
+    Qw: np.ndarray,
+    Rw: np.ndarray,
+    rate: float | None,
+) -> np.ndarray:
+    """A Kalman-type gain from the dual algebraic Riccati equation (floats, scipy).
+
+    Discrete: X = DARE(Āᵀ, Cᵀ, Q, R) with Ā = A/λₛ, L = λₛ Ā X Cᵀ (R + C X Cᵀ)⁻¹, so that
+    Ā − (L/λₛ)C is Schur and ρ(A − LC) < λₛ (λₛ = 1 without an asked rate: the steady-state
+    Kalman predictor gain). Continuous: X = CARE((A + αₛI)ᵀ, Cᵀ, Q, R), L = X Cᵀ R⁻¹, so
+    that A + αₛI − LC is Hurwitz (αₛ = 0 without an asked rate). The error dynamics
+    e⁺ = (A − LC)e is that of the linear observer of Section 5 of the constrained-redesign
+    paper (Astolfi et al., NOLCOS 2019).
+
+    :param A, C: float plant; :param discrete: time domain; :param Qw, Rw: weights (n×n ⪰ 0,
+    p×p ≻ 0); :param rate: λₛ or αₛ, or None."""
+    from scipy.linalg import solve_continuous_are, solve_discrete_are
+
+    n = A.shape[0]
+    if discrete:
+        s = 1.0 if rate is None else rate
+        Ab = A / s
+        X = solve_discrete_are(Ab.T, C.T, Qw, Rw)
+        return s * (Ab @ X @ C.T @ np.linalg.inv(Rw + C @ X @ C.T))
+    a = 0.0 if rate is None else rate
+    X = solve_continuous_are((A + a * np.eye(n)).T, C.T, Qw, Rw)
+    return X @ C.T @ np.linalg.inv(Rw)
+
+
+def placed_gain(A: np.ndarray, C: np.ndarray, poles: np.ndarray) -> np.ndarray:
+    """L with eig(A − LC) = poles, by ``scipy.signal.place_poles`` on the dual pair (Aᵀ, Cᵀ)
+    (floats): the error dynamics of the linear observer of Section 5 of the constrained-redesign
+    paper (Astolfi et al., NOLCOS 2019) with prescribed poles.
+
+    :param A, C: float plant ((C, A) observable); :param poles: n real poles (a pole may
+    repeat at most p times)."""
+    from scipy.signal import place_poles
+
+    return np.asarray(place_poles(A.T, C.T, poles).gain_matrix, dtype=float).T
+
+
 def design_gain(
     spec: Spec, o: Options, progress: Progress | None
+) -> tuple[np.ndarray, SolverResult, str]:
+    """Design L (float) by ``o.design``: ``riccati`` (default, :func:`riccati_gain`),
+    ``place`` (:func:`placed_gain`) or ``lmi`` (:func:`lmi_gain`); the exact detectability of
+    (C, A) and the unobservable modes' bound on an asked rate are checked first (they hold for
+    every L). The decay LMI is eq. (4)-(6), Section 5 of the constrained-redesign paper
+    (Astolfi et al., NOLCOS 2019).
+
+    :param spec: the bound spec; :param o: its options; :param progress: callback.
+    Returns (L, solver result, a note naming the path that ran)."""
+    import time as _time
+
+    s = spec.system
+    time = "discrete" if s.discrete else "continuous"
+    what = "Schur" if s.discrete else "Hurwitz"
+    if lyap.observable_mod_p(s.A.q, s.C.q):
+        det = Detectability(
+            True,
+            True,
+            0,
+            f"observable: the observability matrix has rank {s.n} modulo the prime 2^61 − 1",
+        )
+        Au = fmpq_mat(0, 0)
+    else:
+        det = detectability(s.A.q, s.C.q, time)
+        if not det.detectable:
+            raise InfeasibleError(f"no gain L makes A − LC {what}: (C, A) is {det.reason}")
+        _, Au = unobservable_restriction(s.A.q, s.C.q)
+    if o.rate is not None and Au.nrows():
+        # the unobservable modes are eigenvalues of A − LC for every L (exact)
+        ok, how = lyap.rate_feasibility(lyap.as_qarray(Au), o.rate, s.discrete)
+        if not ok:
+            raise InfeasibleError(
+                f"no gain L gives decay rate {fmt_exact(o.rate)}: an unobservable mode of "
+                f"(C, A) (a root of {Au.charpoly()}) is an eigenvalue of A − LC for every L "
+                f"and fails the rate ({how})"
+            )
+    A, C = s.A.f, s.C.f
+    n, p = s.n, s.p
+    target = None if o.rate is None else float(o.rate)
+    if o.design == "lmi":
+        Lf, res = lmi_gain(spec, o, det.reason, Au, progress)
+        return Lf, res, 'the LMI in (P, X = P L) (design = "lmi", Clarabel)'
+    t0 = _time.perf_counter()
+    if o.design == "place":
+        poles = (
+            default_poles(n, s.discrete, target)
+            if o.poles is None
+            else np.array([float(z) for z in o.poles])
+        )
+        if not det.observable:
+            raise InconclusiveError(
+                f"pole placement needs (C, A) observable, but it is {det.reason}; "
+                'use design = "riccati" or "lmi"'
+            )
+        try:
+            Lf = placed_gain(A, C, poles)
+        except ValueError as e:
+            raise InconclusiveError(f"scipy.signal.place_poles failed: {e}") from e
+        shown = ", ".join(f"{z:.6g}" for z in poles)
+        res = SolverResult(
+            "scipy.signal.place_poles",
+            SolverStatus.CLOSED_FORM,
+            f"pole placement at {shown}",
+            seconds=_time.perf_counter() - t0,
+            extra={"gain_design": "place"},
+        )
+        src = "given" if o.poles is not None else "default"
+        return Lf, res, f'pole placement (design = "place", {src} poles {shown})'
+    Qw = np.eye(n) if o.riccati_Q is None else np.asarray(o.riccati_Q, dtype=float)
+    Rw = np.eye(p) if o.riccati_R is None else np.asarray(o.riccati_R, dtype=float)
+    weights = (
+        DEFAULT_WEIGHTS
+        if o.riccati_Q is None and o.riccati_R is None
+        else "Q, R from riccati_Q / riccati_R"
+    )
+    tries: list[float | None] = [None]
+    if target is not None:
+        tries = [target * (SLACK_DISCRETE if s.discrete else SLACK_CONTINUOUS), target]
+    last = ""
+    for shift in tries:
+        try:
+            with np.errstate(all="ignore"):
+                Lf = riccati_gain(A, C, s.discrete, Qw, Rw, shift)
+        except (np.linalg.LinAlgError, ValueError) as e:
+            last = str(e)
+            continue
+        if np.all(np.isfinite(Lf)):
+            break
+        last = "non-finite gain"
+    else:
+        raise InconclusiveError(
+            f"the Riccati equation gave no gain ({last}) although (C, A) is {det.reason}"
+        )
+    are = "solve_discrete_are" if s.discrete else "solve_continuous_are"
+    how = (
+        f"the {'discrete' if s.discrete else 'continuous'} Riccati equation "
+        f'(design = "riccati", scipy {are}, {weights}'
+        + ("" if shift is None else f", shifted to the rate {shift:.6g}")
+        + ")"
+    )
+    res = SolverResult(
+        f"scipy {are}",
+        SolverStatus.CLOSED_FORM,
+        how,
+        seconds=_time.perf_counter() - t0,
+        extra={"gain_design": "riccati"},
+    )
+    return Lf, res, how
+
+
+def lmi_gain(
+    spec: Spec, o: Options, reason: str, Au: Any, progress: Progress | None
 ) -> tuple[np.ndarray, SolverResult]:
     """Design L through the LMI in (P, X = P L), bisecting on the rate (float gain).
 
     Discrete: [[λ²P, (PA − XC)ᵀ], [PA − XC, P]] ⪰ δ I, the Schur complement of the decay LMI
-    eq. (4)-(6) (Section 5, constrained-redesign paper, Astolfi et al., NOLCOS 2019);
-    continuous: −(AᵀP + PA − CᵀXᵀ − XC + 2αP) ⪰ δ I. Normalization I ⪯ P ⪯ t·I, minimal t.
-    (C, A) is tested for detectability exactly first (exit 1 with the reason when it is not;
-    an asked rate that an unobservable mode forbids is also exit 1); a solver that then finds
-    no gain makes the run inconclusive (exit 4), never "infeasible".
+    λ²P − (A−LC)ᵀP(A−LC) ≻ 0 of eq. (4)-(6) (constrained-redesign paper, Astolfi et al.,
+    NOLCOS 2019, Section 5); continuous: −(AᵀP + PA − CᵀXᵀ − XC + 2αP) ⪰ δ I. With I ⪯ P ⪯ tI,
+    minimal t. The bisection is bracketed by spectral bounds: the unobservable modes bound
+    every rate (no solve beyond them), and the Riccati gain's rate is a feasible start; each
+    rate is solved once (no re-solve of the final point).
 
-    :param spec: the bound spec; :param o: its options; :param progress: callback."""
+    :param spec: the bound spec; :param o: its options; :param reason: the detectability
+    verdict (for messages); :param Au: the exact unobservable restriction of A;
+    :param progress: callback."""
     import cvxpy as cp
 
     from obsdesign.lmi import solve, sym
@@ -152,55 +346,61 @@ def design_gain(
     tol = float(o.rate_tol)
     best: tuple[np.ndarray, str, float] | None = None
     total = 0.0
+    solves = 0
+    seen: dict[float, bool] = {}
 
     def feasible(rate: float) -> bool:
-        nonlocal best, total
+        nonlocal best, total, solves
+        if rate in seen:  # never re-solve a solved point
+            return seen[rate]
         r.value = rate**2 if s.discrete else rate
+        solves += 1
         try:
             res = solve(prob, ("CLARABEL",))  # SCS is slow and loose at the boundary
         except SolverError:
+            seen[rate] = False
             return False
         total += res.seconds
-        if not res.optimal:
-            return False
-        Lc = np.linalg.solve(P.value, X.value)
-        eig = np.linalg.eigvals(A - Lc @ C)
-        # the decay LMI at `rate` implies this; a solver answer that breaks it is not trusted
-        if s.discrete:
-            broken = np.abs(eig).max() > rate * (1 + 1e-6)
-        else:
-            broken = -eig.real.max() < rate * (1 - 1e-6)
-        if broken:
-            return False
-        best = (Lc, res.solver, rate)
-        return True
+        ok = False
+        if res.optimal:
+            Lc = np.linalg.solve(P.value, X.value)
+            eig = np.linalg.eigvals(A - Lc @ C)
+            # the decay LMI at `rate` implies this; a solver answer that breaks it is not trusted
+            if s.discrete:
+                ok = bool(np.abs(eig).max() <= rate * (1 + 1e-6))
+            else:
+                ok = bool(-eig.real.max() >= rate * (1 - 1e-6))
+            if ok:
+                best = (Lc, res.solver, rate)
+        seen[rate] = ok
+        return ok
 
-    time = "discrete" if s.discrete else "continuous"
-    det = detectability(s.A.q, s.C.q, time)
-    what = "Schur" if s.discrete else "Hurwitz"
-    if not det.detectable:
-        raise InfeasibleError(f"no gain L makes A − LC {what}: (C, A) is {det.reason}")
+    # spectral bounds: every L keeps the unobservable modes; the Riccati gain is a start
+    ueig = np.linalg.eigvals(np.asarray(lyap.as_qarray(Au), dtype=float)) if Au.nrows() else []
+    try:
+        with np.errstate(all="ignore"):
+            Lr = riccati_gain(A, C, s.discrete, np.eye(n), np.eye(p), None)
+        reig = np.linalg.eigvals(A - Lr @ C)
+    except (np.linalg.LinAlgError, ValueError):
+        reig = None
     if o.rate is not None:
-        # the unobservable modes are eigenvalues of A − LC for every L (exact)
-        _, Au = unobservable_restriction(s.A.q, s.C.q)
-        if Au.nrows() and not lyap.rate_feasible(lyap.as_qarray(Au), o.rate, s.discrete):
-            raise InfeasibleError(
-                f"no gain L gives decay rate {fmt_exact(o.rate)}: an unobservable mode of "
-                f"(C, A) (a root of {Au.charpoly()}) is an eigenvalue of A − LC for every L "
-                f"and fails the rate ({lyap.stability_test(s.discrete)})"
-            )
         # design with some slack (2 %) so the rounded gain certifies robustly at the asked rate
-        slack = float(o.rate) * (0.98 if s.discrete else 1.02)
+        slack = float(o.rate) * (SLACK_DISCRETE if s.discrete else SLACK_CONTINUOUS)
         if not feasible(slack) and not feasible(float(o.rate)):
             raise InconclusiveError(
                 f"the LMI solver found no gain at rate {fmt_exact(o.rate)}, although (C, A) "
-                f"allows it ({det.reason})"
+                f"allows it ({reason})"
             )
     elif s.discrete:
-        lo, hi = 0.0, 1.0 - tol
+        lo = float(np.abs(ueig).max()) if len(ueig) else 0.0
+        hi = 1.0 - tol
+        if reig is not None and np.isfinite(reig).all():
+            start = min(hi, float(np.abs(reig).max()) + tol)
+            if start > lo and feasible(start):
+                hi = start
         if not feasible(hi):
             raise InconclusiveError(
-                f"the LMI solver found no gain with λ ≤ {1.0 - tol:g} ({det.reason})"
+                f"the LMI solver found no gain with λ ≤ {1.0 - tol:g} ({reason})"
             )
         while hi - lo > tol:
             mid = (lo + hi) / 2
@@ -210,12 +410,17 @@ def design_gain(
                 hi = mid
             else:
                 lo = mid
-        feasible(hi)
     else:
-        lo, hi = 0.0, float(o.rate_cap)
-        if not feasible(tol):
-            raise InconclusiveError(f"the LMI solver found no gain with α ≥ {tol:g} ({det.reason})")
+        hi = float(o.rate_cap)
+        if len(ueig):
+            hi = min(hi, -float(np.real(ueig).max()))
         lo = tol
+        if reig is not None and np.isfinite(reig).all():
+            start = min(hi, -float(reig.real.max()) - tol)
+            if start > lo and feasible(start):
+                lo = start
+        if not feasible(lo):
+            raise InconclusiveError(f"the LMI solver found no gain with α ≥ {tol:g} ({reason})")
         if feasible(hi):
             lo = hi
         while hi - lo > tol:
@@ -226,7 +431,12 @@ def design_gain(
                 lo = mid
             else:
                 hi = mid
-        feasible(lo)
     assert best is not None
-    Lf, name, _ = best
-    return Lf, SolverResult(name, SolverStatus.OPTIMAL, seconds=total)
+    Lf, name, rate = best
+    return Lf, SolverResult(
+        name,
+        SolverStatus.OPTIMAL,
+        f"LMI bisection: {solves} solves, best float rate {rate:.6g}",
+        seconds=total,
+        extra={"gain_design": "lmi", "lmi_solves": solves},
+    )

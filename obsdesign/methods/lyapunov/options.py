@@ -19,7 +19,10 @@ class Options:
     ``L``: the exact n×p gain, or None to design it; ``rate``: the λ (discrete) / α
     (continuous) asked for, or None for the best one found; ``rate_tol``: width of the
     best-rate bracket; ``rate_cap``: the largest α tried when designing L in continuous time;
-    ``iss_gain``: also certify the ISS gain μ; ``margin``: δ of the strict checks M ⪰ δ·I.
+    ``iss_gain``: also certify the ISS gain μ; ``margin``: δ of the strict checks M ⪰ δ·I;
+    ``design``: how L is designed when omitted (``riccati`` default, ``place``, ``lmi``);
+    ``riccati_Q`` / ``riccati_R``: the Riccati weights (None: identity); ``poles``: the
+    closed-loop poles of ``place`` (None: the stated defaults of :mod:`.design`).
     """
 
     L: np.ndarray | None
@@ -28,6 +31,14 @@ class Options:
     rate_cap: fmpq
     iss_gain: bool
     margin: fmpq
+    design: str = "riccati"
+    riccati_Q: np.ndarray | None = None
+    riccati_R: np.ndarray | None = None
+    poles: np.ndarray | None = None
+
+
+#: the gain designs of ``design = ...`` (L omitted)
+DESIGNS = ("riccati", "place", "lmi")
 
 
 def parse_options(table: Table, spec: Spec) -> Options:
@@ -51,8 +62,43 @@ def parse_options(table: Table, spec: Spec) -> Options:
     cap = table.scalar("rate_cap", default=fmpq(10), min=0, strict_min=True)
     iss = table.bool("iss_gain", default=False)
     margin = table.scalar("margin", default=fmpq(1, 10**9), min=0)
+    design = table.str("design", default="riccati", choices=DESIGNS)
+    if L is not None:
+        for k in ("design", "riccati_Q", "riccati_R", "poles"):
+            if table.has(k):
+                raise table.error(k, "designs L: omit L, or omit this key")
+    keys = {"riccati": ("riccati_Q", "riccati_R"), "place": ("poles",), "lmi": ()}
+    for k in ("riccati_Q", "riccati_R", "poles"):
+        if table.has(k) and k not in keys[design]:
+            raise table.error(k, f"is not used by design = {design!r}")
+    wq = wr = poles = None
+    if table.has("riccati_Q"):
+        wq = table.matrix("riccati_Q", rows=s.n, cols=s.n).q
+        if not all(wq[i, j] == wq[j, i] for i in range(s.n) for j in range(s.n)):
+            raise table.error("riccati_Q", "expected a symmetric matrix")
+    if table.has("riccati_R"):
+        wr = table.matrix("riccati_R", rows=s.p, cols=s.p).q
+        if not all(wr[i, j] == wr[j, i] for i in range(s.p) for j in range(s.p)):
+            raise table.error("riccati_R", "expected a symmetric matrix")
+    if table.has("poles"):
+        poles = table.vector("poles", n=s.n).q
+        if s.discrete and any(abs(z) >= 1 for z in poles):
+            raise table.error("poles", "expected poles of modulus < 1 in discrete time")
+        if not s.discrete and any(z >= 0 for z in poles):
+            raise table.error("poles", "expected negative poles in continuous time")
     table.done()
-    return Options(L, None if rate is None else rate.q, tol.q, cap.q, iss, margin.q)
+    return Options(
+        L,
+        None if rate is None else rate.q,
+        tol.q,
+        cap.q,
+        iss,
+        margin.q,
+        design,
+        wq,
+        wr,
+        poles,
+    )
 
 
 def schema(key: str) -> dict[str, Any]:
@@ -74,5 +120,9 @@ def schema(key: str) -> dict[str, Any]:
             "rate_cap": {**NUM, "exclusiveMinimum": 0},
             "iss_gain": {"type": "boolean"},
             "margin": {**NUM, "minimum": 0},
+            "design": {"enum": list(DESIGNS)},
+            "riccati_Q": MAT,
+            "riccati_R": MAT,
+            "poles": {"type": "array", "items": NUM},
         },
     }
