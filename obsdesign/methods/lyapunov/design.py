@@ -67,11 +67,11 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     sym = "λ" if s.discrete else "α"
     if s.discrete:
         bound = float(np.max(np.abs(eig)))
-        params["rho"] = bound
+        params["spectral_radius"] = bound  # ρ(A − LC), informational
         lim = f"spectral radius ≈ {bound:.6g}"
     else:
         bound = float(np.max(eig.real))
-        params["max_real_eig"] = bound
+        params["spectral_abscissa"] = bound  # max Re λ_i(A − LC), informational
         lim = f"largest real part ≈ {bound:.6g}"
     known = None
     if o.rate is not None:
