@@ -13,10 +13,17 @@ from __future__ import annotations
 from typing import Any
 
 from obsdesign.certify.claim import Claim
-from obsdesign.methods.base import Design, Method, Progress, SummaryField
+from obsdesign.methods.base import Design, Method, Progress, SimOption, SummaryField
 from obsdesign.methods.lyapunov import claims as _claims
 from obsdesign.methods.lyapunov import design as _design
-from obsdesign.methods.lyapunov.options import Options, parse_options, schema
+from obsdesign.methods.lyapunov.options import (
+    Options,
+    SimOptions,
+    parse_options,
+    parse_simulate,
+    schema,
+    simulate_schema,
+)
 from obsdesign.params import Parameters
 from obsdesign.spec.models import Spec
 from obsdesign.spec.reader import Table
@@ -31,6 +38,7 @@ class Lyapunov(Method):
         "Section 5 (quadratic Lyapunov function)"
     )
     Options = Options
+    SimOptions = SimOptions
     required_params = ("L", "P")
     summary_fields = (
         SummaryField("lambda", "lambda"),
@@ -40,8 +48,21 @@ class Lyapunov(Method):
         SummaryField("mu", "mu", ".4g"),
     )
 
+    sim_options = (
+        SimOption("runs", "int", None, "Monte Carlo runs (default [simulate] runs, else 1)", min=1),
+        SimOption(
+            "batch", "int", None, "runs stepped together (default: as many as fit in memory)", min=1
+        ),
+    )
+
     def parse_options(self, table: Table, spec: Spec) -> Options:
         return parse_options(table, spec)
+
+    def parse_simulate(self, table: Table, spec: Spec) -> SimOptions:
+        return parse_simulate(table, spec)
+
+    def simulate_schema(self) -> dict[str, Any]:
+        return simulate_schema()
 
     def design(self, spec: Spec, progress: Progress | None = None) -> Design:
         return _design.design(spec, progress)
@@ -49,10 +70,23 @@ class Lyapunov(Method):
     def certify(self, spec: Spec, params: Parameters) -> list[Claim]:
         return _claims.certify(spec, params)
 
-    def simulate(self, spec: Spec, params: Parameters, **options: Any) -> Any:
-        from obsdesign.simulate.linear import simulate_linear_observer
+    def simulate(
+        self, spec: Spec, params: Parameters, runs: int | None = None, batch: int | None = None
+    ) -> Any:
+        """One run of the spec's scenario, or ``runs`` batched Monte Carlo runs (per-run
+        metrics and quantiles; :func:`obsdesign.simulate.linear.simulate_linear_observer_batch`).
+        """
+        from obsdesign.simulate.linear import (
+            simulate_linear_observer,
+            simulate_linear_observer_batch,
+        )
 
-        return simulate_linear_observer(spec, params.float("L"))
+        so = spec.simulate.options if spec.simulate is not None else None
+        n = runs if runs is not None else (so.runs if so is not None else 1)
+        ie = so.initial_error if so is not None else None
+        if n == 1 and ie is None and batch is None:
+            return simulate_linear_observer(spec, params.float("L"))
+        return simulate_linear_observer_batch(spec, params.float("L"), n, ie, batch)
 
     def options_schema(self) -> dict[str, Any]:
         return schema(self.key)

@@ -101,6 +101,32 @@ def parse_options(table: Table, spec: Spec) -> Options:
     )
 
 
+@dataclass
+class SimOptions:
+    """The ``lyapunov`` method's own ``[simulate]`` keys: ``runs`` Monte Carlo runs (default
+    1: the spec's single scenario) and ``initial_error``, the name of a set of ``[sets]`` each
+    run draws its initial error x̂0 − x0 from (None: xhat0 − x0 for every run)."""
+
+    runs: int = 1
+    initial_error: str | None = None
+
+
+def parse_simulate(table: Table, spec: Spec) -> SimOptions:
+    """``[simulate] runs`` and ``initial_error`` (a set of ``[sets]`` of dimension n, see
+    :func:`obsdesign.simulate.montecarlo.parse_initial_error`); never mutates the spec.
+
+    :param table: the ``[simulate]`` table; :param spec: the spec."""
+    from obsdesign.simulate.montecarlo import parse_initial_error
+
+    runs = table.int("runs", default=1, min=1)
+    return SimOptions(runs, parse_initial_error(table, spec))
+
+
+def simulate_schema() -> dict[str, Any]:
+    """JSON-schema properties of the ``lyapunov`` method's own ``[simulate]`` keys."""
+    return {"runs": {"type": "integer", "minimum": 1}, "initial_error": {"type": "string"}}
+
+
 def schema(key: str) -> dict[str, Any]:
     """JSON schema of the ``[method]`` table of ``lyapunov``.
 
