@@ -31,7 +31,7 @@ upper = [1]
 key = "lyapunov"
 L = [0.6, 0.1]
 [simulate]
-horizon = 60
+horizon = 600
 x0 = [1, -1]
 xhat0 = [0, 0]
 seed = 11

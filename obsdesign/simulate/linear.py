@@ -10,8 +10,8 @@ With z = [x; x̂] and the exogenous signals s = [u; d; v] (input, disturbance, n
   z_{k+1} = Φ z_k + Γ s_k, [Φ Γ] = the top rows of expm([[M, E], [0, 0]] dt), gives the
   solution at the grid points up to rounding (no RK45 tolerance).
 
-The exogenous term E s_k is computed for every step before the loop (one matrix product), so
-each step is one matrix-vector product and one addition. :func:`simulate_linear_observer`
+The exogenous terms E s_k are computed before the loop (one matrix product per chunk of
+steps), so each step is one matrix-vector product and one addition. :func:`simulate_linear_observer`
 runs the spec's scenario once; :func:`simulate_linear_observer_batch` runs N Monte Carlo runs
 over a batch axis (:mod:`obsdesign.simulate.montecarlo`).
 """
@@ -77,16 +77,25 @@ def exogenous(u: np.ndarray, d: np.ndarray, v: np.ndarray) -> np.ndarray:
     return np.concatenate([u, d, v], axis=-1)
 
 
-def step_all(js: JointSystem, z0: np.ndarray, W: np.ndarray) -> np.ndarray:
-    """The trajectory z_0 .. z_K of z_{k+1} = M z_k + W_k (W: (K, 2n), precomputed E s_k)."""
-    K = len(W)
+#: steps whose exogenous terms E s_k are computed at once (bounds the extra memory)
+CHUNK = 1 << 16
+
+
+def step_all(js: JointSystem, z0: np.ndarray, S: np.ndarray) -> np.ndarray:
+    """The trajectory z_0 .. z_K of z_{k+1} = M z_k + E s_k for the signals ``S`` ((K, ·):
+    s_0 .. s_{K-1}); E s_k is computed :data:`CHUNK` steps at a time, one product each."""
+    K = len(S)
     Z = np.empty((K + 1, len(z0)))
     Z[0] = z0
-    M = js.M
+    M, ET = js.M, js.E.T
     mm = np.matmul
-    for k in range(K):
-        mm(M, Z[k], out=Z[k + 1])
-        Z[k + 1] += W[k]
+    for k0 in range(0, K, CHUNK):
+        k1 = min(K, k0 + CHUNK)
+        W = S[k0:k1] @ ET
+        for k in range(k0, k1):
+            z = Z[k + 1]
+            mm(M, Z[k], out=z)
+            z += W[k - k0]
     return Z
 
 
@@ -98,10 +107,9 @@ def simulate_linear_observer(spec: Spec, L: np.ndarray) -> SimResult:
     s = spec.system
     js = joint_system(spec, L)
     u, d, v = signals(spec, js.grid)
-    W = exogenous(u, d, v)[:-1] @ js.E.T
     sim = spec.simulate
     assert sim is not None
-    Z = step_all(js, np.concatenate([sim.x0.f, sim.xhat0.f]), W)
+    Z = step_all(js, np.concatenate([sim.x0.f, sim.xhat0.f]), exogenous(u, d, v)[:-1])
     x, xh = Z[:, : js.n], Z[:, js.n :]
     y = x @ s.C.f.T + u @ s.D.f.T + v @ s.Dn.f.T
     return SimResult(js.grid, x, xh, y, s.states)
@@ -118,7 +126,7 @@ def simulate_linear_observer_batch(
     :func:`obsdesign.simulate.montecarlo.run_batch`): run r draws its initial error from the
     set ``initial_error`` of ``[sets]`` (default: xhat0 − x0 for every run) and its signals
     from child r of ``SeedSequence(seed).spawn(runs)``; ``batch`` caps the runs stepped
-    together (default: as many as fit in 64 MB). Per-run metrics in ``extra["per_run"]``,
+    together (default: as many as fit in ``montecarlo.BATCH_BYTES``). Per-run metrics in ``extra["per_run"]``,
     quantiles in ``info["quantiles"]``; the trajectory shown is run 0's."""
     from obsdesign.simulate.montecarlo import run_batch
 

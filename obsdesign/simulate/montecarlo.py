@@ -7,9 +7,10 @@ Randomness: run r uses ``numpy.random.default_rng(SeedSequence(seed).spawn(runs)
 set of ``[sets]``: one point drawn by the set's ``sample``; else xhat0 − x0 for every run),
 then its input, disturbance and noise signals in that order (only when one of them is random;
 a signal with its own ``seed``, or a deterministic one, is the same in every run). So run r's
-result does not depend on how many runs there are or how they are batched: the batch step is
-row-wise (elementwise products and a fixed-order sum, no BLAS blocking), bitwise the same
-for any batch size.
+draws do not depend on how many runs there are or how they are batched. The batch step is
+one row-layout product Z @ Mᵀ (a 2-D product even for one run); with the OpenBLAS build
+numpy ships its rows are bitwise the same for any batch size (tested in
+tests/test_simulate_montecarlo.py), with another BLAS they agree to rounding.
 
 ``[simulate] initial_error = "NAME"`` is read by :func:`parse_initial_error`, which a method
 calls from its ``parse_simulate``.
@@ -27,7 +28,10 @@ from obsdesign.spec.models import Spec
 from obsdesign.spec.reader import Table
 
 #: memory of one batch (trajectory chunk + per-run signals), bytes
-BATCH_BYTES = 64 * 2**20
+BATCH_BYTES = 128 * 2**20
+#: steps stepped between two metric updates (a fixed number, so that batching cannot change
+#: how the RMSE sums are rounded)
+STEPS = 256
 #: quantiles reported for every per-run metric
 QUANTILES = {"q05": 0.05, "q50": 0.5, "q95": 0.95}
 METRICS = ("sup_abs_error", "rmse", "sup_abs_estimate", "final_error_norm")
@@ -89,16 +93,17 @@ def run_batch(
     random = any(_random(g) for g in sigs)
     children = run_seeds(sim.seed, runs)
     shared = None
+    ET = js.E.T
+    width = js.E.shape[1]
     if not random:
         from obsdesign.simulate.runner import signals
 
         shared = signals(spec, grid)
-        W_shared = np.concatenate(shared, axis=1)[:-1] @ js.E.T  # (K, 2n)
-    width = js.E.shape[1]
-    per_run = (K + 1) * (width + 2 * n) * 8 * (1 if random else 0) + 64 * 2 * n * 8
+        S_shared = np.concatenate(shared, axis=1)[:-1]  # (K, width)
+    per_run = (K + 1) * width * 8 if random else 0
     B = batch or int(max(1, min(runs, BATCH_BYTES // max(per_run, 1))))
-    chunk = int(max(1, min(K, BATCH_BYTES // (8 * 2 * n * B * 2))))
-    MT = js.M.T[None, :, :]  # (1, 2n, 2n): z_next[b, i] = sum_j z[b, j] M[i, j]
+    chunk = STEPS  # fixed (not from B): the per-chunk sums then round the same for any B
+    MT = np.ascontiguousarray(js.M.T)  # rows: z_next[b] = z[b] @ M^T
     out = {
         "sup_abs_error": np.zeros((runs, n)),
         "rmse": np.zeros((runs, n)),
@@ -110,17 +115,20 @@ def run_batch(
     sig0 = shared
     for b0 in range(0, runs, B):
         idx = range(b0, min(runs, b0 + B))
+        b = len(idx)
         rngs = [np.random.default_rng(children[r]) for r in idx]
         e0 = np.stack(
             [eset.sample(g, 1)[0] if eset is not None else xhat0 - x0 for g in rngs]
-        ).reshape(len(idx), n)
-        e0_all[b0 : b0 + len(idx)] = e0
+        ).reshape(b, n)
+        e0_all[b0 : b0 + b] = e0
         if random:
-            S = [[g.evaluate(grid, rng) for g in sigs] for rng in rngs]
-            if b0 == 0:
-                sig0 = tuple(S[0])
-            Wb = np.stack([np.concatenate(r, axis=1)[:-1] @ js.E.T for r in S])  # (b, K, 2n)
-        Z = np.concatenate([np.broadcast_to(x0, (len(idx), n)), x0 + e0], axis=1)
+            Sb = np.empty((K, b, width))  # time-major: one step's signals are contiguous
+            for j, rng in enumerate(rngs):
+                one = [g.evaluate(grid, rng) for g in sigs]
+                if b0 == 0 and j == 0:
+                    sig0 = tuple(one)
+                Sb[:, j, :] = np.concatenate(one, axis=1)[:-1]
+        Z = np.concatenate([np.broadcast_to(x0, (b, n)), x0 + e0], axis=1)
         sup_e = np.abs(Z[:, n:] - Z[:, :n])
         sq = sup_e**2
         sup_h = np.abs(Z[:, n:])
@@ -129,15 +137,23 @@ def run_batch(
         k0 = 0
         while k0 < K:
             k1 = min(K, k0 + chunk)
-            buf = np.empty((k1 - k0, len(idx), 2 * n))
-            for k in range(k0, k1):
-                Z = (Z[:, :, None] * MT).sum(axis=1)
-                Z += W_shared[k] if not random else Wb[:, k]
-                buf[k - k0] = Z
-            e = buf[:, :, n:] - buf[:, :, :n]
-            np.maximum(sup_e, np.abs(e).max(axis=0), out=sup_e)
-            sq += (e**2).sum(axis=0)
-            np.maximum(sup_h, np.abs(buf[:, :, n:]).max(axis=0), out=sup_h)
+            if random:
+                Wc = (Sb[k0:k1].reshape(-1, width) @ ET).reshape(k1 - k0, b, 2 * n)
+            else:
+                Wc = S_shared[k0:k1] @ ET  # (chunk, 2n), broadcast over the runs
+            buf = np.empty((k1 - k0, b, 2 * n))
+            for k in range(k1 - k0):
+                dst = buf[k]
+                np.matmul(Z, MT, out=dst)
+                dst += Wc[k]
+                Z = dst
+            # reductions along the (contiguous) time axis, no abs temporaries
+            e = np.subtract(buf[:, :, n:], buf[:, :, :n])
+            np.maximum(sup_e, e.max(axis=0), out=sup_e)
+            np.maximum(sup_e, -e.min(axis=0), out=sup_e)
+            sq += np.einsum("kbi,kbi->bi", e, e)
+            np.maximum(sup_h, buf[:, :, n:].max(axis=0), out=sup_h)
+            np.maximum(sup_h, -buf[:, :, n:].min(axis=0), out=sup_h)
             if b0 == 0:
                 traj0.append(buf[:, 0, :].copy())
             k0 = k1
