@@ -1,0 +1,123 @@
+"""check_pd_fast (issue 12 item 1): the same exact verdict as check_pd, by a float-guided
+certificate checked over Q (M = RᵀR + S, S diagonally dominant; or vᵀMv ≤ 0) or, when neither
+goes through, the fraction-free LDLᵀ over Z. Known answers, must-fail cases on the edge, every
+proof path exercised, agreement with check_pd on random matrices."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from flint import fmpq, fmpq_mat, fmpz_mat
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from obsdesign.certify import psd
+from obsdesign.certify.exact import Q, qmat
+from obsdesign.certify.psd import check_pd, check_pd_fast
+
+
+@pytest.mark.parametrize(
+    ("M", "margin", "ok"),
+    [
+        ([[4, 2, 0], [2, 3, 1], [0, 1, 5]], 0, True),
+        ([[1, 2], [2, 3]], 0, False),  # det −1
+        ([[1, 2], [2, 4]], 0, False),  # singular PSD: not ≻ 0
+        ([[0, 2], [2, 3]], 0, False),  # zero leading minor
+        ([[1, fmpq(1, 2)], [fmpq(1, 2), 1]], fmpq(1, 2), False),  # eigenvalue 1/2 − 1/2 = 0
+        ([[1, fmpq(1, 2)], [fmpq(1, 2), 1]], fmpq(49, 100), True),
+        ([[fmpq(1, 3)]], fmpq(1, 3), False),
+        ([[fmpq(1, 3)]], fmpq(1, 3) - fmpq(1, 10**30), True),
+        ([[-1]], 0, False),
+    ],
+)
+def test_known_answers(M, margin, ok) -> None:  # noqa: ANN001
+    assert check_pd_fast(qmat(M), margin).ok is ok
+    assert check_pd(qmat(M), margin).ok is ok
+
+
+def test_asymmetric_and_empty_and_input_types() -> None:
+    r = check_pd_fast(qmat([[2, 1], [0, 2]]))
+    assert not r.ok and "not symmetric at (0, 1)" in r.detail
+    assert check_pd_fast(np.zeros((0, 0), dtype=object)).ok
+    assert check_pd_fast(fmpz_mat([[2, 1], [1, 2]])).ok
+    assert check_pd_fast(fmpq_mat([[2, 1], [1, 2]]) / 7).ok
+    assert check_pd_fast(np.array([[2.0, 1.0], [1.0, 2.0]])).ok
+    with pytest.raises(ValueError):
+        check_pd_fast(qmat([[1, 2, 3]]))
+
+
+def _hilbert(n: int) -> np.ndarray:
+    return qmat([[fmpq(1, i + j + 1) for j in range(n)] for i in range(n)])
+
+
+def test_every_proof_path() -> None:
+    """Well-conditioned: the Cholesky certificate; indefinite: the rational vector; Hilbert
+    13×13 (condition ≈ 10¹⁸, PD): floats cannot, the fraction-free LDLᵀ decides."""
+    rng = np.random.default_rng(0)
+    B = rng.standard_normal((30, 30))
+    good = qmat(B @ B.T + 30 * np.eye(30))
+    r = check_pd_fast(good)
+    assert r.ok and "RᵀR + S" in r.detail
+    bad = qmat(B + B.T)
+    r = check_pd_fast(bad)
+    assert not r.ok and "vᵀMv" in r.detail
+    H = _hilbert(13)
+    r = check_pd_fast(H)
+    assert r.ok and "fraction-free" in r.detail
+    # δ = 10⁻¹⁷ lies above λ_min(H₁₃) (about 10⁻¹⁸): H − δI is not ≻ 0, the same way
+    lam = fmpq(1, 10**17)
+    assert not check_pd_fast(H, lam).ok and not check_pd(H, lam).ok
+
+
+def test_edge_by_the_smallest_margin() -> None:
+    """M = [[a, b], [b, c]] ≻ 0 iff a > 0 and ac > b²: at c = b²/a exactly it fails, one ulp
+    of 10⁻⁴⁰ above it passes (both paths must see it: the float certificate cannot, so the
+    exact fallback decides)."""
+    a, b = fmpq(3), fmpq(5)
+    edge = b * b / a
+    assert not check_pd_fast(qmat([[a, b], [b, edge]])).ok
+    assert check_pd_fast(qmat([[a, b], [b, edge + fmpq(1, 10**40)]])).ok
+    n = 40
+    rng = np.random.default_rng(1)
+    V = rng.standard_normal((n, n))
+    M = qmat(V @ V.T)
+    # the margin just past λ_min: vᵀ(M − δI)v < 0 for some v; just below: PD
+    lam = float(np.linalg.eigvalsh(np.asarray(M, dtype=float))[0])
+    assert check_pd_fast(M, Q(lam * (1 - 1e-6))).ok
+    assert not check_pd_fast(M, Q(lam * (1 + 1e-6))).ok
+
+
+def test_certificate_cannot_pass_a_wrong_matrix(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A Cholesky factor of another matrix (here: of M + I, for the indefinite M) must not
+    certify M: the exact S = M − RᵀR is not diagonally dominant, so the exact fallback says no."""
+    M = qmat([[1, 2], [2, 1]])  # eigenvalues 3, −1
+    real_eigvalsh = np.linalg.eigvalsh
+    monkeypatch.setattr(np.linalg, "eigvalsh", lambda X: np.abs(real_eigvalsh(X)) + 5)
+    real_chol = np.linalg.cholesky
+    monkeypatch.setattr(np.linalg, "cholesky", lambda X: real_chol(np.array([[5.0, 2], [2, 5]])))
+    r = check_pd_fast(M)
+    assert not r.ok and "fraction-free" in r.detail
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    st.integers(1, 9),
+    st.integers(0, 2**31 - 1),
+    st.sampled_from([0, 1, -1]),
+    st.integers(0, 3),
+)
+def test_agrees_with_check_pd(n: int, seed: int, shift: int, rank_drop: int) -> None:
+    """Random rational symmetric matrices near the PD edge: V Vᵀ of low rank plus a shift of
+    ±10⁻⁹ or 0: the two exact tests give the same verdict."""
+    rng = np.random.default_rng(seed)
+    k = max(1, n - rank_drop)
+    V = rng.integers(-9, 10, size=(n, k))
+    M = qmat(V @ V.T) / 7 + np.diag([fmpq(shift, 10**9)] * n).astype(object)
+    M = qmat(M)
+    assert check_pd_fast(M).ok == check_pd(M).ok
+    margin = fmpq(1, 10**6)
+    assert check_pd_fast(M, margin).ok == check_pd(M, margin).ok
+
+
+def test_fast_check_wording_is_exported() -> None:
+    assert "diagonally dominant" in psd.FAST_CHECK and "fraction-free" in psd.FAST_CHECK
