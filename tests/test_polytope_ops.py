@@ -114,3 +114,32 @@ def test_exact_slicer_matches_float():
     assert np.all((P @ G.T) <= 1 + 1e-9)
     cf = po.qfloat(c)
     assert np.all((P @ cf >= -1e-12) & (P @ cf <= 0.1 + 1e-12))
+
+
+def test_cold_import_pulls_no_heavy_module():
+    """Issue 12 item 3: ``import obsdesign.api`` loads neither scipy.spatial (qhull), cdd,
+    cvxpy nor matplotlib; polytope_ops imports qhull and pycddlib on first use; tool_info
+    reads the dependency versions once per process."""
+    import subprocess
+    import sys
+
+    code = """
+import sys
+import obsdesign.api
+heavy = ("scipy.spatial", "cdd", "cvxpy", "matplotlib")
+print([m for m in heavy if m in sys.modules])
+from obsdesign.sets import polytope_ops as po
+print(po.HAVE_GMP is True, "cdd" in sys.modules)
+po.hull([[1, 0], [0, 1], [-1, -1]])
+print("scipy.spatial" in sys.modules)
+from importlib import metadata
+from obsdesign.report import model
+calls = []
+real = metadata.version
+metadata.version = lambda d: calls.append(d) or real(d)
+a, b = model.tool_info(), model.tool_info()
+a["dependencies"]["numpy"] = "changed"
+print(len(calls) <= len(model.DEPS) + 1, b == model.tool_info(), model.tool_info() != a)
+"""
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert r.stdout.split("\n")[:4] == ["[]", "True True", "True", "True True True"], r.stdout
