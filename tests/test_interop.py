@@ -162,3 +162,18 @@ def test_mat_import_round_trip(tmp_path: Path):
         app, ["import", str(mat), "--A", "Ad", "--C", "Cm", "--method", "lyapunv"]
     )
     assert bad.exit_code == 2 and "did you mean 'lyapunov'" in bad.stderr
+
+
+def test_stubborn_luenberger_part():
+    text = spec_text_from_statespace(
+        control.ss([[0.7, 0.7], [-0.7, 0.7]], [[0], [1]], [[1, 1]], 0, 1), "stubborn"
+    )
+    rep = api.design(api.load_spec_text(text, "<stubborn>"))
+    assert rep.exit_code() == 0
+    K = np.asarray(rep.parameters.float("K"), float).reshape(2, 1)
+    obs = rep.observer_statespace()
+    assert isinstance(obs, control.StateSpace) and obs.dt == 1
+    A = np.array([[0.7, 0.7], [-0.7, 0.7]])
+    np.testing.assert_allclose(obs.A, A - K @ np.array([[1.0, 1.0]]), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(obs.B[:, 1:], K, rtol=0, atol=0)
+    assert max(abs(np.linalg.eigvals(obs.A))) < 1  # the Luenberger part alone is stable
