@@ -232,3 +232,25 @@ def test_sector_scaling_gives_2kmax() -> None:
 def test_load_shipped_example() -> None:
     s = load_spec(EXAMPLE)
     assert s.method == "impulsive"
+
+
+def test_ssd_matrix_known_answer() -> None:
+    """N(κ) = [[Ā + Āᵀ + κI + R, I + Sᵀ], [I + S, Q]] (eq. (7), Lemma 1), exact, with a
+    non-symmetric Ā and S (the symmetrization must not hide a transposed block)."""
+    from obsdesign.methods.impulsive.dissipativity import QSR, ssd_matrix
+
+    A = qmat([[1, 2], [3, 4]])
+    q = QSR(qmat([[-1, 0], [0, -1]]), qmat([[0, 1], [0, 0]]), qmat([[0, 0], [0, 0]]), "test")
+    N = ssd_matrix(A, q, fmpq(1, 2))
+    want = qmat(
+        [
+            [Q("2.5"), 5, 1, 0],
+            [5, Q("8.5"), 1, 1],
+            [1, 1, -1, 0],
+            [0, 1, 0, -1],
+        ]
+    )
+    assert N.shape == want.shape and all(a == b for a, b in zip(N.flat, want.flat, strict=True))
+    q2 = QSR(q.Q, q.S, qmat([[3, 0], [0, 3]]), "test").scaled(2)
+    N2 = ssd_matrix(A, q2, 0)
+    assert N2[0, 0] == 2 + 6 and N2[0, 2] == 1 and N2[0, 3] == 0 and N2[2, 1] == 2 and N2[1, 2] == 2
