@@ -323,6 +323,20 @@ TAMPERS: list[tuple[str, str, Callable, set[str]]] = [
         _set("lambda", lambda v, s: fmpq(1, 2)),
         {"lambda-matches-spec"},
     ),
+    # no asked rate: P = P_best and λ = λ_best share one exact check; a P tampered alone
+    # must still fail alone
+    (
+        "decay-lmi, P = P_best shared",
+        "best",
+        lambda p, s: _tamper_decay(p, s, "P", "lambda"),
+        {"decay-lmi"},
+    ),
+    (
+        "decay-lmi_best, P = P_best shared",
+        "best",
+        lambda p, s: _tamper_decay(p, s, "P_best", "lambda_best"),
+        {"decay-lmi_best"},
+    ),
     (
         "bracket on the wrong side",
         "sec5",
@@ -549,3 +563,130 @@ def test_asked_rate_feasible_but_not_certifiable_is_inconclusive() -> None:
     assert ei.value.exit_code == 4
     with pytest.raises(InfeasibleError, match="exact Schur–Cohn test"):
         api.design(load_spec_text(SEC5.read_text().replace("lambda = 0.955", "lambda = 0.95")))
+
+
+# -- issue 12 item 1: the gain designs (riccati default, place, lmi) ------------------------
+def _fmt(M: np.ndarray) -> str:
+    return "[" + ", ".join("[" + ", ".join(repr(float(v)) for v in r) + "]" for r in M) + "]"
+
+
+def _designed(A: np.ndarray, C: np.ndarray, time: str = "discrete", extra: str = "") -> str:
+    return (
+        f'[system]\ntime = "{time}"\nA = {_fmt(A)}\nC = {_fmt(C)}\n'
+        f'[method]\nkey = "lyapunov"\n{extra}'
+    )
+
+
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    st.integers(1, 10),
+    st.integers(0, 2),
+    st.integers(0, 2**31 - 1),
+    st.sampled_from(["discrete", "continuous"]),
+)
+def test_riccati_path_certifies_random_detectable_systems(
+    m: int, k: int, seed: int, time: str
+) -> None:
+    """Random detectable (C, A), n = m + k ≤ 12: an observable m-block and k stable modes the
+    output never sees (A = [[A₁, 0], [A₂₁, A₂]], C = [C₁, 0]). The default (Riccati) design
+    certifies every claim, verifies, and reports its path."""
+    rng = np.random.default_rng(seed)
+    n = m + k
+    A = np.zeros((n, n))
+    A[:m, :m] = rng.standard_normal((m, m)) * 1.3 / np.sqrt(m)
+    A[m:, :m] = rng.standard_normal((k, m))
+    if k:
+        A2 = rng.standard_normal((k, k))
+        if time == "discrete":
+            A2 *= 0.8 / max(np.abs(np.linalg.eigvals(A2)).max(), 1e-9)
+        else:
+            A2 -= (np.linalg.eigvals(A2).real.max() + 0.5) * np.eye(k)
+        A[m:, m:] = A2
+    C = np.zeros((max(1, m // 3), n))
+    C[:, :m] = rng.standard_normal((C.shape[0], m))
+    rep = api.design(load_spec_text(_designed(A, C, time), "prop.toml"))
+    assert all(c.status == ClaimStatus.CERTIFIED for c in rep.claims)
+    assert rep.solver["gain_design"] == "riccati"
+    assert api.verify(rep).exit_code() == 0
+    L = rep.parameters.float("L")
+    eig = np.linalg.eigvals(A - L @ C)
+    name = "lambda" if time == "discrete" else "alpha"
+    lam = float(rep.parameters.float(f"{name}_best"))
+    if time == "discrete":
+        assert np.abs(eig).max() < lam <= np.abs(eig).max() + 1e-4 + 1e-9
+    else:
+        assert -eig.real.max() - 1e-4 - 1e-9 <= lam < -eig.real.max()
+
+
+A_UO = np.array([[1.1, 1.0], [0.0, 0.9]])
+C_UO = np.array([[1.0, 0.0]])
+
+
+def test_design_modes_report_their_path() -> None:
+    """riccati (default; an asked λ = 0.5 shifts the equation), place (default and given
+    poles), lmi (bracketed bisection, each rate solved once): each certifies and names its
+    path in the solver result."""
+    rep = api.design(load_spec_text(_designed(A_UO, C_UO, extra="lambda = 0.5\n")))
+    assert rep.exit_code() == 0 and rep.solver["gain_design"] == "riccati"
+    assert "shifted to the rate 0.49" in rep.solver["message"]
+    rep = api.design(load_spec_text(_designed(A_UO, C_UO, extra='design = "place"\n')))
+    assert rep.exit_code() == 0 and rep.solver["gain_design"] == "place"
+    eig = np.sort(np.linalg.eigvals(A_UO - rep.parameters.float("L") @ C_UO).real)
+    assert np.allclose(eig, [0.2, 0.4], atol=1e-9)  # default poles 0.2 + 0.4·i/n
+    text = _designed(A_UO, C_UO, extra='design = "place"\npoles = [0.1, -0.3]\n')
+    rep = api.design(load_spec_text(text))
+    eig = np.sort(np.linalg.eigvals(A_UO - rep.parameters.float("L") @ C_UO).real)
+    assert np.allclose(eig, [-0.3, 0.1], atol=1e-9)
+    rep = api.design(load_spec_text(_designed(A_UO, C_UO, extra='design = "lmi"\n')))
+    assert rep.exit_code() == 0 and rep.solver["gain_design"] == "lmi"
+    assert rep.solver["lmi_solves"] <= 16
+    rep = api.design(SEC5)
+    assert rep.solver["gain_design"] == "given"
+
+
+def test_place_needs_observability() -> None:
+    A = np.array([[0.5, 0.0], [0.0, 0.9]])
+    with pytest.raises(InconclusiveError, match="pole placement needs"):
+        api.design(load_spec_text(_designed(A, C_UO, extra='design = "place"\n')))
+    rep = api.design(load_spec_text(_designed(A, C_UO)))  # detectable: riccati works
+    assert rep.exit_code() == 0
+
+
+@pytest.mark.parametrize(
+    ("extra", "key", "why"),
+    [
+        ('L = [1, 1]\ndesign = "riccati"\n', "design", "designs L"),
+        ("poles = [0.1, 0.2]\n", "poles", "not used by design = 'riccati'"),
+        ('design = "place"\nriccati_Q = [[1, 0], [0, 1]]\n', "riccati_Q", "not used"),
+        ('design = "place"\npoles = [0.1, 1.0]\n', "poles", "modulus < 1"),
+        ("riccati_Q = [[1, 2], [0, 1]]\n", "riccati_Q", "symmetric"),
+        ('design = "magic"\n', "design", "one of"),
+    ],
+)
+def test_design_option_errors(extra: str, key: str, why: str) -> None:
+    from obsdesign.errors import SpecError
+
+    with pytest.raises(SpecError, match=re.escape(why)) as ei:
+        load_spec_text(_designed(A_UO, C_UO, extra=extra))
+    assert key in str(ei.value)
+
+
+def test_riccati_weights_change_the_gain() -> None:
+    base = api.design(load_spec_text(_designed(A_UO, C_UO)))
+    heavy = api.design(load_spec_text(_designed(A_UO, C_UO, extra="riccati_R = [[100]]\n")))
+    assert heavy.exit_code() == 0
+    assert "riccati_Q / riccati_R" in heavy.solver["message"]
+    assert not np.allclose(base.parameters.float("L"), heavy.parameters.float("L"))
+
+
+def test_simulate_runs_option(tmp_path: Path) -> None:
+    """--runs N / --option runs=N: N batched Monte Carlo runs with quantiles; a bad value is
+    exit 2."""
+    res = api.simulate(SEC5, options={"runs": "7"})
+    assert res.info.get("runs") == 7 and "quantiles" in res.info
+    one = api.simulate(SEC5)
+    assert "quantiles" not in one.info
+    out = runner.invoke(app, ["simulate", str(SEC5), "--runs", "3"])
+    assert out.exit_code == 0, out.output
+    bad = runner.invoke(app, ["simulate", str(SEC5), "--option", "runs=0"])
+    assert bad.exit_code == 2
