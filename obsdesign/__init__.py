@@ -9,8 +9,8 @@ The heavy modules (numpy, cvxpy, scipy) load on first use, so ``obsdesign --help
 
 from __future__ import annotations
 
+import _signal  # the C module: ``signal`` itself spends milliseconds building its enums
 import os as _os
-import signal as _signal
 import sys as _sys
 from typing import Any
 
@@ -24,8 +24,9 @@ def _early_interrupt(signum: int, frame: object) -> None:  # pragma: no cover - 
 
 
 # Installed here, the first obsdesign code the console script runs (``from obsdesign.cli
-# import main`` imports this package first), so only Python's own start-up (a few ms before
-# any obsdesign code) can still show a traceback on Ctrl-C.
+# import main`` imports this package first). Only Python's own start-up before any obsdesign
+# code (the interpreter, site.py and the .pth files of site-packages) can still show a
+# traceback on Ctrl-C: no package code runs there.
 if _signal.getsignal(_signal.SIGINT) is _signal.default_int_handler and _os.path.basename(
     _sys.argv[0] if _sys.argv else ""
 ) in ("obsdesign", "cli.py"):
