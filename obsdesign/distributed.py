@@ -95,13 +95,18 @@ def dask_client(
         finally:
             c.close()
         return
-    cluster = LocalCluster(
-        n_workers=workers or 1,
-        threads_per_worker=1,
-        processes=True,
-        dashboard_address=None,
-        silence_logs=logging.ERROR,
-    )
+    import dask
+
+    # one task per worker thread at a time: when a worker dies, only the task it was running
+    # is suspected (and retried), not a queued one
+    with dask.config.set({"distributed.scheduler.worker-saturation": 1.0}):
+        cluster = LocalCluster(
+            n_workers=workers or 1,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            silence_logs=logging.ERROR,
+        )
     try:
         c = Client(cluster)
         try:
@@ -136,6 +141,23 @@ def _call(fn: Callable[[T], R], state: tuple[Any, tuple[str, ...]], item: T) -> 
         lim._overridden.update(old_over)
 
 
+def _call_many(fn: Callable[[T], R], state: tuple[Any, tuple[str, ...]], items: list[T]) -> list[R]:
+    """``[fn(x) for x in items]`` in a worker, with the caller's limits in force."""
+    return [_call(fn, state, it) for it in items]
+
+
+#: chunks per worker thread when ``chunk`` is not given: enough to balance uneven tasks,
+#: few enough that the scheduler's per-task cost (a few ms) stays small beside the work
+CHUNKS_PER_THREAD = 8
+
+
+def _lost_message(e: BaseException) -> str:
+    name = type(e).__name__
+    if name == "KilledWorker":
+        return f"internal failure: the task killed every worker it ran on ({e})"
+    return f"internal failure: {name}: {e}"
+
+
 def run_tasks(
     fn: Callable[[T], R],
     items: Sequence[T],
@@ -145,6 +167,7 @@ def run_tasks(
     client: Any = None,
     on_result: Callable[[int, R], None] | None = None,
     lost: Callable[[T, str], R] | None = None,
+    chunk: int | None = None,
 ) -> list[R]:
     """``[fn(x) for x in items]``, in this process or on Dask (see the module docstring).
 
@@ -152,7 +175,12 @@ def run_tasks(
     progress bar); the returned list is in the items' order. ``fn`` should not raise (return
     a result that records the failure); if it does, or if its task kills the workers it runs
     on, the result is ``lost(item, message)`` (the exception is raised when ``lost`` is
-    None)."""
+    None).
+
+    On Dask, consecutive items go together in tasks of ``chunk`` items (default: about
+    :data:`CHUNKS_PER_THREAD` tasks per worker thread), which keeps the scheduler's cost per
+    task small beside short items; a chunk whose task fails is run again item by item, so
+    only the item that fails gets a ``lost`` result."""
     items = list(items)
     results: list[Any] = [None] * len(items)
     if workers is None and scheduler is None and client is None:
@@ -163,33 +191,53 @@ def run_tasks(
                 on_result(i, r)
         return results
     check_workers(workers, scheduler)
+    if chunk is not None and chunk < 1:
+        raise InputError(f"chunk: expected a positive number of items, got {chunk}")
     from dask.distributed import as_completed
 
     state = _limits_state()
     tag = uuid.uuid4().hex[:12]
     with dask_client(workers, scheduler, client) as c:
-        futures = [
-            c.submit(_call, fn, state, it, key=f"obsdesign-{tag}-{i}", pure=False)
-            for i, it in enumerate(items)
-        ]
-        index = {f.key: i for i, f in enumerate(futures)}
+        if chunk is None:
+            threads = max(1, sum(c.nthreads().values()))
+            chunk = max(1, -(-len(items) // (threads * CHUNKS_PER_THREAD)))
+        spans = {}
+        futures = []
+        for a in range(0, len(items), chunk):
+            b = min(len(items), a + chunk)
+            f = c.submit(
+                _call_many, fn, state, items[a:b], key=f"obsdesign-{tag}-{a}-{b}", pure=False
+            )
+            spans[f.key] = (a, b, False)
+            futures.append(f)
+        ac = as_completed(futures)
         try:
-            for fut in as_completed(futures):
-                i = index[fut.key]
+            for fut in ac:
+                a, b, single = spans[fut.key]
                 try:
-                    r = fut.result()
+                    out = fut.result()
                 except Exception as e:  # noqa: BLE001 - KilledWorker, or fn raised
+                    if not single and b - a > 1:  # again item by item: only the bad one is lost
+                        for i in range(a, b):
+                            f = c.submit(
+                                _call_many,
+                                fn,
+                                state,
+                                [items[i]],
+                                key=f"obsdesign-{tag}-retry-{i}",
+                                pure=False,
+                            )
+                            spans[f.key] = (i, i + 1, True)
+                            futures.append(f)
+                            ac.add(f)
+                        continue
                     if lost is None:
                         raise
-                    name = type(e).__name__
-                    if name == "KilledWorker":
-                        msg = f"internal failure: the task killed every worker it ran on ({e})"
-                    else:
-                        msg = f"internal failure: {name}: {e}"
-                    r = lost(items[i], msg)
-                results[i] = r
-                if on_result is not None:
-                    on_result(i, r)
+                    out = [lost(items[a], _lost_message(e))]
+                for i, r in zip(range(a, b), out, strict=True):
+                    results[i] = r
+                    if on_result is not None:
+                        on_result(i, r)
         except BaseException:
             c.cancel(futures)
             raise

@@ -44,7 +44,13 @@ def client():
     from dask.distributed import Client, LocalCluster
 
     # a task may be on one dying worker and be retried once; the second death marks it lost
-    with dask.config.set({"distributed.scheduler.allowed-failures": 1}):
+    # (and, as obsdesign's own LocalCluster, one task per worker thread at a time: only the
+    # running task is suspected when its worker dies)
+    cfg = {
+        "distributed.scheduler.allowed-failures": 1,
+        "distributed.scheduler.worker-saturation": 1.0,
+    }
+    with dask.config.set(cfg):
         cluster = LocalCluster(
             n_workers=2,
             threads_per_worker=1,
@@ -105,13 +111,23 @@ def test_a_worker_killed_mid_sweep_costs_a_retry_not_a_row(client, serial12):
     assert killed[0] not in client.run(os.getpid).values()
 
 
+def test_chunks_give_the_same_results_in_order(client):
+    seen: list[int] = []
+    out = run_tasks(
+        abs, list(range(-7, 0)), client=client, chunk=3, on_result=lambda i, r: seen.append(i)
+    )
+    assert out == [7, 6, 5, 4, 3, 2, 1] and sorted(seen) == list(range(7))
+
+
 def test_a_task_that_kills_every_worker_is_a_row_not_a_hang(client):
     def die_on_3(x: int) -> int:
         if x == 3:
             os._exit(1)
         return x * x
 
-    out = run_tasks(die_on_3, list(range(6)), client=client, lost=lambda x, msg: (x, msg))
+    # chunks [0, 1, 2], [3, 4, 5]: the second dies, is run again item by item, and only
+    # item 3 is lost
+    out = run_tasks(die_on_3, list(range(6)), client=client, lost=lambda x, msg: (x, msg), chunk=3)
     assert out[:3] == [0, 1, 4] and out[4:] == [16, 25]
     assert out[3][0] == 3 and "killed every worker" in out[3][1]
     client.wait_for_workers(2, timeout=60)
