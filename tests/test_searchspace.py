@@ -262,24 +262,19 @@ def _design_failed(text: str, tmp_path: Path) -> set[str]:
     return {c.id for c in rep.failed}
 
 
-def test_input_outside_U(tmp_path):
-    text = TEXT.replace("lower = [0]\nupper = [1]", "lower = [0]\nupper = [0.99]")
-    assert _design_failed(text, tmp_path) == {"input-range"}
-
-
-def test_D_outside_E(tmp_path):
-    text = TEXT.replace("lower = [0, -2]\nupper = [0, 2]", "lower = [0, -2]\nupper = [0, 2.6]")
-    assert _design_failed(text, tmp_path) == {"D-in-E"}
-
-
-def test_alpha_one_breaks_lemma1(tmp_path):
-    text = TEXT.replace("alpha = 0.9 ", "alpha = 1 ")
-    assert _design_failed(text, tmp_path) == {"lemma1-discarding"}
-
-
-def test_gamma0_below_gamma_star(tmp_path):
-    text = TEXT.replace("gamma0 = 1 ", "gamma0 = 0.0499 ")
-    assert _design_failed(text, tmp_path) == {"gamma0-above-star"}
+@pytest.mark.parametrize(
+    ("old", "new", "failed"),
+    [
+        ("lower = [0]\nupper = [1]", "lower = [0]\nupper = [0.99]", "input-range"),
+        ("lower = [0, -2]\nupper = [0, 2]", "lower = [0, -2]\nupper = [0, 2.6]", "D-in-E"),
+        ("alpha = 0.9 ", "alpha = 1 ", "lemma1-discarding"),  # α = 1 breaks Lemma 1
+        ("gamma0 = 1 ", "gamma0 = 0.0499 ", "gamma0-above-star"),  # γ₀ below γ⋆
+    ],
+    ids=["input-outside-U", "D-outside-E", "alpha-one-breaks-lemma1", "gamma0-below-gamma-star"],
+)
+def test_spec_condition_fails_exactly_its_claim(tmp_path, old, new, failed):
+    text = TEXT.replace(old, new)
+    assert _design_failed(text, tmp_path) == {failed}
 
 
 def test_given_constants(tmp_path):
