@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 from flint import fmpq
 from typer.testing import CliRunner
@@ -11,15 +13,10 @@ from obsdesign.cli import app
 from obsdesign.errors import SpecError
 from obsdesign.sets import Box, Ellipsoid, Polytope, SymmetricPolytope
 
-GOOD = """
-[system]
-time = "discrete"
-A = [[0, 1], [1, 0]]
-C = [[1, 0]]
-[method]
-key = "lyapunov"
-L = [-1.87, 1.874]
-"""
+#: the smallest lyapunov spec; the tests below vary it (``[method]`` is its last table)
+GOOD = (Path(__file__).resolve().parent / "specs" / "lyapunov-minimal.toml").read_text(
+    encoding="utf-8"
+)
 
 
 def test_decimal_exactness():
