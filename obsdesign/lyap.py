@@ -112,15 +112,28 @@ def _sym(M: fmpq_mat) -> fmpq_mat:
 def decay_fmat(Acl: Any, P: Any, rate: Any, discrete: bool) -> fmpq_mat:
     """:func:`decay_matrix` for a given Acl = A − LC, as an ``fmpq_mat`` (exact, fast):
     λ²P − AclᵀPAcl (discrete, eq. (5)-(6) with w = 0, constrained-redesign paper, Astolfi et
-    al., NOLCOS 2019) or −(AclᵀP + PAcl + 2αP) (continuous).
+    al., NOLCOS 2019) or −(AclᵀP + PAcl + 2αP) (continuous), symmetrized as (M + Mᵀ)/2.
+
+    The products run over Z: with Acl = A_z/d_A, P = P_z/d_P and the rate p/q,
+    λ²P − AclᵀPAcl = (p² d_A² P_z − q² A_zᵀP_zA_z) / (q² d_A² d_P) and
+    −(AclᵀP + PAcl + 2αP) = −(q (A_zᵀP_z + P_zA_z) + 2p d_A P_z) / (q d_A d_P).
 
     :param Acl: the error dynamics matrix; :param P: symmetric n×n; :param rate: λ or α;
     :param discrete: time domain."""
     Am, Pm = fmat(Acl), fmat(P)
     r = Q(rate)
+    Az, da = Am.numer_denom()
+    Pz, dp = Pm.numer_denom()
+    rp, rq = r.p, r.q
     if discrete:
-        return _sym(Pm * (r * r) - Am.transpose() * Pm * Am)
-    return _sym(-(Am.transpose() * Pm + Pm * Am + Pm * (2 * r)))
+        Mz = Pz * (rp * rp * da * da) - (Az.transpose() * Pz * Az) * (rq * rq)
+        M = fmpq_mat(Mz) / (rq * rq * da * da * dp)
+    else:
+        Mz = -((Az.transpose() * Pz + Pz * Az) * rq + Pz * (2 * rp * da))
+        M = fmpq_mat(Mz) / (rq * da * dp)
+    if Pm == Pm.transpose():  # then M is symmetric already: (M + Mᵀ)/2 = M
+        return M
+    return _sym(M)
 
 
 def decay_matrix(

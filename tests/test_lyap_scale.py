@@ -129,3 +129,24 @@ def test_n100_riccati_design_and_verify() -> None:
     assert time.perf_counter() - t0 < 60
     best, other = rep.parameters["lambda_best"], rep.parameters["lambda_bracket"]
     assert 0 < best - other <= fmpq(1, 10**4)
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(1, 5), st.integers(0, 2**31 - 1), st.booleans(), st.booleans())
+def test_decay_fmat_is_the_formula(n: int, seed: int, discrete: bool, symmetric: bool) -> None:
+    """The integer-scaled products give exactly sym(λ²P − AclᵀPAcl) (continuous:
+    sym(−(AclᵀP + PAcl + 2αP))), also for a non-symmetric P and a non-dyadic rate."""
+    from obsdesign.certify.exact import symmetrize
+
+    rng = np.random.default_rng(seed)
+    Acl = qmat(rng.integers(-9, 10, (n, n))) / 7
+    P = qmat(rng.integers(-9, 10, (n, n))) / 11
+    if symmetric:
+        P = symmetrize(P)
+    r = fmpq(7, 9)
+    if discrete:
+        want = symmetrize(P * (r * r) - Acl.T @ P @ Acl)
+    else:
+        want = symmetrize(-(Acl.T @ P + P @ Acl + P * (2 * r)))
+    got = lyap.as_array(lyap.decay_fmat(Acl, P, r, discrete))
+    assert (got == qmat(want)).all()

@@ -239,9 +239,13 @@ def _gershgorin_certificate(F: Any, Mf: np.ndarray) -> PSDResult | None:
         return None
     z, k = _dyadic_int(R)
     Rz = fmpz_mat(n, n, z)
-    RtR = fmpq_mat(Rz.transpose() * Rz) / fmpq(fmpz(2) ** (2 * k))
-    Sz, _ = (F - RtR).numer_denom()  # S = Sz / d, d > 0: dominance of Sz is that of S
-    ent = [int(v) for v in Sz.entries()]
+    Fz, dF = F.numer_denom()  # F = Fz / dF
+    # S = F − RᵀR = (Fz·2^2k − dF·RzᵀRz) / (dF·2^2k) (k may be negative: scale the other side)
+    if k >= 0:
+        Sz = Fz * (fmpz(2) ** (2 * k)) - (Rz.transpose() * Rz) * dF
+    else:
+        Sz = Fz - (Rz.transpose() * Rz) * (dF * fmpz(2) ** (-2 * k))
+    ent = [int(v) for v in Sz.entries()]  # a positive multiple of S: same dominance
     for i in range(n):
         row = ent[i * n : (i + 1) * n]
         d = row[i]
