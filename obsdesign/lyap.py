@@ -80,12 +80,19 @@ def observable_mod_p(A: Any, C: Any) -> bool:
     Az, _ = Af.numer_denom()
     Cz, _ = Cf.numer_denom()
     Am = nmod_mat(n, n, [int(v) % PRIME for v in Az.entries()], PRIME)
-    block = nmod_mat(Cf.nrows(), n, [int(v) % PRIME for v in Cz.entries()], PRIME)
-    rows: list[Any] = []
-    for _ in range(n):
-        rows += block.entries()
-        block = block * Am
-    return nmod_mat(len(rows) // n, n, [int(v) for v in rows], PRIME).rank() == n
+    p = Cf.nrows()
+    Cm = nmod_mat(p, n, [int(v) % PRIME for v in Cz.entries()], PRIME)
+    # first one fixed combination c = Σ (i+1)·C_z[i] of the outputs: its Krylov rows
+    # c, cA, …, cA^{n−1} lie in the row space, so rank n of that n×n matrix is enough
+    # (generic A); else all p·n rows
+    for block in (nmod_mat(1, p, list(range(1, p + 1)), PRIME) * Cm, Cm):
+        rows: list[Any] = []
+        for _ in range(n):
+            rows += block.entries()
+            block = block * Am
+        if nmod_mat(len(rows) // n, n, [int(v) for v in rows], PRIME).rank() == n:
+            return True
+    return False
 
 
 def fmat(M: Any) -> fmpq_mat:
