@@ -273,8 +273,12 @@ def _lyap_solution(Acl: np.ndarray, rate: float, discrete: bool) -> np.ndarray |
 
     Af = np.asarray(Acl, dtype=float)
     n = Af.shape[0]
+    import warnings
+
     try:
-        with np.errstate(all="ignore"):
+        # a near-singular equation warns and perturbs; the exact check judges the answer
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
             if discrete:
                 X = solve_discrete_lyapunov((Af / rate).T, np.eye(n) / rate**2)
             else:
