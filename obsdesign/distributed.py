@@ -98,8 +98,13 @@ def dask_client(
     import dask
 
     # one task per worker thread at a time: when a worker dies, only the task it was running
-    # is suspected (and retried), not a queued one
-    with dask.config.set({"distributed.scheduler.worker-saturation": 1.0}):
+    # is suspected (and retried), not a queued one; no statistical profiler in the workers
+    # (it samples the running task every 10 ms for a dashboard we do not start)
+    cfg = {
+        "distributed.scheduler.worker-saturation": 1.0,
+        "distributed.worker.profile.enabled": False,
+    }
+    with dask.config.set(cfg):
         cluster = LocalCluster(
             n_workers=workers or 1,
             threads_per_worker=1,
