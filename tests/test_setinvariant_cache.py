@@ -184,3 +184,7 @@ def test_time_budget_refuses_with_reason() -> None:
         api.design(sp)
     rep = api.design(api.load_spec_text(SEED0, "s0.toml"))  # the default budget: converges
     assert rep.exit_code() == 0 and rep.parameters["iterations"] == 2
+    # converged in one iteration, then out of time in the exact Theorem 3.1 loop
+    sp = api.load_spec_text(RANDOM.replace("max_iterations = 60", "time_limit = 1e-9"), "r.toml")
+    with pytest.raises(SolverError, match=r"exact certificate not finished within 1e-09 s"):
+        api.design(sp)

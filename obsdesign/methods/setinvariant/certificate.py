@@ -16,6 +16,7 @@ above the float error, so a skipped entry is provably below the bound.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 from fractions import Fraction
 from itertools import product
@@ -224,6 +225,11 @@ def exact_lp9(G: np.ndarray, phi: list[fmpq], dl: list[fmpq]) -> tuple[fmpq, lis
     return po._q(x[n]), [po._q(t) for t in x[:n]]
 
 
+class BudgetExceeded(Exception):
+    """The design's time budget ran out inside :func:`theorem31` (argument: breakpoints
+    done)."""
+
+
 def theorem31(
     ex: ExactProblem,
     G: np.ndarray,
@@ -231,13 +237,15 @@ def theorem31(
     zs_given: list[fmpq] | None = None,
     v_solver=None,
     vrep: po.ExactVRep | None = None,
+    deadline: float | None = None,
 ) -> Theorem31Result:
     """Exact check of Theorem 3.1 for {G e <= 1} (single output).
 
     With ``vs`` given (verify), every breakpoint of Z_d must be in ``zs_given`` and the check
     uses the given v^l at the Z_d points. Without (design), v^l comes from the float LP (9)
     (``v_solver(G, phi, delta) -> EpsResult``), rounded by :func:`po.snap`, and from an exact
-    cdd.gmp LP wherever the rounded v does not pass.
+    cdd.gmp LP wherever the rounded v does not pass. ``deadline`` (design only): a
+    ``time.perf_counter()`` value checked before each breakpoint (:class:`BudgetExceeded`).
     """
     if vrep is None:
         vrep = po.exact_h_to_v(G)
@@ -274,6 +282,8 @@ def theorem31(
     out_vs: list[list[fmpq]] = []
     n_exact = 0
     for l in range(len(zs)):
+        if deadline is not None and time.perf_counter() > deadline:
+            raise BudgetExceeded(l)
         v = vs_use[l]
         vf = po.qfloat(np.array(v, dtype=object))
         val = sl.phi_float(l) + Gf @ vf + dlf

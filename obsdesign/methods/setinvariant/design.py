@@ -41,14 +41,23 @@ class Stage:
     res: Any
 
 
-def final_stage(data: Data, P: np.ndarray, single: bool, lam: float) -> Stage:
+def final_stage(
+    data: Data,
+    P: np.ndarray,
+    single: bool,
+    lam: float,
+    deadline: float | None = None,
+    o: Options | None = None,
+) -> Stage:
     """The polytope conv(Ω's vertices ∪ P), proved: Ω's vertices exactly, the other points
     snapped (po.snap), one exact hull (cdd.gmp) for G and the edges, then Theorem 3.1 at every
     z^l of Z_d with v^l from LP (9) (Section III, eq. (6), (9)). Without cdd.gmp: the float
     hull and Theorem 3.1 in float64 (numerical.float_stage).
 
     ``data``: float and exact problem; ``P``: float points (rows); ``single``: one output;
-    ``lam``: λ (float, for the float-only stage)."""
+    ``lam``: λ (float, for the float-only stage); ``deadline``: ``time.perf_counter()`` value
+    past which the exact Theorem 3.1 loop stops with a SolverError naming ``o.time_limit``
+    (checked between breakpoints; one cdd.gmp hull call is not interrupted)."""
     fl, ex = data.fl, data.ex
     if ex is None:
         Gf, resf, vrf = numerical.float_stage(fl, P, lam)
@@ -60,7 +69,16 @@ def final_stage(data: Data, P: np.ndarray, single: bool, lam: float) -> Stage:
     Gq, vrep = po.exact_hull(Pq)
     if not single:
         return Stage(Gq, vrep, None)
-    return Stage(Gq, vrep, ce.theorem31(ex, Gq, v_solver=lps.eps_batch, vrep=vrep))
+    try:
+        res = ce.theorem31(ex, Gq, v_solver=lps.eps_batch, vrep=vrep, deadline=deadline)
+    except ce.BudgetExceeded as e:
+        limit = f"{o.time_limit:g} s ([method] time_limit)" if o is not None else "the budget"
+        raise SolverError(
+            f"exact certificate not finished within {limit}: Theorem 3.1 checked at {e} of "
+            f"{2 * len(vrep.V)} or fewer breakpoints of a {len(Gq)}-facet polyhedron (raise "
+            "time_limit, or a larger λ or Δδ for a smaller polyhedron)"
+        ) from None
+    return Stage(Gq, vrep, res)
 
 
 @dataclass
@@ -94,20 +112,20 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
     fl = data.fl
     single = spec.system.p == 1
     lam, dd = float(o.lam), float(o.delta_tol)
-    dl = time.perf_counter() + o.time_limit  # the budget of the float iterations
+    dl = time.perf_counter() + o.time_limit  # the budget of the whole design
     run = _Run(Stage(np.zeros((0, fl.n)), None, None), 0, True)
     hist = run.history
     sym_failed = False
     if o.algorithm == "none":
         run.iterations = 1
-        run.stage = final_stage(data, np.zeros((0, fl.n)), single, lam)
+        run.stage = final_stage(data, np.zeros((0, fl.n)), single, lam, dl, o)
     elif o.algorithm == "symmetric":
         r = al.symmetric(
             fl, lam, lam * (1 + dd), o.max_iterations, progress, history=hist, deadline=dl
         )
         _budget(r, o)
         run.iterations, run.converged = r.iterations, r.converged
-        run.stage = final_stage(data, r.P, single, lam)
+        run.stage = final_stage(data, r.P, single, lam, dl, o)
         res = run.stage.res
         if r.converged and single and res is not None and not res.ok:
             sym_failed = True
@@ -133,7 +151,7 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
                 )  # fmt: skip
                 _budget(r, o)
                 run.iterations, run.converged = r.iterations, r.converged
-                run.stage = final_stage(data, r.P, single, lam)
+                run.stage = final_stage(data, r.P, single, lam, dl, o)
                 run.notes.append(
                     f"general algorithm (Section V) continued from C_K^∞: {r.iterations} "
                     "iterations in all"
@@ -147,7 +165,7 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
         )  # fmt: skip
         _budget(r, o)
         run.iterations, run.converged = r.iterations, r.converged
-        run.stage = final_stage(data, r.P, single, lam)
+        run.stage = final_stage(data, r.P, single, lam, dl, o)
     res = run.stage.res
     if single and o.strict and run.converged and res is not None and not res.ok:
         if o.algorithm != "none" and float(res.factor) <= lam * (1 + 2 * dd):
@@ -164,7 +182,7 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
                 )  # fmt: skip
                 _budget(r, o)
                 run.iterations, run.converged = r.iterations, r.converged
-                run.stage = final_stage(data, r.P, single, lam)
+                run.stage = final_stage(data, r.P, single, lam, dl, o)
     return run
 
 
