@@ -268,10 +268,7 @@ def _main(
     version: Annotated[
         bool,
         typer.Option(
-            "--version",
-            callback=_version,
-            is_eager=True,
-            help="Print the version and exit.",
+            "--version", callback=_version, is_eager=True, help="Print the version and exit."
         ),
     ] = False,
     debug: Annotated[bool, typer.Option("--debug", help="Show tracebacks on errors.")] = False,
@@ -300,16 +297,14 @@ def _main(
 @app.command()
 def design(
     spec: Annotated[
-        Path,
-        typer.Argument(metavar="SPEC", help="Spec file (TOML); - reads it from stdin."),
+        Path, typer.Argument(metavar="SPEC", help="Spec file (TOML); - reads it from stdin.")
     ],
     output: Annotated[
         Path | None,
         typer.Option("-o", "--output", metavar="FILE", help="Write the JSON report here."),
     ] = None,
     fmt: Annotated[
-        Fmt,
-        typer.Option("--format", help="Output format on stdout (json: the report only)."),
+        Fmt, typer.Option("--format", help="Output format on stdout (json: the report only).")
     ] = Fmt.text,
     plot: Annotated[
         Path | None,
@@ -370,8 +365,7 @@ def verify(
     report: Annotated[
         Path,
         typer.Argument(
-            metavar="REPORT",
-            help="JSON report written by 'design'; - reads it from stdin.",
+            metavar="REPORT", help="JSON report written by 'design'; - reads it from stdin."
         ),
     ],
     spec: Annotated[
@@ -668,8 +662,7 @@ def simulate(
         typer.Option("--report", metavar="REPORT", help="Use this report's parameters."),
     ] = None,
     plot: Annotated[
-        Path | None,
-        typer.Option("--plot", metavar="FILE", help="Write a plot (PNG/SVG)."),
+        Path | None, typer.Option("--plot", metavar="FILE", help="Write a plot (PNG/SVG).")
     ] = None,
     fmt: Annotated[Fmt, typer.Option("--format", help="Output format on stdout.")] = Fmt.text,
     option: Annotated[
@@ -681,8 +674,7 @@ def simulate(
         ),
     ] = None,
     force: Annotated[
-        bool,
-        typer.Option("--force", help="Write --plot even where it is refused by default."),
+        bool, typer.Option("--force", help="Write --plot even where it is refused by default.")
     ] = False,
     runs: Annotated[
         int | None,
@@ -755,9 +747,7 @@ def init(
     method: Annotated[
         str,
         typer.Argument(
-            metavar="METHOD",
-            help="Method key (see 'obsdesign methods').",
-            show_default=False,
+            metavar="METHOD", help="Method key (see 'obsdesign methods').", show_default=False
         ),
     ],
 ) -> None:
@@ -919,18 +909,22 @@ def _print_rows(rows: list[Any], fmt: Fmt) -> None:
 
     from obsdesign.report.render import console, esc
 
-    t = Table(title="obsdesign check")
-    for c in ("spec", "method", "verdict", "cert.", "num.", "failed", "result", "s"):
-        t.add_column(c, overflow="fold")
+    t = Table(title="obsdesign check", caption="claims: certified/numerical/failed")
+    # method, verdict and the claim counts never wrap; the spec path folds (no spaces in
+    # it) and the result wraps at spaces with twice the spec's share of the rest
+    t.add_column("spec", overflow="fold", ratio=1)
+    t.add_column("method", no_wrap=True)
+    t.add_column("verdict", no_wrap=True)
+    t.add_column("claims", no_wrap=True)
+    t.add_column("result", overflow="fold", ratio=2)
+    t.add_column("s", no_wrap=True)
     for r in rows:
         verdict = "[green]ok[/]" if r.code == 0 else f"[bold red]exit {r.code}[/]"
         t.add_row(
             esc(r.spec),
             esc(r.method),
             verdict,
-            str(r.certified),
-            str(r.numerical),
-            str(r.failed),
+            f"{r.certified}/{r.numerical}/{r.failed}",
             esc(r.summary if r.code == 0 else r.message),
             f"{r.seconds:.2f}",
         )
@@ -973,23 +967,14 @@ def _read_report(report: Path) -> Any:
 
 
 def _metrics_markdown(m: dict[str, Any]) -> str:
-    lines = [
-        "| state | sup \\|e_i\\| | RMSE | sup \\|x̂_i\\| |",
-        "| --- | --- | --- | --- |",
-    ]
+    lines = ["| state | sup \\|e_i\\| | RMSE | sup \\|x̂_i\\| |", "| --- | --- | --- | --- |"]
     for st, v in m["sup_abs_error"].items():
         lines.append(
             f"| {_md_cell(st)} | {v:.6g} | {m['rmse'][st]:.6g} | {m['sup_abs_estimate'][st]:.6g} |"
         )
     lines += ["", f"final \\|e\\| = {m['final_error_norm']:.6g}"]
     for k, v in m.items():
-        if k not in (
-            "sup_abs_error",
-            "rmse",
-            "final_error_norm",
-            "sup_abs_estimate",
-            "exit_code",
-        ):
+        if k not in ("sup_abs_error", "rmse", "final_error_norm", "sup_abs_estimate", "exit_code"):
             lines.append(f"- {_md_cell(k)}: {_md_cell(v)}")
     return "\n".join(lines) + "\n"
 
@@ -1015,13 +1000,7 @@ def _print_metrics(m: dict[str, Any]) -> None:
     c.print(t)
     c.print(f"final |e| = {m['final_error_norm']:.6g}")
     for k, v in m.items():
-        if k not in (
-            "sup_abs_error",
-            "rmse",
-            "final_error_norm",
-            "sup_abs_estimate",
-            "exit_code",
-        ):
+        if k not in ("sup_abs_error", "rmse", "final_error_norm", "sup_abs_estimate", "exit_code"):
             c.print(esc(f"{k}: {v}"))
 
 

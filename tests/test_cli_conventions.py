@@ -197,3 +197,20 @@ def test_early_interrupt_handler_installed_by_the_package():
         timeout=60,
     )
     assert r.stdout.strip() == "False"  # a library import leaves Ctrl-C alone
+
+
+def test_check_table_at_80_columns(spec: Path, tmp_path: Path):
+    si = tmp_path / "si.toml"
+    si.write_text(runner.invoke(app, ["init", "set-invariant"]).stdout)
+    out = _run("check", str(spec), str(si), "--width", "80")[1]
+    lines = out.splitlines()
+    assert max(len(x) for x in lines) <= 80
+    cells = {c.strip() for line in lines for c in re.split(r"[│┃]", line)}
+    assert {"lyapunov", "set-invariant", "ok"} <= cells  # never broken
+
+
+def test_simulate_from_stdin_json():
+    code, out, _ = _run("simulate", "-", "--format", "json", input=SPEC)
+    assert code == 0 and json.loads(out)["final_error_norm"] >= 0
+    code, out, _ = _run("simulate", "-", "-q", input=SPEC)
+    assert code == 0 and out == ""
