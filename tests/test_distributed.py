@@ -174,6 +174,7 @@ def test_cli_check_workers_2_on_specs_equals_serial():
     assert ra == rb and len(ra) == len(list(SPECS.glob("*.toml")))
 
 
+@pytest.mark.slow  # its own LocalCluster (seconds); the Ctrl-C test runs `sweep --workers 2` too
 def test_cli_sweep_workers_2_writes_the_serial_table(tmp_path: Path, serial12):
     out = tmp_path / "t.jsonl"
     r = CliRunner().invoke(
