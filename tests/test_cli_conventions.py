@@ -150,7 +150,11 @@ def test_did_you_mean(tmp_path: Path):
 
 
 def test_help_metavars_readable():
-    for cmd in ("design", "verify", "check", "simulate", "schema", "init", "methods", "--help"):
+    names = [c.name or c.callback.__name__ for c in app.registered_commands]
+    assert {"design", "verify", "check", "simulate", "schema", "init", "import", "methods"} <= set(
+        names
+    )
+    for cmd in [*names, "--help"]:
         out = runner.invoke(app, [cmd, "--help"] if cmd != "--help" else ["--help"]).stdout
         for bad in ("{", "<list[", "<path>", "<str>"):
             assert bad not in out, (cmd, bad)
