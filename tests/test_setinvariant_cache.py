@@ -184,7 +184,21 @@ def test_time_budget_refuses_with_reason() -> None:
         api.design(sp)
     rep = api.design(api.load_spec_text(SEED0, "s0.toml"))  # the default budget: converges
     assert rep.exit_code() == 0 and rep.parameters["iterations"] == 2
-    # converged in one iteration, then out of time in the exact Theorem 3.1 loop
+    # converged in one iteration, then no time left for the exact stage
     sp = api.load_spec_text(RANDOM.replace("max_iterations = 60", "time_limit = 1e-9"), "r.toml")
-    with pytest.raises(SolverError, match=r"exact certificate not finished within 1e-09 s"):
+    with pytest.raises(SolverError, match=r"exact certificate not started within 1e-09 s"):
         api.design(sp)
+
+
+def test_time_budget_inside_the_exact_theorem31_loop():
+    from obsdesign.methods.setinvariant import certificate as ce
+    from obsdesign.methods.setinvariant import lps
+    from obsdesign.methods.setinvariant.problem import build
+    from obsdesign.sets import polytope_ops as po
+
+    sp = api.load_spec_text(RANDOM, "r.toml")
+    ex = build(sp).ex
+    G, vrep = po.exact_hull(ex.Vo)
+    with pytest.raises(ce.BudgetExceeded):
+        ce.theorem31(ex, G, v_solver=lps.eps_batch, vrep=vrep, deadline=0.0)
+    assert ce.theorem31(ex, G, v_solver=lps.eps_batch, vrep=vrep, deadline=None).zs

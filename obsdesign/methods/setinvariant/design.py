@@ -56,8 +56,9 @@ def final_stage(
 
     ``data``: float and exact problem; ``P``: float points (rows); ``single``: one output;
     ``lam``: λ (float, for the float-only stage); ``deadline``: ``time.perf_counter()`` value
-    past which the exact Theorem 3.1 loop stops with a SolverError naming ``o.time_limit``
-    (checked between breakpoints; one cdd.gmp hull call is not interrupted)."""
+    past which the exact stage does not start, or its Theorem 3.1 loop stops, with a
+    SolverError naming ``o.time_limit`` (checked before the hull and between breakpoints; the
+    cdd.gmp hull call itself is not interrupted)."""
     fl, ex = data.fl, data.ex
     if ex is None:
         Gf, resf, vrf = numerical.float_stage(fl, P, lam)
@@ -66,13 +67,18 @@ def final_stage(
     P = np.asarray(P, dtype=float).reshape(-1, fl.n)
     near = np.array([np.abs(Vo_f - p).max(axis=1).min() <= 1e-9 for p in P], dtype=bool)
     Pq = np.vstack([ex.Vo, po.rationalize(P[~near])]) if (~near).any() else ex.Vo
+    limit = f"{o.time_limit:g} s ([method] time_limit)" if o is not None else "the budget"
+    if deadline is not None and time.perf_counter() > deadline:
+        raise SolverError(
+            f"exact certificate not started within {limit}: the iterations used the budget "
+            f"({len(P)} points to prove; raise time_limit, or a larger λ or Δδ)"
+        )
     Gq, vrep = po.exact_hull(Pq)
     if not single:
         return Stage(Gq, vrep, None)
     try:
         res = ce.theorem31(ex, Gq, v_solver=lps.eps_batch, vrep=vrep, deadline=deadline)
     except ce.BudgetExceeded as e:
-        limit = f"{o.time_limit:g} s ([method] time_limit)" if o is not None else "the budget"
         raise SolverError(
             f"exact certificate not finished within {limit}: Theorem 3.1 checked at {e} of "
             f"{2 * len(vrep.V)} or fewer breakpoints of a {len(Gq)}-facet polyhedron (raise "
