@@ -690,3 +690,18 @@ def test_simulate_runs_option(tmp_path: Path) -> None:
     assert out.exit_code == 0, out.output
     bad = runner.invoke(app, ["simulate", str(SEC5), "--option", "runs=0"])
     assert bad.exit_code == 2
+
+
+def test_simulate_runs_and_initial_error_from_the_spec() -> None:
+    """[simulate] runs = 6 and initial_error = "E0" (a box of [sets]): six runs, initial errors
+    drawn inside the box; an initial_error naming no set is a spec error."""
+    from obsdesign.errors import SpecError
+
+    text = SEC5.read_text().replace("[simulate]\n", '[simulate]\nruns = 6\ninitial_error = "E0"\n')
+    text += '\n[sets.E0]\ntype = "box"\nlower = [-2, -1]\nupper = [2, 1]\n'
+    res = api.simulate(load_spec_text(text, "mc.toml"))
+    e0 = res.extra["initial_errors"]
+    assert res.info["runs"] == 6 and e0.shape == (6, 2)
+    assert np.all(np.abs(e0[:, 0]) <= 2) and np.all(np.abs(e0[:, 1]) <= 1)
+    with pytest.raises(SpecError, match="initial_error"):
+        load_spec_text(text.replace('initial_error = "E0"', 'initial_error = "F"'), "mc.toml")
