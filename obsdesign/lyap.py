@@ -515,7 +515,10 @@ def best_rate(
     (:func:`_predict_certified`) stands in for the exact check at the midpoints it calls
     clearly certified; the exact check runs at the midpoints it calls failed and at the final
     certified end. If that final check fails, the search is rerun with exact checks at every
-    midpoint, so the result is always that of the all-exact bisection. At most
+    midpoint. Both reported ends are always decided exactly; the bracket equals that of the
+    all-exact bisection whenever certification is monotone in the rate (a forecast that
+    wrongly calls a midpoint certified goes unnoticed only if a lower rate then certifies
+    exactly). At most
     :data:`MAX_EXACT_CHECKS` exact checks (then :class:`InconclusiveError`).
 
     :param A, C, L: exact plant and gain; :param discrete: time domain; :param tol: bracket
