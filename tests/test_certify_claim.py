@@ -29,30 +29,10 @@ def test_status_values_and_ok():
 
 def test_exact_and_numerical_claim_fields():
     c = exact_claim("id1", "stmt", "ref", "check", F(1, 3), True, "det", float_ok=False)
-    assert c == Claim(
-        id="id1",
-        statement="stmt",
-        reference="ref",
-        check="check",
-        margin="1/3",
-        status=ClaimStatus.CERTIFIED,
-        detail="det",
-        float_ok=False,
-        extra={},
-    )
+    assert c == Claim("id1", "stmt", "ref", "check", "1/3", ClaimStatus.CERTIFIED, "det", False, {})
     assert exact_claim("i", "s", "r", "c", 0, True, "d").float_ok is None
     n = numerical_claim("id2", "stmt", "ref", "check", 0.5, False, "det")
-    assert n == Claim(
-        id="id2",
-        statement="stmt",
-        reference="ref",
-        check="check",
-        margin="0.5",
-        status=ClaimStatus.FAILED,
-        detail="det",
-        float_ok=False,
-        extra={},
-    )
+    assert n == Claim("id2", "stmt", "ref", "check", "0.5", ClaimStatus.FAILED, "det", False, {})
     assert numerical_claim("i", "s", "r", "c", 0, True, "d").float_ok is True
 
 
@@ -183,3 +163,24 @@ def test_matches_differs_adds_a_failed_claim():
         "scalar-vs-list-matches-spec",
     ]
     assert all(c.status is ClaimStatus.FAILED for c in cs)
+
+
+def test_checked_takes_verdict_and_detail_from_a_result():
+    from obsdesign.certify.psd import check_pd
+
+    cs = Claims()
+    good = cs.checked(
+        id="P", statement="P ≻ 0", reference="r", check="LDLᵀ", result=check_pd(qmat([[1]]))
+    )
+    bad_result = check_pd(qmat([[1, 0], [0, F(-1, 10**30)]]))
+    bad = cs.checked(
+        id="Q", statement="Q ≻ 0", reference="r", check="LDLᵀ", result=bad_result, margin=F(1, 3)
+    )
+    assert good == Claim(
+        "P", "P ≻ 0", "r", "LDLᵀ", "0", ClaimStatus.CERTIFIED, check_pd(qmat([[1]])).detail
+    )
+    assert bad_result.ok is False and bad_result.detail
+    assert bad == Claim(
+        "Q", "Q ≻ 0", "r", "LDLᵀ", "1/3", ClaimStatus.FAILED, bad_result.detail, None, {}
+    )
+    assert list(cs) == [good, bad]

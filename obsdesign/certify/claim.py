@@ -116,7 +116,8 @@ class Claims(list[Claim]):
     ``exact(...)`` records a claim decided by an exact check (certified or failed),
     ``numerical(...)`` one checked in floats only (numerical or failed), ``matches(...)`` the
     exact comparison of a reported value with the value the spec fixes (a mismatch is a failed
-    claim naming the key). Each returns the claim it added.
+    claim naming the key), ``checked(...)`` an exact claim decided by a check's result object
+    (``.ok``, ``.detail``). Each returns the claim it added.
     """
 
     def exact(
@@ -149,6 +150,21 @@ class Claims(list[Claim]):
         c = numerical_claim(id, statement, reference, check, margin, passed, detail)
         self.append(c)
         return c
+
+    def checked(
+        self, *, id: str, statement: str, reference: str, check: str, result: Any, margin: Any = 0
+    ) -> Claim:
+        """An exact claim decided by a check's result object: ``passed=result.ok`` and
+        ``detail=result.detail`` (e.g. the ``PSDResult`` of ``check_pd`` / ``check_psd``)."""
+        return self.exact(
+            id=id,
+            statement=statement,
+            reference=reference,
+            check=check,
+            passed=bool(result.ok),
+            margin=margin,
+            detail=result.detail,
+        )
 
     def failed(self, *, id: str, statement: str, reference: str, detail: str) -> Claim:
         """A claim that cannot be checked at all (missing or malformed data): failed."""
