@@ -148,14 +148,12 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     v_max, v_min, theta = Q(val["v_max"]), Q(val["v_min"]), Q(val["theta"])
 
     # -- Assumption 2: P, the decay LMI, inequality (5) -----------------------------------
-    r = check_pd(P, o.margin)
-    c.exact(
+    c.checked(
         id="P-positive-definite",
         statement="P ≻ 0",
         reference=_ref("eq. (4)"),
         check="exact LDLᵀ over Q",
-        passed=r.ok,
-        detail=r.detail,
+        result=check_pd(P, o.margin),
     )
     if o.model is not None and o.model.nonlinear:
         _iss_sampled(c, spec, P, rho, mu, v_max)
@@ -299,14 +297,12 @@ def _linear_claims(c: Claims, spec: Spec, P: Any, rho: fmpq, mu: fmpq, lam: fmpq
     s = spec.system
     A, C, L = s.A.q, s.C.q, o.L
     if o.P is None and lam is not None:
-        r = check_pd(lyap.decay_matrix(A, C, L, P, lam, True), o.margin)
-        c.exact(
+        c.checked(
             id="decay-lmi",
             statement=f"(A−LC)ᵀP(A−LC) ⪯ λ²P with λ = {fmt_up(lam, 10)}",
             reference=_ref("Section 5"),
             check="exact LDLᵀ over Q of λ²P − (A−LC)ᵀP(A−LC) − margin·I",
-            passed=r.ok,
-            detail=r.detail,
+            result=check_pd(lyap.decay_matrix(A, C, L, P, lam, True), o.margin),
         )
         if o.rho is None:
             c.exact(
@@ -396,14 +392,12 @@ def _convexity(c: Claims, cm: ConstraintMap) -> None:
             detail=f"{cm.n_c} components",
         )
         return
-    r = check_pd(cm.Q_q)
-    c.exact(
+    c.checked(
         id="c-convex",
         statement="c = max(xᵀQx/r − 1, 0)² is convex (Q ≻ 0)",
         reference=_ref("Assumption 3(3), Lemma 1"),
         check="exact LDLᵀ of Q",
-        passed=r.ok,
-        detail=r.detail,
+        result=check_pd(cm.Q_q),
     )
 
 

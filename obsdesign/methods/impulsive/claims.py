@@ -169,24 +169,13 @@ def certify_window(p: Problem, P: dict[str, Any], c: Claims | None = None) -> Cl
     if not p.optimize_scaling:
         c.matches("theta_o", P["theta_o"], 1, '[method].qsr_scaling = "as-given"')
         c.matches("theta_n", P["theta_n"], 1, '[method].qsr_scaling = "as-given"')
-    r = check_pd(-data.qsr_o.Q)
-    c.exact(
-        id="Q_o-negative-definite",
-        statement="Q_o ≺ 0",
-        reference=_ref("Lemma 2"),
-        check="exact LDLᵀ",
-        passed=r.ok,
-        detail=r.detail,
-    )
-    r = check_psd(-data.qsr_n.Q)
-    c.exact(
-        id="Q_n-negative-semidefinite",
-        statement="Q_n ⪯ 0",
-        reference=_ref("Assumption 1"),
-        check="exact LDLᵀ",
-        passed=r.ok,
-        detail=r.detail,
-    )
+    for cid, statement, place, result in (
+        ("Q_o-negative-definite", "Q_o ≺ 0", "Lemma 2", check_pd(-data.qsr_o.Q)),
+        ("Q_n-negative-semidefinite", "Q_n ⪯ 0", "Assumption 1", check_psd(-data.qsr_n.Q)),
+    ):
+        c.checked(
+            id=cid, statement=statement, reference=_ref(place), check="exact LDLᵀ", result=result
+        )
     th_o, th_n = Q(P["theta_o"]), Q(P["theta_n"])
     varpi, kappa_n = Q(P["varpi_o"]), Q(P["kappa_n"])
     ok, det = _ssd(co.Ao, data.qsr_o, th_o, -varpi, "θ_o")

@@ -204,15 +204,13 @@ def lmi_claims(
         g = pr.exact("gamma2", c)
         if g is not None:
             M3 = lmis.l2_gain(s.A.q, s.C.q, s.Bd.q, P, X, _scalar(g), disc)
-            r = check_pd(-M3)
-            c.exact(
+            c.checked(
                 id="l2-gain",
                 statement="the L2 gain from d to e of the Luenberger part (gain K) is ≤ γ with "
                 f"γ² ≤ {fmt_up(_scalar(g), 8)}",
                 reference=f"{PAPER}, criterion 4 (bounded real lemma)",
                 check="exact LDLᵀ of the bounded-real-lemma matrix",
-                passed=r.ok,
-                detail=r.detail,
+                result=check_pd(-M3),
             )
     if full_check and o.lam is None:
         c += lambda_max_claims(spec, pr)
