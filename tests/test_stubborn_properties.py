@@ -30,6 +30,31 @@ def _spec(A: np.ndarray, C: np.ndarray, extra: str = "") -> str:
     )
 
 
+def _not_certified(rep: api.Report) -> list[str]:
+    """Ids of the claims that failed or are numerical only (bar the float λ_max bracket)."""
+    return [
+        c.id
+        for c in rep.claims
+        if c.status == ClaimStatus.FAILED
+        or (c.status == ClaimStatus.NUMERICAL and c.id != "lambda-max-bracket")
+    ]
+
+
+def _noise_free_errors(g: sim.Gains, e0: np.ndarray, steps: int, dt: float) -> np.ndarray:
+    """The stubborn observer's error from e0 with no noise and no saturation bound."""
+    _, e, _ = sim.run_errors(
+        g,
+        e0,
+        lambda k0, k1: np.zeros((k1 - k0, 1)),
+        steps,
+        dt,
+        np.full(1, np.inf),
+        np.array(True),
+        sim.default_sigma0(g, e0),
+    )
+    return e
+
+
 @settings(max_examples=3, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
     a=st.lists(ints, min_size=4, max_size=4),
@@ -43,28 +68,13 @@ def test_detectable_pair_certified_and_gas(a: list[int], c: list[int], e0: list[
     assume(np.linalg.norm(e0) > 0.1)
     sp = api.load_spec_text(_spec(A, C), "p.toml")
     rep = api.design(sp)
-    bad = [
-        c.id
-        for c in rep.claims
-        if c.status == ClaimStatus.FAILED
-        or (c.status == ClaimStatus.NUMERICAL and c.id != "lambda-max-bracket")
-    ]
-    assert not bad
+    assert not _not_certified(rep)
     g = sim.Gains.of(sp, rep.parameters)
     e0a = np.asarray(e0)
     T = 10.0 + 20.0 / g.lam  # a few time constants of σ̄
     dt = 1e-3
     steps = int(T / dt)
-    _, e, _ = sim.run_errors(
-        g,
-        e0a,
-        lambda k0, k1: np.zeros((k1 - k0, 1)),
-        steps,
-        dt,
-        np.full(1, np.inf),
-        np.array(True),
-        sim.default_sigma0(g, e0a),
-    )
+    e = _noise_free_errors(g, e0a, steps, dt)
     assert np.linalg.norm(e) <= 1e-3 * np.linalg.norm(e0a)
 
 
@@ -99,24 +109,9 @@ def test_discrete_redesign_certified_and_gas() -> None:
     )
     sp = api.load_spec_text(text, "d.toml")
     rep = api.design(sp)
-    bad = [
-        c.id
-        for c in rep.claims
-        if c.status == ClaimStatus.FAILED
-        or (c.status == ClaimStatus.NUMERICAL and c.id != "lambda-max-bracket")
-    ]
-    assert not bad
+    assert not _not_certified(rep)
     assert "gain-bound" not in {c.id for c in rep.claims}  # redesign: K is the spec's
     g = sim.Gains.of(sp, rep.parameters)
     e0 = np.array([3.0, -2.0])
-    _, e, _ = sim.run_errors(
-        g,
-        e0,
-        lambda k0, k1: np.zeros((k1 - k0, 1)),
-        400,
-        1.0,
-        np.full(1, np.inf),
-        np.array(True),
-        sim.default_sigma0(g, e0),
-    )
+    e = _noise_free_errors(g, e0, 400, 1.0)
     assert np.linalg.norm(e) <= 1e-6 * np.linalg.norm(e0)
