@@ -22,11 +22,15 @@ ints = st.integers(min_value=-3, max_value=3)
 
 
 def _spec(A: np.ndarray, C: np.ndarray, extra: str = "") -> str:
+    """The Proposition (feasible iff detectable) has no gain bound; the design needs one to
+    bound λ. Integer plants up to ±3 can need ‖K‖₂ > 100 (the default) under P ⪰ I, e.g.
+    A = [[3, 2], [-3, 2]], C = [1, 0] (infeasible at 100, certified at 1000), so the property
+    is checked with gain_bound = 1000."""
     rows = ", ".join("[" + ", ".join(str(int(v)) for v in r) + "]" for r in A)
     crow = ", ".join(str(int(v)) for v in C[0])
     return (
         f'[system]\ntime = "continuous"\nA = [{rows}]\nC = [[{crow}]]\n'
-        f'[method]\nkey = "stubborn"\nlambda_tol = 0.1\n{extra}'
+        f'[method]\nkey = "stubborn"\nlambda_tol = 0.1\ngain_bound = 1000\n{extra}'
     )
 
 
