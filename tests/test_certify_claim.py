@@ -184,3 +184,20 @@ def test_checked_takes_verdict_and_detail_from_a_result():
         "Q", "Q ≻ 0", "r", "LDLᵀ", "1/3", ClaimStatus.FAILED, bad_result.detail, None, {}
     )
     assert list(cs) == [good, bad]
+
+
+def test_missing_claim_is_failed():
+    from obsdesign.certify.claim import missing_claim
+
+    assert missing_claim("P") == Claim(
+        "P-present",
+        "the report gives P",
+        "report",
+        "presence",
+        "0",
+        ClaimStatus.FAILED,
+        "P missing",
+        False,
+        {},
+    )
+    assert missing_claim("lambda_best").ok is False

@@ -347,6 +347,10 @@ def test_random_systems_against_float_pbh(
     N, Au = unobservable_restriction(A, C)
     Af = fmpq_mat(n, n, list(qmat(A).flat))
     assert Af * N == N * Au and N.ncols() == res.unobservable_dim
+    Cf = fmpq_mat(qmat(C).tolist())
+    assert all(v == 0 for v in (Cf * N).entries())  # N spans a subspace of ker C
+    if N.ncols():
+        assert N.rank() == N.ncols()
 
 
 def test_n20_is_fast():
@@ -394,3 +398,20 @@ def test_reasons_defaults_and_small_sizes():
     assert (r.observable, r.detectable, r.unobservable_dim) == (False, True, 1)
     r = detectability(np.empty((0, 0), dtype=object), np.empty((1, 0), dtype=object))
     assert (r.observable, r.detectable, r.unobservable_dim) == (True, True, 0)
+
+
+def test_rational_echelon_form_and_kernel():
+    """A row space whose reduced echelon form is not integral (den ≠ 1 over Z)."""
+    A = qmat([[0, 0, 0], [0, 0, 0], [0, 0, 0]])
+    C = qmat([[2, 1, 0], [0, 3, 4]])
+    V = observable_rowspace(A, C)
+    assert V.tolist() == [[1, 0, F(-2, 3)], [0, 1, F(4, 3)]]
+    N, Au = unobservable_restriction(A, C)
+    assert N.tolist() == [[F(2, 3)], [F(-4, 3)], [1]]
+    Cf = fmpq_mat(C.tolist())
+    assert (Cf * N).tolist() == [[0], [0]]
+    A2 = qmat([[F(1, 2), 0, 1], [0, F(1, 3), 0], [0, 0, F(1, 5)]])
+    N2, Au2 = unobservable_restriction(A2, [[0, 0, 1]])
+    A2f = fmpq_mat(A2.tolist())
+    assert A2f * N2 == N2 * Au2 and N2.ncols() == 2
+    assert (fmpq_mat([[0, 0, 1]]) * N2).tolist() == [[0, 0]]
