@@ -337,6 +337,17 @@ TAMPERS: list[tuple[str, str, Callable, set[str]]] = [
         lambda p, s: _tamper_decay(p, s, "P_best", "lambda_best"),
         {"decay-lmi_best"},
     ),
+    # zero width: the end equals the certified rate (feasible), so only the (0, rate_tol]
+    # width check catches it (kills the `0 < width` → `0 <= width` mutant, docs/mutation.md)
+    (
+        "bracket of zero width",
+        "sec5",
+        lambda p, s: (
+            p.__setitem__("lambda_bracket_kind", "not-certifiable"),
+            p.__setitem__("lambda_bracket", Q(p["lambda_best"])),
+        ),
+        {"lambda_best-bracket"},
+    ),
     (
         "bracket on the wrong side",
         "sec5",
