@@ -687,6 +687,14 @@ def simulate(
             "[simulate] seed; prints quantiles of the per-run metrics.",
         ),
     ] = None,
+    study: Annotated[
+        str | None,
+        typer.Option(
+            "--study",
+            metavar="NAME",
+            help="A method's study (same as --option study=NAME), e.g. 'outliers' for stubborn.",
+        ),
+    ] = None,
     quiet: QuietOpt = False,
     width: WidthOpt = None,
 ) -> None:
@@ -702,6 +710,8 @@ def simulate(
         opts = _kv(option or [])
         if runs is not None:
             opts["runs"] = str(runs)
+        if study is not None:
+            opts["study"] = study
         res = api.simulate(sp, report, options=opts)
         m = res.metrics()
         if fmt == Fmt.json:

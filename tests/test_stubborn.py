@@ -382,16 +382,20 @@ def test_printed_numbers_are_true(ex1: Report, ex4: Report) -> None:
     assert g >= ex4.parameters["gamma2"]
 
 
-def test_study_option_via_cli_json(tmp_path: Path) -> None:
+@pytest.mark.parametrize("how", [["--option", "study=outliers"], ["--study", "outliers"]])
+def test_study_option_via_cli_json(tmp_path: Path, how: list[str]) -> None:
     text = EX1.read_text().replace("runs = 100", "runs = 3").replace("horizon = 10", "horizon = 2")
     f = tmp_path / "s.toml"
     f.write_text(text)
-    r = CliRunner().invoke(
-        app, ["simulate", str(f), "--option", "study=outliers", "--format", "json"]
-    )
+    r = CliRunner().invoke(app, ["simulate", str(f), *how, "--format", "json"])
     assert r.exit_code == 0, r.output
     out = json.loads(r.output)
     assert "outlier_study" in out and "stubborn" in out["outlier_study"]
+
+
+def test_study_unknown_to_the_method_is_bad_input(tmp_path: Path) -> None:
+    r = CliRunner().invoke(app, ["simulate", str(EX1), "--study", "nonesuch"])
+    assert r.exit_code == 2
 
 
 @pytest.mark.slow
