@@ -31,8 +31,8 @@ class SearchSpace(Method):
     key = "search-space"
     title = "Search-space (discarding) observer: ΔT, Δτ = KΔT, γ/ε schedule, hypercube grid"
     paper = (
-        "Hernández, García: An alternative approach to the state observation problem for "
-        "Lipschitz continuous systems with controls (paper 004)"
+        "Hernández, García, An alternative approach to the state observation problem for "
+        "Lipschitz continuous systems with controls"
     )
     Options = _opts.Options
     SimOptions = _opts.SimOptions

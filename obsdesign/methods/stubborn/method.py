@@ -16,7 +16,10 @@ from obsdesign.spec.reader import Table
 class Stubborn(Method):
     key = "stubborn"
     title = "Stubborn observer: K = P⁻¹X, λ, R, W = diag(w_i) by LMIs; high-gain redesign"
-    paper = "002 (Astolfi, Alessandri, Zaccarian, Stubborn observers for linear and nonlinear systems, WUDS 2017)"
+    paper = (
+        "Astolfi, Alessandri, Zaccarian, Stubborn observers for linear and nonlinear systems, "
+        "slides, WUDS 2017"
+    )
     Options = _opts.Options
     SimOptions = _opts.SimOptions
     needs_linear = False  # the high-gain mode reads f / psi; linear modes check A, C themselves
