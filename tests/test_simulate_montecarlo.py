@@ -3,6 +3,8 @@ batching and of the run count, initial errors from a declared set, known quantil
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -12,12 +14,10 @@ from obsdesign.simulate import montecarlo as mc
 from obsdesign.simulate.linear import joint_system, simulate_linear_observer
 from obsdesign.spec.reader import Table
 
-BASE = """
-[system]
-time = "discrete"
-A = [[0.5, 1], [0, 0.8]]
-C = [[1, 0]]
-Bd = [[1], [0]]
+PLANT = Path(__file__).parent / "specs" / "simulate-plant.toml"
+BASE = (
+    PLANT.read_text()
+    + """
 [sets.E0]
 type = "box"
 lower = [-2, -1]
@@ -27,9 +27,6 @@ type = "box"
 dim = 1
 lower = [-1]
 upper = [1]
-[method]
-key = "lyapunov"
-L = [0.6, 0.1]
 [simulate]
 horizon = 600
 x0 = [1, -1]
@@ -38,6 +35,7 @@ seed = 11
 [simulate.noise]
 kind = "NOISE"
 """
+)
 L = np.array([[0.6], [0.1]])
 RANDOM = BASE.replace('kind = "NOISE"', 'kind = "uniform"\nbound = 0.05')
 FIXED = BASE.replace('kind = "NOISE"', 'kind = "constant"\nvalue = [0.02]')

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -12,21 +14,17 @@ from obsdesign.api import load_spec_text
 from obsdesign.simulate.linear import simulate_linear_observer
 from obsdesign.simulate.result import metrics
 
-BASE = """
-[system]
-time = "discrete"
-A = [[0.5, 1], [0, 0.8]]
-C = [[1, 0]]
-Bd = [[1], [0]]
-[method]
-key = "lyapunov"
-L = [0.6, 0.1]
+PLANT = Path(__file__).parent / "specs" / "simulate-plant.toml"
+BASE = (
+    PLANT.read_text()
+    + """
 [simulate]
 horizon = 50
 x0 = [1, -1]
 xhat0 = [0, 0]
 seed = 3
 """
+)
 
 
 def test_windows_are_inclusive_and_add():
