@@ -24,44 +24,16 @@ from pathlib import Path
 
 import numpy as np
 
+from obsdesign.methods.setinvariant.spectext import spec_text
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def _spec_text(A: np.ndarray, B1: np.ndarray, C: np.ndarray, lam: float) -> str:
-    def fmt(M: np.ndarray) -> str:
-        return (
-            "["
-            + ", ".join("[" + ", ".join(repr(float(v)) for v in r) + "]" for r in np.atleast_2d(M))
-            + "]"
-        )
-
-    n = A.shape[0]
-    return f"""
-[system]
-time = "discrete"
-A = {fmt(A)}
-B1 = {fmt(B1.T)[1:-1]}
-C = {fmt(C)}
-[sets.omega]
-type = "box"
-lower = {[-1.0] * n}
-upper = {[1.0] * n}
-[sets.D]
-type = "box"
-dim = 1
-lower = [-1]
-upper = [1]
-[method]
-key = "set-invariant"
-omega = "omega"
-disturbance = "D"
-eta_bar = 0.01
-lambda = {lam}
-algorithm = "general"
-mirror = true
-delta_tol = 0.001
-max_iterations = 60
-"""
+    """The benchmark's spec: the general algorithm with mirrored images, Δδ = 1e-3, ≤ 60 iterations."""
+    return spec_text(
+        A, B1, C, lam, algorithm="general", mirror=True, delta_tol=0.001, max_iterations=60
+    )
 
 
 def random_system(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:

@@ -16,6 +16,7 @@ from obsdesign.api import load_spec_text
 from obsdesign.certify.claim import ClaimStatus
 from obsdesign.errors import InfeasibleError, SolverError, SpecError
 from obsdesign.methods.setinvariant import laws
+from obsdesign.methods.setinvariant.spectext import spec_text as matrix_spec_text
 
 
 @pytest.fixture(scope="module")
@@ -272,14 +273,6 @@ def test_necessary_condition_and_not_converged():
 
 
 # -- property tests (Proposition 4.1) ------------------------------------------------------
-def _fmt(M: np.ndarray) -> str:
-    return (
-        "["
-        + ", ".join("[" + ", ".join(repr(float(v)) for v in r) + "]" for r in np.atleast_2d(M))
-        + "]"
-    )
-
-
 @st.composite
 def systems(draw):
     n = draw(st.sampled_from([2, 3]))
@@ -317,32 +310,18 @@ def _check_system(sys_, maxit: int = 6) -> bool:
     """Design, and if certified simulate; returns whether the simulation part ran."""
     A, B1, C, b, eta, seed = sys_
     n = A.shape[0]
-    text = f"""
-[system]
-time = "discrete"
-A = {_fmt(A)}
-B1 = {_fmt(B1.T)[1:-1]}
-C = {_fmt(C)}
-[sets.omega]
-type = "box"
-lower = {[-1.0] * n}
-upper = {[1.0] * n}
-[sets.D]
-type = "box"
-dim = 1
-lower = [{-b}]
-upper = [{b}]
-[method]
-key = "set-invariant"
-omega = "omega"
-disturbance = "D"
-eta_bar = {eta}
-lambda = 0.9
-algorithm = "general"
-mirror = true
-delta_tol = 0.001
-max_iterations = {maxit}
-"""
+    text = matrix_spec_text(
+        A,
+        B1,
+        C,
+        0.9,
+        bound=b,
+        eta_bar=eta,
+        algorithm="general",
+        mirror=True,
+        delta_tol=0.001,
+        max_iterations=maxit,
+    )
     try:
         sp = load_spec_text(text, "prop.toml")
         rep = api.design(sp)
@@ -398,3 +377,25 @@ def test_template_options_uncommented_still_load():
         t = "\n".join(ln[2:] if i in idx else ln for i, ln in enumerate(lines))
         jsonschema.validate(tomllib.loads(t), api.schema())
         load_spec_text(t, "template.toml")
+
+
+def test_spec_text_builder_round_trips_exact_values():
+    """``spectext.spec_text`` writes every matrix entry, bound, η̄, λ and method key so that
+    the loaded spec holds exactly those values."""
+    text = matrix_spec_text(
+        np.array([[0.5, 0.1], [0.0, 0.5]]),
+        [1, 0.25],
+        [[1, 0]],
+        0.9,
+        bound=0.1,
+        algorithm="general",
+        mirror=True,
+        max_iterations=5,
+    )
+    sp = load_spec_text(text, "built.toml")
+    assert sp.system.A.q.tolist() == [[fmpq(1, 2), fmpq(1, 10)], [0, fmpq(1, 2)]]
+    o = sp.options
+    assert list(o.D.lower_q) == [fmpq(-1, 10)] and list(o.D.upper_q) == [fmpq(1, 10)]
+    assert (o.eta_bar, o.lam) == (fmpq(1, 100), fmpq(9, 10))
+    assert (o.algorithm, o.mirror, o.max_iterations) == ("general", True, 5)
+    assert "eta_bar" not in matrix_spec_text([[0.5]], [1], [[1]], 0.9, eta_bar=None)

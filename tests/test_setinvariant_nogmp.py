@@ -161,19 +161,7 @@ def test_float_backend_checks_the_whole_table(nogmp, tmp_path):
     assert _float_failed(d, tmp_path) == {"injection-table"}
 
 
-NODIST = """
-[system]
-time = "discrete"
-A = [[0.7, 0.7], [-0.7, 0.7]]
-C = [[1, 1]]
-[sets.omega]
-type = "symmetric-polytope"
-Q = [[1, 0], [0, 1]]
-[method]
-key = "set-invariant"
-omega = "omega"
-lambda = 0.9
-"""
+NODIST = (SPEC71.parents[1] / "tests" / "specs" / "setinvariant-nodist.toml").read_text()
 
 
 def _tamper_float(d: dict, how: str) -> None:

@@ -26,6 +26,7 @@ from obsdesign.methods.setinvariant import certificate as ce
 from obsdesign.methods.setinvariant import laws
 from obsdesign.methods.setinvariant.claims import TABLE
 from obsdesign.methods.setinvariant.problem import build, necessary_condition
+from obsdesign.methods.setinvariant.spectext import spec_text
 from obsdesign.params import Parameters
 from obsdesign.report.model import Report
 
@@ -33,21 +34,8 @@ ROOT = Path(__file__).resolve().parents[1]
 SPEC71 = ROOT / "specs" / "dorea-pimenta-7-1.toml"
 runner = CliRunner()
 
-# Example 7.1 without disturbance: contractivity is then scale-invariant, so a polyhedron
-# shrunk by a hair stays λ-contractive and only Ω ⊆ {G e <= 1} becomes false
-NODIST = """
-[system]
-time = "discrete"
-A = [[0.7, 0.7], [-0.7, 0.7]]
-C = [[1, 1]]
-[sets.omega]
-type = "symmetric-polytope"
-Q = [[1, 0], [0, 1]]
-[method]
-key = "set-invariant"
-omega = "omega"
-lambda = 0.9
-"""
+# Example 7.1 without disturbance (only Ω ⊆ {G e <= 1} can be made false by shrinking)
+NODIST = (ROOT / "tests" / "specs" / "setinvariant-nodist.toml").read_text()
 
 TINY = fmpq(1, 10**12)  # relative size of every tamper: false in exact AND in float64
 
@@ -525,27 +513,14 @@ def test_disturbance_name_must_be_a_polyhedron_in_sets() -> None:
 def test_multi_output_needs_its_linear_law(tmp_path: Path) -> None:
     """p = n − 1 = 2 outputs: the linear law is the only injection; a report without L (or
     with L just outside the admissible set) fails linear-law."""
-    text = """
-[system]
-time = "discrete"
-A = [[0.5, 0.1, 0], [0, 0.5, 0], [0, 0, 0.5]]
-B1 = [1, 1, 1]
-C = [[1, 0, 0], [0, 1, 0]]
-[sets.omega]
-type = "box"
-lower = [-1, -1, -1]
-upper = [1, 1, 1]
-[sets.D]
-type = "box"
-dim = 1
-lower = [-0.1]
-upper = [0.1]
-[method]
-key = "set-invariant"
-omega = "omega"
-disturbance = "D"
-lambda = 0.9
-"""
+    text = spec_text(
+        [[0.5, 0.1, 0], [0, 0.5, 0], [0, 0, 0.5]],
+        [1, 1, 1],
+        [[1, 0, 0], [0, 1, 0]],
+        0.9,
+        bound=0.1,
+        eta_bar=None,
+    )
     out = tmp_path / "m.json"
     rep = api.design(api.load_spec_text(text, "m.toml"), out)
     assert rep.exit_code() == 0
