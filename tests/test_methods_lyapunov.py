@@ -30,6 +30,25 @@ SEC5 = ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml"
 runner = CliRunner()
 EPS = fmpq(1, 2**60)
 
+
+def _fmt(M: np.ndarray | str) -> str:
+    """A matrix as a TOML array of rows (``repr`` of each float: exact round trip); a string
+    is taken as already written."""
+    if isinstance(M, str):
+        return M
+    return "[" + ", ".join("[" + ", ".join(repr(float(v)) for v in r) + "]" for r in M) + "]"
+
+
+def _designed(
+    A: np.ndarray | str, C: np.ndarray | str, time: str = "discrete", extra: str = ""
+) -> str:
+    """A lyapunov spec for (A, C); ``extra`` holds further ``[method]`` lines."""
+    return (
+        f'[system]\ntime = "{time}"\nA = {_fmt(A)}\nC = {_fmt(C)}\n'
+        f'[method]\nkey = "lyapunov"\n{extra}'
+    )
+
+
 IDS = [
     "P-positive-definite",
     "decay-lmi",
@@ -122,16 +141,9 @@ def test_printed_numbers_are_exact_or_safe(extra: str) -> None:
 def test_asked_rate_just_above_the_spectral_radius() -> None:
     """ρ(A − LC) = 0.9999999 and λ = 0.99999991: checked directly (was refused: "no decay
     rate below 1 certifies"); the best rate is the asked one, bracketed by 0.99999."""
-    text = """
-[system]
-time = "discrete"
-A = [[0.9999999, 0], [0, 0.5]]
-C = [[0, 1]]
-[method]
-key = "lyapunov"
-L = [0, 0]
-lambda = 0.99999991
-"""
+    text = _designed(
+        "[[0.9999999, 0], [0, 0.5]]", "[[0, 1]]", extra="L = [0, 0]\nlambda = 0.99999991\n"
+    )
     rep = api.design(load_spec_text(text))
     assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
     p = rep.parameters
@@ -407,24 +419,7 @@ def test_missing_mu_fails_when_the_spec_asks_for_it() -> None:
 
 
 def _spec(A, C, L, extra=""):
-    def fmt(M):
-        return (
-            "[" + ", ".join("[" + ", ".join(repr(float(v)) for v in row) + "]" for row in M) + "]"
-        )  # noqa: E731
-
-    return load_spec_text(
-        f"""
-[system]
-time = "discrete"
-A = {fmt(A)}
-C = {fmt(C)}
-[method]
-key = "lyapunov"
-L = {fmt(L)}
-{extra}
-""",
-        "prop.toml",
-    )
+    return load_spec_text(_designed(A, C, extra=f"L = {_fmt(L)}\n{extra}\n"), "prop.toml")
 
 
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -460,15 +455,7 @@ def test_requested_rate_below_spectral_radius_is_infeasible():
 
 
 def test_designed_gain_discrete_and_undetectable():
-    text = """
-[system]
-time = "discrete"
-A = [[1.1, 1], [0, 0.9]]
-C = [[1, 0]]
-[method]
-key = "lyapunov"
-lambda = 0.5
-"""
+    text = _designed("[[1.1, 1], [0, 0.9]]", "[[1, 0]]", extra="lambda = 0.5\n")
     rep = api.design(load_spec_text(text))
     assert all(c.status == ClaimStatus.CERTIFIED for c in rep.claims)
     L = rep.parameters.float("L")
@@ -485,17 +472,12 @@ lambda = 0.5
 
 
 def test_continuous_given_gain_and_iss():
-    text = """
-[system]
-time = "continuous"
-A = [[0, 1], [-2, -0.1]]
-C = [[1, 0]]
-[method]
-key = "lyapunov"
-L = [3, 2]
-alpha = 0.5
-iss_gain = true
-"""
+    text = _designed(
+        "[[0, 1], [-2, -0.1]]",
+        "[[1, 0]]",
+        "continuous",
+        "L = [3, 2]\nalpha = 0.5\niss_gain = true\n",
+    )
     rep = api.design(load_spec_text(text))
     assert all(c.status == ClaimStatus.CERTIFIED for c in rep.claims)
     eig = np.linalg.eigvals(
@@ -524,13 +506,7 @@ def test_designed_gain_random_observable_systems(n: int, seed: int, time: str):
     rng = np.random.default_rng(seed)
     A = rng.standard_normal((n, n)) * 1.2 / np.sqrt(n)
     C = rng.standard_normal((1, n))
-
-    def fmt(M):
-        return (
-            "[" + ", ".join("[" + ", ".join(repr(float(v)) for v in row) + "]" for row in M) + "]"
-        )  # noqa: E731
-
-    text = f'[system]\ntime = "{time}"\nA = {fmt(A)}\nC = {fmt(C)}\n[method]\nkey = "lyapunov"\nrate_cap = 2\n'
+    text = _designed(A, C, time, "rate_cap = 2\n")
     rep = api.design(load_spec_text(text))
     assert all(c.status == ClaimStatus.CERTIFIED for c in rep.claims)
     L = rep.parameters.float("L")
@@ -545,14 +521,7 @@ def test_designed_gain_exact_detectability_reasons() -> None:
     """(C, A) with the unobservable mode 0.9: λ = 0.8 is proved impossible for every L (exit 1,
     naming the mode); λ = 0.95 designs and certifies; continuous, unstable unobservable mode 1/2:
     not detectable (exact test)."""
-    base = """
-[system]
-time = "discrete"
-A = [[0.5, 0], [0, 0.9]]
-C = [[1, 0]]
-[method]
-key = "lyapunov"
-"""
+    base = _designed("[[0.5, 0], [0, 0.9]]", "[[1, 0]]")
     with pytest.raises(InfeasibleError, match="unobservable mode") as ei:
         api.design(load_spec_text(base + "lambda = 0.8\n"))
     assert ei.value.exit_code == 1
@@ -577,17 +546,6 @@ def test_asked_rate_feasible_but_not_certifiable_is_inconclusive() -> None:
 
 
 # -- issue 12 item 1: the gain designs (riccati default, place, lmi) ------------------------
-def _fmt(M: np.ndarray) -> str:
-    return "[" + ", ".join("[" + ", ".join(repr(float(v)) for v in r) + "]" for r in M) + "]"
-
-
-def _designed(A: np.ndarray, C: np.ndarray, time: str = "discrete", extra: str = "") -> str:
-    return (
-        f'[system]\ntime = "{time}"\nA = {_fmt(A)}\nC = {_fmt(C)}\n'
-        f'[method]\nkey = "lyapunov"\n{extra}'
-    )
-
-
 @settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
     st.integers(1, 10),
