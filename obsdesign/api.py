@@ -514,9 +514,23 @@ def simulate(
     spec: str | Path | Spec,
     report: str | Path | Report | None = None,
     options: dict[str, str] | None = None,
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    client: Any = None,
+    batches: int | None = None,
     **kwargs: Any,
 ) -> SimResult:
     """Simulate the plant and the designed observer over the spec's ``[simulate]`` scenario.
+
+    Monte Carlo on Dask (issue 13): with ``workers`` (a LocalCluster of that many processes),
+    ``scheduler`` (``tcp://HOST:PORT``) or ``client``, the N runs are split into one
+    contiguous span per worker thread (``batches`` spans when given; in this process when no
+    Dask is asked for), each span run on a worker with the same spawned child seeds as the
+    serial run (:func:`obsdesign.simulate.montecarlo.run_batch`), and joined in run order
+    with the quantiles computed once (:func:`~obsdesign.simulate.montecarlo.merge`): the
+    numbers do not depend on the number of workers. Only methods whose ``simulate`` takes a
+    ``span`` support this (else :class:`InputError`).
 
     Uses the parameters of ``report`` when given (after checking its spec hash), else designs.
     ``options`` are ``--option KEY=VALUE`` texts, validated against the method's declared
@@ -528,6 +542,21 @@ def simulate(
     if sp.simulate is None:
         raise InputError(f"{sp.file}: [simulate] is missing: nothing to simulate")
     check_sim_memory(sp, kwargs)
+    distributed = any(x is not None for x in (workers, scheduler, client, batches))
+    if distributed:
+        import inspect
+
+        from obsdesign.distributed import check_workers
+
+        m = get_method(sp.method)
+        if "span" not in inspect.signature(m.simulate).parameters:
+            raise InputError(
+                f"method '{sp.method}' has no Monte Carlo runs to distribute: "
+                "run it without --workers/--scheduler"
+            )
+        if batches is not None and batches < 1:
+            raise InputError(f"batches: expected a positive number, got {batches}")
+        check_workers(workers, scheduler)
     if report is None:
         with captured_warnings([]):
             params: Parameters = get_method(sp.method).design(sp).parameters
@@ -548,10 +577,71 @@ def simulate(
             )
         params = rep.parameters
     notes: list[str] = []
-    with captured_warnings(notes):
-        res = get_method(sp.method).simulate(sp, params, **kwargs)
+    if distributed:
+        res = _simulate_spans(sp, params, kwargs, workers, scheduler, client, batches)
+        notes = list(res.info.pop("warnings", []))
+    else:
+        with captured_warnings(notes):
+            res = get_method(sp.method).simulate(sp, params, **kwargs)
     if notes:
         res.info["warnings"] = notes
+    return res
+
+
+def _sim_runs(sp: Spec, kwargs: dict[str, Any]) -> int:
+    """The number of runs of a simulation: ``kwargs["runs"]``, else the spec's, else 1."""
+    runs = kwargs.get("runs")
+    if runs is None:
+        sim = sp.simulate
+        runs = getattr(sim.options, "runs", None) if sim is not None else None
+    return int(runs or 1)
+
+
+def _simulate_span(
+    sp: Spec, params: Parameters, kwargs: dict[str, Any], span: tuple[int, int]
+) -> SimResult:
+    """Runs ``span`` = (a, b) of the Monte Carlo study (a Dask task of :func:`simulate`)."""
+    notes: list[str] = []
+    with captured_warnings(notes):
+        res = get_method(sp.method).simulate(sp, params, span=span, **kwargs)
+    if notes:
+        res.info["warnings"] = notes
+    return res
+
+
+def _simulate_spans(
+    sp: Spec,
+    params: Parameters,
+    kwargs: dict[str, Any],
+    workers: int | None,
+    scheduler: str | None,
+    client: Any,
+    batches: int | None,
+) -> SimResult:
+    """The Monte Carlo runs of :func:`simulate` in contiguous spans, on Dask or in process."""
+    import functools
+
+    from obsdesign.distributed import dask_client, run_tasks
+    from obsdesign.simulate.montecarlo import merge
+
+    runs = _sim_runs(sp, kwargs)
+    fn = functools.partial(_simulate_span, sp, params, kwargs)
+
+    def spans(k: int) -> list[tuple[int, int]]:
+        k = max(1, min(k, runs))
+        cuts = [runs * i // k for i in range(k + 1)]
+        return list(zip(cuts, cuts[1:], strict=False))
+
+    if workers is None and scheduler is None and client is None:
+        parts = run_tasks(fn, spans(batches or 1))
+    else:
+        with dask_client(workers, scheduler, client) as c:
+            k = batches or max(1, sum(c.nthreads().values()))
+            parts = run_tasks(fn, spans(k), client=c, chunk=1)
+    warns = [w for p in parts for w in p.info.pop("warnings", []) if w]
+    res = merge(parts, sp.system.states)
+    if warns:
+        res.info["warnings"] = list(dict.fromkeys(warns))
     return res
 
 

@@ -695,16 +695,25 @@ def simulate(
             help="A method's study (same as --option study=NAME), e.g. 'outliers' for stubborn.",
         ),
     ] = None,
+    workers: WorkersOpt = None,
+    scheduler: SchedulerOpt = None,
     quiet: QuietOpt = False,
     width: WidthOpt = None,
 ) -> None:
-    """Run the plant and the designed observer over the spec's scenario; print metrics."""
+    """Run the plant and the designed observer over the spec's scenario; print metrics.
+
+    With --workers/--scheduler the Monte Carlo runs (--runs) are split into one batch per
+    Dask worker; the numbers are the serial run's."""
 
     def body() -> int:
         _setup(quiet, width)
         _precheck(spec)  # before the heavy imports
         from obsdesign import api
 
+        if workers is not None or scheduler is not None:
+            from obsdesign.distributed import check_workers
+
+            check_workers(workers, scheduler)
         _check_plot(plot, force, _inputs(spec, report))
         sp = _load_spec(spec)
         opts = _kv(option or [])
@@ -712,7 +721,7 @@ def simulate(
             opts["runs"] = str(runs)
         if study is not None:
             opts["study"] = study
-        res = api.simulate(sp, report, options=opts)
+        res = api.simulate(sp, report, options=opts, workers=workers, scheduler=scheduler)
         m = res.metrics()
         if fmt == Fmt.json:
             print(json.dumps(m, indent=2, default=_jsonable))

@@ -69,10 +69,13 @@ def run_batch(
     runs: int,
     initial_error: str | None = None,
     batch: int | None = None,
+    span: tuple[int, int] | None = None,
 ) -> SimResult:
     """``runs`` runs of ``js`` (a :class:`~obsdesign.simulate.linear.JointSystem` of the
     bound ``spec``); ``initial_error``: a set name of ``[sets]`` (None: xhat0 − x0);
-    ``batch``: runs stepped together (None: as many as fit :data:`BATCH_BYTES`).
+    ``batch``: runs stepped together (None: as many as fit :data:`BATCH_BYTES`);
+    ``span = (a, b)``: only runs a..b-1 of the ``runs`` (same child seeds as in the full
+    range, so run r is the same whatever the span: :func:`merge` joins spans; None: all).
 
     Returns run 0's trajectory with ``info`` = runs, where the initial errors come from and
     the quantiles of every per-run metric, and ``extra["per_run"]`` = the per-run metrics
@@ -83,6 +86,9 @@ def run_batch(
         raise InputError(f"{spec.file}: [simulate] is missing: nothing to simulate")
     if runs < 1:
         raise InputError(f"runs: expected at least 1, got {runs}")
+    first, last = span if span is not None else (0, runs)
+    if not 0 <= first < last <= runs:
+        raise InputError(f"span: expected 0 <= a < b <= {runs}, got ({first}, {last})")
     n, grid = js.n, js.grid
     K = len(grid) - 1
     x0, xhat0 = sim.x0.f, sim.xhat0.f
@@ -91,7 +97,8 @@ def run_batch(
     eset = spec.sets[initial_error] if initial_error is not None else None
     sigs = (sim.u, sim.disturbance, sim.noise)
     random = any(_random(g) for g in sigs)
-    children = run_seeds(sim.seed, runs)
+    children = run_seeds(sim.seed, runs)[first:last]
+    total, runs = runs, last - first  # below: runs of the span, indexed from 0
     shared = None
     ET = js.E.T
     width = js.E.shape[1]
@@ -172,10 +179,35 @@ def run_batch(
     res = SimResult(grid, x, xh, y, s.states)
     res.extra["per_run"] = out
     res.extra["initial_errors"] = e0_all
-    res.info["runs"] = runs
+    res.info["runs"] = total
     res.info["initial_error"] = initial_error or "xhat0 - x0 (every run)"
-    res.info["trajectory"] = "run 0"
+    res.info["trajectory"] = f"run {first}"
+    if span is not None:
+        res.info["span"] = [first, last]
     res.info["quantiles"] = quantiles(out, s.states)
+    return res
+
+
+def merge(parts: list[SimResult], states: list[str]) -> SimResult:
+    """Join the results of :func:`run_batch` over contiguous spans (a0 = 0, b_i = a_{i+1},
+    last b = runs, in that order) into the full range's: per-run metrics and initial errors
+    concatenated in run order, quantiles computed once from all runs, run 0's trajectory."""
+    if not parts:
+        raise InputError("merge: no spans to join")
+    spans = [p.info.get("span", [0, p.info["runs"]]) for p in parts]
+    total = parts[0].info["runs"]
+    if (
+        spans[0][0] != 0
+        or spans[-1][1] != total
+        or any(s[1] != t[0] for s, t in zip(spans, spans[1:], strict=False))
+    ):
+        raise InputError(f"merge: spans {spans} do not cover runs 0..{total} in order")
+    res = parts[0]
+    out = {k: np.concatenate([p.extra["per_run"][k] for p in parts]) for k in res.extra["per_run"]}
+    res.extra["per_run"] = out
+    res.extra["initial_errors"] = np.concatenate([p.extra["initial_errors"] for p in parts])
+    res.info.pop("span", None)
+    res.info["quantiles"] = quantiles(out, states)
     return res
 
 

@@ -71,11 +71,17 @@ class Lyapunov(Method):
         return _claims.certify(spec, params)
 
     def simulate(
-        self, spec: Spec, params: Parameters, runs: int | None = None, batch: int | None = None
+        self,
+        spec: Spec,
+        params: Parameters,
+        runs: int | None = None,
+        batch: int | None = None,
+        span: tuple[int, int] | None = None,
     ) -> Any:
         """One run of the spec's scenario, or ``runs`` batched Monte Carlo runs (per-run
-        metrics and quantiles; :func:`obsdesign.simulate.linear.simulate_linear_observer_batch`).
-        """
+        metrics and quantiles; :func:`obsdesign.simulate.linear.simulate_linear_observer_batch`);
+        ``span = (a, b)``: only runs a..b-1 of them (``simulate --workers``, see
+        :func:`obsdesign.simulate.montecarlo.run_batch`)."""
         from obsdesign.simulate.linear import (
             simulate_linear_observer,
             simulate_linear_observer_batch,
@@ -84,6 +90,11 @@ class Lyapunov(Method):
         so = spec.simulate.options if spec.simulate is not None else None
         n = runs if runs is not None else (so.runs if so is not None else 1)
         ie = so.initial_error if so is not None else None
+        if span is not None:
+            from obsdesign.simulate.linear import joint_system
+            from obsdesign.simulate.montecarlo import run_batch
+
+            return run_batch(spec, joint_system(spec, params.float("L")), n, ie, batch, span)
         if n == 1 and ie is None and batch is None:
             return simulate_linear_observer(spec, params.float("L"))
         return simulate_linear_observer_batch(spec, params.float("L"), n, ie, batch)
