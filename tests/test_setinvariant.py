@@ -19,24 +19,24 @@ from obsdesign.methods.setinvariant import laws
 from obsdesign.methods.setinvariant.spectext import spec_text as matrix_spec_text
 
 
-@pytest.fixture(scope="module")
-def rep71(tmp_path_factory):
+def _design_example(tmp_path_factory, example: str):
+    """Design ``specs/dorea-pimenta-<example>.toml``; returns (report, path of its JSON)."""
     from pathlib import Path
 
     root = Path(__file__).resolve().parents[1]
-    out = tmp_path_factory.mktemp("r") / "r71.json"
-    rep = api.design(root / "specs" / "dorea-pimenta-7-1.toml", out)
+    out = tmp_path_factory.mktemp("r") / f"r{example.replace('-', '')}.json"
+    rep = api.design(root / "specs" / f"dorea-pimenta-{example}.toml", out)
     return rep, out
+
+
+@pytest.fixture(scope="module")
+def rep71(tmp_path_factory):
+    return _design_example(tmp_path_factory, "7-1")
 
 
 @pytest.fixture(scope="module")
 def rep72(tmp_path_factory):
-    from pathlib import Path
-
-    root = Path(__file__).resolve().parents[1]
-    out = tmp_path_factory.mktemp("r") / "r72.json"
-    rep = api.design(root / "specs" / "dorea-pimenta-7-2.toml", out)
-    return rep, out
+    return _design_example(tmp_path_factory, "7-2")
 
 
 def _rows_up_to_sign(G: np.ndarray) -> set[tuple[float, ...]]:
