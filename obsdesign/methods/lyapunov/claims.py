@@ -63,9 +63,10 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     # the asked rate omitted, (P, λ) is (P_best, λ_best): one exact check serves both claims
     same = rate == best and P.shape == Pb.shape and bool(np.all(P == Pb))
     pd_claim(c, "P-positive-definite", "P ≻ 0", P, o.margin, pd)
-    decay_claim(c, A, C, L, P, rate, s.discrete, o.margin, "", dec)
+    decay_claim(c, dec, rate, s.discrete, o.margin, "")
     pd_claim(c, "P_best-positive-definite", "P_best ≻ 0", Pb, o.margin, pd if same else None)
-    decay_claim(c, A, C, L, Pb, best, s.discrete, o.margin, "_best", dec if same else None)
+    dec_b = dec if same else decay_check(A, C, L, Pb, best, s.discrete, o.margin)
+    decay_claim(c, dec_b, best, s.discrete, o.margin, "_best")
     bracket_claim(c, A, C, L, best, other, str(params[f"{name}_bracket_kind"]), s.discrete, o)
     if o.iss_gain:
         iss_claim(c, A, C, L, s.Bd.q, s.Dn.q, P, rate, mu, s.discrete)
@@ -94,24 +95,20 @@ def pd_claim(
 
 def decay_claim(
     c: Claims,
-    A: np.ndarray,
-    C: np.ndarray,
-    L: np.ndarray,
-    P: np.ndarray,
+    done: tuple[PSDResult, bool],
     rate: Any,
     discrete: bool,
     margin: Any,
     suffix: str,
-    done: tuple[PSDResult, bool] | None = None,
 ) -> Claim:
     """The decay LMI λ²P − (A−LC)ᵀP(A−LC) ⪰ margin·I (continuous: −((A−LC)ᵀP + P(A−LC) +
     2αP) ⪰ margin·I), rebuilt from the spec's A, C and checked exactly: eq. (4)-(6) with
     w = 0, Section 5 of the constrained-redesign paper (Astolfi et al., NOLCOS 2019).
 
-    :param c: the claim list; :param A, C, L, P: exact matrices; :param rate: λ or α;
-    :param discrete: time domain; :param margin: δ; :param suffix: "" or "_best";
-    :param done: :func:`decay_check` of these very arguments, already made."""
-    r, fl = decay_check(A, C, L, P, rate, discrete, margin) if done is None else done
+    :param c: the claim list; :param done: :func:`decay_check` of the spec's A, C, the gain
+    L, this P and rate (exact and float verdicts); :param rate: λ or α;
+    :param discrete: time domain; :param margin: δ; :param suffix: "" or "_best"."""
+    r, fl = done
     x = fmt_exact(rate)
     if discrete:
         stmt = f"(A−LC)ᵀP{suffix}(A−LC) ⪯ λ{suffix}²·P{suffix} with λ{suffix} = {x}"
