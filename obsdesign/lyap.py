@@ -498,6 +498,7 @@ def best_rate(
     margin: Any,
     known: tuple[Any, np.ndarray] | None = None,
     progress: Callable[[str], None] | None = None,
+    forecast: bool = True,
 ) -> RateBracket:
     """Bisection for the best certified rate of V = eᵀPe: the smallest λ (discrete) or the
     largest α (continuous) at which :func:`certified_P` succeeds, bracketed.
@@ -523,29 +524,10 @@ def best_rate(
 
     :param A, C, L: exact plant and gain; :param discrete: time domain; :param tol: bracket
     width; :param margin: δ of the checks; :param known: a certified (rate, P);
-    :param progress: callback for messages. Raises :class:`InfeasibleError` when Acl is not
-    Schur / Hurwitz (exact) and :class:`InconclusiveError` when it is but nothing certifies."""
-    try:
-        return _best_rate(A, C, L, discrete, tol, margin, known, progress, forecast=True)
-    except _ForecastWrong:
-        return _best_rate(A, C, L, discrete, tol, margin, known, progress, forecast=False)
-
-
-class _ForecastWrong(Exception):
-    """The float forecast called a rate certified that the exact check refuses."""
-
-
-def _best_rate(
-    A: np.ndarray,
-    C: np.ndarray,
-    L: np.ndarray,
-    discrete: bool,
-    tol: Any,
-    margin: Any,
-    known: tuple[Any, np.ndarray] | None,
-    progress: Callable[[str], None] | None,
-    forecast: bool,
-) -> RateBracket:
+    :param progress: callback for messages; :param forecast: let the float forecast stand in
+    for exact checks (False: an exact check at every midpoint; the rerun uses it).
+    Raises :class:`InfeasibleError` when Acl is not Schur / Hurwitz (exact) and
+    :class:`InconclusiveError` when it is but nothing certifies."""
     Acl = closed_loop(A, C, L)
     tol_q = Q(tol)
     grid = _grid(tol_q)
@@ -623,6 +605,16 @@ def _best_rate(
         hi, P = known_r, known[1]  # type: ignore[index]
     if P is pending:
         P = exact(hi)
-        if P is None:
-            raise _ForecastWrong
+        if P is None:  # the forecast called a rate certified that the exact check refuses
+            return best_rate(
+                A,
+                C,
+                L,
+                discrete,
+                tol=tol,
+                margin=margin,
+                known=known,
+                progress=progress,
+                forecast=False,
+            )
     return RateBracket(rate(hi), P, rate(lo), lo_kind, tol_q, checks)

@@ -145,6 +145,32 @@ def test_best_rate_shipped_section5() -> None:
     )
 
 
+def test_best_rate_wrong_forecast_reruns_all_exact(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A float forecast that calls every midpoint certified ends on a rate the exact check
+    refuses (here every λ < 0.9503): the search reruns with exact checks only and returns the
+    all-exact bracket."""
+    real_P = lyap.certified_P
+
+    def strict(A, C, L, discrete, rate, margin, bits=lyap.BITS):  # noqa: ANN001, ANN202
+        return None if rate < fmpq(9503, 10000) else real_P(A, C, L, discrete, rate, margin, bits)
+
+    monkeypatch.setattr(lyap, "certified_P", strict)
+    plain = best_rate(A5, C5, L5, True, tol=TOL, margin=MARGIN, forecast=False)
+    forecasts: list[bool] = []
+    real = lyap.best_rate
+
+    def counted(*a, **k):  # noqa: ANN002, ANN003, ANN202
+        forecasts.append(k.get("forecast", True))
+        return real(*a, **k)
+
+    monkeypatch.setattr(lyap, "_predict_certified", lambda *a, **k: True)
+    monkeypatch.setattr(lyap, "best_rate", counted)
+    br = lyap.best_rate(A5, C5, L5, True, tol=TOL, margin=MARGIN)
+    assert forecasts == [True, False]
+    assert (br.best, br.other, br.kind) == (plain.best, plain.other, plain.kind)
+    assert br.best >= fmpq(9503, 10000) and br.P.tolist() == plain.P.tolist()
+
+
 def test_best_rate_known_rate_finer_than_the_grid() -> None:
     """ρ = 0.9999999 lies above the grid's last point 0.99999: the known (asked) certified
     rate 0.99999991 is the best, bracketed by 0.99999 (infeasible)."""
