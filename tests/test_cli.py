@@ -157,5 +157,3 @@ def test_python_api_one_liner():
         timeout=120,
     )
     assert r.returncode == 0 and r.stdout.strip() == "certified"
-
-
