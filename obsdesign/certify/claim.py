@@ -120,6 +120,10 @@ class Claims(list[Claim]):
     (``.ok``, ``.detail``). Each returns the claim it added.
     """
 
+    def _add(self, c: Claim) -> Claim:
+        self.append(c)
+        return c
+
     def exact(
         self,
         *,
@@ -132,24 +136,25 @@ class Claims(list[Claim]):
         detail: str = "",
         float_ok: bool | None = None,
     ) -> Claim:
-        c = exact_claim(id, statement, reference, check, margin, passed, detail, float_ok)
-        self.append(c)
-        return c
+        """Add a claim decided by an exact check (certified or failed)."""
+        return self._add(
+            exact_claim(id, statement, reference, check, margin, passed, detail, float_ok)
+        )
 
-    def numerical(
-        self,
-        *,
-        id: str,
-        statement: str,
-        reference: str,
-        check: str,
-        passed: bool,
-        margin: Any = 0,
-        detail: str = "",
-    ) -> Claim:
-        c = numerical_claim(id, statement, reference, check, margin, passed, detail)
-        self.append(c)
-        return c
+    def numerical(self, *, passed: bool, margin: Any = 0, detail: str = "", **text: str) -> Claim:
+        """Add a claim checked in floats only (numerical or failed); ``text`` holds ``id``,
+        ``statement``, ``reference`` and ``check``."""
+        return self._add(
+            numerical_claim(
+                text["id"],
+                text["statement"],
+                text["reference"],
+                text["check"],
+                margin,
+                passed,
+                detail,
+            )
+        )
 
     def checked(
         self, *, id: str, statement: str, reference: str, check: str, result: Any, margin: Any = 0
