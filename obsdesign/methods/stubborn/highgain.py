@@ -242,7 +242,7 @@ def simulate(spec: Spec, params: Parameters, observer: str = "stubborn") -> SimR
     ey0 = x[0, 0] - xh[0, 0, 0]
     sg = so.sigma0 if so.sigma0 is not None else ey0**2
     sig[0] = sg
-    stub = np.array([False, True])
+    saturated = np.array([False, True])  # observer 0: standard high-gain; 1: stubborn
 
     def obs(
         xhat: np.ndarray, sg: float, y: float, u: np.ndarray, tt: float
@@ -250,7 +250,7 @@ def simulate(spec: Spec, params: Parameters, observer: str = "stubborn") -> SimR
         xc = np.clip(xhat, -bound, bound) if bound is not None else xhat
         ey = y - xhat[:, 0]
         lev = np.sqrt(max(sg, 0.0))
-        inj = np.where(stub, np.clip(ey, -lev, lev), ey)
+        inj = np.where(saturated, np.clip(ey, -lev, lev), ey)
         dx = F(xc, u, d0, tt) + inj[:, None] * gain
         ds = -ell * lam * sg + ell * (lam + eps) * ey[1] ** 2
         return dx, ds
