@@ -12,7 +12,7 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
-from flint import fmpq
+from flint import fmpq, fmpq_mat
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -25,6 +25,7 @@ from obsdesign.certify.psd import (
     check_pd,
     check_pd_fast,
     check_psd,
+    check_text,
     ldl_pivots,
     to_fmpq_mat,
 )
@@ -297,10 +298,17 @@ def test_random_low_rank_against_minors(n: int, r: int, seed: int):
 
 def test_pd_fast_paths_and_details():
     r = check_pd_fast([[2, 1], [1, 2]])
-    assert r.ok and r.min_pivot == 1.0
-    assert r.detail == (
+    assert r.ok and r.path == "verified-float" and 0 < r.min_pivot < 1e-12
+    assert r.detail.startswith("verified float Cholesky: λ_min(M − δI) ≥ ")
+    assert check_text(r).startswith("verified floating-point Cholesky")
+    # the float-guided certificate behind it (when the verified float test cannot decide)
+    Fm = fmpq_mat([[2, 1], [1, 2]])
+    g = _gershgorin_certificate(Fm, np.array([[2.0, 1.0], [1.0, 2.0]]))
+    assert g is not None and g.ok and g.min_pivot == 1.0 and g.path == "gershgorin"
+    assert g.detail == (
         "M = RᵀR + S with S strictly diagonally dominant (exact), n = 2; float λ_min ≈ 1"
     )
+    assert "diagonally dominant" in check_text(g)
     r = check_pd_fast([[1, 2], [2, 1]])
     assert r == PSDResult(
         False, -1.0, "vᵀMv = -1 <= 0 for a rational v (float eigenvector, checked exactly)"
@@ -322,6 +330,7 @@ def test_pd_fast_paths_and_details():
     assert r.ok and r.detail.startswith("fraction-free LDLᵀ: all 2 leading principal minors > 0")
     assert r.min_pivot == float(F(1, 2**60))
     assert "fraction-free" in FAST_CHECK and "diagonally dominant" in FAST_CHECK
+    assert "verified floating-point Cholesky" in FAST_CHECK and r.path == "fraction-free"
 
 
 def test_pd_fast_inputs_margins_and_errors():
@@ -371,7 +380,9 @@ def test_pd_fast_large():
     M = qmat(B @ B.T + np.eye(n))
     M = (M + M.T) * F(1, 2)
     r = check_pd_fast(M)
-    assert r.ok and r.detail.startswith("M = RᵀR + S")
+    assert r.ok and r.path == "verified-float"
+    g = _gershgorin_certificate(to_fmpq_mat(M), np.asarray(M, dtype=float))
+    assert g is not None and g.ok and g.detail.startswith("M = RᵀR + S")
     bad = M.copy()
     bad[0, 0] = -F(1)
     assert not check_pd_fast(bad).ok

@@ -51,19 +51,19 @@ def _hilbert(n: int) -> np.ndarray:
 
 
 def test_every_proof_path() -> None:
-    """Well-conditioned: the Cholesky certificate; indefinite: the rational vector; Hilbert
+    """Well-conditioned: the verified float Cholesky; indefinite: the rational vector; Hilbert
     13×13 (condition ≈ 10¹⁸, PD): floats cannot, the fraction-free LDLᵀ decides."""
     rng = np.random.default_rng(0)
     B = rng.standard_normal((30, 30))
     good = qmat(B @ B.T + 30 * np.eye(30))
     r = check_pd_fast(good)
-    assert r.ok and "RᵀR + S" in r.detail
+    assert r.ok and r.path == "verified-float" and "verified float Cholesky" in r.detail
     bad = qmat(B + B.T)
     r = check_pd_fast(bad)
     assert not r.ok and "vᵀMv" in r.detail
     H = _hilbert(13)
     r = check_pd_fast(H)
-    assert r.ok and "fraction-free" in r.detail
+    assert r.ok and "fraction-free" in r.detail and r.path == "fraction-free"
     # δ = 10⁻¹⁷ lies above λ_min(H₁₃) (about 10⁻¹⁸): H − δI is not ≻ 0, the same way
     lam = fmpq(1, 10**17)
     assert not check_pd_fast(H, lam).ok and not check_pd(H, lam).ok

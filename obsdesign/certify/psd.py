@@ -9,12 +9,13 @@ All arithmetic is exact (python-flint ``fmpq``), so the answer is a proof, not a
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 from flint import fmpq
 
+from obsdesign.certify import vchol
 from obsdesign.certify.exact import Q, qeye, qmat
 
 
@@ -29,6 +30,8 @@ class PSDResult:
     ok: bool
     min_pivot: float
     detail: str
+    #: which test decided (one of :data:`PATHS`; "" for the plain LDLᵀ tests)
+    path: str = field(default="", compare=False)
 
     def __bool__(self) -> bool:
         return self.ok
@@ -137,11 +140,32 @@ def check_psd(M: Any, margin: Any = 0) -> PSDResult:
 
 
 # -- fast exact test for large matrices (issue 12: exact LDLᵀ at n = 100) ----------------------
-#: the ``check`` wording of :func:`check_pd_fast` (for claims)
+#: the ``check`` wording of :func:`check_pd_fast` (all the tests it may use, in order)
 FAST_CHECK = (
-    "exact: float-guided Cholesky certificate M = RᵀR + S with R dyadic and S = M − RᵀR "
-    "strictly diagonally dominant (checked over Q), else fraction-free LDLᵀ over Z (flint fflu)"
+    "exact: verified floating-point Cholesky (backward-error bound, final inequality over Q), "
+    "else float-guided Cholesky certificate M = RᵀR + S with R dyadic and S = M − RᵀR "
+    "strictly diagonally dominant, or a rational v with vᵀMv ≤ 0 (checked over Q), else "
+    "fraction-free LDLᵀ over Z (flint fflu)"
 )
+#: the test that decided a :func:`check_pd_fast` verdict → the ``check`` wording naming it
+PATHS = {
+    "verified-float": "verified floating-point Cholesky with a rigorous backward-error bound "
+    "(Higham Thm 10.3; obsdesign.certify.vchol), the final inequality checked exactly over Q",
+    "gershgorin": "exact: float-guided Cholesky certificate M = RᵀR + S with R dyadic and "
+    "S = M − RᵀR strictly diagonally dominant (checked over Q)",
+    "eigenvector": "exact: a rational v with vᵀMv ≤ 0 (float eigenvector, checked over Q)",
+    "fraction-free": "exact: fraction-free LDLᵀ over Z (flint fflu, Sylvester's criterion)",
+    "symmetry": "exact: symmetry of the rational matrix",
+    "empty": "empty matrix",
+}
+
+
+def check_text(r: PSDResult) -> str:
+    """The ``check`` wording of a claim decided by :func:`check_pd_fast`: the test that
+    decided (``r.path``), else the list of all of them (:data:`FAST_CHECK`).
+
+    :param r: the verdict."""
+    return PATHS.get(r.path, FAST_CHECK)
 
 
 def to_fmpq_mat(M: Any) -> Any:
@@ -175,7 +199,10 @@ def _fraction_free(F: Any) -> PSDResult:
     for k in range(n):
         if perm[k, k] != 1:
             return PSDResult(
-                False, 0.0, f"leading principal minor {k + 1} is 0 (fraction-free LDLᵀ)"
+                False,
+                0.0,
+                f"leading principal minor {k + 1} is 0 (fraction-free LDLᵀ)",
+                "fraction-free",
             )
         dk = U[k, k]
         piv = fmpq(dk, prev * D) if prev != 0 else fmpq(0)
@@ -184,6 +211,7 @@ def _fraction_free(F: Any) -> PSDResult:
                 False,
                 float(piv),
                 f"fraction-free LDLᵀ: pivot {k} = {float(piv):.6g} <= 0 (leading minor ≤ 0)",
+                "fraction-free",
             )
         mn = piv if mn is None or piv < mn else mn
         prev = dk
@@ -191,6 +219,7 @@ def _fraction_free(F: Any) -> PSDResult:
         True,
         float(mn),  # type: ignore[arg-type]
         f"fraction-free LDLᵀ: all {n} leading principal minors > 0 (min pivot {float(mn):.3g})",  # type: ignore[arg-type]
+        "fraction-free",
     )
 
 
@@ -231,6 +260,7 @@ def _gershgorin_certificate(F: Any, Mf: np.ndarray) -> PSDResult | None:
                 mu,
                 f"vᵀMv = {float(val / fmpq(2) ** (2 * k)):.6g} <= 0 for a rational v "
                 "(float eigenvector, checked exactly)",
+                "eigenvector",
             )
         return None
     try:
@@ -255,6 +285,7 @@ def _gershgorin_certificate(F: Any, Mf: np.ndarray) -> PSDResult | None:
         True,
         mu,
         f"M = RᵀR + S with S strictly diagonally dominant (exact), n = {n}; float λ_min ≈ {mu:.3g}",
+        "gershgorin",
     )
 
 
@@ -262,7 +293,9 @@ def check_pd_fast(M: Any, margin: Any = 0) -> PSDResult:
     """Exact test of M − margin·I ≻ 0 for a symmetric rational M, fast at n ~ 100.
 
     Same verdict as :func:`check_pd` (both are exact decisions), decided by the first of:
-    (1) a float-guided certificate checked exactly: M − δI = RᵀR + S with R a dyadic
+    (0) the verified floating-point Cholesky of :mod:`obsdesign.certify.vchol` (a rigorous
+    backward-error bound, the final inequality checked exactly over Q; it can only prove
+    M − δI ≻ 0, never the contrary); (1) a float-guided certificate checked exactly: M − δI = RᵀR + S with R a dyadic
     (rounded float Cholesky) factor and S = M − δI − RᵀR strictly diagonally dominant with
     positive diagonal over Q, so M − δI ≻ 0; or a rational v with vᵀ(M − δI)v ≤ 0, so not
     ≻ 0; (2) otherwise the fraction-free LDLᵀ: M − δI is scaled by the positive least common
@@ -270,7 +303,7 @@ def check_pd_fast(M: Any, margin: Any = 0) -> PSDResult:
     (flint ``fmpz_mat.fflu``); without row exchanges the k-th diagonal entry of U is the
     leading principal minor Δ_k of Z, so Z ≻ 0 iff no exchange happened and every U_kk > 0
     (Sylvester's criterion); an exchange means some Δ_k = 0 (not ≻ 0). ``detail`` says which
-    proof decided.
+    proof decided, ``path`` names it (:data:`PATHS`).
 
     :param M: square symmetric matrix (object array of rationals / floats, ``fmpq_mat`` or
     ``fmpz_mat``); :param margin: δ ≥ 0 (any exact number)."""
@@ -284,18 +317,19 @@ def check_pd_fast(M: Any, margin: Any = 0) -> PSDResult:
         for i in range(n):
             for j in range(i + 1, n):
                 if F[i, j] != F[j, i]:
-                    return PSDResult(False, float("nan"), f"not symmetric at ({i}, {j})")
+                    return PSDResult(
+                        False, float("nan"), f"not symmetric at ({i}, {j})", "symmetry"
+                    )
     if n == 0:
-        return PSDResult(True, float("inf"), "empty matrix")
+        return PSDResult(True, float("inf"), "empty matrix", "empty")
     m = Q(margin)
     if m != 0:
         F = F - m * type(F)(n, n, [fmpq(int(i == j)) for i in range(n) for j in range(n)])
-    try:
-        with np.errstate(all="ignore"):
-            Mf = np.array([float(x) for x in F.entries()], dtype=float).reshape(n, n)
-    except OverflowError:  # an entry beyond the float range: no float guide, exact path only
-        Mf = np.full((n, n), np.inf)
-    if np.all(np.isfinite(Mf)):
+    Mf = vchol.to_float(F)  # None: an entry beyond the float range, exact path only
+    if Mf is not None:
+        v = vchol.verified_pd(F, 0, Mf)
+        if v is not None:
+            return PSDResult(True, float(v.bound), v.detail, "verified-float")
         r = _gershgorin_certificate(F, Mf)
         if r is not None:
             return r

@@ -1,0 +1,134 @@
+"""The verified floating-point Cholesky (obsdesign.certify.vchol, issue 12 item 1): it may
+say "unknown", never "positive definite" when the exact LDLᵀ says not.
+
+Matrices with an exactly known smallest eigenvalue are built over Q: B Bᵀ with B of rank
+n − 1 has λ_min = 0 exactly, so B Bᵀ + t·I has λ_min = t exactly (t of either sign)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from flint import fmpq, fmpq_mat
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from obsdesign.certify import vchol
+from obsdesign.certify.psd import _fraction_free, check_pd, check_pd_fast, check_text
+from obsdesign.certify.vchol import float_cholesky, to_float, verified_pd
+
+
+def _eye(n: int) -> fmpq_mat:
+    return fmpq_mat(n, n, [fmpq(int(i == j)) for i in range(n) for j in range(n)])
+
+
+def _with_lambda_min(n: int, t: fmpq, seed: int = 0) -> fmpq_mat:
+    """B Bᵀ + t·I with B an integer n×(n−1) matrix: λ_min = t exactly."""
+    rng = np.random.default_rng(seed)
+    B = fmpq_mat(n, n - 1, [fmpq(int(v)) for v in rng.integers(-5, 6, size=n * (n - 1))])
+    return B * B.transpose() / 7 + _eye(n) * t
+
+
+@pytest.mark.parametrize("n", [50, 100])
+@pytest.mark.parametrize("t", [fmpq(-1, 10**12), fmpq(0)])
+def test_not_pd_is_never_proved(n: int, t: fmpq) -> None:
+    """λ_min = −10⁻¹² or exactly 0 at n = 50 / 100: no proof, and the fast test says no."""
+    M = _with_lambda_min(n, t, seed=n)
+    assert verified_pd(M) is None
+    r = check_pd_fast(M)
+    assert not r.ok and r.path in ("eigenvector", "fraction-free")
+
+
+@pytest.mark.parametrize("n", [50, 100])
+def test_margin_just_above_the_true_one(n: int) -> None:
+    """λ_min(M) = 1 exactly: δ = 1 − 10⁻⁹ is proved, δ = 1 and δ = 1 + 10⁻¹⁵ are not."""
+    M = _with_lambda_min(n, fmpq(1), seed=n + 1)
+    v = verified_pd(M, fmpq(1) - fmpq(1, 10**9))
+    assert v is not None and 0 < v.bound <= fmpq(1, 10**9)
+    assert verified_pd(M, 1) is None
+    assert verified_pd(M, fmpq(1) + fmpq(1, 10**15)) is None
+    assert not check_pd_fast(M, 1).ok
+
+
+def test_tampered_matrix() -> None:
+    """A proved matrix with one symmetric pair of entries changed to make it indefinite."""
+    n = 50
+    M = _with_lambda_min(n, fmpq(1, 2), seed=3)
+    assert verified_pd(M) is not None
+    bad = fmpq_mat(M)
+    big = fmpq(10**6)
+    bad[0, 1] = big
+    bad[1, 0] = big
+    assert verified_pd(bad) is None and not check_pd_fast(bad).ok
+
+
+def test_scaled_and_extreme_inputs() -> None:
+    """Exact power-of-two scaling keeps far-out magnitudes away from over/underflow; the
+    zero matrix and the empty matrix are never "proved"."""
+    n = 6
+    for s in (fmpq(1, 10**300), fmpq(10**300)):
+        v = verified_pd(_eye(n) * s)
+        assert v is not None and v.bound > 0
+        assert verified_pd(_eye(n) * s, s) is None
+    assert verified_pd(_eye(n) * 0) is None
+    assert verified_pd(fmpq_mat(0, 0)) is None
+    assert to_float(_eye(2) * fmpq(10**400)) is None  # beyond the float range: unknown
+
+
+def test_conversion_is_correctly_rounded() -> None:
+    """Step 1 of the theorem: every entry of fl(M) is the nearest double."""
+    from fractions import Fraction
+
+    rng = np.random.default_rng(5)
+    vals = [fmpq(int(a), int(b)) for a, b in rng.integers(1, 2**62, size=(50, 2))]
+    vals += [fmpq(1, 3) * fmpq(2) ** -1070, fmpq(10**30 + 1, 7)]
+    H = to_float(fmpq_mat(1, len(vals), vals))
+    assert H is not None
+    for x, h in zip(vals, H[0], strict=True):
+        assert h == float(Fraction(int(x.p), int(x.q)))
+
+
+def test_backward_error_bound_holds() -> None:
+    """Step 3 checked exactly on random matrices: |R̃ᵀR̃ − G| ≤ γ_{n+1}|R̃ᵀ||R̃| entrywise."""
+    rng = np.random.default_rng(11)
+    for n in (5, 30):
+        X = rng.standard_normal((n, n))
+        G = X @ X.T + 1e-3 * np.eye(n)
+        R = float_cholesky(G)
+        assert R is not None
+        q = [fmpq(*v.as_integer_ratio()) for v in R.flat]
+        Rq = fmpq_mat(n, n, q)
+        Aq = fmpq_mat(n, n, [abs(v) for v in q])
+        Gq = fmpq_mat(n, n, [fmpq(*v.as_integer_ratio()) for v in G.flat])
+        D = Rq.transpose() * Rq - Gq
+        B = Aq.transpose() * Aq * vchol._gamma(n + 1)
+        assert all(abs(D[i, j]) <= B[i, j] for i in range(n) for j in range(n))
+    assert float_cholesky(np.array([[1.0, 2.0], [2.0, 1.0]])) is None
+    assert float_cholesky(np.array([[np.inf]])) is None
+
+
+@st.composite
+def _symmetric(draw: st.DrawFn) -> tuple[fmpq_mat, fmpq]:
+    n = draw(st.integers(1, 10))
+    k = draw(st.integers(1, n))
+    ent = st.integers(-20, 20)
+    V = [[fmpq(draw(ent), draw(st.integers(1, 9))) for _ in range(k)] for _ in range(n)]
+    Vm = fmpq_mat(V)
+    shift = draw(st.sampled_from([0, 1, -1, 10**-9, -(10**-9), 10**-15]))
+    sh = fmpq(*float(shift).as_integer_ratio()) if shift else fmpq(0)
+    margin = draw(st.sampled_from([fmpq(0), fmpq(1, 10**6), fmpq(1, 2), fmpq(1)]))
+    return Vm * Vm.transpose() + _eye(n) * sh, margin
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(_symmetric())
+def test_never_pd_when_exact_says_not(case: tuple[fmpq_mat, fmpq]) -> None:
+    """Random symmetric rational matrices near the PD edge: a verified-float proof implies the
+    exact LDLᵀ verdict PD (the converse need not hold: "unknown" is allowed)."""
+    M, margin = case
+    exact = _fraction_free(M - _eye(M.nrows()) * margin).ok
+    assert exact == check_pd(np.array(M.tolist(), dtype=object), margin).ok
+    if verified_pd(M, margin) is not None:
+        assert exact
+    r = check_pd_fast(M, margin)
+    assert r.ok == exact
+    assert check_text(r)
