@@ -13,7 +13,9 @@ from obsdesign.sets.base import ConvexSet
 
 @dataclass(frozen=True, eq=False)
 class Box(ConvexSet):
-    """Box with exact bounds ``lower_q``, ``upper_q`` (object arrays of fmpq)."""
+    """Box with exact bounds ``lower_q`` <= ``upper_q`` (object arrays of fmpq; a side may be
+    degenerate, e.g. the search-space method's initial set D); ``lower``, ``upper`` are their
+    float views."""
 
     lower_q: np.ndarray
     upper_q: np.ndarray
@@ -30,6 +32,10 @@ class Box(ConvexSet):
     @property
     def upper(self) -> np.ndarray:
         return np.array([float(v) for v in self.upper_q])
+
+    def describe(self) -> str:
+        """The exact bounds, e.g. ``[-1, 1] × [0, 1/2]``."""
+        return " × ".join(f"[{a}, {b}]" for a, b in zip(self.lower_q, self.upper_q, strict=True))
 
     def contains(self, x: np.ndarray, tol: float = 1e-12) -> np.ndarray | bool:
         x = np.asarray(x, dtype=float)

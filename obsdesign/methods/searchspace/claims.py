@@ -258,7 +258,7 @@ def _input_range(c: Claims, spec: Spec) -> None:
     o: Options = spec.options
     s = spec.system
     assert o.U is not None and s.u_signal is not None
-    stmt = f"u(t) ∈ U = {_box(o.U.lower, o.U.upper)}"
+    stmt = f"u(t) ∈ U = {_box(o.U.lower_q, o.U.upper_q)}"
     if o.horizon is None:
         c.failed(
             id="input-range",
@@ -269,7 +269,7 @@ def _input_range(c: Claims, spec: Spec) -> None:
         return
     t1 = o.t0 + o.horizon
     ok, excess, used = bounds.range_inside(
-        s.u_signal, "t", o.t0, t1, list(o.U.lower), list(o.U.upper), budget=4096
+        s.u_signal, "t", o.t0, t1, list(o.U.lower_q), list(o.U.upper_q), budget=4096
     )
     c.exact(
         id="input-range",
@@ -289,11 +289,13 @@ def _box(lo: Any, hi: Any) -> str:
 def _d_in_e(c: Claims, o: Options) -> None:
     ok = all(
         e_lo <= d_lo and d_hi <= e_hi
-        for d_lo, d_hi, e_lo, e_hi in zip(o.D.lower, o.D.upper, o.E.lower, o.E.upper, strict=True)
+        for d_lo, d_hi, e_lo, e_hi in zip(
+            o.D.lower_q, o.D.upper_q, o.E.lower_q, o.E.upper_q, strict=True
+        )
     )
     c.exact(
         id="D-in-E",
-        statement=f"D = {_box(o.D.lower, o.D.upper)} ⊆ E = {_box(o.E.lower, o.E.upper)}",
+        statement=f"D = {_box(o.D.lower_q, o.D.upper_q)} ⊆ E = {_box(o.E.lower_q, o.E.upper_q)}",
         reference=f"Lemma 1 (D ⊂ E), {PAPER}",
         check="exact comparison of the box bounds",
         passed=ok,

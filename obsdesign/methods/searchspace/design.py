@@ -63,13 +63,13 @@ def _compute(kind: str, spec: Spec, budget: int, rtol: float) -> bounds.Bound:
     s = spec.system
     o: Options = spec.options
     names = [*s.states, *s.inputs]
-    lo = [*o.E.lower, *(o.U.lower if o.U is not None else [])]
-    hi = [*o.E.upper, *(o.U.upper if o.U is not None else [])]
+    lo = [*o.E.lower_q, *(o.U.lower_q if o.U is not None else [])]
+    hi = [*o.E.upper_q, *(o.U.upper_q if o.U is not None else [])]
     if kind == "L_f":
         return bounds.lipschitz(s.f, names, s.states, lo, hi, budget, rtol)
     if kind == "f_sup":
         return bounds.sup_norm(s.f, names, lo, hi, budget, rtol)
-    return bounds.lipschitz(s.h, s.states, s.states, o.E.lower, o.E.upper, budget, rtol)
+    return bounds.lipschitz(s.h, s.states, s.states, o.E.lower_q, o.E.upper_q, budget, rtol)
 
 
 def interval_bound(kind: str, spec: Spec) -> bounds.Bound:

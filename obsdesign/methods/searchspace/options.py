@@ -25,33 +25,14 @@ REFINE = ("recover", "paper")
 
 
 @dataclass
-class BoxQ:
-    """An axis-aligned box with exact bounds; ``lower ≤ upper`` (a side may be degenerate)."""
-
-    lower: np.ndarray  # object array of fmpq
-    upper: np.ndarray
-
-    @property
-    def lo(self) -> np.ndarray:
-        return np.array([float(v) for v in self.lower])
-
-    @property
-    def hi(self) -> np.ndarray:
-        return np.array([float(v) for v in self.upper])
-
-    def describe(self) -> str:
-        return " × ".join(f"[{a}, {b}]" for a, b in zip(self.lower, self.upper, strict=True))
-
-
-@dataclass
 class Options:
     """Typed ``[method]`` of ``search-space`` (exact numbers are fmpq)."""
 
-    E: BoxQ
+    E: Box
     E_where: str
-    D: BoxQ
+    D: Box
     D_where: str
-    U: BoxQ | None
+    U: Box | None
     horizon: fmpq | None
     alpha: fmpq
     kappa: fmpq | None
@@ -79,7 +60,7 @@ class SimOptions:
     store_every: int = 1
 
 
-def _box(table: Table, k: str, spec: Spec, dim: int, strict: bool) -> tuple[BoxQ, str]:
+def _box(table: Table, k: str, spec: Spec, dim: int, strict: bool) -> tuple[Box, str]:
     """A box from a set name in ``[sets]`` or from an inline table {lower, upper}."""
     raw = table.data.get(k)
     if isinstance(raw, str):
@@ -93,9 +74,7 @@ def _box(table: Table, k: str, spec: Spec, dim: int, strict: bool) -> tuple[BoxQ
             raise table.error(k, f"[sets.{name}] must be a box for the search-space method")
         if s.dim != dim:
             raise table.error(k, f"[sets.{name}] has dimension {s.dim}, expected {dim}")
-        return BoxQ(np.array(s.lower_q, dtype=object), np.array(s.upper_q, dtype=object)), (
-            f"[sets.{name}]"
-        )
+        return s, f"[sets.{name}]"
     t = table.table(k, required=True)
     assert t is not None
     lo = t.vector("lower", n=dim)
@@ -106,7 +85,7 @@ def _box(table: Table, k: str, spec: Spec, dim: int, strict: bool) -> tuple[BoxQ
         if bad:
             rel = "<" if strict else "<="
             raise t.error("upper", f"expected lower {rel} upper in every coordinate (index {i})")
-    return BoxQ(np.array(lo.q, dtype=object), np.array(hi.q, dtype=object)), f"[method.{k}]"
+    return Box(np.array(lo.q, dtype=object), np.array(hi.q, dtype=object)), f"[method.{k}]"
 
 
 def _opt_pos(table: Table, k: str) -> fmpq | None:

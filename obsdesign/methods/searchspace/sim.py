@@ -258,7 +258,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
     t0 = float(o.t0)
     N = int(math.floor(float(spec.simulate.horizon.f) / dT + 1e-9))
     x0 = np.asarray(spec.simulate.x0.f, dtype=float).reshape(1, n)
-    E_lo, E_hi = o.E.lo, o.E.hi
+    E_lo, E_hi = o.E.lower, o.E.upper
     nsub = so.substeps or 1
     bar = _progress(progress, N)
 
@@ -267,7 +267,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
     y = plant.out(x)[0]
     i = 0
     s = eps[0] / math.sqrt(n)
-    C = cover_box(o.D.lo, o.D.hi, s)
+    C = cover_box(o.D.lower, o.D.upper, s)
     C = C[_consistent(plant, C, y, L_h * eps[0]) & _meets(C, s, E_lo, E_hi)]
     if len(C) > so.max_centres:
         raise MemoryCap(
@@ -406,7 +406,7 @@ def _diagnose(run: Run, x: np.ndarray, o: Options, where: str, ctx: Any) -> str:
     """'consistency lost': which assumption or bound failed, from the true trajectory."""
     msg = [f"consistency lost: every centre was discarded by {where}."]
     x0 = run.x[0] if run.x else x
-    if not (np.all(x0 >= o.D.lo - 1e-12) and np.all(x0 <= o.D.hi + 1e-12)):
+    if not np.all(o.D.contains(x0)):
         msg.append(f"x0 = {np.round(x0, 6).tolist()} is not in D = {o.D.describe()}.")
     if ctx is not None:
         C, eps, L_f, since, left_E, flow_err = ctx
