@@ -33,3 +33,31 @@ def write_spec(tmp_path: Path):
         return p
 
     return _w
+
+
+@pytest.fixture(scope="module")
+def dask_client(request: pytest.FixtureRequest):
+    """A Dask client on a LocalCluster of 2 worker processes (one thread each), shared by the
+    test module (starting one costs seconds). One task per worker thread at a time
+    (``worker-saturation`` 1, as obsdesign's own LocalCluster), so only the running task is
+    suspected when its worker dies; a module adds dask settings in ``DASK_CONFIG``."""
+    pytest.importorskip("dask.distributed")
+    import dask
+    from dask.distributed import Client, LocalCluster
+
+    cfg = {"distributed.scheduler.worker-saturation": 1.0}
+    cfg.update(getattr(request.module, "DASK_CONFIG", {}))
+    with dask.config.set(cfg):
+        cluster = LocalCluster(
+            n_workers=2,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            silence_logs=40,
+        )
+        client = Client(cluster)
+        try:
+            yield client
+        finally:
+            client.close()
+            cluster.close()

@@ -2,7 +2,7 @@
 once when a worker dies mid-sweep, lost tasks as rows, the caller's limits in force in the
 workers, Ctrl-C stops the cluster and leaves no file.
 
-One LocalCluster (2 worker processes) is shared by the module: starting one costs seconds."""
+One LocalCluster (2 worker processes: the ``dask_client`` fixture) is shared by the module."""
 
 from __future__ import annotations
 
@@ -38,32 +38,8 @@ FAST = [
 GRID12 = ["method.lambda=0.94:0.99:6", "method.rate_tol=[0.0001, 0.001]"]
 
 
-@pytest.fixture(scope="module")
-def client():
-    import dask
-    from dask.distributed import Client, LocalCluster
-
-    # a task may be on one dying worker and be retried once; the second death marks it lost
-    # (and, as obsdesign's own LocalCluster, one task per worker thread at a time: only the
-    # running task is suspected when its worker dies)
-    cfg = {
-        "distributed.scheduler.allowed-failures": 1,
-        "distributed.scheduler.worker-saturation": 1.0,
-    }
-    with dask.config.set(cfg):
-        cluster = LocalCluster(
-            n_workers=2,
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=None,
-            silence_logs=40,
-        )
-        c = Client(cluster)
-        try:
-            yield c
-        finally:
-            c.close()
-            cluster.close()
+#: a task may be on one dying worker and be retried once; the second death marks it lost
+DASK_CONFIG = {"distributed.scheduler.allowed-failures": 1}
 
 
 def _strip(rows: list[dict]) -> list[dict]:
@@ -76,8 +52,8 @@ def serial12() -> list[dict]:
     return sw.sweep_rows(SPEC, GRID12)
 
 
-def test_twelve_point_sweep_is_the_serial_table(client, serial12):
-    rows = sw.sweep_rows(SPEC, GRID12, client=client)
+def test_twelve_point_sweep_is_the_serial_table(dask_client, serial12):
+    rows = sw.sweep_rows(SPEC, GRID12, client=dask_client)
     assert len(rows) == 12
     assert _strip(rows) == _strip(serial12)
     assert [r["exit_code"] for r in rows] == [1] * 4 + [0] * 8  # λ ≤ 0.95 infeasible
@@ -89,37 +65,37 @@ def test_twelve_point_sweep_is_the_serial_table(client, serial12):
     pd.testing.assert_frame_equal(a, b)
 
 
-def test_a_worker_killed_mid_sweep_costs_a_retry_not_a_row(client, serial12):
-    pids = client.run(os.getpid)
+def test_a_worker_killed_mid_sweep_costs_a_retry_not_a_row(dask_client, serial12):
+    pids = dask_client.run(os.getpid)
     seen: list[int] = []
     killed: list[int] = []
 
     def on_row(row: dict) -> None:
         seen.append(row["point"])
         if not killed:
-            busy = [w for w, keys in client.processing().items() if keys and w in pids]
+            busy = [w for w, keys in dask_client.processing().items() if keys and w in pids]
             victim = pids[busy[0]] if busy else next(iter(pids.values()))
             os.kill(victim, signal.SIGKILL)
             killed.append(victim)
 
-    rows = sw.sweep_rows(SPEC, GRID12, client=client, on_row=on_row)
+    rows = sw.sweep_rows(SPEC, GRID12, client=dask_client, on_row=on_row)
     assert killed
     assert sorted(seen) == list(range(12))  # every point reported exactly once
     assert [r["point"] for r in rows] == list(range(12))
     assert _strip(rows) == _strip(serial12)
-    client.wait_for_workers(2, timeout=60)  # the nanny restarted it
-    assert killed[0] not in client.run(os.getpid).values()
+    dask_client.wait_for_workers(2, timeout=60)  # the nanny restarted it
+    assert killed[0] not in dask_client.run(os.getpid).values()
 
 
-def test_chunks_give_the_same_results_in_order(client):
+def test_chunks_give_the_same_results_in_order(dask_client):
     seen: list[int] = []
     out = run_tasks(
-        abs, list(range(-7, 0)), client=client, chunk=3, on_result=lambda i, r: seen.append(i)
+        abs, list(range(-7, 0)), client=dask_client, chunk=3, on_result=lambda i, r: seen.append(i)
     )
     assert out == [7, 6, 5, 4, 3, 2, 1] and sorted(seen) == list(range(7))
 
 
-def test_a_task_that_kills_every_worker_is_a_row_not_a_hang(client):
+def test_a_task_that_kills_every_worker_is_a_row_not_a_hang(dask_client):
     def die_on_3(x: int) -> int:
         if x == 3:
             os._exit(1)
@@ -127,34 +103,36 @@ def test_a_task_that_kills_every_worker_is_a_row_not_a_hang(client):
 
     # chunks [0, 1, 2], [3, 4, 5]: the second dies, is run again item by item, and only
     # item 3 is lost
-    out = run_tasks(die_on_3, list(range(6)), client=client, lost=lambda x, msg: (x, msg), chunk=3)
+    out = run_tasks(
+        die_on_3, list(range(6)), client=dask_client, lost=lambda x, msg: (x, msg), chunk=3
+    )
     assert out[:3] == [0, 1, 4] and out[4:] == [16, 25]
     assert out[3][0] == 3 and "killed every worker" in out[3][1]
-    client.wait_for_workers(2, timeout=60)
+    dask_client.wait_for_workers(2, timeout=60)
 
 
-def test_the_callers_limits_hold_in_the_workers(client):
+def test_the_callers_limits_hold_in_the_workers(dask_client):
     grid = ["method.lambda=[0.97, 0.97" + "0" * 40 + "1]"]  # 43 digits
     old = set_limits(max_digits=40)
     try:
         serial = sw.sweep_rows(SPEC, grid)
-        dist = sw.sweep_rows(SPEC, grid, client=client)
+        dist = sw.sweep_rows(SPEC, grid, client=dask_client)
     finally:
         reset_limits(old)
     assert [r["exit_code"] for r in serial] == [0, 2]
     assert "digits" in serial[1]["message"]
     assert _strip(dist) == _strip(serial)
     # and the workers are back to their own limits afterwards
-    assert [r["exit_code"] for r in sw.sweep_rows(SPEC, grid, client=client)] == [0, 0]
+    assert [r["exit_code"] for r in sw.sweep_rows(SPEC, grid, client=dask_client)] == [0, 0]
 
 
 def _check_rows(rows: list) -> list[dict]:
     return [{k: v for k, v in r.__dict__.items() if k != "seconds"} for r in rows]
 
 
-def test_check_on_dask_equals_serial_on_the_fast_specs(client):
+def test_check_on_dask_equals_serial_on_the_fast_specs(dask_client):
     serial = api.check(FAST)
-    dist = api.check(FAST, client=client)
+    dist = api.check(FAST, client=dask_client)
     assert [r.spec for r in dist] == [str(f) for f in FAST]
     assert _check_rows(dist) == _check_rows(serial)
     assert all(r.code == 0 for r in dist)

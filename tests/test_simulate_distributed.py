@@ -2,7 +2,7 @@
 spans of the same spawned seed list, one per worker, give the serial run's per-run metrics,
 initial errors, trajectory and quantiles whatever K; methods without Monte Carlo runs refuse.
 
-One LocalCluster (2 worker processes) is shared by the module: starting one costs seconds."""
+One LocalCluster (2 worker processes: the ``dask_client`` fixture) is shared by the module."""
 
 from __future__ import annotations
 
@@ -36,25 +36,6 @@ def _mc_text() -> str:
     text = text.replace("horizon = 300\n", 'horizon = 40\ninitial_error = "E0"\nseed = 5\n')
     text = text.replace(old_noise, 'kind = "uniform"\nbound = 0.05')
     return text + '\n[sets.E0]\ntype = "box"\nlower = [-2, -1]\nupper = [2, 1]\n'
-
-
-@pytest.fixture(scope="module")
-def client():
-    import dask
-    from dask.distributed import Client, LocalCluster
-
-    with dask.config.set({"distributed.scheduler.worker-saturation": 1.0}):
-        cluster = LocalCluster(
-            n_workers=2,
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=None,
-            silence_logs=40,
-        )
-    c = Client(cluster)
-    yield c
-    c.close()
-    cluster.close()
 
 
 @pytest.fixture(scope="module")
@@ -93,24 +74,24 @@ def test_spans_are_the_full_range_cut_in_pieces(spec_and_report):
         mc.merge([mc.run_batch(sp, js, RUNS, "E0", span=(0, 2))], sp.system.states)
 
 
-def test_workers_do_not_change_the_numbers(spec_and_report, client):
+def test_workers_do_not_change_the_numbers(spec_and_report, dask_client):
     _, sp, rep = spec_and_report
     serial = api.simulate(sp, rep, options={"runs": str(RUNS)})
     one = api.simulate(sp, rep, options={"runs": str(RUNS)}, batches=1)  # in process
     three = api.simulate(sp, rep, options={"runs": str(RUNS)}, batches=3)  # in process
-    two = api.simulate(sp, rep, options={"runs": str(RUNS)}, client=client)  # 2 workers
-    five = api.simulate(sp, rep, options={"runs": str(RUNS)}, client=client, batches=5)
+    two = api.simulate(sp, rep, options={"runs": str(RUNS)}, client=dask_client)  # 2 workers
+    five = api.simulate(sp, rep, options={"runs": str(RUNS)}, client=dask_client, batches=5)
     for r in (one, three, two, five):
         _same(serial, r)
 
 
-def test_cli_scheduler_output_is_the_serial_output(spec_and_report, client):
+def test_cli_scheduler_output_is_the_serial_output(spec_and_report, dask_client):
     path, _, _ = spec_and_report
     runner = CliRunner()
     args = ["simulate", str(path), "--runs", str(RUNS), "--format", "json"]
     serial = runner.invoke(app, args)
     assert serial.exit_code == 0, serial.output
-    dist = runner.invoke(app, [*args, "--scheduler", client.scheduler.address])
+    dist = runner.invoke(app, [*args, "--scheduler", dask_client.scheduler.address])
     assert dist.exit_code == 0, dist.output
     assert json.loads(dist.stdout) == json.loads(serial.stdout)
     assert json.loads(serial.stdout)["runs"] == RUNS
