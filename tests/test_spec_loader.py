@@ -88,91 +88,83 @@ def test_impulsive_base_spec_is_valid():
     load_spec_text(_expr("0.2*sin(x1)"), "ok.toml")
 
 
-MALFORMED = [
-    ("bad toml", "[system\ntime = 1", "", "not valid TOML"),
-    ("missing system", "[method]\nkey = 'lyapunov'", "system", "missing"),
-    ("missing A", _replace("A = [[0, 1], [1, 0]]\n", ""), "system.A", "missing"),
-    (
-        "non-square A",
-        _replace("A = [[0, 1], [1, 0]]", "A = [[0, 1, 2], [1, 0, 3]]"),
-        "system.A",
-        "square",
-    ),
-    ("C columns", _replace("C = [[1, 0]]", "C = [[1, 0, 0]]"), "system.C", "shape"),
-    ("ragged A", _replace("A = [[0, 1], [1, 0]]", "A = [[0, 1], [1]]"), "system.A", "equal length"),
-    ("nan", _replace("A = [[0, 1], [1, 0]]", "A = [[0, nan], [1, 0]]"), "system.A", "finite"),
-    ("inf", _replace("L = [-1.87, 1.874]", "L = [-inf, 1.874]"), "method.L", "finite"),
-    (
-        "string entry",
-        _replace("A = [[0, 1], [1, 0]]", "A = [[0, '1'], [1, 0]]"),
-        "system.A",
-        "number",
-    ),
-    ("bad time", _replace('time = "discrete"', 'time = "hybrid"'), "system.time", "one of"),
-    ("unknown method", _replace('key = "lyapunov"', 'key = "magic"'), "method.key", "one of"),
-    ("unknown key", GOOD + "gain = 3\n", "method.gain", "not a known key"),
-    ("L shape", _replace("L = [-1.87, 1.874]", "L = [-1.87, 1.874, 3]"), "method.L", "shape"),
-    ("lambda > 1", GOOD + "lambda = 1.5\n", "method.lambda", "< 1"),
+#: (test id, text of GOOD, what replaces it, the [key] the message names, words it contains)
+REPLACED = [
+    ("missing A", "A = [[0, 1], [1, 0]]\n", "", "system.A", "missing"),
+    ("non-square A", "A = [[0, 1], [1, 0]]", "A = [[0, 1, 2], [1, 0, 3]]", "system.A", "square"),
+    ("C columns", "C = [[1, 0]]", "C = [[1, 0, 0]]", "system.C", "shape"),
+    ("ragged A", "A = [[0, 1], [1, 0]]", "A = [[0, 1], [1]]", "system.A", "equal length"),
+    ("nan", "A = [[0, 1], [1, 0]]", "A = [[0, nan], [1, 0]]", "system.A", "finite"),
+    ("inf", "L = [-1.87, 1.874]", "L = [-inf, 1.874]", "method.L", "finite"),
+    ("string entry", "A = [[0, 1], [1, 0]]", "A = [[0, '1'], [1, 0]]", "system.A", "number"),
+    ("bad time", 'time = "discrete"', 'time = "hybrid"', "system.time", "one of"),
+    ("unknown method", 'key = "lyapunov"', 'key = "magic"', "method.key", "one of"),
+    ("L shape", "L = [-1.87, 1.874]", "L = [-1.87, 1.874, 3]", "method.L", "shape"),
+]
+#: (test id, text appended to GOOD (whose last table is [method]), [key], words)
+APPENDED = [
+    ("unknown key", "gain = 3\n", "method.gain", "not a known key"),
+    ("lambda > 1", "lambda = 1.5\n", "method.lambda", "< 1"),
     (
         "box lower > upper",
-        GOOD + "[sets.X]\ntype='box'\nlower=[1, 0]\nupper=[0, 1]\n",
+        "[sets.X]\ntype='box'\nlower=[1, 0]\nupper=[0, 1]\n",
         "sets.X.upper",
         "lower < upper",
     ),
     (
         "unbounded polytope",
-        GOOD + "[sets.P]\ntype='polytope'\nG=[[1, 0]]\ng=[1]\n",
+        "[sets.P]\ntype='polytope'\nG=[[1, 0]]\ng=[1]\n",
         "sets.P.G",
         "unbounded",
     ),
     (
         "empty polytope",
-        GOOD
-        + "[sets.P]\ntype='polytope'\nG=[[1, 0], [-1, 0], [0, 1], [0, -1]]\ng=[-1, -1, 1, 1]\n",
+        "[sets.P]\ntype='polytope'\nG=[[1, 0], [-1, 0], [0, 1], [0, -1]]\ng=[-1, -1, 1, 1]\n",
         "sets.P.G",
         "empty",
     ),
     (
         "non-symmetric E",
-        GOOD + "[sets.E]\ntype='ellipsoid'\nE=[[1, 1], [0, 1]]\n",
+        "[sets.E]\ntype='ellipsoid'\nE=[[1, 1], [0, 1]]\n",
         "sets.E.E",
         "symmetric",
     ),
     (
         "indefinite E",
-        GOOD + "[sets.E]\ntype='ellipsoid'\nE=[[1, 0], [0, -1]]\n",
+        "[sets.E]\ntype='ellipsoid'\nE=[[1, 0], [0, -1]]\n",
         "sets.E.E",
         "positive definite",
     ),
-    ("bad set type", GOOD + "[sets.E]\ntype='sphere'\n", "sets.E.type", "one of"),
+    ("bad set type", "[sets.E]\ntype='sphere'\n", "sets.E.type", "one of"),
     (
         "simulate horizon",
-        GOOD + "[simulate]\nhorizon = 0\nx0=[0,0]\nxhat0=[0,0]\n",
+        "[simulate]\nhorizon = 0\nx0=[0,0]\nxhat0=[0,0]\n",
         "simulate.horizon",
         ">= 1",
     ),
-    (
-        "simulate x0",
-        GOOD + "[simulate]\nhorizon = 5\nx0=[0]\nxhat0=[0,0]\n",
-        "simulate.x0",
-        "2 numbers",
-    ),
+    ("simulate x0", "[simulate]\nhorizon = 5\nx0=[0]\nxhat0=[0,0]\n", "simulate.x0", "2 numbers"),
     (
         "signal kind",
-        GOOD + "[simulate]\nhorizon = 5\nx0=[0,0]\nxhat0=[0,0]\n[simulate.noise]\nkind='pink'\n",
+        "[simulate]\nhorizon = 5\nx0=[0,0]\nxhat0=[0,0]\n[simulate.noise]\nkind='pink'\n",
         "simulate.noise.kind",
         "one of",
     ),
-    ("unknown top-level", GOOD + "[extra]\na = 1\n", "extra", "not a known key"),
-    (
-        "expr __import__",
-        _expr("__import__('os').system('true')"),
-        "system.psi[0]",
-        "not allowed",
-    ),
-    ("expr attribute", _expr("x1.__class__"), "system.psi[0]", "attribute access"),
-    ("expr lambda", _expr("(lambda: 0)"), "system.psi[0]", "lambda"),
-    ("expr unknown name", _expr("open"), "system.psi[0]", "unknown name"),
+    ("unknown top-level", "[extra]\na = 1\n", "extra", "not a known key"),
+]
+#: (test id, ψ₁ of the impulsive spec, [key], words)
+BAD_EXPRESSIONS = [
+    ("expr __import__", "__import__('os').system('true')", "system.psi[0]", "not allowed"),
+    ("expr attribute", "x1.__class__", "system.psi[0]", "attribute access"),
+    ("expr lambda", "(lambda: 0)", "system.psi[0]", "lambda"),
+    ("expr unknown name", "open", "system.psi[0]", "unknown name"),
+]
+#: (test id, spec text, [key] the message names ("": none), words it contains)
+MALFORMED = [
+    ("bad toml", "[system\ntime = 1", "", "not valid TOML"),
+    ("missing system", "[method]\nkey = 'lyapunov'", "system", "missing"),
+    *[(name, _replace(old, new), key, words) for name, old, new, key, words in REPLACED],
+    *[(name, GOOD + extra, key, words) for name, extra, key, words in APPENDED],
+    *[(name, _expr(psi), key, words) for name, psi, key, words in BAD_EXPRESSIONS],
 ]
 
 
