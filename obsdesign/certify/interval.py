@@ -9,6 +9,7 @@ bound reported as "T_max ≥ 1.0899" is a proof. Directions are explicit in ever
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 from flint import fmpq
@@ -68,34 +69,13 @@ def lower(f: Callable[..., Any], *args: Any) -> fmpq:
     return bounds(f, *args)[0]
 
 
-def sqrt_upper(x: Any) -> fmpq:
-    """A rational ≥ √x."""
-    return upper(iv.sqrt, x)
-
-
-def sqrt_lower(x: Any) -> fmpq:
-    """A rational ≤ √x."""
-    return lower(iv.sqrt, x)
-
-
-def log_upper(x: Any) -> fmpq:
-    """A rational ≥ ln x (x > 0)."""
-    return upper(iv.log, x)
-
-
-def log_lower(x: Any) -> fmpq:
-    """A rational ≤ ln x (x > 0)."""
-    return lower(iv.log, x)
-
-
-def exp_upper(x: Any) -> fmpq:
-    """A rational ≥ eˣ."""
-    return upper(iv.exp, x)
-
-
-def exp_lower(x: Any) -> fmpq:
-    """A rational ≤ eˣ."""
-    return lower(iv.exp, x)
+# One-sided bounds of √x, ln x (x > 0) and eˣ: ``f_upper(x)`` ≥ f(x) ≥ ``f_lower(x)``.
+sqrt_upper: Callable[[Any], fmpq] = partial(upper, iv.sqrt)
+sqrt_lower: Callable[[Any], fmpq] = partial(lower, iv.sqrt)
+log_upper: Callable[[Any], fmpq] = partial(upper, iv.log)
+log_lower: Callable[[Any], fmpq] = partial(lower, iv.log)
+exp_upper: Callable[[Any], fmpq] = partial(upper, iv.exp)
+exp_lower: Callable[[Any], fmpq] = partial(lower, iv.exp)
 
 
 def round_up(x: Any, digits: int) -> fmpq:
