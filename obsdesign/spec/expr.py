@@ -16,6 +16,7 @@ heaviside(x) = 1 if x > 0 else 0``, ``mod(a, b) = a - b*floor(a/b)``. Constants 
 from __future__ import annotations
 
 import ast
+import functools
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -41,25 +42,18 @@ def _mod(a: Any, b: Any) -> Any:
     return a - b * np.floor(a / b)
 
 
+#: one-argument functions that numpy and sympy name as the spec language does
+_ALIKE = ("sin", "cos", "tan", "exp", "log", "sqrt", "tanh", "sinh", "cosh", "sign", "floor")
+#: the whitelisted functions: name → (numpy function, allowed numbers of arguments)
 FUNCTIONS: dict[str, tuple[Callable[..., Any], tuple[int, ...]]] = {
-    "sin": (np.sin, (1,)),
-    "cos": (np.cos, (1,)),
-    "tan": (np.tan, (1,)),
-    "exp": (np.exp, (1,)),
-    "log": (np.log, (1,)),
-    "sqrt": (np.sqrt, (1,)),
+    **{name: (getattr(np, name), (1,)) for name in _ALIKE},
     "abs": (np.abs, (1,)),
-    "tanh": (np.tanh, (1,)),
     "atan": (np.arctan, (1,)),
-    "sinh": (np.sinh, (1,)),
-    "cosh": (np.cosh, (1,)),
     "min": (np.minimum, (2,)),
     "max": (np.maximum, (2,)),
     "sat": (_sat, (1, 2)),
-    "sign": (np.sign, (1,)),
     "step": (_step, (1,)),
     "heaviside": (_step, (1,)),
-    "floor": (np.floor, (1,)),
     "mod": (_mod, (2,)),
 }
 CONSTANTS = {"pi": np.pi, "e": np.e}
@@ -77,10 +71,9 @@ _FORBIDDEN = {
     ast.Attribute: "attribute access is",
     ast.Subscript: "subscripts are",
     ast.Lambda: "lambda is",
-    ast.ListComp: "comprehensions are",
-    ast.GeneratorExp: "comprehensions are",
-    ast.DictComp: "comprehensions are",
-    ast.SetComp: "comprehensions are",
+    **dict.fromkeys(
+        (ast.ListComp, ast.GeneratorExp, ast.DictComp, ast.SetComp), "comprehensions are"
+    ),
     ast.Compare: "comparisons are (use step(x))",
     ast.BoolOp: "boolean operators are",
     ast.IfExp: "conditional expressions are",
@@ -374,6 +367,24 @@ def _compile(node: ast.AST, known: set[str], file: str, key: str) -> Fn:
 
 
 # -- sympy, built from the checked tree ---------------------------------------------------
+@functools.cache
+def _sympy_functions() -> dict[str, Any]:
+    """Spec function name → sympy function, for those sympy has (not sat, step, mod)."""
+    import sympy as sp
+
+    alike = {name: getattr(sp, name) for name in _ALIKE}
+    return {**alike, "abs": sp.Abs, "atan": sp.atan, "min": sp.Min, "max": sp.Max}
+
+
+@functools.cache
+def _numpy_of_sympy() -> dict[Any, Callable[[Any], Any]]:
+    """sympy one-argument function → numpy function (sympy's sqrt is a power: never met)."""
+    import sympy as sp
+
+    alike = {getattr(sp, name): getattr(np, name) for name in _ALIKE}
+    return {**alike, sp.Abs: np.abs, sp.atan: np.arctan}
+
+
 def _to_sympy(node: ast.AST, ex: Expr) -> Any:
     import sympy as sp
 
@@ -410,23 +421,7 @@ def _to_sympy(node: ast.AST, ex: Expr) -> Any:
     assert isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
     args = [_to_sympy(a, ex) for a in node.args]
     name = node.func.id
-    table = {
-        "sin": sp.sin,
-        "cos": sp.cos,
-        "tan": sp.tan,
-        "exp": sp.exp,
-        "log": sp.log,
-        "sqrt": sp.sqrt,
-        "abs": sp.Abs,
-        "tanh": sp.tanh,
-        "atan": sp.atan,
-        "sinh": sp.sinh,
-        "cosh": sp.cosh,
-        "min": sp.Min,
-        "max": sp.Max,
-        "sign": sp.sign,
-        "floor": sp.floor,
-    }
+    table = _sympy_functions()
     if name in table:
         return table[name](*args)
     if name == "sat":
@@ -475,20 +470,7 @@ def _eval_sympy(e: Any, env: dict[str, Any]) -> Any:
         return out
     if e.is_Pow:
         return np.power(args[0], args[1])
-    fn = {
-        sp.sin: np.sin,
-        sp.cos: np.cos,
-        sp.tan: np.tan,
-        sp.exp: np.exp,
-        sp.log: np.log,
-        sp.tanh: np.tanh,
-        sp.atan: np.arctan,
-        sp.sinh: np.sinh,
-        sp.cosh: np.cosh,
-        sp.Abs: np.abs,
-        sp.sign: np.sign,
-        sp.floor: np.floor,
-    }.get(e.func)
+    fn = _numpy_of_sympy().get(e.func)
     if fn is not None:
         return fn(args[0])
     if e.func is sp.Heaviside:
