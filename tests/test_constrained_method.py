@@ -218,9 +218,9 @@ def test_remark2_theta_zero():
 
 def test_large_box_uses_closed_forms():
     """n = 13: 2¹³ vertices exceed the vertex budget; the per-face closed forms keep it fast."""
-    from test_constrained_properties import random_spec
+    from test_constrained_properties import Case, random_spec
 
-    sp, _ = random_spec(13, seed=13, r_pad=0.5, eps_min=0.05, wbound=0.1, rad=0.5)
+    sp, _ = random_spec(Case(n=13, seed=13, r_pad=0.5, eps_min=0.05, wbound=0.1, rad=0.5))
     rep = api.design(sp)
     assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
     assert any("upper bound" in n for n in rep.notes)

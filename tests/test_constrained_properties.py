@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -10,6 +12,7 @@ from hypothesis import strategies as st
 from obsdesign import api
 from obsdesign.api import load_spec_text
 from obsdesign.methods.constrained.design import xhat_set
+from obsdesign.spec.models import Spec
 
 
 def _fmt(M) -> str:
@@ -21,17 +24,38 @@ def _vec(v) -> str:
     return "[" + ", ".join(f"{x:.6f}" for x in v) + "]"
 
 
-def random_spec(
-    n: int,
-    seed: int,
-    r_pad: float,
-    eps_min: float,
-    wbound: float,
-    rad: float = 0.8,
-    norm: str = "euclidean",
-):
+@dataclass(frozen=True)
+class Case:
+    """One random system and design of :func:`random_spec`: ``n`` states, drawn from ``seed``;
+    the box c-map reaches ``r_pad`` beyond X, C_min has ε = ``eps_min``, the noise bound is
+    ``wbound``, the error dynamics have spectral radius ``rad``, and ``norm`` is the c-map's."""
+
+    n: int
+    seed: int
+    r_pad: float
+    eps_min: float
+    wbound: float
+    rad: float = 0.8
+    norm: str = "euclidean"
+
+
+CASES = st.builds(
+    Case,
+    n=st.integers(2, 3),
+    seed=st.integers(0, 2**31 - 1),
+    r_pad=st.floats(0.1, 1.0),
+    eps_min=st.floats(0.05, 0.5),
+    wbound=st.sampled_from([0.0, 0.05, 0.3]),
+    rad=st.sampled_from([0.5, 0.8]),
+    norm=st.sampled_from(["euclidean", "max"]),
+)
+
+
+def random_spec(case: Case) -> tuple[Spec, np.ndarray]:
     """x⁺ = A x with ‖A‖_∞ ≤ 1 (so X = [−1, 1]ⁿ is invariant, Assumption 1), y = x + v
-    (C = I), L = A − K with K of spectral radius ``rad``, λ = rad + 0.1."""
+    (C = I), L = A − K with K of spectral radius ``rad``, λ = rad + 0.1; returns (spec, A)."""
+    n, seed, r_pad, eps_min = case.n, case.seed, case.r_pad, case.eps_min
+    wbound, rad, norm = case.wbound, case.rad, case.norm
     rng = np.random.default_rng(seed)
     A = rng.uniform(-1, 1, (n, n))
     A /= np.abs(A).sum(axis=1).max()
@@ -79,28 +103,21 @@ bound = {_vec(wbound * np.ones(n))}
 
 
 @settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(
-    st.integers(2, 3),
-    st.integers(0, 2**31 - 1),
-    st.floats(0.1, 1.0),
-    st.floats(0.05, 0.5),
-    st.sampled_from([0.0, 0.05, 0.3]),
-    st.sampled_from([0.5, 0.8]),
-    st.sampled_from(["euclidean", "max"]),
-)
-def test_theorem1_invariance_and_lemma3(n, seed, r_pad, eps_min, wbound, rad, norm):
-    check_run(n, seed, r_pad, eps_min, wbound, rad, norm)
+@given(CASES)
+def test_theorem1_invariance_and_lemma3(case: Case):
+    check_run(case)
 
 
 def test_refining_is_exercised():
     """A case where the refining map runs thousands of steps (seed found by search)."""
-    steps = check_run(2, 4, 0.2, 0.05, 0.3, 0.8)
+    steps = check_run(Case(n=2, seed=4, r_pad=0.2, eps_min=0.05, wbound=0.3, rad=0.8))
     assert steps.sum() > 1000
 
 
-def check_run(n, seed, r_pad, eps_min, wbound, rad, norm="euclidean"):
-    """Design, simulate with θ_m = θ, and check (25a), (25b) and Lemma 3 (A.1a)."""
-    sp, _ = random_spec(n, seed, r_pad, eps_min, wbound, rad, norm)
+def check_run(case: Case) -> np.ndarray:
+    """Design, simulate with θ_m = θ, and check (25a), (25b) and Lemma 3 (A.1a); returns the
+    refining steps per sample."""
+    sp, _ = random_spec(case)
     rep = api.design(sp)
     assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
     p = rep.parameters
