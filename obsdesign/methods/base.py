@@ -13,24 +13,29 @@ Declared by each method (class attributes):
   (``nonlinearity``);
 - ``required_params``: parameters a report must carry (checked once, generically, before
   ``certify`` runs);
-- ``summary_fields``: what ``summary()`` shows (label, parameter, format);
+- ``summary_fields``: what ``summary()`` shows (label, parameter, format), with
+  ``summary_format`` the format of the fields that name none;
 - ``sim_options``: the ``--option KEY=VALUE`` keys of ``simulate`` (validated centrally);
 - ``plot_design`` / ``plot_simulation``: plot hooks, None when the method has none.
 
-Implemented by each method: ``parse_options(table, spec) -> Options``,
-``parse_simulate(table, spec) -> SimOptions | None`` (returns, never mutates the spec),
-``design(spec, progress) -> Design``, ``certify(spec, params) -> list[Claim]`` (never looks at
-solver output or stored statuses), ``simulate(spec, params, **options)``.
+Implemented by each method's package, found by the base class's defaults (override them only
+where the facade must decide something itself): ``options.parse_options(table, spec) ->
+Options``, ``options.parse_simulate(table, spec) -> SimOptions`` (when ``SimOptions`` is
+declared; returns, never mutates the spec), ``options.options_schema(key)`` and
+``options.simulate_schema()``, ``design.design(spec, progress) -> Design``,
+``claims.certify(spec, params) -> list[Claim]`` (never looks at solver output or stored
+statuses), ``sim.simulate(spec, params, **options)``.
 """
 
 from __future__ import annotations
 
+import importlib
 import math
-from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import StrEnum
 from pathlib import Path
+from types import ModuleType
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from obsdesign.errors import InputError
@@ -97,12 +102,18 @@ class Design:
 
 @dataclass(frozen=True)
 class SummaryField:
-    """One item of the one-line summary: ``label = value`` with ``value`` formatted by
-    ``fmt`` (a format spec such as ``.6g``); skipped when the parameter is absent."""
+    """One item of the one-line summary: ``label = value`` with ``value`` (each entry of a
+    vector or matrix) formatted by ``fmt`` (a format spec such as ``.6g``; None: the method's
+    ``summary_format``); skipped when the parameter is absent. ``param`` defaults to the
+    label."""
 
     label: str
-    param: str
-    fmt: str = ".6g"
+    param: str = ""
+    fmt: str | None = None
+
+    def __post_init__(self) -> None:
+        if not self.param:
+            object.__setattr__(self, "param", self.label)
 
 
 @dataclass(frozen=True)
@@ -159,8 +170,12 @@ _KIND = {
 }
 
 
-class Method(ABC):
-    """Base class of the design methods (one package each under ``obsdesign.methods``)."""
+class Method:
+    """Base class of the design methods (one package each under ``obsdesign.methods``).
+
+    The defaults of ``parse_options``, ``parse_simulate``, ``design``, ``certify``,
+    ``simulate``, ``options_schema`` and ``simulate_schema`` delegate to the modules of the
+    method's package (see the module docstring), imported on first use."""
 
     key: ClassVar[str] = ""
     title: ClassVar[str] = ""
@@ -175,50 +190,78 @@ class Method(ABC):
     extra_tables: ClassVar[tuple[str, ...]] = ()
     #: parameters every report of this method carries (checked before ``certify``)
     required_params: ClassVar[tuple[str, ...]] = ()
-    #: what ``summary()`` prints
+    #: what ``summary()`` prints, and the format of the fields that give none
     summary_fields: ClassVar[tuple[SummaryField, ...]] = ()
+    summary_format: ClassVar[str] = ".6g"
     #: ``simulate --option`` keys
     sim_options: ClassVar[tuple[SimOption, ...]] = ()
     #: plot hooks: ``plot_design(spec, params, path)``, ``plot_simulation(spec, result, path)``
     plot_design: Callable[..., Any] | None = None
     plot_simulation: Callable[..., Any] | None = None
 
-    @abstractmethod
+    def part(self, name: str) -> ModuleType:
+        """The module ``name`` (``options``, ``design``, ``claims``, ``sim``) of the method's
+        package, imported on first use."""
+        pkg = type(self).__module__.rsplit(".", 1)[0]
+        return importlib.import_module(f"{pkg}.{name}")
+
     def parse_options(self, table: Table, spec: Spec) -> Any:
-        """Typed options from ``[method]``; call ``table.done()`` at the end."""
+        """Typed options from ``[method]`` (``options.parse_options``, which calls
+        ``table.done()`` at the end)."""
+        return self.part("options").parse_options(table, spec)
 
     def parse_simulate(self, table: Table, spec: Spec) -> Any:
-        """The method's own ``[simulate]`` keys as its ``SimOptions`` (None when it has none).
-        Returns the options; never mutates the spec."""
-        return None
+        """The method's own ``[simulate]`` keys as its ``SimOptions`` (``options.parse_simulate``;
+        None when the method declares no ``SimOptions``). Returns the options; never mutates the
+        spec."""
+        if self.SimOptions is None:
+            return None
+        return self.part("options").parse_simulate(table, spec)
 
-    @abstractmethod
     def design(self, spec: Spec, progress: Progress | None = None) -> Design:
-        """Compute the observer parameters (floats from solvers, rounded to exact values)."""
+        """Compute the observer parameters (floats from solvers, rounded to exact values):
+        ``design.design``."""
+        return self.part("design").design(spec, progress)
 
-    @abstractmethod
     def certify(self, spec: Spec, params: Parameters) -> list[Claim]:
-        """Recompute every claim from spec + parameters; exact where it says certified.
+        """Recompute every claim from spec + parameters; exact where it says certified
+        (``claims.certify``).
 
         Anything the spec fixes is read from the spec (and compared exactly with the report's
         copy, where the report carries one)."""
+        return self.part("claims").certify(spec, params)
 
     def simulate(self, spec: Spec, params: Parameters, **options: Any) -> SimResult:
-        """Run plant + observer over the spec's ``[simulate]`` scenario."""
-        raise InputError(f"method '{self.key}' has no simulation")
+        """Run plant + observer over the spec's ``[simulate]`` scenario (``sim.simulate``)."""
+        try:
+            sim = self.part("sim")
+        except ModuleNotFoundError as e:
+            if e.name != f"{type(self).__module__.rsplit('.', 1)[0]}.sim":
+                raise
+            raise InputError(f"method '{self.key}' has no simulation") from None
+        return sim.simulate(spec, params, **options)
 
     # -- generic parts ----------------------------------------------------------------------
     def summary(self, params: Parameters) -> str:
-        """One short line of the key results (from ``summary_fields``)."""
+        """One short line of the key results (from ``summary_fields``): scalars formatted, a
+        vector or matrix as ``[a, b; c, d]`` (rows separated by ';')."""
+        import numpy as np
+
         out = []
         for f in self.summary_fields:
             if f.param not in params:
                 continue
+            fmt = f.fmt or self.summary_format
             try:
-                v = params.float(f.param)
-                out.append(f"{f.label} = {format(v, f.fmt)}")
+                v = np.asarray(params.float(f.param), dtype=float)
+                if v.ndim == 0:
+                    text = format(float(v), fmt)
+                else:
+                    rows = v if v.ndim == 2 else v.reshape(1, -1)
+                    text = "[" + "; ".join(", ".join(format(x, fmt) for x in r) for r in rows) + "]"
             except (TypeError, ValueError):
-                out.append(f"{f.label} = {params[f.param]}")
+                text = str(params[f.param])
+            out.append(f"{f.label} = {text}")
         return ", ".join(out)
 
     def parse_sim_options(self, raw: dict[str, str]) -> dict[str, Any]:
@@ -245,12 +288,32 @@ class Method(ABC):
         return importlib.resources.files(pkg).joinpath("template.toml").read_text("utf-8")
 
     def options_schema(self) -> dict[str, Any]:
-        """JSON schema of the ``[method]`` table."""
-        return {"type": "object", "properties": {"key": {"const": self.key}}}
+        """JSON schema of the ``[method]`` table (``options.options_schema(key)``)."""
+        return self.part("options").options_schema(self.key)
 
     def simulate_schema(self) -> dict[str, Any]:
-        """JSON-schema properties of the method's own ``[simulate]`` keys."""
-        return {}
+        """JSON-schema properties of the method's own ``[simulate]`` keys
+        (``options.simulate_schema()``; none when the method declares no ``SimOptions``)."""
+        if self.SimOptions is None:
+            return {}
+        return self.part("options").simulate_schema()
+
+
+def table_schema(
+    key: str, properties: dict[str, Any], required: tuple[str, ...] = ()
+) -> dict[str, Any]:
+    """JSON schema of a method's ``[method]`` table: ``key`` (the method's key, always
+    required) and the method's own ``properties`` (``required`` besides ``key``), no other
+    key.
+
+    :param key: the method key; :param properties: JSON-schema properties of the other keys;
+    :param required: the keys besides ``key`` a spec must give."""
+    return {
+        "type": "object",
+        "required": ["key", *required],
+        "additionalProperties": False,
+        "properties": {"key": {"const": key}, **properties},
+    }
 
 
 def _did_you_mean(word: str, known: list[str]) -> str:

@@ -7,23 +7,11 @@ from __future__ import annotations
 
 from typing import Any
 
-from obsdesign.certify.claim import Claim
-from obsdesign.methods.base import Design, Method, Progress, SimOption, SummaryField
+from obsdesign.methods.base import Method, SimOption, SummaryField
 from obsdesign.methods.constrained import claims as _claims
-from obsdesign.methods.constrained import sim as _sim
-from obsdesign.methods.constrained.design import design
-from obsdesign.methods.constrained.options import (
-    Options,
-    SimOptions,
-    options_schema,
-    parse_options,
-    parse_sim,
-    simulate_schema,
-)
-from obsdesign.params import Parameters
+from obsdesign.methods.constrained.options import Options, SimOptions
 from obsdesign.simulate.result import SimResult
 from obsdesign.spec.models import Spec
-from obsdesign.spec.reader import Table
 
 
 class Constrained(Method):
@@ -40,13 +28,14 @@ class Constrained(Method):
     needs_linear = False
     required_params = _claims.REQUIRED
     summary_fields = (
-        SummaryField("γ", "gamma", ".4g"),
-        SummaryField("γ_max", "gamma_max", ".4g"),
-        SummaryField("δ", "delta", ".4g"),
-        SummaryField("v_max", "v_max", ".4g"),
-        SummaryField("v_min", "v_min", ".4g"),
-        SummaryField("θ", "theta", ".4g"),
+        SummaryField("γ", "gamma"),
+        SummaryField("γ_max", "gamma_max"),
+        SummaryField("δ", "delta"),
+        SummaryField("v_max"),
+        SummaryField("v_min"),
+        SummaryField("θ", "theta"),
     )
+    summary_format = ".4g"
     sim_options = (
         SimOption(
             "theta_m",
@@ -58,29 +47,10 @@ class Constrained(Method):
         SimOption("saturation_r", "float", None, "also run the saturated observer (29)", min=0),
     )
 
-    def parse_options(self, table: Table, spec: Spec) -> Options:
-        return parse_options(table, spec)
-
-    def parse_simulate(self, table: Table, spec: Spec) -> SimOptions:
-        return parse_sim(table, spec)
-
-    def design(self, spec: Spec, progress: Progress | None = None) -> Design:
-        return design(spec, progress)
-
-    def certify(self, spec: Spec, params: Parameters) -> list[Claim]:
-        return _claims.certify(spec, params)
-
-    def simulate(self, spec: Spec, params: Parameters, **options: Any) -> SimResult:
-        return _sim.simulate(spec, params, **options)
-
     def plot_simulation(self, spec: Spec, result: SimResult, path: Any) -> Any:  # type: ignore[override]
-        return _sim.plot(spec, result, path)
+        from obsdesign.methods.constrained.sim import plot
 
-    def options_schema(self) -> dict[str, Any]:
-        return options_schema(self.key)
-
-    def simulate_schema(self) -> dict[str, Any]:
-        return simulate_schema()
+        return plot(spec, result, path)
 
 
 METHOD = Constrained()

@@ -11,6 +11,7 @@ from flint import fmpq
 from obsdesign.certify.exact import Q
 from obsdesign.certify.psd import check_pd
 from obsdesign.errors import SpecError
+from obsdesign.methods.base import table_schema
 from obsdesign.methods.constrained.cmap import (
     KINDS,
     ConstraintMap,
@@ -277,7 +278,7 @@ def parse_cmap(t: Table, n: int) -> ConstraintMap:
     return cm
 
 
-def parse_sim(table: Table, spec: Spec) -> SimOptions:
+def parse_simulate(table: Table, spec: Spec) -> SimOptions:
     """``[simulate]`` keys of this method: theta_m (int or list), gamma, saturation_r
     (Section 5 / Table 1 and eq. (29) of the constrained-redesign paper, Astolfi et al.,
     NOLCOS 2019).
@@ -342,12 +343,9 @@ def options_schema(key: str) -> dict[str, Any]:
         "additionalProperties": False,
         "properties": {"lower": VEC, "upper": VEC},
     }
-    return {
-        "type": "object",
-        "required": ["key", "X", "c", "eps_min"],
-        "additionalProperties": False,
-        "properties": {
-            "key": {"const": key},
+    return table_schema(
+        key,
+        {
             "L": MAT,
             "lambda": {**NUM, "exclusiveMinimum": 0, "exclusiveMaximum": 1},
             "rho": {**NUM, "minimum": 0, "exclusiveMaximum": 1},
@@ -382,7 +380,8 @@ def options_schema(key: str) -> dict[str, Any]:
             "U": bounds,
             "F": {**EXPRS, "description": "observer map x̂⁺ = F(x̂, u, y) (x1_hat…, u1…, y1…)"},
         },
-    }
+        ("X", "c", "eps_min"),
+    )
 
 
 def simulate_schema() -> dict[str, Any]:

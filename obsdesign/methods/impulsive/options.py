@@ -20,6 +20,7 @@ from obsdesign.certify.exact import Q, qvec
 from obsdesign.certify.linalg import qrank
 from obsdesign.certify.psd import check_pd, check_psd
 from obsdesign.errors import SpecError
+from obsdesign.methods.base import table_schema
 from obsdesign.spec.models import Spec
 from obsdesign.spec.reader import Table
 
@@ -244,12 +245,9 @@ def options_schema(key: str) -> dict[str, Any]:
     """JSON schema of the ``[method]`` table of ``impulsive``."""
     from obsdesign.spec.schema import MAT, NUM
 
-    return {
-        "type": "object",
-        "required": ["key", "L", "alpha", "noise_bound"],
-        "additionalProperties": False,
-        "properties": {
-            "key": {"const": key},
+    return table_schema(
+        key,
+        {
             "L": MAT,
             "alpha": {**NUM, "exclusiveMinimum": 0},
             "noise_bound": {**NUM, "minimum": 0},
@@ -258,7 +256,8 @@ def options_schema(key: str) -> dict[str, Any]:
             "qsr_scaling": {"enum": ["optimize", "as-given"]},
             "digits": {"type": "integer", "minimum": 1, "maximum": MAX_DIGITS},
         },
-    }
+        ("L", "alpha", "noise_bound"),
+    )
 
 
 def simulate_schema() -> dict[str, Any]:

@@ -63,7 +63,7 @@ def check_memory(runs: int, samples: int, n: int, dense: int = 8) -> None:
         )
 
 
-def simulate_spec(
+def simulate(
     spec: Spec,
     params: Parameters,
     runs: int | None = None,

@@ -14,6 +14,7 @@ continuous systems with controls" (paper 004):
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass
 from typing import Any
 
@@ -25,8 +26,10 @@ from obsdesign.certify import interval as ivq
 from obsdesign.certify.exact import Q
 from obsdesign.certify.printing import fmt_up
 from obsdesign.errors import InfeasibleError
+from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
 from obsdesign.methods.searchspace import bounds
 from obsdesign.methods.searchspace.options import Options
+from obsdesign.params import Parameters
 from obsdesign.spec.models import Spec
 
 #: the γ schedule is rounded up to this many significant digits (a coarser grid still covers)
@@ -209,6 +212,23 @@ def params_from(
         "gamma_schedule": np.array(gam, dtype=object),
         "eps_schedule": np.array([g / kappa for g in gam], dtype=object),
     }
+
+
+def design(spec: Spec, progress: Progress | None = None) -> Design:
+    """The constants on E (Lemmas 1-2, by interval arithmetic) and the parameter rules of
+    Theorem 1 (:func:`design_params`), with the solver record of this closed-form design.
+
+    :param spec: the bound spec; :param progress: optional callback for status lines."""
+    if progress:
+        progress("constants on E by interval arithmetic, then Theorem 1's rules")
+    t0 = time.perf_counter()
+    vals, notes = design_params(spec)
+    solver = SolverResult(
+        "interval branch and bound + exact rules",
+        SolverStatus.CLOSED_FORM,
+        seconds=time.perf_counter() - t0,
+    )
+    return Design(Parameters(vals), solver, notes)
 
 
 def design_params(spec: Spec) -> tuple[dict[str, Any], list[str]]:

@@ -5,24 +5,11 @@ of hypercube centres."""
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 from typing import Any
 
-from obsdesign.certify.claim import Claim
-from obsdesign.methods.base import (
-    Design,
-    Method,
-    Progress,
-    SimOption,
-    SolverResult,
-    SolverStatus,
-    SummaryField,
-)
-from obsdesign.methods.searchspace import claims as _claims
+from obsdesign.methods.base import Method, SimOption, SummaryField
 from obsdesign.methods.searchspace import options as _opts
-from obsdesign.methods.searchspace.design import design_params
-from obsdesign.params import Parameters
 from obsdesign.spec.models import Spec
 from obsdesign.spec.reader import Table
 
@@ -51,12 +38,12 @@ class SearchSpace(Method):
         "eps_schedule",
     )
     summary_fields = (
-        SummaryField("L_f", "L_f"),
-        SummaryField("L_h", "L_h"),
+        SummaryField("L_f"),
+        SummaryField("L_h"),
         SummaryField("‖f_u‖", "f_sup"),
         SummaryField("κ", "kappa"),
         SummaryField("ΔT", "dT", ".4g"),
-        SummaryField("K", "K", ".0f"),
+        SummaryField("K", fmt=".0f"),
         SummaryField("ε⋆", "eps_star", ".4g"),
     )
     sim_options = (
@@ -67,42 +54,13 @@ class SearchSpace(Method):
         SimOption("progress", "bool", False, "show a progress bar"),
     )
 
-    def parse_options(self, table: Table, spec: Spec) -> _opts.Options:
-        return _opts.parse_options(table, spec)
-
     def parse_simulate(self, table: Table, spec: Spec) -> _opts.SimOptions:
         return _opts.parse_sim(table, spec)
-
-    def design(self, spec: Spec, progress: Progress | None = None) -> Design:
-        if progress:
-            progress("constants on E by interval arithmetic, then Theorem 1's rules")
-        t0 = time.perf_counter()
-        vals, notes = design_params(spec)
-        solver = SolverResult(
-            "interval branch and bound + exact rules",
-            SolverStatus.CLOSED_FORM,
-            seconds=time.perf_counter() - t0,
-        )
-        return Design(Parameters(vals), solver, notes)
-
-    def certify(self, spec: Spec, params: Parameters) -> list[Claim]:
-        return _claims.certify(spec, params)
-
-    def simulate(self, spec: Spec, params: Parameters, **options: Any) -> Any:
-        from obsdesign.methods.searchspace import sim
-
-        return sim.simulate(spec, params, **options)
 
     def plot_simulation(self, spec: Spec, result: Any, path: str | Path) -> Any:
         from obsdesign.methods.searchspace import plots
 
         return plots.plot_simulation(spec, result, path)
-
-    def options_schema(self) -> dict[str, Any]:
-        return _opts.options_schema(self.key)
-
-    def simulate_schema(self) -> dict[str, Any]:
-        return _opts.simulate_schema()
 
 
 METHOD = SearchSpace()

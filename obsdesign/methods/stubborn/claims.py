@@ -128,6 +128,20 @@ def _read_point(pr: Parameters, c: Claims, spec: Spec, suffix: str) -> dict[str,
     }
 
 
+def certify(spec: Spec, params: Parameters) -> list[Claim]:
+    """Every claim of a stubborn design (Astolfi, Alessandri, Zaccarian, WUDS 2017): the
+    slides' Theorem (LMIs (1)-(3) / (7)-(9), :func:`lmi_claims`) in the linear modes, the
+    high-gain redesign's claims (:func:`obsdesign.methods.stubborn.highgain.certify`) in mode
+    ``high-gain``.
+
+    :param spec: the bound spec; :param params: the report's parameters."""
+    if spec.options.mode == "high-gain":
+        from obsdesign.methods.stubborn.highgain import certify as high_gain
+
+        return high_gain(spec, params)
+    return lmi_claims(spec, params)
+
+
 def lmi_claims(
     spec: Spec, params: dict[str, Any] | Parameters, full_check: bool = True
 ) -> list[Claim]:

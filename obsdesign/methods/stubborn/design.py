@@ -24,10 +24,11 @@ from flint import fmpq
 from obsdesign.certify.exact import Q, dyadic, symmetrize, to_float
 from obsdesign.errors import InconclusiveError, InfeasibleError, SolverError
 from obsdesign.lmi import solve
-from obsdesign.methods.base import SolverResult, SolverStatus
+from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
 from obsdesign.methods.stubborn import claims as _claims
 from obsdesign.methods.stubborn.detect import detectability
 from obsdesign.methods.stubborn.options import Options
+from obsdesign.params import Parameters
 from obsdesign.spec.models import Spec
 
 #: bits of the dyadic rounding of the solution (relative per entry)
@@ -232,6 +233,21 @@ def _chosen(o: Options, best: fmpq, discrete: bool) -> fmpq:
     """λ from the best rate: fraction·λ_max (continuous), 1 − fraction·(1 − λ_best)
     (discrete: the decay margin 1 − λ is the fraction of the best one)."""
     return o.fraction * best if not discrete else 1 - o.fraction * (1 - best)
+
+
+def design(spec: Spec, progress: Progress | None = None) -> Design:
+    """The stubborn design (Astolfi, Alessandri, Zaccarian, WUDS 2017): the slides' Theorem
+    (LMIs (1)-(3) / (7)-(9), :func:`design_params`) in the linear modes, the high-gain
+    redesign (:func:`obsdesign.methods.stubborn.highgain.design_params`) in mode ``high-gain``.
+
+    :param spec: the bound spec; :param progress: optional callback for status lines."""
+    if spec.options.mode == "high-gain":
+        from obsdesign.methods.stubborn.highgain import design_params as high_gain
+
+        vals, solver, notes = high_gain(spec, progress)
+    else:
+        vals, solver, notes = design_params(spec, progress)
+    return Design(Parameters(vals), solver, notes)
 
 
 def design_params(

@@ -4,10 +4,12 @@ Alessandri, Zaccarian, "Stubborn observers for linear and nonlinear systems", WU
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from flint import fmpq
 
+from obsdesign.methods.base import table_schema
 from obsdesign.spec.models import Spec
 from obsdesign.spec.reader import Table
 
@@ -154,7 +156,7 @@ def parse_options(table: Table, spec: Spec) -> Options:
     return o
 
 
-def parse_sim(table: Table, spec: Spec) -> SimOptions:
+def parse_simulate(table: Table, spec: Spec) -> SimOptions:
     """The method's own ``[simulate]`` keys (the outlier model of the study)."""
     o = SimOptions()
     if table.has("noise_std"):
@@ -177,3 +179,48 @@ def parse_sim(table: Table, spec: Spec) -> SimOptions:
         o.hf_stop = float(table.scalar("hf_stop", min=0).f)
         o.hf_amplitude = float(table.scalar("hf_amplitude", min=0).f)
     return o
+
+
+def options_schema(key: str) -> dict[str, Any]:
+    """JSON schema of the method's ``[method]`` table."""
+    num = {"type": "number"}
+    vec = {"type": "array", "items": num}
+    mat = {"type": "array", "items": {"anyOf": [num, vec]}}
+    return table_schema(
+        key,
+        {
+            "mode": {"enum": list(MODES)},
+            "K": mat,
+            "lambda": {**num, "exclusiveMinimum": 0},
+            "lambda_fraction": {**num, "exclusiveMinimum": 0, "maximum": 1},
+            "gain_bound": {**num, "exclusiveMinimum": 0},
+            "r_bound": {**num, "exclusiveMinimum": 0},
+            "criterion": {"enum": list(CRITERIA)},
+            "margin": {**num, "exclusiveMinimum": 0},
+            "lambda_tol": {**num, "exclusiveMinimum": 0},
+            "lipschitz": {**num, "minimum": 0},
+            "ell": {**num, "minimum": 1},
+            "epsilon": {**num, "exclusiveMinimum": 0},
+            "state_bound": {
+                **vec,
+                "description": "high-gain mode: the estimate is clipped to |x̂_i| ≤ state_bound_i inside φ",
+            },
+        },
+    )
+
+
+def simulate_schema() -> dict[str, Any]:
+    """JSON-schema properties of the method's own ``[simulate]`` keys."""
+    num = {"type": "number"}
+    return {
+        "noise_std": {**num, "minimum": 0},
+        "outlier_rate": {**num, "minimum": 0, "maximum": 1},
+        "amplitudes": {"type": "array", "items": {**num, "minimum": 0}},
+        "runs": {"type": "integer", "minimum": 1},
+        "sigma0": {**num, "minimum": 0},
+        "impulse_time": {**num, "minimum": 0},
+        "impulse_value": num,
+        "hf_start": {**num, "minimum": 0},
+        "hf_stop": {**num, "minimum": 0},
+        "hf_amplitude": {**num, "minimum": 0},
+    }
