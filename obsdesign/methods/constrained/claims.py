@@ -237,15 +237,7 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         check="per-face support functions, exact/outward rounding",
         passed=ok,
     )
-    need = max(v_max - v_min, fmpq(0)) / (gamma * eps_min**2)
-    c.exact(
-        id="theta-covers",
-        statement=f"θ = {_int_or_exact(theta)} ≥ (v_max − v_min)/(γ ε_min²)",
-        reference=_ref("eq. (22)"),
-        check="exact rational comparison; θ an integer",
-        passed=theta >= need and _is_int(theta),
-        detail=f"(v_max − v_min)/(γ ε_min²) ≤ {fmt_up(need, 10)}",
-    )
+    _theta_covers(c, "theta", theta, "v_max", v_max, v_min, gamma, eps_min, "eq. (22)")
     if o.X0 is not None and o.Xhat0 is not None:
         _breve(c, params, o, P, rho, mu, W, v_max, v_min, gamma, eps_min)
     return c
@@ -278,14 +270,41 @@ def _breve(
         passed=vbr >= ref and rho < 1,
         detail=f"recomputed bound ≤ {fmt_up(ref, 10)}",
     )
-    need = max(min(vbr, v_max) - v_min, fmpq(0)) / (gamma * eps_min**2)
+    top = min(vbr, v_max)
+    _theta_covers(
+        c, "theta_breve", tb, "min(v_max, v̆_max)", top, v_min, gamma, eps_min, "Section 4, eq. (22)"
+    )
+
+
+def _theta_covers(
+    c: Claims,
+    key: str,
+    theta: fmpq,
+    top_label: str,
+    top: fmpq,
+    v_min: fmpq,
+    gamma: fmpq,
+    eps_min: fmpq,
+    where: str,
+) -> None:
+    """The refining budget covers the descent, eq. (22) (constrained-redesign paper, Astolfi et
+    al., NOLCOS 2019): θ (or θ̆ of Section 4, with v̆_max) is an integer with
+    θ ≥ (top − v_min)/(γ ε_min²), where each refining step lowers V by at least γ ε_min².
+
+    :param key: ``theta`` or ``theta_breve`` (the claim id is ``<key>-covers``);
+    :param theta: the reported budget; :param top_label: how the statement names ``top``;
+    :param top: the level V starts from; :param v_min: v_min (eq. (21)); :param gamma: γ;
+    :param eps_min: ε_min; :param where: the paper reference."""
+    sym = {"theta": "θ", "theta_breve": "θ̆"}[key]
+    ratio = f"({top_label} − v_min)/(γ ε_min²)"
+    need = max(top - v_min, fmpq(0)) / (gamma * eps_min**2)
     c.exact(
-        id="theta_breve-covers",
-        statement=f"θ̆ = {_int_or_exact(tb)} ≥ (min(v_max, v̆_max) − v_min)/(γ ε_min²)",
-        reference=_ref("Section 4, eq. (22)"),
-        check="exact rational comparison; θ̆ an integer",
-        passed=tb >= need and _is_int(tb),
-        detail=f"(min(v_max, v̆_max) − v_min)/(γ ε_min²) ≤ {fmt_up(need, 10)}",
+        id=f"{key}-covers",
+        statement=f"{sym} = {_int_or_exact(theta)} ≥ {ratio}",
+        reference=_ref(where),
+        check=f"exact rational comparison; {sym} an integer",
+        passed=theta >= need and _is_int(theta),
+        detail=f"{ratio} ≤ {fmt_up(need, 10)}",
     )
 
 
@@ -383,54 +402,70 @@ def _iss_sampled(c: Claims, spec: Spec, P: Any, rho: fmpq, mu: fmpq, v_max: fmpq
 def _convexity(c: Claims, cm: ConstraintMap) -> None:
     """Assumption 3(3): c convex (Lemma 1: ellipsoid map (18) with Q ≻ 0; Lemma 2: affine φ)."""
     if cm.affine:
-        c.exact(
-            id="c-convex",
-            statement="each c_i = max(g_iᵀx − h_i, 0)² is convex",
-            reference=_ref("Assumption 3(3), Lemma 2"),
-            check="by construction (affine φ_i)",
-            passed=True,
-            detail=f"{cm.n_c} components",
+        statement, lemma, check = (
+            "each c_i = max(g_iᵀx − h_i, 0)² is convex",
+            "Lemma 2",
+            "by construction (affine φ_i)",
         )
-        return
-    c.checked(
+        passed, detail = True, f"{cm.n_c} components"
+    else:
+        statement, lemma, check = (
+            "c = max(xᵀQx/r − 1, 0)² is convex (Q ≻ 0)",
+            "Lemma 1",
+            "exact LDLᵀ of Q",
+        )
+        r = check_pd(cm.Q_q)
+        passed, detail = bool(r.ok), r.detail
+    c.exact(
         id="c-convex",
-        statement="c = max(xᵀQx/r − 1, 0)² is convex (Q ≻ 0)",
-        reference=_ref("Assumption 3(3), Lemma 1"),
-        check="exact LDLᵀ of Q",
-        result=check_pd(cm.Q_q),
+        statement=statement,
+        reference=_ref(f"Assumption 3(3), {lemma}"),
+        check=check,
+        passed=passed,
+        detail=detail,
     )
 
 
 def _inclusions(c: Claims, o: Options, Xhat: ConvexSet, eps_min: fmpq, eps_max: fmpq) -> None:
-    """Assumption 3(1): X ⊂ C_0 ⊂ C_min ⊂ X̂ ⊂ C_max."""
+    """Assumption 3(1): X ⊂ C_0 ⊂ C_min ⊂ X̂ ⊂ C_max, one claim per link of the chain (C_0 ⊂
+    C_min holds by definition)."""
     cm = o.cmap
     worst = max(B.max_phi_over(cm, o.X))
-    c.exact(
-        id="X-in-C0",
-        statement="X ⊂ C_0 = {c = 0}",
-        reference=_ref("Assumption 3(1)"),
-        check="exact: φ_i at the vertices of X",
-        passed=worst <= 0,
-        detail=f"max φ over X = {fmt_exact(worst)}",
-    )
     ok, det = cmin_in_xhat(cm, eps_min, Xhat)
-    c.exact(
-        id="Cmin-in-Xhat",
-        statement="C_min ⊂ X̂",
-        reference=_ref("Assumption 3(1)"),
-        check="exact: the outer set {φ_i ≤ t}, t ≥ √ε_min, lies in X̂",
-        passed=ok,
-        detail=det,
-    )
     sup = B.sup_norm_c_over_set(cm, Xhat)
-    c.exact(
-        id="Xhat-in-Cmax",
-        statement="X̂ ⊂ C_max",
-        reference=_ref("Assumption 3(1)"),
-        check="sup |c| over X̂ (vertices / support function) ≤ ε_max",
-        passed=sup <= eps_max,
-        detail=f"sup |c| over X̂ ≤ {fmt_up(sup, 10)}",
+    chain = (
+        # id, statement, check, passed, detail
+        (
+            "X-in-C0",
+            "X ⊂ C_0 = {c = 0}",
+            "exact: φ_i at the vertices of X",
+            worst <= 0,
+            f"max φ over X = {fmt_exact(worst)}",
+        ),
+        (
+            "Cmin-in-Xhat",
+            "C_min ⊂ X̂",
+            "exact: the outer set {φ_i ≤ t}, t ≥ √ε_min, lies in X̂",
+            ok,
+            det,
+        ),
+        (
+            "Xhat-in-Cmax",
+            "X̂ ⊂ C_max",
+            "sup |c| over X̂ (vertices / support function) ≤ ε_max",
+            sup <= eps_max,
+            f"sup |c| over X̂ ≤ {fmt_up(sup, 10)}",
+        ),
     )
+    for cid, statement, check, passed, detail in chain:
+        c.exact(
+            id=cid,
+            statement=statement,
+            reference=_ref("Assumption 3(1)"),
+            check=check,
+            passed=passed,
+            detail=detail,
+        )
 
 
 def cmin_in_xhat(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet) -> tuple[bool, str]:
