@@ -54,6 +54,141 @@ def closed_loop(A: np.ndarray, C: np.ndarray, L: np.ndarray) -> np.ndarray:
     return as_array(fmat(A) - fmat(L) * fmat(C))
 
 
+def closed_loop_fmat(A: Any, C: Any, L: Any) -> fmpq_mat:
+    """Acl = A − L C as an ``fmpq_mat`` (exact): :func:`closed_loop` without the conversion
+    back to an object array, for the exact checks of eq. (4)-(6) (constrained-redesign paper,
+    Astolfi et al., NOLCOS 2019) that take it again and again.
+
+    :param A: n×n state matrix; :param C: p×n output matrix; :param L: n×p gain."""
+    if isinstance(A, fmpq_mat) and isinstance(C, fmpq_mat) and isinstance(L, fmpq_mat):
+        return A - L * C
+    if np.shape(A)[0] == 0 or np.shape(C)[0] == 0:
+        return fmat(np.asarray(A, dtype=object) - np.asarray(L) @ np.asarray(C))
+    return fmat(A) - fmat(L) * fmat(C)
+
+
+def dyadic_fast(x: Any, bits: int) -> np.ndarray:
+    """:func:`obsdesign.certify.exact.dyadic` of a float matrix, the same values entry for
+    entry (each float rounded half-to-even to ``bits`` significant bits), vectorized: the
+    rounded P of eq. (4) (constrained-redesign paper, Section 5) at n = 100 in milliseconds.
+
+    :param x: finite float array; :param bits: significant bits (≤ 53)."""
+    arr = np.asarray(x, dtype=float)
+    if not np.all(np.isfinite(arr)):
+        raise ValueError("cannot round a non-finite number")
+    m, e = np.frexp(arr)  # arr = m·2^e, 0.5 <= |m| < 1 (m = 0 for 0)
+    num = np.rint(np.ldexp(m, bits)).astype(np.int64)  # exact scaling, half-to-even
+    k = (bits - e).astype(np.int64)
+    pw: dict[int, int] = {}
+    out = []
+    for a, b in zip(num.ravel().tolist(), k.ravel().tolist(), strict=True):
+        if a == 0:
+            out.append(fmpq(0))
+        elif b >= 0:
+            d = pw.get(b)
+            if d is None:
+                d = pw[b] = 1 << b
+            out.append(fmpq(a, d))
+        else:
+            out.append(fmpq(a << -b))
+    return np.array(out, dtype=object).reshape(arr.shape)
+
+
+class ExactMemo:
+    """Exact verdicts the design made, for ``certify`` within the same process: a verdict is
+    returned only for exactly the same inputs (the matrices are compared exactly, entry by
+    entry in flint), so it is the verdict a recomputation would give. ``verify`` loads the
+    spec anew and never sees it (it recomputes everything)."""
+
+    def __init__(self) -> None:
+        self._d: dict[tuple[Any, ...], tuple[tuple[fmpq_mat, ...], Any]] = {}
+
+    def put(self, key: tuple[Any, ...], mats: tuple[fmpq_mat, ...], value: Any) -> None:
+        """Record ``value`` for ``key`` (exact scalars and flags) and the exact ``mats``."""
+        self._d[key] = (mats, value)
+
+    def get(self, key: tuple[Any, ...], mats: tuple[fmpq_mat, ...]) -> Any:
+        """The recorded value when ``key`` and every matrix match exactly, else None."""
+        hit = self._d.get(key)
+        if hit is None or len(hit[0]) != len(mats):
+            return None
+        for a, b in zip(hit[0], mats, strict=True):
+            if a.nrows() != b.nrows() or a.ncols() != b.ncols() or a != b:
+                return None
+        return hit[1]
+
+
+#: the attribute of a bound spec under which the design leaves its :class:`ExactMemo`
+MEMO_ATTR = "_lyapunov_exact_memo"
+
+
+def memo_of(spec: Any) -> ExactMemo | None:
+    """The :class:`ExactMemo` the design left on this very spec object, if any."""
+    m = getattr(spec, MEMO_ATTR, None)
+    return m if isinstance(m, ExactMemo) else None
+
+
+def attach_memo(spec: Any, memo: ExactMemo) -> None:
+    """Leave ``memo`` on the spec object for ``certify`` in the same process (best effort)."""
+    try:
+        setattr(spec, MEMO_ATTR, memo)
+    except (AttributeError, TypeError):
+        pass
+
+
+def decay_verdict(
+    Acl: fmpq_mat,
+    P: Any,
+    rate: Any,
+    discrete: bool,
+    margin: Any,
+    memo: ExactMemo | None = None,
+    Pm: fmpq_mat | None = None,
+) -> tuple[Any, bool]:
+    """The exact verdict on the decay LMI of eq. (4)-(6) (constrained-redesign paper, Astolfi
+    et al., NOLCOS 2019) — :func:`decay_fmat` − margin·I ≻ 0 by
+    :func:`obsdesign.certify.psd.check_pd_fast` — and the float verdict beside it
+    (λ_min of the float matrix > 0), looked up in / recorded into ``memo``.
+
+    :param Acl: exact A − LC; :param P: symmetric n×n (exact); :param rate: λ or α;
+    :param discrete: time domain; :param margin: δ; :param memo: verdicts of this process;
+    :param Pm: ``P`` as an ``fmpq_mat`` when already converted."""
+    from obsdesign.certify.psd import check_pd_fast_float
+
+    Pm = fmat(P) if Pm is None else Pm
+    key = ("decay", Q(rate), Q(margin), discrete)
+    if memo is not None:
+        hit = memo.get(key, (Acl, Pm))
+        if hit is not None:
+            return hit
+    r, H = check_pd_fast_float(decay_fmat(Acl, Pm, rate, discrete), margin)
+    fl = bool(np.linalg.eigvalsh(H).min() > 0) if H is not None and H.size else True
+    if memo is not None:
+        memo.put(key, (Acl, Pm), (r, fl))
+    return r, fl
+
+
+def pd_verdict(
+    P: Any, margin: Any, memo: ExactMemo | None = None, Pm: fmpq_mat | None = None
+) -> Any:
+    """P − margin·I ≻ 0 exactly (:func:`obsdesign.certify.psd.check_pd_fast`): V = eᵀPe of
+    eq. (4) (constrained-redesign paper) is positive definite; looked up in / recorded into
+    ``memo``.
+
+    :param P: symmetric matrix; :param margin: δ; :param memo: verdicts of this process;
+    :param Pm: ``P`` as an ``fmpq_mat`` when already converted."""
+    Pm = fmat(P) if Pm is None else Pm
+    key = ("pd", Q(margin))
+    if memo is not None:
+        hit = memo.get(key, (Pm,))
+        if hit is not None:
+            return hit
+    r = check_pd_fast(Pm, margin)
+    if memo is not None:
+        memo.put(key, (Pm,), r)
+    return r
+
+
 #: the prime of :func:`observable_mod_p` (2⁶¹ − 1, a Mersenne prime)
 PRIME = 2**61 - 1
 
@@ -290,7 +425,9 @@ def _lyap_solution(Acl: np.ndarray, rate: float, discrete: bool) -> np.ndarray |
     return (X + X.T) / 2
 
 
-def rate_feasibility(Acl: np.ndarray, rate: Any, discrete: bool) -> tuple[bool, str]:
+def rate_feasibility(
+    Acl: Any, rate: Any, discrete: bool, memo: ExactMemo | None = None
+) -> tuple[bool, str]:
     """Whether some P ≻ 0 makes :func:`decay_matrix` ≻ 0 at ``rate``, decided exactly, and how.
 
     Feasible iff every eigenvalue z of Acl has |z| < λ (discrete) / Re z < −α (continuous).
@@ -310,34 +447,66 @@ def rate_feasibility(Acl: np.ndarray, rate: Any, discrete: bool) -> tuple[bool, 
     (λ² − |z|²) v*Pv. This decides the decay LMI of eq. (4)-(6), Section 5 of the
     constrained-redesign paper (Astolfi et al., NOLCOS 2019), for a fixed gain.
 
-    :param Acl: A − LC (exact); :param rate: λ or α (exact); :param discrete: time domain.
+    :param Acl: A − LC (exact; object array or ``fmpq_mat``); :param rate: λ or α (exact);
+    :param discrete: time domain; :param memo: verdicts already made in this process.
     Returns (verdict, the proof used)."""
     r = Q(rate)
-    n = Acl.shape[0]
+    Am = fmat(Acl)
+    n = Am.nrows()
     if n == 0:
         return True, "empty matrix"
     if discrete and r <= 0:
         return False, "λ ≤ 0"
-    X = _lyap_solution(Acl, float(r), discrete)
+    key = ("feasible", r, discrete)
+    if memo is not None:
+        hit = memo.get(key, (Am,))
+        if hit is not None:
+            return hit  # type: ignore[no-any-return]
+    out = _rate_feasibility(Am, r, discrete)
+    if memo is not None:
+        memo.put(key, (Am,), out)
+    return out
+
+
+def _rate_feasibility(Am: fmpq_mat, r: fmpq, discrete: bool) -> tuple[bool, str]:
+    n = Am.nrows()
+    X = _lyap_solution(mat_float(Am), float(r), discrete)
     if X is not None and np.any(X != 0):
-        Xq = symmetrize(dyadic(X, INERTIA_BITS))
-        if check_pd_fast(decay_fmat(Acl, Xq, r, discrete)):
+        Xq = fmat(symmetrize(dyadic_fast(X, INERTIA_BITS)))
+        if check_pd_fast(decay_fmat(Am, Xq, r, discrete)):
             pd = check_pd_fast(Xq)
             return pd.ok, "exact Lyapunov inertia certificate (D(X) ≻ 0, X " + (
                 "≻ 0)" if pd.ok else "⊁ 0)"
             )
+    Acl = as_array(Am)
     if discrete:
         return schur_stable(_charpoly(Acl * (1 / r)))[0], stability_test(True)
     return hurwitz_stable(_charpoly(Acl + qeye(n) * r))[0], stability_test(False)
 
 
-def rate_feasible(Acl: np.ndarray, rate: Any, discrete: bool) -> bool:
+def mat_float(Am: fmpq_mat) -> np.ndarray:
+    """The nearest float matrix of an exact one (correctly rounded entry by entry), e.g. the
+    error dynamics A − LC of eq. (3) (constrained-redesign paper) for its spectrum.
+
+    :param Am: the exact matrix."""
+    from obsdesign.certify.vchol import to_float
+
+    H = to_float(Am)
+    if H is None:  # beyond the float range
+        return np.array([float(x) for x in Am.entries()], dtype=float).reshape(
+            Am.nrows(), Am.ncols()
+        )
+    return H
+
+
+def rate_feasible(Acl: Any, rate: Any, discrete: bool, memo: ExactMemo | None = None) -> bool:
     """Whether some P ≻ 0 makes :func:`decay_matrix` ≻ 0 at ``rate``, decided exactly
     (:func:`rate_feasibility` without the proof's name): eq. (4)-(6), Section 5 of the
     constrained-redesign paper (Astolfi et al., NOLCOS 2019), for a fixed gain.
 
-    :param Acl: A − LC (exact); :param rate: λ or α (exact); :param discrete: time domain."""
-    return rate_feasibility(Acl, rate, discrete)[0]
+    :param Acl: A − LC (exact); :param rate: λ or α (exact); :param discrete: time domain;
+    :param memo: verdicts already made in this process."""
+    return rate_feasibility(Acl, rate, discrete, memo)[0]
 
 
 def stability_test(discrete: bool) -> str:
@@ -388,8 +557,15 @@ def lyapunov_P(
     return (P + P.T) / 2
 
 
-def _float_P(A: np.ndarray, C: np.ndarray, L: np.ndarray, discrete: bool, r: fmpq) -> Any:
-    Af, Cf, Lf = (np.asarray(x, dtype=float) for x in (A, C, L))
+def _float_P(
+    A: np.ndarray,
+    C: np.ndarray,
+    L: np.ndarray,
+    discrete: bool,
+    r: fmpq,
+    floats: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+) -> Any:
+    Af, Cf, Lf = floats or tuple(np.asarray(x, dtype=float) for x in (A, C, L))
     try:
         Pf = lyapunov_P(Af, Cf, Lf, float(r), discrete)
     except (np.linalg.LinAlgError, ValueError):
@@ -407,6 +583,9 @@ def certified_P(
     rate: Any,
     margin: Any,
     bits: int = BITS,
+    memo: ExactMemo | None = None,
+    Acl: fmpq_mat | None = None,
+    floats: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
 ) -> np.ndarray | None:
     """A rational P (the Lyapunov-equation P rounded to ``bits`` dyadic bits) with
     P − margin·I ≻ 0 and :func:`decay_matrix` − margin·I ≻ 0 exactly, or None.
@@ -416,43 +595,89 @@ def certified_P(
     (:func:`obsdesign.certify.psd.check_pd_fast`); no SDP.
 
     :param A, C, L: exact plant and gain; :param discrete: time domain; :param rate: λ or α
-    (exact); :param margin: δ of the strict checks; :param bits: rounding of P."""
+    (exact); :param margin: δ of the strict checks; :param bits: rounding of P;
+    :param memo: records the exact verdicts (for ``certify`` in the same process);
+    :param Acl: A − LC as an ``fmpq_mat``, when already made; :param floats: A, C, L as
+    float arrays (``np.asarray(x, dtype=float)``), when already made."""
     r = Q(rate)
     if (discrete and r <= 0) or A.shape[0] == 0:
         return None
-    Pf = _float_P(A, C, L, discrete, r)
+    Pf = _float_P(A, C, L, discrete, r, floats)
     if Pf is None:
         return None
-    P = symmetrize(dyadic(Pf, bits))
-    if not check_pd_fast(P, margin):
+    Pm = _sym(fmat(dyadic_fast(Pf, bits)))  # = symmetrize(dyadic(Pf, bits)), in flint
+    P = as_array(Pm)
+    if not pd_verdict(P, margin, memo, Pm):
         return None
-    if not check_pd_fast(decay_fmat(closed_loop(A, C, L), P, r, discrete), margin):
+    Am = closed_loop_fmat(A, C, L) if Acl is None else Acl
+    if not decay_verdict(Am, P, r, discrete, margin, memo, Pm)[0]:
         return None
     return P
 
 
-def _predict_certified(
-    A: np.ndarray, C: np.ndarray, L: np.ndarray, discrete: bool, r: fmpq, margin: Any
-) -> bool:
-    """Float forecast of :func:`certified_P` (a guess that steers the search, never a proof):
-    both matrices' smallest eigenvalues exceed the margin by a clear relative gap."""
-    Pf = _float_P(A, C, L, discrete, r)
-    if Pf is None:
-        return False
-    Acl = np.asarray(A, dtype=float) - np.asarray(L, dtype=float) @ np.asarray(C, dtype=float)
-    rf = float(r)
-    if discrete:
-        M = rf * rf * Pf - Acl.T @ Pf @ Acl
-    else:
-        M = -(Acl.T @ Pf + Pf @ Acl + 2 * rf * Pf)
-    M = (M + M.T) / 2
-    m = float(margin)
-    gap = 1e-6
-    wp = np.linalg.eigvalsh(Pf)
-    wm = np.linalg.eigvalsh(M)
-    return bool(
-        wp[0] - m > gap * abs(wp[-1]) and wm[0] - m > gap * max(abs(wm[-1]), abs(wm[0]), 1.0)
-    )
+class _Forecast:
+    """Float forecast of :func:`certified_P` along the rate search (a guess that steers the
+    search, never a proof): the Lyapunov-equation P at each rate, then both matrices' smallest
+    eigenvalues must exceed the margin by a clear relative gap.
+
+    With Acl = VΛV⁻¹ (one eigendecomposition, when V is well conditioned), the P of
+    :func:`lyapunov_P` is V⁻ᴴYV⁻¹ with Y_ij = G_ij/(λ² − w̄_i w_j) (discrete) or
+    −G_ij/(w̄_i + w_j + 2α) (continuous), G = VᴴV: two products per rate instead of a
+    Schur-based solve (eq. (4)-(6) of the constrained-redesign paper, Astolfi et al., NOLCOS
+    2019, Section 5, with Q = I). Otherwise scipy solves each rate.
+
+    :param Af: float A − LC; :param discrete: time domain; :param margin: δ."""
+
+    def __init__(self, Af: np.ndarray, discrete: bool, margin: Any) -> None:
+        self.Af, self.discrete, self.m = Af, discrete, float(margin)
+        self.V: np.ndarray | None = None
+        n = Af.shape[0]
+        try:
+            w, V = np.linalg.eig(Af)
+            Vi = np.linalg.inv(V)
+            if np.all(np.isfinite(Vi)) and np.linalg.norm(V) * np.linalg.norm(Vi) < 1e8 * n:
+                self.w, self.V, self.Vi, self.G = w, V, Vi, V.conj().T @ V
+        except np.linalg.LinAlgError:
+            pass
+
+    def P(self, rf: float) -> np.ndarray | None:
+        """The float Lyapunov-equation P at rate ``rf`` (None when it cannot be had)."""
+        if self.V is None:
+            n = self.Af.shape[0]
+            z = np.zeros((0, n)) if n else np.zeros((0, 0))
+            return _float_P(self.Af, z, z.T, self.discrete, Q(rf))
+        wc = self.w.conj()[:, None]
+        with np.errstate(all="ignore"):
+            if self.discrete:
+                Y = self.G / (rf * rf - wc * self.w[None, :])
+            else:
+                Y = -self.G / (wc + self.w[None, :] + 2 * rf)
+            P = (self.Vi.conj().T @ Y @ self.Vi).real
+        if not np.all(np.isfinite(P)):
+            return None
+        return (P + P.T) / 2
+
+    def __call__(self, r: fmpq) -> bool:
+        """Whether :func:`certified_P` is expected to succeed at the rate ``r``."""
+        rf = float(r)
+        if self.discrete and rf <= 0:
+            return False
+        Pf = self.P(rf)
+        if Pf is None:
+            return False
+        Acl = self.Af
+        if self.discrete:
+            M = rf * rf * Pf - Acl.T @ Pf @ Acl
+        else:
+            M = -(Acl.T @ Pf + Pf @ Acl + 2 * rf * Pf)
+        M = (M + M.T) / 2
+        m = self.m
+        gap = 1e-6
+        wp = np.linalg.eigvalsh(Pf)
+        wm = np.linalg.eigvalsh(M)
+        return bool(
+            wp[0] - m > gap * abs(wp[-1]) and wm[0] - m > gap * max(abs(wm[-1]), abs(wm[0]), 1.0)
+        )
 
 
 # -- the best rate, bracketed --------------------------------------------------------------
@@ -499,6 +724,7 @@ def best_rate(
     known: tuple[Any, np.ndarray] | None = None,
     progress: Callable[[str], None] | None = None,
     forecast: bool = True,
+    memo: ExactMemo | None = None,
 ) -> RateBracket:
     """Bisection for the best certified rate of V = eᵀPe: the smallest λ (discrete) or the
     largest α (continuous) at which :func:`certified_P` succeeds, bracketed.
@@ -513,7 +739,7 @@ def best_rate(
     a worse rate.
 
     Cost: every step is one Lyapunov equation, no SDP. A float forecast
-    (:func:`_predict_certified`) stands in for the exact check at the midpoints it calls
+    (:class:`_Forecast`) stands in for the exact check at the midpoints it calls
     clearly certified; the exact check runs at the midpoints it calls failed and at the final
     certified end. If that final check fails, the search is rerun with exact checks at every
     midpoint. Both reported ends are always decided exactly; the bracket equals that of the
@@ -525,13 +751,17 @@ def best_rate(
     :param A, C, L: exact plant and gain; :param discrete: time domain; :param tol: bracket
     width; :param margin: δ of the checks; :param known: a certified (rate, P);
     :param progress: callback for messages; :param forecast: let the float forecast stand in
-    for exact checks (False: an exact check at every midpoint; the rerun uses it).
+    for exact checks (False: an exact check at every midpoint; the rerun uses it);
+    :param memo: records the exact verdicts (for ``certify`` in the same process).
     Raises :class:`InfeasibleError` when Acl is not Schur / Hurwitz (exact) and
     :class:`InconclusiveError` when it is but nothing certifies."""
-    Acl = closed_loop(A, C, L)
+    Acl = closed_loop_fmat(A, C, L)
     tol_q = Q(tol)
     grid = _grid(tol_q)
-    eig = np.linalg.eigvals(np.asarray(Acl, dtype=float))
+    Af = mat_float(Acl)  # correctly rounded, as np.asarray(closed_loop(A, C, L), dtype=float)
+    eig = np.linalg.eigvals(Af)
+    floats = (np.asarray(A, dtype=float), np.asarray(C, dtype=float), np.asarray(L, dtype=float))
+    guess = _Forecast(Af, discrete, margin) if forecast else None
     # r-space: r = λ (discrete) or r = −α (continuous); smaller r is better in both
     sign = 1 if discrete else -1
     checks = 0
@@ -547,15 +777,15 @@ def best_rate(
             raise InconclusiveError(
                 f"best-rate search: more than {MAX_EXACT_CHECKS} exact checks without a bracket"
             )
-        return certified_P(A, C, L, discrete, rate(r), margin)
+        return certified_P(A, C, L, discrete, rate(r), margin, memo=memo, Acl=Acl, floats=floats)
 
     def cert(r: fmpq) -> Any:
-        if forecast and _predict_certified(A, C, L, discrete, rate(r), margin):
+        if guess is not None and guess(rate(r)):
             return pending
         return exact(r)
 
     def feasible(r: fmpq) -> bool:
-        return rate_feasible(Acl, rate(r), discrete)
+        return rate_feasible(Acl, rate(r), discrete, memo)
 
     bound = float(np.max(np.abs(eig))) if discrete else float(np.max(eig.real))
     lo = _snap(Q(max(bound, 0.0)) if discrete else Q(bound), grid, False)
@@ -616,5 +846,6 @@ def best_rate(
                 known=known,
                 progress=progress,
                 forecast=False,
+                memo=memo,
             )
     return RateBracket(rate(hi), P, rate(lo), lo_kind, tol_q, checks)

@@ -151,8 +151,10 @@ def test_best_rate_wrong_forecast_reruns_all_exact(monkeypatch: pytest.MonkeyPat
     all-exact bracket."""
     real_P = lyap.certified_P
 
-    def strict(A, C, L, discrete, rate, margin, bits=lyap.BITS):  # noqa: ANN001, ANN202
-        return None if rate < fmpq(9503, 10000) else real_P(A, C, L, discrete, rate, margin, bits)
+    def strict(A, C, L, discrete, rate, margin, bits=lyap.BITS, **kw):  # noqa: ANN001, ANN003, ANN202
+        if rate < fmpq(9503, 10000):
+            return None
+        return real_P(A, C, L, discrete, rate, margin, bits, **kw)
 
     monkeypatch.setattr(lyap, "certified_P", strict)
     plain = best_rate(A5, C5, L5, True, tol=TOL, margin=MARGIN, forecast=False)
@@ -163,7 +165,7 @@ def test_best_rate_wrong_forecast_reruns_all_exact(monkeypatch: pytest.MonkeyPat
         forecasts.append(k.get("forecast", True))
         return real(*a, **k)
 
-    monkeypatch.setattr(lyap, "_predict_certified", lambda *a, **k: True)
+    monkeypatch.setattr(lyap._Forecast, "__call__", lambda *a, **k: True)
     monkeypatch.setattr(lyap, "best_rate", counted)
     br = lyap.best_rate(A5, C5, L5, True, tol=TOL, margin=MARGIN)
     assert forecasts == [True, False]
@@ -192,10 +194,10 @@ def test_best_rate_never_worse_than_a_known_rate(monkeypatch: pytest.MonkeyPatch
     real = lyap.certified_P
     known_P = real(A5, C5, L5, True, fmpq(955, 1000), MARGIN)
 
-    def flaky(A, C, L, discrete, rate, margin, bits=lyap.BITS):  # noqa: ANN001, ANN202
+    def flaky(A, C, L, discrete, rate, margin, bits=lyap.BITS, **kw):  # noqa: ANN001, ANN003, ANN202
         if fmpq(6, 10) < rate < fmpq(99, 100) and rate != fmpq(955, 1000):
             return None
-        return real(A, C, L, discrete, rate, margin, bits)
+        return real(A, C, L, discrete, rate, margin, bits, **kw)
 
     monkeypatch.setattr(lyap, "certified_P", flaky)
     br = best_rate(A5, C5, L5, True, tol=TOL, margin=MARGIN, known=(fmpq(955, 1000), known_P))

@@ -88,11 +88,11 @@ def test_wrong_forecast_falls_back_to_the_exact_search(monkeypatch: pytest.Monke
     """A forecast that calls every rate certified (wrong near ρ = 0.95) must not change the
     bracket: the final exact check refuses, the all-exact bisection runs, same answer."""
     ref = lyap.best_rate(A5, C5, L5, True, tol=fmpq(1, 10**4), margin=fmpq(1, 10**9))
-    monkeypatch.setattr(lyap, "_predict_certified", lambda *a: True)
+    monkeypatch.setattr(lyap._Forecast, "__call__", lambda *a: True)
     got = lyap.best_rate(A5, C5, L5, True, tol=fmpq(1, 10**4), margin=fmpq(1, 10**9))
     assert (got.best, got.other, got.kind) == (ref.best, ref.other, ref.kind)
     assert got.best == fmpq(47503, 50000) and got.other == fmpq(19, 20)
-    monkeypatch.setattr(lyap, "_predict_certified", lambda *a: False)  # all exact
+    monkeypatch.setattr(lyap._Forecast, "__call__", lambda *a: False)  # all exact
     ex = lyap.best_rate(A5, C5, L5, True, tol=fmpq(1, 10**4), margin=fmpq(1, 10**9))
     assert (ex.best, ex.other, ex.kind) == (ref.best, ref.other, ref.kind)
     assert ref.exact_checks < ex.exact_checks
@@ -100,7 +100,7 @@ def test_wrong_forecast_falls_back_to_the_exact_search(monkeypatch: pytest.Monke
 
 def test_exact_check_cap(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(lyap, "MAX_EXACT_CHECKS", 2)
-    monkeypatch.setattr(lyap, "_predict_certified", lambda *a: False)
+    monkeypatch.setattr(lyap._Forecast, "__call__", lambda *a: False)
     with pytest.raises(InconclusiveError, match="more than 2 exact checks"):
         lyap.best_rate(A5, C5, L5, True, tol=fmpq(1, 10**4), margin=fmpq(1, 10**9))
 
@@ -150,3 +150,43 @@ def test_decay_fmat_is_the_formula(n: int, seed: int, discrete: bool, symmetric:
         want = symmetrize(-(Acl.T @ P + P @ Acl + P * (2 * r)))
     got = lyap.as_array(lyap.decay_fmat(Acl, P, r, discrete))
     assert (got == qmat(want)).all()
+
+
+def test_dyadic_fast_is_dyadic() -> None:
+    """The vectorized rounding gives exactly the values of exact.dyadic (ties, zeros, tiny,
+    huge and negative entries included)."""
+    rng = np.random.default_rng(4)
+    x = rng.standard_normal((7, 9)) * 10.0 ** rng.integers(-300, 300, size=(7, 9))
+    x[0, :4] = [0.0, 0.5, -1.5 * 2.0**-40, 1 + 2.0**-41]  # 1 + 2⁻⁴¹: a tie at 40 bits
+    x[1, 0] = 5e-324
+    for bits in (lyap.BITS, lyap.INERTIA_BITS, 24):
+        got, want = lyap.dyadic_fast(x, bits), dyadic(x, bits)
+        assert got.tolist() == want.tolist()
+    with pytest.raises(ValueError):
+        lyap.dyadic_fast(np.array([[np.nan]]), 40)
+
+
+def test_memo_serves_only_exactly_equal_inputs() -> None:
+    """The design's exact verdicts reach certify in the same process only for exactly the same
+    matrices: P changed in place after the design (by 2⁻⁶⁰ on one symmetric pair) is
+    rechecked, and a P that is not ≻ 0 fails."""
+    from obsdesign import api
+
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.5, 0.2], [0.0, 0.7]]\nC = [[1.0, 0.0]]\n'
+        '[method]\nkey = "lyapunov"\n'
+    )
+    spec = api.load_spec_text(text, "memo.toml")
+    rep = api.design(spec)
+    assert rep.exit_code() == 0
+    memo = lyap.memo_of(spec)
+    assert memo is not None
+    P = rep.parameters["P"]
+    Pm = lyap.fmat(P)
+    assert memo.get(("pd", Q(spec.options.margin)), (Pm,)) is not None
+    moved = Pm + lyap.fmat(qmat([[0, fmpq(1, 2**60)], [fmpq(1, 2**60), 0]]))
+    assert memo.get(("pd", Q(spec.options.margin)), (moved,)) is None
+    P[0, 0] = -P[0, 0]  # in place, the very array the design certified
+    claims = {c.id: c.status.value for c in api.certify(spec, rep.parameters)}
+    assert claims["P-positive-definite"] == "failed"
+    assert claims["decay-lmi"] == "failed"

@@ -157,10 +157,10 @@ def test_best_never_worse_than_the_asked_rate(monkeypatch: pytest.MonkeyPatch) -
     λ_best ≤ 0.955 (was: a best rate worse than a certified asked rate)."""
     real = lyap.certified_P
 
-    def flaky(A, C, L, discrete, rate, margin, bits=lyap.BITS):  # noqa: ANN001, ANN202
+    def flaky(A, C, L, discrete, rate, margin, bits=lyap.BITS, **kw):  # noqa: ANN001, ANN003, ANN202
         if fmpq(6, 10) < rate < fmpq(99, 100) and rate != fmpq(955, 1000):
             return None
-        return real(A, C, L, discrete, rate, margin, bits)
+        return real(A, C, L, discrete, rate, margin, bits, **kw)
 
     monkeypatch.setattr(lyap, "certified_P", flaky)
     rep = api.design(SEC5)

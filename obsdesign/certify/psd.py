@@ -174,7 +174,7 @@ def to_fmpq_mat(M: Any) -> Any:
     binary value).
 
     :param M: the matrix."""
-    from flint import fmpq_mat, fmpz_mat
+    from flint import fmpq, fmpq_mat, fmpz_mat
 
     if isinstance(M, fmpq_mat):
         return M
@@ -184,7 +184,10 @@ def to_fmpq_mat(M: Any) -> Any:
     if arr.ndim != 2:
         raise ValueError("expected a matrix")
     r, c = arr.shape
-    return fmpq_mat(r, c, [Q(x) for x in arr.flat])
+    flat = arr.ravel().tolist()
+    if all(type(x) is fmpq for x in flat):  # already exact: no per-entry conversion
+        return fmpq_mat(r, c, flat)
+    return fmpq_mat(r, c, [Q(x) for x in flat])
 
 
 def _fraction_free(F: Any) -> PSDResult:
@@ -307,6 +310,14 @@ def check_pd_fast(M: Any, margin: Any = 0) -> PSDResult:
 
     :param M: square symmetric matrix (object array of rationals / floats, ``fmpq_mat`` or
     ``fmpz_mat``); :param margin: δ ≥ 0 (any exact number)."""
+    return check_pd_fast_float(M, margin)[0]
+
+
+def check_pd_fast_float(M: Any, margin: Any = 0) -> tuple[PSDResult, np.ndarray | None]:
+    """:func:`check_pd_fast` and the float matrix fl(M − margin·I) it made (None when it made
+    none), for a float verdict beside the exact one without a second conversion.
+
+    :param M: square symmetric matrix; :param margin: δ (exact)."""
     from flint import fmpq
 
     F = to_fmpq_mat(M)
@@ -319,9 +330,9 @@ def check_pd_fast(M: Any, margin: Any = 0) -> PSDResult:
                 if F[i, j] != F[j, i]:
                     return PSDResult(
                         False, float("nan"), f"not symmetric at ({i}, {j})", "symmetry"
-                    )
+                    ), None
     if n == 0:
-        return PSDResult(True, float("inf"), "empty matrix", "empty")
+        return PSDResult(True, float("inf"), "empty matrix", "empty"), None
     m = Q(margin)
     if m != 0:
         F = F - m * type(F)(n, n, [fmpq(int(i == j)) for i in range(n) for j in range(n)])
@@ -329,8 +340,8 @@ def check_pd_fast(M: Any, margin: Any = 0) -> PSDResult:
     if Mf is not None:
         v = vchol.verified_pd(F, 0, Mf)
         if v is not None:
-            return PSDResult(True, float(v.bound), v.detail, "verified-float")
+            return PSDResult(True, float(v.bound), v.detail, "verified-float"), Mf
         r = _gershgorin_certificate(F, Mf)
         if r is not None:
-            return r
-    return _fraction_free(F)
+            return r, Mf
+    return _fraction_free(F), Mf

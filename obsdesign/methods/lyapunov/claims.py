@@ -18,7 +18,7 @@ from obsdesign import lyap
 from obsdesign.certify.claim import Claim, Claims
 from obsdesign.certify.exact import Q
 from obsdesign.certify.printing import fmt_exact, fmt_up
-from obsdesign.certify.psd import FAST_CHECK, PSDResult, check_pd_fast
+from obsdesign.certify.psd import PSDResult, check_pd_fast, check_text
 from obsdesign.methods.lyapunov.design import rate_name
 from obsdesign.methods.lyapunov.options import Options
 from obsdesign.params import Parameters
@@ -58,16 +58,26 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         rate = o.rate
     rate, best, other = Q(rate), Q(best), Q(other)
     A, C = s.A.q, s.C.q
-    pd = check_pd_fast(P, o.margin)
-    dec = decay_check(A, C, L, P, rate, s.discrete, o.margin)
+    memo = lyap.memo_of(spec)  # the design's exact verdicts, same process, same inputs only
+    Acl = lyap.closed_loop_fmat(A, C, L)
+    pd = lyap.pd_verdict(P, o.margin, memo)
+    dec = decay_check(A, C, L, P, rate, s.discrete, o.margin, memo, Acl)
     # the asked rate omitted, (P, λ) is (P_best, λ_best): one exact check serves both claims
     same = rate == best and P.shape == Pb.shape and bool(np.all(P == Pb))
     pd_claim(c, "P-positive-definite", "P ≻ 0", P, o.margin, pd)
     decay_claim(c, dec, rate, s.discrete, o.margin, "")
-    pd_claim(c, "P_best-positive-definite", "P_best ≻ 0", Pb, o.margin, pd if same else None)
-    dec_b = dec if same else decay_check(A, C, L, Pb, best, s.discrete, o.margin)
+    pd_claim(
+        c,
+        "P_best-positive-definite",
+        "P_best ≻ 0",
+        Pb,
+        o.margin,
+        pd if same else lyap.pd_verdict(Pb, o.margin, memo),
+    )
+    dec_b = dec if same else decay_check(A, C, L, Pb, best, s.discrete, o.margin, memo, Acl)
     decay_claim(c, dec_b, best, s.discrete, o.margin, "_best")
-    bracket_claim(c, A, C, L, best, other, str(params[f"{name}_bracket_kind"]), s.discrete, o)
+    kind = str(params[f"{name}_bracket_kind"])
+    bracket_claim(c, A, C, L, best, other, kind, s.discrete, o, memo, Acl)
     if o.iss_gain:
         iss_claim(c, A, C, L, s.Bd.q, s.Dn.q, P, rate, mu, s.discrete)
     return list(c)
@@ -86,7 +96,7 @@ def pd_claim(
         id=id,
         statement=what,
         reference=REF,
-        check=FAST_CHECK,
+        check=check_text(r),
         passed=r.ok,
         margin=margin,
         detail=r.detail,
@@ -118,7 +128,7 @@ def decay_claim(
         id=f"decay-lmi{suffix}",
         statement=stmt,
         reference=REF,
-        check=f"{FAST_CHECK}, of the matrix rebuilt from the spec",
+        check=f"{check_text(r)}, of the matrix rebuilt from the spec",
         passed=r.ok,
         margin=margin,
         detail=r.detail,
@@ -134,18 +144,17 @@ def decay_check(
     rate: Any,
     discrete: bool,
     margin: Any,
+    memo: lyap.ExactMemo | None = None,
+    Acl: Any = None,
 ) -> tuple[PSDResult, bool]:
     """The exact verdict on the decay LMI of eq. (4)-(6) (constrained-redesign paper, Astolfi et
     al., NOLCOS 2019), rebuilt from A, C, L, P and the rate, and the float verdict beside it.
 
     :param A, C, L, P: exact matrices; :param rate: λ or α; :param discrete: time domain;
-    :param margin: δ."""
-    M = lyap.decay_fmat(lyap.closed_loop(A, C, L), P, rate, discrete)
-    r = check_pd_fast(M, margin)
-    n = M.nrows()
-    Mf = np.array([float(x) for x in M.entries()], dtype=float).reshape(n, n)
-    fl = bool(np.linalg.eigvalsh(Mf).min() > float(margin)) if n else True
-    return r, fl
+    :param margin: δ; :param memo: the design's verdicts (used for exactly equal inputs only);
+    :param Acl: A − LC as an ``fmpq_mat`` when already made."""
+    Am = lyap.closed_loop_fmat(A, C, L) if Acl is None else Acl
+    return lyap.decay_verdict(Am, P, rate, discrete, margin, memo)  # type: ignore[no-any-return]
 
 
 def bracket_claim(
@@ -158,6 +167,8 @@ def bracket_claim(
     kind: str,
     discrete: bool,
     o: Options,
+    memo: lyap.ExactMemo | None = None,
+    Acl: Any = None,
 ) -> Claim:
     """The best rate is best to within ``rate_tol``: the other end of its bracket lies within
     the tolerance, beyond it (λ_bracket < λ_best, α_bracket > α_best), not beyond a rate the
@@ -169,7 +180,9 @@ def bracket_claim(
 
     :param c: the claim list; :param A, C, L: exact plant and gain; :param best: the
     certified best rate; :param other: the bracket's other end; :param kind: its kind;
-    :param discrete: time domain; :param o: the spec's options (rate_tol, asked rate)."""
+    :param discrete: time domain; :param o: the spec's options (rate_tol, asked rate);
+    :param memo: the design's verdicts (used for exactly equal inputs only); :param Acl: A − LC
+    as an ``fmpq_mat`` when already made."""
     sym, name = ("λ", "lambda") if discrete else ("α", "alpha")
     best, other, tol = Q(best), Q(other), Q(o.rate_tol)
     width = best - other if discrete else other - best
@@ -182,7 +195,8 @@ def bracket_claim(
         problems.append(
             f"{sym}_best = {fmt_exact(best)} is worse than the asked {fmt_exact(o.rate)}"
         )
-    feasible, how = lyap.rate_feasibility(lyap.closed_loop(A, C, L), other, discrete)
+    Am = lyap.closed_loop_fmat(A, C, L) if Acl is None else Acl
+    feasible, how = lyap.rate_feasibility(Am, other, discrete, memo)
     if kind == lyap.INFEASIBLE:
         if feasible:
             problems.append(f"{sym} = {fmt_exact(other)} is feasible ({how})")
@@ -243,7 +257,7 @@ def iss_claim(
         id="iss-gain",
         statement=f"{what}{tail} with μ = {shown}",
         reference=REF,
-        check=FAST_CHECK,
+        check=check_text(r),
         passed=r.ok,
         detail=r.detail,
     )

@@ -17,7 +17,6 @@ from flint import fmpq_mat
 
 from obsdesign import lyap
 from obsdesign.certify.detect import Detectability, detectability, unobservable_restriction
-from obsdesign.certify.exact import dyadic
 from obsdesign.certify.printing import fmt_exact
 from obsdesign.errors import InconclusiveError, InfeasibleError, SolverError
 from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
@@ -56,12 +55,13 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     )
     if o.L is None:
         Lf, solver, how = design_gain(spec, o, progress)
-        L = dyadic(Lf, lyap.BITS)
+        L = lyap.dyadic_fast(Lf, lyap.BITS)  # = dyadic(Lf, BITS), vectorized
         notes.append(f"L designed by {how}; certified with L rounded to {lyap.BITS} bits")
     else:
         L = o.L
-    Acl = lyap.closed_loop(A, C, L)
-    eig = np.linalg.eigvals(np.asarray(Acl, dtype=float))
+    memo = lyap.ExactMemo()  # the exact verdicts, reused by certify in this process only
+    Acl = lyap.closed_loop_fmat(A, C, L)
+    eig = np.linalg.eigvals(lyap.mat_float(Acl))
     params = Parameters({"L": L})
     name = rate_name(s.discrete)
     sym = "λ" if s.discrete else "α"
@@ -76,9 +76,9 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     known = None
     if o.rate is not None:
         # the asked rate first, directly: no search can make it fail
-        P = lyap.certified_P(A, C, L, s.discrete, o.rate, o.margin)
+        P = lyap.certified_P(A, C, L, s.discrete, o.rate, o.margin, memo=memo, Acl=Acl)
         if P is None:
-            ok, how = lyap.rate_feasibility(Acl, o.rate, s.discrete)
+            ok, how = lyap.rate_feasibility(Acl, o.rate, s.discrete, memo)
             if not ok:
                 raise InfeasibleError(
                     f"no P ≻ 0 gives decay rate {sym} = {fmt_exact(o.rate)}: A − LC has an "
@@ -94,14 +94,22 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
         known = (o.rate, P)
     elif bound >= 1 - 1e-6 if s.discrete else bound >= -1e-6:
         # (a float bound clearly inside: the certified best rate below proves Schur / Hurwitz)
-        ok, how = lyap.rate_feasibility(Acl, 1 if s.discrete else 0, s.discrete)
+        ok, how = lyap.rate_feasibility(Acl, 1 if s.discrete else 0, s.discrete, memo)
         if not ok:
             raise InfeasibleError(
                 f"A − LC is not {'Schur' if s.discrete else 'Hurwitz'}: {lim} ({how})"
                 + ("" if o.L is None else " (the given L does not stabilize the error)")
             )
     br = lyap.best_rate(
-        A, C, L, s.discrete, tol=o.rate_tol, margin=o.margin, known=known, progress=progress
+        A,
+        C,
+        L,
+        s.discrete,
+        tol=o.rate_tol,
+        margin=o.margin,
+        known=known,
+        progress=progress,
+        memo=memo,
     )
     rate, P = (br.best, br.P) if known is None else known
     solver.extra["best_rate_exact_checks"] = br.exact_checks
@@ -114,7 +122,7 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     if o.iss_gain:
         Bw = lyap.error_input(s.Bd.q, s.Dn.q, L)
         rho = lyap.decay_factor(rate, s.discrete)
-        params["mu"] = lyap.iss_mu(Acl, Bw, P, rho, s.discrete, strict=True)
+        params["mu"] = lyap.iss_mu(lyap.as_array(Acl), Bw, P, rho, s.discrete, strict=True)
     why = (
         "no P ≻ 0 exists there (proved exactly, see the bracket claim)"
         if br.kind == lyap.INFEASIBLE
@@ -125,6 +133,7 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
         f"{fmt_exact(o.rate_tol)}); {name} = {fmt_exact(br.other)} is {br.kind}: {why}; "
         + (f"infimum {bound:.6g}" if s.discrete else f"supremum {-bound:.6g}")
     )
+    lyap.attach_memo(spec, memo)
     return Design(params, solver, notes)
 
 
