@@ -9,7 +9,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from obsdesign.certify.claim import Claim, ClaimStatus, exact_claim
 from obsdesign.errors import (
@@ -25,8 +25,10 @@ from obsdesign.methods import get_method, method_keys
 from obsdesign.methods.base import Method, Progress
 from obsdesign.params import Parameters
 from obsdesign.report.model import TOP_KEYS, Report, check_output, write_atomic
-from obsdesign.simulate.result import SimResult
 from obsdesign.spec import Spec, read_spec, read_spec_text
+
+if TYPE_CHECKING:  # the simulation modules load with the first simulate
+    from obsdesign.simulate.result import SimResult
 
 
 # -- binding a spec to its method ----------------------------------------------------------

@@ -5,7 +5,8 @@ failure; 4 numerically inconclusive. Errors are one line on stderr; ``--debug`` 
 traceback.
 """
 
-from __future__ import annotations
+# No ``from __future__ import annotations``: typer evaluates string annotations again for
+# every command (all of them, for --help too) on each run.
 
 import os
 import signal
@@ -22,7 +23,6 @@ if signal.getsignal(signal.SIGINT) is signal.default_int_handler and os.path.bas
 ) in ("obsdesign", "cli.py"):
     signal.signal(signal.SIGINT, _early_interrupt)
 
-import json  # noqa: E402
 import warnings  # noqa: E402
 from collections.abc import Callable  # noqa: E402
 from enum import StrEnum  # noqa: E402
@@ -53,6 +53,106 @@ if hasattr(typer.core.TyperArgument, "_usage_display_name"):
     typer.core.TyperArgument._usage_display_name = _usage_name  # type: ignore[method-assign]
 _ARG_TYPE = typer.core.TyperArgument.display_type_rich
 typer.core.TyperArgument.display_type_rich = _arg_type  # type: ignore[method-assign]
+
+#: "take typer's own path" (see :func:`_fast_value`)
+_SLOW = object()
+
+
+def _fast_leaf(ann: Any, info: Any, value: Any, param: Any, ctx: Any) -> Any:
+    """``value`` coerced to ``ann`` as typer's pydantic adapter would, for the plain cases
+    (a str, a Path, a decimal int within min/max, an enum member or its name); ``_SLOW``
+    for anything else, which typer then handles itself, with its own error message."""
+    from enum import Enum
+
+    from typer import _param_types as pt
+
+    if ann is str:
+        return value if type(value) is str else _SLOW
+    if ann is int and not info.clamp:
+        if type(value) is str:
+            digits = value.removeprefix("-")
+            if not (digits.isascii() and digits.isdigit() and len(digits) <= 18):
+                return _SLOW
+            value = int(value)
+        if type(value) is not int:
+            return _SLOW
+        if (info.min is not None and value < info.min) or (
+            info.max is not None and value > info.max
+        ):
+            return _SLOW
+        return value
+    if isinstance(ann, type) and issubclass(ann, Enum):
+        try:
+            return pt.coerce_cli_choice(
+                value, choices=tuple(ann), case_sensitive=info.case_sensitive, ctx=ctx
+            )
+        except ValueError:
+            return _SLOW
+    if isinstance(ann, type) and issubclass(ann, Path) and info.path_type is None:
+        if type(value) is str:
+            value = ann(value)  # what pydantic's Path validator returns for a str
+        if not isinstance(value, ann):
+            return _SLOW
+        try:
+            return pt.coerce_cli_path(value, info, path_type=ann, param=param, ctx=ctx)
+        except Exception:  # noqa: BLE001 - typer's own path raises its own message
+            return _SLOW
+    return _SLOW
+
+
+def _fast_value(desc: Any, value: Any, param: Any, ctx: Any) -> Any:
+    """A command-line value coerced without pydantic where :func:`_fast_leaf` can (lists
+    item by item, as typer's list adapter does), else ``_SLOW``."""
+    from typing import get_args, get_origin
+
+    info = desc.parameter_info
+    if info.parser is not None or desc.file_annotation is not None:
+        return _SLOW
+    if get_origin(desc.annotation) is list and isinstance(value, (list, tuple)):
+        (item,) = get_args(desc.annotation)
+        out = [_fast_leaf(item, info, v, param, ctx) for v in value]
+        return _SLOW if any(o is _SLOW for o in out) else out
+    return _fast_leaf(desc.annotation, info, value, param, ctx)
+
+
+def _install_fast_coercion() -> None:
+    """typer ≥ 0.2x coerces every command-line value through a pydantic ``TypeAdapter``
+    built per parameter when a command runs: importing pydantic and building the adapters
+    costs ~150 ms of a ~0.5 s cold ``obsdesign design``. Values of the plain types this CLI
+    declares are coerced directly (the results pydantic gives); anything else, and every
+    value typer would refuse, goes through typer's own adapter, so results and error
+    messages are typer's. Older typer (click types, no pydantic): nothing to do."""
+    try:
+        from dataclasses import dataclass
+
+        from typer import _coercion
+        from typer.core import _TyperParameter
+
+        base, build = _coercion.RuntimeParam, _coercion.build_runtime_param
+        _TyperParameter.get_runtime_param  # noqa: B018 - present in the versions patched
+    except (ImportError, AttributeError):  # pragma: no cover - typer without pydantic
+        return
+
+    @dataclass(frozen=True)
+    class FastParam(base):  # type: ignore[misc, valid-type]
+        descriptor: Any = None
+
+        def _coerce_value(self, value: Any, param: Any, ctx: Any) -> Any:
+            out = _fast_value(self.descriptor, value, param, ctx)
+            if out is _SLOW:
+                out = build(self.descriptor)._coerce_value(value, param=param, ctx=ctx)
+            return out
+
+    def get_runtime_param(self: Any) -> Any:
+        if self._runtime_param is None:
+            d = self.type_descriptor
+            self._runtime_param = FastParam(d.parameter_info, d.annotation, d)
+        return self._runtime_param
+
+    _TyperParameter.get_runtime_param = get_runtime_param  # type: ignore[method-assign]
+
+
+_install_fast_coercion()
 
 app = typer.Typer(
     name="obsdesign",
@@ -473,7 +573,7 @@ def check(
 
             write_junit(junit, rows)
         if fmt == Fmt.json:
-            print(json.dumps([r.__dict__ for r in rows], indent=2, default=_jsonable))
+            print(_dumps([r.__dict__ for r in rows], indent=2, default=_jsonable))
         else:
             if not quiet:
                 _print_rows(rows, fmt)
@@ -600,7 +700,7 @@ def sweep(
             sw.check_plot_column(rows, axes, y or "", x)
             _write_plot(plot, lambda tmp: sw.plot_sweep(rows, axes, y or "", tmp, x), force)
         if fmt == Fmt.json:
-            print(json.dumps(rows, indent=2, ensure_ascii=False, default=_jsonable))
+            print(_dumps(rows, indent=2, ensure_ascii=False, default=_jsonable))
             return sw.exit_code(rows)
         if output is None and not quiet:
             _print_sweep(rows, fmt)
@@ -724,7 +824,7 @@ def simulate(
         res = api.simulate(sp, report, options=opts, workers=workers, scheduler=scheduler)
         m = res.metrics()
         if fmt == Fmt.json:
-            print(json.dumps(m, indent=2, default=_jsonable))
+            print(_dumps(m, indent=2, default=_jsonable))
         elif fmt == Fmt.md and not quiet:
             sys.stdout.write(_metrics_markdown(m))
         elif not quiet:
@@ -755,7 +855,7 @@ def schema(
     def body() -> int:
         from obsdesign import api
 
-        print(json.dumps(api.schema(), indent=2, ensure_ascii=False))
+        print(_dumps(api.schema(), indent=2, ensure_ascii=False))
         return 0
 
     _run(body)
@@ -853,7 +953,7 @@ def methods(
                 }
                 for m in ms
             ]
-            print(json.dumps({"version": __version__, "methods": rows}, indent=2))
+            print(_dumps({"version": __version__, "methods": rows}, indent=2))
         elif fmt == Fmt.md:
             print("| key | title | paper |")
             print("| --- | --- | --- |")
@@ -878,6 +978,13 @@ def _kv(items: list[str]) -> dict[str, str]:
         k, v = it.split("=", 1)
         out[k.strip()] = v.strip()
     return out
+
+
+def _dumps(obj: Any, **kw: Any) -> str:
+    """``json.dumps`` (json loads only on the paths that print JSON)."""
+    import json
+
+    return json.dumps(obj, **kw)
 
 
 def _jsonable(o: Any) -> Any:
@@ -970,6 +1077,8 @@ def _read_report(report: Path) -> Any:
     """The report path, or for ``-`` the report read from stdin (a Report)."""
     if not _is_stdin(report):
         return report
+    import json
+
     from obsdesign.errors import InputError
     from obsdesign.limits import int_digits
     from obsdesign.report.model import Report
