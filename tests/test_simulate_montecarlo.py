@@ -1,8 +1,10 @@
 """Batched Monte Carlo runs (obsdesign.simulate.montecarlo): results independent of the
-batching and of the run count, initial errors from a declared set, known quantiles."""
+batching and of the run count, every run equal (to rounding) to the same run simulated on its
+own, initial errors from a declared set, known quantiles."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -11,34 +13,49 @@ import pytest
 from obsdesign.api import load_spec_text
 from obsdesign.errors import SpecError
 from obsdesign.simulate import montecarlo as mc
-from obsdesign.simulate.linear import joint_system, simulate_linear_observer
+from obsdesign.simulate.linear import (
+    exogenous,
+    joint_system,
+    step_all,
+)
+from obsdesign.simulate.result import SimResult
 from obsdesign.spec.reader import Table
 
-PLANT = Path(__file__).parent / "specs" / "simulate-plant.toml"
-BASE = (
-    PLANT.read_text()
-    + """
-[sets.E0]
-type = "box"
-lower = [-2, -1]
-upper = [2, 1]
-[sets.line]
-type = "box"
-dim = 1
-lower = [-1]
-upper = [1]
-[simulate]
-horizon = 600
-x0 = [1, -1]
-xhat0 = [0, 0]
-seed = 11
-[simulate.noise]
-kind = "NOISE"
-"""
-)
+PLANT = (Path(__file__).parent / "specs" / "simulate-plant.toml").read_text()
 L = np.array([[0.6], [0.1]])
-RANDOM = BASE.replace('kind = "NOISE"', 'kind = "uniform"\nbound = 0.05')
-FIXED = BASE.replace('kind = "NOISE"', 'kind = "constant"\nvalue = [0.02]')
+
+
+def _value(v: object) -> str:
+    """A TOML value: tables inline, lists and scalars as JSON (which TOML reads)."""
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{k} = {_value(x)}" for k, x in v.items()) + " }"
+    if isinstance(v, list):
+        return "[" + ", ".join(_value(x) for x in v) + "]"
+    return json.dumps(v)
+
+
+def toml(name: str, **keys: object) -> str:
+    """One TOML table ``[name]`` with ``keys``."""
+    return f"\n[{name}]\n" + "".join(f"{k} = {_value(v)}\n" for k, v in keys.items())
+
+
+SETS = toml("sets.E0", type="box", lower=[-2, -1], upper=[2, 1]) + toml(
+    "sets.line", type="box", dim=1, lower=[-1], upper=[1]
+)
+
+
+def scenario(plant: str = PLANT, horizon: int = 600, **signals: dict) -> str:
+    """``plant`` with the sets above and a ``[simulate]`` table (x0 = [1, -1], x̂0 = 0, seed 11)
+    whose signals are given as ``noise={"kind": ...}``, ``u=...``, ``disturbance=...``."""
+    sim = toml("simulate", horizon=horizon, x0=[1, -1], xhat0=[0, 0], seed=11)
+    return plant + SETS + sim + "".join(toml(f"simulate.{k}", **v) for k, v in signals.items())
+
+
+UNIFORM = {"kind": "uniform", "bound": 0.05}
+RANDOM = scenario(noise=UNIFORM)
+FIXED = scenario(noise={"kind": "constant", "value": [0.02]})
+#: a plant with an input: random u and d reach the plant (every run has its own x)
+INPUT_PLANT = PLANT.replace("Bd = [[1], [0]]", "B = [[0], [1]]\nD = [[0.5]]\nBd = [[1], [0]]")
 
 
 def _run(text, runs, batch=None, ie="E0"):
@@ -46,18 +63,81 @@ def _run(text, runs, batch=None, ie="E0"):
     return mc.run_batch(sp, joint_system(sp, L), runs, ie, batch), sp
 
 
-@pytest.mark.parametrize("text", [RANDOM, FIXED])
-def test_results_do_not_depend_on_batching_or_run_count(text):
-    a, _ = _run(text, 7)
-    b, _ = _run(text, 7, batch=1)
-    c, _ = _run(text, 7, batch=3)
-    d, _ = _run(text, 4, batch=2)
+def separate(sp, runs, ie="E0"):
+    """Every run simulated on its own: its generator (child r of the seed), its initial error
+    and signals drawn in the documented order, stepped by the single-run engine
+    (``linear.step_all``), metrics by ``SimResult.metrics``."""
+    js, sim = joint_system(sp, L), sp.simulate
+    out = []
+    for child in mc.run_seeds(sim.seed, runs):
+        g = np.random.default_rng(child)
+        e0 = sp.sets[ie].sample(g, 1)[0] if ie else sim.xhat0.f - sim.x0.f
+        u, d, v = (sig.evaluate(js.grid, g) for sig in (sim.u, sim.disturbance, sim.noise))
+        Z = step_all(js, np.concatenate([sim.x0.f, sim.x0.f + e0]), exogenous(u, d, v)[:-1])
+        out.append(SimResult(js.grid, Z[:, :2], Z[:, 2:], None, sp.system.states).metrics())
+    return out
+
+
+def assert_runs_match(per_run, ref, rtol=1e-12):
+    for i, m in enumerate(ref):
+        for k in ("sup_abs_error", "rmse", "sup_abs_estimate"):
+            want = [m[k]["x1"], m[k]["x2"]]
+            np.testing.assert_allclose(per_run[k][i], want, rtol=rtol, atol=1e-13)
+        np.testing.assert_allclose(
+            per_run["final_error_norm"][i], m["final_error_norm"], rtol=1e-9, atol=1e-13
+        )
+
+
+CASES = {
+    "uniform noise": RANDOM,
+    "constant noise": FIXED,
+    "outliers": scenario(noise={"kind": "outliers", "amplitude": 2, "rate": 0.05, "bound": 0.01}),
+    "random u, d, noise": scenario(
+        INPUT_PLANT,
+        u={"kind": "uniform", "bound": 1},
+        disturbance={"kind": "uniform", "bound": 0.1},
+        noise=UNIFORM,
+    ),
+    "windows and a seeded noise": scenario(
+        disturbance={"kind": "windows", "windows": [{"start": 3, "stop": 9, "value": [0.3]}]},
+        noise={**UNIFORM, "seed": 4},
+    ),
+    "continuous": scenario(horizon=3, noise=UNIFORM)
+    .replace('"discrete"', '"continuous"')
+    .replace("horizon = 3", "horizon = 3\ndt = 0.01")
+    .replace("[[0.5, 1], [0, 0.8]]", "[[0, 1], [-2, -0.3]]"),
+}
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_each_run_is_the_same_run_simulated_on_its_own(case):
+    r, sp = _run(CASES[case], 6)
+    assert_runs_match(r.extra["per_run"], separate(sp, 6))
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_results_do_not_depend_on_batching_or_run_count(case, monkeypatch):
+    a, _ = _run(CASES[case], 7)
+    b, _ = _run(CASES[case], 7, batch=1)
+    c, _ = _run(CASES[case], 7, batch=3)
+    d, _ = _run(CASES[case], 4, batch=2)
+    monkeypatch.setattr(mc, "CHUNK", 48)  # the draws made in other pieces: the same numbers
+    e, _ = _run(CASES[case], 7)
     for k, arr in a.extra["per_run"].items():
-        np.testing.assert_array_equal(arr, b.extra["per_run"][k])
-        np.testing.assert_array_equal(arr, c.extra["per_run"][k])
+        for other in (b, c, e):
+            np.testing.assert_array_equal(arr, other.extra["per_run"][k])
         np.testing.assert_array_equal(arr[:4], d.extra["per_run"][k])
     np.testing.assert_array_equal(a.extra["initial_errors"], c.extra["initial_errors"])
     np.testing.assert_array_equal(a.xhat, b.xhat)  # run 0's trajectory
+
+
+def test_run_0_trajectory_is_its_separate_run():
+    r, sp = _run(RANDOM, 3)
+    m = separate(sp, 1)[0]
+    got = r.metrics()
+    for k in ("sup_abs_error", "rmse", "sup_abs_estimate"):
+        for st in ("x1", "x2"):
+            assert got[k][st] == pytest.approx(m[k][st], rel=1e-12)
 
 
 def test_initial_errors_come_from_the_set_and_differ():
@@ -70,23 +150,27 @@ def test_initial_errors_come_from_the_set_and_differ():
     np.testing.assert_array_equal(fixed.extra["initial_errors"], [[-1, 1]] * 3)
 
 
-def test_each_run_is_the_single_simulation_from_its_initial_error():
-    r, _ = _run(FIXED, 5)
-    for i in (0, 3):
-        e0 = r.extra["initial_errors"][i]
-        sp = load_spec_text(
-            FIXED.replace(
-                "xhat0 = [0, 0]", f"xhat0 = [{float(1 + e0[0])!r}, {float(-1 + e0[1])!r}]"
-            )
-        )
-        m = simulate_linear_observer(sp, L).metrics()
-        for k in ("sup_abs_error", "rmse", "sup_abs_estimate"):
-            np.testing.assert_allclose(
-                r.extra["per_run"][k][i], [m[k]["x1"], m[k]["x2"]], rtol=1e-12, atol=1e-12
-            )
-        assert r.extra["per_run"]["final_error_norm"][i] == pytest.approx(
-            m["final_error_norm"], rel=1e-9, abs=1e-12
-        )
+@pytest.mark.parametrize(
+    "table",
+    [
+        {"type": "box", "lower": [-2, -1], "upper": [2, 1]},
+        {"type": "ellipsoid", "E": [[2, 0.5], [0.5, 1]], "center": [0.5, 0]},
+        # a thin strip (2 % of its bounding box): many runs find no point in the first block
+        {"type": "polytope", "G": [[1, -1], [-1, 1], [1, 1], [-1, -1]], "g": [0.02] * 2 + [2] * 2},
+    ],
+)
+def test_initial_errors_at_once_are_the_sets_own_samples(table):
+    sp = load_spec_text(scenario(noise=UNIFORM) + toml("sets.S", **table))
+    S = sp.sets["S"]
+    kids = mc.run_seeds(5, 40)
+    want = np.stack([S.sample(np.random.default_rng(c), 1)[0] for c in kids])
+    gens = [np.random.default_rng(c) for c in kids]
+    np.testing.assert_array_equal(mc.initial_errors(S, gens, np.zeros(2)), want)
+    after = [np.random.default_rng(c) for c in kids]
+    for g in after:
+        S.sample(g, 1)
+    # each generator is left where the set's sample leaves it (the signals come next)
+    assert [g.random() for g in gens] == [g.random() for g in after]
 
 
 def test_noise_seeds_are_spawned_per_run():

@@ -126,7 +126,8 @@ def simulate_linear_observer_batch(
     :func:`obsdesign.simulate.montecarlo.run_batch`): run r draws its initial error from the
     set ``initial_error`` of ``[sets]`` (default: xhat0 − x0 for every run) and its signals
     from child r of ``SeedSequence(seed).spawn(runs)``; ``batch`` caps the runs stepped
-    together (default: as many as fit in ``montecarlo.BATCH_BYTES``). Per-run metrics in ``extra["per_run"]``,
+    together (default: ``montecarlo.BATCH_RUNS``, fewer when their draws do not fit
+    ``montecarlo.BATCH_BYTES``). Per-run metrics in ``extra["per_run"]``,
     quantiles in ``info["quantiles"]``; the trajectory shown is run 0's."""
     from obsdesign.simulate.montecarlo import run_batch
 

@@ -7,10 +7,17 @@ Randomness: run r uses ``numpy.random.default_rng(SeedSequence(seed).spawn(runs)
 set of ``[sets]``: one point drawn by the set's ``sample``; else xhat0 − x0 for every run),
 then its input, disturbance and noise signals in that order (only when one of them is random;
 a signal with its own ``seed``, or a deterministic one, is the same in every run). So run r's
-draws do not depend on how many runs there are or how they are batched. The batch step is
-one row-layout product Z @ Mᵀ (a 2-D product even for one run); with the OpenBLAS build
-numpy ships its rows are bitwise the same for any batch size (tested in
-tests/test_simulate_montecarlo.py), with another BLAS they agree to rounding.
+draws do not depend on how many runs there are or how they are batched.
+
+Speed (issue 12 item 4): the plant trajectory x is computed once when no random signal
+reaches it (then only the estimate is stepped per run, x entering as a shared input), the
+deterministic signals enter as one shared term per block; the time recursion goes :data:`BLOCK` steps per matrix product
+over the batch axis; uniform draws are made :data:`CHUNK` steps at a time as raw U[0, 1)
+numbers (the range and offset folded into the matrices); only per-run metrics are kept. The
+products keep the runs as rows, which OpenBLAS computes the same way whatever the number
+of rows, so a run's numbers are bitwise the same for any batch size or span (tested in
+tests/test_simulate_montecarlo.py); they agree with a separate run
+(:func:`obsdesign.simulate.linear.simulate_linear_observer`) to rounding.
 
 ``[simulate] initial_error = "NAME"`` is read by :func:`parse_initial_error`, which a method
 calls from its ``parse_simulate``.
@@ -18,20 +25,28 @@ calls from its ``parse_simulate``.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from obsdesign.errors import InputError
+from obsdesign.sets.base import ConvexSet
 from obsdesign.simulate.result import SimResult
 from obsdesign.spec.models import Spec
 from obsdesign.spec.reader import Table
 
-#: memory of one batch (trajectory chunk + per-run signals), bytes
+#: memory of one batch's random draws, bytes
 BATCH_BYTES = 128 * 2**20
-#: steps stepped between two metric updates (a fixed number, so that batching cannot change
-#: how the RMSE sums are rounded)
-STEPS = 256
+#: runs stepped together at most (the block arrays of a batch then stay in cache)
+BATCH_RUNS = 1024
+#: steps per block of the time recursion (one matrix product per block over the batch axis)
+BLOCK = 16
+#: steps whose random draws are made at once, per run (a multiple of :data:`BLOCK`, fixed so
+#: that the batching cannot change any number)
+CHUNK = 1024
+#: points of the first rejection-sampling block of ``ConvexSet.sample(rng, 1)``
+SAMPLE_BLOCK = 64
 #: quantiles reported for every per-run metric
 QUANTILES = {"q05": 0.05, "q50": 0.5, "q95": 0.95}
 METRICS = ("sup_abs_error", "rmse", "sup_abs_estimate", "final_error_norm")
@@ -63,6 +78,178 @@ def run_seeds(seed: int, runs: int) -> list[np.random.SeedSequence]:
     return np.random.SeedSequence(seed).spawn(runs)
 
 
+def initial_errors(
+    eset: ConvexSet | None, rngs: list[np.random.Generator], default: np.ndarray
+) -> np.ndarray:
+    """One initial error per run, ``eset.sample(rngs[r], 1)[0]`` (``default`` for every run when
+    ``eset`` is None), drawn for all runs at once when the set keeps the rejection sampler of
+    :meth:`ConvexSet.sample <obsdesign.sets.base.ConvexSet.sample>`: each run's first block of
+    :data:`SAMPLE_BLOCK` uniform points of the bounding box (``lo + (hi − lo)·U``, the formula
+    of ``Generator.uniform``, so the same numbers), one membership test for all runs, and the
+    set's own ``sample`` only for a run none of whose points is inside (the generator then
+    continues exactly where ``sample`` would). Returns (runs, n)."""
+    R = len(rngs)
+    if eset is None:
+        return np.tile(default, (R, 1))
+    if type(eset).sample is not ConvexSet.sample:
+        return np.stack([eset.sample(g, 1)[0] for g in rngs]).reshape(R, -1)
+    n = eset.dim
+    lo, hi = eset.bounding_box()
+    lo, rg = np.asarray(lo, dtype=float), np.subtract(hi, lo, dtype=float)
+    raw = np.empty((R, SAMPLE_BLOCK * n))
+    for r, g in enumerate(rngs):
+        g.random(out=raw[r])
+    pts = lo + rg * raw.reshape(R, SAMPLE_BLOCK, n)
+    inside = np.asarray(eset.contains(pts.reshape(-1, n))).reshape(R, SAMPLE_BLOCK)
+    first = inside.argmax(axis=1)
+    out = pts[np.arange(R), first]
+    for r in np.flatnonzero(~inside.any(axis=1)):
+        out[r] = eset.sample(rngs[r], 1)[0]
+    return out
+
+
+@dataclass
+class _Blocks:
+    """The time recursion s_{k+1} = F s_k + G w_k grouped in blocks of b steps: the states
+    s_{k0+1} .. s_{k0+b} (stacked, b·N rows) are ``P`` s_{k0} + ``T`` [w_{k0}; …; w_{k0+b-1}]
+    with P = [F; F²; …; F^b] and T the block lower-triangular Toeplitz matrix of F^{i-j} G
+    (one matrix product per block over the whole batch axis)."""
+
+    P: np.ndarray  # (b·N, N)
+    T: np.ndarray  # (b·N, b·w)
+
+    @classmethod
+    def of(cls, F: np.ndarray, G: np.ndarray, b: int) -> _Blocks:
+        N, w = G.shape
+        pows = [np.eye(N)]
+        for _ in range(b):
+            pows.append(F @ pows[-1])
+        P = np.concatenate(pows[1:], axis=0)
+        T = np.zeros((b * N, b * w))
+        for i in range(b):
+            for j in range(i + 1):
+                T[i * N : (i + 1) * N, j * w : (j + 1) * w] = pows[i - j] @ G
+        return cls(P, T)
+
+
+def _step_blocks(F: np.ndarray, G: np.ndarray, s0: np.ndarray, W: np.ndarray) -> np.ndarray:
+    """The single trajectory s_0 .. s_K of s⁺ = F s + G w_k for the inputs ``W`` (K, w), by
+    :class:`_Blocks` of :data:`BLOCK` steps (a few hundred products instead of K)."""
+    K, N = len(W), len(s0)
+    out = np.empty((K + 1, N))
+    out[0] = s0
+    bl = _Blocks.of(F, G, BLOCK)
+    for k0 in range(0, K, BLOCK):
+        m = min(BLOCK, K - k0)
+        blk = bl.P[: m * N] @ out[k0] + bl.T[: m * N, : m * G.shape[1]] @ W[k0 : k0 + m].ravel()
+        out[k0 + 1 : k0 + m + 1] = blk.reshape(m, N)
+    return out
+
+
+@dataclass
+class _Plan:
+    """How a batch is stepped (see :func:`run_batch`): the per-run state coordinates ``idx``
+    of z = [x; x̂] (the estimate only, when the plant trajectory x is the same in every run),
+    the shared input w_sh(k) (deterministic signals, the offsets of uniform draws and, when x
+    is shared, x(k)) with its matrix, and per random signal its columns and scale."""
+
+    idx: np.ndarray
+    F: np.ndarray
+    G_sh: np.ndarray
+    W_sh: np.ndarray  # (K, ·)
+    x_sh: np.ndarray | None  # (K + 1, n) when x is the same in every run
+    rand: list[int]  # indices into (u, d, v) of the random signals
+    G_rand: list[np.ndarray]  # (N, dim_i), scaled by the uniform range
+    fast: bool  # all random signals uniform: draws made chunk by chunk from raw U[0, 1)
+
+
+def _plan(js: Any, sigs: tuple[Any, ...], grid: np.ndarray, x0: np.ndarray, seed: int) -> _Plan:
+    n, M, E = js.n, js.M, js.E
+    K = len(grid) - 1
+    dims = [g.dim for g in sigs]
+    cols = np.cumsum([0, *dims])
+    rand = [i for i, g in enumerate(sigs) if _random(g)]
+    fast = all(sigs[i].kind == "uniform" for i in rand)
+    S = np.zeros((K + 1, E.shape[1]))
+    lo: dict[int, np.ndarray] = {}
+    rg: dict[int, np.ndarray] = {}
+    rng = np.random.default_rng(seed)  # deterministic kinds do not use it
+    for i, g in enumerate(sigs):
+        c = slice(cols[i], cols[i + 1])
+        if i not in rand:
+            S[:, c] = g.evaluate(grid, rng)
+        elif fast:  # Generator.uniform(-b, b) = -b + (b - (-b))·U
+            lo[i] = -np.asarray(g.bound, dtype=float)
+            rg[i] = np.subtract(g.bound, lo[i])
+            S[:, c] = lo[i]
+    rcols = np.concatenate([np.arange(cols[i], cols[i + 1]) for i in rand] or [[]]).astype(int)
+    x_varies = bool(np.any(E[:n, rcols] != 0)) or bool(np.any(M[:n, n:] != 0))
+    x_sh = None
+    if x_varies:
+        idx = np.arange(2 * n)
+        G_sh, W_sh = E, S[:-1]
+    else:
+        idx = np.arange(n, 2 * n)
+        x_sh = _step_blocks(M[:n, :n], E[:n], x0, S[:-1])
+        G_sh = np.concatenate([M[n:, :n], E[n:]], axis=1)
+        W_sh = np.concatenate([x_sh[:-1], S[:-1]], axis=1)
+    G_rand = []
+    for i in rand:
+        Gi = E[idx][:, cols[i] : cols[i + 1]]
+        G_rand.append(Gi * rg[i] if fast else Gi)
+    return _Plan(idx, M[np.ix_(idx, idx)], G_sh, W_sh, x_sh, rand, G_rand, fast)
+
+
+class _Draws:
+    """The random signals of a batch of runs, chunk by chunk: ``chunk(k0, k1)`` gives, per
+    random signal, a (runs, (k1 − k0)·dim) array whose row r holds run r's values (raw U[0, 1)
+    draws in the fast path; scale and offset are in the plan) for steps k0..k1-1, time-major
+    as ``Signal.evaluate`` draws them. Fast path: signal j of run r draws from run r's
+    generator advanced past the earlier random signals' (K + 1)·dim draws, so the numbers are
+    those of ``evaluate`` called in order; otherwise every signal is evaluated whole, run by
+    run, in order (``outliers``)."""
+
+    def __init__(
+        self, plan: _Plan, sigs: tuple[Any, ...], rngs: list[np.random.Generator], grid: Any
+    ):
+        self.plan, self.dims = plan, [sigs[i].dim for i in plan.rand]
+        R, K1 = len(rngs), len(grid)
+        if plan.fast:
+            self.gens: list[list[np.random.Generator]] = []
+            skip = 0
+            for d in self.dims:
+                if skip == 0:
+                    self.gens.append(rngs)
+                else:
+                    self.gens.append([_advanced(g, skip) for g in rngs])
+                skip += K1 * d
+            self.buf = [np.empty((R, CHUNK * d)) for d in self.dims]
+        else:
+            self.full = [np.empty((R, K1 * d)) for d in self.dims]
+            for r, g in enumerate(rngs):
+                vals = [s.evaluate(grid, g) for s in sigs]
+                for j, i in enumerate(plan.rand):
+                    self.full[j][r] = vals[i].ravel()
+
+    def chunk(self, k0: int, k1: int) -> list[np.ndarray]:
+        if not self.plan.fast:
+            return [f[:, k0 * d : k1 * d] for f, d in zip(self.full, self.dims, strict=True)]
+        out = []
+        for gens, buf, d in zip(self.gens, self.buf, self.dims, strict=True):
+            m = (k1 - k0) * d
+            for r, g in enumerate(gens):
+                g.random(out=buf[r, :m])
+            out.append(buf[:, :m])
+        return out
+
+
+def _advanced(g: np.random.Generator, steps: int) -> np.random.Generator:
+    """A copy of ``g`` advanced by ``steps`` 64-bit draws (one per float64 of ``random``)."""
+    bg = type(g.bit_generator)()
+    bg.state = g.bit_generator.state
+    return np.random.Generator(bg.advance(steps))
+
+
 def run_batch(
     spec: Spec,
     js: Any,
@@ -73,9 +260,17 @@ def run_batch(
 ) -> SimResult:
     """``runs`` runs of ``js`` (a :class:`~obsdesign.simulate.linear.JointSystem` of the
     bound ``spec``); ``initial_error``: a set name of ``[sets]`` (None: xhat0 − x0);
-    ``batch``: runs stepped together (None: as many as fit :data:`BATCH_BYTES`);
-    ``span = (a, b)``: only runs a..b-1 of the ``runs`` (same child seeds as in the full
-    range, so run r is the same whatever the span: :func:`merge` joins spans; None: all).
+    ``batch``: runs stepped together (None: :data:`BATCH_RUNS`, fewer if they do not fit
+    :data:`BATCH_BYTES`); ``span = (a, b)``: only runs a..b-1 of the ``runs`` (same child
+    seeds as in the full range, so run r is the same whatever the span: :func:`merge` joins
+    spans; None: all).
+
+    Linearity does the work: every run is the trajectory from [x0; x0] under the shared
+    (deterministic) signals plus its own part from its initial error and random draws; only
+    the estimate x̂ is stepped per run when no random signal reaches the plant. The steps
+    are grouped :data:`BLOCK` at a time (one product per block over the batch axis,
+    :class:`_Blocks`), the metrics are updated per block and nothing of a run but its
+    metrics is kept (run 0's trajectory excepted).
 
     Returns run 0's trajectory with ``info`` = runs, where the initial errors come from and
     the quantiles of every per-run metric, and ``extra["per_run"]`` = the per-run metrics
@@ -96,85 +291,26 @@ def run_batch(
         raise InputError(f"{spec.file}: initial_error = {initial_error!r} is not in [sets]")
     eset = spec.sets[initial_error] if initial_error is not None else None
     sigs = (sim.u, sim.disturbance, sim.noise)
-    random = any(_random(g) for g in sigs)
     children = run_seeds(sim.seed, runs)[first:last]
     total, runs = runs, last - first  # below: runs of the span, indexed from 0
-    shared = None
-    ET = js.E.T
-    width = js.E.shape[1]
-    if not random:
-        from obsdesign.simulate.runner import signals
-
-        shared = signals(spec, grid)
-        S_shared = np.concatenate(shared, axis=1)[:-1]  # (K, width)
-    per_run = (K + 1) * width * 8 if random else 0
-    B = batch or int(max(1, min(runs, BATCH_BYTES // max(per_run, 1))))
-    chunk = STEPS  # fixed (not from B): the per-chunk sums then round the same for any B
-    MT = np.ascontiguousarray(js.M.T)  # rows: z_next[b] = z[b] @ M^T
-    out = {
-        "sup_abs_error": np.zeros((runs, n)),
-        "rmse": np.zeros((runs, n)),
-        "sup_abs_estimate": np.zeros((runs, n)),
-        "final_error_norm": np.zeros(runs),
-    }
+    plan = _plan(js, sigs, grid, x0, sim.seed)
+    w = sum(sigs[i].dim for i in plan.rand)
+    per_run = (CHUNK if plan.fast else K + 1) * w * 8
+    B = batch or int(max(1, min(runs, BATCH_RUNS, BATCH_BYTES // max(per_run, 1))))
+    out = {k: np.zeros((runs, n)) for k in METRICS[:3]}
+    out["final_error_norm"] = np.zeros(runs)
     e0_all = np.zeros((runs, n))
-    traj0: list[np.ndarray] = []
-    sig0 = shared
+    traj0 = np.empty((K + 1, len(plan.idx)))
     for b0 in range(0, runs, B):
-        idx = range(b0, min(runs, b0 + B))
-        b = len(idx)
-        rngs = [np.random.default_rng(children[r]) for r in idx]
-        e0 = np.stack(
-            [eset.sample(g, 1)[0] if eset is not None else xhat0 - x0 for g in rngs]
-        ).reshape(b, n)
-        e0_all[b0 : b0 + b] = e0
-        if random:
-            Sb = np.empty((K, b, width))  # time-major: one step's signals are contiguous
-            for j, rng in enumerate(rngs):
-                one = [g.evaluate(grid, rng) for g in sigs]
-                if b0 == 0 and j == 0:
-                    sig0 = tuple(one)
-                Sb[:, j, :] = np.concatenate(one, axis=1)[:-1]
-        Z = np.concatenate([np.broadcast_to(x0, (b, n)), x0 + e0], axis=1)
-        sup_e = np.abs(Z[:, n:] - Z[:, :n]).T.copy()  # (n, b) accumulators
-        sq = sup_e**2
-        sup_h = np.abs(Z[:, n:]).T.copy()
-        if b0 == 0:
-            traj0.append(Z[:1].copy())
-        k0 = 0
-        while k0 < K:
-            k1 = min(K, k0 + chunk)
-            if random:
-                Wc = (Sb[k0:k1].reshape(-1, width) @ ET).reshape(k1 - k0, b, 2 * n)
-            else:
-                Wc = S_shared[k0:k1] @ ET  # (chunk, 2n), broadcast over the runs
-            buf = np.empty((k1 - k0, b, 2 * n))
-            for k in range(k1 - k0):
-                dst = buf[k]
-                np.matmul(Z, MT, out=dst)
-                dst += Wc[k]
-                Z = dst
-            # metrics on the runs-last copy (k, 2n, b): every operation then runs along
-            # contiguous rows of b values (column slices of (k, b, 2n) cost several times more)
-            bt = np.ascontiguousarray(buf.transpose(0, 2, 1))
-            e = bt[:, n:] - bt[:, :n]  # (k, n, b)
-            np.maximum(sup_e, e.max(axis=0), out=sup_e)
-            np.maximum(sup_e, -e.min(axis=0), out=sup_e)
-            sq += np.einsum("kib,kib->ib", e, e)
-            np.maximum(sup_h, bt[:, n:].max(axis=0), out=sup_h)
-            np.maximum(sup_h, -bt[:, n:].min(axis=0), out=sup_h)
-            if b0 == 0:
-                traj0.append(buf[:, 0, :].copy())
-            k0 = k1
-        sl = slice(b0, b0 + len(idx))
-        out["sup_abs_error"][sl] = sup_e.T
-        out["rmse"][sl] = np.sqrt(sq / (K + 1)).T
-        out["sup_abs_estimate"][sl] = sup_h.T
-        out["final_error_norm"][sl] = np.linalg.norm(Z[:, n:] - Z[:, :n], axis=1)
-    Z0 = np.concatenate(traj0)
-    x, xh = Z0[:, :n], Z0[:, n:]
-    assert sig0 is not None
-    u, _, v = sig0
+        rngs = [np.random.default_rng(c) for c in children[b0 : b0 + B]]
+        e0 = initial_errors(eset, rngs, xhat0 - x0)
+        e0_all[b0 : b0 + len(rngs)] = e0
+        draws = _Draws(plan, sigs, rngs, grid) if plan.rand else None
+        m = _run(plan, draws, x0, e0, K, n, traj0 if b0 == 0 else None)
+        for k, a in m.items():
+            out[k][b0 : b0 + len(rngs)] = a
+    x, xh = _trajectory(plan, traj0, n)
+    u, _, v = _signals0(spec, grid, eset, children[0])
     y = x @ s.C.f.T + u @ s.D.f.T + v @ s.Dn.f.T
     res = SimResult(grid, x, xh, y, s.states)
     res.extra["per_run"] = out
@@ -186,6 +322,139 @@ def run_batch(
         res.info["span"] = [first, last]
     res.info["quantiles"] = quantiles(out, s.states)
     return res
+
+
+def _run(
+    plan: _Plan,
+    draws: _Draws | None,
+    x0: np.ndarray,
+    e0: np.ndarray,
+    K: int,
+    n: int,
+    traj0: np.ndarray | None,
+) -> dict[str, np.ndarray]:
+    """Step one batch (initial errors ``e0`` (R, n)) over K steps; per-run metrics.
+
+    The products keep the runs as rows (state (R, N + 1) with a column of ones for the shared
+    block term, block (R, b·N)): OpenBLAS then computes every row the same way whatever the
+    number of rows (two or more; one run is stepped as two equal rows), so a run's numbers do
+    not depend on the batching. The metrics are taken on a runs-last copy of each block
+    ((b, N, R): every reduction then runs along contiguous rows). ``traj0`` (K + 1, N)
+    receives run 0's states when given."""
+    R, N = len(e0), len(plan.idx)
+    shared_x = plan.x_sh is not None
+    st = np.ones((max(R, 2), N + 1))  # the states and a column of ones
+    xh0 = x0 + e0  # (R, n)
+    if shared_x:
+        st[:R, :N] = xh0
+    else:
+        st[:R, :n] = x0
+        st[:R, n:N] = xh0
+    st[R:] = st[:1]
+    e = (xh0 - x0).T
+    sup_e = np.abs(e)
+    sq = e * e
+    sup_h = np.abs(xh0.T)
+    if traj0 is not None:
+        traj0[0] = st[0, :N]
+    sh = _Blocks.of(plan.F, plan.G_sh, BLOCK)
+    Csh = _shared_terms(sh, plan.W_sh, K, N)  # (blocks, b·N)
+    rbT = [_Blocks.of(plan.F, G, BLOCK).T.T.copy() for G in plan.G_rand]  # (b·w, b·N)
+    PAT = np.empty((N + 1, BLOCK * N))  # [P | shared term]ᵀ
+    PAT[:N] = sh.P.T
+    dims = draws.dims if draws is not None else []
+    # buffers reused by every block (fresh ones cost page faults at this size)
+    Rr = len(st)
+    bufs = {m: _BlockBufs(Rr, m, N, n, R) for m in {BLOCK, K % BLOCK} if m}
+    for c0 in range(0, K, CHUNK):
+        c1 = min(K, c0 + CHUNK)
+        raw = draws.chunk(c0, c1) if draws is not None else []
+        for k0 in range(c0, c1, BLOCK):
+            m = min(BLOCK, c1 - k0)
+            rows = m * N
+            bb = bufs[m]
+            PAT[N, :rows] = Csh[k0 // BLOCK, :rows]
+            D = bb.D
+            np.matmul(st, PAT[:, :rows], out=D)
+            for TT, a, d in zip(rbT, raw, dims, strict=True):
+                j = (k0 - c0) * d
+                np.matmul(_rows(a[:, j : j + m * d]), TT[: m * d, :rows], out=bb.D2)
+                np.add(D, bb.D2, out=D)
+            st[:, :N] = D[:, rows - N :]
+            if R == 1:
+                st[1:] = st[:1]
+            np.copyto(bb.Zt, D[:R].T)
+            Z = bb.Zt.reshape(m, N, R)
+            if shared_x:
+                assert plan.x_sh is not None
+                H, E = Z, bb.E
+                np.subtract(Z, plan.x_sh[k0 + 1 : k0 + m + 1, :, None], out=E)
+            else:
+                H, E = Z[:, n:], bb.E
+                np.subtract(H, Z[:, :n], out=E)
+            t = bb.t
+            for acc, a in ((sup_h, H), (sup_e, E)):
+                np.max(a, axis=0, out=t)
+                np.maximum(acc, t, out=acc)
+                np.min(a, axis=0, out=t)
+                np.negative(t, out=t)
+                np.maximum(acc, t, out=acc)
+            np.add(sq, np.einsum("kir,kir->ir", E, E), out=sq)
+            if traj0 is not None:
+                traj0[k0 + 1 : k0 + m + 1] = Z[:, :, 0]
+    fin = st[:R, :N]
+    e_end = fin - plan.x_sh[K] if plan.x_sh is not None else fin[:, n:] - fin[:, :n]
+    return {
+        "sup_abs_error": sup_e.T,
+        "rmse": np.sqrt(sq / (K + 1)).T,
+        "sup_abs_estimate": sup_h.T,
+        "final_error_norm": np.linalg.norm(e_end, axis=1),
+    }
+
+
+class _BlockBufs:
+    """The arrays of one block of m steps: products (R' ≥ 2 rows, m·N), their runs-last
+    copy, the errors (m, n, R) and a per-run reduction (n, R)."""
+
+    def __init__(self, Rr: int, m: int, N: int, n: int, R: int):
+        self.D = np.empty((Rr, m * N))
+        self.D2 = np.empty((Rr, m * N))
+        self.Zt = np.empty((m * N, R))
+        self.E = np.empty((m, n, R))
+        self.t = np.empty((n, R))
+
+
+def _rows(a: np.ndarray) -> np.ndarray:
+    """``a`` with at least two rows (a single row repeated: see :func:`_run`)."""
+    return a if len(a) > 1 else np.concatenate([a, a])
+
+
+def _shared_terms(bl: _Blocks, W: np.ndarray, K: int, N: int) -> np.ndarray:
+    """Per block, the contribution T [w_{k0}; …] of the shared inputs (blocks, b·N); the
+    last block is padded with zero inputs (only its first rows are used)."""
+    nb = -(-K // BLOCK)
+    Wp = np.zeros((nb * BLOCK, W.shape[1]))
+    Wp[:K] = W
+    return Wp.reshape(nb, -1) @ bl.T.T
+
+
+def _trajectory(plan: _Plan, traj0: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Run 0's (x, x̂) from its stepped coordinates."""
+    if plan.x_sh is not None:
+        return plan.x_sh, traj0
+    return traj0[:, :n], traj0[:, n:]
+
+
+def _signals0(
+    spec: Spec, grid: np.ndarray, eset: ConvexSet | None, child: np.random.SeedSequence
+) -> tuple[np.ndarray, ...]:
+    """Run 0's signals u, d, v (drawn again from its generator, after its initial error)."""
+    sim = spec.simulate
+    assert sim is not None
+    g = np.random.default_rng(child)
+    if eset is not None:
+        eset.sample(g, 1)
+    return tuple(sig.evaluate(grid, g) for sig in (sim.u, sim.disturbance, sim.noise))
 
 
 def merge(parts: list[SimResult], states: list[str]) -> SimResult:
