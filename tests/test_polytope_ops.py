@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 from flint import fmpq
@@ -143,3 +145,150 @@ print(len(calls) <= len(model.DEPS) + 1, b == model.tool_info(), model.tool_info
 """
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert r.stdout.split("\n")[:4] == ["[]", "True True", "True", "True True True"], r.stdout
+
+
+def _hard_clouds(seed: int, n: int) -> list[np.ndarray]:
+    """Exact point clouds: a rationalized sphere with interior points, a cube with points on
+    its faces and inside (non-simplicial facets), a cube with caps, a cross-polytope with an
+    edge midpoint (a point on an edge that is not a vertex)."""
+    rng = np.random.default_rng(seed)
+    S = rng.normal(size=(40, n))
+    S /= np.linalg.norm(S, axis=1)[:, None]
+    cube = np.array(np.meshgrid(*[[-1, 1]] * n)).reshape(n, -1).T
+    face = rng.uniform(-1, 1, size=(6, n))
+    face[:3, 0] = 1
+    E = np.eye(n)
+    return [
+        po.rationalize(np.vstack([S, 0.3 * rng.normal(size=(5, n))])),
+        po.qarray(np.vstack([cube, face, [[0.5] * n]])),
+        po.qarray(np.vstack([cube, 1.5 * E, -2 * E])),
+        po.qarray(np.vstack([E, -E, 0.5 * (E[0] + E[1])[None]])),
+    ]
+
+
+@pytest.mark.parametrize("n", [2, 3, 4])
+def test_incidence_hull_is_the_cdd_hull(n):
+    """The hull proved from incidences (exact_hull's first path) is cdd.gmp's hull: the same
+    canonical rows, the same vertices in the same order, the same edges."""
+    for P in _hard_clouds(n, n):
+        G, idx, edges = po._cdd_hull(P)
+        Gi, vr = po.exact_hull(P)
+        assert [tuple(r) for r in Gi] == [tuple(r) for r in G]
+        assert [tuple(v) for v in vr.V] == [tuple(P[j]) for j in idx]
+        assert vr.edges == edges
+        ok, detail, vr2 = po.exact_check_forms(G, P[idx])
+        assert ok and vr2.edges == edges, detail
+
+
+def test_hull_certificate_fails_each_check():
+    """Every condition of hull_certificate can fail, each with its reason; and a
+    tampered form never passes exact_check_forms."""
+    cube = po.qarray(np.array(np.meshgrid(*[[-1, 1]] * 3)).reshape(3, -1).T)
+    G, _, _ = po._cdd_hull(cube)
+    assert not isinstance(po.hull_certificate(G, cube), str)
+    # 1. a point outside a row
+    out = cube.copy()
+    out[0] = out[0] * fmpq(1001, 1000)
+    assert "violates" in po.hull_certificate(G, out)
+    # 2. a repeated row, a row that only touches an edge (valid but not a facet)
+    assert "repeated" in po.hull_certificate(np.vstack([G, G[:1]]), cube)
+    edge_row = po.qarray([[fmpq(1, 2), fmpq(1, 2), 0]])
+    assert "not a facet" in po.hull_certificate(np.vstack([G, edge_row]), cube)
+    # 5. a missing facet (a cube with a pyramid on top, one triangle of the pyramid
+    # dropped): the ridges of the square below it are not closed (non-simplicial) ...
+    cap = np.vstack([cube, po.qarray([[0, 0, 2]])])
+    Gc, _, _ = po._cdd_hull(cap)
+    tri = [k for k, r in enumerate(Gc) if r[2] != 0 and r[2] != -1][0]
+    assert "not determined" in po.hull_certificate(np.delete(Gc, tri, axis=0), cap)
+    assert "not a facet" in po.hull_certificate(G[1:], cube)  # (vertices lost with it)
+    # ... and, on a simplicial polytope (octahedron), a ridge on no other row
+    octa = po.qarray(np.vstack([np.eye(3), -np.eye(3)]))
+    Go, _, _ = po._cdd_hull(octa)
+    assert "no other row" in po.hull_certificate(Go[1:], octa)
+    # flat: a square in the plane e3 = 1 with its one row (no point has 3 independent rows)
+    sq = po.qarray([[1, 1, 1], [1, -1, 1], [-1, 1, 1], [-1, -1, 1]])
+    assert "not a facet" in po.hull_certificate(po.qarray([[0, 0, 1]]), sq)
+    # 3. a point on an edge is not a vertex: the hull holds but the forms claim fails
+    mid = np.vstack([octa, po.qarray([[fmpq(1, 2), fmpq(1, 2), 0]])])
+    assert len(po.hull_certificate(Go, mid).keep) == 6
+    ok, detail, _ = po.exact_check_forms(Go, mid)
+    assert not ok and "not vertices" in detail
+    # the smallest tamper of one facet row, and of one vertex
+    for k in range(len(Go)):
+        T = Go.copy()
+        T[k] = T[k] * fmpq(10**12 + 1, 10**12)
+        assert not po.exact_check_forms(T, octa)[0]
+    for j in range(len(octa)):
+        W = octa.copy()
+        W[j] = W[j] * fmpq(10**12 - 1, 10**12)
+        assert not po.exact_check_forms(Go, W)[0]
+
+
+def _sphere4(k: int) -> np.ndarray:
+    rng = np.random.default_rng(7)
+    S = rng.normal(size=(k, 4))
+    return po.rationalize(S / np.linalg.norm(S, axis=1)[:, None])
+
+
+def test_cdd_hull_in_a_child_gives_the_same_hull():
+    P = _hard_clouds(1, 3)[0]
+    G, idx, edges = po._cdd_hull(P)
+    G2, idx2, edges2 = po._cdd_hull_bounded(P, time.perf_counter() + 60)
+    assert [tuple(r) for r in G2] == [tuple(r) for r in G] and idx2 == idx and edges2 == edges
+
+
+def test_time_budget_stops_a_long_exact_hull(monkeypatch):
+    """Issue 12 item 2: a budget of 1 s on an exact hull that cdd.gmp needs a minute for
+    (150 points on the 4-sphere, the incidence proof switched off) is refused within the
+    budget plus the child's start and kill."""
+    monkeypatch.setattr(po, "_float_facets", lambda P: None)
+    P = _sphere4(150)
+    t0 = time.perf_counter()
+    with pytest.raises(po.HullTimeout):
+        po.exact_hull(P, deadline=t0 + 1.0)
+    assert time.perf_counter() - t0 < 1.0 + 2.0
+
+
+def test_child_dies_with_its_parent():
+    """Ctrl-C (SIGINT) and SIGKILL of the calling process end the cdd.gmp child too."""
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    code = (
+        "import time, numpy as np\n"
+        "from obsdesign.sets import polytope_ops as po\n"
+        "rng = np.random.default_rng(7); S = rng.normal(size=(150, 4))\n"
+        "P = po.rationalize(S / np.linalg.norm(S, axis=1)[:, None])\n"
+        "print('go', flush=True)\n"
+        "po._cdd_hull_bounded(P, time.perf_counter() + 120)\n"
+    )
+
+    def children(pid: int) -> list[int]:
+        out = []
+        for d in os.listdir("/proc"):
+            try:
+                cmd = open(f"/proc/{d}/cmdline", "rb").read().split(b"\0")
+            except OSError:
+                continue
+            if (
+                b"from obsdesign.sets.polytope_ops import _child; _child()" in cmd
+                and str(pid).encode() in cmd
+            ):
+                out.append(int(d))
+        return out
+
+    for sig in (signal.SIGINT, signal.SIGKILL):
+        p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE)
+        assert p.stdout.readline().strip() == b"go"
+        t0 = time.perf_counter()
+        while not children(p.pid) and time.perf_counter() - t0 < 20:
+            time.sleep(0.05)
+        assert children(p.pid), "the child did not start"
+        p.send_signal(sig)
+        p.wait(timeout=20)
+        t0 = time.perf_counter()
+        while children(p.pid) and time.perf_counter() - t0 < 5:
+            time.sleep(0.05)
+        assert not children(p.pid), f"the child outlived its parent ({sig!r})"

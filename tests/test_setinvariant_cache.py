@@ -187,3 +187,100 @@ def test_time_budget_inside_the_exact_theorem31_loop():
     with pytest.raises(ce.BudgetExceeded):
         ce.theorem31(ex, G, v_solver=lps.eps_batch, vrep=vrep, deadline=0.0)
     assert ce.theorem31(ex, G, v_solver=lps.eps_batch, vrep=vrep, deadline=None).zs
+
+
+def test_time_budget_stops_the_exact_hull_of_the_final_stage(monkeypatch):
+    """The one uninterruptible exact step (a cdd.gmp hull, needed when the incidence proof
+    of the float hull fails: switched off here) runs in a child process that the budget
+    kills: 150 points on a 4-sphere (about a minute in cdd.gmp) with 1 s left are refused
+    within the budget plus the child's start, with the reason."""
+    import dataclasses
+    import time
+
+    from obsdesign.methods.setinvariant.design import final_stage
+    from obsdesign.methods.setinvariant.problem import build
+    from obsdesign.sets import polytope_ops as po
+
+    sp = api.load_spec_text(
+        spec_text(np.diag([0.5, 0.4, 0.3, 0.2]), [0.0] * 4, [[1.0, 1.0, 0.5, 0.2]], 0.9),
+        "four.toml",
+    )
+    S = np.random.default_rng(7).normal(size=(150, 4))
+    P = 3 * S / np.linalg.norm(S, axis=1)[:, None]
+    monkeypatch.setattr(po, "_float_facets", lambda P: None)
+    t0 = time.perf_counter()
+    with pytest.raises(
+        SolverError, match=r"exact certificate not finished within 1 s .*exact hull"
+    ):
+        final_stage(
+            build(sp),
+            P,
+            True,
+            0.9,
+            t0 + 1.0,
+            dataclasses.replace(sp.options, time_limit=1.0),
+        )
+    assert time.perf_counter() - t0 < 1.0 + 2.0
+
+
+def _levels(ex, G, vrep, zs, vs) -> list[fmpq]:
+    """Brute force: the exact level max_i(φ_i(z) + G_i v + δ_i) at every breakpoint, φ from
+    every exact slice point (no float prefilter)."""
+    from obsdesign.methods.setinvariant import certificate as ce
+    from obsdesign.sets import polytope_ops as po
+
+    GA = ce.qmatmul(G, ex.A)
+    dl = ce.delta_exact(G, ex.B1, ex.Dv)
+    cv = [po.qdot(ex.C[0], v) for v in vrep.V]
+    out = []
+    for z, v in zip(zs, vs, strict=True):
+        S = po.exact_slice_points(vrep.V, vrep.edges, cv, z - ex.eta, z + ex.eta)
+        out.append(
+            max(max(po.qdot(GA[i], p) for p in S) + po.qdot(G[i], v) + dl[i] for i in range(len(G)))
+        )
+    return out
+
+
+def test_theorem31_factor_is_the_max_over_every_breakpoint():
+    """Theorem 3.1 evaluates exactly only the breakpoints whose float bracket can reach λ or
+    the maximum. Known answer: the factor is the brute-force maximum; and a breakpoint far
+    below it (skipped before), raised exactly to just above λ, fails the check, and raised
+    to between the factor and λ, becomes the certified factor."""
+    from obsdesign.methods.setinvariant import certificate as ce
+    from obsdesign.methods.setinvariant.problem import build
+    from obsdesign.sets import polytope_ops as po
+
+    sp = api.load_spec_text(SEED0, "s0.toml")
+    p = api.design(sp).parameters
+    ex = build(sp).ex
+    G = np.asarray(p["G"], dtype=object)
+    ok, _, vrep = po.exact_check_forms(G, np.asarray(p["V"], dtype=object))
+    zs = list(p["breakpoints"])
+    vs = [list(r) for r in p["v_breakpoints"]]
+    lv = _levels(ex, G, vrep, zs, vs)
+    res = ce.theorem31(ex, G, vs=vs, zs_given=zs, vrep=vrep)
+    assert ok and res.ok and res.factor == max(lv) == p["contractivity"]
+    l = min(range(len(zs)), key=lambda k: lv[k])
+    assert float(lv[l]) < float(res.factor) - 1e-3  # far below: its float bracket is too
+    u = list(G[0])
+
+    def raised(target: fmpq) -> list[list[fmpq]]:
+        # v^l + s G_0 with the smallest s at which some row's term reaches ``target``
+        base = _levels(ex, G, vrep, [zs[l]], [vs[l]])[0]
+        rows = [(po.qdot(G[i], u), i) for i in range(len(G))]
+        s = min((target - base) / gu for gu, i in rows if gu > 0)
+        for _ in range(50):  # the level of v + s u is reached by one row at exactly target
+            w = [a + s * b for a, b in zip(vs[l], u, strict=True)]
+            lev = _levels(ex, G, vrep, [zs[l]], [w])[0]
+            if lev == target:
+                break
+            s += (target - lev) / max(gu for gu, _ in rows)
+        assert lev == target
+        return vs[:l] + [w] + vs[l + 1 :]
+
+    bad = raised(ex.lam * (1 + fmpq(1, 10**12)))
+    r1 = ce.theorem31(ex, G, vs=bad, zs_given=zs, vrep=vrep)
+    assert not r1.ok and r1.factor == ex.lam * (1 + fmpq(1, 10**12)) and r1.worst == l
+    mid = (res.factor + ex.lam) / 2
+    r2 = ce.theorem31(ex, G, vs=raised(mid), zs_given=zs, vrep=vrep)
+    assert r2.ok and r2.factor == mid and r2.worst == l

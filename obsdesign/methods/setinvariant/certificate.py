@@ -98,7 +98,9 @@ class Theorem31Result:
     factor: fmpq
     zs: list[fmpq]
     vs: list[list[fmpq]]
-    eps: list[fmpq]
+    #: the exact level max_i(φ_i + G_i v + δ_i) at each z^l where it can reach λ or the
+    #: maximum; None where the float bracket proves it below both
+    eps: list[fmpq | None]
     worst: int
     n_vertices: int
     exact_lp: int = 0
@@ -130,30 +132,40 @@ class _Slices:
         self.zs = zs
         e = np.array(vrep.edges, dtype=int).reshape(-1, 2)
         self.ea, self.eb = e[:, 0], e[:, 1]
-        self.emin = np.minimum(self.cvf[self.ea], self.cvf[self.eb])
-        self.emax = np.maximum(self.cvf[self.ea], self.cvf[self.eb])
-        self.tol = 1e-9 * max(1.0, float(np.abs(self.cvf).max()))
-        self.cands: list[list[tuple]] = []
+        ca, cb = self.cvf[self.ea], self.cvf[self.eb]
+        emin, emax = np.minimum(ca, cb), np.maximum(ca, cb)
+        tol = 1e-9 * max(1.0, float(np.abs(self.cvf).max()))
+        dV = self.Vf[self.eb] - self.Vf[self.ea]
+        #: per z^l: (vertex indices, [edge indices crossing z − η̄, z + η̄]) of the candidates
+        self.cands: list[tuple[np.ndarray, list[np.ndarray]]] = []
         self.ptsf: list[np.ndarray] = []
         for z in zs:
             lo, hi = float(z - ex.eta), float(z + ex.eta)
-            cand: list[tuple] = []
-            pts = []
-            for j in np.nonzero((self.cvf >= lo - self.tol) & (self.cvf <= hi + self.tol))[0]:
-                cand.append(("v", int(j)))
-                pts.append(self.Vf[j])
-            for side, t in ((0, lo), (1, hi)):
-                if side == 1 and ex.eta == 0:
-                    break
-                for k in np.nonzero((self.emin <= t + self.tol) & (self.emax >= t - self.tol))[0]:
-                    a, b = int(self.ea[k]), int(self.eb[k])
-                    ca, cb = self.cvf[a], self.cvf[b]
-                    w = 0.5 if cb == ca else min(1.0, max(0.0, (t - ca) / (cb - ca)))
-                    cand.append(("e", a, b, side))
-                    pts.append(self.Vf[a] + w * (self.Vf[b] - self.Vf[a]))
-            self.cands.append(cand)
-            self.ptsf.append(np.array(pts).reshape(-1, ex.n))
+            vj = np.nonzero((self.cvf >= lo - tol) & (self.cvf <= hi + tol))[0]
+            pts = [self.Vf[vj]]
+            sides = []
+            for t in (lo, hi) if ex.eta != 0 else (lo,):
+                k = np.nonzero((emin <= t + tol) & (emax >= t - tol))[0]
+                den = cb[k] - ca[k]
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    w = np.where(den == 0, 0.5, np.clip((t - ca[k]) / den, 0.0, 1.0))
+                pts.append(self.Vf[self.ea[k]] + w[:, None] * dV[k])
+                sides.append(k)
+            self.cands.append((vj, sides))
+            self.ptsf.append(np.vstack(pts).reshape(-1, ex.n))
         self._cache: dict[tuple, tuple | None] = {}
+
+    def _cand(self, l: int, j: int) -> tuple:
+        """The j-th candidate of slice l: ("v", vertex) or ("e", a, b, side)."""
+        vj, sides = self.cands[l]
+        if j < len(vj):
+            return ("v", int(vj[j]))
+        j -= len(vj)
+        for side, k in enumerate(sides):
+            if j < len(k):
+                return ("e", int(self.ea[k[j]]), int(self.eb[k[j]]), side)
+            j -= len(k)
+        raise IndexError(j)  # pragma: no cover
 
     def _exact_point(self, l: int, cand: tuple) -> tuple | None:
         key = (l, cand)
@@ -191,7 +203,7 @@ class _Slices:
         for i in rows:
             best = None
             for j in np.nonzero(M[i] >= M[i].max() - tol[i])[0]:
-                p = self._exact_point(l, self.cands[l][j])
+                p = self._exact_point(l, self._cand(l, int(j)))
                 if p is not None:
                     val = po.qdot(self.GA[i], p)
                     best = val if best is None or val > best else best
@@ -278,31 +290,59 @@ def theorem31(
         er = v_solver(Gf, phif, dlf)
         vs_use = [[po.snap(x) for x in er.v[l]] for l in range(len(zs))]
     absG = np.abs(Gf)
-    eps_l: list[fmpq] = []
-    out_vs: list[list[fmpq]] = []
+    lamf = float(ex.lam)
+    nz = len(zs)
+    # float level of every breakpoint, bracketed: hi[l] >= the exact level > lo[l] (the
+    # margin _FILTER is far above the float error); exact work only where it can matter
+    fl_rows = []
+    hi, lo = np.empty(nz), np.empty(nz)
+    for l in range(nz):
+        vf = po.qfloat(np.array(vs_use[l], dtype=object))
+        phf = sl.phi_float(l)
+        val = phf + Gf @ vf + dlf
+        tol = _FILTER * (np.abs(phf) + absG @ np.abs(vf) + np.abs(dlf) + 1.0)
+        fl_rows.append((val, tol))
+        hi[l], lo[l] = float((val + tol).max()), float((val - tol).max())
+    eps_l: list[fmpq | None] = [None] * nz
+    out_vs: list[list[fmpq]] = [list(v) for v in vs_use]
     n_exact = 0
-    for l in range(len(zs)):
+
+    def exact_at(l: int) -> None:
+        nonlocal n_exact
         if deadline is not None and time.perf_counter() > deadline:
-            raise BudgetExceeded(l)
+            raise BudgetExceeded(sum(e is not None for e in eps_l))
         v = vs_use[l]
-        vf = po.qfloat(np.array(v, dtype=object))
-        val = sl.phi_float(l) + Gf @ vf + dlf
-        tol = _FILTER * (np.abs(sl.phi_float(l)) + absG @ np.abs(vf) + np.abs(dlf) + 1.0)
-        thr = min(float(ex.lam), float(val.max()))
+        val, tol = fl_rows[l]
+        thr = min(lamf, float(val.max()))
         rows = np.nonzero(val >= thr - tol)[0]
         ph = sl.phi_exact(l, rows)
         e = max(ph[i] + po.qdot(G[i], v) + dl[i] for i in ph)
         # the exact LP only helps where the float LP says ε(z) <= λ and rounding broke it;
         # where the float optimum is already above λ (a non-converged polyhedron) it cannot
         # pass and costs ~0.4 s per breakpoint
-        if e > ex.lam and vs is None and er.eps[l] <= float(ex.lam) * (1 + 1e-9):
+        if e > ex.lam and vs is None and er.eps[l] <= lamf * (1 + 1e-9):
             phall = sl.phi_exact(l)
             e, v = exact_lp9(G, [phall[i] for i in range(len(G))], dl)
             n_exact += 1
-        eps_l.append(e)
-        out_vs.append(list(v))
-    worst = int(max(range(len(zs)), key=lambda k: eps_l[k])) if zs else 0
-    factor = eps_l[worst] if zs else fmpq(0)
+        eps_l[l] = e
+        out_vs[l] = list(v)
+
+    # 1. every breakpoint whose level may exceed λ (where the exact LP may replace v^l)
+    for l in np.nonzero(hi > lamf)[0]:
+        exact_at(int(l))
+    # 2. every breakpoint whose level may reach the largest: the certified factor is exact;
+    #    the others are provably below it (and below λ)
+    floor = max(
+        [float(e) for e in eps_l if e is not None]
+        + [float(lo[l]) for l in range(nz) if eps_l[l] is None],
+        default=0.0,
+    )
+    for l in range(nz):
+        if eps_l[l] is None and hi[l] >= floor:
+            exact_at(l)
+    done = [l for l in range(nz) if eps_l[l] is not None]
+    worst = max(done, key=lambda k: eps_l[k]) if done else 0
+    factor = eps_l[worst] if done else fmpq(0)
     return Theorem31Result(
         factor <= ex.lam, factor, zs, out_vs, eps_l, worst, len(vrep.V), n_exact, notes
     )

@@ -50,15 +50,16 @@ def final_stage(
     o: Options | None = None,
 ) -> Stage:
     """The polytope conv(Ω's vertices ∪ P), proved: Ω's vertices exactly, the other points
-    snapped (po.snap), one exact hull (cdd.gmp) for G and the edges, then Theorem 3.1 at every
+    snapped (po.snap), one exact hull (po.exact_hull) for G and the edges, then Theorem 3.1 at every
     z^l of Z_d with v^l from LP (9) (Section III, eq. (6), (9)). Without cdd.gmp: the float
     hull and Theorem 3.1 in float64 (numerical.float_stage).
 
     ``data``: float and exact problem; ``P``: float points (rows); ``single``: one output;
     ``lam``: λ (float, for the float-only stage); ``deadline``: ``time.perf_counter()`` value
     past which the exact stage does not start, or its Theorem 3.1 loop stops, with a
-    SolverError naming ``o.time_limit`` (checked before the hull and between breakpoints; the
-    cdd.gmp hull call itself is not interrupted)."""
+    SolverError naming ``o.time_limit`` (checked before the hull and between breakpoints; a
+    cdd.gmp hull, needed only when the incidence proof of the float hull fails, runs in a
+    child process killed at the deadline)."""
     fl, ex = data.fl, data.ex
     if ex is None:
         Gf, resf, vrf = numerical.float_stage(fl, P, lam)
@@ -73,7 +74,14 @@ def final_stage(
             f"exact certificate not started within {limit}: the iterations used the budget "
             f"({len(P)} points to prove; raise time_limit, or a larger λ or Δδ)"
         )
-    Gq, vrep = po.exact_hull(Pq)
+    try:
+        Gq, vrep = po.exact_hull(Pq, deadline=deadline)
+    except po.HullTimeout:
+        raise SolverError(
+            f"exact certificate not finished within {limit}: the exact hull (cdd.gmp) of "
+            f"{len(Pq)} points was stopped (raise time_limit, or a larger λ or Δδ for a "
+            "smaller polyhedron)"
+        ) from None
     if not single:
         return Stage(Gq, vrep, None)
     try:
