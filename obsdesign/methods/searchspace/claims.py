@@ -146,50 +146,45 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
             ok = bool(k_int and ((K + 1) * dT * L_f >= hi or K == 1 and dT * L_f >= hi))
         else:
             hi, ok = None, bool(K == 1)
-        c.exact(
-            id="K-rule",
-            statement=(
-                f"K = {fmt_exact(K)} is the largest integer with K ΔT < log(κ/L_h^E)/L_f^E "
-                "(at least 1, the paper's max{·, 1})"
-            ),
-            reference=f"Theorem 1, hypothesis 1, {PAPER}",
-            check="(K+1)·ΔT·L_f ≥ upper bound of log(κ/L_h) (outward rounding, 113 bits)",
-            passed=ok,
+        _verdict(
+            c,
+            "K-rule",
+            f"K = {fmt_exact(K)} is the largest integer with K ΔT < log(κ/L_h^E)/L_f^E "
+            "(at least 1, the paper's max{·, 1})",
+            "Theorem 1, hypothesis 1",
+            "(K+1)·ΔT·L_f ≥ upper bound of log(κ/L_h) (outward rounding, 113 bits)",
+            ok,
+            "a larger K also keeps Lemma 2's horizon",
             margin=0 if hi is None else (K + 1) * dT * L_f - hi,
-            detail="" if ok else "a larger K also keeps Lemma 2's horizon",
-            float_ok=ok,
         )
     if ratio > 1:
         lo = ivq.log_lower(ratio)
         ok2 = bool(L_f * dtau < lo)
         stmt_bound = f" (log(κ/L_h^E)/L_f^E ≥ {fmt_down(lo / L_f, 8)})"
+        excess = fmt_down(L_f * dtau - ivq.log_upper(ratio))
     else:
-        lo, ok2, stmt_bound = fmpq(0), False, ""
-    c.exact(
-        id="lemma2-consistency",
-        statement=f"Δτ = {fmt_exact(dtau)} < log(κ/L_h^E)/L_f^E{stmt_bound}",
-        reference=f"Lemma 2 (consistency) with γ_i/ε_i = κ, Theorem 1, {PAPER}",
-        check="L_f·Δτ < lower bound of log(κ/L_h) (outward rounding, 113 bits)",
-        passed=ok2,
+        lo, ok2, stmt_bound, excess = fmpq(0), False, "", "κ ≤ L_h"
+    _verdict(
+        c,
+        "lemma2-consistency",
+        f"Δτ = {fmt_exact(dtau)} < log(κ/L_h^E)/L_f^E{stmt_bound}",
+        "Lemma 2 (consistency) with γ_i/ε_i = κ, Theorem 1",
+        "L_f·Δτ < lower bound of log(κ/L_h) (outward rounding, 113 bits)",
+        ok2,
+        f"L_f Δτ exceeds log(κ/L_h) by at least {excess}"
+        + (" (K = 1 already too long: decrease α or γ⋆)" if K == 1 else ""),
         margin=lo - L_f * dtau,
-        detail=""
-        if ok2
-        else (
-            f"L_f Δτ exceeds log(κ/L_h) by at least {fmt_down(L_f * dtau - ivq.log_upper(ratio)) if ratio > 1 else 'κ ≤ L_h'}"
-            + (" (K = 1 already too long: decrease α or γ⋆)" if K == 1 else "")
-        ),
-        float_ok=ok2,
     )
     _schedule(c, gam, g_star, L_f, dtau)
-    ok_eps = len(eps) == len(gam) and all(e == g / kappa for e, g in zip(eps, gam, strict=False))
-    c.exact(
-        id="eps-schedule",
-        statement=f"ε_i = γ_i/κ for each of the {len(gam)} entries of the schedule",
-        reference=f"Theorem 1, hypothesis 3, {PAPER}",
-        check="exact rational equality, entry by entry",
-        passed=ok_eps,
-        detail="" if ok_eps else _first_bad_eps(eps, gam, kappa),
-        float_ok=ok_eps,
+    bad_eps = _first_bad_eps(eps, gam, kappa)
+    _verdict(
+        c,
+        "eps-schedule",
+        f"ε_i = γ_i/κ for each of the {len(gam)} entries of the schedule",
+        "Theorem 1, hypothesis 3",
+        "exact rational equality, entry by entry",
+        not bad_eps,
+        bad_eps,
     )
     es = v["eps_star"]
     c.exact(
@@ -203,6 +198,31 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         float_ok=float(es) == float(g_star) / float(kappa),
     )
     return c
+
+
+def _verdict(
+    c: Claims,
+    cid: str,
+    statement: str,
+    where: str,
+    check: str,
+    ok: bool,
+    why: str,
+    margin: Any = 0,
+) -> None:
+    """An exact claim on exact data (Lemmas 1-2, Theorem 1 of Hernández & García) whose float
+    check is the same verdict: ``why`` is its detail when it fails, ``where`` the place in
+    the paper."""
+    c.exact(
+        id=cid,
+        statement=statement,
+        reference=f"{where}, {PAPER}",
+        check=check,
+        passed=ok,
+        margin=margin,
+        detail="" if ok else why,
+        float_ok=ok,
+    )
 
 
 def _by(what: str, x: fmpq, lo: fmpq, hi: fmpq) -> str:
@@ -239,18 +259,16 @@ def _schedule(c: Claims, gam: list[fmpq], g_star: fmpq, L_f: fmpq, dtau: fmpq) -
         bad = f"the schedule ends at {fmt_exact(gam[-1])}, not at γ⋆ = {fmt_exact(g_star)}"
     if not bad and e_hi > 2:
         bad = "e^(L_f Δτ)/2 > 1: γ⋆ is not a fixed point of the rule (Δτ too long)"
-    c.exact(
-        id="gamma-schedule",
-        statement=(
-            f"each of the {len(gam)} entries follows γ_(i+1) = max(γ_i e^(L_f Δτ)/2, γ⋆) "
-            "(rounded up by at most 1e-12 relative), the last is γ⋆ and stays γ⋆ "
-            "(e^(L_f Δτ)/2 ≤ 1)"
-        ),
-        reference=f"Theorem 1, hypothesis 2, {PAPER}",
-        check="every entry against outward-rounded bounds of e^(L_f Δτ) (113 bits)",
-        passed=not bad,
-        detail=bad,
-        float_ok=not bad,
+    _verdict(
+        c,
+        "gamma-schedule",
+        f"each of the {len(gam)} entries follows γ_(i+1) = max(γ_i e^(L_f Δτ)/2, γ⋆) "
+        "(rounded up by at most 1e-12 relative), the last is γ⋆ and stays γ⋆ "
+        "(e^(L_f Δτ)/2 ≤ 1)",
+        "Theorem 1, hypothesis 2",
+        "every entry against outward-rounded bounds of e^(L_f Δτ) (113 bits)",
+        not bad,
+        bad,
     )
 
 
@@ -271,14 +289,14 @@ def _input_range(c: Claims, spec: Spec) -> None:
     ok, excess, used = bounds.range_inside(
         s.u_signal, "t", o.t0, t1, list(o.U.lower_q), list(o.U.upper_q), budget=4096
     )
-    c.exact(
-        id="input-range",
-        statement=stmt + f" for every t ∈ [{fmt_exact(o.t0)}, {fmt_exact(t1)}]",
-        reference=f"Remark 2.5 (the fixed input u), {PAPER}",
-        check=f"interval enclosures of u on {used} sub-intervals of the horizon (outward rounding)",
-        passed=ok,
-        detail="" if ok else f"an enclosure leaves U by up to {excess:.3g} (not proved)",
-        float_ok=ok,
+    _verdict(
+        c,
+        "input-range",
+        stmt + f" for every t ∈ [{fmt_exact(o.t0)}, {fmt_exact(t1)}]",
+        "Remark 2.5 (the fixed input u)",
+        f"interval enclosures of u on {used} sub-intervals of the horizon (outward rounding)",
+        ok,
+        f"an enclosure leaves U by up to {excess:.3g} (not proved)",
     )
 
 
@@ -293,14 +311,14 @@ def _d_in_e(c: Claims, o: Options) -> None:
             o.D.lower_q, o.D.upper_q, o.E.lower_q, o.E.upper_q, strict=True
         )
     )
-    c.exact(
-        id="D-in-E",
-        statement=f"D = {_box(o.D.lower_q, o.D.upper_q)} ⊆ E = {_box(o.E.lower_q, o.E.upper_q)}",
-        reference=f"Lemma 1 (D ⊂ E), {PAPER}",
-        check="exact comparison of the box bounds",
-        passed=ok,
-        detail="" if ok else f"D ({o.D_where}) is not inside E ({o.E_where})",
-        float_ok=ok,
+    _verdict(
+        c,
+        "D-in-E",
+        f"D = {_box(o.D.lower_q, o.D.upper_q)} ⊆ E = {_box(o.E.lower_q, o.E.upper_q)}",
+        "Lemma 1 (D ⊂ E)",
+        "exact comparison of the box bounds",
+        ok,
+        f"D ({o.D_where}) is not inside E ({o.E_where})",
     )
 
 
