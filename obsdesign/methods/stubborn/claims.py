@@ -142,6 +142,27 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     return lmi_claims(spec, params)
 
 
+def identity_claim(
+    c: Claims, cid: str, statement: str, reference: str, check: str, holds: bool, detail: str
+) -> None:
+    """An exact matrix identity of the slides (K = P⁻¹X of the Theorem; the Lyapunov equation
+    of the high-gain redesign), compared entry by entry over Q: its float check is the same
+    verdict.
+
+    :param c: the claims to add to; :param cid: the claim id; :param statement: what holds;
+    :param reference: where in the slides; :param check: how it was compared;
+    :param holds: whether it holds; :param detail: what to say either way."""
+    c.exact(
+        id=cid,
+        statement=statement,
+        reference=reference,
+        check=check,
+        passed=holds,
+        detail=detail,
+        float_ok=holds,
+    )
+
+
 def lmi_claims(
     spec: Spec, params: dict[str, Any] | Parameters, full_check: bool = True
 ) -> list[Claim]:
@@ -180,14 +201,14 @@ def lmi_claims(
     P, K = pt["P"], pt["K"]
     X = P @ K
     eq = all(X[i, j] == Xr[i, j] for i in range(n) for j in range(p))
-    c.exact(
-        id="gain-relation",
-        statement="K = P⁻¹X: the reported X equals P K exactly",
-        reference=f"{PAPER}, Theorem (K = P⁻¹X)",
-        check="exact matrix product",
-        passed=eq,
-        detail="X = P K" if eq else "the reported X differs from P K",
-        float_ok=eq,
+    identity_claim(
+        c,
+        "gain-relation",
+        "K = P⁻¹X: the reported X equals P K exactly",
+        f"{PAPER}, Theorem (K = P⁻¹X)",
+        "exact matrix product",
+        eq,
+        "X = P K" if eq else "the reported X differs from P K",
     )
     res = point_checks(spec, P, K, pt["U"], pt["W"], pt["Y"], pt["R"], lam)
     eqs = ("(7)", "(8)", "(9)") if disc else ("(1)", "(2)", "(3)")

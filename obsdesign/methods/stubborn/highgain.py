@@ -27,6 +27,7 @@ from obsdesign.certify.exact import Q, qeye, qmat, qzeros, to_float
 from obsdesign.certify.printing import fmt_exact, fmt_up
 from obsdesign.certify.psd import check_pd, check_psd
 from obsdesign.methods.base import SolverResult, SolverStatus
+from obsdesign.methods.stubborn.claims import identity_claim
 from obsdesign.methods.stubborn.options import ELL_FACTOR, Options, SimOptions
 from obsdesign.params import Parameters
 from obsdesign.simulate.result import SimResult
@@ -138,14 +139,14 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     Ac = A - K @ C
     E = P @ Ac + Ac.T @ P + qeye(n)
     ok = all(x == 0 for x in E.flat)
-    c.exact(
-        id="lyapunov-equation",
-        statement="P(A − KC) + (A − KC)ᵀP = −I with K = (k_1..k_n) of [method].K",
-        reference=f"{PAPER}, scaled error dynamics",
-        check="exact matrix equation",
-        passed=ok,
-        detail="holds exactly" if ok else "residual ≠ 0",
-        float_ok=ok,
+    identity_claim(
+        c,
+        "lyapunov-equation",
+        "P(A − KC) + (A − KC)ᵀP = −I with K = (k_1..k_n) of [method].K",
+        f"{PAPER}, scaled error dynamics",
+        "exact matrix equation",
+        ok,
+        "holds exactly" if ok else "residual ≠ 0",
     )
     c.checked(
         id="P-positive",
@@ -156,20 +157,31 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     )
     L = o.lipschitz
     ell, ell_star = Q(vals["ell"]), Q(vals["ell_star"])
-    c.checked(
-        id="ell-star-bound",
-        statement=f"ℓ* = 2L|P| ≤ {fmt_up(ell_star, 8)} (L = {fmt_exact(L)} from [method].lipschitz)",
-        reference=f"{PAPER}, convergence for ℓ > ℓ* = 2L|P|",
-        check="exact LDLᵀ of ℓ*·I − 2L·P (⪰ 0)",
-        result=check_psd(qeye(n) * ell_star - P * (2 * L)),
+    # both bounds are the sign of v·I − 2L·P: ℓ* bounds 2L|P| (⪰ 0), ℓ exceeds it (≻ 0)
+    bounds = (
+        (
+            "ell-star-bound",
+            f"ℓ* = 2L|P| ≤ {fmt_up(ell_star, 8)} (L = {fmt_exact(L)} from [method].lipschitz)",
+            "exact LDLᵀ of ℓ*·I − 2L·P (⪰ 0)",
+            ell_star,
+            check_psd,
+        ),
+        (
+            "ell-bound",
+            f"ℓ = {fmt_exact(ell)} > 2L|P| (the high-gain observer converges)",
+            "exact LDLᵀ of ℓ·I − 2L·P (≻ 0; |P| = λ_max(P) for P ≻ 0)",
+            ell,
+            check_pd,
+        ),
     )
-    c.checked(
-        id="ell-bound",
-        statement=f"ℓ = {fmt_exact(ell)} > 2L|P| (the high-gain observer converges)",
-        reference=f"{PAPER}, convergence for ℓ > ℓ* = 2L|P|",
-        check="exact LDLᵀ of ℓ·I − 2L·P (≻ 0; |P| = λ_max(P) for P ≻ 0)",
-        result=check_pd(qeye(n) * ell - P * (2 * L)),
-    )
+    for cid, statement, check, v, sign in bounds:
+        c.checked(
+            id=cid,
+            statement=statement,
+            reference=f"{PAPER}, convergence for ℓ > ℓ* = 2L|P|",
+            check=check,
+            result=sign(qeye(n) * v - P * (2 * L)),
+        )
     return c
 
 
