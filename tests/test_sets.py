@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from flint import fmpq
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -43,3 +44,15 @@ def test_sampling_stays_inside(seed: int):
     assert np.all(E.contains(pts))
     lo, hi = E.bounding_box()
     np.testing.assert_allclose(lo, [0.5, -1]) and np.testing.assert_allclose(hi, [1.5, 1])
+
+
+def test_float_views_are_rounded_cached_and_read_only():
+    b = Box(qvec([fmpq(-1, 3), 0]), qvec([fmpq(1, 3), 2]))
+    assert b.lower.tolist() == [-1 / 3, 0.0] and b.upper.tolist() == [1 / 3, 2.0]
+    assert b.lower is b.lower  # computed once: the sets are frozen
+    with pytest.raises(ValueError, match="read-only"):
+        b.lower[0] = 5.0  # an in-place change would corrupt the set for every later caller
+    P = Polytope(qmat([[1, 1], [-1, 0], [0, -1]]), np.array([[fmpq(1)], [0], [0]], dtype=object))
+    assert P.g.shape == (3,) and P.G.shape == (3, 2)  # g is flat even from a column
+    E = Ellipsoid(qmat([[4, 0], [0, 1]]), qvec([fmpq(1, 10), 0]))
+    assert E.center.tolist() == [0.1, 0.0] and not E.E.flags.writeable

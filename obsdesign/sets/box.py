@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from obsdesign.certify.exact import qzeros
-from obsdesign.sets.base import ConvexSet
+from obsdesign.sets.base import ConvexSet, float_view
 
 
 @dataclass(frozen=True, eq=False)
@@ -25,13 +25,8 @@ class Box(ConvexSet):
     def dim(self) -> int:
         return len(self.lower_q)
 
-    @property
-    def lower(self) -> np.ndarray:
-        return np.array([float(v) for v in self.lower_q])
-
-    @property
-    def upper(self) -> np.ndarray:
-        return np.array([float(v) for v in self.upper_q])
+    lower = float_view("lower_q")
+    upper = float_view("upper_q")
 
     def describe(self) -> str:
         """The exact bounds, e.g. ``[-1, 1] × [0, 1/2]``."""

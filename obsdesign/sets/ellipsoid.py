@@ -6,8 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from obsdesign.certify.exact import to_float
-from obsdesign.sets.base import ConvexSet
+from obsdesign.sets.base import ConvexSet, float_view
 
 
 @dataclass(frozen=True, eq=False)
@@ -17,18 +16,12 @@ class Ellipsoid(ConvexSet):
     E_q: np.ndarray
     center_q: np.ndarray
     kind = "ellipsoid"
+    E = float_view("E_q")
+    center = float_view("center_q")
 
     @property
     def dim(self) -> int:
         return self.E_q.shape[0]
-
-    @property
-    def E(self) -> np.ndarray:
-        return np.asarray(to_float(self.E_q), dtype=float)
-
-    @property
-    def center(self) -> np.ndarray:
-        return np.asarray(to_float(self.center_q), dtype=float)
 
     def contains(self, x: np.ndarray, tol: float = 1e-12) -> np.ndarray | bool:
         d = np.asarray(x, dtype=float) - self.center

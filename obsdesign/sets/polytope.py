@@ -17,7 +17,7 @@ from flint import fmpq
 
 from obsdesign.certify.exact import Q, to_float
 from obsdesign.sets import polytope_ops as po
-from obsdesign.sets.base import ConvexSet
+from obsdesign.sets.base import ConvexSet, float_view
 
 
 def _frac(q: fmpq) -> Fraction:
@@ -100,18 +100,12 @@ class Polytope(ConvexSet):
     G_q: np.ndarray
     g_q: np.ndarray
     kind = "polytope"
+    G = float_view("G_q")
+    g = float_view("g_q", flat=True)
 
     @property
     def dim(self) -> int:
         return self.G_q.shape[1]
-
-    @property
-    def G(self) -> np.ndarray:
-        return np.asarray(to_float(self.G_q), dtype=float)
-
-    @property
-    def g(self) -> np.ndarray:
-        return np.asarray(to_float(self.g_q), dtype=float).reshape(-1)
 
     def h_form_q(self) -> tuple[np.ndarray, np.ndarray]:
         return self.G_q, self.g_q
