@@ -214,9 +214,9 @@ def observable_mod_p(A: Any, C: Any) -> bool:
         return False
     Az, _ = Af.numer_denom()
     Cz, _ = Cf.numer_denom()
-    Am = nmod_mat(n, n, [int(v) % PRIME for v in Az.entries()], PRIME)
+    Am = nmod_mat(Az, PRIME)  # reduced modulo the prime in flint
     p = Cf.nrows()
-    Cm = nmod_mat(p, n, [int(v) % PRIME for v in Cz.entries()], PRIME)
+    Cm = nmod_mat(Cz, PRIME)
     # first one fixed combination c = Σ (i+1)·C_z[i] of the outputs: its Krylov rows
     # c, cA, …, cA^{n−1} lie in the row space, so rank n of that n×n matrix is enough
     # (generic A); else all p·n rows
@@ -725,6 +725,7 @@ def best_rate(
     progress: Callable[[str], None] | None = None,
     forecast: bool = True,
     memo: ExactMemo | None = None,
+    Acl: fmpq_mat | None = None,
 ) -> RateBracket:
     """Bisection for the best certified rate of V = eᵀPe: the smallest λ (discrete) or the
     largest α (continuous) at which :func:`certified_P` succeeds, bracketed.
@@ -752,10 +753,11 @@ def best_rate(
     width; :param margin: δ of the checks; :param known: a certified (rate, P);
     :param progress: callback for messages; :param forecast: let the float forecast stand in
     for exact checks (False: an exact check at every midpoint; the rerun uses it);
-    :param memo: records the exact verdicts (for ``certify`` in the same process).
+    :param memo: records the exact verdicts (for ``certify`` in the same process);
+    :param Acl: A − LC as an ``fmpq_mat``, when already made.
     Raises :class:`InfeasibleError` when Acl is not Schur / Hurwitz (exact) and
     :class:`InconclusiveError` when it is but nothing certifies."""
-    Acl = closed_loop_fmat(A, C, L)
+    Acl = closed_loop_fmat(A, C, L) if Acl is None else Acl
     tol_q = Q(tol)
     grid = _grid(tol_q)
     Af = mat_float(Acl)  # correctly rounded, as np.asarray(closed_loop(A, C, L), dtype=float)
@@ -847,5 +849,6 @@ def best_rate(
                 progress=progress,
                 forecast=False,
                 memo=memo,
+                Acl=Acl,
             )
     return RateBracket(rate(hi), P, rate(lo), lo_kind, tol_q, checks)

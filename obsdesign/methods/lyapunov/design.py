@@ -110,6 +110,7 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
         known=known,
         progress=progress,
         memo=memo,
+        Acl=Acl,
     )
     rate, P = (br.best, br.P) if known is None else known
     solver.extra["best_rate_exact_checks"] = br.exact_checks
