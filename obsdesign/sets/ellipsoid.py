@@ -11,7 +11,8 @@ from obsdesign.sets.base import ConvexSet, float_view
 
 @dataclass(frozen=True, eq=False)
 class Ellipsoid(ConvexSet):
-    """Ellipsoid with exact shape ``E_q`` and centre ``center_q``."""
+    """Ellipsoid with exact shape ``E_q`` (symmetric positive definite) and centre
+    ``center_q``, object arrays of fmpq; ``E`` and ``center`` are their float views."""
 
     E_q: np.ndarray
     center_q: np.ndarray

@@ -95,7 +95,8 @@ def check_polytope_q(G_q: np.ndarray, g_q: np.ndarray) -> tuple[bool, bool, bool
 
 @dataclass(frozen=True, eq=False)
 class Polytope(ConvexSet):
-    """{x : G x <= g} with exact data ``G_q``, ``g_q``."""
+    """{x : G x <= g} with exact data ``G_q`` (m × n) and ``g_q`` (m), object arrays of fmpq;
+    ``G`` and ``g`` (always 1-D) are their float views."""
 
     G_q: np.ndarray
     g_q: np.ndarray
