@@ -254,3 +254,14 @@ def test_ssd_matrix_known_answer() -> None:
     q2 = QSR(q.Q, q.S, qmat([[3, 0], [0, 3]]), "test").scaled(2)
     N2 = ssd_matrix(A, q2, 0)
     assert N2[0, 0] == 2 + 6 and N2[0, 2] == 1 and N2[0, 3] == 0 and N2[2, 1] == 2 and N2[1, 2] == 2
+
+
+def test_qsr_blocks_must_be_square_of_one_size() -> None:
+    """(Q, S, R) of eq. (15) are k×k blocks: a mismatched S is refused, naming the source."""
+    from obsdesign.methods.impulsive.dissipativity import QSR
+
+    with pytest.raises(ValueError, match="mine"):
+        QSR(qmat([[-1]]), qmat([[0, 0]]), qmat([[1]]), "mine")
+    with pytest.raises(ValueError):
+        QSR(qmat([[-1, 0], [0, -1]]), qmat([[0, 0], [0, 0]]), qmat([[1]]), "mine")
+    assert QSR(qmat([[-1]]), qmat([[0]]), qmat([[1]]), "ok").k == 1

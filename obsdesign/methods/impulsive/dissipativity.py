@@ -40,15 +40,23 @@ class QSR:
     R: np.ndarray
     how: str
 
+    def __post_init__(self) -> None:
+        k = np.shape(self.Q)[0] if np.ndim(self.Q) else 0
+        if any(np.shape(x) != (k, k) for x in (self.Q, self.S, self.R)):
+            raise ValueError(f"QSR ({self.how}): Q, S and R must be k×k blocks of one size")
+
     @property
     def k(self) -> int:
+        """The block size k (the dimension of ε and φ in eq. (15))."""
         return self.Q.shape[0]
 
     def scaled(self, theta: Any) -> QSR:
+        """θ·(Q, S, R): the same supply rate scaled by θ > 0 (valid for any θ > 0, see above)."""
         t = Q(theta)
         return QSR(self.Q * t, self.S * t, self.R * t, self.how)
 
     def floats(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Q, S, R in float64 (k×k each), for the solver."""
         return tuple(
             np.asarray(to_float(x), dtype=float).reshape(self.k, self.k)
             for x in (self.Q, self.S, self.R)
