@@ -28,7 +28,7 @@ from flint import fmpq, fmpq_mat, fmpq_poly
 
 from obsdesign.certify.detect import hurwitz_stable, schur_stable
 from obsdesign.certify.exact import Q, dyadic, qeye, symmetrize
-from obsdesign.certify.psd import check_pd_fast, check_psd, to_fmpq_mat
+from obsdesign.certify.psd import check_pd_fast, check_psd, negative_direction, to_fmpq_mat
 from obsdesign.errors import InconclusiveError, InfeasibleError
 
 #: reference printed in claims that check these formulas
@@ -472,11 +472,14 @@ def _rate_feasibility(Am: fmpq_mat, r: fmpq, discrete: bool) -> tuple[bool, str]
     n = Am.nrows()
     X = _lyap_solution(mat_float(Am), float(r), discrete)
     if X is not None and np.any(X != 0):
-        Xq = fmat(symmetrize(dyadic_fast(X, INERTIA_BITS)))
+        Xq = _sym(fmat(dyadic_fast(X, INERTIA_BITS)))  # = symmetrize(dyadic(X)), in flint
         if check_pd_fast(decay_fmat(Am, Xq, r, discrete)):
-            pd = check_pd_fast(Xq)
-            return pd.ok, "exact Lyapunov inertia certificate (D(X) ≻ 0, X " + (
-                "≻ 0)" if pd.ok else "⊁ 0)"
+            # X ⊁ 0 shown by a rational direction first (the float X guides, exact product
+            # decides), else the full exact test
+            neg = negative_direction(Xq, X) if np.linalg.eigvalsh(X)[0] < 0 else None
+            ok = False if neg is not None else check_pd_fast(Xq).ok
+            return ok, "exact Lyapunov inertia certificate (D(X) ≻ 0, X " + (
+                "≻ 0)" if ok else "⊁ 0)"
             )
     Acl = as_array(Am)
     if discrete:

@@ -236,6 +236,37 @@ def _dyadic_int(x: np.ndarray, bits: int = 52) -> tuple[list[int], int]:
     return [int(v) for v in z.flat], k
 
 
+def negative_direction(F: Any, Mf: np.ndarray, mu: float | None = None) -> PSDResult | None:
+    """A proof that F is not positive definite — a rational v ≠ 0 (the float eigenvector of
+    the smallest eigenvalue of ``Mf``, rounded to a dyadic vector) with vᵀFv ≤ 0, computed
+    exactly — or None when that v does not show it. ``Mf`` is only a guide (any float
+    approximation of F); the exact product decides.
+
+    :param F: symmetric ``fmpq_mat``; :param Mf: float approximation of F; :param mu: its
+    smallest float eigenvalue, when known (for the report)."""
+    from flint import fmpq, fmpq_mat
+
+    n = F.nrows()
+    w, V = np.linalg.eigh(Mf)
+    v = V[:, 0]
+    if not np.all(np.isfinite(v)):
+        return None
+    z, k = _dyadic_int(v)
+    if not any(z):  # v = 0 proves nothing
+        return None
+    vq = fmpq_mat(n, 1, [fmpq(t) for t in z])
+    val = (vq.transpose() * F * vq)[0, 0]
+    if val > 0:
+        return None
+    return PSDResult(
+        False,
+        float(w[0]) if mu is None else mu,
+        f"vᵀMv = {float(val / fmpq(2) ** (2 * k)):.6g} <= 0 for a rational v "
+        "(float eigenvector, checked exactly)",
+        "eigenvector",
+    )
+
+
 def _gershgorin_certificate(F: Any, Mf: np.ndarray) -> PSDResult | None:
     """A proof of F ≻ 0 from a float Cholesky factor, or of F ⊁ 0 from a float eigenvector,
     each checked exactly; None when neither proof goes through (near-singular F).
@@ -244,28 +275,12 @@ def _gershgorin_certificate(F: Any, Mf: np.ndarray) -> PSDResult | None:
     a dyadic grid; S = F − RᵀR is computed exactly; S symmetric with S_ii > Σ_{j≠i}|S_ij|
     (Gershgorin, checked over Q) gives S ≻ 0, hence F = RᵀR + S ≻ 0 (RᵀR ⪰ 0).
     Not PD: v the float eigenvector of μ < 0, rounded to a dyadic vector; vᵀFv ≤ 0 exactly."""
-    from flint import fmpq, fmpq_mat, fmpz, fmpz_mat
+    from flint import fmpz, fmpz_mat
 
     n = F.nrows()
     mu = float(np.linalg.eigvalsh(Mf)[0])
     if mu <= 0 or not np.isfinite(mu):
-        v = np.linalg.eigh(Mf)[1][:, 0]
-        if not np.all(np.isfinite(v)):
-            return None
-        z, k = _dyadic_int(v)
-        if not any(z):  # v = 0 proves nothing
-            return None
-        vq = fmpq_mat(n, 1, [fmpq(t) for t in z])
-        val = (vq.transpose() * F * vq)[0, 0]
-        if val <= 0:
-            return PSDResult(
-                False,
-                mu,
-                f"vᵀMv = {float(val / fmpq(2) ** (2 * k)):.6g} <= 0 for a rational v "
-                "(float eigenvector, checked exactly)",
-                "eigenvector",
-            )
-        return None
+        return negative_direction(F, Mf, mu)
     try:
         R = np.linalg.cholesky(Mf - (mu / 2) * np.eye(n)).T  # upper triangular, F ≈ RᵀR
     except np.linalg.LinAlgError:
