@@ -1,0 +1,575 @@
+"""The bodies of the ``obsdesign`` commands, and their printing.
+
+Imported when a command runs (:func:`obsdesign.cli._run`), so that ``obsdesign --help``
+reads (and, without cached bytecode, compiles) only the declarations in
+:mod:`obsdesign.cli`. Each body returns the command's exit code; errors are raised as
+:class:`obsdesign.errors.ObsdesignError` and mapped to exit codes by the caller.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from obsdesign.cli import PLOT_SUFFIXES, STDIN, STDIN_NAME, Fmt, _state
+
+
+def _is_stdin(path: Path | None) -> bool:
+    return path is not None and str(path) == STDIN
+
+
+def _inputs(*paths: Path | None) -> tuple[Path, ...]:
+    """The input files among ``paths`` (stdin and None left out), for the output checks."""
+    return tuple(p for p in paths if p is not None and not _is_stdin(p))
+
+
+def _read_stdin(what: str) -> str:
+    """Standard input as text, within ``max_file_bytes`` (``-`` in place of a path)."""
+    from obsdesign.errors import InputError
+    from obsdesign.limits import limits
+
+    lim = limits().max_file_bytes
+    data = sys.stdin.buffer.read(lim + 1)
+    if len(data) > lim:
+        raise InputError(
+            f"{STDIN_NAME}: {what} is above the limit of {lim} bytes (--limit max_file_bytes=N)"
+        )
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise InputError(f"{STDIN_NAME}: {what} is not UTF-8 text") from None
+
+
+def _precheck(spec: Path) -> None:
+    """The cheap checks of a spec file before the heavy imports (none for stdin)."""
+    if not _is_stdin(spec):
+        from obsdesign.limits import precheck_spec
+
+        precheck_spec(spec)
+
+
+def _load_spec(spec: Path) -> Any:
+    """The bound spec at ``spec``, or read from stdin for ``-`` (file name ``<stdin>``)."""
+    from obsdesign import api
+
+    if not _is_stdin(spec):
+        return api.load_spec(spec)
+    from obsdesign.errors import InputError
+    from obsdesign.limits import limits
+
+    text = _read_stdin("spec")
+    if text.count(",") >= limits().max_values:
+        raise InputError(
+            f"{STDIN_NAME}: holds about {text.count(',') + 1} values, above the limit of "
+            f"{limits().max_values} (--limit max_values=N)"
+        )
+    return api.load_spec_text(text, STDIN_NAME)
+
+
+def _say(text: str) -> None:
+    """An informational line on stdout (text format), unless --quiet."""
+    if not _state["quiet"]:
+        print(text)
+
+
+def _check_plot(path: Path | None, force: bool, inputs: tuple[Path, ...] = ()) -> None:
+    """Refuse a plot path before any work: an unknown format or a path that
+    :func:`obsdesign.report.model.check_output` refuses (exit 2)."""
+    if path is None:
+        return
+    from obsdesign.errors import InputError
+    from obsdesign.report.model import check_output
+
+    if path.suffix.lower() not in PLOT_SUFFIXES:
+        raise InputError(
+            f"{path}: unknown plot format {path.suffix or '(no suffix)'!r} "
+            f"(expected one of {', '.join(PLOT_SUFFIXES)})"
+        )
+    check_output(path, force, inputs)
+
+
+def _write_plot(path: Path, draw: Callable[[Path], Any], force: bool) -> None:
+    from obsdesign.report.model import write_via
+
+    write_via(path, draw, force)
+
+
+def _check_distributed(
+    paths: list[Path], workers: int | None, scheduler: str | None, quiet: bool
+) -> list[Any]:
+    """``check`` on Dask, with a progress bar on stderr (unless --quiet)."""
+    from obsdesign import api
+    from obsdesign.distributed import check_workers, progress_bar
+
+    check_workers(workers, scheduler)
+    n = len(api.spec_files(list(paths)))
+    with progress_bar(n, "check", quiet) as advance:
+        return api.check(
+            list(paths), workers=workers, scheduler=scheduler, on_row=lambda r: advance(r.code != 0)
+        )
+
+
+def _print_sweep(rows: list[dict[str, Any]], fmt: Fmt) -> None:
+    from obsdesign.sweep import TIMING_COLUMNS, columns
+
+    cols = [c for c in columns(rows) if c not in ("method", *TIMING_COLUMNS)]
+    if fmt == Fmt.md:
+        print("| " + " | ".join(cols) + " |")
+        print("|" + " --- |" * len(cols))
+        for r in rows:
+            print("| " + " | ".join(_md_cell(r.get(c, "")) for c in cols) + " |")
+        return
+    from rich.table import Table
+
+    from obsdesign.report.render import console, esc
+
+    t = Table(title="obsdesign sweep")
+    for c in cols:
+        t.add_column(esc(c), overflow="fold")
+    for r in rows:
+        t.add_row(*(esc(_sweep_cell(r.get(c))) for c in cols))
+    console().print(t)
+
+
+def _sweep_cell(v: Any) -> str:
+    if v is None:
+        return ""
+    if isinstance(v, float):
+        return format(v, ".6g")
+    return str(v)
+
+
+def _kv(items: list[str]) -> dict[str, str]:
+    from obsdesign.errors import InputError
+
+    out = {}
+    for it in items:
+        if "=" not in it:
+            raise InputError(f"--option expects KEY=VALUE, got {it!r}")
+        k, v = it.split("=", 1)
+        out[k.strip()] = v.strip()
+    return out
+
+
+def _dumps(obj: Any, **kw: Any) -> str:
+    """``json.dumps`` (json loads only on the paths that print JSON)."""
+    import json
+
+    return json.dumps(obj, **kw)
+
+
+def _jsonable(o: Any) -> Any:
+    try:
+        import numpy as np
+
+        if isinstance(o, np.ndarray):
+            return o.tolist()
+        if isinstance(o, (np.floating, np.integer)):
+            return o.item()
+    except ImportError:  # pragma: no cover
+        pass
+    return str(o)
+
+
+def _progress() -> Callable[[str], None]:
+    def show(msg: str) -> None:
+        if sys.stderr.isatty():
+            sys.stderr.write(f"\r\033[K{msg}")
+            sys.stderr.flush()
+
+    return show
+
+
+def _print_report(rep: Any, fmt: Fmt) -> None:
+    from obsdesign.report.render import render_markdown, render_text
+
+    if sys.stderr.isatty() and fmt == Fmt.text:
+        sys.stderr.write("\r\033[K")
+    if fmt == Fmt.json:
+        print(rep.to_json())
+    elif fmt == Fmt.md:
+        sys.stdout.write(render_markdown(rep))
+    else:
+        render_text(rep)
+
+
+def _print_rows(rows: list[Any], fmt: Fmt) -> None:
+    if fmt == Fmt.md:
+        print("| spec | method | exit | certified | numerical | failed | result | seconds |")
+        print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+        for r in rows:
+            cells = [r.spec, r.method, r.code, r.certified, r.numerical, r.failed]
+            cells += [r.summary or r.message, f"{r.seconds:.2f}"]
+            print("| " + " | ".join(_md_cell(c) for c in cells) + " |")
+        return
+    from rich.table import Table
+
+    from obsdesign.report.render import console, esc
+
+    t = Table(title="obsdesign check", caption="claims: certified/numerical/failed")
+    # method, verdict and the claim counts never wrap; the spec path folds (no spaces in
+    # it) and the result wraps at spaces with twice the spec's share of the rest
+    t.add_column("spec", overflow="fold", ratio=1)
+    t.add_column("method", no_wrap=True)
+    t.add_column("verdict", no_wrap=True)
+    t.add_column("claims", no_wrap=True)
+    t.add_column("result", overflow="fold", ratio=2)
+    t.add_column("s", no_wrap=True)
+    for r in rows:
+        verdict = "[green]ok[/]" if r.code == 0 else f"[bold red]exit {r.code}[/]"
+        t.add_row(
+            esc(r.spec),
+            esc(r.method),
+            verdict,
+            f"{r.certified}/{r.numerical}/{r.failed}",
+            esc(r.summary if r.code == 0 else r.message),
+            f"{r.seconds:.2f}",
+        )
+    console().print(t)
+
+
+def _check_verdict(rows: list[Any]) -> str:
+    """The one-line verdict of ``check``."""
+    ok = sum(r.code == 0 for r in rows)
+    cert = sum(r.certified for r in rows)
+    num = sum(r.numerical for r in rows)
+    fail = sum(r.failed for r in rows)
+    claims = f"{cert} claim{'s' if cert != 1 else ''} certified"
+    if num:
+        claims += f", {num} numerical"
+    head = "checked" if ok == len(rows) else "NOT all checked"
+    return (
+        f"{head}: {len(rows)} spec{'s' if len(rows) != 1 else ''}, {ok} ok, "
+        f"{len(rows) - ok} failed; {claims}, {fail} failed"
+    )
+
+
+def _read_report(report: Path) -> Any:
+    """The report path, or for ``-`` the report read from stdin (a Report)."""
+    if not _is_stdin(report):
+        return report
+    import json
+
+    from obsdesign.errors import InputError
+    from obsdesign.limits import int_digits
+    from obsdesign.report.model import Report
+
+    text = _read_stdin("report")
+    try:
+        with int_digits():
+            d = json.loads(text)
+    except json.JSONDecodeError as e:
+        raise InputError(f"{STDIN_NAME}: not a readable JSON report ({e})") from None
+    except RecursionError:
+        raise InputError(f"{STDIN_NAME}: JSON nested too deeply") from None
+    return Report.from_dict(d, STDIN_NAME)[0]
+
+
+def _metrics_markdown(m: dict[str, Any]) -> str:
+    lines = ["| state | sup \\|e_i\\| | RMSE | sup \\|x̂_i\\| |", "| --- | --- | --- | --- |"]
+    for st, v in m["sup_abs_error"].items():
+        lines.append(
+            f"| {_md_cell(st)} | {v:.6g} | {m['rmse'][st]:.6g} | {m['sup_abs_estimate'][st]:.6g} |"
+        )
+    lines += ["", f"final \\|e\\| = {m['final_error_norm']:.6g}"]
+    for k, v in m.items():
+        if k not in ("sup_abs_error", "rmse", "final_error_norm", "sup_abs_estimate", "exit_code"):
+            lines.append(f"- {_md_cell(k)}: {_md_cell(v)}")
+    return "\n".join(lines) + "\n"
+
+
+def _md_cell(v: Any) -> str:
+    """A Markdown table cell: pipes escaped, one line."""
+    return str(v).replace("|", "\\|").replace("\n", " ")
+
+
+def _print_metrics(m: dict[str, Any]) -> None:
+    from rich.table import Table
+
+    from obsdesign.report.render import console, esc
+
+    t = Table(title="simulation metrics")
+    t.add_column("state")
+    t.add_column("sup |e_i|")
+    t.add_column("RMSE")
+    t.add_column("sup |x̂_i|")
+    for s, v in m["sup_abs_error"].items():
+        t.add_row(esc(s), f"{v:.6g}", f"{m['rmse'][s]:.6g}", f"{m['sup_abs_estimate'][s]:.6g}")
+    c = console()
+    c.print(t)
+    c.print(f"final |e| = {m['final_error_norm']:.6g}")
+    for k, v in m.items():
+        if k not in ("sup_abs_error", "rmse", "final_error_norm", "sup_abs_estimate", "exit_code"):
+            c.print(esc(f"{k}: {v}"))
+
+
+def design(
+    spec: Path, output: Path | None, fmt: Fmt, plot: Path | None, force: bool, quiet: bool
+) -> int:
+    """The body of ``obsdesign design`` (see :func:`obsdesign.cli.design`)."""
+    _precheck(spec)  # before the heavy imports: an oversized spec is refused at once
+    from obsdesign import api
+    from obsdesign.errors import InputError
+    from obsdesign.report.model import check_output
+
+    if output is not None:
+        check_output(output, force, _inputs(spec))
+    _check_plot(plot, force, _inputs(spec, output))
+    progress = _progress() if fmt == Fmt.text and not quiet else None
+    sp = _load_spec(spec)
+    if plot is not None and api.method(sp.method).plot_design is None:
+        raise InputError(f"--plot: method '{sp.method}' has no design plot")
+    rep = api.design(sp, output, progress=progress, force=force)
+    if not quiet or fmt == Fmt.json:
+        _print_report(rep, fmt)
+    if plot is not None:
+        _write_plot(plot, lambda tmp: api.plot_design(sp, rep.parameters, tmp), force)
+        if fmt == Fmt.text:
+            _say(f"plot written to {plot}")
+    if output is not None and fmt == Fmt.text:
+        _say(f"report written to {output}")
+    return rep.exit_code()
+
+
+def verify(report: Path, spec: Path | None, fmt: Fmt, quiet: bool) -> int:
+    """The body of ``obsdesign verify`` (see :func:`obsdesign.cli.verify`)."""
+    from obsdesign.limits import precheck_spec, read_input
+
+    if not _is_stdin(report):
+        read_input(report, "report")  # before the heavy imports (regular file, size)
+    if spec is not None:
+        precheck_spec(spec)
+    from obsdesign import api
+    from obsdesign.report.render import verdict_line
+
+    rep = api.verify(_read_report(report), spec)
+    if not quiet or fmt == Fmt.json:
+        _print_report(rep, fmt)
+    if fmt == Fmt.md and not quiet:
+        print(f"\n**{verdict_line(rep)}**")
+    elif fmt != Fmt.json:
+        print(verdict_line(rep))
+    return rep.exit_code()
+
+
+def check(
+    paths: list[Path],
+    fmt: Fmt,
+    junit: Path | None,
+    quiet: bool,
+    workers: int | None,
+    scheduler: str | None,
+) -> int:
+    """The body of ``obsdesign check`` (see :func:`obsdesign.cli.check`)."""
+    from obsdesign import api
+
+    if junit is not None:
+        from obsdesign.report.model import check_output
+
+        check_output(junit, False, _inputs(*paths))
+
+    def each(f: Path) -> None:
+        if fmt == Fmt.text and not quiet:
+            sys.stderr.write(f"checking {f} ...\n")
+
+    if workers is None and scheduler is None:
+        rows = api.check(list(paths), on_start=each)
+    else:
+        rows = _check_distributed(list(paths), workers, scheduler, quiet)
+    if junit is not None:
+        from obsdesign.junit import write_junit
+
+        write_junit(junit, rows)
+    if fmt == Fmt.json:
+        print(_dumps([r.__dict__ for r in rows], indent=2, default=_jsonable))
+    else:
+        if not quiet:
+            _print_rows(rows, fmt)
+        line = _check_verdict(rows)
+        print(f"\n**{line}**" if fmt == Fmt.md and not quiet else line)
+    return api.check_exit_code(rows)
+
+
+def sweep(
+    spec: Path,
+    sets: list[str],
+    simulate: bool,
+    option: list[str] | None,
+    output: Path | None,
+    plot: Path | None,
+    y: str | None,
+    x: str | None,
+    fmt: Fmt,
+    workers: int | None,
+    scheduler: str | None,
+    force: bool,
+    quiet: bool,
+) -> int:
+    """The body of ``obsdesign sweep`` (see :func:`obsdesign.cli.sweep`)."""
+    _precheck(spec)
+    import types
+
+    from obsdesign import sweep as sw
+    from obsdesign.distributed import check_workers, progress_bar
+    from obsdesign.errors import InputError
+
+    check_workers(workers, scheduler)
+    if output is not None:
+        sw.check_output_path(output, force, _inputs(spec))
+    if plot is not None and y is None:
+        raise InputError("--plot needs --y COLUMN (the plotted column)")
+    if plot is None and (y is not None or x is not None):
+        raise InputError("--y/--x choose what --plot draws: give --plot FILE")
+    _check_plot(plot, force, _inputs(spec, output))
+    src: Any = spec
+    if _is_stdin(spec):
+        src = types.SimpleNamespace(text=_read_stdin("spec"), file=STDIN_NAME)
+    axes = sw.parse_grid(sets)
+    _, tasks = sw.plan(src, sets, simulate, _kv(option or []))
+    if plot is not None:
+        cols = sw.expected_columns(tasks[0].text, axes, simulate)
+        if x is not None and x not in [a.key for a in axes]:
+            raise InputError(f"--x {x}: not a swept key")
+        if cols is not None and y not in cols:
+            raise InputError(f"--y {y}: not a column of this sweep ({', '.join(sorted(cols))})")
+    with progress_bar(len(tasks), "sweep", quiet) as advance:
+        rows = sw.sweep_rows(
+            src,
+            sets,
+            simulate=simulate,
+            options=_kv(option or []),
+            workers=workers,
+            scheduler=scheduler,
+            on_row=lambda r: advance(r["exit_code"] != 0),
+        )
+    if output is not None:
+        sw.write_table(output, rows, force)
+    if plot is not None:
+        sw.check_plot_column(rows, axes, y or "", x)
+        _write_plot(plot, lambda tmp: sw.plot_sweep(rows, axes, y or "", tmp, x), force)
+    if fmt == Fmt.json:
+        print(_dumps(rows, indent=2, ensure_ascii=False, default=_jsonable))
+        return sw.exit_code(rows)
+    if output is None and not quiet:
+        _print_sweep(rows, fmt)
+    ok = sum(r["exit_code"] == 0 for r in rows)
+    pts = f"{len(rows)} point{'' if len(rows) == 1 else 's'}"
+    line = f"swept: {pts}, {ok} ok, {len(rows) - ok} not ok"
+    if rows and ok < len(rows):
+        line += f" (worst exit {sw.exit_code(rows)})"
+    print(f"\n**{line}**" if fmt == Fmt.md and not quiet else line)
+    if output is not None and fmt == Fmt.text:
+        _say(f"table written to {output}")
+    if plot is not None and fmt == Fmt.text:
+        _say(f"plot written to {plot}")
+    return sw.exit_code(rows)
+
+
+def simulate(
+    spec: Path,
+    report: Path | None,
+    plot: Path | None,
+    fmt: Fmt,
+    option: list[str] | None,
+    force: bool,
+    runs: int | None,
+    study: str | None,
+    workers: int | None,
+    scheduler: str | None,
+    quiet: bool,
+) -> int:
+    """The body of ``obsdesign simulate`` (see :func:`obsdesign.cli.simulate`)."""
+    _precheck(spec)  # before the heavy imports
+    from obsdesign import api
+
+    if workers is not None or scheduler is not None:
+        from obsdesign.distributed import check_workers
+
+        check_workers(workers, scheduler)
+    _check_plot(plot, force, _inputs(spec, report))
+    sp = _load_spec(spec)
+    opts = _kv(option or [])
+    if runs is not None:
+        opts["runs"] = str(runs)
+    if study is not None:
+        opts["study"] = study
+    res = api.simulate(sp, report, options=opts, workers=workers, scheduler=scheduler)
+    m = res.metrics()
+    if fmt == Fmt.json:
+        print(_dumps(m, indent=2, default=_jsonable))
+    elif fmt == Fmt.md and not quiet:
+        sys.stdout.write(_metrics_markdown(m))
+    elif not quiet:
+        _print_metrics(m)
+    if plot is not None:
+        _write_plot(plot, lambda tmp: api.plot_simulation(sp, res, tmp), force)
+        if fmt == Fmt.text:
+            _say(f"plot written to {plot}")
+    return int(res.info.get("exit_code", 0))
+
+
+def schema() -> int:
+    """The body of ``obsdesign schema`` (see :func:`obsdesign.cli.schema`)."""
+    from obsdesign import api
+
+    print(_dumps(api.schema(), indent=2, ensure_ascii=False))
+    return 0
+
+
+def init(method: str) -> int:
+    """The body of ``obsdesign init`` (see :func:`obsdesign.cli.init`)."""
+    from obsdesign import api
+
+    sys.stdout.write(api.template(method))
+    return 0
+
+
+def import_mat(
+    mat: Path,
+    a: str,
+    c: str,
+    b: str | None,
+    d: str | None,
+    bd: str | None,
+    dt: float | None,
+    dt_var: str | None,
+    method: str,
+) -> int:
+    """The body of ``obsdesign import`` (see :func:`obsdesign.cli.import_mat`)."""
+    from obsdesign import api
+    from obsdesign.interop import spec_text_from_mat
+
+    api.method(method)  # an unknown key: "did you mean"
+    names = {"A": a, "C": c, "B": b, "D": d, "Bd": bd}
+    sys.stdout.write(spec_text_from_mat(mat, names, method, dt=dt, dt_name=dt_var))
+    return 0
+
+
+def methods(fmt: Fmt) -> int:
+    """The body of ``obsdesign methods`` (see :func:`obsdesign.cli.methods`)."""
+    from obsdesign import __version__, api
+
+    ms = api.methods()
+    if fmt == Fmt.json:
+        rows = [
+            {
+                "key": m.key,
+                "title": m.title,
+                "paper": m.paper,
+                "needs_linear": m.needs_linear,
+                "extra_tables": list(m.extra_tables),
+            }
+            for m in ms
+        ]
+        print(_dumps({"version": __version__, "methods": rows}, indent=2))
+    elif fmt == Fmt.md:
+        print("| key | title | paper |")
+        print("| --- | --- | --- |")
+        for m in ms:
+            print(f"| {_md_cell(m.key)} | {_md_cell(m.title)} | {_md_cell(m.paper)} |")
+    else:
+        for m in ms:
+            print(f"{m.key:15s} {m.title}  ({m.paper})")
+    return 0
