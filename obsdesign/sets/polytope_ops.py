@@ -301,15 +301,56 @@ def qfloat(a: np.ndarray) -> np.ndarray:
     return np.array([float(x) for x in arr.reshape(-1)], dtype=float).reshape(arr.shape)
 
 
+def _best(n0: int, d0: int, max_den: int) -> tuple[int, int]:
+    """``Fraction(n0, d0).limit_denominator(max_den)`` (the closest fraction with
+    denominator <= max_den; ties to the smaller denominator) in plain integers: the same
+    continued-fraction steps, without building Fraction objects (~10× faster)."""
+    if d0 <= max_den:
+        return n0, d0
+    p0, q0, p1, q1 = 0, 1, 1, 0
+    n, d = n0, d0
+    while True:
+        a = n // d
+        q2 = q0 + a * q1
+        if q2 > max_den:
+            break
+        p0, q0, p1, q1 = p1, q1, p0 + a * p1, q2
+        n, d = d, n - a * d
+    k = (max_den - q0) // q1
+    pb, qb = p0 + k * p1, q0 + k * q1
+    if abs(p1 * d0 - n0 * q1) * qb <= abs(pb * d0 - n0 * qb) * q1:
+        return p1, q1
+    return pb, qb
+
+
+def _simple(x: float, tol: float = 1e-12) -> fmpq | None:
+    """The closest rational with denominator <= 10⁶ if it is within ``tol`` (relative) of
+    ``x``, else None."""
+    n0, d0 = x.as_integer_ratio()
+    p, q = _best(n0, d0, 10**6)
+    if abs(p / q - x) <= tol * max(1.0, abs(x)):
+        return fmpq(p, q)
+    return None
+
+
 def snap(x: float, max_den: int = 10**6, tol: float = 1e-12) -> fmpq:
     """The simplest rational with denominator ``<= max_den`` within ``tol`` (relative) of
     ``x``, else ``x`` exactly. Recovers values such as 10/9 from float iterations; the exact
     check afterwards decides, so snapping can never make a false claim pass."""
-    f = Fraction(float(x))
-    s = f.limit_denominator(max_den)
-    if abs(float(s) - float(x)) <= tol * max(1.0, abs(float(x))):
-        return _q(s)
-    return _q(f)
+    x = float(x)
+    n0, d0 = x.as_integer_ratio()
+    p, q = _best(n0, d0, max_den)
+    if abs(p / q - x) <= tol * max(1.0, abs(x)):
+        return fmpq(p, q)
+    return fmpq(n0, d0)
+
+
+def _round_half_even(num: int, den: int) -> int:
+    """``round(Fraction(num, den))`` (den > 0): the nearest integer, ties to even."""
+    q, r = divmod(num, den)
+    if 2 * r > den or (2 * r == den and q % 2):
+        q += 1
+    return q
 
 
 def rationalize(M: np.ndarray, bits: int | None = 36) -> np.ndarray:
@@ -326,19 +367,19 @@ def rationalize(M: np.ndarray, bits: int | None = 36) -> np.ndarray:
     for i, row in enumerate(M2):
         s = float(np.abs(row).max()) if row.size else 0.0
         k = bits - int(np.frexp(s)[1]) if (bits is not None and s > 0) else None
-        for j, v in enumerate(row):
-            f = Fraction(float(v))
-            simple = f.limit_denominator(10**6)
-            if abs(float(simple) - float(v)) <= 1e-12 * max(1.0, abs(float(v))):
-                out[i, j] = _q(simple)
+        for j, v in enumerate(row.tolist()):
+            simple = _simple(v)
+            if simple is not None:
+                out[i, j] = simple
             elif k is not None:
-                out[i, j] = _q(
-                    Fraction(round(f * 2**k), 2**k)
+                n0, d0 = v.as_integer_ratio()
+                out[i, j] = (
+                    fmpq(_round_half_even(n0 * 2**k, d0), 2**k)
                     if k >= 0
-                    else Fraction(round(f / 2 ** (-k)) * 2 ** (-k))
+                    else fmpq(_round_half_even(n0, d0 * 2 ** (-k)) * 2 ** (-k))
                 )
             else:
-                out[i, j] = _q(f)
+                out[i, j] = fmpq(*v.as_integer_ratio())
     return out.reshape(M.shape)
 
 
@@ -663,15 +704,15 @@ def _float_facets(P: np.ndarray) -> np.ndarray | None:
         h = _qhull(qfloat(P))
     except _QhullFailed:
         return None
-    rows: set[tuple[fmpq, ...]] = set()
+    rows: dict[tuple, list[fmpq]] = {}
     one = fmpq_mat(n, 1, [1] * n)
     for s in np.asarray(h.simplices, dtype=int):
         try:
-            a = fmpq_mat([list(P[j]) for j in s]).solve(one)
+            a = fmpq_mat([list(P[j]) for j in s]).solve(one).entries()
         except ZeroDivisionError:  # a flat simplex (joggled or coplanar input)
             continue
-        rows.add(tuple(a[i, 0] for i in range(n)))
-    return np.array(sorted(rows), dtype=object).reshape(len(rows), n)
+        rows.setdefault(tuple((x.p, x.q) for x in a), a)  # (fmpq hashes slowly)
+    return np.array(sorted(rows.values()), dtype=object).reshape(len(rows), n)
 
 
 def exact_hull(P: np.ndarray, deadline: float | None = None) -> tuple[np.ndarray, ExactVRep]:
@@ -792,7 +833,7 @@ def hull_certificate(G: np.ndarray, P: np.ndarray) -> Incidence | str:
     k, n = G.shape
     if n < 2 or k == 0 or len(P) == 0:
         return "fewer than 2 dimensions, no rows or no points"
-    if len({tuple(r) for r in G}) != k:
+    if len({tuple((x.p, x.q) for x in r) for r in G}) != k:
         return "G has a repeated row"
     Gf, Pf = qfloat(G), qfloat(P)
     M = Gf @ Pf.T

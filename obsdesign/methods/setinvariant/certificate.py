@@ -48,17 +48,18 @@ class ExactProblem:
 
 
 def qmatmul(X: np.ndarray, Y: np.ndarray) -> np.ndarray:
-    """Exact product of two fmpq object arrays."""
+    """Exact product of two fmpq object arrays (python-flint's fmpq_mat)."""
+    from flint import fmpq_mat
+
     X = np.asarray(X, dtype=object)
     Y = np.asarray(Y, dtype=object)
-    out = np.empty((X.shape[0], Y.shape[1]), dtype=object)
-    for i in range(X.shape[0]):
-        for j in range(Y.shape[1]):
-            s = fmpq(0)
-            for k in range(X.shape[1]):
-                s += X[i, k] * Y[k, j]
-            out[i, j] = s
-    return out
+    (r, k), c = X.shape, Y.shape[1]
+    if r == 0 or c == 0 or k == 0:
+        out = np.empty((r, c), dtype=object)
+        out[...] = fmpq(0)
+        return out
+    P = fmpq_mat(r, k, X.reshape(-1).tolist()) * fmpq_mat(k, c, Y.reshape(-1).tolist())
+    return np.array(P.entries(), dtype=object).reshape(r, c)
 
 
 def delta_exact(G: np.ndarray, B1: np.ndarray, Dv: np.ndarray) -> list[fmpq]:
@@ -86,8 +87,8 @@ def omega_contained(G: np.ndarray, Vo: np.ndarray) -> tuple[bool, fmpq]:
 def exact_zd(V: np.ndarray, c: np.ndarray, eta: fmpq) -> tuple[list[fmpq], list[fmpq]]:
     """(Z_d sorted and distinct, c·V per vertex), exactly (Section III)."""
     cv = [po.qdot(c, v) for v in V]
-    zs = {x - eta for x in cv} | {x + eta for x in cv}
-    return sorted(zs), cv
+    zs = sorted([x - eta for x in cv] + [x + eta for x in cv])  # (sort, not a set: fmpq
+    return [z for i, z in enumerate(zs) if i == 0 or z != zs[i - 1]], cv  # hashes slowly)
 
 
 @dataclass
@@ -267,8 +268,8 @@ def theorem31(
     notes: list[str] = []
     if vs is not None:
         assert zs_given is not None
-        pos = {z: i for i, z in enumerate(zs_given)}
-        missing = [z for z in zs if z not in pos]
+        pos = {(z.p, z.q): i for i, z in enumerate(zs_given)}
+        missing = [z for z in zs if (z.p, z.q) not in pos]
         if missing:
             return Theorem31Result(
                 False,
@@ -281,7 +282,7 @@ def theorem31(
                 0,
                 [f"breakpoint {missing[0]} of Z_d is missing from the injection table"],
             )
-        vs_use = [vs[pos[z]] for z in zs]
+        vs_use = [vs[pos[z.p, z.q]] for z in zs]
     sl = _Slices(ex, G, vrep, zs, cv)
     Gf = po.qfloat(G)
     dlf = po.qfloat(np.array(dl, dtype=object))

@@ -8,6 +8,7 @@ side 1, which needs the origin in its interior).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -64,6 +65,17 @@ def disturbance_vertices_float(s: Any, nd: int) -> np.ndarray:
     return vertices_float(s.G, s.g)[0].reshape(-1, nd)
 
 
+@lru_cache(maxsize=16)
+def _omega_vertices(rows: tuple[tuple[fmpq, ...], ...]) -> np.ndarray:
+    return po.exact_h_to_v(np.array(rows, dtype=object)).V
+
+
+def omega_vertices(G0: np.ndarray) -> np.ndarray:
+    """Exact vertices of Ω = {G0 e <= 1} (cdd.gmp), computed once per Ω and process (the
+    design and its certify both build the problem); a copy, keyed by the exact rows."""
+    return _omega_vertices(tuple(tuple(r) for r in np.asarray(G0, dtype=object))).copy()
+
+
 def build(spec: Spec) -> Data:
     """Float and exact data of the spec (the options were validated by parse_options)."""
     o = spec.options
@@ -81,7 +93,7 @@ def build(spec: Spec) -> Data:
             ),
             None,
         )
-    Vo = po.exact_h_to_v(G0).V
+    Vo = omega_vertices(G0)
     D = o.D
     Dv = disturbance_vertices(D, s.nd)
     B1 = np.asarray(s.Bd.q, dtype=object).reshape(s.n, s.nd)
