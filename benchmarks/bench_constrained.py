@@ -36,7 +36,7 @@ def _system(n: int, seed: int = 0):
 
 def main() -> None:
     from obsdesign import api
-    from obsdesign.methods.constrained.observer import run_batch
+    from obsdesign.methods.constrained.observer import Observer
 
     api.design(SPEC)  # warm imports
     t0 = time.perf_counter()
@@ -80,7 +80,7 @@ def main() -> None:
     U = np.zeros((B, N + 1, 0))
     Xh0 = rng.uniform(-1.2, 1.2, (B, n)) * 8  # start far off: peaking and refining
     t0 = time.perf_counter()
-    est, steps = run_batch(F, U, Y, Xh0, ref, 10)
+    est, steps = Observer(F, ref, 10).run_batch(U, Y, Xh0)
     tv = time.perf_counter() - t0
     rate_v = B * N / tv
     sub = 100  # the plain loop on a subset, same arithmetic (rate per sample)

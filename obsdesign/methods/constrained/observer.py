@@ -142,60 +142,58 @@ class Trace:
         return np.max(np.abs(np.vstack(pts)), axis=0)
 
 
-def run_observer(
-    F: LinearF,
-    u: np.ndarray,
-    y: np.ndarray,
-    xhat0: np.ndarray,
-    refiner: Refiner | None = None,
-    theta_m: int = 0,
-    sat_r: np.ndarray | float | None = None,
-) -> Trace:
-    """Run the unmodified (2), modified (8)-(10)+(23), or saturated (29) observer on given
-    inputs and outputs (rows k = 0..N); the estimate has N+1 rows (x̂_0 … x̂_N)."""
-    N = len(y) - 1
-    n = len(xhat0)
-    xh = np.zeros((N + 1, n))
-    xh[0] = xhat0
-    its: list[list[np.ndarray]] = []
-    steps = np.zeros(N, dtype=np.int64)
-    for k in range(N):
-        x1 = F(xh[k], u[k], y[k])
-        path = [x1]
-        if refiner is not None and theta_m > 0:
-            x1, steps[k] = refiner.refine(x1, theta_m, path)
-        if sat_r is not None:
-            x1 = sat(x1, sat_r)
-        its.append(path)
-        xh[k + 1] = x1
-    return Trace(xh, its, steps)
+@dataclass(frozen=True)
+class Observer:
+    """One observer of the comparison: x̂_{k,1} = F(x̂_k, u_k, y_k) (eq. (2) / (8)); with a
+    ``refiner`` and θ_m > 0, at most θ_m refining steps G of eq. (23) (the modified observer
+    (8)-(10)); with ``sat_r``, x̂_{k+1} = sat_r(·) (the saturated observer (29)). Without
+    either it is the unmodified observer (2)."""
 
+    F: LinearF
+    refiner: Refiner | None = None
+    theta_m: int = 0
+    sat_r: np.ndarray | float | None = None
 
-def run_batch(
-    F: LinearF,
-    U: np.ndarray,
-    Y: np.ndarray,
-    Xh0: np.ndarray,
-    refiner: Refiner | None = None,
-    theta_m: int = 0,
-) -> tuple[np.ndarray, np.ndarray]:
-    """The modified observer (8)-(10), (23) on a batch of trajectories at once.
+    def run(self, u: np.ndarray, y: np.ndarray, xhat0: np.ndarray) -> Trace:
+        """One trajectory: inputs and outputs in rows k = 0..N; the estimate has N+1 rows
+        (x̂_0 … x̂_N), every iterate x̂_{k,i} and the steps per sample are kept."""
+        N = len(y) - 1
+        n = len(xhat0)
+        xh = np.zeros((N + 1, n))
+        xh[0] = xhat0
+        its: list[list[np.ndarray]] = []
+        steps = np.zeros(N, dtype=np.int64)
+        for k in range(N):
+            x1 = self.F(xh[k], u[k], y[k])
+            path = [x1]
+            if self.refiner is not None and self.theta_m > 0:
+                x1, steps[k] = self.refiner.refine(x1, self.theta_m, path)
+            if self.sat_r is not None:
+                x1 = sat(x1, self.sat_r)
+            its.append(path)
+            xh[k + 1] = x1
+        return Trace(xh, its, steps)
 
-    ``U`` (B, N+1, m), ``Y`` (B, N+1, p), ``Xh0`` (B, n). Returns the estimates (B, N+1, n)
-    and the steps used (B, N). Each sample is one vectorized F and at most θ_m vectorized
-    refining passes over the rows still in C_max \\ C_min.
-    """
-    Bn, N1 = Y.shape[0], Y.shape[1]
-    n = Xh0.shape[1]
-    out = np.empty((Bn, N1, n))
-    out[:, 0] = Xh0
-    steps = np.zeros((Bn, N1 - 1), dtype=np.int64)
-    for k in range(N1 - 1):
-        x1 = F(out[:, k], U[:, k], Y[:, k])
-        if refiner is not None and theta_m > 0:
-            x1, steps[:, k], _ = refiner.refine_batch(x1, theta_m)
-        out[:, k + 1] = x1
-    return out, steps
+    def run_batch(
+        self, U: np.ndarray, Y: np.ndarray, Xh0: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """A batch of trajectories at once: ``U`` (B, N+1, m), ``Y`` (B, N+1, p), ``Xh0``
+        (B, n). Returns the estimates (B, N+1, n) and the steps used (B, N). Each sample is one
+        vectorized F and at most θ_m vectorized refining passes over the rows still in
+        C_max \\ C_min."""
+        Bn, N1 = Y.shape[0], Y.shape[1]
+        n = Xh0.shape[1]
+        out = np.empty((Bn, N1, n))
+        out[:, 0] = Xh0
+        steps = np.zeros((Bn, N1 - 1), dtype=np.int64)
+        for k in range(N1 - 1):
+            x1 = self.F(out[:, k], U[:, k], Y[:, k])
+            if self.refiner is not None and self.theta_m > 0:
+                x1, steps[:, k], _ = self.refiner.refine_batch(x1, self.theta_m)
+            if self.sat_r is not None:
+                x1 = sat(x1, self.sat_r)
+            out[:, k + 1] = x1
+        return out, steps
 
 
 def _record(path: list | None, x: np.ndarray) -> bool:

@@ -12,7 +12,7 @@ from obsdesign.certify.exact import Q, to_float
 from obsdesign.errors import InputError
 from obsdesign.methods.constrained import bounds as B
 from obsdesign.methods.constrained.design import xhat_set
-from obsdesign.methods.constrained.observer import LinearF, Refiner, Trace, run_observer
+from obsdesign.methods.constrained.observer import LinearF, Observer, Refiner, Trace
 from obsdesign.methods.constrained.options import Options, SimOptions
 from obsdesign.params import Parameters
 from obsdesign.simulate.result import SimResult
@@ -115,11 +115,12 @@ def simulate(
     Pf = np.asarray(to_float(P), dtype=float)
     Xhat = xhat_set(o)
 
-    traces: dict[str, Trace] = {"unmodified": run_observer(F, u, y, sm.xhat0.f)}
+    observers = {"unmodified": Observer(F)}
     for tm in thetas:
-        traces[f"modified θ_m={tm}"] = run_observer(F, u, y, sm.xhat0.f, ref, tm)
+        observers[f"modified θ_m={tm}"] = Observer(F, ref, tm)
     if sat_r is not None:
-        traces[f"saturated r={_fmt(sat_r)}"] = run_observer(F, u, y, sm.xhat0.f, sat_r=sat_r)
+        observers[f"saturated r={_fmt(sat_r)}"] = Observer(F, sat_r=sat_r)
+    traces: dict[str, Trace] = {k: ob.run(u, y, sm.xhat0.f) for k, ob in observers.items()}
 
     info: dict[str, Any] = {
         "theta (22)": theta,
