@@ -115,6 +115,20 @@ def _qhull(points: np.ndarray) -> ConvexHull:
             raise _QhullFailed(str(exc)) from exc
 
 
+def _rhs1_hull(P: np.ndarray, failed: str, origin: str) -> tuple[ConvexHull, np.ndarray]:
+    """qhull of ``P`` and its facets as rows ``a`` with ``a·x = 1`` (which needs the origin
+    strictly inside). PolytopeError ``failed`` (with qhull's message) when qhull fails,
+    ``origin`` when a facet passes through or beyond the origin."""
+    try:
+        h = _qhull(P)
+    except _QhullFailed as exc:
+        raise PolytopeError(f"{failed} ({exc})") from exc
+    eq = h.equations
+    if np.any(eq[:, -1] >= -1e-12):
+        raise PolytopeError(origin)
+    return h, eq[:, :-1] / (-eq[:, -1:])
+
+
 def merge_rows(rows: np.ndarray, tol: float = 1e-10) -> tuple[np.ndarray, np.ndarray]:
     """Merge rows equal up to ``tol`` (relative); returns (representatives, labels)."""
     rows = np.asarray(rows, dtype=float)
@@ -160,18 +174,14 @@ def hull(points: np.ndarray, with_edges: bool = True) -> HullState:
         if not lo < 0 < hi:
             raise PolytopeError("the origin is not interior to the hull")
         return HullState(np.array([[lo], [hi]]), np.array([[0, 1]]), np.array([[1 / hi], [1 / lo]]))
-    try:
-        h = _qhull(P)
-    except _QhullFailed as exc:
-        raise PolytopeError(f"the points are not full-dimensional ({exc})") from exc
-    eq = h.equations
-    if np.any(eq[:, -1] >= -1e-12):
-        raise PolytopeError("the origin is not interior to the hull")
+    h, rows = _rhs1_hull(
+        P, "the points are not full-dimensional", "the origin is not interior to the hull"
+    )
     remap = np.full(len(P), -1, dtype=int)
     remap[h.vertices] = np.arange(len(h.vertices))
     V = P[h.vertices]
     edges = _edges_from_simplices(h.simplices, remap) if with_edges else np.zeros((0, 2), dtype=int)
-    G, _ = merge_rows(eq[:, :-1] / (-eq[:, -1:]))
+    G, _ = merge_rows(rows)
     return HullState(V, edges, outward_fix(G, P))
 
 
@@ -195,15 +205,12 @@ def h_to_v(G: np.ndarray) -> VRep:
         if not (len(pos) and len(neg)):
             raise PolytopeError("the polytope is unbounded")
         return VRep(np.array([[1 / neg.min()], [1 / pos.max()]]), np.array([[0, 1]]))
-    pts = np.vstack([G, np.zeros((1, n))])
-    try:
-        h = _qhull(pts)
-    except _QhullFailed as exc:
-        raise PolytopeError(f"the polytope is unbounded ({exc})") from exc
-    eq = h.equations
-    if np.any(eq[:, -1] >= -1e-12):
-        raise PolytopeError("the polytope is unbounded (its rows do not surround the origin)")
-    V, labels = merge_rows(eq[:, :-1] / (-eq[:, -1:]))
+    h, rows = _rhs1_hull(
+        np.vstack([G, np.zeros((1, n))]),
+        "the polytope is unbounded",
+        "the polytope is unbounded (its rows do not surround the origin)",
+    )
+    V, labels = merge_rows(rows)
     nb = np.asarray(h.neighbors)
     src = np.repeat(np.arange(len(nb)), nb.shape[1])
     dst = nb.reshape(-1)

@@ -500,18 +500,23 @@ def _linear(
     s = spec.system
     c = emit.c
     lam = o.lam
+
+    def law(cid: str, L: np.ndarray) -> Any:
+        """Proposition 7.1 for the linear injection v = L z: claim ``cid``; the factor."""
+        ok, f = b.linear(G, V, L)
+        emit(
+            cid,
+            ok,
+            f"certified factor {b.show(f)} (λ = {lam})",
+            b.margin(lam, f),
+            b.leq(f, b.lam)[1],
+        )
+        return f
+
     if "L" in params:
         L = b.read(params, "L", c)
         if L is not None:
-            L = b.matrix(L, s.p).reshape(s.n, s.p)
-            ok, f = b.linear(G, V, L)
-            emit(
-                "linear-law",
-                ok,
-                f"certified factor {b.show(f)} (λ = {lam})",
-                b.margin(lam, f),
-                b.leq(f, b.lam)[1],
-            )
+            f = law("linear-law", b.matrix(L, s.p).reshape(s.n, s.p))
             if "L_factor" in params:
                 fr = b.read(params, "L_factor", c)
                 if fr is not None:
@@ -535,11 +540,4 @@ def _linear(
             )
     if o.L is not None:
         L = o.L if b.exact else np.asarray(po.qfloat(o.L), dtype=float)
-        ok, f = b.linear(G, V, np.asarray(L).reshape(s.n, s.p))
-        emit(
-            "linear-law-user",
-            ok,
-            f"certified factor {b.show(f)} (λ = {lam})",
-            b.margin(lam, f),
-            b.leq(f, b.lam)[1],
-        )
+        law("linear-law-user", np.asarray(L).reshape(s.n, s.p))
