@@ -1,0 +1,63 @@
+"""The generic parts of ``methods/base.py``: summary(), the delegation defaults, table_schema."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from flint import fmpq
+
+from obsdesign.errors import InputError
+from obsdesign.methods.base import Method, SummaryField, table_schema
+from obsdesign.params import Parameters
+
+
+class _Plain(Method):
+    key = "plain"
+    summary_fields = (
+        SummaryField("λ", "lambda"),
+        SummaryField("v_max"),
+        SummaryField("K", fmt=".3g"),
+        SummaryField("n", "count", "d"),
+        SummaryField("absent"),
+    )
+    summary_format = ".4g"
+
+
+def test_summary_formats_scalars_vectors_and_matrices() -> None:
+    p = Parameters(
+        {
+            "lambda": fmpq(1, 3),
+            "v_max": fmpq(2),
+            "K": np.array([[fmpq(1, 3), 0], [2, fmpq(-1, 7)]], dtype=object),
+            "count": 6,
+        }
+    )
+    assert _Plain().summary(p) == "λ = 0.3333, v_max = 2, K = [0.333, 0; 2, -0.143], n = 6"
+    vec = Parameters({"K": np.array([fmpq(1, 2), 3], dtype=object)})
+    assert _Plain().summary(vec) == "K = [0.5, 3]"
+
+
+def test_summary_field_param_defaults_to_label() -> None:
+    assert SummaryField("v_max").param == "v_max"
+    assert SummaryField("γ", "gamma").param == "gamma"
+    assert SummaryField("v_max").fmt is None
+
+
+def test_defaults_without_the_package_modules() -> None:
+    """A method whose package has no sim module has no simulation (InputError); no SimOptions
+    means no [simulate] keys of its own."""
+    m = _Plain()
+    with pytest.raises(InputError, match="has no simulation"):
+        m.simulate(None, Parameters())  # type: ignore[arg-type]
+    assert m.simulate_schema() == {}
+    assert m.parse_simulate(None, None) is None  # type: ignore[arg-type]
+
+
+def test_table_schema() -> None:
+    s = table_schema("k", {"a": {"type": "number"}}, ("a",))
+    assert s == {
+        "type": "object",
+        "required": ["key", "a"],
+        "additionalProperties": False,
+        "properties": {"key": {"const": "k"}, "a": {"type": "number"}},
+    }
