@@ -45,6 +45,8 @@ BLOCK = 16
 #: steps whose random draws are made at once, per run (a multiple of :data:`BLOCK`, fixed so
 #: that the batching cannot change any number)
 CHUNK = 1024
+#: rows × columns × inner size of a product that OpenBLAS runs on one thread
+MNK_ONE_THREAD = 1 << 18
 #: points of the first rejection-sampling block of ``ConvexSet.sample(rng, 1)``
 SAMPLE_BLOCK = 64
 #: quantiles reported for every per-run metric
@@ -132,17 +134,47 @@ class _Blocks:
         return cls(P, T)
 
 
+def _mm(a: np.ndarray, b: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """``a @ b`` in row pieces of at least two rows, each small enough for OpenBLAS to run
+    it on one thread (:data:`MNK_ONE_THREAD`): a threaded product of this size gains little
+    and, on a loaded machine, can stall for milliseconds. A row of a product does not depend
+    on the other rows (two or more), so the pieces change no number."""
+    R = a.shape[0]
+    if out is None:
+        out = np.empty((R, b.shape[1]))
+    step = max(2, MNK_ONE_THREAD // max(1, b.shape[0] * b.shape[1]))
+    pieces = max(1, R // step)
+    cuts = [R * i // pieces for i in range(pieces + 1)]
+    for i, j in zip(cuts, cuts[1:], strict=False):
+        np.matmul(a[i:j], b, out=out[i:j])
+    return out
+
+
+def _block_inputs(bl: _Blocks, W: np.ndarray, K: int) -> np.ndarray:
+    """Per block, the contribution T [w_{k0}; …; w_{k0+b-1}] of the inputs ``W`` (K, w):
+    (blocks, b·N); the last block is padded with zero inputs."""
+    nb, w = -(-K // BLOCK), W.shape[1]
+    Wp = np.zeros((nb * BLOCK, w))
+    Wp[:K] = W
+    return _mm(Wp.reshape(nb, BLOCK * w), np.ascontiguousarray(bl.T.T))
+
+
 def _step_blocks(F: np.ndarray, G: np.ndarray, s0: np.ndarray, W: np.ndarray) -> np.ndarray:
     """The single trajectory s_0 .. s_K of s⁺ = F s + G w_k for the inputs ``W`` (K, w), by
-    :class:`_Blocks` of :data:`BLOCK` steps (a few hundred products instead of K)."""
+    :class:`_Blocks` of :data:`BLOCK` steps: all block input terms in one product, the block
+    starts one small step each, then all states in one product."""
     K, N = len(W), len(s0)
+    bl = _Blocks.of(F, G, BLOCK)
+    U = _block_inputs(bl, W, K)
+    Fb = bl.P[-N:]
+    starts = np.empty((len(U), N))
+    s = np.asarray(s0, dtype=float)
+    for i in range(len(U)):
+        starts[i] = s
+        s = Fb @ s + U[i, -N:]
     out = np.empty((K + 1, N))
     out[0] = s0
-    bl = _Blocks.of(F, G, BLOCK)
-    for k0 in range(0, K, BLOCK):
-        m = min(BLOCK, K - k0)
-        blk = bl.P[: m * N] @ out[k0] + bl.T[: m * N, : m * G.shape[1]] @ W[k0 : k0 + m].ravel()
-        out[k0 + 1 : k0 + m + 1] = blk.reshape(m, N)
+    out[1:] = (_mm(starts, np.ascontiguousarray(bl.P.T)) + U).reshape(-1, N)[:K]
     return out
 
 
@@ -358,7 +390,7 @@ def _run(
     if traj0 is not None:
         traj0[0] = st[0, :N]
     sh = _Blocks.of(plan.F, plan.G_sh, BLOCK)
-    Csh = _shared_terms(sh, plan.W_sh, K, N)  # (blocks, b·N)
+    Csh = _block_inputs(sh, plan.W_sh, K)  # (blocks, b·N)
     rbT = [_Blocks.of(plan.F, G, BLOCK).T.T.copy() for G in plan.G_rand]  # (b·w, b·N)
     PAT = np.empty((N + 1, BLOCK * N))  # [P | shared term]ᵀ
     PAT[:N] = sh.P.T
@@ -375,10 +407,10 @@ def _run(
             bb = bufs[m]
             PAT[N, :rows] = Csh[k0 // BLOCK, :rows]
             D = bb.D
-            np.matmul(st, PAT[:, :rows], out=D)
+            _mm(st, PAT[:, :rows], out=D)
             for TT, a, d in zip(rbT, raw, dims, strict=True):
                 j = (k0 - c0) * d
-                np.matmul(_rows(a[:, j : j + m * d]), TT[: m * d, :rows], out=bb.D2)
+                _mm(_rows(a[:, j : j + m * d]), TT[: m * d, :rows], out=bb.D2)
                 np.add(D, bb.D2, out=D)
             st[:, :N] = D[:, rows - N :]
             if R == 1:
@@ -427,15 +459,6 @@ class _BlockBufs:
 def _rows(a: np.ndarray) -> np.ndarray:
     """``a`` with at least two rows (a single row repeated: see :func:`_run`)."""
     return a if len(a) > 1 else np.concatenate([a, a])
-
-
-def _shared_terms(bl: _Blocks, W: np.ndarray, K: int, N: int) -> np.ndarray:
-    """Per block, the contribution T [w_{k0}; …] of the shared inputs (blocks, b·N); the
-    last block is padded with zero inputs (only its first rows are used)."""
-    nb = -(-K // BLOCK)
-    Wp = np.zeros((nb * BLOCK, W.shape[1]))
-    Wp[:K] = W
-    return Wp.reshape(nb, -1) @ bl.T.T
 
 
 def _trajectory(plan: _Plan, traj0: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
