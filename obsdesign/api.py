@@ -786,20 +786,12 @@ def check(
             if on_row is not None:
                 on_row(rows[-1])
         return rows
-    from obsdesign.distributed import run_tasks
+    from obsdesign.sweep import run_rows
 
     def lost(f: Path, message: str) -> CheckRow:
         return CheckRow(str(f), "?", EXIT_SOLVER, 0, 0, 0, "", 0.0, message)
 
-    return run_tasks(
-        check_one,
-        files,
-        workers=workers,
-        scheduler=scheduler,
-        client=client,
-        on_result=(lambda i, r: on_row(r)) if on_row is not None else None,
-        lost=lost,
-    )
+    return run_rows(check_one, files, lost, workers, scheduler, client, on_row)
 
 
 def sweep(

@@ -541,16 +541,32 @@ def sweep_rows(
 ) -> list[dict[str, Any]]:
     """One row per grid point, in grid order (see the module docstring); ``on_row(row)`` is
     called as each row arrives (completion order)."""
-    from obsdesign.distributed import run_tasks
-
     _, tasks = plan(spec, grid, simulate, options)
 
     def lost(task: PointTask, message: str) -> dict[str, Any]:
         return failure_row(task, EXIT_SOLVER, message)
 
+    return run_rows(run_point, tasks, lost, workers, scheduler, client, on_row)
+
+
+def run_rows(
+    fn: Callable[[Any], Any],
+    items: Sequence[Any],
+    lost: Callable[[Any, str], Any],
+    workers: int | None,
+    scheduler: str | None,
+    client: Any,
+    on_row: Callable[[Any], None] | None,
+) -> list[Any]:
+    """``[fn(item) for item in items]``, in this process or on Dask
+    (:func:`obsdesign.distributed.run_tasks`: ``workers``, ``scheduler`` or ``client``), in
+    item order; ``on_row(row)`` as each row arrives; ``lost(item, message)`` is the row of an
+    item whose worker died. Shared by ``sweep`` and ``check``."""
+    from obsdesign.distributed import run_tasks
+
     return run_tasks(
-        run_point,
-        tasks,
+        fn,
+        items,
         workers=workers,
         scheduler=scheduler,
         client=client,
