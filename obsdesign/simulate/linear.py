@@ -38,12 +38,24 @@ class JointSystem:
     n: int
 
 
+def sim_grid(spec: Spec) -> np.ndarray:
+    """The simulation grid of the bound spec: sample indices 0..horizon (discrete time) or
+    times 0, dt, …, horizon (continuous time)."""
+    sim = spec.simulate
+    if sim is None:
+        raise InputError(f"{spec.file}: [simulate] is missing: nothing to simulate")
+    if spec.system.discrete:
+        return np.arange(int(sim.horizon.f) + 1, dtype=float)
+    assert sim.dt is not None
+    T, dt = float(sim.horizon.f), float(sim.dt.f)
+    return np.arange(0.0, T + dt / 2, dt)
+
+
 def joint_system(spec: Spec, L: np.ndarray) -> JointSystem:
     """The joint plant + observer map of the bound spec for gain ``L`` (n×p): discrete
     matrices as they are, continuous ones discretized exactly (zero-order hold over dt)."""
     s, sim = spec.system, spec.simulate
-    if sim is None:
-        raise InputError(f"{spec.file}: [simulate] is missing: nothing to simulate")
+    grid = sim_grid(spec)
     A, B, C, Bd, Dn = s.A.f, s.B.f, s.C.f, s.Bd.f, s.Dn.f
     n = s.n
     L = np.asarray(L, dtype=float).reshape(n, s.p)
@@ -57,13 +69,10 @@ def joint_system(spec: Spec, L: np.ndarray) -> JointSystem:
         ]
     )
     if s.discrete:
-        grid = np.arange(int(sim.horizon.f) + 1, dtype=float)
         return JointSystem(M, E, grid, n)
     from scipy.linalg import expm
 
-    assert sim.dt is not None
-    T, dt = float(sim.horizon.f), float(sim.dt.f)
-    grid = np.arange(0.0, T + dt / 2, dt)
+    dt = float(sim.dt.f)
     k = 2 * n + m + nd + nv
     aug = np.zeros((k, k))
     aug[: 2 * n, : 2 * n] = M
@@ -101,10 +110,16 @@ def step_all(js: JointSystem, z0: np.ndarray, S: np.ndarray) -> np.ndarray:
 
 def simulate_linear_observer(spec: Spec, L: np.ndarray) -> SimResult:
     """Simulate the linear Luenberger observer with gain L against the spec's plant over
-    the ``[simulate]`` scenario (x0, xhat0, signals from ``seed``); one run."""
+    the ``[simulate]`` scenario (x0, xhat0, signals from ``seed``); one run. A plant given by
+    expressions (``[system] f / psi / h``) runs through
+    :func:`obsdesign.simulate.nonlinear.simulate_one`."""
     from obsdesign.simulate.runner import signals
 
     s = spec.system
+    if not s.linear:
+        from obsdesign.simulate.nonlinear import simulate_one
+
+        return simulate_one(spec, L)
     js = joint_system(spec, L)
     u, d, v = signals(spec, js.grid)
     sim = spec.simulate
@@ -121,14 +136,23 @@ def simulate_linear_observer_batch(
     runs: int,
     initial_error: str | None = None,
     batch: int | None = None,
+    span: tuple[int, int] | None = None,
 ) -> SimResult:
     """N Monte Carlo runs of the linear observer with gain L (see
-    :func:`obsdesign.simulate.montecarlo.run_batch`): run r draws its initial error from the
+    :func:`obsdesign.simulate.montecarlo.run_batch`; a plant given by expressions:
+    :func:`obsdesign.simulate.nonlinear.batch_stepper`): run r draws its initial error from the
     set ``initial_error`` of ``[sets]`` (default: xhat0 − x0 for every run) and its signals
     from child r of ``SeedSequence(seed).spawn(runs)``; ``batch`` caps the runs stepped
     together (default: ``montecarlo.BATCH_RUNS``, fewer when their draws do not fit
     ``montecarlo.BATCH_BYTES``). Per-run metrics in ``extra["per_run"]``,
-    quantiles in ``info["quantiles"]``; the trajectory shown is run 0's."""
-    from obsdesign.simulate.montecarlo import run_batch
+    quantiles in ``info["quantiles"]``; the trajectory shown is run 0's. ``span = (a, b)``:
+    only runs a..b-1 (``simulate --workers``, see :func:`~obsdesign.simulate.montecarlo.merge`).
+    """
+    from obsdesign.simulate import montecarlo as mc
 
-    return run_batch(spec, joint_system(spec, L), runs, initial_error, batch)
+    if spec.system.linear:
+        return mc.run_batch(spec, joint_system(spec, L), runs, initial_error, batch, span)
+    from obsdesign.simulate.nonlinear import batch_stepper
+
+    grid, per_run, step = batch_stepper(spec, L)
+    return mc.study(spec, grid, runs, initial_error, batch, span, per_run, step)

@@ -76,7 +76,8 @@ def _random(sig: Any) -> bool:
 
 
 def run_seeds(seed: int, runs: int) -> list[np.random.SeedSequence]:
-    """The N independent child seeds of ``seed`` (numpy ``SeedSequence.spawn``)."""
+    """The N independent child seeds of ``seed`` (numpy ``SeedSequence.spawn``; child r is
+    ``SeedSequence(seed, spawn_key=(r,))``)."""
     return np.random.SeedSequence(seed).spawn(runs)
 
 
@@ -242,11 +243,16 @@ class _Draws:
     run, in order (``outliers``)."""
 
     def __init__(
-        self, plan: _Plan, sigs: tuple[Any, ...], rngs: list[np.random.Generator], grid: Any
+        self,
+        rand: list[int],
+        fast: bool,
+        sigs: tuple[Any, ...],
+        rngs: list[np.random.Generator],
+        grid: Any,
     ):
-        self.plan, self.dims = plan, [sigs[i].dim for i in plan.rand]
+        self.fast, self.dims = fast, [sigs[i].dim for i in rand]
         R, K1 = len(rngs), len(grid)
-        if plan.fast:
+        if fast:
             self.gens: list[list[np.random.Generator]] = []
             skip = 0
             for d in self.dims:
@@ -260,11 +266,11 @@ class _Draws:
             self.full = [np.empty((R, K1 * d)) for d in self.dims]
             for r, g in enumerate(rngs):
                 vals = [s.evaluate(grid, g) for s in sigs]
-                for j, i in enumerate(plan.rand):
+                for j, i in enumerate(rand):
                     self.full[j][r] = vals[i].ravel()
 
     def chunk(self, k0: int, k1: int) -> list[np.ndarray]:
-        if not self.plan.fast:
+        if not self.fast:
             return [f[:, k0 * d : k1 * d] for f, d in zip(self.full, self.dims, strict=True)]
         out = []
         for gens, buf, d in zip(self.gens, self.buf, self.dims, strict=True):
@@ -297,54 +303,91 @@ def run_batch(
     seeds as in the full range, so run r is the same whatever the span: :func:`merge` joins
     spans; None: all).
 
-    Linearity does the work: every run is the trajectory from [x0; x0] under the shared
-    (deterministic) signals plus its own part from its initial error and random draws; only
-    the estimate x̂ is stepped per run when no random signal reaches the plant. The steps
-    are grouped :data:`BLOCK` at a time (one product per block over the batch axis,
-    :class:`_Blocks`), the metrics are updated per block and nothing of a run but its
-    metrics is kept (run 0's trajectory excepted).
+    Linearity does the work: the deterministic signals (and the plant trajectory x when no
+    random signal reaches it: only the estimate is then stepped per run) enter as one
+    shared term per block; the steps are grouped :data:`BLOCK` at a time (one product per
+    block over the batch axis, :class:`_Blocks`), the metrics are updated per block and
+    nothing of a run but its metrics is kept (run 0's trajectory excepted).
 
-    Returns run 0's trajectory with ``info`` = runs, where the initial errors come from and
-    the quantiles of every per-run metric, and ``extra["per_run"]`` = the per-run metrics
-    (sup |e_i|, RMSE of e_i, sup |x̂_i|: arrays (runs, n); final |e|: (runs,)) and
-    ``extra["initial_errors"]`` (runs, n)."""
-    sim, s = spec.simulate, spec.system
-    if sim is None:
+    Returns what :func:`study` returns."""
+    sim = _need(spec)
+    n, grid = js.n, js.grid
+    K = len(grid) - 1
+    sigs = (sim.u, sim.disturbance, sim.noise)
+    plan = _plan(js, sigs, grid, sim.x0.f, sim.seed)
+    w = sum(sigs[i].dim for i in plan.rand)
+
+    def step(rngs: list[np.random.Generator], e0: np.ndarray, keep: bool) -> Any:
+        draws = _Draws(plan.rand, plan.fast, sigs, rngs, grid) if plan.rand else None
+        traj0 = np.empty((K + 1, len(plan.idx))) if keep else None
+        m = _run(plan, draws, sim.x0.f, e0, K, n, traj0)
+        if traj0 is None:
+            return m, None
+        x, xh = _trajectory(plan, traj0, n)
+        return m, (x, xh)
+
+    per_run = (CHUNK if plan.fast else K + 1) * w * 8
+    res = study(spec, grid, runs, initial_error, batch, span, per_run, step)
+    s = spec.system
+    eset = spec.sets[initial_error] if initial_error is not None else None
+    child = np.random.SeedSequence(sim.seed, spawn_key=(span[0] if span else 0,))
+    u, _, v = _signals0(spec, grid, eset, child)
+    res.y = res.x @ s.C.f.T + u @ s.D.f.T + v @ s.Dn.f.T
+    return res
+
+
+def _need(spec: Spec) -> Any:
+    if spec.simulate is None:
         raise InputError(f"{spec.file}: [simulate] is missing: nothing to simulate")
+    return spec.simulate
+
+
+def study(
+    spec: Spec,
+    grid: np.ndarray,
+    runs: int,
+    initial_error: str | None,
+    batch: int | None,
+    span: tuple[int, int] | None,
+    per_run_bytes: int,
+    step: Any,
+) -> SimResult:
+    """The Monte Carlo study of the bound ``spec`` on ``grid``: the child seeds, the batches
+    (``batch`` runs, default :data:`BATCH_RUNS` or fewer when ``per_run_bytes`` each do not
+    fit :data:`BATCH_BYTES`), each run's generator and initial error, then
+    ``step(rngs, e0, keep)`` → (per-run metrics of the batch, run 0's (x, x̂) or (x, x̂, y)
+    when ``keep``) (the generators stand just after the initial errors' draws).
+
+    Returns run 0's trajectory with ``info`` = runs, where the
+    initial errors come from and the quantiles of every per-run metric, and
+    ``extra["per_run"]`` = the per-run metrics (sup |e_i|, RMSE of e_i, sup |x̂_i|: arrays
+    (runs, n); final |e|: (runs,)) and ``extra["initial_errors"]`` (runs, n)."""
+    sim, s = _need(spec), spec.system
     if runs < 1:
         raise InputError(f"runs: expected at least 1, got {runs}")
     first, last = span if span is not None else (0, runs)
     if not 0 <= first < last <= runs:
         raise InputError(f"span: expected 0 <= a < b <= {runs}, got ({first}, {last})")
-    n, grid = js.n, js.grid
-    K = len(grid) - 1
-    x0, xhat0 = sim.x0.f, sim.xhat0.f
     if initial_error is not None and initial_error not in spec.sets:
         raise InputError(f"{spec.file}: initial_error = {initial_error!r} is not in [sets]")
     eset = spec.sets[initial_error] if initial_error is not None else None
-    sigs = (sim.u, sim.disturbance, sim.noise)
+    n = s.n
     children = run_seeds(sim.seed, runs)[first:last]
     total, runs = runs, last - first  # below: runs of the span, indexed from 0
-    plan = _plan(js, sigs, grid, x0, sim.seed)
-    w = sum(sigs[i].dim for i in plan.rand)
-    per_run = (CHUNK if plan.fast else K + 1) * w * 8
-    B = batch or int(max(1, min(runs, BATCH_RUNS, BATCH_BYTES // max(per_run, 1))))
+    B = batch or int(max(1, min(runs, BATCH_RUNS, BATCH_BYTES // max(per_run_bytes, 1))))
     out = {k: np.zeros((runs, n)) for k in METRICS[:3]}
     out["final_error_norm"] = np.zeros(runs)
     e0_all = np.zeros((runs, n))
-    traj0 = np.empty((K + 1, len(plan.idx)))
+    traj: Any = None
     for b0 in range(0, runs, B):
         rngs = [np.random.default_rng(c) for c in children[b0 : b0 + B]]
-        e0 = initial_errors(eset, rngs, xhat0 - x0)
+        e0 = initial_errors(eset, rngs, sim.xhat0.f - sim.x0.f)
         e0_all[b0 : b0 + len(rngs)] = e0
-        draws = _Draws(plan, sigs, rngs, grid) if plan.rand else None
-        m = _run(plan, draws, x0, e0, K, n, traj0 if b0 == 0 else None)
+        m, t0 = step(rngs, e0, b0 == 0)
+        traj = t0 if b0 == 0 else traj
         for k, a in m.items():
             out[k][b0 : b0 + len(rngs)] = a
-    x, xh = _trajectory(plan, traj0, n)
-    u, _, v = _signals0(spec, grid, eset, children[0])
-    y = x @ s.C.f.T + u @ s.D.f.T + v @ s.Dn.f.T
-    res = SimResult(grid, x, xh, y, s.states)
+    res = SimResult(grid, traj[0], traj[1], traj[2] if len(traj) > 2 else None, s.states)
     res.extra["per_run"] = out
     res.extra["initial_errors"] = e0_all
     res.info["runs"] = total

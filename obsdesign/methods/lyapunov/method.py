@@ -90,14 +90,9 @@ class Lyapunov(Method):
         so = spec.simulate.options if spec.simulate is not None else None
         n = runs if runs is not None else (so.runs if so is not None else 1)
         ie = so.initial_error if so is not None else None
-        if span is not None:
-            from obsdesign.simulate.linear import joint_system
-            from obsdesign.simulate.montecarlo import run_batch
-
-            return run_batch(spec, joint_system(spec, params.float("L")), n, ie, batch, span)
-        if n == 1 and ie is None and batch is None:
+        if n == 1 and ie is None and batch is None and span is None:
             return simulate_linear_observer(spec, params.float("L"))
-        return simulate_linear_observer_batch(spec, params.float("L"), n, ie, batch)
+        return simulate_linear_observer_batch(spec, params.float("L"), n, ie, batch, span)
 
     def options_schema(self) -> dict[str, Any]:
         return schema(self.key)

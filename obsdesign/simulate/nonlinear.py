@@ -1,0 +1,223 @@
+"""The linear observer x̂⁺ = A x̂ + B u + L (y − C x̂ − D u) (or its continuous analogue)
+against a plant given by expressions (``[system] f``, ``psi``, ``h``), for one run or a batch
+of Monte Carlo runs at once.
+
+Plant: x⁺ (or ẋ) = f(x, u, d, t), or A x + B u + Bd d + ψ(x, u, d, t); y = h(x, u, v, t), or
+C x + D u + Dn v; ``t`` is the grid value (the sample index in discrete time, the time in
+continuous time). Every expression is compiled once (``Expr.on``) and evaluated on the
+(runs, ·) array of all runs together, so a step costs a few numpy calls whatever the number
+of runs. Continuous time: the classical Runge–Kutta scheme (RK4) with :data:`SUBSTEPS` equal
+steps per ``dt``, the signals held over each ``dt`` (as the linear path holds them).
+
+Monte Carlo runs draw their initial errors and signals exactly as the linear path does
+(:func:`obsdesign.simulate.montecarlo.study`: same child seeds, same order of draws, same
+per-run metrics), and every operation acts on each run's row alone, so a run's numbers do
+not depend on the batching.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from obsdesign.simulate import montecarlo as mc
+from obsdesign.simulate.linear import sim_grid
+from obsdesign.simulate.result import SimResult
+from obsdesign.spec.models import Spec
+
+#: RK4 steps per sample interval ``dt`` (continuous time)
+SUBSTEPS = 8
+
+
+class Plant:
+    """The plant's right-hand side and output map over a batch (arrays (R, ·)), and the
+    observer's matrices for gain ``L``: x̂⁺ = (A − L C) x̂ + (B − L D) u + L y."""
+
+    def __init__(self, spec: Spec, L: np.ndarray):
+        s = self.s = spec.system
+        self.n = s.n
+        x_u_d_t = [*s.states, *s.inputs, *s.disturbances, "t"]
+        x_u_v_t = [*s.states, *s.inputs, *s.noises, "t"]
+        self.f = [e.on(x_u_d_t) for e in (s.f or s.psi or [])]
+        self.additive = s.f is None
+        self.h = [e.on(x_u_v_t) for e in s.h] if s.h is not None else None
+        A, B, C, D = s.A.f, s.B.f, s.C.f, s.D.f
+        L = np.asarray(L, dtype=float).reshape(s.n, s.p)
+        #: [x̂, u, y] @ obsT is the observer's x̂⁺ (discrete) or dx̂/dt (continuous)
+        self.obsT = np.concatenate([A - L @ C, B - L @ D, L], axis=1).T.copy()
+
+    def rhs(self, X: np.ndarray, U: np.ndarray, Dd: np.ndarray, t: float) -> np.ndarray:
+        """x⁺ (discrete) or ẋ (continuous) of every run: (R, n)."""
+        s = self.s
+        Z = _args(X, U, Dd, t)
+        parts = np.stack([g(Z) for g in self.f], axis=-1) if self.f else 0.0
+        if not self.additive:
+            return parts
+        return X @ s.A.f.T + U @ s.B.f.T + Dd @ s.Bd.f.T + parts
+
+    def out(self, X: np.ndarray, U: np.ndarray, V: np.ndarray, t: float) -> np.ndarray:
+        """y of every run: (R, p)."""
+        s = self.s
+        if self.h is None:
+            return X @ s.C.f.T + U @ s.D.f.T + V @ s.Dn.f.T
+        Z = _args(X, U, V, t)
+        return np.stack([g(Z) for g in self.h], axis=-1)
+
+    def observer(self, XH: np.ndarray, U: np.ndarray, Y: np.ndarray) -> np.ndarray:
+        """The observer's x̂⁺ (discrete) or dx̂/dt (continuous), one product with the runs
+        as rows (see :func:`obsdesign.simulate.montecarlo._mm`)."""
+        return mc._mm(np.concatenate([XH, U, Y], axis=1), self.obsT)
+
+
+def _args(X: np.ndarray, a: np.ndarray, b: np.ndarray, t: float) -> np.ndarray:
+    """The expressions' argument array [x, a, b, t] of every run: (R, n + · + · + 1)."""
+    return np.concatenate([X, a, b, np.full((len(X), 1), t)], axis=1)
+
+
+#: the signals u, d, v of every run at step k: (R, m), (R, nd), (R, nv)
+Signals = Callable[[int], tuple[np.ndarray, np.ndarray, np.ndarray]]
+
+
+def step_runs(
+    plant: Plant,
+    spec: Spec,
+    grid: np.ndarray,
+    X0: np.ndarray,
+    XH0: np.ndarray,
+    at: Signals,
+    keep: bool,
+) -> tuple[dict[str, np.ndarray], tuple[np.ndarray, ...] | None]:
+    """Step R ≥ 2 runs (rows of ``X0``, ``XH0``) over ``grid``; per-run metrics (as
+    :func:`obsdesign.simulate.montecarlo.study` names them) and, when ``keep``, run 0's
+    (x, x̂, y) trajectories."""
+    K = len(grid) - 1
+    X, XH = X0.copy(), XH0.copy()
+    E = XH - X
+    sup_e, sq, sup_h = np.abs(E), E * E, np.abs(XH)
+    traj = [np.empty((K + 1, plant.n)), np.empty((K + 1, plant.n)), np.empty((K + 1, plant.s.p))]
+    dt = float(grid[1] - grid[0]) if K else 0.0
+    for k in range(K + 1):
+        U, Dd, V = at(k)
+        if keep:
+            traj[0][k], traj[1][k] = X[0], XH[0]
+            traj[2][k] = plant.out(X[:1], U[:1], V[:1], grid[k])[0]
+        if k == K:
+            break
+        if plant.s.discrete:
+            Y = plant.out(X, U, V, grid[k])
+            X, XH = plant.rhs(X, U, Dd, grid[k]), plant.observer(XH, U, Y)
+        else:
+            X, XH = _rk4(plant, X, XH, U, Dd, V, grid[k], dt)
+        E = XH - X
+        np.maximum(sup_e, np.abs(E), out=sup_e)
+        sq += E * E
+        np.maximum(sup_h, np.abs(XH), out=sup_h)
+    m = {
+        "sup_abs_error": sup_e,
+        "rmse": np.sqrt(sq / (K + 1)),
+        "sup_abs_estimate": sup_h,
+        "final_error_norm": np.linalg.norm(E, axis=1),
+    }
+    return m, (tuple(traj) if keep else None)
+
+
+def _rk4(
+    plant: Plant,
+    X: np.ndarray,
+    XH: np.ndarray,
+    U: np.ndarray,
+    Dd: np.ndarray,
+    V: np.ndarray,
+    t0: float,
+    dt: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """One sample interval of the joint ODE (plant, observer) by :data:`SUBSTEPS` RK4 steps
+    with u, d, v held."""
+    h = dt / SUBSTEPS
+
+    def F(t: float, X: np.ndarray, XH: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return plant.rhs(X, U, Dd, t), plant.observer(XH, U, plant.out(X, U, V, t))
+
+    for i in range(SUBSTEPS):
+        t = t0 + i * h
+        k1 = F(t, X, XH)
+        k2 = F(t + h / 2, X + h / 2 * k1[0], XH + h / 2 * k1[1])
+        k3 = F(t + h / 2, X + h / 2 * k2[0], XH + h / 2 * k2[1])
+        k4 = F(t + h, X + h * k3[0], XH + h * k3[1])
+        X = X + h / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
+        XH = XH + h / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
+    return X, XH
+
+
+def simulate_one(spec: Spec, L: np.ndarray) -> SimResult:
+    """The spec's scenario once (x0, xhat0, signals from ``seed``), stepped as two equal rows
+    (so that it is run 0 of a batch to the bit)."""
+    from obsdesign.simulate.runner import signals
+
+    sim = mc._need(spec)
+    grid = sim_grid(spec)
+    sig = signals(spec, grid)
+    pair = [np.stack([a, a], axis=1) for a in sig]  # (K + 1, 2, ·)
+    X0, XH0 = np.tile(sim.x0.f, (2, 1)), np.tile(sim.xhat0.f, (2, 1))
+    _, traj = step_runs(
+        Plant(spec, L), spec, grid, X0, XH0, lambda k: (pair[0][k], pair[1][k], pair[2][k]), True
+    )
+    assert traj is not None
+    return SimResult(grid, traj[0], traj[1], traj[2], spec.system.states)
+
+
+def batch_stepper(spec: Spec, L: np.ndarray) -> tuple[np.ndarray, int, Any]:
+    """What :func:`obsdesign.simulate.montecarlo.study` needs to run Monte Carlo runs of the
+    observer with gain ``L`` against the expression plant, stepped together: the grid, the
+    memory of a run's random draws, and the batch step (draws as the linear path makes them,
+    then :func:`step_runs`)."""
+    sim = mc._need(spec)
+    grid = sim_grid(spec)
+    plant = Plant(spec, L)
+    sigs = (sim.u, sim.disturbance, sim.noise)
+    rand = [i for i, g in enumerate(sigs) if mc._random(g)]
+    fast = all(sigs[i].kind == "uniform" for i in rand)
+    shared = [g.evaluate(grid, np.random.default_rng(sim.seed)) for g in sigs]
+    w = sum(sigs[i].dim for i in rand)
+
+    def step(rngs: list[np.random.Generator], e0: np.ndarray, keep: bool) -> Any:
+        R = len(rngs)
+        rows = max(R, 2)  # one run is stepped as two equal rows
+        draws = mc._Draws(rand, fast, sigs, rngs, grid) if rand else None
+        now: dict[str, Any] = {"c1": -1}
+
+        def at(k: int) -> tuple[np.ndarray, ...]:
+            if draws is not None and k >= now["c1"]:
+                now["c0"], now["c1"] = k, min(len(grid), k + mc.CHUNK)
+                now["vals"] = [
+                    _values(sigs[i], raw, rows, fast)
+                    for i, raw in zip(rand, draws.chunk(k, now["c1"]), strict=True)
+                ]
+            out = []
+            for i, g in enumerate(sigs):
+                if i in rand:
+                    out.append(now["vals"][rand.index(i)][:, k - now["c0"]])
+                else:
+                    out.append(np.broadcast_to(shared[i][k], (rows, g.dim)))
+            return tuple(out)
+
+        X0 = np.tile(sim.x0.f, (rows, 1))
+        XH0 = X0 + np.concatenate([e0, e0[:1]]) if R == 1 else X0 + e0
+        m, traj = step_runs(plant, spec, grid, X0, XH0, at, keep)
+        return {k: a[:R] for k, a in m.items()}, traj
+
+    return grid, (mc.CHUNK if fast else len(grid)) * w * 8, step
+
+
+def _values(sig: Any, raw: np.ndarray, rows: int, fast: bool) -> np.ndarray:
+    """A chunk of a random signal's values (rows, steps, dim): ``-b + 2b·U`` from raw draws
+    (the formula of ``Generator.uniform``), else the values themselves."""
+    V = raw.reshape(len(raw), -1, sig.dim)
+    if fast:
+        lo = -np.asarray(sig.bound, dtype=float)
+        V = lo + np.subtract(sig.bound, lo) * V
+    if len(V) < rows:
+        V = np.concatenate([V, V[:1]])
+    return V
