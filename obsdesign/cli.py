@@ -116,20 +116,20 @@ def _fast_value(desc: Any, value: Any, param: Any, ctx: Any) -> Any:
 
 
 def _fast_param_class() -> Any:
-    """The ``RuntimeParam`` of :func:`_fast_runtime_param` (made once, on first use)."""
+    """The ``RuntimeParam`` of :func:`_fast_runtime_param` (made once, on first use; a plain
+    subclass: a dataclass costs milliseconds to create)."""
     if "cls" not in _FAST:
-        from dataclasses import dataclass
-
         from typer import _coercion
 
-        @dataclass(frozen=True)
         class FastParam(_coercion.RuntimeParam):
-            descriptor: Any = None
+            def __init__(self, descriptor: Any) -> None:
+                super().__init__(descriptor.parameter_info, descriptor.annotation)
+                object.__setattr__(self, "descriptor", descriptor)  # frozen dataclass
 
             def _coerce_value(self, value: Any, param: Any, ctx: Any) -> Any:
-                out = _fast_value(self.descriptor, value, param, ctx)
+                out = _fast_value(self.descriptor, value, param, ctx)  # type: ignore[attr-defined]
                 if out is _SLOW:
-                    slow = _coercion.build_runtime_param(self.descriptor)
+                    slow = _coercion.build_runtime_param(self.descriptor)  # type: ignore[attr-defined]
                     out = slow._coerce_value(value, param=param, ctx=ctx)
                 return out
 
@@ -149,8 +149,7 @@ def _fast_runtime_param(self: Any) -> Any:
     would refuse, goes through typer's own adapter, so results and error messages are
     typer's."""
     if self._runtime_param is None:
-        d = self.type_descriptor
-        self._runtime_param = _fast_param_class()(d.parameter_info, d.annotation, d)
+        self._runtime_param = _fast_param_class()(self.type_descriptor)
     return self._runtime_param
 
 
