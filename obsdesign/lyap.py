@@ -103,6 +103,11 @@ class ExactMemo:
     def __init__(self) -> None:
         self._d: dict[tuple[Any, ...], tuple[tuple[fmpq_mat, ...], Any]] = {}
 
+    def __reduce__(self) -> tuple[type, tuple[()]]:
+        # a copied or pickled spec (e.g. sent to a Dask worker) gets an empty memo: the
+        # verdicts stay in this process (and flint matrices do not pickle)
+        return (ExactMemo, ())
+
     def put(self, key: tuple[Any, ...], mats: tuple[fmpq_mat, ...], value: Any) -> None:
         """Record ``value`` for ``key`` (exact scalars and flags) and the exact ``mats``."""
         self._d[key] = (mats, value)

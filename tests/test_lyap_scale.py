@@ -190,3 +190,16 @@ def test_memo_serves_only_exactly_equal_inputs() -> None:
     claims = {c.id: c.status.value for c in api.certify(spec, rep.parameters)}
     assert claims["P-positive-definite"] == "failed"
     assert claims["decay-lmi"] == "failed"
+
+
+def test_memo_does_not_travel() -> None:
+    """A pickled or deep-copied spec (a Dask worker's) carries an empty memo."""
+    import copy
+    import pickle
+
+    memo = lyap.ExactMemo()
+    memo.put(("pd", fmpq(0)), (lyap.fmat(qeye(2)),), True)
+    assert memo.get(("pd", fmpq(0)), (lyap.fmat(qeye(2)),)) is True
+    for other in (pickle.loads(pickle.dumps(memo)), copy.deepcopy(memo)):
+        assert isinstance(other, lyap.ExactMemo)
+        assert other.get(("pd", fmpq(0)), (lyap.fmat(qeye(2)),)) is None
