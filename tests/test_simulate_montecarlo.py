@@ -60,26 +60,27 @@ INPUT_PLANT = PLANT.replace("Bd = [[1], [0]]", "B = [[0], [1]]\nD = [[0.5]]\nBd 
 
 def _run(text, runs, batch=None, ie="E0"):
     sp = load_spec_text(text)
-    return mc.run_batch(sp, joint_system(sp, L), runs, ie, batch), sp
+    return mc.run_batch(sp, joint_system(sp, L), runs, ie, batch=batch), sp
 
 
 def separate(sp, runs, ie="E0"):
     """Every run simulated on its own: its generator (child r of the seed), its initial error
     and signals drawn in the documented order, stepped by the single-run engine
-    (``linear.step_all``), metrics by ``SimResult.metrics``."""
-    js, sim = joint_system(sp, L), sp.simulate
+    (``linear.step_all``); a SimResult per run."""
+    js, sim, s = joint_system(sp, L), sp.simulate, sp.system
     out = []
     for child in mc.run_seeds(sim.seed, runs):
         g = np.random.default_rng(child)
         e0 = sp.sets[ie].sample(g, 1)[0] if ie else sim.xhat0.f - sim.x0.f
         u, d, v = (sig.evaluate(js.grid, g) for sig in (sim.u, sim.disturbance, sim.noise))
         Z = step_all(js, np.concatenate([sim.x0.f, sim.x0.f + e0]), exogenous(u, d, v)[:-1])
-        out.append(SimResult(js.grid, Z[:, :2], Z[:, 2:], None, sp.system.states).metrics())
+        y = Z[:, :2] @ s.C.f.T + u @ s.D.f.T + v @ s.Dn.f.T
+        out.append(SimResult(js.grid, Z[:, :2], Z[:, 2:], y, s.states))
     return out
 
 
 def assert_runs_match(per_run, ref, rtol=1e-12):
-    for i, m in enumerate(ref):
+    for i, m in enumerate(r.metrics() for r in ref):
         for k in ("sup_abs_error", "rmse", "sup_abs_estimate"):
             want = [m[k]["x1"], m[k]["x2"]]
             np.testing.assert_allclose(per_run[k][i], want, rtol=rtol, atol=1e-13)
@@ -131,9 +132,13 @@ def test_results_do_not_depend_on_batching_or_run_count(case, monkeypatch):
     np.testing.assert_array_equal(a.xhat, b.xhat)  # run 0's trajectory
 
 
-def test_run_0_trajectory_is_its_separate_run():
-    r, sp = _run(RANDOM, 3)
-    m = separate(sp, 1)[0]
+@pytest.mark.parametrize("case", ["uniform noise", "random u, d, noise"])
+def test_run_0_trajectory_is_its_separate_run(case):
+    r, sp = _run(CASES[case], 3)
+    one = separate(sp, 1)[0]
+    np.testing.assert_allclose(r.xhat, one.xhat, rtol=1e-12, atol=1e-13)
+    np.testing.assert_allclose(r.y, one.y, rtol=1e-12, atol=1e-13)
+    m = one.metrics()
     got = r.metrics()
     for k in ("sup_abs_error", "rmse", "sup_abs_estimate"):
         for st in ("x1", "x2"):
@@ -179,6 +184,8 @@ def test_noise_seeds_are_spawned_per_run():
     assert len(set(sup.tolist())) == 4
     kids = mc.run_seeds(11, 4)
     assert [k.spawn_key for k in kids] == [(0,), (1,), (2,), (3,)]
+    again = np.random.SeedSequence(11, spawn_key=(2,)).generate_state(4)
+    assert kids[2].generate_state(4).tolist() == again.tolist()
 
 
 def test_quantiles_known_answer():

@@ -151,7 +151,8 @@ def simulate_linear_observer_batch(
     from obsdesign.simulate import montecarlo as mc
 
     if spec.system.linear:
-        return mc.run_batch(spec, joint_system(spec, L), runs, initial_error, batch, span)
+        js = joint_system(spec, L)
+        return mc.run_batch(spec, js, runs, initial_error, batch=batch, span=span)
     from obsdesign.simulate.nonlinear import batch_stepper
 
     grid, per_run, step = batch_stepper(spec, L)

@@ -289,19 +289,12 @@ def _advanced(g: np.random.Generator, steps: int) -> np.random.Generator:
 
 
 def run_batch(
-    spec: Spec,
-    js: Any,
-    runs: int,
-    initial_error: str | None = None,
-    batch: int | None = None,
-    span: tuple[int, int] | None = None,
+    spec: Spec, js: Any, runs: int, initial_error: str | None = None, **study_options: Any
 ) -> SimResult:
     """``runs`` runs of ``js`` (a :class:`~obsdesign.simulate.linear.JointSystem` of the
     bound ``spec``); ``initial_error``: a set name of ``[sets]`` (None: xhat0 − x0);
-    ``batch``: runs stepped together (None: :data:`BATCH_RUNS`, fewer if they do not fit
-    :data:`BATCH_BYTES`); ``span = (a, b)``: only runs a..b-1 of the ``runs`` (same child
-    seeds as in the full range, so run r is the same whatever the span: :func:`merge` joins
-    spans; None: all).
+    ``study_options``: ``batch`` (runs stepped together) and ``span`` (only runs a..b-1),
+    see :func:`study`.
 
     Linearity does the work: the deterministic signals (and the plant trajectory x when no
     random signal reaches it: only the estimate is then stepped per run) enter as one
@@ -327,6 +320,7 @@ def run_batch(
         return m, (x, xh)
 
     per_run = (CHUNK if plan.fast else K + 1) * w * 8
+    batch, span = study_options.get("batch"), study_options.get("span")
     res = study(spec, grid, runs, initial_error, batch, span, per_run, step)
     s = spec.system
     eset = spec.sets[initial_error] if initial_error is not None else None
@@ -354,7 +348,9 @@ def study(
 ) -> SimResult:
     """The Monte Carlo study of the bound ``spec`` on ``grid``: the child seeds, the batches
     (``batch`` runs, default :data:`BATCH_RUNS` or fewer when ``per_run_bytes`` each do not
-    fit :data:`BATCH_BYTES`), each run's generator and initial error, then
+    fit :data:`BATCH_BYTES`; ``span = (a, b)``: only runs a..b-1 of the ``runs``, with the
+    same child seeds as in the full range, so run r is the same whatever the span:
+    :func:`merge` joins spans; None: all), each run's generator and initial error, then
     ``step(rngs, e0, keep)`` → (per-run metrics of the batch, run 0's (x, x̂) or (x, x̂, y)
     when ``keep``) (the generators stand just after the initial errors' draws).
 
