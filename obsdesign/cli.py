@@ -168,7 +168,7 @@ app = typer.Typer(
     add_completion=True,
     rich_markup_mode=None,  # plain click help: rendering help through rich costs ~150 ms
 )
-_state = {"debug": False, "quiet": False}
+_state = {"debug": False}
 #: ``-`` in place of a spec (or report) path: read it from standard input
 STDIN = "-"
 STDIN_NAME = "<stdin>"
@@ -225,15 +225,6 @@ SpecArg = Annotated[
 ]
 
 
-def _setup(quiet: bool = False, width: int | None = None) -> None:
-    """Apply -q/--quiet and --width for this command."""
-    _state["quiet"] = quiet
-    if width is not None:
-        from obsdesign.report.render import set_width
-
-        set_width(width)
-
-
 def _run(fn: Callable[[Any], int], quiet: bool = False, width: int | None = None) -> None:
     """Run a command body ``fn(obsdesign.cli_commands)`` with -q/--quiet and --width applied,
     mapping errors to exit codes without a traceback."""
@@ -243,8 +234,9 @@ def _run(fn: Callable[[Any], int], quiet: bool = False, width: int | None = None
         # from here on Ctrl-C raises KeyboardInterrupt (handled below, cleanup runs)
         if signal.getsignal(signal.SIGINT) is _early_interrupt:
             signal.signal(signal.SIGINT, signal.default_int_handler)
-        _setup(quiet, width)
         from obsdesign import cli_commands
+
+        cli_commands.setup(quiet, width)
 
         # the API turns warnings into report notes; any other stray warning (numpy, scipy)
         # is not printed unless --debug

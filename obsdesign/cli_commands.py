@@ -13,7 +13,20 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from obsdesign.cli import PLOT_SUFFIXES, STDIN, STDIN_NAME, Fmt, _state
+from obsdesign.cli import PLOT_SUFFIXES, STDIN, STDIN_NAME, Fmt
+
+#: -q/--quiet of the running command (kept here, not in :mod:`obsdesign.cli`: run as
+#: ``python obsdesign/cli.py`` that module is ``__main__`` and this one imports a copy)
+_state = {"quiet": False}
+
+
+def setup(quiet: bool = False, width: int | None = None) -> None:
+    """Apply -q/--quiet and --width for this command."""
+    _state["quiet"] = quiet
+    if width is not None:
+        from obsdesign.report.render import set_width
+
+        set_width(width)
 
 
 def _is_stdin(path: Path | None) -> bool:
