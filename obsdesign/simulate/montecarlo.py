@@ -13,9 +13,10 @@ Speed (issue 12 item 4): the plant trajectory x is computed once when no random 
 reaches it (then only the estimate is stepped per run, x entering as a shared input), the
 deterministic signals enter as one shared term per block; the time recursion goes :data:`BLOCK` steps per matrix product
 over the batch axis; uniform draws are made :data:`CHUNK` steps at a time as raw U[0, 1)
-numbers (the range and offset folded into the matrices); only per-run metrics are kept. The
-products keep the runs as rows, which OpenBLAS computes the same way whatever the number
-of rows, so a run's numbers are bitwise the same for any batch size or span (tested in
+numbers (the range and offset folded into the matrices); only running per-run metrics are
+kept (elementwise over the blocks, on whole contiguous arrays). The products keep the runs
+as rows, which OpenBLAS computes the same way whatever the number of rows (two or more), so
+a run's numbers are bitwise the same for any batch size or span (tested in
 tests/test_simulate_montecarlo.py); they agree with a separate run
 (:func:`obsdesign.simulate.linear.simulate_linear_observer`) to rounding.
 
@@ -144,7 +145,7 @@ def _mm(a: np.ndarray, b: np.ndarray, out: np.ndarray | None = None) -> np.ndarr
     if out is None:
         out = np.empty((R, b.shape[1]))
     step = max(2, MNK_ONE_THREAD // max(1, b.shape[0] * b.shape[1]))
-    pieces = max(1, R // step)
+    pieces = max(1, min(-(-R // step), R // 2))  # pieces of at most `step`, at least 2 rows
     cuts = [R * i // pieces for i in range(pieces + 1)]
     for i, j in zip(cuts, cuts[1:], strict=False):
         np.matmul(a[i:j], b, out=out[i:j])
@@ -406,15 +407,18 @@ def _run(
 ) -> dict[str, np.ndarray]:
     """Step one batch (initial errors ``e0`` (R, n)) over K steps; per-run metrics.
 
-    The products keep the runs as rows (state (R, N + 1) with a column of ones for the shared
-    block term, block (R, b·N)): OpenBLAS then computes every row the same way whatever the
-    number of rows (two or more; one run is stepped as two equal rows), so a run's numbers do
-    not depend on the batching. The metrics are taken on a runs-last copy of each block
-    ((b, N, R): every reduction then runs along contiguous rows). ``traj0`` (K + 1, N)
-    receives run 0's states when given."""
+    Every block of m steps gives, per run, the estimates H = (x̂_{k0+1}, …, x̂_{k0+m}) and
+    the errors E as rows of (R, m·n) arrays, each from products with the runs as rows
+    ([state, 1] times the block matrices, plus the raw draws times the Toeplitz part; the
+    shared terms ride on the column of ones): OpenBLAS computes every row the same way
+    whatever the number of rows (two or more; one run is stepped as two equal rows), so a
+    run's numbers do not depend on the batching. The metrics are running elementwise
+    max / min / sum of squares over the blocks (whole contiguous arrays), reduced over the
+    m positions once at the end. ``traj0`` (K + 1, N) receives run 0's states when given."""
     R, N = len(e0), len(plan.idx)
+    Rr = max(R, 2)
     shared_x = plan.x_sh is not None
-    st = np.ones((max(R, 2), N + 1))  # the states and a column of ones
+    st = np.ones((Rr, N + 1))  # the states and a column of ones
     xh0 = x0 + e0  # (R, n)
     if shared_x:
         st[:R, :N] = xh0
@@ -422,77 +426,118 @@ def _run(
         st[:R, :n] = x0
         st[:R, n:N] = xh0
     st[R:] = st[:1]
-    e = (xh0 - x0).T
-    sup_e = np.abs(e)
-    sq = e * e
-    sup_h = np.abs(xh0.T)
     if traj0 is not None:
         traj0[0] = st[0, :N]
-    sh = _Blocks.of(plan.F, plan.G_sh, BLOCK)
-    Csh = _block_inputs(sh, plan.W_sh, K)  # (blocks, b·N)
-    rbT = [_Blocks.of(plan.F, G, BLOCK).T.T.copy() for G in plan.G_rand]  # (b·w, b·N)
-    PAT = np.empty((N + 1, BLOCK * N))  # [P | shared term]ᵀ
-    PAT[:N] = sh.P.T
+    bm = _BlockMatrices(plan, K, n)
+    acc = {k: np.full((Rr, BLOCK * n), v) for k, v in _ACC.items()}
+    bufs = {m: [np.empty((Rr, m * n)) for _ in range(4)] for m in {BLOCK, K % BLOCK} if m}
     dims = draws.dims if draws is not None else []
-    # buffers reused by every block (fresh ones cost page faults at this size)
-    Rr = len(st)
-    bufs = {m: _BlockBufs(Rr, m, N, n, R) for m in {BLOCK, K % BLOCK} if m}
+    E = np.empty((Rr, 0))
     for c0 in range(0, K, CHUNK):
         c1 = min(K, c0 + CHUNK)
         raw = draws.chunk(c0, c1) if draws is not None else []
         for k0 in range(c0, c1, BLOCK):
             m = min(BLOCK, c1 - k0)
-            rows = m * N
-            bb = bufs[m]
-            PAT[N, :rows] = Csh[k0 // BLOCK, :rows]
-            D = bb.D
-            _mm(st, PAT[:, :rows], out=D)
-            for TT, a, d in zip(rbT, raw, dims, strict=True):
-                j = (k0 - c0) * d
-                _mm(_rows(a[:, j : j + m * d]), TT[: m * d, :rows], out=bb.D2)
-                np.add(D, bb.D2, out=D)
-            st[:, :N] = D[:, rows - N :]
-            if R == 1:
-                st[1:] = st[:1]
-            np.copyto(bb.Zt, D[:R].T)
-            Z = bb.Zt.reshape(m, N, R)
-            if shared_x:
-                assert plan.x_sh is not None
-                H, E = Z, bb.E
-                np.subtract(Z, plan.x_sh[k0 + 1 : k0 + m + 1, :, None], out=E)
-            else:
-                H, E = Z[:, n:], bb.E
-                np.subtract(H, Z[:, :n], out=E)
-            t = bb.t
-            for acc, a in ((sup_h, H), (sup_e, E)):
-                np.max(a, axis=0, out=t)
-                np.maximum(acc, t, out=acc)
-                np.min(a, axis=0, out=t)
-                np.negative(t, out=t)
-                np.maximum(acc, t, out=acc)
-            np.add(sq, np.einsum("kir,kir->ir", E, E), out=sq)
+            cm = m * n
+            H, E, X, T = bufs[m]
+            PH, PE, PX = bm.at(k0 // BLOCK)
+            _mm(st, PH[:, :cm], out=H)
+            _mm(st, (PE if shared_x else PX)[:, :cm], out=E if shared_x else X)
+            for j, (a, d) in enumerate(zip(raw, dims, strict=True)):
+                blk = _rows(a[:, (k0 - c0) * d : (k0 - c0 + m) * d])
+                _mm(blk, bm.TH[j][: m * d, :cm], out=T)
+                np.add(H, T, out=H)
+                if shared_x:
+                    np.add(E, T, out=E)
+                else:
+                    _mm(blk, bm.TX[j][: m * d, :cm], out=T)
+                    np.add(X, T, out=X)
+            if not shared_x:
+                np.subtract(H, X, out=E)
+                st[:, :n] = X[:, cm - n :]
+            st[:, N - n : N] = H[:, cm - n :]
+            _accumulate(acc, H, E, T, cm)
             if traj0 is not None:
-                traj0[k0 + 1 : k0 + m + 1] = Z[:, :, 0]
-    fin = st[:R, :N]
-    e_end = fin - plan.x_sh[K] if plan.x_sh is not None else fin[:, n:] - fin[:, :n]
+                traj0[k0 + 1 : k0 + m + 1, N - n :] = H[0].reshape(m, n)
+                if not shared_x:
+                    traj0[k0 + 1 : k0 + m + 1, :n] = X[0].reshape(m, n)
+    e = xh0 - x0
+    e_end = E[:R, -n:] if K else e
+    pos = {k: a[:R].reshape(R, BLOCK, n) for k, a in acc.items()}
+    sup_h = np.maximum(pos["hi"].max(axis=1), -pos["lo"].min(axis=1))
+    sup_e = np.maximum(pos["ehi"].max(axis=1), -pos["elo"].min(axis=1))
     return {
-        "sup_abs_error": sup_e.T,
-        "rmse": np.sqrt(sq / (K + 1)).T,
-        "sup_abs_estimate": sup_h.T,
+        "sup_abs_error": np.maximum(sup_e, np.abs(e)),
+        "rmse": np.sqrt((e * e + pos["sq"].sum(axis=1)) / (K + 1)),
+        "sup_abs_estimate": np.maximum(sup_h, np.abs(xh0)),
         "final_error_norm": np.linalg.norm(e_end, axis=1),
     }
 
 
-class _BlockBufs:
-    """The arrays of one block of m steps: products (R' ≥ 2 rows, m·N), their runs-last
-    copy, the errors (m, n, R) and a per-run reduction (n, R)."""
+#: the running metrics of :func:`_run` and their start values
+_ACC = {"hi": -np.inf, "lo": np.inf, "ehi": -np.inf, "elo": np.inf, "sq": 0.0}
 
-    def __init__(self, Rr: int, m: int, N: int, n: int, R: int):
-        self.D = np.empty((Rr, m * N))
-        self.D2 = np.empty((Rr, m * N))
-        self.Zt = np.empty((m * N, R))
-        self.E = np.empty((m, n, R))
-        self.t = np.empty((n, R))
+
+def _accumulate(
+    acc: dict[str, np.ndarray], H: np.ndarray, E: np.ndarray, T: np.ndarray, cm: int
+) -> None:
+    """Running elementwise max / min of the estimates H and errors E and sum of E² (T: a
+    scratch array of E's shape); a shorter last block updates its ``cm`` first positions."""
+    full = cm == acc["sq"].shape[1]
+    for k, a, f in (
+        ("hi", H, np.maximum),
+        ("lo", H, np.minimum),
+        ("ehi", E, np.maximum),
+        ("elo", E, np.minimum),
+    ):
+        if full:
+            f(acc[k], a, out=acc[k])
+        else:
+            acc[k][:, :cm] = f(acc[k][:, :cm], a)
+    np.multiply(E, E, out=T)
+    if full:
+        np.add(acc["sq"], T, out=acc["sq"])
+    else:
+        acc["sq"][:, :cm] += T
+
+
+class _BlockMatrices:
+    """The block matrices of :func:`_run`, columns step-major (position i·n + j: state j of
+    step i + 1, so that a shorter block uses a prefix): ``at(block)`` gives the (N + 1)-row
+    maps [state; 1] → estimates, errors (when the plant trajectory is shared: the estimates
+    minus x(k)) and plant states, whose last row is that block's shared term; ``TH[j]``,
+    ``TX[j]``: the Toeplitz maps of random signal j's raw draws to estimates, plant states."""
+
+    def __init__(self, plan: _Plan, K: int, n: int):
+        N = len(plan.idx)
+        sh = _Blocks.of(plan.F, plan.G_sh, BLOCK)
+        steps = np.arange(BLOCK)[:, None] * N
+        rows_h = (steps + np.arange(N - n, N)).ravel()  # the estimate's coordinates
+        rows_x = (steps + np.arange(n)).ravel()
+        Csh = _block_inputs(sh, plan.W_sh, K)  # (blocks, b·N)
+        self.CH = Csh[:, rows_h]
+        self.CX = Csh[:, rows_x]
+        if plan.x_sh is not None:
+            xs = np.zeros((len(Csh) * BLOCK, n))
+            xs[:K] = plan.x_sh[1:]
+            self.CE = self.CH - xs.reshape(len(Csh), BLOCK * n)
+        self.PH = np.vstack([sh.P[rows_h].T, np.zeros((1, BLOCK * n))])
+        self.PE = self.PH.copy()
+        self.PX = np.vstack([sh.P[rows_x].T, np.zeros((1, BLOCK * n))])
+        self.shared_x = plan.x_sh is not None
+        self.TH, self.TX = [], []
+        for G in plan.G_rand:
+            T = _Blocks.of(plan.F, G, BLOCK).T
+            self.TH.append(np.ascontiguousarray(T[rows_h].T))
+            self.TX.append(np.ascontiguousarray(T[rows_x].T))
+
+    def at(self, block: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        self.PH[-1] = self.CH[block]
+        if self.shared_x:
+            self.PE[-1] = self.CE[block]
+        else:
+            self.PX[-1] = self.CX[block]
+        return self.PH, self.PE, self.PX
 
 
 def _rows(a: np.ndarray) -> np.ndarray:
