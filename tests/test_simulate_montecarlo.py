@@ -202,3 +202,12 @@ def test_parse_initial_error():
         mc.parse_initial_error(Table({"initial_error": "nope"}, "f.toml", "simulate"), sp)
     with pytest.raises(SpecError, match="dimension 2"):
         mc.parse_initial_error(Table({"initial_error": "line"}, "f.toml", "simulate"), sp)
+
+
+def test_products_in_pieces_keep_every_row():
+    g = np.random.default_rng(0)
+    a, b = g.standard_normal((1001, 19)), g.standard_normal((19, 64))
+    whole = mc._mm(a, b)  # cut into pieces of at most 2^18 / (19·64) rows
+    np.testing.assert_allclose(whole, a @ b, rtol=1e-13)
+    for rows in (slice(0, 2), slice(5, 8), slice(300, 1001)):
+        np.testing.assert_array_equal(mc._mm(a[rows], b), whole[rows])

@@ -11,14 +11,14 @@ draws do not depend on how many runs there are or how they are batched.
 
 Speed (issue 12 item 4): the plant trajectory x is computed once when no random signal
 reaches it (then only the estimate is stepped per run, x entering as a shared input), the
-deterministic signals enter as one shared term per block; the time recursion goes :data:`BLOCK` steps per matrix product
-over the batch axis; uniform draws are made :data:`CHUNK` steps at a time as raw U[0, 1)
-numbers (the range and offset folded into the matrices); only running per-run metrics are
-kept (elementwise over the blocks, on whole contiguous arrays). The products keep the runs
-as rows, which OpenBLAS computes the same way whatever the number of rows (two or more), so
-a run's numbers are bitwise the same for any batch size or span (tested in
-tests/test_simulate_montecarlo.py); they agree with a separate run
-(:func:`obsdesign.simulate.linear.simulate_linear_observer`) to rounding.
+deterministic signals enter as one shared term per block; the time recursion goes
+:data:`BLOCK` steps per matrix product over the batch axis; uniform draws are made
+:data:`CHUNK` steps at a time as raw U[0, 1) numbers (the range and offset folded into the
+matrices); only running per-run metrics are kept (elementwise over the blocks, on whole
+contiguous arrays). The products keep the runs as rows, which OpenBLAS computes the same way
+whatever the number of rows (two or more), so a run's numbers are bitwise the same for any
+batch size or span (tested in tests/test_simulate_montecarlo.py); they agree with a separate
+run (:func:`obsdesign.simulate.linear.simulate_linear_observer`) to rounding.
 
 ``[simulate] initial_error = "NAME"`` is read by :func:`parse_initial_error`, which a method
 calls from its ``parse_simulate``.
