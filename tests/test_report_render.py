@@ -1,0 +1,69 @@
+"""The terminal renderer: highlighting is skipped only where it cannot change a byte (no
+colour system), and the dependency versions of a report are read as importlib.metadata
+reads them (issue 12 item 3: both are cold-start savings that must not change output)."""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from obsdesign import api
+from obsdesign.report import model, render
+
+ROOT = Path(__file__).resolve().parents[1]
+SPEC = ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+
+
+def _rendered(monkeypatch: pytest.MonkeyPatch, rep: Any, **console_kw: Any) -> str:
+    """render_text of ``rep`` into a string through a Console made with ``console_kw``."""
+    from rich.console import Console
+
+    buf = io.StringIO()
+    monkeypatch.setattr(render, "console", lambda: Console(file=buf, width=100, **console_kw))
+    rep.notes = [*rep.notes, "0.5 and 'text' and None and [1, 2] and x=3"]  # highlightable
+    render.render_text(rep)
+    return buf.getvalue()
+
+
+@pytest.mark.parametrize("color", [None, "truecolor"])
+def test_highlight_changes_nothing_without_a_colour_system(
+    monkeypatch: pytest.MonkeyPatch, color: str | None
+) -> None:
+    rep = api.design(SPEC)
+    kw: dict[str, Any] = {"color_system": color, "force_terminal": color is not None}
+    on = _rendered(monkeypatch, rep, highlight=True, **kw)
+    off = _rendered(monkeypatch, api.design(SPEC), highlight=False, **kw)
+    if color is None:
+        assert on == off and "\x1b[" not in on
+    else:  # with colours the highlighting shows, so it must stay on there
+        assert on != off
+
+
+def test_console_highlights_only_with_colours(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv("FORCE_COLOR", raising=False)
+    monkeypatch.setenv("TERM", "dumb")
+    plain = render.console()  # stdout is captured by pytest: not a terminal
+    assert plain.color_system is None and plain._highlight is False
+    monkeypatch.setenv("FORCE_COLOR", "1")
+    monkeypatch.setenv("TERM", "xterm-256color")
+    coloured = render.console()
+    assert coloured.color_system is not None and coloured._highlight is True
+
+
+def test_dependency_versions_match_importlib_metadata() -> None:
+    from importlib import metadata
+
+    names = (*model.DEPS, "obsdesign", "typer", "rich", "no-such-distribution-xyz")
+    fast = model.dist_versions(names)
+    for n in names:
+        try:
+            want: str | None = metadata.version(n)
+        except metadata.PackageNotFoundError:
+            want = None
+        assert fast[n] == want, n
+    info = model.tool_info()
+    assert info["version"] == metadata.version("obsdesign")
+    assert set(info["dependencies"]) == set(model.DEPS)
