@@ -189,9 +189,7 @@ def _system(t: Table) -> System:
             if not k.isidentifier():
                 raise pt.error(k, "expected an identifier as parameter name")
             params[k] = pt.scalar(k)
-    sys = System(
-        time, A, B, C, D, Bd, Dn, sample_time, list(states), params, n_states=n, n_outputs=p
-    )
+    sys = System(time, A, B, C, D, Bd, Dn, sample_time, list(states), n, p, params)
     if has_f and t.has("psi"):
         raise t.error(
             "psi", "give the plant as f (whole right-hand side) or as A x + psi, not both"

@@ -21,6 +21,10 @@ class System:
     ``f`` the whole right-hand side (x⁺ or ẋ), or ``psi`` an additive term
     (x⁺ or ẋ = A x + B u + Bd d + ψ); ``h`` the whole output map; ``u_signal`` an open-loop
     input u(t). A and C are None when only expressions describe the plant.
+
+    Dimensions, fixed when the spec is read: ``n`` states and ``p`` outputs (given by A and
+    C, or counted from ``f`` / ``states`` and ``h``), and ``m``, ``nd``, ``nv``, the numbers of
+    inputs u, disturbance inputs d and noise inputs v (the columns of B, Bd and Dn).
     """
 
     time: str
@@ -32,33 +36,19 @@ class System:
     Dn: Value
     sample_time: Value | None
     states: list[str]
+    n: int
+    p: int
     parameters: dict[str, Value] = field(default_factory=dict)
     f: list[Expr] | None = None
     psi: list[Expr] | None = None
     h: list[Expr] | None = None
     u_signal: list[Expr] | None = None
-    n_states: int = 0
-    n_outputs: int = 0
+    m: int = field(init=False)
+    nd: int = field(init=False)
+    nv: int = field(init=False)
 
-    @property
-    def n(self) -> int:
-        return self.A.shape[0] if self.A is not None else self.n_states
-
-    @property
-    def p(self) -> int:
-        return self.C.shape[0] if self.C is not None else self.n_outputs
-
-    @property
-    def m(self) -> int:
-        return self.B.shape[1]
-
-    @property
-    def nd(self) -> int:
-        return self.Bd.shape[1]
-
-    @property
-    def nv(self) -> int:
-        return self.Dn.shape[1]
+    def __post_init__(self) -> None:
+        self.m, self.nd, self.nv = self.B.shape[1], self.Bd.shape[1], self.Dn.shape[1]
 
     @property
     def discrete(self) -> bool:
