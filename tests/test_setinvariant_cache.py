@@ -165,14 +165,20 @@ SEED0 = spec_text(
 
 def test_time_budget_refuses_with_reason() -> None:
     sp = api.load_spec_text(SEED0.replace("max_iterations = 60", "time_limit = 1e-9"), "t.toml")
-    with pytest.raises(SolverError, match=r"not converged within 1e-09 s .* / 1 iterations"):
+    with pytest.raises(
+        SolverError,
+        match=r"not converged within 1e-09 s .* / 0 iterations: no iteration finished with",
+    ):
         api.design(sp)
     rep = api.design(api.load_spec_text(SEED0, "s0.toml"))  # the default budget: converges
     assert rep.exit_code() == 0 and rep.parameters["iterations"] == 2
-    # converged in one iteration, then no time left for the exact stage
+    # iterations done, no time left for the exact stage
+    from obsdesign.methods.setinvariant.design import final_stage
+    from obsdesign.methods.setinvariant.problem import build
+
     sp = api.load_spec_text(RANDOM.replace("max_iterations = 60", "time_limit = 1e-9"), "r.toml")
     with pytest.raises(SolverError, match=r"exact certificate not started within 1e-09 s"):
-        api.design(sp)
+        final_stage(build(sp), np.zeros((0, 3)), True, 0.8979, 0.0, sp.options)
 
 
 def test_time_budget_inside_the_exact_theorem31_loop():
@@ -284,3 +290,22 @@ def test_theorem31_factor_is_the_max_over_every_breakpoint():
     mid = (res.factor + ex.lam) / 2
     r2 = ce.theorem31(ex, G, vs=raised(mid), zs_given=zs, vrep=vrep)
     assert r2.ok and r2.factor == mid and r2.worst == l
+
+
+def test_time_budget_inside_an_iteration():
+    """The budget is checked inside an iteration too (between slices and LP blocks), not
+    only between iterations: a deadline already past stops the first iteration."""
+    from obsdesign.methods.setinvariant import algorithms as al
+    from obsdesign.methods.setinvariant import lps
+    from obsdesign.methods.setinvariant.budget import Timeout
+    from obsdesign.methods.setinvariant.problem import build
+
+    fl = build(api.load_spec_text(SEED0, "s0.toml")).fl
+    r = al.general(fl, 0.9604, 0.9604, 60, True, deadline=0.0)
+    assert r.timed_out and r.iterations == 0 and not r.converged
+    assert al.general(fl, 0.9604 / 1.001, 0.9604, 60, True, deadline=None).converged
+    G = fl.G0
+    with pytest.raises(Timeout):
+        lps.eps_batch(G, np.zeros((3, len(G))), np.zeros(len(G)), deadline=0.0)
+    with pytest.raises(Timeout):
+        lps.phi_at(G, fl.A, np.eye(3), np.zeros((0, 2), dtype=int), fl.C[0], 0.01, np.zeros(1), 0.0)

@@ -27,6 +27,7 @@ import numpy as np
 from obsdesign.sets import polytope_ops as po
 
 from . import lps
+from .budget import Timeout
 
 Progress = Callable[[str], None]
 
@@ -79,6 +80,7 @@ def _eps_screened(
     zs: np.ndarray,
     prev: tuple[np.ndarray, np.ndarray] | None,
     lam_stop: float,
+    deadline: float | None = None,
 ) -> lps.EpsResult:
     """ε(z^l) of LP (9), solving the LP only where needed.
 
@@ -88,14 +90,14 @@ def _eps_screened(
     and the bound is reported as its ε); the LP is solved at the other z^l. The worst z and
     the stopping decision are therefore the same as with all LPs solved."""
     if prev is None or len(prev[0]) < 2:
-        return lps.eps_batch(G, phi, dl)
+        return lps.eps_batch(G, phi, dl, deadline=deadline)
     zp, vp = prev
     vi = np.stack([np.interp(zs, zp, vp[:, k]) for k in range(vp.shape[1])], axis=1)
     ub = (phi + dl[None, :] + vi @ G.T).max(axis=1)
     need = np.nonzero(ub > lam_stop)[0]
     eps, v = ub.copy(), vi
     if len(need):
-        er = lps.eps_batch(G, phi[need], dl)
+        er = lps.eps_batch(G, phi[need], dl, deadline=deadline)
         better = er.eps < ub[need]
         eps[need] = np.where(better, er.eps, ub[need])
         v[need] = np.where(better[:, None], er.v, vi[need])
@@ -132,8 +134,11 @@ def general(
         P, G = st.V, st.G
         dl = lps.delta(G, pb.B1, pb.Dv)
         zs = lps.z_d(P, c, pb.eta)  # step 3
-        phi, slices = lps.phi_at(G, pb.A, P, st.edges, c, pb.eta, zs)  # step 4a
-        er = _eps_screened(G, phi, dl, zs, prev, lam_stop)  # step 4b
+        try:
+            phi, slices = lps.phi_at(G, pb.A, P, st.edges, c, pb.eta, zs, deadline)  # step 4a
+            er = _eps_screened(G, phi, dl, zs, prev, lam_stop, deadline)  # step 4b
+        except Timeout:  # the budget ran out inside the iteration
+            return IterResult(G, P, eps_l, it - 1, False, hist, timed_out=True)
         prev = (zs, er.v)
         l = int(np.argmax(er.eps))  # step 5
         eps_l = float(er.eps[l])

@@ -56,7 +56,9 @@ TABLE: dict[str, ClaimDef] = {
             "{{e : G e <= 1}} = conv(V): a bounded polytope with the origin inside, given by its "
             "facets G and vertices V (facets = rows of G, vertices = rows of V)",
             f"{REF}, Section III",
-            "exact hull of V (cdd.gmp) has exactly the rows of G; every point of V is a vertex",
+            "exact vertex-facet incidences: every point of V satisfies every row; each row has "
+            "n independent points of V on it; rows through each point have rank n; every "
+            "ridge of every facet lies on a second row",
         ),
         ClaimDef(
             "omega-contained",

@@ -111,10 +111,14 @@ def _budget(r: al.IterResult, o: Options) -> None:
     """Stop the design when the iterations ran out of time (``[method] time_limit``): a
     SolverError (exit 3) saying how far they got, instead of running for minutes."""
     if r.timed_out:
+        last = (
+            f"last ε = {r.eps:.6g} > λ = {float(o.lam):g}"
+            if np.isfinite(r.eps)
+            else "no iteration finished"
+        )
         raise SolverError(
             f"not converged within {o.time_limit:g} s ([method] time_limit) / {r.iterations} "
-            f"iterations: last ε = {r.eps:.6g} > λ = {float(o.lam):g} with {len(r.G)} facets "
-            "(raise time_limit, or a larger λ or Δδ)"
+            f"iterations: {last} with {len(r.G)} facets (raise time_limit, or a larger λ or Δδ)"
         )
 
 
