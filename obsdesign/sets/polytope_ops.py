@@ -460,8 +460,10 @@ def canonical(G: np.ndarray, g: np.ndarray | None = None) -> np.ndarray:
         G = np.array(
             [[G[i, j] / gv[i] for j in range(G.shape[1])] for i in range(G.shape[0])], dtype=object
         )
-    uniq = sorted({tuple(_fr(x) for x in r) for r in G})
-    return np.array([[_q(x) for x in r] for r in uniq], dtype=object).reshape(len(uniq), G.shape[1])
+    rows = [[x if isinstance(x, fmpq) else _q(_fr(x)) for x in r] for r in G]
+    uniq = {tuple((x.p, x.q) for x in r): r for r in rows}  # (fmpq hashes slowly)
+    out = sorted(uniq.values())  # lexicographic, exact comparisons
+    return np.array(out, dtype=object).reshape(len(out), G.shape[1])
 
 
 def exact_remove_redundant(G: np.ndarray) -> np.ndarray:
