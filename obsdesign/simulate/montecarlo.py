@@ -145,6 +145,8 @@ def _mm(a: np.ndarray, b: np.ndarray, out: np.ndarray | None = None) -> np.ndarr
     if out is None:
         out = np.empty((R, b.shape[1]))
     step = max(2, MNK_ONE_THREAD // max(1, b.shape[0] * b.shape[1]))
+    if R <= step:
+        return np.matmul(a, b, out=out)
     pieces = max(1, min(-(-R // step), R // 2))  # pieces of at most `step`, at least 2 rows
     cuts = [R * i // pieces for i in range(pieces + 1)]
     for i, j in zip(cuts, cuts[1:], strict=False):
