@@ -167,3 +167,23 @@ def test_mixed_and_empty_inputs_stay_exact():
     assert p.tolist() == [F(1), F(2)] and all(isinstance(x, fmpq) for x in p)
     assert qparse([[3], [4]]).shape == (2, 1)
     assert qparse([0.1])[0] == Q(0.1)
+
+
+@given(st.integers(-(10**40), 10**40), st.integers(1, 10**40))
+def test_q_of_ratio_text_and_nearest_float_match_fraction(p: int, q: int) -> None:
+    """The integer-parsing fast path of Q and the int/int float of to_float agree with
+    Fraction (parse, and correctly rounded float) on canonical and non-canonical texts."""
+    fr = Fraction(p, q)
+    for text in (f"{p}/{q}", str(fr)):
+        x = Q(text)
+        assert (int(x.p), int(x.q)) == (fr.numerator, fr.denominator)
+        assert to_float(x) == float(fr)
+    assert list(to_float(qparse([f"{p}/{q}", str(p)]))) == [float(fr), float(p)]
+
+
+def test_q_of_text_rejects_zero_denominator_and_keeps_fraction_forms() -> None:
+    with pytest.raises(ZeroDivisionError):
+        Q("3/0")
+    assert Q("1.25") == fmpq(5, 4) and Q(" -2/4 ") == fmpq(-1, 2) and Q("1e2") == 100
+    with pytest.raises(ValueError):
+        Q("1/2/3")

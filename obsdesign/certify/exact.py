@@ -9,6 +9,7 @@ in exact arithmetic with ordinary numpy syntax. Never mix ``fmpq`` with ``fracti
 from __future__ import annotations
 
 import math
+import re
 from decimal import Decimal
 from fractions import Fraction
 from typing import Any
@@ -17,6 +18,7 @@ import numpy as np
 from flint import fmpq
 
 Rational = fmpq
+_RATIO = re.compile(r"(-?[0-9]+)(?:/([0-9]+))?")
 QMatrix = np.ndarray  # dtype=object, entries fmpq
 
 
@@ -41,6 +43,9 @@ def Q(x: Any) -> fmpq:  # noqa: N802 - Q for the rationals
     if isinstance(x, Fraction):
         return fmpq(x.numerator, x.denominator)
     if isinstance(x, str):
+        m = _RATIO.fullmatch(x)
+        if m:  # the canonical "p/q" or "p" of qstr: integer parsing, no Fraction round trip
+            return fmpq(int(m[1]), int(m[2])) if m[2] else fmpq(int(m[1]))
         fr = Fraction(x.strip())
         return fmpq(fr.numerator, fr.denominator)
     raise TypeError(f"cannot convert {type(x).__name__} to a rational")
@@ -83,12 +88,17 @@ def to_float(a: Any) -> np.ndarray | float:
     if isinstance(a, fmpq):
         return _qfloat(a)
     arr = np.asarray(a, dtype=object)
-    return np.vectorize(_qfloat, otypes=[float])(arr) if arr.size else arr.astype(float)
+    if not arr.size:
+        return arr.astype(float)
+    return np.fromiter((_qfloat(v) for v in arr.flat), dtype=float, count=arr.size).reshape(
+        arr.shape
+    )
 
 
 def _qfloat(x: Any) -> float:
     if isinstance(x, fmpq):
-        return float(Fraction(int(x.p), int(x.q)))  # correctly rounded
+        # int / int is correctly rounded in CPython (it is what Fraction.__float__ does)
+        return int(x.p) / int(x.q)
     return float(x)
 
 
@@ -143,12 +153,13 @@ def qparse(s: Any) -> Any:
         arr = np.array(s, dtype=object)
         if arr.size == 0 or any(isinstance(v, list) for v in arr.flat):
             raise ValueError("ragged or empty exact array")
-        out = np.empty(arr.shape, dtype=object)
-        for idx, v in np.ndenumerate(arr):
+        flat = arr.reshape(-1)
+        for v in flat:
             if isinstance(v, bool) or not isinstance(v, (str, int, float)):
                 raise ValueError(f"not an exact value: {v!r}")
-            out[idx] = Q(v)
-        return out
+        out = np.empty(flat.shape, dtype=object)
+        out[:] = [Q(v) for v in flat]
+        return out.reshape(arr.shape)
     raise ValueError(f"not an exact value: {s!r}")
 
 
