@@ -620,8 +620,10 @@ class HullTimeout(Exception):
 
 
 #: exact hulls of at most this many points run in the calling process even under a time
-#: budget (measured: cdd.gmp needs < 0.05 s for 60 points in 4-D, starting the child ~0.25 s)
-CHILD_MIN_POINTS = 60
+#: budget. Measured on the shared 2-core machine (load ~6): starting the child and handing
+#: the points over costs 0.2 s idle, ~0.9 s loaded; cdd.gmp itself takes 0.03-0.3 s for 10-20
+#: points in 3-/4-D, but 1.3 s for 30 and 2.4 s for 40 points on the 4-sphere
+CHILD_MIN_POINTS = 20
 
 
 def _pack(P: np.ndarray) -> list[list[tuple[int, int]]]:

@@ -35,10 +35,11 @@ class Options:
     mirrored images (general algorithm); ``strict``: the certified factor must be ≤ λ;
     ``fallback``: what follows a symmetric C_K^∞ that fails Theorem 3.1; ``L``: a linear gain
     to certify (n×p, exact); ``linear_law``: compute the admissible linear gains (p = n − 1);
-    ``time_limit``: seconds the design may run (default :data:`TIME_LIMIT`): past it, between
-    two iterations or two breakpoints of the exact Theorem 3.1 check, it stops with "not
-    converged within N s / K iterations" or "exact certificate not finished within N s"
-    (exit 3).
+    ``time_limit``: seconds the design may run (default :data:`TIME_LIMIT`): past it (checked
+    between slices, LP blocks, iterations and breakpoints of the exact Theorem 3.1 check; a
+    cdd.gmp hull runs in a child process killed at the deadline) it stops with "not
+    converged within N s / K iterations" or "exact certificate not started / not finished
+    within N s" (exit 3).
     """
 
     omega: str
@@ -58,7 +59,7 @@ class Options:
 
 
 #: default time budget of a design, in seconds (``[method] time_limit``): the float
-#: iterations and the exact Theorem 3.1 loop check it (a cdd.gmp hull call is not interrupted)
+#: iterations and the exact stage check it; a cdd.gmp hull runs in a child process it kills
 TIME_LIMIT = 45.0
 
 
