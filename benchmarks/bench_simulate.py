@@ -14,10 +14,13 @@
    a few runs for reference.
 3. The same study with the plant given by an expression (``[system] psi``): the batched runs
    (:mod:`obsdesign.simulate.nonlinear`) against separate runs. Target >= 100×.
+
+``OBSDESIGN_BENCH_QUICK=1``: fewer repetitions, and 2,000 steps in the nonlinear study.
 """
 
 from __future__ import annotations
 
+import os
 import re
 import statistics
 import time
@@ -26,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+QUICK = bool(os.environ.get("OBSDESIGN_BENCH_QUICK"))
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml"
 
@@ -176,8 +180,12 @@ def monte_carlo_nonlinear(runs: int = 1000, N: int = 10**4, rounds: int = 3) -> 
 
 def main() -> None:
     million_steps()
-    monte_carlo()
-    monte_carlo_nonlinear()
+    if QUICK:
+        monte_carlo(rounds=3, sample=4)
+        monte_carlo_nonlinear(N=2000, rounds=1)
+    else:
+        monte_carlo()
+        monte_carlo_nonlinear()
 
 
 if __name__ == "__main__":
