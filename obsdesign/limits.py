@@ -234,18 +234,45 @@ def int_digits() -> Iterator[None]:
 
 
 # -- nesting --------------------------------------------------------------------------------
+# A node of the walk is (parent node, key, is_dict_key) or None for the top: the key path is
+# only spelled out for the node that breaks a limit (building ~10⁵ path strings for a
+# 100-state report cost more than the checks).
+_Node = tuple[Any, Any, bool] | None
+
+
+def _path(node: _Node) -> str:
+    parts: list[tuple[Any, bool]] = []
+    while node is not None:
+        node, key, is_key = node
+        parts.append((key, is_key))
+    out = ""
+    for key, is_key in reversed(parts):
+        out = (f"{out}.{key}" if out else str(key)) if is_key else f"{out}[{key}]"
+    return out
+
+
 def walk(data: Any) -> Iterator[tuple[str, Any, int]]:
     """Every (key path, value, depth) of nested dicts/lists, iteratively (no recursion)."""
-    stack: list[tuple[str, Any, int]] = [("", data, 0)]
+    for node, v, depth in _walk(data, None):
+        yield _path(node), v, depth
+
+
+def _walk(data: Any, skip_float_at: int | None) -> Iterator[tuple[_Node, Any, int]]:
+    """(node, value, depth) of nested dicts/lists, depth first, iteratively; list entries
+    that are plain floats are not visited at depths up to ``skip_float_at`` (they can break
+    no limit there)."""
+    stack: list[tuple[_Node, Any, int]] = [(None, data, 0)]
     while stack:
-        path, v, depth = stack.pop()
-        yield path, v, depth
+        node, v, depth = stack.pop()
+        yield node, v, depth
         if isinstance(v, dict):
             for k, x in v.items():
-                stack.append((f"{path}.{k}" if path else str(k), x, depth + 1))
+                stack.append(((node, k, True), x, depth + 1))
         elif isinstance(v, list):
+            skip = skip_float_at is not None and depth + 1 <= skip_float_at
             for i, x in enumerate(v):
-                stack.append((f"{path}[{i}]", x, depth + 1))
+                if not (skip and type(x) is float):
+                    stack.append(((node, i, False), x, depth + 1))
 
 
 def data_problem(data: Any, exact_strings: bool = False) -> tuple[str, str] | None:
@@ -253,9 +280,9 @@ def data_problem(data: Any, exact_strings: bool = False) -> tuple[str, str] | No
     depth, digits or exponent of a number (Decimal or int), and, with ``exact_strings``,
     the text of a string that reads as a number."""
     lim = _current
-    for path, v, depth in walk(data):
+    for node, v, depth in _walk(data, lim.max_depth):
         if depth > lim.max_depth:
-            return path.split("[")[0] or "(top)", (
+            return _path(node).split("[")[0] or "(top)", (
                 f"is nested more than {lim.max_depth} levels deep (--limit max_depth=N)"
             )
         why: str | None = None
@@ -268,5 +295,5 @@ def data_problem(data: Any, exact_strings: bool = False) -> tuple[str, str] | No
         elif exact_strings and isinstance(v, str):
             why = number_text_problem(v)
         if why:
-            return path or "(top)", why
+            return _path(node) or "(top)", why
     return None

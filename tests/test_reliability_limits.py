@@ -258,3 +258,27 @@ def test_shipped_specs_stay_within_the_limits(tmp_path: Path):
     for f in sorted((ROOT / "specs").glob("*.toml")):
         shutil.copy(f, tmp_path / f.name)
         read_spec(tmp_path / f.name)  # no limit error
+
+
+def test_data_problem_names_the_path_and_sees_floats_past_the_depth_limit() -> None:
+    """The walk spells the key path of the offending node only (dict keys dotted, list
+    indices bracketed), and plain floats it skips below the depth limit still count above it."""
+    from decimal import Decimal
+
+    from obsdesign.limits import data_problem, walk
+
+    bad = Decimal("1e" + "9" * 12)
+    assert data_problem({"a": [1.0, {"b": [2.0, bad]}]})[0] == "a[1].b[1]"
+    assert data_problem([0.5, {"x": 10 ** (10**5)}])[0] == "[1].x"
+    assert (
+        data_problem({"p": {"exact": {"P": [["1/2", "9" * 10**5]]}}}, exact_strings=True)[0]
+        == "p.exact.P[0][1]"
+    )
+    assert data_problem({"p": {"exact": {"P": [["1/2", "9" * 10**5]]}}}) is None
+    old = set_limits(max_depth=3)
+    try:
+        assert data_problem({"a": [[1.0]]}) is None
+        assert data_problem({"a": [[[1.0]]]})[0] == "a"
+    finally:
+        reset_limits(old)
+    assert [p for p, _, _ in walk({"a": [1.0, {"b": 2}]})] == ["", "a", "a[1]", "a[1].b", "a[0]"]
