@@ -187,3 +187,13 @@ def test_q_of_text_rejects_zero_denominator_and_keeps_fraction_forms() -> None:
     assert Q("1.25") == fmpq(5, 4) and Q(" -2/4 ") == fmpq(-1, 2) and Q("1e2") == 100
     with pytest.raises(ValueError):
         Q("1/2/3")
+
+
+@given(
+    st.decimals(allow_nan=False, allow_infinity=False),
+    st.floats(allow_nan=False, allow_infinity=False),
+)
+def test_q_of_decimal_and_float_is_their_exact_value(d: Decimal, f: float) -> None:
+    fd, ff = Fraction(d), Fraction(f)
+    assert (int(Q(d).p), int(Q(d).q)) == (fd.numerator, fd.denominator)
+    assert (int(Q(f).p), int(Q(f).q)) == (ff.numerator, ff.denominator)

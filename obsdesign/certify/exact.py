@@ -33,13 +33,11 @@ def Q(x: Any) -> fmpq:  # noqa: N802 - Q for the rationals
     if isinstance(x, (float, np.floating)):
         if not math.isfinite(float(x)):
             raise ValueError(f"not a finite number: {x!r}")
-        fr = Fraction(float(x))
-        return fmpq(fr.numerator, fr.denominator)
+        return fmpq(*float(x).as_integer_ratio())
     if isinstance(x, Decimal):
         if not x.is_finite():
             raise ValueError(f"not a finite number: {x!r}")
-        fr = Fraction(x)
-        return fmpq(fr.numerator, fr.denominator)
+        return fmpq(*x.as_integer_ratio())
     if isinstance(x, Fraction):
         return fmpq(x.numerator, x.denominator)
     if isinstance(x, str):
