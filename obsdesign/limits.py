@@ -253,14 +253,16 @@ def _path(node: _Node) -> str:
 
 def walk(data: Any) -> Iterator[tuple[str, Any, int]]:
     """Every (key path, value, depth) of nested dicts/lists, iteratively (no recursion)."""
-    for node, v, depth in _walk(data, None):
+    for node, v, depth in _walk(data):
         yield _path(node), v, depth
 
 
-def _walk(data: Any, skip_float_at: int | None) -> Iterator[tuple[_Node, Any, int]]:
+def _walk(
+    data: Any, skip_at: int | None = None, skip: tuple[type, ...] = ()
+) -> Iterator[tuple[_Node, Any, int]]:
     """(node, value, depth) of nested dicts/lists, depth first, iteratively; list entries
-    that are plain floats are not visited at depths up to ``skip_float_at`` (they can break
-    no limit there)."""
+    of exactly the types ``skip`` are not visited at depths up to ``skip_at`` (the caller
+    says they can break no limit there)."""
     stack: list[tuple[_Node, Any, int]] = [(None, data, 0)]
     while stack:
         node, v, depth = stack.pop()
@@ -269,9 +271,9 @@ def _walk(data: Any, skip_float_at: int | None) -> Iterator[tuple[_Node, Any, in
             for k, x in v.items():
                 stack.append(((node, k, True), x, depth + 1))
         elif isinstance(v, list):
-            skip = skip_float_at is not None and depth + 1 <= skip_float_at
+            leaves = skip_at is not None and depth + 1 <= skip_at
             for i, x in enumerate(v):
-                if not (skip and type(x) is float):
+                if not (leaves and type(x) in skip):
                     stack.append(((node, i, False), x, depth + 1))
 
 
@@ -280,7 +282,8 @@ def data_problem(data: Any, exact_strings: bool = False) -> tuple[str, str] | No
     depth, digits or exponent of a number (Decimal or int), and, with ``exact_strings``,
     the text of a string that reads as a number."""
     lim = _current
-    for node, v, depth in _walk(data, lim.max_depth):
+    inert = (float,) if exact_strings else (float, str)
+    for node, v, depth in _walk(data, lim.max_depth, inert):
         if depth > lim.max_depth:
             return _path(node).split("[")[0] or "(top)", (
                 f"is nested more than {lim.max_depth} levels deep (--limit max_depth=N)"

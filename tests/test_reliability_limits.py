@@ -279,6 +279,8 @@ def test_data_problem_names_the_path_and_sees_floats_past_the_depth_limit() -> N
     try:
         assert data_problem({"a": [[1.0]]}) is None
         assert data_problem({"a": [[[1.0]]]})[0] == "a"
+        assert data_problem({"a": [[["text"]]]})[0] == "a"
+        assert data_problem({"a": [["text"]]}) is None
     finally:
         reset_limits(old)
     assert [p for p, _, _ in walk({"a": [1.0, {"b": 2}]})] == ["", "a", "a[1]", "a[1].b", "a[0]"]
