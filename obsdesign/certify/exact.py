@@ -139,7 +139,9 @@ def qstr(a: Any) -> Any:
     arr = np.asarray(a, dtype=object)
     if arr.ndim == 0:
         return str(Q(arr.item()))
-    return [qstr(x) for x in arr] if arr.ndim == 1 else [qstr(row) for row in arr]
+    flat = np.empty(arr.size, dtype=object)
+    flat[:] = [str(x) if isinstance(x, fmpq) else str(Q(x)) for x in arr.flat]
+    return flat.reshape(arr.shape).tolist()
 
 
 def qparse(s: Any) -> Any:
