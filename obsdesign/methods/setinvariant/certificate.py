@@ -68,8 +68,8 @@ def delta_exact(G: np.ndarray, B1: np.ndarray, Dv: np.ndarray) -> list[fmpq]:
     """δ_i = max_{d ∈ vert D} G_i B1 d exactly (Section III)."""
     if B1.shape[1] == 0 or len(Dv) == 0:
         return [fmpq(0)] * len(G)
-    GB = qmatmul(G, B1)
-    return [max(po.qdot(GB[i], d) for d in Dv) for i in range(len(G))]
+    GBD = qmatmul(qmatmul(G, B1), np.asarray(Dv, dtype=object).T)
+    return [max(row) for row in GBD.tolist()]
 
 
 def omega_contained(G: np.ndarray, Vo: np.ndarray) -> tuple[bool, fmpq]:
