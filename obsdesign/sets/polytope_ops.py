@@ -770,6 +770,7 @@ def _scaled(M: np.ndarray) -> tuple[list[list[int]], list[int]]:
 
     vecs, dens = [], []
     for r in M:
+        r = [x if isinstance(x, fmpq) else _q(_fr(x)) for x in r]  # (ints, Fractions)
         d = lcm(1, *(int(x.q) for x in r))
         vecs.append([int(x.p) * (d // int(x.q)) for x in r])
         dens.append(d)
@@ -844,6 +845,7 @@ def hull_certificate(G: np.ndarray, P: np.ndarray) -> Incidence | str:
     k, n = G.shape
     if n < 2 or k == 0 or len(P) == 0:
         return "fewer than 2 dimensions, no rows or no points"
+    G = np.array([[x if isinstance(x, fmpq) else _q(_fr(x)) for x in r] for r in G], dtype=object)
     if len({tuple((x.p, x.q) for x in r) for r in G}) != k:
         return "G has a repeated row"
     Gf, Pf = qfloat(G), qfloat(P)
