@@ -882,15 +882,12 @@ def hull_certificate(G: np.ndarray, P: np.ndarray) -> Incidence | str:
         for U in ridges:
             if not set.intersection(*(faces.at[x] for x in U)) - {i}:
                 return f"a ridge of facet {i} lies on no other row: G misses a facet of conv(P)"
-    edges = set()
-    for S in onv:
-        for u in S:
-            for w in S:
-                if u < w:
-                    common = faces.at[u] & faces.at[w]
-                    if set.intersection(*(onv[r] for r in common)) == {u, w}:
-                        edges.add((u, w))
-    return Incidence(keep, sorted(edges))
+    edges = []
+    for u, w in sorted({(u, w) for S in onv for u in S for w in S if u < w}):
+        common = faces.at[u] & faces.at[w]  # an edge lies on >= n - 1 rows
+        if len(common) >= n - 1 and set.intersection(*(onv[r] for r in common)) == {u, w}:
+            edges.append((u, w))
+    return Incidence(keep, edges)
 
 
 def exact_check_forms(G: np.ndarray, V: np.ndarray) -> tuple[bool, str, ExactVRep | None]:
