@@ -54,102 +54,17 @@ if hasattr(typer.core.TyperArgument, "_usage_display_name"):
 _ARG_TYPE = typer.core.TyperArgument.display_type_rich
 typer.core.TyperArgument.display_type_rich = _arg_type  # type: ignore[method-assign]
 
-#: "take typer's own path" (see :func:`_fast_value`)
-_SLOW = object()
-
-
-def _fast_leaf(ann: Any, info: Any, value: Any, param: Any, ctx: Any) -> Any:
-    """``value`` coerced to ``ann`` as typer's pydantic adapter would, for the plain cases
-    (a str, a Path, a decimal int within min/max, an enum member or its name); ``_SLOW``
-    for anything else, which typer then handles itself, with its own error message."""
-    from enum import Enum
-
-    from typer import _param_types as pt
-
-    if ann is str:
-        return value if type(value) is str else _SLOW
-    if ann is int and not info.clamp:
-        if type(value) is str:
-            digits = value.removeprefix("-")
-            if not (digits.isascii() and digits.isdigit() and len(digits) <= 18):
-                return _SLOW
-            value = int(value)
-        if type(value) is not int:
-            return _SLOW
-        if (info.min is not None and value < info.min) or (
-            info.max is not None and value > info.max
-        ):
-            return _SLOW
-        return value
-    if isinstance(ann, type) and issubclass(ann, Enum):
-        try:
-            return pt.coerce_cli_choice(
-                value, choices=tuple(ann), case_sensitive=info.case_sensitive, ctx=ctx
-            )
-        except ValueError:
-            return _SLOW
-    if isinstance(ann, type) and issubclass(ann, Path) and info.path_type is None:
-        if type(value) is str:
-            value = ann(value)  # what pydantic's Path validator returns for a str
-        if not isinstance(value, ann):
-            return _SLOW
-        try:
-            return pt.coerce_cli_path(value, info, path_type=ann, param=param, ctx=ctx)
-        except Exception:  # noqa: BLE001 - typer's own path raises its own message
-            return _SLOW
-    return _SLOW
-
-
-def _fast_value(desc: Any, value: Any, param: Any, ctx: Any) -> Any:
-    """A command-line value coerced without pydantic where :func:`_fast_leaf` can (lists
-    item by item, as typer's list adapter does), else ``_SLOW``."""
-    from typing import get_args, get_origin
-
-    info = desc.parameter_info
-    if info.parser is not None or desc.file_annotation is not None:
-        return _SLOW
-    if get_origin(desc.annotation) is list and isinstance(value, (list, tuple)):
-        (item,) = get_args(desc.annotation)
-        out = [_fast_leaf(item, info, v, param, ctx) for v in value]
-        return _SLOW if any(o is _SLOW for o in out) else out
-    return _fast_leaf(desc.annotation, info, value, param, ctx)
-
-
-def _fast_param_class() -> Any:
-    """The ``RuntimeParam`` of :func:`_fast_runtime_param` (made once, on first use; a plain
-    subclass: a dataclass costs milliseconds to create)."""
-    if "cls" not in _FAST:
-        from typer import _coercion
-
-        class FastParam(_coercion.RuntimeParam):
-            def __init__(self, descriptor: Any) -> None:
-                super().__init__(descriptor.parameter_info, descriptor.annotation)
-                object.__setattr__(self, "descriptor", descriptor)  # frozen dataclass
-
-            def _coerce_value(self, value: Any, param: Any, ctx: Any) -> Any:
-                out = _fast_value(self.descriptor, value, param, ctx)  # type: ignore[attr-defined]
-                if out is _SLOW:
-                    slow = _coercion.build_runtime_param(self.descriptor)  # type: ignore[attr-defined]
-                    out = slow._coerce_value(value, param=param, ctx=ctx)
-                return out
-
-        _FAST["cls"] = FastParam
-    return _FAST["cls"]
-
-
-_FAST: dict[str, Any] = {}
-
 
 def _fast_runtime_param(self: Any) -> Any:
     """``_TyperParameter.get_runtime_param`` of typer ≥ 0.2x, which coerces every
     command-line value through a pydantic ``TypeAdapter`` built per parameter when a command
     runs: importing pydantic and building the adapters costs ~150 ms of a ~0.5 s cold
-    ``obsdesign design``. Values of the plain types this CLI declares are coerced directly
-    (to what pydantic gives, :func:`_fast_value`); anything else, and every value typer
-    would refuse, goes through typer's own adapter, so results and error messages are
-    typer's."""
+    ``obsdesign design``. See :mod:`obsdesign.cli_coerce` (loaded with the first value a
+    command coerces; ``--help`` coerces none)."""
     if self._runtime_param is None:
-        self._runtime_param = _fast_param_class()(self.type_descriptor)
+        from obsdesign.cli_coerce import FastParam
+
+        self._runtime_param = FastParam(self.type_descriptor)
     return self._runtime_param
 
 
