@@ -309,3 +309,36 @@ def test_time_budget_inside_an_iteration():
         lps.eps_batch(G, np.zeros((3, len(G))), np.zeros(len(G)), deadline=0.0)
     with pytest.raises(Timeout):
         lps.phi_at(G, fl.A, np.eye(3), np.zeros((0, 2), dtype=int), fl.C[0], 0.01, np.zeros(1), 0.0)
+
+
+def test_lp9_on_the_merged_float_rows_then_on_all_rows_where_tight():
+    """The design solves LP (9) on the float hull's merged rows (fewer than the exact hull's)
+    and again on all exact rows only where that v^l is tight (within 10⁻⁹ of λ); the exact
+    check decides. Seed 0 of the benchmark: 44 merged rows, 48 exact facets; with λ set to
+    the factor the merged rows give, the worst breakpoint is tight and re-solved."""
+    import dataclasses
+
+    from obsdesign.methods.setinvariant import certificate as ce
+    from obsdesign.methods.setinvariant import lps
+    from obsdesign.methods.setinvariant.design import _merged
+    from obsdesign.methods.setinvariant.problem import build
+    from obsdesign.sets import polytope_ops as po
+
+    sp = api.load_spec_text(SEED0, "s0.toml")
+    ex = build(sp).ex
+    V = np.asarray(api.design(sp).parameters["V"], dtype=object)
+    G, vrep = po.exact_hull(V)
+    Gm = _merged(V)
+    assert Gm is not None and len(Gm) < len(G)
+    calls: list[int] = []
+
+    def solver(Gf, phi, dl, deadline=None):
+        calls.append(len(Gf))
+        return lps.eps_batch(Gf, phi, dl, deadline=deadline)
+
+    merged = ce.theorem31(ex, G, v_solver=solver, vrep=vrep, v_rows=Gm)
+    assert calls == [len(Gm)] and merged.ok  # nothing tight at the spec's λ
+    tight = dataclasses.replace(ex, lam=merged.factor)
+    calls.clear()
+    again = ce.theorem31(tight, G, v_solver=solver, vrep=vrep, v_rows=Gm)
+    assert calls == [len(Gm), len(G)] and again.ok and again.factor <= merged.factor

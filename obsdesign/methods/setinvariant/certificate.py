@@ -250,6 +250,34 @@ class BudgetExceeded(Exception):
     done)."""
 
 
+def _solve_v(
+    ex: ExactProblem,
+    sl: _Slices,
+    Gf: np.ndarray,
+    phif: np.ndarray,
+    dlf: np.ndarray,
+    v_solver,
+    deadline: float | None,
+    v_rows: np.ndarray | None,
+):
+    """v^l of LP (9) at every breakpoint (see :func:`theorem31`, ``v_rows``); the returned
+    ``eps`` is the float level of v^l on all rows of G."""
+    if v_rows is None or len(v_rows) >= len(Gf):
+        return v_solver(Gf, phif, dlf, deadline=deadline)
+    Af, B1f, Dvf = po.qfloat(ex.A), po.qfloat(ex.B1), po.qfloat(ex.Dv)
+    GmA = v_rows @ Af
+    phim = np.array([(GmA @ sl.ptsf[l].T).max(axis=1) for l in range(len(phif))])
+    dlm = (v_rows @ B1f @ Dvf.T).max(axis=1) if B1f.shape[1] and len(Dvf) else np.zeros(len(v_rows))
+    er = v_solver(v_rows, phim.reshape(len(phif), len(v_rows)), dlm, deadline=deadline)
+    er.eps = (phif + dlf[None, :] + er.v @ Gf.T).max(axis=1)
+    lamf = float(ex.lam)
+    tight = np.nonzero(er.eps > lamf * (1 - 1e-9))[0]
+    if len(tight):
+        full = v_solver(Gf, phif[tight], dlf, deadline=deadline)
+        er.v[tight], er.eps[tight] = full.v, full.eps
+    return er
+
+
 def theorem31(
     ex: ExactProblem,
     G: np.ndarray,
@@ -258,6 +286,7 @@ def theorem31(
     v_solver=None,
     vrep: po.ExactVRep | None = None,
     deadline: float | None = None,
+    v_rows: np.ndarray | None = None,
 ) -> Theorem31Result:
     """Exact check of Theorem 3.1 for {G e <= 1} (single output).
 
@@ -266,6 +295,10 @@ def theorem31(
     (``v_solver(G, phi, delta, deadline=...) -> EpsResult``), rounded by :func:`po.snap`, and from an exact
     cdd.gmp LP wherever the rounded v does not pass. ``deadline`` (design only): a
     ``time.perf_counter()`` value checked before each breakpoint (:class:`BudgetExceeded`).
+    ``v_rows`` (design only): float rows of the same polytope with near-coplanar facets
+    merged (the float hull; fewer rows than the exact G): LP (9) is solved on them, and
+    again on all rows of G only at the breakpoints where that v^l does not stay below λ
+    with a 10⁻⁹ margin; the exact check below decides either way.
     """
     if vrep is None:
         vrep = po.exact_h_to_v(G)
@@ -300,7 +333,7 @@ def theorem31(
                 raise BudgetExceeded(0)
             phif[l] = sl.phi_float(l)
         try:
-            er = v_solver(Gf, phif, dlf, deadline=deadline)
+            er = _solve_v(ex, sl, Gf, phif, dlf, v_solver, deadline, v_rows)
         except Timeout:
             raise BudgetExceeded(0) from None
         vs_use = [[po.snap(x) for x in er.v[l]] for l in range(len(zs))]
