@@ -29,7 +29,6 @@ HEAVY = (
     "distributed",
     "pydantic",
     "sympy",
-    "mpmath",
     "pandas",
     "pyarrow",
     "obsdesign.sweep",
