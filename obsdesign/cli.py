@@ -62,16 +62,20 @@ def _fast_runtime_param(self: Any) -> Any:
     ``obsdesign design``. See :mod:`obsdesign.cli_coerce` (loaded with the first value a
     command coerces; ``--help`` coerces none)."""
     if self._runtime_param is None:
-        from obsdesign.cli_coerce import FastParam
+        try:
+            from obsdesign.cli_coerce import FastParam
 
-        self._runtime_param = FastParam(self.type_descriptor)
+            self._runtime_param = FastParam(self.type_descriptor)
+        except (ImportError, AttributeError, TypeError):  # a typer whose internals differ
+            return _TYPER_RUNTIME_PARAM(self)
     return self._runtime_param
 
 
 # typer without pydantic coercion (click types, < 0.2x) has no such method: nothing to do
-if hasattr(typer.core, "_TyperParameter") and hasattr(
-    typer.core._TyperParameter, "get_runtime_param"
-):
+_TYPER_RUNTIME_PARAM = getattr(
+    getattr(typer.core, "_TyperParameter", None), "get_runtime_param", None
+)
+if _TYPER_RUNTIME_PARAM is not None:
     typer.core._TyperParameter.get_runtime_param = _fast_runtime_param  # type: ignore[method-assign]
 
 app = typer.Typer(

@@ -176,3 +176,21 @@ def test_fast_coercion_matches_typer(value: Any, tmp_path: Path) -> None:
                 assert fast is slow
             checked += 1
     assert checked > 0  # every value is a plain one for some parameter
+
+
+def test_typer_internals_changed_falls_back_to_typer(monkeypatch: pytest.MonkeyPatch) -> None:
+    """If typer's RuntimeParam no longer takes what FastParam gives it, commands still run,
+    through typer's own coercion (with its messages)."""
+    from typer.testing import CliRunner
+
+    from obsdesign import cli_coerce
+    from obsdesign.cli import app
+
+    def broken(descriptor: Any) -> Any:
+        raise TypeError("typer internals changed")
+
+    monkeypatch.setattr(cli_coerce, "FastParam", broken)
+    r = CliRunner().invoke(app, ["init", "lyapunov"])
+    assert r.exit_code == 0 and "[method]" in r.output
+    r = CliRunner().invoke(app, ["design", str(SPEC), "--width", "10"])
+    assert r.exit_code == 2 and "--width" in r.output
