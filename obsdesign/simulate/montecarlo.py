@@ -437,6 +437,9 @@ def _run(
     bufs = {m: [np.empty((Rr, m * n)) for _ in range(4)] for m in {BLOCK, K % BLOCK} if m}
     dims = draws.dims if draws is not None else []
     E = np.empty((Rr, 0))
+    mm = _matmul_for(Rr, max(N + 1, BLOCK * max(dims, default=1)), BLOCK * n)
+    PH, PE, PX = bm.PH, bm.PE, bm.PX
+    hi, lo, ehi, elo, sq = (acc[k] for k in _ACC)
     for c0 in range(0, K, CHUNK):
         c1 = min(K, c0 + CHUNK)
         raw = draws.chunk(c0, c1) if draws is not None else []
@@ -444,23 +447,37 @@ def _run(
             m = min(BLOCK, c1 - k0)
             cm = m * n
             H, E, X, T = bufs[m]
-            PH, PE, PX = bm.at(k0 // BLOCK)
-            _mm(st, PH[:, :cm], out=H)
-            _mm(st, (PE if shared_x else PX)[:, :cm], out=E if shared_x else X)
+            bm.at(k0 // BLOCK)
+            full = m == BLOCK
+            mm(st, PH if full else PH[:, :cm], out=H)
+            if shared_x:
+                mm(st, PE if full else PE[:, :cm], out=E)
+            else:
+                mm(st, PX if full else PX[:, :cm], out=X)
             for j, (a, d) in enumerate(zip(raw, dims, strict=True)):
-                blk = _rows(a[:, (k0 - c0) * d : (k0 - c0 + m) * d])
-                _mm(blk, bm.TH[j][: m * d, :cm], out=T)
+                blk = a[:, (k0 - c0) * d : (k0 - c0 + m) * d]
+                if R == 1:
+                    blk = np.concatenate([blk, blk])
+                mm(blk, bm.TH[j] if full else bm.TH[j][: m * d, :cm], out=T)
                 np.add(H, T, out=H)
                 if shared_x:
                     np.add(E, T, out=E)
                 else:
-                    _mm(blk, bm.TX[j][: m * d, :cm], out=T)
+                    mm(blk, bm.TX[j] if full else bm.TX[j][: m * d, :cm], out=T)
                     np.add(X, T, out=X)
             if not shared_x:
                 np.subtract(H, X, out=E)
                 st[:, :n] = X[:, cm - n :]
             st[:, N - n : N] = H[:, cm - n :]
-            _accumulate(acc, H, E, T, cm)
+            if full:
+                np.maximum(hi, H, out=hi)
+                np.minimum(lo, H, out=lo)
+                np.maximum(ehi, E, out=ehi)
+                np.minimum(elo, E, out=elo)
+                np.multiply(E, E, out=T)
+                np.add(sq, T, out=sq)
+            else:
+                _accumulate_part(acc, H, E, T, cm)
             if traj0 is not None:
                 traj0[k0 + 1 : k0 + m + 1, N - n :] = H[0].reshape(m, n)
                 if not shared_x:
@@ -482,34 +499,34 @@ def _run(
 _ACC = {"hi": -np.inf, "lo": np.inf, "ehi": -np.inf, "elo": np.inf, "sq": 0.0}
 
 
-def _accumulate(
+def _accumulate_part(
     acc: dict[str, np.ndarray], H: np.ndarray, E: np.ndarray, T: np.ndarray, cm: int
 ) -> None:
-    """Running elementwise max / min of the estimates H and errors E and sum of E² (T: a
-    scratch array of E's shape); a shorter last block updates its ``cm`` first positions."""
-    full = cm == acc["sq"].shape[1]
+    """The running metrics of :func:`_run` for a last, shorter block: its ``cm`` first
+    positions (T: a scratch array of E's shape)."""
     for k, a, f in (
         ("hi", H, np.maximum),
         ("lo", H, np.minimum),
         ("ehi", E, np.maximum),
         ("elo", E, np.minimum),
     ):
-        if full:
-            f(acc[k], a, out=acc[k])
-        else:
-            acc[k][:, :cm] = f(acc[k][:, :cm], a)
+        acc[k][:, :cm] = f(acc[k][:, :cm], a)
     np.multiply(E, E, out=T)
-    if full:
-        np.add(acc["sq"], T, out=acc["sq"])
-    else:
-        acc["sq"][:, :cm] += T
+    acc["sq"][:, :cm] += T
+
+
+def _matmul_for(rows: int, inner: int, cols: int) -> Any:
+    """``np.matmul`` when products of ``rows`` × ``inner`` × ``cols`` run on one thread,
+    else :func:`_mm` (pieces)."""
+    return np.matmul if rows * inner * cols <= MNK_ONE_THREAD else _mm
 
 
 class _BlockMatrices:
     """The block matrices of :func:`_run`, columns step-major (position i·n + j: state j of
     step i + 1, so that a shorter block uses a prefix): ``at(block)`` gives the (N + 1)-row
     maps [state; 1] → estimates, errors (when the plant trajectory is shared: the estimates
-    minus x(k)) and plant states, whose last row is that block's shared term; ``TH[j]``,
+    minus x(k)) and plant states ``PH``, ``PE``, ``PX``, whose last row is that block's shared
+    term after ``at(block)``; ``TH[j]``,
     ``TX[j]``: the Toeplitz maps of random signal j's raw draws to estimates, plant states."""
 
     def __init__(self, plan: _Plan, K: int, n: int):
@@ -535,18 +552,13 @@ class _BlockMatrices:
             self.TH.append(np.ascontiguousarray(T[rows_h].T))
             self.TX.append(np.ascontiguousarray(T[rows_x].T))
 
-    def at(self, block: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def at(self, block: int) -> None:
+        """Put that block's shared terms in the last rows of PH and PE (or PX)."""
         self.PH[-1] = self.CH[block]
         if self.shared_x:
             self.PE[-1] = self.CE[block]
         else:
             self.PX[-1] = self.CX[block]
-        return self.PH, self.PE, self.PX
-
-
-def _rows(a: np.ndarray) -> np.ndarray:
-    """``a`` with at least two rows (a single row repeated: see :func:`_run`)."""
-    return a if len(a) > 1 else np.concatenate([a, a])
 
 
 def _trajectory(plan: _Plan, traj0: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
