@@ -784,12 +784,17 @@ class _Faces:
     def __init__(self, pts: list[list[int]], on: list[set[int]], at: list[set[int]]) -> None:
         self.pts, self.on, self.at = pts, on, at
         self._memo: dict[frozenset[int], list[frozenset[int]] | None] = {}
+        self._ranks: dict[frozenset[int], int] = {}
 
     def rank(self, F: frozenset[int] | set[int]) -> int:
-        """Linear rank of the points F (= affine dimension + 1 on a facet's hyperplane)."""
+        """Linear rank of the points F (= affine dimension + 1 on a facet's hyperplane);
+        once per set (a ridge is met from both of its facets)."""
         from flint import fmpz_mat
 
-        return fmpz_mat([self.pts[j] for j in sorted(F)]).rank() if F else 0
+        key = frozenset(F)
+        if key not in self._ranks:
+            self._ranks[key] = fmpz_mat([self.pts[j] for j in sorted(F)]).rank() if F else 0
+        return self._ranks[key]
 
     def facets_of(self, F: frozenset[int], d: int) -> list[frozenset[int]] | None:
         """The facets of the d-dimensional face F (a face of a facet), proved complete, or
