@@ -39,13 +39,13 @@ from obsdesign.spec.reader import Table
 
 #: memory of one batch's random draws, bytes
 BATCH_BYTES = 128 * 2**20
-#: runs stepped together at most (the block arrays of a batch then stay in cache; 256-512
-#: measured ~10 % faster than 1000 on the 2-core development machine)
+#: runs stepped together at most: the block arrays of a batch stay in cache and, at n = 2,
+#: every block product runs on one OpenBLAS thread (256-512 measured ~10 % faster than 1000)
 BATCH_RUNS = 512
 #: steps per block of the time recursion (one matrix product per block over the batch axis)
 BLOCK = 16
-#: steps whose random draws are made at once, per run (a multiple of :data:`BLOCK`, fixed so
-#: that the batching cannot change any number)
+#: steps whose random draws are made at once, per run (a multiple of :data:`BLOCK`: blocks
+#: then start at multiples of BLOCK, so the chunking changes no number)
 CHUNK = 1024
 #: rows × columns × inner size of a product that OpenBLAS runs on one thread
 MNK_ONE_THREAD = 1 << 18
