@@ -72,6 +72,15 @@ def bind(spec: Spec) -> Spec:
                 raise SpecError(
                     spec.file, f"system.{k}", f"is missing: method '{m.key}' needs the linear model"
                 )
+    for k, v in (("f", s.f), ("psi", s.psi), ("h", s.h), ("u", s.u_signal)):
+        if v is not None and k not in m.plant_expressions:
+            raise SpecError(
+                spec.file,
+                f"system.{k}",
+                f"is not read by method '{m.key}' (its certificate and simulation use the "
+                "linear model A, B, C, D only): remove it, or choose a method for "
+                "nonlinear plants",
+            )
     for name in spec.tables:
         if name not in m.extra_tables:
             raise SpecError(spec.file, name, f"is not read by method '{m.key}'")

@@ -674,3 +674,20 @@ def test_simulate_runs_and_initial_error_from_the_spec() -> None:
     assert np.all(np.abs(e0[:, 0]) <= 2) and np.all(np.abs(e0[:, 1]) <= 1)
     with pytest.raises(SpecError, match="initial_error"):
         load_spec_text(text.replace('initial_error = "E0"', 'initial_error = "F"'), "mc.toml")
+
+
+def test_an_expression_plant_fails_linear_plant_and_still_simulates() -> None:
+    """[system] psi makes the plant nonlinear: the decay certificate covers A − LC only, so
+    design and verify fail the claim linear-plant (and only it), and simulate still runs the
+    observer on the nonlinear plant."""
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "specs" / "constrained-redesign-sec5-lyapunov.toml").read_text()
+    i = text.index("[system]") + len("[system]\n")
+    spec = load_spec_text(text[:i] + 'psi = ["0.001*sin(x1)", "0"]\n' + text[i:], "psi.toml")
+    rep = api.design(spec)
+    assert [c.id for c in rep.failed] == ["linear-plant"] and rep.exit_code() == 1
+    assert "psi" in rep.failed[0].detail
+    assert [c.id for c in api.verify(rep).failed] == ["linear-plant"]
+    assert np.isfinite(api.simulate(spec, rep).metrics()["final_error_norm"])
+    linear = api.design(load_spec_text(text, "lin.toml"))
+    assert "linear-plant" not in [c.id for c in linear.claims]

@@ -491,3 +491,19 @@ def test_r_bound_instead_of_gain_bound() -> None:
     d = rep.to_dict()
     _set(d, "R", np.array([[fmpq(100) + TINY]], dtype=object))
     assert _failed(d) == {"r-bound"}
+
+
+@pytest.mark.parametrize("mode", ["full", "redesign"])
+def test_linear_modes_refuse_an_expression_plant(mode: str) -> None:
+    """LMIs (1)-(3)/(7)-(9) certify the linear plant: psi in full or redesign mode exits 2
+    naming system.psi instead of being ignored."""
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "specs" / "astolfi-stubborn-example1.toml").read_text()
+    i = text.index("[system]") + len("[system]\n")
+    text = text[:i] + 'psi = ["0.001*sin(x1)", "0"]\n' + text[i:]
+    if mode == "redesign" and "mode" not in text:
+        text = text.replace(
+            'key = "stubborn"', 'key = "stubborn"\nmode = "redesign"\nK = [[1], [1]]'
+        )
+    with pytest.raises(api.SpecError, match=r"system\.psi.*not read in (full|redesign) mode"):
+        api.load_spec_text(text, "psi.toml")

@@ -11,6 +11,9 @@ Declared by each method (class attributes):
 - ``needs_linear``: whether ``[system]`` must give A and C (checked once, by the API);
 - ``extra_tables``: top-level tables it reads besides system/sets/method/simulate
   (``nonlinearity``);
+- ``plant_expressions``: the expression keys of ``[system]`` (``f``, ``psi``, ``h``, ``u``)
+  the method reads or diagnoses itself; the API refuses the others (exit 2), so that no
+  certificate silently ignores part of the plant;
 - ``required_params``: parameters a report must carry (checked once, generically, before
   ``certify`` runs);
 - ``summary_fields``: what ``summary()`` shows (label, parameter, format), with
@@ -188,6 +191,8 @@ class Method:
     needs_linear: ClassVar[bool] = True
     #: top-level spec tables (besides system/sets/method/simulate) this method reads
     extra_tables: ClassVar[tuple[str, ...]] = ()
+    #: expression keys of ``[system]`` (f, psi, h, u) this method reads or diagnoses itself
+    plant_expressions: ClassVar[frozenset[str]] = frozenset()
     #: parameters every report of this method carries (checked before ``certify``)
     required_params: ClassVar[tuple[str, ...]] = ()
     #: what ``summary()`` prints, and the format of the fields that give none

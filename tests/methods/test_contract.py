@@ -150,3 +150,33 @@ def test_template_has_a_docs_page_with_the_standard_headings(key: str) -> None:
         "Benchmarks",
     ]
     assert "../shared" not in text
+
+
+def _with_expression(text: str, key: str, n: int, p: int, m: int) -> str:
+    """The template with ``[system] <key>`` added (a well-formed list of expressions)."""
+    count = {"f": n, "psi": n, "h": p, "u": m}[key]
+    var = "t" if key == "u" else "x1"
+    line = f"{key} = [{', '.join([f'0.001*sin({var})'] * count)}]\n".replace("0.0", '"0.0')
+    line = line.replace("), ", ')", ').replace(")]", ')"]')
+    i = text.index("[system]") + len("[system]\n")
+    return text[:i] + line + text[i:]
+
+
+@pytest.mark.parametrize("key", KEYS)
+@pytest.mark.parametrize("expr", ["f", "psi", "h", "u"])
+def test_an_expression_the_method_does_not_read_is_refused(key: str, expr: str) -> None:
+    """No certificate silently ignores part of the plant: an expression key of [system]
+    outside the method's ``plant_expressions`` exits 2 naming system.<key>."""
+    m = api.method(key)
+    if expr in m.plant_expressions:
+        pytest.skip(f"{key} reads or diagnoses {expr} itself")
+    base = api.load_spec_text(api.template(key), "t.toml").system
+    if base.f is not None or base.psi is not None:
+        pytest.skip("the template already gives the plant by expressions")
+    count = {"f": base.n, "psi": base.n, "h": base.p, "u": base.m}[expr]
+    if count == 0:
+        pytest.skip(f"no {expr} entries to give")
+    text = _with_expression(api.template(key), expr, base.n, base.p, base.m)
+    with pytest.raises(api.SpecError) as e:
+        api.load_spec_text(text, "t.toml")
+    assert f"system.{expr}" in str(e.value) and "is not read" in str(e.value)

@@ -26,6 +26,7 @@ class Constrained(Method):
     Options = Options
     SimOptions = SimOptions
     needs_linear = False
+    plant_expressions = frozenset({"f", "h", "psi"})  # psi: refused with its own message
     required_params = _claims.REQUIRED
     summary_fields = (
         SummaryField("γ", "gamma"),

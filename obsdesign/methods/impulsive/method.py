@@ -30,6 +30,7 @@ class Impulsive(Method):
     Options = Options
     SimOptions = SimOptions
     extra_tables = ("nonlinearity",)
+    plant_expressions = frozenset({"psi", "f", "h", "u"})  # f, h, u refused with its own message
     required_params = _claims.PARAM_KEYS
     summary_fields = (
         SummaryField("T_min"),

@@ -38,6 +38,7 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     o: Options = spec.options
     name = rate_name(s.discrete)
     c = Claims()
+    linear_plant_claim(c, spec)
     need = ["L", "P", name, "P_best", f"{name}_best", f"{name}_bracket", f"{name}_bracket_kind"]
     if not params.require(need, c):
         return list(c)
@@ -81,6 +82,28 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     if o.iss_gain:
         iss_claim(c, A, C, L, s.Bd.q, s.Dn.q, P, rate, mu, s.discrete)
     return list(c)
+
+
+def linear_plant_claim(c: Claims, spec: Spec) -> None:
+    """The failed claim ``linear-plant`` when ``[system]`` gives the plant by expressions
+    (f, psi or h): the decay LMI of eq. (4)-(6) (constrained-redesign paper, Astolfi et al.,
+    NOLCOS 2019) is certified for the linear model A, C only, so it says nothing about that
+    plant (which ``simulate`` still runs the observer on). Nothing is added for a linear plant.
+
+    :param c: the claim list; :param spec: the bound spec."""
+    s = spec.system
+    given = [k for k, v in (("f", s.f), ("psi", s.psi), ("h", s.h)) if v is not None]
+    if given:
+        c.exact(
+            id="linear-plant",
+            statement="the plant of [system] is the linear model (A, C) the certificate covers",
+            reference=REF,
+            check="[system] gives no f, psi or h expression",
+            passed=False,
+            detail=f"[system] {', '.join(given)} make(s) the plant nonlinear: the decay "
+            "certificate covers the linear model only (simulate runs the observer on the "
+            "nonlinear plant)",
+        )
 
 
 def pd_claim(

@@ -40,6 +40,9 @@ class Lyapunov(Method):
     Options = Options
     SimOptions = SimOptions
     required_params = ("L", "P")
+    # certified on the linear model; an expression plant gets the failed claim linear-plant
+    # (the observer can still be simulated on it)
+    plant_expressions = frozenset({"f", "psi", "h"})
     summary_fields = (
         SummaryField("lambda", "lambda"),
         SummaryField("alpha", "alpha"),

@@ -24,6 +24,7 @@ class SearchSpace(Method):
     Options = _opts.Options
     SimOptions = _opts.SimOptions
     needs_linear = False
+    plant_expressions = frozenset({"f", "h", "u"})
     required_params = (
         "L_f",
         "L_h",

@@ -20,6 +20,7 @@ class Stubborn(Method):
     Options = _opts.Options
     SimOptions = _opts.SimOptions
     needs_linear = False  # the high-gain mode reads f / psi; linear modes check A, C themselves
+    plant_expressions = frozenset({"f", "psi", "u"})  # f / psi: high-gain mode only
     required_params = ("K", "lambda")
     summary_fields = (
         SummaryField("λ", "lambda"),

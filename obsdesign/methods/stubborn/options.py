@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 from flint import fmpq
 
+from obsdesign.errors import SpecError
 from obsdesign.methods.base import table_schema
 from obsdesign.spec.models import Spec
 from obsdesign.spec.reader import Table
@@ -121,6 +122,14 @@ def parse_options(table: Table, spec: Spec) -> Options:
         )
     if s.A is None or s.C is None:
         raise table.error("mode", "full and redesign modes need the linear model A, C in [system]")
+    for key, v in (("f", s.f), ("psi", s.psi)):
+        if v is not None:
+            raise SpecError(
+                spec.file,
+                f"system.{key}",
+                f"is not read in {mode} mode (LMIs (1)-(3)/(7)-(9) certify the linear plant "
+                "A, C): remove it, or use mode = 'high-gain'",
+            )
     K = None
     if mode == "redesign":
         if not table.has("K"):
