@@ -408,10 +408,10 @@ def _float_problems(rep: Report) -> list[str]:
     if not isinstance(raw, dict):
         return []
     exact = raw.get("exact", {})
-    canon = rep.parameters.to_json()
+    params = rep.parameters
     out = []
     for k in exact if isinstance(exact, dict) else ():
-        if k in raw and k in canon and not _same_floats(raw[k], canon[k]):
+        if k in raw and k in params and not _same_floats(raw[k], params.float_json(k)):
             out.append(
                 f"parameter '{k}': the float is not the nearest double to the exact value "
                 f"(the exact value is authoritative)"

@@ -74,6 +74,10 @@ class Parameters:
         f = _floats(v)
         return np.asarray(f, dtype=float) if isinstance(f, list) else f
 
+    def float_json(self, k: str) -> Any:
+        """The float form ``to_json`` writes for parameter ``k`` (lists for arrays)."""
+        return _floats(self._v[k])
+
     def is_exact(self, k: str) -> bool:
         return _is_exact(self._v.get(k))
 
