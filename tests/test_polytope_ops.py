@@ -292,3 +292,25 @@ def test_child_dies_with_its_parent():
         while children(p.pid) and time.perf_counter() - t0 < 5:
             time.sleep(0.05)
         assert not children(p.pid), f"the child outlived its parent ({sig!r})"
+
+
+@pytest.mark.parametrize("n", [3, 4])
+def test_repaired_hull_of_near_coplanar_points_is_the_cdd_hull(n):
+    """Points 10⁻¹⁵ off a cube's face, in and out: qhull merges them, so the incidence proof
+    of its facets fails (a point violates a row); the gift-wrapping repair then gives
+    cdd.gmp's hull exactly (rows, vertices, edges), without cdd."""
+    rng = np.random.default_rng(5 + n)
+    cube = [
+        [fmpq(int(x)) for x in v] for v in np.array(np.meshgrid(*[[-1, 1]] * n)).reshape(n, -1).T
+    ]
+    face = [
+        [1 + fmpq(int(rng.integers(-5, 6)), 10**15)]
+        + [fmpq(int(rng.integers(-900, 900)), 1000) for _ in range(n - 1)]
+        for _ in range(12)
+    ]
+    P = np.array(cube + face, dtype=object)
+    assert "violates" in po.hull_certificate(po._float_facets(P), P)
+    G, vr = po.exact_hull(P)
+    G1, idx, edges = po._cdd_hull(P)
+    assert [tuple(r) for r in G] == [tuple(r) for r in G1]
+    assert [tuple(v) for v in vr.V] == [tuple(P[j]) for j in idx] and vr.edges == edges

@@ -745,6 +745,9 @@ def exact_hull(P: np.ndarray, deadline: float | None = None) -> tuple[np.ndarray
     G = _float_facets(P) if n >= 2 else None
     if G is not None and len(G):
         cert = hull_certificate(G, P)
+        if isinstance(cert, str):  # qhull merged near-coplanar points: repair, then decide
+            G = _repair(G, P, deadline)
+            cert = hull_certificate(G, P) if G is not None else cert
         if isinstance(cert, Incidence):
             return G, ExactVRep(P[cert.keep], cert.edges)
     if deadline is not None and len(P) > CHILD_MIN_POINTS:
@@ -827,6 +830,104 @@ class _Faces:
         return out
 
 
+def _incidences(
+    G: np.ndarray, P: np.ndarray, pts: tuple | None = None
+) -> tuple[list[list[int]], list[list[int]], list[set[int]], list[tuple[int, int]]]:
+    """Exact incidences of the rows G (rhs 1) and the points P: (scaled rows, scaled points,
+    the points on each row, the (row, point) pairs with G_i p > 1). A float prefilter with a
+    margin far above the float error picks the pairs evaluated exactly, in integers.
+    ``pts``: (floats, scaled vectors, denominators) of P when already computed."""
+    Pf, pv, pd = pts if pts is not None else (qfloat(P), *_scaled(P))
+    Gf = qfloat(G)
+    M = Gf @ Pf.T
+    near = np.argwhere(M >= 1 - (1e-9 * (np.abs(Gf) @ np.abs(Pf).T) + 1e-300))
+    gv, gd = _scaled(G)
+    on: list[set[int]] = [set() for _ in range(len(G))]
+    bad = []
+    for i, j in near.tolist():
+        s = sum(a * b for a, b in zip(gv[i], pv[j], strict=True)) - gd[i] * pd[j]
+        if s > 0:
+            bad.append((i, j))
+        elif s == 0:
+            on[i].add(j)
+    return gv, pv, on, bad
+
+
+def _wrap(P: np.ndarray, pts: tuple, R: list[int], q: int, steps: int = 64) -> list[fmpq] | None:
+    """Gift-wrapping around the ridge R (n − 1 point indices): the hyperplane a·x = 1 through
+    R and a point q, pivoted to the most violating point until no point of P is beyond it
+    (exact check); None when it does not settle (degenerate input). ``pts`` as for
+    :func:`_incidences`."""
+    from flint import fmpq_mat
+
+    n = P.shape[1]
+    one = fmpq_mat(n, 1, [1] * n)
+    for _ in range(steps):
+        try:
+            a = fmpq_mat([list(P[j]) for j in [*R, q]]).solve(one).entries()
+        except ZeroDivisionError:
+            return None
+        row = np.array([a], dtype=object)
+        _, _, _, bad = _incidences(row, P, pts)
+        if not bad:
+            return a
+        af = qfloat(row)[0]
+        q = max((j for _, j in bad), key=lambda j: float(af @ pts[0][j]))
+    return None
+
+
+def _repair(
+    G: np.ndarray, P: np.ndarray, deadline: float | None = None, rounds: int = 8
+) -> np.ndarray | None:
+    """Candidate facets of conv(P) repaired where qhull merged near-coplanar points: rows
+    that a point violates are dropped, and every ridge of a simplicial facet that lies on no
+    other row gets its neighbor by exact gift-wrapping (:func:`_wrap`). Only candidates:
+    :func:`hull_certificate` decides. None when nothing could be repaired; HullTimeout past
+    ``deadline`` (checked before each ridge)."""
+    import time
+
+    from flint import fmpz_mat
+
+    n = P.shape[1]
+    pts = (qfloat(P), *_scaled(P))
+    rows = {tuple((x.p, x.q) for x in r): list(r) for r in G}
+    for _ in range(rounds):
+        Gc = np.array(list(rows.values()), dtype=object).reshape(len(rows), n)
+        _, pv, on, bad = _incidences(Gc, P, pts)
+        drop = {i for i, _ in bad}
+        keep = [
+            i
+            for i in range(len(Gc))
+            if i not in drop and len(on[i]) >= n and fmpz_mat([pv[j] for j in on[i]]).rank() == n
+        ]
+        new: dict[tuple, list[fmpq]] = {}
+        at: dict[int, set[int]] = {}
+        for i in keep:
+            for j in on[i]:
+                at.setdefault(j, set()).add(i)
+        for i in keep:
+            if len(on[i]) != n:
+                continue
+            S = sorted(on[i])
+            off = next(j for j in range(len(P)) if j not in on[i])
+            for x in S:
+                R = [j for j in S if j != x]
+                if set.intersection(*(at[j] for j in R)) - {i}:  # on a second row
+                    continue
+                if deadline is not None and time.perf_counter() > deadline:
+                    raise HullTimeout(0.0)
+                a = _wrap(P, pts, R, off)
+                if a is not None:
+                    new.setdefault(tuple((y.p, y.q) for y in a), a)
+        kept = {tuple((x.p, x.q) for x in Gc[i]): list(Gc[i]) for i in keep}
+        if not new and len(kept) == len(rows):
+            break
+        rows = {**kept, **new}
+    if not rows:
+        return None
+    return np.array(sorted(rows.values()), dtype=object).reshape(len(rows), n)
+
+
 def hull_certificate(G: np.ndarray, P: np.ndarray) -> Incidence | str:
     """Exact proof that ``{e : G e <= 1} = conv(P)`` with every row of ``G`` a facet, from
     vertex–facet incidences (no exact hull). Returns the :class:`Incidence` (which points
@@ -853,19 +954,13 @@ def hull_certificate(G: np.ndarray, P: np.ndarray) -> Incidence | str:
     G = np.array([[x if isinstance(x, fmpq) else _q(_fr(x)) for x in r] for r in G], dtype=object)
     if len({tuple((x.p, x.q) for x in r) for r in G}) != k:
         return "G has a repeated row"
-    Gf, Pf = qfloat(G), qfloat(P)
-    M = Gf @ Pf.T
-    near = np.argwhere(M >= 1 - (1e-9 * (np.abs(Gf) @ np.abs(Pf).T) + 1e-300))
-    gv, gd = _scaled(G)
-    pv, pd = _scaled(P)
-    on: list[set[int]] = [set() for _ in range(k)]
+    gv, pv, on, bad = _incidences(G, P)
+    if bad:
+        i, j = bad[0]
+        return f"point {j} violates row {i} (conv(P) is not inside {{G e <= 1}})"
     at: list[set[int]] = [set() for _ in range(len(P))]
-    for i, j in near.tolist():
-        s = sum(a * b for a, b in zip(gv[i], pv[j], strict=True)) - gd[i] * pd[j]
-        if s > 0:
-            return f"point {j} violates row {i} (conv(P) is not inside {{G e <= 1}})"
-        if s == 0:
-            on[i].add(j)
+    for i, S in enumerate(on):
+        for j in S:
             at[j].add(i)
     from flint import fmpz_mat
 

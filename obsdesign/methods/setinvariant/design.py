@@ -78,9 +78,9 @@ def final_stage(
         Gq, vrep = po.exact_hull(Pq, deadline=deadline)
     except po.HullTimeout:
         raise SolverError(
-            f"exact certificate not finished within {limit}: the exact hull (cdd.gmp) of "
-            f"{len(Pq)} points was stopped (raise time_limit, or a larger λ or Δδ for a "
-            "smaller polyhedron)"
+            f"exact certificate not finished within {limit}: the exact hull of {len(Pq)} "
+            "points (the repair of qhull's facets or the cdd.gmp run) was stopped (raise "
+            "time_limit, or a larger λ or Δδ for a smaller polyhedron)"
         ) from None
     if not single:
         return Stage(Gq, vrep, None)
