@@ -658,9 +658,9 @@ def _simulate_spans(
 
 def check_sim_memory(sp: Spec, kwargs: dict[str, Any]) -> None:
     """Refuse a simulation of the bound spec ``sp`` with the typed ``kwargs`` of ``simulate``
-    whose trajectories would not fit: ``runs × steps × states``
-    doubles (plant, estimate, error and output per step) estimated before anything is
-    allocated, against ``max_sim_bytes`` (:mod:`obsdesign.limits`). ``runs`` is the
+    that would not fit: the method's estimate (:meth:`Method.sim_bytes`; by default every
+    run's trajectories) made before anything is allocated, against ``max_sim_bytes``
+    (:mod:`obsdesign.limits`). ``runs`` is the
     ``--option runs`` value, else the spec's, else 1; steps are the horizon (discrete time)
     or horizon / dt (continuous time)."""
     sim = sp.simulate
@@ -673,8 +673,7 @@ def check_sim_memory(sp: Spec, kwargs: dict[str, Any]) -> None:
         steps = horizon
     else:
         steps = horizon / max(float(sim.dt.f), 1e-300)
-    width = 4 * sp.system.n + sp.system.p + sp.system.m + 2
-    need = 8.0 * float(runs) * (steps + 1.0) * width
+    need = get_method(sp.method).sim_bytes(sp, int(runs), steps, kwargs)
     cap = limits().max_sim_bytes
     if need > cap:
         raise InputError(

@@ -284,3 +284,24 @@ def test_data_problem_names_the_path_and_sees_floats_past_the_depth_limit() -> N
     finally:
         reset_limits(old)
     assert [p for p, _, _ in walk({"a": [1.0, {"b": 2}]})] == ["", "a", "a[1]", "a[1].b", "a[0]"]
+
+
+def test_simulation_memory_estimate_follows_the_method() -> None:
+    """lyapunov's batched Monte Carlo keeps run 0's trajectories, per-run metrics and one
+    batch's buffers: 10⁶ runs × 10⁴ steps fit (the all-trajectories estimate said ~1 TB),
+    10⁹ runs (their metrics) and a batch of 10⁶ runs (its buffers) do not."""
+    from obsdesign import api
+    from obsdesign.errors import InputError
+
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "specs" / "constrained-redesign-sec5-lyapunov.toml").read_text()
+    sp = api.load_spec_text(
+        text.replace("horizon = 300", "horizon = 10000") if "horizon = 300" in text else text,
+        "mc.toml",
+    )
+    api.check_sim_memory(sp, {"runs": 10**6})
+    m = api.method("lyapunov")
+    assert m.sim_bytes(sp, 10**6, 1e4, {}) < 1e-3 * super(type(m), m).sim_bytes(sp, 10**6, 1e4, {})
+    for kwargs in ({"runs": 10**9}, {"runs": 10**6, "batch": 10**6}):
+        with pytest.raises(InputError, match="max_sim_bytes"):
+            api.check_sim_memory(sp, kwargs)

@@ -246,6 +246,16 @@ class Method:
             raise InputError(f"method '{self.key}' has no simulation") from None
         return sim.simulate(spec, params, **options)
 
+    def sim_bytes(self, spec: Spec, runs: int, steps: float, options: dict[str, Any]) -> float:
+        """Bytes a simulation of ``runs`` runs × ``steps`` steps needs, estimated before
+        anything is allocated (checked by the API against ``max_sim_bytes``). Default: every
+        run's trajectories are kept (plant, estimate, error, output, input per step).
+
+        :param spec: the bound spec; :param runs: runs; :param steps: steps per run;
+        :param options: the typed ``simulate`` options."""
+        s = spec.system
+        return 8.0 * float(runs) * (steps + 1.0) * (4 * s.n + s.p + s.m + 2)
+
     # -- generic parts ----------------------------------------------------------------------
     def summary(self, params: Parameters) -> str:
         """One short line of the key results (from ``summary_fields``): scalars formatted, a

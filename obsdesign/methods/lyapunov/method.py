@@ -97,6 +97,23 @@ class Lyapunov(Method):
             return simulate_linear_observer(spec, params.float("L"))
         return simulate_linear_observer_batch(spec, params.float("L"), n, ie, batch, span)
 
+    def sim_bytes(self, spec: Spec, runs: int, steps: float, options: dict[str, Any]) -> float:
+        """One run keeps its trajectories; several runs keep run 0's trajectories, per-run
+        metrics and one batch's block buffers (:mod:`obsdesign.simulate.montecarlo`).
+
+        :param spec: the bound spec; :param runs: runs; :param steps: steps per run;
+        :param options: the typed ``simulate`` options (``batch``)."""
+        from obsdesign.simulate import montecarlo as mc
+
+        s = spec.system
+        one = super().sim_bytes(spec, 1, steps, options)
+        if runs == 1:
+            return one
+        width = 4 * s.n + s.p + s.m + 2
+        batch = options.get("batch") or mc.BATCH_RUNS
+        blocks = 8.0 * min(batch, runs) * (mc.CHUNK + mc.BLOCK + 1) * width
+        return one + 8.0 * runs * (5 * s.n + 1) + blocks
+
     def options_schema(self) -> dict[str, Any]:
         return schema(self.key)
 
