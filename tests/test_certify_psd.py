@@ -386,3 +386,38 @@ def test_pd_fast_large():
     bad = M.copy()
     bad[0, 0] = -F(1)
     assert not check_pd_fast(bad).ok
+
+
+def test_negative_direction_never_proves_a_positive_definite_matrix_not_pd() -> None:
+    """negative_direction is a proof of F ⊁ 0 guided by a float matrix: a lying guide (a
+    negative eigenvalue where F is PD), or F PD by the smallest margin, gives None; a
+    singular PSD F (vᵀFv = 0 exactly) is shown not PD."""
+    from flint import fmpq, fmpq_mat
+
+    from obsdesign.certify.psd import negative_direction
+
+    F = fmpq_mat(2, 2, [2, 1, 1, 2])
+    assert negative_direction(F, np.array([[1.0, 0.0], [0.0, -1.0]])) is None
+    assert negative_direction(F, np.array([[2.0, 1.0], [1.0, 2.0]])) is None
+    tiny = fmpq(1, 2**60)  # det = tiny > 0: PD by the smallest margin in reach of floats
+    G = fmpq_mat(2, 2, [1, 1, 1, 1 + tiny])
+    assert negative_direction(G, np.array([[1.0, 1.0], [1.0, 1.0]])) is None
+    S = fmpq_mat(2, 2, [1, 1, 1, 1])
+    r = negative_direction(S, np.array([[1.0, 1.0], [1.0, 1.0]]))
+    assert r is not None and not r.ok
+
+
+@given(st.lists(st.integers(-50, 50), min_size=9, max_size=9), st.integers(1, 10**6))
+def test_negative_direction_with_random_guides_on_pd_matrices(entries: list[int], k: int) -> None:
+    """F = BᵀB + I/k is PD; whatever float guide is given (here −F and a random symmetric
+    matrix), negative_direction must not claim F ⊁ 0."""
+    from flint import fmpq, fmpq_mat
+
+    from obsdesign.certify.psd import negative_direction
+
+    B = fmpq_mat(3, 3, entries)
+    F = B.transpose() * B + fmpq_mat(3, 3, [fmpq(1, k) if i % 4 == 0 else 0 for i in range(9)])
+    Ff = np.array([[float(F[i, j]) for j in range(3)] for i in range(3)])
+    R = np.array(entries, dtype=float).reshape(3, 3)
+    for guide in (-Ff, R + R.T):
+        assert negative_direction(F, guide) is None
