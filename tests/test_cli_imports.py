@@ -105,6 +105,15 @@ def test_cold_lyapunov_design_loads_no_heavy_module(tmp_path: Path) -> None:
         assert f"obsdesign.methods.{other}" not in mods
 
 
+@pytest.mark.parametrize("args", [["methods"], ["schema"]])
+def test_listing_commands_load_no_solver(args: list[str], tmp_path: Path) -> None:
+    """``methods`` and ``schema`` import every method's facade and options, never its
+    solvers (impulsive's scipy.optimize and set-invariant's LPs load with its design)."""
+    code, mods = _loaded(args, tmp_path)
+    assert code in (0, None)
+    assert _present(mods, HEAVY + ("scipy.sparse", "scipy.integrate")) == []
+
+
 # -- the pydantic-free coercion of command-line values must give typer's own results ----
 def _typer_params() -> list[tuple[Any, Any]]:
     import typer.main

@@ -14,7 +14,6 @@ from typing import Any
 
 import numpy as np
 from flint import fmpq
-from scipy.optimize import minimize
 
 from obsdesign.certify.exact import Q, dyadic, to_float
 from obsdesign.certify.linalg import norm_upper
@@ -139,6 +138,8 @@ def optimize_M(p: Problem, seed: int = 0, starts: int = 6) -> np.ndarray:
     best, best_val = M0, float_window(p, M0)
     for s in range(starts):
         x0 = (M0 if s == 0 else M0 + rng.normal(scale=0.5, size=M0.shape)).ravel()
+        from scipy.optimize import minimize  # loaded by the designs that need it
+
         res = minimize(
             lambda v: -float_window(p, v.reshape(n - m, n)),
             x0,

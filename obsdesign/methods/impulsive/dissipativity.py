@@ -25,7 +25,6 @@ from typing import Any
 
 import numpy as np
 from flint import fmpq
-from scipy.optimize import minimize_scalar
 
 from obsdesign.certify.exact import Q, dyadic, qeye, qzeros, symmetrize, to_float
 
@@ -126,6 +125,8 @@ def best_rate(Ablk: np.ndarray, qsr: QSR, optimize: bool) -> tuple[float, fmpq, 
     vals = [neg(g) for g in grid]
     i = int(np.argmin(vals))
     lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
+    from scipy.optimize import minimize_scalar  # loaded by the designs that need it
+
     res = minimize_scalar(neg, bounds=(lo, hi), method="bounded", options={"xatol": 1e-9})
     theta = dyadic(float(np.exp(res.x)), 24)
     tf = float(to_float(theta))

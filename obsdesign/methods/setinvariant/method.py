@@ -12,18 +12,13 @@ is ambiguous are listed in docs/methods/set-invariant.md.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
-from obsdesign.certify.claim import Claim
-from obsdesign.methods.base import Design, Method, Progress, SimOption, SummaryField
+from obsdesign.methods.base import Method, SimOption, SummaryField
 from obsdesign.params import Parameters
 from obsdesign.simulate.result import SimResult
 from obsdesign.spec.models import Spec
-from obsdesign.spec.reader import Table
 
-from . import claims as _claims
-from . import design as _design
-from .options import LAWS, Options, options_schema, parse_options
+from .options import LAWS, Options
 
 
 class SetInvariant(Method):
@@ -56,23 +51,8 @@ class SetInvariant(Method):
         ),
     )
 
-    def parse_options(self, table: Table, spec: Spec) -> Options:
-        """Typed ``[method]`` (see :mod:`.options`)."""
-        return parse_options(table, spec)
-
-    def design(self, spec: Spec, progress: Progress | None = None) -> Design:
-        """Polyhedron, injection table and linear gains (see :mod:`.design`)."""
-        return _design.design(spec, progress)
-
-    def certify(self, spec: Spec, params: Parameters) -> list[Claim]:
-        """Every claim recomputed from spec + parameters (see :mod:`.claims`)."""
-        return _claims.certify(spec, params)
-
-    def simulate(self, spec: Spec, params: Parameters, **options: Any) -> SimResult:
-        """Plant + observer over ``[simulate]``; ``law`` picks the injection law."""
-        from .sim import simulate
-
-        return simulate(spec, params, **options)
+    # parse_options, design, certify, simulate, options_schema: the base class's defaults
+    # (options / design / claims / sim modules of this package, imported on first use)
 
     def plot_simulation(self, spec: Spec, res: SimResult, path: str | Path) -> Path:
         """The polyhedra with the error trajectory (Fig. 1)."""
@@ -85,10 +65,6 @@ class SetInvariant(Method):
         from .plots import plot_design
 
         return plot_design(spec, params, path)
-
-    def options_schema(self) -> dict[str, Any]:
-        """JSON schema of ``[method]``."""
-        return options_schema(self.key)
 
 
 METHOD = SetInvariant()
