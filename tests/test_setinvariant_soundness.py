@@ -9,12 +9,15 @@ from __future__ import annotations
 import copy
 import json
 import re
+from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 from flint import fmpq
+from hypothesis import given
+from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from obsdesign import api
@@ -543,3 +546,55 @@ def test_multi_output_needs_its_linear_law(tmp_path: Path) -> None:
     assert not ok
     d = put(base, L=L * s, L_factor=f)
     assert failed_certify(d) == {"linear-law"}
+
+
+@pytest.mark.parametrize("spec", ["dorea-pimenta-7-1.toml", "dorea-pimenta-7-2.toml"])
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_theorem31_holds_with_float_crossings_off_by_their_error_bound(
+    spec: str, sign: float, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The certificate's float prefilter widens each edge crossing's φ value by the bound on
+    its float weight's error (_weight_error): with every float crossing moved along its edge
+    by that whole bound, verify gives the same claims."""
+    root = Path(__file__).resolve().parents[1]
+    rep = api.design(api.load_spec(root / "specs" / spec))
+    before = [(c.id, c.status, c.statement) for c in api.verify(rep).claims]
+    init = ce._Slices.__init__
+    moved = []
+
+    def shifted(self, *args: Any, **kwargs: Any) -> None:
+        init(self, *args, **kwargs)
+        for l, (dirs, err, _) in enumerate(self.ends):
+            self.ptsf[l] = self.ptsf[l] + sign * err[:, None] * dirs
+            moved.append(float(np.abs(err[:, None] * dirs).max(initial=0.0)))
+
+    monkeypatch.setattr(ce._Slices, "__init__", shifted)
+    after = [(c.id, c.status, c.statement) for c in api.verify(rep).claims]
+    assert moved and after == before
+    assert all(s == ClaimStatus.CERTIFIED for _, s, _ in after)
+
+
+@given(
+    st.fractions(-10, 10, max_denominator=10**30),
+    st.fractions(-10, 10, max_denominator=10**30),
+    st.floats(0.0, 1.0),
+    st.integers(0, 60),
+)
+def test_weight_error_bounds_the_float_crossing_weight(
+    a: Fraction, b: Fraction, frac: float, level: int
+) -> None:
+    """|w − w*| ≤ _weight_error for the float weight of an edge crossing, checked exactly,
+    including edges nearly level in c (b − a down to 2⁻⁶⁰ relative)."""
+    b = a + (b - a) / 2**level
+    if a == b:
+        return
+    t_exact = a + (b - a) * Fraction(frac)
+    if not (min(a, b) < t_exact < max(a, b)):
+        return
+    t, ca, cb = float(t_exact), np.array([float(a)]), np.array([float(b)])
+    den = cb - ca
+    with np.errstate(divide="ignore", invalid="ignore"):
+        w = float(np.where(den == 0, 0.5, np.clip((t - ca) / den, 0.0, 1.0))[0])
+    w_exact = (t_exact - a) / (b - a)
+    bound = float(ce._weight_error(t, ca, cb, den)[0])
+    assert abs(Fraction(w) - w_exact) <= Fraction(bound)

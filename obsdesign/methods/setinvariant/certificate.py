@@ -10,8 +10,10 @@
 * :func:`linear_law` — Proposition 7.1 / linear injection ``v = L z``: for every vertex e of
   {G e <= 1} and every vertex η of the noise box, ``G (A + L C) e + G L η + δ <= λ 1``.
 
-Float values are used only to pick which entries to evaluate exactly, with a threshold far
-above the float error, so a skipped entry is provably below the bound.
+Float values are used only to pick which entries to evaluate exactly. Each is a rigorous
+bracket: a relative slack far above the rounding of the float products, and for an edge
+crossing of a slice the whole possible error of its float weight (:func:`_weight_error`),
+so a skipped entry is provably below the bound.
 """
 
 from __future__ import annotations
@@ -110,6 +112,21 @@ class Theorem31Result:
     notes: list[str] = field(default_factory=list)
 
 
+def _weight_error(t: float, ca: np.ndarray, cb: np.ndarray, den: np.ndarray) -> np.ndarray:
+    """A rigorous bound on |w − w*| for the float weight w = clip((t − ca)/(cb − ca), 0, 1)
+    of an edge crossing, w* = (t* − ca*)/(cb* − ca*) its exact value: t, ca, cb are the
+    nearest floats of exact t*, ca*, cb* (relative error ≤ u = 2⁻⁵³ each) and each float
+    operation adds one more, so the numerator and the denominator are each within
+    e = 4u(|t| + |ca| + |cb|) of their exact values; with |den| > 2e,
+    |w − w*| ≤ (e + e·|w*|)/(|den| − e) ≤ 2e/(|den| − e) (|w*| ≤ 1), doubled for margin.
+    1 (the whole edge) where the edge is too level in c for that."""
+    e = 4.0 * 2.0**-53 * (abs(t) + np.abs(ca) + np.abs(cb)) + 2.0**-1070
+    gap = np.abs(den) - e
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = np.where(np.abs(den) > 2 * e, 4 * e / gap, 1.0)
+    return np.minimum(out, 1.0)
+
+
 class _Slices:
     """Slices of {G e <= 1} at each z^l: float candidates, exact points on demand.
 
@@ -142,10 +159,16 @@ class _Slices:
         #: per z^l: (vertex indices, [edge indices crossing z − η̄, z + η̄]) of the candidates
         self.cands: list[tuple[np.ndarray, list[np.ndarray]]] = []
         self.ptsf: list[np.ndarray] = []
+        #: per z^l: each candidate's edge direction (zero for a vertex), a rigorous bound on
+        #: the error of its float weight w (1: anywhere on the edge) and whether it certainly
+        #: exists exactly (float c-values beyond tol): see :meth:`cand_bounds`
+        self.ends: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
         for z in zs:
             lo, hi = float(z - ex.eta), float(z + ex.eta)
             vj = np.nonzero((self.cvf >= lo - tol) & (self.cvf <= hi + tol))[0]
             pts = [self.Vf[vj]]
+            dirs, errs = [np.zeros((len(vj), ex.n))], [np.zeros(len(vj))]
+            sure = [(self.cvf[vj] >= lo + tol) & (self.cvf[vj] <= hi - tol)]
             sides = []
             for t in (lo, hi) if ex.eta != 0 else (lo,):
                 k = np.nonzero((emin <= t + tol) & (emax >= t - tol))[0]
@@ -153,11 +176,18 @@ class _Slices:
                 with np.errstate(divide="ignore", invalid="ignore"):
                     w = np.where(den == 0, 0.5, np.clip((t - ca[k]) / den, 0.0, 1.0))
                 pts.append(self.Vf[self.ea[k]] + w[:, None] * dV[k])
+                dirs.append(dV[k])
+                errs.append(_weight_error(t, ca[k], cb[k], den))
+                sure.append((emin[k] < t - tol) & (emax[k] > t + tol))
                 sides.append(k)
             self.cands.append((vj, sides))
             self.ptsf.append(np.vstack(pts).reshape(-1, ex.n))
+            self.ends.append(
+                (np.vstack(dirs).reshape(-1, ex.n), np.concatenate(errs), np.concatenate(sure))
+            )
         self._cache: dict[tuple, tuple | None] = {}
         self._phif: dict[int, np.ndarray] = {}
+        self._bounds: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
 
     def _cand(self, l: int, j: int) -> tuple:
         """The j-th candidate of slice l: ("v", vertex) or ("e", a, b, side)."""
@@ -201,16 +231,36 @@ class _Slices:
             self._phif[l] = (self.GAf @ self.ptsf[l].T).max(axis=1)
         return self._phif[l]
 
+    def cand_bounds(self, l: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Per row i and candidate j of slice l: float bounds ``up[i, j]`` ≥ G_i A p_j and,
+        for a candidate that certainly exists, ``low[i, j]`` ≤ G_i A p_j (−inf otherwise),
+        whatever the float error of the candidate's point: the exact crossing is
+        p_j = V_a + w*·(V_b − V_a) with |w* − w| ≤ ``err`` (:func:`_weight_error`; 1 when the
+        edge is too level in c to say), so G_i A p_j is within |G_i A (V_b − V_a)|·err of
+        its float value; the slack ``_FILTER`` (relative) covers the rounding of the float
+        products (~1e-15 relative). Also the row bounds ``phi_up`` ≥ φ_i(z^l) ≥ ``phi_low``
+        (LP (6))."""
+        if l not in self._bounds:
+            dirs, err, sure = self.ends[l]
+            S = self.ptsf[l]
+            cen = self.GAf @ S.T
+            rad = np.abs(self.GAf @ dirs.T) * err[None, :]
+            rad += _FILTER * (self.absGA @ (np.abs(S) + np.abs(dirs)).T) + 1e-300
+            up = cen + rad
+            low = np.where(sure[None, :], cen - rad, -np.inf)
+            self._bounds[l] = (up, low, up.max(axis=1), low.max(axis=1))
+        return self._bounds[l]
+
     def phi_exact(self, l: int, rows=None) -> dict[int, fmpq]:
-        """Exact φ_i(z^l) (LP (6)) for the given rows: max of G_i A over the slice vertices."""
-        S = self.ptsf[l]
-        M = self.GAf @ S.T
-        tol = _FILTER * (self.absGA @ np.abs(S).T).max(axis=1) + 1e-300
+        """Exact φ_i(z^l) (LP (6)) for the given rows: max of G_i A over the slice vertices
+        (only over the candidates whose rigorous upper bound reaches the row's rigorous
+        lower bound: :meth:`cand_bounds`)."""
+        up, _, _, phi_low = self.cand_bounds(l)
         rows = range(len(self.G)) if rows is None else rows
         out = {}
         for i in rows:
             best = None
-            for j in np.nonzero(M[i] >= M[i].max() - tol[i])[0]:
+            for j in np.nonzero(up[i] >= phi_low[i])[0]:
                 p = self._exact_point(l, self._cand(l, int(j)))
                 if p is not None:
                     val = po.qdot(self.GA[i], p)
@@ -346,11 +396,12 @@ def theorem31(
     hi, lo = np.empty(nz), np.empty(nz)
     for l in range(nz):
         vf = po.qfloat(np.array(vs_use[l], dtype=object))
-        phf = sl.phi_float(l)
-        val = phf + Gf @ vf + dlf
-        tol = _FILTER * (np.abs(phf) + absG @ np.abs(vf) + np.abs(dlf) + 1.0)
-        fl_rows.append((val, tol))
-        hi[l], lo[l] = float((val + tol).max()), float((val - tol).max())
+        _, _, phi_up, phi_low = sl.cand_bounds(l)
+        rest = Gf @ vf + dlf
+        tol = _FILTER * (np.abs(phi_up) + absG @ np.abs(vf) + np.abs(dlf) + 1.0)
+        up, low = phi_up + rest + tol, phi_low + rest - tol  # low may be -inf
+        fl_rows.append((up, low))
+        hi[l], lo[l] = float(up.max()), float(low.max())
     eps_l: list[fmpq | None] = [None] * nz
     out_vs: list[list[fmpq]] = [list(v) for v in vs_use]
     n_exact = 0
@@ -360,9 +411,9 @@ def theorem31(
         if deadline is not None and time.perf_counter() > deadline:
             raise BudgetExceeded(sum(e is not None for e in eps_l))
         v = vs_use[l]
-        val, tol = fl_rows[l]
-        thr = min(lamf, float(val.max()))
-        rows = np.nonzero(val >= thr - tol)[0]
+        up, low = fl_rows[l]
+        thr = min(lamf, float(low.max()))
+        rows = np.nonzero(up >= thr)[0]  # every row that can reach the level or λ
         ph = sl.phi_exact(l, rows)
         e = max(ph[i] + po.qdot(G[i], v) + dl[i] for i in ph)
         # the exact LP only helps where the float LP says ε(z) <= λ and rounding broke it;
