@@ -132,3 +132,33 @@ def test_never_pd_when_exact_says_not(case: tuple[fmpq_mat, fmpq]) -> None:
     r = check_pd_fast(M, margin)
     assert r.ok == exact
     assert check_text(r)
+
+
+@pytest.mark.parametrize(
+    ("n", "seed", "margin"), [(5, 1, fmpq(0)), (30, 2, fmpq(1, 10)), (60, 3, fmpq(0))]
+)
+def test_the_proved_bound_leaves_room_for_every_error_term(n: int, seed: int, margin: fmpq) -> None:
+    """The bound verified_pd reports is at most c − δ minus every term of the theorem,
+    recomputed here exactly from the same factor R̃ (γ_{n+1}·Σ r̃², n·τ, u·‖H‖_F + nη,
+    u·max|G_ii|): an under-estimated error term (even by half) fails this test."""
+    F = _with_lambda_min(n, fmpq(1, 3), seed)
+    res = verified_pd(F, margin)
+    assert res is not None
+    H = to_float(F)
+    G = H.copy()
+    G[np.arange(n), np.arange(n)] = np.subtract(np.diag(H), res.shift)
+    R = float_cholesky(G)
+    assert R is not None
+
+    def q(x: float) -> fmpq:
+        return fmpq(*float(x).as_integer_ratio())
+
+    u, eta = fmpq(1, 2**53), fmpq(1, 2**1074)
+    gamma = (n + 1) * u / (1 - (n + 1) * u)
+    sum_r2 = sum((q(x) * q(x) for x in R.ravel()), fmpq(0))
+    tau = fmpq(1, 2**1000) * (n + 2) * (1 + q(np.max(np.diag(R))))
+    gmax = q(np.max(np.abs(np.diag(G))))
+    room = q(res.shift) - margin - gamma * sum_r2 - n * tau - u * gmax - n * eta - res.bound
+    sum_h2 = sum((q(x) * q(x) for x in H.ravel()), fmpq(0))
+    assert room >= 0 and room * room >= u * u * sum_h2  # room ≥ u·‖H‖_F
+    assert res.bound > 0
