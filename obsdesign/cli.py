@@ -147,12 +147,17 @@ SpecArg = Annotated[
 def _run(fn: Callable[[Any], int], quiet: bool = False, width: int | None = None) -> None:
     """Run a command body ``fn(obsdesign.cli_commands)`` with -q/--quiet and --width applied,
     mapping errors to exit codes without a traceback."""
+    from obsdesign import interrupt
     from obsdesign.errors import EXIT_SOLVER, ObsdesignError
 
+    # the console script (not an in-process caller such as CliRunner) owns SIGINT: from here
+    # on Ctrl-C raises KeyboardInterrupt (handled below, cleanup runs) and is recorded, so
+    # that it ends in exit 130 even when the exception is lost on its way up
+    owned = signal.getsignal(signal.SIGINT) is _early_interrupt
+    interrupt.reset()
     try:
-        # from here on Ctrl-C raises KeyboardInterrupt (handled below, cleanup runs)
-        if signal.getsignal(signal.SIGINT) is _early_interrupt:
-            signal.signal(signal.SIGINT, signal.default_int_handler)
+        if owned:
+            signal.signal(signal.SIGINT, interrupt.handler)
         from obsdesign import cli_commands
 
         cli_commands.setup(quiet, width)
@@ -162,22 +167,26 @@ def _run(fn: Callable[[Any], int], quiet: bool = False, width: int | None = None
         with warnings.catch_warnings(record=True) as stray:
             warnings.simplefilter("always")
             code = fn(cli_commands)
+        _settle(owned)
         if _state["debug"]:
             for w in stray:
                 _err(f"warning: {w.category.__name__}: {w.message}")
     except ObsdesignError as e:
+        _settle(owned)
         if _state["debug"]:
             raise
         _err(e.message)
         raise typer.Exit(e.exit_code) from None
     except typer.Exit:
+        _settle(owned)
         raise
     except BrokenPipeError:
         _quiet_broken_pipe()
     except KeyboardInterrupt:
-        _err("interrupted")
-        raise typer.Exit(130) from None
+        _settle(owned)
+        _interrupted()
     except Exception as e:  # noqa: BLE001 - last line of defence: no traceback for users
+        _settle(owned)
         if _state["debug"]:
             raise
         _err(f"internal failure: {type(e).__name__}: {e} (run with --debug for the traceback)")
@@ -187,6 +196,24 @@ def _run(fn: Callable[[Any], int], quiet: bool = False, width: int | None = None
     except BrokenPipeError:
         _quiet_broken_pipe()
     raise typer.Exit(code)
+
+
+def _settle(owned: bool) -> None:
+    """The command body has ended: a Ctrl-C from now on is ignored (the work is done and its
+    files are written; Python's shutdown would otherwise die of the signal, exit -2), and a
+    Ctrl-C recorded during the body ends the command with exit 130 whatever it returned."""
+    from obsdesign import interrupt
+
+    if owned:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if interrupt.requested():
+        _interrupted()
+
+
+def _interrupted() -> None:
+    """One line and exit 130, as after Ctrl-C in a shell."""
+    _err("interrupted")
+    raise typer.Exit(130) from None
 
 
 def _quiet_broken_pipe() -> None:

@@ -376,7 +376,7 @@ def check(
     scheduler: str | None,
 ) -> int:
     """The body of ``obsdesign check`` (see :func:`obsdesign.cli.check`)."""
-    from obsdesign import api
+    from obsdesign import api, interrupt
 
     if junit is not None:
         from obsdesign.report.model import check_output
@@ -384,6 +384,7 @@ def check(
         check_output(junit, False, _inputs(*paths))
 
     def each(f: Path) -> None:
+        interrupt.check()  # a Ctrl-C whose exception was lost in the last spec stops here
         if fmt == Fmt.text and not quiet:
             sys.stderr.write(f"checking {f} ...\n")
 

@@ -55,7 +55,10 @@ def solve(problem: Any, solvers: tuple[str, ...] = SOLVERS) -> SolveResult:
         try:
             with warnings.catch_warnings():  # "solution may be inaccurate": we read the status
                 warnings.simplefilter("ignore", UserWarning)
-                problem.solve(solver=name)
+                if name == "SCS":
+                    _solve_scs(problem)
+                else:
+                    problem.solve(solver=name)
         except cp.error.SolverError as e:
             last = f"{name}: {e}"
             continue
@@ -66,6 +69,20 @@ def solve(problem: Any, solvers: tuple[str, ...] = SOLVERS) -> SolveResult:
     if last.endswith("inaccurate"):
         return SolveResult(last.split(": ")[1], last.split(":")[0], time.perf_counter() - t0)
     raise SolverError(f"no SDP solver succeeded ({last or 'none installed'})")
+
+
+def _solve_scs(problem: Any) -> None:
+    """``problem.solve(solver="SCS")`` through cvxpy's documented steps (get_problem_data,
+    solve_via_data, unpack_results), so that SCS's raw status can be read: SCS replaces the
+    SIGINT handler while it iterates and, on Ctrl-C, stops with status "interrupted", which
+    cvxpy reports as a solver error, so the interrupt would be lost (and the next solver
+    tried). That status raises KeyboardInterrupt here."""
+    data, chain, inverse = problem.get_problem_data(solver="SCS")
+    raw = chain.solve_via_data(problem, data)
+    info = raw.get("info", {}) if isinstance(raw, dict) else {}
+    if info.get("status_val") == -5 or info.get("status") == "interrupted":  # SCS_SIGINT
+        raise KeyboardInterrupt
+    problem.unpack_results(raw, chain, inverse)
 
 
 def value(x: Any) -> np.ndarray:

@@ -1,0 +1,86 @@
+"""The recorded Ctrl-C (obsdesign.interrupt) and how the CLI acts on it."""
+
+from __future__ import annotations
+
+import pytest
+import typer
+
+from obsdesign import cli, interrupt
+
+
+@pytest.fixture(autouse=True)
+def _clean():
+    interrupt.reset()
+    yield
+    interrupt.reset()
+
+
+def test_the_handler_records_and_raises():
+    assert not interrupt.requested()
+    interrupt.check()  # nothing recorded: no exception
+    with pytest.raises(KeyboardInterrupt):
+        interrupt.handler(2, None)
+    assert interrupt.requested()
+    with pytest.raises(KeyboardInterrupt):
+        interrupt.check()
+    interrupt.reset()
+    assert not interrupt.requested()
+
+
+def _swallowing_body(cmd: object) -> int:
+    """A command body in which the KeyboardInterrupt is lost on its way up (as C code that
+    clears a callback's error does) and which then finishes normally."""
+    try:
+        interrupt.handler(2, None)
+    except BaseException:  # noqa: BLE001 - the point of the test
+        pass
+    return 0
+
+
+def test_a_lost_keyboard_interrupt_still_ends_in_exit_130(capsys: pytest.CaptureFixture[str]):
+    with pytest.raises(typer.Exit) as e:
+        cli._run(_swallowing_body)
+    assert e.value.exit_code == 130
+    assert capsys.readouterr().err.strip().endswith("interrupted")
+
+
+def test_a_lost_interrupt_wins_over_an_error_raised_after_it():
+    from obsdesign.errors import InputError
+
+    def body(cmd: object) -> int:
+        _swallowing_body(cmd)
+        raise InputError("x.toml: bad")
+
+    with pytest.raises(typer.Exit) as e:
+        cli._run(body)
+    assert e.value.exit_code == 130
+
+
+def test_each_command_starts_with_no_recorded_interrupt():
+    with pytest.raises(KeyboardInterrupt):
+        interrupt.handler(2, None)
+    with pytest.raises(typer.Exit) as e:
+        cli._run(lambda cmd: 0)
+    assert e.value.exit_code == 0
+
+
+def test_check_stops_before_the_next_spec_once_an_interrupt_is_recorded(tmp_path, monkeypatch):
+    from obsdesign import api
+    from obsdesign.cli_commands import Fmt, check
+
+    for name in ("a.toml", "b.toml"):
+        (tmp_path / name).write_text("")
+    seen: list[str] = []
+
+    def one(path):
+        seen.append(path.name)
+        try:
+            interrupt.handler(2, None)
+        except KeyboardInterrupt:
+            pass
+        return api.CheckRow(str(path), "x", 0, 0, 0, 0, "", 0.0)
+
+    monkeypatch.setattr(api, "check_one", one)
+    with pytest.raises(KeyboardInterrupt):
+        check([tmp_path], Fmt.text, None, True, None, None)
+    assert seen == ["a.toml"]
