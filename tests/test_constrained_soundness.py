@@ -395,7 +395,7 @@ def test_v_min_bound(sec5, tmp_path) -> None:
 
 def test_theta_covers(sec5, tmp_path) -> None:
     t = p_exact(sec5, "theta")
-    assert t == 1109771083252742
+    assert t == 1109771083259869
     assert_only(sec5, tmp_path, {"theta-covers"}, {"theta": t}, {"theta": t - 1})
     # a non-integer θ above the bound is refused too (θ counts steps)
     assert failed_ids(tamper(sec5, theta=t + fmpq(1, 2))) == {"theta-covers"}

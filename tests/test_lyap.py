@@ -129,7 +129,7 @@ def test_iss_mu_is_certified_and_near_the_infimum(discrete: bool) -> None:
 
 
 def test_best_rate_shipped_section5() -> None:
-    """Same search as before the bracket existed: λ_best = 0.95006 (P_best unchanged); the
+    """Same search as before the bracket existed: λ_best = 0.95006 (P_best as the numpy Lyapunov solve of issue 12 gives it); the
     other end 0.95 = ρ(A − LC) is proved infeasible."""
     br = best_rate(A5, C5, L5, True, tol=TOL, margin=MARGIN)
     assert br.best == fmpq(47503, 50000)
@@ -138,8 +138,8 @@ def test_best_rate_shipped_section5() -> None:
         br.P.tolist()
         == qmat(
             [
-                ["529058895159/32768", "278434182085/16384"],
-                ["278434182085/16384", "586140837409/32768"],
+                ["529058893979/32768", "556868362929/32768"],
+                ["556868362929/32768", "586140836101/32768"],
             ]
         ).tolist()
     )
@@ -267,3 +267,62 @@ def test_best_rate_bracket_property(n: int, seed: int, discrete: bool, tol: fmpq
         assert (
             (float(br.other) <= bound + 1e-12) if discrete else (float(br.other) >= bound - 1e-12)
         )
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    n=st.integers(1, lyap.KRONECKER_MAX_N),
+    seed=st.integers(0, 2**32 - 1),
+    discrete=st.booleans(),
+    gap=st.floats(1e-6, 1.0),
+)
+def test_solve_lyapunov_small_systems_match_scipy(n: int, seed: int, discrete: bool, gap: float):
+    """Up to KRONECKER_MAX_N states the equations are solved as one n²×n² linear system by
+    numpy: the solution satisfies its equation to rounding and agrees with scipy's solvers
+    to the equation's conditioning."""
+    from scipy.linalg import solve_continuous_lyapunov, solve_discrete_lyapunov
+
+    rng = np.random.default_rng(seed)
+    A = rng.standard_normal((n, n))
+    eye = np.eye(n)
+    if discrete:
+        rate = max(abs(np.linalg.eigvals(A))) * (1 + gap)
+        X = lyap.solve_lyapunov(A, rate, True)
+        R = rate**2 * X - A.T @ X @ A - eye
+        ref = solve_discrete_lyapunov((A / rate).T, eye / rate**2)
+    else:
+        rate = -max(np.linalg.eigvals(A).real) - gap
+        M = A + rate * eye
+        X = lyap.solve_lyapunov(A, rate, False)
+        R = -(M.T @ X + X @ M) - eye
+        ref = solve_continuous_lyapunov(M.T, -eye)
+    scale = max(1.0, np.linalg.norm(X))
+    assert np.linalg.norm(R) <= 1e-9 * scale * max(1.0, np.linalg.norm(A)) ** 2
+    # both solve the same equation: they differ by at most its conditioning times rounding
+    cond = np.linalg.cond(
+        rate**2 * np.eye(n * n) - np.kron(A.T, A.T)
+        if discrete
+        else np.kron(M.T, eye) + np.kron(eye, M.T)
+    )
+    assert np.linalg.norm(X - ref) <= 1e-12 * cond * scale
+
+
+def test_solve_lyapunov_singular_operator_gets_a_least_squares_solution():
+    """α between two modes of a continuous Acl (eigenvalues of M at ±1) makes the operator
+    singular: the least-squares X is diag(−1/2, 1/2), which the inertia certificate uses
+    to prove the rate infeasible (scipy's solvers perturb and return the same)."""
+    X = lyap.solve_lyapunov(np.diag([-1.0, -3.0]), 2.0, False)
+    assert np.allclose(X, np.diag([-0.5, 0.5]))
+
+
+def test_solve_lyapunov_large_systems_use_scipy(monkeypatch: pytest.MonkeyPatch):
+    """Above KRONECKER_MAX_N states the n²×n² system would cost O(n⁶): scipy solves it."""
+    n = lyap.KRONECKER_MAX_N + 1
+    A = 0.5 * np.eye(n)
+    calls: list[int] = []
+    real = np.linalg.solve
+    monkeypatch.setattr(np.linalg, "solve", lambda *a: calls.append(1) or real(*a))
+    X = lyap.solve_lyapunov(A, 1.0, True)  # X − AᵀXA = I: X = I/(1 − 0.25)
+    assert not calls and np.allclose(X, np.eye(n) / 0.75)
+    X = lyap.solve_lyapunov(A[:-1, :-1], 1.0, True)
+    assert calls and np.allclose(X, np.eye(n - 1) / 0.75)

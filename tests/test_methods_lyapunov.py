@@ -82,25 +82,25 @@ def test_shipped_spec_key_results_exact() -> None:
     ex = json.loads(rep.to_json())["parameters"]["exact"]
     assert ex["L"] == [["-187/100"], ["937/500"]]
     assert ex["P"] == [
-        ["1056385108643/8388608", "553027016185/4194304"],
-        ["553027016185/4194304", "579147225817/4194304"],
+        ["528192554325/4194304", "553027016189/4194304"],
+        ["553027016189/4194304", "579147225821/4194304"],
     ]
     assert ex["lambda"] == "191/200"
     assert ex["P_best"] == [
-        ["529058895159/32768", "278434182085/16384"],
-        ["278434182085/16384", "586140837409/32768"],
+        ["529058893979/32768", "556868362929/32768"],
+        ["556868362929/32768", "586140836101/32768"],
     ]
     assert ex["lambda_best"] == "47503/50000"
     assert ex["lambda_bracket"] == "19/20"
     assert rep.parameters["lambda_bracket_kind"] == "infeasible"
-    assert ex["mu"] == "256225184"
+    assert ex["mu"] == "512450229/2"
     assert [c.id for c in rep.claims] == IDS
     assert all(c.status == ClaimStatus.CERTIFIED for c in rep.claims)
     st = {c.id: c.statement for c in rep.claims}
     assert st["decay-lmi"] == "(A−LC)ᵀP(A−LC) ⪯ λ²·P with λ = 0.955"
     assert st["decay-lmi_best"] == "(A−LC)ᵀP_best(A−LC) ⪯ λ_best²·P_best with λ_best = 0.95006"
     # was "μ = 2.56225e+08", below the certified μ: now exact
-    assert st["iss-gain"] == "V(e⁺) ≤ λ²V(e) + μ|v|² with μ = 256225184"
+    assert st["iss-gain"] == "V(e⁺) ≤ λ²V(e) + μ|v|² with μ = 256225114.5"
     assert st["lambda_best-bracket"].startswith("λ_best = 0.95006 is best to within 0.0001: ")
     assert rep.solver["status"] == "closed_form"
     assert api.method("lyapunov").summary(rep.parameters) == (
