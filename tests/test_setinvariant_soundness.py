@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import pytest
 from flint import fmpq
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 from typer.testing import CliRunner
 
@@ -598,3 +598,92 @@ def test_weight_error_bounds_the_float_crossing_weight(
     w_exact = (t_exact - a) / (b - a)
     bound = float(ce._weight_error(t, ca, cb, den)[0])
     assert abs(Fraction(w) - w_exact) <= Fraction(bound)
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_row_bounds_hold_for_a_crossing_on_an_edge_nearly_level_in_c(sign: float) -> None:
+    """The prefilter's bounds (row_bounds, cand_up) must contain the exact φ_i(z) even where
+    the float crossing is as far from the exact one as its weight-error bound allows. The
+    quadrilateral's right edge runs from (1, −1) to (1 + 10⁻²⁰, 1): in floats it is level in
+    c = (1, 0) (error bound 1: anywhere on the edge); the slice at z = r = 1 + 10⁻²⁰/2 is the
+    segment from (r, 0) (on that edge) to (r, 1) (on the top edge). The float crossing on
+    the level edge is moved to an end of the edge (y = ±2 off): the bounds must still hold,
+    checked against the exact points."""
+    q = fmpq
+    tiny = q(1, 10**20)
+    r = q(1) + tiny / 2
+    G = np.array(
+        [[q(0), q(-1)], [q(-1), q(0)], [q(0), q(1)], [q(1) / r, -tiny / 2 / r]], dtype=object
+    )
+    ex = ce.ExactProblem(
+        A=np.array([[q(1), q(0)], [q(0), q(1)]], dtype=object),
+        B1=np.zeros((2, 0), dtype=object),
+        C=np.array([[q(1), q(0)]], dtype=object),
+        G0=G,
+        Vo=np.zeros((0, 2), dtype=object),
+        Dv=np.zeros((0, 0), dtype=object),
+        eta=q(0),
+        lam=q(1),
+    )
+    vrep = ce.po.exact_h_to_v(G)
+    assert sorted(map(tuple, vrep.V)) == sorted(
+        [(q(-1), q(-1)), (q(1), q(-1)), (q(1) + tiny, q(1)), (q(-1), q(1))]
+    )
+    _, cv = ce.exact_zd(vrep.V, ex.C[0], ex.eta)
+    sl = ce._Slices(ex, G, vrep, [r], cv)
+    dirs, err, _ = sl.ends[0]
+    assert err.max() == 1.0  # the level edge: the float weight may be anywhere
+    sl.ptsf[0] = sl.ptsf[0] + sign * err[:, None] * dirs
+    up, low = sl.row_bounds(0)
+    exact_pts = [sl._exact_point(0, sl._cand(0, j)) for j in range(len(err))]
+    assert sorted(p for p in exact_pts if p is not None) == [(r, q(0)), (r, q(1))]
+    for i in range(len(G)):
+        phi = max(ce.po.qdot(sl.GA[i], p) for p in exact_pts if p is not None)
+        assert low[i] <= float(phi) <= up[i]
+        cu = sl.cand_up(0, i)
+        for j, p in enumerate(exact_pts):
+            if p is not None:
+                assert cu[j] >= float(ce.po.qdot(sl.GA[i], p))
+    assert sl.phi_exact(0) == {
+        i: max(ce.po.qdot(sl.GA[i], (r, y)) for y in (q(0), q(1))) for i in range(len(G))
+    }
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_row_bounds_contain_the_exact_phi_on_random_polytopes(seed: int) -> None:
+    """On random 3-D polytopes (hulls of random integer points around the origin, random A
+    and c), at every breakpoint:
+    phi_low ≤ the exact φ_i(z) (max of G_i A e over the exact slice points) ≤ phi_up, and
+    phi_exact equals that brute-force maximum."""
+    q = fmpq
+    rng = np.random.default_rng(seed)
+    pts = np.vstack([rng.integers(-20, 21, size=(12, 3)), 21 * np.eye(3), -21 * np.eye(3)])
+    G, vrep = ce.po.exact_hull(np.array([[q(int(x)) for x in p] for p in pts], dtype=object))
+    Aq = np.array(
+        [[q(int(x), 7) for x in row] for row in rng.integers(-5, 6, (3, 3))], dtype=object
+    )
+    cq = np.array([[q(int(x)) for x in rng.integers(-3, 4, 3)]], dtype=object)
+    if all(x == 0 for x in cq[0]):
+        return
+    ex = ce.ExactProblem(
+        A=Aq,
+        B1=np.zeros((3, 0), dtype=object),
+        C=cq,
+        G0=G,
+        Vo=np.zeros((0, 3), dtype=object),
+        Dv=np.zeros((0, 0), dtype=object),
+        eta=q(1, 3),
+        lam=q(1),
+    )
+    zs, cv = ce.exact_zd(vrep.V, ex.C[0], ex.eta)
+    sl = ce._Slices(ex, G, vrep, zs, cv)
+    for l in range(len(zs)):
+        up, low = sl.row_bounds(l)
+        exact_pts = [sl._exact_point(l, sl._cand(l, j)) for j in range(len(sl.ends[l][1]))]
+        exact_pts = [p for p in exact_pts if p is not None]
+        phis = sl.phi_exact(l)
+        for i in range(len(G)):
+            phi = max(ce.po.qdot(sl.GA[i], p) for p in exact_pts)
+            assert low[i] <= float(phi) <= up[i]
+            assert phis[i] == phi

@@ -31,6 +31,9 @@ from obsdesign.sets import polytope_ops as po
 from .budget import Timeout
 
 _FILTER = 1e-7  # relative slack of the float prefilter (float error is ~1e-15 relative)
+#: a candidate whose weight error (:func:`_weight_error`) is at most this shares one radius
+#: vector in :meth:`_Slices.row_bounds`; a larger one (an edge nearly level in c) has its own
+_PRECISE = 1e-6
 
 
 @dataclass
@@ -161,7 +164,7 @@ class _Slices:
         self.ptsf: list[np.ndarray] = []
         #: per z^l: each candidate's edge direction (zero for a vertex), a rigorous bound on
         #: the error of its float weight w (1: anywhere on the edge) and whether it certainly
-        #: exists exactly (float c-values beyond tol): see :meth:`cand_bounds`
+        #: exists exactly (float c-values beyond tol): see :meth:`row_bounds`
         self.ends: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
         for z in zs:
             lo, hi = float(z - ex.eta), float(z + ex.eta)
@@ -187,7 +190,7 @@ class _Slices:
             )
         self._cache: dict[tuple, tuple | None] = {}
         self._phif: dict[int, np.ndarray] = {}
-        self._bounds: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
+        self._bounds: dict[int, tuple[np.ndarray, np.ndarray]] = {}
 
     def _cand(self, l: int, j: int) -> tuple:
         """The j-th candidate of slice l: ("v", vertex) or ("e", a, b, side)."""
@@ -231,36 +234,78 @@ class _Slices:
             self._phif[l] = (self.GAf @ self.ptsf[l].T).max(axis=1)
         return self._phif[l]
 
-    def cand_bounds(self, l: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Per row i and candidate j of slice l: float bounds ``up[i, j]`` ≥ G_i A p_j and,
-        for a candidate that certainly exists, ``low[i, j]`` ≤ G_i A p_j (−inf otherwise),
-        whatever the float error of the candidate's point: the exact crossing is
-        p_j = V_a + w*·(V_b − V_a) with |w* − w| ≤ ``err`` (:func:`_weight_error`; 1 when the
-        edge is too level in c to say), so G_i A p_j is within |G_i A (V_b − V_a)|·err of
-        its float value; the slack ``_FILTER`` (relative) covers the rounding of the float
-        products (~1e-15 relative). Also the row bounds ``phi_up`` ≥ φ_i(z^l) ≥ ``phi_low``
-        (LP (6))."""
+    def _rad(self, l: int, rows: np.ndarray | slice, cols: np.ndarray | slice) -> np.ndarray:
+        """The radius of :meth:`row_bounds` for the given rows and candidates of slice l:
+        |G_i A (V_b − V_a)|·err_j (the candidate's weight error) plus the slack ``_FILTER``
+        (relative) for the rounding of the float products (~1e-15 relative)."""
+        dirs, err, _ = self.ends[l]
+        S, D = self.ptsf[l][cols], dirs[cols]
+        GA, aGA = self.GAf[rows], self.absGA[rows]
+        rad = np.abs(GA @ D.T) * err[cols][None, :]
+        rad += _FILTER * (aGA @ (np.abs(S) + np.abs(D)).T) + 1e-300
+        return rad
+
+    def cand_up(self, l: int, i: int) -> np.ndarray:
+        """Per candidate j of slice l, a float bound ``up[j]`` ≥ G_i A p_j whatever the float
+        error of the candidate's point: the exact crossing is p_j = V_a + w*·(V_b − V_a)
+        with |w* − w| ≤ ``err`` (:func:`_weight_error`; 1 when the edge is too level in c to
+        say), so G_i A p_j is within |G_i A (V_b − V_a)|·err of its float value
+        (:meth:`_rad`). One row at a time: only the rows evaluated exactly need it."""
+        row = np.array([i])
+        return (self.GAf[row] @ self.ptsf[l].T + self._rad(l, row, slice(None)))[0]
+
+    def row_bounds(self, l: int) -> tuple[np.ndarray, np.ndarray]:
+        """Rigorous row bounds ``phi_up`` ≥ φ_i(z^l) ≥ ``phi_low`` (LP (6); −inf when no
+        candidate certainly exists) from one float product over the candidates.
+
+        For the candidates whose weight error is small (≤ ``_PRECISE``: every vertex and
+        nearly every crossing) the radius of :meth:`_rad` is bounded row by row by
+        |G_i A|·r with r_k = max_j (err_j |d_jk| + _FILTER (|p_jk| + |d_jk|)), which
+        dominates every term: max_j (c_ij ± rad_ij) is within max_j c_ij ± |G_i A|·r. The few
+        candidates with a large error (an edge nearly level in c) get their own radius. So
+        the bounds cost O(rows × candidates) once, not three such products per breakpoint
+        (81 of 153 s of a 2372-facet design before)."""
         if l not in self._bounds:
             dirs, err, sure = self.ends[l]
             S = self.ptsf[l]
-            cen = self.GAf @ S.T
-            rad = np.abs(self.GAf @ dirs.T) * err[None, :]
-            rad += _FILTER * (self.absGA @ (np.abs(S) + np.abs(dirs)).T) + 1e-300
-            up = cen + rad
-            low = np.where(sure[None, :], cen - rad, -np.inf)
-            self._bounds[l] = (up, low, up.max(axis=1), low.max(axis=1))
+            m = self.GAf.shape[0]
+            up = np.full(m, -np.inf)
+            low = np.full(m, -np.inf)
+            prec = err <= _PRECISE
+
+            def cmax(cols: np.ndarray) -> np.ndarray:  # max_j c_ij over the columns (or -inf)
+                if not cols.any():
+                    return np.full(m, -np.inf)
+                return (self.GAf @ S[cols].T).max(axis=1)
+
+            if prec.any():
+                Sp, Dp = np.abs(S[prec]), np.abs(dirs[prec])
+                r = (err[prec][:, None] * Dp + _FILTER * (Sp + Dp)).max(axis=0)
+                radp = self.absGA @ r + 1e-300
+                sure_max = cmax(prec & sure)
+                up = np.maximum(sure_max, cmax(prec & ~sure)) + radp
+                low = sure_max - radp
+            loose = np.nonzero(~prec)[0]
+            if len(loose):
+                cen = self.GAf @ S[loose].T
+                rad = self._rad(l, slice(None), loose)
+                up = np.maximum(up, (cen + rad).max(axis=1))
+                ls = sure[loose]
+                if ls.any():
+                    low = np.maximum(low, (cen[:, ls] - rad[:, ls]).max(axis=1))
+            self._bounds[l] = (up, low)
         return self._bounds[l]
 
     def phi_exact(self, l: int, rows=None) -> dict[int, fmpq]:
         """Exact φ_i(z^l) (LP (6)) for the given rows: max of G_i A over the slice vertices
         (only over the candidates whose rigorous upper bound reaches the row's rigorous
-        lower bound: :meth:`cand_bounds`)."""
-        up, _, _, phi_low = self.cand_bounds(l)
+        lower bound: :meth:`cand_up`, :meth:`row_bounds`)."""
+        _, phi_low = self.row_bounds(l)
         rows = range(len(self.G)) if rows is None else rows
         out = {}
         for i in rows:
             best = None
-            for j in np.nonzero(up[i] >= phi_low[i])[0]:
+            for j in np.nonzero(self.cand_up(l, int(i)) >= phi_low[i])[0]:
                 p = self._exact_point(l, self._cand(l, int(j)))
                 if p is not None:
                     val = po.qdot(self.GA[i], p)
@@ -396,7 +441,9 @@ def theorem31(
     hi, lo = np.empty(nz), np.empty(nz)
     for l in range(nz):
         vf = po.qfloat(np.array(vs_use[l], dtype=object))
-        _, _, phi_up, phi_low = sl.cand_bounds(l)
+        if deadline is not None and time.perf_counter() > deadline:
+            raise BudgetExceeded(0)
+        phi_up, phi_low = sl.row_bounds(l)
         rest = Gf @ vf + dlf
         tol = _FILTER * (np.abs(phi_up) + absG @ np.abs(vf) + np.abs(dlf) + 1.0)
         up, low = phi_up + rest + tol, phi_low + rest - tol  # low may be -inf
