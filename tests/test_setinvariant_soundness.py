@@ -640,7 +640,7 @@ def test_row_bounds_hold_for_a_crossing_on_an_edge_nearly_level_in_c(sign: float
     for i in range(len(G)):
         phi = max(ce.po.qdot(sl.GA[i], p) for p in exact_pts if p is not None)
         assert low[i] <= float(phi) <= up[i]
-        cu = sl.cand_up(0, i)
+        cu = sl.cand_up(0, np.array([i]))[0]
         for j, p in enumerate(exact_pts):
             if p is not None:
                 assert cu[j] >= float(ce.po.qdot(sl.GA[i], p))

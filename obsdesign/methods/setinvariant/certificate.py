@@ -115,7 +115,9 @@ class Theorem31Result:
     notes: list[str] = field(default_factory=list)
 
 
-def _weight_error(t: float, ca: np.ndarray, cb: np.ndarray, den: np.ndarray) -> np.ndarray:
+def _weight_error(
+    t: float | np.ndarray, ca: np.ndarray, cb: np.ndarray, den: np.ndarray
+) -> np.ndarray:
     """A rigorous bound on |w − w*| for the float weight w = clip((t − ca)/(cb − ca), 0, 1)
     of an edge crossing, w* = (t* − ca*)/(cb* − ca*) its exact value: t, ca, cb are the
     nearest floats of exact t*, ca*, cb* (relative error ≤ u = 2⁻⁵³ each) and each float
@@ -123,7 +125,7 @@ def _weight_error(t: float, ca: np.ndarray, cb: np.ndarray, den: np.ndarray) -> 
     e = 4u(|t| + |ca| + |cb|) of their exact values; with |den| > 2e,
     |w − w*| ≤ (e + e·|w*|)/(|den| − e) ≤ 2e/(|den| − e) (|w*| ≤ 1), doubled for margin.
     1 (the whole edge) where the edge is too level in c for that."""
-    e = 4.0 * 2.0**-53 * (abs(t) + np.abs(ca) + np.abs(cb)) + 2.0**-1070
+    e = 4.0 * 2.0**-53 * (np.abs(t) + np.abs(ca) + np.abs(cb)) + 2.0**-1070
     gap = np.abs(den) - e
     with np.errstate(divide="ignore", invalid="ignore"):
         out = np.where(np.abs(den) > 2 * e, 4 * e / gap, 1.0)
@@ -166,27 +168,53 @@ class _Slices:
         #: the error of its float weight w (1: anywhere on the edge) and whether it certainly
         #: exists exactly (float c-values beyond tol): see :meth:`row_bounds`
         self.ends: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
-        for z in zs:
-            lo, hi = float(z - ex.eta), float(z + ex.eta)
-            vj = np.nonzero((self.cvf >= lo - tol) & (self.cvf <= hi + tol))[0]
-            pts = [self.Vf[vj]]
-            dirs, errs = [np.zeros((len(vj), ex.n))], [np.zeros(len(vj))]
-            sure = [(self.cvf[vj] >= lo + tol) & (self.cvf[vj] <= hi - tol)]
-            sides = []
-            for t in (lo, hi) if ex.eta != 0 else (lo,):
-                k = np.nonzero((emin <= t + tol) & (emax >= t - tol))[0]
-                den = cb[k] - ca[k]
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    w = np.where(den == 0, 0.5, np.clip((t - ca[k]) / den, 0.0, 1.0))
-                pts.append(self.Vf[self.ea[k]] + w[:, None] * dV[k])
-                dirs.append(dV[k])
-                errs.append(_weight_error(t, ca[k], cb[k], den))
-                sure.append((emin[k] < t - tol) & (emax[k] > t + tol))
-                sides.append(k)
-            self.cands.append((vj, sides))
-            self.ptsf.append(np.vstack(pts).reshape(-1, ex.n))
+        # every (breakpoint, vertex) and (breakpoint, edge) pair at once (numpy calls per
+        # breakpoint cost more than the arithmetic on small polytopes), then split by
+        # breakpoint: vertices first, then the crossings of z − η̄, then of z + η̄
+        lo = np.array([float(z - ex.eta) for z in zs])
+        hi = np.array([float(z + ex.eta) for z in zs])
+        nz, n = len(zs), ex.n
+        vm = (self.cvf[None, :] >= lo[:, None] - tol) & (self.cvf[None, :] <= hi[:, None] + tol)
+        lv, jv = np.nonzero(vm)
+        parts = [
+            (
+                jv,
+                np.bincount(lv, minlength=nz),
+                self.Vf[jv],
+                np.zeros((len(jv), n)),
+                np.zeros(len(jv)),
+                (self.cvf[jv] >= lo[lv] + tol) & (self.cvf[jv] <= hi[lv] - tol),
+            )
+        ]
+        for T in (lo, hi) if ex.eta != 0 else (lo,):
+            lk, k = np.nonzero(
+                (emin[None, :] <= T[:, None] + tol) & (emax[None, :] >= T[:, None] - tol)
+            )
+            t = T[lk]
+            den = cb[k] - ca[k]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                w = np.where(den == 0, 0.5, np.clip((t - ca[k]) / den, 0.0, 1.0))
+            parts.append(
+                (
+                    k,
+                    np.bincount(lk, minlength=nz),
+                    self.Vf[self.ea[k]] + w[:, None] * dV[k],
+                    dV[k],
+                    _weight_error(t, ca[k], cb[k], den),
+                    (emin[k] < t - tol) & (emax[k] > t + tol),
+                )
+            )
+        cuts = [np.cumsum(c)[:-1] for _, c, *_ in parts]
+        split = [
+            [np.split(x, cut) for x in part[2:]] + [np.split(part[0], cut)]
+            for part, cut in zip(parts, cuts, strict=True)
+        ]
+        for l in range(nz):
+            pts, dirs, errs, sure, idx = zip(*[[a[l] for a in sp] for sp in split], strict=True)
+            self.cands.append((idx[0], list(idx[1:])))
+            self.ptsf.append(np.concatenate(pts).reshape(-1, n))
             self.ends.append(
-                (np.vstack(dirs).reshape(-1, ex.n), np.concatenate(errs), np.concatenate(sure))
+                (np.concatenate(dirs).reshape(-1, n), np.concatenate(errs), np.concatenate(sure))
             )
         self._cache: dict[tuple, tuple | None] = {}
         self._phif: dict[int, np.ndarray] = {}
@@ -245,14 +273,14 @@ class _Slices:
         rad += _FILTER * (aGA @ (np.abs(S) + np.abs(D)).T) + 1e-300
         return rad
 
-    def cand_up(self, l: int, i: int) -> np.ndarray:
-        """Per candidate j of slice l, a float bound ``up[j]`` ≥ G_i A p_j whatever the float
-        error of the candidate's point: the exact crossing is p_j = V_a + w*·(V_b − V_a)
-        with |w* − w| ≤ ``err`` (:func:`_weight_error`; 1 when the edge is too level in c to
-        say), so G_i A p_j is within |G_i A (V_b − V_a)|·err of its float value
-        (:meth:`_rad`). One row at a time: only the rows evaluated exactly need it."""
-        row = np.array([i])
-        return (self.GAf[row] @ self.ptsf[l].T + self._rad(l, row, slice(None)))[0]
+    def cand_up(self, l: int, rows: np.ndarray) -> np.ndarray:
+        """Per row i of ``rows`` and candidate j of slice l, a float bound ``up[i, j]`` ≥
+        G_i A p_j whatever the float error of the candidate's point: the exact crossing is
+        p_j = V_a + w*·(V_b − V_a) with |w* − w| ≤ ``err`` (:func:`_weight_error`; 1 when
+        the edge is too level in c to say), so G_i A p_j is within |G_i A (V_b − V_a)|·err
+        of its float value (:meth:`_rad`). Only for the given rows: only the rows evaluated
+        exactly need it."""
+        return self.GAf[rows] @ self.ptsf[l].T + self._rad(l, rows, slice(None))
 
     def row_bounds(self, l: int) -> tuple[np.ndarray, np.ndarray]:
         """Rigorous row bounds ``phi_up`` ≥ φ_i(z^l) ≥ ``phi_low`` (LP (6); −inf when no
@@ -301,11 +329,12 @@ class _Slices:
         (only over the candidates whose rigorous upper bound reaches the row's rigorous
         lower bound: :meth:`cand_up`, :meth:`row_bounds`)."""
         _, phi_low = self.row_bounds(l)
-        rows = range(len(self.G)) if rows is None else rows
+        rows = np.arange(len(self.G)) if rows is None else np.asarray(rows, dtype=int)
+        up = self.cand_up(l, rows)
         out = {}
-        for i in rows:
+        for r, i in enumerate(rows):
             best = None
-            for j in np.nonzero(self.cand_up(l, int(i)) >= phi_low[i])[0]:
+            for j in np.nonzero(up[r] >= phi_low[i])[0]:
                 p = self._exact_point(l, self._cand(l, int(j)))
                 if p is not None:
                     val = po.qdot(self.GA[i], p)
