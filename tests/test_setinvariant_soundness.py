@@ -457,6 +457,22 @@ def test_linear_gains_vertex_listed_twice(base71: dict[str, Any]) -> None:
     assert failed_certify(d) == {"linear-gains-vertices"}
 
 
+def _undisturbed(A: np.ndarray, c: list[fmpq], G: np.ndarray, eta: fmpq) -> ce.ExactProblem:
+    """An ExactProblem without disturbance (B1, Dv empty) or Ω vertices, single output c,
+    λ = 1: what the slice and φ tests need."""
+    n = A.shape[0]
+    return ce.ExactProblem(
+        A=A,
+        B1=np.zeros((n, 0), dtype=object),
+        C=np.array([c], dtype=object),
+        G0=G,
+        Vo=np.zeros((0, n), dtype=object),
+        Dv=np.zeros((0, 0), dtype=object),
+        eta=eta,
+        lam=fmpq(1),
+    )
+
+
 def test_phi_is_the_max_over_the_slice_even_for_near_ties() -> None:
     """LP (6) φ_i(z) = max over the slice of G_i A e: two slice points whose values differ by
     2·10⁻¹⁰ relative (inside the float prefilter's tolerance, so both are evaluated exactly)
@@ -464,16 +480,7 @@ def test_phi_is_the_max_over_the_slice_even_for_near_ties() -> None:
     q = fmpq
     eps = q(1, 10**10)
     G = np.array([[q(1), q(0)], [q(-1), q(0)], [q(0), q(1)], [q(0), q(-1)]], dtype=object)
-    ex = ce.ExactProblem(
-        A=np.array([[q(1), eps], [q(0), q(1)]], dtype=object),
-        B1=np.zeros((2, 0), dtype=object),
-        C=np.array([[q(1), q(0)]], dtype=object),
-        G0=G,
-        Vo=np.zeros((0, 2), dtype=object),
-        Dv=np.zeros((0, 0), dtype=object),
-        eta=q(0),
-        lam=q(1),
-    )
+    ex = _undisturbed(np.array([[q(1), eps], [q(0), q(1)]], dtype=object), [q(1), q(0)], G, q(0))
     vrep = ce.po.exact_h_to_v(G)
     zs, cv = ce.exact_zd(vrep.V, ex.C[0], ex.eta)
     assert zs == [q(-1), q(1)]
@@ -615,16 +622,7 @@ def test_row_bounds_hold_for_a_crossing_on_an_edge_nearly_level_in_c(sign: float
     G = np.array(
         [[q(0), q(-1)], [q(-1), q(0)], [q(0), q(1)], [q(1) / r, -tiny / 2 / r]], dtype=object
     )
-    ex = ce.ExactProblem(
-        A=np.array([[q(1), q(0)], [q(0), q(1)]], dtype=object),
-        B1=np.zeros((2, 0), dtype=object),
-        C=np.array([[q(1), q(0)]], dtype=object),
-        G0=G,
-        Vo=np.zeros((0, 2), dtype=object),
-        Dv=np.zeros((0, 0), dtype=object),
-        eta=q(0),
-        lam=q(1),
-    )
+    ex = _undisturbed(np.array([[q(1), q(0)], [q(0), q(1)]], dtype=object), [q(1), q(0)], G, q(0))
     vrep = ce.po.exact_h_to_v(G)
     assert sorted(map(tuple, vrep.V)) == sorted(
         [(q(-1), q(-1)), (q(1), q(-1)), (q(1) + tiny, q(1)), (q(-1), q(1))]
@@ -666,16 +664,7 @@ def test_row_bounds_contain_the_exact_phi_on_random_polytopes(seed: int) -> None
     cq = np.array([[q(int(x)) for x in rng.integers(-3, 4, 3)]], dtype=object)
     if all(x == 0 for x in cq[0]):
         return
-    ex = ce.ExactProblem(
-        A=Aq,
-        B1=np.zeros((3, 0), dtype=object),
-        C=cq,
-        G0=G,
-        Vo=np.zeros((0, 3), dtype=object),
-        Dv=np.zeros((0, 0), dtype=object),
-        eta=q(1, 3),
-        lam=q(1),
-    )
+    ex = _undisturbed(Aq, list(cq[0]), G, q(1, 3))
     zs, cv = ce.exact_zd(vrep.V, ex.C[0], ex.eta)
     sl = ce._Slices(ex, G, vrep, zs, cv)
     for l in range(len(zs)):
