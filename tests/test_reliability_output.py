@@ -182,8 +182,19 @@ def test_ctrl_c_is_one_line_no_traceback(delay: float):
 
     exe = Path(sys.executable).parent / "obsdesign"
     specs = Path(__file__).resolve().parents[1] / "specs"
+
+    def as_from_a_terminal() -> None:
+        # the child starts as from an interactive shell, whatever the test runner inherited
+        # (a runner started in the background without job control ignores SIGINT)
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
     p = subprocess.Popen(
-        [str(exe), "check", str(specs)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        [str(exe), "check", str(specs)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=as_from_a_terminal,  # noqa: PLW1509 - no threads here
     )
     time.sleep(delay)
     p.send_signal(signal.SIGINT)
