@@ -449,6 +449,15 @@ def solve_lyapunov(Acl: np.ndarray, rate: float, discrete: bool) -> np.ndarray:
     return solve_continuous_lyapunov((Af + rate * eye).T, -eye)
 
 
+def lyapunov_solver_name(n: int, discrete: bool) -> str:
+    """The solver :func:`solve_lyapunov` uses for ``n`` states, as reports name it.
+
+    :param n: state dimension; :param discrete: time domain."""
+    if n <= KRONECKER_MAX_N:
+        return "Lyapunov equation: numpy, one n²×n² linear system"
+    return f"Lyapunov equation: scipy solve_{'discrete' if discrete else 'continuous'}_lyapunov"
+
+
 def _lyap_solution(Acl: np.ndarray, rate: float, discrete: bool) -> np.ndarray | None:
     """Float X of :func:`solve_lyapunov`, whatever the stability of Acl (an unstable Acl
     gives an indefinite X); None when the solver fails."""

@@ -326,3 +326,7 @@ def test_solve_lyapunov_large_systems_use_scipy(monkeypatch: pytest.MonkeyPatch)
     assert not calls and np.allclose(X, np.eye(n) / 0.75)
     X = lyap.solve_lyapunov(A[:-1, :-1], 1.0, True)
     assert calls and np.allclose(X, np.eye(n - 1) / 0.75)
+    # the report names the path that ran
+    assert "numpy" in lyap.lyapunov_solver_name(n - 1, True)
+    assert lyap.lyapunov_solver_name(n, True).endswith("scipy solve_discrete_lyapunov")
+    assert lyap.lyapunov_solver_name(n, False).endswith("scipy solve_continuous_lyapunov")

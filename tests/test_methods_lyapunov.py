@@ -103,6 +103,7 @@ def test_shipped_spec_key_results_exact() -> None:
     assert st["iss-gain"] == "V(e⁺) ≤ λ²V(e) + μ|v|² with μ = 256225114.5"
     assert st["lambda_best-bracket"].startswith("λ_best = 0.95006 is best to within 0.0001: ")
     assert rep.solver["status"] == "closed_form"
+    assert rep.solver["name"] == "Lyapunov equation: numpy, one n²×n² linear system"
     assert api.method("lyapunov").summary(rep.parameters) == (
         "lambda = 0.955, best = 0.95006, mu = 2.562e+08"
     )

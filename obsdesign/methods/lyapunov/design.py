@@ -48,7 +48,7 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     A, C = s.A.q, s.C.q
     notes: list[str] = []
     solver = SolverResult(
-        "scipy Lyapunov equation",
+        lyap.lyapunov_solver_name(A.shape[0], s.discrete),
         SolverStatus.CLOSED_FORM,
         "L given; P from one Lyapunov equation per rate, checked exactly",
         extra={"gain_design": "given"},
