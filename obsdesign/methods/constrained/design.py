@@ -99,7 +99,8 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     name = (
         "user-given Lyapunov data (P, ρ, μ) + exact rational bounds"
         if o.P is not None
-        else "Lyapunov equation (scipy) certified exactly + exact rational bounds"
+        else f"{lyap.lyapunov_solver_name(spec.system.n, spec.system.discrete)}, certified "
+        "exactly + exact rational bounds"
     )
     solver = SolverResult(name, SolverStatus.CLOSED_FORM, seconds=time.perf_counter() - t0)
     return Design(Parameters(vals), solver, notes)
