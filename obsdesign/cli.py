@@ -211,7 +211,11 @@ def _settle(owned: bool) -> None:
 
 
 def _interrupted() -> None:
-    """One line and exit 130, as after Ctrl-C in a shell."""
+    """One line and exit 130, as after Ctrl-C in a shell (the record is cleared: the
+    ``except typer.Exit`` branch of :func:`_run` settles again and must not say it twice)."""
+    from obsdesign import interrupt
+
+    interrupt.reset()
     _err("interrupted")
     raise typer.Exit(130) from None
 

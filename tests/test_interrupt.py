@@ -41,10 +41,12 @@ def test_a_lost_keyboard_interrupt_still_ends_in_exit_130(capsys: pytest.Capture
     with pytest.raises(typer.Exit) as e:
         cli._run(_swallowing_body)
     assert e.value.exit_code == 130
-    assert capsys.readouterr().err.strip().endswith("interrupted")
+    assert capsys.readouterr().err == "obsdesign: error: interrupted\n"  # one line, once
 
 
-def test_a_lost_interrupt_wins_over_an_error_raised_after_it():
+def test_a_lost_interrupt_wins_over_an_error_raised_after_it(
+    capsys: pytest.CaptureFixture[str],
+):
     from obsdesign.errors import InputError
 
     def body(cmd: object) -> int:
@@ -54,6 +56,7 @@ def test_a_lost_interrupt_wins_over_an_error_raised_after_it():
     with pytest.raises(typer.Exit) as e:
         cli._run(body)
     assert e.value.exit_code == 130
+    assert capsys.readouterr().err == "obsdesign: error: interrupted\n"
 
 
 def test_each_command_starts_with_no_recorded_interrupt():
