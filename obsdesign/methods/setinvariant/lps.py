@@ -19,7 +19,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import linprog
 
-from obsdesign.errors import SolverError
+from obsdesign.errors import InconclusiveError, SolverError
 from obsdesign.sets import polytope_ops as po
 
 from .budget import check_deadline
@@ -106,13 +106,36 @@ def eps_batch(
     return _eps_block(G, phi, dlt)
 
 
+#: HiGHS takes matrix entries above 1e15 and right-hand sides from 1e20 on as infinite and
+#: then stops with "Model error": LP data beyond these are out of a float LP's range
+HIGHS_MATRIX_MAX = 1e15
+HIGHS_INFINITY = 1e20
+
+
+def check_lp_range(A: np.ndarray, b: np.ndarray, what: str) -> None:
+    """Raise InconclusiveError (exit 4) when the float LP ``what`` has data that HiGHS would
+    read as infinite, or no finite data at all, instead of its "Model error" (exit 3).
+
+    :param A: the constraint matrix (dense); :param b: the right-hand side."""
+    a = float(np.max(np.abs(A), initial=0.0))
+    r = float(np.max(np.abs(b), initial=0.0))
+    if not (np.isfinite(a) and np.isfinite(r)) or a > HIGHS_MATRIX_MAX or r >= HIGHS_INFINITY:
+        raise InconclusiveError(
+            f"{what} is out of a float LP's range (largest |coefficient| {a:.3g}, largest "
+            f"|right-hand side| {r:.3g}; HiGHS takes values above {HIGHS_MATRIX_MAX:g} and "
+            f"{HIGHS_INFINITY:g} as infinite): the spec's numbers (B1, the sets) are too large "
+            "for the float design"
+        )
+
+
 def _eps_block(G: np.ndarray, phi: np.ndarray, dlt: np.ndarray) -> EpsResult:
     nz, g = phi.shape
     n = G.shape[1]
+    b_ub = (-dlt[None, :] - phi).reshape(-1)
+    check_lp_range(G, b_ub, "LP (9)")
     Ablk = sp.kron(sp.eye(nz, format="csr"), sp.csr_matrix(G))
     Eblk = -sp.kron(sp.eye(nz, format="csr"), sp.csr_matrix(np.ones((g, 1))))
     A_ub = sp.hstack([Ablk, Eblk]).tocsr()
-    b_ub = (-dlt[None, :] - phi).reshape(-1)
     cost = np.concatenate([np.zeros(nz * n), np.ones(nz)])
     res = linprog(cost, A_ub=A_ub, b_ub=b_ub, bounds=(None, None), method="highs")
     if res.status != 0 and nz > 1:
