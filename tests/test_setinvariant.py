@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 from obsdesign import api
 from obsdesign.api import load_spec_text
 from obsdesign.certify.claim import ClaimStatus
-from obsdesign.errors import InfeasibleError, SolverError, SpecError
+from obsdesign.errors import InconclusiveError, InfeasibleError, SolverError, SpecError
 from obsdesign.methods.setinvariant import laws
 from obsdesign.methods.setinvariant.spectext import spec_text as matrix_spec_text
 
@@ -399,3 +399,19 @@ def test_spec_text_builder_round_trips_exact_values():
     assert (o.eta_bar, o.lam) == (fmpq(1, 100), fmpq(9, 10))
     assert (o.algorithm, o.mirror, o.max_iterations) == ("general", True, 5)
     assert "eta_bar" not in matrix_spec_text([[0.5]], [1], [[1]], 0.9, eta_bar=None)
+
+
+def test_a_set_too_thin_for_floats_is_inconclusive_not_an_internal_failure() -> None:
+    """Ω = {|Q e|∞ <= 1} with Q = [[1e50, 0], [0, 1]] (found by the spec fuzzer) is 10⁻⁵⁰
+    wide: qhull cannot build its float hull. That is exit 4 naming the float polytope
+    computation, not exit 3 "internal failure: PolytopeError"."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "specs" / "dorea-pimenta-7-1.toml").read_text()
+    assert "\nQ = [[1, 0], [0, 1]]\n" in text
+    spec = load_spec_text(
+        text.replace("\nQ = [[1, 0], [0, 1]]\n", "\nQ = [[1e50, 0], [0, 1]]\n"), "t.toml"
+    )
+    with pytest.raises(InconclusiveError, match="float polytope computation failed") as e:
+        api.design(spec)
+    assert e.value.exit_code == 4 and "\n" not in e.value.message

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from obsdesign.errors import SolverError
+from obsdesign.errors import InconclusiveError, SolverError
 from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
 from obsdesign.params import Parameters
 from obsdesign.sets import polytope_ops as po
@@ -287,9 +287,19 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     (Section II)."""
     o: Options = spec.options
     t0 = time.perf_counter()
-    data = build(spec)
-    check_detectable(data.fl.A, data.fl.C, float(o.lam))
-    run = _iterate(spec, data, progress)
+    try:
+        data = build(spec)
+        check_detectable(data.fl.A, data.fl.C, float(o.lam))
+        run = _iterate(spec, data, progress)
+    except po.PolytopeError as e:
+        # a float hull or vertex enumeration that qhull cannot do (a set thinner or larger
+        # than float arithmetic resolves, e.g. Q = [[1e50, 0], [0, 1]]): numerically
+        # inconclusive (exit 4), not an internal failure
+        first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+        raise InconclusiveError(
+            f"a float polytope computation failed: {first} (a set of the spec may be too "
+            "thin or too large for float arithmetic)"
+        ) from e
     notes = list(run.notes)
     params = polytope_params(spec, data, run.stage, notes)
     params["iterations"] = run.iterations
