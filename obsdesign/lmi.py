@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from obsdesign.errors import SolverError
+from obsdesign.errors import InconclusiveError, SolverError
 
 SOLVERS = ("CLARABEL", "SCS")
 
@@ -62,6 +62,9 @@ def solve(problem: Any, solvers: tuple[str, ...] = SOLVERS) -> SolveResult:
         except cp.error.SolverError as e:
             last = f"{name}: {e}"
             continue
+        except ValueError as e:
+            overflow(e)
+            raise
         status = str(problem.status)
         if status in ("optimal", "infeasible", "unbounded"):
             return SolveResult(status, name, time.perf_counter() - t0)
@@ -69,6 +72,19 @@ def solve(problem: Any, solvers: tuple[str, ...] = SOLVERS) -> SolveResult:
     if last.endswith("inaccurate"):
         return SolveResult(last.split(": ")[1], last.split(":")[0], time.perf_counter() - t0)
     raise SolverError(f"no SDP solver succeeded ({last or 'none installed'})")
+
+
+def overflow(e: ValueError) -> None:
+    """Raise InconclusiveError (exit 4) for cvxpy's "Problem data contains NaN or Inf": a
+    product of the spec's numbers overflowed float64 (C = [[1e300, ...]] makes CᵀC
+    infinite), which no float solver can take; other ValueErrors are left to the caller.
+
+    :param e: the ValueError cvxpy raised."""
+    if "NaN or Inf" in str(e):
+        raise InconclusiveError(
+            "the LMIs' float data are not finite (a product of the spec's numbers overflows "
+            "float64): the numbers are too large for a float SDP solver"
+        ) from e
 
 
 def _solve_scs(problem: Any) -> None:

@@ -69,3 +69,34 @@ def test_ctrl_c_during_an_scs_solve_is_a_keyboard_interrupt():
         done.set()
         t.join()
         signal.signal(signal.SIGINT, old)
+
+
+def test_non_finite_problem_data_is_inconclusive_not_an_internal_failure():
+    """A product of huge spec numbers overflows float64 (1e300² = inf): cvxpy refuses the
+    problem with "Problem data contains NaN or Inf"; that is exit 4, not exit 3."""
+    from obsdesign.errors import InconclusiveError
+
+    P = cp.Variable((2, 2), symmetric=True)
+    big = np.array([[1e300, 0.0], [0.0, 1.0]])
+    a = cp.Parameter(nonneg=True, value=1.0)  # as stubborn's λ: cvxpy checks the data then
+    prob = cp.Problem(cp.Minimize(cp.trace(P)), [P >> np.eye(2), a * (big @ P @ big) << np.eye(2)])
+    with pytest.raises(InconclusiveError, match="not finite") as e:
+        lmi.solve(prob)
+    assert e.value.exit_code == 4
+    lmi.overflow(ValueError("other"))  # any other ValueError is left to the caller
+
+
+def test_a_stubborn_spec_whose_products_overflow_is_inconclusive():
+    """C = [[1e300, 0, 0, 0], ...] (found by the spec fuzzer): exit 4 naming the overflow."""
+    from pathlib import Path
+
+    from obsdesign import api
+    from obsdesign.errors import InconclusiveError
+
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "specs" / "astolfi-stubborn-example4.toml").read_text()
+    old = "\nC = [[1, 0, 0, 0], [0, 0, 1, 0]]\n"
+    assert old in text
+    spec = api.load_spec_text(text.replace(old, old.replace("[[1,", "[[1e300,")), "t.toml")
+    with pytest.raises(InconclusiveError, match="not finite"):
+        api.design(spec)

@@ -23,7 +23,7 @@ from flint import fmpq
 
 from obsdesign.certify.exact import Q, dyadic, symmetrize, to_float
 from obsdesign.errors import InconclusiveError, InfeasibleError, SolverError
-from obsdesign.lmi import solve
+from obsdesign.lmi import overflow, solve
 from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
 from obsdesign.methods.stubborn import claims as _claims
 from obsdesign.methods.stubborn.detect import detectability
@@ -150,6 +150,9 @@ def solve_cold(prob: Any) -> tuple[bool, str]:
             prob.solve(solver="CLARABEL", warm_start=False)
     except cp.error.SolverError as e:
         return False, f"solver failure ({e})"
+    except ValueError as e:
+        overflow(e)
+        raise
     return prob.status == "optimal", str(prob.status)
 
 
