@@ -207,7 +207,12 @@ def design(
     )
     report.verdict = report.computed_verdict()
     if out is not None:
-        write_atomic(out, report.to_json(), force)
+        try:
+            text = report.to_json()
+        except ObsdesignError as e:  # a value beyond the float range (Report.to_dict)
+            _write_error_report(sp, out, e.exit_code, e.message, force)
+            raise
+        write_atomic(out, text, force)
     return report
 
 

@@ -169,3 +169,46 @@ def test_v_max_ellipsoid_bound_is_sound(n):
     xs = rng.choice([-1.0, 1.0], (2000, n))
     d = pts - xs
     assert np.einsum("ij,jk,ik->i", d, Pf, d).max() <= float(vb.value)
+
+
+@given(st.integers(1, 10**700), st.integers(1, 10**50))
+def test_floor_log10_is_exact_beyond_the_float_range(p: int, q: int) -> None:
+    """⌊log10(p/q)⌋ exactly, also where p/q is beyond the float range (no float used)."""
+    a = fmpq(p, q)
+    e = B.floor_log10(a)
+    assert fmpq(10) ** e <= a < fmpq(10) ** (e + 1)
+
+
+def test_floor_log10_at_powers_of_ten_and_round_sig_beyond_floats() -> None:
+    for k in (-400, -1, 0, 1, 308, 309, 600):
+        t = fmpq(10) ** k
+        assert B.floor_log10(t) == k
+        assert B.floor_log10(t - t / 10**30) == k - 1
+    # 1e600 + 1 to 6 significant digits, up: 1.00001e600 (exact, no float overflow)
+    assert B.round_sig(fmpq(10) ** 600 + 1, 6, up=True) == fmpq(100001) * fmpq(10) ** 595
+    assert B.round_sig(fmpq(10) ** 600 + 1, 6, up=False) == fmpq(10) ** 600
+
+
+def test_a_set_edge_at_1e300_is_inconclusive_not_an_internal_failure(tmp_path) -> None:
+    """c's box edge at 1e300 (found by the spec fuzzer): the exact bounds reach ~1e600,
+    beyond the float range of the report's float view. exit 4 with an error report, not
+    "internal failure: OverflowError" (exit 3)."""
+    import json
+    from pathlib import Path
+
+    from obsdesign import api
+    from obsdesign.errors import InconclusiveError
+
+    text = (
+        Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5.toml"
+    ).read_text()
+    old = '[method.c]\ntype = "box"\nlower = [-1.1, -1.1]\nupper = [1.1, 1.1]\n'
+    assert old in text
+    spec = tmp_path / "s.toml"
+    spec.write_text(text.replace(old, old.replace("upper = [1.1,", "upper = [1e300,")))
+    out = tmp_path / "r.json"
+    with pytest.raises(InconclusiveError, match="beyond the float range") as e:
+        api.design(spec, out)
+    assert e.value.exit_code == 4
+    rep = json.loads(out.read_text())
+    assert rep["verdict"] == "error" and rep["error"]["exit_code"] == 4

@@ -15,7 +15,13 @@ from pathlib import Path
 from typing import Any
 
 from obsdesign.certify.claim import Claim, ClaimStatus
-from obsdesign.errors import EXIT_INCONCLUSIVE, EXIT_INFEASIBLE, EXIT_OK, InputError
+from obsdesign.errors import (
+    EXIT_INCONCLUSIVE,
+    EXIT_INFEASIBLE,
+    EXIT_OK,
+    InconclusiveError,
+    InputError,
+)
 from obsdesign.params import Parameters
 
 SCHEMA_VERSION = "1.1"
@@ -174,6 +180,16 @@ class Report:
         return VERDICTS.get(self.exit_code(), "failed")
 
     def to_dict(self) -> dict[str, Any]:
+        """The report as JSON data. A parameter whose exact value lies beyond the float range
+        has no float view (e.g. v_max from a set's edge at 1e300): InconclusiveError (exit 4)
+        naming it, not an internal failure."""
+        try:
+            params = self.parameters.to_json()
+        except OverflowError as e:
+            raise InconclusiveError(
+                "a parameter's exact value lies beyond the float range, so the report cannot "
+                f"give its float view ({e}): the spec's numbers are too large"
+            ) from e
         d = {
             "schema_version": self.schema_version,
             "tool": self.tool,
@@ -182,7 +198,7 @@ class Report:
             "spec": self.spec,
             "spec_file": self.spec_file,
             "spec_sha256": self.spec_sha256,
-            "parameters": self.parameters.to_json(),
+            "parameters": params,
             "claims": [c.to_dict() for c in self.claims],
             "solver": self.solver,
             "timings": self.timings,

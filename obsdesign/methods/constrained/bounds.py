@@ -39,12 +39,25 @@ class Bound:
 
 
 # -- rational helpers ----------------------------------------------------------------------
+def floor_log10(a: fmpq) -> int:
+    """⌊log10 a⌋ for a rational a > 0, exactly: no float (a may lie beyond the float range,
+    e.g. a bound built from a set's edge 1e300); an estimate from the bit lengths is moved
+    by exact comparisons with powers of 10."""
+    e = int((int(a.p).bit_length() - int(a.q).bit_length()) * 0.3010299956639812)
+    ten = fmpq(10)
+    while a < ten**e:
+        e -= 1
+    while a >= ten ** (e + 1):
+        e += 1
+    return e
+
+
 def round_sig(x: Any, digits: int, up: bool) -> fmpq:
     """Round an exact rational to ``digits`` significant decimal digits, up or down."""
     q = Q(x)
     if q == 0:
         return q
-    e = int(np.floor(np.log10(abs(float(q))))) - digits + 1
+    e = floor_log10(abs(q)) - digits + 1
     scale = fmpq(10) ** (-e) if e < 0 else fmpq(1, 10**e)
     t = q * scale
     k = t.ceil() if up else t.floor()
