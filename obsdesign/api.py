@@ -16,6 +16,7 @@ from obsdesign.errors import (
     EXIT_BAD_INPUT,
     EXIT_OK,
     EXIT_SOLVER,
+    InconclusiveError,
     InputError,
     ObsdesignError,
     SpecError,
@@ -135,11 +136,18 @@ def _did_you_mean(word: str, known: list[str]) -> str:
 def captured_warnings(notes: list[str]) -> Iterator[None]:
     """Turn Python warnings (numpy RuntimeWarning, scipy LinAlgWarning, ...) raised inside
     the block into report notes instead of letting them reach stderr (one note per distinct
-    message)."""
+    message). An OverflowError inside the block (an exact value converted to float beyond
+    its range, or float math that overflows: a spec number such as 1e300 in a product)
+    becomes InconclusiveError (exit 4) saying so, not an internal failure (exit 3)."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
             yield
+        except OverflowError as e:
+            raise InconclusiveError(
+                f"a number is beyond the float range ({e}): the spec's numbers are too "
+                "large for this computation"
+            ) from e
         finally:
             seen: set[str] = set()
             for w in caught:

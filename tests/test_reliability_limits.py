@@ -305,3 +305,19 @@ def test_simulation_memory_estimate_follows_the_method() -> None:
     for kwargs in ({"runs": 10**9}, {"runs": 10**6, "batch": 10**6}):
         with pytest.raises(InputError, match="max_sim_bytes"):
             api.check_sim_memory(sp, kwargs)
+
+
+def test_an_overflow_inside_a_computation_is_inconclusive_not_internal() -> None:
+    """api.captured_warnings wraps every design, certify, verify and simulate block: an
+    OverflowError there (an exact value beyond the float range converted to float) is
+    InconclusiveError, exit 4, naming the float range; other errors pass through."""
+    from obsdesign import api
+    from obsdesign.errors import InconclusiveError
+
+    with pytest.raises(InconclusiveError, match="beyond the float range") as e:
+        with api.captured_warnings([]):
+            float(10**400)
+    assert e.value.exit_code == 4
+    with pytest.raises(ZeroDivisionError):
+        with api.captured_warnings([]):
+            1 / 0  # noqa: B018
