@@ -406,14 +406,23 @@ def d_pow_int(a: Dual, k: int) -> Dual:
 
 
 def _pow_int(x: I, k: int) -> I:
+    """x^k (k >= 0) by squaring: x^k = (x^(k/2))² for even k (the tight square), x·x^(k−1)
+    for odd k. Iterative (the steps of that recursion, applied from x up), so an exponent
+    such as 1e308 (about 2000 steps) does not exhaust Python's recursion limit."""
     if k == 0:
         return ONE
-    if k == 1:
-        return x
-    if k % 2 == 0:
-        h = _pow_int(x, k // 2)
-        return h.sqr()
-    return x * _pow_int(x, k - 1)
+    steps: list[bool] = []  # True: square, False: multiply by x
+    while k > 1:
+        if k % 2 == 0:
+            steps.append(True)
+            k //= 2
+        else:
+            steps.append(False)
+            k -= 1
+    r = x
+    for square in reversed(steps):
+        r = r.sqr() if square else x * r
+    return r
 
 
 def d_fn(a: Dual, name: str) -> Dual:
