@@ -96,12 +96,26 @@ class Parameters:
         return not missing
 
     def to_json(self) -> dict[str, Any]:
+        """The report's ``parameters`` object: floats, and ``exact`` strings beside them.
+
+        A value held under two keys (the lyapunov method's P and P_best when the asked rate
+        is the best one) is converted once; each key still gets its own lists."""
         out: dict[str, Any] = {}
         exact: dict[str, Any] = {}
+        done: dict[int, tuple[Any, Any]] = {}  # id of an array value → (floats, exact strings)
         for k, v in self._v.items():
-            out[k] = _floats(v)
-            if _is_exact(v):
-                exact[k] = qstr(v)
+            hit = done.get(id(v)) if isinstance(v, np.ndarray) else None
+            if hit is None:
+                hit = (_floats(v), qstr(v) if _is_exact(v) else None)
+                if isinstance(v, np.ndarray):
+                    done[id(v)] = hit
+                    out[k], ex = hit
+                else:
+                    out[k], ex = hit
+            else:
+                out[k], ex = _copy_rows(hit[0]), _copy_rows(hit[1])
+            if ex is not None:
+                exact[k] = ex
         out["exact"] = exact
         return out
 
@@ -116,18 +130,31 @@ class Parameters:
             raise InputError("report: 'parameters.exact' must be an object")
         vals: dict[str, Any] = {}
         problems: list[str] = []
+        # exact lists already parsed, with their float lists and verdict: a value written
+        # under two keys (P and P_best) is parsed once, each key getting its own copy
+        parsed: list[tuple[list[Any], Any, Any, bool]] = []
         for k, v in d.items():
             if k == "exact":
                 continue
             if k in exact:
-                try:
-                    q = qparse(exact[k])
-                except (ValueError, TypeError, ZeroDivisionError) as e:
-                    raise InputError(
-                        f"report: parameters.exact.{k}: not an exact value ({e})"
-                    ) from e
+                ek = exact[k]
+                hit = None
+                if isinstance(ek, list):
+                    hit = next((h for h in parsed if h[0] == ek and h[1] == v), None)
+                if hit is not None:
+                    q, same = hit[2].copy(), hit[3]
+                else:
+                    try:
+                        q = qparse(ek)
+                    except (ValueError, TypeError, ZeroDivisionError) as e:
+                        raise InputError(
+                            f"report: parameters.exact.{k}: not an exact value ({e})"
+                        ) from e
+                    same = _same(_floats(q), v)
+                    if isinstance(ek, list):
+                        parsed.append((ek, v, q, same))
                 vals[k] = q
-                if not _same(_floats(q), v):
+                if not same:
                     problems.append(f"parameter '{k}': float value differs from its exact value")
             else:
                 vals[k] = np.asarray(v, dtype=float) if _numeric_list(v) else v
@@ -135,6 +162,11 @@ class Parameters:
             if k not in d:
                 problems.append(f"parameter '{k}': exact value without a float value")
         return cls(vals), problems
+
+
+def _copy_rows(x: Any) -> Any:
+    """A copy of nested lists (the leaves shared: numbers and strings are immutable)."""
+    return [_copy_rows(r) for r in x] if isinstance(x, list) else x
 
 
 def _numeric_list(v: Any) -> bool:
@@ -148,6 +180,17 @@ def _numeric_list(v: Any) -> bool:
 
 
 def _same(a: Any, b: Any) -> bool:
+    """Whether the float form ``b`` read from a report still matches ``a``, the floats of its
+    exact value: numbers within a relative 10⁻¹², nested lists entry by entry (vectorized for
+    a rectangular array of plain numbers, the same test)."""
+    if isinstance(a, list) and isinstance(b, list):
+        fa, fb = _plain_array(a), _plain_array(b)
+        if fa is not None and fb is not None:
+            if fa.shape != fb.shape:
+                return False
+            tol = np.maximum(1e-12 * np.maximum(np.abs(fa), np.abs(fb)), 1e-300)
+            with np.errstate(invalid="ignore", over="ignore"):
+                return bool(np.all(np.abs(fa - fb) <= tol))
     if isinstance(a, list) or isinstance(b, list):
         if not (isinstance(a, list) and isinstance(b, list)) or len(a) != len(b):
             return False
@@ -157,6 +200,32 @@ def _same(a: Any, b: Any) -> bool:
     if not isinstance(b, (int, float)):
         return False
     return math.isclose(float(a), float(b), rel_tol=1e-12, abs_tol=1e-300)
+
+
+def _plain_array(x: list[Any]) -> np.ndarray | None:
+    """A list (of lists) of plain ints and floats as a finite float array, None for anything
+    else (booleans, strings, ragged lists, non-finite values, ints beyond the float range):
+    :func:`_same` then compares entry by entry."""
+    shape: list[int] = []
+    level: Any = x
+    while isinstance(level, list):
+        shape.append(len(level))
+        level = level[0] if level else None
+    try:
+        arr = np.array(x, dtype=object)
+    except ValueError:
+        return None
+    if arr.shape != tuple(shape):
+        return None
+    for v in arr.flat:
+        t = type(v)
+        if t is not float and t is not int:
+            return None
+    try:
+        out = arr.astype(float)
+    except OverflowError:
+        return None
+    return out if np.all(np.isfinite(out)) else None
 
 
 def exact_param(params: Parameters, k: str, claims: list[Any], accept_float: bool = True) -> Any:

@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from flint import fmpq
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
 
 from obsdesign.certify.exact import qmat
 from obsdesign.params import Parameters, exact_param
@@ -27,3 +31,81 @@ def test_json_round_trip_3d_exact():
         cube[idx] = fmpq(i, 7)
     back, problems = Parameters.from_json(Parameters({"Lp": cube}).to_json())
     assert problems == [] and back["Lp"].shape == (2, 1, 2) and (back["Lp"] == cube).all()
+
+
+def test_shared_value_written_once_read_as_two():
+    """P and P_best holding one array: both keys written, lists not shared; read back as two
+    arrays (editing one leaves the other), and an edit of either copy is still seen."""
+    P = qmat([[2, fmpq(1, 3)], [fmpq(1, 3), 5]])
+    d = Parameters({"P": P, "P_best": P}).to_json()
+    assert d["P"] == d["P_best"] and d["exact"]["P"] == d["exact"]["P_best"]
+    assert d["P"] is not d["P_best"] and d["P"][0] is not d["P_best"][0]
+    assert d["exact"]["P"][0] is not d["exact"]["P_best"][0]
+    back, problems = Parameters.from_json(d)
+    assert problems == [] and (back["P"] == P).all() and (back["P_best"] == P).all()
+    back["P"][0, 0] = fmpq(7)
+    assert back["P_best"][0, 0] == 2
+    # the float of the second copy edited: caught although the exact strings are the same
+    d["P_best"][1][1] = 5.5
+    assert Parameters.from_json(d)[1] == [
+        "parameter 'P_best': float value differs from its exact value"
+    ]
+    # the exact string of the second copy edited: parsed as its own value
+    d["P_best"][1][1] = 5.0
+    d["exact"]["P_best"][1][1] = "6"
+    back, problems = Parameters.from_json(d)
+    assert back["P_best"][1, 1] == 6 and back["P"][1, 1] == 5
+    assert problems == ["parameter 'P_best': float value differs from its exact value"]
+
+
+_num = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.integers(min_value=-(10**400), max_value=10**400),
+)
+_leaf = st.one_of(_num, st.booleans(), st.just("1/2"), st.none())
+
+
+@given(
+    a=st.lists(st.lists(_num, min_size=0, max_size=3), min_size=0, max_size=3),
+    b=st.lists(st.lists(_leaf, min_size=0, max_size=3), min_size=0, max_size=3),
+    copy=st.booleans(),
+)
+@example(a=[[1.0, 2.0]], b=[[1.0, 2.0 * (1 + 3e-12)]], copy=False)  # just outside
+@example(a=[[1.0, 2.0]], b=[[1.0, 2.0 * (1 + 5e-13)]], copy=False)  # just inside
+@example(a=[[0.0]], b=[[1e-301]], copy=False)
+@example(a=[[0.0]], b=[[2e-300]], copy=False)
+@example(a=[[1.0]], b=[[True]], copy=False)
+@example(a=[[1.0], [2.0]], b=[[1.0], [2.0, 3.0]], copy=False)
+@settings(max_examples=300, deadline=None)
+def test_same_vectorized_agrees_with_entrywise(a, b, copy):
+    """The vectorized float comparison of a report's float lists (``b``, anything a report
+    may hold) with the floats of the exact values (``a``) gives the entry-by-entry verdict
+    (ragged lists, booleans, strings, non-finite and huge numbers included)."""
+    from obsdesign import params as pm
+
+    if copy:
+        b = [list(r) for r in a]
+
+    def entrywise(x, y):
+        if isinstance(x, list) or isinstance(y, list):
+            if not (isinstance(x, list) and isinstance(y, list)) or len(x) != len(y):
+                return False
+            return all(entrywise(u, v) for u, v in zip(x, y, strict=True))
+        if isinstance(x, bool) or isinstance(y, bool):
+            return x == y
+        if not isinstance(y, (int, float)):
+            return False
+        return math.isclose(float(x), float(y), rel_tol=1e-12, abs_tol=1e-300)
+
+    try:
+        want = entrywise(a, b)
+    except OverflowError:
+        want = "overflow"
+    try:
+        got = pm._same(a, b)
+    except (OverflowError, TypeError, ValueError):
+        got = "overflow"
+    if want == "overflow":
+        assert got in ("overflow", False)
+    else:
+        assert got == want

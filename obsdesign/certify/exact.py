@@ -154,11 +154,19 @@ def qparse(s: Any) -> Any:
         if arr.size == 0 or any(isinstance(v, list) for v in arr.flat):
             raise ValueError("ragged or empty exact array")
         flat = arr.reshape(-1)
+        vals: list[fmpq] = []
+        match = _RATIO.fullmatch
         for v in flat:
+            if type(v) is str and (m := match(v)) is not None:
+                # the canonical "p/q" or "p" of qstr, inline (Q's first case; ~2× faster at
+                # the 2×10⁴ strings of a 100-state lyapunov report)
+                vals.append(fmpq(int(m[1]), int(m[2])) if m[2] else fmpq(int(m[1])))
+                continue
             if isinstance(v, bool) or not isinstance(v, (str, int, float)):
                 raise ValueError(f"not an exact value: {v!r}")
+            vals.append(Q(v))
         out = np.empty(flat.shape, dtype=object)
-        out[:] = [Q(v) for v in flat]
+        out[:] = vals
         return out.reshape(arr.shape)
     raise ValueError(f"not an exact value: {s!r}")
 
