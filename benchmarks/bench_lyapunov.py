@@ -105,7 +105,7 @@ def ours(A: np.ndarray, C: np.ndarray) -> tuple[float, float, int, float, float]
 
 
 def worker() -> None:
-    """Measure every size (median of 3 for n ≤ 32, 1 run beyond) and print one line each."""
+    """Measure every size (median of 3 paired runs) and print one line each."""
     from obsdesign import api
 
     A, C = system(4)
@@ -117,7 +117,7 @@ def worker() -> None:
     )
     for n in SIZES:
         A, C = system(n)
-        reps = 3 if n <= 64 else 1
+        reps = 3
         runs, fls = [], []
         for _ in range(reps):  # paired: ours and the baseline interleaved
             runs.append(ours(A, C))

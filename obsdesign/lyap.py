@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from flint import fmpq, fmpq_mat, fmpq_poly
+from flint import fmpq, fmpq_mat, fmpq_poly, fmpz, fmpz_mat
 
 from obsdesign.certify.detect import hurwitz_stable, schur_stable
 from obsdesign.certify.exact import Q, dyadic, qeye, symmetrize
@@ -151,22 +151,21 @@ def decay_verdict(
     Pm: fmpq_mat | None = None,
 ) -> tuple[Any, bool]:
     """The exact verdict on the decay LMI of eq. (4)-(6) (constrained-redesign paper, Astolfi
-    et al., NOLCOS 2019) — :func:`decay_fmat` − margin·I ≻ 0 by
-    :func:`obsdesign.certify.psd.check_pd_fast` — and the float verdict beside it
+    et al., NOLCOS 2019) — :func:`decay_fmat` − margin·I ≻ 0 by :func:`decay_pd` (the
+    tests of :func:`obsdesign.certify.psd.check_pd_fast` on the integer matrix) — and the
+    float verdict beside it
     (λ_min of the float matrix > 0), looked up in / recorded into ``memo``.
 
     :param Acl: exact A − LC; :param P: symmetric n×n (exact); :param rate: λ or α;
     :param discrete: time domain; :param margin: δ; :param memo: verdicts of this process;
     :param Pm: ``P`` as an ``fmpq_mat`` when already converted."""
-    from obsdesign.certify.psd import check_pd_fast_float
-
     Pm = fmat(P) if Pm is None else Pm
     key = ("decay", Q(rate), Q(margin), discrete)
     if memo is not None:
         hit = memo.get(key, (Acl, Pm))
         if hit is not None:
             return hit
-    r, H = check_pd_fast_float(decay_fmat(Acl, Pm, rate, discrete), margin)
+    r, H = decay_pd(Acl, Pm, rate, discrete, margin)
     fl = bool(np.linalg.eigvalsh(H).min() > 0) if H is not None and H.size else True
     if memo is not None:
         memo.put(key, (Acl, Pm), (r, fl))
@@ -256,16 +255,17 @@ def _sym(M: fmpq_mat) -> fmpq_mat:
     return (M + M.transpose()) * fmpq(1, 2)
 
 
-def decay_fmat(Acl: Any, P: Any, rate: Any, discrete: bool) -> fmpq_mat:
-    """:func:`decay_matrix` for a given Acl = A − LC, as an ``fmpq_mat`` (exact, fast):
-    λ²P − AclᵀPAcl (discrete, eq. (5)-(6) with w = 0, constrained-redesign paper, Astolfi et
-    al., NOLCOS 2019) or −(AclᵀP + PAcl + 2αP) (continuous), symmetrized as (M + Mᵀ)/2.
+def decay_int(Acl: Any, P: Any, rate: Any, discrete: bool) -> tuple[fmpz_mat, fmpz]:
+    """(Z, D) with :func:`decay_fmat` = Z / D exactly: an integer matrix and a positive
+    integer, the decay matrix of eq. (5)-(6) with w = 0 (constrained-redesign paper, Astolfi
+    et al., NOLCOS 2019) before any rational entry is formed.
 
-    The products run over Z: with Acl = A_z/d_A, P = P_z/d_P and the rate p/q,
-    λ²P − AclᵀPAcl = (p² d_A² P_z − q² A_zᵀP_zA_z) / (q² d_A² d_P) and
-    −(AclᵀP + PAcl + 2αP) = −(q (A_zᵀP_z + P_zA_z) + 2p d_A P_z) / (q d_A d_P).
+    With Acl = A_z/d_A, P = P_z/d_P and the rate p/q: λ²P − AclᵀPAcl =
+    (p² d_A² P_z − q² A_zᵀP_zA_z) / (q² d_A² d_P) (discrete) and −(AclᵀP + PAcl + 2αP) =
+    −(q (A_zᵀP_z + P_zA_z) + 2p d_A P_z) / (q d_A d_P) (continuous); when P_z is not
+    symmetric, Z + Zᵀ over 2D, i.e. (M + Mᵀ)/2.
 
-    :param Acl: the error dynamics matrix; :param P: symmetric n×n; :param rate: λ or α;
+    :param Acl: the error dynamics matrix; :param P: n×n (exact); :param rate: λ or α;
     :param discrete: time domain."""
     Am, Pm = fmat(Acl), fmat(P)
     r = Q(rate)
@@ -273,14 +273,47 @@ def decay_fmat(Acl: Any, P: Any, rate: Any, discrete: bool) -> fmpq_mat:
     Pz, dp = Pm.numer_denom()
     rp, rq = r.p, r.q
     if discrete:
-        Mz = Pz * (rp * rp * da * da) - (Az.transpose() * Pz * Az) * (rq * rq)
-        M = fmpq_mat(Mz) / (rq * rq * da * da * dp)
+        Z = Pz * (rp * rp * da * da) - (Az.transpose() * Pz * Az) * (rq * rq)
+        D = rq * rq * da * da * dp
     else:
-        Mz = -((Az.transpose() * Pz + Pz * Az) * rq + Pz * (2 * rp * da))
-        M = fmpq_mat(Mz) / (rq * da * dp)
-    if Pm == Pm.transpose():  # then M is symmetric already: (M + Mᵀ)/2 = M
-        return M
-    return _sym(M)
+        Z = -((Az.transpose() * Pz + Pz * Az) * rq + Pz * (2 * rp * da))
+        D = rq * da * dp
+    if Pz != Pz.transpose():
+        Z, D = Z + Z.transpose(), 2 * D
+    return Z, fmpz(D)
+
+
+def decay_fmat(Acl: Any, P: Any, rate: Any, discrete: bool) -> fmpq_mat:
+    """:func:`decay_matrix` for a given Acl = A − LC, as an ``fmpq_mat`` (exact, fast):
+    λ²P − AclᵀPAcl (discrete, eq. (5)-(6) with w = 0, constrained-redesign paper, Astolfi et
+    al., NOLCOS 2019) or −(AclᵀP + PAcl + 2αP) (continuous), symmetrized as (M + Mᵀ)/2;
+    the products run over Z (:func:`decay_int`).
+
+    :param Acl: the error dynamics matrix; :param P: symmetric n×n; :param rate: λ or α;
+    :param discrete: time domain."""
+    Z, D = decay_int(Acl, P, rate, discrete)
+    return fmpq_mat(Z) / D
+
+
+def decay_pd(Acl: Any, P: Any, rate: Any, discrete: bool, margin: Any) -> tuple[Any, Any]:
+    """:func:`decay_fmat` − margin·I ≻ 0, decided exactly on the integer matrix
+    Z·b − a·D·I (margin a/b, decay matrix Z/D from :func:`decay_int`; the same matrix times
+    the positive 1/(bD)) by :func:`obsdesign.certify.psd.check_pd_int`: eq. (4)-(6) of the
+    constrained-redesign paper (Astolfi et al., NOLCOS 2019).
+
+    :param Acl, P, rate, discrete: as in :func:`decay_int`; :param margin: δ ≥ 0 (exact).
+    Returns the verdict and the float matrix it used (a positive multiple of
+    fl(decay − δI)), as :func:`obsdesign.certify.psd.check_pd_fast_float`."""
+    from obsdesign.certify.psd import check_pd_int
+
+    Z, D = decay_int(Acl, P, rate, discrete)
+    m = Q(margin)
+    if m != 0:
+        Z = Z * m.q
+        c = m.p * D
+        for i in range(Z.nrows()):
+            Z[i, i] = Z[i, i] - c
+    return check_pd_int(Z, fmpq(1) / (D * m.q))
 
 
 def decay_matrix(
@@ -523,7 +556,7 @@ def _rate_feasibility(Am: fmpq_mat, r: fmpq, discrete: bool) -> tuple[bool, str]
     X = _lyap_solution(mat_float(Am), float(r), discrete)
     if X is not None and np.any(X != 0):
         Xq = _sym(fmat(dyadic_fast(X, INERTIA_BITS)))  # = symmetrize(dyadic(X)), in flint
-        if check_pd_fast(decay_fmat(Am, Xq, r, discrete)):
+        if decay_pd(Am, Xq, r, discrete, 0)[0]:
             # X ⊁ 0 shown by a rational direction first (the float X guides, exact product
             # decides), else the full exact test
             neg = negative_direction(Xq, X) if np.linalg.eigvalsh(X)[0] < 0 else None

@@ -6,15 +6,23 @@ n − 1 has λ_min = 0 exactly, so B Bᵀ + t·I has λ_min = t exactly (t of ei
 
 from __future__ import annotations
 
+from fractions import Fraction
+
 import numpy as np
 import pytest
-from flint import fmpq, fmpq_mat
+from flint import fmpq, fmpq_mat, fmpz_mat
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from obsdesign.certify import vchol
-from obsdesign.certify.psd import _fraction_free, check_pd, check_pd_fast, check_text
-from obsdesign.certify.vchol import float_cholesky, to_float, verified_pd
+from obsdesign.certify.psd import (
+    _fraction_free,
+    check_pd,
+    check_pd_fast,
+    check_pd_int,
+    check_text,
+)
+from obsdesign.certify.vchol import float_cholesky, int_to_float, to_float, verified_pd
 
 
 def _eye(n: int) -> fmpq_mat:
@@ -162,3 +170,93 @@ def test_the_proved_bound_leaves_room_for_every_error_term(n: int, seed: int, ma
     sum_h2 = sum((q(x) * q(x) for x in H.ravel()), fmpq(0))
     assert room >= 0 and room * room >= u * u * sum_h2  # room ≥ u·‖H‖_F
     assert res.bound > 0
+
+
+# -- integer matrices (check_pd_int: the decay matrix times its positive denominator) ------
+def _int_part(M: fmpq_mat) -> tuple[fmpz_mat, fmpq]:
+    """(Z, c) with M = c·Z, Z an integer matrix, c > 0."""
+    Z, d = M.numer_denom()
+    return Z, fmpq(1) / fmpq(d)
+
+
+@pytest.mark.parametrize("n", [30, 100])
+def test_int_path_margin_at_the_exact_minimum(n: int) -> None:
+    """λ_min(M) = 1 exactly, M = c·Z: M − δI ≻ 0 is proved for δ = 1 − 10⁻⁹ and refused for
+    δ = 1 (singular) and δ = 1 + 10⁻¹⁵, through the integer matrix b·Z − a·D·I."""
+    M = _with_lambda_min(n, fmpq(1), seed=n + 5)
+    for delta, want in (
+        (fmpq(1) - fmpq(1, 10**9), True),
+        (fmpq(1), False),
+        (fmpq(1) + fmpq(1, 10**15), False),
+    ):
+        N = M - _eye(n) * delta
+        Z, c = _int_part(N)
+        r, H = check_pd_int(Z, c)
+        assert r.ok is want, (delta, r)
+        assert H is not None and H.shape == (n, n)
+        if want:
+            assert r.path == "verified-float" and 0 < r.min_pivot <= 1e-9 * 1.0001
+
+
+def test_int_path_reports_the_bound_of_the_scaled_matrix() -> None:
+    """The bound reported is a lower bound on λ_min(c·Z) (here 3), in c·Z's units: it scales
+    with c, while the float matrix Z·2⁻ˢ it was proved on does not."""
+    M = _with_lambda_min(20, fmpq(3), seed=2)
+    Z, c = _int_part(M)
+    r, H = check_pd_int(Z, c)
+    r2, H2 = check_pd_int(Z, c * 1024)
+    assert r.ok and r2.ok and 0 < r.min_pivot <= 3 and 0 < r2.min_pivot <= 3 * 1024
+    assert r2.min_pivot == 1024 * r.min_pivot and (H == H2).all()
+
+
+def test_int_path_refuses_asymmetry_and_bad_scale() -> None:
+    Z = fmpz_mat(2, 2, [2, 1, 0, 2])
+    r, H = check_pd_int(Z, 1)
+    assert not r.ok and r.path == "symmetry" and "(0, 1)" in r.detail and H is None
+    with pytest.raises(ValueError):
+        check_pd_int(fmpz_mat(2, 2, [2, 0, 0, 2]), 0)
+    assert check_pd_int(fmpz_mat(0, 0, []), 1)[0].ok
+
+
+def test_int_to_float_is_correctly_rounded_beyond_the_float_range() -> None:
+    """Entries of 2⁻ˢZ rounded to nearest (ties to even) even when Z's entries are far beyond
+    the float range, and the largest lands in [1, 2]."""
+    big = 2**3000
+    vals = [big + 1, -(big // 3), 7, 0, 2**3000 - 2**2947, -(2**2946) - 1]
+    Z = fmpz_mat(2, 3, vals)
+    H, s = int_to_float(Z)
+    for z, h in zip(vals, H.ravel().tolist(), strict=True):
+        assert h == float(Fraction(z, 2**s))  # Fraction → float: correctly rounded
+    assert 1 <= np.max(np.abs(H)) <= 2
+    # a tie at 2⁻⁵³ relative: rounds to even
+    Z = fmpz_mat(1, 2, [2**60, 2**60 + 2**7])
+    H, s = int_to_float(Z)
+    assert s == 60 and H[0, 1] == 1.0
+
+
+@given(
+    n=st.integers(1, 7),
+    seed=st.integers(0, 10**6),
+    scale_bits=st.integers(0, 1200),
+    t=st.sampled_from([fmpq(-1, 10**9), fmpq(0), fmpq(1, 10**9), fmpq(1)]),
+)
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+def test_int_path_agrees_with_exact_ldl(n: int, seed: int, scale_bits: int, t: fmpq) -> None:
+    """Random symmetric integer matrices with λ_min of either sign or exactly 0, scaled by
+    2^scale_bits (far beyond the float range): the verdict is the exact LDLᵀ's."""
+    M = _with_lambda_min(n + 1, t, seed) * 7 * fmpq(10**9)  # integer entries
+    Z, c = _int_part(M)
+    Z = Z * (2**scale_bits)
+    assert check_pd_int(Z, c)[0].ok == _fraction_free(fmpq_mat(Z)).ok
+
+
+def test_exact_paths_with_pivots_beyond_the_float_range() -> None:
+    """Entries and pivots beyond the float range (no float conversion possible): the exact
+    verdict, its pivot shown as ±inf, no OverflowError (found with the integer path's
+    property test: the fraction-free path showed a pivot with float())."""
+    big = fmpq(2) ** 1100
+    assert check_pd_fast(fmpq_mat(2, 2, [big, 0, 0, big])).min_pivot == float("inf")
+    r = check_pd_fast(fmpq_mat(2, 2, [big, 0, 0, -big]))
+    assert not r.ok and r.min_pivot == float("-inf")
+    r, _ = check_pd_int(fmpz_mat(2, 2, [2**1100, 0, 0, -(2**1100)]), 1)
+    assert not r.ok

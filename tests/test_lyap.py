@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from obsdesign import lyap
-from obsdesign.certify.exact import qeye, qmat
+from obsdesign.certify.exact import dyadic, qeye, qmat
 from obsdesign.certify.psd import check_pd, check_psd
 from obsdesign.errors import InconclusiveError, InfeasibleError
 from obsdesign.lyap import (
@@ -232,7 +232,7 @@ def test_certified_P_checks_the_decay_matrix() -> None:
     assert rate_feasible(closed_loop(A5, C5, L5), lam, True)
     assert certified_P(A5, C5, L5, True, lam, MARGIN) is None
     Pf = lyap.lyapunov_P(*(np.asarray(x, dtype=float) for x in (A5, C5, L5)), float(lam), True)
-    P = lyap.symmetrize(lyap.dyadic(Pf, lyap.BITS))
+    P = lyap.symmetrize(dyadic(Pf, lyap.BITS))
     assert check_pd(P, MARGIN)
 
 
@@ -334,3 +334,59 @@ def test_solve_lyapunov_large_systems_use_scipy(monkeypatch: pytest.MonkeyPatch)
     assert "numpy" in lyap.lyapunov_solver_name(n - 1, True)
     assert lyap.lyapunov_solver_name(n, True).endswith("scipy solve_discrete_lyapunov")
     assert lyap.lyapunov_solver_name(n, False).endswith("scipy solve_continuous_lyapunov")
+
+
+# -- the decay check on the integer matrix (decay_int / decay_pd) ---------------------------
+@pytest.mark.parametrize("discrete", [True, False])
+def test_decay_pd_margin_at_the_exact_minimum(discrete: bool) -> None:
+    """Acl = diag(±1/2, −1/3), P = diag(1, 3): the decay matrix is diagonal and known, and its
+    smallest entry m is exact. Margin m − 10⁻²⁰ is proved, m (singular) and m + 10⁻²⁰ not."""
+    Acl = qmat([[fmpq(1 if discrete else -1, 2), 0], [0, fmpq(-1, 3)]])
+    P = qmat([[1, 0], [0, 3]])
+    rate = fmpq(9, 10) if discrete else fmpq(1, 10)
+    M = decay_matrix(Acl, qmat([[0, 0]]), qmat([[0], [0]]), P, rate, discrete)
+    m = min(M[0, 0], M[1, 1])
+    assert m > 0
+    eps = fmpq(1, 10**20)
+    assert lyap.decay_pd(Acl, P, rate, discrete, m - eps)[0].ok
+    assert not lyap.decay_pd(Acl, P, rate, discrete, m)[0].ok
+    assert not lyap.decay_pd(Acl, P, rate, discrete, m + eps)[0].ok
+
+
+@given(
+    n=st.integers(1, 5),
+    seed=st.integers(0, 10**6),
+    discrete=st.booleans(),
+    symmetric=st.booleans(),
+    margin=st.sampled_from([fmpq(0), fmpq(1, 10**9), fmpq(1, 3)]),
+)
+@settings(max_examples=60, deadline=None)
+def test_decay_pd_agrees_with_exact_ldl(
+    n: int, seed: int, discrete: bool, symmetric: bool, margin: fmpq
+) -> None:
+    """Random rational Acl and P (symmetric or not: the check is on (M + Mᵀ)/2) near the
+    boundary: the integer-matrix verdict is the exact LDLᵀ verdict of decay_fmat − δI, and
+    decay_fmat is Z/D of decay_int."""
+    rng = np.random.default_rng(seed)
+    Acl = qmat([[fmpq(int(v), 7) for v in row] for row in rng.integers(-4, 5, (n, n))])
+    B = rng.integers(-3, 4, (n, n))
+    Pint = B @ B.T + np.eye(n, dtype=int) if symmetric else B + 4 * np.eye(n, dtype=int)
+    P = qmat([[fmpq(int(v), 5) for v in row] for row in Pint])
+    eig = np.linalg.eigvals(np.asarray(Acl, dtype=float))
+    rate = (
+        dyadic(float(np.max(np.abs(eig))) * 1.05 + 0.01, 20)
+        if discrete
+        else dyadic(max(-float(np.max(eig.real)) * 0.95, 0.01), 20)
+    )
+    Z, D = lyap.decay_int(Acl, P, rate, discrete)
+    F = lyap.decay_fmat(Acl, P, rate, discrete)
+    # independently, in object arrays of fmpq: (M + Mᵀ)/2
+    if discrete:
+        M = P * (rate * rate) - Acl.T @ P @ Acl
+    else:
+        M = -(Acl.T @ P + P @ Acl + P * (2 * rate))
+    M = (M + M.T) * fmpq(1, 2)
+    assert D > 0 and (lyap.as_array(F) == M).all()
+    assert lyap.fmpq_mat(Z) / D == F
+    want = check_pd(M - qeye(n) * margin).ok
+    assert lyap.decay_pd(Acl, P, rate, discrete, margin)[0].ok == want

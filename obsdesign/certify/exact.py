@@ -93,6 +93,15 @@ def to_float(a: Any) -> np.ndarray | float:
     )
 
 
+def float_or_inf(x: Any) -> float:
+    """The nearest float of an exact number for display (a pivot, a bound), ±inf beyond the
+    float range instead of an OverflowError (the exact value decided; this only shows it)."""
+    try:
+        return _qfloat(Q(x))
+    except OverflowError:
+        return math.inf if Q(x) > 0 else -math.inf
+
+
 def _qfloat(x: Any) -> float:
     if isinstance(x, fmpq):
         # int / int is correctly rounded in CPython (it is what Fraction.__float__ does)

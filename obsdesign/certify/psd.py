@@ -16,7 +16,7 @@ import numpy as np
 from flint import fmpq
 
 from obsdesign.certify import vchol
-from obsdesign.certify.exact import Q, qeye, qmat
+from obsdesign.certify.exact import Q, float_or_inf, qeye, qmat
 
 
 @dataclass(frozen=True)
@@ -98,9 +98,13 @@ def check_pd(M: Any, margin: Any = 0) -> PSDResult:
     pivots = ldl_pivots(arr)
     mn = min(pivots)
     if mn > 0:
-        return PSDResult(True, float(mn), f"all {n} LDLᵀ pivots > 0 (min {float(mn):.3g})")
+        return PSDResult(
+            True, float_or_inf(mn), f"all {n} LDLᵀ pivots > 0 (min {float_or_inf(mn):.3g})"
+        )
     k = next(i for i, p in enumerate(pivots) if p <= 0)
-    return PSDResult(False, float(mn), f"LDLᵀ pivot {k} = {float(pivots[k]):.6g} <= 0")
+    return PSDResult(
+        False, float_or_inf(mn), f"LDLᵀ pivot {k} = {float_or_inf(pivots[k]):.6g} <= 0"
+    )
 
 
 def check_psd(M: Any, margin: Any = 0) -> PSDResult:
@@ -121,7 +125,9 @@ def check_psd(M: Any, margin: Any = 0) -> PSDResult:
         p = a[k][k]
         min_piv = p if min_piv is None or p < min_piv else min_piv
         if p < 0:
-            return PSDResult(False, float(p), f"negative diagonal {float(p):.6g} after elimination")
+            return PSDResult(
+                False, float_or_inf(p), f"negative diagonal {float_or_inf(p):.6g} after elimination"
+            )
         if p == 0:
             for i in idx:
                 for j in idx:
@@ -136,7 +142,7 @@ def check_psd(M: Any, margin: Any = 0) -> PSDResult:
                 continue
             for j in idx:
                 a[i][j] -= f * a[k][j]
-    return PSDResult(True, float(min_piv if min_piv is not None else 0), "PSD (full rank)")
+    return PSDResult(True, float_or_inf(min_piv if min_piv is not None else 0), "PSD (full rank)")
 
 
 # -- fast exact test for large matrices (issue 12: exact LDLᵀ at n = 100) ----------------------
@@ -212,16 +218,16 @@ def _fraction_free(F: Any) -> PSDResult:
         if dk <= 0:
             return PSDResult(
                 False,
-                float(piv),
-                f"fraction-free LDLᵀ: pivot {k} = {float(piv):.6g} <= 0 (leading minor ≤ 0)",
+                float_or_inf(piv),
+                f"fraction-free LDLᵀ: pivot {k} = {float_or_inf(piv):.6g} <= 0 (leading minor ≤ 0)",
                 "fraction-free",
             )
         mn = piv if mn is None or piv < mn else mn
         prev = dk
     return PSDResult(
         True,
-        float(mn),  # type: ignore[arg-type]
-        f"fraction-free LDLᵀ: all {n} leading principal minors > 0 (min pivot {float(mn):.3g})",  # type: ignore[arg-type]
+        float_or_inf(mn),  # type: ignore[arg-type]
+        f"fraction-free LDLᵀ: all {n} leading principal minors > 0 (min pivot {float_or_inf(mn):.3g})",  # type: ignore[arg-type]
         "fraction-free",
     )
 
@@ -261,7 +267,7 @@ def negative_direction(F: Any, Mf: np.ndarray, mu: float | None = None) -> PSDRe
     return PSDResult(
         False,
         float(w[0]) if mu is None else mu,
-        f"vᵀMv = {float(val / fmpq(2) ** (2 * k)):.6g} <= 0 for a rational v "
+        f"vᵀMv = {float_or_inf(val / fmpq(2) ** (2 * k)):.6g} <= 0 for a rational v "
         "(float eigenvector, checked exactly)",
         "eigenvector",
     )
@@ -355,8 +361,54 @@ def check_pd_fast_float(M: Any, margin: Any = 0) -> tuple[PSDResult, np.ndarray 
     if Mf is not None:
         v = vchol.verified_pd(F, 0, Mf)
         if v is not None:
-            return PSDResult(True, float(v.bound), v.detail, "verified-float"), Mf
+            return PSDResult(True, float_or_inf(v.bound), v.detail, "verified-float"), Mf
         r = _gershgorin_certificate(F, Mf)
         if r is not None:
             return r, Mf
     return _fraction_free(F), Mf
+
+
+def check_pd_int(Z: Any, scale: Any = 1) -> tuple[PSDResult, np.ndarray | None]:
+    """:func:`check_pd_fast_float` for M = scale·Z, a symmetric integer matrix Z (flint
+    ``fmpz_mat``) times a positive rational: M ≻ 0 iff Z ≻ 0, decided exactly without forming
+    M's rational entries (at n = 100 the canonical fractions of a decay matrix and their
+    common denominator cost more than the products that made them).
+
+    The verified float Cholesky runs on H = fl(Z·2⁻ˢ) (:func:`obsdesign.certify.vchol.int_to_float`,
+    entries correctly rounded, so step 1 of its theorem holds for Z·2⁻ˢ); when it does not
+    decide, the exact paths of :func:`check_pd_fast` run on M. The reported bound is on
+    λ_min(M) (the scaled proof's bound times 2ˢ·scale, exactly).
+
+    :param Z: square symmetric integer matrix; :param scale: the positive factor (exact).
+    Returns the verdict and the float matrix it used (H, a positive multiple of fl(M), so its
+    eigenvalues have the signs of M's), None when it made none."""
+    from flint import fmpq, fmpq_mat
+
+    c = Q(scale)
+    if c <= 0:
+        raise ValueError("scale must be positive")
+    n = Z.nrows()
+    if Z.ncols() != n:
+        raise ValueError("expected a square matrix")
+    if Z != Z.transpose():
+        for i in range(n):
+            for j in range(i + 1, n):
+                if Z[i, j] != Z[j, i]:
+                    return PSDResult(
+                        False, float("nan"), f"not symmetric at ({i}, {j})", "symmetry"
+                    ), None
+    if n == 0:
+        return PSDResult(True, float("inf"), "empty matrix", "empty"), None
+    H, sh = vchol.int_to_float(Z)
+    v = vchol.verified_pd_float(H, fmpq(0))
+    if v is not None:
+        k = c * fmpq(2) ** sh  # M = k · (Z·2⁻ˢ)
+        v = vchol.VCholResult(v.bound * k, float_or_inf(fmpq(*v.shift.as_integer_ratio()) * k), n)
+        return PSDResult(True, float_or_inf(v.bound), v.detail, "verified-float"), H
+    F = fmpq_mat(Z) * c
+    Mf = vchol.to_float(F)
+    if Mf is not None:
+        r = _gershgorin_certificate(F, Mf)
+        if r is not None:
+            return r, Mf
+    return _fraction_free(F), (Mf if Mf is not None else H)

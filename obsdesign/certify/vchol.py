@@ -11,6 +11,11 @@ Notation: u = 2⁻⁵³ (unit roundoff of IEEE double), η = 2⁻¹⁰⁷⁴ (sm
    integer numerator and the common denominator (CPython's int/int true division is correctly
    rounded). Then |M − H| ≤ E with E_ij = u·|H_ij| + η, so ‖M − H‖₂ ≤ ‖E‖_F ≤ u‖H‖_F + nη.
    H is exactly symmetric (the same rounding of the same number).
+   *Integer form* (:func:`int_to_float`): for M = c·Z with Z an integer matrix and c > 0
+   rational, M − 0·I ≻ 0 iff Z·2⁻ˢ ≻ 0; H = fl(Z·2⁻ˢ), each entry an int/int quotient,
+   correctly rounded, satisfies step 1 for the matrix Z·2⁻ˢ, and the proved bound times c·2ˢ
+   bounds λ_min(M). The decay matrix of a Lyapunov check is proved this way, without its
+   rational entries (:func:`obsdesign.lyap.decay_pd`).
 2. *Shift.* For a float c ≥ 0, G equals H off the diagonal and G_ii = fl(H_ii − c); an IEEE
    subtraction is correctly rounded (and exact in the subnormal range), so
    |G_ii − (H_ii − c)| ≤ u·|G_ii|.
@@ -47,6 +52,8 @@ from typing import Any
 import numpy as np
 from flint import fmpq, fmpq_mat
 
+from obsdesign.certify.exact import float_or_inf
+
 #: unit roundoff u = 2⁻⁵³ and the smallest subnormal η = 2⁻¹⁰⁷⁴, exactly
 U = fmpq(1, 2**53)
 ETA = fmpq(1, 2**1074)
@@ -74,7 +81,7 @@ class VCholResult:
     def detail(self) -> str:
         """One line for the claim's detail."""
         return (
-            f"verified float Cholesky: λ_min(M − δI) ≥ {float(self.bound):.3g} > 0 "
+            f"verified float Cholesky: λ_min(M − δI) ≥ {float_or_inf(self.bound):.3g} > 0 "
             f"(shift c = {self.shift:.3g}, n = {self.n})"
         )
 
@@ -147,6 +154,24 @@ def _gamma(k: int) -> fmpq:
     return k * U / (1 - k * U)
 
 
+def int_to_float(Z: Any) -> tuple[np.ndarray, int]:
+    """H = fl(Z·2⁻ˢ) entry by entry for an integer matrix Z, each entry correctly rounded
+    (step 1 of the theorem, for the matrix Z·2⁻ˢ), with the exponent s chosen so that the
+    largest entry of Z·2⁻ˢ lies in [1, 2): no overflow, and the scaling is exact. Positive
+    definiteness is invariant under the positive factor 2⁻ˢ, so an integer matrix (e.g. the
+    decay matrix of eq. (4)-(6), constrained-redesign paper, times its positive common
+    denominator) is tested without forming its rational entries.
+
+    :param Z: a flint ``fmpz_mat``. Returns (H, s); s = 0 for the zero matrix."""
+    n, m = Z.nrows(), Z.ncols()
+    ents = [int(z) for z in Z.entries()]
+    top = max(map(abs, ents), default=0)
+    s = top.bit_length() - 1 if top else 0
+    d = 1 << s
+    vals = [z / d for z in ents]  # int/int true division: correctly rounded, |value| ≤ 2
+    return np.array(vals, dtype=float).reshape(n, m), s
+
+
 def verified_pd(F: fmpq_mat, margin: Any = 0, H: np.ndarray | None = None) -> VCholResult | None:
     """A proof that F − margin·I ≻ 0 by the theorem of this module, or None (unknown: never a
     proof of the contrary).
@@ -173,6 +198,24 @@ def verified_pd(F: fmpq_mat, margin: Any = 0, H: np.ndarray | None = None) -> VC
         H = to_float(F)
         if H is None:
             return None
+    return verified_pd_float(H, delta)
+
+
+def verified_pd_float(H: np.ndarray, delta: fmpq) -> VCholResult | None:
+    """Steps 2-4 of the theorem: a proof that M − δI ≻ 0 from H, or None (unknown).
+
+    H must be the entrywise correctly rounded float matrix of the (symmetric, exact) matrix M
+    meant — :func:`to_float` of M, or :func:`int_to_float` of an integer matrix Z with
+    M = Z·2⁻ˢ — so that |M − H| ≤ u|H| + η (step 1); every entry finite and the largest
+    within 2^±500 of 1 (:func:`verified_pd` rescales when it is not).
+
+    :param H: the float matrix; :param delta: δ ≥ 0 (exact)."""
+    n = H.shape[0]
+    if n == 0 or not np.all(np.isfinite(H)):
+        return None
+    top = float(np.max(np.abs(H)))
+    if top == 0.0 or not -500 <= math.frexp(top)[1] <= 500:
+        return None
     try:
         hf = _sqrt_up(_sum_sq_up(H))
         conv = U * hf + n * ETA  # ≥ ‖M − H‖₂
