@@ -24,7 +24,7 @@ from obsdesign.errors import (
 from obsdesign.limits import limits, max_states_for
 from obsdesign.methods import get_method, method_keys
 from obsdesign.methods.base import Method, Progress
-from obsdesign.params import Parameters
+from obsdesign.params import Parameters, same_bits
 from obsdesign.report.model import TOP_KEYS, Report, check_output, write_atomic
 from obsdesign.spec import Spec, read_spec, read_spec_text
 
@@ -424,22 +424,12 @@ def _float_problems(rep: Report) -> list[str]:
     params = rep.parameters
     out = []
     for k in exact if isinstance(exact, dict) else ():
-        if k in raw and k in params and not _same_floats(raw[k], params.float_json(k)):
+        if k in raw and k in params and not same_bits(raw[k], params.float_json(k)):
             out.append(
                 f"parameter '{k}': the float is not the nearest double to the exact value "
                 f"(the exact value is authoritative)"
             )
     return out
-
-
-def _same_floats(a: Any, b: Any) -> bool:
-    if isinstance(a, list) and isinstance(b, list):
-        return len(a) == len(b) and all(_same_floats(x, y) for x, y in zip(a, b, strict=True))
-    if isinstance(a, bool) or isinstance(b, bool) or isinstance(a, list) or isinstance(b, list):
-        return False
-    if not isinstance(a, (int, float)) or not isinstance(b, (int, float)):
-        return False
-    return float(a) == float(b)
 
 
 def compare_claims(reported: list[Claim], fresh: list[Claim]) -> list[Claim]:

@@ -49,12 +49,16 @@ class Parameters:
 
     def __init__(self, values: dict[str, Any] | None = None) -> None:
         self._v: dict[str, Any] = dict(values or {})
+        #: float forms (:meth:`float_json`) already made, by key (``from_json`` makes them
+        #: for its consistency check); dropped when the key is set again
+        self._fj: dict[str, Any] = {}
 
     def __getitem__(self, k: str) -> Any:
         return self._v[k]
 
     def __setitem__(self, k: str, v: Any) -> None:
         self._v[k] = v
+        self._fj.pop(k, None)
 
     def __contains__(self, k: object) -> bool:
         return k in self._v
@@ -75,7 +79,10 @@ class Parameters:
         return np.asarray(f, dtype=float) if isinstance(f, list) else f
 
     def float_json(self, k: str) -> Any:
-        """The float form ``to_json`` writes for parameter ``k`` (lists for arrays)."""
+        """The float form ``to_json`` writes for parameter ``k`` (lists for arrays; a fresh
+        copy, the caller may change it)."""
+        if k in self._fj:
+            return _copy_rows(self._fj[k])
         return _floats(self._v[k])
 
     def is_exact(self, k: str) -> bool:
@@ -132,7 +139,8 @@ class Parameters:
         problems: list[str] = []
         # exact lists already parsed, with their float lists and verdict: a value written
         # under two keys (P and P_best) is parsed once, each key getting its own copy
-        parsed: list[tuple[list[Any], Any, Any, bool]] = []
+        parsed: list[tuple[list[Any], Any, Any, bool, Any]] = []
+        fj: dict[str, Any] = {}
         for k, v in d.items():
             if k == "exact":
                 continue
@@ -142,7 +150,7 @@ class Parameters:
                 if isinstance(ek, list):
                     hit = next((h for h in parsed if h[0] == ek and h[1] == v), None)
                 if hit is not None:
-                    q, same = hit[2].copy(), hit[3]
+                    q, same, fl = hit[2].copy(), hit[3], hit[4]
                 else:
                     try:
                         q = qparse(ek)
@@ -150,10 +158,12 @@ class Parameters:
                         raise InputError(
                             f"report: parameters.exact.{k}: not an exact value ({e})"
                         ) from e
-                    same = _same(_floats(q), v)
+                    fl = _floats(q)
+                    same = _same(fl, v)
                     if isinstance(ek, list):
-                        parsed.append((ek, v, q, same))
+                        parsed.append((ek, v, q, same, fl))
                 vals[k] = q
+                fj[k] = fl
                 if not same:
                     problems.append(f"parameter '{k}': float value differs from its exact value")
             else:
@@ -161,7 +171,9 @@ class Parameters:
         for k in exact:
             if k not in d:
                 problems.append(f"parameter '{k}': exact value without a float value")
-        return cls(vals), problems
+        out = cls(vals)
+        out._fj = fj
+        return out, problems
 
 
 def _copy_rows(x: Any) -> Any:
@@ -177,6 +189,22 @@ def _numeric_list(v: Any) -> bool:
         return True
     except (TypeError, ValueError):
         return False
+
+
+def same_bits(a: Any, b: Any) -> bool:
+    """Whether two float forms (numbers, nested lists) are equal entry by entry as doubles
+    (``float(x) == float(y)``; booleans, strings and ragged lists are never equal to
+    numbers), vectorized for rectangular arrays of plain numbers."""
+    if isinstance(a, list) and isinstance(b, list):
+        fa, fb = _plain_array(a), _plain_array(b)
+        if fa is not None and fb is not None:
+            return fa.shape == fb.shape and bool(np.array_equal(fa, fb))
+        return len(a) == len(b) and all(same_bits(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, bool) or isinstance(b, bool) or isinstance(a, list) or isinstance(b, list):
+        return False
+    if not isinstance(a, (int, float)) or not isinstance(b, (int, float)):
+        return False
+    return float(a) == float(b)
 
 
 def _same(a: Any, b: Any) -> bool:

@@ -109,3 +109,52 @@ def test_same_vectorized_agrees_with_entrywise(a, b, copy):
         assert got in ("overflow", False)
     else:
         assert got == want
+
+
+@given(
+    a=st.lists(st.lists(_leaf, min_size=0, max_size=3), min_size=0, max_size=3),
+    b=st.lists(st.lists(_leaf, min_size=0, max_size=3), min_size=0, max_size=3),
+    copy=st.booleans(),
+)
+@example(a=[[1.0, 2.0]], b=[[1.0, 2.0000000000000004]], copy=False)  # one ulp
+@example(a=[[0.0]], b=[[-0.0]], copy=False)
+@example(a=[[1.0]], b=[[1]], copy=False)
+@settings(max_examples=300, deadline=None)
+def test_same_bits_vectorized_agrees_with_entrywise(a, b, copy):
+    """verify's bit-for-bit float check (same_bits) gives the entry-by-entry verdict."""
+    from obsdesign.params import same_bits
+
+    if copy:
+        b = [list(r) for r in a]
+
+    def entrywise(x, y):
+        if isinstance(x, list) and isinstance(y, list):
+            return len(x) == len(y) and all(entrywise(u, v) for u, v in zip(x, y, strict=True))
+        if isinstance(x, (bool, list)) or isinstance(y, (bool, list)):
+            return False
+        if not isinstance(x, (int, float)) or not isinstance(y, (int, float)):
+            return False
+        return float(x) == float(y)
+
+    try:
+        want = entrywise(a, b)
+    except OverflowError:
+        want = "overflow"
+    try:
+        got = same_bits(a, b)
+    except OverflowError:
+        got = "overflow"
+    assert got == want
+
+
+def test_float_forms_kept_from_reading_and_dropped_on_change():
+    """from_json keeps the float forms it made for its check; float_json hands out copies,
+    and setting the key again drops the kept form."""
+    d = Parameters({"P": qmat([[1, fmpq(1, 3)], [fmpq(1, 3), 2]])}).to_json()
+    back, _ = Parameters.from_json(d)
+    f1 = back.float_json("P")
+    assert f1 == d["P"]
+    f1[0][0] = 99.0
+    assert back.float_json("P")[0][0] == 1.0
+    back["P"] = qmat([[5, 0], [0, 5]])
+    assert back.float_json("P") == [[5.0, 0.0], [0.0, 5.0]]

@@ -11,6 +11,8 @@ import time
 from pathlib import Path
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from obsdesign.cli import app
@@ -321,3 +323,40 @@ def test_an_overflow_inside_a_computation_is_inconclusive_not_internal() -> None
     with pytest.raises(ZeroDivisionError):
         with api.captured_warnings([]):
             1 / 0  # noqa: B018
+
+
+@given(
+    neg=st.booleans(),
+    ip=st.text("0123456789", min_size=0, max_size=12),
+    fp=st.one_of(st.none(), st.text("0123456789", min_size=0, max_size=12)),
+    ex=st.one_of(st.none(), st.integers(-30, 30)),
+    md=st.integers(1, 12),
+    me=st.integers(1, 12),
+)
+@settings(max_examples=400, deadline=None)
+def test_number_size_checks_fast_paths_give_the_full_verdict(neg, ip, fp, ex, md, me) -> None:
+    """decimal_problem, number_text_problem and data_problem's inline test of a list's
+    strings skip the full check for short plain numbers; with small limits (the boundary in
+    reach) their verdict is the full check's, computed here independently."""
+    from decimal import Decimal
+
+    from obsdesign.limits import data_problem, decimal_problem, number_text_problem
+
+    body = ip + ("" if fp is None else "." + fp)
+    if not any(c.isdigit() for c in body):
+        body = "0" + body
+    text = ("-" if neg else "") + body + ("" if ex is None else f"e{ex}")
+    digits = sum(c.isdigit() for c in body)
+    d = Decimal(text)
+    t = d.as_tuple()
+    nd, e = len(t.digits), int(t.exponent)
+    want_dec = nd <= md and abs(e) <= me + md and abs(e + nd - 1) <= me
+    want_txt = digits <= md and (ex is None or abs(ex) <= me + digits)
+    old = set_limits(max_digits=md, max_exponent=me)
+    try:
+        assert (decimal_problem(d) is None) == want_dec, (text, md, me)
+        assert (number_text_problem(text) is None) == want_txt, (text, md, me)
+        assert (data_problem({"P": [[text]]}, exact_strings=True) is None) == want_txt
+        assert (data_problem({"a": [d]}) is None) == want_dec
+    finally:
+        reset_limits(old)

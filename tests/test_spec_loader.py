@@ -201,3 +201,23 @@ def test_expression_injection_rejected_through_spec(tmp_path):
     with pytest.raises(SpecError) as ei:
         parse_expr("__import__('os').getcwd()", ["x1"], file="s.toml", key="nonlinearity.psi")
     assert "s.toml: [nonlinearity.psi]" in ei.value.message
+
+
+def test_numbers_checked_once_by_the_loader_and_always_in_a_bare_table() -> None:
+    """The loader walks every number before building tables (they are marked checked and skip
+    the per-number size check); a Table made from other data keeps the check."""
+    from decimal import Decimal
+
+    from obsdesign.errors import SpecError
+    from obsdesign.spec.loader import read_spec_text
+    from obsdesign.spec.reader import Table
+
+    bare = Table({"x": Decimal("1e" + "9" * 12)}, "t.toml")
+    assert not bare.checked
+    with pytest.raises(SpecError, match="t.toml.*x.*exponent"):
+        bare.scalar("x")
+    text = '[system]\ntime = "discrete"\nA = [[0.5]]\nC = [[1]]\n[method]\nkey = "lyapunov"\n'
+    sp = read_spec_text(text, "s.toml")
+    assert sp.method_table.checked
+    with pytest.raises(SpecError, match="s.toml.*exponent"):
+        read_spec_text(text.replace("0.5", "0.5e99999999"), "s.toml")

@@ -52,7 +52,7 @@ def read_spec_text(text: str, file: str = "<spec>") -> Spec:
     binds the method, which reads its own keys."""
     data = _parse_toml(text, file)
     sha = hashlib.sha256(text.encode("utf-8")).hexdigest()
-    root = Table(data, file)
+    root = Table(data, file, checked=True)  # _parse_toml walked every number
     title = root.str("title", default="")
     root.str("description", default="")
     root.str("reference", default="")

@@ -47,10 +47,17 @@ def _is_number(v: Any) -> bool:
 class Table:
     """A TOML table with its file name and key path; getters validate and convert."""
 
-    def __init__(self, data: dict[str, Any], file: str, path: str = "") -> None:
+    def __init__(
+        self, data: dict[str, Any], file: str, path: str = "", checked: bool = False
+    ) -> None:
+        """:param data: the table's parsed TOML; :param file: for messages; :param path: the
+        key path; :param checked: every number in ``data`` has passed
+        :func:`obsdesign.limits.data_problem` (the loader's walk): the getters then skip the
+        per-number size check before the exact conversion (it would repeat the walk's)."""
         self.data = data
         self.file = file
         self.path = path
+        self.checked = checked
         self._used: set[str] = set()
 
     # -- plumbing ---------------------------------------------------------------------------
@@ -96,7 +103,7 @@ class Table:
             return None
         if not isinstance(v, dict):
             raise self.error(k, "expected a table")
-        return Table(v, self.file, self.key(k))
+        return Table(v, self.file, self.key(k), self.checked)
 
     def tables(self, k: str) -> dict[str, Table]:
         t = self.table(k)
@@ -107,7 +114,7 @@ class Table:
             if not isinstance(v, dict):
                 raise t.error(name, "expected a table")
             t.mark(name)
-            out[name] = Table(v, self.file, t.key(name))
+            out[name] = Table(v, self.file, t.key(name), self.checked)
         return out
 
     # -- scalars ----------------------------------------------------------------------------
@@ -168,7 +175,10 @@ class Table:
             raise self.error(k, f"expected a number, got {_tname(v)}")
         if isinstance(v, Decimal) and not v.is_finite():
             raise self.error(k, f"expected a finite number, got {v}")
-        why = decimal_problem(v) if isinstance(v, Decimal) else int_problem(v)
+        if self.checked:  # the loader's walk checked every number of the spec already
+            why = None
+        else:
+            why = decimal_problem(v) if isinstance(v, Decimal) else int_problem(v)
         if why:  # checked before the conversion to a rational (which could take forever)
             raise self.error(k, why)
         return Q(v)

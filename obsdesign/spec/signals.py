@@ -80,7 +80,7 @@ def parse_signal(t: Table | None, dim: int) -> Signal:
         if not isinstance(ws, list) or not ws or not all(isinstance(w, dict) for w in ws):
             raise t.error("windows", "expected an array of tables {start, stop, value}")
         for i, w in enumerate(ws):
-            wt = Table(w, t.file, t.key(f"windows[{i}]"))
+            wt = Table(w, t.file, t.key(f"windows[{i}]"), t.checked)
             start = float(wt.scalar("start").f)
             stop = float(wt.scalar("stop").f)
             if stop < start:
