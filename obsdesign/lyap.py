@@ -509,7 +509,11 @@ def _lyap_solution(Acl: np.ndarray, rate: float, discrete: bool) -> np.ndarray |
 
 
 def rate_feasibility(
-    Acl: Any, rate: Any, discrete: bool, memo: ExactMemo | None = None
+    Acl: Any,
+    rate: Any,
+    discrete: bool,
+    memo: ExactMemo | None = None,
+    Af: np.ndarray | None = None,
 ) -> tuple[bool, str]:
     """Whether some P ≻ 0 makes :func:`decay_matrix` ≻ 0 at ``rate``, decided exactly, and how.
 
@@ -531,7 +535,8 @@ def rate_feasibility(
     constrained-redesign paper (Astolfi et al., NOLCOS 2019), for a fixed gain.
 
     :param Acl: A − LC (exact; object array or ``fmpq_mat``); :param rate: λ or α (exact);
-    :param discrete: time domain; :param memo: verdicts already made in this process.
+    :param discrete: time domain; :param memo: verdicts already made in this process;
+    :param Af: :func:`mat_float` of Acl, when already made (it only guides the proof).
     Returns (verdict, the proof used)."""
     r = Q(rate)
     Am = fmat(Acl)
@@ -545,15 +550,17 @@ def rate_feasibility(
         hit = memo.get(key, (Am,))
         if hit is not None:
             return hit  # type: ignore[no-any-return]
-    out = _rate_feasibility(Am, r, discrete)
+    out = _rate_feasibility(Am, r, discrete, Af)
     if memo is not None:
         memo.put(key, (Am,), out)
     return out
 
 
-def _rate_feasibility(Am: fmpq_mat, r: fmpq, discrete: bool) -> tuple[bool, str]:
+def _rate_feasibility(
+    Am: fmpq_mat, r: fmpq, discrete: bool, Af: np.ndarray | None = None
+) -> tuple[bool, str]:
     n = Am.nrows()
-    X = _lyap_solution(mat_float(Am), float(r), discrete)
+    X = _lyap_solution(mat_float(Am) if Af is None else Af, float(r), discrete)
     if X is not None and np.any(X != 0):
         Xq = _sym(fmat(dyadic_fast(X, INERTIA_BITS)))  # = symmetrize(dyadic(X)), in flint
         if decay_pd(Am, Xq, r, discrete, 0)[0]:
@@ -585,14 +592,21 @@ def mat_float(Am: fmpq_mat) -> np.ndarray:
     return H
 
 
-def rate_feasible(Acl: Any, rate: Any, discrete: bool, memo: ExactMemo | None = None) -> bool:
+def rate_feasible(
+    Acl: Any,
+    rate: Any,
+    discrete: bool,
+    memo: ExactMemo | None = None,
+    Af: np.ndarray | None = None,
+) -> bool:
     """Whether some P ≻ 0 makes :func:`decay_matrix` ≻ 0 at ``rate``, decided exactly
     (:func:`rate_feasibility` without the proof's name): eq. (4)-(6), Section 5 of the
     constrained-redesign paper (Astolfi et al., NOLCOS 2019), for a fixed gain.
 
     :param Acl: A − LC (exact); :param rate: λ or α (exact); :param discrete: time domain;
-    :param memo: verdicts already made in this process."""
-    return rate_feasibility(Acl, rate, discrete, memo)[0]
+    :param memo: verdicts already made in this process; :param Af: :func:`mat_float` of
+    Acl, when already made."""
+    return rate_feasibility(Acl, rate, discrete, memo, Af)[0]
 
 
 def stability_test(discrete: bool) -> str:
@@ -805,6 +819,7 @@ def best_rate(
     forecast: bool = True,
     memo: ExactMemo | None = None,
     Acl: fmpq_mat | None = None,
+    Af: np.ndarray | None = None,
 ) -> RateBracket:
     """Bisection for the best certified rate of V = eᵀPe: the smallest λ (discrete) or the
     largest α (continuous) at which :func:`certified_P` succeeds, bracketed.
@@ -833,13 +848,15 @@ def best_rate(
     :param progress: callback for messages; :param forecast: let the float forecast stand in
     for exact checks (False: an exact check at every midpoint; the rerun uses it);
     :param memo: records the exact verdicts (for ``certify`` in the same process);
-    :param Acl: A − LC as an ``fmpq_mat``, when already made.
+    :param Acl: A − LC as an ``fmpq_mat``, when already made; :param Af: its
+    :func:`mat_float`, when already made.
     Raises :class:`InfeasibleError` when Acl is not Schur / Hurwitz (exact) and
     :class:`InconclusiveError` when it is but nothing certifies."""
     Acl = closed_loop_fmat(A, C, L) if Acl is None else Acl
     tol_q = Q(tol)
     grid = _grid(tol_q)
-    Af = mat_float(Acl)  # correctly rounded, as np.asarray(closed_loop(A, C, L), dtype=float)
+    if Af is None:  # correctly rounded, as np.asarray(closed_loop(A, C, L), dtype=float)
+        Af = mat_float(Acl)
     eig = np.linalg.eigvals(Af)
     floats = (np.asarray(A, dtype=float), np.asarray(C, dtype=float), np.asarray(L, dtype=float))
     guess = _Forecast(Af, discrete, margin) if forecast else None
@@ -866,7 +883,7 @@ def best_rate(
         return exact(r)
 
     def feasible(r: fmpq) -> bool:
-        return rate_feasible(Acl, rate(r), discrete, memo)
+        return rate_feasible(Acl, rate(r), discrete, memo, Af)
 
     bound = float(np.max(np.abs(eig))) if discrete else float(np.max(eig.real))
     lo = _snap(Q(max(bound, 0.0)) if discrete else Q(bound), grid, False)
@@ -929,5 +946,6 @@ def best_rate(
                 forecast=False,
                 memo=memo,
                 Acl=Acl,
+                Af=Af,
             )
     return RateBracket(rate(hi), P, rate(lo), lo_kind, tol_q, checks)

@@ -61,7 +61,8 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
         L = o.L
     memo = lyap.ExactMemo()  # the exact verdicts, reused by certify in this process only
     Acl = lyap.closed_loop_fmat(A, C, L)
-    eig = np.linalg.eigvals(lyap.mat_float(Acl))
+    Af = lyap.mat_float(Acl)  # converted once: the float guide of every step below
+    eig = np.linalg.eigvals(Af)
     params = Parameters({"L": L})
     name = rate_name(s.discrete)
     sym = "λ" if s.discrete else "α"
@@ -78,7 +79,7 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
         # the asked rate first, directly: no search can make it fail
         P = lyap.certified_P(A, C, L, s.discrete, o.rate, o.margin, memo=memo, Acl=Acl)
         if P is None:
-            ok, how = lyap.rate_feasibility(Acl, o.rate, s.discrete, memo)
+            ok, how = lyap.rate_feasibility(Acl, o.rate, s.discrete, memo, Af)
             if not ok:
                 raise InfeasibleError(
                     f"no P ≻ 0 gives decay rate {sym} = {fmt_exact(o.rate)}: A − LC has an "
@@ -94,7 +95,7 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
         known = (o.rate, P)
     elif bound >= 1 - 1e-6 if s.discrete else bound >= -1e-6:
         # (a float bound clearly inside: the certified best rate below proves Schur / Hurwitz)
-        ok, how = lyap.rate_feasibility(Acl, 1 if s.discrete else 0, s.discrete, memo)
+        ok, how = lyap.rate_feasibility(Acl, 1 if s.discrete else 0, s.discrete, memo, Af)
         if not ok:
             raise InfeasibleError(
                 f"A − LC is not {'Schur' if s.discrete else 'Hurwitz'}: {lim} ({how})"
@@ -111,6 +112,7 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
         progress=progress,
         memo=memo,
         Acl=Acl,
+        Af=Af,
     )
     rate, P = (br.best, br.P) if known is None else known
     solver.extra["best_rate_exact_checks"] = br.exact_checks
