@@ -175,7 +175,7 @@ def decay_verdict(
 def pd_verdict(
     P: Any, margin: Any, memo: ExactMemo | None = None, Pm: fmpq_mat | None = None
 ) -> Any:
-    """P − margin·I ≻ 0 exactly (:func:`obsdesign.certify.psd.check_pd_fast`): V = eᵀPe of
+    """P − margin·I ≻ 0 exactly (:func:`pd_int`): V = eᵀPe of
     eq. (4) (constrained-redesign paper) is positive definite; looked up in / recorded into
     ``memo``.
 
@@ -187,10 +187,35 @@ def pd_verdict(
         hit = memo.get(key, (Pm,))
         if hit is not None:
             return hit
-    r = check_pd_fast(Pm, margin)
+    r = pd_int(Pm, margin)
     if memo is not None:
         memo.put(key, (Pm,), r)
     return r
+
+
+def pd_int(Pm: fmpq_mat, margin: Any) -> Any:
+    """P − margin·I ≻ 0 exactly, decided on the integer matrix b·P_z − a·d·I (P = P_z/d,
+    margin a/b; the same matrix times the positive 1/(bd)) by
+    :func:`obsdesign.certify.psd.check_pd_int`: the verdict of
+    :func:`obsdesign.certify.psd.check_pd_fast` without P's rational entries (eq. (4) of the
+    constrained-redesign paper, Astolfi et al., NOLCOS 2019: V = eᵀPe positive definite).
+
+    :param Pm: P (exact); :param margin: δ ≥ 0 (exact)."""
+    from obsdesign.certify.psd import check_pd_int
+
+    Z, D = Pm.numer_denom()
+    return check_pd_int(*_minus_margin(Z, D, margin))[0]
+
+
+def _minus_margin(Z: fmpz_mat, D: Any, margin: Any) -> tuple[fmpz_mat, fmpq]:
+    """(Z', c) with Z/D − margin·I = c·Z' (c > 0): Z' = b·Z − a·D·I for margin a/b."""
+    m = Q(margin)
+    if m != 0:
+        Z = Z * m.q
+        sub = m.p * D
+        for i in range(Z.nrows()):
+            Z[i, i] = Z[i, i] - sub
+    return Z, fmpq(1) / (fmpq(D) * m.q)
 
 
 #: the prime of :func:`observable_mod_p` (2⁶¹ − 1, a Mersenne prime)
@@ -307,13 +332,7 @@ def decay_pd(Acl: Any, P: Any, rate: Any, discrete: bool, margin: Any) -> tuple[
     from obsdesign.certify.psd import check_pd_int
 
     Z, D = decay_int(Acl, P, rate, discrete)
-    m = Q(margin)
-    if m != 0:
-        Z = Z * m.q
-        c = m.p * D
-        for i in range(Z.nrows()):
-            Z[i, i] = Z[i, i] - c
-    return check_pd_int(Z, fmpq(1) / (D * m.q))
+    return check_pd_int(*_minus_margin(Z, D, margin))
 
 
 def decay_matrix(
@@ -567,7 +586,7 @@ def _rate_feasibility(
             # X ⊁ 0 shown by a rational direction first (the float X guides, exact product
             # decides), else the full exact test
             neg = negative_direction(Xq, X) if np.linalg.eigvalsh(X)[0] < 0 else None
-            ok = False if neg is not None else check_pd_fast(Xq).ok
+            ok = False if neg is not None else pd_int(Xq, 0).ok
             return ok, "exact Lyapunov inertia certificate (D(X) ≻ 0, X " + (
                 "≻ 0)" if ok else "⊁ 0)"
             )

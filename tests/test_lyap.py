@@ -390,3 +390,26 @@ def test_decay_pd_agrees_with_exact_ldl(
     assert lyap.fmpq_mat(Z) / D == F
     want = check_pd(M - qeye(n) * margin).ok
     assert lyap.decay_pd(Acl, P, rate, discrete, margin)[0].ok == want
+
+
+@given(
+    n=st.integers(1, 5),
+    seed=st.integers(0, 10**6),
+    t=st.sampled_from([fmpq(-1, 10**9), fmpq(0), fmpq(1, 10**9), fmpq(1, 3)]),
+    margin=st.sampled_from([fmpq(0), fmpq(1, 10**9), fmpq(1, 3)]),
+    symmetric=st.booleans(),
+)
+@settings(max_examples=60, deadline=None)
+def test_pd_int_agrees_with_exact_ldl(n, seed, t, margin, symmetric) -> None:
+    """P − δI ≻ 0 on the integer matrix (pd_int, used for P, P_best and the inertia
+    certificate X) is the exact LDLᵀ verdict; λ_min(P) = t exactly, so t = δ is the boundary
+    (singular, refused); an asymmetric P is refused."""
+    rng = np.random.default_rng(seed)
+    B = qmat([[fmpq(int(v), 3) for v in row] for row in rng.integers(-3, 4, (n + 1, n))])
+    P = B @ B.T + qeye(n + 1) * t  # λ_min(B Bᵀ) = 0 (rank n): λ_min(P) = t
+    if not symmetric:
+        P[0, n] += fmpq(1, 7)
+    want = symmetric and check_pd(P - qeye(n + 1) * margin).ok
+    assert lyap.pd_int(lyap.fmat(P), margin).ok == want
+    if symmetric and t == margin:
+        assert not want

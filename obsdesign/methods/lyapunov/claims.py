@@ -61,8 +61,9 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     A, C = s.A.q, s.C.q
     memo = lyap.memo_of(spec)  # the design's exact verdicts, same process, same inputs only
     Acl = lyap.closed_loop_fmat(A, C, L)
-    pd = lyap.pd_verdict(P, o.margin, memo)
-    dec = decay_check(A, C, L, P, rate, s.discrete, o.margin, memo, Acl)
+    Pm = lyap.fmat(P)  # converted once for both checks
+    pd = lyap.pd_verdict(P, o.margin, memo, Pm)
+    dec = decay_check(A, C, L, P, rate, s.discrete, o.margin, memo, Acl, Pm)
     # the asked rate omitted, (P, λ) is (P_best, λ_best): one exact check serves both claims
     same = rate == best and P.shape == Pb.shape and bool(np.all(P == Pb))
     pd_claim(c, "P-positive-definite", "P ≻ 0", P, o.margin, pd)
@@ -169,15 +170,17 @@ def decay_check(
     margin: Any,
     memo: lyap.ExactMemo | None = None,
     Acl: Any = None,
+    Pm: Any = None,
 ) -> tuple[PSDResult, bool]:
     """The exact verdict on the decay LMI of eq. (4)-(6) (constrained-redesign paper, Astolfi et
     al., NOLCOS 2019), rebuilt from A, C, L, P and the rate, and the float verdict beside it.
 
     :param A, C, L, P: exact matrices; :param rate: λ or α; :param discrete: time domain;
     :param margin: δ; :param memo: the design's verdicts (used for exactly equal inputs only);
-    :param Acl: A − LC as an ``fmpq_mat`` when already made."""
+    :param Acl: A − LC as an ``fmpq_mat`` when already made; :param Pm: P as an
+    ``fmpq_mat`` when already made."""
     Am = lyap.closed_loop_fmat(A, C, L) if Acl is None else Acl
-    return lyap.decay_verdict(Am, P, rate, discrete, margin, memo)  # type: ignore[no-any-return]
+    return lyap.decay_verdict(Am, P, rate, discrete, margin, memo, Pm)  # type: ignore[no-any-return]
 
 
 def bracket_claim(
