@@ -313,6 +313,24 @@ def _gershgorin_certificate(F: Any, Mf: np.ndarray) -> PSDResult | None:
     )
 
 
+def _square_symmetric(F: Any) -> PSDResult | None:
+    """The verdict on a flint matrix that is not symmetric (the first asymmetric pair named)
+    or empty; None for a nonempty symmetric one. ValueError when it is not square."""
+    n = F.nrows()
+    if F.ncols() != n:
+        raise ValueError("expected a square matrix")
+    if F != F.transpose():
+        for i in range(n):
+            for j in range(i + 1, n):
+                if F[i, j] != F[j, i]:
+                    return PSDResult(
+                        False, float("nan"), f"not symmetric at ({i}, {j})", "symmetry"
+                    )
+    if n == 0:
+        return PSDResult(True, float("inf"), "empty matrix", "empty")
+    return None
+
+
 def check_pd_fast(M: Any, margin: Any = 0) -> PSDResult:
     """Exact test of M − margin·I ≻ 0 for a symmetric rational M, fast at n ~ 100.
 
@@ -343,17 +361,9 @@ def check_pd_fast_float(M: Any, margin: Any = 0) -> tuple[PSDResult, np.ndarray 
 
     F = to_fmpq_mat(M)
     n = F.nrows()
-    if F.ncols() != n:
-        raise ValueError("expected a square matrix")
-    if F != F.transpose():
-        for i in range(n):
-            for j in range(i + 1, n):
-                if F[i, j] != F[j, i]:
-                    return PSDResult(
-                        False, float("nan"), f"not symmetric at ({i}, {j})", "symmetry"
-                    ), None
-    if n == 0:
-        return PSDResult(True, float("inf"), "empty matrix", "empty"), None
+    early = _square_symmetric(F)
+    if early is not None:
+        return early, None
     m = Q(margin)
     if m != 0:
         F = F - m * type(F)(n, n, [fmpq(int(i == j)) for i in range(n) for j in range(n)])
@@ -388,17 +398,9 @@ def check_pd_int(Z: Any, scale: Any = 1) -> tuple[PSDResult, np.ndarray | None]:
     if c <= 0:
         raise ValueError("scale must be positive")
     n = Z.nrows()
-    if Z.ncols() != n:
-        raise ValueError("expected a square matrix")
-    if Z != Z.transpose():
-        for i in range(n):
-            for j in range(i + 1, n):
-                if Z[i, j] != Z[j, i]:
-                    return PSDResult(
-                        False, float("nan"), f"not symmetric at ({i}, {j})", "symmetry"
-                    ), None
-    if n == 0:
-        return PSDResult(True, float("inf"), "empty matrix", "empty"), None
+    early = _square_symmetric(Z)
+    if early is not None:
+        return early, None
     H, sh = vchol.int_to_float(Z)
     v = vchol.verified_pd_float(H, fmpq(0))
     if v is not None:
