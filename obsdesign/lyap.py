@@ -149,6 +149,7 @@ def decay_verdict(
     margin: Any,
     memo: ExactMemo | None = None,
     Pm: fmpq_mat | None = None,
+    Af: np.ndarray | None = None,
 ) -> tuple[Any, bool]:
     """The exact verdict on the decay LMI of eq. (4)-(6) (constrained-redesign paper, Astolfi
     et al., NOLCOS 2019) — :func:`decay_fmat` − margin·I ≻ 0 by :func:`decay_pd` (the
@@ -158,14 +159,15 @@ def decay_verdict(
 
     :param Acl: exact A − LC; :param P: symmetric n×n (exact); :param rate: λ or α;
     :param discrete: time domain; :param margin: δ; :param memo: verdicts of this process;
-    :param Pm: ``P`` as an ``fmpq_mat`` when already converted."""
+    :param Pm: ``P`` as an ``fmpq_mat`` when already converted; :param Af: :func:`mat_float`
+    of Acl, when already made."""
     Pm = fmat(P) if Pm is None else Pm
     key = ("decay", Q(rate), Q(margin), discrete)
     if memo is not None:
         hit = memo.get(key, (Acl, Pm))
         if hit is not None:
             return hit
-    r, H = decay_pd(Acl, Pm, rate, discrete, margin)
+    r, H = decay_pd(Acl, Pm, rate, discrete, margin, Af)
     fl = bool(np.linalg.eigvalsh(H).min() > 0) if H is not None and H.size else True
     if memo is not None:
         memo.put(key, (Acl, Pm), (r, fl))
@@ -320,19 +322,69 @@ def decay_fmat(Acl: Any, P: Any, rate: Any, discrete: bool) -> fmpq_mat:
     return fmpq_mat(Z) / D
 
 
-def decay_pd(Acl: Any, P: Any, rate: Any, discrete: bool, margin: Any) -> tuple[Any, Any]:
-    """:func:`decay_fmat` − margin·I ≻ 0, decided exactly on the integer matrix
-    Z·b − a·D·I (margin a/b, decay matrix Z/D from :func:`decay_int`; the same matrix times
-    the positive 1/(bD)) by :func:`obsdesign.certify.psd.check_pd_int`: eq. (4)-(6) of the
+def decay_pd(
+    Acl: Any,
+    P: Any,
+    rate: Any,
+    discrete: bool,
+    margin: Any,
+    Af: np.ndarray | None = None,
+) -> tuple[Any, Any]:
+    """:func:`decay_fmat` − margin·I ≻ 0, decided exactly: eq. (4)-(6) of the
     constrained-redesign paper (Astolfi et al., NOLCOS 2019).
 
-    :param Acl, P, rate, discrete: as in :func:`decay_int`; :param margin: δ ≥ 0 (exact).
-    Returns the verdict and the float matrix it used (a positive multiple of
-    fl(decay − δI)), as :func:`obsdesign.certify.psd.check_pd_fast_float`."""
+    First the float enclosure of :mod:`obsdesign.certify.enclosure` (BLAS products of the
+    correctly rounded A − LC and P with a rigorous error bound e, and a verified Cholesky with
+    the margin raised by e; it can only prove), else the integer matrix Z·b − a·D·I (margin
+    a/b, decay matrix Z/D from :func:`decay_int`; the same matrix times the positive 1/(bD))
+    by :func:`obsdesign.certify.psd.check_pd_int`, which decides either way.
+
+    :param Acl, P, rate, discrete: as in :func:`decay_int`; :param margin: δ ≥ 0 (exact);
+    :param Af: the correctly rounded float copy of Acl (:func:`mat_float`, which is
+    :func:`obsdesign.certify.vchol.to_float` whenever it returns), when already made: the
+    enclosure's error bound assumes it. Returns the verdict and the float matrix beside it (≈ the decay matrix − δI, or a
+    positive multiple of it), as :func:`obsdesign.certify.psd.check_pd_fast_float`."""
     from obsdesign.certify.psd import check_pd_int
 
-    Z, D = decay_int(Acl, P, rate, discrete)
+    Am, Pm = fmat(Acl), fmat(P)
+    hit = _enclosure_pd(Am, Pm, Q(rate), discrete, Q(margin), Af)
+    if hit is not None:
+        return hit
+    Z, D = decay_int(Am, Pm, rate, discrete)
     return check_pd_int(*_minus_margin(Z, D, margin))
+
+
+def _enclosure_pd(
+    Am: fmpq_mat, Pm: fmpq_mat, r: fmpq, discrete: bool, m: fmpq, Af: np.ndarray | None
+) -> tuple[Any, np.ndarray] | None:
+    """The proof of :func:`decay_pd` through the float enclosure, or None (not proved)."""
+    from obsdesign.certify import vchol
+    from obsdesign.certify.enclosure import decay_enclosure
+    from obsdesign.certify.exact import float_or_inf
+    from obsdesign.certify.psd import PSDResult
+
+    if Am.nrows() == 0 or m < 0 or (discrete and r <= 0):
+        return None
+    if Af is None or not np.all(np.isfinite(Af)):
+        Af = vchol.to_float(Am)  # correctly rounded, or None beyond the float range
+    Pf = vchol.to_float(Pm)
+    if Af is None or Pf is None:
+        return None
+    enc = decay_enclosure(Af, Pf, r, discrete)
+    if enc is None:
+        return None
+    H, e = enc
+    v = vchol.verified_pd_float(H, m + e)
+    if v is None:
+        return None
+    n = H.shape[0]
+    detail = (
+        f"float enclosure ‖M − V‖₂ ≤ {float_or_inf(e):.3g} (V the float matrix); verified "
+        f"float Cholesky of V: "
+        f"λ_min(M − δI) ≥ {float_or_inf(v.bound):.3g} > 0 (n = {n})"
+    )
+    Hm = H - float(m) * np.eye(n)
+    return PSDResult(True, float_or_inf(v.bound), detail, "float-enclosure"), Hm
 
 
 def decay_matrix(
@@ -579,10 +631,11 @@ def _rate_feasibility(
     Am: fmpq_mat, r: fmpq, discrete: bool, Af: np.ndarray | None = None
 ) -> tuple[bool, str]:
     n = Am.nrows()
-    X = _lyap_solution(mat_float(Am) if Af is None else Af, float(r), discrete)
+    Af = mat_float(Am) if Af is None else Af
+    X = _lyap_solution(Af, float(r), discrete)
     if X is not None and np.any(X != 0):
         Xq = _sym(fmat(dyadic_fast(X, INERTIA_BITS)))  # = symmetrize(dyadic(X)), in flint
-        if decay_pd(Am, Xq, r, discrete, 0)[0]:
+        if decay_pd(Am, Xq, r, discrete, 0, Af)[0]:
             # X ⊁ 0 shown by a rational direction first (the float X guides, exact product
             # decides), else the full exact test
             neg = negative_direction(Xq, X) if np.linalg.eigvalsh(X)[0] < 0 else None
@@ -698,6 +751,7 @@ def certified_P(
     memo: ExactMemo | None = None,
     Acl: fmpq_mat | None = None,
     floats: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+    Af: np.ndarray | None = None,
 ) -> np.ndarray | None:
     """A rational P (the Lyapunov-equation P rounded to ``bits`` dyadic bits) with
     P − margin·I ≻ 0 and :func:`decay_matrix` − margin·I ≻ 0 exactly, or None.
@@ -710,7 +764,8 @@ def certified_P(
     (exact); :param margin: δ of the strict checks; :param bits: rounding of P;
     :param memo: records the exact verdicts (for ``certify`` in the same process);
     :param Acl: A − LC as an ``fmpq_mat``, when already made; :param floats: A, C, L as
-    float arrays (``np.asarray(x, dtype=float)``), when already made."""
+    float arrays (``np.asarray(x, dtype=float)``), when already made; :param Af:
+    :func:`mat_float` of A − LC, when already made."""
     r = Q(rate)
     if (discrete and r <= 0) or A.shape[0] == 0:
         return None
@@ -722,7 +777,7 @@ def certified_P(
     if not pd_verdict(P, margin, memo, Pm):
         return None
     Am = closed_loop_fmat(A, C, L) if Acl is None else Acl
-    if not decay_verdict(Am, P, r, discrete, margin, memo, Pm)[0]:
+    if not decay_verdict(Am, P, r, discrete, margin, memo, Pm, Af)[0]:
         return None
     return P
 
@@ -894,7 +949,9 @@ def best_rate(
             raise InconclusiveError(
                 f"best-rate search: more than {MAX_EXACT_CHECKS} exact checks without a bracket"
             )
-        return certified_P(A, C, L, discrete, rate(r), margin, memo=memo, Acl=Acl, floats=floats)
+        return certified_P(
+            A, C, L, discrete, rate(r), margin, memo=memo, Acl=Acl, floats=floats, Af=Af
+        )
 
     def cert(r: fmpq) -> Any:
         if guess is not None and guess(rate(r)):

@@ -161,6 +161,10 @@ PATHS = {
     "S = M − RᵀR strictly diagonally dominant (checked over Q)",
     "eigenvector": "exact: a rational v with vᵀMv ≤ 0 (float eigenvector, checked over Q)",
     "fraction-free": "exact: fraction-free LDLᵀ over Z (flint fflu, Sylvester's criterion)",
+    "float-enclosure": "rigorous float enclosure of the decay matrix (BLAS products from "
+    "correctly rounded data with an a priori rounding-error bound e; "
+    "obsdesign.certify.enclosure) and a verified floating-point Cholesky of its midpoint with "
+    "the margin raised by e, the final inequality checked exactly over Q",
     "symmetry": "exact: symmetry of the rational matrix",
     "empty": "empty matrix",
 }

@@ -201,6 +201,15 @@ def verified_pd(F: fmpq_mat, margin: Any = 0, H: np.ndarray | None = None) -> VC
     return verified_pd_float(H, delta)
 
 
+def subnormals_kept() -> bool:
+    """Whether numpy's arithmetic keeps subnormal numbers in this process (no flush-to-zero
+    or denormals-are-zero mode, which a library built with fast-math can switch on for the
+    whole process): the underflow terms η of the theorem assume gradual underflow. When it
+    does not, the float proofs say "unknown" and the exact tests decide."""
+    tiny = np.array([2.0**-1074, 2.0**-1060])
+    return bool(np.all((tiny * 1.0) == tiny) and (tiny[1] * 0.5) > 0.0)
+
+
 def verified_pd_float(H: np.ndarray, delta: fmpq) -> VCholResult | None:
     """Steps 2-4 of the theorem: a proof that M − δI ≻ 0 from H, or None (unknown).
 
@@ -211,7 +220,7 @@ def verified_pd_float(H: np.ndarray, delta: fmpq) -> VCholResult | None:
 
     :param H: the float matrix; :param delta: δ ≥ 0 (exact)."""
     n = H.shape[0]
-    if n == 0 or not np.all(np.isfinite(H)):
+    if n == 0 or not np.all(np.isfinite(H)) or not subnormals_kept():
         return None
     top = float(np.max(np.abs(H)))
     if top == 0.0 or not -500 <= math.frexp(top)[1] <= 500:

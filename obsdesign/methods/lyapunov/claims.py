@@ -61,9 +61,10 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     A, C = s.A.q, s.C.q
     memo = lyap.memo_of(spec)  # the design's exact verdicts, same process, same inputs only
     Acl = lyap.closed_loop_fmat(A, C, L)
+    Af = lyap.mat_float(Acl)  # correctly rounded, once: the enclosures and the bracket's proof
     Pm = lyap.fmat(P)  # converted once for both checks
     pd = lyap.pd_verdict(P, o.margin, memo, Pm)
-    dec = decay_check(A, C, L, P, rate, s.discrete, o.margin, memo, Acl, Pm)
+    dec = decay_check(A, C, L, P, rate, s.discrete, o.margin, memo, Acl, Pm, Af)
     # the asked rate omitted, (P, λ) is (P_best, λ_best): one exact check serves both claims
     same = rate == best and P.shape == Pb.shape and bool(np.all(P == Pb))
     pd_claim(c, "P-positive-definite", "P ≻ 0", P, o.margin, pd)
@@ -76,10 +77,12 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         o.margin,
         pd if same else lyap.pd_verdict(Pb, o.margin, memo),
     )
-    dec_b = dec if same else decay_check(A, C, L, Pb, best, s.discrete, o.margin, memo, Acl)
+    dec_b = (
+        dec if same else decay_check(A, C, L, Pb, best, s.discrete, o.margin, memo, Acl, None, Af)
+    )
     decay_claim(c, dec_b, best, s.discrete, o.margin, "_best")
     kind = str(params[f"{name}_bracket_kind"])
-    bracket_claim(c, A, C, L, best, other, kind, s.discrete, o, memo, Acl)
+    bracket_claim(c, A, C, L, best, other, kind, s.discrete, o, memo, Acl, Af)
     if o.iss_gain:
         iss_claim(c, A, C, L, s.Bd.q, s.Dn.q, P, rate, mu, s.discrete)
     return list(c)
@@ -171,6 +174,7 @@ def decay_check(
     memo: lyap.ExactMemo | None = None,
     Acl: Any = None,
     Pm: Any = None,
+    Af: Any = None,
 ) -> tuple[PSDResult, bool]:
     """The exact verdict on the decay LMI of eq. (4)-(6) (constrained-redesign paper, Astolfi et
     al., NOLCOS 2019), rebuilt from A, C, L, P and the rate, and the float verdict beside it.
@@ -178,9 +182,10 @@ def decay_check(
     :param A, C, L, P: exact matrices; :param rate: λ or α; :param discrete: time domain;
     :param margin: δ; :param memo: the design's verdicts (used for exactly equal inputs only);
     :param Acl: A − LC as an ``fmpq_mat`` when already made; :param Pm: P as an
-    ``fmpq_mat`` when already made."""
+    ``fmpq_mat`` when already made; :param Af: :func:`obsdesign.lyap.mat_float` of A − LC
+    when already made."""
     Am = lyap.closed_loop_fmat(A, C, L) if Acl is None else Acl
-    return lyap.decay_verdict(Am, P, rate, discrete, margin, memo, Pm)  # type: ignore[no-any-return]
+    return lyap.decay_verdict(Am, P, rate, discrete, margin, memo, Pm, Af)  # type: ignore[no-any-return]
 
 
 def bracket_claim(
@@ -195,6 +200,7 @@ def bracket_claim(
     o: Options,
     memo: lyap.ExactMemo | None = None,
     Acl: Any = None,
+    Af: Any = None,
 ) -> Claim:
     """The best rate is best to within ``rate_tol``: the other end of its bracket lies within
     the tolerance, beyond it (λ_bracket < λ_best, α_bracket > α_best), not beyond a rate the
@@ -208,7 +214,8 @@ def bracket_claim(
     certified best rate; :param other: the bracket's other end; :param kind: its kind;
     :param discrete: time domain; :param o: the spec's options (rate_tol, asked rate);
     :param memo: the design's verdicts (used for exactly equal inputs only); :param Acl: A − LC
-    as an ``fmpq_mat`` when already made."""
+    as an ``fmpq_mat`` when already made; :param Af: its :func:`obsdesign.lyap.mat_float`,
+    when already made."""
     sym, name = ("λ", "lambda") if discrete else ("α", "alpha")
     best, other, tol = Q(best), Q(other), Q(o.rate_tol)
     width = best - other if discrete else other - best
@@ -222,7 +229,7 @@ def bracket_claim(
             f"{sym}_best = {fmt_exact(best)} is worse than the asked {fmt_exact(o.rate)}"
         )
     Am = lyap.closed_loop_fmat(A, C, L) if Acl is None else Acl
-    feasible, how = lyap.rate_feasibility(Am, other, discrete, memo)
+    feasible, how = lyap.rate_feasibility(Am, other, discrete, memo, Af)
     if kind == lyap.INFEASIBLE:
         if feasible:
             problems.append(f"{sym} = {fmt_exact(other)} is feasible ({how})")
