@@ -8,7 +8,10 @@ exactly) + ``api.verify`` (every claim recomputed from the report). Float baseli
 ``solve_discrete_are`` gain, one ``solve_discrete_lyapunov`` at the rate ρ(A − LC) + 10⁻⁴ and
 numpy eigenvalue checks of P and of the decay matrix.
 
-Beside the total, ``exact`` is the method's own exact recheck (``api.certify`` on a freshly
+``d/fl`` (information, no target) is the design alone — Riccati gain, Lyapunov P, best rate
+with its bracket, every claim certified exactly — over the same float baseline: the float
+script's own counterpart; ``ratio`` adds the independent ``verify``. Beside the total,
+``exact`` is the method's own exact recheck (``api.certify`` on a freshly
 loaded spec: P ≻ 0, the decay LMI and the bracket end, as ``verify`` runs them) and ``io`` what
 ``verify`` spends outside the method (re-reading the embedded spec, the report's JSON round
 trip with every exact parameter string parsed): the part of the ratio that the method's code
@@ -113,7 +116,8 @@ def worker() -> None:
     float_baseline(A, C)  # warm the imports
     print(
         f"{'n':>4s} {'design+verify':>14s} {'(design':>8s} {'verify)':>8s} "
-        f"{'float':>8s} {'ratio':>7s} {'checks':>6s} {'exact':>7s} {'io':>7s}   targets"
+        f"{'float':>8s} {'ratio':>7s} {'d/fl':>6s} {'checks':>6s} {'exact':>7s} {'io':>7s}"
+        "   targets"
     )
     for n in SIZES:
         A, C = system(n)
@@ -131,8 +135,8 @@ def worker() -> None:
             want.append(f"< {TARGETS[n]:g} s {'ok' if tot < TARGETS[n] else 'MISSED'}")
         want.append(f"<= {RATIO:g}x float {'ok' if ratio <= RATIO else 'MISSED'}")
         print(
-            f"{n:4d} {tot:12.3f} s {d:8.3f} {v:8.3f} {fl * 1e3:6.1f}ms {ratio:6.1f}x {k:6d} "
-            f"{ex:7.3f} {io:7.3f}   " + "; ".join(want),
+            f"{n:4d} {tot:12.3f} s {d:8.3f} {v:8.3f} {fl * 1e3:6.1f}ms {ratio:6.1f}x "
+            f"{d / fl:5.1f}x {k:6d} {ex:7.3f} {io:7.3f}   " + "; ".join(want),
             flush=True,
         )
 

@@ -94,6 +94,41 @@ def dyadic_fast(x: Any, bits: int) -> np.ndarray:
     return np.array(out, dtype=object).reshape(arr.shape)
 
 
+def dyadic_fmat(x: Any, bits: int) -> tuple[fmpq_mat, np.ndarray]:
+    """:func:`dyadic_fast` of a float matrix as an ``fmpq_mat`` — the same values (each float
+    rounded half-to-even to ``bits`` ≤ 53 significant bits) — and their float copy, built
+    from one integer matrix over a common power of two (no per-entry rational): the rounded
+    P, X and L of eq. (4)-(6) (constrained-redesign paper, Section 5) at n = 100.
+
+    The float copy holds the rounded values themselves (``bits`` ≤ 53: exact in the normal
+    range; ``ldexp`` rounds correctly below it), i.e. the correctly rounded copy that
+    :mod:`obsdesign.certify.enclosure` needs.
+
+    :param x: finite float matrix; :param bits: significant bits."""
+    arr = np.asarray(x, dtype=float)
+    if arr.ndim != 2 or not np.all(np.isfinite(arr)):
+        raise ValueError("cannot round a non-finite number (or not a matrix)")
+    r, c = arr.shape
+    m, e = np.frexp(arr)
+    num = np.rint(np.ldexp(m, bits)).astype(np.int64)  # |num| ≤ 2^bits, exact scaling
+    k = (bits - e).astype(np.int64)  # value = num · 2^-k
+    flo = np.ldexp(num.astype(float), -k)
+    nz = num != 0
+    if not nz.any():
+        return fmpq_mat(r, c), flo
+    K = max(int(k[nz].max()), 0)
+    sh = K - k  # ≥ 0 on the nonzero entries: value · 2^K = num · 2^sh
+    if int(sh[nz].max()) <= 62 - bits:
+        ints = np.where(nz, np.left_shift(num, np.where(nz, sh, 0)), 0).ravel().tolist()
+    else:
+        ints = [
+            a << b if a else 0
+            for a, b in zip(num.ravel().tolist(), sh.ravel().tolist(), strict=True)
+        ]
+    F = fmpq_mat(fmpz_mat(r, c, ints))
+    return (F / fmpz(2) ** K if K else F), flo
+
+
 class ExactMemo:
     """Exact verdicts the design made, for ``certify`` within the same process: a verdict is
     returned only for exactly the same inputs (the matrices are compared exactly, entry by
@@ -150,6 +185,7 @@ def decay_verdict(
     memo: ExactMemo | None = None,
     Pm: fmpq_mat | None = None,
     Af: np.ndarray | None = None,
+    Pf: np.ndarray | None = None,
 ) -> tuple[Any, bool]:
     """The exact verdict on the decay LMI of eq. (4)-(6) (constrained-redesign paper, Astolfi
     et al., NOLCOS 2019) — :func:`decay_fmat` − margin·I ≻ 0 by :func:`decay_pd` (the
@@ -160,14 +196,15 @@ def decay_verdict(
     :param Acl: exact A − LC; :param P: symmetric n×n (exact); :param rate: λ or α;
     :param discrete: time domain; :param margin: δ; :param memo: verdicts of this process;
     :param Pm: ``P`` as an ``fmpq_mat`` when already converted; :param Af: :func:`mat_float`
-    of Acl, when already made."""
+    of Acl, when already made; :param Pf: the correctly rounded float copy of P, when
+    already made."""
     Pm = fmat(P) if Pm is None else Pm
     key = ("decay", Q(rate), Q(margin), discrete)
     if memo is not None:
         hit = memo.get(key, (Acl, Pm))
         if hit is not None:
             return hit
-    r, H = decay_pd(Acl, Pm, rate, discrete, margin, Af)
+    r, H = decay_pd(Acl, Pm, rate, discrete, margin, Af, Pf)
     fl = bool(np.linalg.eigvalsh(H).min() > 0) if H is not None and H.size else True
     if memo is not None:
         memo.put(key, (Acl, Pm), (r, fl))
@@ -329,6 +366,7 @@ def decay_pd(
     discrete: bool,
     margin: Any,
     Af: np.ndarray | None = None,
+    Pf: np.ndarray | None = None,
 ) -> tuple[Any, Any]:
     """:func:`decay_fmat` − margin·I ≻ 0, decided exactly: eq. (4)-(6) of the
     constrained-redesign paper (Astolfi et al., NOLCOS 2019).
@@ -342,12 +380,13 @@ def decay_pd(
     :param Acl, P, rate, discrete: as in :func:`decay_int`; :param margin: δ ≥ 0 (exact);
     :param Af: the correctly rounded float copy of Acl (:func:`mat_float`, which is
     :func:`obsdesign.certify.vchol.to_float` whenever it returns), when already made: the
-    enclosure's error bound assumes it. Returns the verdict and the float matrix beside it (≈ the decay matrix − δI, or a
+    enclosure's error bound assumes it; :param Pf: the same for P (e.g. from
+    :func:`dyadic_fmat`). Returns the verdict and the float matrix beside it (≈ the decay matrix − δI, or a
     positive multiple of it), as :func:`obsdesign.certify.psd.check_pd_fast_float`."""
     from obsdesign.certify.psd import check_pd_int
 
     Am, Pm = fmat(Acl), fmat(P)
-    hit = _enclosure_pd(Am, Pm, Q(rate), discrete, Q(margin), Af)
+    hit = _enclosure_pd(Am, Pm, Q(rate), discrete, Q(margin), Af, Pf)
     if hit is not None:
         return hit
     Z, D = decay_int(Am, Pm, rate, discrete)
@@ -355,7 +394,13 @@ def decay_pd(
 
 
 def _enclosure_pd(
-    Am: fmpq_mat, Pm: fmpq_mat, r: fmpq, discrete: bool, m: fmpq, Af: np.ndarray | None
+    Am: fmpq_mat,
+    Pm: fmpq_mat,
+    r: fmpq,
+    discrete: bool,
+    m: fmpq,
+    Af: np.ndarray | None,
+    Pf: np.ndarray | None = None,
 ) -> tuple[Any, np.ndarray] | None:
     """The proof of :func:`decay_pd` through the float enclosure, or None (not proved)."""
     from obsdesign.certify import vchol
@@ -367,7 +412,8 @@ def _enclosure_pd(
         return None
     if Af is None or not np.all(np.isfinite(Af)):
         Af = vchol.to_float(Am)  # correctly rounded, or None beyond the float range
-    Pf = vchol.to_float(Pm)
+    if Pf is None or Pf.shape != (Pm.nrows(), Pm.ncols()) or not np.all(np.isfinite(Pf)):
+        Pf = vchol.to_float(Pm)
     if Af is None or Pf is None:
         return None
     enc = decay_enclosure(Af, Pf, r, discrete)
@@ -634,8 +680,10 @@ def _rate_feasibility(
     Af = mat_float(Am) if Af is None else Af
     X = _lyap_solution(Af, float(r), discrete)
     if X is not None and np.any(X != 0):
-        Xq = _sym(fmat(dyadic_fast(X, INERTIA_BITS)))  # = symmetrize(dyadic(X)), in flint
-        if decay_pd(Am, Xq, r, discrete, 0, Af)[0]:
+        Xq, Xq_f = dyadic_fmat(X, INERTIA_BITS)  # = dyadic(X), in flint, and its float copy
+        if Xq != Xq.transpose():  # (X is symmetric: never)
+            Xq, Xq_f = _sym(Xq), None
+        if decay_pd(Am, Xq, r, discrete, 0, Af, Xq_f)[0]:
             # X ⊁ 0 shown by a rational direction first (the float X guides, exact product
             # decides), else the full exact test
             neg = negative_direction(Xq, X) if np.linalg.eigvalsh(X)[0] < 0 else None
@@ -772,12 +820,14 @@ def certified_P(
     Pf = _float_P(A, C, L, discrete, r, floats)
     if Pf is None:
         return None
-    Pm = _sym(fmat(dyadic_fast(Pf, bits)))  # = symmetrize(dyadic(Pf, bits)), in flint
+    Pm, Pq_f = dyadic_fmat(Pf, bits)  # = dyadic(Pf, bits), in flint, and its float copy
+    if Pm != Pm.transpose():  # (Pf is symmetric: never, but the checks need a symmetric P)
+        Pm, Pq_f = _sym(Pm), None
     P = as_array(Pm)
     if not pd_verdict(P, margin, memo, Pm):
         return None
     Am = closed_loop_fmat(A, C, L) if Acl is None else Acl
-    if not decay_verdict(Am, P, r, discrete, margin, memo, Pm, Af)[0]:
+    if not decay_verdict(Am, P, r, discrete, margin, memo, Pm, Af, Pq_f)[0]:
         return None
     return P
 

@@ -53,14 +53,16 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
         "L given; P from one Lyapunov equation per rate, checked exactly",
         extra={"gain_design": "given"},
     )
+    Lm = None  # the designed gain as an fmpq_mat
     if o.L is None:
         Lf, solver, how = design_gain(spec, o, progress)
-        L = lyap.dyadic_fast(Lf, lyap.BITS)  # = dyadic(Lf, BITS), vectorized
+        Lm, _ = lyap.dyadic_fmat(Lf, lyap.BITS)  # = dyadic(Lf, BITS), in flint
+        L = lyap.as_array(Lm)
         notes.append(f"L designed by {how}; certified with L rounded to {lyap.BITS} bits")
     else:
         L = o.L
     memo = lyap.ExactMemo()  # the exact verdicts, reused by certify in this process only
-    Acl = lyap.closed_loop_fmat(A, C, L)
+    Acl = lyap.closed_loop_fmat(A, C, L if Lm is None else Lm)
     Af = lyap.mat_float(Acl)  # converted once: the float guide of every step below
     eig = np.linalg.eigvals(Af)
     params = Parameters({"L": L})
