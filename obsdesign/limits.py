@@ -317,6 +317,10 @@ def data_problem(data: Any, exact_strings: bool = False) -> tuple[str, str] | No
                     not exact_strings or (len(x) <= short and "e" not in x and "E" not in x)
                 ):
                     continue  # number_text_problem's own first test, inline
+                if t is Decimal:
+                    text = str(x)  # decimal_problem's own first test, inline
+                    if "E" not in text and len(text) <= short:
+                        continue
                 if t is list or t is dict or isinstance(x, (list, dict)):
                     stack.append(((node, i, False), x, depth + 1))
                     continue

@@ -178,7 +178,11 @@ class Parameters:
 
 def _copy_rows(x: Any) -> Any:
     """A copy of nested lists (the leaves shared: numbers and strings are immutable)."""
-    return [_copy_rows(r) for r in x] if isinstance(x, list) else x
+    if not isinstance(x, list):
+        return x
+    if any(isinstance(v, list) for v in x):
+        return [_copy_rows(v) for v in x]
+    return x[:]  # a row of leaves: one C-level copy
 
 
 def _numeric_list(v: Any) -> bool:

@@ -171,6 +171,8 @@ class Table:
         return Value.of(q)
 
     def _number(self, k: str, v: Any) -> fmpq:
+        if type(v) is Decimal and self.checked and v.is_finite():
+            return fmpq(*v.as_integer_ratio())  # the common case, as below without the tests
         if not _is_number(v):
             raise self.error(k, f"expected a number, got {_tname(v)}")
         if isinstance(v, Decimal) and not v.is_finite():
