@@ -212,24 +212,50 @@ def decay_verdict(
 
 
 def pd_verdict(
-    P: Any, margin: Any, memo: ExactMemo | None = None, Pm: fmpq_mat | None = None
+    P: Any,
+    margin: Any,
+    memo: ExactMemo | None = None,
+    Pm: fmpq_mat | None = None,
+    Pf: np.ndarray | None = None,
 ) -> Any:
-    """P − margin·I ≻ 0 exactly (:func:`pd_int`): V = eᵀPe of
-    eq. (4) (constrained-redesign paper) is positive definite; looked up in / recorded into
-    ``memo``.
+    """P − margin·I ≻ 0 exactly: V = eᵀPe of eq. (4) (constrained-redesign paper) is positive
+    definite; looked up in / recorded into ``memo``. With the correctly rounded float copy
+    ``Pf`` (e.g. :func:`dyadic_fmat`'s, the values themselves), the verified Cholesky of
+    :mod:`obsdesign.certify.vchol` runs on it first (step 1 of its theorem is what correct
+    rounding gives); otherwise, and whenever that does not prove, :func:`pd_int` decides.
 
     :param P: symmetric matrix; :param margin: δ; :param memo: verdicts of this process;
-    :param Pm: ``P`` as an ``fmpq_mat`` when already converted."""
+    :param Pm: ``P`` as an ``fmpq_mat`` when already converted; :param Pf: its correctly
+    rounded float copy, when already made."""
     Pm = fmat(P) if Pm is None else Pm
     key = ("pd", Q(margin))
     if memo is not None:
         hit = memo.get(key, (Pm,))
         if hit is not None:
             return hit
-    r = pd_int(Pm, margin)
+    r = _pd_float(Pm, Q(margin), Pf) if Pf is not None else None
+    if r is None:
+        r = pd_int(Pm, margin)
     if memo is not None:
         memo.put(key, (Pm,), r)
     return r
+
+
+def _pd_float(Pm: fmpq_mat, m: fmpq, Pf: np.ndarray) -> Any:
+    """The proof of :func:`pd_verdict` by the verified Cholesky of the float copy, or None."""
+    from obsdesign.certify import vchol
+    from obsdesign.certify.exact import float_or_inf
+    from obsdesign.certify.psd import PSDResult
+
+    n = Pm.nrows()
+    if m < 0 or n == 0 or Pf.shape != (n, n) or Pm != Pm.transpose():
+        return None
+    if not (np.all(np.isfinite(Pf)) and np.array_equal(Pf, Pf.T)):
+        return None
+    v = vchol.verified_pd_float(Pf, m)
+    if v is None:
+        return None
+    return PSDResult(True, float_or_inf(v.bound), v.detail, "verified-float")
 
 
 def pd_int(Pm: fmpq_mat, margin: Any) -> Any:
@@ -824,7 +850,7 @@ def certified_P(
     if Pm != Pm.transpose():  # (Pf is symmetric: never, but the checks need a symmetric P)
         Pm, Pq_f = _sym(Pm), None
     P = as_array(Pm)
-    if not pd_verdict(P, margin, memo, Pm):
+    if not pd_verdict(P, margin, memo, Pm, Pq_f):
         return None
     Am = closed_loop_fmat(A, C, L) if Acl is None else Acl
     if not decay_verdict(Am, P, r, discrete, margin, memo, Pm, Af, Pq_f)[0]:

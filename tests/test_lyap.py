@@ -436,3 +436,28 @@ def test_dyadic_fmat_is_dyadic_fast_in_flint(r, c, seed, bits, spread) -> None:
     assert F == lyap.fmat(lyap.dyadic_fast(x, bits))
     H = vchol.to_float(F)
     assert H is not None and (H == fl).all()
+
+
+@pytest.mark.parametrize("n", [3, 40])
+def test_pd_verdict_float_copy_at_the_exact_minimum(n: int) -> None:
+    """With P's exact float copy (dyadic P), the verified Cholesky runs first: λ_min(P) = t
+    exactly; δ = t and δ = t + 10⁻²⁰ are refused (the exact path decides), δ = t − 10⁻⁶ is
+    proved on the float copy; a copy that is not symmetric is not used."""
+    from obsdesign.certify import vchol
+
+    rng = np.random.default_rng(n)
+    B = qmat([[fmpq(int(v), 4) for v in row] for row in rng.integers(-3, 4, (n, n - 1))])
+    t = fmpq(1, 2)
+    P = B @ B.T + qeye(n) * t
+    Pm = lyap.fmat(P)
+    Pf = vchol.to_float(Pm)
+    assert lyap.dyadic_fmat(Pf, 53)[0] == Pm  # the copy is exact
+    for m in (t, t + fmpq(1, 10**20)):
+        r = lyap.pd_verdict(P, m, None, Pm, Pf)
+        assert not r.ok and r.path != "verified-float"
+    r = lyap.pd_verdict(P, t - fmpq(1, 10**6), None, Pm, Pf)
+    assert r.ok and r.path == "verified-float"
+    bad = Pf.copy()
+    bad[0, 1] += 1.0
+    assert lyap._pd_float(Pm, t - fmpq(1, 10**6), bad) is None
+    assert lyap.pd_verdict(P, t - fmpq(1, 10**6), None, Pm, bad).ok  # decided exactly

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from obsdesign import lyap
+from obsdesign.certify import vchol
 from obsdesign.certify.claim import Claim, Claims
 from obsdesign.certify.exact import Q
 from obsdesign.certify.printing import fmt_exact, fmt_up
@@ -61,10 +62,13 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     A, C = s.A.q, s.C.q
     memo = lyap.memo_of(spec)  # the design's exact verdicts, same process, same inputs only
     Acl = lyap.closed_loop_fmat(A, C, L)
-    Af = lyap.mat_float(Acl)  # correctly rounded, once: the enclosures and the bracket's proof
-    Pm = lyap.fmat(P)  # converted once for both checks
-    pd = lyap.pd_verdict(P, o.margin, memo, Pm)
-    dec = decay_check(A, C, L, P, rate, s.discrete, o.margin, memo, Acl, Pm, Af)
+    # correctly rounded, once, for the enclosures and the bracket's proof (left to them
+    # when the design's verdicts are at hand: the memo then answers without it)
+    Af = lyap.mat_float(Acl) if memo is None else None
+    Pm = lyap.fmat(P)  # converted once for both checks, with its correctly rounded copy
+    Pf = None if memo is not None else vchol.to_float(Pm)
+    pd = lyap.pd_verdict(P, o.margin, memo, Pm, Pf)
+    dec = decay_check(A, C, L, P, rate, s.discrete, o.margin, memo, Acl, Pm, Af, Pf)
     # the asked rate omitted, (P, λ) is (P_best, λ_best): one exact check serves both claims
     same = rate == best and P.shape == Pb.shape and bool(np.all(P == Pb))
     pd_claim(c, "P-positive-definite", "P ≻ 0", P, o.margin, pd)
@@ -175,6 +179,7 @@ def decay_check(
     Acl: Any = None,
     Pm: Any = None,
     Af: Any = None,
+    Pf: Any = None,
 ) -> tuple[PSDResult, bool]:
     """The exact verdict on the decay LMI of eq. (4)-(6) (constrained-redesign paper, Astolfi et
     al., NOLCOS 2019), rebuilt from A, C, L, P and the rate, and the float verdict beside it.
@@ -183,9 +188,9 @@ def decay_check(
     :param margin: δ; :param memo: the design's verdicts (used for exactly equal inputs only);
     :param Acl: A − LC as an ``fmpq_mat`` when already made; :param Pm: P as an
     ``fmpq_mat`` when already made; :param Af: :func:`obsdesign.lyap.mat_float` of A − LC
-    when already made."""
+    when already made; :param Pf: the correctly rounded float copy of P, when already made."""
     Am = lyap.closed_loop_fmat(A, C, L) if Acl is None else Acl
-    return lyap.decay_verdict(Am, P, rate, discrete, margin, memo, Pm, Af)  # type: ignore[no-any-return]
+    return lyap.decay_verdict(Am, P, rate, discrete, margin, memo, Pm, Af, Pf)  # type: ignore[no-any-return]
 
 
 def bracket_claim(
