@@ -171,7 +171,8 @@ def design(
     never the spec itself, a symbolic link, a non-regular or a write-protected file unless
     ``force``). The report is written whatever the verdict, so ``out`` never keeps a stale
     report: its ``verdict`` says ``ok``, ``failed`` or ``inconclusive``; a design that stops
-    with an error (exit 1, 3 or 4 raised before any claim) writes a report with
+    with an error (exit 1, 3 or 4 raised while designing, certifying or writing the report)
+    writes a report with
     ``"verdict": "error"`` and the error, which ``verify`` reports as such. Bad input (exit 2)
     writes nothing and leaves ``out`` untouched."""
     if out is not None:
@@ -181,20 +182,10 @@ def design(
     t1 = time.perf_counter()
     m = get_method(sp.method)
     notes: list[str] = []
-    try:
-        with captured_warnings(notes):
-            d = m.design(sp, progress)
-    except ObsdesignError as e:
-        if out is not None and e.exit_code != EXIT_BAD_INPUT:
-            _write_error_report(sp, out, e.exit_code, e.message, force)
-        raise
-    except Exception as e:
-        if out is not None:
-            msg = f"internal failure: {type(e).__name__}: {e}"
-            _write_error_report(sp, out, EXIT_SOLVER, msg, force)
-        raise
+    with _error_report_on_failure(sp, out, force), captured_warnings(notes):
+        d = m.design(sp, progress)
     t2 = time.perf_counter()
-    with captured_warnings(notes):
+    with _error_report_on_failure(sp, out, force), captured_warnings(notes):
         claims = certify(sp, d.parameters)
     t3 = time.perf_counter()
     notes = [*getattr(sp, "warnings", []), *notes]
@@ -215,13 +206,29 @@ def design(
     )
     report.verdict = report.computed_verdict()
     if out is not None:
-        try:
+        with _error_report_on_failure(sp, out, force):  # e.g. a value beyond the float range
             text = report.to_json()
-        except ObsdesignError as e:  # a value beyond the float range (Report.to_dict)
-            _write_error_report(sp, out, e.exit_code, e.message, force)
-            raise
         write_atomic(out, text, force)
     return report
+
+
+@contextmanager
+def _error_report_on_failure(sp: Spec, out: str | Path | None, force: bool) -> Iterator[None]:
+    """Write the error report (``"verdict": "error"``) to ``out`` when the block raises: an
+    :class:`ObsdesignError` other than bad input (exit 2 writes nothing), or any other
+    exception as an internal failure (exit 3); then re-raise. ``out`` never keeps a stale
+    report of an earlier run."""
+    try:
+        yield
+    except ObsdesignError as e:
+        if out is not None and e.exit_code != EXIT_BAD_INPUT:
+            _write_error_report(sp, out, e.exit_code, e.message, force)
+        raise
+    except Exception as e:
+        if out is not None:
+            msg = f"internal failure: {type(e).__name__}: {e}"
+            _write_error_report(sp, out, EXIT_SOLVER, msg, force)
+        raise
 
 
 def _write_error_report(sp: Spec, out: str | Path, code: int, message: str, force: bool) -> None:

@@ -129,6 +129,55 @@ def test_failed_design_replaces_stale_report(spec: Path, tmp_path: Path):
     assert json.loads(out.read_text())["verdict"] in ("error", "failed", "inconclusive")
 
 
+@pytest.mark.parametrize(
+    ("exc", "code"),
+    [("inconclusive", 4), ("overflow", 4), ("internal", 3)],
+)
+def test_error_while_certifying_replaces_stale_report(
+    spec: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, exc: str, code: int
+):
+    """An error raised by the certify step (after the design returned) writes the error
+    report too, never leaving an earlier run's report at -o (found by the spec fuzzer:
+    search-space alpha = 1e-320 overflowed in certify, exit 4, and the old report stayed)."""
+    from obsdesign import api
+    from obsdesign.errors import InconclusiveError
+
+    out = tmp_path / "r.json"
+    assert runner.invoke(app, ["design", str(spec), "-o", str(out)]).exit_code == 0
+
+    def boom(*a, **k):
+        if exc == "inconclusive":
+            raise InconclusiveError("certify could not decide")
+        if exc == "overflow":
+            raise OverflowError("integer division result too large for a float")
+        raise RuntimeError("bug")
+
+    monkeypatch.setattr(api, "certify", boom)
+    res = runner.invoke(app, ["design", str(spec), "-o", str(out)])
+    assert res.exit_code == code, res.output
+    d = json.loads(out.read_text())
+    assert d["verdict"] == "error" and d["error"]["exit_code"] == code
+    monkeypatch.undo()
+    assert runner.invoke(app, ["verify", str(out)]).exit_code == code
+
+
+def test_overflow_in_certify_of_a_fuzzed_spec_writes_the_error_report(tmp_path: Path):
+    """The fuzzer's case itself: search-space with alpha = 1e-320."""
+    text = (
+        Path(__file__).resolve().parents[1] / "specs" / "hernandez-garcia-example.toml"
+    ).read_text()
+    assert "alpha = " in text
+    import re
+
+    bad = tmp_path / "s.toml"
+    bad.write_text(re.sub(r"(?m)^alpha = .*$", "alpha = 1e-320", text))
+    out = tmp_path / "r.json"
+    res = runner.invoke(app, ["design", str(bad), "-o", str(out)])
+    assert res.exit_code == 4, res.output
+    assert json.loads(out.read_text())["verdict"] == "error"
+    assert runner.invoke(app, ["verify", str(out)]).exit_code == 4
+
+
 def test_bad_input_leaves_output_untouched(spec: Path, tmp_path: Path):
     out = tmp_path / "r.json"
     out.write_text("old")
