@@ -1023,7 +1023,9 @@ def best_rate(
         checks += 1
         if checks > MAX_EXACT_CHECKS:
             raise InconclusiveError(
-                f"best-rate search: more than {MAX_EXACT_CHECKS} exact checks without a bracket"
+                f"best-rate search: more than {MAX_EXACT_CHECKS} exact checks without a bracket "
+                f"of width rate_tol = {float(tol_q):.3g} (a width near or below the float "
+                "resolution of the rate, ~1e-16, cannot be reached: raise rate_tol)"
             )
         return certified_P(
             A, C, L, discrete, rate(r), margin, memo=memo, Acl=Acl, floats=floats, Af=Af
@@ -1039,8 +1041,16 @@ def best_rate(
 
     bound = float(np.max(np.abs(eig))) if discrete else float(np.max(eig.real))
     lo = _snap(Q(max(bound, 0.0)) if discrete else Q(bound), grid, False)
-    while feasible(lo):  # float error put the spectral bound above a feasible grid point
-        lo -= grid
+    # float error put the spectral bound above a feasible grid point. That error is about
+    # u·ρ for a simple eigenvalue but u^(1/k) for a k-fold one (a triple pole at 0.5: 3·10⁻⁶),
+    # i.e. any number of grid steps when rate_tol is small (10³⁰⁶ of them at rate_tol =
+    # 1e-320, found by the spec fuzzer; one exact test each). Step down from the float
+    # resolution at the bound, doubling: O(log) tests, lo stays on the grid, λ stays ≥ 0
+    # (λ = 0 is never feasible); the bisection below then narrows the wider bracket.
+    step = max(grid, _snap(max(abs(lo), fmpq(1)) / 2**52, grid, True))
+    while feasible(lo):
+        lo = max(lo - step, fmpq(0)) if discrete else lo - step
+        step *= 2
     lo_kind = INFEASIBLE
     edge = fmpq(1) if discrete else fmpq(0)  # r must stay below it
     if lo >= edge:

@@ -461,3 +461,43 @@ def test_pd_verdict_float_copy_at_the_exact_minimum(n: int) -> None:
     bad[0, 1] += 1.0
     assert lyap._pd_float(Pm, t - fmpq(1, 10**6), bad) is None
     assert lyap.pd_verdict(P, t - fmpq(1, 10**6), None, Pm, bad).ok  # decided exactly
+
+
+def _count_feasibility(monkeypatch: pytest.MonkeyPatch) -> list[int]:
+    calls = [0]
+    orig = lyap.rate_feasible
+
+    def counting(*a, **k):
+        calls[0] += 1
+        assert calls[0] <= 1000, "runaway feasibility tests"  # fail, do not hang
+        return orig(*a, **k)
+
+    monkeypatch.setattr(lyap, "rate_feasible", counting)
+    return calls
+
+
+def test_best_rate_float_bound_far_above_the_true_one(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A triple eigenvalue 1/2 of A − LC: the float spectral radius is 0.5000033 (u^(1/3)
+    error), hundreds of grid steps above the true one at rate_tol = 10⁻⁸. The infeasible end is
+    found by doubling steps (was one exact test per grid step: 3316 of them), and the bracket
+    is still a bracket."""
+    A = qmat([[0, 1, 0], [0, 0, 1], [0, 0, 0]])
+    C = qmat([[1, 0, 0]])
+    L = qmat([[fmpq(-3, 2)], [fmpq(3, 4)], [fmpq(-1, 8)]])  # det(zI − A + LC) = (z − 1/2)³
+    calls = _count_feasibility(monkeypatch)
+    tol = fmpq(1, 10**8)
+    br = best_rate(A, C, L, True, tol=tol, margin=MARGIN)
+    assert calls[0] <= 40
+    assert 0 < br.best - br.other <= tol and br.other >= fmpq(1, 2)
+    assert certified_P(A, C, L, True, br.best, MARGIN) is not None
+    assert lyap.rate_feasible(closed_loop(A, C, L), br.other, True) == (br.kind != INFEASIBLE)
+    assert not lyap.rate_feasible(closed_loop(A, C, L), fmpq(1, 2), True)
+
+
+def test_best_rate_tolerance_beyond_float_resolution_stops(monkeypatch: pytest.MonkeyPatch):
+    """rate_tol = 10⁻³²⁰ (the spec fuzzer's case: the search walked ~10³⁰⁶ grid steps):
+    a clear InconclusiveError naming rate_tol after a bounded number of exact tests."""
+    calls = _count_feasibility(monkeypatch)
+    with pytest.raises(InconclusiveError, match="rate_tol"):
+        best_rate(A5, C5, L5, True, tol=fmpq(1, 10**320), margin=MARGIN)
+    assert calls[0] <= 200
