@@ -179,7 +179,9 @@ def spec_mutation(draw: Any) -> tuple[str, str, str]:
         elif op == "duplicate" and isinstance(parent, dict):
             parent[f"{key}_copy"] = copy.deepcopy(value)
         elif op == "retype":
-            parent[key] = draw(st.sampled_from(WEIRD))
+            # a copy: a later op of the same example may edit it in place, and WEIRD must stay
+            # the same for hypothesis to replay its choices (else FlakyStrategyDefinition)
+            parent[key] = copy.deepcopy(draw(st.sampled_from(WEIRD)))
         elif op == "resize" and isinstance(value, list):
             if value and draw(st.booleans()):
                 value.pop(draw(st.integers(0, len(value) - 1)))
@@ -198,10 +200,28 @@ def spec_mutation(draw: Any) -> tuple[str, str, str]:
                 n = len(parent.get("A", parent.get("f", [1])))
                 parent["psi" if "A" in parent and "f" not in parent else "f"] = [expr] * max(n, 1)
         elif op == "add" and isinstance(value, dict):
-            value[draw(st.sampled_from(["typo", "lamda", "psi", "h", "dim", "L"]))] = draw(
-                st.sampled_from(WEIRD)
+            value[draw(st.sampled_from(["typo", "lamda", "psi", "h", "dim", "L"]))] = copy.deepcopy(
+                draw(st.sampled_from(WEIRD))
             )
     return name, dump_toml(data), "; ".join(ops)
+
+
+def test_mutations_leave_the_weird_values_alone() -> None:
+    """Drawing many mutations never edits WEIRD itself (a shared [] once became [1.5] and made
+    hypothesis's replay flaky: FlakyStrategyDefinition in an explore run)."""
+    from hypothesis import HealthCheck, given, settings
+
+    before = copy.deepcopy(WEIRD)
+
+    @settings(
+        max_examples=2000, deadline=None, database=None, suppress_health_check=list(HealthCheck)
+    )
+    @given(spec_mutation())
+    def draw_only(m: tuple[str, str, str]) -> None:
+        pass
+
+    draw_only()
+    assert WEIRD == before
 
 
 def _no_traceback(out: str) -> None:
