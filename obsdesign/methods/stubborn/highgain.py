@@ -46,9 +46,10 @@ def chain(n: int) -> tuple[np.ndarray, np.ndarray]:
     return A, C
 
 
-def lyapunov_exact(Ac: np.ndarray) -> np.ndarray:
+def lyapunov_exact(Ac: np.ndarray) -> np.ndarray | None:
     """The exact rational solution P of P Ac + Acᵀ P = −I (Ac Hurwitz: unique), by solving the
-    n² × n² linear system (I ⊗ Acᵀ + Acᵀ ⊗ I) vec P = −vec I over Q."""
+    n² × n² linear system (I ⊗ Acᵀ + Acᵀ ⊗ I) vec P = −vec I over Q; None when that system is
+    singular (two eigenvalues of Ac sum to 0, e.g. a pair ±iω: Ac is not Hurwitz)."""
     n = Ac.shape[0]
     N = n * n
     M = fmpq_mat(N, N)
@@ -60,7 +61,10 @@ def lyapunov_exact(Ac: np.ndarray) -> np.ndarray:
                 M[r, i * n + k] += Ac[k, j]
                 M[r, k * n + j] += Ac[k, i]
             rhs[r, 0] = fmpq(-1) if i == j else fmpq(0)
-    sol = M.solve(rhs)
+    try:
+        sol = M.solve(rhs)
+    except ZeroDivisionError:  # flint: singular matrix
+        return None
     P = qzeros((n, n))
     for i in range(n):
         for j in range(n):
@@ -91,7 +95,7 @@ def design_params(
     K = np.asarray(o.K, dtype=object)
     Ac = A - K @ C
     P = lyapunov_exact(Ac)
-    if not check_pd(P).ok:
+    if P is None or not check_pd(P).ok:
         raise InfeasibleError(
             "stubborn high-gain: A − KC is not Hurwitz (the Lyapunov equation has no P ≻ 0): "
             "choose k_1..k_n with a Hurwitz polynomial sⁿ + k_1 sⁿ⁻¹ + … + k_n"
