@@ -214,7 +214,11 @@ def test_mutations_leave_the_weird_values_alone() -> None:
     before = copy.deepcopy(WEIRD)
 
     @settings(
-        max_examples=2000, deadline=None, database=None, suppress_health_check=list(HealthCheck)
+        max_examples=2000,
+        deadline=None,
+        database=None,
+        derandomize=True,
+        suppress_health_check=list(HealthCheck),
     )
     @given(spec_mutation())
     def draw_only(m: tuple[str, str, str]) -> None:
