@@ -203,3 +203,59 @@ def test_memo_does_not_travel() -> None:
     for other in (pickle.loads(pickle.dumps(memo)), copy.deepcopy(memo)):
         assert isinstance(other, lyap.ExactMemo)
         assert other.get(("pd", fmpq(0)), (lyap.fmat(qeye(2)),)) is None
+
+
+@pytest.mark.parametrize("discrete", [True, False])
+def test_verify_at_scale_refuses_the_smallest_false_rate(discrete: bool) -> None:
+    """n = 40, where the decay LMI goes through the float enclosure: a report whose rate is
+    moved to its bracket's infeasible end (no P ≻ 0 exists there: the smallest false claim
+    the report can make) fails decay-lmi (and the bracket) in verify; P scaled by a positive
+    factor (still a certificate) verifies; P with one diagonal entry halved fails."""
+    from obsdesign import api
+    from obsdesign.api import load_spec_text
+    from obsdesign.certify.claim import ClaimStatus
+
+    rng = np.random.default_rng(40)
+    n = 40
+    A = rng.standard_normal((n, n))
+    if discrete:
+        A *= 0.95 / np.max(np.abs(np.linalg.eigvals(A)))
+    else:
+        A -= (np.max(np.linalg.eigvals(A).real) + 0.5) * np.eye(n)
+    C = rng.standard_normal((5, n))
+
+    def fmt(M: np.ndarray) -> str:
+        return "[" + ", ".join("[" + ", ".join(repr(float(v)) for v in r) + "]" for r in M) + "]"
+
+    time_ = "discrete" if discrete else "continuous"
+    text = f'[system]\ntime = "{time_}"\nA = {fmt(A)}\nC = {fmt(C)}\n[method]\nkey = "lyapunov"\n'
+    rep = api.design(load_spec_text(text, "n40.toml"))
+    assert rep.exit_code() == 0
+    checks = {c.id: c.check for c in rep.claims}
+    assert "float enclosure" in checks["decay-lmi"]
+    name = "lambda" if discrete else "alpha"
+
+    def failed(mutate) -> set[str]:
+        r = api.design(load_spec_text(text, "n40.toml"))
+        mutate(r.parameters)
+        return {c.id for c in api.verify(r).claims if c.status == ClaimStatus.FAILED}
+
+    def to_bracket(p) -> None:
+        p[name] = p[name + "_bracket"]
+        p[name + "_best"] = p[name + "_bracket"]
+
+    got = failed(to_bracket)
+    assert {"decay-lmi", "decay-lmi_best"} <= got
+
+    def scaled(p) -> None:
+        p["P"] = p["P"] * fmpq(3)
+        p["P_best"] = p["P"]
+
+    assert failed(scaled) == set()
+
+    def halved(p) -> None:
+        P = p["P"].copy()
+        P[0, 0] = P[0, 0] / 2
+        p["P"] = P
+
+    assert "decay-lmi" in failed(halved)
