@@ -67,50 +67,26 @@ def closed_loop_fmat(A: Any, C: Any, L: Any) -> fmpq_mat:
     return fmat(A) - fmat(L) * fmat(C)
 
 
-def dyadic_fast(x: Any, bits: int) -> np.ndarray:
-    """:func:`obsdesign.certify.exact.dyadic` of a float matrix, the same values entry for
-    entry (each float rounded half-to-even to ``bits`` significant bits), vectorized: the
-    rounded P of eq. (4) (constrained-redesign paper, Section 5) at n = 100 in milliseconds.
-
-    :param x: finite float array; :param bits: significant bits (≤ 53)."""
-    arr = np.asarray(x, dtype=float)
-    if not np.all(np.isfinite(arr)):
-        raise ValueError("cannot round a non-finite number")
-    m, e = np.frexp(arr)  # arr = m·2^e, 0.5 <= |m| < 1 (m = 0 for 0)
-    num = np.rint(np.ldexp(m, bits)).astype(np.int64)  # exact scaling, half-to-even
-    k = (bits - e).astype(np.int64)
-    pw: dict[int, int] = {}
-    out = []
-    for a, b in zip(num.ravel().tolist(), k.ravel().tolist(), strict=True):
-        if a == 0:
-            out.append(fmpq(0))
-        elif b >= 0:
-            d = pw.get(b)
-            if d is None:
-                d = pw[b] = 1 << b
-            out.append(fmpq(a, d))
-        else:
-            out.append(fmpq(a << -b))
-    return np.array(out, dtype=object).reshape(arr.shape)
-
-
 def dyadic_fmat(x: Any, bits: int) -> tuple[fmpq_mat, np.ndarray]:
-    """:func:`dyadic_fast` of a float matrix as an ``fmpq_mat`` — the same values (each float
-    rounded half-to-even to ``bits`` ≤ 53 significant bits) — and their float copy, built
-    from one integer matrix over a common power of two (no per-entry rational): the rounded
-    P, X and L of eq. (4)-(6) (constrained-redesign paper, Section 5) at n = 100.
+    """:func:`obsdesign.certify.exact.dyadic` of a float matrix (each float rounded
+    half-to-even to ``bits`` ≤ 62 significant bits; beyond 53 the float itself) as an
+    ``fmpq_mat``, and the float copy of those values, built from one integer matrix over a
+    common power of two (no per-entry rational): the rounded P, X and L of eq. (4)-(6)
+    (constrained-redesign paper, Section 5) at n = 100 in milliseconds.
 
-    The float copy holds the rounded values themselves (``bits`` ≤ 53: exact in the normal
-    range; ``ldexp`` rounds correctly below it), i.e. the correctly rounded copy that
+    The float copy holds the rounded values themselves (exact in the normal range; ``ldexp``
+    rounds correctly below it), i.e. the correctly rounded copy that
     :mod:`obsdesign.certify.enclosure` needs.
 
-    :param x: finite float matrix; :param bits: significant bits."""
+    :param x: finite float matrix; :param bits: significant bits (1 … 62)."""
+    if not 1 <= bits <= 62:
+        raise ValueError("bits must be in 1 … 62")
     arr = np.asarray(x, dtype=float)
     if arr.ndim != 2 or not np.all(np.isfinite(arr)):
         raise ValueError("cannot round a non-finite number (or not a matrix)")
     r, c = arr.shape
     m, e = np.frexp(arr)
-    num = np.rint(np.ldexp(m, bits)).astype(np.int64)  # |num| ≤ 2^bits, exact scaling
+    num = np.rint(np.ldexp(m, bits)).astype(np.int64)  # |num| ≤ 2^bits ≤ 2^62, exact scaling
     k = (bits - e).astype(np.int64)  # value = num · 2^-k
     flo = np.ldexp(num.astype(float), -k)
     nz = num != 0

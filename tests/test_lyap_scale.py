@@ -152,7 +152,7 @@ def test_decay_fmat_is_the_formula(n: int, seed: int, discrete: bool, symmetric:
     assert (got == qmat(want)).all()
 
 
-def test_dyadic_fast_is_dyadic() -> None:
+def test_dyadic_fmat_is_dyadic() -> None:
     """The vectorized rounding gives exactly the values of exact.dyadic (ties, zeros, tiny,
     huge and negative entries included)."""
     rng = np.random.default_rng(4)
@@ -160,10 +160,12 @@ def test_dyadic_fast_is_dyadic() -> None:
     x[0, :4] = [0.0, 0.5, -1.5 * 2.0**-40, 1 + 2.0**-41]  # 1 + 2⁻⁴¹: a tie at 40 bits
     x[1, 0] = 5e-324
     for bits in (lyap.BITS, lyap.INERTIA_BITS, 24):
-        got, want = lyap.dyadic_fast(x, bits), dyadic(x, bits)
+        got, want = lyap.as_array(lyap.dyadic_fmat(x, bits)[0]), dyadic(x, bits)
         assert got.tolist() == want.tolist()
     with pytest.raises(ValueError):
-        lyap.dyadic_fast(np.array([[np.nan]]), 40)
+        lyap.dyadic_fmat(np.array([[np.nan]]), 40)
+    with pytest.raises(ValueError):
+        lyap.dyadic_fmat(x, 63)
 
 
 def test_memo_serves_only_exactly_equal_inputs() -> None:
