@@ -953,7 +953,9 @@ def best_rate(
     The certified/feasible side of eq. (4)-(6) (constrained-redesign paper, Astolfi et al.,
     NOLCOS 2019, Section 5) is searched on a decimal grid of step tol/10. The bracket starts
     from the spectral bound: the grid point just beyond ρ(Acl) (resp. −max Re eig(Acl)) proved
-    infeasible by :func:`rate_feasible`, and the certified end 1 − grid (resp. grid), or finer
+    infeasible by :func:`rate_feasible`. The rate tol beyond it is tried first: certified, it
+    ends the search with a bracket of width tol (the usual case: one check); refused, it
+    becomes the other end. Otherwise the certified end is 1 − grid (resp. grid), or finer
     candidates when those fail. Each midpoint is decided by :func:`certified_P`; a midpoint
     that fails is the new infeasible / not-certifiable end. ``known`` = (rate, P), a rate
     already certified (the user's), keeps the result at least as good: the search never reports
@@ -1035,7 +1037,20 @@ def best_rate(
         raise InfeasibleError(f"A − LC is not {what}: {lim} ({stability_test(discrete)})")
     known_r = None if known is None else Q(known[0]) * sign
     hi, P = edge - grid, None
-    if hi > lo:
+    # first the rate one bracket width beyond the infeasible end: certified there, the
+    # bracket is already within tol (the usual case, one check instead of ~13 midpoints
+    # from the edge); refused there, it is the new other end, as a refused midpoint is.
+    # Forecast and all-exact searches probe it alike, so they still agree.
+    near = _snap(lo + tol_q, grid, False)
+    if lo < near < hi:
+        P = cert(near)
+        if P is not None:
+            hi = near
+        elif known_r is not None and known_r < near:
+            hi, P = known_r, known[1]  # type: ignore[index]
+        else:
+            lo, lo_kind = near, (NOT_CERTIFIABLE if feasible(near) else INFEASIBLE)
+    if P is None and hi > lo:
         P = cert(hi)
     k = 1
     while P is None and k <= 12:

@@ -129,17 +129,18 @@ def test_iss_mu_is_certified_and_near_the_infimum(discrete: bool) -> None:
 
 
 def test_best_rate_shipped_section5() -> None:
-    """Same search as before the bracket existed: λ_best = 0.95006 (P_best as the numpy Lyapunov solve of issue 12 gives it); the
-    other end 0.95 = ρ(A − LC) is proved infeasible."""
+    """λ_best = 0.9501, the first candidate one rate_tol above the infeasible end (0.95006
+    from the bisection before session 11; P_best as the numpy Lyapunov solve of issue 12
+    gives it); the other end 0.95 = ρ(A − LC) is proved infeasible."""
     br = best_rate(A5, C5, L5, True, tol=TOL, margin=MARGIN)
-    assert br.best == fmpq(47503, 50000)
+    assert br.best == fmpq(9501, 10000) and br.exact_checks == 1
     assert br.other == fmpq(19, 20) and br.kind == INFEASIBLE
     assert (
         br.P.tolist()
         == qmat(
             [
-                ["529058893979/32768", "556868362929/32768"],
-                ["556868362929/32768", "586140836101/32768"],
+                ["632376363209/65536", "665588140049/65536"],
+                ["665588140049/65536", "175136653153/16384"],
             ]
         ).tolist()
     )

@@ -84,21 +84,48 @@ C5 = qmat([[1, 0]])
 L5 = qmat([["-187/100"], ["1874/1000"]])
 
 
-def test_wrong_forecast_falls_back_to_the_exact_search(monkeypatch: pytest.MonkeyPatch) -> None:
-    """A forecast that calls every rate certified (wrong near ρ = 0.95) must not change the
-    bracket: the final exact check refuses, the all-exact bisection runs, same answer."""
+def test_near_candidate_ends_the_search() -> None:
+    """The rate one rate_tol beyond the infeasible end certifies: one exact check, bracket
+    width rate_tol; the all-exact search probes it too and gives the same bracket."""
     ref = lyap.best_rate(A5, C5, L5, True, tol=fmpq(1, 10**4), margin=fmpq(1, 10**9))
+    assert (ref.best, ref.other, ref.kind) == (fmpq(9501, 10000), fmpq(19, 20), "infeasible")
+    assert ref.exact_checks == 1
+    ex = lyap.best_rate(A5, C5, L5, True, tol=fmpq(1, 10**4), margin=fmpq(1, 10**9), forecast=False)
+    assert (ex.best, ex.other, ex.kind) == (ref.best, ref.other, ref.kind)
+
+
+def test_wrong_forecast_falls_back_to_the_exact_search(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A forecast that calls every rate certified must not change the bracket: with the exact
+    check refusing every rate below 0.9502 (the near candidate 0.9501 among them), the final
+    exact check refuses, the all-exact search runs, and the bracket is the all-exact one."""
+    real = lyap.certified_P
+    below = fmpq(9502, 10000)
+
+    def refusing(A, C, L, discrete, r, *a, **k):  # type: ignore[no-untyped-def]
+        return None if Q(r) < below else real(A, C, L, discrete, r, *a, **k)
+
+    monkeypatch.setattr(lyap, "certified_P", refusing)
+    ref = lyap.best_rate(A5, C5, L5, True, tol=fmpq(1, 10**4), margin=fmpq(1, 10**9))
+    assert below <= ref.best <= below + fmpq(1, 10**4)
+    assert ref.other < below and ref.kind == "not-certifiable"
     monkeypatch.setattr(lyap._Forecast, "__call__", lambda *a: True)
     got = lyap.best_rate(A5, C5, L5, True, tol=fmpq(1, 10**4), margin=fmpq(1, 10**9))
     assert (got.best, got.other, got.kind) == (ref.best, ref.other, ref.kind)
-    assert got.best == fmpq(47503, 50000) and got.other == fmpq(19, 20)
     monkeypatch.setattr(lyap._Forecast, "__call__", lambda *a: False)  # all exact
     ex = lyap.best_rate(A5, C5, L5, True, tol=fmpq(1, 10**4), margin=fmpq(1, 10**9))
     assert (ex.best, ex.other, ex.kind) == (ref.best, ref.other, ref.kind)
-    assert ref.exact_checks < ex.exact_checks
+    assert got.exact_checks == ex.exact_checks  # the all-exact rerun gave the answer
 
 
 def test_exact_check_cap(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Near candidate refused (below 0.9502), the edge certified: the first midpoint is the
+    third exact check, over a cap of 2."""
+    real = lyap.certified_P
+
+    def refusing(A, C, L, discrete, r, *a, **k):  # type: ignore[no-untyped-def]
+        return None if Q(r) < fmpq(9502, 10000) else real(A, C, L, discrete, r, *a, **k)
+
+    monkeypatch.setattr(lyap, "certified_P", refusing)
     monkeypatch.setattr(lyap, "MAX_EXACT_CHECKS", 2)
     monkeypatch.setattr(lyap._Forecast, "__call__", lambda *a: False)
     with pytest.raises(InconclusiveError, match="more than 2 exact checks"):

@@ -86,11 +86,13 @@ def test_shipped_spec_key_results_exact() -> None:
         ["553027016189/4194304", "579147225821/4194304"],
     ]
     assert ex["lambda"] == "191/200"
+    # P_best, λ_best: the search's first candidate, one rate_tol above the infeasible end
+    # (0.95006 from a bisection from the stability edge before session 11)
     assert ex["P_best"] == [
-        ["529058893979/32768", "556868362929/32768"],
-        ["556868362929/32768", "586140836101/32768"],
+        ["632376363209/65536", "665588140049/65536"],
+        ["665588140049/65536", "175136653153/16384"],
     ]
-    assert ex["lambda_best"] == "47503/50000"
+    assert ex["lambda_best"] == "9501/10000"
     assert ex["lambda_bracket"] == "19/20"
     assert rep.parameters["lambda_bracket_kind"] == "infeasible"
     assert ex["mu"] == "512450229/2"
@@ -98,14 +100,14 @@ def test_shipped_spec_key_results_exact() -> None:
     assert all(c.status == ClaimStatus.CERTIFIED for c in rep.claims)
     st = {c.id: c.statement for c in rep.claims}
     assert st["decay-lmi"] == "(A−LC)ᵀP(A−LC) ⪯ λ²·P with λ = 0.955"
-    assert st["decay-lmi_best"] == "(A−LC)ᵀP_best(A−LC) ⪯ λ_best²·P_best with λ_best = 0.95006"
+    assert st["decay-lmi_best"] == "(A−LC)ᵀP_best(A−LC) ⪯ λ_best²·P_best with λ_best = 0.9501"
     # was "μ = 2.56225e+08", below the certified μ: now exact
     assert st["iss-gain"] == "V(e⁺) ≤ λ²V(e) + μ|v|² with μ = 256225114.5"
-    assert st["lambda_best-bracket"].startswith("λ_best = 0.95006 is best to within 0.0001: ")
+    assert st["lambda_best-bracket"].startswith("λ_best = 0.9501 is best to within 0.0001: ")
     assert rep.solver["status"] == "closed_form"
     assert rep.solver["name"] == "Lyapunov equation: numpy, one n²×n² linear system"
     assert api.method("lyapunov").summary(rep.parameters) == (
-        "lambda = 0.955, best = 0.95006, mu = 2.562e+08"
+        "lambda = 0.955, best = 0.9501, mu = 2.562e+08"
     )
 
 
@@ -292,7 +294,7 @@ TAMPERS: list[tuple[str, str, Callable, set[str]]] = [
         "sec5",
         _set(
             "lambda_bracket",
-            lambda v, s: Q(s.options.rate_tol) * -1 + EPS * -1 + fmpq(47503, 50000),
+            lambda v, s: Q(s.options.rate_tol) * -1 + EPS * -1 + fmpq(9501, 10000),
         ),
         {"lambda_best-bracket"},
     ),
