@@ -197,3 +197,13 @@ def test_q_of_decimal_and_float_is_their_exact_value(d: Decimal, f: float) -> No
     fd, ff = Fraction(d), Fraction(f)
     assert (int(Q(d).p), int(Q(d).q)) == (fd.numerator, fd.denominator)
     assert (int(Q(f).p), int(Q(f).q)) == (ff.numerator, ff.denominator)
+
+
+@given(
+    st.integers(min_value=-(10**40), max_value=10**40),
+    st.integers(min_value=1, max_value=10**40),
+)
+def test_qstr_entries_are_flints_str(p: int, q: int) -> None:
+    """qstr's fast entry format is flint's str of the same fmpq (sign, q = 1, big ints)."""
+    x = fmpq(p, q)
+    assert qstr(np.array([x, -x], dtype=object)) == [str(x), str(-x)]
