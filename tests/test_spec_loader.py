@@ -221,3 +221,38 @@ def test_numbers_checked_once_by_the_loader_and_always_in_a_bare_table() -> None
     assert sp.method_table.checked
     with pytest.raises(SpecError, match="s.toml.*exponent"):
         read_spec_text(text.replace("0.5", "0.5e99999999"), "s.toml")
+
+
+def test_parse_memo_gives_fresh_copies_and_keys_on_the_limits(monkeypatch) -> None:
+    """The loader's one-entry parse memo (verify re-reads the spec design just read): the
+    same text parses once, every caller gets its own containers (changing one changes no
+    later parse), and a change of limits parses afresh (the memo keys on them)."""
+    import tomllib
+
+    from obsdesign.limits import reset_limits, set_limits
+    from obsdesign.spec import loader
+
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.5, 1], [0, 0.25]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\n'
+    )
+    calls: list[str] = []
+    real = tomllib.loads
+    monkeypatch.setattr(loader.tomllib, "loads", lambda t, **k: calls.append(t) or real(t, **k))
+    fresh = loader._parse_toml_fresh(text, "s.toml")
+    first = loader._parse_toml(text, "s.toml")
+    first["system"]["A"][0][0] = "edited"
+    first["method"]["key"] = "edited"
+    second = loader._parse_toml(text, "s.toml")
+    assert second == fresh and second is not first
+    assert second["system"]["A"] is not first["system"]["A"]
+    assert len(calls) == 2  # the fresh one and the first memoized one; the second is a copy
+    old = set_limits(max_digits=2)
+    try:
+        with pytest.raises(SpecError, match="digits"):
+            loader._parse_toml(text.replace("0.25", "0.125"), "s.toml")
+        # the memoized text itself under the new limits: parsed again, not the memo
+        loader._parse_toml(text, "s.toml")
+        assert len(calls) == 4
+    finally:
+        reset_limits(old)

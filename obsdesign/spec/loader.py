@@ -73,10 +73,43 @@ def read_spec_text(text: str, file: str = "<spec>") -> Spec:
     return spec
 
 
+#: the last successful parse: (text, limits) → data. ``verify`` re-reads the spec that
+#: ``design`` read moments before in the same process (``check``, the API); the parse is a
+#: pure function of the text and the limits, so byte-identical text under the same limits
+#: gets a copy of the same data (the stdlib's pure-Python TOML parser is ~70 ms on the 10⁴
+#: numbers of a 100-state plant). Every check is still recomputed from that data. One entry:
+#: memory stays that of one spec within the limits.
+_LAST_PARSE: tuple[tuple[str, Any], dict[str, Any]] | None = None
+
+
 def _parse_toml(text: str, file: str) -> dict[str, Any]:
     """TOML → data (floats as Decimal), within the limits (:mod:`obsdesign.limits`): size,
     nesting depth, digits and exponent of every number, checked before any number is turned
-    into a rational. Errors name the file and the key (or the line)."""
+    into a rational. Errors name the file and the key (or the line). A fresh copy of the
+    containers every time (the numbers and strings in them are immutable)."""
+    global _LAST_PARSE
+    key = (text, limits())
+    last = _LAST_PARSE
+    if last is not None and last[0] == key:
+        return _copy_tree(last[1])
+    data = _parse_toml_fresh(text, file)
+    _LAST_PARSE = (key, data)
+    return _copy_tree(data)
+
+
+def _copy_tree(x: Any) -> Any:
+    """A copy of TOML data: new dicts and lists, the leaves (numbers, strings, dates) shared."""
+    if isinstance(x, dict):
+        return {k: _copy_tree(v) for k, v in x.items()}
+    if isinstance(x, list):
+        if any(isinstance(v, (list, dict)) for v in x):
+            return [_copy_tree(v) for v in x]
+        return x[:]
+    return x
+
+
+def _parse_toml_fresh(text: str, file: str) -> dict[str, Any]:
+    """:func:`_parse_toml` without the memo."""
     lim = limits()
     if len(text) > lim.max_file_bytes:
         raise SpecError(file, "", f"is above the limit of {lim.max_file_bytes} bytes")
