@@ -247,9 +247,13 @@ class Report:
 
         if not isinstance(d, dict):
             raise InputError(f"{file}: a report is a JSON object")
-        bad = data_problem(d)
-        if bad is None and isinstance(d.get("parameters"), dict):
-            bad = data_problem({"parameters": d["parameters"]}, exact_strings=True)
+        params = d.get("parameters")
+        if isinstance(params, dict):  # walked once, with the exact strings' checks too
+            bad = data_problem({k: v for k, v in d.items() if k != "parameters"})
+            if bad is None:
+                bad = data_problem({"parameters": params}, exact_strings=True)
+        else:
+            bad = data_problem(d)
         if bad is not None:
             raise InputError(f"{file}: [{bad[0]}] {bad[1]}")
         for k in ("schema_version", "method", "spec", "spec_sha256", "parameters", "claims"):
