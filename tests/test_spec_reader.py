@@ -1,0 +1,84 @@
+"""Tests of obsdesign.spec.reader: the checked-rows fast path of ``Table.matrix``."""
+
+from __future__ import annotations
+
+from decimal import Decimal
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from obsdesign.certify.exact import Q, to_float
+from obsdesign.errors import SpecError
+from obsdesign.spec.reader import Table, _checked_rows
+
+_num = st.one_of(
+    st.builds(
+        lambda m, e: Decimal(f"{m}e{e}"),
+        st.integers(-(10**20), 10**20),
+        st.integers(-330, 320),
+    ),
+    st.integers(-(10**30), 10**30),
+    st.floats(allow_nan=False, allow_infinity=False).map(lambda f: Decimal(repr(f))),
+)
+
+
+@given(st.integers(1, 4), st.integers(1, 4), st.data())
+def test_checked_rows_equal_the_general_path(r: int, c: int, data: st.DataObject) -> None:
+    """Exact values equal; floats bit for bit the correctly rounded ones of to_float; a
+    number beyond the float range is the same SpecError naming the key on both paths."""
+    rows = [[data.draw(_num) for _ in range(c)] for _ in range(r)]
+    qs = np.array([[Q(x) for x in row] for row in rows], dtype=object)
+    try:
+        want = np.asarray(to_float(qs), dtype=float)
+    except OverflowError:
+        for checked in (True, False):
+            with pytest.raises(SpecError, match=r"t.toml: \[M\] .*beyond the float range"):
+                Table({"M": rows}, "t.toml", checked=checked).matrix("M")
+        return
+    fast = Table({"M": rows}, "t.toml", checked=True).matrix("M")
+    assert (fast.q == qs).all()
+    assert fast.f.tobytes() == want.tobytes()
+    slow = Table({"M": rows}, "t.toml").matrix("M")  # no fast path: per-number checks
+    assert (slow.q == fast.q).all() and slow.f.tobytes() == fast.f.tobytes()
+
+
+@pytest.mark.parametrize(
+    "bad",
+    [True, Decimal("inf"), Decimal("nan"), Decimal("1e400"), "1", 1.5],
+)
+def test_checked_rows_decline_what_the_general_path_must_decide(bad: object) -> None:
+    """A boolean, a non-finite or beyond-float Decimal, a string, a float: the fast path
+    declines (None) and the general path decides."""
+    assert _checked_rows([[Decimal(1), bad]]) is None
+    with pytest.raises(SpecError, match=r"t.toml: \[M\]"):
+        Table({"M": [[1, bad]]}, "t.toml", checked=True).matrix("M")
+
+
+def test_checked_rows_shape_error_names_the_key() -> None:
+    with pytest.raises(SpecError, match=r"t.toml.*M.*expected shape 2×2, got 1×2"):
+        Table({"M": [[1, 2]]}, "t.toml", checked=True).matrix("M", rows=2, cols=2)
+
+
+@pytest.mark.parametrize("key", ["A = [[1e309]]", "B = [[-2e308]]", "Dn = [[1e400]]"])
+def test_number_beyond_the_float_range_is_bad_input(tmp_path, key: str) -> None:
+    """exit 2 naming the file and key, no report (it was exit 4 with no key named)."""
+    from typer.testing import CliRunner
+
+    from obsdesign.cli import app
+
+    base = {"A": "A = [[0.5]]", "B": "B = [[1]]", "Dn": "Dn = [[1]]"}
+    base[key.split(" ")[0]] = key
+    spec = tmp_path / "s.toml"
+    spec.write_text(
+        '[system]\ntime = "discrete"\n' + "\n".join(base.values()) + "\nC = [[1]]\n"
+        '[method]\nkey = "lyapunov"\n'
+    )
+    out = tmp_path / "r.json"
+    res = CliRunner().invoke(app, ["design", str(spec), "-o", str(out)])
+    assert res.exit_code == 2, res.output
+    assert f"s.toml: [system.{key.split(' ')[0]}] has a number beyond the float range" in (
+        res.output
+    )
+    assert "Traceback" not in res.output and not out.exists()
