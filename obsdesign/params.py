@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 from flint import fmpq
 
-from obsdesign.certify.exact import qparse, qstr, to_float
+from obsdesign.certify.exact import qparse_floats, qstr, qstr_floats, to_float
 from obsdesign.errors import InputError
 
 
@@ -113,7 +113,11 @@ class Parameters:
         for k, v in self._v.items():
             hit = done.get(id(v)) if isinstance(v, np.ndarray) else None
             if hit is None:
-                hit = (_floats(v), qstr(v) if _is_exact(v) else None)
+                both = qstr_floats(v) if _is_exact(v) and isinstance(v, np.ndarray) else None
+                if both is not None:
+                    hit = (both[1], both[0])
+                else:
+                    hit = (_floats(v), qstr(v) if _is_exact(v) else None)
                 if isinstance(v, np.ndarray):
                     done[id(v)] = hit
                     out[k], ex = hit
@@ -153,12 +157,11 @@ class Parameters:
                     q, same, fl = hit[2].copy(), hit[3], hit[4]
                 else:
                     try:
-                        q = qparse(ek)
+                        q, fl = qparse_floats(ek)  # OverflowError passes, as _floats's did
                     except (ValueError, TypeError, ZeroDivisionError) as e:
                         raise InputError(
                             f"report: parameters.exact.{k}: not an exact value ({e})"
                         ) from e
-                    fl = _floats(q)
                     same = _same(fl, v)
                     if isinstance(ek, list):
                         parsed.append((ek, v, q, same, fl))

@@ -207,3 +207,44 @@ def test_qstr_entries_are_flints_str(p: int, q: int) -> None:
     """qstr's fast entry format is flint's str of the same fmpq (sign, q = 1, big ints)."""
     x = fmpq(p, q)
     assert qstr(np.array([x, -x], dtype=object)) == [str(x), str(-x)]
+
+
+_ent = st.one_of(
+    st.builds(fmpq, st.integers(-(10**30), 10**30), st.integers(1, 10**30)),
+    st.builds(lambda e: fmpq(2**e) if e >= 0 else fmpq(1, 2**-e), st.integers(-1100, 1100)),
+)
+
+
+@given(st.lists(_ent, min_size=1, max_size=9), st.sampled_from([(1, -1), (-1, 1), (-1,)]))
+def test_qstr_floats_and_qparse_floats_equal_the_separate_passes(xs, shape) -> None:
+    """The one-pass forms give qstr / qparse and to_float exactly (floats bit for bit), and
+    raise OverflowError where to_float does; non-canonical strings take the general path."""
+    from obsdesign.certify.exact import qparse_floats, qstr_floats
+
+    a = np.array(xs, dtype=object).reshape(shape)
+    try:
+        want_f = np.asarray(to_float(a), dtype=float).tolist()
+    except OverflowError:
+        with pytest.raises(OverflowError):
+            qstr_floats(a)
+        with pytest.raises(OverflowError):
+            qparse_floats(qstr(a))
+        return
+    s, f = qstr_floats(a)
+    assert s == qstr(a) and np.array(f).tobytes() == np.array(want_f).tobytes()
+    q, f2 = qparse_floats(s)
+    assert (q == a).all() and np.array(f2).tobytes() == np.array(want_f).tobytes()
+    flat = [f"{2 * x.p}/{2 * x.q}" if i % 2 else str(x) for i, x in enumerate(a.flat)]
+    odd = np.array(flat, dtype=object).reshape(a.shape).tolist()
+    q3, f3 = qparse_floats(odd)  # "2p/2q" entries: not in lowest terms
+    assert (q3 == qparse(odd)).all()
+    assert np.array(f3).tobytes() == np.asarray(to_float(qparse(odd)), dtype=float).tobytes()
+
+
+def test_qstr_floats_declines_mixed_arrays_and_qparse_floats_scalars() -> None:
+    from obsdesign.certify.exact import qparse_floats, qstr_floats
+
+    assert qstr_floats(np.array([fmpq(1), 2], dtype=object)) is None
+    assert qparse_floats("-3/4") == (fmpq(-3, 4), -0.75)
+    with pytest.raises(ZeroDivisionError):
+        qparse_floats(["1/0"])

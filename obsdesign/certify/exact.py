@@ -160,9 +160,45 @@ def _qs(x: fmpq) -> str:
     return f"{int(x.p)}/{q}" if q != 1 else str(int(x.p))
 
 
+def qstr_floats(a: np.ndarray) -> tuple[list[Any], list[Any]] | None:
+    """(:func:`qstr` of ``a``, :func:`to_float` of ``a`` as nested lists) in one pass over
+    Python ints, for an object array of ``fmpq`` (None for anything else): a report's exact
+    strings and the floats beside them, each entry's numerator and denominator converted
+    once. OverflowError beyond the float range, as :func:`to_float`."""
+    flat = a.ravel().tolist()
+    if not flat or not all(type(x) is fmpq for x in flat):
+        return None
+    strs: list[str] = []
+    fls: list[float] = []
+    for x in flat:
+        p, q = int(x.p), int(x.q)
+        strs.append(f"{p}/{q}" if q != 1 else str(p))
+        fls.append(p / q)  # int / int: correctly rounded, as _qfloat
+    out = np.empty(len(strs), dtype=object)
+    out[:] = strs
+    return out.reshape(a.shape).tolist(), np.array(fls, dtype=float).reshape(a.shape).tolist()
+
+
 def qparse(s: Any) -> Any:
     """Inverse of :func:`qstr`: a string (or nested lists of them, any depth) back to ``fmpq``
     (an object array for lists)."""
+    return _qparse(s, None)
+
+
+def qparse_floats(s: Any) -> tuple[Any, Any]:
+    """(:func:`qparse` of ``s``, its :func:`to_float` as a float or nested lists) with each
+    canonical "p/q" string's integers converted once (a report's exact parameters and the
+    floats its consistency check compares). OverflowError beyond the float range."""
+    if isinstance(s, list):
+        fls: list[float] = []
+        q = _qparse(s, fls)
+        return q, np.array(fls, dtype=float).reshape(q.shape).tolist()
+    q = _qparse(s, None)
+    return q, _qfloat(q)
+
+
+def _qparse(s: Any, floats: list[float] | None) -> Any:
+    """:func:`qparse`; with ``floats``, each entry's nearest float appended to it."""
     if isinstance(s, (str, int, float)) and not isinstance(s, bool):
         return Q(s)
     if isinstance(s, list):
@@ -176,11 +212,17 @@ def qparse(s: Any) -> Any:
             if type(v) is str and (m := match(v)) is not None:
                 # the canonical "p/q" or "p" of qstr, inline (Q's first case; ~2× faster at
                 # the 2×10⁴ strings of a 100-state lyapunov report)
-                vals.append(fmpq(int(m[1]), int(m[2])) if m[2] else fmpq(int(m[1])))
+                p, q = int(m[1]), (int(m[2]) if m[2] else 1)
+                vals.append(fmpq(p, q))  # ZeroDivisionError for q = 0, before p / q
+                if floats is not None:
+                    floats.append(p / q)  # int / int: correctly rounded, as _qfloat
                 continue
             if isinstance(v, bool) or not isinstance(v, (str, int, float)):
                 raise ValueError(f"not an exact value: {v!r}")
-            vals.append(Q(v))
+            x = Q(v)
+            vals.append(x)
+            if floats is not None:
+                floats.append(_qfloat(x))
         out = np.empty(flat.shape, dtype=object)
         out[:] = vals
         return out.reshape(arr.shape)
