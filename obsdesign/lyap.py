@@ -134,6 +134,9 @@ class ExactMemo:
         return hit[1]
 
 
+#: the :class:`ExactMemo` key of A − LC (the spec's A and C, the matrix L compared exactly)
+CLOSED_LOOP_KEY = ("closed-loop",)
+
 #: the attribute of a bound spec under which the design leaves its :class:`ExactMemo`
 MEMO_ATTR = "_lyapunov_exact_memo"
 

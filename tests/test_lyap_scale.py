@@ -221,6 +221,29 @@ def test_memo_serves_only_exactly_equal_inputs() -> None:
     assert claims["decay-lmi"] == "failed"
 
 
+def test_memo_closed_loop_only_for_the_same_L(monkeypatch: pytest.MonkeyPatch) -> None:
+    """certify after the design takes A − LC from the memo for the design's own L (no new
+    product) and recomputes it for an L changed in place by 2⁻⁶⁰, whose decay claim then
+    rests on the new product."""
+    from obsdesign import api
+
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.5, 0.2], [0.0, 0.7]]\nC = [[1.0, 0.0]]\n'
+        '[method]\nkey = "lyapunov"\n'
+    )
+    spec = api.load_spec_text(text, "memo.toml")
+    rep = api.design(spec)
+    calls: list[object] = []
+    real = lyap.closed_loop_fmat
+    monkeypatch.setattr(lyap, "closed_loop_fmat", lambda *a: calls.append(a) or real(*a))
+    assert all(c.status.value == "certified" for c in api.certify(spec, rep.parameters))
+    assert calls == []
+    L = rep.parameters["L"]
+    L[0, 0] += fmpq(1, 2**60)
+    api.certify(spec, rep.parameters)
+    assert len(calls) == 1 and lyap.fmat(calls[0][2]) == lyap.fmat(L)
+
+
 def test_memo_does_not_travel() -> None:
     """A pickled or deep-copied spec (a Dask worker's) carries an empty memo."""
     import copy

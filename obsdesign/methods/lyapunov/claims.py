@@ -61,7 +61,10 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     rate, best, other = Q(rate), Q(best), Q(other)
     A, C = s.A.q, s.C.q
     memo = lyap.memo_of(spec)  # the design's exact verdicts, same process, same inputs only
-    Acl = lyap.closed_loop_fmat(A, C, L)
+    Lq = lyap.fmat(L)
+    Acl = None if memo is None else memo.get(lyap.CLOSED_LOOP_KEY, (Lq,))
+    if Acl is None:
+        Acl = lyap.closed_loop_fmat(A, C, Lq)
     # correctly rounded, once, for the enclosures and the bracket's proof (left to them
     # when the design's verdicts are at hand: the memo then answers without it)
     Af = lyap.mat_float(Acl) if memo is None else None

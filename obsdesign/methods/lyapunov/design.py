@@ -62,7 +62,9 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     else:
         L = o.L
     memo = lyap.ExactMemo()  # the exact verdicts, reused by certify in this process only
-    Acl = lyap.closed_loop_fmat(A, C, L if Lm is None else Lm)
+    Lm = lyap.fmat(L) if Lm is None else Lm
+    Acl = lyap.closed_loop_fmat(A, C, Lm)
+    memo.put(lyap.CLOSED_LOOP_KEY, (Lm,), Acl)  # A − LC for this spec's A, C and this L
     Af = lyap.mat_float(Acl)  # converted once: the float guide of every step below
     eig = np.linalg.eigvals(Af)
     params = Parameters({"L": L})
