@@ -829,12 +829,60 @@ def certified_P(
     if Pm != Pm.transpose():  # (Pf is symmetric: never, but the checks need a symmetric P)
         Pm, Pq_f = _sym(Pm), None
     P = as_array(Pm)
-    if not pd_verdict(P, margin, memo, Pm, Pq_f):
-        return None
     Am = closed_loop_fmat(A, C, L) if Acl is None else Acl
-    if not decay_verdict(Am, P, r, discrete, margin, memo, Pm, Af, Pq_f)[0]:
+    if (
+        pd_verdict(P, margin, memo, Pm, Pq_f)
+        and decay_verdict(Am, P, r, discrete, margin, memo, Pm, Af, Pq_f)[0]
+    ):
+        return P
+    return _certified_P_hp(Am, r, discrete, margin, memo, Af)
+
+
+def _certified_P_hp(
+    Am: fmpq_mat,
+    r: fmpq,
+    discrete: bool,
+    margin: Any,
+    memo: ExactMemo | None,
+    Af: np.ndarray | None,
+) -> np.ndarray | None:
+    """:func:`certified_P`'s fallback when the float P fails: the Lyapunov-equation P in
+    high precision (:mod:`obsdesign.lyap_hp`, n ≤ its ``MAX_N``), scaled by a power of two
+    c ≥ 2δ when the margin δ is not below ½ (its decay matrix is c·I), checked by the same
+    exact tests. Skipped for a rate the float spectrum puts clearly on the infeasible side
+    (the exact check would refuse it: the solve would be wasted)."""
+    from obsdesign import lyap_hp
+
+    n = Am.nrows()
+    if n > lyap_hp.MAX_N:
         return None
-    return P
+    Af = mat_float(Am) if Af is None else Af
+    with np.errstate(all="ignore"):
+        try:
+            eig = np.linalg.eigvals(Af)
+        except np.linalg.LinAlgError:
+            return None
+    rf = float(r)
+    if discrete and float(np.max(np.abs(eig))) >= rf * (1 + 1e-9):
+        return None
+    if not discrete and float(np.max(eig.real)) >= -rf + 1e-9 * max(1.0, abs(rf)):
+        return None
+    d = Q(margin)
+    c = fmpq(1)
+    while c < 2 * d:
+        c *= 2
+    for prec in lyap_hp.PRECISIONS:
+        Pm = lyap_hp.lyapunov_P_hp(Am, r, discrete, prec)
+        if Pm is None:
+            continue
+        Pm = Pm * c
+        P = as_array(Pm)
+        if (
+            pd_verdict(P, margin, memo, Pm, None)
+            and decay_verdict(Am, P, r, discrete, margin, memo, Pm, Af, None)[0]
+        ):
+            return P
+    return None
 
 
 class _Forecast:

@@ -226,11 +226,16 @@ def test_best_rate_not_schur_and_not_certifiable() -> None:
         best_rate(A, qmat([[1]]), qmat([[0]]), True, tol=TOL, margin=MARGIN)
 
 
-def test_certified_P_checks_the_decay_matrix() -> None:
+def test_certified_P_checks_the_decay_matrix(monkeypatch: pytest.MonkeyPatch) -> None:
     """λ = 0.95 + 10⁻¹⁰ is feasible, and the rounded Lyapunov-equation P is ≻ 0, but the
-    rounding breaks the decay LMI: no P is returned (not certifiable)."""
+    rounding breaks the decay LMI: without the high-precision fallback no P is returned (not
+    certifiable); with it, the 128-bit P certifies."""
+    from obsdesign import lyap_hp
+
     lam = fmpq(19, 20) + fmpq(1, 10**10)
     assert rate_feasible(closed_loop(A5, C5, L5), lam, True)
+    assert certified_P(A5, C5, L5, True, lam, MARGIN) is not None
+    monkeypatch.setattr(lyap_hp, "MAX_N", 0)
     assert certified_P(A5, C5, L5, True, lam, MARGIN) is None
     Pf = lyap.lyapunov_P(*(np.asarray(x, dtype=float) for x in (A5, C5, L5)), float(lam), True)
     P = lyap.symmetrize(dyadic(Pf, lyap.BITS))

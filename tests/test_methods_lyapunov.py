@@ -538,12 +538,20 @@ def test_designed_gain_exact_detectability_reasons() -> None:
         api.design(load_spec_text(cont))
 
 
-def test_asked_rate_feasible_but_not_certifiable_is_inconclusive() -> None:
-    """λ = 0.9500000001 > ρ = 0.95: feasible (exact test) but the 40-bit P fails: exit 4."""
+def test_asked_rate_feasible_but_not_certifiable_is_inconclusive(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """λ = 0.9500000001 > ρ = 0.95: feasible (exact test) but the 40-bit P fails: the
+    high-precision P certifies it; without that fallback, exit 4 naming both causes."""
+    from obsdesign import lyap_hp
+
     text = SEC5.read_text().replace("lambda = 0.955", "lambda = 0.9500000001")
-    with pytest.raises(InconclusiveError, match="feasible") as ei:
+    assert api.design(load_spec_text(text, "x.toml")).exit_code() == 0
+    monkeypatch.setattr(lyap_hp, "MAX_N", 0)
+    with pytest.raises(InconclusiveError, match="feasible.*too close.*badly conditioned") as ei:
         api.design(load_spec_text(text, "x.toml"))
     assert ei.value.exit_code == 4
+    monkeypatch.undo()
     with pytest.raises(InfeasibleError, match="exact Schur–Cohn test"):
         api.design(load_spec_text(SEC5.read_text().replace("lambda = 0.955", "lambda = 0.95")))
 

@@ -94,7 +94,8 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
                 f"decay rate {sym} = {fmt_exact(o.rate)} is feasible "
                 f"({how}) but the "
                 f"rounded Lyapunov-equation P fails the exact check with margin "
-                f"{fmt_exact(o.margin)} (too close to the limit: {lim})"
+                f"{fmt_exact(o.margin)} (the rate is too close to the limit, or A − LC too "
+                f"badly conditioned: {lim}, ‖A − LC‖ ≈ {np.linalg.norm(Af, 2):.3g})"
             )
         known = (o.rate, P)
     elif bound >= 1 - 1e-6 if s.discrete else bound >= -1e-6:
@@ -138,7 +139,8 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     notes.append(
         f"best rate {name} = {fmt_exact(br.best)} for this L (bracket tolerance "
         f"{fmt_exact(o.rate_tol)}); {name} = {fmt_exact(br.other)} is {br.kind}: {why}; "
-        + (f"infimum {bound:.6g}" if s.discrete else f"supremum {-bound:.6g}")
+        + (f"infimum ≈ {bound:.6g}" if s.discrete else f"supremum ≈ {-bound:.6g}")
+        + " (float eigenvalues)"
     )
     lyap.attach_memo(spec, memo)
     return Design(params, solver, notes)

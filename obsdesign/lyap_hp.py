@@ -1,0 +1,91 @@
+"""The Lyapunov-equation P in high precision, for the error dynamics the float solve cannot
+serve: a badly scaled or strongly non-normal A − LC (entries of 10⁵ around a spectral
+radius of 0.02, found by the soundness audit), where the float P's residual in the decay
+LMI exceeds the LMI's own size and no rounding of it certifies, however far the rate is
+from the spectral bound.
+
+The exact Lyapunov P of a feasible rate certifies by construction: λ²P − AclᵀPAcl = I
+(discrete) or −((Acl + αI)ᵀP + P(Acl + αI)) = I (continuous) gives the decay matrix I and
+P ⪰ I/λ² (discrete; P ≻ 0 in both), so every margin δ < 1 holds, and the rounded P keeps
+that when the rounding is fine enough. Here the n² × n² Kronecker form of the equation is
+solved by python-flint's ``arb_mat`` at ``prec`` bits (approximate solve: no error bounds
+are needed, the exact check of the result decides), and the midpoints are the exact dyadic
+P. Cost: the Kronecker system is (n²)³/3 operations at ``prec`` bits, ~70 ms at n = 12, so
+it is a fallback for n ≤ :data:`MAX_N` only. Eq. (4)-(6), Section 5 of the
+constrained-redesign paper (Astolfi et al., NOLCOS 2019), with Q = I.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from flint import arb_mat, ctx, fmpq, fmpq_mat
+
+#: the largest state dimension the high-precision solve is tried at (n² unknowns)
+MAX_N = 16
+
+#: the working precisions tried, in bits
+PRECISIONS = (128, 320)
+
+
+def kronecker_fmat(Acl: fmpq_mat, rate: fmpq, discrete: bool) -> fmpq_mat:
+    """The n² × n² matrix K of the Lyapunov equation in row-major vec form, exactly:
+    K·vec(P) = vec(λ²P − AclᵀPAcl) (discrete) or vec(−(FᵀP + PF)), F = Acl + αI
+    (continuous); eq. (4)-(6), constrained-redesign paper, with the decay matrix on the
+    left-hand side.
+
+    :param Acl: A − LC (exact); :param rate: λ or α (exact); :param discrete: time domain."""
+    n = Acl.nrows()
+    a = [[Acl[i, j] for j in range(n)] for i in range(n)]
+    N = n * n
+    K = [[fmpq(0)] * N for _ in range(N)]
+    if discrete:
+        r2 = rate * rate
+        for i in range(n):
+            for j in range(n):
+                row = K[i * n + j]
+                row[i * n + j] += r2
+                for k in range(n):
+                    aki = a[k][i]
+                    if aki == 0:
+                        continue
+                    for m in range(n):
+                        if a[m][j] != 0:
+                            row[k * n + m] -= aki * a[m][j]  # (AᵀPA)_ij = Σ A_ki P_km A_mj
+    else:
+        f = [[a[i][j] + (rate if i == j else 0) for j in range(n)] for i in range(n)]
+        for i in range(n):
+            for j in range(n):
+                row = K[i * n + j]
+                for k in range(n):
+                    row[k * n + j] -= f[k][i]  # (FᵀP)_ij = Σ F_ki P_kj
+                    row[i * n + k] -= f[k][j]  # (PF)_ij = Σ P_ik F_kj
+    return fmpq_mat(N, N, [x for row in K for x in row])
+
+
+def lyapunov_P_hp(Acl: fmpq_mat, rate: Any, discrete: bool, prec: int) -> fmpq_mat | None:
+    """The Lyapunov-equation P with decay matrix I (see the module docstring), solved at
+    ``prec`` bits and symmetrized exactly: an exact dyadic ``fmpq_mat``, or None when the
+    system is singular at that precision (a rate on the spectrum) or the solve is not
+    finite. Never a proof: the caller's exact check decides.
+
+    :param Acl: A − LC (exact); :param rate: λ or α; :param discrete: time domain;
+    :param prec: working precision in bits."""
+    n = Acl.nrows()
+    K = kronecker_fmat(Acl, fmpq(rate) if not isinstance(rate, fmpq) else rate, discrete)
+    rhs = [1 if i == j else 0 for i in range(n) for j in range(n)]
+    with ctx.workprec(prec):
+        try:
+            x = arb_mat(K).solve(arb_mat(n * n, 1, rhs), algorithm="approx")
+        except (ZeroDivisionError, ValueError):
+            return None
+        vals = []
+        for k in range(n * n):
+            v = x[k, 0]
+            if not v.is_finite():
+                return None
+            m, e = v.mid().man_exp()  # the midpoint m·2^e, exactly
+            e = int(e)
+            vals.append(fmpq(int(m) << e) if e >= 0 else fmpq(int(m), 1 << -e))
+    P = fmpq_mat(n, n, vals)
+    return (P + P.transpose()) * fmpq(1, 2)

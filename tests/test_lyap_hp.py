@@ -1,0 +1,130 @@
+"""Tests of obsdesign.lyap_hp: the Lyapunov-equation P in high precision, the fallback of
+lyap.certified_P for a badly conditioned A − LC."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from flint import fmpq, fmpq_mat
+from hypothesis import given
+from hypothesis import strategies as st
+
+from obsdesign import api, lyap, lyap_hp
+from obsdesign.certify.exact import qmat
+
+#: the soundness audit's spec (session 11): a Riccati gain makes A − LC entries of ~1e5
+#: around a spectral radius of 0.02; the float P failed at every rate (exit 4)
+AUDIT = (
+    '[system]\ntime = "discrete"\nA = [[-125123, -127590.0], [107378, 1.180e+05]]\n'
+    'C = [[1.74345, -1.769e-01]]\n[method]\nkey = "lyapunov"\nlambda = 9.9e-1\n'
+    "rate_tol = 1e-6\niss_gain = true\n"
+)
+
+_q = st.builds(fmpq, st.integers(-40, 40), st.integers(1, 9))
+
+
+@given(st.integers(1, 3), st.booleans(), st.data())
+def test_kronecker_form_is_the_decay_matrix(n: int, discrete: bool, data: st.DataObject) -> None:
+    """K·vec(P) = vec(λ²P − AᵀPA) (discrete) or vec(−((A + αI)ᵀP + P(A + αI))), exactly,
+    for random A, symmetric or not P, rate."""
+    A = fmpq_mat(n, n, [data.draw(_q) for _ in range(n * n)])
+    P = fmpq_mat(n, n, [data.draw(_q) for _ in range(n * n)])
+    r = data.draw(_q)
+    K = lyap_hp.kronecker_fmat(A, r, discrete)
+    v = K * fmpq_mat(n * n, 1, [P[i, j] for i in range(n) for j in range(n)])
+    if discrete:
+        D = r * r * P - A.transpose() * P * A
+    else:
+        F = A + fmpq_mat(n, n, [r if i == j else 0 for i in range(n) for j in range(n)])
+        D = -(F.transpose() * P + P * F)
+    assert [v[k, 0] for k in range(n * n)] == [D[i, j] for i in range(n) for j in range(n)]
+
+
+def _audit_system() -> tuple[object, object, object, fmpq_mat]:
+    from obsdesign.methods.lyapunov.design import design_gain
+
+    sp = api.load_spec_text(AUDIT, "audit.toml")
+    Lf, _, _ = design_gain(sp, sp.options, None)
+    Lm, _ = lyap.dyadic_fmat(Lf, lyap.BITS)
+    A, C, L = sp.system.A.q, sp.system.C.q, lyap.as_array(Lm)
+    return A, C, L, lyap.closed_loop_fmat(A, C, L)
+
+
+def test_badly_conditioned_rate_certifies_only_through_the_fallback(monkeypatch) -> None:
+    """λ = 0.99 against ρ ≈ 0.02: the float P fails the exact check (the fallback switched
+    off: None), the high-precision P passes it; below the exact spectral radius nothing does."""
+    A, C, L, Acl = _audit_system()
+    r, d = fmpq(99, 100), fmpq(1, 10**9)
+    P = lyap.certified_P(A, C, L, True, r, d, Acl=Acl)
+    assert P is not None
+    Pm = lyap.fmat(P)
+    D = r * r * Pm - Acl.transpose() * Pm * Acl
+    E = D - d * fmpq_mat(2, 2, [1, 0, 0, 1])
+    assert E[0, 0] > 0 and E[0, 0] * E[1, 1] - E[0, 1] * E[1, 0] > 0  # Sylvester, exactly
+    monkeypatch.setattr(lyap_hp, "MAX_N", 0)
+    assert lyap.certified_P(A, C, L, True, r, d, Acl=Acl) is None
+    monkeypatch.undo()
+    assert lyap.certified_P(A, C, L, True, fmpq(2, 100), d, Acl=Acl) is None  # ρ > 0.02
+
+
+def test_hp_P_at_an_infeasible_rate_fails_the_exact_check(monkeypatch) -> None:
+    """The float-spectrum skip switched off, a rate just below the spectral radius: the
+    high-precision solve runs and its P is refused by the exact check (not ≻ 0)."""
+    Acl = qmat([[fmpq(1, 2), 1], [0, fmpq(1, 3)]])
+    monkeypatch.setattr(np.linalg, "eigvals", lambda M: np.zeros(M.shape[0]))
+    calls: list[int] = []
+    real = lyap_hp.lyapunov_P_hp
+    monkeypatch.setattr(lyap_hp, "lyapunov_P_hp", lambda *a: calls.append(a[-1]) or real(*a))
+    got = lyap._certified_P_hp(lyap.fmat(Acl), fmpq(49, 100), True, fmpq(0), None, None)
+    assert got is None and calls == list(lyap_hp.PRECISIONS)
+    got = lyap._certified_P_hp(lyap.fmat(Acl), fmpq(51, 100), True, fmpq(0), None, None)
+    assert got is not None and calls[-1] == lyap_hp.PRECISIONS[0]
+
+
+def test_singular_equation_and_large_margin() -> None:
+    """A rate with λ² = w_i·w_j (a singular Kronecker system) gives None, no exception; a
+    margin δ ≥ ½ scales P by a power of two c ≥ 2δ and still certifies."""
+    Acl = lyap.fmat(qmat([[fmpq(1, 2), 0], [0, fmpq(1, 2)]]))
+    assert lyap_hp.lyapunov_P_hp(Acl, fmpq(1, 2), True, 128) is None
+    P = lyap._certified_P_hp(Acl, fmpq(3, 4), True, fmpq(3), None, None)
+    assert P is not None
+    Pm = lyap.fmat(P)
+    D = fmpq(9, 16) * Pm - Acl.transpose() * Pm * Acl
+    # c = 8 ≥ 2δ = 6: decay matrix c·I up to the 128-bit solve (P = 8·16/5 is not dyadic)
+    assert all(
+        abs(D[i, j] - (8 if i == j else 0)) < fmpq(1, 2**100) for i in (0, 1) for j in (0, 1)
+    )
+
+
+def test_continuous_badly_conditioned() -> None:
+    """Continuous time: a strongly non-normal Hurwitz A − LC (|entries| 10⁶, eigenvalues
+    −1, −2) certifies α = 1/2 through the fallback."""
+    k = 10**6
+    Acl = lyap.fmat(qmat([[-1, k], [0, -2]]))
+    P = lyap._certified_P_hp(Acl, fmpq(1, 2), False, fmpq(1, 10**9), None, None)
+    assert P is not None
+    Pm = lyap.fmat(P)
+    F = Acl + fmpq_mat(2, 2, [fmpq(1, 2), 0, 0, fmpq(1, 2)])
+    D = -(F.transpose() * Pm + Pm * F)
+    assert D[0, 0] > 0 and D[0, 0] * D[1, 1] - D[0, 1] ** 2 > 0
+
+
+def test_audit_spec_designs_and_verifies(tmp_path: Path) -> None:
+    """The audit's spec end to end: exit 0, every claim certified, verify agrees."""
+    spec = tmp_path / "audit.toml"
+    spec.write_text(AUDIT)
+    rep = api.design(spec)
+    assert rep.exit_code() == 0
+    assert all(c.status.value == "certified" for c in rep.claims)
+    out = tmp_path / "r.json"
+    out.write_text(rep.to_json())
+    assert api.verify(out).exit_code() == 0
+    assert float(rep.parameters.float("lambda_best")) < 0.021
+
+
+@pytest.mark.parametrize("n", [lyap_hp.MAX_N + 1])
+def test_beyond_max_n_no_fallback(n: int) -> None:
+    Acl = lyap.fmat(qmat(np.diag([fmpq(1, 2)] * n).tolist()))
+    assert lyap._certified_P_hp(Acl, fmpq(3, 4), True, fmpq(0), None, None) is None
