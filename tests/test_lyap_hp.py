@@ -128,3 +128,22 @@ def test_audit_spec_designs_and_verifies(tmp_path: Path) -> None:
 def test_beyond_max_n_no_fallback(n: int) -> None:
     Acl = lyap.fmat(qmat(np.diag([fmpq(1, 2)] * n).tolist()))
     assert lyap._certified_P_hp(Acl, fmpq(3, 4), True, fmpq(0), None, None) is None
+
+
+def test_float_spectrum_far_off_does_not_skip_the_fallback(tmp_path: Path) -> None:
+    """The audit's continuous example: A ~ 1e-5, a given L ~ 1e9, ‖A − LC‖ ≈ 3·10¹⁰. The
+    float eigenvalues have real parts up to +2.7·10⁻³ (not Hurwitz) although the exact test
+    says Hurwitz; the best α ≈ 0.1501 certifies through the fallback (the float spectrum
+    put every candidate rate on the infeasible side, and the skip used to trust it)."""
+    text = (Path(__file__).parent / "specs" / "lyapunov-nonnormal-continuous.toml").read_text()
+    sp = api.load_spec_text(text, "nn.toml")
+    Af = lyap.mat_float(lyap.closed_loop_fmat(sp.system.A.q, sp.system.C.q, sp.options.L))
+    assert np.max(np.linalg.eigvals(Af).real) > 0
+    rep = api.design(sp)
+    assert rep.exit_code() == 0
+    assert all(c.status.value == "certified" for c in rep.claims)
+    assert rep.parameters["alpha_bracket_kind"] == "infeasible"
+    assert fmpq(15, 100) < rep.parameters["alpha_best"] < fmpq(16, 100)
+    out = tmp_path / "r.json"
+    out.write_text(rep.to_json())
+    assert api.verify(out).exit_code() == 0
