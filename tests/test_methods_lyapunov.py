@@ -702,3 +702,15 @@ def test_an_expression_plant_fails_linear_plant_and_still_simulates() -> None:
     assert np.isfinite(api.simulate(spec, rep).metrics()["final_error_norm"])
     linear = api.design(load_spec_text(text, "lin.toml"))
     assert "linear-plant" not in [c.id for c in linear.claims]
+
+
+def test_rate_cap_caps_the_gain_design_not_the_reported_rate() -> None:
+    """docs/methods/lyapunov.md: rate_cap bounds the LMI bisection that picks L; the best
+    certified α of that L may exceed it (the double integrator: α_best ≈ 1.43 > 1)."""
+    text = (
+        '[system]\ntime = "continuous"\nA = [[0, 1], [0, 0]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\ndesign = "lmi"\nrate_cap = 1\n'
+    )
+    rep = api.design(load_spec_text(text, "cap.toml"))
+    assert rep.exit_code() == 0
+    assert 1.4 < float(rep.parameters.float("alpha_best")) < 1.5
