@@ -309,6 +309,16 @@ def data_problem(data: Any, exact_strings: bool = False) -> tuple[str, str] | No
         if isinstance(v, list):
             if v and depth + 1 > max_depth:
                 return _too_deep((node, 0, False), max_depth)
+            # whole lists the loop below would pass entry by entry, decided at C speed: all
+            # floats / booleans, or all strings that pass the inline test of the loop (a
+            # report's 10⁴-entry rows of floats and of exact "p/q" strings)
+            kinds = set(map(type, v))
+            if kinds <= _NEVER_A_PROBLEM:
+                continue
+            if kinds == _STRINGS and (
+                not exact_strings or (max(map(len, v)) <= short and _no_exponent("".join(v)))
+            ):
+                continue
             for i, x in enumerate(v):
                 t = type(x)
                 if t is float or t is bool:
@@ -332,6 +342,14 @@ def data_problem(data: Any, exact_strings: bool = False) -> tuple[str, str] | No
         if why:
             return _path(node) or "(top)", why
     return None
+
+
+_NEVER_A_PROBLEM = {float, bool}
+_STRINGS = {str}
+
+
+def _no_exponent(text: str) -> bool:
+    return "e" not in text and "E" not in text
 
 
 def _too_deep(node: _Node, max_depth: int) -> tuple[str, str]:

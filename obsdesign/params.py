@@ -183,7 +183,7 @@ def _copy_rows(x: Any) -> Any:
     """A copy of nested lists (the leaves shared: numbers and strings are immutable)."""
     if not isinstance(x, list):
         return x
-    if any(isinstance(v, list) for v in x):
+    if any(issubclass(t, list) for t in set(map(type, x))):  # the kinds, not the entries
         return [_copy_rows(v) for v in x]
     return x[:]  # a row of leaves: one C-level copy
 

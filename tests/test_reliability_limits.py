@@ -360,3 +360,47 @@ def test_number_size_checks_fast_paths_give_the_full_verdict(neg, ip, fp, ex, md
         assert (data_problem({"a": [d]}) is None) == want_dec
     finally:
         reset_limits(old)
+
+
+_leaf = st.one_of(
+    st.floats(allow_nan=False),
+    st.booleans(),
+    st.text("0123456789/-eE.", max_size=14),
+    st.integers(-(10**20), 10**20),
+)
+
+
+@given(st.lists(_leaf, max_size=8), st.booleans(), st.integers(3, 12))
+def test_whole_list_fast_path_gives_the_entrywise_verdict(
+    v: list, exact_strings: bool, md: int
+) -> None:
+    """data_problem's whole-list shortcut (all floats / booleans, all plain strings) gives
+    the verdict of checking each entry on its own: None when every entry passes, else the
+    first failing entry's reason."""
+    from obsdesign.limits import data_problem
+
+    old = set_limits(max_digits=md, max_exponent=md)
+    try:
+        got = data_problem({"p": v}, exact_strings=exact_strings)
+        each = [data_problem({"p": [x]}, exact_strings=exact_strings) for x in v]
+    finally:
+        reset_limits(old)
+    first = next(((i, w) for i, w in enumerate(each) if w is not None), None)
+    if first is None:
+        assert got is None
+    else:
+        assert got == (f"p[{first[0]}]", first[1][1])
+
+
+def test_copy_rows_copies_nested_lists_of_any_kind() -> None:
+    from obsdesign.params import _copy_rows
+
+    class Row(list):
+        pass
+
+    inner = Row([1.0, 2.0])
+    x = [0.5, inner, "s"]
+    y = _copy_rows(x)
+    assert y == x and y is not x and y[1] is not inner
+    flat = [1.0, 2.0]
+    assert _copy_rows(flat) == flat and _copy_rows(flat) is not flat
