@@ -41,3 +41,37 @@ def test_a_huge_disturbance_gain_is_inconclusive_not_a_solver_failure() -> None:
     with pytest.raises(InconclusiveError, match=r"LP \(9\) is out of a float LP's range") as e:
         api.design(spec)
     assert e.value.exit_code == 4
+
+
+def test_failing_highs_stops_at_the_deadline(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A HiGHS that keeps failing (status 4 after 100 ms each call) on a 64-block LP (9):
+    the split-and-retry stops at the budget (Timeout) instead of about 2·64·3 calls; every
+    call gets the remaining seconds as its time limit. The soundness audit's 3-state spec
+    with time_limit = 30 ran past 300 s inside these retries."""
+    import time
+    from types import SimpleNamespace
+
+    from obsdesign.methods.setinvariant.budget import Timeout
+
+    limits: list[float] = []
+
+    def failing(*a, options=None, **k):  # type: ignore[no-untyped-def]
+        limits.append(options["time_limit"])
+        time.sleep(0.1)
+        return SimpleNamespace(status=4, message="Solve error", x=None)
+
+    monkeypatch.setattr(lps, "linprog", failing)
+    G = np.vstack([np.eye(2), -np.eye(2)])
+    t0 = time.perf_counter()
+    with pytest.raises(Timeout):
+        lps.eps_batch(G, np.zeros((64, 4)), np.zeros(4), deadline=t0 + 0.3)
+    assert time.perf_counter() - t0 < 1.0
+    assert 0 < len(limits) < 10 and all(0 < t <= 0.3 for t in limits)
+    # without a budget the failure is HiGHS's, reported as such
+    monkeypatch.setattr(
+        lps, "linprog", lambda *a, **k: SimpleNamespace(status=4, message="Solve error", x=None)
+    )
+    from obsdesign.errors import SolverError
+
+    with pytest.raises(SolverError, match="HiGHS failed on LP \\(9\\)"):
+        lps.eps_batch(G, np.zeros((4, 4)), np.zeros(4))

@@ -13,7 +13,9 @@ For ``Ω = {e : G e <= 1}`` with vertices ``e^j`` and edges:
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -100,10 +102,10 @@ def eps_batch(
         parts = []
         for i in range(0, nz, chunk):
             check_deadline(deadline)
-            parts.append(_eps_block(G, phi[i : i + chunk], dlt))
+            parts.append(_eps_block(G, phi[i : i + chunk], dlt, deadline))
         return EpsResult(np.concatenate([p.eps for p in parts]), np.vstack([p.v for p in parts]))
     check_deadline(deadline)
-    return _eps_block(G, phi, dlt)
+    return _eps_block(G, phi, dlt, deadline)
 
 
 #: HiGHS takes matrix entries above 1e15 and right-hand sides from 1e20 on as infinite and
@@ -128,7 +130,14 @@ def check_lp_range(A: np.ndarray, b: np.ndarray, what: str) -> None:
         )
 
 
-def _eps_block(G: np.ndarray, phi: np.ndarray, dlt: np.ndarray) -> EpsResult:
+def _eps_block(
+    G: np.ndarray, phi: np.ndarray, dlt: np.ndarray, deadline: float | None = None
+) -> EpsResult:
+    """One block-diagonal HiGHS LP (9) for the rows of ``phi``; each HiGHS call gets the
+    budget's remaining seconds as its time limit and the budget is checked before each
+    retry, so a struggling solver stops at ``deadline`` (:class:`Timeout`) instead of
+    splitting and retrying for minutes (found by the soundness audit: a 3-state spec with
+    ``time_limit = 30`` still running at 300 s, inside these retries)."""
     nz, g = phi.shape
     n = G.shape[1]
     b_ub = (-dlt[None, :] - phi).reshape(-1)
@@ -137,22 +146,37 @@ def _eps_block(G: np.ndarray, phi: np.ndarray, dlt: np.ndarray) -> EpsResult:
     Eblk = -sp.kron(sp.eye(nz, format="csr"), sp.csr_matrix(np.ones((g, 1))))
     A_ub = sp.hstack([Ablk, Eblk]).tocsr()
     cost = np.concatenate([np.zeros(nz * n), np.ones(nz)])
-    res = linprog(cost, A_ub=A_ub, b_ub=b_ub, bounds=(None, None), method="highs")
+    res = _linprog(cost, A_ub, b_ub, "highs", deadline)
     if res.status != 0 and nz > 1:
         # HiGHS occasionally reports "Solve error" on a large block LP (seen on a random
         # 3-state system): the blocks are independent, so split and retry
+        check_deadline(deadline)
         half = nz // 2
-        a, b = _eps_block(G, phi[:half], dlt), _eps_block(G, phi[half:], dlt)
+        a = _eps_block(G, phi[:half], dlt, deadline)
+        b = _eps_block(G, phi[half:], dlt, deadline)
         return EpsResult(np.concatenate([a.eps, b.eps]), np.vstack([a.v, b.v]))
     for method in ("highs-ds", "highs-ipm"):
         if res.status == 0:
             break
-        res = linprog(cost, A_ub=A_ub, b_ub=b_ub, bounds=(None, None), method=method)
+        check_deadline(deadline)
+        res = _linprog(cost, A_ub, b_ub, method, deadline)
     if res.status != 0:
+        check_deadline(deadline)  # stopped by the time limit: the budget's, not a failure
         raise SolverError(f"HiGHS failed on LP (9): {res.message}")
     v = res.x[: nz * n].reshape(nz, n)
     eps = (phi + dlt[None, :] + v @ G.T).max(axis=1)
     return EpsResult(eps, v)
+
+
+def _linprog(
+    cost: np.ndarray, A_ub: Any, b_ub: np.ndarray, method: str, deadline: float | None
+) -> Any:
+    """scipy's HiGHS ``linprog`` of LP (9) (free variables), with the budget's remaining
+    seconds (at least 10 ms) as HiGHS's own time limit when there is a budget."""
+    opts = None
+    if deadline is not None:
+        opts = {"time_limit": max(deadline - time.perf_counter(), 0.01)}
+    return linprog(cost, A_ub=A_ub, b_ub=b_ub, bounds=(None, None), method=method, options=opts)
 
 
 def epsilon_profile(
