@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 from obsdesign import api
 from obsdesign.api import load_spec_text
 from obsdesign.certify.claim import ClaimStatus
+from obsdesign.certify.exact import qmat
 from obsdesign.errors import InconclusiveError, InfeasibleError, SolverError, SpecError
 from obsdesign.methods.setinvariant import laws
 from obsdesign.methods.setinvariant.spectext import spec_text as matrix_spec_text
@@ -257,6 +258,30 @@ def test_not_detectable_exit_1():
     sp = load_spec_text(spec_text(A="[[0.5, 0], [0, 0.95]]", C="[[1, 0]]"), "slow.toml")
     with pytest.raises(InfeasibleError, match="λ"):
         api.design(sp)
+
+
+def test_unobservable_mode_at_lambda_goes_on_to_the_algorithm() -> None:
+    """The soundness audit's example: μ = 1 unobservable with λ = 1, not excited (B1 = [0.1,
+    0]): the box Ω is invariant, so it is not refused; it certifies and verifies. The same
+    mode with λ = 0.9 (|μ| > λ) and μ = 1.0000001 with λ = 1 are refused exactly as before;
+    a mode exactly at λ = 0.95 goes on to the algorithm (no up-front refusal)."""
+    from obsdesign.methods.setinvariant.problem import check_detectable
+
+    box = 'type = "box"\nlower = [-1, -1]\nupper = [1, 1]'
+    kw = dict(A="[[0.5, 0], [0, 1]]", C="[[1, 0]]", B1="[0.1, 0]", omega=box, alg="none")
+    rep = api.design(load_spec_text(spec_text(lam="1", **kw), "marginal.toml"))
+    assert rep.exit_code() == 0
+    assert all(c.status == ClaimStatus.CERTIFIED for c in rep.claims)
+    with pytest.raises(InfeasibleError, match="λ"):
+        api.design(load_spec_text(spec_text(lam="0.9", **kw), "slow.toml"))
+    A = qmat([[fmpq(1, 2), 0], [0, fmpq(10000001, 10000000)]])
+    with pytest.raises(InfeasibleError, match="not detectable"):
+        check_detectable(A, qmat([[1, 0]]), fmpq(1))
+    A = qmat([[fmpq(1, 2), 0], [0, fmpq(19, 20)]])
+    check_detectable(A, qmat([[1, 0]]), fmpq(19, 20))  # |μ| = λ exactly: not refused
+    with pytest.raises(InfeasibleError, match="λ"):
+        check_detectable(A, qmat([[1, 0]]), fmpq(19, 20) - fmpq(1, 10**6))
+    check_detectable(A, qmat([[1, 1]]), fmpq(1, 10))  # observable: nothing to refuse
 
 
 def test_necessary_condition_and_not_converged():

@@ -289,7 +289,7 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     t0 = time.perf_counter()
     try:
         data = build(spec)
-        check_detectable(data.fl.A, data.fl.C, float(o.lam))
+        check_detectable(spec.system.A.q, spec.system.C.q, o.lam)
         run = _iterate(spec, data, progress)
     except po.PolytopeError as e:
         # a float hull or vertex enumeration that qhull cannot do (a set thinner or larger

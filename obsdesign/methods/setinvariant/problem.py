@@ -118,27 +118,51 @@ def build(spec: Spec) -> Data:
     return Data(fl, ex)
 
 
-def check_detectable(A: np.ndarray, C: np.ndarray, lam: float) -> None:
-    """PBH test (floats): every mode of A with |μ| > λ must be observable.
+def check_detectable(A: Any, C: Any, lam: Any) -> None:
+    """Refuse (InfeasibleError) only a mode the output cannot see that is provably faster
+    than λ (Section II: the injection cannot act on an unobservable mode, so a λ-contractive
+    set needs |μ| <= λ for each).
 
-    A λ-contractive set needs every unobservable mode to have |μ| <= λ (the injection cannot
-    act on it). Raises InfeasibleError naming the mode: "(C, A) not detectable" when |μ| >= 1,
-    else "unobservable mode faster than λ"."""
-    n = A.shape[0]
-    for mu in np.linalg.eigvals(A):
-        M = np.vstack([A - mu * np.eye(n), C.astype(complex)])
-        sv = np.linalg.svd(M, compute_uv=False)
-        if sv.min() <= 1e-9 * max(1.0, sv.max()):
-            if abs(mu) >= 1:
-                raise InfeasibleError(
-                    f"(C, A) is not detectable: the mode μ = {mu:.6g} (|μ| = {abs(mu):.6g} >= 1) "
-                    "is unobservable, so no bounded set is D-(C,A)-invariant"
-                )
-            if abs(mu) > lam * (1 + 1e-12):
-                raise InfeasibleError(
-                    f"the unobservable mode μ = {mu:.6g} has |μ| = {abs(mu):.6g} > λ = {lam:g}: "
-                    "no polyhedron is λ-contractive (choose λ >= |μ|)"
-                )
+    Exact first: the unobservable modes are the roots of the characteristic polynomial of A
+    restricted to the unobservable subspace (:func:`obsdesign.certify.detect.unobservable_restriction`);
+    none (observable) or all with |μ| < λ (exact Schur–Cohn test of χ(λz)) pass. Otherwise
+    some unobservable |μ| >= λ exactly, and the design is refused only when its float modulus
+    is clearly above λ (by 10⁻⁹ relative). A mode with |μ| = λ (e.g. μ = 1 with λ = 1, not
+    excited by the disturbance: the soundness audit's example, whose box Ω is invariant)
+    goes on to the algorithm, which decides. The message says "(C, A) is not detectable"
+    when |μ| > 1.
+
+    :param A, C: exact plant matrices (object arrays); :param lam: λ (exact)."""
+    from flint import fmpq_poly
+
+    from obsdesign.certify.detect import schur_stable, unobservable_restriction
+    from obsdesign.certify.exact import Q
+
+    _, Au = unobservable_restriction(A, C)
+    k = Au.nrows()
+    if k == 0:
+        return
+    lq = Q(lam)
+    chi = Au.charpoly()
+    # χ(λz) = Σ a_i λ^i z^i: its roots are μ/λ
+    scaled = fmpq_poly([c * lq**i for i, c in enumerate(chi.coeffs())])
+    if lq > 0 and schur_stable(scaled)[0]:
+        return
+    coeffs = [float(c) for c in chi.coeffs()][::-1]
+    mus = np.roots(coeffs) if k > 0 else np.zeros(0)
+    lf = float(lq)
+    for mu in sorted(mus, key=abs, reverse=True):
+        if abs(mu) <= lf * (1 + 1e-9):
+            return
+        if abs(mu) > 1:
+            raise InfeasibleError(
+                f"(C, A) is not detectable: the mode μ = {mu:.6g} (|μ| = {abs(mu):.6g} > 1) "
+                "is unobservable, so no bounded set is D-(C,A)-invariant"
+            )
+        raise InfeasibleError(
+            f"the unobservable mode μ = {mu:.6g} has |μ| = {abs(mu):.6g} > λ = {lf:g}: "
+            "no polyhedron is λ-contractive (choose λ >= |μ|)"
+        )
 
 
 def necessary_condition(
