@@ -440,3 +440,25 @@ def test_a_set_too_thin_for_floats_is_inconclusive_not_an_internal_failure() -> 
     with pytest.raises(InconclusiveError, match="float polytope computation failed") as e:
         api.design(spec)
     assert e.value.exit_code == 4 and "\n" not in e.value.message
+
+
+def test_diverging_general_algorithm_is_not_converged_exit_1() -> None:
+    """The soundness audit's A = [[0.14, 0], [726.54, 0.12]] (Ω a 4-facet polytope, λ = 0.9):
+    the general algorithm's polyhedron grows without bound; it used to reach 10²⁰ and end
+    with exit 4 ("out of a float LP's range"). It now stops when a new vertex passes
+    GROWTH_MAX times Ω's size: not converged (exit 1), the last polyhedron reported, a note
+    saying why."""
+    from obsdesign.methods.setinvariant import algorithms as al
+
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.14, 0.0], [726.54, 0.12]]\nC = [[-0.54, 0.36]]\n'
+        '[sets.omega]\ntype = "polytope"\n'
+        "G = [[1.30, 0.95], [-0.70, -1.27], [-0.62, 0.04], [-0.05, 0.26]]\n"
+        'g = [2.00, 0.50, 0.50, 2.00]\n[method]\nkey = "set-invariant"\nomega = "omega"\n'
+        'eta_bar = 0.0\nlambda = 0.90\nalgorithm = "general"\nmax_iterations = 40\n'
+    )
+    rep = api.design(load_spec_text(text, "diverge.toml"))
+    assert rep.exit_code() == 1
+    assert rep.parameters["converged"] is False and rep.parameters["iterations"] < 40
+    assert any("diverges" in n and f"{al.GROWTH_MAX:g}" in n for n in rep.notes)
+    assert {c.id: c.status for c in rep.claims}["converged"] == ClaimStatus.FAILED

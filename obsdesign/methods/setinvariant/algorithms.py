@@ -64,6 +64,15 @@ class IterResult:
     history: list[dict[str, float]] = field(default_factory=list)
     #: stopped at the time budget (``deadline``), not at the iteration cap
     timed_out: bool = False
+    #: stopped because the polyhedron grew past :data:`GROWTH_MAX` times Ω's size
+    diverged: bool = False
+
+
+#: the general algorithm stops, not converged, when a new vertex lies more than this many
+#: times Ω's largest vertex norm from the origin: the iteration is diverging (the soundness
+#: audit's A = [[0.14, 0], [726.54, 0.12]] grew to 10²⁰ and ended with exit 4 "out of a float
+#: LP's range"); a polyhedron that size is beyond what the float LPs and hulls resolve anyway
+GROWTH_MAX = 1e10
 
 
 def _drop_inside(img: np.ndarray, G: np.ndarray, tol: float) -> np.ndarray:
@@ -124,6 +133,7 @@ def general(
     c = pb.C.reshape(-1)
     Vo = po.h_to_v(pb.G0).V
     P = Vo if start is None else np.vstack([start, Vo])
+    too_far = GROWTH_MAX * float(np.max(np.linalg.norm(Vo, axis=1)))
     hist = [] if history is None else history
     Bd = pb.Dv @ pb.B1.T if pb.B1.shape[1] else np.zeros((1, pb.n))
     eps_l = np.inf
@@ -153,6 +163,8 @@ def general(
         img = po.minkowski_points(img, Bd) / lam_run  # step 8
         if mirror:
             img = np.vstack([img, -img])
+        if len(img) and not float(np.max(np.linalg.norm(img, axis=1))) <= too_far:
+            return IterResult(G, P, eps_l, it, False, hist, diverged=True)
         P = np.vstack([P, _drop_inside(img, G, drop_tol)])
     assert st is not None
     return IterResult(st.G, st.V, eps_l, it0 + max_iter, False, hist)

@@ -119,9 +119,17 @@ class _Run:
     extra: dict[str, Any] = field(default_factory=dict)
 
 
-def _budget(r: al.IterResult, o: Options) -> None:
+def _budget(r: al.IterResult, o: Options, run: _Run) -> None:
     """Stop the design when the iterations ran out of time (``[method] time_limit``): a
-    SolverError (exit 3) saying how far they got, instead of running for minutes."""
+    SolverError (exit 3) saying how far they got, instead of running for minutes. A run that
+    diverged (:data:`algorithms.GROWTH_MAX`) gets a note saying so (it is reported not
+    converged, exit 1, with its last polyhedron)."""
+    if r.diverged:
+        run.notes.append(
+            f"the general algorithm diverges: after {r.iterations} iterations a new vertex lies "
+            f"more than {al.GROWTH_MAX:g} times Ω's size from the origin (last ε = "
+            f"{r.eps:.6g} > λ = {float(o.lam):g}); stopped there, not converged"
+        )
     if r.timed_out:
         last = (
             f"last ε = {r.eps:.6g} > λ = {float(o.lam):g}"
@@ -153,7 +161,7 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
         r = al.symmetric(
             fl, lam, lam * (1 + dd), o.max_iterations, progress, history=hist, deadline=dl
         )
-        _budget(r, o)
+        _budget(r, o, run)
         run.iterations, run.converged = r.iterations, r.converged
         run.stage = final_stage(data, r.P, single, lam, dl, o)
         res = run.stage.res
@@ -179,7 +187,7 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
                     start=r.P, progress=progress, it0=r.iterations, history=hist,
                     deadline=dl,
                 )  # fmt: skip
-                _budget(r, o)
+                _budget(r, o, run)
                 run.iterations, run.converged = r.iterations, r.converged
                 run.stage = final_stage(data, r.P, single, lam, dl, o)
                 run.notes.append(
@@ -193,7 +201,7 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
             fl, lam_run, lam_stop, o.max_iterations, o.mirror, progress=progress, history=hist,
             deadline=dl,
         )  # fmt: skip
-        _budget(r, o)
+        _budget(r, o, run)
         run.iterations, run.converged = r.iterations, r.converged
         run.stage = final_stage(data, r.P, single, lam, dl, o)
     res = run.stage.res
@@ -210,7 +218,7 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
                     start=V0, progress=progress, it0=run.iterations, history=hist,
                     deadline=dl,
                 )  # fmt: skip
-                _budget(r, o)
+                _budget(r, o, run)
                 run.iterations, run.converged = r.iterations, r.converged
                 run.stage = final_stage(data, r.P, single, lam, dl, o)
     return run
