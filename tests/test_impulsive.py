@@ -265,3 +265,51 @@ def test_qsr_blocks_must_be_square_of_one_size() -> None:
     with pytest.raises(ValueError):
         QSR(qmat([[-1, 0], [0, -1]]), qmat([[0, 0], [0, 0]]), qmat([[1]]), "mine")
     assert QSR(qmat([[-1]]), qmat([[0]]), qmat([[1]]), "ok").k == 1
+
+
+@given(
+    st.floats(1e-300, 1 - 1e-9),
+    st.floats(0.0, 300.0),
+    st.floats(1e-6, 1e6),
+)
+def test_kappa_widest_positive_for_any_alpha(gamma: float, log_alpha: float, d0: float) -> None:
+    """The widest κ of (26b)-(26c) is positive (or inf: no interior maximum) for α from 1 to
+    10³⁰⁰, never 0 or NaN (α ≫ γ made (α − γ)/α round to 1 and κ = 0: exit 3 on valid
+    input); where the plain formula has full accuracy it agrees with it."""
+    from obsdesign.methods.impulsive.window import kappa_widest
+
+    alpha = max(10.0**log_alpha, 1.0)
+    if alpha <= gamma:
+        return
+    k = kappa_widest(d0, 0.0, gamma, alpha)
+    assert k > 0 and not np.isnan(k)
+    if gamma / alpha > 1e-6 and np.isfinite(k):
+        r = np.sqrt(np.log((alpha - gamma) / alpha) / np.log((1 - gamma) ** 2))
+        assert k == pytest.approx(d0 * r / (1 - r), rel=1e-6)
+
+
+def test_kappa_widest_with_a_huge_alpha_designs_and_verifies(tmp_path: Path) -> None:
+    """The audit's spec (α = 10¹⁶, κ = "widest"): exit 0, every claim certified, verify agrees;
+    κ = 0 or negative put into the report fails verify (exit 1), no internal error."""
+    text = (
+        '[system]\ntime = "continuous"\nA = [[0, 0], [0, -3]]\nC = [[1, 0]]\n'
+        'states = ["x1", "x2"]\npsi = ["0", "0"]\n[nonlinearity.o]\nlipschitz = 0.1\n'
+        '[nonlinearity.n]\nlipschitz = 0.1\n[method]\nkey = "impulsive"\nL = [0.8]\n'
+        'alpha = 1e16\nnoise_bound = 0.1\nM = [[0, 1]]\nkappa = "widest"\n'
+    )
+    spec = tmp_path / "wide.toml"
+    spec.write_text(text)
+    rep = api.design(spec)
+    assert rep.exit_code() == 0
+    assert all(c.status.value == "certified" for c in rep.claims)
+    assert rep.parameters["kappa"] > 0
+    out = tmp_path / "r.json"
+    out.write_text(rep.to_json())
+    assert api.verify(out).exit_code() == 0
+    for bad in ("0", "-1/10"):
+        d = json.loads(out.read_text())
+        d["parameters"]["exact"]["kappa"] = bad
+        d["parameters"]["kappa"] = float(Q(bad))
+        t = tmp_path / "t.json"
+        t.write_text(json.dumps(d))
+        assert api.verify(t).exit_code() == 1

@@ -112,8 +112,8 @@ def float_window(p: Problem, Mf: np.ndarray) -> float:
     if kmax <= 0:
         return kmax - 10.0
     kap = _kappa_float(p, max(varpi, 0.0), coup, g, kmax)
-    tmax = -np.log((1 - g) ** 2) / (max(varpi, 0.0) + kap + coup)
-    tmin = -np.log((float(p.alpha) - g) / float(p.alpha)) / kap
+    tmax = -2.0 * np.log1p(-g) / (max(varpi, 0.0) + kap + coup)  # (26b)
+    tmin = -np.log1p(-g / float(p.alpha)) / kap  # (26c), log1p: α ≫ γ keeps its digits
     return tmax - tmin
 
 

@@ -35,17 +35,29 @@ def kappa_max(kappa_n: Any, lam_no: Any, lam_on: Any, beta: Any) -> fmpq:
 
 
 def kappa_widest(varpi_o: float, coup: float, gamma: float, alpha: float) -> float:
-    """κ maximizing T_max(κ) − T_min(κ) = c₁/(D₀ + κ) − c₂/κ (26b)-(26c), D₀ = ϖ_o + coupling.
+    """κ maximizing T_max(κ) − T_min(κ) = c₁/(D₀ + κ) − c₂/κ (26b)-(26c), D₀ = ϖ_o + coupling,
+    c₁ = −ln((1−γ)²), c₂ = −ln((α − γ)/α).
 
-    Stationary point: κ/(D₀ + κ) = √(c₂/c₁), i.e. κ = D₀ r/(1 − r), r = √(c₂/c₁).
+    Stationary point: κ/(D₀ + κ) = √(c₂/c₁), i.e. κ = D₀ r/(1 − r), r = √(c₂/c₁). The
+    logarithms go through log1p: with α ≫ γ, (α − γ)/α rounds to 1 in floats and c₂ was 0,
+    so κ = 0 and the exact T_min bound (26c) refused it (exit 3 on valid input, found by the
+    soundness audit at α = 10¹⁶). r is formed in log space (c₂ ≈ γ/α may be subnormal) and a
+    κ that still underflows is returned as the smallest positive double: the caller caps it
+    by the largest admissible κ, and the exact checks decide the window either way.
     """
-    c1 = -np.log((1 - gamma) ** 2)
-    c2 = -np.log((alpha - gamma) / alpha)
-    r = np.sqrt(c2 / c1)
+    c1 = -2.0 * np.log1p(-gamma)
+    c2 = -np.log1p(-gamma / alpha)
     d0 = varpi_o + coup
-    if r >= 1 or d0 <= 0:
+    if d0 <= 0 or not c1 > 0:
         return np.inf
-    return d0 * r / (1 - r)
+    if c2 > 0:
+        r = float(np.exp(0.5 * (np.log(c2) - np.log(c1))))
+    else:  # γ/α below the float range: c₂ ≈ γ/α, its logarithm from the factors
+        r = float(np.exp(0.5 * (np.log(gamma) - np.log(alpha) - np.log(c1))))
+    if r >= 1:
+        return np.inf
+    kappa = d0 * r / (1 - r)
+    return kappa if kappa > 0 else float(np.nextafter(0.0, 1.0))
 
 
 def T_max_lower(gamma: Any, varpi_o: Any, kappa: Any, lam_no: Any, lam_on: Any, beta: Any) -> fmpq:
