@@ -384,3 +384,45 @@ def test_spec_fixed_kappa_and_K_are_bound(tmp_path):
     assert _failed(_report_with(rep, v, tmp_path)) == {"kappa-matches-spec"}
     v = _consistent(sp, K=49)
     assert _failed(_report_with(rep, v, tmp_path)) == {"K-matches-spec"}
+
+
+_INPUT_SPEC = """
+[system]
+time = "continuous"
+states = ["x1", "x2"]
+f = ["u1*x2", "-u1*x1"]
+h = ["x1"]
+u = ["{u}"]
+[method]
+key = "search-space"
+alpha = 0.9
+gamma_star = 0.05
+gamma0 = 1
+horizon = 6
+[method.E]
+lower = [-2, -2]
+upper = [2, 2]
+[method.D]
+lower = [0, -1]
+upper = [0, 1]
+[method.U]
+lower = [{lo}]
+upper = [{hi}]
+"""
+
+
+@pytest.mark.parametrize(
+    "u,lo,hi,status,code",
+    [
+        ("0.1", "0.1", "1", "certified", 0),  # the soundness audit's case (was failed, exit 1)
+        ("0.3*sin(t)", "-0.3", "0.3", "failed", 4),  # true, not provable in floats
+        ("0.31*sin(t)", "-0.3", "0.3", "failed", 1),  # proved violation
+    ],
+)
+def test_input_range_claim_exit_codes(u: str, lo: str, hi: str, status: str, code: int) -> None:
+    from obsdesign.api import load_spec_text
+
+    rep = api.design(load_spec_text(_INPUT_SPEC.format(u=u, lo=lo, hi=hi), "u.toml"))
+    claim = next(c for c in rep.claims if c.id == "input-range")
+    assert claim.status.value == status
+    assert rep.exit_code() == code

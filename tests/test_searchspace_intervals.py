@@ -14,6 +14,7 @@ from flint import fmpq
 from hypothesis import given
 from hypothesis import strategies as st
 
+from obsdesign.certify.exact import Q
 from obsdesign.methods.searchspace import bounds as B
 from obsdesign.methods.searchspace.intervals import (
     ONE,
@@ -125,10 +126,44 @@ def test_sup_norm_and_range():
     b = B.sup_norm(ex, ["x1", "x2"], [-1, -2], [1, 2], 100, 1e-6)
     assert b.upper >= math.sqrt(5) and b.upper <= math.sqrt(5) * (1 + 1e-12)
     u = [parse_expr("0.5*sin(t)", ["t"])]
-    ok, _, _ = B.range_inside(u, "t", 0, 8, [fmpq(-1, 2)], [fmpq(1, 2)], 64)
-    assert ok
-    ok, excess, _ = B.range_inside(u, "t", 0, 8, [fmpq(-1, 2)], [fmpq(49, 100)], 64)
-    assert not ok and excess > 0
+    ok, _, _, out = B.range_inside(u, "t", 0, 8, [fmpq(-1, 2)], [fmpq(1, 2)], 64)
+    assert ok and not out
+    ok, excess, _, out = B.range_inside(u, "t", 0, 8, [fmpq(-1, 2)], [fmpq(49, 100)], 64)
+    assert not ok and excess > 0 and out  # sin(π/2) = 1: proved outside
+
+
+@pytest.mark.parametrize(
+    "u,lo,hi,ok,out",
+    [
+        ("0.1", "1/10", "1", True, False),  # exactly at the bound (the audit's case)
+        ("0.7", "0", "7/10", True, False),
+        ("0.1000001", "0", "1/10", False, True),
+        ("pi/10", "31/100", "32/100", True, False),  # sympy decides real constants
+        ("sqrt(2)", "1", "14/10", False, True),
+        ("0.3*sin(t)", "-3/10", "3/10", False, False),  # true, not provable: inconclusive
+        ("0.31*sin(t)", "-3/10", "3/10", False, True),
+    ],
+)
+def test_range_inside_exact_constants_and_proved_violations(
+    u: str, lo: str, hi: str, ok: bool, out: bool
+) -> None:
+    """A constant u is compared exactly; "outside" only for a proved violation (an
+    enclosure wholly beyond a bound)."""
+    got = B.range_inside([parse_expr(u, ["t"])], "t", 0, 8, [Q(lo)], [Q(hi)], 256)
+    assert (got[0], got[3]) == (ok, out)
+
+
+@given(st.integers(-(10**6), 10**6), st.integers(-(10**6), 10**6), st.integers(-(10**6), 10**6))
+def test_constant_input_proved_iff_inside(c: int, a: int, b: int) -> None:
+    """u = c/1000 (a decimal literal) against U = [a/1000, b/1000]: proved inside iff
+    a ≤ c ≤ b exactly, proved outside otherwise."""
+    lo, hi = min(a, b), max(a, b)
+    text = f"{c / 1000:.3f}" if c >= 0 else f"-{-c / 1000:.3f}"
+    got = B.range_inside(
+        [parse_expr(text, ["t"])], "t", 0, 1, [fmpq(lo, 1000)], [fmpq(hi, 1000)], 16
+    )
+    inside = lo <= c <= hi
+    assert (got[0], got[3]) == (inside, not inside)
 
 
 def test_norm_upper_is_an_upper_bound():

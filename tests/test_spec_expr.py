@@ -89,3 +89,22 @@ def test_nondifferentiable_reported():
     e = parse_expr("floor(x1)", ["x1"])
     with pytest.raises(ValueError):
         e.derivative("x1")
+
+
+@pytest.mark.parametrize(
+    "text,num,den",
+    [
+        ("43.191", 43191, 1000),
+        ("1.5e-3", 3, 2000),
+        ("0.10000000000000000001", 10**19 + 1, 10**20),  # more digits than a float keeps
+        ("1_000.5", 2001, 2),
+    ],
+)
+def test_sympy_form_takes_decimal_literals_exactly(text: str, num: int, den: int) -> None:
+    """Expr.sympy() is the literal's exact rational (sympy's nsimplify made 43.191 a product
+    of surds that only approximates it)."""
+    import sympy as sp
+
+    from obsdesign.spec.expr import parse_expr
+
+    assert parse_expr(text, ["t"]).sympy() == sp.Rational(num, den)

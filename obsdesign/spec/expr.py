@@ -20,6 +20,7 @@ import functools
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from fractions import Fraction
 from typing import Any
 
 import numpy as np
@@ -389,7 +390,16 @@ def _to_sympy(node: ast.AST, ex: Expr) -> Any:
     import sympy as sp
 
     if isinstance(node, ast.Constant):
-        return sp.nsimplify(node.value) if isinstance(node.value, float) else sp.Integer(node.value)
+        if not isinstance(node.value, float):
+            return sp.Integer(node.value)
+        # the decimal literal's exact value, from the text the tree was parsed from (as the
+        # interval enclosures take it); sp.nsimplify made 43.191 a product of surds that only
+        # approximates it (found comparing a constant input with its bound exactly)
+        seg = ast.get_source_segment(ex.source.strip().replace("^", "**"), node)
+        try:
+            return sp.Rational(Fraction(seg.replace("_", "")) if seg else Fraction(node.value))
+        except (ValueError, ZeroDivisionError):
+            return sp.Rational(Fraction(node.value))
     if isinstance(node, ast.Name):
         if node.id in ex.parameters:
             from obsdesign.certify.exact import Q

@@ -301,29 +301,53 @@ def range_inside(
     lo: Sequence[Any],
     hi: Sequence[Any],
     budget: int,
-) -> tuple[bool, float, int]:
+) -> tuple[bool, float, int, bool]:
     """Whether every component i of ``exprs`` (functions of the one variable ``var``) stays in
-    [lo_i, hi_i] for var ∈ [t_lo, t_hi], by interval enclosures on a bisection of the
-    variable's interval (at most ``budget`` sub-intervals). Returns (proved, largest excess of
-    an enclosure beyond the bounds (0 when proved), sub-intervals used)."""
+    [lo_i, hi_i] for var ∈ [t_lo, t_hi] (Remark 2.5, Hernández & García), and whether some
+    point provably leaves it.
+
+    A component that does not depend on ``var`` is compared exactly (its sympy value: a
+    decimal literal is its exact rational, so u = 0.1 in [0.1, 1] is proved; float
+    enclosures of 0.1 reach below 0.1). The others go through interval enclosures on a
+    bisection of the variable's interval (at most ``budget`` sub-intervals). Returns
+    (proved inside, largest excess of an enclosure beyond the bounds (0 when proved),
+    sub-intervals used, proved outside: some enclosure, of a sub-interval or of a constant,
+    lies wholly beyond a bound)."""
     LO = [Fraction(int(q.p), int(q.q)) for q in lo]
     HI = [Fraction(int(q.p), int(q.q)) for q in hi]
+    live = []
+    outside = False
+    for i, ex in enumerate(exprs):
+        if ex.uses(var):
+            live.append(i)
+            continue
+        inside, out = _constant_inside(ex, LO[i], HI[i])
+        if out:
+            return False, math.inf, 0, True
+        if not inside:
+            live.append(i)  # not decided exactly: the enclosures below try
+    if not live:
+        return True, 0.0, 0, False
+    exprs = [exprs[i] for i in live]
+    LO, HI = [LO[i] for i in live], [HI[i] for i in live]
 
-    def excess(b: Box) -> float:
+    def excess(b: Box) -> tuple[float, bool]:
         try:
             vs = _enclose(exprs, [var], b, ())
         except (ArithmeticError, ValueError):
-            return math.inf
+            return math.inf, False
         worst = 0.0
+        out = False
         for d, a, z in zip(vs, LO, HI, strict=True):
             if not d.v.finite:
-                return math.inf
+                return math.inf, False
             below = a - Fraction(d.v.lo)
             above = Fraction(d.v.hi) - z
             worst = max(worst, float(below), float(above))
             if below > 0 or above > 0:
                 worst = max(worst, 1e-300)
-        return worst
+            out = out or Fraction(d.v.hi) < a or Fraction(d.v.lo) > z
+        return worst, out
 
     stack = [_box([t_lo], [t_hi])]
     used = 0
@@ -331,7 +355,8 @@ def range_inside(
     while stack:
         b = stack.pop()
         used += 1
-        ex = excess(b)
+        ex, out = excess(b)
+        outside = outside or out
         if ex <= 0.0:
             continue
         parts = _split(b, [1.0])
@@ -339,4 +364,26 @@ def range_inside(
             worst_left = max(worst_left, ex)
             continue
         stack.extend(parts)
-    return worst_left == 0.0, worst_left, used
+    return worst_left == 0.0, worst_left, used, outside
+
+
+def _constant_inside(ex: Expr, lo: Fraction, hi: Fraction) -> tuple[bool, bool]:
+    """(proved lo ≤ value ≤ hi, proved outside) for an expression without the variable,
+    compared exactly through sympy (rationals exactly; other real constants by sympy's
+    own decision, which is exact or undecided). Undecided: (False, False)."""
+    import sympy
+
+    try:
+        v = ex.sympy()
+        a, b = (
+            sympy.Rational(lo.numerator, lo.denominator),
+            sympy.Rational(hi.numerator, hi.denominator),
+        )
+        ge, le = (v >= a), (v <= b)
+    except (TypeError, ValueError, ArithmeticError, AttributeError):
+        return False, False
+    if ge is sympy.true and le is sympy.true:
+        return True, False
+    if ge is sympy.false or le is sympy.false:
+        return False, True
+    return False, False

@@ -286,17 +286,26 @@ def _input_range(c: Claims, spec: Spec) -> None:
         )
         return
     t1 = o.t0 + o.horizon
-    ok, excess, used = bounds.range_inside(
+    ok, excess, used, outside = bounds.range_inside(
         s.u_signal, "t", o.t0, t1, list(o.U.lower_q), list(o.U.upper_q), budget=4096
     )
-    _verdict(
-        c,
-        "input-range",
-        stmt + f" for every t ∈ [{fmt_exact(o.t0)}, {fmt_exact(t1)}]",
-        "Remark 2.5 (the fixed input u)",
-        f"interval enclosures of u on {used} sub-intervals of the horizon (outward rounding)",
-        ok,
-        f"an enclosure leaves U by up to {excess:.3g} (not proved)",
+    # failed and proved: u leaves U somewhere (exit 1); failed, not proved either way: the
+    # enclosures reach past U but nothing shows a point outside (inconclusive, exit 4)
+    c.exact(
+        id="input-range",
+        statement=stmt + f" for every t ∈ [{fmt_exact(o.t0)}, {fmt_exact(t1)}]",
+        reference=f"Remark 2.5 (the fixed input u), {PAPER}",
+        check="exact comparison of a constant u; interval enclosures of a time-varying u on "
+        f"{used} sub-intervals of the horizon (outward rounding)",
+        passed=ok,
+        detail=""
+        if ok
+        else (
+            "u leaves U: an enclosure lies wholly beyond a bound (proved)"
+            if outside
+            else f"an enclosure leaves U by up to {excess:.3g} (not proved either way)"
+        ),
+        float_ok=ok or not outside,
     )
 
 
