@@ -209,3 +209,18 @@ def test_pow_int_with_a_huge_exponent_does_not_recurse() -> None:
     assert big.lo == math.inf or big.lo > 1e300
     small = _pow_int(I(0.0, 0.5), k)
     assert small.lo == 0.0 and 0.0 <= small.hi <= 1e-300
+
+
+@pytest.mark.parametrize("text", ["-x1*step(x1)", "(-x1)*step(x1)", "step(x1)*(-x1)"])
+def test_negated_ramp_pattern_is_lipschitz(text: str) -> None:
+    """-X*step(X) (parsed as (-X)*step(X)) = -max(X, 0): Lipschitz constant 1 (it was
+    refused as unbounded, helper audit), and its enclosure on a box holds the true values;
+    -x2*step(x1) jumps in x1 where x2 ≠ 0 and stays refused."""
+    ex = [parse_expr(text, ["x1"])]
+    b = B.lipschitz(ex, ["x1"], ["x1"], [-1], [1], 200, 1e-3)
+    assert b.finite and 1.0 <= b.upper <= 1.0 + 1e-9
+    for lo, hi in ((-1.0, -0.5), (-0.25, 0.5), (0.25, 1.0)):
+        (d,) = B._enclose(ex, ["x1"], B._box([Q(lo)], [Q(hi)]), ())
+        assert d.v.lo <= -max(hi, 0.0) and -max(lo, 0.0) <= d.v.hi
+    jump = [parse_expr("-x2*step(x1)", ["x1", "x2"])]
+    assert not B.lipschitz(jump, ["x1", "x2"], ["x1", "x2"], [-1, -1], [1, 1], 200, 1e-3).finite

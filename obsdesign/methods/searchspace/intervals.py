@@ -23,7 +23,7 @@ hull of the gradients of the operands that may be active), so by Clarke's mean-v
 the magnitude of the enclosure bounds the Lipschitz constant on a convex box. A discontinuity
 (``step``, ``sign``, ``floor`` where they jump) gives an unbounded derivative: the function is
 not Lipschitz on that box. Two patterns are recognized exactly: ``X*step(X)`` (= max(X, 0),
-the paper's y = x₁·[x₁ > 0]) and ``X - floor(X)`` / ``mod(X, c)`` (the sawtooth input).
+the paper's y = x₁·[x₁ > 0]; also ``-X*step(X)``, which parses as ``(-X)*step(X)``) and ``X - floor(X)`` / ``mod(X, c)`` (the sawtooth input).
 """
 
 from __future__ import annotations
@@ -503,6 +503,14 @@ def evaluate(
                 if _is_call(s, "step", "heaviside") and _same(s.args[0], x):
                     a = evaluate(x, env, params, nd, src)
                     return d_max(a, _const(ZERO, nd))  # X*step(X) = max(X, 0)
+                if (
+                    _is_call(s, "step", "heaviside")
+                    and isinstance(x, ast.UnaryOp)
+                    and isinstance(x.op, ast.USub)
+                    and _same(s.args[0], x.operand)
+                ):  # -X*step(X) parses as (-X)*step(X) = -max(X, 0)
+                    a = evaluate(x.operand, env, params, nd, src)
+                    return d_neg(d_max(a, _const(ZERO, nd)))
         if op is ast.Sub and _is_call(right, "floor") and _same(right.args[0], left):
             return d_frac(evaluate(left, env, params, nd, src))
         a = evaluate(left, env, params, nd, src)
