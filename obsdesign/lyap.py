@@ -987,6 +987,29 @@ def _snap(x: fmpq, grid: fmpq, up: bool) -> fmpq:
 MAX_EXACT_CHECKS = 40
 
 
+class RateResolutionError(InconclusiveError):
+    """The best-rate bisection cannot narrow its bracket to ``rate_tol``: the float midpoint of
+    the two ends is one of them (the width is at the float resolution of the rate, where the
+    float Lyapunov solve cannot tell the ends apart). ``width`` is the narrowest bracket
+    reached, as a float; the design refuses the tolerance (a spec error naming
+    ``[method] rate_tol``) rather than report a bracket wider than asked."""
+
+    def __init__(self, tol: fmpq, width: fmpq, rate: fmpq) -> None:
+        super().__init__(
+            f"rate_tol = {float(tol):.3g} is below the float resolution of the rate near "
+            f"{float(rate):.6g}: the narrowest bracket reached has width {float(width):.3g}"
+        )
+        self.tol, self.width, self.rate = tol, width, rate
+
+    def hint(self) -> str:
+        """The spec error's wording: what was asked, what is reachable."""
+        return (
+            f"rate_tol = {float(self.tol):.3g} cannot be met: the best-rate bracket cannot be "
+            f"narrower than {float(self.width):.3g} near the rate {float(self.rate):.6g} (the "
+            f"float resolution there); expected rate_tol ≥ {float(self.width):.2g}"
+        )
+
+
 def best_rate(
     A: np.ndarray,
     C: np.ndarray,
@@ -1024,7 +1047,8 @@ def best_rate(
     all-exact bisection whenever certification is monotone in the rate (a forecast that
     wrongly calls a midpoint certified goes unnoticed only if a lower rate then certifies
     exactly). At most
-    :data:`MAX_EXACT_CHECKS` exact checks (then :class:`InconclusiveError`).
+    :data:`MAX_EXACT_CHECKS` exact checks (then :class:`InconclusiveError`). A bracket that
+    cannot be narrowed to ``tol`` in float midpoints raises :class:`RateResolutionError`.
 
     :param A, C, L: exact plant and gain; :param discrete: time domain; :param tol: bracket
     width; :param margin: δ of the checks; :param known: a certified (rate, P);
@@ -1073,6 +1097,9 @@ def best_rate(
         return rate_feasible(Acl, rate(r), discrete, memo, Af)
 
     bound = float(np.max(np.abs(eig))) if discrete else float(np.max(eig.real))
+    resolution = Q(abs(bound)) / 2**52  # about one ulp of the rate
+    if tol_q < resolution:  # no bisection in float midpoints gets there
+        raise RateResolutionError(tol_q, resolution, Q(bound))
     lo = _snap(Q(max(bound, 0.0)) if discrete else Q(bound), grid, False)
     # float error put the spectral bound above a feasible grid point. That error is about
     # u·ρ for a simple eigenvalue but u^(1/k) for a k-fold one (a triple pole at 0.5: 3·10⁻⁶),
@@ -1126,8 +1153,8 @@ def best_rate(
     while hi - lo > tol_q:
         # the midpoint through float64 (as the search always did: same candidates, same result)
         mid = _snap(Q(float((lo + hi) / 2)), grid, True)
-        if mid >= hi:
-            break
+        if mid >= hi or mid <= lo:
+            raise RateResolutionError(tol_q, hi - lo, rate(hi))
         if progress:
             progress(f"bisection {'λ' if discrete else 'α'} = {float(rate(mid)):.6g}")
         Pm = cert(mid)

@@ -309,3 +309,12 @@ def test_linear_observer_needs_A_and_C():
     with pytest.raises(SpecError) as e:
         load_spec_text(text.replace("[system]\n", '[system]\nstates = ["x1", "x2"]\n'), "a.toml")
     assert "system.A" in str(e.value)
+
+
+def test_rate_tol_below_float_resolution_is_a_spec_error():
+    """λ searched (no ``lambda``) with rate_tol = 10⁻¹⁷ below the float resolution of λ ≈ 0.95:
+    a spec error naming [method.rate_tol] (was: a failed bracket claim, exit 1)."""
+    text = variant(replace=(("lambda = 0.955\nrho = 0.955\n", "rate_tol = 1e-17\n"),))
+    with pytest.raises(SpecError) as e:
+        api.design(load_spec_text(text, "bad.toml"))
+    assert "method.rate_tol" in str(e.value) and "bad.toml" in str(e.value)

@@ -507,3 +507,16 @@ def test_best_rate_tolerance_beyond_float_resolution_stops(monkeypatch: pytest.M
     with pytest.raises(InconclusiveError, match="rate_tol"):
         best_rate(A5, C5, L5, True, tol=fmpq(1, 10**320), margin=MARGIN)
     assert calls[0] <= 200
+
+
+def test_best_rate_below_the_float_resolution_is_refused() -> None:
+    """rate_tol = 10⁻¹⁷ at λ ≈ 0.95 (ulp 1.1·10⁻¹⁶): the float midpoint of the last bracket is
+    one of its ends, so the search raises RateResolutionError with the width it reached (was:
+    a bracket wider than rate_tol reported, its claim failed, exit 1). 10⁻¹⁵ is met."""
+    with pytest.raises(lyap.RateResolutionError) as info:
+        best_rate(A5, C5, L5, True, tol=fmpq(1, 10**17), margin=MARGIN)
+    e = info.value
+    assert fmpq(1, 10**17) < e.width <= fmpq(1, 2**52) and "rate_tol" in e.hint()
+    tol = fmpq(1, 10**15)
+    br = best_rate(A5, C5, L5, True, tol=tol, margin=MARGIN)
+    assert 0 < br.best - br.other <= tol

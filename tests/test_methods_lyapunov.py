@@ -714,3 +714,18 @@ def test_rate_cap_caps_the_gain_design_not_the_reported_rate() -> None:
     rep = api.design(load_spec_text(text, "cap.toml"))
     assert rep.exit_code() == 0
     assert 1.4 < float(rep.parameters.float("alpha_best")) < 1.5
+
+
+@pytest.mark.parametrize("tol", ["1e-17", "1e-300"])
+def test_rate_tol_below_float_resolution_exit_2(tmp_path: Path, tol: str) -> None:
+    """A rate_tol the bisection cannot reach is a spec error naming [method.rate_tol], exit 2,
+    no report written (was: a failed bracket claim of the design's own making, exit 1)."""
+    spec = tmp_path / "s.toml"
+    spec.write_text(_designed("[[0.5, 1], [0, 0.9]]", "[[1, 0]]", extra=f"rate_tol = {tol}\n"))
+    out = tmp_path / "r.json"
+    res = runner.invoke(app, ["design", str(spec), "-o", str(out)])
+    assert res.exit_code == 2, res.output
+    assert "[method.rate_tol]" in res.output and "Traceback" not in res.output
+    assert not out.exists()
+    spec.write_text(_designed("[[0.5, 1], [0, 0.9]]", "[[1, 0]]", extra="rate_tol = 1e-15\n"))
+    assert runner.invoke(app, ["design", str(spec), "-o", str(out)]).exit_code == 0

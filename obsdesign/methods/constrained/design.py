@@ -16,7 +16,7 @@ from flint import fmpq
 from obsdesign import lyap
 from obsdesign.certify.exact import Q
 from obsdesign.certify.interval import sqrt_upper
-from obsdesign.errors import InconclusiveError, InfeasibleError
+from obsdesign.errors import InconclusiveError, InfeasibleError, SpecError
 from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
 from obsdesign.methods.constrained import bounds as B
 from obsdesign.methods.constrained.lyap import w_sq_max
@@ -63,7 +63,10 @@ def lyapunov_data(spec: Spec) -> LyapData:
         )
     bracket: tuple[fmpq | None, str] = (None, "")
     if o.lam is None:
-        br = lyap.best_rate(A, C, o.L, True, tol=o.rate_tol, margin=o.margin)
+        try:
+            br = lyap.best_rate(A, C, o.L, True, tol=o.rate_tol, margin=o.margin)
+        except lyap.RateResolutionError as e:
+            raise SpecError(spec.file, "method.rate_tol", e.hint()) from None
         lam, P = br.best, br.P
         bracket = (br.other, br.kind)
     else:

@@ -18,7 +18,7 @@ from flint import fmpq_mat
 from obsdesign import lyap
 from obsdesign.certify.detect import Detectability, detectability, unobservable_restriction
 from obsdesign.certify.printing import fmt_exact
-from obsdesign.errors import InconclusiveError, InfeasibleError, SolverError
+from obsdesign.errors import InconclusiveError, InfeasibleError, SolverError, SpecError
 from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
 from obsdesign.methods.lyapunov.options import Options
 from obsdesign.params import Parameters
@@ -106,19 +106,22 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
                 f"A − LC is not {'Schur' if s.discrete else 'Hurwitz'}: {lim} ({how})"
                 + ("" if o.L is None else " (the given L does not stabilize the error)")
             )
-    br = lyap.best_rate(
-        A,
-        C,
-        L,
-        s.discrete,
-        tol=o.rate_tol,
-        margin=o.margin,
-        known=known,
-        progress=progress,
-        memo=memo,
-        Acl=Acl,
-        Af=Af,
-    )
+    try:
+        br = lyap.best_rate(
+            A,
+            C,
+            L,
+            s.discrete,
+            tol=o.rate_tol,
+            margin=o.margin,
+            known=known,
+            progress=progress,
+            memo=memo,
+            Acl=Acl,
+            Af=Af,
+        )
+    except lyap.RateResolutionError as e:
+        raise SpecError(spec.file, "method.rate_tol", e.hint()) from None
     rate, P = (br.best, br.P) if known is None else known
     solver.extra["best_rate_exact_checks"] = br.exact_checks
     params["P"] = P
