@@ -108,3 +108,26 @@ def test_sympy_form_takes_decimal_literals_exactly(text: str, num: int, den: int
     from obsdesign.spec.expr import parse_expr
 
     assert parse_expr(text, ["t"]).sympy() == sp.Rational(num, den)
+
+
+@pytest.mark.parametrize(
+    "text,msg",
+    [
+        ("1e-99999999*sin(t)", "decimal exponent -99999999"),  # hung the input-range check
+        ("2*1E+1001", "decimal exponent 1001"),
+        ("1e400*t", "beyond the float range"),
+        ("t + .5e99999", "decimal exponent 99999"),
+    ],
+)
+def test_literal_beyond_the_exponent_limit_is_refused(text: str, msg: str) -> None:
+    """A literal's exact value is taken from its text (interval enclosures, sympy): its
+    exponent is bounded like the spec's numbers (max_exponent), and a literal beyond the float
+    range is refused, naming the key."""
+    with pytest.raises(SpecError) as e:
+        parse_expr(text, ["t"], file="s.toml", key="system.u")
+    assert msg in str(e.value) and "[system.u]" in str(e.value)
+
+
+def test_literal_at_the_exponent_limit_is_kept() -> None:
+    ex = parse_expr("1e-1000*t + 1e300 + x1e5", ["t", "x1e5"])
+    assert float(ex(t=1.0, x1e5=0.0)) == 1e300

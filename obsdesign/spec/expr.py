@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import ast
 import functools
+import math
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -190,6 +191,14 @@ def parse_expr(
     tree_depth = _tree_depth(tree)
     if tree_depth > lim.max_expr_depth:
         raise SpecError(file, key, _too_deep(tree_depth))
+    for m in _EXPONENT.finditer(text):
+        if abs(int(m.group(1))) > lim.max_exponent:
+            raise SpecError(
+                file,
+                key,
+                f"has the constant {m.group(0).strip()[:40]}: decimal exponent {int(m.group(1))}, "
+                f"outside ±{lim.max_exponent} (--limit max_exponent=N)",
+            )
     known = set(variables) | set(parameters) | set(CONSTANTS)
     clash = set(variables) & (set(parameters) | set(FUNCTIONS))
     if clash:
@@ -208,6 +217,12 @@ def _too_deep(depth: int) -> str:
         f"(--limit max_expr_depth=N)"
     )
 
+
+#: a decimal exponent in a numeric literal, bounded by the ``max_exponent`` limit as the
+#: spec's numbers are: the exact value of a literal (the interval enclosures and the sympy
+#: form take decimal literals exactly) is otherwise a power of ten with that many digits
+#: (u = "1e-99999999*sin(t)" hung the input-range check)
+_EXPONENT = re.compile(r"(?<![A-Za-z_\d.])(?:\d+\.?\d*|\.\d+)[eE]([+-]?\d+)")
 
 _TOKEN = re.compile(
     r"\s*(?:(\d+\.?\d*(?:[eE][+-]?\d+)?|\.\d+(?:[eE][+-]?\d+)?)|([A-Za-z_]\w*)|(\*\*|[-+*/%^(),]))"
@@ -325,6 +340,8 @@ def _compile(node: ast.AST, known: set[str], file: str, key: str) -> Fn:
         if isinstance(node.value, int) and node.value.bit_length() > 1024:
             raise SpecError(file, key, "has an integer constant beyond the float range")
         c = float(node.value)
+        if not math.isfinite(c):
+            raise SpecError(file, key, "has a constant beyond the float range")
         return lambda env: c
     if isinstance(node, ast.Name):
         name = node.id
