@@ -415,7 +415,8 @@ upper = [{hi}]
     "u,lo,hi,status,code",
     [
         ("0.1", "0.1", "1", "certified", 0),  # the soundness audit's case (was failed, exit 1)
-        ("0.3*sin(t)", "-0.3", "0.3", "failed", 4),  # true, not provable in floats
+        ("0.3*sin(t)", "-0.3", "0.3", "certified", 0),  # attained: exact end points (was 4)
+        ("0.3*sin(t) + 1e-30", "-0.3", "0.3", "failed", 4),  # over by 1e-30: not proved either way
         ("0.31*sin(t)", "-0.3", "0.3", "failed", 1),  # proved violation
     ],
 )

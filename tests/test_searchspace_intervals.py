@@ -140,7 +140,13 @@ def test_sup_norm_and_range():
         ("0.1000001", "0", "1/10", False, True),
         ("pi/10", "31/100", "32/100", True, False),  # sympy decides real constants
         ("sqrt(2)", "1", "14/10", False, True),
-        ("0.3*sin(t)", "-3/10", "3/10", False, False),  # true, not provable: inconclusive
+        ("0.3*sin(t)", "-3/10", "3/10", True, False),  # attained: the exact end points
+        ("0.3*sin(t) + 1e-30", "-3/10", "3/10", False, False),  # 10⁻³⁰ over: never proved in
+        ("0.5 + 0.6*sin(2*t)", "-1/10", "11/10", True, False),
+        ("0.5 + 0.6*sin(2*t)", "-1/10", "1099999/1000000", False, True),
+        ("floor(t) - t + 1", "0", "1", True, False),
+        ("t - floor(t)", "0", "1", True, False),
+        ("t - floor(t)", "1/1000000", "1", False, True),  # 0 at t = 0
         ("0.31*sin(t)", "-3/10", "3/10", False, True),
     ],
 )

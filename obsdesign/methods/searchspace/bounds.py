@@ -36,6 +36,7 @@ from obsdesign.methods.searchspace.intervals import (
     mul_hi,
     sqrt_hi,
 )
+from obsdesign.methods.searchspace.qintervals import QI, evaluate_q
 from obsdesign.spec.expr import Expr
 
 
@@ -309,7 +310,10 @@ def range_inside(
     A component that does not depend on ``var`` is compared exactly (its sympy value: a
     decimal literal is its exact rational, so u = 0.1 in [0.1, 1] is proved; float
     enclosures of 0.1 reach below 0.1). The others go through interval enclosures on a
-    bisection of the variable's interval (at most ``budget`` sub-intervals). Returns
+    bisection of the variable's interval (at most ``budget`` sub-intervals): the float
+    enclosure first and, where it does not prove a bound, the enclosure with exact rational
+    end points (:mod:`~obsdesign.methods.searchspace.qintervals`: u = 0.3·sin(t) in
+    [−0.3, 0.3] is proved; the float enclosure reaches 0.30000000000000004). Returns
     (proved inside, largest excess of an enclosure beyond the bounds (0 when proved),
     sub-intervals used, proved outside: some enclosure, of a sub-interval or of a constant,
     lies wholly beyond a bound)."""
@@ -338,15 +342,20 @@ def range_inside(
             return math.inf, False
         worst = 0.0
         out = False
-        for d, a, z in zip(vs, LO, HI, strict=True):
+        for k, (d, a, z) in enumerate(zip(vs, LO, HI, strict=True)):
             if not d.v.finite:
                 return math.inf, False
-            below = a - Fraction(d.v.lo)
-            above = Fraction(d.v.hi) - z
+            lo_k, hi_k = Fraction(d.v.lo), Fraction(d.v.hi)
+            if lo_k < a or hi_k > z:  # not proved in floats: the exact-end-point enclosure
+                q = _enclose_q(exprs[k], var, b)
+                if q is not None:
+                    lo_k, hi_k = max(lo_k, q.lo), min(hi_k, q.hi)
+            below = a - lo_k
+            above = hi_k - z
             worst = max(worst, float(below), float(above))
             if below > 0 or above > 0:
                 worst = max(worst, 1e-300)
-            out = out or Fraction(d.v.hi) < a or Fraction(d.v.lo) > z
+            out = out or hi_k < a or lo_k > z
         return worst, out
 
     stack = [_box([t_lo], [t_hi])]
@@ -365,6 +374,19 @@ def range_inside(
             continue
         stack.extend(parts)
     return worst_left == 0.0, worst_left, used, outside
+
+
+def _enclose_q(ex: Expr, var: str, b: Box) -> QI | None:
+    """The exact-end-point enclosure of ``ex`` over the one-variable box b
+    (:func:`~obsdesign.methods.searchspace.qintervals.evaluate_q`), or None when it finds no
+    finite one."""
+    params = {k: QI.of_float(v) for k, v in _params([ex]).items()}
+    try:
+        return evaluate_q(
+            ex.tree, {var: QI.of_float(b[0])}, params, ex.source.strip().replace("^", "**")
+        )
+    except (ArithmeticError, ValueError, KeyError):
+        return None
 
 
 def _constant_inside(ex: Expr, lo: Fraction, hi: Fraction) -> tuple[bool, bool]:

@@ -296,7 +296,8 @@ def _input_range(c: Claims, spec: Spec) -> None:
         statement=stmt + f" for every t ∈ [{fmt_exact(o.t0)}, {fmt_exact(t1)}]",
         reference=f"Remark 2.5 (the fixed input u), {PAPER}",
         check="exact comparison of a constant u; interval enclosures of a time-varying u on "
-        f"{used} sub-intervals of the horizon (outward rounding)",
+        f"{used} sub-intervals of the horizon (outward rounding, then exact rational end "
+        "points where the floats do not prove a bound)",
         passed=ok,
         detail=""
         if ok

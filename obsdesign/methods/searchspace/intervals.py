@@ -23,7 +23,7 @@ hull of the gradients of the operands that may be active), so by Clarke's mean-v
 the magnitude of the enclosure bounds the Lipschitz constant on a convex box. A discontinuity
 (``step``, ``sign``, ``floor`` where they jump) gives an unbounded derivative: the function is
 not Lipschitz on that box. Two patterns are recognized exactly: ``X*step(X)`` (= max(X, 0),
-the paper's y = x₁·[x₁ > 0]; also ``-X*step(X)``, which parses as ``(-X)*step(X)``) and ``X - floor(X)`` / ``mod(X, c)`` (the sawtooth input).
+the paper's y = x₁·[x₁ > 0]; also ``-X*step(X)``, which parses as ``(-X)*step(X)``) and ``X - floor(X)`` / ``mod(X, c)`` (the sawtooth input; ``floor(X) - X`` is its negative).
 """
 
 from __future__ import annotations
@@ -513,6 +513,8 @@ def evaluate(
                     return d_neg(d_max(a, _const(ZERO, nd)))
         if op is ast.Sub and _is_call(right, "floor") and _same(right.args[0], left):
             return d_frac(evaluate(left, env, params, nd, src))
+        if op is ast.Sub and _is_call(left, "floor") and _same(left.args[0], right):
+            return d_neg(d_frac(evaluate(right, env, params, nd, src)))  # floor(X) - X
         a = evaluate(left, env, params, nd, src)
         if op in (ast.Pow, ast.BitXor):
             if isinstance(right, ast.Constant) and float(right.value) == int(right.value):

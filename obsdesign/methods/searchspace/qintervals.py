@@ -1,0 +1,268 @@
+"""Interval enclosures with exact rational end points of a spec expression's value (no
+derivatives), for the input-range claim u(t) ∈ U (Remark 2.5, Hernández & García).
+
+The float enclosures of :mod:`obsdesign.methods.searchspace.intervals` round every operation
+outward, so a bound the input attains exactly is never proved: u = 0.3·sin(t) against
+U = [−0.3, 0.3] gives 0.3 (the nearest double, below 0.3) times [−1, 1], rounded out to
+±0.30000000000000004 (exit 4, "not proved either way"). A :class:`QI` keeps its end points as
+``Fraction`` and is exact wherever the arithmetic is rational:
+
+- decimal literals at their exact value, ``+ − × ÷`` and integer powers exactly (÷ refuses a
+  divisor interval that contains 0), ``abs max min sat step heaviside sign floor mod`` and the
+  patterns ``X*step(X)``, ``-X*step(X)``, ``X - floor(X)``, ``floor(X) - X`` exactly;
+- the smooth functions (``sin cos tan exp log sqrt atan tanh sinh cosh``) through the float
+  enclosure of their argument (:func:`~obsdesign.methods.searchspace.intervals.d_fn`,
+  rigorous) intersected with the exact range of the function: [−1, 1] for sin, cos and tanh,
+  [0, ∞) for exp and sqrt, [1, ∞) for cosh; so sin(t) on any interval lies in [−1, 1] exactly,
+  and 0.5 + 0.6·sin(2t) in [−0.1, 1.1];
+- anything else (a non-integer power, ``pi`` and ``e``) through the float enclosure of that
+  sub-expression, converted exactly.
+
+Every result contains the exact value of the expression at every point of the box (each rule
+is an interval extension of the operation, and an intersection of two enclosures is one).
+"""
+
+from __future__ import annotations
+
+import ast
+import math
+from dataclasses import dataclass
+from fractions import Fraction
+
+from obsdesign.methods.searchspace.intervals import (
+    _CONSTS,
+    Dual,
+    I,
+    _is_call,
+    _lit,
+    _same,
+    d_fn,
+    evaluate,
+)
+
+_SMOOTH = ("exp", "log", "sqrt", "sin", "cos", "tan", "atan", "tanh", "sinh", "cosh")
+#: the exact range of a smooth function, where it has a rational one
+_RANGE: dict[str, tuple[Fraction | None, Fraction | None]] = {
+    "sin": (Fraction(-1), Fraction(1)),
+    "cos": (Fraction(-1), Fraction(1)),
+    "tanh": (Fraction(-1), Fraction(1)),
+    "exp": (Fraction(0), None),
+    "sqrt": (Fraction(0), None),
+    "cosh": (Fraction(1), None),
+}
+
+
+@dataclass(frozen=True, slots=True)
+class QI:
+    """A closed interval [lo, hi] with exact rational (finite) end points."""
+
+    lo: Fraction
+    hi: Fraction
+
+    @staticmethod
+    def point(x: Fraction) -> QI:
+        return QI(x, x)
+
+    @staticmethod
+    def of_float(x: I) -> QI:
+        """The float interval x, exactly (ArithmeticError when an end point is infinite)."""
+        if not x.finite:
+            raise ArithmeticError("unbounded enclosure")
+        return QI(Fraction(x.lo), Fraction(x.hi))
+
+    def to_float(self) -> I:
+        """The tightest float interval containing this one."""
+        return I(I.of_q(self.lo).lo, I.of_q(self.hi).hi)
+
+    def __add__(self, o: QI) -> QI:
+        return QI(self.lo + o.lo, self.hi + o.hi)
+
+    def __neg__(self) -> QI:
+        return QI(-self.hi, -self.lo)
+
+    def __sub__(self, o: QI) -> QI:
+        return QI(self.lo - o.hi, self.hi - o.lo)
+
+    def __mul__(self, o: QI) -> QI:
+        ps = [a * b for a in (self.lo, self.hi) for b in (o.lo, o.hi)]
+        return QI(min(ps), max(ps))
+
+    def __truediv__(self, o: QI) -> QI:
+        if o.lo <= 0 <= o.hi:
+            raise ArithmeticError("division by an interval that contains 0")
+        return self * QI(1 / o.hi, 1 / o.lo)
+
+    def meet(self, lo: Fraction | None, hi: Fraction | None) -> QI:
+        """The intersection with [lo, hi] (None: unbounded), where the exact range of the
+        enclosed values is known to lie (so the intersection is never empty)."""
+        a = self.lo if lo is None else max(self.lo, lo)
+        b = self.hi if hi is None else min(self.hi, hi)
+        return QI(a, b) if a <= b else self
+
+    def abs(self) -> QI:
+        if self.lo >= 0:
+            return self
+        if self.hi <= 0:
+            return -self
+        return QI(Fraction(0), max(-self.lo, self.hi))
+
+
+ZERO_Q = QI(Fraction(0), Fraction(0))
+ONE_Q = QI(Fraction(1), Fraction(1))
+
+
+def qmax(a: QI, b: QI) -> QI:
+    return QI(max(a.lo, b.lo), max(a.hi, b.hi))
+
+
+def qmin(a: QI, b: QI) -> QI:
+    return QI(min(a.lo, b.lo), min(a.hi, b.hi))
+
+
+def qstep(a: QI, sign: bool = False) -> QI:
+    """step(a) = [a > 0], or sign(a) (as :func:`~.intervals.d_step`, values only)."""
+    if a.lo > 0:
+        return ONE_Q
+    if a.hi < 0 or (a.hi <= 0 and not sign):
+        return QI(Fraction(-1), Fraction(-1)) if sign else ZERO_Q
+    if sign and a.lo == a.hi == 0:
+        return ZERO_Q
+    return QI(Fraction(-1 if (sign and a.lo < 0) else 0), Fraction(1 if a.hi > 0 else 0))
+
+
+def qfloor(a: QI) -> QI:
+    return QI(Fraction(math.floor(a.lo)), Fraction(math.floor(a.hi)))
+
+
+def qfrac(a: QI) -> QI:
+    """a − floor(a) ∈ [0, 1): exact where floor(a) is constant."""
+    k = math.floor(a.lo)
+    if k == math.floor(a.hi):
+        return a - QI.point(Fraction(k))
+    return QI(Fraction(0), Fraction(1))
+
+
+def qpow_int(a: QI, k: int) -> QI:
+    """a^k for an integer k, exactly (k < 0: 1/a^|k|, refused when a contains 0). The
+    exponent's size is the caller's to bound (the spec's expression limits)."""
+    if k == 0:
+        return ONE_Q
+    if k < 0:
+        return ONE_Q / qpow_int(a, -k)
+    lo, hi = a.lo**k, a.hi**k
+    if k % 2 == 1:
+        return QI(lo, hi)
+    if a.lo <= 0 <= a.hi:
+        return QI(Fraction(0), max(lo, hi))
+    return QI(min(lo, hi), max(lo, hi))
+
+
+def _qmod(a: QI, b: QI) -> QI:
+    """mod(a, b) = b·frac(a/b) for b > 0."""
+    if b.lo <= 0:
+        raise ArithmeticError("mod(a, b) is enclosed only for b > 0")
+    return qfrac(a / b) * b
+
+
+#: integer powers beyond this exponent go through the float enclosure (the exact end points
+#: of x^k grow like k digits)
+MAX_EXACT_POWER = 64
+
+
+def evaluate_q(node: ast.AST, env: dict[str, QI], params: dict[str, QI], src: str | None) -> QI:
+    """Enclosure of the value of ``node`` over the box ``env`` (variable → :class:`QI`),
+    ``params`` the spec parameters' intervals, ``src`` the text the tree was parsed from
+    (decimal literals at their exact value). Raises ArithmeticError or ValueError when no
+    finite enclosure is found (the caller then says "not proved")."""
+    if isinstance(node, ast.Expression):
+        node = node.body
+    if isinstance(node, ast.Constant):
+        seg = ast.get_source_segment(src, node) if src is not None else None
+        try:
+            return QI.point(Fraction(seg)) if seg is not None else _float_q(node, env, params, src)
+        except (ValueError, ZeroDivisionError):
+            return QI.of_float(_lit(float(node.value), 0).v)
+    if isinstance(node, ast.Name):
+        if node.id in env:
+            return env[node.id]
+        if node.id in params:
+            return params[node.id]
+        return QI.of_float(_CONSTS[node.id])
+    if isinstance(node, ast.UnaryOp):
+        a = evaluate_q(node.operand, env, params, src)
+        return -a if isinstance(node.op, ast.USub) else a
+    if isinstance(node, ast.BinOp):
+        return _binop(node, env, params, src)
+    if isinstance(node, ast.Call) and isinstance(node.func, ast.Name):
+        name = node.func.id
+        if name in _SMOOTH:
+            a = evaluate_q(node.args[0], env, params, src)
+            v = d_fn(Dual(a.to_float(), ()), name).v
+            return QI.of_float(v).meet(*_RANGE.get(name, (None, None)))
+        args = [evaluate_q(x, env, params, src) for x in node.args]
+        if name == "abs":
+            return args[0].abs()
+        if name == "max":
+            return qmax(args[0], args[1])
+        if name == "min":
+            return qmin(args[0], args[1])
+        if name == "sat":
+            r = args[1] if len(args) == 2 else ONE_Q
+            return qmax(-r, qmin(r, args[0]))
+        if name in ("step", "heaviside"):
+            return qstep(args[0])
+        if name == "sign":
+            return qstep(args[0], sign=True)
+        if name == "floor":
+            return qfloor(args[0])
+        if name == "mod":
+            return _qmod(args[0], args[1])
+    return _float_q(node, env, params, src)
+
+
+def _binop(node: ast.BinOp, env: dict[str, QI], params: dict[str, QI], src: str | None) -> QI:
+    op = type(node.op)
+    left, right = node.left, node.right
+    if op is ast.Mult:
+        for x, s in ((left, right), (right, left)):
+            if _is_call(s, "step", "heaviside") and _same(s.args[0], x):
+                return qmax(evaluate_q(x, env, params, src), ZERO_Q)  # X*step(X) = max(X, 0)
+            if (
+                _is_call(s, "step", "heaviside")
+                and isinstance(x, ast.UnaryOp)
+                and isinstance(x.op, ast.USub)
+                and _same(s.args[0], x.operand)
+            ):  # -X*step(X) parses as (-X)*step(X) = -max(X, 0)
+                return -qmax(evaluate_q(x.operand, env, params, src), ZERO_Q)
+    if op is ast.Sub and _is_call(right, "floor") and _same(right.args[0], left):
+        return qfrac(evaluate_q(left, env, params, src))
+    if op is ast.Sub and _is_call(left, "floor") and _same(left.args[0], right):
+        return -qfrac(evaluate_q(right, env, params, src))  # floor(X) - X = -frac(X)
+    if op in (ast.Pow, ast.BitXor):
+        if (
+            isinstance(right, ast.Constant)
+            and float(right.value) == int(right.value)
+            and abs(int(right.value)) <= MAX_EXACT_POWER
+        ):
+            return qpow_int(evaluate_q(left, env, params, src), int(right.value))
+        return _float_q(node, env, params, src)
+    a = evaluate_q(left, env, params, src)
+    b = evaluate_q(right, env, params, src)
+    if op is ast.Add:
+        return a + b
+    if op is ast.Sub:
+        return a - b
+    if op is ast.Mult:
+        return a * b
+    if op is ast.Div:
+        return a / b
+    if op is ast.Mod:
+        return _qmod(a, b)
+    raise ValueError(f"operator {op.__name__}")
+
+
+def _float_q(node: ast.AST, env: dict[str, QI], params: dict[str, QI], src: str | None) -> QI:
+    """The float enclosure of the sub-expression ``node`` (rigorous), converted exactly."""
+    fenv = {k: Dual(v.to_float(), ()) for k, v in env.items()}
+    fpar = {k: v.to_float() for k, v in params.items()}
+    return QI.of_float(evaluate(node, fenv, fpar, 0, src).v)

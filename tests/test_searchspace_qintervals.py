@@ -1,0 +1,104 @@
+"""Exact-end-point value enclosures (obsdesign.methods.searchspace.qintervals): every
+enclosure contains the exact value at every point of its box, and it is exact where the
+arithmetic is rational."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+import pytest
+import sympy
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from obsdesign.methods.searchspace.qintervals import QI, evaluate_q, qpow_int
+from obsdesign.spec.expr import parse_expr
+
+TEMPLATES = [
+    "{a}*sin({k}*t) + {c}",
+    "{a}*cos(t)^2 - {c}",
+    "({a}*t - {c})^3",
+    "abs({a}*t - {c}) + floor(t)",
+    "sat({a}*t, {k}) * {c}",
+    "t - floor(t) + {c}*step(t - {k})",
+    "floor(t) - t + {a}",
+    "mod({a}*t, {k})",
+    "max({a}*t, {c}) - min(t, {k})",
+    "exp(-{k}*t) * {a}",
+    "tanh({a}*t) + sqrt(t + {k})",
+    "{a}/(t + {k})",
+    "(t - {c})*step(t - {c})",
+    "-(t - {c})*step(t - {c})",
+    "sign(t - {c}) * {a}",
+]
+
+
+def _enclose(text: str, lo: Fraction, hi: Fraction) -> QI:
+    ex = parse_expr(text, ["t"])
+    return evaluate_q(ex.tree, {"t": QI(lo, hi)}, {}, ex.source.strip().replace("^", "**"))
+
+
+def _exact(text: str, t: Fraction) -> sympy.Expr:
+    ex = parse_expr(text, ["t"])
+    return ex.sympy().subs(sympy.Symbol("t"), sympy.Rational(t.numerator, t.denominator))
+
+
+@settings(max_examples=120, deadline=None)
+@given(
+    st.sampled_from(TEMPLATES),
+    st.integers(-30, 30),
+    st.integers(1, 9),
+    st.integers(-30, 30),
+    st.integers(0, 800),
+    st.integers(0, 300),
+    st.lists(st.integers(0, 1000), min_size=3, max_size=3),
+)
+def test_enclosure_contains_the_exact_value(
+    tpl: str, a: int, k: int, c: int, t0: int, w: int, fracs: list[int]
+) -> None:
+    """At rational points of a random sub-interval of [0, 11], the exact value (sympy: exact
+    for rational arithmetic, 60 digits for the transcendental functions) lies in the
+    enclosure of the sub-interval."""
+    text = tpl.format(a=a / 10, k=k, c=c / 10)
+    lo, hi = Fraction(t0, 100), Fraction(t0 + w, 100)
+    q = _enclose(text, lo, hi)
+    assert q.lo <= q.hi
+    for f in [0, 1000, *fracs]:
+        t = lo + (hi - lo) * Fraction(f, 1000)
+        v = _exact(text, t)
+        if v.is_Rational:
+            assert q.lo <= Fraction(int(v.p), int(v.q)) <= q.hi, (text, t)
+        else:
+            x = sympy.Float(v.evalf(60), 60)
+            assert sympy.Rational(q.lo.numerator, q.lo.denominator) <= x, (text, t)
+            assert x <= sympy.Rational(q.hi.numerator, q.hi.denominator), (text, t)
+
+
+@pytest.mark.parametrize(
+    "text,lo,hi,want",
+    [
+        ("0.3*sin(t)", 0, 8, (Fraction(-3, 10), Fraction(3, 10))),
+        ("0.5 + 0.6*sin(2*t)", 0, 8, (Fraction(-1, 10), Fraction(11, 10))),
+        ("0.1*t^2 - t", -1, 2, (Fraction(-2), Fraction(7, 5))),  # no dependency tracking
+        ("floor(t) - t + 1", Fraction(1, 2), 3, (Fraction(0), Fraction(1))),
+        ("(t - 1)*step(t - 1)", 0, 2, (Fraction(0), Fraction(1))),
+        ("t/(t + 1)", 1, 3, (Fraction(1, 4), Fraction(3, 2))),
+    ],
+)
+def test_exact_where_rational(text: str, lo: int, hi: int, want: tuple) -> None:
+    q = _enclose(text, Fraction(lo), Fraction(hi))
+    assert (q.lo, q.hi) == want
+
+
+def test_refusals_and_powers() -> None:
+    """A divisor interval containing 0 raises (the caller says "not proved"); integer powers
+    are exact with the sign rules of even and odd exponents."""
+    with pytest.raises(ArithmeticError):
+        _enclose("1/t", Fraction(-1), Fraction(1))
+    x = QI(Fraction(-2), Fraction(1))
+    assert qpow_int(x, 2) == QI(Fraction(0), Fraction(4))
+    assert qpow_int(x, 3) == QI(Fraction(-8), Fraction(1))
+    assert qpow_int(QI(Fraction(1, 2), Fraction(2)), -2) == QI(Fraction(1, 4), Fraction(4))
+    # a non-integer power goes through the float enclosure: contains 2^0.5
+    q = _enclose("t^0.5", Fraction(2), Fraction(2))
+    assert q.lo < Fraction(14142135623730951, 10**16) and q.hi > Fraction(14142135623730950, 10**16)
