@@ -102,3 +102,17 @@ def test_refusals_and_powers() -> None:
     # a non-integer power goes through the float enclosure: contains 2^0.5
     q = _enclose("t^0.5", Fraction(2), Fraction(2))
     assert q.lo < Fraction(14142135623730951, 10**16) and q.hi > Fraction(14142135623730950, 10**16)
+
+
+def test_nested_powers_stay_small() -> None:
+    """((t^64)^64)^64 on [1/2, 3/4]: the exact end points would have ~10⁶ bits; they are
+    widened to the enclosing float interval past MAX_BITS (3/4 to the 262144th underflows to
+    the smallest subnormal or 0 in floats: the enclosure still contains the value)."""
+    from obsdesign.methods.searchspace import qintervals as qi
+
+    q = _enclose("((t^64)^64)^64", Fraction(1, 2), Fraction(3, 4))
+    assert q.lo >= 0 and q.hi > 0
+    assert max(q.hi.numerator.bit_length(), q.hi.denominator.bit_length()) <= 1100
+    assert q.lo <= Fraction(1, 2) ** 262144 and q.hi >= Fraction(3, 4) ** 262144
+    big = qi._cap(QI(Fraction(3, 4) ** 4000, Fraction(1)))
+    assert big.lo <= Fraction(3, 4) ** 4000 and big.hi == 1

@@ -167,6 +167,31 @@ def _qmod(a: QI, b: QI) -> QI:
 #: integer powers beyond this exponent go through the float enclosure (the exact end points
 #: of x^k grow like k digits)
 MAX_EXACT_POWER = 64
+#: an end point whose numerator or denominator passes this many bits is widened to the
+#: enclosing float interval (rigorous), so nested powers such as ((t^64)^64)^64 cannot
+#: build numbers of millions of digits
+MAX_BITS = 4096
+
+
+def _bits(q: QI) -> int:
+    """The largest bit length of a numerator or denominator of q's end points."""
+    return max(
+        q.lo.numerator.bit_length(),
+        q.lo.denominator.bit_length(),
+        q.hi.numerator.bit_length(),
+        q.hi.denominator.bit_length(),
+    )
+
+
+def _cap(q: QI) -> QI:
+    """q, or the float interval enclosing it when an end point has grown past MAX_BITS
+    (ArithmeticError when that is beyond the float range)."""
+    if _bits(q) > MAX_BITS:
+        try:
+            return QI.of_float(q.to_float())
+        except OverflowError:
+            raise ArithmeticError("enclosure beyond the float range") from None
+    return q
 
 
 def evaluate_q(node: ast.AST, env: dict[str, QI], params: dict[str, QI], src: str | None) -> QI:
@@ -192,7 +217,7 @@ def evaluate_q(node: ast.AST, env: dict[str, QI], params: dict[str, QI], src: st
         a = evaluate_q(node.operand, env, params, src)
         return -a if isinstance(node.op, ast.USub) else a
     if isinstance(node, ast.BinOp):
-        return _binop(node, env, params, src)
+        return _cap(_binop(node, env, params, src))
     if isinstance(node, ast.Call) and isinstance(node.func, ast.Name):
         name = node.func.id
         if name in _SMOOTH:
@@ -244,7 +269,9 @@ def _binop(node: ast.BinOp, env: dict[str, QI], params: dict[str, QI], src: str 
             and float(right.value) == int(right.value)
             and abs(int(right.value)) <= MAX_EXACT_POWER
         ):
-            return qpow_int(evaluate_q(left, env, params, src), int(right.value))
+            a = evaluate_q(left, env, params, src)
+            if _bits(a) * abs(int(right.value)) <= MAX_BITS:
+                return qpow_int(a, int(right.value))
         return _float_q(node, env, params, src)
     a = evaluate_q(left, env, params, src)
     b = evaluate_q(right, env, params, src)
