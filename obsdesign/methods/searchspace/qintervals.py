@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import ast
 import math
+import operator
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -273,19 +274,20 @@ def _binop(node: ast.BinOp, env: dict[str, QI], params: dict[str, QI], src: str 
             if _bits(a) * abs(int(right.value)) <= MAX_BITS:
                 return qpow_int(a, int(right.value))
         return _float_q(node, env, params, src)
-    a = evaluate_q(left, env, params, src)
-    b = evaluate_q(right, env, params, src)
-    if op is ast.Add:
-        return a + b
-    if op is ast.Sub:
-        return a - b
-    if op is ast.Mult:
-        return a * b
-    if op is ast.Div:
-        return a / b
-    if op is ast.Mod:
-        return _qmod(a, b)
-    raise ValueError(f"operator {op.__name__}")
+    fn = _ARITH.get(op)
+    if fn is None:
+        raise ValueError(f"operator {op.__name__}")
+    return fn(evaluate_q(left, env, params, src), evaluate_q(right, env, params, src))
+
+
+#: the exact binary operations on :class:`QI`
+_ARITH = {
+    ast.Add: operator.add,
+    ast.Sub: operator.sub,
+    ast.Mult: operator.mul,
+    ast.Div: operator.truediv,
+    ast.Mod: _qmod,
+}
 
 
 def _float_q(node: ast.AST, env: dict[str, QI], params: dict[str, QI], src: str | None) -> QI:
