@@ -230,3 +230,12 @@ def test_negated_ramp_pattern_is_lipschitz(text: str) -> None:
         assert d.v.lo <= -max(hi, 0.0) and -max(lo, 0.0) <= d.v.hi
     jump = [parse_expr("-x2*step(x1)", ["x1", "x2"])]
     assert not B.lipschitz(jump, ["x1", "x2"], ["x1", "x2"], [-1, -1], [1, 1], 200, 1e-3).finite
+
+
+def test_range_inside_takes_parameters_exactly() -> None:
+    """u = a·sin(t) with the spec parameter a = 0.3 against U = [−0.3, 0.3]: proved (the
+    parameter at its exact value in the exact-end-point enclosure); a = 0.3000001 is not."""
+    for a, ok in ((fmpq(3, 10), True), (fmpq(3000001, 10**7), False)):
+        u = [parse_expr("a*sin(t)", ["t"], {"a": a})]
+        got = B.range_inside(u, "t", 0, 8, [fmpq(-3, 10)], [fmpq(3, 10)], 256)
+        assert (got[0], got[3]) == (ok, not ok)

@@ -380,8 +380,13 @@ def _enclose_q(ex: Expr, var: str, b: Box) -> QI | None:
     """The exact-end-point enclosure of ``ex`` over the one-variable box b
     (:func:`~obsdesign.methods.searchspace.qintervals.evaluate_q`), or None when it finds no
     finite one."""
-    params = {k: QI.of_float(v) for k, v in _params([ex]).items()}
+    from obsdesign.certify.exact import Q
+
     try:
+        params = {
+            k: QI.point(Fraction(int(q.p), int(q.q)))
+            for k, q in ((k, Q(v)) for k, v in ex.parameters.items())
+        }  # the spec parameters at their exact values
         return evaluate_q(
             ex.tree, {var: QI.of_float(b[0])}, params, ex.source.strip().replace("^", "**")
         )
