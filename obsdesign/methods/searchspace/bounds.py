@@ -335,6 +335,8 @@ def range_inside(
     exprs = [exprs[i] for i in live]
     LO, HI = [LO[i] for i in live], [HI[i] for i in live]
 
+    qparams = [_exact_params(ex) for ex in exprs]  # once, for every sub-interval
+
     def excess(b: Box) -> tuple[float, bool]:
         try:
             vs = _enclose(exprs, [var], b, ())
@@ -347,7 +349,7 @@ def range_inside(
                 return math.inf, False
             lo_k, hi_k = Fraction(d.v.lo), Fraction(d.v.hi)
             if lo_k < a or hi_k > z:  # not proved in floats: the exact-end-point enclosure
-                q = _enclose_q(exprs[k], var, b)
+                q = _enclose_q(exprs[k], var, b, qparams[k])
                 if q is not None:
                     lo_k, hi_k = max(lo_k, q.lo), min(hi_k, q.hi)
             below = a - lo_k
@@ -376,17 +378,21 @@ def range_inside(
     return worst_left == 0.0, worst_left, used, outside
 
 
-def _enclose_q(ex: Expr, var: str, b: Box) -> QI | None:
-    """The exact-end-point enclosure of ``ex`` over the one-variable box b
-    (:func:`~obsdesign.methods.searchspace.qintervals.evaluate_q`), or None when it finds no
-    finite one."""
+def _exact_params(ex: Expr) -> dict[str, QI]:
+    """The spec parameters of ``ex`` at their exact values, as point intervals."""
     from obsdesign.certify.exact import Q
 
+    return {
+        k: QI.point(Fraction(int(q.p), int(q.q)))
+        for k, q in ((k, Q(v)) for k, v in ex.parameters.items())
+    }
+
+
+def _enclose_q(ex: Expr, var: str, b: Box, params: dict[str, QI]) -> QI | None:
+    """The exact-end-point enclosure of ``ex`` over the one-variable box b
+    (:func:`~obsdesign.methods.searchspace.qintervals.evaluate_q`) with the parameters
+    ``params`` (:func:`_exact_params`), or None when it finds no finite one."""
     try:
-        params = {
-            k: QI.point(Fraction(int(q.p), int(q.q)))
-            for k, q in ((k, Q(v)) for k, v in ex.parameters.items())
-        }  # the spec parameters at their exact values
         return evaluate_q(
             ex.tree, {var: QI.of_float(b[0])}, params, ex.source.strip().replace("^", "**")
         )
