@@ -603,12 +603,13 @@ C_UO = np.array([[1.0, 0.0]])
 
 
 def test_design_modes_report_their_path() -> None:
-    """riccati (default; an asked λ = 0.5 shifts the equation), place (default and given
+    """riccati (default; an asked λ = 0.5 shifts the equation; the doubling solver), place (default and given
     poles), lmi (bracketed bisection, each rate solved once): each certifies and names its
     path in the solver result."""
     rep = api.design(load_spec_text(_designed(A_UO, C_UO, extra="lambda = 0.5\n")))
     assert rep.exit_code() == 0 and rep.solver["gain_design"] == "riccati"
     assert "shifted to the rate 0.49" in rep.solver["message"]
+    assert rep.solver["name"] == "structure-preserving doubling (numpy)"  # discrete: SDA
     rep = api.design(load_spec_text(_designed(A_UO, C_UO, extra='design = "place"\n')))
     assert rep.exit_code() == 0 and rep.solver["gain_design"] == "place"
     eig = np.sort(np.linalg.eigvals(A_UO - rep.parameters.float("L") @ C_UO).real)

@@ -179,29 +179,35 @@ def riccati_gain(
     Qw: np.ndarray,
     Rw: np.ndarray,
     rate: float | None,
-) -> np.ndarray:
-    """A Kalman-type gain from the dual algebraic Riccati equation (floats, scipy).
+) -> tuple[np.ndarray, str]:
+    """A Kalman-type gain from the dual algebraic Riccati equation (floats), and the name of
+    the Riccati solver that ran.
 
-    Discrete: X = DARE(Āᵀ, Cᵀ, Q, R) with Ā = A/λₛ, L = λₛ Ā X Cᵀ (R + C X Cᵀ)⁻¹, so that
+    Discrete: X = DARE(Āᵀ, Cᵀ, Q, R) (:func:`obsdesign.riccati.solve_dare`: the
+    structure-preserving doubling algorithm, scipy's ``solve_discrete_are`` as its fallback)
+    with Ā = A/λₛ, L = λₛ Ā X Cᵀ (R + C X Cᵀ)⁻¹, so that
     Ā − (L/λₛ)C is Schur and ρ(A − LC) < λₛ (λₛ = 1 without an asked rate: the steady-state
-    Kalman predictor gain). Continuous: X = CARE((A + αₛI)ᵀ, Cᵀ, Q, R), L = X Cᵀ R⁻¹, so
+    Kalman predictor gain). Continuous: X = CARE((A + αₛI)ᵀ, Cᵀ, Q, R) (scipy's
+    ``solve_continuous_are``), L = X Cᵀ R⁻¹, so
     that A + αₛI − LC is Hurwitz (αₛ = 0 without an asked rate). The error dynamics
     e⁺ = (A − LC)e is that of the linear observer of Section 5 of the constrained-redesign
     paper (Astolfi et al., NOLCOS 2019).
 
     :param A, C: float plant; :param discrete: time domain; :param Qw, Rw: weights (n×n ⪰ 0,
     p×p ≻ 0); :param rate: λₛ or αₛ, or None."""
-    from scipy.linalg import solve_continuous_are, solve_discrete_are
-
     n = A.shape[0]
     if discrete:
+        from obsdesign.riccati import solve_dare
+
         s = 1.0 if rate is None else rate
         Ab = A / s
-        X = solve_discrete_are(Ab.T, C.T, Qw, Rw)
-        return s * (Ab @ X @ C.T @ np.linalg.inv(Rw + C @ X @ C.T))
+        X, name = solve_dare(Ab.T, C.T, Qw, Rw)
+        return s * (Ab @ X @ C.T @ np.linalg.inv(Rw + C @ X @ C.T)), name
+    from scipy.linalg import solve_continuous_are
+
     a = 0.0 if rate is None else rate
     X = solve_continuous_are((A + a * np.eye(n)).T, C.T, Qw, Rw)
-    return X @ C.T @ np.linalg.inv(Rw)
+    return X @ C.T @ np.linalg.inv(Rw), "scipy solve_continuous_are"
 
 
 def placed_gain(A: np.ndarray, C: np.ndarray, poles: np.ndarray) -> np.ndarray:
@@ -300,7 +306,7 @@ def design_gain(
     for shift in tries:
         try:
             with np.errstate(all="ignore"):
-                Lf = riccati_gain(A, C, s.discrete, Qw, Rw, shift)
+                Lf, are = riccati_gain(A, C, s.discrete, Qw, Rw, shift)
         except (np.linalg.LinAlgError, ValueError) as e:
             last = str(e)
             continue
@@ -311,15 +317,14 @@ def design_gain(
         raise InconclusiveError(
             f"the Riccati equation gave no gain ({last}) although (C, A) is {det.reason}"
         )
-    are = "solve_discrete_are" if s.discrete else "solve_continuous_are"
     how = (
         f"the {'discrete' if s.discrete else 'continuous'} Riccati equation "
-        f'(design = "riccati", scipy {are}, {weights}'
+        f'(design = "riccati", {are}, {weights}'
         + ("" if shift is None else f", shifted to the rate {shift:.6g}")
         + ")"
     )
     res = SolverResult(
-        f"scipy {are}",
+        are,
         SolverStatus.CLOSED_FORM,
         how,
         seconds=_time.perf_counter() - t0,
@@ -400,7 +405,7 @@ def lmi_gain(
     ueig = np.linalg.eigvals(np.asarray(lyap.as_qarray(Au), dtype=float)) if Au.nrows() else []
     try:
         with np.errstate(all="ignore"):
-            Lr = riccati_gain(A, C, s.discrete, np.eye(n), np.eye(p), None)
+            Lr, _ = riccati_gain(A, C, s.discrete, np.eye(n), np.eye(p), None)
         reig = np.linalg.eigvals(A - Lr @ C)
     except (np.linalg.LinAlgError, ValueError):
         reig = None
