@@ -625,6 +625,31 @@ def test_design_modes_report_their_path() -> None:
     assert rep.solver["gain_design"] == "given"
 
 
+#: a badly conditioned plant (found by the spec fuzzer): ρ(A) ≈ 2000, one output; the float
+#: Riccati solution (scipy's QZ; the doubling refuses it) gives an L with ρ(A − LC) ≈ 34
+BAD_A = np.array([[-2104.0, -581.0, 0.0], [1189.0, -1014.0, 667.0], [795.0, -699.0, -188.0]])
+BAD_C = np.array([[1.8, 1.7, 0.9]])
+
+
+def test_a_designed_gain_that_fails_is_inconclusive_not_infeasible() -> None:
+    """(C, A) observable, so some L makes A − LC Schur: a designed L that does not is the
+    design's failure (exit 4, naming the path), not an infeasible problem (exit 1). The same
+    plant with a given non-stabilizing L stays infeasible (exit 1)."""
+    from obsdesign.errors import InconclusiveError
+
+    with pytest.raises(InconclusiveError) as ei:
+        api.design(load_spec_text(_designed(BAD_A, BAD_C)))
+    msg = ei.value.message
+    assert ei.value.exit_code == 4
+    assert "the designed gain fails: A − LC is not Schur" in msg
+    assert "Riccati" in msg and "(C, A) is detectable, proved exactly" in msg
+    with pytest.raises(InconclusiveError, match="meet the rate"):
+        api.design(load_spec_text(_designed(BAD_A, BAD_C, extra="lambda = 0.5\n")))
+    with pytest.raises(InfeasibleError) as ei:
+        api.design(_spec(BAD_A, BAD_C, np.zeros((3, 1))))
+    assert ei.value.exit_code == 1 and "not Schur" in ei.value.message
+
+
 def test_place_needs_observability() -> None:
     A = np.array([[0.5, 0.0], [0.0, 0.9]])
     with pytest.raises(InconclusiveError, match="pole placement needs"):

@@ -45,10 +45,9 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     :param progress: callback for progress messages."""
     o: Options = spec.options
     s = spec.system
-    A, C = s.A.q, s.C.q
     notes: list[str] = []
     solver = SolverResult(
-        lyap.lyapunov_solver_name(A.shape[0], s.discrete),
+        lyap.lyapunov_solver_name(s.n, s.discrete),
         SolverStatus.CLOSED_FORM,
         "L given; P from one Lyapunov equation per rate, checked exactly",
         extra={"gain_design": "given"},
@@ -59,8 +58,54 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
         Lm, _ = lyap.dyadic_fmat(Lf, lyap.BITS)  # = dyadic(Lf, BITS), in flint
         L = lyap.as_array(Lm)
         notes.append(f"L designed by {how}; certified with L rounded to {lyap.BITS} bits")
-    else:
-        L = o.L
+        try:
+            return _design_for(spec, L, Lm, solver, notes, progress)
+        except InfeasibleError as e:
+            raise designed_gain_failed(e, how, Lf, o.rate is not None) from None
+    return _design_for(spec, o.L, None, solver, notes, progress)
+
+
+def designed_gain_failed(
+    e: InfeasibleError, how: str, Lf: np.ndarray, rate_asked: bool
+) -> InconclusiveError:
+    """The error for a *designed* L that misses the asked rate or is not Schur / Hurwitz at
+    all: inconclusive (exit 4), not infeasible. :func:`design_gain` proved exactly that
+    (C, A) is detectable and that its unobservable modes meet an asked rate, so some L
+    reaches it (the observable part's poles are assignable); only this float design failed —
+    in practice on a badly conditioned plant, e.g. a 3-state plant with ρ(A) ≈ 2000 and one
+    output, where the float Riccati solution (scipy's QZ and the doubling alike) or the
+    placement is wrong (found by the spec fuzzer).
+
+    :param e: the exact verdict about the designed L; :param how: the design path;
+    :param Lf: the float gain; :param rate_asked: whether the spec asks a rate."""
+    also = " and its unobservable modes meet the rate" if rate_asked else ""
+    return InconclusiveError(
+        f"the designed gain fails: {e.message}; yet some L succeeds ((C, A) is detectable"
+        f"{also}, proved exactly): the float design by {how} is inaccurate on this badly "
+        f"conditioned plant (max |L| ≈ {float(np.abs(Lf).max()):.3g}); give L, or try "
+        "another design or weights"
+    )
+
+
+def _design_for(
+    spec: Spec,
+    L: Any,
+    Lm: Any,
+    solver: SolverResult,
+    notes: list[str],
+    progress: Progress | None,
+) -> Design:
+    """:func:`design` for the gain L (given, or designed and rounded: then ``Lm`` is its
+    ``fmpq_mat``): P at the asked or best rate, the bracket and μ, eq. (4)-(7) of the
+    constrained-redesign paper (Section 5). InfeasibleError when L misses the asked rate or
+    is not Schur / Hurwitz (proved exactly).
+
+    :param spec: the bound spec; :param L: the gain (exact object array);
+    :param Lm: L as an ``fmpq_mat`` or None; :param solver: the solver result so far;
+    :param notes: the design notes so far; :param progress: callback."""
+    o: Options = spec.options
+    s = spec.system
+    A, C = s.A.q, s.C.q
     memo = lyap.ExactMemo()  # the exact verdicts, reused by certify in this process only
     Lm = lyap.fmat(L) if Lm is None else Lm
     Acl = lyap.closed_loop_fmat(A, C, Lm)
