@@ -631,12 +631,27 @@ BAD_A = np.array([[-2104.0, -581.0, 0.0], [1189.0, -1014.0, 667.0], [795.0, -699
 BAD_C = np.array([[1.8, 1.7, 0.9]])
 
 
-def test_a_designed_gain_that_fails_is_inconclusive_not_infeasible() -> None:
-    """(C, A) observable, so some L makes A − LC Schur: a designed L that does not is the
-    design's failure (exit 4, naming the path), not an infeasible problem (exit 1). The same
-    plant with a given non-stabilizing L stays infeasible (exit 1)."""
+def test_a_badly_conditioned_plant_takes_the_high_precision_riccati() -> None:
+    """The float Riccati gain of BAD_A is not Schur; the doubling in 128-bit arithmetic gives
+    one that is, rounded to 40 bits: certified, verified, the path named."""
+    rep = api.design(load_spec_text(_designed(BAD_A, BAD_C)))
+    assert rep.exit_code() == 0
+    assert rep.solver["name"] == "structure-preserving doubling at 128 bits (python-flint arb_mat)"
+    assert float(rep.parameters.float("lambda_best")) < 0.2
+    assert api.verify(rep).exit_code() == 0
+
+
+def test_a_designed_gain_that_fails_is_inconclusive_not_infeasible(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """(C, A) observable, so some L makes A − LC Schur: a designed L that does not (here the
+    float Riccati gain of BAD_A, the high-precision solve switched off) is the design's
+    failure (exit 4, naming the path), not an infeasible problem (exit 1). The same plant with
+    a given non-stabilizing L stays infeasible (exit 1)."""
+    from obsdesign import riccati
     from obsdesign.errors import InconclusiveError
 
+    monkeypatch.setattr(riccati, "HP_MAX_N", 0)
     with pytest.raises(InconclusiveError) as ei:
         api.design(load_spec_text(_designed(BAD_A, BAD_C)))
     msg = ei.value.message

@@ -109,3 +109,22 @@ def test_a_wrong_solution_is_refused(monkeypatch: pytest.MonkeyPatch) -> None:
     with np.errstate(all="ignore"):
         assert riccati.dare_sda(A, B, Q, R) is None
     assert riccati.solve_dare(A, B, Q, R)[1] == riccati.SCIPY_NAME
+
+
+def test_high_precision_doubling_scalar_and_refusal() -> None:
+    """dare_sda_hp at 128 bits: the scalar DARE x² − 4x − 1 = 0 gives 2 + √5 to 10⁻³⁰;
+    Q = 0 with an unstable A (Aₖ does not vanish) gives None."""
+    from flint import arb, ctx, fmpq_mat
+
+    old = ctx.prec
+    ctx.prec = 128
+    try:
+        one = fmpq_mat([[1]])
+        X = riccati.dare_sda_hp(fmpq_mat([[2]]), one, one, one, 128)
+        assert X is not None
+        assert abs(X[0, 0] - (2 + arb(5).sqrt())) < arb(10) ** -30
+        A = fmpq_mat([[3, 1], [0, 1]])
+        B = fmpq_mat([[0], [1]])
+        assert riccati.dare_sda_hp(A, B, fmpq_mat(2, 2), one, 128) is None
+    finally:
+        ctx.prec = old
