@@ -93,7 +93,8 @@ def designed_gain_failed(
     reaches it (the observable part's poles are assignable); only this float design failed —
     in practice on a badly conditioned plant, e.g. a 3-state plant with ρ(A) ≈ 2000 and one
     output, where the float Riccati solution (scipy's QZ and the doubling alike) or the
-    placement is wrong (found by the spec fuzzer).
+    placement is wrong (found by the spec fuzzer). The decay LMI is eq. (4)-(6), Section 5
+    of the constrained-redesign paper (Astolfi et al., NOLCOS 2019).
 
     :param e: the exact verdict about the designed L; :param how: the design path;
     :param Lf: the float gain; :param rate_asked: whether the spec asks a rate."""
@@ -478,7 +479,9 @@ def riccati_retry_hp(spec: Spec, o: Options) -> tuple[np.ndarray, SolverResult, 
     same equation solved in high precision (:func:`riccati_gain_hp`) at the first shift the
     float design tries (0.98 λ with an asked rate, else none), taken when, rounded as the
     design rounds it, it meets that bound in floats (a guide: the exact tests decide again).
-    None when there is none (continuous time has no high-precision path).
+    None when there is none (continuous time has no high-precision path). The error
+    dynamics e⁺ = (A − LC)e are those of the linear observer of Section 5 of the
+    constrained-redesign paper (Astolfi et al., NOLCOS 2019), eq. (4)-(6).
 
     :param spec: the bound spec; :param o: its options."""
     import time as _time
