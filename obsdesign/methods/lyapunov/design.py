@@ -428,11 +428,7 @@ def design_gain(
         return Lf, res, f'pole placement (design = "place", {src} poles {shown})'
     Qw = np.eye(n) if o.riccati_Q is None else np.asarray(o.riccati_Q, dtype=float)
     Rw = np.eye(p) if o.riccati_R is None else np.asarray(o.riccati_R, dtype=float)
-    weights = (
-        DEFAULT_WEIGHTS
-        if o.riccati_Q is None and o.riccati_R is None
-        else "Q, R from riccati_Q / riccati_R"
-    )
+    weights = weights_text(o)
     tries: list[float | None] = [None]
     if target is not None:
         tries = [target * (SLACK_DISCRETE if s.discrete else SLACK_CONTINUOUS), target]
@@ -497,12 +493,17 @@ def riccati_retry_hp(spec: Spec, o: Options) -> tuple[np.ndarray, SolverResult, 
     )
     if hp is None:
         return None
-    weights = (
-        DEFAULT_WEIGHTS
-        if o.riccati_Q is None and o.riccati_R is None
-        else "Q, R from riccati_Q / riccati_R"
-    )
-    return _riccati_result(hp[0], hp[1], True, weights, shift, _time.perf_counter() - t0)
+    return _riccati_result(hp[0], hp[1], True, weights_text(o), shift, _time.perf_counter() - t0)
+
+
+def weights_text(o: Options) -> str:
+    """How the Riccati weights were chosen, for the notes (the defaults, or the spec's): the
+    Kalman-type design of the observer gain of Section 5 of the constrained-redesign paper.
+
+    :param o: the options."""
+    if o.riccati_Q is None and o.riccati_R is None:
+        return DEFAULT_WEIGHTS
+    return "Q, R from riccati_Q / riccati_R"
 
 
 def lmi_gain(
