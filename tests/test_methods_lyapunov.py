@@ -641,6 +641,45 @@ def test_a_badly_conditioned_plant_takes_the_high_precision_riccati() -> None:
     assert api.verify(rep).exit_code() == 0
 
 
+def test_a_sensitive_closed_loop_keeps_more_bits_of_the_gain() -> None:
+    """The 7-state plant of tests/data (ρ(A) ≈ 97, one output): the 128-bit doubling converges
+    to a wrong X, the 320-bit one to a gain that is unstable rounded to 40 bits; rounded to 64
+    bits it certifies, and verify agrees (the report's exact L has 64 significant bits)."""
+    from flint import fmpq
+
+    path = Path(__file__).parent / "data" / "lyapunov-ill-conditioned-7state.toml"
+    rep = api.design(load_spec_text(path.read_text(), str(path)))
+    assert rep.exit_code() == 0
+    assert rep.solver["name"] == "structure-preserving doubling at 320 bits (python-flint arb_mat)"
+    assert any("certified with L rounded to 64 bits" in n for n in rep.notes)
+    L = rep.parameters["L"]
+    assert max(abs(int(fmpq(v).p)).bit_length() for v in L.ravel()) > 53  # beyond a double
+    assert api.verify(rep).exit_code() == 0
+
+
+@pytest.mark.parametrize(
+    ("man", "exp", "bits", "want"),
+    [
+        (0b1011, 0, 3, 12),  # 11 → 12 (half up to even: 101|1 → 110)
+        (0b1001, 0, 3, 8),  # 9 → 8 (half to even: 100|1 → 100)
+        (0b1101, -2, 3, 3),  # 13/4 = 3.25, a tie: 110|1 → 110 (even), ·2⁻¹ = 3
+        (0b11011, -3, 3, fmpq(7, 2)),  # 27/8 = 3.375 above the tie: 110|11 → 111, ·2⁻¹
+        (-0b1011, 0, 3, -12),  # sign symmetric
+        (-0b1001, 0, 3, -8),
+        (5, 10, 8, 5 * 1024),  # fewer bits than asked: unchanged
+        (0b10111, 0, 4, 24),  # above half: up
+    ],
+)
+def test_round_bits(man: int, exp: int, bits: int, want: object) -> None:
+    """_round_bits rounds man·2^exp half-to-even to the asked significant bits, exactly."""
+    from flint import fmpq
+
+    from obsdesign.methods.lyapunov.design import _round_bits
+
+    expected = want if isinstance(want, fmpq) else fmpq(want)
+    assert _round_bits(man, exp, bits) == expected
+
+
 def test_a_designed_gain_that_fails_is_inconclusive_not_infeasible(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:

@@ -15,7 +15,7 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from flint import fmpq_mat
+from flint import fmpq, fmpq_mat
 
 from obsdesign import lyap
 from obsdesign.certify.detect import Detectability, detectability, unobservable_restriction
@@ -56,36 +56,42 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     )
     if o.L is None:
         Lf, solver, how = design_gain(spec, o, progress)
+        Lm, _ = lyap.dyadic_fmat(Lf, lyap.BITS)  # = dyadic(Lf, BITS), in flint
         try:
-            return _design_rounded(spec, Lf, solver, how, progress)
+            return _design_rounded(spec, Lm, lyap.BITS, solver, how, progress)
         except InfeasibleError as e:
             # the float gain failed the exact tests: the high-precision Riccati gain, if any
             hp = riccati_retry_hp(spec, o)
             if hp is None:
-                raise designed_gain_failed(e, how, Lf, o.rate is not None) from None
-            Lf, solver, how = hp
+                raise designed_gain_failed(e, how, Lm, o.rate is not None) from None
+            Lm, bits, solver, how = hp
             try:
-                return _design_rounded(spec, Lf, solver, how, progress)
+                return _design_rounded(spec, Lm, bits, solver, how, progress)
             except InfeasibleError as e2:
-                raise designed_gain_failed(e2, how, Lf, o.rate is not None) from None
+                raise designed_gain_failed(e2, how, Lm, o.rate is not None) from None
     return _design_for(spec, o.L, None, solver, notes, progress)
 
 
 def _design_rounded(
-    spec: Spec, Lf: np.ndarray, solver: SolverResult, how: str, progress: Progress | None
+    spec: Spec,
+    Lm: fmpq_mat,
+    bits: int,
+    solver: SolverResult,
+    how: str,
+    progress: Progress | None,
 ) -> Design:
-    """:func:`_design_for` the designed float gain rounded to :data:`obsdesign.lyap.BITS`
-    bits (the rounded values are the gain certified and reported).
+    """:func:`_design_for` a designed gain rounded to ``bits`` significant bits (the rounded
+    values are the gain certified and reported).
 
-    :param spec: the bound spec; :param Lf: the float gain; :param solver: its solver result;
-    :param how: the path that designed it; :param progress: callback."""
-    Lm, _ = lyap.dyadic_fmat(Lf, lyap.BITS)  # = dyadic(Lf, BITS), in flint
-    notes = [f"L designed by {how}; certified with L rounded to {lyap.BITS} bits"]
+    :param spec: the bound spec; :param Lm: the rounded gain (exact); :param bits: its bits;
+    :param solver: its solver result; :param how: the path that designed it;
+    :param progress: callback."""
+    notes = [f"L designed by {how}; certified with L rounded to {bits} bits"]
     return _design_for(spec, lyap.as_array(Lm), Lm, solver, notes, progress)
 
 
 def designed_gain_failed(
-    e: InfeasibleError, how: str, Lf: np.ndarray, rate_asked: bool
+    e: InfeasibleError, how: str, Lm: fmpq_mat, rate_asked: bool
 ) -> InconclusiveError:
     """The error for a *designed* L that misses the asked rate or is not Schur / Hurwitz at
     all: inconclusive (exit 4), not infeasible. :func:`design_gain` proved exactly that
@@ -97,12 +103,13 @@ def designed_gain_failed(
     of the constrained-redesign paper (Astolfi et al., NOLCOS 2019).
 
     :param e: the exact verdict about the designed L; :param how: the design path;
-    :param Lf: the float gain; :param rate_asked: whether the spec asks a rate."""
+    :param Lm: the gain (exact); :param rate_asked: whether the spec asks a rate."""
     also = " and its unobservable modes meet the rate" if rate_asked else ""
     return InconclusiveError(
         f"the designed gain fails: {e.message}; yet some L succeeds ((C, A) is detectable"
         f"{also}, proved exactly): the float design by {how} is inaccurate on this badly "
-        f"conditioned plant (max |L| ≈ {float(np.abs(Lf).max()):.3g}); give L, or try "
+        f"conditioned plant (max |L| ≈ {float(np.abs(lyap.mat_float(Lm)).max()):.3g}); give "
+        "L, or try "
         "another design or weights"
     )
 
@@ -275,15 +282,11 @@ def riccati_gain(
     return X @ C.T @ np.linalg.inv(Rw), "scipy solve_continuous_are"
 
 
-def _rounded_radius(s: Any, L: np.ndarray) -> float:
-    """ρ(A − L̃C) in floats for L̃ = L rounded to :data:`obsdesign.lyap.BITS` bits as the
-    design rounds it, A − L̃C formed exactly and then rounded (a guide only: the exact tests
-    decide); inf when L is not finite.
+def _rounded_radius(s: Any, Lm: fmpq_mat) -> float:
+    """ρ(A − LC) in floats for the exact gain ``Lm``, A − LC formed exactly and then rounded
+    (a guide only: the exact tests decide); inf when not finite.
 
-    :param s: the spec's system; :param L: a float gain."""
-    if not np.all(np.isfinite(L)):
-        return math.inf
-    Lm, _ = lyap.dyadic_fmat(L, lyap.BITS)
+    :param s: the spec's system; :param Lm: the gain (exact)."""
     Af = lyap.mat_float(lyap.closed_loop_fmat(s.A.q, s.C.q, Lm))
     if not np.all(np.isfinite(Af)):
         return math.inf
@@ -291,22 +294,24 @@ def _rounded_radius(s: Any, L: np.ndarray) -> float:
 
 
 def riccati_gain_hp(
-    A: Any, C: Any, Qw: Any, Rw: Any, rate: float | None, good: Callable[[np.ndarray], bool]
-) -> tuple[np.ndarray, str] | None:
+    A: Any, C: Any, Qw: Any, Rw: Any, rate: float | None, good: Callable[[fmpq_mat], bool]
+) -> tuple[fmpq_mat, int, str] | None:
     """:func:`riccati_gain` (discrete time) with the DARE solved by the doubling algorithm in
     high precision (:func:`obsdesign.riccati.dare_sda_hp`, python-flint ``arb_mat``) from the
     exact A, C, weights and shift, and the gain L = A X Cᵀ (R + C X Cᵀ)⁻¹ formed at the same
-    precision, then rounded to floats: for badly conditioned plants whose float Riccati
-    solution gives a gain that is not even Schur in floats. The precisions of
-    :data:`obsdesign.riccati.HP_PRECISIONS` are tried in turn until the gain is ``good``: at
-    too low a precision the doubling can meet its step criterion far from the solution (a
-    7-state plant with ρ(A) ≈ 97 and one output: ρ(A − LC) ≈ 57 at 128 bits, 0.03 at 320).
-    None above :data:`obsdesign.riccati.HP_MAX_N` states or when no precision gives a good
-    gain.
+    precision: for badly conditioned plants whose float Riccati solution gives a gain that is
+    not even Schur in floats. The precisions of :data:`obsdesign.riccati.HP_PRECISIONS` are
+    tried in turn, and at each the gain rounded to each of :data:`GAIN_BITS` significant bits
+    (no more than the precision) until it is ``good``: at too low a precision the doubling can
+    meet its step criterion far from the solution, and the closed loop of such a plant can be
+    so sensitive that 40 bits of L are not enough (a 7-state plant with ρ(A) ≈ 97 and one
+    output: ρ(A − LC) ≈ 57 at 128 bits; at 320 bits 0.03, and 0.28 with L rounded to 53 bits).
+    Returns (the rounded gain, exact; its bits; the solver's name), or None above
+    :data:`obsdesign.riccati.HP_MAX_N` states or when nothing is good.
 
     :param A, C: exact plant (object arrays); :param Qw, Rw: exact weights or None (I);
-    :param rate: λₛ or None (1); :param good: the acceptance test of a float gain."""
-    from flint import arb_mat, ctx, fmpq
+    :param rate: λₛ or None (1); :param good: the acceptance test of a rounded gain."""
+    from flint import arb_mat, ctx
 
     from obsdesign.certify.exact import Q
     from obsdesign.riccati import HP_MAX_N, HP_PRECISIONS, dare_sda_hp
@@ -335,13 +340,36 @@ def riccati_gain_hp(
                 L = arb_mat(Aq) * (arb_mat(Rq) + Ch * XC).solve(XC.transpose()).transpose()
             except (ZeroDivisionError, ValueError):
                 continue
-            Lf = np.array([[float(L[i, j].mid()) for j in range(p)] for i in range(n)], dtype=float)
+            mids = [L[i, j].mid().man_exp() for i in range(n) for j in range(p)]
             ctx.prec = old  # the acceptance test computes at the caller's precision
-            if np.all(np.isfinite(Lf)) and good(Lf):
-                return Lf, f"structure-preserving doubling at {prec} bits (python-flint arb_mat)"
+            for bits in GAIN_BITS:
+                if bits > prec:
+                    break
+                Lm = fmpq_mat(n, p, [_round_bits(int(m), int(e), bits) for m, e in mids])
+                if good(Lm):
+                    name = f"structure-preserving doubling at {prec} bits (python-flint arb_mat)"
+                    return Lm, bits, name
     finally:
         ctx.prec = old
     return None
+
+
+#: the significant bits a high-precision gain is rounded to, fewest first
+GAIN_BITS = (lyap.BITS, 64, 96, 128, 192, 256)
+
+
+def _round_bits(man: int, exp: int, bits: int) -> fmpq:
+    """man·2^exp rounded half-to-even to ``bits`` significant bits, exactly.
+
+    :param man, exp: the exact value's mantissa and exponent; :param bits: ≥ 1."""
+    extra = abs(man).bit_length() - bits
+    if extra > 0:
+        q, r = divmod(man, 1 << extra)  # floor division: r ≥ 0
+        half = 1 << (extra - 1)
+        if r > half or (r == half and q & 1):
+            q += 1
+        man, exp = q, exp + extra
+    return fmpq(man << exp) if exp >= 0 else fmpq(man, 1 << -exp)
 
 
 def placed_gain(A: np.ndarray, C: np.ndarray, poles: np.ndarray) -> np.ndarray:
@@ -451,7 +479,7 @@ def design_gain(
 
 
 def _riccati_result(
-    Lf: np.ndarray, are: str, discrete: bool, weights: str, shift: float | None, seconds: float
+    Lf: Any, are: str, discrete: bool, weights: str, shift: float | None, seconds: float
 ) -> tuple[np.ndarray, SolverResult, str]:
     """(L, the solver result, the note naming the path) of a Riccati gain.
 
@@ -470,11 +498,12 @@ def _riccati_result(
     return Lf, res, how
 
 
-def riccati_retry_hp(spec: Spec, o: Options) -> tuple[np.ndarray, SolverResult, str] | None:
+def riccati_retry_hp(spec: Spec, o: Options) -> tuple[fmpq_mat, int, SolverResult, str] | None:
     """After a float Riccati gain failed the exact tests (discrete time): the gain of the
     same equation solved in high precision (:func:`riccati_gain_hp`) at the first shift the
-    float design tries (0.98 λ with an asked rate, else none), taken when, rounded as the
-    design rounds it, it meets that bound in floats (a guide: the exact tests decide again).
+    float design tries (0.98 λ with an asked rate, else none), rounded to the fewest bits of
+    :data:`GAIN_BITS` with which it meets that bound in floats (a guide: the exact tests
+    decide again). Returns (the rounded gain, its bits, the solver result, the path's note).
     None when there is none (continuous time has no high-precision path). The error
     dynamics e⁺ = (A − LC)e are those of the linear observer of Section 5 of the
     constrained-redesign paper (Astolfi et al., NOLCOS 2019), eq. (4)-(6).
@@ -493,7 +522,11 @@ def riccati_retry_hp(spec: Spec, o: Options) -> tuple[np.ndarray, SolverResult, 
     )
     if hp is None:
         return None
-    return _riccati_result(hp[0], hp[1], True, weights_text(o), shift, _time.perf_counter() - t0)
+    Lm, bits, are = hp
+    _, res, how = _riccati_result(
+        None, are, True, weights_text(o), shift, _time.perf_counter() - t0
+    )
+    return Lm, bits, res, how
 
 
 def weights_text(o: Options) -> str:
