@@ -657,6 +657,26 @@ def test_a_sensitive_closed_loop_keeps_more_bits_of_the_gain() -> None:
     assert api.verify(rep).exit_code() == 0
 
 
+def test_no_float_riccati_gain_takes_the_high_precision_one(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The 4-state plant of tests/data: no float solver gives a gain; the 128-bit doubling
+    does and λ = 0.3 certifies. With the high-precision path off, the design is exit 4 naming
+    the Riccati equation (not exit 1)."""
+    from obsdesign import riccati
+    from obsdesign.errors import InconclusiveError
+
+    path = Path(__file__).parent / "data" / "lyapunov-no-float-riccati-4state.toml"
+    rep = api.design(load_spec_text(path.read_text(), str(path)))
+    assert rep.exit_code() == 0
+    assert rep.solver["name"] == "structure-preserving doubling at 128 bits (python-flint arb_mat)"
+    assert api.verify(rep).exit_code() == 0
+    monkeypatch.setattr(riccati, "HP_MAX_N", 0)
+    with pytest.raises(InconclusiveError, match="the Riccati equation gave no gain") as ei:
+        api.design(load_spec_text(path.read_text(), str(path)))
+    assert ei.value.exit_code == 4
+
+
 @pytest.mark.parametrize(
     ("man", "exp", "bits", "want"),
     [

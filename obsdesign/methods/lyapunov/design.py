@@ -35,6 +35,11 @@ def rate_name(discrete: bool) -> str:
     return "lambda" if discrete else "alpha"
 
 
+class NoRiccatiGain(InconclusiveError):
+    """The float Riccati solvers gave no finite gain although (C, A) is detectable (exit 4,
+    unless the high-precision solve gives one)."""
+
+
 def design(spec: Spec, progress: Progress | None = None) -> Design:
     """Parameters of the ``lyapunov`` method: L, P at the asked (or best) rate, the best rate
     with its bracket (``<rate>_best``, ``<rate>_bracket``, ``<rate>_bracket_kind``) and μ.
@@ -55,20 +60,27 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
         extra={"gain_design": "given"},
     )
     if o.L is None:
-        Lf, solver, how = design_gain(spec, o, progress)
-        Lm, _ = lyap.dyadic_fmat(Lf, lyap.BITS)  # = dyadic(Lf, BITS), in flint
+        asked = o.rate is not None
+        first: InconclusiveError
         try:
-            return _design_rounded(spec, Lm, lyap.BITS, solver, how, progress)
-        except InfeasibleError as e:
-            # the float gain failed the exact tests: the high-precision Riccati gain, if any
-            hp = riccati_retry_hp(spec, o)
-            if hp is None:
-                raise designed_gain_failed(e, how, Lm, o.rate is not None) from None
-            Lm, bits, solver, how = hp
+            Lf, solver, how = design_gain(spec, o, progress)
+        except NoRiccatiGain as e:  # no float gain at all
+            first = e
+        else:
+            Lm, _ = lyap.dyadic_fmat(Lf, lyap.BITS)  # = dyadic(Lf, BITS), in flint
             try:
-                return _design_rounded(spec, Lm, bits, solver, how, progress)
-            except InfeasibleError as e2:
-                raise designed_gain_failed(e2, how, Lm, o.rate is not None) from None
+                return _design_rounded(spec, Lm, lyap.BITS, solver, how, progress)
+            except InfeasibleError as e:
+                first = designed_gain_failed(e, how, Lm, asked)
+        # the float Riccati gain is missing or failed the exact tests: the high-precision one
+        hp = riccati_retry_hp(spec, o)
+        if hp is None:
+            raise first from None
+        Lm, bits, solver, how = hp
+        try:
+            return _design_rounded(spec, Lm, bits, solver, how, progress)
+        except InfeasibleError as e2:
+            raise designed_gain_failed(e2, how, Lm, asked) from None
     return _design_for(spec, o.L, None, solver, notes, progress)
 
 
@@ -472,7 +484,7 @@ def design_gain(
             break
         last = "non-finite gain"
     else:
-        raise InconclusiveError(
+        raise NoRiccatiGain(
             f"the Riccati equation gave no gain ({last}) although (C, A) is {det.reason}"
         )
     return _riccati_result(Lf, are, s.discrete, weights, shift, _time.perf_counter() - t0)
