@@ -642,12 +642,15 @@ def test_a_badly_conditioned_plant_takes_the_high_precision_riccati() -> None:
 
 
 def test_a_sensitive_closed_loop_keeps_more_bits_of_the_gain() -> None:
-    """The 7-state plant of tests/data (ρ(A) ≈ 97, one output): the 128-bit doubling converges
+    """The 8-state plant of tests/data (ρ(A) ≈ 87, one output): the 128-bit doubling converges
     to a wrong X, the 320-bit one to a gain that is unstable rounded to 40 bits; rounded to 64
-    bits it certifies, and verify agrees (the report's exact L has 64 significant bits)."""
+    bits it certifies, and verify agrees (the report's exact L has 64 significant bits).
+    Pole placement on the same plant fails (exit 4, not 1: some L succeeds)."""
     from flint import fmpq
 
-    path = Path(__file__).parent / "data" / "lyapunov-ill-conditioned-7state.toml"
+    from obsdesign.errors import InconclusiveError
+
+    path = Path(__file__).parent / "data" / "lyapunov-ill-conditioned-8state.toml"
     rep = api.design(load_spec_text(path.read_text(), str(path)))
     assert rep.exit_code() == 0
     assert rep.solver["name"] == "structure-preserving doubling at 320 bits (python-flint arb_mat)"
@@ -655,6 +658,14 @@ def test_a_sensitive_closed_loop_keeps_more_bits_of_the_gain() -> None:
     L = rep.parameters["L"]
     assert max(abs(int(fmpq(v).p)).bit_length() for v in L.ravel()) > 53  # beyond a double
     assert api.verify(rep).exit_code() == 0
+    text = "".join(
+        line.replace('key = "lyapunov"', 'key = "lyapunov"\ndesign = "place"')
+        for line in path.read_text().splitlines(keepends=True)
+        if not line.startswith("riccati_Q")
+    )
+    with pytest.raises(InconclusiveError, match="pole placement") as ei:
+        api.design(load_spec_text(text, str(path)))
+    assert ei.value.exit_code == 4 and "the designed gain fails" in ei.value.message
 
 
 def test_no_float_riccati_gain_takes_the_high_precision_one(
