@@ -604,9 +604,32 @@ def simulate(
     else:
         with captured_warnings(notes):
             res = get_method(sp.method).simulate(sp, params, **kwargs)
+    left = _left_float_range(res)
+    if left is not None:
+        notes.insert(0, left)
     if notes:
         res.info["warnings"] = notes
     return res
+
+
+def _left_float_range(res: SimResult) -> str | None:
+    """A plain warning when the shown trajectory leaves the float range (an unstable plant or
+    observer over a long horizon): where it does, instead of numpy's overflow warnings alone;
+    None when every value is finite.
+
+    :param res: the simulation result."""
+    import numpy as np
+
+    bad = [np.flatnonzero(~np.isfinite(a).all(axis=1)) for a in (res.x, res.xhat) if a.ndim == 2]
+    first = min((int(b[0]) for b in bad if b.size), default=None)
+    if first is None:
+        return None
+    at = float(res.t[first]) if first < len(res.t) else float(first)
+    return (
+        f"the trajectory leaves the float range at t = {at:g} (sample {first} of {len(res.t)}): "
+        "the plant or the observer diverges over this horizon, so the metrics are not finite; "
+        "shorten [simulate] horizon"
+    )
 
 
 def _sim_runs(sp: Spec, kwargs: dict[str, Any]) -> int:

@@ -94,3 +94,21 @@ def test_metrics():
     assert m["sup_abs_error"] == {"a": 3.0, "b": 2.0}
     assert m["rmse"]["a"] == pytest.approx(np.sqrt(10 / 3))
     assert m["final_error_norm"] == 3.0
+
+
+def test_a_diverging_trajectory_gets_a_plain_warning():
+    """An unstable plant over a long horizon: the first warning says where the trajectory
+    leaves the float range (not only numpy's overflow warnings); a stable one has none."""
+    from obsdesign import api
+
+    text = (
+        '[system]\ntime = "discrete"\nA = [[400.0]]\nC = [[1.0]]\n'
+        '[method]\nkey = "lyapunov"\nL = [[400.0]]\n'
+        "[simulate]\nhorizon = 200\nx0 = [1]\nxhat0 = [0]\n"
+    )
+    res = api.simulate(load_spec_text(text, "diverge.toml"))
+    first = res.info["warnings"][0]
+    assert "leaves the float range at t = 119 (sample 119 of 201)" in first  # 400^119 > 1e308
+    stable = text.replace("A = [[400.0]]", "A = [[0.5]]").replace("L = [[400.0]]", "L = [[0.5]]")
+    res = api.simulate(load_spec_text(stable, "stable.toml"))
+    assert not any("float range" in w for w in res.info.get("warnings", []))
