@@ -1,5 +1,7 @@
-"""The discrete algebraic Riccati equation in floats: the structure-preserving doubling
-algorithm (SDA) first, scipy's ``solve_discrete_are`` when SDA does not pass its own checks.
+"""The algebraic Riccati equations in floats: the structure-preserving doubling algorithm
+(SDA) first — directly for the discrete equation, after a Cayley transform for the continuous
+one — and scipy's ``solve_discrete_are`` / ``solve_continuous_are`` when SDA does not pass its
+own checks; the discrete one also in python-flint ``arb_mat`` high precision.
 
 Why not scipy alone (issue 12, item 1): scipy's solver (an ordered QZ of a 2n×2n pencil) is
 ~90 % of the float baseline and of the lyapunov design's float work at n = 100 (90 ms); SDA
@@ -62,12 +64,84 @@ def dare_residual(
     return res / scale
 
 
+def doubling(E: np.ndarray, G: np.ndarray, H: np.ndarray) -> np.ndarray | None:
+    """The doubling iteration of the module docstring from (E₀, G₀, H₀) = (E, G, H): the limit
+    of Hₖ, or None when it does not converge within :data:`MAX_STEPS` steps with every value
+    finite, or Eₖ does not vanish (Eₖ ≈ S^(2^k) up to factors, S the closed loop of the
+    equation's discrete form: it vanishes only for the stabilizing solution).
+
+    :param E: n×n; :param G, H: n×n symmetric."""
+    n = E.shape[0]
+    eye = np.eye(n)
+    Ek, Gk, Hk = E.copy(), (G + G.T) / 2, (H + H.T) / 2
+    for _ in range(MAX_STEPS):
+        S = np.linalg.solve(eye + Gk @ Hk, np.hstack([Ek, Gk]))
+        SE, SG = S[:, :n], S[:, n:]
+        Hn = Hk + Ek.T @ (Hk @ SE)
+        Gk = Gk + Ek @ SG @ Ek.T
+        Ek = Ek @ SE
+        Hn = (Hn + Hn.T) / 2
+        Gk = (Gk + Gk.T) / 2
+        if not (np.all(np.isfinite(Hn)) and np.all(np.isfinite(Ek))):
+            return None
+        step = float(np.abs(Hn - Hk).max())
+        Hk = Hn
+        if step <= STEP_TOL * float(np.abs(Hk).max()):
+            return Hk if float(np.abs(Ek).max()) <= 1e-3 else None
+    return None
+
+
+def _psd(X: np.ndarray) -> bool:
+    """X ⪰ 0 to rounding (its smallest eigenvalue ≥ −10⁻⁹ of its largest entry)."""
+    return float(np.linalg.eigvalsh(X)[0]) >= -1e-9 * float(np.abs(X).max())
+
+
 def dare_sda(A: np.ndarray, B: np.ndarray, Q: np.ndarray, R: np.ndarray) -> np.ndarray | None:
     """The stabilizing solution X of the DARE by the structure-preserving doubling algorithm
-    (module docstring), or None when it does not pass its checks: converged within
-    :data:`MAX_STEPS` steps with every value finite, Aₖ → 0 (the solution is the stabilizing
-    one), relative residual ≤ :data:`RESIDUAL_TOL`, X symmetric positive semidefinite to
-    rounding.
+    (module docstring; E₀ = A, G₀ = B R⁻¹ Bᵀ, H₀ = Q), or None when it does not pass its
+    checks: those of :func:`doubling`, relative residual ≤ :data:`RESIDUAL_TOL`, X symmetric
+    positive semidefinite to rounding.
+
+    :param A: n×n; :param B: n×m; :param Q: n×n symmetric ⪰ 0; :param R: m×m symmetric ≻ 0."""
+    try:
+        X = doubling(A, B @ np.linalg.solve(R, B.T), Q)
+        if X is None or dare_residual(A, B, Q, R, X) > RESIDUAL_TOL or not _psd(X):
+            return None
+    except np.linalg.LinAlgError:
+        return None
+    return X
+
+
+def care_residual(
+    A: np.ndarray, B: np.ndarray, Q: np.ndarray, R: np.ndarray, X: np.ndarray
+) -> float:
+    """The relative residual of the continuous algebraic Riccati equation
+    AᵀX + XA − XB R⁻¹BᵀX + Q = 0: its max-norm over the largest max-norm of its terms (0
+    when every term is 0).
+
+    :param A, B, Q, R: as :func:`care_sda`; :param X: the candidate solution."""
+    XB = X @ B
+    terms = (A.T @ X, X @ A, XB @ np.linalg.solve(R, XB.T), Q)
+    res = float(np.abs(terms[0] + terms[1] - terms[2] + terms[3]).max())
+    scale = max(float(np.abs(t).max()) for t in terms)
+    return 0.0 if scale == 0.0 else res / scale
+
+
+def care_sda(A: np.ndarray, B: np.ndarray, Q: np.ndarray, R: np.ndarray) -> np.ndarray | None:
+    """The stabilizing solution X of the CARE AᵀX + XA − XGX + Q = 0 (G = B R⁻¹ Bᵀ) by the
+    doubling algorithm after a Cayley transform (SDA-1 of Chu, Fan & Lin, "A
+    structure-preserving doubling algorithm for continuous-time algebraic Riccati
+    equations", Linear Algebra Appl. 396 (2005)): with γ > 0, A_γ = A − γI and
+    W = A_γᵀ + Q A_γ⁻¹ G,
+
+        E₀ = I + 2γ W⁻ᵀ,   G₀ = 2γ A_γ⁻¹ G W⁻¹,   H₀ = 2γ W⁻¹ Q A_γ⁻¹,
+
+    then :func:`doubling` (the closed loop's eigenvalues λ map to (λ + γ)/(λ − γ), inside the
+    unit circle for Re λ < 0). These formulas were checked numerically against scipy's
+    ``solve_continuous_are`` (tests/test_riccati.py). γ = max(1.05‖A‖_F, √(‖G‖_F‖Q‖_F)):
+    above the spectral radius of A (so A_γ is invertible) and of the size of the Hamiltonian's
+    spectrum. None when the checks of :func:`doubling` fail, the relative residual exceeds
+    :data:`RESIDUAL_TOL` or X is not ⪰ 0 to rounding.
 
     :param A: n×n; :param B: n×m; :param Q: n×n symmetric ⪰ 0; :param R: m×m symmetric ≻ 0."""
     n = A.shape[0]
@@ -75,34 +149,23 @@ def dare_sda(A: np.ndarray, B: np.ndarray, Q: np.ndarray, R: np.ndarray) -> np.n
     try:
         G = B @ np.linalg.solve(R, B.T)
         G = (G + G.T) / 2
-        Ak, Gk, Hk = A.copy(), G, (Q + Q.T) / 2
-        for _ in range(MAX_STEPS):
-            S = np.linalg.solve(eye + Gk @ Hk, np.hstack([Ak, Gk]))
-            SA, SG = S[:, :n], S[:, n:]
-            Hn = Hk + Ak.T @ (Hk @ SA)
-            Gk = Gk + Ak @ SG @ Ak.T
-            Ak = Ak @ SA
-            Hn = (Hn + Hn.T) / 2
-            Gk = (Gk + Gk.T) / 2
-            if not (np.all(np.isfinite(Hn)) and np.all(np.isfinite(Ak))):
-                return None
-            step = float(np.abs(Hn - Hk).max())
-            Hk = Hn
-            if step <= STEP_TOL * float(np.abs(Hk).max()):
-                break
-        else:
+        gam = max(
+            1.05 * float(np.linalg.norm(A)), float(np.sqrt(np.linalg.norm(G) * np.linalg.norm(Q)))
+        )
+        if not (math.isfinite(gam) and gam > 0):
             return None
-        top = float(np.abs(Hk).max())
-        # Aₖ ≈ A_cl^(2^k) up to factors: it vanishes only for the stabilizing solution
-        if float(np.abs(Ak).max()) > 1e-3:
-            return None
-        if dare_residual(A, B, Q, R, Hk) > RESIDUAL_TOL:
-            return None
-        if float(np.linalg.eigvalsh(Hk)[0]) < -1e-9 * top:
+        Ag = A - gam * eye
+        AgiG = np.linalg.solve(Ag, G)
+        Wi = np.linalg.inv(Ag.T + Q @ AgiG)
+        E0 = eye + 2 * gam * Wi.T
+        G0 = 2 * gam * AgiG @ Wi
+        H0 = 2 * gam * Wi @ np.linalg.solve(Ag.T, Q.T).T  # W⁻¹ Q A_γ⁻¹
+        X = doubling(E0, G0, H0)
+        if X is None or care_residual(A, B, Q, R, X) > RESIDUAL_TOL or not _psd(X):
             return None
     except np.linalg.LinAlgError:
         return None
-    return Hk
+    return X
 
 
 def solve_dare(
@@ -121,9 +184,27 @@ def solve_dare(
     return solve_discrete_are(A, B, Q, R), SCIPY_NAME
 
 
-#: the solver names :func:`solve_dare` reports
+def solve_care(
+    A: np.ndarray, B: np.ndarray, Q: np.ndarray, R: np.ndarray
+) -> tuple[np.ndarray, str]:
+    """(X, the solver that ran): :func:`care_sda`, or scipy's ``solve_continuous_are`` when
+    it does not pass its checks (scipy's errors pass through).
+
+    :param A, B, Q, R: as :func:`care_sda`."""
+    with np.errstate(all="ignore"):
+        X = care_sda(A, B, Q, R)
+    if X is not None:
+        return X, SDA_CARE_NAME
+    from scipy.linalg import solve_continuous_are
+
+    return solve_continuous_are(A, B, Q, R), SCIPY_CARE_NAME
+
+
+#: the solver names :func:`solve_dare` and :func:`solve_care` report
 SDA_NAME = "structure-preserving doubling (numpy)"
 SCIPY_NAME = "scipy solve_discrete_are"
+SDA_CARE_NAME = "structure-preserving doubling after a Cayley transform (numpy)"
+SCIPY_CARE_NAME = "scipy solve_continuous_are"
 
 
 #: the largest state dimension the high-precision doubling is tried at

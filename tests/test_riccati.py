@@ -128,3 +128,52 @@ def test_high_precision_doubling_scalar_and_refusal() -> None:
         assert riccati.dare_sda_hp(A, B, fmpq_mat(2, 2), one, 128) is None
     finally:
         ctx.prec = old
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    n=st.integers(1, 9),
+    m=st.integers(1, 4),
+    scale=st.sampled_from([0.3, 1.0, 3.0]),
+)
+def test_care_by_doubling_matches_scipy(seed: int, n: int, m: int, scale: float) -> None:
+    """The Cayley-transformed doubling solves the CARE: where it answers, X is scipy's to
+    10⁻⁷ relative, meets the residual bound, and A − GX is Hurwitz."""
+    A, B, Q, R = _problem(seed, n, min(m, n), scale)
+    with np.errstate(all="ignore"):
+        X = riccati.care_sda(A, B, Q, R)
+    Xs = sl.solve_continuous_are(A, B, Q, R)
+    if X is None:
+        return
+    assert riccati.care_residual(A, B, Q, R, X) <= riccati.RESIDUAL_TOL
+    assert np.abs(X - Xs).max() <= 1e-7 * max(1.0, np.abs(Xs).max())
+    G = B @ np.linalg.solve(R, B.T)
+    assert np.linalg.eigvals(A - G @ X).real.max() < 0
+
+
+def test_care_answers_the_observer_problem_and_falls_back() -> None:
+    """A 30-state observer problem: the doubling answers, to 10⁻¹² of scipy. Q = 0 with an
+    unstable A: the doubling cannot leave X = 0 and scipy answers."""
+    rng = np.random.default_rng(8)
+    A = rng.standard_normal((30, 30))
+    A -= (np.linalg.eigvals(A).real.max() + 0.1) * np.eye(30)
+    C = rng.standard_normal((3, 30))
+    X, name = riccati.solve_care(A.T, C.T, np.eye(30), np.eye(3))
+    assert name == riccati.SDA_CARE_NAME
+    Xs = sl.solve_continuous_are(A.T, C.T, np.eye(30), np.eye(3))
+    assert np.abs(X - Xs).max() <= 1e-12 * np.abs(Xs).max()
+    A2 = np.array([[1.0, 1.0], [0.0, -2.0]])
+    B2 = np.array([[1.0], [0.0]])
+    X2, name2 = riccati.solve_care(A2, B2, np.zeros((2, 2)), np.eye(1))
+    assert name2 == riccati.SCIPY_CARE_NAME
+    assert riccati.care_residual(A2, B2, np.zeros((2, 2)), np.eye(1), X2) < 1e-10
+
+
+def test_care_residual_is_relative_to_the_terms() -> None:
+    """Scalar CARE 2ax − x²b²/r + q = 0 with a = 1, b = r = q = 1: x = 1 + √2 has residual
+    ~ rounding, a perturbed x does not."""
+    x = 1.0 + np.sqrt(2.0)
+    one = np.array([[1.0]])
+    assert riccati.care_residual(one, one, one, one, np.array([[x]])) < 1e-15
+    assert riccati.care_residual(one, one, one, one, np.array([[x * (1 + 1e-6)]])) > 1e-8

@@ -271,8 +271,9 @@ def riccati_gain(
     structure-preserving doubling algorithm, scipy's ``solve_discrete_are`` as its fallback)
     with Ā = A/λₛ, L = λₛ Ā X Cᵀ (R + C X Cᵀ)⁻¹, so that
     Ā − (L/λₛ)C is Schur and ρ(A − LC) < λₛ (λₛ = 1 without an asked rate: the steady-state
-    Kalman predictor gain). Continuous: X = CARE((A + αₛI)ᵀ, Cᵀ, Q, R) (scipy's
-    ``solve_continuous_are``), L = X Cᵀ R⁻¹, so
+    Kalman predictor gain). Continuous: X = CARE((A + αₛI)ᵀ, Cᵀ, Q, R)
+    (:func:`obsdesign.riccati.solve_care`: the doubling after a Cayley transform, scipy's
+    ``solve_continuous_are`` as its fallback), L = X Cᵀ R⁻¹, so
     that A + αₛI − LC is Hurwitz (αₛ = 0 without an asked rate). The error dynamics
     e⁺ = (A − LC)e is that of the linear observer of Section 5 of the constrained-redesign
     paper (Astolfi et al., NOLCOS 2019).
@@ -287,11 +288,11 @@ def riccati_gain(
         Ab = A / s
         X, name = solve_dare(Ab.T, C.T, Qw, Rw)
         return s * (Ab @ X @ C.T @ np.linalg.inv(Rw + C @ X @ C.T)), name
-    from scipy.linalg import solve_continuous_are
+    from obsdesign.riccati import solve_care
 
     a = 0.0 if rate is None else rate
-    X = solve_continuous_are((A + a * np.eye(n)).T, C.T, Qw, Rw)
-    return X @ C.T @ np.linalg.inv(Rw), "scipy solve_continuous_are"
+    X, name = solve_care((A + a * np.eye(n)).T, C.T, Qw, Rw)
+    return X @ C.T @ np.linalg.inv(Rw), name
 
 
 def _rounded_radius(s: Any, Lm: fmpq_mat) -> float:
