@@ -175,13 +175,7 @@ def solve_dare(
     does not pass its checks (scipy's errors — LinAlgError, ValueError — pass through).
 
     :param A, B, Q, R: as :func:`dare_sda`."""
-    with np.errstate(all="ignore"):
-        X = dare_sda(A, B, Q, R)
-    if X is not None:
-        return X, SDA_NAME
-    from scipy.linalg import solve_discrete_are
-
-    return solve_discrete_are(A, B, Q, R), SCIPY_NAME
+    return _doubling_or_scipy(dare_sda, "solve_discrete_are", SDA_NAME, A, B, Q, R)
 
 
 def solve_care(
@@ -191,13 +185,20 @@ def solve_care(
     it does not pass its checks (scipy's errors pass through).
 
     :param A, B, Q, R: as :func:`care_sda`."""
-    with np.errstate(all="ignore"):
-        X = care_sda(A, B, Q, R)
-    if X is not None:
-        return X, SDA_CARE_NAME
-    from scipy.linalg import solve_continuous_are
+    return _doubling_or_scipy(care_sda, "solve_continuous_are", SDA_CARE_NAME, A, B, Q, R)
 
-    return solve_continuous_are(A, B, Q, R), SCIPY_CARE_NAME
+
+def _doubling_or_scipy(
+    sda: Any, scipy_name: str, sda_name: str, *args: np.ndarray
+) -> tuple[np.ndarray, str]:
+    """``sda(*args)`` named ``sda_name``, else ``scipy.linalg.<scipy_name>(*args)``."""
+    with np.errstate(all="ignore"):
+        X = sda(*args)
+    if X is not None:
+        return X, sda_name
+    import scipy.linalg
+
+    return getattr(scipy.linalg, scipy_name)(*args), f"scipy {scipy_name}"
 
 
 #: the solver names :func:`solve_dare` and :func:`solve_care` report
