@@ -26,6 +26,8 @@ Sₖ = (I + GₖHₖ)⁻¹,
 
 When (A, B) is stabilizable and (A, Q^½) detectable, Hₖ converges quadratically to the
 stabilizing solution X: ‖Hₖ − X‖ = O(ρ(A_cl)^(2^(k+1))), A_cl = A − B(R + BᵀXB)⁻¹BᵀXA.
+:func:`doubling` runs this iteration from any (E₀, G₀, H₀) (Eₖ for Aₖ); the continuous
+equation enters it through the Cayley transform of :func:`care_sda`.
 """
 
 from __future__ import annotations
