@@ -10,7 +10,6 @@ constraints guaranteed in prescribed convex set", NOLCOS 2019; the maths is in
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from typing import Any
 
@@ -295,15 +294,17 @@ def riccati_gain(
     return X @ C.T @ np.linalg.inv(Rw), name
 
 
-def _rounded_radius(s: Any, Lm: fmpq_mat) -> float:
-    """ρ(A − LC) in floats for the exact gain ``Lm``, A − LC formed exactly and then rounded
-    (a guide only: the exact tests decide); inf when not finite.
+def _gain_certifies(s: Any, Lm: fmpq_mat, rate: fmpq) -> bool:
+    """Whether the exact gain ``Lm`` gives decay rate ``rate`` (discrete time), proved as the
+    design proves it (:func:`obsdesign.lyap.certified_P`: the Lyapunov-equation P, in high
+    precision for a badly conditioned A − LC, checked exactly; eq. (4)-(6), Section 5 of the
+    constrained-redesign paper). Only a proof accepts: float eigenvalues of such a closed loop
+    can be far off (a 5-state plant with ρ(A) ≈ 6000: a good 64-bit gain looked unstable).
 
-    :param s: the spec's system; :param Lm: the gain (exact)."""
-    Af = lyap.mat_float(lyap.closed_loop_fmat(s.A.q, s.C.q, Lm))
-    if not np.all(np.isfinite(Af)):
-        return math.inf
-    return float(np.max(np.abs(np.linalg.eigvals(Af))))
+    :param s: the spec's system; :param Lm: the gain (exact); :param rate: λ (exact)."""
+    Acl = lyap.closed_loop_fmat(s.A.q, s.C.q, Lm)
+    L = lyap.as_array(Lm)
+    return lyap.certified_P(s.A.q, s.C.q, L, True, rate, fmpq(0), Acl=Acl) is not None
 
 
 def riccati_gain_hp(
@@ -312,8 +313,8 @@ def riccati_gain_hp(
     """:func:`riccati_gain` (discrete time) with the DARE solved by the doubling algorithm in
     high precision (:func:`obsdesign.riccati.dare_sda_hp`, python-flint ``arb_mat``) from the
     exact A, C, weights and shift, and the gain L = A X Cᵀ (R + C X Cᵀ)⁻¹ formed at the same
-    precision: for badly conditioned plants whose float Riccati solution gives a gain that is
-    not even Schur in floats. The precisions of :data:`obsdesign.riccati.HP_PRECISIONS` are
+    precision: for badly conditioned plants whose float Riccati solution gives no gain or a
+    wrong one. The precisions of :data:`obsdesign.riccati.HP_PRECISIONS` are
     tried in turn, and at each the gain rounded to each of :data:`GAIN_BITS` significant bits
     (no more than the precision) until it is ``good``: at too low a precision the doubling can
     meet its step criterion far from the solution, and the closed loop of such a plant can be
@@ -515,8 +516,8 @@ def riccati_retry_hp(spec: Spec, o: Options) -> tuple[fmpq_mat, int, SolverResul
     """After a float Riccati gain failed the exact tests (discrete time): the gain of the
     same equation solved in high precision (:func:`riccati_gain_hp`) at the first shift the
     float design tries (0.98 λ with an asked rate, else none), rounded to the fewest bits of
-    :data:`GAIN_BITS` with which it meets that bound in floats (a guide: the exact tests
-    decide again). Returns (the rounded gain, its bits, the solver result, the path's note).
+    :data:`GAIN_BITS` with which it provably gives the asked rate (λ = 1, i.e. Schur, without
+    one: :func:`_gain_certifies`); the design's exact tests then run on it. Returns (the rounded gain, its bits, the solver result, the path's note).
     None when there is none (continuous time has no high-precision path). The error
     dynamics e⁺ = (A − LC)e are those of the linear observer of Section 5 of the
     constrained-redesign paper (Astolfi et al., NOLCOS 2019), eq. (4)-(6).
@@ -529,9 +530,9 @@ def riccati_retry_hp(spec: Spec, o: Options) -> tuple[fmpq_mat, int, SolverResul
         return None
     t0 = _time.perf_counter()
     shift = None if o.rate is None else float(o.rate) * SLACK_DISCRETE
-    bound = 1.0 if shift is None else shift
+    need = fmpq(1) if o.rate is None else o.rate
     hp = riccati_gain_hp(
-        s.A.q, s.C.q, o.riccati_Q, o.riccati_R, shift, lambda L: _rounded_radius(s, L) < bound
+        s.A.q, s.C.q, o.riccati_Q, o.riccati_R, shift, lambda L: _gain_certifies(s, L, need)
     )
     if hp is None:
         return None
