@@ -33,9 +33,13 @@ equation enters it through the Cayley transform of :func:`care_sda`.
 from __future__ import annotations
 
 import math
-from typing import Any
+from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from flint import arb_mat, fmpq_mat
 
 #: doubling steps before giving up: 2⁶⁰ squarings cover any ρ(A_cl) < 1 − 10⁻¹⁶
 MAX_STEPS = 60
@@ -191,7 +195,7 @@ def solve_care(
 
 
 def _doubling_or_scipy(
-    sda: Any, scipy_name: str, sda_name: str, *args: np.ndarray
+    sda: Callable[..., np.ndarray | None], scipy_name: str, sda_name: str, *args: np.ndarray
 ) -> tuple[np.ndarray, str]:
     """``sda(*args)`` named ``sda_name``, else ``scipy.linalg.<scipy_name>(*args)``."""
     with np.errstate(all="ignore"):
@@ -216,7 +220,7 @@ HP_MAX_N = 24
 HP_PRECISIONS = (128, 320, 1024)
 
 
-def dare_sda_hp(A: Any, B: Any, Q: Any, R: Any, prec: int) -> Any:
+def dare_sda_hp(A: fmpq_mat, B: fmpq_mat, Q: fmpq_mat, R: fmpq_mat, prec: int) -> arb_mat | None:
     """:func:`dare_sda` in python-flint ``arb_mat`` arithmetic at ``prec`` bits (midpoints
     only: no error bounds are needed, whatever the solution proposes is checked exactly
     afterwards), for the badly conditioned problems where every float solver is wrong — e.g.
@@ -228,7 +232,7 @@ def dare_sda_hp(A: Any, B: Any, Q: Any, R: Any, prec: int) -> Any:
 
     :param A: n×n; :param B: n×m; :param Q: n×n; :param R: m×m (``fmpq_mat``, exact);
     :param prec: working precision in bits (the caller sets ``flint.ctx.prec`` to it)."""
-    from flint import arb_mat
+    from flint import arb_mat  # noqa: F811 (the runtime import of the type-checking name)
 
     n = A.nrows()
     eye = arb_mat([[1 if i == j else 0 for j in range(n)] for i in range(n)])
@@ -253,7 +257,7 @@ def dare_sda_hp(A: Any, B: Any, Q: Any, R: Any, prec: int) -> Any:
     return None
 
 
-def _max_abs(M: Any) -> float:
+def _max_abs(M: arb_mat) -> float:
     """max |midpoint| of an ``arb_mat``'s entries, as a float (inf beyond the float range)."""
     return max(
         (abs(float(M[i, j].mid())) for i in range(M.nrows()) for j in range(M.ncols())), default=0.0
