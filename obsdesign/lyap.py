@@ -30,6 +30,7 @@ from obsdesign.certify.detect import hurwitz_stable, schur_stable
 from obsdesign.certify.exact import Q, dyadic, qeye, symmetrize
 from obsdesign.certify.psd import check_pd_fast, check_psd, negative_direction, to_fmpq_mat
 from obsdesign.errors import InconclusiveError, InfeasibleError
+from obsdesign.spectrum import Spectrum, spectrum
 
 #: reference printed in claims that check these formulas
 REF = (
@@ -805,6 +806,7 @@ def certified_P(
     Acl: fmpq_mat | None = None,
     floats: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
     Af: np.ndarray | None = None,
+    guide: Spectrum | None = None,
 ) -> np.ndarray | None:
     """A rational P (the Lyapunov-equation P rounded to ``bits`` dyadic bits) with
     P − margin·I ≻ 0 and :func:`decay_matrix` − margin·I ≻ 0 exactly, or None.
@@ -818,7 +820,9 @@ def certified_P(
     :param memo: records the exact verdicts (for ``certify`` in the same process);
     :param Acl: A − LC as an ``fmpq_mat``, when already made; :param floats: A, C, L as
     float arrays (``np.asarray(x, dtype=float)``), when already made; :param Af:
-    :func:`mat_float` of A − LC, when already made."""
+    :func:`mat_float` of A − LC, when already made; :param guide: the
+    :func:`~obsdesign.spectrum.spectrum` of A − LC, when already made (it decides only
+    whether the high-precision fallback is worth running)."""
     r = Q(rate)
     if (discrete and r <= 0) or A.shape[0] == 0:
         return None
@@ -835,7 +839,7 @@ def certified_P(
         and decay_verdict(Am, P, r, discrete, margin, memo, Pm, Af, Pq_f)[0]
     ):
         return P
-    return _certified_P_hp(Am, r, discrete, margin, memo, Af)
+    return _certified_P_hp(Am, r, discrete, margin, memo, Af, guide)
 
 
 def _certified_P_hp(
@@ -845,31 +849,30 @@ def _certified_P_hp(
     margin: Any,
     memo: ExactMemo | None,
     Af: np.ndarray | None,
+    guide: Spectrum | None = None,
 ) -> np.ndarray | None:
     """:func:`certified_P`'s fallback when the float P fails: the Lyapunov-equation P in
     high precision (:mod:`obsdesign.lyap_hp`, n ≤ its ``MAX_N``), scaled by a power of two
     c ≥ 2δ when the margin δ is not below ½ (its decay matrix is c·I), checked by the same
-    exact tests. Skipped for a rate the float spectrum puts clearly on the infeasible side
-    (the exact check would refuse it: the solve would be wasted)."""
+    exact tests. Skipped for a rate the spectrum (:func:`obsdesign.spectrum.spectrum`: float
+    eigenvalues when their error bound is small, else high-precision ones) puts clearly on
+    the infeasible side (the exact check would refuse it: the solve would be wasted)."""
     from obsdesign import lyap_hp
 
     n = Am.nrows()
     if n > lyap_hp.MAX_N:
         return None
     Af = mat_float(Am) if Af is None else Af
-    with np.errstate(all="ignore"):
-        try:
-            eig = np.linalg.eigvals(Af)
-        except np.linalg.LinAlgError:
-            return None
-    # float eigenvalues of a non-normal matrix are off by far more than u·‖A − LC‖ (the
+    if guide is None:
+        guide = spectrum(Am, Af)
+    # a small slack beyond the guide's own accuracy (float eigenvalues of a non-normal matrix
+    # are off by far more than u·‖A − LC‖: the guide takes high-precision ones then; the
     # audit's continuous example: ‖A − LC‖ ≈ 3·10¹⁰, float real parts +2.7·10⁻³ for an
-    # exactly Hurwitz matrix): skip only well beyond √u·‖A − LC‖
+    # exactly Hurwitz matrix)
     rf = float(r)
     slack = 1e-8 * max(1.0, float(np.max(np.abs(Af))) * n)
-    if discrete and float(np.max(np.abs(eig))) - rf > slack:
-        return None
-    if not discrete and float(np.max(eig.real)) + rf > slack:
+    bound = guide.bound(discrete)
+    if (bound - rf if discrete else bound + rf) > slack:
         return None
     d = Q(margin)
     c = fmpq(1)
@@ -900,19 +903,17 @@ class _Forecast:
     Schur-based solve (eq. (4)-(6) of the constrained-redesign paper, Astolfi et al., NOLCOS
     2019, Section 5, with Q = I). Otherwise scipy solves each rate.
 
-    :param Af: float A − LC; :param discrete: time domain; :param margin: δ."""
+    :param Af: float A − LC; :param discrete: time domain; :param margin: δ;
+    :param guide: the :func:`~obsdesign.spectrum.spectrum` of A − LC (its float
+    eigendecomposition is used when it has one)."""
 
-    def __init__(self, Af: np.ndarray, discrete: bool, margin: Any) -> None:
+    def __init__(self, Af: np.ndarray, discrete: bool, margin: Any, guide: Spectrum) -> None:
         self.Af, self.discrete, self.m = Af, discrete, float(margin)
         self.V: np.ndarray | None = None
         n = Af.shape[0]
-        try:
-            w, V = np.linalg.eig(Af)
-            Vi = np.linalg.inv(V)
-            if np.all(np.isfinite(Vi)) and np.linalg.norm(V) * np.linalg.norm(Vi) < 1e8 * n:
-                self.w, self.V, self.Vi, self.G = w, V, Vi, V.conj().T @ V
-        except np.linalg.LinAlgError:
-            pass
+        w, V, Vi = guide.w, guide.V, guide.Vi
+        if V is not None and Vi is not None and np.linalg.norm(V) * np.linalg.norm(Vi) < 1e8 * n:
+            self.w, self.V, self.Vi, self.G = w, V, Vi, V.conj().T @ V
 
     def P(self, rf: float) -> np.ndarray | None:
         """The float Lyapunov-equation P at rate ``rf`` (None when it cannot be had)."""
@@ -1024,6 +1025,7 @@ def best_rate(
     memo: ExactMemo | None = None,
     Acl: fmpq_mat | None = None,
     Af: np.ndarray | None = None,
+    guide: Spectrum | None = None,
 ) -> RateBracket:
     """Bisection for the best certified rate of V = eᵀPe: the smallest λ (discrete) or the
     largest α (continuous) at which :func:`certified_P` succeeds, bracketed.
@@ -1056,7 +1058,9 @@ def best_rate(
     for exact checks (False: an exact check at every midpoint; the rerun uses it);
     :param memo: records the exact verdicts (for ``certify`` in the same process);
     :param Acl: A − LC as an ``fmpq_mat``, when already made; :param Af: its
-    :func:`mat_float`, when already made.
+    :func:`mat_float`, when already made; :param guide: the
+    :func:`~obsdesign.spectrum.spectrum` of A − LC, when already made (where the search
+    starts; the forecast's eigendecomposition).
     Raises :class:`InfeasibleError` when Acl is not Schur / Hurwitz (exact) and
     :class:`InconclusiveError` when it is but nothing certifies."""
     Acl = closed_loop_fmat(A, C, L) if Acl is None else Acl
@@ -1064,9 +1068,10 @@ def best_rate(
     grid = _grid(tol_q)
     if Af is None:  # correctly rounded, as np.asarray(closed_loop(A, C, L), dtype=float)
         Af = mat_float(Acl)
-    eig = np.linalg.eigvals(Af)
+    if guide is None:
+        guide = spectrum(Acl, Af)
     floats = (np.asarray(A, dtype=float), np.asarray(C, dtype=float), np.asarray(L, dtype=float))
-    guess = _Forecast(Af, discrete, margin) if forecast else None
+    guess = _Forecast(Af, discrete, margin, guide) if forecast else None
     # r-space: r = λ (discrete) or r = −α (continuous); smaller r is better in both
     sign = 1 if discrete else -1
     checks = 0
@@ -1085,7 +1090,17 @@ def best_rate(
                 "resolution of the rate, ~1e-16, cannot be reached: raise rate_tol)"
             )
         return certified_P(
-            A, C, L, discrete, rate(r), margin, memo=memo, Acl=Acl, floats=floats, Af=Af
+            A,
+            C,
+            L,
+            discrete,
+            rate(r),
+            margin,
+            memo=memo,
+            Acl=Acl,
+            floats=floats,
+            Af=Af,
+            guide=guide,
         )
 
     def cert(r: fmpq) -> Any:
@@ -1096,7 +1111,7 @@ def best_rate(
     def feasible(r: fmpq) -> bool:
         return rate_feasible(Acl, rate(r), discrete, memo, Af)
 
-    bound = float(np.max(np.abs(eig))) if discrete else float(np.max(eig.real))
+    bound = guide.bound(discrete)
     resolution = Q(abs(bound)) / 2**52  # about one ulp of the rate
     if tol_q < resolution:  # no bisection in float midpoints gets there
         raise RateResolutionError(tol_q, resolution, Q(bound))
@@ -1182,5 +1197,6 @@ def best_rate(
                 memo=memo,
                 Acl=Acl,
                 Af=Af,
+                guide=guide,
             )
     return RateBracket(rate(hi), P, rate(lo), lo_kind, tol_q, checks)

@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 
 from obsdesign import api, lyap, lyap_hp
 from obsdesign.certify.exact import qmat
+from obsdesign.spectrum import Spectrum
 
 #: the soundness audit's spec (session 11): a Riccati gain makes A − LC entries of ~1e5
 #: around a spectral radius of 0.02; the float P failed at every rate (exit 4)
@@ -74,17 +75,21 @@ def test_badly_conditioned_rate_certifies_only_through_the_fallback(monkeypatch)
 
 
 def test_hp_P_at_an_infeasible_rate_fails_the_exact_check(monkeypatch) -> None:
-    """The float-spectrum skip switched off, a rate just below the spectral radius: the
-    high-precision solve runs and its P is refused by the exact check (not ≻ 0)."""
-    Acl = qmat([[fmpq(1, 2), 1], [0, fmpq(1, 3)]])
-    monkeypatch.setattr(np.linalg, "eigvals", lambda M: np.zeros(M.shape[0]))
+    """The spectrum's skip switched off (a guide of zero eigenvalues), a rate just below the
+    spectral radius: the high-precision solve runs and its P is refused by the exact check
+    (not ≻ 0). With the true spectrum as guide the solve is skipped there."""
+    Acl = lyap.fmat(qmat([[fmpq(1, 2), 1], [0, fmpq(1, 3)]]))
+    zeros = Spectrum(np.zeros(2, dtype=complex), "a wrong guide")
     calls: list[int] = []
     real = lyap_hp.lyapunov_P_hp
     monkeypatch.setattr(lyap_hp, "lyapunov_P_hp", lambda *a: calls.append(a[-1]) or real(*a))
-    got = lyap._certified_P_hp(lyap.fmat(Acl), fmpq(49, 100), True, fmpq(0), None, None)
+    got = lyap._certified_P_hp(Acl, fmpq(49, 100), True, fmpq(0), None, None, zeros)
     assert got is None and calls == list(lyap_hp.PRECISIONS)
-    got = lyap._certified_P_hp(lyap.fmat(Acl), fmpq(51, 100), True, fmpq(0), None, None)
+    got = lyap._certified_P_hp(Acl, fmpq(51, 100), True, fmpq(0), None, None, zeros)
     assert got is not None and calls[-1] == lyap_hp.PRECISIONS[0]
+    calls.clear()
+    assert lyap._certified_P_hp(Acl, fmpq(49, 100), True, fmpq(0), None, None) is None
+    assert calls == []  # the true spectrum (ρ = ½) puts 0.49 clearly on the infeasible side
 
 
 def test_singular_equation_and_large_margin() -> None:

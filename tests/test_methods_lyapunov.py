@@ -641,6 +641,32 @@ def test_a_badly_conditioned_plant_takes_the_high_precision_riccati() -> None:
     assert api.verify(rep).exit_code() == 0
 
 
+def test_a_huge_spectral_radius_certifies_through_the_high_precision_spectrum(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The 5-state plant of tests/data (ρ(A) ≈ 6000, one output): the 320-bit Riccati gain
+    (rounded to 64 bits) gives an exactly Schur A − LC of radius 0.6466 whose float
+    eigenvalues say 4.7 (‖A − LC‖ ≈ 2·10⁴, strongly non-normal). The spectral guide takes
+    python-flint eigenvalues, so the high-precision Lyapunov P is tried at the right rates:
+    certified, the bracket's infeasible end proved, verified. The note names the guide.
+    With the high-precision spectrum switched off the same design is exit 4 (the float guide
+    puts every rate below 4.7 on the infeasible side)."""
+    from obsdesign import spectrum
+
+    path = Path(__file__).parent / "data" / "lyapunov-rho-6000-5state.toml"
+    rep = api.design(load_spec_text(path.read_text(), str(path)))
+    assert rep.exit_code() == 0
+    lam = float(rep.parameters.float("lambda_best"))
+    assert 0.6465 < lam < 0.6468
+    assert abs(float(rep.parameters.float("spectral_radius")) - 0.646557) < 1e-6
+    assert any("(python-flint eigenvalues at" in n for n in rep.notes)
+    assert api.verify(rep).exit_code() == 0
+    monkeypatch.setattr(spectrum, "HP_MAX_N", 0)
+    with pytest.raises(InconclusiveError, match="the designed gain fails") as ei:
+        api.design(load_spec_text(path.read_text(), str(path)))
+    assert ei.value.exit_code == 4
+
+
 def test_a_sensitive_closed_loop_keeps_more_bits_of_the_gain() -> None:
     """The 8-state plant of tests/data (ρ(A) ≈ 87, one output): the 128-bit doubling converges
     to a wrong X, the 320-bit one to a gain that is unstable rounded to 40 bits; rounded to 64

@@ -24,6 +24,7 @@ from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
 from obsdesign.methods.lyapunov.options import Options
 from obsdesign.params import Parameters
 from obsdesign.spec.models import Spec
+from obsdesign.spectrum import FLOAT_SOURCE, spectrum
 
 
 def rate_name(discrete: bool) -> str:
@@ -149,22 +150,24 @@ def _design_for(
     Acl = lyap.closed_loop_fmat(A, C, Lm)
     memo.put(lyap.CLOSED_LOOP_KEY, (Lm,), Acl)  # A − LC for this spec's A, C and this L
     Af = lyap.mat_float(Acl)  # converted once: the float guide of every step below
-    eig = np.linalg.eigvals(Af)
+    # the eigenvalues, a guide (float ones, or high-precision ones when those are inaccurate)
+    guide = spectrum(Acl, Af)
+    bound = guide.bound(s.discrete)
     params = Parameters({"L": L})
     name = rate_name(s.discrete)
     sym = "λ" if s.discrete else "α"
     if s.discrete:
-        bound = float(np.max(np.abs(eig)))
         params["spectral_radius"] = bound  # ρ(A − LC), informational
         lim = f"spectral radius ≈ {bound:.6g}"
     else:
-        bound = float(np.max(eig.real))
         params["spectral_abscissa"] = bound  # max Re λ_i(A − LC), informational
         lim = f"largest real part ≈ {bound:.6g}"
+    if guide.source != FLOAT_SOURCE:
+        lim += f" from {guide.source}"
     known = None
     if o.rate is not None:
         # the asked rate first, directly: no search can make it fail
-        P = lyap.certified_P(A, C, L, s.discrete, o.rate, o.margin, memo=memo, Acl=Acl)
+        P = lyap.certified_P(A, C, L, s.discrete, o.rate, o.margin, memo=memo, Acl=Acl, guide=guide)
         if P is None:
             ok, how = lyap.rate_feasibility(Acl, o.rate, s.discrete, memo, Af)
             if not ok:
@@ -202,6 +205,7 @@ def _design_for(
             memo=memo,
             Acl=Acl,
             Af=Af,
+            guide=guide,
         )
     except lyap.RateResolutionError as e:
         raise SpecError(spec.file, "method.rate_tol", e.hint()) from None
@@ -226,7 +230,7 @@ def _design_for(
         f"best rate {name} = {fmt_exact(br.best)} for this L (bracket tolerance "
         f"{fmt_exact(o.rate_tol)}); {name} = {fmt_exact(br.other)} is {br.kind}: {why}; "
         + (f"infimum ≈ {bound:.6g}" if s.discrete else f"supremum ≈ {-bound:.6g}")
-        + " (float eigenvalues)"
+        + f" ({guide.source})"
     )
     lyap.attach_memo(spec, memo)
     return Design(params, solver, notes)

@@ -1,0 +1,98 @@
+"""Tests of obsdesign/spectrum.py: the eigenvalue guide (float eigenvalues when their
+Bauer–Fike bound is small, python-flint ones otherwise)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from flint import fmpq, fmpq_mat
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from obsdesign import lyap, spectrum
+from obsdesign.spectrum import FLOAT_SOURCE, Spectrum, eig_hp
+
+
+def _exact(M: list[list[int | fmpq]]) -> fmpq_mat:
+    return fmpq_mat([[fmpq(x) for x in row] for row in M])
+
+
+def _jordan_in_disguise(z: fmpq, n: int, scale: int) -> fmpq_mat:
+    """S J S⁻¹ exactly, J the n×n Jordan block of z, S = I + scale·(subdiagonal ones): a
+    defective, strongly non-normal matrix whose float eigenvalues are off by ~(u‖·‖)^(1/n)."""
+    J = fmpq_mat(
+        n, n, [z if i == j else (1 if j == i + 1 else 0) for i in range(n) for j in range(n)]
+    )
+    S = fmpq_mat(
+        n, n, [1 if i == j else (scale if i == j + 1 else 0) for i in range(n) for j in range(n)]
+    )
+    return S * J * S.inv()
+
+
+def test_a_well_conditioned_matrix_keeps_its_float_eigenvalues() -> None:
+    Am = _exact([[fmpq(1, 2), 1], [0, fmpq(-1, 3)]])
+    g = spectrum.spectrum(Am, lyap.mat_float(Am))
+    assert g.source == FLOAT_SOURCE and g.V is not None and g.Vi is not None
+    assert g.bound(True) == pytest.approx(0.5, abs=1e-15)
+    assert g.bound(False) == pytest.approx(0.5, abs=1e-15)
+
+
+def test_a_defective_non_normal_matrix_takes_high_precision_eigenvalues() -> None:
+    """A triple eigenvalue 0.9 in disguise: numpy's radius is off (here by more than 10⁻⁶);
+    the guide's is 0.9 to 10⁻¹², from python-flint, with no float eigenvectors."""
+    Am = _jordan_in_disguise(fmpq(9, 10), 3, 1000)
+    Af = lyap.mat_float(Am)
+    assert abs(float(np.max(np.abs(np.linalg.eigvals(Af)))) - 0.9) > 1e-6
+    g = spectrum.spectrum(Am, Af)
+    assert g.source.startswith("python-flint eigenvalues at") and g.V is None
+    assert g.bound(True) == pytest.approx(0.9, abs=1e-12)
+    assert g.bound(False) == pytest.approx(0.9, abs=1e-12)
+
+
+def test_above_the_size_limit_the_float_eigenvalues_stay(monkeypatch: pytest.MonkeyPatch) -> None:
+    Am = _jordan_in_disguise(fmpq(9, 10), 3, 1000)
+    monkeypatch.setattr(spectrum, "HP_MAX_N", 2)
+    g = spectrum.spectrum(Am, lyap.mat_float(Am))
+    assert g.source == FLOAT_SOURCE
+    assert abs(g.bound(True) - 0.9) > 1e-6  # the poor float answer, as documented
+
+
+def test_precisions_must_agree_else_the_last_one_is_returned(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    Am = _jordan_in_disguise(fmpq(1, 2), 2, 10)
+    w, prec = eig_hp(Am)  # type: ignore[misc]
+    assert prec == spectrum.PRECISIONS[1] and np.allclose(w, 0.5, atol=1e-15)
+    monkeypatch.setattr(spectrum, "AGREE_TOL", -1.0)  # never agree
+    w, prec = eig_hp(Am)  # type: ignore[misc]
+    assert prec == spectrum.PRECISIONS[-1] and np.allclose(w, 0.5, atol=1e-15)
+
+
+def test_empty_spectrum_bounds() -> None:
+    g = Spectrum(np.zeros(0, dtype=complex), FLOAT_SOURCE)
+    assert g.bound(True) == 0.0 and g.bound(False) == -np.inf
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    st.integers(1, 6).flatmap(
+        lambda n: st.lists(
+            st.lists(st.integers(-20, 20), min_size=n, max_size=n), min_size=n, max_size=n
+        )
+    ),
+    st.integers(0, 4),
+)
+def test_the_guide_agrees_with_high_precision_eigenvalues(rows: list[list[int]], k: int) -> None:
+    """Random integer matrices, scaled by 10^k (badly scaled ones included): whichever source
+    the guide takes, its radius and abscissa agree with python-flint's 1024-bit eigenvalues
+    to its documented tolerance (float: relative 10⁻⁹ when its error bound allows it)."""
+    Am = _exact(rows) * 10**k
+    Af = lyap.mat_float(Am)
+    g = spectrum.spectrum(Am, Af)
+    ref = eig_hp(Am)
+    assert ref is not None
+    w = ref[0]
+    size = max(1.0, float(np.max(np.abs(w))))
+    tol = 1e-7 * size  # a defective eigenvalue at 128 bits agrees to ~u^(1/n) of 2^-128
+    assert abs(g.bound(True) - float(np.max(np.abs(w)))) <= tol
+    assert abs(g.bound(False) - float(np.max(w.real))) <= tol
