@@ -212,3 +212,29 @@ def test_a_set_edge_at_1e300_is_inconclusive_not_an_internal_failure(tmp_path) -
     assert e.value.exit_code == 4
     rep = json.loads(out.read_text())
     assert rep["verdict"] == "error" and rep["error"]["exit_code"] == 4
+
+
+def test_faces_with_the_same_direction_are_bounded_together():
+    """A polytope map with a redundant face in the direction of another (−x ≤ 1 and
+    −½x ≤ ½: both violated left of −1; found by the random-spec fuzzer). At the worst points
+    — x at X's left end, e at the left end of {V(e) ≤ v} — both faces are violated, and v_min
+    (21), sup |c| over X̂_max (15) and δ (Assumption 3(4)) must still hold. Putting the two
+    faces in one antipodal class (at most one violated) under-estimated all three: v_min
+    0.24999999 where |c| = 0.0103 > ε_min = 0.01, sup |c| 0.49 where it is 0.505, δ² 4ε_max
+    where it is 4.12ε_max."""
+    cm = polytope_map(qmat([[1], [-1], [fmpq(-1, 2)]]), np.array([Q(1), Q(1), fmpq(1, 2)]))
+    assert cm.classes == [[0, 1], [2]]
+    P = qmat([[fmpq(25, 4)]])
+    X = _box([fmpq(-9, 10)], [fmpq(9, 10)])
+    eps = fmpq(1, 100)
+    vb = B.v_min_lower(cm, P, qinv(P), X, eps)
+    worst = -0.9 - np.sqrt(float(vb.value) / 6.25)
+    assert cm.norm_c(np.array([worst])) <= 0.01 * (1 + 1e-12)
+    v = fmpq(4)
+    sup = B.sup_norm_c_over_Xhat_max(cm, P, qinv(P), X, v)
+    worst = -0.9 - np.sqrt(4 / 6.25)
+    assert cm.norm_c(np.array([worst])) <= float(sup) * (1 + 1e-12)
+    dsq = B.delta_sq_upper(cm, sup)
+    xs = np.linspace(-3, 3, 60001)[:, None]
+    J = _jacobian_norms(cm, xs[cm.norm_c(xs) <= float(sup)])
+    assert J.max() ** 2 <= float(dsq.value) * (1 + 1e-12)

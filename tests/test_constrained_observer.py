@@ -123,3 +123,30 @@ def test_ellipsoid_map_values():
     x = np.array([2.0, 0.0])  # xᵀx/r − 1 = 1 → c = 1
     np.testing.assert_allclose(cm.c(x), [1.0])
     np.testing.assert_allclose(cm.jtc(x), 4 * 1 * x / 2)
+
+
+def test_antipodal_classes_never_hold_two_faces_of_one_direction():
+    """A face pairs with at most one negative multiple: −x ≤ 1 and −½x ≤ ½ can be violated
+    together, so they are never in one class (the bounds assume one violated face per class)."""
+    assert antipodal_classes(qmat([[1], [-1], [fmpq(-1, 2)]])) == [[0, 1], [2]]
+    assert antipodal_classes(qmat([[1], [2], [-1], [-3]])) == [[0, 2], [1, 3]]
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(
+        st.tuples(st.sampled_from([(1, 0), (0, 1), (1, 1), (2, -1)]), st.integers(-3, 3)),
+        min_size=1,
+        max_size=8,
+    ).filter(lambda rows: all(k != 0 for _, k in rows)),
+    st.lists(st.tuples(st.floats(-9, 9), st.floats(-9, 9)), min_size=1, max_size=20),
+)
+def test_at_most_one_face_per_class_is_violated(rows, points):
+    """Random faces (multiples of a few directions, h = 1: the polytope holds 0), random
+    points: no class ever has two violated faces."""
+    G = qmat([[k * d[0], k * d[1]] for d, k in rows])
+    cm = polytope_map(G, np.array([fmpq(1)] * len(rows), dtype=object))
+    phi = cm.phi(np.asarray(points, dtype=float))
+    for cls in cm.classes:
+        assert len(cls) <= 2
+        assert np.all((phi[:, cls] > 0).sum(axis=1) <= 1)

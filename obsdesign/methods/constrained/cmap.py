@@ -9,9 +9,9 @@ Every component is ``c_i(x) = max(φ_i(x), 0)²`` with φ_i convex:
 
 The sublevel sets are C_ε = {x : |c(x)| ≤ ε} (eq. (16), |·| the Euclidean norm), so
 C_0 = {φ_i ≤ 0 ∀i}. For affine φ, C_ε lies between the inner polytope {φ_i ≤ t_in(ε)} and the
-outer polytope {φ_i ≤ √ε}; at most one face of each *antipodal class* (faces whose normals are
-negative multiples of each other, e.g. the two faces of a box coordinate) can be violated at a
-point, which the bounds below use.
+outer polytope {φ_i ≤ √ε}; at most one face of each *antipodal class* (a face alone, or a pair
+of faces whose normals are negative multiples of each other, e.g. the two faces of a box
+coordinate) can be violated at a point, which the bounds below use.
 """
 
 from __future__ import annotations
@@ -138,10 +138,18 @@ class ConstraintMap:
 
 
 def antipodal_classes(G: np.ndarray) -> list[list[int]]:
-    """Group the faces of {G x ≤ h} whose normals are negative multiples of each other.
+    """Group the faces of {G x ≤ h} in *antipodal classes*: a face alone, or a pair of faces
+    whose normals are negative multiples of each other (exact rational test on the rows).
 
-    Two such faces can never be violated at the same point of a non-empty polytope, so at
-    most one φ_i per class is positive at any x (exact rational test on the rows).
+    The two faces of a pair can never be violated at the same point of a non-empty polytope
+    (g x > h₁ and −s g x > h₂ need h₁ < g x < −h₂/s ≤ h₁), so at most one φ_i per class is
+    positive at any x: the bounds of :mod:`obsdesign.methods.constrained.bounds` (Σ over
+    classes of the worst face) rely on it. Faces with the *same* outward direction (a
+    redundant face such as −x ≤ 1 beside −½x ≤ ½) can be violated together, so they never
+    share a class: each face pairs with at most one antipodal face, the first unpaired one.
+    (Grouping every negative multiple of a face together put two same-direction faces in one
+    class and under-estimated |c| and |dc/dx|: a certified v_min that was false; found by
+    the random-spec fuzzer.)
     """
     m = G.shape[0]
     cls: list[list[int]] = []
@@ -149,13 +157,15 @@ def antipodal_classes(G: np.ndarray) -> list[list[int]]:
     for i in range(m):
         if used[i]:
             continue
-        group = [i]
         used[i] = True
-        for j in range(i + 1, m):
-            if not used[j] and _negative_multiple(G[i], G[j]):
-                group.append(j)
-                used[j] = True
-        cls.append(group)
+        j = next(
+            (j for j in range(i + 1, m) if not used[j] and _negative_multiple(G[i], G[j])), None
+        )
+        if j is None:
+            cls.append([i])
+        else:
+            used[j] = True
+            cls.append([i, j])
     return cls
 
 
