@@ -12,16 +12,18 @@ import re
 from pathlib import Path
 from typing import Any
 
+import hypothesis
 import numpy as np
 import pytest
 from flint import fmpq
+from hypothesis import strategies as st
 from test_constrained_method import spec_text, variant
 from test_constrained_nonlinear import NL
 from typer.testing import CliRunner
 
 from obsdesign import api
 from obsdesign.certify.claim import Claims, ClaimStatus
-from obsdesign.certify.exact import Q, qeye, qparse, qstr, to_float
+from obsdesign.certify.exact import Q, dyadic, qeye, qparse, qstr, symmetrize, to_float
 from obsdesign.certify.psd import check_pd, check_psd
 from obsdesign.cli import app
 from obsdesign.lyap import closed_loop, decay_matrix, error_input, iss_matrix
@@ -570,6 +572,61 @@ def test_cmin_in_xhat_ellipsoid_map(face: int) -> None:
     k = [ok] * 4
     k[face] = low
     assert not CL.cmin_in_xhat(cm, EPS, _faces(k))[0]
+
+
+def test_cmin_in_xhat_offset_ellipsoid() -> None:
+    """Ellipsoid map, Q = I, r = 2: outer set of C_min the disc |x|² ≤ R = 2(1 + t). An X̂
+    disc of radius 2 centred at (δ, 0) contains it iff δ ≤ 2 − √R: passes at
+    δ = 2 − √R − 10⁻⁶ (S-lemma, exact PSD), fails at δ = 2 − √R + 10⁻⁶ (the inclusion is
+    false: the point (−√R, 0) is outside X̂). Was refused at every δ ≠ 0 before."""
+    cm = ellipsoid_map(qeye(2), Q(2))
+    R = 2 * (1 + _t())
+    gap = 2 - np.sqrt(float(R))
+    for d, want in ((gap - 1e-6, True), (gap + 1e-6, False), (0.5, True), (-0.5, True)):
+        centre = np.array([Q(d), Q(0)], dtype=object)
+        ok, detail = CL.cmin_in_xhat(cm, EPS, Ellipsoid(qeye(2) * fmpq(1, 4), centre))
+        assert ok is want, (d, detail)
+        if want:
+            assert "S-lemma" in detail
+    far = np.array([Q(3), Q(0)], dtype=object)  # X̂ misses 0, the outer set's centre
+    assert not CL.cmin_in_xhat(cm, EPS, Ellipsoid(qeye(2) * fmpq(1, 4), far))[0]
+
+
+@hypothesis.settings(max_examples=40, deadline=None)
+@hypothesis.given(st.integers(0, 2**31 - 1), st.integers(1, 3), st.floats(0.05, 3.0))
+def test_ellipsoid_in_ellipsoid_is_sound_and_proves_clear_inclusions(
+    seed: int, n: int, slack: float
+) -> None:
+    """Random A, B ≻ 0 and centres: whenever the S-lemma test says yes, points on the
+    boundary of {xᵀAx ≤ 1} lie in {(x − c)ᵀB(x − c) ≤ 1}; and X̂ made to contain the first
+    set with room (B scaled so that an upper bound of (x − c)ᵀB(x − c) on that set is
+    1/(1 + slack)) is proved."""
+    rng = np.random.default_rng(seed)
+
+    def spd() -> np.ndarray:
+        M = rng.standard_normal((n, n))
+        return M @ M.T + 0.3 * np.eye(n)
+
+    Af, Bf, cf = spd(), spd(), rng.standard_normal(n) * 0.5
+    u = rng.standard_normal((400, n))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    pts = u @ np.linalg.cholesky(np.linalg.inv(Af)).T  # on the boundary of xᵀAx = 1
+    # (x − c)ᵀB(x − c) ≤ (|B^½x| + |B^½c|)² ≤ (√λ_max(A⁻¹B) + √(cᵀBc))² on xᵀAx ≤ 1
+    kmax = float(np.max(np.linalg.eigvals(np.linalg.solve(Af, Bf)).real))
+    worst = (np.sqrt(kmax) + np.sqrt(float(cf @ Bf @ cf))) ** 2
+    assert np.max(np.einsum("ki,ij,kj->k", pts - cf, Bf, pts - cf)) <= worst * (1 + 1e-9)
+    Aq, cq = dyadic(Af, 20), dyadic(cf, 20)
+    for scale, must in ((1.0, False), (1 / (worst * (1 + slack)) * 0.999, True)):
+        Bq = dyadic(Bf * scale, 20)
+        ok, _ = CL.ellipsoid_in_ellipsoid(symmetrize(Aq), symmetrize(Bq), cq)
+        Bs = np.asarray(to_float(symmetrize(Bq)), dtype=float)
+        Asf = np.asarray(to_float(symmetrize(Aq)), dtype=float)
+        p2 = u @ np.linalg.cholesky(np.linalg.inv(Asf)).T
+        inside = np.einsum("ki,ij,kj->k", p2 - cf, Bs, p2 - cf) <= 1 + 1e-9
+        if ok:
+            assert inside.all()
+        if must:
+            assert ok
 
 
 # -- printed numbers are true as printed ------------------------------------------------------

@@ -497,10 +497,10 @@ def cmin_in_xhat(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet) -> tuple[bool
         return not bad, f"{len(V)} vertices checked" + (f"; {len(bad)} outside X̂" if bad else "")
     R = Q(cm.r_q) * (1 + t)  # ellipsoid map: the outer set {xᵀQx ≤ r(1 + t)}
     if isinstance(Xhat, Ellipsoid):
-        if any(x != 0 for x in Xhat.center_q):
-            return False, "X̂ ellipsoid must be centred at 0 for this check"
-        r = check_psd(cm.Q_q * (1 / R) - Xhat.E_q)
-        return r.ok, f"E_X̂ ⪯ Q/(r(1+t)): {r.detail}"
+        if all(x == 0 for x in Xhat.center_q):
+            r = check_psd(cm.Q_q * (1 / R) - Xhat.E_q)
+            return r.ok, f"E_X̂ ⪯ Q/(r(1+t)): {r.detail}"
+        return ellipsoid_in_ellipsoid(cm.Q_q * (1 / R), Xhat.E_q, Xhat.center_q)
     G, g = Xhat.h_form_q()  # type: ignore[attr-defined]
     Qinv = B.qinv(cm.Q_q)
     bad_faces = [
@@ -511,6 +511,69 @@ def cmin_in_xhat(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet) -> tuple[bool
     if bad_faces:
         return False, f"faces {bad_faces}: support of the outer ellipsoid above the face"
     return True, f"support function of the outer ellipsoid below all {G.shape[0]} faces of X̂"
+
+
+#: bits of the S-lemma multiplier τ of :func:`ellipsoid_in_ellipsoid`
+TAU_BITS = 40
+
+
+def ellipsoid_in_ellipsoid(Am: np.ndarray, Bm: np.ndarray, c: np.ndarray) -> tuple[bool, str]:
+    """Whether {x : xᵀAx ≤ 1} ⊆ {x : (x − c)ᵀB(x − c) ≤ 1} (A, B ≻ 0, exact), proved by the
+    S-lemma: the inclusion holds iff some τ ≥ 0 makes
+
+        M(τ) = [[τA − B, Bc], [cᵀB, 1 − τ − cᵀBc]] ⪰ 0
+
+    (M(τ) ⪰ 0 says τ(xᵀAx − 1) − ((x − c)ᵀB(x − c) − 1) ≥ 0 for every x; the first set has
+    the interior point 0, so the S-lemma's condition is also necessary). τ maximizes the
+    smallest eigenvalue of M(τ) in floats over [0, 1 − cᵀBc] (a concave function: bounded
+    scalar search), is rounded to :data:`TAU_BITS` bits, and M(τ) ⪰ 0 is checked exactly.
+    A tight inclusion (max λ_min = 0) may go unproved: the answer is then False, never a
+    false True. Used for C_min ⊂ X̂ (Assumption 3(1), constrained-redesign paper, Astolfi et
+    al., NOLCOS 2019) with the outer ellipsoid of C_min and an X̂ ellipsoid not centred at 0.
+
+    :param Am, Bm: exact n×n matrices; :param c: the exact centre. Returns (holds, detail)."""
+    from scipy.optimize import minimize_scalar
+
+    from obsdesign.certify.exact import dyadic
+
+    n = Am.shape[0]
+    Bc = Bm.dot(c)
+    cBc = sum((c[i] * Bc[i] for i in range(n)), fmpq(0))
+    top = 1 - cBc
+    if top < 0:
+        return False, "the centre 0 of the outer set of C_min is outside X̂"
+
+    def M(tau: Any) -> np.ndarray:
+        out = np.empty((n + 1, n + 1), dtype=object)
+        out[:n, :n] = Am * tau - Bm
+        out[:n, n] = Bc
+        out[n, :n] = Bc
+        out[n, n] = top - tau
+        return out
+
+    Af, Bf = (np.asarray(to_float(X), dtype=float) for X in (Am, Bm))
+    Bcf, topf = np.asarray(to_float(Bc), dtype=float), float(top)
+
+    def neg_min_eig(tau: float) -> float:
+        Mf = np.empty((n + 1, n + 1))
+        Mf[:n, :n] = tau * Af - Bf
+        Mf[:n, n] = Mf[n, :n] = Bcf
+        Mf[n, n] = topf - tau
+        return -float(np.linalg.eigvalsh(Mf)[0])
+
+    res = minimize_scalar(
+        neg_min_eig,
+        bounds=(0.0, topf),
+        method="bounded",
+        options={"xatol": 1e-12 * max(topf, 1e-300)},
+    )
+    tau = dyadic(float(res.x), TAU_BITS)
+    tau = min(max(tau, fmpq(0)), top)
+    r = check_psd(M(tau))
+    return r.ok, (
+        f"S-lemma: [[τA − E, Ec], [cᵀE, 1 − τ − cᵀEc]] ⪰ 0 with τ = {fmt_exact(tau)}, "
+        f"A = Q/(r(1+t)), E, c of X̂: {r.detail}"
+    )
 
 
 def contains_q(S: ConvexSet, v: np.ndarray) -> bool:
