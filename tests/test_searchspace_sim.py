@@ -128,6 +128,34 @@ def test_cli_simulate_option_and_cap(tmp_path):
     assert r.exit_code == 2
 
 
+def test_time_limit_stops_the_simulation_with_a_clear_message(example, tmp_path, monkeypatch):
+    """A budget below the run's time (``time_limit``, as an option and as a ``[simulate]``
+    key) stops it with exit 3 and a message naming the key and the progress; the default
+    (300 s) lets the example finish. A clock that jumps past the budget inside the
+    refinement stops there (checked per chunk of rows)."""
+    import time as _time
+
+    from obsdesign.methods.searchspace import sim as S
+
+    sp, rep, res = example
+    assert res.x.shape[0] > 2  # the default budget: finished
+    with pytest.raises(
+        S.TimeBudget, match=r"not finished within 0\.001 s \(\[simulate\] time_limit\)"
+    ):
+        api.simulate(sp, rep, time_limit=1e-3)
+    text = TEXT.replace("[simulate]", "[simulate]\ntime_limit = 0.001", 1)
+    p = tmp_path / "s.toml"
+    p.write_text(text, encoding="utf-8")
+    r = CliRunner().invoke(app, ["simulate", str(p)])
+    assert r.exit_code == 3 and "time_limit" in r.output and "samples done" in r.output
+    r = CliRunner().invoke(app, ["simulate", str(SPEC), "--option", "time_limit=0"])
+    assert r.exit_code == 2
+    C = np.random.default_rng(0).uniform(-1, 1, size=(40, 2))
+    with pytest.raises(S.TimeBudget, match="refinement"):
+        S.recover(C, 0.3, 0.1, 10**6, (_time.perf_counter() - 1, 5.0))
+    assert len(S.recover(C, 0.3, 0.1, 10**6, (_time.perf_counter() + 60, 60.0)))
+
+
 def test_recover_covers_every_ball_point():
     """Sound re-covering: every point within η of a centre lies in a returned cell."""
     rng = np.random.default_rng(1)

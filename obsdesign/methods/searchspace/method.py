@@ -52,6 +52,7 @@ class SearchSpace(Method):
         SimOption("refine", "str", None, "refinement at switches", choices=_opts.REFINE),
         SimOption("substeps", "int", None, "RK4 steps per sample (0: automatic)", 0),
         SimOption("store_every", "int", None, "store the centres every k samples", 1),
+        SimOption("time_limit", "float", None, "seconds the simulation may run", 1e-3),
         SimOption("progress", "bool", False, "show a progress bar"),
     )
 

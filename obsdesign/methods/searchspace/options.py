@@ -52,12 +52,14 @@ class Options:
 @dataclass
 class SimOptions:
     """Method keys of ``[simulate]``: the memory cap (live centres), the refinement scheme at
-    the switches, RK4 steps per sample (0: automatic) and how often centres are stored."""
+    the switches, RK4 steps per sample (0: automatic), how often centres are stored and the
+    seconds the simulation may run (checked after every sample and inside the refinement)."""
 
     max_centres: int = 2_000_000
     refine: str = "recover"
     substeps: int = 0
     store_every: int = 1
+    time_limit: float = 300.0
 
 
 def _box(table: Table, k: str, spec: Spec, dim: int, strict: bool) -> tuple[Box, str]:
@@ -169,6 +171,7 @@ def parse_sim(table: Table, spec: Spec) -> SimOptions:
         refine=table.str("refine", default="recover", choices=REFINE),
         substeps=table.int("substeps", default=0, min=0),
         store_every=table.int("store_every", default=1, min=1),
+        time_limit=float(table.scalar("time_limit", default=fmpq(300), min=0, strict_min=True).q),
     )
 
 
@@ -222,4 +225,5 @@ def simulate_schema() -> dict[str, Any]:
         "refine": {"enum": list(REFINE)},
         "substeps": {"type": "integer", "minimum": 0},
         "store_every": {"type": "integer", "minimum": 1},
+        "time_limit": {"type": "number", "exclusiveMinimum": 0},
     }

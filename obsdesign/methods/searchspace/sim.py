@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from obsdesign.errors import InfeasibleError
+from obsdesign.errors import InfeasibleError, SolverError
 from obsdesign.methods.searchspace.options import Options, SimOptions
 from obsdesign.params import Parameters
 from obsdesign.simulate.result import SimResult
@@ -54,6 +54,24 @@ class ConsistencyLost(InfeasibleError):
 
 class MemoryCap(InfeasibleError):
     """The search space needs more live centres than the cap allows."""
+
+
+class TimeBudget(SolverError):
+    """The simulation ran past ``[simulate] time_limit`` (exit 3, as a set-invariant design
+    past its ``time_limit``)."""
+
+
+def _check_time(deadline: float, limit: float, where: str) -> None:
+    """Raise :class:`TimeBudget` when ``deadline`` (a ``time.perf_counter`` value) has passed.
+
+    :param deadline: the end of the budget; :param limit: the budget in seconds (for the
+    message); :param where: what was running and how far it got."""
+    if time.perf_counter() > deadline:
+        raise TimeBudget(
+            f"simulation not finished within {limit:g} s ([simulate] time_limit): {where} "
+            "(raise time_limit, or lower max_centres, start from a smaller D or a larger γ₀, "
+            "or shorten the horizon)"
+        )
 
 
 @dataclass
@@ -176,9 +194,16 @@ def cover_box(lo: np.ndarray, hi: np.ndarray, s: float) -> np.ndarray:
     return grid * (2 * s)
 
 
-def recover(C: np.ndarray, eta: float, s: float, cap: int) -> np.ndarray:
+def recover(
+    C: np.ndarray,
+    eta: float,
+    s: float,
+    cap: int,
+    budget: tuple[float, float] | None = None,
+) -> np.ndarray:
     """Centres of the grid 2sℤⁿ whose cells meet some ball B(c, η), c a row of C (merged:
-    each cell once). Raises :class:`MemoryCap` when more than ``cap`` cells are needed."""
+    each cell once). Raises :class:`MemoryCap` when more than ``cap`` cells are needed, and
+    :class:`TimeBudget` past ``budget`` = (deadline, seconds) (checked per chunk of rows)."""
     n = C.shape[1]
     eta = eta * (1 + INFLATE) + INFLATE * s
     R = math.ceil((eta + s) / (2 * s) + 0.5)
@@ -188,6 +213,8 @@ def recover(C: np.ndarray, eta: float, s: float, cap: int) -> np.ndarray:
     keys: list[np.ndarray] = []
     total = 0
     for a in range(0, C.shape[0], step):
+        if budget is not None:
+            _check_time(*budget, f"refinement ({a:,} of {C.shape[0]:,} centres done)")
         idx = base[a : a + step, None, :] + offs[None, :, :]
         g = idx * (2 * s)
         d = np.maximum(np.abs(C[a : a + step, None, :] - g) - s, 0.0)
@@ -279,6 +306,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
     flow_err = 0.0
     left_E: float | None = None
     t_start = time.perf_counter()
+    deadline = t_start + so.time_limit
     if not len(C):
         raise ConsistencyLost(_diagnose(run, x0[0], o, "the output filter at t₀", None))
     _record(run, t, x[0], y, C, eps[0], 0.0, L_f, gam[0], so, 0)
@@ -318,7 +346,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
                     )
             else:
                 eta = e_old * math.exp(L_f * K * dT) + K * flow_err
-                C = recover(C, eta, s, so.max_centres)
+                C = recover(C, eta, s, so.max_centres, (deadline, so.time_limit))
             C = C[_consistent(plant, C, y, L_h * e_new) & _meets(C, s, E_lo, E_hi)]
             run.switches.append(t)
             tau = t
@@ -339,6 +367,10 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
         _record(run, t, x[0], y, C, e_cur, t - tau, L_f, gam[min(i, len(gam) - 1)], so, k)
         if bar is not None:
             bar(k, len(C))
+        if k < N:
+            _check_time(
+                deadline, so.time_limit, f"{k:,} of {N:,} samples done, {len(C):,} live centres"
+            )
     secs = time.perf_counter() - t_start
     if bar is not None:
         bar(None, 0)
