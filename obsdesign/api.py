@@ -589,11 +589,12 @@ def simulate(
         )
         if rep.spec_sha256 != sp.sha256:
             raise InputError(f"{sp.file}: the report was made from another spec (sha256 differs)")
+        where = "report" if isinstance(report, Report) else str(report)
         if problems:
-            raise InputError(f"report: {problems[0]}")
+            raise InputError(f"{where}: {problems[0]}")
         if rep.error is not None:
             raise InputError(
-                f"report: records a design that stopped with an error "
+                f"{where}: records a design that stopped with an error "
                 f"({rep.error.get('message', '')}): no parameters to simulate"
             )
         params = rep.parameters

@@ -247,6 +247,18 @@ def test_v_max_breve_and_tampered_gamma(specs_dir):
     assert "gamma-bound" in failed and ver.exit_code() == 1
 
 
+def test_X0_must_be_a_box_or_polytope(specs_dir):
+    """An ellipsoid X0 is refused with the key named and the set's kind in plain English."""
+    text = (specs_dir / SEC5).read_text()
+    text = text.replace(
+        "[method]",
+        '[sets.X0]\ntype = "ellipsoid"\nE = [[1, 0], [0, 1]]\n[method]',
+        1,
+    ).replace("eps_min = 0.01", 'eps_min = 0.01\nX0 = "X0"')
+    with pytest.raises(SpecError, match=r"\[method\.X0\].*\[sets\.X0\] is an ellipsoid"):
+        load_spec_text(text, "x0.toml")
+
+
 def test_sec5_max_norm_matches_issue_estimate(specs_dir):
     """With |c| the max-norm, C_min/C_max are boxes, v_min has an exact closed form, and
     δ = 643.47, γ = 3.2434e-5 (the issue's estimate: δ ≈ 637, γ ≈ 3.3e-5)."""

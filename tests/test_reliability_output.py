@@ -260,3 +260,4 @@ def test_simulate_refuses_an_error_report(spec: Path, tmp_path: Path):
     assert runner.invoke(app, ["design", str(bad), "-o", str(out)]).exit_code == 1
     res = runner.invoke(app, ["simulate", str(bad), "--report", str(out)])
     _refused(res, "stopped with an error")
+    assert f"{out}: records a design that stopped" in res.output  # names the report file

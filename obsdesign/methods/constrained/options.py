@@ -235,7 +235,7 @@ def _set_ref(table: Table, key: str, spec: Spec, kinds: tuple[str, ...]) -> tupl
     S = spec.sets[name]
     if S.kind not in kinds and not (S.kind == "symmetric-polytope" and "polytope" in kinds):
         raise table.error(
-            key, f"expected a set of type {' or '.join(kinds)}; [sets.{name}] is a {S.kind}"
+            key, f"expected a set of type {' or '.join(kinds)}; [sets.{name}] is {_a(S.kind)}"
         )
     return name, S
 
@@ -402,3 +402,8 @@ def simulate_schema() -> dict[str, Any]:
             "description": "level r of the saturated observer (29)",
         },
     }
+
+
+def _a(word: str) -> str:
+    """``word`` with its indefinite article ("an ellipsoid", "a box")."""
+    return ("an " if word[:1] in "aeiou" else "a ") + word
