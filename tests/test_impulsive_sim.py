@@ -135,3 +135,71 @@ def test_simulation_memory_is_checked_before_allocating(tmp_path: Path) -> None:
     )
     assert res.exit_code == 2 and "GiB" in res.output
     assert time.perf_counter() - t0 < 5
+
+
+IMP = """[system]
+time = "continuous"
+A = {A}
+C = {C}
+states = ["x1", "x2"]
+psi = ["0", "0"]
+[nonlinearity]
+lipschitz_x = 0
+[method]
+key = "impulsive"
+L = [0.5]
+alpha = 3
+noise_bound = 0
+M = {M}
+[simulate]
+horizon = {horizon}
+x0 = [{x1}, 1]
+xhat0 = [0, 0]
+runs = 3
+"""
+
+
+def _sim(x1: str = "1", **kw: str) -> dict:
+    sp = load_spec_text(IMP.format(x1=x1, **kw), "imp.toml")
+    rep = api.design(sp)
+    assert rep.exit_code() == 0
+    return api.simulate(sp, rep).info
+
+
+def test_the_jump_uses_the_measured_output_C_x() -> None:
+    """y_k = C x(t_k) + w_k with C = [0 1] (not the first state): x1 decays by itself, the
+    jumps halve the error in x2, so the noise-free error vanishes. The simulation used
+    y = x1 before (the first m states) and reported no decay (random-spec fuzzer)."""
+    info = _sim(A="[[-3, 0], [0, 0]]", C="[[0, 1]]", M="[[1, 0]]", horizon=20)
+    assert info["noise_free_decay"] and info["noise_free_final_eps_max"] < 1e-9
+    assert info["diverged_runs"] == 0
+
+
+def test_batched_and_one_by_one_agree_for_a_general_C() -> None:
+    from obsdesign.methods.impulsive.hybrid import simulate_hybrid, simulate_one_by_one
+
+    A = np.array([[-1.0, 0.3], [0.2, -0.5]])
+    T = np.array([[1.0, 2.0], [0.0, 1.0]])  # C = [1 2], M = [0 1]
+
+    def f(X: np.ndarray) -> np.ndarray:
+        return X @ A.T
+
+    H = np.full((1, 12), 0.2)
+    W = np.zeros((1, 12, 1))
+    x0, xh0 = np.array([[1.0, -1.0]]), np.array([[0.0, 0.0]])
+    b = simulate_hybrid(f, T, np.array([0.7]), x0, xh0, H, W, dense=1, rtol=1e-10, atol=1e-12)
+    ref = simulate_one_by_one(f, T, np.array([0.7]), x0[0], xh0[0], H[0], W[0, :, 0], 1e-10, 1e-12)
+    np.testing.assert_allclose(b.x[0, -1], ref[:2], rtol=1e-8, atol=1e-10)
+    # b stores the pre-jump value at t_K; ref is after the last jump: compare z_n (not jumped)
+    np.testing.assert_allclose((b.xhat[0, -1] @ T.T)[1], ref[3], rtol=1e-8, atol=1e-10)
+
+
+def test_an_unstable_plant_is_not_an_observer_divergence() -> None:
+    """ẋ1 = x1: the plant grows to e³⁰ ≈ 10¹³ while the error vanishes — no run is
+    'diverged' (the old test flagged |x| > 10⁸); from x1 = 10¹⁴⁰ it passes 10¹⁵⁰ within the
+    horizon: the runs stop as 'plant_escaped', not 'diverged'."""
+    info = _sim(A="[[1, 0], [0, -3]]", C="[[1, 0]]", M="[[0, 1]]", horizon=30)
+    assert info["diverged_runs"] == 0 and info["plant_escaped_runs"] == 0
+    assert info["noise_free_decay"]
+    info = _sim(A="[[1, 0], [0, -3]]", C="[[1, 0]]", M="[[0, 1]]", horizon=30, x1="1e140")
+    assert info["diverged_runs"] == 0 and info["plant_escaped_runs"] == 3

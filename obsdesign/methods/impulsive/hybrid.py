@@ -29,7 +29,11 @@ class HybridBatch:
 
     ``t``: (N, G) times; ``x``, ``xhat``: (N, G, n); ``eps``: (N, G) ‖ẑ − z‖ (z-coordinates,
     the ε of (12)); ``valid``: (N, G) mask (False on padding after the horizon or after a
-    run diverged); ``sample_times``: (N, K) instants t_k (NaN for padding).
+    run stopped); ``sample_times``: (N, K) instants t_k (NaN for padding); ``diverged``:
+    (N,) runs stopped because the *error* blew up (ε above ``blowup``·max(1, ε(0)) and above
+    10⁻³‖z‖, or not finite); ``escaped``: (N,) runs stopped because the *plant* left the float range
+    (‖x‖ above :data:`ESCAPE`, an unstable plant over a long horizon: not an observer
+    failure).
     """
 
     t: np.ndarray
@@ -39,6 +43,11 @@ class HybridBatch:
     valid: np.ndarray
     sample_times: np.ndarray
     diverged: np.ndarray
+    escaped: np.ndarray
+
+
+#: a run stops when its plant state exceeds this (products of such states would overflow)
+ESCAPE = 1e150
 
 
 def draw_intervals(
@@ -76,6 +85,7 @@ def simulate_hybrid(
 ) -> HybridBatch:
     """Run plant + observer (11) for N runs: x0, xhat0 (N, n); H (N, K) intervals (0 = padding);
     W (N, K, m) noise w_k at the sample ending interval k. ``dense`` points per interval.
+    The output at a sample is y_k = C x(t_k) + w_k with C the first m rows of T = [C; M].
 
     The observer state is integrated in z-coordinates exactly as (11a) reads (ψ̄(z) = Tψ(T⁻¹z)).
     """
@@ -99,12 +109,15 @@ def simulate_hybrid(
     X = x0.copy()
     Z = xhat0 @ T.T
     xs[:, 0], zs[:, 0], valid[:, 0] = X, Z, True
+    with np.errstate(all="ignore"):
+        e0 = np.nan_to_num(np.linalg.norm(Z - X @ T.T, axis=1), posinf=np.inf)
     diverged = np.zeros(N, dtype=bool)
+    escaped = np.zeros(N, dtype=bool)
     s_eval = np.linspace(0.0, 1.0, dense + 1)[1:]
     tk = np.zeros(N)
     sample_times = np.full((N, K), np.nan)
     for k in range(K):
-        h = np.where(diverged, 0.0, H[:, k])
+        h = np.where(diverged | escaped, 0.0, H[:, k])
         active = h > 0
         if not active.any():
             break
@@ -134,21 +147,29 @@ def simulate_hybrid(
         X = np.where(active[:, None], U[:, 0, :, -1], X)
         Z = np.where(active[:, None], U[:, 1, :, -1], Z)
         tk = tk + h
-        # jump (11b) at t_k = end of interval k, only for runs that really sampled
-        y = X[:, :m] + W[:, k, :]
+        # jump (11b) at t_k = end of interval k, only for runs that really sampled:
+        # y_k = C x(t_k) + w_k = (T x)_o + w_k, T = [C; M] (eq. (9))
+        y = (X @ T[:m].T) + W[:, k, :]
         Zo = Z[:, :m] - Ld * (Z[:, :m] - y)
         Z[:, :m] = np.where(active[:, None], Zo, Z[:, :m])
         sample_times[:, k] = np.where(active, tk, np.nan)
-        bad = ~np.all(np.isfinite(Z), axis=1) | ~np.all(np.isfinite(X), axis=1)
-        bad |= (np.abs(Z).max(axis=1) > blowup) | (np.abs(X).max(axis=1) > blowup)
-        if bad.any():
+        with np.errstate(all="ignore"):
+            xmax = np.abs(X).max(axis=1)
+            out = ~np.all(np.isfinite(X), axis=1) | (xmax > ESCAPE)
+            e = np.linalg.norm(Z - X @ T.T, axis=1)
+            zn = np.linalg.norm(X @ T.T, axis=1)
+        big = (e > blowup * np.maximum(1.0, e0)) & (e > 1e-3 * zn)
+        bad = ~out & (~np.all(np.isfinite(Z), axis=1) | big)
+        stop = bad | out
+        if stop.any():
             diverged |= bad
-            X[bad], Z[bad] = 0.0, 0.0
+            escaped |= out
+            X[stop], Z[stop] = 0.0, 0.0
         # the post-jump value is what the next interval starts from; the stored point at t_k
         # is the pre-jump (left-continuous) value, as in the paper.
     xhat = zs @ Ti.T
     eps = np.linalg.norm(zs - xs @ T.T, axis=2)
-    return HybridBatch(t, xs, xhat, eps, valid, sample_times, diverged)
+    return HybridBatch(t, xs, xhat, eps, valid, sample_times, diverged, escaped)
 
 
 def simulate_one_by_one(
@@ -184,7 +205,7 @@ def simulate_one_by_one(
         X, Z = sol.y[:n, -1].copy(), sol.y[n:, -1].copy()
         if not final_jump and k == len(h) - 1:
             break
-        Z[:m] = Z[:m] - np.asarray(L_diag, dtype=float) * (Z[:m] - (X[:m] + w[k]))
+        Z[:m] = Z[:m] - np.asarray(L_diag, dtype=float) * (Z[:m] - ((T @ X)[:m] + w[k]))
     return np.concatenate([X, Z])
 
 
@@ -209,7 +230,7 @@ def ball_report(b: HybridBatch, radius: float, after: float) -> BallReport:
     last_out = np.where(out.any(axis=1), np.max(np.where(out, b.t, -np.inf), axis=1), 0.0)
     last_idx = np.array([np.max(np.nonzero(b.valid[j])[0]) for j in range(N)])
     inside_end = b.eps[np.arange(N), last_idx] <= radius
-    inside_end &= ~b.diverged
+    inside_end &= ~(b.diverged | b.escaped)
     settle = np.where(inside_end, last_out, np.nan)
     mask = b.valid & (b.t > after)
     worst = np.where(mask.any(axis=1), np.max(np.where(mask, b.eps, -np.inf), axis=1), np.nan)

@@ -129,6 +129,7 @@ def simulate(
         "max_settle_time": float(np.nanmax(br.settle_time)) if br.entered.any() else None,
         f"worst_eps_after_t{after:g}": float(np.nanmax(br.worst_after)),
         "diverged_runs": int(noisy.diverged.sum()),
+        "plant_escaped_runs": int(noisy.escaped.sum()),
         "noise_free_final_eps_max": float(cl_end.max()),
         "noise_free_decay": bool(np.all(cl_end < cl_start) and not clean.diverged.any()),
         "open_loop_final_eps": float(open_.eps[0, np.nonzero(open_.valid[0])[0][-1]]),
