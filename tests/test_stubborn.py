@@ -507,3 +507,57 @@ def test_linear_modes_refuse_an_expression_plant(mode: str) -> None:
         )
     with pytest.raises(api.SpecError, match=r"system\.psi.*not read in (full|redesign) mode"):
         api.load_spec_text(text, "psi.toml")
+
+
+STUB_D = """[system]
+time = "{time}"
+A = [[{a}]]
+C = [[1]]
+Bd = [[1]]
+[method]
+key = "stubborn"
+mode = "redesign"
+K = [[{k}]]
+lambda = 0.5
+[simulate]
+horizon = {horizon}
+{dt}x0 = [0]
+xhat0 = [0]
+noise_std = 0
+outlier_rate = 0
+[simulate.disturbance]
+kind = "constant"
+value = [1]
+"""
+
+
+@pytest.mark.parametrize("time", ["discrete", "continuous"])
+def test_the_disturbance_enters_the_simulated_error(time: str) -> None:
+    """d = 1 constant, unknown to the observer: the simulated estimate must be the observer's
+    own recursion x̂⁺ = A x̂ + K sat_σ(y − x̂), σ̄⁺ = λσ̄ + R e_y², driven by the plant's y
+    (written out here), not x − e with e blind to d (which gave e ≡ 0: random-spec fuzzer)."""
+    disc = time == "discrete"
+    text = STUB_D.format(
+        time=time,
+        a="0.5" if disc else "-1",
+        k="0.25" if disc else "2",
+        horizon=50 if disc else 5,
+        dt="" if disc else "dt = 0.001\n",
+    )
+    sp = api.load_spec_text(text, "d.toml")
+    rep = api.design(sp)
+    assert rep.exit_code() == 0
+    res = api.simulate(sp, rep)
+    p = rep.parameters
+    R, W, lam = float(p.float("R")[0][0]), float(p.float("W")[0]), float(p.float("lambda"))
+    A, K = (0.5, 0.25) if disc else (-1.0, 2.0)
+    assert float(res.x[-1, 0]) == pytest.approx(2.0 if disc else 1.0, rel=1e-2)
+    if disc:
+        x, xh, sb = 0.0, 0.0, 0.0
+        for _ in range(50):
+            ey = x - xh
+            s = (sb / W) ** 0.5
+            xh, sb, x = A * xh + K * min(s, max(-s, ey)), lam * sb + R * ey * ey, A * x + 1
+        assert float(res.xhat[-1, 0]) == pytest.approx(xh, rel=1e-12, abs=1e-15)
+    err = res.x[:, 0] - res.xhat[:, 0]
+    assert np.abs(err).max() > 0.01  # d moves the plant; the estimate cannot follow at once

@@ -1,9 +1,12 @@
 """Simulation of the stubborn observer, batched over Monte Carlo runs and observers.
 
 The error e = x − x̂ of every observer x̂' = A x̂ + B u + K sat_σ(y − ŷ) obeys
-ė = A e − K sat_σ(C e + ν) (discrete: e⁺ = ...), independent of u, so the plant is simulated
-once and the observers' errors are integrated together as arrays of shape
+ė = A e + B_d d − K sat_σ(C e + ν) (discrete: e⁺ = ...), independent of u, so the plant is
+simulated once and the observers' errors are integrated together as arrays of shape
 (observers, amplitudes, runs, n): one numpy step advances every run (vectorized across runs).
+The single run (:func:`single_run`) carries the plant's disturbance B_d d into the error (the
+observer does not know d); the outlier study is the slides' noise-and-outlier study, without
+disturbance.
 
 Observers (slides, Examples 1-3 tables): the stubborn observer (adaptive saturation
 σ̄' = −λσ̄ + e_yᵀRe_y, σ_i = √(σ̄/w_i); discrete σ̄⁺ = λσ̄ + e_yᵀRe_y), the Luenberger observer
@@ -68,9 +71,10 @@ def run_errors(
     levels: np.ndarray,
     adaptive: np.ndarray,
     sigma0: float,
+    dist: Any = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Integrate the errors of a batch of observers: the error dynamics of the stubborn-observer
-    slides (Astolfi, Alessandri, Zaccarian, WUDS 2017), ė = Ae − K sat_σ(Ce + ν),
+    slides (Astolfi, Alessandri, Zaccarian, WUDS 2017), ė = Ae + B_d d − K sat_σ(Ce + ν),
     σ̄' = −λσ̄ + e_yᵀRe_y (discrete: e⁺ = …, σ̄⁺ = λσ̄ + e_yᵀRe_y), σ_i = √(σ̄/w_i).
 
     e0: (..., n) initial errors (broadcast); nu(k0, k1) -> (k1 − k0, ..., p) the output noise
@@ -78,7 +82,9 @@ def run_errors(
     adaptive (...,) bool: the stubborn observer's adaptive level instead. Continuous time:
     Heun's method with ν held over each step. Returns the sums of e_i² over the grid points
     0..steps (for the RMSE, shape (..., n)), the final e and the final σ̄ (trajectories are
-    not kept: :func:`single_run` steps one at a time to record them)."""
+    not kept: :func:`single_run` steps one at a time to record them). ``dist(k0, k1)`` ->
+    (k1 − k0, n): the plant's disturbance term B_d d of steps k0..k1−1 (held over each step),
+    the same for every observer (None: no disturbance)."""
     e = np.broadcast_to(e0, adaptive.shape + (g.A.shape[0],)).astype(float).copy()
     sb = np.where(adaptive, sigma0, 0.0)
     sq = e**2
@@ -95,21 +101,23 @@ def run_errors(
     for k0 in range(0, steps, chunk):
         k1 = min(steps, k0 + chunk)
         V = nu(k0, k1)
+        Dd = dist(k0, k1) if dist is not None else None
         for k in range(k1 - k0):
             v = V[k]
+            d = 0.0 if Dd is None else Dd[k]
             q, ey = inject(e, sb, v)
             ry = np.einsum("...i,ij,...j->...", ey, g.R, ey)
             if g.discrete:
-                e = e @ AT - q
+                e = e @ AT - q + d
                 sb = np.where(adaptive, g.lam * sb + ry, 0.0)
             else:
-                de1 = e @ AT - q
+                de1 = e @ AT - q + d
                 ds1 = -g.lam * sb + ry
                 e2 = e + dt * de1
                 s2 = np.maximum(sb + dt * ds1, 0.0)
                 q2, ey2 = inject(e2, s2, v)
                 ry2 = np.einsum("...i,ij,...j->...", ey2, g.R, ey2)
-                e = e + dt / 2 * (de1 + e2 @ AT - q2)
+                e = e + dt / 2 * (de1 + e2 @ AT - q2 + d)
                 sb = np.where(
                     adaptive, np.maximum(sb + dt / 2 * (ds1 - g.lam * s2 + ry2), 0.0), 0.0
                 )
@@ -243,7 +251,7 @@ def single_run(spec: Spec, params: Parameters, observer: str = "stubborn") -> Si
         V = v @ np.asarray(s.Dn.f, float).T
     else:
         V = noise_fn(rng, (), p, so, np.asarray(10.0))(0, steps + 1)
-    x = _plant(spec, steps, dt, rng)
+    x, Dd = _plant(spec, steps, dt, rng)
     e0 = x[0] - np.asarray(sim.xhat0.f, float)
     s0 = so.sigma0 if so.sigma0 is not None else default_sigma0(g, e0)
     E = np.empty((steps + 1, n))
@@ -253,7 +261,17 @@ def single_run(spec: Spec, params: Parameters, observer: str = "stubborn") -> Si
     lev = np.full(p, np.inf)
     e, sb = e0, s0
     for k in range(steps):
-        _, e, sb = run_errors(g, e, lambda a, b, k=k: V[k : k + 1], 1, dt, lev, adaptive, sb)
+        _, e, sb = run_errors(
+            g,
+            e,
+            lambda a, b, k=k: V[k : k + 1],
+            1,
+            dt,
+            lev,
+            adaptive,
+            sb,
+            lambda a, b, k=k: Dd[k : k + 1],
+        )
         E[k + 1], S[k + 1] = e, sb
     xhat = x - E
     y = x @ np.asarray(s.C.f, float).T + V
@@ -269,9 +287,13 @@ def single_run(spec: Spec, params: Parameters, observer: str = "stubborn") -> Si
     )
 
 
-def _plant(spec: Spec, steps: int, dt: float, rng: np.random.Generator) -> np.ndarray:
+def _plant(
+    spec: Spec, steps: int, dt: float, rng: np.random.Generator
+) -> tuple[np.ndarray, np.ndarray]:
     """Plant trajectory x (steps+1, n): ẋ = A x + B u(t) + Bd d (RK4, u from [system] u or
-    [simulate.u], d from [simulate.disturbance] held over each step); x⁺ = ... in discrete time."""
+    [simulate.u], d from [simulate.disturbance] held over each step); x⁺ = ... in discrete
+    time. Also returns the disturbance term Bd d_k (steps+1, n), which the observer does not
+    know: it enters the error dynamics."""
     s = spec.system
     sim = spec.simulate
     A, B, Bd = (np.asarray(M.f, float) for M in (s.A, s.B, s.Bd))
@@ -304,7 +326,7 @@ def _plant(spec: Spec, steps: int, dt: float, rng: np.random.Generator) -> np.nd
         k3 = f(tk + dt / 2, xk + dt / 2 * k2)
         k4 = f(tk + dt, xk + dt * k3)
         x[k + 1] = xk + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-    return x
+    return x, np.asarray(D, dtype=float).reshape(steps + 1, -1) @ Bd.T
 
 
 def simulate(
