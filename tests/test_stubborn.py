@@ -315,6 +315,46 @@ def test_undetectable_exit_1_names_detectability() -> None:
         api.design(api.load_spec_text(text, "u.toml"))
 
 
+def test_an_unobservable_oscillator_is_refused_before_any_lmi(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Two undamped oscillators, one seen (random-spec fuzzer): the solver called a tiny λ
+    feasible and the design ended with exit 4; the exact detectability test now runs first
+    (exit 1) and no LMI is solved."""
+    from obsdesign.methods.stubborn import design as D
+
+    def no_lmi(*a: Any, **k: Any) -> Any:
+        raise AssertionError("an LMI was solved")
+
+    monkeypatch.setattr(D, "_problem", no_lmi)
+    text = (
+        '[system]\ntime = "continuous"\n'
+        "A = [[0, 1, 0, 0], [-1, 0, 0, 0], [0, 0, 0, 3], [0, 0, -3, 0]]\n"
+        'C = [[0, 0, 0, 1]]\n[method]\nkey = "stubborn"\n'
+    )
+    with pytest.raises(InfeasibleError, match="not detectable.*x\\^2 \\+ 1"):
+        api.design(api.load_spec_text(text, "osc.toml"))
+
+
+@pytest.mark.parametrize(
+    "a, bound, says", [(2.6, 10**6, "does not suffice"), (2.4, 1, "raise gain_bound")]
+)
+def test_discrete_infeasible_says_whether_a_bound_is_the_cause(
+    a: float, bound: int, says: str
+) -> None:
+    """A = a, C = 1 (detectable): at a = 2.6 LMIs (7)-(9) have no solution whatever the gain
+    bound, and the message says detectability does not suffice in discrete time (it said
+    'raise gain_bound (now 1e+06)'); at a = 2.4 they are feasible without the bound, so a
+    tight bound is named."""
+    text = (
+        f'[system]\ntime = "discrete"\nA = [[{a}]]\nC = [[1]]\n'
+        f'[method]\nkey = "stubborn"\ngain_bound = {bound}\n'
+    )
+    with pytest.raises(InfeasibleError, match=says) as ei:
+        api.design(api.load_spec_text(text, "s.toml"))
+    assert ("does not suffice" in ei.value.message) == (a == 2.6)
+
+
 @pytest.mark.parametrize(
     "extra, key",
     [

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import time
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -265,6 +265,7 @@ def design_params(
     t0 = time.perf_counter()
     notes: list[str] = []
     vals: dict[str, Any] = {}
+    _require_detectable(spec, pl)
     if o.lam is not None:
         lam_q = o.lam  # a rate the user asks for is checked directly, before any search
         if not feasible(pl, o, float(lam_q))[0]:
@@ -396,9 +397,26 @@ def _round(v: dict[str, Any], o: Options, lam_q: fmpq) -> dict[str, Any]:
     return out
 
 
+def _require_detectable(spec: Spec, pl: Plant) -> None:
+    """Refuse a plant whose (C, A) is not detectable (exact test), before any LMI solve: the
+    (1,1) block of (2) (resp. (8)) makes A − KC Hurwitz (Schur) for the design's K, so such a
+    plant makes LMIs (1)-(3) / (7)-(9) infeasible for every λ. A solver can still report
+    'feasible' at a tiny λ near an unobservable mode on the stability boundary (two undamped
+    oscillators, one seen: λ ≈ 3·10⁻⁵, then exit 4 "could not be certified"; random-spec
+    fuzzer), so the exact test runs first. An inconclusive verdict (float fallback) does not
+    stop the design."""
+    det = detectability(spec.system.A.q, spec.system.C.q, pl.discrete)
+    if det.verdict is False:
+        raise InfeasibleError(
+            f"stubborn: (C, A) is not detectable ({det.detail}); LMIs {_refs(pl)} are infeasible"
+        )
+
+
 def _infeasible(spec: Spec, pl: Plant, o: Options, where: str) -> None:
-    """Say why: (C, A) not detectable (Proposition: the LMIs are feasible iff it is), or the
-    bounds of the design (gain bound, given K, given λ)."""
+    """Say why: (C, A) not detectable (necessary for the LMIs; in continuous time also
+    sufficient, the slides' Proposition), or the bounds of the design (gain bound, given K,
+    given λ); in discrete time, when the LMIs are infeasible even without the bounds, that a
+    detectable (C, A) is not enough there."""
     det = detectability(spec.system.A.q, spec.system.C.q, pl.discrete)
     if det.verdict is False:
         raise InfeasibleError(
@@ -419,6 +437,16 @@ def _infeasible(spec: Spec, pl: Plant, o: Options, where: str) -> None:
         )
         first = "try a smaller λ or raise " if o.lam is not None else "(C, A) is detectable: raise "
         why = first + bounds
+        if det.verdict is True and pl.discrete and bounds and o.lam is None:
+            free = replace(o, gain_bound=None, r_bound=None)
+            if not feasible(pl, free, 1 - 1e-6)[0]:
+                why = (
+                    f"(C, A) is detectable, but the LMIs are infeasible even without {bounds}: "
+                    "in discrete time detectability does not suffice (the sector conditions of "
+                    "the saturation, (8)-(9), also limit how unstable A may be; e.g. A = 2.6, "
+                    "C = 1 has no solution): a faster sampling (A closer to I) or the "
+                    "continuous-time model may help"
+                )
     raise InfeasibleError(f"stubborn: LMIs {_refs(pl)} infeasible {where}: {why}")
 
 
