@@ -601,3 +601,23 @@ def test_the_disturbance_enters_the_simulated_error(time: str) -> None:
         assert float(res.xhat[-1, 0]) == pytest.approx(xh, rel=1e-12, abs=1e-15)
     err = res.x[:, 0] - res.xhat[:, 0]
     assert np.abs(err).max() > 0.01  # d moves the plant; the estimate cannot follow at once
+
+
+def test_a_step_too_large_for_heun_is_warned() -> None:
+    """K = 10⁴ (given), dt = 10⁻³: dt·|eig(A − KC)| ≈ 10 > 2, so Heun's method is unstable
+    and the simulated error may grow although the design is certified: simulate says so and
+    gives the largest safe dt. At dt = 10⁻⁵ no warning."""
+    base = (
+        '[system]\ntime = "continuous"\nA = [[-1]]\nC = [[1]]\n[method]\nkey = "stubborn"\n'
+        'mode = "redesign"\nK = [[10000]]\nlambda = 1\n[simulate]\nhorizon = 0.05\n'
+        "dt = {dt}\nx0 = [1]\nxhat0 = [0]\nnoise_std = 0\noutlier_rate = 0\n"
+    )
+    for dt, warned in ((0.001, True), (0.00001, False)):
+        sp = api.load_spec_text(base.format(dt=dt), "h.toml")
+        rep = api.design(sp)
+        assert rep.exit_code() == 0
+        notes = api.simulate(sp, rep).info.get("warnings", [])
+        hit = [w for w in notes if "too large for this gain" in w]
+        assert bool(hit) is warned, notes
+        if warned:
+            assert "use dt ≤ 0.0002" in hit[0]
