@@ -203,3 +203,25 @@ def test_an_unstable_plant_is_not_an_observer_divergence() -> None:
     assert info["noise_free_decay"]
     info = _sim(A="[[1, 0], [0, -3]]", C="[[1, 0]]", M="[[0, 1]]", horizon=30, x1="1e140")
     assert info["diverged_runs"] == 0 and info["plant_escaped_runs"] == 3
+
+
+def test_time_limit_stops_the_simulation_with_a_clear_message(tmp_path: Path) -> None:
+    """A budget below the run's time (option or [simulate] key) stops it with exit 3 naming
+    the key and how far it got; the default budget (300 s) lets the run finish."""
+    from typer.testing import CliRunner
+
+    from obsdesign.cli import app
+    from obsdesign.errors import SolverError
+
+    text = IMP.format(A="[[-3, 0], [0, 0]]", C="[[0, 1]]", M="[[1, 0]]", horizon=20, x1="1")
+    sp = load_spec_text(text, "imp.toml")
+    rep = api.design(sp)
+    with pytest.raises(
+        SolverError, match=r"not finished within 0\.001 s \(\[simulate\] time_limit\)"
+    ):
+        api.simulate(sp, rep, time_limit=1e-3)
+    p = tmp_path / "imp.toml"
+    p.write_text(text.replace("runs = 3", "runs = 3\ntime_limit = 0.001"))
+    r = CliRunner().invoke(app, ["simulate", str(p)])
+    assert r.exit_code == 3 and "sampling interval" in r.output and "Traceback" not in r.output
+    assert api.simulate(sp, rep).info["noise_free_decay"]

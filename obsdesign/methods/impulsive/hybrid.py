@@ -82,10 +82,12 @@ def simulate_hybrid(
     rtol: float = 1e-7,
     atol: float = 1e-9,
     blowup: float = 1e8,
+    check: Callable[[int, int], None] | None = None,
 ) -> HybridBatch:
     """Run plant + observer (11) for N runs: x0, xhat0 (N, n); H (N, K) intervals (0 = padding);
     W (N, K, m) noise w_k at the sample ending interval k. ``dense`` points per interval.
     The output at a sample is y_k = C x(t_k) + w_k with C the first m rows of T = [C; M].
+    ``check(k, K)`` runs before each interval k of K (a time budget may raise there).
 
     The observer state is integrated in z-coordinates exactly as (11a) reads (ψ̄(z) = Tψ(T⁻¹z)).
     """
@@ -117,6 +119,8 @@ def simulate_hybrid(
     tk = np.zeros(N)
     sample_times = np.full((N, K), np.nan)
     for k in range(K):
+        if check is not None:
+            check(k, K)
         h = np.where(diverged | escaped, 0.0, H[:, k])
         active = h > 0
         if not active.any():

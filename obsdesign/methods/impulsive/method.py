@@ -46,6 +46,7 @@ class Impulsive(Method):
         SimOption("seed", "int", 0, "seed of the sampling intervals and the noise", min=0),
         SimOption("sampling_file", "path", None, "sampling intervals from a file (one run)"),
         SimOption("rtol", "float", 1e-7, "relative tolerance of RK45", min=1e-14, max=1e-2),
+        SimOption("time_limit", "float", None, "seconds the simulation may run", min=1e-3),
     )
 
     def plot_simulation(self, spec: Spec, result: SimResult, path: str | Path) -> Path:

@@ -56,11 +56,13 @@ class Options:
 @dataclass
 class SimOptions:
     """The method's own ``[simulate]`` keys: ``runs`` (sampling sequences), ``sampling_file``
-    (intervals from a file, one run), ``rtol`` (RK45 relative tolerance)."""
+    (intervals from a file, one run), ``rtol`` (RK45 relative tolerance), ``time_limit``
+    (seconds the simulation may run, checked after every sampling interval)."""
 
     runs: int = 20
     sampling_file: Path | None = None
     rtol: float = 1e-7
+    time_limit: float = 300.0
 
 
 def parse_options(table: Table, spec: Spec) -> Options:
@@ -193,7 +195,8 @@ def parse_simulate(table: Table, spec: Spec) -> SimOptions:
         p = Path(table.str("sampling_file"))
         sf = p if p.is_absolute() else Path(spec.file).resolve().parent / p
     rtol = float(table.scalar("rtol", default=fmpq(1, 10**7), min=0, strict_min=True).f)
-    return SimOptions(runs, sf, rtol)
+    limit = float(table.scalar("time_limit", default=fmpq(300), min=0, strict_min=True).f)
+    return SimOptions(runs, sf, rtol, limit)
 
 
 def _diag_gain(table: Table, m: int) -> np.ndarray:
@@ -266,4 +269,5 @@ def simulate_schema() -> dict[str, Any]:
         "runs": {"type": "integer", "minimum": 1},
         "sampling_file": {"type": "string"},
         "rtol": {"type": "number", "exclusiveMinimum": 0},
+        "time_limit": {"type": "number", "exclusiveMinimum": 0},
     }

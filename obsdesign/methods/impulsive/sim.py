@@ -13,11 +13,13 @@ B = {‖ε‖ ≤ √(α‖w‖∞)} and the last time it was outside.
 
 from __future__ import annotations
 
+import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
-from obsdesign.errors import InputError
+from obsdesign.errors import InputError, SolverError
 from obsdesign.methods.impulsive.hybrid import (
     ball_report,
     draw_intervals,
@@ -70,9 +72,12 @@ def simulate(
     seed: int | None = None,
     sampling_file: Path | None = None,
     rtol: float | None = None,
+    time_limit: float | None = None,
 ) -> SimResult:
-    """Run the three scenarios. ``runs``, ``seed``, ``sampling_file``, ``rtol`` (typed values
-    of ``simulate --option``, validated by the API) override the spec's ``[simulate]``."""
+    """Run the three scenarios. ``runs``, ``seed``, ``sampling_file``, ``rtol``,
+    ``time_limit`` (typed values of ``simulate --option``, validated by the API) override the
+    spec's ``[simulate]``. Past ``time_limit`` seconds (all three scenarios together) the
+    simulation stops with :class:`SolverError` (exit 3) saying how far it got."""
     o = spec.options
     sim = spec.simulate
     if sim is None:
@@ -82,6 +87,8 @@ def simulate(
     seed = sim.seed if seed is None else int(seed)
     sampling_file = so.sampling_file if sampling_file is None else Path(sampling_file)
     rtol = so.rtol if rtol is None else float(rtol)
+    limit = so.time_limit if time_limit is None else float(time_limit)
+    deadline = time.perf_counter() + limit
     horizon = float(sim.horizon.f)
     T = np.asarray(params.float("T"), dtype=float)
     Ld = np.array([float(v) for v in o.problem.L])
@@ -108,9 +115,25 @@ def simulate(
     f = plant_field(spec)
     x0 = np.tile(sim.x0.f, (runs, 1))
     xh0 = np.tile(sim.xhat0.f, (runs, 1))
-    noisy = simulate_hybrid(f, T, Ld, x0, xh0, H, W, rtol=rtol)
-    clean = simulate_hybrid(f, T, Ld, x0, xh0, H, np.zeros_like(W), rtol=rtol)
-    open_ = simulate_hybrid(f, T, np.zeros(m), x0[:1], xh0[:1], H[:1], W[:1], rtol=rtol)
+
+    def budget(name: str) -> Callable[[int, int], None]:
+        def check(k: int, K: int) -> None:
+            if time.perf_counter() > deadline:
+                raise SolverError(
+                    f"simulation not finished within {limit:g} s ([simulate] time_limit): "
+                    f"the {name} runs at sampling interval {k:,} of {K:,} (raise time_limit, "
+                    "or fewer runs, a shorter horizon, a looser rtol)"
+                )
+
+        return check
+
+    noisy = simulate_hybrid(f, T, Ld, x0, xh0, H, W, rtol=rtol, check=budget("noisy"))
+    clean = simulate_hybrid(
+        f, T, Ld, x0, xh0, H, np.zeros_like(W), rtol=rtol, check=budget("noise-free")
+    )
+    open_ = simulate_hybrid(
+        f, T, np.zeros(m), x0[:1], xh0[:1], H[:1], W[:1], rtol=rtol, check=budget("open-loop")
+    )
     after = horizon / 2
     br = ball_report(noisy, radius, after)
     used = H[H > 0]
