@@ -629,7 +629,8 @@ def _left_float_range(res: SimResult) -> str | None:
     return (
         f"the trajectory leaves the float range at t = {at:g} (sample {first} of {len(res.t)}): "
         "the plant or the observer diverges over this horizon, so the metrics are not finite; "
-        "shorten [simulate] horizon"
+        "shorten [simulate] horizon (or take a smaller [simulate] dt when a warning below says "
+        "it is too large for the gain)"
     )
 
 

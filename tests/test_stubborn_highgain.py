@@ -141,3 +141,18 @@ def test_printed_bound_is_true(rep: Report) -> None:
     assert m and Q(m.group(1)) >= rep.parameters["ell_star"]
     m = re.search(r"ℓ = ([0-9./]+)", by["ell-bound"])
     assert m and Q(m.group(1)) == rep.parameters["ell"]
+
+
+def test_a_step_too_large_for_the_high_gain_is_warned() -> None:
+    """k = (1000, 0.001) makes ℓ ≈ 1.3·10⁷: Heun at dt = 10⁻⁴ is unstable, so the run
+    overflows; the warning names dt and the largest safe step (random-spec fuzzer: the only
+    message blamed the horizon). The helper alone: quiet at a safe step."""
+    import warnings
+
+    from obsdesign.methods.stubborn.highgain import _check_step
+
+    with pytest.warns(UserWarning, match=r"dt = 0\.0001 is too large for the high gain"):
+        _check_step(np.array([1000.0, 0.001]), 1.33e7, 1e-4)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        _check_step(np.array([2.0, 1.0]), 10.0, 1e-3)  # dt·ℓ·|root| = 0.01

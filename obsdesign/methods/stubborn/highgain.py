@@ -17,6 +17,7 @@ but give no formula, so ε > ε* is not claimed.
 from __future__ import annotations
 
 import time
+import warnings
 from typing import Any
 
 import numpy as np
@@ -221,6 +222,26 @@ def _rhs(spec: Spec) -> Any:
     return F
 
 
+def _check_step(k: np.ndarray, ell: float, dt: float) -> None:
+    """Warn when Heun's step ``dt`` is too large for the high-gain injection: the linear part
+    of the error dynamics has eigenvalues ℓ·r, r the roots of sⁿ + k₁sⁿ⁻¹ + … + kₙ (the
+    high-gain observer of the stubborn-observer slides, gains k_i ℓⁱ), and Heun's method is
+    stable for dt·|z| up to about 2. Past it the simulation overflows (ℓ ≈ 10⁷ at
+    dt = 10⁻⁴: random-spec fuzzer) and the horizon is not the cause."""
+    from obsdesign.methods.stubborn.sim import HEUN_LIMIT
+
+    with np.errstate(all="ignore"):
+        roots = np.roots(np.concatenate([[1.0], k]))
+    rate = ell * float(np.max(np.abs(roots))) if roots.size else 0.0
+    if np.isfinite(rate) and dt * rate > HEUN_LIMIT:
+        warnings.warn(
+            f"[simulate] dt = {dt:g} is too large for the high gain ℓ = {ell:.4g}: "
+            f"dt·ℓ·max|root| ≈ {dt * rate:.3g} > {HEUN_LIMIT:g} (Heun's method is unstable "
+            f"there: the simulation may overflow); use dt ≤ {HEUN_LIMIT / rate:.3g}",
+            stacklevel=2,
+        )
+
+
 def simulate(spec: Spec, params: Parameters, observer: str = "stubborn") -> SimResult:
     """Plant, standard and stubborn high-gain observers (Heun, step dt); ν: the spec's
     impulsive outlier and high-frequency noise window. Reports |x̂ − x| of both."""
@@ -236,6 +257,7 @@ def simulate(spec: Spec, params: Parameters, observer: str = "stubborn") -> SimR
     ell = float(params.float("ell"))
     k = np.asarray(params.float("K"), float).reshape(n)
     gain = k * ell ** np.arange(1, n + 1)
+    _check_step(k, ell, dt)
     lam, eps = float(params.float("lambda")), float(params.float("epsilon"))
     o: Options = spec.options
     bound = o.state_bound
