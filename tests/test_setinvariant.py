@@ -250,6 +250,26 @@ def test_multi_output_needs_p_equal_n_minus_1_and_no_noise():
     assert any(c.id == "linear-law" and c.status == ClaimStatus.CERTIFIED for c in rep.claims)
 
 
+def test_linear_law_off_with_several_outputs_needs_a_given_L() -> None:
+    """p = n − 1 = 2 with linear_law = false (random-spec fuzzer): no injection law would be
+    left, and the design failed a 'linear-law' claim saying no gain was found although no
+    search ran. Now a spec error naming the key; with a given L the user's law is certified
+    and no 'linear-law' claim is made."""
+    base = (
+        '[system]\ntime = "discrete"\nA = [[0.1, 0, 0.2], [0, 0.1, 0], [0, 0, 0.4]]\n'
+        'C = [[1, 0, 0], [0, 1, 0]]\n[sets.omega]\ntype = "box"\nlower = [-1, -1, -1]\n'
+        'upper = [1, 1, 1]\n[method]\nkey = "set-invariant"\nomega = "omega"\n'
+        "lambda = 0.9\nlinear_law = false\n"
+    )
+    with pytest.raises(SpecError, match=r"\[method\.linear_law\] expected true"):
+        load_spec_text(base, "off.toml")
+    rep = api.design(load_spec_text(base + "L = [[-0.1, 0], [0, -0.1], [0, 0]]\n", "L.toml"))
+    ids = {c.id: c.status for c in rep.claims}
+    assert rep.exit_code() == 0 and "linear-law" not in ids
+    assert ids["linear-law-user"] == ClaimStatus.CERTIFIED
+    assert api.verify(rep).exit_code() == 0
+
+
 def test_not_detectable_exit_1():
     # the mode 1.2 of e2 is not seen by C = [1, 0]
     sp = load_spec_text(spec_text(A="[[0.5, 0], [0, 1.2]]", C="[[1, 0]]"), "nd.toml")

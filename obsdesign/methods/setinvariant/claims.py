@@ -528,7 +528,7 @@ def _linear(
                         f"reported {b.show(fr)}, recomputed {b.show(f)}",
                         float_ok=False,
                     )
-    elif s.p != 1:
+    elif s.p != 1 and o.linear_law:
         emit("linear-law", False, "no admissible linear gain was found", float_ok=False)
     if "L_admissible_vertices" in params:
         Vs = b.read(params, "L_admissible_vertices", c)

@@ -170,6 +170,15 @@ def parse_options(table: Table, spec: Spec) -> Options:
                 f"expected 'symmetric': with p = {s.p} > 1 outputs only the symmetric algorithm "
                 "and the linear law (Proposition 7.1) apply",
             )
+        if not linear_law and L is None:
+            # the piecewise-affine table (Proposition 4.1) needs one output: without the
+            # linear law and without a given L nothing could certify an injection
+            raise table.error(
+                "linear_law",
+                f"expected true (or a given [method] L): with p = {s.p} > 1 outputs the linear "
+                "law of Proposition 7.1 is the only injection law (the piecewise-affine table "
+                "needs one output)",
+            )
     table.done()
     return Options(
         omega=omega,
