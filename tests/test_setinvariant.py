@@ -482,3 +482,23 @@ def test_diverging_general_algorithm_is_not_converged_exit_1() -> None:
     assert rep.parameters["converged"] is False and rep.parameters["iterations"] < 40
     assert any("diverges" in n and f"{al.GROWTH_MAX:g}" in n for n in rep.notes)
     assert {c.id: c.status for c in rep.claims}["converged"] == ClaimStatus.FAILED
+
+
+def test_simulated_error_of_an_unstable_plant_keeps_its_digits() -> None:
+    """x⁺ = 3x with v = −2.5 z (e⁺ = 0.5 e): over 40 steps x reaches 3⁴⁰ ≈ 10¹⁹, so x − x̂
+    would have no correct digit left; the error is stepped by its own recursion (eq. (3)),
+    so it is 0.5^(k+1) to rounding and the run stays in the polyhedron (a certified design
+    'left' it in simulation before; random-spec fuzzer)."""
+    text = (
+        '[system]\ntime = "discrete"\nA = [[3]]\nC = [[1]]\n[sets.omega]\ntype = "box"\n'
+        'lower = [-1]\nupper = [1]\n[method]\nkey = "set-invariant"\nomega = "omega"\n'
+        "lambda = 0.9\nL = [-2.5]\n[simulate]\nhorizon = 40\nx0 = [1]\nxhat0 = [0.5]\n"
+    )
+    sp = load_spec_text(text, "u.toml")
+    rep = api.design(sp)
+    assert rep.exit_code() == 0
+    res = api.simulate(sp, rep, law="linear")
+    e = res.extra["e_paper"][:, 0]
+    np.testing.assert_allclose(e, 0.5 ** np.arange(1, 42), rtol=1e-12)
+    assert res.x[-1, 0] == pytest.approx(3.0**40)
+    assert res.info["error_in_polyhedron"] and "exit_code" not in res.info
