@@ -311,6 +311,44 @@ def test_time_budget_inside_an_iteration():
         lps.phi_at(G, fl.A, np.eye(3), np.zeros((0, 2), dtype=int), fl.C[0], 0.01, np.zeros(1), 0.0)
 
 
+def test_time_budget_inside_the_hull_and_the_point_screening(monkeypatch):
+    """The hull of the grown cloud and the screening of the new points are checked too (a
+    4-state design grew from 5,676 to 43,564 facets in one iteration and ran 17 s against
+    time_limit = 8: random-spec fuzzer): past the deadline in the second iteration's hull,
+    the run stops with the first iteration's polyhedron, timed out; the screening and the
+    blocks of outward_fix raise at a past deadline."""
+    from obsdesign.methods.setinvariant import algorithms as al
+    from obsdesign.methods.setinvariant.budget import Timeout
+    from obsdesign.methods.setinvariant.problem import build
+    from obsdesign.sets import polytope_ops as po
+
+    fl = build(api.load_spec_text(SEED0, "s0.toml")).fl
+    real = po.hull
+    calls: list[bool] = []
+
+    def hull(P, with_edges=True, check=None):
+        calls.append(check is not None)
+        if check is not None:  # the budget runs out inside this hull
+            raise Timeout
+        return real(P, with_edges)
+
+    monkeypatch.setattr(po, "hull", hull)
+    r = al.general(fl, 0.9604, 0.9604, 60, True, deadline=1e18)
+    assert calls == [False, True]  # the first hull unchecked (a polyhedron to report)
+    assert r.timed_out and r.iterations == 1 and not r.converged
+    monkeypatch.undo()
+    G = fl.G0
+    with pytest.raises(Timeout):
+        al._drop_inside(np.ones((5, G.shape[1])), G, 1e-10, deadline=0.0)
+    assert len(al._drop_inside(np.ones((5, G.shape[1])) * 9, G, 1e-10, deadline=None)) == 5
+
+    def stop() -> None:
+        raise Timeout
+
+    with pytest.raises(Timeout):
+        po.outward_fix(G, np.eye(G.shape[1]), stop)
+
+
 def test_lp9_on_the_merged_float_rows_then_on_all_rows_where_tight():
     """The design solves LP (9) on the float hull's merged rows (fewer than the exact hull's)
     and again on all exact rows only where that v^l is tight (within 10⁻⁹ of λ); the exact

@@ -24,6 +24,7 @@ converted to rationals and proved.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from fractions import Fraction
 from typing import TYPE_CHECKING, Any
@@ -138,13 +139,27 @@ def merge_rows(rows: np.ndarray, tol: float = 1e-10) -> tuple[np.ndarray, np.nda
     return rows[first], np.asarray(labels).reshape(-1)
 
 
-def outward_fix(G: np.ndarray, P: np.ndarray) -> np.ndarray:
+#: rows × points of one block of :func:`outward_fix` (a ``check`` call between blocks)
+BLOCK_ENTRIES = 1 << 22
+
+
+def outward_fix(
+    G: np.ndarray, P: np.ndarray, check: Callable[[], None] | None = None
+) -> np.ndarray:
     """Rescale each row of ``G`` so that ``max_p G_i p = 1`` over the points ``P``.
 
     After this, every point of ``P`` satisfies ``G p <= 1`` (up to one float rounding), so
     the polytope contains ``conv(P)``: a vertex qhull merged or dropped cannot shrink it.
+    ``check()`` runs between blocks of :data:`BLOCK_ENTRIES` products (a time budget may
+    raise there: 43,000 facets × the cloud took seconds in one product).
     """
-    m = (np.asarray(G) @ np.asarray(P).T).max(axis=1)
+    G, P = np.asarray(G), np.asarray(P)
+    step = max(1, BLOCK_ENTRIES // max(1, len(P)))
+    m = np.empty(len(G))
+    for a in range(0, len(G), step):
+        if check is not None:
+            check()
+        m[a : a + step] = (G[a : a + step] @ P.T).max(axis=1)
     if np.any(m <= 0):
         raise PolytopeError("a facet does not separate the points from the origin")
     return G / m[:, None]
@@ -161,11 +176,14 @@ def _edges_from_simplices(simplices: np.ndarray, remap: np.ndarray) -> np.ndarra
     return np.unique(E, axis=0) if len(E) else E.reshape(0, 2)
 
 
-def hull(points: np.ndarray, with_edges: bool = True) -> HullState:
+def hull(
+    points: np.ndarray, with_edges: bool = True, check: Callable[[], None] | None = None
+) -> HullState:
     """Convex hull of a point cloud containing the origin in its interior (float).
 
     Returns the extreme points, the triangulation edges (a superset of the edges) and the
-    canonical, outward-fixed H-form (one row per facet, right-hand side 1).
+    canonical, outward-fixed H-form (one row per facet, right-hand side 1). ``check()`` runs
+    before qhull and between the blocks of :func:`outward_fix` (a time budget may raise).
     """
     P = np.asarray(points, dtype=float)
     n = P.shape[1]
@@ -174,6 +192,8 @@ def hull(points: np.ndarray, with_edges: bool = True) -> HullState:
         if not lo < 0 < hi:
             raise PolytopeError("the origin is not interior to the hull")
         return HullState(np.array([[lo], [hi]]), np.array([[0, 1]]), np.array([[1 / hi], [1 / lo]]))
+    if check is not None:
+        check()
     h, rows = _rhs1_hull(
         P, "the points are not full-dimensional", "the origin is not interior to the hull"
     )
@@ -182,7 +202,7 @@ def hull(points: np.ndarray, with_edges: bool = True) -> HullState:
     V = P[h.vertices]
     edges = _edges_from_simplices(h.simplices, remap) if with_edges else np.zeros((0, 2), dtype=int)
     G, _ = merge_rows(rows)
-    return HullState(V, edges, outward_fix(G, P))
+    return HullState(V, edges, outward_fix(G, P, check))
 
 
 def v_to_h(points: np.ndarray) -> np.ndarray:

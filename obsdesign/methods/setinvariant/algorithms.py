@@ -27,7 +27,7 @@ import numpy as np
 from obsdesign.sets import polytope_ops as po
 
 from . import lps
-from .budget import Timeout
+from .budget import Timeout, check_deadline
 
 Progress = Callable[[str], None]
 
@@ -75,11 +75,27 @@ class IterResult:
 GROWTH_MAX = 1e10
 
 
-def _drop_inside(img: np.ndarray, G: np.ndarray, tol: float) -> np.ndarray:
-    """Keep only the new points that stick out of {G e <= 1} by more than ``tol``."""
+def _drop_inside(
+    img: np.ndarray, G: np.ndarray, tol: float, deadline: float | None = None
+) -> np.ndarray:
+    """Keep only the new points that stick out of {G e <= 1} by more than ``tol``, in blocks
+    of points with the budget checked between them (:class:`Timeout` past ``deadline``)."""
     if len(img) == 0:
         return img
-    return img[(img @ G.T).max(axis=1) > 1 + tol]
+    step = max(1, po.BLOCK_ENTRIES // max(1, len(G)))
+    keep = np.empty(len(img), dtype=bool)
+    for a in range(0, len(img), step):
+        check_deadline(deadline)
+        keep[a : a + step] = (img[a : a + step] @ G.T).max(axis=1) > 1 + tol
+    return img[keep]
+
+
+def _hull(P: np.ndarray, deadline: float | None, first: bool) -> po.HullState:
+    """The iteration's hull; the budget is checked inside it except in the first iteration
+    (which must give a polyhedron to report)."""
+    if first or deadline is None:
+        return po.hull(P)
+    return po.hull(P, check=lambda: check_deadline(deadline))
 
 
 def _eps_screened(
@@ -140,7 +156,12 @@ def general(
     st = None
     prev: tuple[np.ndarray, np.ndarray] | None = None
     for it in range(it0 + 1, it0 + max_iter + 1):
-        st = po.hull(P)
+        try:
+            nxt = _hull(P, deadline, st is None)
+        except Timeout:  # the budget ran out in the hull of the grown cloud
+            assert st is not None
+            return IterResult(st.G, st.V, eps_l, it - 1, False, hist, timed_out=True)
+        st = nxt
         P, G = st.V, st.G
         dl = lps.delta(G, pb.B1, pb.Dv)
         zs = lps.z_d(P, c, pb.eta)  # step 3
@@ -165,7 +186,10 @@ def general(
             img = np.vstack([img, -img])
         if len(img) and not float(np.max(np.linalg.norm(img, axis=1))) <= too_far:
             return IterResult(G, P, eps_l, it, False, hist, diverged=True)
-        P = np.vstack([P, _drop_inside(img, G, drop_tol)])
+        try:
+            P = np.vstack([P, _drop_inside(img, G, drop_tol, deadline)])
+        except Timeout:
+            return IterResult(G, P, eps_l, it, False, hist, timed_out=True)
     assert st is not None
     return IterResult(st.G, st.V, eps_l, it0 + max_iter, False, hist)
 
@@ -195,7 +219,12 @@ def symmetric(
     eps = np.inf
     st = None
     for it in range(it0 + 1, it0 + max_iter + 1):
-        st = po.hull(P)
+        try:
+            nxt = _hull(P, deadline, st is None)
+        except Timeout:  # the budget ran out in the hull of the grown cloud
+            assert st is not None
+            return IterResult(st.G, st.V, eps, it - 1, False, hist, timed_out=True)
+        st = nxt
         P, G = st.V, st.G
         xi = lps.delta(G, pb.B1, Dv)  # (13)
         if c is not None:
@@ -213,6 +242,9 @@ def symmetric(
             return IterResult(G, P, eps, it, False, hist, timed_out=True)
         img = po.minkowski_points(S @ pb.A.T, Bd) / lam_run
         img = np.vstack([img, -img])
-        P = np.vstack([P, _drop_inside(img, G, drop_tol)])
+        try:
+            P = np.vstack([P, _drop_inside(img, G, drop_tol, deadline)])
+        except Timeout:
+            return IterResult(G, P, eps, it, False, hist, timed_out=True)
     assert st is not None
     return IterResult(st.G, st.V, eps, it0 + max_iter, False, hist)
