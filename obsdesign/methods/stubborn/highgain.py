@@ -17,7 +17,6 @@ but give no formula, so ε > ε* is not claimed.
 from __future__ import annotations
 
 import time
-import warnings
 from typing import Any
 
 import numpy as np
@@ -228,18 +227,12 @@ def _check_step(k: np.ndarray, ell: float, dt: float) -> None:
     high-gain observer of the stubborn-observer slides, gains k_i ℓⁱ), and Heun's method is
     stable for dt·|z| up to about 2. Past it the simulation overflows (ℓ ≈ 10⁷ at
     dt = 10⁻⁴: random-spec fuzzer) and the horizon is not the cause."""
-    from obsdesign.methods.stubborn.sim import HEUN_LIMIT
+    from obsdesign.methods.stubborn.sim import heun_warning
 
     with np.errstate(all="ignore"):
         roots = np.roots(np.concatenate([[1.0], k]))
     rate = ell * float(np.max(np.abs(roots))) if roots.size else 0.0
-    if np.isfinite(rate) and dt * rate > HEUN_LIMIT:
-        warnings.warn(
-            f"[simulate] dt = {dt:g} is too large for the high gain ℓ = {ell:.4g}: "
-            f"dt·ℓ·max|root| ≈ {dt * rate:.3g} > {HEUN_LIMIT:g} (Heun's method is unstable "
-            f"there: the simulation may overflow); use dt ≤ {HEUN_LIMIT / rate:.3g}",
-            stacklevel=2,
-        )
+    heun_warning(dt, rate, f"the high gain ℓ = {ell:.4g}: dt·ℓ·max|root|")
 
 
 def simulate(spec: Spec, params: Parameters, observer: str = "stubborn") -> SimResult:

@@ -143,12 +143,18 @@ def check_step(g: Gains, dt: float) -> None:
             rate = float(np.max(np.abs(np.linalg.eigvals(g.A - g.K @ g.C))))
         except np.linalg.LinAlgError:
             return
+    heun_warning(dt, rate, "this gain: dt·max|eig(A − KC)|")
+
+
+def heun_warning(dt: float, rate: float, what: str) -> None:
+    """The warning of :func:`check_step` (and of the high-gain simulation) when
+    dt·``rate`` exceeds :data:`HEUN_LIMIT`; ``what`` names the gain and the product."""
     if np.isfinite(rate) and dt * rate > HEUN_LIMIT:
         warnings.warn(
-            f"[simulate] dt = {dt:g} is too large for this gain: dt·max|eig(A − KC)| ≈ "
-            f"{dt * rate:.3g} > {HEUN_LIMIT:g} (Heun's method is unstable there: the simulated "
-            f"error may grow although the design is certified); use dt ≤ {HEUN_LIMIT / rate:.3g}",
-            stacklevel=2,
+            f"[simulate] dt = {dt:g} is too large for {what} ≈ {dt * rate:.3g} > "
+            f"{HEUN_LIMIT:g} (Heun's method is unstable there: the simulated error may grow, "
+            f"or overflow, although the design is certified); use dt ≤ {HEUN_LIMIT / rate:.3g}",
+            stacklevel=3,
         )
 
 
