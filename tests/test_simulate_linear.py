@@ -120,3 +120,27 @@ def test_one_batched_run_equals_the_single_run_without_randomness():
         for st, val in ma[k].items():
             assert abs(b.extra["per_run"][k][0, a.states.index(st)] - val) <= 1e-12
     assert abs(b.extra["per_run"]["final_error_norm"][0] - ma["final_error_norm"]) <= 1e-12
+
+
+def test_the_single_run_keeps_the_error_of_an_unstable_plant() -> None:
+    """x⁺ = 3x, L = 2.5 (A − LC = 0.5): after 60 steps x ≈ 4·10²⁸ and x̂ − x computed from
+    the two would be pure rounding (|error| ~ 10¹²); the run steps [x; e], so the error is
+    0.5^k exactly as the observer's recursion gives it (random-spec fuzzer), in discrete and
+    continuous time (ẋ = x, L = 3: ė = −2e)."""
+
+    disc = load_spec_text(
+        '[system]\ntime = "discrete"\nA = [[3]]\nC = [[1]]\n[method]\nkey = "lyapunov"\n'
+        "L = [2.5]\n[simulate]\nhorizon = 60\nx0 = [1]\nxhat0 = [2]\n",
+        "u.toml",
+    )
+    r = simulate_linear_observer(disc, np.array([[2.5]]))
+    np.testing.assert_allclose(r.e[:, 0], 0.5 ** np.arange(61), rtol=1e-13)
+    assert r.x[-1, 0] == 3.0**60 and r.metrics()["final_error_norm"] < 1e-18
+    np.testing.assert_allclose(r.xhat, r.x + r.e, rtol=1e-15)
+    cont = load_spec_text(
+        '[system]\ntime = "continuous"\nA = [[1]]\nC = [[1]]\n[method]\nkey = "lyapunov"\n'
+        "L = [3]\n[simulate]\nhorizon = 40\ndt = 0.01\nx0 = [1]\nxhat0 = [2]\n",
+        "c.toml",
+    )
+    r = simulate_linear_observer(cont, np.array([[3.0]]))
+    np.testing.assert_allclose(r.e[:, 0], np.exp(-2 * r.t), rtol=1e-9)

@@ -11,7 +11,10 @@ With z = [x; x̂] and the exogenous signals s = [u; d; v] (input, disturbance, n
   solution at the grid points up to rounding (no RK45 tolerance).
 
 The exogenous terms E s_k are computed before the loop (one matrix product per chunk of
-steps), so each step is one matrix-vector product and one addition. :func:`simulate_linear_observer`
+steps), so each step is one matrix-vector product and one addition. The single run steps
+[x; e], e = x̂ − x, instead (:func:`joint_system` with ``error=True``; x̂ = x + e): the
+error of an unstable plant's observer keeps its digits when x grows past 10¹⁶·|e|. The
+Monte Carlo runs step [x; x̂] (see :mod:`obsdesign.simulate.montecarlo`). :func:`simulate_linear_observer`
 runs the spec's scenario once; :func:`simulate_linear_observer_batch` runs N Monte Carlo runs
 over a batch axis (:mod:`obsdesign.simulate.montecarlo`).
 """
@@ -51,23 +54,27 @@ def sim_grid(spec: Spec) -> np.ndarray:
     return np.arange(0.0, T + dt / 2, dt)
 
 
-def joint_system(spec: Spec, L: np.ndarray) -> JointSystem:
+def joint_system(spec: Spec, L: np.ndarray, error: bool = False) -> JointSystem:
     """The joint plant + observer map of the bound spec for gain ``L`` (n×p): discrete
-    matrices as they are, continuous ones discretized exactly (zero-order hold over dt)."""
+    matrices as they are, continuous ones discretized exactly (zero-order hold over dt).
+
+    ``error``: in the coordinates z = [x; e], e = x̂ − x, instead of [x; x̂]:
+    e⁺ = (A − LC) e − Bd d + L Dn v (the error dynamics of eq. (3) of the constrained-redesign
+    paper's linear observer), M = diag(A, A − LC), E = [[B, Bd, 0], [0, −Bd, L Dn]]."""
     s, sim = spec.system, spec.simulate
     grid = sim_grid(spec)
     A, B, C, Bd, Dn = s.A.f, s.B.f, s.C.f, s.Bd.f, s.Dn.f
     n = s.n
     L = np.asarray(L, dtype=float).reshape(n, s.p)
     LC = L @ C
-    M = np.block([[A, np.zeros((n, n))], [LC, A - LC]])
     m, nd, nv = B.shape[1], Bd.shape[1], Dn.shape[1]
-    E = np.block(
-        [
-            [B, Bd, np.zeros((n, nv))],
-            [B, np.zeros((n, nd)), L @ Dn],
-        ]
-    )
+    Z = np.zeros((n, n))
+    if error:
+        M = np.block([[A, Z], [Z, A - LC]])
+        E = np.block([[B, Bd, np.zeros((n, nv))], [np.zeros((n, m)), -Bd, L @ Dn]])
+    else:
+        M = np.block([[A, Z], [LC, A - LC]])
+        E = np.block([[B, Bd, np.zeros((n, nv))], [B, np.zeros((n, nd)), L @ Dn]])
     if s.discrete:
         return JointSystem(M, E, grid, n)
     from scipy.linalg import expm
@@ -120,14 +127,15 @@ def simulate_linear_observer(spec: Spec, L: np.ndarray) -> SimResult:
         from obsdesign.simulate.nonlinear import simulate_one
 
         return simulate_one(spec, L)
-    js = joint_system(spec, L)
+    js = joint_system(spec, L, error=True)
     u, d, v = signals(spec, js.grid)
     sim = spec.simulate
     assert sim is not None
-    Z = step_all(js, np.concatenate([sim.x0.f, sim.xhat0.f]), exogenous(u, d, v)[:-1])
-    x, xh = Z[:, : js.n], Z[:, js.n :]
+    z0 = np.concatenate([sim.x0.f, sim.xhat0.f - sim.x0.f])
+    Z = step_all(js, z0, exogenous(u, d, v)[:-1])
+    x, e = Z[:, : js.n], Z[:, js.n :]
     y = x @ s.C.f.T + u @ s.D.f.T + v @ s.Dn.f.T
-    return SimResult(js.grid, x, xh, y, s.states)
+    return SimResult(js.grid, x, x + e, y, s.states, error=e)
 
 
 def simulate_linear_observer_batch(

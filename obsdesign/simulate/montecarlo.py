@@ -20,6 +20,12 @@ whatever the number of rows (two or more), so a run's numbers are bitwise the sa
 batch size or span (tested in tests/test_simulate_montecarlo.py); they agree with a separate
 run (:func:`obsdesign.simulate.linear.simulate_linear_observer`) to rounding.
 
+Coordinates: the runs step the estimate x̂ (and x when it varies) and take the error as
+x̂ − x. The single run steps [x; e] instead, because on an unstable plant over a long horizon
+x̂ − x loses its digits once |x| passes 10¹⁶·|e|; the Monte Carlo metrics have that limit
+(not changed: the block recursion, its shared terms and its bitwise batching tests are built
+on [x; x̂]).
+
 ``[simulate] initial_error = "NAME"`` is read by :func:`parse_initial_error`, which a method
 calls from its ``parse_simulate``.
 """
