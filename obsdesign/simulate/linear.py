@@ -13,8 +13,8 @@ With z = [x; x̂] and the exogenous signals s = [u; d; v] (input, disturbance, n
 The exogenous terms E s_k are computed before the loop (one matrix product per chunk of
 steps), so each step is one matrix-vector product and one addition. The single run steps
 [x; e], e = x̂ − x, instead (:func:`joint_system` with ``error=True``; x̂ = x + e): the
-error of an unstable plant's observer keeps its digits when x grows past 10¹⁶·|e|. The
-Monte Carlo runs step [x; x̂] (see :mod:`obsdesign.simulate.montecarlo`). :func:`simulate_linear_observer`
+error of an unstable plant's observer keeps its digits when x grows past 10¹⁶·|e|; so do
+the Monte Carlo runs (:mod:`obsdesign.simulate.montecarlo`). :func:`simulate_linear_observer`
 runs the spec's scenario once; :func:`simulate_linear_observer_batch` runs N Monte Carlo runs
 over a batch axis (:mod:`obsdesign.simulate.montecarlo`).
 """
@@ -39,6 +39,20 @@ class JointSystem:
     E: np.ndarray
     grid: np.ndarray
     n: int
+    #: coordinates: [x; e], e = x̂ − x (True) or [x; x̂] (False)
+    error: bool = False
+
+    def in_error_coordinates(self) -> JointSystem:
+        """The same map in [x; e], e = x̂ − x: with T = [[I, 0], [−I, I]], M ↦ T M T⁻¹,
+        E ↦ T E (itself when already there)."""
+        if self.error:
+            return self
+        n = self.n
+        T = np.eye(2 * n)
+        T[n:, :n] = -np.eye(n)
+        Ti = np.eye(2 * n)
+        Ti[n:, :n] = np.eye(n)
+        return JointSystem(T @ self.M @ Ti, T @ self.E, self.grid, n, True)
 
 
 def sim_grid(spec: Spec) -> np.ndarray:
@@ -76,7 +90,7 @@ def joint_system(spec: Spec, L: np.ndarray, error: bool = False) -> JointSystem:
         M = np.block([[A, Z], [LC, A - LC]])
         E = np.block([[B, Bd, np.zeros((n, nv))], [B, np.zeros((n, nd)), L @ Dn]])
     if s.discrete:
-        return JointSystem(M, E, grid, n)
+        return JointSystem(M, E, grid, n, error)
     from scipy.linalg import expm
 
     dt = float(sim.dt.f)
@@ -85,7 +99,7 @@ def joint_system(spec: Spec, L: np.ndarray, error: bool = False) -> JointSystem:
     aug[: 2 * n, : 2 * n] = M
     aug[: 2 * n, 2 * n :] = E
     F = expm(aug * dt)
-    return JointSystem(F[: 2 * n, : 2 * n], F[: 2 * n, 2 * n :], grid, n)
+    return JointSystem(F[: 2 * n, : 2 * n], F[: 2 * n, 2 * n :], grid, n, error)
 
 
 def exogenous(u: np.ndarray, d: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -159,7 +173,7 @@ def simulate_linear_observer_batch(
     from obsdesign.simulate import montecarlo as mc
 
     if spec.system.linear:
-        js = joint_system(spec, L)
+        js = joint_system(spec, L, error=True)
         return mc.run_batch(spec, js, runs, initial_error, batch=batch, span=span)
     from obsdesign.simulate.nonlinear import batch_stepper
 

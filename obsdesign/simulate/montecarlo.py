@@ -20,11 +20,11 @@ whatever the number of rows (two or more), so a run's numbers are bitwise the sa
 batch size or span (tested in tests/test_simulate_montecarlo.py); they agree with a separate
 run (:func:`obsdesign.simulate.linear.simulate_linear_observer`) to rounding.
 
-Coordinates: the runs step the estimate x̂ (and x when it varies) and take the error as
-x̂ − x. The single run steps [x; e] instead, because on an unstable plant over a long horizon
-x̂ − x loses its digits once |x| passes 10¹⁶·|e|; the Monte Carlo metrics have that limit
-(not changed: the block recursion, its shared terms and its bitwise batching tests are built
-on [x; x̂]).
+Coordinates: the joint system is in [x; e], e = x̂ − x (:func:`obsdesign.simulate.linear.
+joint_system` with ``error=True``): the runs step the error (and x when it varies) and form
+the estimate as x + e, never the error as x̂ − x, which on an unstable plant over a long
+horizon loses every digit once |x| passes 10¹⁶·|e| (x⁺ = 3x with e⁺ = 0.5e: every run's
+"error" was 10¹² at step 60; random-spec fuzzer). Run 0's trajectory carries its error too.
 
 ``[simulate] initial_error = "NAME"`` is read by :func:`parse_initial_error`, which a method
 calls from its ``parse_simulate``.
@@ -314,6 +314,7 @@ def run_batch(
 
     Returns what :func:`study` returns."""
     sim = _need(spec)
+    js = js.in_error_coordinates()
     n, grid = js.n, js.grid
     K = len(grid) - 1
     sigs = (sim.u, sim.disturbance, sim.noise)
@@ -326,8 +327,8 @@ def run_batch(
         m = _run(plan, draws, sim.x0.f, e0, K, n, traj0)
         if traj0 is None:
             return m, None
-        x, xh = _trajectory(plan, traj0, n)
-        return m, (x, xh)
+        x, e = _trajectory(plan, traj0, n)
+        return m, (x, x + e, None, e)
 
     per_run = (CHUNK if plan.fast else K + 1) * w * 8
     batch, span = study_options.get("batch"), study_options.get("span")
@@ -361,8 +362,9 @@ def study(
     fit :data:`BATCH_BYTES`; ``span = (a, b)``: only runs a..b-1 of the ``runs``, with the
     same child seeds as in the full range, so run r is the same whatever the span:
     :func:`merge` joins spans; None: all), each run's generator and initial error, then
-    ``step(rngs, e0, keep)`` → (per-run metrics of the batch, run 0's (x, x̂) or (x, x̂, y)
-    when ``keep``) (the generators stand just after the initial errors' draws).
+    ``step(rngs, e0, keep)`` → (per-run metrics of the batch, run 0's (x, x̂), (x, x̂, y) or
+    (x, x̂, y or None, e) when ``keep``) (the generators stand just after the initial errors'
+    draws).
 
     Returns run 0's trajectory with ``info`` = runs, where the
     initial errors come from and the quantiles of every per-run metric, and
@@ -394,7 +396,9 @@ def study(
         traj = t0 if b0 == 0 else traj
         for k, a in m.items():
             out[k][b0 : b0 + len(rngs)] = a
-    res = SimResult(grid, traj[0], traj[1], traj[2] if len(traj) > 2 else None, s.states)
+    y0 = traj[2] if len(traj) > 2 else None
+    err = traj[3] if len(traj) > 3 else None
+    res = SimResult(grid, traj[0], traj[1], y0, s.states, error=err)
     res.extra["per_run"] = out
     res.extra["initial_errors"] = e0_all
     res.info["runs"] = total
@@ -417,24 +421,26 @@ def _run(
 ) -> dict[str, np.ndarray]:
     """Step one batch (initial errors ``e0`` (R, n)) over K steps; per-run metrics.
 
-    Every block of m steps gives, per run, the estimates H = (x̂_{k0+1}, …, x̂_{k0+m}) and
-    the errors E as rows of (R, m·n) arrays, each from products with the runs as rows
-    ([state, 1] times the block matrices, plus the raw draws times the Toeplitz part; the
-    shared terms ride on the column of ones): OpenBLAS computes every row the same way
-    whatever the number of rows (two or more; one run is stepped as two equal rows), so a
-    run's numbers do not depend on the batching. The metrics are running elementwise
-    max / min / sum of squares over the blocks (whole contiguous arrays), reduced over the
-    m positions once at the end. ``traj0`` (K + 1, N) receives run 0's states when given."""
+    The joint state is [x; e] (e = x̂ − x; the error alone when x is shared). Every block of
+    m steps gives, per run, the estimates H = (x̂_{k0+1}, …, x̂_{k0+m}) and the errors E as
+    rows of (R, m·n) arrays, each from products with the runs as rows ([state, 1] times the
+    block matrices, plus the raw draws times the Toeplitz part; the shared terms ride on the
+    column of ones): OpenBLAS computes every row the same way whatever the number of rows
+    (two or more; one run is stepped as two equal rows), so a run's numbers do not depend on
+    the batching. E is stepped; H = E + x (shared x: its block term; else the stepped X).
+    The metrics are running elementwise max / min / sum of squares over the blocks (whole
+    contiguous arrays), reduced over the m positions once at the end. ``traj0`` (K + 1, N)
+    receives run 0's stepped states ([x; e], or e) when given."""
     R, N = len(e0), len(plan.idx)
     Rr = max(R, 2)
     shared_x = plan.x_sh is not None
     st = np.ones((Rr, N + 1))  # the states and a column of ones
     xh0 = x0 + e0  # (R, n)
     if shared_x:
-        st[:R, :N] = xh0
+        st[:R, :N] = e0
     else:
         st[:R, :n] = x0
-        st[:R, n:N] = xh0
+        st[:R, n:N] = e0
     st[R:] = st[:1]
     if traj0 is not None:
         traj0[0] = st[0, :N]
@@ -455,9 +461,9 @@ def _run(
             H, E, X, T = bufs[m]
             bm.at(k0 // BLOCK)
             full = m == BLOCK
-            mm(st, PH if full else PH[:, :cm], out=H)
+            mm(st, PE if full else PE[:, :cm], out=E)  # the stepped error
             if shared_x:
-                mm(st, PE if full else PE[:, :cm], out=E)
+                mm(st, PH if full else PH[:, :cm], out=H)  # e + x(k) (x in the block term)
             else:
                 mm(st, PX if full else PX[:, :cm], out=X)
             for j, (a, d) in enumerate(zip(raw, dims, strict=True)):
@@ -465,16 +471,16 @@ def _run(
                 if R == 1:
                     blk = np.concatenate([blk, blk])
                 mm(blk, bm.TH[j] if full else bm.TH[j][: m * d, :cm], out=T)
-                np.add(H, T, out=H)
+                np.add(E, T, out=E)
                 if shared_x:
-                    np.add(E, T, out=E)
+                    np.add(H, T, out=H)
                 else:
                     mm(blk, bm.TX[j] if full else bm.TX[j][: m * d, :cm], out=T)
                     np.add(X, T, out=X)
             if not shared_x:
-                np.subtract(H, X, out=E)
+                np.add(E, X, out=H)
                 st[:, :n] = X[:, cm - n :]
-            st[:, N - n : N] = H[:, cm - n :]
+            st[:, N - n : N] = E[:, cm - n :]
             if full:
                 np.maximum(hi, H, out=hi)
                 np.minimum(lo, H, out=lo)
@@ -485,10 +491,10 @@ def _run(
             else:
                 _accumulate_part(acc, H, E, T, cm)
             if traj0 is not None:
-                traj0[k0 + 1 : k0 + m + 1, N - n :] = H[0].reshape(m, n)
+                traj0[k0 + 1 : k0 + m + 1, N - n :] = E[0].reshape(m, n)
                 if not shared_x:
                     traj0[k0 + 1 : k0 + m + 1, :n] = X[0].reshape(m, n)
-    e = xh0 - x0
+    e = e0
     e_end = E[:R, -n:] if K else e
     pos = {k: a[:R].reshape(R, BLOCK, n) for k, a in acc.items()}
     sup_h = np.maximum(pos["hi"].max(axis=1), -pos["lo"].min(axis=1))
@@ -530,10 +536,10 @@ def _matmul_for(rows: int, inner: int, cols: int) -> Any:
 class _BlockMatrices:
     """The block matrices of :func:`_run`, columns step-major (position i·n + j: state j of
     step i + 1, so that a shorter block uses a prefix): ``at(block)`` gives the (N + 1)-row
-    maps [state; 1] → estimates, errors (when the plant trajectory is shared: the estimates
-    minus x(k)) and plant states ``PH``, ``PE``, ``PX``, whose last row is that block's shared
+    maps [state; 1] → errors, estimates (when the plant trajectory is shared: the errors
+    plus x(k)) and plant states ``PE``, ``PH``, ``PX``, whose last row is that block's shared
     term after ``at(block)``; ``TH[j]``,
-    ``TX[j]``: the Toeplitz maps of random signal j's raw draws to estimates, plant states."""
+    ``TX[j]``: the Toeplitz maps of random signal j's raw draws to errors, plant states."""
 
     def __init__(self, plan: _Plan, K: int, n: int):
         N = len(plan.idx)
@@ -542,14 +548,14 @@ class _BlockMatrices:
         rows_h = (steps + np.arange(N - n, N)).ravel()  # the estimate's coordinates
         rows_x = (steps + np.arange(n)).ravel()
         Csh = _block_inputs(sh, plan.W_sh, K)  # (blocks, b·N)
-        self.CH = Csh[:, rows_h]
+        self.CE = Csh[:, rows_h]  # the error's coordinates (the last n of the state)
         self.CX = Csh[:, rows_x]
         if plan.x_sh is not None:
             xs = np.zeros((len(Csh) * BLOCK, n))
             xs[:K] = plan.x_sh[1:]
-            self.CE = self.CH - xs.reshape(len(Csh), BLOCK * n)
-        self.PH = np.vstack([sh.P[rows_h].T, np.zeros((1, BLOCK * n))])
-        self.PE = self.PH.copy()
+            self.CH = self.CE + xs.reshape(len(Csh), BLOCK * n)
+        self.PE = np.vstack([sh.P[rows_h].T, np.zeros((1, BLOCK * n))])
+        self.PH = self.PE.copy()
         self.PX = np.vstack([sh.P[rows_x].T, np.zeros((1, BLOCK * n))])
         self.shared_x = plan.x_sh is not None
         self.TH, self.TX = [], []
@@ -559,16 +565,16 @@ class _BlockMatrices:
             self.TX.append(np.ascontiguousarray(T[rows_x].T))
 
     def at(self, block: int) -> None:
-        """Put that block's shared terms in the last rows of PH and PE (or PX)."""
-        self.PH[-1] = self.CH[block]
+        """Put that block's shared terms in the last rows of PE and PH (or PX)."""
+        self.PE[-1] = self.CE[block]
         if self.shared_x:
-            self.PE[-1] = self.CE[block]
+            self.PH[-1] = self.CH[block]
         else:
             self.PX[-1] = self.CX[block]
 
 
 def _trajectory(plan: _Plan, traj0: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Run 0's (x, x̂) from its stepped coordinates."""
+    """Run 0's (x, e) from its stepped coordinates ([x; e], or e with x shared)."""
     if plan.x_sh is not None:
         return plan.x_sh, traj0
     return traj0[:, :n], traj0[:, n:]
