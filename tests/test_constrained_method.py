@@ -144,6 +144,17 @@ def test_bad_gamma_above_bound_names_the_bound():
     with pytest.raises(InfeasibleError) as e:
         api.design(sp)
     assert "2.3965e-05" in str(e.value) and "(24)" in str(e.value)
+    assert "× too large" in str(e.value)
+
+
+def test_gamma_just_above_its_bound_says_by_how_much() -> None:
+    """γ a millionth above the largest certified γ: the message said "1× too large"; now the
+    relative excess (random-spec fuzzer)."""
+    from obsdesign.certify.exact import Q
+    from obsdesign.methods.constrained.design import _over
+
+    assert _over(Q("1.000001"), 1) == "1e-06 (relative) above it"
+    assert _over(17, Q("2.3965e-05")) == "7.09e+05× too large"
 
 
 def test_gamma_uncertified_is_failed_claim():

@@ -163,7 +163,7 @@ def design_params(spec: Spec) -> tuple[dict[str, Any], list[str]]:
             msg = (
                 f"γ = {float(gamma):g} exceeds the bound (24) γ ≤ λ_min(P)/δ²: the largest certified γ is "
                 f"{float(g_max):.6g} (λ_min(P) ≥ {float(B.lambda_min_lower(P)):.6g}, δ² ≤ {float(dsq.value):.6g}); "
-                f"γ is {float(gamma / g_max):.3g}× too large"
+                f"γ is {_over(gamma, g_max)}"
             )
             if not o.gamma_uncertified:
                 raise InfeasibleError(
@@ -229,3 +229,10 @@ def v_max_breve(
     :param w_sq: max |w|² over D."""
     v0 = B.max_V_diff(P, X0, Xhat0).value
     return v0 + Q(mu) * Q(w_sq) / (1 - Q(rho))
+
+
+def _over(value: Any, bound: Any) -> str:
+    """How far ``value`` exceeds ``bound`` (> 0), readable at any size: "3.2× too large", or
+    "1e-06 (relative) above it" when the ratio would print as 1× (a γ just past (24))."""
+    r = float(Q(value) / Q(bound))
+    return f"{r:.3g}× too large" if r >= 1.01 else f"{r - 1:.2g} (relative) above it"
