@@ -156,6 +156,41 @@ def test_time_limit_stops_the_simulation_with_a_clear_message(example, tmp_path,
     assert len(S.recover(C, 0.3, 0.1, 10**6, (_time.perf_counter() + 60, 60.0)))
 
 
+def test_consistency_lost_after_leaving_E_blames_E_not_L_h(tmp_path):
+    """The true state leaves E (f pushes it out), then every centre is discarded: the
+    message names that cause and stops there — it also blamed L_h before (random-spec
+    fuzzer), though outside E no constant of the design applies."""
+    text = """[system]
+time = "continuous"
+states = ["x1"]
+f = ["0.18*x1 + 0.63*sqrt(1 + x1^2)"]
+h = ["sin(20*x1)"]
+u = ["-0.34", "0.25"]
+[method]
+key = "search-space"
+alpha = 0.43
+eps_star = 0.04
+gamma0 = 1.6
+[method.E]
+lower = [-0.0718]
+upper = [1.28]
+[method.D]
+lower = [0.437]
+upper = [0.771]
+[method.U]
+lower = [-0.34, 0.25]
+upper = [-0.34, 0.25]
+[simulate]
+horizon = 2.3
+x0 = [0.617]
+xhat0 = [0]
+"""
+    sp, rep = _load(text, tmp_path)
+    with pytest.raises(ConsistencyLost, match="The true state left E at t = 0.648") as ei:
+        api.simulate(sp, rep)
+    assert "L_h" not in ei.value.message and "Lemma 2" not in ei.value.message
+
+
 def test_recover_covers_every_ball_point():
     """Sound re-covering: every point within η of a centre lies in a returned cell."""
     rng = np.random.default_rng(1)

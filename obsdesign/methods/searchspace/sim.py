@@ -446,6 +446,9 @@ def _diagnose(run: Run, x: np.ndarray, o: Options, where: str, ctx: Any) -> str:
             msg.append(
                 f"The true state left E at t = {left_E:.6g}: the constants on E do not apply."
             )
+            # outside E the constants are not Lipschitz constants there: that is the cause,
+            # the bound checks below would only blame L_h or L_f for it
+            return " ".join(msg)
         bound = eps * math.exp(L_f * since) + flow_err
         d = float(np.min(np.linalg.norm(C - x, axis=1))) if len(C) else math.inf
         if "refinement" in where and d <= bound:
