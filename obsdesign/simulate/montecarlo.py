@@ -445,20 +445,28 @@ def _run(
     if traj0 is not None:
         traj0[0] = st[0, :N]
     bm = _BlockMatrices(plan, K, n)
-    acc = {k: np.full((Rr, BLOCK * n), v) for k, v in _ACC.items()}
-    bufs = {m: [np.empty((Rr, m * n)) for _ in range(4)] for m in {BLOCK, K % BLOCK} if m}
+    hi = np.full((2, Rr, BLOCK * n), -np.inf)  # running max of [H; E] per position
+    lo = np.full((2, Rr, BLOCK * n), np.inf)
+    sq = np.zeros((Rr, BLOCK * n))  # running sum of E² per position
+    # per block length: [H; E] stacked (each half contiguous, and the whole: one max and one
+    # min call per block for both), X and a scratch T
+    bufs = {
+        m: (np.empty((2, Rr, m * n)), np.empty((Rr, m * n)), np.empty((Rr, m * n)))
+        for m in {BLOCK, K % BLOCK}
+        if m
+    }
     dims = draws.dims if draws is not None else []
     E = np.empty((Rr, 0))
     mm = _matmul_for(Rr, max(N + 1, BLOCK * max(dims, default=1)), BLOCK * n)
     PH, PE, PX = bm.PH, bm.PE, bm.PX
-    hi, lo, ehi, elo, sq = (acc[k] for k in _ACC)
     for c0 in range(0, K, CHUNK):
         c1 = min(K, c0 + CHUNK)
         raw = draws.chunk(c0, c1) if draws is not None else []
         for k0 in range(c0, c1, BLOCK):
             m = min(BLOCK, c1 - k0)
             cm = m * n
-            H, E, X, T = bufs[m]
+            HE, X, T = bufs[m]
+            H, E = HE[0], HE[1]
             bm.at(k0 // BLOCK)
             full = m == BLOCK
             mm(st, PE if full else PE[:, :cm], out=E)  # the stepped error
@@ -481,50 +489,29 @@ def _run(
                 np.add(E, X, out=H)
                 st[:, :n] = X[:, cm - n :]
             st[:, N - n : N] = E[:, cm - n :]
+            np.multiply(E, E, out=T)
             if full:
-                np.maximum(hi, H, out=hi)
-                np.minimum(lo, H, out=lo)
-                np.maximum(ehi, E, out=ehi)
-                np.minimum(elo, E, out=elo)
-                np.multiply(E, E, out=T)
+                np.maximum(hi, HE, out=hi)
+                np.minimum(lo, HE, out=lo)
                 np.add(sq, T, out=sq)
-            else:
-                _accumulate_part(acc, H, E, T, cm)
+            else:  # a last, shorter block: its cm first positions
+                hi[:, :, :cm] = np.maximum(hi[:, :, :cm], HE)
+                lo[:, :, :cm] = np.minimum(lo[:, :, :cm], HE)
+                sq[:, :cm] += T
             if traj0 is not None:
                 traj0[k0 + 1 : k0 + m + 1, N - n :] = E[0].reshape(m, n)
                 if not shared_x:
                     traj0[k0 + 1 : k0 + m + 1, :n] = X[0].reshape(m, n)
     e = e0
     e_end = E[:R, -n:] if K else e
-    pos = {k: a[:R].reshape(R, BLOCK, n) for k, a in acc.items()}
-    sup_h = np.maximum(pos["hi"].max(axis=1), -pos["lo"].min(axis=1))
-    sup_e = np.maximum(pos["ehi"].max(axis=1), -pos["elo"].min(axis=1))
+    top = np.maximum(hi[:, :R], -lo[:, :R]).reshape(2, R, BLOCK, n).max(axis=2)
+    sup_h, sup_e = top[0], top[1]
     return {
         "sup_abs_error": np.maximum(sup_e, np.abs(e)),
-        "rmse": np.sqrt((e * e + pos["sq"].sum(axis=1)) / (K + 1)),
+        "rmse": np.sqrt((e * e + sq[:R].reshape(R, BLOCK, n).sum(axis=1)) / (K + 1)),
         "sup_abs_estimate": np.maximum(sup_h, np.abs(xh0)),
         "final_error_norm": np.linalg.norm(e_end, axis=1),
     }
-
-
-#: the running metrics of :func:`_run` and their start values
-_ACC = {"hi": -np.inf, "lo": np.inf, "ehi": -np.inf, "elo": np.inf, "sq": 0.0}
-
-
-def _accumulate_part(
-    acc: dict[str, np.ndarray], H: np.ndarray, E: np.ndarray, T: np.ndarray, cm: int
-) -> None:
-    """The running metrics of :func:`_run` for a last, shorter block: its ``cm`` first
-    positions (T: a scratch array of E's shape)."""
-    for k, a, f in (
-        ("hi", H, np.maximum),
-        ("lo", H, np.minimum),
-        ("ehi", E, np.maximum),
-        ("elo", E, np.minimum),
-    ):
-        acc[k][:, :cm] = f(acc[k][:, :cm], a)
-    np.multiply(E, E, out=T)
-    acc["sq"][:, :cm] += T
 
 
 def _matmul_for(rows: int, inner: int, cols: int) -> Any:
