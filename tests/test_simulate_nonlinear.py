@@ -112,8 +112,10 @@ def test_one_run_is_run_0_of_a_batch():
     batch = simulate_linear_observer_batch(sp, L, 3)
     np.testing.assert_array_equal(one.xhat, batch.xhat)
     np.testing.assert_array_equal(one.y, batch.y)
-    m = one.metrics()
-    assert batch.extra["per_run"]["rmse"][0].tolist() == [m["rmse"]["x1"], m["rmse"]["x2"]]
+    np.testing.assert_array_equal(one.e, batch.e)
+    m = one.metrics()  # np.mean's pairwise sum against the batch's running sum: to rounding
+    got = batch.extra["per_run"]["rmse"][0]
+    np.testing.assert_allclose(got, [m["rmse"]["x1"], m["rmse"]["x2"]], rtol=1e-14)
 
 
 def test_a_linear_plant_as_expressions_gives_the_linear_numbers():
@@ -151,3 +153,37 @@ def test_simulate_runs_through_the_api_uses_the_expressions(write_spec):
     np.testing.assert_allclose(got, [m["final_error_norm"] for m in want], rtol=1e-9)
     one = api.simulate(path)  # one run: run 0 of the four, through the expression plant
     assert one.extra["per_run"]["final_error_norm"][0] == got[0]
+
+
+def test_an_unstable_expression_plant_keeps_its_error() -> None:
+    """x⁺ = 3x + 0.1 sin(x), L = 2.5: e⁺ = 0.5e − 0.1 sin(x), so |e| ≤ 0.2 after the start,
+    while x passes 10²⁸. The runs step [x; e]; from x and x̂ the error would be rounding of
+    size 10¹² (found by a random-spec fuzzer on the linear path). Same in continuous time
+    (ẋ = x + 0.1 sin(x), L = 3: ė = −2e − 0.1 sin(x), so |e| → ≤ 0.05), and in the batch."""
+    disc = load_spec_text(
+        '[system]\ntime = "discrete"\nA = [[3]]\nC = [[1]]\npsi = ["0.1*sin(x1)"]\n'
+        '[method]\nkey = "lyapunov"\nL = [2.5]\n[simulate]\nhorizon = 60\nx0 = [1]\n'
+        "xhat0 = [2]\n",
+        "u.toml",
+    )
+    r = simulate_linear_observer(disc, np.array([[2.5]]))
+    x, e = [1.0], [1.0]
+    for _ in range(60):  # the plant and the error's recursion written out
+        x, e = [*x, 3 * x[-1] + 0.1 * np.sin(x[-1])], [*e, 0.5 * e[-1] - 0.1 * np.sin(x[-1])]
+    assert abs(r.x[-1, 0]) > 1e28
+    np.testing.assert_allclose(r.x[:, 0], x, rtol=1e-15)
+    np.testing.assert_allclose(r.e[:, 0], e, rtol=1e-12, atol=1e-15)
+    assert r.metrics()["final_error_norm"] <= 0.2
+    b = simulate_linear_observer_batch(disc, np.array([[2.5]]), 3)
+    assert np.all(b.extra["per_run"]["final_error_norm"] <= 0.2)
+    cont = load_spec_text(
+        '[system]\ntime = "continuous"\nA = [[1]]\nC = [[1]]\npsi = ["0.1*sin(x1)"]\n'
+        '[method]\nkey = "lyapunov"\nL = [3]\n[simulate]\nhorizon = 40\ndt = 0.05\nx0 = [1]\n'
+        "xhat0 = [2]\n",
+        "c.toml",
+    )
+    r = simulate_linear_observer(cont, np.array([[3.0]]))
+    assert abs(r.x[-1, 0]) > 1e16
+    late = np.abs(r.e[r.t >= 10, 0])  # e^{-20} of the start is left by t = 10
+    assert late.max() <= 0.05 + 1e-8
+    np.testing.assert_allclose(r.xhat, r.x + r.e, rtol=1e-15)

@@ -7,7 +7,9 @@ C x + D u + Dn v; ``t`` is the grid value (the sample index in discrete time, th
 continuous time). Every expression is compiled once (``Expr.on``) and evaluated on the
 (runs, ·) array of all runs together, so a step costs a few numpy calls whatever the number
 of runs. Continuous time: the classical Runge–Kutta scheme (RK4) with :data:`SUBSTEPS` equal
-steps per ``dt``, the signals held over each ``dt`` (as the linear path holds them).
+steps per ``dt``, the signals held over each ``dt`` (as the linear path holds them). The
+runs step the plant x and the error e = x̂ − x (:class:`Plant`), as the linear path does, so
+an unstable plant keeps its error's digits; x̂ = x + e.
 
 Monte Carlo runs draw their initial errors and signals exactly as the linear path does
 (:func:`obsdesign.simulate.montecarlo.study`: same child seeds, same order of draws, same
@@ -33,7 +35,14 @@ SUBSTEPS = 8
 
 class Plant:
     """The plant's right-hand side and output map over a batch (arrays (R, ·)), and the
-    observer's matrices for gain ``L``: x̂⁺ = (A − L C) x̂ + (B − L D) u + L y."""
+    observer's matrices for gain ``L``: x̂⁺ = (A − L C) x̂ + (B − L D) u + L y.
+
+    The runs step [x; e] (e = x̂ − x), never x̂ alone: the error's recursion,
+    e⁺ = (A − L C) e + L (y − C x − D u) − (x⁺ − A x − B u) (:meth:`error_step`; ė the
+    same in continuous time), takes the defects y − C x − D u and x⁺ − A x − B u as the
+    model gives them (D_n v and B_d d + ψ when the plant is A x + … + ψ; h − C x − D u and
+    f − A x − B u when ``f`` or ``h`` give the whole map), so an unstable plant whose x
+    passes 10¹⁶·|e| keeps its error (x̂ − x from x and x̂ would lose every digit)."""
 
     def __init__(self, spec: Spec, L: np.ndarray):
         s = self.s = spec.system
@@ -43,32 +52,44 @@ class Plant:
         self.f = [e.on(x_u_d_t) for e in (s.f or s.psi or [])]
         self.additive = s.f is None
         self.h = [e.on(x_u_v_t) for e in s.h] if s.h is not None else None
-        A, B, C, D = s.A.f, s.B.f, s.C.f, s.D.f
+        A, C, D = s.A.f, s.C.f, s.D.f
         L = np.asarray(L, dtype=float).reshape(s.n, s.p)
-        #: [x̂, u, y] @ obsT is the observer's x̂⁺ (discrete) or dx̂/dt (continuous)
-        self.obsT = np.concatenate([A - L @ C, B - L @ D, L], axis=1).T.copy()
+        #: [e, y − C x − D u] @ errT is (A − L C) e + L (y − C x − D u)
+        self.errT = np.concatenate([A - L @ C, L], axis=1).T.copy()
+        self.linT = np.concatenate([A, s.B.f], axis=1).T.copy()  # [x, u] @ linT = A x + B u
+        self.outT = np.concatenate([C, D], axis=1).T.copy()  # [x, u] @ outT = C x + D u
 
-    def rhs(self, X: np.ndarray, U: np.ndarray, Dd: np.ndarray, t: float) -> np.ndarray:
-        """x⁺ (discrete) or ẋ (continuous) of every run: (R, n)."""
+    def rhs(
+        self, X: np.ndarray, U: np.ndarray, Dd: np.ndarray, t: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(x⁺ or ẋ, its defect x⁺ − A x − B u) of every run: (R, n) each."""
         s = self.s
         Z = _args(X, U, Dd, t)
         parts = np.stack([g(Z) for g in self.f], axis=-1) if self.f else 0.0
+        lin = mc._mm(np.concatenate([X, U], axis=1), self.linT)
         if not self.additive:
-            return parts
-        return X @ s.A.f.T + U @ s.B.f.T + Dd @ s.Bd.f.T + parts
+            return parts, parts - lin
+        defect = Dd @ s.Bd.f.T + parts
+        return lin + defect, defect
 
-    def out(self, X: np.ndarray, U: np.ndarray, V: np.ndarray, t: float) -> np.ndarray:
-        """y of every run: (R, p)."""
+    def out(
+        self, X: np.ndarray, U: np.ndarray, V: np.ndarray, t: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(y, its defect y − C x − D u) of every run: (R, p) each."""
         s = self.s
+        lin = mc._mm(np.concatenate([X, U], axis=1), self.outT)
         if self.h is None:
-            return X @ s.C.f.T + U @ s.D.f.T + V @ s.Dn.f.T
+            defect = V @ s.Dn.f.T
+            return lin + defect, defect
         Z = _args(X, U, V, t)
-        return np.stack([g(Z) for g in self.h], axis=-1)
+        y = np.stack([g(Z) for g in self.h], axis=-1)
+        return y, y - lin
 
-    def observer(self, XH: np.ndarray, U: np.ndarray, Y: np.ndarray) -> np.ndarray:
-        """The observer's x̂⁺ (discrete) or dx̂/dt (continuous), one product with the runs
-        as rows (see :func:`obsdesign.simulate.montecarlo._mm`)."""
-        return mc._mm(np.concatenate([XH, U, Y], axis=1), self.obsT)
+    def error_step(self, E: np.ndarray, y_defect: np.ndarray, x_defect: np.ndarray) -> np.ndarray:
+        """The error's e⁺ (discrete) or ė (continuous) of every run,
+        (A − L C) e + L (y − C x − D u) − (x⁺ − A x − B u): one product with the runs as rows
+        (see :func:`obsdesign.simulate.montecarlo._mm`)."""
+        return mc._mm(np.concatenate([E, y_defect], axis=1), self.errT) - x_defect
 
 
 def _args(X: np.ndarray, a: np.ndarray, b: np.ndarray, t: float) -> np.ndarray:
@@ -93,24 +114,25 @@ def step_runs(
     :func:`obsdesign.simulate.montecarlo.study` names them) and, when ``keep``, run 0's
     (x, x̂, y) trajectories."""
     K = len(grid) - 1
-    X, XH = X0.copy(), XH0.copy()
-    E = XH - X
+    X, E = X0.copy(), XH0 - X0
+    XH = X + E
     sup_e, sq, sup_h = np.abs(E), E * E, np.abs(XH)
-    traj = [np.empty((K + 1, plant.n)), np.empty((K + 1, plant.n)), np.empty((K + 1, plant.s.p))]
+    traj = [np.empty((K + 1, plant.n)) for _ in range(3)] + [np.empty((K + 1, plant.s.p))]
     dt = float(grid[1] - grid[0]) if K else 0.0
     for k in range(K + 1):
         U, Dd, V = at(k)
         if keep:
-            traj[0][k], traj[1][k] = X[0], XH[0]
-            traj[2][k] = plant.out(X[:1], U[:1], V[:1], grid[k])[0]
+            traj[0][k], traj[1][k], traj[2][k] = X[0], XH[0], E[0]
+            traj[3][k] = plant.out(X[:1], U[:1], V[:1], grid[k])[0][0]
         if k == K:
             break
         if plant.s.discrete:
-            Y = plant.out(X, U, V, grid[k])
-            X, XH = plant.rhs(X, U, Dd, grid[k]), plant.observer(XH, U, Y)
+            _, ydef = plant.out(X, U, V, grid[k])
+            Xn, xdef = plant.rhs(X, U, Dd, grid[k])
+            X, E = Xn, plant.error_step(E, ydef, xdef)
         else:
-            X, XH = _rk4(plant, X, XH, U, Dd, V, grid[k], dt)
-        E = XH - X
+            X, E = _rk4(plant, X, E, U, Dd, V, grid[k], dt)
+        XH = X + E
         np.maximum(sup_e, np.abs(E), out=sup_e)
         sq += E * E
         np.maximum(sup_h, np.abs(XH), out=sup_h)
@@ -120,35 +142,38 @@ def step_runs(
         "sup_abs_estimate": sup_h,
         "final_error_norm": np.linalg.norm(E, axis=1),
     }
-    return m, (tuple(traj) if keep else None)
+    # run 0's (x, x̂, y, e), in the order montecarlo.study reads them
+    return m, ((traj[0], traj[1], traj[3], traj[2]) if keep else None)
 
 
 def _rk4(
     plant: Plant,
     X: np.ndarray,
-    XH: np.ndarray,
+    E: np.ndarray,
     U: np.ndarray,
     Dd: np.ndarray,
     V: np.ndarray,
     t0: float,
     dt: float,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """One sample interval of the joint ODE (plant, observer) by :data:`SUBSTEPS` RK4 steps
-    with u, d, v held."""
+    """One sample interval of the joint ODE (plant x, error e = x̂ − x; see
+    :class:`Plant`) by :data:`SUBSTEPS` RK4 steps with u, d, v held (RK4 commutes with the
+    linear change of coordinates from (x, x̂), so these are its numbers to rounding)."""
     h = dt / SUBSTEPS
 
-    def F(t: float, X: np.ndarray, XH: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        return plant.rhs(X, U, Dd, t), plant.observer(XH, U, plant.out(X, U, V, t))
+    def F(t: float, X: np.ndarray, E: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        xdot, xdef = plant.rhs(X, U, Dd, t)
+        return xdot, plant.error_step(E, plant.out(X, U, V, t)[1], xdef)
 
     for i in range(SUBSTEPS):
         t = t0 + i * h
-        k1 = F(t, X, XH)
-        k2 = F(t + h / 2, X + h / 2 * k1[0], XH + h / 2 * k1[1])
-        k3 = F(t + h / 2, X + h / 2 * k2[0], XH + h / 2 * k2[1])
-        k4 = F(t + h, X + h * k3[0], XH + h * k3[1])
+        k1 = F(t, X, E)
+        k2 = F(t + h / 2, X + h / 2 * k1[0], E + h / 2 * k1[1])
+        k3 = F(t + h / 2, X + h / 2 * k2[0], E + h / 2 * k2[1])
+        k4 = F(t + h, X + h * k3[0], E + h * k3[1])
         X = X + h / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
-        XH = XH + h / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
-    return X, XH
+        E = E + h / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
+    return X, E
 
 
 def simulate_one(spec: Spec, L: np.ndarray) -> SimResult:
@@ -165,7 +190,7 @@ def simulate_one(spec: Spec, L: np.ndarray) -> SimResult:
         Plant(spec, L), spec, grid, X0, XH0, lambda k: (pair[0][k], pair[1][k], pair[2][k]), True
     )
     assert traj is not None
-    return SimResult(grid, traj[0], traj[1], traj[2], spec.system.states)
+    return SimResult(grid, traj[0], traj[1], traj[2], spec.system.states, error=traj[3])
 
 
 def batch_stepper(spec: Spec, L: np.ndarray) -> tuple[np.ndarray, int, Any]:
