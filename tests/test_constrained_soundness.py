@@ -664,3 +664,46 @@ def test_printed_numbers_are_true(sec5) -> None:
     assert vm <= p["v_min"] and B.v_min_condition(o.cmap, P, B.qinv(P), o.X, o.eps_min, vm)
     assert _num(st["theta-covers"], "θ =") == p["theta"]
     assert st["eps-order"] == "ε_max = 140098 > ε_min = 0.01 > 0"
+
+
+@pytest.mark.parametrize("which", ["X0", "Xhat0"])
+@pytest.mark.parametrize("corner", range(4))
+def test_initial_sets_inside_X_and_Xhat(which: str, corner: int) -> None:
+    """Assumption 1 / Corollary 1: X0 ⊂ X and X̂0 ⊂ X̂, exact at every vertex. X0 = X (a box)
+    and X̂0 the square inscribed in the ellipsoid X̂ = {|x|² ≤ 2} pass (every vertex on the
+    boundary); either set grown by 10⁻³⁰ at any one corner fails, and only its claim."""
+    half = Q(1)
+    X = Box(np.array([-half, -half], dtype=object), np.array([half, half], dtype=object))
+    Xhat = Ellipsoid(qeye(2) * fmpq(1, 2), np.array([Q(0), Q(0)], dtype=object))
+    c = Claims()
+    CL._initial_sets(c, X, X, X, Xhat)
+    assert [(x.id, x.status) for x in c] == [
+        ("X0-in-X", ClaimStatus.CERTIFIED),
+        ("Xhat0-in-Xhat", ClaimStatus.CERTIFIED),
+    ]
+    lo, hi = [-half, -half], [half, half]
+    (lo if corner < 2 else hi)[corner % 2] += (-1 if corner < 2 else 1) * TINY
+    grown = Box(np.array(lo, dtype=object), np.array(hi, dtype=object))
+    c = Claims()
+    CL._initial_sets(c, grown if which == "X0" else X, X, grown if which == "Xhat0" else X, Xhat)
+    failed = [x.id for x in c if x.status == ClaimStatus.FAILED]
+    assert failed == ["X0-in-X" if which == "X0" else "Xhat0-in-Xhat"]
+    assert "is outside" in next(x.detail for x in c if x.id == failed[0])
+
+
+def test_an_initial_set_outside_X_fails_the_design() -> None:
+    """X0 = [−3, 3]² against X = [−1, 1]² (random-spec fuzzer: θ̆ was certified with every
+    trajectory from X0 starting outside X): the design's one failed claim is X0 ⊂ X."""
+    text = variant(
+        add='X0 = "X0"\nXhat0 = "Xhat0"',
+        replace=[
+            (
+                "[method]",
+                '[sets.X0]\ntype = "box"\nlower = [-3, -3]\nupper = [3, 3]\n\n'
+                '[sets.Xhat0]\ntype = "box"\nlower = [0.9, 0.9]\nupper = [1, 1]\n\n[method]',
+            )
+        ],
+    )
+    rep = _design(text)
+    assert [c.id for c in rep.claims if c.status == ClaimStatus.FAILED] == ["X0-in-X"]
+    assert rep.exit_code() == 1

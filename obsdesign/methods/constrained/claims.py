@@ -239,8 +239,35 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     )
     _theta_covers(c, "theta", theta, "v_max", v_max, v_min, gamma, eps_min, "eq. (22)")
     if o.X0 is not None and o.Xhat0 is not None:
+        _initial_sets(c, o.X0, o.X, o.Xhat0, Xhat)
         _breve(c, params, o, P, rho, mu, W, v_max, v_min, gamma, eps_min)
     return c
+
+
+def _initial_sets(
+    c: Claims, X0: ConvexSet, X: ConvexSet, Xhat0: ConvexSet, Xhat: ConvexSet
+) -> None:
+    """X0 ⊂ X (Assumption 1: a trajectory from X0 stays in X, k = 0 included) and X̂0 ⊂ X̂
+    (Corollary 1: the estimate starts in X̂), constrained-redesign paper (Astolfi et al.,
+    NOLCOS 2019): the premises under which v̆_max and θ̆ of Section 4 speak about the
+    redesigned observer. Exact, at the vertices of X0 and X̂0 (X, X̂ are convex).
+
+    :param X0, X, Xhat0, Xhat: the sets of the spec (X̂ as the design uses it)."""
+    for cid, inner, outer, names, ref in (
+        ("X0-in-X", X0, X, ("X0", "X"), "Assumption 1"),
+        ("Xhat0-in-Xhat", Xhat0, Xhat, ("X̂0", "X̂"), "Corollary 1"),
+    ):
+        out = next((v for v in inner.vertices_q() if not contains_q(outer, v)), None)
+        pt = "" if out is None else "(" + ", ".join(fmt_exact(Q(v)) for v in out) + ")"
+        where = f"vertex {pt} of {names[0]} is outside {names[1]}" if pt else ""
+        c.exact(
+            id=cid,
+            statement=f"{names[0]} ⊂ {names[1]}",
+            reference=_ref(ref),
+            check=f"exact: every vertex of {names[0]} lies in {names[1]}",
+            passed=out is None,
+            detail=where or f"every vertex of {names[0]} is in {names[1]}",
+        )
 
 
 def _breve(
