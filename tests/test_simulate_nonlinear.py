@@ -155,17 +155,22 @@ def test_simulate_runs_through_the_api_uses_the_expressions(write_spec):
     assert one.extra["per_run"]["final_error_norm"][0] == got[0]
 
 
+def _scalar_plant(time: str, a: float, gain: float, horizon: str):
+    """x⁺ (or ẋ) = a x + 0.1 sin(x), y = x, the observer gain ``gain``, x0 = 1, x̂0 = 2."""
+    return load_spec_text(
+        f'[system]\ntime = "{time}"\nA = [[{a}]]\nC = [[1]]\npsi = ["0.1*sin(x1)"]\n'
+        f'[method]\nkey = "lyapunov"\nL = [{gain}]\n[simulate]\nhorizon = {horizon}\n'
+        "x0 = [1]\nxhat0 = [2]\n",
+        f"{time}.toml",
+    )
+
+
 def test_an_unstable_expression_plant_keeps_its_error() -> None:
     """x⁺ = 3x + 0.1 sin(x), L = 2.5: e⁺ = 0.5e − 0.1 sin(x), so |e| ≤ 0.2 after the start,
     while x passes 10²⁸. The runs step [x; e]; from x and x̂ the error would be rounding of
     size 10¹² (found by a random-spec fuzzer on the linear path). Same in continuous time
     (ẋ = x + 0.1 sin(x), L = 3: ė = −2e − 0.1 sin(x), so |e| → ≤ 0.05), and in the batch."""
-    disc = load_spec_text(
-        '[system]\ntime = "discrete"\nA = [[3]]\nC = [[1]]\npsi = ["0.1*sin(x1)"]\n'
-        '[method]\nkey = "lyapunov"\nL = [2.5]\n[simulate]\nhorizon = 60\nx0 = [1]\n'
-        "xhat0 = [2]\n",
-        "u.toml",
-    )
+    disc = _scalar_plant("discrete", a=3, gain=2.5, horizon="60")
     r = simulate_linear_observer(disc, np.array([[2.5]]))
     x, e = [1.0], [1.0]
     for _ in range(60):  # the plant and the error's recursion written out
@@ -176,12 +181,7 @@ def test_an_unstable_expression_plant_keeps_its_error() -> None:
     assert r.metrics()["final_error_norm"] <= 0.2
     b = simulate_linear_observer_batch(disc, np.array([[2.5]]), 3)
     assert np.all(b.extra["per_run"]["final_error_norm"] <= 0.2)
-    cont = load_spec_text(
-        '[system]\ntime = "continuous"\nA = [[1]]\nC = [[1]]\npsi = ["0.1*sin(x1)"]\n'
-        '[method]\nkey = "lyapunov"\nL = [3]\n[simulate]\nhorizon = 40\ndt = 0.05\nx0 = [1]\n'
-        "xhat0 = [2]\n",
-        "c.toml",
-    )
+    cont = _scalar_plant("continuous", a=1, gain=3, horizon="40\ndt = 0.05")
     r = simulate_linear_observer(cont, np.array([[3.0]]))
     assert abs(r.x[-1, 0]) > 1e16
     late = np.abs(r.e[r.t >= 10, 0])  # e^{-20} of the start is left by t = 10
