@@ -289,7 +289,8 @@ def test_kappa_widest_positive_for_any_alpha(gamma: float, log_alpha: float, d0:
 
 
 def test_kappa_widest_with_a_huge_alpha_designs_and_verifies(tmp_path: Path) -> None:
-    """The audit's spec (α = 10¹⁶, κ = "widest"): exit 0, every claim certified, verify agrees;
+    """The audit's spec (α = 10¹⁶, κ = "widest"): exit 0, every claim certified (B: numerical),
+    verify agrees;
     κ = 0 or negative put into the report fails verify (exit 1), no internal error."""
     text = (
         '[system]\ntime = "continuous"\nA = [[0, 0], [0, -3]]\nC = [[1, 0]]\n'
@@ -301,7 +302,9 @@ def test_kappa_widest_with_a_huge_alpha_designs_and_verifies(tmp_path: Path) -> 
     spec.write_text(text)
     rep = api.design(spec)
     assert rep.exit_code() == 0
-    assert all(c.status.value == "certified" for c in rep.claims)
+    status = {c.id: c.status.value for c in rep.claims}
+    assert status.pop("ball_radius") == "numerical"  # B's invariance is not proven
+    assert set(status.values()) == {"certified"}
     assert rep.parameters["kappa"] > 0
     out = tmp_path / "r.json"
     out.write_text(rep.to_json())

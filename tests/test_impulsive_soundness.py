@@ -24,8 +24,11 @@ from flint import fmpq
 from typer.testing import CliRunner
 
 from obsdesign import api
+from obsdesign.api import load_spec_text
+from obsdesign.certify.claim import Claims
 from obsdesign.certify.exact import Q, qmat
 from obsdesign.cli import app
+from obsdesign.methods.impulsive.claims import _ball
 from obsdesign.methods.impulsive.core import BlockData
 from obsdesign.methods.impulsive.dissipativity import QSR
 from obsdesign.params import Parameters
@@ -355,7 +358,38 @@ def test_claim_ids_of_the_example() -> None:
         "window",
         "ball_radius",
     ]
-    assert all(c.status.value == "certified" for c in rep.claims)
+    assert [c.status.value for c in rep.claims] == ["certified"] * 14 + ["numerical"]
+
+
+def test_ball_invariance_is_never_certified_and_fails_when_a_jump_leaves_B() -> None:
+    """B = {‖ε‖ ≤ r_B} rests on the paper's jump bound (24b), which (13b) does not give, so the
+    claim is numerical at best. r_B < w̄: from ε = r_B e_i a jump with w = w̄ e_i gives
+    ‖ε⁺‖ = (1 − L_i) r_B + L_i w̄ > r_B, so B is not invariant and the claim fails — at the
+    smallest false margin (r_B = w̄ − 10⁻³⁰ with α w̄ ≤ r_B²); r_B = w̄ is numerical. The
+    random-spec fuzzer's case (α = 1.5, w̄ = 2, L = 0.99: the error peaks at 1.99 > r_B = 1.73)
+    fails through the design, and verify agrees."""
+    w = fmpq(2)
+    for rad, alpha, status in (
+        (w, fmpq(2), "numerical"),
+        (w - TINY, (w - TINY) ** 2 / w, "failed"),
+        (w - TINY, fmpq(3, 2), "failed"),
+        (w + TINY, fmpq(2), "numerical"),
+    ):
+        c = Claims()
+        _ball(c, rad, alpha, w)
+        assert [(x.id, x.status.value) for x in c] == [("ball_radius", status)], (rad, alpha)
+    c = Claims()
+    _ball(c, w - TINY, fmpq(2), w)  # r_B² < α w̄: the arithmetic fails first, exactly
+    assert [x.status.value for x in c] == ["failed"] and "r_B² ≥ α w̄" in list(c)[0].check
+    text = (
+        '[system]\ntime = "continuous"\nA = [[-1, 0], [0, -2]]\nC = [[1, 0]]\n'
+        'states = ["x1", "x2"]\npsi = ["0", "0"]\n[nonlinearity.o]\nlipschitz = 0\n'
+        '[nonlinearity.n]\nlipschitz = 0\n[method]\nkey = "impulsive"\nL = [0.99]\n'
+        'alpha = 1.5\nnoise_bound = 2\nM = [[0, 1]]\nkappa = "widest"\n'
+    )
+    rep = api.design(load_spec_text(text, "ball.toml"))
+    assert [c.id for c in rep.claims if c.status.value == "failed"] == ["ball_radius"]
+    assert rep.exit_code() == 1 and api.verify(rep).exit_code() == 1
 
 
 def _with_data(spec: Spec, **kw: Any) -> Spec:

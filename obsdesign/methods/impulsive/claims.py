@@ -290,20 +290,44 @@ def certify_window(p: Problem, P: dict[str, Any], c: Claims | None = None) -> Cl
         passed=T_min < T_max,
         margin=T_max - T_min,
     )
-    rad = Q(P["ball_radius"])
-    aw = Q(p.alpha) * Q(p.w_bar)
-    c.exact(
-        id="ball_radius",
-        statement=(
-            f"radius of B: r_B ≥ √(α‖w‖∞) = √({fmt_exact(p.alpha)}·{fmt_exact(p.w_bar)}), "
-            f"r_B ≤ {fmt_up(rad)}"
-        ),
-        reference=_ref("Theorem 2"),
-        check="exact r_B ≥ 0 and r_B² ≥ α w̄",
-        passed=rad >= 0 and rad * rad >= aw,
-        margin=rad * rad - aw,
-    )
+    _ball(c, Q(P["ball_radius"]), Q(p.alpha), Q(p.w_bar))
     return c
+
+
+def _ball(c: Claims, rad: fmpq, alpha: fmpq, w_bar: fmpq) -> None:
+    """The set B of Theorem 2 (impulsive-dissipativity paper, Schaum et al., MTNS 2020):
+    B = {‖ε‖ ≤ r_B}, r_B ≥ √(α‖w‖∞), exact. Never ``certified``: the theorem rests on the
+    jump bound (24b), σ⁺ ≤ σ + γ‖w‖, which (13b), ε_o⁺ = (I − L) ε_o + L w, does not give
+    (a jump adds up to ‖L w‖², quadratic in ‖w‖; random-spec fuzzer: an error peaking at
+    1.99 against r_B = 1.73). So the claim is ``numerical`` (the formula holds, the
+    invariance is not proven) and ``failed`` when a jump provably leaves B: from
+    ε = r_B e_i (ε_n = 0, in B) with w = w̄ e_i, ‖ε⁺‖ = (1 − L_i) r_B + L_i w̄ > r_B
+    whenever r_B < w̄ (any 0 < L_i < 1; w admissible whether w̄ bounds ‖w‖₂ or ‖w‖∞)."""
+    aw = alpha * w_bar
+    statement = (
+        f"radius of B: r_B ≥ √(α‖w‖∞) = √({fmt_exact(alpha)}·{fmt_exact(w_bar)}), "
+        f"r_B ≤ {fmt_up(rad)}; B is not proven invariant (see detail)"
+    )
+    text = {"id": "ball_radius", "statement": statement, "reference": _ref("Theorem 2")}
+    if not (rad >= 0 and rad * rad >= aw):
+        c.exact(**text, check="exact r_B ≥ 0 and r_B² ≥ α w̄", passed=False, margin=rad * rad - aw)
+        return
+    escapes = rad < w_bar
+    detail = (
+        f"B is not invariant: r_B = {fmt_up(rad)} < w̄ = {fmt_exact(w_bar)}, so the jump "
+        "(13b) from ε = r_B e_i with w = w̄ e_i leaves it ((1 − L_i) r_B + L_i w̄ > r_B); "
+        "α ≥ w̄ is necessary"
+        if escapes
+        else "r_B² ≥ α w̄ holds exactly; that ε enters and stays in B rests on the paper's "
+        "jump bound (24b), which (13b) does not give (a jump adds up to ‖L w‖²): not proven"
+    )
+    c.numerical(
+        **text,
+        check="exact r_B² ≥ α w̄ and r_B ≥ w̄ (no jump provably leaves B); invariance unproven",
+        passed=not escapes,
+        margin=float(rad - w_bar),
+        detail=detail,
+    )
 
 
 def _ssd(Ablk: np.ndarray, qsr: Any, theta: fmpq, rate: fmpq, name: str) -> tuple[bool, str]:
