@@ -14,6 +14,7 @@ B = {‖ε‖ ≤ √(α‖w‖∞)} and the last time it was outside.
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 
@@ -112,6 +113,14 @@ def simulate(
     K = H.shape[1]
     Dn = spec.system.Dn.f
     W = np.stack([sim.noise.evaluate(np.arange(K, dtype=float), rng) @ Dn.T for _ in range(runs)])
+    w_max = float(np.max(np.abs(W))) if W.size else 0.0
+    w_bar = params.float("w_bar")
+    if w_max > w_bar:
+        warnings.warn(
+            f"[simulate] the noise reaches |w| = {w_max:.4g} > noise_bound = {w_bar:g} of the "
+            "design: the runs are outside the premise of Theorem 2 and the radius of B",
+            stacklevel=2,
+        )
     f = plant_field(spec)
     x0 = np.tile(sim.x0.f, (runs, 1))
     xh0 = np.tile(sim.xhat0.f, (runs, 1))
@@ -148,6 +157,7 @@ def simulate(
         "intervals_in_window": in_window,
         "interval_min_max": [float(used.min()), float(used.max())],
         "ball_radius": radius,
+        "noise_max_abs": w_max,
         "runs_ending_in_ball": int(br.entered.sum()),
         "max_settle_time": float(np.nanmax(br.settle_time)) if br.entered.any() else None,
         f"worst_eps_after_t{after:g}": float(np.nanmax(br.worst_after)),
