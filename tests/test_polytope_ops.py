@@ -224,6 +224,24 @@ def test_hull_certificate_fails_each_check():
         assert not po.exact_check_forms(Go, W)[0]
 
 
+@pytest.mark.parametrize("n", [1, 2, 3])
+def test_a_point_listed_twice_is_one_vertex_and_never_two(n):
+    """A set-invariant design rounded two float points to the same rational and reported 13
+    "vertices" of a 12-vertex polytope as certified (random-spec fuzzer); its verify failed.
+    exact_hull now keeps one copy of a repeated point, and exact_check_forms refuses a V
+    that lists a point twice (in every dimension, whatever the rows), naming it."""
+    cube = po.qarray(np.array(np.meshgrid(*[[-1, 1]] * n)).reshape(n, -1).T)
+    G, vr = po.exact_hull(cube)
+    twice = np.vstack([cube, cube[-1:], cube[:1]])
+    G2, vr2 = po.exact_hull(twice)
+    assert [tuple(r) for r in G2] == [tuple(r) for r in G]
+    assert [tuple(v) for v in vr2.V] == [tuple(v) for v in vr.V]
+    assert po.exact_check_forms(G, vr.V)[0]
+    dup = np.vstack([vr.V, vr.V[:1]])
+    ok, detail, rep = po.exact_check_forms(G, dup)
+    assert not ok and rep is None and "twice" in detail
+
+
 def _sphere4(k: int) -> np.ndarray:
     rng = np.random.default_rng(7)
     S = rng.normal(size=(k, 4))
