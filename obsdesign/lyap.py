@@ -839,7 +839,42 @@ def certified_P(
         and decay_verdict(Am, P, r, discrete, margin, memo, Pm, Af, Pq_f)[0]
     ):
         return P
+    c = margin_scale(Pf, margin)
+    if c != 1:  # the margin asks for a larger P (its decay matrix is c·I)
+        Pm, Pq_f = dyadic_fmat(Pf * float(c), bits)
+        Pm = Pm if Pm == Pm.transpose() else _sym(Pm)
+        P = as_array(Pm)
+        if (
+            pd_verdict(P, margin, memo, Pm, None)
+            and decay_verdict(Am, P, r, discrete, margin, memo, Pm, Af, None)[0]
+        ):
+            return P
     return _certified_P_hp(Am, r, discrete, margin, memo, Af, guide)
+
+
+def margin_scale(Pf: np.ndarray, margin: Any) -> fmpq:
+    """The power of two c by which the Lyapunov-equation P (decay matrix I, eq. (4)-(6) of
+    the constrained-redesign paper, Astolfi et al., NOLCOS 2019, with Q = I) is scaled so
+    that both strict checks can hold with the margin δ: c·I ⪰ 2δ·I and c·λ_min(P) ≥ 2δ
+    (float λ_min, a guide only: the exact checks decide). 1 when δ = 0 or P is not positive
+    definite in floats. Before, only c ≥ 2δ was used (in the fallback): a continuous plant
+    with λ_min(P) = ⅙ and δ = 0.4 was refused (exit 4) with a valid P = diag(½, 1) at hand
+    (random-spec fuzzer).
+
+    :param Pf: the float P; :param margin: δ."""
+    d = Q(margin)
+    c = fmpq(1)
+    if d <= 0:
+        return c
+    with np.errstate(all="ignore"):
+        try:
+            lmin = float(np.linalg.eigvalsh((Pf + Pf.T) / 2)[0])
+        except np.linalg.LinAlgError:
+            lmin = 0.0
+    need = 2 * d if not lmin > 0 else 2 * d / Q(min(1.0, lmin))
+    while c < need:
+        c *= 2
+    return c
 
 
 def _certified_P_hp(
@@ -852,9 +887,8 @@ def _certified_P_hp(
     guide: Spectrum | None = None,
 ) -> np.ndarray | None:
     """:func:`certified_P`'s fallback when the float P fails: the Lyapunov-equation P in
-    high precision (:mod:`obsdesign.lyap_hp`, n ≤ its ``MAX_N``), scaled by a power of two
-    c ≥ 2δ when the margin δ is not below ½ (its decay matrix is c·I), checked by the same
-    exact tests. Skipped for a rate the spectrum (:func:`obsdesign.spectrum.spectrum`: float
+    high precision (:mod:`obsdesign.lyap_hp`, n ≤ its ``MAX_N``), scaled by
+    :func:`margin_scale` (its decay matrix is c·I), checked by the same exact tests. Skipped for a rate the spectrum (:func:`obsdesign.spectrum.spectrum`: float
     eigenvalues when their error bound is small, else high-precision ones) puts clearly on
     the infeasible side (the exact check would refuse it: the solve would be wasted)."""
     from obsdesign import lyap_hp
@@ -874,15 +908,11 @@ def _certified_P_hp(
     bound = guide.bound(discrete)
     if (bound - rf if discrete else bound + rf) > slack:
         return None
-    d = Q(margin)
-    c = fmpq(1)
-    while c < 2 * d:
-        c *= 2
     for prec in lyap_hp.PRECISIONS:
         Pm = lyap_hp.lyapunov_P_hp(Am, r, discrete, prec)
         if Pm is None:
             continue
-        Pm = Pm * c
+        Pm = Pm * margin_scale(mat_float(Pm), margin)
         P = as_array(Pm)
         if (
             pd_verdict(P, margin, memo, Pm, None)
@@ -950,6 +980,9 @@ class _Forecast:
         gap = 1e-6
         wp = np.linalg.eigvalsh(Pf)
         wm = np.linalg.eigvalsh(M)
+        if m > 0 and (wp[0] <= m or wm[0] <= m):  # certified_P scales P for the margin
+            c = float(margin_scale(Pf, self.m))
+            wp, wm = wp * c, wm * c
         return bool(
             wp[0] - m > gap * abs(wp[-1]) and wm[0] - m > gap * max(abs(wm[-1]), abs(wm[0]), 1.0)
         )

@@ -242,6 +242,31 @@ def test_certified_P_checks_the_decay_matrix(monkeypatch: pytest.MonkeyPatch) ->
     assert check_pd(P, MARGIN)
 
 
+@pytest.mark.parametrize("margin", [fmpq(2, 5), fmpq(1), fmpq(50)])
+def test_certified_P_scales_for_a_large_margin(margin: fmpq, monkeypatch) -> None:
+    """ẋ = diag(−3, −2) x, L = 0, α = 1: the Lyapunov-equation P = diag(1/4, 1/2) has
+    λ_min = ¼ and decay matrix I, so with δ ≥ ¼ neither it nor 2δ·P passes; P scaled by
+    margin_scale (c·λ_min ≥ 2δ) does (random-spec fuzzer: exit 4 with P = diag(½, 1) valid).
+    The exact checks still decide: P − δI and the decay matrix − δI are ≻ 0, and without the
+    scaling (monkeypatched to 1) no P comes out."""
+    A, C, L = qmat([[-3, 0], [0, -2]]), qmat([[1, 1]]), qmat([[0], [0]])
+    P = certified_P(A, C, L, False, fmpq(1), margin)
+    assert P is not None
+    M = lyap.decay_matrix(A, C, L, P, fmpq(1), False)
+    assert check_pd(P, margin) and check_pd(M, margin)
+    assert not check_pd(P, 100 * margin)  # c is the least power of two: λ_min(P) < 4δ
+    monkeypatch.setattr(lyap, "margin_scale", lambda Pf, m: fmpq(1))
+    assert certified_P(A, C, L, False, fmpq(1), margin) is None
+
+
+def test_margin_scale_covers_both_matrices() -> None:
+    """c is the least power of two with c ≥ 2δ and c·λ_min(P) ≥ 2δ; δ = 0 gives 1."""
+    assert lyap.margin_scale(np.diag([0.25, 0.5]), fmpq(2, 5)) == 4
+    assert lyap.margin_scale(np.eye(2) * 10, fmpq(2, 5)) == 1
+    assert lyap.margin_scale(np.eye(2) * 10, fmpq(3)) == 8
+    assert lyap.margin_scale(np.diag([1e-3, 1.0]), 0) == 1
+
+
 @settings(max_examples=20, deadline=None)
 @given(
     st.integers(1, 4),
