@@ -788,6 +788,29 @@ def test_design_option_errors(extra: str, key: str, why: str) -> None:
     assert key in str(ei.value)
 
 
+@pytest.mark.parametrize(
+    ("time", "rate", "slow", "fast"),
+    [
+        ("discrete", "lambda = 0.5", "[0.1, -0.5]", "[0.1, -0.4999999]"),
+        ("continuous", "alpha = 2", "[-3, -2]", "[-3, -2.0000001]"),
+    ],
+)
+def test_place_poles_the_rate_excludes_are_refused(time, rate, slow, fast) -> None:
+    """A − LC placed at the given poles has them as eigenvalues, so a pole with |z| ≥ λ
+    (Re z ≥ −α) can never meet the asked rate: exit 2 naming [method.poles] (before: exit 4
+    blaming the plant's conditioning; random-spec fuzzer). The boundary pole is refused, one
+    just inside designs and certifies."""
+    from obsdesign.errors import SpecError
+
+    A = A_UO if time == "discrete" else np.array([[1.3, 0.5], [-0.3, 0.8]])
+    extra = f'design = "place"\n{rate}\npoles = '
+    with pytest.raises(SpecError, match=r"\[method\.poles\] pole .* cannot meet") as ei:
+        load_spec_text(_designed(A, C_UO, time, extra + slow + "\n"))
+    assert ei.value.exit_code == 2
+    rep = api.design(load_spec_text(_designed(A, C_UO, time, extra + fast + "\n")))
+    assert rep.exit_code() == 0
+
+
 def test_riccati_weights_change_the_gain() -> None:
     base = api.design(load_spec_text(_designed(A_UO, C_UO)))
     heavy = api.design(load_spec_text(_designed(A_UO, C_UO, extra="riccati_R = [[100]]\n")))

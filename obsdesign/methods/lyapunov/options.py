@@ -41,6 +41,26 @@ class Options:
 DESIGNS = ("riccati", "place", "lmi")
 
 
+def _poles_meet_the_rate(table: Any, poles: Any, rate: Any, discrete: bool) -> None:
+    """Refuse poles that the asked rate excludes: the placed A − LC has them as eigenvalues,
+    and a rate λ (α) needs every eigenvalue with |z| < λ (Re z < −α), Section 5 of the
+    constrained-redesign paper (Astolfi et al., NOLCOS 2019). Before, the design ran and
+    blamed the plant's conditioning (exit 4; random-spec fuzzer)."""
+    key = "lambda" if discrete else "alpha"
+    slow = [z for z in poles if (abs(z) >= rate if discrete else z >= -rate)]
+    if slow:
+        need = (
+            f"|pole| < {key} = {float(rate):g}"
+            if discrete
+            else f"poles < −{key} = {-float(rate):g}"
+        )
+        raise table.error(
+            "poles",
+            f"pole {float(slow[0]):g} cannot meet {key} = {float(rate):g} (A − LC has it as an "
+            f"eigenvalue; {need} are needed): give faster poles or a smaller {key}",
+        )
+
+
 def parse_options(table: Table, spec: Spec) -> Options:
     """:class:`Options` from ``[method]``; λ in (0, 1) is discrete-only, α > 0
     continuous-only (the other one is an error naming the key).
@@ -86,6 +106,8 @@ def parse_options(table: Table, spec: Spec) -> Options:
             raise table.error("poles", "expected poles of modulus < 1 in discrete time")
         if not s.discrete and any(z >= 0 for z in poles):
             raise table.error("poles", "expected negative poles in continuous time")
+        if rate is not None:
+            _poles_meet_the_rate(table, poles, rate.q, s.discrete)
     table.done()
     return Options(
         L,
