@@ -337,22 +337,33 @@ def test_an_unobservable_oscillator_is_refused_before_any_lmi(
 
 
 @pytest.mark.parametrize(
-    "a, bound, says", [(2.6, 10**6, "does not suffice"), (2.4, 1, "raise gain_bound")]
+    "a, bound, lam, says",
+    [
+        (2.6, 10**6, None, "does not suffice"),
+        (2.4, 1, None, "raise gain_bound"),
+        (2.6, 10**6, 0.99, "does not suffice"),  # given λ: no λ < 1 helps either
+        ("[[1, 1], [0, 1]]", 100, 0.1, r"try a larger λ \(closer to 1\)"),
+    ],
 )
 def test_discrete_infeasible_says_whether_a_bound_is_the_cause(
-    a: float, bound: int, says: str
+    a: float | str, bound: int, lam: float | None, says: str
 ) -> None:
     """A = a, C = 1 (detectable): at a = 2.6 LMIs (7)-(9) have no solution whatever the gain
-    bound, and the message says detectability does not suffice in discrete time (it said
-    'raise gain_bound (now 1e+06)'); at a = 2.4 they are feasible without the bound, so a
-    tight bound is named."""
+    bound or λ, and the message says detectability does not suffice in discrete time (it said
+    'raise gain_bound (now 1e+06)', and with λ given 'try a smaller λ'); at a = 2.4 they are
+    feasible without the bound, so a tight bound is named; a given λ too small asks for a
+    larger one (the double integrator with ‖K‖ ≤ 100 at λ = 0.1; (7) weakens as λ → 1 and
+    the hint said "smaller": random-spec fuzzer)."""
+    A, C = (a, "[[1, 0]]") if isinstance(a, str) else (f"[[{a}]]", "[[1]]")
     text = (
-        f'[system]\ntime = "discrete"\nA = [[{a}]]\nC = [[1]]\n'
+        f'[system]\ntime = "discrete"\nA = {A}\nC = {C}\n'
         f'[method]\nkey = "stubborn"\ngain_bound = {bound}\n'
+        + (f"lambda = {lam}\n" if lam is not None else "")
     )
     with pytest.raises(InfeasibleError, match=says) as ei:
         api.design(api.load_spec_text(text, "s.toml"))
     assert ("does not suffice" in ei.value.message) == (a == 2.6)
+    assert "smaller λ" not in ei.value.message
 
 
 @pytest.mark.parametrize(
@@ -621,3 +632,38 @@ def test_a_step_too_large_for_heun_is_warned() -> None:
         assert bool(hit) is warned, notes
         if warned:
             assert "use dt ≤ 0.0002" in hit[0]
+
+
+#: discrete, K given, l2 at λ = λ_max (fraction 1): Clarabel fails the l2 step there
+L2_AT_MAX = (
+    '[system]\ntime = "discrete"\nA = [[0.2, -0.2], [-1, -0.7]]\nC = [[-1.4, 1]]\n'
+    'Bd = [[0.9], [0.1]]\n[method]\nkey = "stubborn"\nK = [[-0.18], [-0.63]]\n'
+    'lambda_fraction = 1.0\ncriterion = "l2"\n'
+)
+
+
+def test_l2_step_failing_falls_back_on_a_certified_bound() -> None:
+    """The l2 step fails at λ_max (the solver gives up at the feasibility boundary): the
+    design used to end in exit 4 although a certified point exists (random-spec fuzzer). Now
+    the feasibility point, scaled by a power of two (the LMIs are homogeneous), carries a
+    certified L2-gain bound γ² (not minimized: said in the notes). The bound is a true one:
+    at least the H∞ norm² of e⁺ = (A − KC)e + B_d d (5.479 on a 20,001-point grid), and the
+    same γ² 10 % lower fails the exact l2 check."""
+    from obsdesign.api import load_spec_text
+
+    rep = api.design(load_spec_text(L2_AT_MAX, "l2max.toml"))
+    assert rep.exit_code() == 0
+    assert any("γ² is a certified bound" in n for n in rep.notes)
+    assert {c.id: c.status for c in rep.claims}["l2-gain"] == ClaimStatus.CERTIFIED
+    g2 = float(rep.parameters["gamma2"])
+    A = np.array([[0.2, -0.2], [-1, -0.7]])
+    Acl = A - np.array([[-0.18], [-0.63]]) @ np.array([[-1.4, 1]])
+    h = max(
+        np.linalg.norm(np.linalg.solve(np.exp(1j * w) * np.eye(2) - Acl, [[0.9], [0.1]]), 2)
+        for w in np.linspace(0, np.pi, 20001)
+    )
+    assert g2 >= h * h
+    assert api.verify(rep).exit_code() == 0
+    d = rep.to_dict()
+    _set(d, "gamma2", _get(d, "gamma2") * fmpq(9, 10))
+    assert "l2-gain" in _failed(d)

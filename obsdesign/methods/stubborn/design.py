@@ -292,15 +292,21 @@ def design_params(
     if progress:
         progress(f"criterion '{o.criterion}' at λ = {float(lam_q):.6g}")
     cand, margin, solver = _certify_point(spec, pl, o, lam_q, o.criterion)
-    if cand is None and o.criterion != "l2":
+    if cand is None:
         # the criterion step did not give a certifiable optimum: fall back on the certified
-        # feasibility point at the same λ (the criterion is then not optimized; said in notes)
+        # feasibility point at the same λ (the criterion is then not optimized; said in notes);
+        # for l2, with a certified L2-gain bound of that point (_l2_bound)
         why = solver
         cand, margin, solver = _certify_point(spec, pl, o, lam_q, None)
+        if cand is not None and o.criterion == "l2":
+            cand = _l2_bound(spec, cand)
+            solver = solver if cand is not None else "no certified L2-gain bound at the point"
         if cand is not None:
             notes.append(
                 f"criterion '{o.criterion}' step not certified ({why}): the reported point is "
-                "the certified feasibility solution at this λ (criterion not optimized)"
+                "the certified feasibility solution at this λ (criterion not optimized"
+                + ("; γ² is a certified bound for it, scaled" if o.criterion == "l2" else "")
+                + ")"
             )
     if cand is None:
         raise InconclusiveError(
@@ -369,6 +375,65 @@ def _certify_point(
     return None, margin, last
 
 
+def _l2_bound(spec: Spec, cand: dict[str, Any]) -> dict[str, Any] | None:
+    """A certified L2-gain bound γ² for a certified point of LMIs (1)-(3) / (7)-(9) (slides,
+    criterion 4, bounded real lemma :func:`~obsdesign.methods.stubborn.lmis.l2_gain`), when
+    the l2 criterion step itself fails (Clarabel inaccurate at λ near λ_max: exit 4 before;
+    random-spec fuzzer). The LMIs are homogeneous in (P, X, U, W, Y, R), so the point scaled
+    by a power of two s ≥ 1 still passes them exactly (same K); the bounded real lemma's
+    constant I then weighs less: with N₀ = He(G) (continuous) or [[−P, Gᵀ], [G, −P]]
+    (discrete), ≺ 0 by LMI (2) / (8), N(s) = s N₀ + diag(I, 0) ≺ 0 once s λ_min(−N₀) > 1,
+    and the Schur complement gives γ² > λ_max(bᵀ(−N(s))⁻¹b), b = s[P B_d] (continuous) or
+    s[0; P B_d] (discrete). The s with the least float γ² is tried first; the exact check
+    (:func:`~obsdesign.methods.stubborn.claims.point_failures`) decides. None when no
+    scaling certifies (or R ⪯ r_bound·I would be lost)."""
+    o: Options = spec.options
+    sy = spec.system
+    A, C, Bd = (np.asarray(to_float(M), float) for M in (sy.A.q, sy.C.q, sy.Bd.q))
+    P0 = np.asarray(to_float(cand["P"]), float)
+    K = np.asarray(to_float(cand["K"]), float)
+    n, k = P0.shape[0], Bd.shape[1]
+    G0 = P0 @ A - P0 @ K @ C
+    if sy.discrete:
+        N0 = np.block([[-P0, G0.T], [G0, -P0]])
+        E = np.diag([1.0] * n + [0.0] * n)
+        b0 = np.vstack([np.zeros((n, k)), P0 @ Bd])
+    else:
+        N0, E, b0 = G0 + G0.T, np.eye(n), P0 @ Bd
+    with np.errstate(all="ignore"):
+        try:
+            mu = float(np.linalg.eigvalsh(-(N0 + N0.T) / 2)[0])
+        except np.linalg.LinAlgError:
+            return None
+    if not mu > 0 or not np.isfinite(mu):
+        return None
+    k0 = max(0, int(np.ceil(np.log2(2 / mu))))
+    trials = []
+    for j in range(k0, k0 + 12):
+        sc = 2.0**j
+        with np.errstate(all="ignore"):
+            try:
+                g = float(
+                    np.linalg.eigvalsh(sc * sc * b0.T @ np.linalg.solve(-(sc * N0 + E), b0))[-1]
+                )
+            except np.linalg.LinAlgError:
+                continue
+        if np.isfinite(g) and g >= 0:
+            trials.append((g, j))
+    for g, j in sorted(trials)[:4]:
+        sc = fmpq(2**j)
+        out = dict(cand)
+        for key in ("P", "U", "W", "Y", "R"):
+            out[key] = np.asarray(cand[key], dtype=object) * sc
+        out["X"] = out["P"] @ out["K"]
+        if o.r_bound is not None and sc != 1 and _claims.point_failures(spec, out, False):
+            return None  # R ⪯ r_bound·I lost by the scaling
+        out["gamma2"] = dyadic(g * (1 + 1e-6) + 1e-12, BITS)
+        if not _claims.point_failures(spec, out, True):
+            return out
+    return None
+
+
 def _snap(M: Any) -> np.ndarray:
     """Entries below 10⁻¹² of the largest set to 0 (solver noise; the exact check decides)."""
     a = np.array(M, dtype=float)
@@ -435,15 +500,21 @@ def _infeasible(spec: Spec, pl: Plant, o: Options, where: str) -> None:
             for k, v in (("gain_bound", o.gain_bound), ("r_bound", o.r_bound))
             if v is not None
         )
-        first = "try a smaller λ or raise " if o.lam is not None else "(C, A) is detectable: raise "
-        why = first + bounds
-        if det.verdict is True and pl.discrete and bounds and o.lam is None:
+        # λ: the decay asked of V, λ·V in (1) (larger is harder) but λ·P in (7), where a
+        # λ closer to 1 is weaker (random-spec fuzzer: the discrete hint said "smaller")
+        lam_hint = ""
+        if o.lam is not None:
+            lam_hint = "a larger λ (closer to 1)" if pl.discrete else "a smaller λ"
+        hints = [h for h in (lam_hint and f"try {lam_hint}", bounds and f"raise {bounds}") if h]
+        why = "(C, A) is detectable: " + (" or ".join(hints) or "no bound or λ to relax")
+        if det.verdict is True and pl.discrete:
             free = replace(o, gain_bound=None, r_bound=None)
             if not feasible(pl, free, 1 - 1e-6)[0]:
+                without = f" even without {bounds} and at any λ < 1" if bounds else " at any λ < 1"
                 why = (
-                    f"(C, A) is detectable, but the LMIs are infeasible even without {bounds}: "
-                    "in discrete time detectability does not suffice (the sector conditions of "
-                    "the saturation, (8)-(9), also limit how unstable A may be; e.g. A = 2.6, "
+                    f"(C, A) is detectable, but the LMIs are infeasible{without}: in discrete "
+                    "time detectability does not suffice (the sector conditions of the "
+                    "saturation, (8)-(9), also limit how unstable A may be; e.g. A = 2.6, "
                     "C = 1 has no solution): a faster sampling (A closer to I) or the "
                     "continuous-time model may help"
                 )
