@@ -137,9 +137,13 @@ def test_falsification_samples_capped() -> None:
 
 
 def test_empty_window_is_infeasible() -> None:
-    """α just above γ makes T_min huge: T_min ≥ T_max is reported (exit 1)."""
-    with pytest.raises(InfeasibleError, match="empty window"):
+    """α just above γ makes T_min huge: T_min ≥ T_max is reported (exit 1), with advice that
+    holds: a larger α lowers T_min (it said "a smaller γ (L closer to I)", but γ = min L_ii
+    grows as L approaches I: random-spec fuzzer)."""
+    with pytest.raises(InfeasibleError, match="empty window") as ei:
         api.design(load_spec_text_ex(alpha="0.8001"))
+    assert "a larger α lowers T_min" in ei.value.message
+    assert "L closer to I" not in ei.value.message
 
 
 def test_given_kappa_outside_22() -> None:

@@ -258,8 +258,9 @@ def design_window(p: Problem) -> tuple[dict[str, Any], list[str]]:
     if not T_min_r < T_max_r:
         raise Infeasible(
             f"empty window: T_min = {float(T_min):.6g} ≥ T_max = {float(T_max):.6g} "
-            f"(κ = {float(kappa):.6g}); a larger α, a smaller γ (L closer to I) or another κ/M "
-            "may help"
+            f"(κ = {float(kappa):.6g}); a larger α lowers T_min (26c); another L changes "
+            "both ends (γ = min L_ii raises T_min and the numerator of (26b), β = 1/(1 − γ)² "
+            "its denominator), another κ or M may help"
         )
     params: dict[str, Any] = {
         "T": co.T,
