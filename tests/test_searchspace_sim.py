@@ -191,6 +191,50 @@ xhat0 = [0]
     assert "L_h" not in ei.value.message and "Lemma 2" not in ei.value.message
 
 
+def test_input_leaving_U_and_a_run_past_the_horizon_are_said(tmp_path):
+    """u = t with U = [0, 1/8] and [method] horizon = 1/8, simulated to t = 2: the design
+    certifies (u stays in U over its horizon); the run leaves U at the first midpoint past
+    1/8 and runs past the horizon, and simulate says both (random-spec fuzzer: a true-cell
+    distance 2.9× the bound ε e^(L_f t) with exit 0 and no word). Within the horizon: no
+    warning."""
+    text = """[system]
+time = "continuous"
+states = ["x1"]
+f = ["u1*x1"]
+h = ["x1^3"]
+u = ["t"]
+[method]
+key = "search-space"
+alpha = 0.9
+gamma_star = 0.1
+gamma0 = 0.2
+horizon = 0.125
+[method.E]
+lower = [-3]
+upper = [3]
+[method.D]
+lower = [-0.5]
+upper = [0.5]
+[method.U]
+lower = [0]
+upper = [0.125]
+[simulate]
+horizon = 2
+x0 = [0.2]
+xhat0 = [0]
+"""
+    sp, rep = _load(text, tmp_path)
+    assert rep.exit_code() == 0
+    res = api.simulate(sp, rep)
+    said = " ".join(res.info.get("warnings", []))
+    assert "leaves the input range U" in said and "beyond [method] horizon = 0.125" in said
+    assert 0.125 < res.info["left_U_at"] < 0.13 and res.info["past_horizon"] == 0.125
+    sp2, rep2 = _load(text.replace("horizon = 2\n", "horizon = 0.125\n"), tmp_path)
+    res = api.simulate(sp2, rep2)
+    assert not res.info.get("warnings")
+    assert "left_U_at" not in res.info and "past_horizon" not in res.info
+
+
 def test_recover_covers_every_ball_point():
     """Sound re-covering: every point within η of a centre lies in a returned cell."""
     rng = np.random.default_rng(1)

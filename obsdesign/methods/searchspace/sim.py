@@ -32,6 +32,7 @@ from __future__ import annotations
 import itertools
 import math
 import time
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -305,6 +306,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
     steps = 0
     flow_err = 0.0
     left_E: float | None = None
+    left_U = _left_U(plant, o, t0, dT, N)
     t_start = time.perf_counter()
     deadline = t_start + so.time_limit
     if not len(C):
@@ -326,7 +328,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
                     x[0],
                     o,
                     f"discarding at t = {t:.6g} (γ = {gam[min(i, len(gam) - 1)]:.6g})",
-                    (C, eps[min(i, len(eps) - 1)], L_f, t - tau, left_E, flow_err),
+                    (C, eps[min(i, len(eps) - 1)], L_f, t - tau, left_E, flow_err, left_U),
                 )
             )
         C = C[keep]
@@ -357,7 +359,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
                         x[0],
                         o,
                         f"the refinement at τ = {t:.6g}",
-                        (survivors, e_old, L_f, since, left_E, flow_err),
+                        (survivors, e_old, L_f, since, left_E, flow_err, left_U),
                     )
                 )
             if so.substeps == 0:
@@ -374,7 +376,49 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
     secs = time.perf_counter() - t_start
     if bar is not None:
         bar(None, 0)
-    return _result(spec, run, params, steps, secs, nsub, flow_err, left_E, so)
+    res = _result(spec, run, params, steps, secs, nsub, flow_err, left_E, so)
+    _outside_the_design(res, o, t0, N * dT, left_U)
+    return res
+
+
+def _left_U(plant: Plant, o: Options, t0: float, dT: float, N: int) -> float | None:
+    """The first sample time or midpoint t0 + j·dT/2 where u(t) leaves the input range U of
+    the design (None: never, or no U). Outside U, L_f and the bound of f are not constants of
+    the plant along the run (random-spec fuzzer: u = t run past U gave a true-cell distance
+    2.9× the bound ε e^(L_f t) with no word of why)."""
+    if o.U is None or not plant.inputs:
+        return None
+    lo, hi = np.asarray(o.U.lower, dtype=float), np.asarray(o.U.upper, dtype=float)
+    for j in range(2 * N + 1):
+        t = t0 + j * dT / 2
+        u = np.array([plant.u(t)[name] for name in plant.inputs])
+        if np.any(u < lo) or np.any(u > hi):
+            return t
+    return None
+
+
+def _outside_the_design(
+    res: SimResult, o: Options, t0: float, span: float, left_U: float | None
+) -> None:
+    """Warn (and record in ``info``) when the run leaves what the design certified: u left U
+    (``left_U_at``), or the run goes past ``[method] horizon`` (``past_horizon``), where the
+    input range was checked (search-space paper, Hernández & García, Lemmas 1-2 hold for
+    the constants on E × U)."""
+    if left_U is not None:
+        res.info["left_U_at"] = left_U
+        warnings.warn(
+            f"[simulate] u(t) leaves the input range U = {o.U.describe() if o.U else ''} at "
+            f"t = {left_U:.6g}: L_f and the bound of f are not certified there, so neither "
+            "are the observer's bounds",
+            stacklevel=3,
+        )
+    if o.horizon is not None and span > float(o.horizon) * (1 + 1e-12):
+        res.info["past_horizon"] = float(o.horizon)
+        warnings.warn(
+            f"[simulate] the run covers {span:.6g} s past t0, beyond [method] horizon = "
+            f"{float(o.horizon):g}, over which the design checked the input range",
+            stacklevel=3,
+        )
 
 
 def _consistent(plant: Plant, C: np.ndarray, y: np.ndarray, r: float) -> np.ndarray:
@@ -441,7 +485,12 @@ def _diagnose(run: Run, x: np.ndarray, o: Options, where: str, ctx: Any) -> str:
     if not np.all(o.D.contains(x0)):
         msg.append(f"x0 = {np.round(x0, 6).tolist()} is not in D = {o.D.describe()}.")
     if ctx is not None:
-        C, eps, L_f, since, left_E, flow_err = ctx
+        C, eps, L_f, since, left_E, flow_err, left_U = ctx
+        if left_U is not None and (not run.t or left_U <= run.t[-1] + 1e-12):
+            msg.append(
+                f"The input left U at t = {left_U:.6g}: the constants on E × U do not apply."
+            )
+            return " ".join(msg)
         if left_E is not None:
             msg.append(
                 f"The true state left E at t = {left_E:.6g}: the constants on E do not apply."
