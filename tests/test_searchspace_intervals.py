@@ -159,6 +159,30 @@ def test_range_inside_exact_constants_and_proved_violations(
     assert (got[0], got[3]) == (ok, out)
 
 
+@pytest.mark.parametrize(
+    "t0,t1,lo,hi,ok",
+    [
+        ("0", "1/10", "0", "1/10", True),  # u = t reaches U's end exactly at t = 1/10
+        ("1/10", "3/10", "1/10", "3/10", True),  # both ends decimal: both attained
+        ("0", "1/10", "0", "1/10 - 1/10**20", False),  # the smallest false margin
+        ("1/10", "3/10", "1/10 + 1/10**20", "3/10", False),
+    ],
+)
+def test_range_inside_uses_the_exact_ends_of_the_horizon(t0, t1, lo, hi, ok) -> None:
+    """u = t over [t0, t1] against U = [lo, hi]: the outermost sub-intervals end at the exact
+    t0, t1, not at their outward float enclosures (float(1/10) > 1/10 left U by 5.6e-18: the
+    input-range claim was inconclusive, exit 4; random-spec fuzzer). Any U smaller by 10⁻²⁰
+    is not proved."""
+    import sympy
+
+    def q(x: str) -> fmpq:
+        r = sympy.Rational(sympy.sympify(x))
+        return fmpq(int(r.p), int(r.q))
+
+    got = B.range_inside([parse_expr("t", ["t"])], "t", q(t0), q(t1), [q(lo)], [q(hi)], 256)
+    assert got[0] == ok
+
+
 @given(st.integers(-(10**6), 10**6), st.integers(-(10**6), 10**6), st.integers(-(10**6), 10**6))
 def test_constant_input_proved_iff_inside(c: int, a: int, b: int) -> None:
     """u = c/1000 (a decimal literal) against U = [a/1000, b/1000]: proved inside iff

@@ -317,8 +317,8 @@ def range_inside(
     (proved inside, largest excess of an enclosure beyond the bounds (0 when proved),
     sub-intervals used, proved outside: some enclosure, of a sub-interval or of a constant,
     lies wholly beyond a bound)."""
-    LO = [Fraction(int(q.p), int(q.q)) for q in lo]
-    HI = [Fraction(int(q.p), int(q.q)) for q in hi]
+    LO = [_frac(q) for q in lo]
+    HI = [_frac(q) for q in hi]
     live = []
     outside = False
     for i, ex in enumerate(exprs):
@@ -349,7 +349,7 @@ def range_inside(
                 return math.inf, False
             lo_k, hi_k = Fraction(d.v.lo), Fraction(d.v.hi)
             if lo_k < a or hi_k > z:  # not proved in floats: the exact-end-point enclosure
-                q = _enclose_q(exprs[k], var, b, qparams[k])
+                q = _enclose_q(exprs[k], var, b, qparams[k], ends)
                 if q is not None:
                     lo_k, hi_k = max(lo_k, q.lo), min(hi_k, q.hi)
             below = a - lo_k
@@ -361,6 +361,10 @@ def range_inside(
         return worst, out
 
     stack = [_box([t_lo], [t_hi])]
+    # the outermost sub-interval ends are the exact t_lo, t_hi, not their outward float
+    # enclosures (u = t, U = [0, 1/10], horizon 1/10: the float end 0.1 + 5.6e-18 left U and
+    # the claim was inconclusive, exit 4; random-spec fuzzer)
+    ends = (stack[0][0].lo, _frac(t_lo), stack[0][0].hi, _frac(t_hi))
     used = 0
     worst_left = 0.0
     while stack:
@@ -388,14 +392,31 @@ def _exact_params(ex: Expr) -> dict[str, QI]:
     }
 
 
-def _enclose_q(ex: Expr, var: str, b: Box, params: dict[str, QI]) -> QI | None:
+def _frac(q: Any) -> Fraction:
+    """An exact rational (fmpq, Fraction or int) as a Fraction."""
+    if isinstance(q, (Fraction, int)):
+        return Fraction(q)
+    return Fraction(int(q.p), int(q.q))
+
+
+def _enclose_q(
+    ex: Expr,
+    var: str,
+    b: Box,
+    params: dict[str, QI],
+    ends: tuple[float, Fraction, float, Fraction] | None = None,
+) -> QI | None:
     """The exact-end-point enclosure of ``ex`` over the one-variable box b
     (:func:`~obsdesign.methods.searchspace.qintervals.evaluate_q`) with the parameters
-    ``params`` (:func:`_exact_params`), or None when it finds no finite one."""
+    ``params`` (:func:`_exact_params`), or None when it finds no finite one. ``ends`` =
+    (float lo, exact lo, float hi, exact hi) of the whole interval: an end of b at a float
+    end is replaced by the exact one (the float ends enclose the exact ones outwards)."""
+    t = QI.of_float(b[0])
+    if ends is not None:
+        f_lo, q_lo, f_hi, q_hi = ends
+        t = QI(q_lo if b[0].lo == f_lo else t.lo, q_hi if b[0].hi == f_hi else t.hi)
     try:
-        return evaluate_q(
-            ex.tree, {var: QI.of_float(b[0])}, params, ex.source.strip().replace("^", "**")
-        )
+        return evaluate_q(ex.tree, {var: t}, params, ex.source.strip().replace("^", "**"))
     except (ArithmeticError, ValueError, KeyError):
         return None
 
