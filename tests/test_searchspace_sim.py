@@ -269,3 +269,52 @@ def test_consistency_lost_names_L_h(tmp_path):
     assert {c.id for c in rep.failed} == {"L_h-bound"}
     with pytest.raises(ConsistencyLost, match="L_h is not a Lipschitz constant of h"):
         api.simulate(sp, rep)
+
+
+_TRIVIAL = """[system]
+time = "continuous"
+states = ["x1"]
+f = ["F"]
+h = ["H"]
+[method]
+key = "search-space"
+alpha = 0.9
+gamma_star = 0.1
+gamma0 = 0.2
+[method.E]
+lower = [-2]
+upper = [2]
+[method.D]
+lower = [-0.5]
+upper = [0.5]
+[simulate]
+horizon = 2
+x0 = [0.2]
+xhat0 = [0]
+"""
+
+
+@pytest.mark.parametrize("h", ["1", "0*x1"])
+def test_a_constant_output_is_refused_as_unobservable(h, tmp_path):
+    """h constant on E (L_h^E = 0): the output says nothing about x. It used to be floored at
+    10⁻⁶ silently, giving ΔT = 18000 and failed claims advising "decrease α or γ⋆"
+    (random-spec fuzzer); now exit 1 saying why."""
+    from obsdesign.errors import InfeasibleError
+
+    p = tmp_path / "s.toml"
+    p.write_text(_TRIVIAL.replace("F", "-x1").replace("H", h), encoding="utf-8")
+    with pytest.raises(InfeasibleError, match="h is constant on E") as ei:
+        api.design(api.load_spec(p))
+    assert ei.value.exit_code == 1
+
+
+def test_zero_dynamics_floor_is_said_and_a_run_without_samples_warns(tmp_path):
+    """f ≡ 0: L_f = ‖f_u‖ = 0 on E, floored at 10⁻⁶ (a true upper bound; Theorem 1's rules
+    divide by them), which the notes now say; ΔT then exceeds the 2 s horizon, and simulate
+    warns that the observer takes no sample (it ran 0 samples silently)."""
+    sp, rep = _load(_TRIVIAL.replace("F", "0").replace("H", "x1"), tmp_path)
+    assert rep.exit_code() == 0
+    said = " ".join(rep.notes)
+    assert "L_f: interval bound 0" in said and "the bound is 0, so 0.000001" in said
+    res = api.simulate(sp, rep)
+    assert any("takes no sample" in w for w in res.info.get("warnings", []))

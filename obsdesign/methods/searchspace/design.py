@@ -24,7 +24,7 @@ from mpmath import iv
 
 from obsdesign.certify import interval as ivq
 from obsdesign.certify.exact import Q
-from obsdesign.certify.printing import fmt_up
+from obsdesign.certify.printing import fmt_exact, fmt_up
 from obsdesign.errors import InfeasibleError
 from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
 from obsdesign.methods.searchspace import bounds
@@ -116,7 +116,14 @@ def constants(spec: Spec) -> Constants:
                     + f"; give [method].{k} to use your own value"
                 )
             vals[k] = round_up_q(b.upper, o.digits)
-            if vals[k] == 0:
+            if vals[k] == 0 and k == "L_h":
+                # h constant on E: y tells nothing about x (random-spec fuzzer: the floor below
+                # gave ΔT = 18000 and failed claims with "decrease α or γ⋆")
+                raise InfeasibleError(
+                    "L_h^E = 0: h is constant on E, so the output carries no information about "
+                    "x and nothing can be observed (Theorem 1 needs γ-observability)"
+                )
+            if vals[k] == 0:  # f ≡ 0 on E: any positive value is a true upper bound
                 vals[k] = fmpq(1, 10**o.digits)
     return Constants(vals["L_f"], vals["L_h"], vals["f_sup"], bs["L_f"], bs["L_h"], bs["f_sup"])
 
@@ -248,6 +255,12 @@ def design_params(spec: Spec) -> tuple[dict[str, Any], list[str]]:
                 f"{k}: {'given ' + str(getattr(o, k)) + '; ' if given else ''}interval bound "
                 f"{fmt_up(b.upper, 6) if b.finite else '∞'} on {b.boxes} sub-boxes, sampled lower "
                 f"estimate {b.lower_est:.6g} (bound/estimate {t:.4g})"
+                + (
+                    f"; the bound is 0, so {fmt_exact(getattr(c, k))} (10^-digits) is used: "
+                    "the rules of Theorem 1 divide by it"
+                    if not given and b.finite and b.upper == 0
+                    else ""
+                )
             )
     n_sw = len(vals["gamma_schedule"]) - 1
     notes.append(

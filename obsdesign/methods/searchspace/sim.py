@@ -285,6 +285,12 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
     L_f, L_h = params.float("L_f"), params.float("L_h")
     t0 = float(o.t0)
     N = int(math.floor(float(spec.simulate.horizon.f) / dT + 1e-9))
+    if N == 0:
+        warnings.warn(
+            f"[simulate] horizon = {float(spec.simulate.horizon.f):g} is shorter than one "
+            f"sampling period ΔT = {dT:.6g}: the observer takes no sample",
+            stacklevel=2,
+        )
     x0 = np.asarray(spec.simulate.x0.f, dtype=float).reshape(1, n)
     E_lo, E_hi = o.E.lower, o.E.upper
     nsub = so.substeps or 1
