@@ -166,8 +166,13 @@ def test_tamper_f_sup(example, tmp_path):
 
 
 def test_tamper_kappa(example, tmp_path):
+    """κ = 2 = 2L_h, the open interval's end: failed, and the detail names the end point (it
+    read "κ leaves (L_h, 2L_h) by 0")."""
     sp, rep = example
-    assert _failed(_report_with(rep, _consistent(sp, kappa=fmpq(2)), tmp_path)) == {"kappa-range"}
+    path = _report_with(rep, _consistent(sp, kappa=fmpq(2)), tmp_path)
+    assert _failed(path) == {"kappa-range"}
+    detail = next(c.detail for c in api.verify(path).failed if c.id == "kappa-range")
+    assert "κ = 2L_h = 2, and the interval is open" in detail and "by 0" not in detail
 
 
 def test_tamper_gamma_star(example, tmp_path):

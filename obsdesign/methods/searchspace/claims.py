@@ -226,6 +226,11 @@ def _verdict(
 
 
 def _by(what: str, x: fmpq, lo: fmpq, hi: fmpq) -> str:
+    """How far x lies outside the open interval (lo, hi); at an end point, which one (the
+    interval is open: "leaves … by 0" read as a pass, random-spec fuzzer)."""
+    if x == lo or x == hi:
+        end = "L_h" if x == lo else "2L_h"
+        return f"{what}: κ = {end} = {fmt_exact(x)}, and the interval is open"
     gap = lo - x if x <= lo else x - hi
     return f"{what} by {fmt_up(gap)} (κ = {fmt_exact(x)})"
 
