@@ -131,6 +131,22 @@ def test_sqrt_strict_on_non_squares():
     assert sqrt_lower(F(9, 4)) <= F(3, 2) <= sqrt_upper(F(9, 4))
 
 
+@pytest.mark.parametrize("x", [F(9, 25), F(0), F(10**40), F(1, 10**40), F(144, 169)], ids=str)
+def test_sqrt_of_a_rational_square_is_exact(x: fmpq):
+    """√(9/25) = 3/5 exactly on both sides (the outward end lay strictly above: C_min equal
+    to X̂ failed its inclusion, random-spec fuzzer); a square times (1 + 10⁻³⁰) is not a
+    square and gets strict bounds."""
+    q = x
+    r = interval.exact_sqrt(q)
+    assert r is not None and r * r == q
+    assert sqrt_lower(q) == r == sqrt_upper(q)
+    if q:
+        off = q * (1 + F(1, 10**30))
+        assert interval.exact_sqrt(off) is None
+        assert sqrt_lower(off) ** 2 < off < sqrt_upper(off) ** 2
+    assert interval.exact_sqrt(-q - 1) is None
+
+
 def test_precision_is_113_bits_and_restored():
     assert PREC == 113
     lo, hi = sqrt_lower(2), sqrt_upper(2)

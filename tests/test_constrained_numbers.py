@@ -48,7 +48,7 @@ def test_shipped_spec_exact_numbers() -> None:
     assert p["lambda_min_P"] == fmpq(901260129, 67108864)  # 13.43
     assert p["v_min"] == fmpq(90753137, 100000000)
     assert round(p.float("v_max"), 1) == 2659567.3
-    assert p["theta"] == 1109771083259869  # 1.11e15
+    assert p["theta"] == 1109771083258944  # 1.11e15
     summary = api.method("constrained").summary(p)
     assert summary == (
         "γ = 2.396e-05, γ_max = 2.396e-05, δ = 748.6, v_max = 2.66e+06, v_min = 0.9075, "

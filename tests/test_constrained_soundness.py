@@ -397,7 +397,7 @@ def test_v_min_bound(sec5, tmp_path) -> None:
 
 def test_theta_covers(sec5, tmp_path) -> None:
     t = p_exact(sec5, "theta")
-    assert t == 1109771083259869
+    assert t == 1109771083258944
     assert_only(sec5, tmp_path, {"theta-covers"}, {"theta": t}, {"theta": t - 1})
     # a non-integer θ above the bound is refused too (θ counts steps)
     assert failed_ids(tamper(sec5, theta=t + fmpq(1, 2))) == {"theta-covers"}
@@ -436,13 +436,13 @@ def test_X_in_C0(tmp_path, write_spec) -> None:
 
 
 def test_Cmin_in_Xhat_spec(tmp_path) -> None:
-    """X̂ with one face on the outer box of C_min (the default X̂), rounded up at 40 decimals:
-    certified; rounded down (inside by < 10⁻⁴⁰): exactly Cmin-in-Xhat fails."""
+    """X̂ with one face on the outer box of C_min (the default X̂; t = √ε_min = 1/10 exactly):
+    certified; 10⁻⁴⁰ inside: exactly Cmin-in-Xhat fails."""
     from obsdesign.certify.interval import sqrt_upper
 
-    edge = fmpq(11, 10) + sqrt_upper(fmpq(1, 100))
+    edge = fmpq(11, 10) + sqrt_upper(fmpq(1, 100))  # = 6/5 exactly (√0.01 = 1/10)
     for j, up in enumerate((True, False)):
-        face = _dec(edge, up)
+        face = _dec(edge, up) if up else _dec(edge - fmpq(1, 10**40), False)
         text = variant(
             add='Xhat = "Xh"',
             replace=[
@@ -707,3 +707,14 @@ def test_an_initial_set_outside_X_fails_the_design() -> None:
     rep = _design(text)
     assert [c.id for c in rep.claims if c.status == ClaimStatus.FAILED] == ["X0-in-X"]
     assert rep.exit_code() == 1
+
+
+def test_cmin_equal_to_xhat_is_included() -> None:
+    """Ellipsoid map Q = I, r = 5/2, ε_min = 9/25: C_min is the disc |x| ≤ 2, and X̂ that very
+    disc passes (t = √ε_min = 3/5 is now exact; its outward end lay above 3/5 and the
+    inclusion failed by 1.2e-35: random-spec fuzzer); X̂ smaller by 10⁻³⁰ fails."""
+    cm = ellipsoid_map(qeye(2), fmpq(5, 2))
+    zero = np.array([Q(0), Q(0)], dtype=object)
+    eps = fmpq(9, 25)
+    assert CL.cmin_in_xhat(cm, eps, Ellipsoid(qeye(2) * fmpq(1, 4), zero))[0]
+    assert not CL.cmin_in_xhat(cm, eps, Ellipsoid(qeye(2) * (fmpq(1, 4) + TINY), zero))[0]

@@ -70,8 +70,32 @@ def lower(f: Callable[..., Any], *args: Any) -> fmpq:
 
 
 # One-sided bounds of √x, ln x (x > 0) and eˣ: ``f_upper(x)`` ≥ f(x) ≥ ``f_lower(x)``.
-sqrt_upper: Callable[[Any], fmpq] = partial(upper, iv.sqrt)
-sqrt_lower: Callable[[Any], fmpq] = partial(lower, iv.sqrt)
+def exact_sqrt(x: Any) -> fmpq | None:
+    """√x when it is rational (x ≥ 0 a square of a rational), else None."""
+    from math import isqrt
+
+    q = Q(x)
+    if q < 0:
+        return None
+    n, d = int(q.p), int(q.q)
+    rn, rd = isqrt(n), isqrt(d)
+    return fmpq(rn, rd) if rn * rn == n and rd * rd == d else None
+
+
+def sqrt_upper(x: Any) -> fmpq:
+    """An upper bound of √x: √x itself when rational (an outward interval end lies strictly
+    above it, so X̂ = C_min exactly failed the inclusion: random-spec fuzzer), else the
+    outward-rounded interval end."""
+    r = exact_sqrt(x)
+    return r if r is not None else upper(iv.sqrt, x)
+
+
+def sqrt_lower(x: Any) -> fmpq:
+    """A lower bound of √x: √x itself when rational, else the outward interval end."""
+    r = exact_sqrt(x)
+    return r if r is not None else lower(iv.sqrt, x)
+
+
 log_upper: Callable[[Any], fmpq] = partial(upper, iv.log)
 log_lower: Callable[[Any], fmpq] = partial(lower, iv.log)
 exp_upper: Callable[[Any], fmpq] = partial(upper, iv.exp)
