@@ -245,3 +245,17 @@ def test_noise_beyond_the_designs_bound_warns(tmp_path: Path) -> None:
     with pytest.warns(UserWarning, match=r"noise reaches \|w\| = .* > noise_bound = 0.1"):
         res = get_method("impulsive").simulate(loud, rep.parameters)
     assert res.info["noise_max_abs"] > 0.1
+
+
+def test_sampling_file_must_be_a_regular_file(tmp_path: Path) -> None:
+    """/dev/zero as sampling_file grew to 24 GB until the OOM killer ended it, and a FIFO
+    blocked forever (CLI fuzzer): both are refused before reading, like a spec."""
+    import os
+
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    for bad in ("/dev/zero", str(fifo), str(tmp_path)):
+        spec = load_spec_text(_spec3(f'\nsampling_file = "{bad}"'), str(tmp_path / "s.toml"))
+        rep = api.design(spec)
+        with pytest.raises(InputError, match="not a regular file|is a directory"):
+            get_method("impulsive").simulate(spec, rep.parameters)

@@ -35,11 +35,15 @@ from obsdesign.spec.models import Spec
 
 
 def read_intervals(path: Path) -> np.ndarray:
-    """Sampling intervals from a text file: numbers separated by whitespace/commas/newlines."""
+    """Sampling intervals from a text file: numbers separated by whitespace/commas/newlines.
+    Read through :func:`obsdesign.limits.read_input` (a regular file within
+    ``max_file_bytes``): /dev/zero ran out of memory and a FIFO blocked forever (CLI fuzzer)."""
+    from obsdesign.limits import read_input
+
     try:
-        txt = path.read_text(encoding="utf-8")
-    except OSError as e:
-        raise InputError(f"{path}: cannot read sampling file ({e.strerror})") from None
+        txt = read_input(path, "sampling-interval").decode("utf-8")
+    except UnicodeDecodeError:
+        raise InputError(f"{path}: sampling file is not UTF-8 text") from None
     try:
         vals = np.array([float(t) for t in txt.replace(",", " ").split()], dtype=float)
     except ValueError:
