@@ -8,6 +8,8 @@ reads (and, without cached bytecode, compiles) only the declarations in
 
 from __future__ import annotations
 
+import os
+import stat
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -34,8 +36,22 @@ def _is_stdin(path: Path | None) -> bool:
 
 
 def _inputs(*paths: Path | None) -> tuple[Path, ...]:
-    """The input files among ``paths`` (stdin and None left out), for the output checks."""
-    return tuple(p for p in paths if p is not None and not _is_stdin(p))
+    """The input files among ``paths`` (None left out), for the output checks; stdin (``-``)
+    as ``/dev/stdin`` when it is a regular file (``design - -o spec.toml < spec.toml``
+    overwrote the spec: CLI fuzzer)."""
+    out = []
+    for p in paths:
+        if p is None:
+            continue
+        if not _is_stdin(p):
+            out.append(p)
+            continue
+        try:
+            if stat.S_ISREG(os.fstat(0).st_mode) and os.path.exists("/dev/stdin"):
+                out.append(Path("/dev/stdin"))
+        except OSError:
+            pass
+    return tuple(out)
 
 
 def _read_stdin(what: str) -> str:
@@ -85,6 +101,23 @@ def _say(text: str) -> None:
     """An informational line on stdout (text format), unless --quiet."""
     if not _state["quiet"]:
         print(text)
+
+
+def _distinct_outputs(a: Path | None, b: Path | None) -> None:
+    """Refuse one file named for two outputs (``-o X --plot X`` kept the plot and said
+    "report written": CLI fuzzer), whether or not it exists, --force or not."""
+    if a is None or b is None:
+        return
+    from obsdesign.errors import InputError
+
+    same = os.path.realpath(a) == os.path.realpath(b)
+    if not same:
+        try:
+            same = os.path.samefile(a, b)
+        except OSError:
+            same = False
+    if same:
+        raise InputError(f"{b}: is given for two outputs; name two different files")
 
 
 def _check_plot(path: Path | None, force: bool, inputs: tuple[Path, ...] = ()) -> None:
@@ -327,6 +360,7 @@ def design(
     from obsdesign.errors import InputError
     from obsdesign.report.model import check_output
 
+    _distinct_outputs(output, plot)
     if output is not None:
         check_output(output, force, _inputs(spec))
     _check_plot(plot, force, _inputs(spec, output))
@@ -381,7 +415,9 @@ def check(
     if junit is not None:
         from obsdesign.report.model import check_output
 
-        check_output(junit, False, _inputs(*paths))
+        # every spec the folders hold, not only the paths named (check DIR --junit DIR/x.toml
+        # replaced a spec with the JUnit XML: CLI fuzzer)
+        check_output(junit, False, _inputs(*paths, *api.spec_files(list(paths))))
 
     def each(f: Path) -> None:
         interrupt.check()  # a Ctrl-C whose exception was lost in the last spec stops here
@@ -430,6 +466,7 @@ def sweep(
     from obsdesign.errors import InputError
 
     check_workers(workers, scheduler)
+    _distinct_outputs(output, plot)
     if output is not None:
         sw.check_output_path(output, force, _inputs(spec))
     if plot is not None and y is None:

@@ -261,3 +261,66 @@ def test_simulate_refuses_an_error_report(spec: Path, tmp_path: Path):
     res = runner.invoke(app, ["simulate", str(bad), "--report", str(out)])
     _refused(res, "stopped with an error")
     assert f"{out}: records a design that stopped" in res.output  # names the report file
+
+
+def test_a_spec_on_stdin_is_not_overwritten(spec: Path):
+    """``design - -o s.toml < s.toml`` replaced the spec with the report (CLI fuzzer): stdin
+    that is a regular file counts as the input file."""
+    exe = Path(sys.executable).parent / "obsdesign"
+    before = spec.read_bytes()
+    with open(spec, "rb") as f:
+        r = subprocess.run(
+            [str(exe), "design", "-", "-o", str(spec)], stdin=f, capture_output=True, text=True
+        )
+    assert r.returncode == 2 and "input file itself" in r.stderr, r.stderr
+    assert spec.read_bytes() == before
+
+
+def test_one_file_named_for_two_outputs(spec: Path, tmp_path: Path):
+    """``design -o X --plot X`` kept the plot and said "report written" (CLI fuzzer): refused,
+    whether X exists or not, with or without --force; likewise sweep -o / --plot."""
+    out = tmp_path / "x.svg"
+    for extra in ([], ["--force"]):
+        _refused(
+            runner.invoke(app, ["design", str(spec), "-o", str(out), "--plot", str(out), *extra]),
+            "two outputs",
+        )
+        out.write_text("keep")
+    assert out.read_text() == "keep"
+    res = runner.invoke(
+        app,
+        ["sweep", str(spec), "--set", "method.margin=1e-9", "-o", str(tmp_path / "t.csv"),
+         "--plot", str(tmp_path / "." / "t.csv"), "--y", "exit_code"],
+    )  # fmt: skip
+    _refused(res, "two outputs")
+
+
+def test_junit_over_a_spec_inside_a_checked_folder(spec: Path):
+    """``check DIR --junit DIR/s.toml`` replaced the spec with the JUnit XML (the guard knew
+    only the paths named): every spec the folders hold is an input."""
+    before = spec.read_bytes()
+    _refused(runner.invoke(app, ["check", str(spec.parent), "--junit", str(spec)]), "itself")
+    assert spec.read_bytes() == before
+
+
+def test_an_output_folder_that_takes_no_file_is_refused_before_the_work(
+    spec: Path, tmp_path: Path, monkeypatch
+):
+    """``sweep -o /sys/s.csv`` and ``check --junit /sys/j.xml`` ran every point, then lost all
+    rows on the write (CLI fuzzer): the folder is tried first (an empty probe file, removed)."""
+    from obsdesign.report import model
+
+    ran = []
+    monkeypatch.setattr("obsdesign.api.check", lambda *a, **k: ran.append(1) or [])
+
+    def no(*a, **k):
+        raise OSError(errno.EROFS, os.strerror(errno.EROFS))
+
+    monkeypatch.setattr(model.tempfile, "mkstemp", no)
+    res = runner.invoke(app, ["check", str(spec), "--junit", str(tmp_path / "j.xml")])
+    _refused(res, "cannot write in", os.strerror(errno.EROFS))
+    assert not ran
+    monkeypatch.undo()
+    res = runner.invoke(app, ["check", str(spec), "--junit", str(tmp_path / "j.xml")])
+    assert res.exit_code == 0, res.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["j.xml", "s.toml"]  # probe removed

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import platform
@@ -335,14 +336,19 @@ def check_output(path: str | Path, force: bool = False, inputs: tuple[Path, ...]
     """Refuse (:class:`InputError`, one line) an output path that would destroy something:
     one of ``inputs`` (the spec itself), a symbolic link, an existing file that is not a
     regular file (device, FIFO, socket), or a write-protected file, unless ``force``; a
-    directory always. Nothing is written or created here."""
+    directory, a path given for two outputs, or a directory that cannot take a new file
+    always. Nothing is written here (an empty probe file is created and removed)."""
     p = Path(path)
+    for i in inputs:  # an output given twice (-o X --plot X) is one file written twice
+        if not os.path.exists(i) and os.path.realpath(p) == os.path.realpath(i):
+            raise InputError(f"{p}: is given for two outputs; name two different files")
     try:
         lst = os.lstat(p)
     except FileNotFoundError:
         parent = p.parent
         if parent.exists() and not parent.is_dir():
             raise InputError(f"{p}: cannot write ({parent} is not a directory)") from None
+        _probe_dir(p)
         return
     except OSError as e:
         raise InputError(f"{p}: cannot write ({e.strerror})") from None
@@ -373,6 +379,23 @@ def check_output(path: str | Path, force: bool = False, inputs: tuple[Path, ...]
     protected = not os.access(p, os.W_OK) or not st.st_mode & 0o222  # (root ignores access)
     if stat.S_ISREG(st.st_mode) and protected and not force:
         raise InputError(f"{p}: is write-protected; refusing to replace it (--force)")
+    if stat.S_ISREG(st.st_mode):
+        _probe_dir(p)
+
+
+def _probe_dir(p: Path) -> None:
+    """Refuse (one line) an output whose directory cannot take the new file: the result is
+    written to a temporary file there and renamed (:func:`write_via`), so that is tried now,
+    with an empty probe file removed at once (``sweep -o /sys/s.csv`` and ``check --junit
+    /sys/j.xml`` ran every point, then lost the rows: CLI fuzzer)."""
+    parent = p.parent if str(p.parent) else Path(".")
+    try:
+        fd, name = tempfile.mkstemp(prefix=".obsdesign-probe-", dir=parent)
+    except OSError as e:
+        raise InputError(f"{p}: cannot write in {parent} ({e.strerror})") from None
+    os.close(fd)
+    with contextlib.suppress(OSError):
+        os.unlink(name)
 
 
 def _umask_mode() -> int:
