@@ -162,7 +162,9 @@ def test_error_while_certifying_replaces_stale_report(
 
 
 def test_overflow_in_certify_of_a_fuzzed_spec_writes_the_error_report(tmp_path: Path):
-    """The fuzzer's case itself: search-space with alpha = 1e-320."""
+    """The fuzzer's case: search-space with a tiny alpha. 1e-320 (below the normal float
+    range) is now refused as input, exit 2 naming the key; 1e-307 still overflows inside the
+    computation, and the report says so."""
     text = (
         Path(__file__).resolve().parents[1] / "specs" / "hernandez-garcia-example.toml"
     ).read_text()
@@ -172,6 +174,9 @@ def test_overflow_in_certify_of_a_fuzzed_spec_writes_the_error_report(tmp_path: 
     bad = tmp_path / "s.toml"
     bad.write_text(re.sub(r"(?m)^alpha = .*$", "alpha = 1e-320", text))
     out = tmp_path / "r.json"
+    _refused(runner.invoke(app, ["design", str(bad), "-o", str(out)]), "[method.alpha]", "below")
+    assert not out.exists()
+    bad.write_text(re.sub(r"(?m)^alpha = .*$", "alpha = 1e-307", text))
     res = runner.invoke(app, ["design", str(bad), "-o", str(out)])
     assert res.exit_code == 4, res.output
     assert json.loads(out.read_text())["verdict"] == "error"

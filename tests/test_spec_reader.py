@@ -27,7 +27,8 @@ _num = st.one_of(
 @given(st.integers(1, 4), st.integers(1, 4), st.data())
 def test_checked_rows_equal_the_general_path(r: int, c: int, data: st.DataObject) -> None:
     """Exact values equal; floats bit for bit the correctly rounded ones of to_float; a
-    number beyond the float range is the same SpecError naming the key on both paths."""
+    number beyond the float range, or nonzero below the normal range (|x| < 2.2e-308), is
+    the same SpecError naming the key on both paths."""
     rows = [[data.draw(_num) for _ in range(c)] for _ in range(r)]
     qs = np.array([[Q(x) for x in row] for row in rows], dtype=object)
     try:
@@ -35,6 +36,12 @@ def test_checked_rows_equal_the_general_path(r: int, c: int, data: st.DataObject
     except OverflowError:
         for checked in (True, False):
             with pytest.raises(SpecError, match=r"t.toml: \[M\] .*beyond the float range"):
+                Table({"M": rows}, "t.toml", checked=checked).matrix("M")
+        return
+    tiny = np.finfo(float).tiny
+    if any(q != 0 and abs(f) < tiny for q, f in zip(qs.flat, want.flat, strict=True)):
+        for checked in (True, False):
+            with pytest.raises(SpecError, match=r"t.toml: \[M\] .*below the float range"):
                 Table({"M": rows}, "t.toml", checked=checked).matrix("M")
         return
     fast = Table({"M": rows}, "t.toml", checked=True).matrix("M")

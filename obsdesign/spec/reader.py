@@ -234,7 +234,9 @@ class Table:
                     k,
                     f"expected shape {_dim(rows)}×{_dim(cols)}, got {arr.shape[0]}×{arr.shape[1]}",
                 )
-            return Value(arr, np.array(fast[1], dtype=float).reshape(arr.shape))
+            val = Value(arr, np.array(fast[1], dtype=float).reshape(arr.shape))
+            self._no_underflow(k, val)
+            return val
         arr = np.empty((len(v), len(v[0])), dtype=object)
         for i, r in enumerate(v):
             for j, x in enumerate(r):
@@ -253,11 +255,33 @@ class Table:
         """:meth:`Value.of`, with a number beyond the float range (|x| ≥ 2^1024 after
         rounding) as bad input naming the key: the design computes in floats too."""
         try:
-            return Value.of(q)
+            val = Value.of(q)
         except OverflowError:
             raise self.error(
                 k, "has a number beyond the float range (magnitude above 1.8e308)"
             ) from None
+        self._no_underflow(k, val)
+        return val
+
+    def _no_underflow(self, k: str, val: Value) -> None:
+        """A nonzero number below the normal float range (|x| < 2.2e-308) is bad input naming
+        the key, as one above it is: the design computes in floats too, where it becomes 0 or
+        loses its digits (rate_tol = 1e-400 ended in exit 4 'the spec's numbers are too
+        large', C = 1e-400 in a singular-matrix error, exit 3: CLI fuzzer)."""
+        f = np.abs(np.asarray(val.f, dtype=float))
+        if not np.any(f < _TINY):
+            return
+        q = np.asarray(val.q, dtype=object).reshape(f.shape)
+        if any(q.flat[i] != 0 for i in np.flatnonzero(f < _TINY)):
+            raise self.error(
+                k,
+                "has a nonzero number below the float range (magnitude under 2.2e-308, which "
+                "floats round to 0 or to few digits)",
+            )
+
+
+#: the smallest normal float64
+_TINY = float(np.finfo(float).tiny)
 
 
 def _checked_rows(rows: list[list[Any]]) -> tuple[list[fmpq], list[float]] | None:
