@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import hashlib
+import signal
+import threading
 import time
 import warnings
 from collections.abc import Iterator
@@ -752,11 +754,58 @@ def spec_files(paths: list[str | Path]) -> list[Path]:
     return out
 
 
-def check_one(path: Path) -> CheckRow:
+class SpecTimeout(BaseException):
+    """A spec of ``check`` ran past its time budget (a BaseException: no ``except Exception``
+    inside a method swallows it)."""
+
+
+@contextmanager
+def _time_budget(seconds: float | None) -> Any:
+    """Raise :class:`SpecTimeout` in the main thread after ``seconds`` of wall time (SIGALRM;
+    None, 0 or another thread: no budget). A long C call (a solver) is interrupted when it
+    returns to Python."""
+    if not seconds or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def on_alarm(signum: int, frame: Any) -> None:
+        raise SpecTimeout
+
+    old = signal.signal(signal.SIGALRM, on_alarm)
+    signal.setitimer(signal.ITIMER_REAL, float(seconds))
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+
+
+def check_one(path: Path, timeout: float | None = None) -> CheckRow:
     """Design, serialize, reload and verify the spec at ``path``. Always returns a row: an error of any
     kind (bad input, solver failure, an internal error) becomes that row's exit code and
-    message, so one spec never loses the others' rows (KeyboardInterrupt still stops)."""
+    message, so one spec never loses the others' rows (KeyboardInterrupt still stops).
+    ``timeout``: seconds for the whole spec (in the main thread; None: no limit), past which
+    the row is exit 3 "not finished" (one spec that hung cost every row: CLI fuzzer)."""
     t0 = time.perf_counter()
+    method_key = "?"
+    try:
+        with _time_budget(timeout):
+            return _check_one(path, t0)
+    except SpecTimeout:
+        return CheckRow(
+            str(path),
+            method_key,
+            EXIT_SOLVER,
+            0,
+            0,
+            0,
+            "",
+            time.perf_counter() - t0,
+            f"not finished within {timeout:g} s (check --timeout SECONDS; 0: no limit)",
+        )
+
+
+def _check_one(path: Path, t0: float) -> CheckRow:
     method_key = "?"
     try:
         sp = load_spec(path)
@@ -809,9 +858,11 @@ def check(
     scheduler: str | None = None,
     client: Any = None,
     on_row: Any = None,
+    timeout: float | None = None,
 ) -> list[CheckRow]:
     """Design and verify every spec under ``paths`` (folders recursively, see
     :func:`spec_files`); ``on_start(path)`` is called before each (in-process runs only).
+    ``timeout``: seconds per spec (in-process runs; see :func:`check_one`).
     One row per spec, in file order. ``workers`` (a Dask LocalCluster of that many
     processes), ``scheduler`` (an existing Dask scheduler's address; its workers must see
     the same files) or ``client`` (a ``dask.distributed.Client``) run the specs on Dask
@@ -825,7 +876,7 @@ def check(
         for f in files:
             if on_start is not None:
                 on_start(f)
-            rows.append(check_one(f))
+            rows.append(check_one(f, timeout))
             if on_row is not None:
                 on_row(rows[-1])
         return rows

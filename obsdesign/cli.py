@@ -373,6 +373,16 @@ def check(
     width: WidthOpt = None,
     workers: WorkersOpt = None,
     scheduler: SchedulerOpt = None,
+    timeout: Annotated[
+        float,
+        typer.Option(
+            "--timeout",
+            metavar="SECONDS",
+            min=0,
+            help="Time budget per spec (0: none); a spec past it gets exit 3 and the others "
+            "still run. In-process runs only.",
+        ),
+    ] = 600.0,
 ) -> None:
     """Design and verify every spec; one row per spec; non-zero exit if any fails.
 
@@ -381,7 +391,7 @@ def check(
     The last line (text and md) is the verdict, e.g. "checked: 13 specs, 13 ok, 0 failed;
     149 claims certified, 7 numerical, 0 failed"."""
 
-    _run(lambda cmd: cmd.check(paths, fmt, junit, quiet, workers, scheduler), quiet, width)
+    _run(lambda cmd: cmd.check(paths, fmt, junit, quiet, workers, scheduler, timeout), quiet, width)
 
 
 @app.command()

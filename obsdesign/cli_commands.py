@@ -408,6 +408,7 @@ def check(
     quiet: bool,
     workers: int | None,
     scheduler: str | None,
+    timeout: float | None = None,
 ) -> int:
     """The body of ``obsdesign check`` (see :func:`obsdesign.cli.check`)."""
     from obsdesign import api, interrupt
@@ -425,7 +426,7 @@ def check(
             sys.stderr.write(f"checking {f} ...\n")
 
     if workers is None and scheduler is None:
-        rows = api.check(list(paths), on_start=each)
+        rows = api.check(list(paths), on_start=each, timeout=timeout or None)
     else:
         rows = _check_distributed(list(paths), workers, scheduler, quiet)
     if junit is not None:

@@ -75,7 +75,7 @@ def test_check_stops_before_the_next_spec_once_an_interrupt_is_recorded(tmp_path
         (tmp_path / name).write_text("")
     seen: list[str] = []
 
-    def one(path):
+    def one(path, timeout=None):
         seen.append(path.name)
         try:
             interrupt.handler(2, None)

@@ -42,6 +42,36 @@ def test_internal_error_in_one_spec_keeps_every_row(tmp_path: Path, monkeypatch)
     assert res.exit_code == 3
 
 
+def test_a_spec_past_its_time_budget_keeps_every_row(tmp_path: Path, monkeypatch):
+    """One spec that hangs (search-space with γ⋆ = 1e-400 ran for minutes, and check printed
+    no row at all: CLI fuzzer) is stopped at --timeout with exit 3 and the others still run;
+    even a design that catches every Exception cannot swallow the stop."""
+    import time
+
+    shutil.copy(SPEC, tmp_path / "a.toml")
+    (tmp_path / "b.toml").write_text(SPEC.read_text().replace("0.955", "0.956"))
+    shutil.copy(SPEC, tmp_path / "c.toml")
+    real = api.design
+
+    def hangs(spec, *a, **k):
+        if str(getattr(spec, "file", spec)).endswith("b.toml"):
+            while True:
+                try:
+                    time.sleep(0.05)
+                except Exception:  # noqa: BLE001, S110 - a method that swallows everything
+                    pass
+        return real(spec, *a, **k)
+
+    monkeypatch.setattr(api, "design", hangs)
+    t0 = time.perf_counter()
+    res = runner.invoke(app, ["check", str(tmp_path), "--format", "json", "--timeout", "1"])
+    assert time.perf_counter() - t0 < 30
+    rows = _rows(res.output)
+    assert [r["code"] for r in rows] == [0, 3, 0]
+    assert "not finished within 1 s" in rows[1]["message"]
+    assert res.exit_code == 3
+
+
 def test_check_recurses_into_subfolders(tmp_path: Path):
     sub = tmp_path / "sub" / "deeper"
     sub.mkdir(parents=True)
