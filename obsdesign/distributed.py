@@ -24,6 +24,7 @@ is an :class:`InputError` that says how to install it (exit 2).
 from __future__ import annotations
 
 import logging
+import os
 import sys
 import uuid
 from collections.abc import Callable, Iterator, Sequence
@@ -56,6 +57,10 @@ def _require_dask() -> None:
         raise InputError(INSTALL_HINT)
 
 
+#: the most local worker processes ``--workers`` may start
+MAX_LOCAL_WORKERS = max(64, 4 * (os.cpu_count() or 1))
+
+
 def check_workers(workers: int | None, scheduler: str | None) -> None:
     """Refuse (exit 2) a bad ``--workers``/``--scheduler`` pair, or Dask missing, before any
     work starts."""
@@ -63,6 +68,13 @@ def check_workers(workers: int | None, scheduler: str | None) -> None:
         raise InputError("--workers and --scheduler exclude each other (a scheduler has its own)")
     if workers is not None and workers < 1:
         raise InputError(f"--workers: expected a positive number of processes, got {workers}")
+    if workers is not None and workers > MAX_LOCAL_WORKERS:
+        # 100,000 local processes were still starting after 120 s (CLI fuzzer)
+        raise InputError(
+            f"--workers: {workers} processes on this machine is above {MAX_LOCAL_WORKERS} "
+            f"(4 × its {os.cpu_count() or 1} CPUs, at least 64); for more, start a Dask "
+            "cluster and give --scheduler"
+        )
     if scheduler is not None and "://" not in scheduler:
         raise InputError(
             f"--scheduler: expected an address such as tcp://HOST:8786, got {scheduler!r}"

@@ -239,6 +239,7 @@ def test_cli_sweep_parquet(tmp_path: Path):
         (["--y", "mu"], "give --plot"),
         (["--plot", "{tmp}/p.png", "--y", "nope"], "--y nope: not a column"),
         (["--workers", "0"], "positive number"),
+        (["--workers", "100000"], "start a Dask cluster"),  # was still starting after 120 s
         (["--workers", "2", "--scheduler", "tcp://h:1"], "exclude each other"),
         (["--scheduler", "localhost"], "tcp://HOST"),
         (["--set", "method.lambda=1"], "given twice"),
