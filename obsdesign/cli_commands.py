@@ -60,6 +60,8 @@ def _read_stdin(what: str) -> str:
     from obsdesign.limits import limits
 
     lim = limits().max_file_bytes
+    if sys.stdin is None:  # started with stdin closed (obsdesign design - <&-)
+        raise InputError(f"{STDIN_NAME}: standard input is closed; give a file instead of -")
     data = sys.stdin.buffer.read(lim + 1)
     if len(data) > lim:
         raise InputError(
@@ -300,7 +302,7 @@ def _read_report(report: Path) -> Any:
 
     from obsdesign.errors import InputError
     from obsdesign.limits import int_digits
-    from obsdesign.report.model import Report
+    from obsdesign.report.model import Report, no_lone_surrogates
 
     text = _read_stdin("report")
     try:
@@ -310,6 +312,7 @@ def _read_report(report: Path) -> Any:
         raise InputError(f"{STDIN_NAME}: not a readable JSON report ({e})") from None
     except RecursionError:
         raise InputError(f"{STDIN_NAME}: JSON nested too deeply") from None
+    no_lone_surrogates(text, d, STDIN_NAME)
     return Report.from_dict(d, STDIN_NAME)[0]
 
 

@@ -329,3 +329,28 @@ def test_an_output_folder_that_takes_no_file_is_refused_before_the_work(
     res = runner.invoke(app, ["check", str(spec), "--junit", str(tmp_path / "j.xml")])
     assert res.exit_code == 0, res.output
     assert sorted(p.name for p in tmp_path.iterdir()) == ["j.xml", "s.toml"]  # probe removed
+
+
+def test_lone_surrogate_escapes_and_a_closed_stdin_are_bad_input(spec: Path, tmp_path: Path):
+    """A report whose JSON holds "\\ud800" (valid JSON, but no UTF-8 output can print it)
+    ended in UnicodeEncodeError, exit 3, and ``design - <&-`` in AttributeError (CLI
+    fuzzer): both are one-line exit 2. A valid surrogate pair (an emoji) verifies."""
+    out = tmp_path / "r.json"
+    assert runner.invoke(app, ["design", str(spec), "-o", str(out)]).exit_code == 0
+    d = json.loads(out.read_text())
+    for note, code in (("\\ud800", 2), ("\\ud83d\\ude00", 0)):
+        text = json.dumps({**d, "notes": [*d["notes"], "NOTE"]}).replace("NOTE", note)
+        bad = tmp_path / "b.json"
+        bad.write_text(text)
+        res = runner.invoke(app, ["verify", str(bad)])
+        if code == 2:
+            _refused(res, "not valid Unicode")
+        else:
+            assert res.exit_code == 0, res.output
+    exe = Path(sys.executable).parent / "obsdesign"
+    r = subprocess.run(
+        f"'{exe}' design - <&-", shell=True, executable="/bin/bash", capture_output=True,
+        text=True, timeout=60,
+    )  # fmt: skip
+    assert r.returncode == 2 and "standard input is closed" in r.stderr, r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1

@@ -240,6 +240,7 @@ class Report:
                 f"{p}: has a number with more than {max(4300, limits().max_digits)} digits "
                 f"(--limit max_digits=N)"
             ) from None
+        no_lone_surrogates(raw, d, str(p))
         return cls.from_dict(d, str(p))
 
     @classmethod
@@ -330,6 +331,28 @@ def _notes(d: dict[str, Any], file: str) -> list[str]:
     if not all(isinstance(n, str) for n in v):
         raise InputError(f"{file}: 'notes' must be a list of strings")
     return v
+
+
+_SURROGATE_ESCAPE = re.compile(rb"\\u[dD][89a-fA-F]")
+
+
+def no_lone_surrogates(raw: bytes | str, d: Any, file: str) -> None:
+    """Refuse (one line) a JSON text whose escapes decode to a lone UTF-16 surrogate
+    ("\\ud800"): Python reads it, but no UTF-8 output can hold it (verify ended in a
+    UnicodeEncodeError, exit 3: CLI fuzzer). A cheap scan of the raw text first; the decoded
+    object is re-encoded only when a surrogate escape appears (a valid pair is fine)."""
+    b = raw.encode("utf-8", "surrogatepass") if isinstance(raw, str) else raw
+    if not _SURROGATE_ESCAPE.search(b):
+        return
+    try:
+        json.dumps(d, ensure_ascii=False).encode("utf-8")
+    except UnicodeEncodeError:
+        raise InputError(
+            f"{file}: holds a string that is not valid Unicode (a lone surrogate escape "
+            "such as \\ud800)"
+        ) from None
+    except (RecursionError, ValueError, TypeError):
+        pass
 
 
 def check_output(path: str | Path, force: bool = False, inputs: tuple[Path, ...] = ()) -> None:
