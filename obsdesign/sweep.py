@@ -328,6 +328,18 @@ def set_key(text: str, key: str, literal: str, file: str = "<spec>") -> str:
 
 
 def _check_edit(old: str, new: str, parts: list[str], literal: str, file: str) -> None:
+    """The edited text sets exactly ``parts`` to ``literal`` and nothing else. A spec nested
+    too deeply for the TOML parser is bad input (a RecursionError was exit 3: CLI fuzzer;
+    the spec loader refuses it by its own depth limit)."""
+    try:
+        _check_edit_parsed(old, new, parts, literal, file)
+    except RecursionError:
+        raise InputError(
+            f"{file}: nested too deeply to edit (tables, arrays or dotted keys)"
+        ) from None
+
+
+def _check_edit_parsed(old: str, new: str, parts: list[str], literal: str, file: str) -> None:
     key = ".".join(parts)
     try:
         before = tomllib.loads(old)

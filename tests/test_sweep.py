@@ -276,3 +276,13 @@ def test_workers_without_dask_say_how_to_install_it(monkeypatch: pytest.MonkeyPa
         r = runner.invoke(app, cmd)
         assert r.exit_code == 2
         assert "pip install 'obsdesign[distributed]'" in r.stderr
+
+
+def test_a_spec_too_deep_to_edit_is_bad_input(tmp_path: Path):
+    """A dotted key 2,000 levels deep made the sweep's TOML edit check overflow the stack
+    (RecursionError, exit 3: CLI fuzzer): exit 2, one line naming the file."""
+    spec = tmp_path / "s.toml"
+    spec.write_text(SPEC.read_text(encoding="utf-8") + "\n" + ".".join(["a"] * 2000) + " = 1\n")
+    r = runner.invoke(app, ["sweep", str(spec), "--set", "method.lambda=0.96"])
+    assert r.exit_code == 2, r.output
+    assert "nested too deeply" in r.stderr and str(spec) in r.stderr
