@@ -315,6 +315,12 @@ def test_simulate_options_validated_centrally(specs_dir, tmp_path):
     assert out.exit_code == 2 and "gamma" in out.output
     out = r.invoke(app, ["simulate", spec, "--option", "theta_m=1,x"])
     assert out.exit_code == 2 and "theta_m" in out.output
+    # θ_m = 10³⁰ ran past 120 s with memory growing (CLI fuzzer): the total is bounded first;
+    # 300 samples × 333,333 steps is within 10⁸, one more step per sample is not
+    out = r.invoke(app, ["simulate", spec, "--option", "theta_m=1000000000000000000000000000000"])
+    assert out.exit_code == 2 and "above 100,000,000 steps in all" in out.output
+    out = r.invoke(app, ["simulate", spec, "--option", "theta_m=333334"])
+    assert out.exit_code == 2 and "steps in all" in out.output
     res = api.simulate(specs_dir / SEC5, options={"theta_m": "2", "saturation_r": "3"})
     assert set(res.extra["traces"]) == {"unmodified", "modified θ_m=2", "saturated r=[3]"}
 

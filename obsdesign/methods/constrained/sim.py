@@ -21,6 +21,8 @@ from obsdesign.spec.models import Spec
 
 #: default step budget per sample when θ (22) is astronomically large
 THETA_CAP = 10_000
+#: θ_m × horizon of a simulation at most (refining steps of one observer)
+MAX_REFINING_STEPS = 10**8
 
 
 def _exact(params: Parameters, k: str) -> Any:
@@ -96,6 +98,13 @@ def simulate(
     )
 
     N = int(sm.horizon.f)
+    if thetas and max(thetas) * max(N, 1) > MAX_REFINING_STEPS:
+        # theta_m = 1e30 ran past 120 s with memory growing (CLI fuzzer)
+        raise InputError(
+            f"{spec.file}: [simulate] theta_m = {max(thetas):,} refining steps per sample "
+            f"over {N:,} samples is above {MAX_REFINING_STEPS:,} steps in all (a smaller "
+            "theta_m or horizon)"
+        )
     k = np.arange(N + 1)
     u, d, v = signals(spec, k)
     from obsdesign.methods.constrained.nonlinear import Model, plant_f, plant_h
