@@ -259,3 +259,21 @@ def test_sampling_file_must_be_a_regular_file(tmp_path: Path) -> None:
         rep = api.design(spec)
         with pytest.raises(InputError, match="not a regular file|is a directory"):
             get_method("impulsive").simulate(spec, rep.parameters)
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")
+def test_time_limit_holds_inside_one_sampling_interval(tmp_path: Path) -> None:
+    """ψ = sqrt(−1) (NaN dynamics): RK45 shrinks its step without end inside the first
+    interval, where the budget used to be checked only between intervals (time_limit = 5 ran
+    past 120 s: CLI fuzzer). The budget is now also checked inside the right-hand side."""
+    import time
+
+    from obsdesign.errors import SolverError
+
+    txt = _spec3().replace('"0.2*sin(x1)"', '"sqrt(-1)"', 1)
+    sp = load_spec_text(txt, str(tmp_path / "s.toml"))
+    rep = api.design(load_spec_text(_spec3(), str(tmp_path / "ok.toml")))
+    t0 = time.perf_counter()
+    with pytest.raises(SolverError, match="not finished within 1 s"):
+        get_method("impulsive").simulate(sp, rep.parameters, time_limit=1)
+    assert time.perf_counter() - t0 < 20
