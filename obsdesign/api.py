@@ -792,17 +792,18 @@ def check_one(path: Path, timeout: float | None = None) -> CheckRow:
         with _time_budget(timeout):
             return _check_one(path, t0)
     except SpecTimeout:
-        return CheckRow(
-            str(path),
+        return _error_row(
+            path,
             method_key,
             EXIT_SOLVER,
-            0,
-            0,
-            0,
-            "",
-            time.perf_counter() - t0,
+            t0,
             f"not finished within {timeout:g} s (check --timeout SECONDS; 0: no limit)",
         )
+
+
+def _error_row(path: Path, method_key: str, code: int, t0: float, message: str) -> CheckRow:
+    """The row of a spec that stopped with an error: its code and message, no claims."""
+    return CheckRow(str(path), method_key, code, 0, 0, 0, "", time.perf_counter() - t0, message)
 
 
 def _check_one(path: Path, t0: float) -> CheckRow:
@@ -833,21 +834,10 @@ def _check_one(path: Path, t0: float) -> CheckRow:
             claims,
         )
     except ObsdesignError as e:
-        return CheckRow(
-            str(path), method_key, e.exit_code, 0, 0, 0, "", time.perf_counter() - t0, e.message
-        )
+        return _error_row(path, method_key, e.exit_code, t0, e.message)
     except Exception as e:  # noqa: BLE001 - one row per spec, whatever happened in it
-        return CheckRow(
-            str(path),
-            method_key,
-            EXIT_SOLVER,
-            0,
-            0,
-            0,
-            "",
-            time.perf_counter() - t0,
-            f"internal failure: {type(e).__name__}: {e}",
-        )
+        msg = f"internal failure: {type(e).__name__}: {e}"
+        return _error_row(path, method_key, EXIT_SOLVER, t0, msg)
 
 
 def check(
