@@ -114,6 +114,24 @@ def test_safe_direction_and_tight(q: fmpq, digits: int):
         assert len(mant) <= digits
 
 
+@given(
+    st.builds(
+        lambda p, q, e: F(p, q) * F(10) ** e,
+        st.integers(-(10**9), 10**9).filter(bool),
+        st.integers(1, 10**6),
+        st.integers(-700, 700),
+    ),
+    st.integers(1, 12),
+)
+def test_safe_and_tight_at_any_exponent(q: fmpq, digits: int):
+    """The exponent now comes from the bit lengths (one big-rational power per number instead
+    of ~400 steps): safe and one unit tight from 1e-700 to 1e700, where the old −400 floor
+    printed 1e-500 as "1e-400" (safe but not tight: this test fails on it)."""
+    up, down = parse(fmt_up(q, digits)), parse(fmt_down(q, digits))
+    assert down <= q <= up
+    assert up - down <= abs(q) * F(10) ** (1 - digits) * 10
+
+
 @given(finite)
 def test_exact_roundtrip(q: fmpq):
     assert parse(fmt_exact(q)) == q
