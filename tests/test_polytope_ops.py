@@ -332,3 +332,16 @@ def test_repaired_hull_of_near_coplanar_points_is_the_cdd_hull(n):
     G1, idx, edges = po._cdd_hull(P)
     assert [tuple(r) for r in G] == [tuple(r) for r in G1]
     assert [tuple(v) for v in vr.V] == [tuple(P[j]) for j in idx] and vr.edges == edges
+
+
+def test_slice_points_sees_a_crossing_whose_product_underflows() -> None:
+    """An edge from c·e = −10⁻²⁰⁰ to +10⁻²⁰⁰ crosses the plane c·e = 0; the product of the two
+    signed distances underflows to −0.0, which the old test ``da * db < 0`` missed (and a
+    product of two 10²⁰⁰ distances overflowed with a RuntimeWarning)."""
+    V = np.array([[-1e-200, 0.0], [1e-200, 1.0]])
+    S = po.slice_points(V, np.array([[0, 1]]), np.array([1.0, 0.0]), 0.0, 0.0)
+    assert S.shape == (1, 2) and S[0, 0] == 0.0 and S[0, 1] == pytest.approx(0.5)
+    W = np.array([[-1e200, 0.0], [1e200, 1.0]])
+    with np.errstate(over="raise"):
+        big = po.slice_points(W, np.array([[0, 1]]), np.array([1.0, 0.0]), 0.0, 0.0)
+    assert big.shape == (1, 2) and big[0, 1] == pytest.approx(0.5)

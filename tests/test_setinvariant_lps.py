@@ -75,3 +75,32 @@ def test_failing_highs_stops_at_the_deadline(monkeypatch: pytest.MonkeyPatch) ->
 
     with pytest.raises(SolverError, match="HiGHS failed on LP \\(9\\)"):
         lps.eps_batch(G, np.zeros((4, 4)), np.zeros(4))
+
+
+def test_lp_in_range_is_the_check_without_raising() -> None:
+    """``lp_in_range`` answers what ``check_lp_range`` raises on."""
+    assert lps.lp_in_range(np.ones((1, 2)), np.array([1.0]))
+    assert not lps.lp_in_range(np.array([[np.inf, 1.0]]), np.array([1.0]))
+    assert not lps.lp_in_range(np.ones((1, 2)), np.array([lps.HIGHS_INFINITY]))
+
+
+#: the CLI fuzzer's spec: its linear-gain LP is beyond a float LP's range (C = 1e300)
+HUGE_C = ROOT / "tests" / "specs" / "setinvariant-huge-C.toml"
+
+
+def test_linear_gain_lp_beyond_float_range_is_not_an_internal_failure() -> None:
+    """Found by the CLI fuzzer: η̄ = 1e300 or C = [[1e300, 1]] made the linear-gain LP (proof
+    of Proposition 7.1) raise scipy's "A_ub must not contain values inf" (exit 3). The LP is
+    now skipped when its data are beyond a float LP's range; the exact candidates (vertices
+    of the admissible set, Proposition 7.1) are still tried."""
+    spec = api.load_spec(HUGE_C)
+    rep = api.design(spec)
+    assert rep.exit_code() == 0 and "L" in rep.parameters
+    assert any(c.id == "linear-gains-vertices" and c.status == "certified" for c in rep.claims)
+    # η̄ = 1e300: the design's breakpoints lie beyond the float range of the report: exit 4
+    # when the report is written, not an internal failure during the design
+    text = HUGE_C.read_text().replace("C = [[1e300, 1]]", "C = [[1, 1]]")
+    rep = api.design(api.load_spec_text(text.replace("eta_bar = 0", "eta_bar = 1e300"), "t.toml"))
+    with pytest.raises(InconclusiveError, match="beyond the float range") as e:
+        rep.to_dict()
+    assert e.value.exit_code == 4

@@ -266,3 +266,12 @@ def test_float_backend_gain_vertex_of_the_arrangement(monkeypatch, tmp_path):
     p["L_admissible_vertices"][0] = [float(t) for t in x]
     p["exact"]["L_admissible_vertices"][0] = [str(Q(float(t))) for t in x]
     assert _float_failed(d, tmp_path) == {"linear-gains-vertices"}
+
+
+def test_float_backend_linear_gain_lp_beyond_float_range(nogmp):
+    """C = [[1e300, 1]] (the CLI fuzzer's spec): without gmp the linear-gain LP's row norms
+    overflowed and scipy's linprog raised ValueError (exit 3); the float backend now says
+    that the LP is out of range and designs no linear law."""
+    rep = api.design(SPEC71.parents[1] / "tests" / "specs" / "setinvariant-huge-C.toml")
+    assert "L" not in rep.parameters
+    assert any("beyond a float LP's range" in n for n in rep.notes)

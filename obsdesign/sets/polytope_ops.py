@@ -285,7 +285,7 @@ def slice_points(
         a, b = edges[:, 0], edges[:, 1]
         for t in {lo, hi}:
             da, db = cv[a] - t, cv[b] - t
-            cross = da * db < 0
+            cross = np.sign(da) * np.sign(db) < 0  # not da·db: it under/overflows
             if cross.any():
                 aa, bb = a[cross], b[cross]
                 w = (t - cv[aa]) / (cv[bb] - cv[aa])

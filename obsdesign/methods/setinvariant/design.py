@@ -224,6 +224,14 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
     return run
 
 
+def _vec_text(M: np.ndarray) -> str:
+    """An exact matrix as a flat list of 4 significant digits for a note (a fixed number of
+    decimals showed a gain of 10⁻³⁰¹ as 0.0)."""
+    return (
+        "[" + ", ".join(f"{x:.4g}" for x in np.asarray(po.qfloat(M), dtype=float).reshape(-1)) + "]"
+    )
+
+
 def polytope_params(spec: Spec, data: Data, stage: Stage, notes: list[str]) -> Parameters:
     """Every reported quantity derived from a proved polytope: G, V, the certified factor and
     the injection table of Proposition 4.1 (breakpoints = Z_d, v^l, and the interpolation (12)
@@ -269,16 +277,13 @@ def polytope_params(spec: Spec, data: Data, stage: Stage, notes: list[str]) -> P
                 )
             notes.append(f"linear law v = L z: {gs.how}")
             if len(gs.vertices) > 1:
-                vs_txt = "; ".join(
-                    str(np.asarray(po.qfloat(v)).round(4).reshape(-1).tolist()) for v in gs.vertices
-                )
+                vs_txt = "; ".join(_vec_text(v) for v in gs.vertices)
                 notes.append(
                     f"admissible linear gains: the convex hull of {len(gs.vertices)} vertices "
                     f"({vs_txt}); dimension {gs.dimension}"
                 )
             for i, Lp in gs.prop71:
-                Lf = np.asarray(po.qfloat(Lp)).round(4).reshape(-1).tolist()
-                notes.append(f"Proposition 7.1 with Q_I = row {i} of G gives L = {Lf}")
+                notes.append(f"Proposition 7.1 with Q_I = row {i} of G gives L = {_vec_text(Lp)}")
         else:
             notes.append(f"no linear law: {gs.how}")
     if o.L is not None:

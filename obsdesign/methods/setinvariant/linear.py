@@ -26,6 +26,7 @@ from scipy.optimize import linprog
 from obsdesign.sets import polytope_ops as po
 
 from .certificate import ExactProblem, delta_exact, linear_law, noise_vertices, qmatmul
+from .lps import lp_in_range
 
 
 @dataclass
@@ -146,20 +147,22 @@ def admissible_gains(
     bf = po.qfloat(np.array(rhs, dtype=object))
     nl = n * p
     # max-margin LP: max t s.t. A x + t·‖a‖ <= b, t <= 1
-    norms = np.linalg.norm(Af, axis=1)
+    with np.errstate(over="ignore", invalid="ignore"):
+        norms = np.linalg.norm(Af, axis=1)
     c = np.zeros(nl + 1)
     c[-1] = -1.0
-    res = linprog(
-        c,
-        A_ub=np.hstack([Af, norms[:, None]]),
-        b_ub=bf,
-        bounds=[(None, None)] * nl + [(None, 1.0)],
-        method="highs",
-    )
+    A_lp = np.hstack([Af, norms[:, None]])
+    res = None
+    if lp_in_range(A_lp, bf):
+        res = linprog(
+            c, A_ub=A_lp, b_ub=bf, bounds=[(None, None)] * nl + [(None, 1.0)], method="highs"
+        )
     prop = prop71_gains(ex, G)
-    if res.status != 0 or res.x[-1] < -1e-9:
+    if res is not None and (res.status != 0 or res.x[-1] < -1e-9):
         return GainSet(None, None, "the admissible set of linear gains is empty", prop71=prop)
-    margin = float(res.x[-1])
+    # data beyond a float LP's range (huge B1, η̄ or C): no max-margin point; the exact
+    # candidates (vertices of 𝓛, Proposition 7.1) are still tried
+    margin = float(res.x[-1]) if res is not None else 0.0
     verts: list[np.ndarray] = []
     dim = None
     if nl <= max_dim_enum:
@@ -188,9 +191,13 @@ def admissible_gains(
         candidates.append((avg, "average of the Proposition 7.1 gains"))
         for i, L in prop:
             candidates.append((L, f"Proposition 7.1 with Q_I = row {i}"))
-    candidates.append((po.rationalize(res.x[:nl]).reshape(n, p), "max-margin LP point"))
+    if res is not None:
+        candidates.append((po.rationalize(res.x[:nl]).reshape(n, p), "max-margin LP point"))
     for L, how in candidates:
         ok, f = linear_law(ex, G, V, L)
         if ok:
             return GainSet(L, f, how, verts, dim, prop, margin)
-    return GainSet(None, None, "no candidate gain passed the exact check", verts, dim, prop, margin)
+    why = "no candidate gain passed the exact check"
+    if res is None:
+        why += " (the max-margin LP was skipped: its data are beyond a float LP's range)"
+    return GainSet(None, None, why, verts, dim, prop, margin)

@@ -114,14 +114,25 @@ HIGHS_MATRIX_MAX = 1e15
 HIGHS_INFINITY = 1e20
 
 
+def lp_in_range(A: np.ndarray, b: np.ndarray) -> bool:
+    """Whether the float LP data ``A``, ``b`` are finite and inside what HiGHS reads as finite
+    (scipy's ``linprog`` raises ValueError on inf/nan; HiGHS stops with "Model error" above
+    :data:`HIGHS_MATRIX_MAX` / :data:`HIGHS_INFINITY`).
+
+    :param A: the constraint matrix (dense); :param b: the right-hand side."""
+    a = float(np.max(np.abs(A), initial=0.0))
+    r = float(np.max(np.abs(b), initial=0.0))
+    return bool(np.isfinite(a) and np.isfinite(r) and a <= HIGHS_MATRIX_MAX and r < HIGHS_INFINITY)
+
+
 def check_lp_range(A: np.ndarray, b: np.ndarray, what: str) -> None:
     """Raise InconclusiveError (exit 4) when the float LP ``what`` has data that HiGHS would
     read as infinite, or no finite data at all, instead of its "Model error" (exit 3).
 
     :param A: the constraint matrix (dense); :param b: the right-hand side."""
-    a = float(np.max(np.abs(A), initial=0.0))
-    r = float(np.max(np.abs(b), initial=0.0))
-    if not (np.isfinite(a) and np.isfinite(r)) or a > HIGHS_MATRIX_MAX or r >= HIGHS_INFINITY:
+    if not lp_in_range(A, b):
+        a = float(np.max(np.abs(A), initial=0.0))
+        r = float(np.max(np.abs(b), initial=0.0))
         raise InconclusiveError(
             f"{what} is out of a float LP's range (largest |coefficient| {a:.3g}, largest "
             f"|right-hand side| {r:.3g}; HiGHS takes values above {HIGHS_MATRIX_MAX:g} and "

@@ -154,12 +154,16 @@ def float_gains(fl: Problem, lam: float, G: np.ndarray, V: np.ndarray) -> GainSe
     the admissible set's vertices are not enumerated (that needs cdd.gmp)."""
     n, p = fl.n, fl.p
     Af, bf = gain_constraints(fl, lam, G, V)
-    norms = np.linalg.norm(Af, axis=1)
+    with np.errstate(over="ignore", invalid="ignore"):
+        norms = np.linalg.norm(Af, axis=1)
+    A_lp = np.hstack([Af, norms[:, None]])
+    if not lps.lp_in_range(A_lp, bf):
+        return GainSet(None, None, "the linear-gain LP's data are beyond a float LP's range")
     c = np.zeros(n * p + 1)
     c[-1] = -1.0
     res = linprog(
         c,
-        A_ub=np.hstack([Af, norms[:, None]]),
+        A_ub=A_lp,
         b_ub=bf,
         bounds=[(None, None)] * (n * p) + [(None, 1.0)],
         method="highs",
