@@ -311,7 +311,12 @@ def spec_text_from_mat(
         arr = np.asarray(data[v])
         if arr.dtype.kind not in "fiu":
             raise InputError(f"{path}: variable '{v}' ({key}) is not a real numeric matrix")
-        return arr.astype(float)
+        if arr.ndim > 2:
+            raise InputError(f"{path}: variable '{v}' ({key}) has {arr.ndim} dimensions, not 2")
+        arr = arr.astype(float)
+        if not np.all(np.isfinite(arr)):
+            raise InputError(f"{path}: variable '{v}' ({key}) has a non-finite entry (inf or nan)")
+        return arr
 
     A, C = var("A"), var("C")
     if A is None or C is None:
@@ -319,12 +324,25 @@ def spec_text_from_mat(
     n = A.shape[0]
     B, D, Bd = var("B"), var("D"), var("Bd")
     if dt_name is not None:
-        t = var_dt = data.get(dt_name)
+        t = data.get(dt_name)
         if t is None:
             raise InputError(f"{path}: no variable '{dt_name}' for the sample time")
-        dt = float(np.asarray(var_dt).reshape(-1)[0])
+        t = np.asarray(t)
+        if t.dtype.kind not in "fiu" or t.size != 1:
+            raise InputError(
+                f"{path}: variable '{dt_name}' (the sample time) is not a real numeric scalar"
+            )
+        dt = float(t.reshape(-1)[0])
+        if not (np.isfinite(dt) and dt >= 0):
+            raise InputError(
+                f"{path}: variable '{dt_name}' (the sample time) is {dt:g}; expected a finite "
+                "number >= 0 (0: continuous time)"
+            )
     Bm = B if B is not None else np.zeros((n, 0))
     Dm = D if D is not None else np.zeros((C.shape[0], Bm.shape[1]))
-    return spec_text_from_statespace(
-        (A, Bm, C, Dm, dt if dt else 0), method, Bd=Bd, title=f"imported from {Path(path).name}"
-    )
+    try:
+        return spec_text_from_statespace(
+            (A, Bm, C, Dm, dt if dt else 0), method, Bd=Bd, title=f"imported from {Path(path).name}"
+        )
+    except InputError as e:  # e.g. shapes that do not fit: name the file
+        raise InputError(f"{path}: {e}") from None

@@ -164,6 +164,33 @@ def test_mat_import_round_trip(tmp_path: Path):
     assert bad.exit_code == 2 and "did you mean 'lyapunov'" in bad.stderr
 
 
+@pytest.mark.parametrize(
+    ("extra", "args", "message"),
+    [
+        ({"Ts": "x"}, ["--dt-var", "Ts"], "'Ts' (the sample time) is not a real numeric scalar"),
+        ({"Ts": np.array([[1.0, 2.0]])}, ["--dt-var", "Ts"], "not a real numeric scalar"),
+        ({"Ts": np.nan}, ["--dt-var", "Ts"], "'Ts' (the sample time) is nan; expected a finite"),
+        ({"Ts": -1.0}, ["--dt-var", "Ts"], "(the sample time) is -1; expected a finite number"),
+        ({"Ad": np.array([[np.inf, 0], [0, 1]])}, [], "'Ad' (A) has a non-finite entry"),
+        ({"Ad": np.zeros((2, 2, 2))}, [], "'Ad' (A) has 3 dimensions, not 2"),
+        ({"Ad": np.zeros((2, 3))}, [], "plant.mat: state-space shapes do not fit"),
+    ],
+)
+def test_mat_import_bad_variables_are_exit_2_naming_file_and_variable(
+    tmp_path: Path, extra: dict, args: list[str], message: str
+) -> None:
+    """Found by the CLI fuzzer: a string --dt-var was an internal failure (exit 3, "could not
+    convert string to float"); a vector or NaN sample time, a 3-D or non-finite matrix were
+    taken or failed without naming the file."""
+    from scipy.io import savemat
+
+    mat = tmp_path / "plant.mat"
+    savemat(mat, {"Ad": np.array(A_D), "Cm": np.array([[1.0, 0.0]]), **extra})
+    r = CliRunner().invoke(app, ["import", str(mat), "--A", "Ad", "--C", "Cm", *args])
+    assert r.exit_code == 2, r.stderr
+    assert message in r.stderr and str(mat) in r.stderr and len(r.stderr.splitlines()) == 1
+
+
 def test_stubborn_luenberger_part():
     text = spec_text_from_statespace(
         control.ss([[0.7, 0.7], [-0.7, 0.7]], [[0], [1]], [[1, 1]], 0, 1), "stubborn"
