@@ -22,6 +22,7 @@ from obsdesign.errors import (
     InputError,
     ObsdesignError,
     SpecError,
+    one_line,
 )
 from obsdesign.limits import limits, max_states_for
 from obsdesign.methods import get_method, method_keys
@@ -802,8 +803,10 @@ def check_one(path: Path, timeout: float | None = None) -> CheckRow:
 
 
 def _error_row(path: Path, method_key: str, code: int, t0: float, message: str) -> CheckRow:
-    """The row of a spec that stopped with an error: its code and message, no claims."""
-    return CheckRow(str(path), method_key, code, 0, 0, 0, "", time.perf_counter() - t0, message)
+    """The row of a spec that stopped with an error: its code and message (one line, see
+    :func:`obsdesign.errors.one_line`), no claims."""
+    t = time.perf_counter() - t0
+    return CheckRow(str(path), method_key, code, 0, 0, 0, "", t, one_line(message))
 
 
 def _check_one(path: Path, t0: float) -> CheckRow:

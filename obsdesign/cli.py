@@ -114,7 +114,9 @@ class Fmt(StrEnum):
 
 
 def _err(msg: str) -> None:
-    sys.stderr.write(f"obsdesign: error: {msg}\n")
+    from obsdesign.errors import one_line
+
+    sys.stderr.write(f"obsdesign: error: {one_line(msg)}\n")
 
 
 # options shared by the commands that print results

@@ -6,6 +6,9 @@
 
 from __future__ import annotations
 
+import re
+import unicodedata
+
 EXIT_OK = 0
 EXIT_INFEASIBLE = 1
 EXIT_BAD_INPUT = 2
@@ -13,12 +16,37 @@ EXIT_SOLVER = 3
 EXIT_INCONCLUSIVE = 4
 
 
+#: runs of digits at least this long are shortened in messages
+_LONG_DIGITS = re.compile(r"\d{100,}")
+
+
+def _escape_char(c: str) -> str:
+    if c in "\n\r\t":
+        return {"\n": "\\n", "\r": "\\r", "\t": "\\t"}[c]
+    o = ord(c)
+    return f"\\x{o:02x}" if o < 0x100 else f"\\u{o:04x}"
+
+
+def one_line(message: str) -> str:
+    """``message`` safe to print as one line: control characters (newline, ESC, …) and
+    Unicode line/paragraph separators from user-given names (TOML keys, file names) are
+    written as escapes, so a key cannot break the line or drive the terminal; a run of 100 or
+    more digits (a 5000-digit number from a file) is shortened to its first 20 digits and
+    its length. Idempotent on ordinary text."""
+    out = "".join(
+        _escape_char(c) if unicodedata.category(c) in ("Cc", "Zl", "Zp") else c for c in message
+    )
+    return _LONG_DIGITS.sub(lambda m: f"{m[0][:20]}…({len(m[0])} digits)", out)
+
+
 class ObsdesignError(Exception):
-    """Base class: carries the exit code and a one-line message for the user."""
+    """Base class: carries the exit code and a one-line message for the user (made one line
+    by :func:`one_line`)."""
 
     exit_code: int = EXIT_SOLVER
 
     def __init__(self, message: str) -> None:
+        message = one_line(message)
         super().__init__(message)
         self.message = message
 

@@ -241,7 +241,8 @@ class Report:
                 f"(--limit max_digits=N)"
             ) from None
         no_lone_surrogates(raw, d, str(p))
-        return cls.from_dict(d, str(p))
+        with int_digits():  # from_dict may print an integer as long as the parser read
+            return cls.from_dict(d, str(p))
 
     @classmethod
     def from_dict(cls, d: Any, file: str = "<report>") -> tuple[Report, list[str]]:

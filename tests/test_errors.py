@@ -1,0 +1,66 @@
+"""obsdesign.errors: exit codes of the error types and one-line messages."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from hypothesis import given
+from hypothesis import strategies as st
+from typer.testing import CliRunner
+
+from obsdesign import api
+from obsdesign.cli import app
+from obsdesign.errors import InputError, SpecError, one_line
+
+ROOT = Path(__file__).resolve().parents[1]
+runner = CliRunner()
+
+
+def test_one_line_escapes_control_characters_and_shortens_digit_runs() -> None:
+    assert one_line("a\nb\r\tc\x1b[2K\x85d\u2028e") == "a\\nb\\r\\tc\\x1b[2K\\x85d\\u2028e"
+    assert one_line("x " + "9" * 99 + " y") == "x " + "9" * 99 + " y"
+    assert one_line("9" * 100) == "9" * 20 + "…(100 digits)"
+    assert one_line("plain message: [method.lambda] 0.5 ∈ (0, 1)") == (
+        "plain message: [method.lambda] 0.5 ∈ (0, 1)"
+    )
+
+
+@given(st.text())
+def test_one_line_is_one_printable_line_and_idempotent(s: str) -> None:
+    out = one_line(s)
+    assert len(out.splitlines()) <= 1 and "\x1b" not in out
+    assert one_line(out) == out
+
+
+def test_errors_carry_one_line_messages() -> None:
+    e = SpecError("f\n.toml", "method.evil\x1b[2K", "is not a known key here")
+    assert e.message == "f\\n.toml: [method.evil\\x1b[2K] is not a known key here"
+    assert str(InputError("a\nb")) == "a\\nb"
+
+
+def test_a_key_with_a_newline_and_escape_gives_one_line(tmp_path: Path) -> None:
+    """Found by the CLI fuzzer: a quoted TOML key with a newline and an ESC sequence was
+    printed raw, a two-line error that also erased part of the terminal line."""
+    text = (ROOT / "tests" / "specs" / "lyapunov-minimal.toml").read_text()
+    spec = tmp_path / "s.toml"
+    spec.write_text(text.replace("[method]\n", '[method]\n"evil\\nok\\u001b[2K" = 1\n', 1))
+    r = runner.invoke(app, ["design", str(spec), "-o", str(tmp_path / "r.json")])
+    assert r.exit_code == 2
+    assert r.stderr.count("\n") == 1 and "\x1b" not in r.stderr
+    assert "[method.evil\\nok\\x1b[2K] is not a known key here" in r.stderr
+
+
+def test_a_5000_digit_schema_version_is_one_short_line(tmp_path: Path) -> None:
+    """Found by the CLI fuzzer: with --limit max_digits=10000 a report whose schema_version
+    has 5000 digits was an internal failure (exit 3, Python's int-string limit); it is now
+    exit 2 with the number shortened."""
+    rep = api.design(api.load_spec(ROOT / "tests" / "specs" / "lyapunov-minimal.toml"))
+    d = rep.to_dict()
+    d["schema_version"] = "SV"
+    bad = tmp_path / "r.json"
+    bad.write_text(json.dumps(d).replace('"SV"', "9" * 5000))
+    r = runner.invoke(app, ["--limit", "max_digits=10000", "verify", str(bad)])
+    assert r.exit_code == 2, r.stderr
+    assert r.stderr.count("\n") == 1 and len(r.stderr) < 300
+    assert "schema_version 99999999999999999999…(5000 digits) is not supported" in r.stderr
