@@ -131,14 +131,15 @@ class Parameters:
         return out
 
     @classmethod
-    def from_json(cls, d: dict[str, Any]) -> tuple[Parameters, list[str]]:
+    def from_json(cls, d: dict[str, Any], file: str = "report") -> tuple[Parameters, list[str]]:
         """Parameters from a report's ``parameters`` object, and a list of inconsistencies
-        (a float that no longer matches its exact value)."""
+        (a float that no longer matches its exact value); ``file`` names the report in
+        error messages."""
         if not isinstance(d, dict):
-            raise InputError("report: 'parameters' must be an object")
+            raise InputError(f"{file}: 'parameters' must be an object")
         exact = d.get("exact", {})
         if not isinstance(exact, dict):
-            raise InputError("report: 'parameters.exact' must be an object")
+            raise InputError(f"{file}: 'parameters.exact' must be an object")
         vals: dict[str, Any] = {}
         problems: list[str] = []
         # exact lists already parsed, with their float lists and verdict: a value written
@@ -160,7 +161,7 @@ class Parameters:
                         q, fl = qparse_floats(ek)  # OverflowError passes, as _floats's did
                     except (ValueError, TypeError, ZeroDivisionError) as e:
                         raise InputError(
-                            f"report: parameters.exact.{k}: not an exact value ({e})"
+                            f"{file}: parameters.exact.{k}: not an exact value ({e})"
                         ) from e
                     same = _same(fl, v)
                     if isinstance(ek, list):

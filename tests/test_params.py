@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from flint import fmpq
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
@@ -158,3 +159,31 @@ def test_float_forms_kept_from_reading_and_dropped_on_change():
     assert back.float_json("P")[0][0] == 1.0
     back["P"] = qmat([[5, 0], [0, 5]])
     assert back.float_json("P") == [[5.0, 0.0], [0.0, 5.0]]
+
+
+def test_report_errors_name_the_report_file(tmp_path) -> None:
+    """The CLI fuzzer found verify errors about 'parameters' that said "report:" instead of
+    the report's path."""
+    import json
+    from pathlib import Path
+
+    from obsdesign import api
+    from obsdesign.errors import InputError
+    from obsdesign.report.model import Report
+
+    spec = Path(__file__).resolve().parent / "specs" / "lyapunov-minimal.toml"
+    d = api.design(api.load_spec(spec)).to_dict()
+    key = next(iter(d["parameters"]["exact"]))
+    cases = [
+        ({**d, "parameters": {**d["parameters"], "exact": []}}, "'parameters.exact' must be"),
+        (
+            {**d, "parameters": {**d["parameters"], "exact": {key: "1/0x"}}},
+            f"parameters.exact.{key}: not an exact value",
+        ),
+    ]
+    for i, (bad, msg) in enumerate(cases):
+        f = tmp_path / f"r{i}.json"
+        f.write_text(json.dumps(bad))
+        with pytest.raises(InputError) as e:
+            Report.load(f)
+        assert e.value.message.startswith(f"{f}: ") and msg in e.value.message

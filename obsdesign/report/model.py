@@ -286,7 +286,7 @@ class Report:
                 raise InputError(
                     f"{file}: an error report has verdict 'error' and error.exit_code/message"
                 )
-        params, problems = Parameters.from_json(d["parameters"])
+        params, problems = Parameters.from_json(d["parameters"], file)
         try:
             claims = [Claim.from_dict(c) for c in d["claims"]]
         except (KeyError, TypeError, ValueError) as e:
