@@ -610,13 +610,44 @@ def methods(
 # -- helpers -------------------------------------------------------------------------------
 
 
+def _click_kind(e: BaseException) -> str | None:
+    """Which of click's exceptions ``e`` is ("NoArgsIsHelpError", "UsageError",
+    "ClickException", "Abort"), by class name: typer 0.2x vendors click as ``typer._click``,
+    older ones use ``click`` itself, so the classes differ by version."""
+    names = [c.__name__ for c in type(e).__mro__]
+    for kind in ("NoArgsIsHelpError", "UsageError", "ClickException", "Abort"):
+        if kind in names:
+            return kind
+    return None
+
+
 def main() -> None:
-    """Console-script entry point."""
+    """Console-script entry point. Click's own usage errors (an unknown option, a missing
+    argument, a bad option value) become one line, like every other bad input: "obsdesign:
+    error: <what> (see 'obsdesign CMD --help')", exit 2, instead of click's four-line
+    usage block."""
     try:
-        app()
+        rv = app(standalone_mode=False)
     except KeyboardInterrupt:  # pragma: no cover - Ctrl-C outside a command body
         _err("interrupted")
         sys.exit(130)
+    except Exception as e:
+        kind = _click_kind(e)
+        if kind is None:
+            raise
+        if kind == "NoArgsIsHelpError":  # bare `obsdesign`: the help, as click shows it
+            e.show()  # type: ignore[attr-defined]
+        elif kind == "UsageError":
+            ctx = getattr(e, "ctx", None)
+            where = ctx.command_path if ctx is not None else "obsdesign"
+            _err(f"{e.format_message()} (see '{where} --help')")  # type: ignore[attr-defined]
+        elif kind == "ClickException":  # e.g. a click.File that cannot be opened
+            _err(e.format_message())  # type: ignore[attr-defined]
+        else:  # Abort: EOF at a prompt (there is none today)
+            _err("interrupted")
+            sys.exit(130)
+        sys.exit(getattr(e, "exit_code", 2))
+    sys.exit(rv if isinstance(rv, int) else 0)
 
 
 if __name__ == "__main__":

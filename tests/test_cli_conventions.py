@@ -218,3 +218,55 @@ def test_simulate_from_stdin_json():
     assert code == 0 and json.loads(out)["final_error_norm"] >= 0
     code, out, _ = _run("simulate", "-", "-q", input=SPEC)
     assert code == 0 and out == ""
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (
+            ["design", "--bogus", "s.toml"],
+            "No such option: --bogus (see 'obsdesign design --help')",
+        ),
+        (["desgn"], "No such command 'desgn'. Did you mean 'design'? (see 'obsdesign --help')"),
+        (["design"], "Missing argument 'SPEC'. (see 'obsdesign design --help')"),
+        (["design", "--width", "3", "s.toml"], "Invalid value for '--width'"),
+        (["simulate", "s.toml", "--runs", "x"], "Invalid value for '--runs'"),
+    ],
+)
+def test_usage_errors_are_one_line_exit_2(
+    argv: list[str], message: str, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
+) -> None:
+    """Click's own usage errors printed a four-line block ("Usage: …", "Try …", blank,
+    "Error: …"); through the console entry point they are now one line like every other
+    bad input, exit 2."""
+    from obsdesign.cli import main
+
+    monkeypatch.setattr(sys, "argv", ["obsdesign", *argv])
+    with pytest.raises(SystemExit) as e:
+        main()
+    assert e.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("obsdesign: error: ") and err.count("\n") == 1 and message in err
+
+
+def test_entry_point_passes_exit_codes_and_help_through(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
+) -> None:
+    """main() runs click outside its standalone mode: a command's exit code, --help and a
+    bare ``obsdesign`` (the help, exit 2 as click gives it) are unchanged."""
+    from obsdesign.cli import main
+
+    spec = tmp_path / "s.toml"
+    spec.write_text(SPEC)
+    for argv, code in (
+        (["design", str(spec), "-q"], 0),
+        (["design", str(spec).replace("s.toml", "t.toml")], 2),
+        (["--help"], 0),
+        ([], 2),
+    ):
+        monkeypatch.setattr(sys, "argv", ["obsdesign", *argv])
+        with pytest.raises(SystemExit) as e:
+            main()
+        assert e.value.code == code, argv
+    c = capsys.readouterr()
+    assert "Usage: obsdesign" in c.out and "Usage: obsdesign" in c.err
