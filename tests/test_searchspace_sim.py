@@ -13,6 +13,7 @@ from typer.testing import CliRunner
 
 from obsdesign import api
 from obsdesign.cli import app
+from obsdesign.errors import InputError
 from obsdesign.methods.searchspace.sim import ConsistencyLost, MemoryCap, cover_box, recover
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -233,6 +234,19 @@ xhat0 = [0]
     res = api.simulate(sp2, rep2)
     assert not res.info.get("warnings")
     assert "left_U_at" not in res.info and "past_horizon" not in res.info
+
+
+def test_a_horizon_beyond_the_record_budget_is_refused_before_the_run(tmp_path):
+    """[simulate] horizon = 1e30 (CLI fuzzer): the pass that looked for u leaving U went over
+    all 3·10³¹ half-periods before the loop and its time budget, and the loop itself ran
+    until time_limit. The number of sampling periods is now checked against max_sim_bytes
+    first (exit 2 naming the key), and u is checked period by period inside the loop."""
+    sp, rep = _load(TEXT.replace("\nhorizon = 12\n", "\nhorizon = 1e30\n"), tmp_path)
+    with pytest.raises(
+        InputError, match=r"\[simulate\] horizon = 1e\+30 is .* sampling periods"
+    ) as e:
+        api.simulate(sp, rep)
+    assert e.value.exit_code == 2 and "max_sim_bytes" in e.value.message
 
 
 def test_recover_covers_every_ball_point():

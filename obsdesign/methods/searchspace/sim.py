@@ -38,7 +38,8 @@ from typing import Any
 
 import numpy as np
 
-from obsdesign.errors import InfeasibleError, SolverError
+from obsdesign.errors import InfeasibleError, InputError, SolverError
+from obsdesign.limits import limits
 from obsdesign.methods.searchspace.options import Options, SimOptions
 from obsdesign.params import Parameters
 from obsdesign.simulate.result import SimResult
@@ -284,7 +285,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
     eps = [float(e) for e in params.float("eps_schedule")]
     L_f, L_h = params.float("L_f"), params.float("L_h")
     t0 = float(o.t0)
-    N = int(math.floor(float(spec.simulate.horizon.f) / dT + 1e-9))
+    N = _samples(spec, dT)
     if N == 0:
         warnings.warn(
             f"[simulate] horizon = {float(spec.simulate.horizon.f):g} is shorter than one "
@@ -312,7 +313,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
     steps = 0
     flow_err = 0.0
     left_E: float | None = None
-    left_U = _left_U(plant, o, t0, dT, N)
+    left_U = _left_U(plant, o, t0, dT, 0)
     t_start = time.perf_counter()
     deadline = t_start + so.time_limit
     if not len(C):
@@ -321,6 +322,8 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
     if so.substeps == 0:
         nsub, flow_err = _auto_substeps(plant, C, t, dT, nsub, eps[0])
     for k in range(1, N + 1):
+        if left_U is None:
+            left_U = _left_U(plant, o, t0, dT, k)
         t_next = t0 + k * dT
         steps += len(C) * nsub
         C, keep, x, y = observer_step(plant, C, x, t, dT, nsub, gam[min(i, len(gam) - 1)])
@@ -387,15 +390,46 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
     return res
 
 
-def _left_U(plant: Plant, o: Options, t0: float, dT: float, N: int) -> float | None:
-    """The first sample time or midpoint t0 + j·dT/2 where u(t) leaves the input range U of
-    the design (None: never, or no U). Outside U, L_f and the bound of f are not constants of
-    the plant along the run (random-spec fuzzer: u = t run past U gave a true-cell distance
-    2.9× the bound ε e^(L_f t) with no word of why)."""
+#: bytes one sample's record takes (:func:`_record`: four small arrays, five floats and the
+#: list entries), beside 8 bytes per state and output entry
+RECORD_BYTES = 700
+
+
+def _samples(spec: Spec, dT: float) -> int:
+    """The number of sampling periods ΔT in ``[simulate] horizon``, refused (InputError, exit
+    2, naming the key) when their records would not fit in ``max_sim_bytes``: the samples
+    follow ΔT of the design, not ``[simulate] dt``, so the API's check before the run cannot
+    count them, and ``horizon = 1e30`` ran until ``time_limit``.
+
+    :param spec: the bound spec; :param dT: the design's sampling period."""
+    assert spec.simulate is not None
+    h = float(spec.simulate.horizon.f)
+    ratio = h / dT
+    s = spec.system
+    per = RECORD_BYTES + 8.0 * (3 * s.n + s.p)
+    cap = limits().max_sim_bytes
+    if not math.isfinite(ratio) or (ratio + 1.0) * per > cap:
+        raise InputError(
+            f"{spec.file}: [simulate] horizon = {h:g} is {ratio:.3g} sampling periods ΔT = "
+            f"{dT:.6g} of the design, whose records need about {(ratio + 1.0) * per / 2**30:.3g} "
+            f"GiB, above the limit of {cap / 2**30:.3g} GiB (a shorter horizon, or --limit "
+            "max_sim_bytes=N)"
+        )
+    return int(math.floor(ratio + 1e-9))
+
+
+def _left_U(plant: Plant, o: Options, t0: float, dT: float, k: int) -> float | None:
+    """The first of the times t0 + (2k − 1)·dT/2 and t0 + k·dT (k = 0: t0 alone), the
+    midpoint and the end of sampling period k, where u(t) leaves the input range U of the
+    design (None: it does not, or no U). Outside U, L_f and the bound of f are not constants
+    of the plant along the run (random-spec fuzzer: u = t run past U gave a true-cell distance
+    2.9× the bound ε e^(L_f t) with no word of why). Called once per period inside the
+    simulation loop, so it runs under ``time_limit`` (a pass over the whole horizon before the
+    loop did not: ``horizon = 1e30`` ran past every limit)."""
     if o.U is None or not plant.inputs:
         return None
     lo, hi = np.asarray(o.U.lower, dtype=float), np.asarray(o.U.upper, dtype=float)
-    for j in range(2 * N + 1):
+    for j in (0,) if k == 0 else (2 * k - 1, 2 * k):
         t = t0 + j * dT / 2
         u = np.array([plant.u(t)[name] for name in plant.inputs])
         if np.any(u < lo) or np.any(u > hi):
