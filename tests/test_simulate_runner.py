@@ -112,3 +112,18 @@ def test_a_diverging_trajectory_gets_a_plain_warning():
     stable = text.replace("A = [[400.0]]", "A = [[0.5]]").replace("L = [[400.0]]", "L = [[0.5]]")
     res = api.simulate(load_spec_text(stable, "stable.toml"))
     assert not any("float range" in w for w in res.info.get("warnings", []))
+
+
+def test_obsdesign_simulate_stays_callable_after_the_subpackage_loads() -> None:
+    """README's ``obsdesign.simulate(spec)``: the first call imports ``obsdesign.simulate.*``,
+    which rebinds the package attribute to the subpackage; the subpackage is callable, so a
+    second call works too (it raised "'module' object is not callable")."""
+    from pathlib import Path
+
+    import obsdesign
+    import obsdesign.simulate.runner  # noqa: F401 - what the first call does
+
+    spec = Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+    a = obsdesign.simulate(obsdesign.load_spec(spec))
+    b = obsdesign.simulate(obsdesign.load_spec(spec))
+    assert type(a).__name__ == "SimResult" and (a.xhat == b.xhat).all()
