@@ -98,7 +98,7 @@ def three_state() -> None:
     reps = 3
     t0 = time.perf_counter()
     for r in range(reps):
-        Cn, keep, _, _ = observer_step(plant, C, x, r * dT, dT, 1, 10.0)
+        Cn, keep, _, _, _ = observer_step(plant, C, x, r * dT, dT, 1, 10.0)
     dt = time.perf_counter() - t0
     rate = len(C) * reps / dt
     line(f"3-state, {len(C):,} live centres: centre-steps/s", f"{rate:.3g}", "", None)
