@@ -347,3 +347,66 @@ def test_rate_tol_below_float_resolution_is_a_spec_error():
     with pytest.raises(SpecError) as e:
         api.design(load_spec_text(text, "bad.toml"))
     assert "method.rate_tol" in str(e.value) and "bad.toml" in str(e.value)
+
+
+#: the independent simulate review's random spec: w = (d, v) inside D, θ = 704,498 spent in
+#: full, x̂_k ∈ X̂ for every k
+R2 = """[system]
+time = "discrete"
+A = [[0.6, 0.2], [-0.1, 0.5]]
+C = [[1, 0], [0, 1]]
+Bd = [[1, 0], [0, 1]]
+[sets.X]
+type = "box"
+lower = [-1, -1]
+upper = [1, 1]
+[method]
+key = "constrained"
+L = [[0, -0.4], [0.5, -0.1]]
+lambda = 0.9
+X = "X"
+eps_min = 0.04
+[method.c]
+type = "box"
+lower = [-1.1, -1.1]
+upper = [1.1, 1.1]
+[method.D]
+lower = [-0.1, -0.1, -0.5, -0.5]
+upper = [0.1, 0.1, 0.5, 0.5]
+[simulate]
+horizon = 60
+x0 = [0.6, -0.6]
+xhat0 = [-1.2, 1.2]
+seed = 4
+[simulate.disturbance]
+kind = "uniform"
+bound = 0.1
+[simulate.noise]
+kind = "uniform"
+bound = 0.5
+"""
+
+
+def test_simulate_says_when_a_run_is_outside_the_premises_of_theorem_1(tmp_path) -> None:
+    """Noise outside D, a refining budget θ_m < θ spent at some sample, and a plant leaving X
+    break the premises of (25b): simulate printed "x̂_k in X̂ for all k ≥ 1: False" with no
+    word of why (independent simulate review). Inside D with a budget never spent: "hold",
+    no warning."""
+    p = tmp_path / "r2.toml"
+
+    def run(text: str, **options: str) -> tuple[str, str]:
+        p.write_text(text)
+        info = api.simulate(p, options=options or None).info
+        return info["premises of Theorem 1 (25b)"], " ".join(info.get("warnings", []))
+
+    premises, said = run(R2)
+    assert premises == "hold" and said == ""
+    premises, said = run(R2.replace("bound = 0.5", "bound = 0.6"))
+    assert premises.startswith("w_k = (d_k, v_k) leaves D at k = ")
+    assert "outside the premises of the guarantee x̂_k ∈ X̂" in said
+    premises, said = run(R2, theta_m="1")
+    assert premises == "θ_m = 1 < θ = 704,498 steps, all spent at some sample" and premises in said
+    premises, said = run(
+        R2.replace("lower = [-1, -1]\nupper = [1, 1]", "lower = [-0.5, -0.5]\nupper = [1, 1]")
+    )
+    assert "the plant leaves X at k = 0 (Assumption 1)" in premises and premises in said

@@ -4,6 +4,7 @@ the naive saturated observer (29), on the same plant trajectory."""
 
 from __future__ import annotations
 
+import warnings
 from typing import Any
 
 import numpy as np
@@ -52,6 +53,41 @@ def _positive(v: float, key: str) -> float:
     if not v > 0:
         raise InputError(f"--option {key}: expected a positive number, got {v!r}")
     return float(v)
+
+
+def _first(bad: np.ndarray) -> int:
+    return int(np.argmax(bad))
+
+
+def _outside_premises(
+    o: Options, x: np.ndarray, u: np.ndarray, d: np.ndarray, v: np.ndarray
+) -> list[str]:
+    """The premises of Theorem 1 (constrained-redesign paper) that the simulated run breaks,
+    one phrase each: w_k = (d_k, v_k) ∈ D for every k, x_k ∈ X (Assumption 1), and u_k in the
+    input range of an expression model. Without them "x̂_k ∈ X̂ for all k" may fail with the
+    design intact (independent simulate review: noise ±3 against D = [−0.3, 0.3] printed
+    "False" with no word of why)."""
+    out: list[str] = []
+    K = len(x)
+    w = np.hstack([np.asarray(d, float).reshape(K, -1), np.asarray(v, float).reshape(K, -1)])
+    lo, hi = np.asarray(o.D_lower, float), np.asarray(o.D_upper, float)
+    if w.shape[1] == lo.size and lo.size:
+        bad = np.any((w < lo - 1e-12) | (w > hi + 1e-12), axis=1)
+        if bad.any():
+            k = _first(bad)
+            out.append(
+                f"w_k = (d_k, v_k) leaves D at k = {k} ({int(bad.sum())} of {K} samples; "
+                f"w_{k} = {np.round(w[k], 6).tolist()})"
+            )
+    bad = ~np.asarray(o.X.contains(x, tol=1e-9), dtype=bool).reshape(-1)
+    if bad.any():
+        out.append(f"the plant leaves X at k = {_first(bad)} (Assumption 1)")
+    if o.model is not None and o.U_lower.size:
+        U = np.asarray(u, float).reshape(K, -1)
+        bad = np.any((U < o.U_lower.astype(float)) | (U > o.U_upper.astype(float)), axis=1)
+        if U.shape[1] == o.U_lower.size and bad.any():
+            out.append(f"u_k leaves the input range U at k = {_first(bad)}")
+    return out
 
 
 def simulate(
@@ -161,6 +197,27 @@ def simulate(
             info[f"{name}: max V increase over a refining step"] = f"{_v_increase(tr, x, Pf):.3g}"
         if name.startswith("saturated"):
             info[f"{name}: final x̂"] = _fmt(tr.xhat[-1])
+    outside = _outside_premises(o, x, u, d, v)
+    # θ_m < θ matters only where a sample spent its whole budget (Lemma 3: the refining
+    # ends within θ steps; a budget never reached ran as θ would)
+    spent = [
+        tm
+        for tm in thetas
+        if tm < theta and int(traces[f"modified θ_m={tm}"].steps.max(initial=0)) >= tm
+    ]
+    if spent or not g_ok:
+        outside.append(
+            "; ".join(
+                [f"θ_m = {tm:,} < θ = {theta:,} steps, all spent at some sample" for tm in spent]
+                + ([] if g_ok else ["γ is above the bound (24) (Lemma 3 needs it)"])
+            )
+        )
+    info["premises of Theorem 1 (25b)"] = "hold" if not outside else "; ".join(outside)
+    for why in outside:
+        warnings.warn(
+            f"[simulate] outside the premises of the guarantee x̂_k ∈ X̂ (Theorem 1, (25b)): {why}",
+            stacklevel=2,
+        )
     main = next((n for n in traces if n.startswith("modified")), "unmodified")
     res = SimResult(k.astype(float), x, traces[main].xhat, y, s.states)
     res.extra = {
