@@ -475,6 +475,14 @@ def simulate(
     plot: Annotated[
         Path | None, typer.Option("--plot", metavar="FILE", help="Write a plot (PNG/SVG).")
     ] = None,
+    csv: Annotated[
+        Path | None,
+        typer.Option(
+            "--csv",
+            metavar="FILE",
+            help="Write the trajectories as CSV: t, x_*, xhat_*, e_*, y* (run 0 of --runs).",
+        ),
+    ] = None,
     fmt: FmtOpt = Fmt.text,
     option: Annotated[
         list[str] | None,
@@ -485,7 +493,8 @@ def simulate(
         ),
     ] = None,
     force: Annotated[
-        bool, typer.Option("--force", help="Write --plot even where it is refused by default.")
+        bool,
+        typer.Option("--force", help="Write --plot / --csv even where refused by default."),
     ] = False,
     runs: Annotated[
         int | None,
@@ -518,7 +527,7 @@ def simulate(
 
     _run(
         lambda cmd: cmd.simulate(
-            spec, report, plot, fmt, option, force, runs, study, workers, scheduler, quiet
+            spec, report, plot, fmt, option, force, runs, study, workers, scheduler, quiet, csv
         ),
         quiet,
         width,

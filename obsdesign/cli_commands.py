@@ -534,16 +534,21 @@ def simulate(
     workers: int | None,
     scheduler: str | None,
     quiet: bool,
+    csv: Path | None = None,
 ) -> int:
     """The body of ``obsdesign simulate`` (see :func:`obsdesign.cli.simulate`)."""
     _precheck(spec)  # before the heavy imports
     from obsdesign import api
+    from obsdesign.report.model import check_output
 
     if workers is not None or scheduler is not None:
         from obsdesign.distributed import check_workers
 
         check_workers(workers, scheduler)
+    _distinct_outputs(plot, csv)
     _check_plot(plot, force, _inputs(spec, report))
+    if csv is not None:
+        check_output(csv, force, _inputs(spec, report))
     sp = _load_spec(spec)
     opts = _kv(option or [])
     if runs is not None:
@@ -562,6 +567,12 @@ def simulate(
         _write_plot(plot, lambda tmp: api.plot_simulation(sp, res, tmp), force)
         if fmt == Fmt.text:
             _say(f"plot written to {plot}")
+    if csv is not None:
+        from obsdesign.report.model import write_atomic
+
+        write_atomic(csv, res.csv_text(), force)
+        if fmt == Fmt.text:
+            _say(f"trajectories written to {csv}")
     return int(res.info.get("exit_code", 0))
 
 

@@ -157,3 +157,51 @@ def test_python_api_one_liner():
         timeout=120,
     )
     assert r.returncode == 0 and r.stdout.strip() == "certified"
+
+
+def test_simulate_csv_writes_the_trajectories(tmp_path: Path) -> None:
+    """``simulate --csv FILE`` (independent simulate review: trajectories were reachable only
+    through the Python API): one row per grid point, the simulated doubles back exactly; the
+    output rules of -o and --plot apply (never the spec, never one path for two outputs, no
+    file when the run fails)."""
+    import csv as csvmod
+
+    import numpy as np
+
+    from obsdesign import api
+
+    spec = tmp_path / "s.toml"
+    spec.write_text(
+        (
+            Path(__file__).resolve().parents[1]
+            / "specs"
+            / "constrained-redesign-sec5-lyapunov.toml"
+        ).read_text()
+    )
+    out = tmp_path / "traj.csv"
+    r = CliRunner().invoke(app, ["simulate", str(spec), "--csv", str(out)])
+    assert r.exit_code == 0, r.stderr
+    rows = list(csvmod.reader(out.open()))
+    assert rows[0] == ["t", "x_x1", "x_x2", "xhat_x1", "xhat_x2", "e_x1", "e_x2", "y1"]
+    tab = np.array(rows[1:], dtype=float)
+    res = api.simulate(api.load_spec(spec))
+    assert np.array_equal(tab[:, 0], res.t) and np.array_equal(tab[:, 1:3], res.x)
+    assert np.array_equal(tab[:, 3:5], res.xhat) and np.array_equal(tab[:, 5:7], res.e)
+    before = spec.read_text()
+    r = CliRunner().invoke(app, ["simulate", str(spec), "--csv", str(spec)])
+    assert r.exit_code == 2 and spec.read_text() == before
+    r = CliRunner().invoke(
+        app,
+        [
+            "simulate",
+            str(spec),
+            "--csv",
+            str(tmp_path / "p.png"),
+            "--plot",
+            str(tmp_path / "p.png"),
+        ],
+    )
+    assert r.exit_code == 2 and "two outputs" in r.stderr
+    gone = tmp_path / "none.csv"
+    r = CliRunner().invoke(app, ["simulate", str(spec), "--csv", str(gone), "--option", "bogus=1"])
+    assert r.exit_code == 2 and not gone.exists()

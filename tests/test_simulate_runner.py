@@ -127,3 +127,19 @@ def test_obsdesign_simulate_stays_callable_after_the_subpackage_loads() -> None:
     a = obsdesign.simulate(obsdesign.load_spec(spec))
     b = obsdesign.simulate(obsdesign.load_spec(spec))
     assert type(a).__name__ == "SimResult" and (a.xhat == b.xhat).all()
+
+
+def test_csv_text_quotes_names_and_round_trips_floats() -> None:
+    import csv
+    import io
+
+    import numpy as np
+
+    from obsdesign.simulate.result import SimResult
+
+    x = np.array([[0.1, 1e-300], [2.0 / 3.0, -5.0]])
+    res = SimResult(np.array([0.0, 0.5]), x, x + 0.25, None, ["a,b", 'q"'])
+    rows = list(csv.reader(io.StringIO(res.csv_text())))
+    assert rows[0] == ["t", "x_a,b", 'x_q"', "xhat_a,b", 'xhat_q"', "e_a,b", 'e_q"']
+    tab = np.array(rows[1:], dtype=float)
+    assert np.array_equal(tab[:, 1:3], x) and np.array_equal(tab[:, 5:7], res.e)

@@ -38,6 +38,32 @@ class SimResult:
         }
         return {**m, **self.info}
 
+    def csv_text(self) -> str:
+        """The trajectories as CSV: one row per grid point, columns ``t``, ``x_<state>``,
+        ``xhat_<state>``, ``e_<state>`` (the error the metrics use) and ``y<j>``; floats by
+        their shortest round-trip repr, so a reader gets the simulated doubles back. For a
+        Monte Carlo run, the trajectory the method keeps (its run 0)."""
+        n = self.x.shape[1]
+        names = self.states or [f"x{i + 1}" for i in range(n)]
+        cols = [np.asarray(self.t, dtype=float).reshape(-1, 1), self.x, self.xhat, self.e]
+        head = ["t", *(f"x_{s}" for s in names), *(f"xhat_{s}" for s in names)]
+        head += [f"e_{s}" for s in names]
+        if self.y is not None:
+            y = np.asarray(self.y, dtype=float).reshape(len(self.t), -1)
+            cols.append(y)
+            head += [f"y{j + 1}" for j in range(y.shape[1])]
+        table = np.hstack([np.asarray(c, dtype=float) for c in cols])
+        lines = [",".join(_csv_name(h) for h in head)]
+        lines += [",".join(repr(float(v)) for v in row) for row in table]
+        return "\n".join(lines) + "\n"
+
+
+def _csv_name(name: str) -> str:
+    """A CSV header cell: quoted when a state name holds a comma, quote or line break."""
+    if any(c in name for c in ',"\n\r'):
+        return '"' + name.replace('"', '""') + '"'
+    return name
+
 
 def metrics(e: np.ndarray, states: list[str] | None = None) -> dict[str, Any]:
     """sup_k |e_i(k)|, RMSE of each e_i, and the final Euclidean |e|."""
