@@ -636,7 +636,7 @@ def main() -> None:
     error: <what> (see 'obsdesign CMD --help')", exit 2, instead of click's four-line
     usage block."""
     try:
-        rv = app(standalone_mode=False)
+        rv = app(standalone_mode=False, prog_name="obsdesign")
     except KeyboardInterrupt:  # pragma: no cover - Ctrl-C outside a command body
         _err("interrupted")
         sys.exit(130)
