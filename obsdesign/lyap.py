@@ -581,7 +581,7 @@ def solve_lyapunov(Acl: np.ndarray, rate: float, discrete: bool) -> np.ndarray:
     continuous Acl) gets numpy's least-squares solution, as scipy's solvers perturb and go on.
     Larger systems use scipy's ``solve_discrete_lyapunov`` / ``solve_continuous_lyapunov``
     (O(n³)). Either way X is only a candidate: the exact checks decide. Raises numpy's
-    LinAlgError (or ValueError) when the solver fails.
+    LinAlgError (or ValueError) when the solver fails or the operator overflows float64.
 
     :param Acl: the float closed-loop matrix; :param rate: λ or α; :param discrete: time domain."""
     Af = np.asarray(Acl, dtype=float)
@@ -593,6 +593,11 @@ def solve_lyapunov(Acl: np.ndarray, rate: float, discrete: bool) -> np.ndarray:
         else:
             M = (Af + rate * eye).T
             K = -(np.kron(M, eye) + np.kron(eye, M))
+        if not np.all(np.isfinite(K)):
+            # ‖Acl‖² beyond the float range: LAPACK's least-squares SVD never returns on an
+            # inf entry (hard-case fuzzer: A = [[0.5, 1e200], [0, 0.5]] hung, past Ctrl-C and
+            # check --timeout); the callers take this as "no float solution"
+            raise np.linalg.LinAlgError("the Lyapunov operator overflows float64")
         rhs = eye.reshape(-1)
         try:
             return np.linalg.solve(K, rhs).reshape(n, n)

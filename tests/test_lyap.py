@@ -545,3 +545,18 @@ def test_best_rate_below_the_float_resolution_is_refused() -> None:
     tol = fmpq(1, 10**15)
     br = best_rate(A5, C5, L5, True, tol=tol, margin=MARGIN)
     assert 0 < br.best - br.other <= tol
+
+
+def test_solve_lyapunov_refuses_an_overflowing_operator_instead_of_hanging() -> None:
+    """A = [[0.5, 1e200], [0, 0.5]] (hard-case fuzzer): λ²I − Aᵀ⊗Aᵀ holds −inf and is singular
+    at λ = ρ(A) = 0.5, and numpy's lstsq (LAPACK dgelsd) never returned on it, past Ctrl-C.
+    Now LinAlgError, which :func:`_lyap_solution` reads as no float solution."""
+    import numpy as np
+    import pytest
+
+    from obsdesign import lyap
+
+    A = np.array([[0.5, 1e200], [0.0, 0.5]])
+    with pytest.raises(np.linalg.LinAlgError, match="overflows"):
+        lyap.solve_lyapunov(A, 0.5, True)
+    assert lyap._lyap_solution(A, 0.5, True) is None
