@@ -667,3 +667,27 @@ def test_l2_step_failing_falls_back_on_a_certified_bound() -> None:
     d = rep.to_dict()
     _set(d, "gamma2", _get(d, "gamma2") * fmpq(9, 10))
     assert "l2-gain" in _failed(d)
+
+
+def test_infeasible_with_a_given_K_points_at_lambda_too() -> None:
+    """Continuous, A ≈ −100·I, a given K and λ = 1000 (hard-case fuzzer): the message blamed
+    the given K alone, but on ker C the (1,1) block of (1) does not depend on K; it now also
+    says to try a smaller λ, raise r_bound, or omit K."""
+    from obsdesign import api
+    from obsdesign.errors import InfeasibleError
+
+    text = """[system]
+time = "continuous"
+A = [[-99.91073, 2.76064, 0.23936], [1.36144, -98.99884, 1.99884], [0.1685, 0.03, -101.03]]
+C = [[-1, -2, 2], [2, -2, 2]]
+[method]
+key = "stubborn"
+K = [[0.05003, 0.06965], [-0.4542, -0.04638], [-0.3995, -0.1155]]
+lambda = 1e3
+r_bound = 1
+"""
+    with pytest.raises(InfeasibleError) as e:
+        api.design(api.load_spec_text(text, "k.toml"))
+    msg = e.value.message
+    assert "with the given K" in msg and "try a smaller λ" in msg
+    assert "raise r_bound (now 1)" in msg and "omit K" in msg

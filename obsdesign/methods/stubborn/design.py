@@ -492,20 +492,25 @@ def _infeasible(spec: Spec, pl: Plant, o: Options, where: str) -> None:
             f"stubborn: LMIs {_refs(pl)} infeasible {where}, and detectability of (C, A) is "
             f"numerically inconclusive ({det.detail})"
         )
+    bounds = ", ".join(
+        f"{k} (now {float(v):g})"
+        for k, v in (("gain_bound", o.gain_bound), ("r_bound", o.r_bound))
+        if v is not None
+    )
+    # λ: the decay asked of V, λ·V in (1) (larger is harder) but λ·P in (7), where a
+    # λ closer to 1 is weaker (random-spec fuzzer: the discrete hint said "smaller")
+    lam_hint = ""
+    if o.lam is not None:
+        lam_hint = "a larger λ (closer to 1)" if pl.discrete else "a smaller λ"
+    hints = [h for h in (lam_hint and f"try {lam_hint}", bounds and f"raise {bounds}") if h]
     if o.K is not None:
-        why = "the given K does not allow it (redesign: X = P K)"
-    else:
-        bounds = ", ".join(
-            f"{k} (now {float(v):g})"
-            for k, v in (("gain_bound", o.gain_bound), ("r_bound", o.r_bound))
-            if v is not None
+        # the given K may not be the obstacle: on ker C the (1,1) block of (1) does not depend
+        # on K, so a λ beyond A's own decay there fails for every K (hard-case fuzzer: "the
+        # given K does not allow it" at λ = 1000 with A ≈ −100·I)
+        why = "(C, A) is detectable; with the given K (redesign: X = P K): " + " or ".join(
+            [*hints, "omit K to let the design choose it"]
         )
-        # λ: the decay asked of V, λ·V in (1) (larger is harder) but λ·P in (7), where a
-        # λ closer to 1 is weaker (random-spec fuzzer: the discrete hint said "smaller")
-        lam_hint = ""
-        if o.lam is not None:
-            lam_hint = "a larger λ (closer to 1)" if pl.discrete else "a smaller λ"
-        hints = [h for h in (lam_hint and f"try {lam_hint}", bounds and f"raise {bounds}") if h]
+    else:
         why = "(C, A) is detectable: " + (" or ".join(hints) or "no bound or λ to relax")
         if det.verdict is True and pl.discrete:
             free = replace(o, gain_bound=None, r_bound=None)
