@@ -19,6 +19,7 @@ options object. Exact functions take and return ``fmpq`` object arrays (see
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -213,7 +214,9 @@ def pd_verdict(
         hit = memo.get(key, (Pm,))
         if hit is not None:
             return hit
-    r = _pd_float(Pm, Q(margin), Pf) if Pf is not None else None
+    r = pd_small(Pm, margin)
+    if r is None and Pf is not None:
+        r = _pd_float(Pm, Q(margin), Pf)
     if r is None:
         r = pd_int(Pm, margin)
     if memo is not None:
@@ -236,6 +239,22 @@ def _pd_float(Pm: fmpq_mat, m: fmpq, Pf: np.ndarray) -> Any:
     if v is None:
         return None
     return PSDResult(True, float_or_inf(v.bound), v.detail, "verified-float")
+
+
+def pd_small(Pm: fmpq_mat, margin: Any) -> Any:
+    """P − margin·I ≻ 0 decided exactly by the fraction-free LDLᵀ of the integer matrix
+    b·P_z − a·d·I (as :func:`pd_int`) when that is the cheap proof
+    (:func:`obsdesign.certify.psd.fflu_cheap`: small n, short entries, where the verified
+    float Cholesky's fixed cost dominates); None otherwise (eq. (4) of the
+    constrained-redesign paper, Astolfi et al., NOLCOS 2019: V = eᵀPe positive definite).
+
+    :param Pm: symmetric P (exact); :param margin: δ ≥ 0 (exact)."""
+    from obsdesign.certify.psd import fflu_cheap, fraction_free_int
+
+    if Pm.nrows() > FFLU_MAX_N or Pm.nrows() == 0 or Pm != Pm.transpose():
+        return None
+    Z, c = _minus_margin(*Pm.numer_denom(), margin)
+    return fraction_free_int(Z, c) if fflu_cheap(Z) else None
 
 
 def pd_int(Pm: fmpq_mat, margin: Any) -> Any:
@@ -261,6 +280,12 @@ def _minus_margin(Z: fmpz_mat, D: Any, margin: Any) -> tuple[fmpz_mat, fmpq]:
         for i in range(Z.nrows()):
             Z[i, i] = Z[i, i] - sub
     return Z, fmpq(1) / (fmpq(D) * m.q)
+
+
+#: the largest n at which :func:`pd_small` and :func:`decay_pd` try the fraction-free LDLᵀ
+#: first (:func:`obsdesign.certify.psd.fflu_cheap` then decides by the entries' size); 0
+#: turns that path off (the float proofs run first, as for larger n)
+FFLU_MAX_N = 16
 
 
 #: the prime of :func:`observable_mod_p` (2⁶¹ − 1, a Mersenne prime)
@@ -389,14 +414,44 @@ def decay_pd(
     enclosure's error bound assumes it; :param Pf: the same for P (e.g. from
     :func:`dyadic_fmat`). Returns the verdict and the float matrix beside it (≈ the decay matrix − δI, or a
     positive multiple of it), as :func:`obsdesign.certify.psd.check_pd_fast_float`."""
-    from obsdesign.certify.psd import check_pd_int
+    from obsdesign.certify.psd import check_pd_int, fflu_cheap, fraction_free_int
+    from obsdesign.certify.vchol import int_to_float
 
     Am, Pm = fmat(Acl), fmat(P)
+    if _decay_small(Am, Pm, Q(rate), discrete, Q(margin), Af):
+        Zm, c = _minus_margin(*decay_int(Am, Pm, rate, discrete), margin)
+        if fflu_cheap(Zm):  # the exact LDLᵀ costs less than the enclosure here
+            r = fraction_free_int(Zm, c)
+            return r, (None if r.ok else int_to_float(Zm)[0])
     hit = _enclosure_pd(Am, Pm, Q(rate), discrete, Q(margin), Af, Pf)
     if hit is not None:
         return hit
     Z, D = decay_int(Am, Pm, rate, discrete)
     return check_pd_int(*_minus_margin(Z, D, margin))
+
+
+def _decay_small(
+    Am: fmpq_mat, Pm: fmpq_mat, r: fmpq, discrete: bool, m: fmpq, Af: np.ndarray | None
+) -> bool:
+    """Whether :func:`decay_pd` should form the integer decay matrix for the fraction-free
+    LDLᵀ (:func:`obsdesign.certify.psd.fflu_cheap`) before the float enclosure: n at most
+    :data:`FFLU_MAX_N` and an estimate of its entries' bits (from those of A − LC, P, the
+    rate and the margin, as :func:`decay_int` and :func:`_minus_margin` combine them) within
+    the same cost bound. A speed choice only."""
+    from obsdesign.certify.psd import FFLU_FIRST_COST
+
+    n = Am.nrows()
+    if not 0 < n <= FFLU_MAX_N or m < 0 or (discrete and r <= 0) or Pm != Pm.transpose():
+        return False
+    Pz = Pm.numer_denom()[0]
+    da = Am.numer_denom()[1]
+    top = float(np.max(np.abs(Af))) if Af is not None and Af.size else 0.0
+    a_bits = int(da).bit_length() + (math.frexp(top)[1] if 0 < top < math.inf else 64)
+    p_bits = max(Pz[i, i].bit_length() for i in range(n))
+    r_bits = max(int(r.p).bit_length(), int(r.q).bit_length())
+    m_bits = int(m.q).bit_length() if m else 0
+    bits = 2 * a_bits + p_bits + 2 * r_bits + m_bits
+    return n**4 * bits <= FFLU_FIRST_COST
 
 
 def _enclosure_pd(
@@ -654,7 +709,8 @@ def rate_feasibility(
        the rate feasible (X is a certificate), and X ⊁ 0 proves it infeasible: were Acl/λ
        Schur (Acl + αI Hurwitz), the equation λ²Y − AclᵀYAcl = D(X) would have the unique
        solution Y = Σ_k (Acl/λ)ᵀᵏ (D(X)/λ²) (Acl/λ)ᵏ ≻ 0 (continuous: ∫ e^{Bᵀt} D(X) e^{Bt} dt,
-       B = Acl + αI), and Y = X.
+       B = Acl + αI), and Y = X. Whether X ≻ 0 is decided by the fraction-free LDLᵀ at small
+       n (:func:`pd_small`), else by a rational direction v with vᵀXv < 0 or :func:`pd_int`.
     2. Otherwise the exact Schur–Cohn test of det(zI − Acl/λ) (continuous: Routh test of
        det(sI − Acl − αI)), from :mod:`obsdesign.certify.detect` (slow beyond n ≈ 20).
 
@@ -697,8 +753,12 @@ def _rate_feasibility(
         if decay_pd(Am, Xq, r, discrete, 0, Af, Xq_f)[0]:
             # X ⊁ 0 shown by a rational direction first (the float X guides, exact product
             # decides), else the full exact test
-            neg = negative_direction(Xq, X) if np.linalg.eigvalsh(X)[0] < 0 else None
-            ok = False if neg is not None else pd_int(Xq, 0).ok
+            small = pd_small(Xq, 0)
+            if small is not None:
+                ok = small.ok
+            else:
+                neg = negative_direction(Xq, X) if np.linalg.eigvalsh(X)[0] < 0 else None
+                ok = False if neg is not None else pd_int(Xq, 0).ok
             return ok, "exact Lyapunov inertia certificate (D(X) ≻ 0, X " + (
                 "≻ 0)" if ok else "⊁ 0)"
             )

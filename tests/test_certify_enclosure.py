@@ -21,6 +21,13 @@ from obsdesign.certify.enclosure import decay_enclosure
 U = fmpq(1, 2**53)
 
 
+@pytest.fixture(autouse=True)
+def _float_proofs_first(monkeypatch: pytest.MonkeyPatch) -> None:
+    """These tests are about the enclosure: lyap.decay_pd must not answer small matrices by
+    the fraction-free LDLᵀ first (its speed path, tested in test_lyap.py)."""
+    monkeypatch.setattr(lyap, "FFLU_MAX_N", 0)
+
+
 def _eye(n: int) -> fmpq_mat:
     return fmpq_mat(n, n, [fmpq(int(i == j)) for i in range(n) for j in range(n)])
 

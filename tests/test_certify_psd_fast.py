@@ -121,3 +121,35 @@ def test_agrees_with_check_pd(n: int, seed: int, shift: int, rank_drop: int) -> 
 
 def test_fast_check_wording_is_exported() -> None:
     assert "diagonally dominant" in psd.FAST_CHECK and "fraction-free" in psd.FAST_CHECK
+
+
+def test_fraction_free_int_known_answers_and_edges() -> None:
+    """scale·Z ≻ 0 by Sylvester's criterion: the pivots are those of scale·Z; a zero leading
+    minor (a row exchange), a zero or negative pivot are refused, each naming where."""
+    r = psd.fraction_free_int(fmpz_mat([[2, 1], [1, 2]]), fmpq(1, 2))
+    assert r.ok and r.path == "fraction-free" and r.min_pivot == 0.75  # pivots 1, 3/4
+    r = psd.fraction_free_int(fmpz_mat([[4]]), fmpq(1, 8))
+    assert r.ok and r.min_pivot == 0.5
+    r = psd.fraction_free_int(fmpz_mat([[2, 3], [3, 2]]))
+    assert not r.ok and r.min_pivot == -2.5 and "pivot 1" in r.detail
+    r = psd.fraction_free_int(fmpz_mat([[1, 1], [1, 1]]))  # singular: last pivot exactly 0
+    assert not r.ok and r.min_pivot == 0.0 and "pivot 1" in r.detail
+    r = psd.fraction_free_int(fmpz_mat([[0, 1], [1, 2]]))  # Δ_1 = 0: flint exchanges rows
+    assert not r.ok and "leading principal minor 1 is 0" in r.detail
+    r = psd.fraction_free_int(fmpz_mat([[5, 0, 0], [0, 0, 1], [0, 1, 7]]))
+    assert not r.ok and "leading principal minor 2 is 0" in r.detail
+    assert not psd.fraction_free_int(fmpz_mat([[-1]])).ok
+    assert psd.fraction_free_int(fmpz_mat(0, 0, [])).ok
+    # the smallest false margin: diag(3, 5) − 3·I has a zero pivot; 1 below it is ≻ 0
+    assert not psd.fraction_free_int(fmpz_mat([[0, 0], [0, 2]])).ok
+    assert psd.fraction_free_int(fmpz_mat([[1, 0], [0, 3]])).ok
+
+
+def test_fflu_cheap_by_size_and_entries() -> None:
+    """The speed choice: small n with short entries yes; long diagonal entries or n beyond
+    FFLU_FIRST_MAX_N no."""
+    assert psd.fflu_cheap(fmpz_mat(2, 2, [2, 1, 1, 2]))
+    assert psd.fflu_cheap(fmpz_mat(8, 8, [(2**300 if i % 9 == 0 else 1) for i in range(64)]))
+    assert not psd.fflu_cheap(fmpz_mat(8, 8, [(2**1000 if i % 9 == 0 else 1) for i in range(64)]))
+    n = psd.FFLU_FIRST_MAX_N + 1
+    assert not psd.fflu_cheap(fmpz_mat(n, n, [int(i % (n + 1) == 0) for i in range(n * n)]))

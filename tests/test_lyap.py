@@ -86,7 +86,13 @@ def test_rate_feasible_known_answers(M: list, rate: fmpq, discrete: bool, expect
     assert rate_feasible(qmat(M), rate, discrete) is expected
 
 
-def test_rate_feasible_agrees_with_eigenvalues() -> None:
+@pytest.mark.parametrize("fflu_max_n", [lyap.FFLU_MAX_N, 0])
+def test_rate_feasible_agrees_with_eigenvalues(
+    fflu_max_n: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Both ways of proving the inertia certificate's X ⊁ 0 / ≻ 0 at small n: the
+    fraction-free LDLᵀ first (default) and the float proofs first (``FFLU_MAX_N = 0``)."""
+    monkeypatch.setattr(lyap, "FFLU_MAX_N", fflu_max_n)
     rng = np.random.default_rng(7)
     for _ in range(200):
         n = int(rng.integers(1, 5))
@@ -470,11 +476,16 @@ def test_dyadic_fmat_is_dyadic_in_flint(r, c, seed, bits, spread) -> None:
 
 
 @pytest.mark.parametrize("n", [3, 40])
-def test_pd_verdict_float_copy_at_the_exact_minimum(n: int) -> None:
-    """With P's exact float copy (dyadic P), the verified Cholesky runs first: λ_min(P) = t
-    exactly; δ = t and δ = t + 10⁻²⁰ are refused (the exact path decides), δ = t − 10⁻⁶ is
-    proved on the float copy; a copy that is not symmetric is not used."""
+def test_pd_verdict_float_copy_at_the_exact_minimum(
+    n: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With P's exact float copy (dyadic P), the verified Cholesky runs first (the small-n
+    fraction-free path switched off): λ_min(P) = t exactly; δ = t and δ = t + 10⁻²⁰ are
+    refused (the exact path decides), δ = t − 10⁻⁶ is proved on the float copy; a copy that
+    is not symmetric is not used."""
     from obsdesign.certify import vchol
+
+    monkeypatch.setattr(lyap, "FFLU_MAX_N", 0)
 
     rng = np.random.default_rng(n)
     B = qmat([[fmpq(int(v), 4) for v in row] for row in rng.integers(-3, 4, (n, n - 1))])
@@ -560,3 +571,70 @@ def test_solve_lyapunov_refuses_an_overflowing_operator_instead_of_hanging() -> 
     with pytest.raises(np.linalg.LinAlgError, match="overflows"):
         lyap.solve_lyapunov(A, 0.5, True)
     assert lyap._lyap_solution(A, 0.5, True) is None
+
+
+# -- the small-n fraction-free path (psd.fflu_cheap) -----------------------------------------
+def test_pd_small_decides_at_the_exact_minimum() -> None:
+    """n = 3, λ_min(P) = t exactly: the fraction-free LDLᵀ (the small-n path of pd_verdict)
+    refuses δ = t and δ = t + 10⁻³⁰ and proves δ = t − 10⁻³⁰, a margin no float proof
+    resolves."""
+    rng = np.random.default_rng(3)
+    B = qmat([[fmpq(int(v), 4) for v in row] for row in rng.integers(-3, 4, (3, 2))])
+    t = fmpq(1, 2)
+    P = B @ B.T + qeye(3) * t
+    Pm = lyap.fmat(P)
+    eps = fmpq(1, 10**30)
+    for m, want in ((t, False), (t + eps, False), (t - eps, True)):
+        r = lyap.pd_verdict(P, m, None, Pm, None)
+        assert r.ok is want and r.path == "fraction-free", (m, r)
+        assert lyap.pd_small(Pm, m).ok is want
+    assert lyap.pd_small(lyap.fmat(qeye(17)), 0) is None  # beyond FFLU_MAX_N: not this path
+
+
+@pytest.mark.parametrize("discrete", [True, False])
+def test_decay_pd_small_decides_at_the_exact_minimum(discrete: bool) -> None:
+    """Acl = diag(d), P = diag(p): the decay matrix is diagonal with a known smallest entry
+    μ; the small-n path (decay_int + fraction-free LDLᵀ) refuses δ = μ and proves
+    δ = μ − 10⁻³⁰, and a refusal carries the float matrix for the float verdict."""
+    d = [fmpq(1, 3), fmpq(-2, 5), fmpq(1, 7)]
+    p = [fmpq(2), fmpq(3, 2), fmpq(5)]
+    A = qmat([[d[i] if i == j else 0 for j in range(3)] for i in range(3)])
+    P = qmat([[p[i] if i == j else 0 for j in range(3)] for i in range(3)])
+    if discrete:
+        r = fmpq(9, 10)
+        mu = min(pi * (r * r - di * di) for pi, di in zip(p, d, strict=True))
+    else:
+        A = A - qeye(3)
+        r = fmpq(1, 10)
+        mu = min(-2 * pi * (di - 1 + r) for pi, di in zip(p, d, strict=True))
+    assert mu > 0
+    eps = fmpq(1, 10**30)
+    for m, want in ((mu, False), (mu + eps, False), (mu - eps, True)):
+        res, H = lyap.decay_pd(A, P, r, discrete, m)
+        assert res.ok is want and res.path == "fraction-free", (m, res)
+        assert (H is None) is want  # the float matrix comes with a refusal
+        if not want:
+            assert H.shape == (3, 3) and np.linalg.eigvalsh(H)[0] <= 1e-12 * np.abs(H).max()
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    n=st.integers(1, 6),
+    seed=st.integers(0, 10**6),
+    shift=st.integers(-3, 3),
+)
+def test_small_paths_agree_with_check_pd(n: int, seed: int, shift: int) -> None:
+    """pd_small and the small-n decay_pd give check_pd's verdict (the reference LDLᵀ over Q)
+    on random rational matrices near the positive definite edge."""
+    rng = np.random.default_rng(seed)
+    B = qmat([[fmpq(int(v), 3) for v in row] for row in rng.integers(-4, 5, (n, n))])
+    P = B @ B.T + qeye(n) * fmpq(shift, 4)
+    m = fmpq(int(rng.integers(0, 3)), 8)
+    Pm = lyap.fmat(P)
+    small = lyap.pd_small(Pm, m)
+    assert small is not None and small.ok == check_pd(P, m).ok
+    A = qmat([[fmpq(int(v), 5) for v in row] for row in rng.integers(-4, 5, (n, n))])
+    for discrete, r in ((True, fmpq(int(rng.integers(1, 9)), 4)), (False, fmpq(1, 4))):
+        res, _ = lyap.decay_pd(A, P, r, discrete, m)
+        M = lyap.decay_fmat(A, P, r, discrete)
+        assert res.ok == check_pd(lyap.as_array(M), m).ok
