@@ -54,6 +54,9 @@ def test_to_dict_and_back():
     c.extra["x"] = [1, 2]
     d = c.to_dict()
     assert d["extra"] == {"x": [1, 2]}
+    d["extra"]["x"].append(3)  # a deep copy: the claim is not changed through its dict
+    assert c.extra == {"x": [1, 2]}
+    d = c.to_dict()
     assert Claim.from_dict(d) == c
     minimal = {
         "id": 5,
