@@ -285,7 +285,7 @@ def _minus_margin(Z: fmpz_mat, D: Any, margin: Any) -> tuple[fmpz_mat, fmpq]:
 #: the largest n at which :func:`pd_small` and :func:`decay_pd` try the fraction-free LDLᵀ
 #: first (:func:`obsdesign.certify.psd.fflu_cheap` then decides by the entries' size); 0
 #: turns that path off (the float proofs run first, as for larger n)
-FFLU_MAX_N = 16
+FFLU_MAX_N = 10
 
 
 #: the prime of :func:`observable_mod_p` (2⁶¹ − 1, a Mersenne prime)
@@ -414,12 +414,20 @@ def decay_pd(
     enclosure's error bound assumes it; :param Pf: the same for P (e.g. from
     :func:`dyadic_fmat`). Returns the verdict and the float matrix beside it (≈ the decay matrix − δI, or a
     positive multiple of it), as :func:`obsdesign.certify.psd.check_pd_fast_float`."""
-    from obsdesign.certify.psd import check_pd_int, fflu_cheap, fraction_free_int
+    from obsdesign.certify.psd import (
+        check_pd_int,
+        diag_dominant_int,
+        fflu_cheap,
+        fraction_free_int,
+    )
     from obsdesign.certify.vchol import int_to_float
 
     Am, Pm = fmat(Acl), fmat(P)
     if _decay_small(Am, Pm, Q(rate), discrete, Q(margin), Af):
         Zm, c = _minus_margin(*decay_int(Am, Pm, rate, discrete), margin)
+        dd = diag_dominant_int(Zm, c)  # ≈ c·I when P solves the Lyapunov equation
+        if dd is not None:
+            return dd, None
         if fflu_cheap(Zm):  # the exact LDLᵀ costs less than the enclosure here
             r = fraction_free_int(Zm, c)
             return r, (None if r.ok else int_to_float(Zm)[0])
@@ -430,16 +438,21 @@ def decay_pd(
     return check_pd_int(*_minus_margin(Z, D, margin))
 
 
+#: :func:`_decay_small`'s bound on the estimated bits of the integer decay matrix's entries
+DECAY_SMALL_BITS = 4096
+
+
 def _decay_small(
     Am: fmpq_mat, Pm: fmpq_mat, r: fmpq, discrete: bool, m: fmpq, Af: np.ndarray | None
 ) -> bool:
-    """Whether :func:`decay_pd` should form the integer decay matrix for the fraction-free
-    LDLᵀ (:func:`obsdesign.certify.psd.fflu_cheap`) before the float enclosure: n at most
+    """Whether :func:`decay_pd` should form the integer decay matrix (:func:`decay_int`)
+    before the float enclosure, for the exact diagonal-dominance proof
+    (:func:`obsdesign.certify.psd.diag_dominant_int`) or the fraction-free LDLᵀ: n at most
     :data:`FFLU_MAX_N` and an estimate of its entries' bits (from those of A − LC, P, the
-    rate and the margin, as :func:`decay_int` and :func:`_minus_margin` combine them) within
-    the same cost bound. A speed choice only."""
-    from obsdesign.certify.psd import FFLU_FIRST_COST
-
+    rate and the margin, as :func:`decay_int` and :func:`_minus_margin` combine them) at most
+    :data:`DECAY_SMALL_BITS`. A speed choice only (measured in a whole design + verify: at
+    n = 8 and 10 the four decay checks cost half of what the enclosures do; at n = 12 and 16
+    more)."""
     n = Am.nrows()
     if not 0 < n <= FFLU_MAX_N or m < 0 or (discrete and r <= 0) or Pm != Pm.transpose():
         return False
@@ -450,8 +463,7 @@ def _decay_small(
     p_bits = max(Pz[i, i].bit_length() for i in range(n))
     r_bits = max(int(r.p).bit_length(), int(r.q).bit_length())
     m_bits = int(m.q).bit_length() if m else 0
-    bits = 2 * a_bits + p_bits + 2 * r_bits + m_bits
-    return n**4 * bits <= FFLU_FIRST_COST
+    return 2 * a_bits + p_bits + 2 * r_bits + m_bits <= DECAY_SMALL_BITS
 
 
 def _enclosure_pd(

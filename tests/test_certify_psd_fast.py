@@ -153,3 +153,35 @@ def test_fflu_cheap_by_size_and_entries() -> None:
     assert not psd.fflu_cheap(fmpz_mat(8, 8, [(2**1000 if i % 9 == 0 else 1) for i in range(64)]))
     n = psd.FFLU_FIRST_MAX_N + 1
     assert not psd.fflu_cheap(fmpz_mat(n, n, [int(i % (n + 1) == 0) for i in range(n * n)]))
+
+
+def test_diag_dominant_int_proves_only_strict_dominance() -> None:
+    """Gershgorin over Z: strict dominance with positive diagonal proves scale·Z ≻ 0 with
+    λ_min ≥ scale·min slack; a row exactly balanced (the smallest false margin), a
+    non-positive diagonal or an empty matrix give no conclusion."""
+    r = psd.diag_dominant_int(fmpz_mat([[5, -2], [-2, 4]]), fmpq(1, 2))
+    assert r is not None and r.ok and r.path == "diagonal-dominance" and r.min_pivot == 1.0
+    assert psd.diag_dominant_int(fmpz_mat([[2, -2], [-2, 4]])) is None  # row 0 balanced
+    assert psd.diag_dominant_int(fmpz_mat([[3, -2], [-2, 3]])) is not None
+    assert psd.diag_dominant_int(fmpz_mat([[-3, 1], [1, 3]])) is None
+    assert psd.diag_dominant_int(fmpz_mat([[0]])) is None
+    assert psd.diag_dominant_int(fmpz_mat(0, 0, [])) is None
+    assert psd.diag_dominant_int(fmpz_mat([[2, 1, 1], [1, 2, 1], [1, 1, 2]])) is None  # ≻ 0
+
+
+@settings(max_examples=80, deadline=None)
+@given(n=st.integers(1, 6), seed=st.integers(0, 10**6))
+def test_diag_dominant_int_agrees_with_check_pd(n: int, seed: int) -> None:
+    """Whenever diagonal dominance proves a random symmetric integer matrix ≻ 0, the exact
+    LDLᵀ agrees, and the bound is below its smallest eigenvalue (M − bound·I ⪰ 0 is not
+    contradicted: M − 2·bound·I may fail, M − bound·I/2 must hold)."""
+    rng = np.random.default_rng(seed)
+    B = rng.integers(-5, 6, (n, n))
+    S = B + B.T
+    S[np.diag_indices(n)] = np.abs(S).sum(axis=1) - np.abs(np.diag(S)) + rng.integers(-2, 3, n)
+    Z = fmpz_mat([[int(v) for v in row] for row in S])
+    r = psd.diag_dominant_int(Z)
+    M = qmat(S.tolist())
+    if r is not None:
+        assert check_pd(M).ok
+        assert check_pd(M, Q(r.min_pivot) / 2).ok

@@ -594,8 +594,9 @@ def test_pd_small_decides_at_the_exact_minimum() -> None:
 @pytest.mark.parametrize("discrete", [True, False])
 def test_decay_pd_small_decides_at_the_exact_minimum(discrete: bool) -> None:
     """Acl = diag(d), P = diag(p): the decay matrix is diagonal with a known smallest entry
-    μ; the small-n path (decay_int + fraction-free LDLᵀ) refuses δ = μ and proves
-    δ = μ − 10⁻³⁰, and a refusal carries the float matrix for the float verdict."""
+    μ; the small-n path (decay_int, then diagonal dominance or the fraction-free LDLᵀ)
+    refuses δ = μ and proves δ = μ − 10⁻³⁰, and a refusal carries the float matrix for the
+    float verdict."""
     d = [fmpq(1, 3), fmpq(-2, 5), fmpq(1, 7)]
     p = [fmpq(2), fmpq(3, 2), fmpq(5)]
     A = qmat([[d[i] if i == j else 0 for j in range(3)] for i in range(3)])
@@ -611,7 +612,10 @@ def test_decay_pd_small_decides_at_the_exact_minimum(discrete: bool) -> None:
     eps = fmpq(1, 10**30)
     for m, want in ((mu, False), (mu + eps, False), (mu - eps, True)):
         res, H = lyap.decay_pd(A, P, r, discrete, m)
-        assert res.ok is want and res.path == "fraction-free", (m, res)
+        # a diagonal decay matrix is proved by its dominant diagonal; at δ = μ one row is
+        # zero (not dominant) and the fraction-free LDLᵀ refuses it
+        want_path = "diagonal-dominance" if want else "fraction-free"
+        assert res.ok is want and res.path == want_path, (m, res)
         assert (H is None) is want  # the float matrix comes with a refusal
         if not want:
             assert H.shape == (3, 3) and np.linalg.eigvalsh(H)[0] <= 1e-12 * np.abs(H).max()
@@ -638,3 +642,15 @@ def test_small_paths_agree_with_check_pd(n: int, seed: int, shift: int) -> None:
         res, _ = lyap.decay_pd(A, P, r, discrete, m)
         M = lyap.decay_fmat(A, P, r, discrete)
         assert res.ok == check_pd(lyap.as_array(M), m).ok
+
+
+def test_decay_pd_small_not_dominant_goes_to_the_ldlt() -> None:
+    """A decay matrix that is positive definite but not diagonally dominant (P far from the
+    Lyapunov solution) is still proved at small n, by the fraction-free LDLᵀ; the same P at a
+    rate where the decay matrix is indefinite is refused."""
+    A = qmat([["1/2", 0], [0, "1/2"]])
+    P = qmat([[1, 2], [2, 5]])  # eigenvalues 3 ± √8 > 0, row 0 not dominant
+    res, H = lyap.decay_pd(A, P, fmpq(1), True, 0)  # (1 − 1/4)·P ≻ 0, not dominant
+    assert res.ok and res.path == "fraction-free" and H is None
+    res, H = lyap.decay_pd(A, P, fmpq(1, 2), True, 0)  # (1/4 − 1/4)·P = 0
+    assert not res.ok and H is not None
