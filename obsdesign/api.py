@@ -346,11 +346,12 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
             )
         ]
         return _replace_claims(rep, claims, time.perf_counter() - t0)
+    named = "report" if isinstance(report, Report) else str(report)
     if rep.method not in method_keys():
-        raise InputError(f"report: unknown method '{rep.method}'")
+        raise InputError(f"{named}: unknown method '{rep.method}'")
     sp = load_spec_text(text, file)
     if sp.method != rep.method:
-        raise InputError(f"report: method '{rep.method}' but the spec says '{sp.method}'")
+        raise InputError(f"{named}: method '{rep.method}' but the spec says '{sp.method}'")
     if rep.error is not None:
         return _replace_claims(rep, [_error_claim(rep)], time.perf_counter() - t0)
     claims: list[Claim] = []
@@ -581,6 +582,7 @@ def simulate(
         if batches is not None and batches < 1:
             raise InputError(f"batches: expected a positive number, got {batches}")
         check_workers(workers, scheduler)
+    where = "report"
     if report is None:
         with captured_warnings([]):
             params: Parameters = get_method(sp.method).design(sp).parameters
@@ -603,17 +605,32 @@ def simulate(
         params = rep.parameters
     notes: list[str] = []
     if distributed:
-        res = _simulate_spans(sp, params, kwargs, workers, scheduler, client, batches)
+        try:
+            res = _simulate_spans(sp, params, kwargs, workers, scheduler, client, batches)
+        except InputError as e:
+            raise _report_named(e, where) from None
         notes = list(res.info.pop("warnings", []))
     else:
         with captured_warnings(notes):
-            res = get_method(sp.method).simulate(sp, params, **kwargs)
+            try:
+                res = get_method(sp.method).simulate(sp, params, **kwargs)
+            except InputError as e:
+                raise _report_named(e, where) from None
     left = _left_float_range(res)
     if left is not None:
         notes.insert(0, left)
     if notes:
         res.info["warnings"] = notes
     return res
+
+
+def _report_named(e: InputError, where: str) -> InputError:
+    """A method's complaint about its parameters ("report: …") naming the report file they
+    came from (``where``); any other error as it is."""
+    text = str(e)
+    if where != "report" and text.startswith("report:"):
+        return InputError(f"{where}:{text[len('report:') :]}")
+    return e
 
 
 def _left_float_range(res: SimResult) -> str | None:

@@ -410,3 +410,22 @@ def test_simulate_says_when_a_run_is_outside_the_premises_of_theorem_1(tmp_path)
         R2.replace("lower = [-1, -1]\nupper = [1, 1]", "lower = [-0.5, -0.5]\nupper = [1, 1]")
     )
     assert "the plant leaves X at k = 0 (Assumption 1)" in premises and premises in said
+
+
+def test_simulate_with_a_report_missing_a_parameter_names_the_report(tmp_path) -> None:
+    """simulate --report whose parameters lack theta: a one-line InputError naming the
+    report file (it said "report: …")."""
+    import json
+
+    from obsdesign.errors import InputError
+
+    p = tmp_path / "r2.toml"
+    p.write_text(R2)
+    d = api.design(api.load_spec(p)).to_dict()
+    del d["parameters"]["theta"]
+    d["parameters"].get("exact", {}).pop("theta", None)
+    rp = tmp_path / "r.json"
+    rp.write_text(json.dumps(d))
+    with pytest.raises(InputError) as e:
+        api.simulate(p, report=rp)
+    assert str(e.value) == f"{rp}: parameter 'theta' is missing"

@@ -313,3 +313,25 @@ def test_time_limit_holds_inside_one_sampling_interval(tmp_path: Path) -> None:
     with pytest.raises(SolverError, match="not finished within 1 s"):
         get_method("impulsive").simulate(sp, rep.parameters, time_limit=1)
     assert time.perf_counter() - t0 < 20
+
+
+def test_a_report_with_T_min_above_T_max_is_named_in_the_error(tmp_path: Path) -> None:
+    """simulate --report with a tampered window (T_min > T_max, floats and exact values
+    consistent): a one-line InputError naming the report file, not "report:"."""
+    import json
+
+    sp = tmp_path / "s.toml"
+    sp.write_text(_spec3(), encoding="utf-8")
+    d = api.design(api.load_spec(sp)).to_dict()
+    p = d["parameters"]
+    lo, hi = p["T_min"], p["T_max"]
+    p["T_min"], p["T_max"] = hi * 2, lo
+    ex = p.get("exact", {})
+    if "T_min" in ex:
+        ex["T_min"], ex["T_max"] = str(Q(hi * 2)), str(Q(lo))
+    rp = tmp_path / "r.json"
+    rp.write_text(json.dumps(d), encoding="utf-8")
+    with pytest.raises(InputError) as e:
+        api.simulate(sp, report=rp)
+    msg = str(e.value)
+    assert msg.startswith(f"{rp}: expected 0 < T_min ≤ T_max") and "\n" not in msg
