@@ -691,3 +691,18 @@ r_bound = 1
     msg = e.value.message
     assert "with the given K" in msg and "try a smaller λ" in msg
     assert "raise r_bound (now 1)" in msg and "omit K" in msg
+
+
+def test_outlier_study_run_r_does_not_depend_on_the_number_of_runs(ex1: Report) -> None:
+    """Run r draws from child r of SeedSequence(seed + 1): the RMSEs of runs 0-2 are the
+    same in a study of 3 runs and in one of 5 (one generator for all runs made them
+    depend on the count)."""
+    from obsdesign.methods.stubborn import sim
+
+    text = EX1.read_text().replace("dt = 0.001", "dt = 0.01")
+    sp = api.load_spec_text(text, str(EX1))
+    a = sim.study(sp, ex1.parameters, runs=3)["rmse"]
+    b = sim.study(sp, ex1.parameters, runs=5)["rmse"]
+    assert a.shape[2] == 3 and b.shape[2] == 5
+    np.testing.assert_array_equal(a, b[:, :, :3])
+    assert not np.array_equal(b[:, :, 3], b[:, :, 4])  # the runs differ

@@ -189,6 +189,28 @@ def noise_fn(
     return nu
 
 
+def run_noise_fn(
+    rngs: list[np.random.Generator], na: int, p: int, so: SimOptions, amps: np.ndarray
+) -> Any:
+    """ν of the outlier model for ``na`` amplitudes × ``len(rngs)`` runs, run r drawing from
+    its own generator ``rngs[r]`` (per chunk: the Gaussian noise, the outlier events, the
+    outlier values, each (m, na, p)), so that run r's numbers do not depend on how many runs
+    there are; ``amps`` (na,). Returns nu(k0, k1) -> (k1 − k0, na, runs, p)."""
+    a = np.asarray(amps, dtype=float).reshape(1, na, 1)
+
+    def nu(k0: int, k1: int) -> np.ndarray:
+        m = k1 - k0
+        out = np.empty((m, na, len(rngs), p))
+        for r, g in enumerate(rngs):
+            v = g.normal(0.0, so.noise_std, size=(m, na, p))
+            hit = g.random(size=(m, na, p)) < so.outlier_rate
+            o = g.uniform(-1.0, 1.0, size=(m, na, p)) * a
+            out[:, :, r] = v + np.where(hit, o, 0.0)
+        return out
+
+    return nu
+
+
 def sigma_levels(
     g: Gains, e0: np.ndarray, so: SimOptions, steps: int, dt: float, seed: int
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -222,7 +244,6 @@ def study(spec: Spec, params: Parameters, runs: int | None = None) -> dict[str, 
     _, mean_l, max_l = sigma_levels(g, e0, so, steps, dt, sim.seed)
     amps = np.asarray(so.amplitudes, float)
     no, na = len(OBSERVERS), len(amps)
-    shape = (na, runs)
     levels = np.empty((no, na, runs, p))
     levels[0] = np.inf
     levels[1] = mean_l
@@ -231,8 +252,10 @@ def study(spec: Spec, params: Parameters, runs: int | None = None) -> dict[str, 
     adaptive = np.zeros((no, na, runs), bool)
     adaptive[3] = True
     s0 = so.sigma0 if so.sigma0 is not None else default_sigma0(g, e0)
-    rng = np.random.default_rng(sim.seed + 1)
-    base = noise_fn(rng, shape, p, so, amps[:, None])
+    # run r draws from child r of SeedSequence(seed + 1): the same numbers for any number of
+    # runs (one generator for all runs made run r's numbers depend on how many there were)
+    rngs = [np.random.default_rng(c) for c in np.random.SeedSequence(sim.seed + 1).spawn(runs)]
+    base = run_noise_fn(rngs, na, p, so, amps)
 
     def nu(k0: int, k1: int) -> np.ndarray:
         return base(k0, k1)[:, None]  # same noise for every observer
