@@ -148,6 +148,11 @@ def test_sup_norm_and_range():
         ("t - floor(t)", "0", "1", True, False),
         ("t - floor(t)", "1/1000000", "1", False, True),  # 0 at t = 0
         ("0.31*sin(t)", "-3/10", "3/10", False, True),
+        # atan(0) = 0 exactly: proved inside [0, 1.5707963] on [0, 8] (it was inconclusive,
+        # the float enclosure near t = 0 reaching −5e-324); a lower bound 10⁻³⁰⁰ above 0
+        # is broken at t = 0 and never proved
+        ("atan(t)", "0", "1.5707963", True, False),
+        ("atan(t)", "1e-300", "1.5707963", False, False),
     ],
 )
 def test_range_inside_exact_constants_and_proved_violations(
@@ -263,3 +268,21 @@ def test_range_inside_takes_parameters_exactly() -> None:
         u = [parse_expr("a*sin(t)", ["t"], {"a": a})]
         got = B.range_inside(u, "t", 0, 8, [fmpq(-3, 10)], [fmpq(3, 10)], 256)
         assert (got[0], got[3]) == (ok, not ok)
+
+
+def test_input_range_detail_of_an_excess_below_the_float_range(monkeypatch) -> None:
+    """An enclosure past U by less than the float range (the excess floored at 1e-300) is
+    worded as such, not as "by up to 1e-300" (fuzz report, session 17)."""
+    from pathlib import Path
+
+    from obsdesign import api
+    from obsdesign.certify.claim import Claims
+    from obsdesign.methods.searchspace import claims
+
+    root = Path(__file__).resolve().parents[1]
+    sp = api.load_spec(root / "specs" / "hernandez-garcia-pendulum.toml")
+    monkeypatch.setattr(B, "range_inside", lambda *a, **k: (False, 1e-300, 7, False))
+    c = Claims()
+    claims._input_range(c, sp)
+    (got,) = [x for x in c if x.id == "input-range"]
+    assert "less than 1e-300" in got.detail and "up to" not in got.detail

@@ -30,6 +30,10 @@ TEMPLATES = [
     "(t - {c})*step(t - {c})",
     "-(t - {c})*step(t - {c})",
     "sign(t - {c}) * {a}",
+    "atan(t - {c}/3) * {a}",
+    "sinh((t - {k})/4) + tanh(t - {c}/3)",
+    "log(t/{k} + 1/2) + exp(({c}/10 - t)/4)",
+    "sqrt(t/{k}) - {a}",
 ]
 
 
@@ -116,3 +120,32 @@ def test_nested_powers_stay_small() -> None:
     assert q.lo <= Fraction(1, 2) ** 262144 and q.hi >= Fraction(3, 4) ** 262144
     big = qi._cap(QI(Fraction(3, 4) ** 4000, Fraction(1)))
     assert big.lo <= Fraction(3, 4) ** 4000 and big.hi == 1
+
+
+@pytest.mark.parametrize(
+    "text,lo,hi,want_lo,want_hi",
+    [
+        ("atan(t)", "0", "1/2", Fraction(0), None),  # atan(0) = 0: t ≥ 0 gives ≥ 0 exactly
+        ("atan(t)", "-1/2", "0", None, Fraction(0)),
+        ("atan(t)", "0", "0", Fraction(0), Fraction(0)),
+        ("tanh(t)", "-3", "0", None, Fraction(0)),
+        ("sinh(t)", "0", "2", Fraction(0), None),
+        ("exp(t)", "0", "1", Fraction(1), None),
+        ("exp(t)", "-1", "0", None, Fraction(1)),
+        ("log(t)", "1", "2", Fraction(0), None),
+        ("log(t)", "1/2", "1", None, Fraction(0)),
+        ("sqrt(t)", "1", "4", Fraction(1), None),
+        ("sqrt(t)", "0", "1", Fraction(0), Fraction(1)),
+    ],
+)
+def test_increasing_functions_are_exact_at_their_anchor(
+    text: str, lo: str, hi: str, want_lo: Fraction | None, want_hi: Fraction | None
+) -> None:
+    """f(c) = v exactly for an increasing f (atan, tanh, sinh at 0; exp(0) = 1; log(1) = 0;
+    sqrt(0) = 0, sqrt(1) = 1): on an interval at or beyond c the enclosure's end is v, not
+    a float rounded outwards past it."""
+    q = _enclose(text, Fraction(lo), Fraction(hi))
+    if want_lo is not None:
+        assert q.lo == want_lo, q
+    if want_hi is not None:
+        assert q.hi == want_hi, q

@@ -309,7 +309,12 @@ def _input_range(c: Claims, spec: Spec) -> None:
         else (
             "u leaves U: an enclosure lies wholly beyond a bound (proved)"
             if outside
-            else f"an enclosure leaves U by up to {excess:.3g} (not proved either way)"
+            else (
+                f"an enclosure leaves U by up to {excess:.3g} (not proved either way)"
+                if excess > 1e-300
+                else "an enclosure leaves U by less than 1e-300 (below the float "
+                "resolution; not proved either way)"
+            )
         ),
         float_ok=ok or not outside,
     )

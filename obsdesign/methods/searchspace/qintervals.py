@@ -14,7 +14,9 @@ U = [−0.3, 0.3] gives 0.3 (the nearest double, below 0.3) times [−1, 1], rou
   enclosure of their argument (:func:`~obsdesign.methods.searchspace.intervals.d_fn`,
   rigorous) intersected with the exact range of the function: [−1, 1] for sin, cos and tanh,
   [0, ∞) for exp and sqrt, [1, ∞) for cosh; so sin(t) on any interval lies in [−1, 1] exactly,
-  and 0.5 + 0.6·sin(2t) in [−0.1, 1.1];
+  and 0.5 + 0.6·sin(2t) in [−0.1, 1.1]; the increasing ones also by their exact values at a
+  rational point (``_ANCHORS``: atan, tanh, sinh at 0; exp(0) = 1; log(1) = 0; sqrt at 0 and
+  1), so atan(t) ≥ 0 exactly for t ≥ 0;
 - anything else (a non-integer power, ``pi`` and ``e``) through the float enclosure of that
   sub-expression, converted exactly.
 
@@ -50,6 +52,18 @@ _RANGE: dict[str, tuple[Fraction | None, Fraction | None]] = {
     "exp": (Fraction(0), None),
     "sqrt": (Fraction(0), None),
     "cosh": (Fraction(1), None),
+}
+
+#: exact values of increasing smooth functions at a rational point: f(c) = v, so f(x) ≥ v
+#: for x ≥ c and f(x) ≤ v for x ≤ c (u = atan(t) on [0, 10⁶] against U = [0, 1.5707963]
+#: was inconclusive: the float enclosure of atan near t = 0 reaches −5e-324)
+_ANCHORS: dict[str, tuple[tuple[Fraction, Fraction], ...]] = {
+    "atan": ((Fraction(0), Fraction(0)),),
+    "tanh": ((Fraction(0), Fraction(0)),),
+    "sinh": ((Fraction(0), Fraction(0)),),
+    "exp": ((Fraction(0), Fraction(1)),),
+    "log": ((Fraction(1), Fraction(0)),),
+    "sqrt": ((Fraction(0), Fraction(0)), (Fraction(1), Fraction(1))),
 }
 
 
@@ -224,7 +238,13 @@ def evaluate_q(node: ast.AST, env: dict[str, QI], params: dict[str, QI], src: st
         if name in _SMOOTH:
             a = evaluate_q(node.args[0], env, params, src)
             v = d_fn(Dual(a.to_float(), ()), name).v
-            return QI.of_float(v).meet(*_RANGE.get(name, (None, None)))
+            out = QI.of_float(v).meet(*_RANGE.get(name, (None, None)))
+            for c, fc in _ANCHORS.get(name, ()):  # monotone: the side of f(c) is exact
+                if a.lo >= c:
+                    out = out.meet(fc, None)
+                if a.hi <= c:
+                    out = out.meet(None, fc)
+            return out
         args = [evaluate_q(x, env, params, src) for x in node.args]
         if name == "abs":
             return args[0].abs()
