@@ -502,3 +502,40 @@ def test_simulated_error_of_an_unstable_plant_keeps_its_digits() -> None:
     np.testing.assert_allclose(e, 0.5 ** np.arange(1, 42), rtol=1e-12)
     assert res.x[-1, 0] == pytest.approx(3.0**40)
     assert res.info["error_in_polyhedron"] and "exit_code" not in res.info
+
+
+THIN_OMEGA = """[system]
+time = "discrete"
+A = [[0.5, 0.2], [0.1, 0.4]]
+C = [[1, 1]]
+B1 = [0.01, 0]
+[sets.omega]
+type = "polytope"
+G = [[1, 0], [-1, 0], [0, 1], [0, -1]]
+g = [1e-9, 1e-9, 1, 1]
+[sets.D]
+type = "box"
+dim = 1
+lower = [-1]
+upper = [1]
+[method]
+key = "set-invariant"
+omega = "omega"
+disturbance = "D"
+eta_bar = 0
+lambda = 0.9
+algorithm = "general"
+time_limit = 60
+"""
+
+
+def test_a_set_too_thin_for_float_hulls_is_inconclusive_naming_the_file_and_sets() -> None:
+    """Ω = {|e₁| ≤ 10⁻⁹, |e₂| ≤ 1}: qhull cannot build the float hull, exit 4 with one line
+    naming the spec file and the sets (it named neither; fuzz report, session 17)."""
+    from obsdesign.errors import InconclusiveError
+
+    with pytest.raises(InconclusiveError) as e:
+        api.design(load_spec_text(THIN_OMEGA, "thin.toml"))
+    msg = str(e.value)
+    assert msg.startswith("thin.toml: a float polytope computation failed")
+    assert "[sets.omega], [sets.D]" in msg and "\n" not in msg

@@ -309,9 +309,11 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
         # than float arithmetic resolves, e.g. Q = [[1e50, 0], [0, 1]]): numerically
         # inconclusive (exit 4), not an internal failure
         first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+        sets = f"[sets.{o.omega}]" + (f", [sets.{o.disturbance}]" if o.disturbance else "")
         raise InconclusiveError(
-            f"a float polytope computation failed: {first} (a set of the spec may be too "
-            "thin or too large for float arithmetic)"
+            f"{spec.file}: a float polytope computation failed: {first} (a set of the spec, "
+            f"{sets} or the noise bound eta_bar, may be too thin or too large for float "
+            "arithmetic)"
         ) from e
     notes = list(run.notes)
     params = polytope_params(spec, data, run.stage, notes)
