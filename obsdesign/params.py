@@ -88,10 +88,14 @@ class Parameters:
     def is_exact(self, k: str) -> bool:
         return _is_exact(self._v.get(k))
 
-    def exact(self, k: str, claims: list[Any], accept_float: bool = True) -> Any:
+    def exact(self, k: str, claims: list[Any], accept_float: bool = False) -> Any:
         """The exact value of parameter ``k`` for a certificate, or None after appending a
-        failed claim saying why (missing; or float-only when ``accept_float`` is False). A
-        float-only value, when accepted, is taken at its exact binary value."""
+        failed claim saying why (missing; or float-only, ``<k>-exact``, unless
+        ``accept_float``: a report carries every certified parameter exactly, and the exact
+        value is authoritative, so a report whose exact value was removed is not certified
+        on its float by any method; before, constrained, lyapunov and stubborn took the
+        float's binary value while impulsive refused it). A float-only value, when accepted
+        (a simulation), is taken at its exact binary value."""
         return exact_param(self, k, claims, accept_float)
 
     def require(self, keys: tuple[str, ...] | list[str], claims: list[Any]) -> bool:

@@ -28,7 +28,7 @@ MAX_REFINING_STEPS = 10**8
 
 def _exact(params: Parameters, k: str) -> Any:
     """Parameter ``k`` exactly (a float-only value at its exact binary value)."""
-    v = params.exact(k, [])
+    v = params.exact(k, [], accept_float=True)  # a simulation may take the float
     if v is None:
         raise InputError(f"report: parameter {k!r} is missing")
     return v
