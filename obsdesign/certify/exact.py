@@ -166,7 +166,7 @@ def qstr_floats(a: np.ndarray) -> tuple[list[Any], list[Any]] | None:
     strings and the floats beside them, each entry's numerator and denominator converted
     once. OverflowError beyond the float range, as :func:`to_float`."""
     flat = a.ravel().tolist()
-    if not flat or not all(type(x) is fmpq for x in flat):
+    if not flat or set(map(type, flat)) != {fmpq}:
         return None
     strs: list[str] = []
     fls: list[float] = []
