@@ -504,29 +504,12 @@ def test_simulated_error_of_an_unstable_plant_keeps_its_digits() -> None:
     assert res.info["error_in_polyhedron"] and "exit_code" not in res.info
 
 
-THIN_OMEGA = """[system]
-time = "discrete"
-A = [[0.5, 0.2], [0.1, 0.4]]
-C = [[1, 1]]
-B1 = [0.01, 0]
-[sets.omega]
-type = "polytope"
-G = [[1, 0], [-1, 0], [0, 1], [0, -1]]
-g = [1e-9, 1e-9, 1, 1]
-[sets.D]
-type = "box"
-dim = 1
-lower = [-1]
-upper = [1]
-[method]
-key = "set-invariant"
-omega = "omega"
-disturbance = "D"
-eta_bar = 0
-lambda = 0.9
-algorithm = "general"
-time_limit = 60
-"""
+THIN_OMEGA = spec_text(
+    A="[[0.5, 0.2], [0.1, 0.4]]",
+    B1="[0.01, 0]",
+    omega='type = "polytope"\nG = [[1, 0], [-1, 0], [0, 1], [0, -1]]\ng = [1e-9, 1e-9, 1, 1]',
+    alg="general",
+)
 
 
 def test_a_set_too_thin_for_float_hulls_is_inconclusive_naming_the_file_and_sets() -> None:
