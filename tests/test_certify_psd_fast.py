@@ -185,3 +185,23 @@ def test_diag_dominant_int_agrees_with_check_pd(n: int, seed: int) -> None:
     if r is not None:
         assert check_pd(M).ok
         assert check_pd(M, Q(r.min_pivot) / 2).ok
+
+
+def test_integer_tests_refuse_their_premises_broken() -> None:
+    """A non-symmetric Z or a scale ≤ 0 is a caller's error (ValueError), never a verdict:
+    [[1, 3], [0, 1]] has an indefinite symmetric part, and −1·[[1]] is not ≻ 0, yet the
+    unguarded tests said "≻ 0" (session-17 review)."""
+    for f in (psd.fraction_free_int, psd.diag_dominant_int):
+        with pytest.raises(ValueError, match="symmetric"):
+            f(fmpz_mat([[1, 3], [0, 1]]))
+        for bad in (-1, 0):
+            with pytest.raises(ValueError, match="positive"):
+                f(fmpz_mat([[1]]), bad)
+
+
+def test_diag_dominance_bound_is_shown_at_or_below_the_exact_one() -> None:
+    """λ_min = 9/7 exactly, and the bound is tight: the float shown is ≤ 9/7 (the nearest
+    float lies above it)."""
+    r = psd.diag_dominant_int(fmpz_mat([[3, 0], [0, 3]]), fmpq(3, 7))
+    assert r is not None and Q(r.min_pivot) <= fmpq(9, 7)
+    assert float(fmpq(9, 7)) > r.min_pivot  # one step below the nearest

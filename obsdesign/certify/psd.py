@@ -235,6 +235,29 @@ def fflu_cheap(Z: Any) -> bool:
     return n**4 * max(bits, 1) <= FFLU_FIRST_COST
 
 
+def _positive_scale(Z: Any, scale: Any) -> Any:
+    """The scale as an exact rational, after checking the premises of the integer tests:
+    Z square and symmetric, scale > 0 (ValueError otherwise: a caller's error, never a
+    verdict; found by the session-17 review, where a non-symmetric Z or a scale ≤ 0 gave
+    a wrong "≻ 0")."""
+    c = Q(scale)
+    if c <= 0:
+        raise ValueError("scale must be positive")
+    if Z.ncols() != Z.nrows() or Z != Z.transpose():
+        raise ValueError("expected a square symmetric integer matrix")
+    return c
+
+
+def _float_down(q: Any) -> float:
+    """A float ≤ the exact rational q (the nearest one, or the next below it)."""
+    import math
+
+    f = float_or_inf(q)
+    if math.isfinite(f) and Q(f) > q:
+        f = math.nextafter(f, -math.inf)
+    return f
+
+
 def diag_dominant_int(Z: Any, scale: Any = 1) -> PSDResult | None:
     """A proof that M = scale·Z ≻ 0 for a symmetric integer matrix Z (flint ``fmpz_mat``) and
     a rational scale > 0 by strict diagonal dominance, checked exactly: every z_ii >
@@ -246,6 +269,7 @@ def diag_dominant_int(Z: Any, scale: Any = 1) -> PSDResult | None:
 
     :param Z: square symmetric integer matrix; :param scale: the positive factor (exact)."""
     n = Z.nrows()
+    c = _positive_scale(Z, scale)
     if n == 0:
         return None
     ents = [int(z) for z in Z.entries()]
@@ -257,12 +281,13 @@ def diag_dominant_int(Z: Any, scale: Any = 1) -> PSDResult | None:
         if s <= 0:
             return None
         slack = s if slack is None or s < slack else slack
-    bound = Q(scale) * slack
+    bound = c * slack
+    shown = _float_down(bound)  # a lower bound: never shown above the exact one
     return PSDResult(
         True,
-        float_or_inf(bound),
+        shown,
         f"strictly diagonally dominant with positive diagonal (exact): λ_min ≥ "
-        f"{float_or_inf(bound):.3g} > 0 by Gershgorin (n = {n})",
+        f"{shown:.3g} > 0 by Gershgorin (n = {n})",
         "diagonal-dominance",
     )
 
@@ -278,7 +303,7 @@ def fraction_free_int(Z: Any, scale: Any = 1) -> PSDResult:
     :param Z: square symmetric integer matrix; :param scale: the positive factor (exact)."""
     from flint import fmpq
 
-    c = Q(scale)
+    c = _positive_scale(Z, scale)
     n = Z.nrows()
     if n == 0:
         return PSDResult(True, float("inf"), "empty matrix", "empty")
