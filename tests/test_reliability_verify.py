@@ -166,3 +166,29 @@ def test_bad_verdict_value_is_refused(good, tmp_path: Path, verdict):
     p.write_text(json.dumps(d))
     res = runner.invoke(app, ["verify", str(p)])
     assert res.exit_code == 2 and "verdict" in res.output
+
+
+@pytest.mark.parametrize(
+    ("spec", "key"),
+    [
+        ("constrained-redesign-sec5.toml", "v_min"),
+        ("constrained-redesign-sec5-lyapunov.toml", "P"),
+        ("astolfi-stubborn-example4.toml", "K"),
+    ],
+)
+def test_verify_refuses_a_parameter_whose_exact_value_was_removed(
+    spec: str, key: str, tmp_path: Path
+) -> None:
+    """Every method reads certified parameters exactly: a report whose exact value of
+    ``key`` was deleted (its float kept) fails ``<key>-exact`` (exit 1) instead of being
+    certified on the float's binary value (constrained, lyapunov and stubborn accepted it;
+    fuzz report, session 17)."""
+    rep = api.design(api.load_spec(Path(__file__).resolve().parents[1] / "specs" / spec))
+    assert rep.exit_code() == 0
+    d = rep.to_dict()
+    del d["parameters"]["exact"][key]
+    out = tmp_path / "r.json"
+    out.write_text(json.dumps(d), encoding="utf-8")
+    ver = api.verify(out)
+    assert ver.exit_code() == 1
+    assert any(c.id == f"{key}-exact" and not c.ok for c in ver.claims)
