@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 from obsdesign.certify import psd
 from obsdesign.certify.exact import Q, qmat
-from obsdesign.certify.psd import check_pd, check_pd_fast
+from obsdesign.certify.psd import check_pd, check_pd_fast, check_psd
 
 
 @pytest.mark.parametrize(
@@ -153,6 +153,19 @@ def test_fflu_cheap_by_size_and_entries() -> None:
     assert not psd.fflu_cheap(fmpz_mat(8, 8, [(2**1000 if i % 9 == 0 else 1) for i in range(64)]))
     n = psd.FFLU_FIRST_MAX_N + 1
     assert not psd.fflu_cheap(fmpz_mat(n, n, [int(i % (n + 1) == 0) for i in range(n * n)]))
+    n = psd.FFLU_FIRST_MAX_N  # the largest size still taken
+    assert psd.fflu_cheap(fmpz_mat(n, n, [int(i % (n + 1) == 0) for i in range(n * n)]))
+    assert psd.fflu_cheap(fmpz_mat(0, 0, []))
+    # n⁴ × bits exactly at the bound (10⁴ × 130 = 1.3·10⁶) is taken, one bit more is not
+    assert psd.FFLU_FIRST_COST == 1_300_000
+    assert psd.fflu_cheap(fmpz_mat(10, 10, [(2**129 if i % 11 == 0 else 0) for i in range(100)]))
+    assert not psd.fflu_cheap(
+        fmpz_mat(10, 10, [(2**130 if i % 11 == 0 else 0) for i in range(100)])
+    )
+
+
+def test_check_text_of_an_unknown_path_lists_every_test() -> None:
+    assert psd.check_text(psd.PSDResult(True, 1.0, "", "no-such-path")) == psd.FAST_CHECK
 
 
 def test_diag_dominant_int_proves_only_strict_dominance() -> None:
@@ -161,6 +174,9 @@ def test_diag_dominant_int_proves_only_strict_dominance() -> None:
     non-positive diagonal or an empty matrix give no conclusion."""
     r = psd.diag_dominant_int(fmpz_mat([[5, -2], [-2, 4]]), fmpq(1, 2))
     assert r is not None and r.ok and r.path == "diagonal-dominance" and r.min_pivot == 1.0
+    assert "by Gershgorin" in r.detail and "λ_min ≥ 1 " in r.detail
+    r = psd.diag_dominant_int(fmpz_mat([[4, -2], [-2, 5]]), fmpq(1, 2))  # the smallest slack
+    assert r is not None and r.min_pivot == 1.0  # is row 0's, not the last row's
     assert psd.diag_dominant_int(fmpz_mat([[2, -2], [-2, 4]])) is None  # row 0 balanced
     assert psd.diag_dominant_int(fmpz_mat([[3, -2], [-2, 3]])) is not None
     assert psd.diag_dominant_int(fmpz_mat([[-3, 1], [1, 3]])) is None
@@ -184,7 +200,7 @@ def test_diag_dominant_int_agrees_with_check_pd(n: int, seed: int) -> None:
     M = qmat(S.tolist())
     if r is not None:
         assert check_pd(M).ok
-        assert check_pd(M, Q(r.min_pivot) / 2).ok
+        assert check_psd(M, Q(r.min_pivot)).ok  # the bound shown is ≤ λ_min
 
 
 def test_integer_tests_refuse_their_premises_broken() -> None:

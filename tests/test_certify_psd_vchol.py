@@ -260,3 +260,13 @@ def test_exact_paths_with_pivots_beyond_the_float_range() -> None:
     assert not r.ok and r.min_pivot == float("-inf")
     r, _ = check_pd_int(fmpz_mat(2, 2, [2**1100, 0, 0, -(2**1100)]), 1)
     assert not r.ok
+
+
+def test_int_to_float_of_zero_and_empty_matrices() -> None:
+    """The zero matrix has shift 0 (no largest entry to scale), the empty one too."""
+    H, s = vchol.int_to_float(fmpz_mat(2, 2, [0, 0, 0, 0]))
+    assert s == 0 and H.dtype == float and not H.any() and H.shape == (2, 2)
+    H, s = vchol.int_to_float(fmpz_mat(0, 0, []))
+    assert s == 0 and H.shape == (0, 0)
+    H, s = vchol.int_to_float(fmpz_mat(1, 2, [3, -5]))
+    assert s == 2 and H.tolist() == [[0.75, -1.25]]
