@@ -348,6 +348,33 @@ def test_solve_lyapunov_small_systems_match_scipy(n: int, seed: int, discrete: b
     assert np.linalg.norm(X - ref) <= 1e-12 * kappa * scale
 
 
+@settings(max_examples=40, deadline=None)
+@given(
+    n=st.integers(1, lyap.KRONECKER_MAX_N),
+    seed=st.integers(0, 2**32 - 1),
+    discrete=st.booleans(),
+    rate=st.floats(0.01, 3.0),
+)
+def test_solve_lyapunov_operator_is_the_kronecker_form_to_the_bit(
+    n: int, seed: int, discrete: bool, rate: float
+) -> None:
+    """The n²×n² operator is built by broadcasting; it must be np.kron's operator bit for
+    bit: λ²I − Aᵀ⊗Aᵀ (discrete) or −(M⊗I + I⊗M), M = (A + αI)ᵀ (continuous)."""
+    A = np.random.default_rng(seed).standard_normal((n, n))
+    eye = np.eye(n)
+    if discrete:
+        want = rate**2 * np.eye(n * n) - np.kron(A.T, A.T)
+    else:
+        M = (A + rate * eye).T
+        want = -(np.kron(M, eye) + np.kron(eye, M))
+    seen: list[np.ndarray] = []
+    real = np.linalg.solve
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(np.linalg, "solve", lambda K, b: seen.append(K.copy()) or real(K, b))
+        lyap.solve_lyapunov(A, rate, discrete)
+    assert len(seen) == 1 and np.array_equal(seen[0], want)
+
+
 def test_solve_lyapunov_singular_operator_gets_a_least_squares_solution():
     """α between two modes of a continuous Acl (eigenvalues of M at ±1) makes the operator
     singular: the least-squares X is diag(−1/2, 1/2), which the inertia certificate uses
