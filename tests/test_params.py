@@ -187,3 +187,22 @@ def test_report_errors_name_the_report_file(tmp_path) -> None:
         with pytest.raises(InputError) as e:
             Report.load(f)
         assert e.value.message.startswith(f"{f}: ") and msg in e.value.message
+
+
+@pytest.mark.parametrize("exact", [str(10**400), [["1/3", str(-(10**309))]]])
+def test_from_json_refuses_an_exact_value_beyond_the_float_range(exact: object) -> None:
+    """No report carries an exact value beyond the float range (its float view would be
+    infinite); a hand-edited one was an internal failure (OverflowError, exit 3). It is bad
+    input naming the report and the key."""
+    from obsdesign.errors import InputError
+
+    fl = [[0.0, 0.0]] if isinstance(exact, list) else 0.0
+    with pytest.raises(InputError) as e:
+        Parameters.from_json({"v": fl, "exact": {"v": exact}}, "r.json")
+    assert "r.json: parameters.exact.v" in str(e.value) and "beyond the float range" in str(e.value)
+
+
+def test_from_json_parses_the_largest_float_range_values() -> None:
+    """2¹⁰²³ (inside the float range) still parses, consistent with its float."""
+    back, problems = Parameters.from_json({"v": float(2**1023), "exact": {"v": str(2**1023)}})
+    assert back["v"] == fmpq(2**1023) and not problems
