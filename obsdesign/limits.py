@@ -55,8 +55,11 @@ class Limits:
 _current = Limits()
 _overridden: set[str] = set()
 
-#: per-method practical state-dimension limits (a method may declare ``max_states`` itself)
-METHOD_MAX_STATES: dict[str, int] = {"set-invariant": 12}
+#: per-method practical state-dimension limits (a method may declare ``max_states`` itself).
+#: stubborn: its LMIs (1)-(3) / (7)-(9) go to an interior-point SDP solver many times (the λ
+#: search): ~1 min at n = 24 on 2 cores, and n = 100 ran past 300 s with 9.7 GB (stubborn
+#: review)
+METHOD_MAX_STATES: dict[str, int] = {"set-invariant": 12, "stubborn": 24}
 
 
 def limits() -> Limits:

@@ -50,7 +50,7 @@ def test_example1_design_certified(ex1: Report) -> None:
     ids = {c.id for c in ex1.claims}
     assert ids == {
         "gain-relation", "P-positive", "U-positive", "W-positive", "R-positive",
-        "lambda-range", "lambda-choice", "lmi-regional", "lmi-global", "lmi-sector",
+        "lambda-range", "lambda-choice", "lmi-global", "lmi-regional", "lmi-sector",
         "gain-bound", "lambda-max-certified", "lambda-max-bracket",
     }  # fmt: skip
     p = ex1.parameters
@@ -60,10 +60,14 @@ def test_example1_design_certified(ex1: Report) -> None:
     assert p["lambda"] == fmpq(1, 2) * p["lambda_max"]
     # X = P K exactly, K = P⁻¹X
     assert (p["P"] @ p["K"] == p["X"]).all()
-    # with ‖X‖₂ ≤ 100 and P ⪰ I the best λ of Example 1 is ≈ 7.5 (bracket within 0.1 %)
+    # with ‖X‖₂ ≤ 100 and P ⪰ I the best λ of Example 1 is ≈ 7.5. Clarabel answers
+    # 'optimal' up to ≈ 7.51, inaccurate or fails on ≈ 7.52 … 7.55 (a certificate exists at
+    # 7.53: stubborn review), 'infeasible' beyond: the far end is where it says infeasible,
+    # so the bracket is wider than lambda_tol = 0.1 % (≈ 0.7 % here) and a note says so
     lo, hi = p["lambda_bracket"]
     assert lo == p["lambda_max"]
-    assert Q("7.3") < lo < hi <= lo * fmpq(1001, 1000)
+    assert Q("7.3") < lo < hi <= lo * fmpq(102, 100)
+    assert any("wider than lambda_tol" in n for n in ex1.notes) == (hi > lo * fmpq(1001, 1000))
     K = p.float("K").ravel()
     assert np.linalg.norm(K) <= 100
     assert (
@@ -146,18 +150,18 @@ def _tampered(rep: Report, name: str) -> dict[str, Any]:
         _set(d, "lambda", fmpq(0))
     elif name == "lambda-choice":
         _set(d, "lambda", _get(d, "lambda") + TINY)
-    elif name == "lmi-regional":  # R just below the smallest R for which (1) holds
+    elif name == "lmi-global":  # R just below the smallest R for which (1) holds
         R = _r_star(d) * (1 - fmpq(1, 10**9))
         _set(d, "R", np.array([[R]], dtype=object))
-    elif name == "lmi-global":  # −Y keeps (3) (quadratic in Y) and breaks (2)
+    elif name == "lmi-regional":  # −Y keeps (3) (quadratic in Y) and breaks (2)
         _set(d, "Y", -Y)
     elif name == "lambda-max-certified":  # a singular P at λ_max
         Pm = _get(d, "P_at_max")
         Pm[0, 0] = Pm[0, 1] * Pm[1, 0] / Pm[1, 1]
         _set(d, "P_at_max", Pm)
-    elif name == "lambda-max-bracket":  # far end just beyond the tolerance (1e-3)
+    elif name == "lambda-max-bracket":  # far end 2⁻⁸⁰ past the certified λ_max: feasible
         lo = _get(d, "lambda_max")
-        _set(d, "lambda_bracket", np.array([lo, lo * fmpq(1001, 1000) + TINY], dtype=object))
+        _set(d, "lambda_bracket", np.array([lo, lo + TINY], dtype=object))
     elif name == "lmi-sector":  # Y_1 scaled just past Y_1 P⁻¹ Y_1ᵀ = w_1
         q = (Y @ _inv2(P) @ Y.T)[0, 0]
         c = Q(float(np.sqrt(float(w[0] / q)))) * (1 + fmpq(1, 10**9))
@@ -185,7 +189,7 @@ def _r_star(d: dict[str, Any]) -> fmpq:
     lam = float(to_float(_get(d, "lambda")))
 
     def ok(r: float) -> bool:
-        M = lmis.regional(A, C, P, X, u.reshape(-1), np.array([[r]]), lam, False).astype(float)
+        M = lmis.global_sector(A, C, P, X, u.reshape(-1), np.array([[r]]), lam, False).astype(float)
         return bool(np.linalg.eigvalsh(-M).min() > 0)
 
     lo, hi = 0.0, float(to_float(_get(d, "R"))[0, 0])
@@ -198,14 +202,14 @@ def _r_star(d: dict[str, Any]) -> fmpq:
 EXPECTED = {
     "gain-relation": {"gain-relation"},
     # a singular P breaks every LMI that carries P (all three here)
-    "P-positive": {"P-positive", "lmi-sector", "lmi-global", "lmi-regional"},
-    "U-positive": {"U-positive", "lmi-regional"},
-    "W-positive": {"W-positive", "lmi-global", "lmi-sector"},
-    "R-positive": {"R-positive", "lmi-regional"},
+    "P-positive": {"P-positive", "lmi-sector", "lmi-regional", "lmi-global"},
+    "U-positive": {"U-positive", "lmi-global"},
+    "W-positive": {"W-positive", "lmi-regional", "lmi-sector"},
+    "R-positive": {"R-positive", "lmi-global"},
     "lambda-range": {"lambda-range", "lambda-choice"},
     "lambda-choice": {"lambda-choice"},
-    "lmi-regional": {"lmi-regional"},
     "lmi-global": {"lmi-global"},
+    "lmi-regional": {"lmi-regional"},
     "lmi-sector": {"lmi-sector"},
     "lambda-max-certified": {"lambda-max-certified"},
     "lambda-max-bracket": {"lambda-max-bracket"},
@@ -234,9 +238,68 @@ def test_tamper_each_claim(ex1: Report, name: str) -> None:
 
 def test_tamper_verify_cli_exit_1(ex1: Report, tmp_path: Path) -> None:
     out = tmp_path / "t.json"
-    out.write_text(json.dumps(_tampered(ex1, "lmi-regional")))
+    out.write_text(json.dumps(_tampered(ex1, "lmi-global")))
     r = CliRunner().invoke(app, ["verify", str(out)])
     assert r.exit_code == 1, r.output
+
+
+@pytest.mark.parametrize(
+    "bracket, why",
+    [
+        (lambda lo, hi: [lo, lo - TINY], "far end on the wrong side"),
+        (lambda lo, hi: [lo + TINY, hi], "does not start at λ_max"),
+        (lambda lo, hi: [lo, hi, hi], "not a pair"),
+        (lambda lo, hi: [lo, -hi], "far end on the wrong side"),
+    ],
+)
+def test_tamper_lambda_bracket_shapes(ex1: Report, bracket: Any, why: str) -> None:
+    """Each condition of the bracket claim fails on its own (a far end beyond the float range
+    or negative is refused without a solve, not a crash)."""
+    d = ex1.to_dict()
+    lo, hi = _get(d, "lambda_bracket")
+    _set(d, "lambda_bracket", np.array(bracket(lo, hi), dtype=object))
+    rep, problems = Report.from_dict(json.loads(json.dumps(d)))
+    assert not problems
+    ver = api.verify(rep)
+    (claim,) = [c for c in ver.claims if c.id == "lambda-max-bracket"]
+    assert claim.status == ClaimStatus.FAILED and why in claim.detail, claim.detail
+
+
+def test_tamper_lambda_bracket_beyond_the_float_range(ex1: Report, tmp_path: Path) -> None:
+    """A far end of 10⁴⁰⁰ (no float view: no report carries one) is bad input naming the
+    report and the key (exit 2), not an internal failure (exit 3, before)."""
+    d = ex1.to_dict()
+    lo = d["parameters"]["exact"]["lambda_bracket"][0]
+    d["parameters"]["exact"]["lambda_bracket"] = [lo, str(10**400)]
+    out = tmp_path / "big.json"
+    out.write_text(json.dumps(d))
+    r = CliRunner().invoke(app, ["verify", str(out)])
+    assert r.exit_code == 2, r.output
+    assert "parameters.exact.lambda_bracket" in r.output and "beyond the float range" in r.output
+    assert "Traceback" not in r.output
+
+
+def test_far_end_needs_the_solvers_infeasibility_certificate() -> None:
+    """The search's far end is a λ where Clarabel says 'infeasible', moved outward past
+    inaccurate answers; the bisection stops at adjacent floats (lambda_tol 1e-17 hung)."""
+    from obsdesign.methods.stubborn import design as dz
+
+    answers = {1.0: "optimal", 1.5: "optimal_inaccurate", 2.0: "solver failure", 3.0: "infeasible"}
+
+    def feas(lam: float) -> tuple[bool, str]:
+        st = next(v for k, v in sorted(answers.items(), reverse=True) if lam >= k)
+        return st == "optimal", st
+
+    good, bad, st, known = dz._bisect(feas, 1.0, 4.0, "infeasible", 1e-17)  # type: ignore[arg-type]
+    assert good < 1.5 <= bad and np.nextafter(good, np.inf) == bad
+    assert st == "optimal_inaccurate" and known == 4.0
+    far, st2 = dz._far_end(feas, good, bad, st, known, False)  # type: ignore[arg-type]
+    assert st2 == "infeasible" and 3.0 <= far <= known
+    # discrete: outward is down
+    far, st3 = dz._far_end(
+        lambda lam: (False, "infeasible" if lam < 0.2 else "x"), 0.5, 0.4, "x", None, True
+    )  # type: ignore[arg-type]
+    assert st3 == "infeasible" and far < 0.2
 
 
 def test_tamper_l2_gain(ex4: Report) -> None:
@@ -496,10 +559,10 @@ def test_lmi_formulas_match_the_slides() -> None:
     G = P @ A - X @ C
     # (1): He[[PA − XC + ½(λP − CᵀRC), X], [UC, −U]]
     want1 = _he_blocks([[G + h * (lam * P - C.T @ R @ C), X], [U @ C, -U]])
-    assert (lmis.regional(A, C, P, X, u, R, lam, False) == want1).all()
+    assert (lmis.global_sector(A, C, P, X, u, R, lam, False) == want1).all()
     # (2): He[[PA − XC, X], [WC + Y, −W]]
     want2 = _he_blocks([[G, X], [W @ C + Y, -W]])
-    assert (lmis.global_(A, C, P, X, w, Y, False) == want2).all()
+    assert (lmis.regional_sector(A, C, P, X, w, Y, False) == want2).all()
     # (7): He[[−½(λP + CᵀRC), 0, 0], [UC, −U, 0], [PA − XC, X, −½P]]
     Z22 = np.full((2, 2), fmpq(0), dtype=object)
     want7 = _he_blocks(
@@ -509,10 +572,10 @@ def test_lmi_formulas_match_the_slides() -> None:
             [G, X, -h * P],
         ]
     )
-    assert (lmis.regional(A, C, P, X, u, R, lam, True) == want7).all()
+    assert (lmis.global_sector(A, C, P, X, u, R, lam, True) == want7).all()
     # (8): He[[−½P, 0, 0], [WC + Y, −W, 0], [PA − XC, X, −½P]]
     want8 = _he_blocks([[-h * P, Z0, Z22], [W @ C + Y, -W, Z0.T], [G, X, -h * P]])
-    assert (lmis.global_(A, C, P, X, w, Y, True) == want8).all()
+    assert (lmis.regional_sector(A, C, P, X, w, Y, True) == want8).all()
     # (3) / (9): [[P, Y_1ᵀ], [Y_1, w_1]]
     assert (lmis.sector(P, Y, w, 0) == np.block([[P, Y.T], [Y, W]])).all()
 
@@ -691,6 +754,89 @@ r_bound = 1
     msg = e.value.message
     assert "with the given K" in msg and "try a smaller λ" in msg
     assert "raise r_bound (now 1)" in msg and "omit K" in msg
+
+
+@pytest.mark.parametrize(
+    "A, K, discrete, stable",
+    [
+        ("[[1]]", "[0.5]", False, False),  # A − KC = 0.5: not Hurwitz (review's spec)
+        ("[[1]]", "[1]", False, False),  # A − KC = 0: on the boundary, not Hurwitz
+        ("[[1]]", "[1.000001]", False, True),  # −10⁻⁶: Hurwitz, the smallest margin
+        ("[[1.5]]", "[0.5]", True, False),  # A − KC = 1: on the unit circle, not Schur
+        ("[[1.5]]", "[0.500001]", True, True),
+    ],
+)
+def test_redesign_with_an_unstable_A_minus_KC_says_so(
+    A: str, K: str, discrete: bool, stable: bool
+) -> None:
+    """Redesign with a K that leaves A − KC unstable: no λ can help (LMI (2)/(8) needs it
+    Hurwitz/Schur), and the gain bound is not the redesign's to raise. The message said "try a
+    smaller λ or raise gain_bound (now 100)" (stubborn review); the exact test decides."""
+    from obsdesign.errors import InfeasibleError
+
+    time = "discrete" if discrete else "continuous"
+    lam = "0.9" if discrete else "1"
+    text = (
+        f'[system]\ntime = "{time}"\nA = {A}\nC = [[1]]\n[method]\nkey = "stubborn"\n'
+        f"K = {K}\nlambda = {lam}\n"
+    )
+    spec = api.load_spec_text(text, "r.toml")
+    from obsdesign.methods.stubborn.design import _stable_gain
+
+    assert _stable_gain(spec, spec.options.K, discrete) == stable
+    if stable:
+        return
+    with pytest.raises(InfeasibleError) as e:
+        api.design(spec)
+    msg = e.value.message
+    assert "A − KC is not " + ("Schur" if discrete else "Hurwitz") in msg
+    assert "gain_bound" not in msg and "smaller λ" not in msg
+
+
+@pytest.mark.parametrize(
+    "change, key",
+    [
+        (('time = "continuous"', 'time = "discrete"'), "[system.time]"),
+        (("C = [[1, 0]]", "C = [[0, 1]]"), "[system.C]"),
+        (("C = [[1, 0]]", "C = [[1, 1e-30]]"), "[system.C]"),
+    ],
+)
+def test_high_gain_mode_refuses_what_it_would_ignore(change: tuple[str, str], key: str) -> None:
+    """High-gain mode is the continuous-time redesign with y = x1: a discrete spec was
+    certified (with the continuous ℓ-bound) and crashed in simulate, and C = [[0, 1]] was
+    ignored (the observer measured x1) — stubborn review. Both are bad input naming the key."""
+    text = (SPECS / "astolfi-stubborn-duffing.toml").read_text()
+    assert change[0] in text
+    api.load_spec_text(text, "hg.toml")  # as shipped: accepted
+    with pytest.raises(SpecError) as e:
+        api.load_spec_text(text.replace(change[0], change[1], 1), "hg.toml")
+    assert key in str(e.value)
+
+
+def test_runs_without_the_outlier_study_is_refused(ex1: Report) -> None:
+    """``simulate --runs N`` without ``--study outliers`` printed one run and ignored N."""
+    from obsdesign.errors import InputError
+
+    with pytest.raises(InputError, match="--study outliers"):
+        api.simulate(EX1, report=ex1, runs=3)
+
+
+def test_stubborn_state_limit() -> None:
+    """25 states exceed the method's limit (24: the SDPs ran past 300 s with 9.7 GB at
+    n = 100 — stubborn review); the refusal names the spec and the override."""
+    n = 25
+    A = (
+        "["
+        + ", ".join(
+            "[" + ", ".join("-1" if i == j else "0" for j in range(n)) + "]" for i in range(n)
+        )
+        + "]"
+    )
+    C = "[[" + ", ".join("1" for _ in range(n)) + "]]"
+    text = f'[system]\ntime = "continuous"\nA = {A}\nC = {C}\n[method]\nkey = "stubborn"\n'
+    with pytest.raises(SpecError) as e:
+        api.design(api.load_spec_text(text, "big.toml"))
+    assert "24" in str(e.value) and "max_states" in str(e.value)
 
 
 def test_outlier_study_run_r_does_not_depend_on_the_number_of_runs(ex1: Report) -> None:

@@ -11,13 +11,14 @@ the report's copy.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
 from flint import fmpq
 
 from obsdesign.certify.claim import Claim, Claims
-from obsdesign.certify.exact import Q, qmat
+from obsdesign.certify.exact import Q, float_or_inf, qmat
 from obsdesign.certify.printing import fmt_exact, fmt_up
 from obsdesign.certify.psd import PSDResult, check_pd, check_psd
 from obsdesign.methods.stubborn import lmis
@@ -71,8 +72,8 @@ def point_checks(
         "W-positive": _sign(w),
         "R-positive": check_pd(R),
         "lambda-range": PSDResult(bool(lam > 0 and (lam < 1 or not disc)), float(lam), ""),
-        "lmi-regional": check_pd(-lmis.regional(A, C, P, X, u, R, lam, disc)),
-        "lmi-global": check_pd(-lmis.global_(A, C, P, X, w, Y, disc)),
+        "lmi-global": check_pd(-lmis.global_sector(A, C, P, X, u, R, lam, disc)),
+        "lmi-regional": check_pd(-lmis.regional_sector(A, C, P, X, w, Y, disc)),
     }
     bad = [
         f"i = {i + 1}: {r.detail}"
@@ -218,8 +219,8 @@ def lmi_claims(
         "W-positive": ("W = diag(w) ≻ 0 (σ_i = √(σ̄/w_i))", "regional sector condition", "exact sign of each entry"),
         "R-positive": ("R = Rᵀ ≻ 0", "adaptive saturation law", "exact LDLᵀ"),
         "lambda-range": (f"λ = {fmt_exact(lam)} " + ("∈ (0, 1)" if disc else "> 0"), "adaptive saturation law", "exact comparison"),
-        "lmi-regional": (f"LMI {eqs[0]} holds strictly at λ = {fmt_exact(lam)} with K = P⁻¹X", f"eq. {eqs[0]}", "exact LDLᵀ of −M (all pivots > 0)"),
-        "lmi-global": (f"LMI {eqs[1]} holds strictly", f"eq. {eqs[1]}", "exact LDLᵀ of −M (all pivots > 0)"),
+        "lmi-global": (f"LMI {eqs[0]} holds strictly at λ = {fmt_exact(lam)} with K = P⁻¹X", f"eq. {eqs[0]}", "exact LDLᵀ of −M (all pivots > 0)"),
+        "lmi-regional": (f"LMI {eqs[1]} holds strictly", f"eq. {eqs[1]}", "exact LDLᵀ of −M (all pivots > 0)"),
         "lmi-sector": (f"LMI {eqs[2]} holds (strictly) for every output i = 1..{p}", f"eq. {eqs[2]}", "exact LDLᵀ of each [[P, Y_iᵀ], [Y_i, w_i]]"),
         "r-bound": (f"R ⪯ {fmt_exact(o.r_bound or 0)}·I ([method].r_bound)", "optimized parameter selection (the bound that makes the best λ finite)", "exact LDLᵀ of r_bound·I − R (⪰ 0)"),
         "gain-bound": (f"‖K‖₂ ≤ {fmt_exact(o.gain_bound or 0)} ([method].gain_bound)", "optimized parameter selection (the bound that makes the best λ finite)", "exact LDLᵀ of bound²·I − KᵀK (⪰ 0)"),
@@ -256,7 +257,7 @@ def lambda_max_claims(spec: Spec, pr: Parameters) -> list[Claim]:
     """The best λ: certified at λ_max (a second certificate P, K, U, W, Y, R ``*_at_max``), and
     bracketed: λ_other within lambda_tol of λ_max where the solver does not find the LMIs
     feasible (re-solved here: numerical)."""
-    from obsdesign.methods.stubborn.design import Feasibility, Plant
+    from obsdesign.methods.stubborn.design import INFEASIBLE, Feasibility, Plant
 
     o: Options = spec.options
     disc = spec.system.discrete
@@ -285,22 +286,34 @@ def lambda_max_claims(spec: Spec, pr: Parameters) -> list[Claim]:
         return c
     arr = np.asarray(br, dtype=object).reshape(-1)
     lo, hi = Q(arr[0]), Q(arr[-1])
-    close = arr.size == 2 and abs(hi - lo) <= o.lambda_tol * abs(lo)
-    side = (hi < lo) if disc else (hi > lo)
-    ok_hi, st_hi = Feasibility(Plant.of(spec), o)(float(hi))
+    pair = arr.size == 2
+    close = abs(hi - lo) <= o.lambda_tol * abs(lo)
+    side = (0 < hi < lo) if disc else (0 < lo < hi)
+    far = float_or_inf(hi)
+    solvable = side and math.isfinite(far)
+    st_hi = Feasibility(Plant.of(spec), o)(far)[1] if solvable else "not solved"
     word = "smallest" if disc else "largest"
+    width = abs(hi - lo) / abs(lo) if lo != 0 else None
     c.numerical(
         id="lambda-max-bracket",
-        statement=f"the {word} λ with LMIs {eqs} feasible is within a relative "
-        f"{fmt_exact(o.lambda_tol)} of λ_max = {fmt_exact(lo)}: the solver does not find them "
-        f"feasible at {fmt_exact(hi)}",
+        statement=f"the {word} λ with LMIs {eqs} feasible lies between λ_max = {fmt_exact(lo)} "
+        f"and {fmt_exact(hi)}"
+        + (f" (relative width {float(width):.3g})" if width is not None else "")
+        + f": the solver finds them infeasible at {fmt_exact(hi)}",
         reference=f"{PAPER}, optimized parameter selection (first maximize λ)",
-        check="exact bracket width and side; feasibility SDP re-solved at the far end (Clarabel)",
-        passed=bool(close and side and lo == lm and not ok_hi),
+        check="exact side; feasibility SDP re-solved at the far end (Clarabel, cold start): "
+        f"status '{INFEASIBLE}' required",
+        passed=bool(pair and side and lo == lm and st_hi == INFEASIBLE),
         detail=f"at the far end: {st_hi}"
-        + ("" if close else "; bracket wider than lambda_tol")
+        + ("" if pair else "; the bracket is not a pair [λ_max, λ_other]")
         + ("" if side else "; far end on the wrong side")
-        + ("" if lo == lm else "; the bracket does not start at λ_max"),
+        + ("" if lo == lm else "; the bracket does not start at λ_max")
+        + (
+            ""
+            if close
+            else f"; wider than lambda_tol = {fmt_exact(o.lambda_tol)} (the far end is where "
+            "the solver reports infeasibility; nearer, its answers are inaccurate)"
+        ),
     )
     return c
 

@@ -182,12 +182,28 @@ def feasible(pl: Plant, o: Options, lam: float) -> tuple[bool, str]:
     return Feasibility(pl, o)(lam)
 
 
+#: the solver status that counts as "the LMIs are infeasible" at the bracket's far end
+INFEASIBLE = "infeasible"
+#: the far end is moved outward at most this many times (doubling its distance each time:
+#: from a gap of one ulp, 2⁸⁰ times it passes the search caps)
+FAR_STEPS = 80
+
+
 def search_lambda(pl: Plant, o: Options) -> tuple[float, float, str]:
     """The best λ to a relative tolerance: (certifiable side, other side, status there).
 
     Continuous time: the largest λ > 0 (feasibility is monotone: a smaller λ only relaxes
     (1)); doubling from 1 brackets it, bisection refines until hi − lo ≤ tol·lo. Discrete
-    time: the smallest λ ∈ (0, 1) (a larger λ relaxes (7)); bisection on (0, 1)."""
+    time: the smallest λ ∈ (0, 1) (a larger λ relaxes (7)); bisection on (0, 1).
+
+    Only Clarabel's ``optimal`` counts as feasible. The bisection treats every other answer
+    as "not found feasible", but the far end of the bracket must be a λ where the solver
+    reports ``infeasible``: near the boundary Clarabel also answers ``optimal_inaccurate``,
+    ``infeasible_inaccurate`` or fails (Example 1: optimal at 7.5117, inaccurate or failing
+    on 7.52 … 7.55, infeasible from 7.57 on; a certificate exists at 7.53 — stubborn review),
+    so a far end without a solver infeasibility certificate is moved outward
+    (:func:`_far_end`) and the bracket may end wider than ``lambda_tol``: it says where the
+    solver's answers are reliable, not more."""
     tol = float(o.lambda_tol) / 2  # half the tolerance: _certified_best may step back tol/8 ×3
     feas = Feasibility(pl, o)
 
@@ -206,30 +222,67 @@ def search_lambda(pl: Plant, o: Options) -> tuple[float, float, str]:
             lo = 1e-6
             if not feasible(pl, o, lo)[0]:
                 return 0.0, lo, st
-            lo, hi = _bisect(feas, lo, hi, tol)
-            return lo, hi, st
-        lo, hi = _bisect(feas, lo, hi, tol)
-        return lo, hi, feasible(pl, o, hi)[1]
+        lo, hi, st, known = _bisect(feas, lo, hi, st, tol)
+        return (lo, *_far_end(feas, lo, hi, st, known, False))
     top = 1 - 1e-6
     if not feasible(pl, o, top)[0]:
         return 1.0, top, "infeasible"
     bot = 1 / LAMBDA_CAP
-    if feasible(pl, o, bot)[0]:
+    ok, st = feasible(pl, o, bot)
+    if ok:
         return bot, 0.0, "feasible down to the cap"
-    hi, lo = _bisect(feas, top, bot, tol)
-    return hi, lo, feasible(pl, o, lo)[1]
+    hi, lo, st, known = _bisect(feas, top, bot, st, tol)
+    return (hi, *_far_end(feas, hi, lo, st, known, True))
 
 
-def _bisect(feas: Feasibility, good: float, bad: float, tol: float) -> tuple[float, float]:
-    """Bisection between a feasible λ (good) and an infeasible one (bad) until
-    |bad − good| ≤ tol·|good|."""
+def _bisect(
+    feas: Feasibility, good: float, bad: float, status: str, tol: float
+) -> tuple[float, float, str, float | None]:
+    """Bisection between a feasible λ (good) and one not found feasible (bad, the solver's
+    ``status`` there) until |bad − good| ≤ tol·|good|, or until the two are adjacent floats
+    (a ``lambda_tol`` below the float resolution: the midpoint equals an end and the gap
+    can shrink no more; such a tolerance hung the design — stubborn review). Returns
+    (good, bad, the status at bad, the nearest λ the solver reported infeasible or None)."""
+    known = bad if status == INFEASIBLE else None
     while abs(bad - good) > tol * abs(good):
         mid = (good + bad) / 2
-        if feas(mid)[0]:
+        if mid == good or mid == bad:
+            break
+        ok, st = feas(mid)
+        if ok:
             good = mid
         else:
-            bad = mid
-    return good, bad
+            bad, status = mid, st
+            if st == INFEASIBLE:
+                known = mid
+    return good, bad, status, known
+
+
+def _far_end(
+    feas: Feasibility,
+    good: float,
+    bad: float,
+    status: str,
+    known: float | None,
+    discrete: bool,
+) -> tuple[float, str]:
+    """The bracket's far end: ``bad`` when the solver reports it ``infeasible``, else the
+    first of good ± 2ᵏ·|bad − good| (k = 1, 2, …; outward: up in continuous time, down in
+    discrete) where it does — or ``known``, the nearest λ the search already found
+    infeasible, once the steps pass it — within the search caps. Returns (far end, status
+    there); when none is found the last point tried and its status (the bracket claim then
+    names the status and fails)."""
+    gap = abs(bad - good)
+    k = 0
+    while status != INFEASIBLE and k < FAR_STEPS:
+        k += 1
+        cand = good + gap * 2**k if not discrete else good - gap * 2**k
+        if known is not None and (cand >= known if not discrete else cand <= known):
+            return known, INFEASIBLE
+        if (not discrete and cand > LAMBDA_CAP) or (discrete and cand < 1 / LAMBDA_CAP):
+            break
+        bad, status = cand, feas(cand)[1]
+    return bad, status
 
 
 def _chosen(o: Options, best: fmpq, discrete: bool) -> fmpq:
@@ -289,6 +342,13 @@ def design_params(
             + (f"; solver: {st} at {float(bad):.6g})" if other is not None else ", search cap)")
             + f"; λ = {'fraction·λ_max' if not pl.discrete else '1 − fraction·(1 − λ_best)'}"
         )
+        if other is not None and abs(other - best) > o.lambda_tol * abs(best):
+            notes.append(
+                f"the λ bracket [{float(best):.6g}, {float(bad):.6g}] is wider than lambda_tol "
+                f"= {float(o.lambda_tol):g}: the solver reports the LMIs infeasible nowhere "
+                "nearer (near the boundary its answers are inaccurate), so the far end is the "
+                "nearest λ found where it does"
+            )
     if progress:
         progress(f"criterion '{o.criterion}' at λ = {float(lam_q):.6g}")
     cand, margin, solver = _certify_point(spec, pl, o, lam_q, o.criterion)
@@ -330,7 +390,8 @@ POINT_KEYS = ("K", "P", "U", "W", "Y", "R")
 def _certified_best(spec: Spec, pl: Plant, o: Options, good: float) -> tuple[fmpq, dict[str, Any]]:
     """A certified point at (or just inside) the solver's best λ: λ_max rounded to 20 bits
     towards the feasible side, then stepped back by tol/8 (up to 3 times) until the rounded
-    solution passes the exact checks. The bracket [λ_max, λ_other] stays within lambda_tol."""
+    solution passes the exact checks (the bracket [λ_max, λ_other] widens by at most 3/8 of
+    lambda_tol: the search's own bracket is half of it)."""
     step = float(o.lambda_tol) / 8 * abs(good)
     for i in range(4):
         g = good - i * step if not pl.discrete else good + i * step
@@ -492,9 +553,21 @@ def _infeasible(spec: Spec, pl: Plant, o: Options, where: str) -> None:
             f"stubborn: LMIs {_refs(pl)} infeasible {where}, and detectability of (C, A) is "
             f"numerically inconclusive ({det.detail})"
         )
+    if o.K is not None and not _stable_gain(spec, o.K, pl.discrete):
+        # the (1,1) block of (2) / (8) needs A − KC Hurwitz (Schur): no λ or R can help (the
+        # hint used to say "try a smaller λ or raise gain_bound", a key the redesign refuses —
+        # stubborn review)
+        kind = "Schur (spectral radius < 1)" if pl.discrete else "Hurwitz"
+        raise InfeasibleError(
+            f"stubborn: LMIs {_refs(pl)} infeasible {where}: A − KC is not {kind} for the "
+            "given K (exact test), which LMI "
+            f"{'(8)' if pl.discrete else '(2)'} requires for every λ: give a K that makes A − KC "
+            f"{kind}, or omit K to let the design choose it"
+        )
+    # the gain bound applies in full mode only (redesign keeps the given K)
     bounds = ", ".join(
         f"{k} (now {float(v):g})"
-        for k, v in (("gain_bound", o.gain_bound), ("r_bound", o.r_bound))
+        for k, v in (("gain_bound", o.gain_bound if o.K is None else None), ("r_bound", o.r_bound))
         if v is not None
     )
     # λ: the decay asked of V, λ·V in (1) (larger is harder) but λ·P in (7), where a
@@ -524,6 +597,21 @@ def _infeasible(spec: Spec, pl: Plant, o: Options, where: str) -> None:
                     "continuous-time model may help"
                 )
     raise InfeasibleError(f"stubborn: LMIs {_refs(pl)} infeasible {where}: {why}")
+
+
+def _stable_gain(spec: Spec, K: Any, discrete: bool) -> bool:
+    """Whether A − KC is Hurwitz (continuous) or Schur (discrete), decided exactly (Routh /
+    Schur–Cohn test of its characteristic polynomial): the (1,1) block He(P(A − KC)) of
+    LMI (2) (resp. −P + (A − KC)ᵀP(A − KC) of (8)) needs it, for any λ."""
+    from obsdesign.certify.detect import hurwitz_stable, schur_stable
+    from obsdesign.lyap import fmat
+
+    s = spec.system
+    M = np.asarray(s.A.q, dtype=object) - np.asarray(K, dtype=object) @ np.asarray(
+        s.C.q, dtype=object
+    )
+    poly = fmat(M).charpoly()
+    return bool((schur_stable if discrete else hurwitz_stable)(poly)[0])
 
 
 def _refs(pl: Plant) -> str:

@@ -25,7 +25,7 @@ def _diag(v: np.ndarray, zero: Any) -> np.ndarray:
     return D
 
 
-def regional(
+def global_sector(
     A: np.ndarray,
     C: np.ndarray,
     P: np.ndarray,
@@ -35,7 +35,8 @@ def regional(
     lam: Any,
     discrete: bool,
 ) -> np.ndarray:
-    """The matrix of LMI (1) (continuous) or (7) (discrete); the LMI says it is ≺ 0.
+    """The matrix of LMI (1) (continuous) or (7) (discrete); the LMI says it is ≺ 0. It
+    carries U, the multiplier of the slides' *global* sector condition (claim ``lmi-global``).
 
     (1): He[[PA − XC + ½(λP − CᵀRC), X], [UC, −U]];
     (7): He[[−½(λP + CᵀRC), 0, 0], [UC, −U, 0], [PA − XC, X, −½P]].
@@ -56,7 +57,7 @@ def regional(
     )
 
 
-def global_(
+def regional_sector(
     A: np.ndarray,
     C: np.ndarray,
     P: np.ndarray,
@@ -65,7 +66,8 @@ def global_(
     Y: np.ndarray,
     discrete: bool,
 ) -> np.ndarray:
-    """The matrix of LMI (2) (continuous) or (8) (discrete); the LMI says it is ≺ 0.
+    """The matrix of LMI (2) (continuous) or (8) (discrete); the LMI says it is ≺ 0. It
+    carries W and Y of the slides' *regional* sector condition (claim ``lmi-regional``).
 
     (2): He[[PA − XC, X], [WC + Y, −W]];
     (8): He[[−½P, 0, 0], [WC + Y, −W, 0], [PA − XC, X, −½P]]. ``w``: the diagonal of W."""

@@ -96,6 +96,25 @@ def parse_options(table: Table, spec: Spec) -> Options:
     if mode == "high-gain":
         if s.p != 1:
             raise table.error("mode", "the high-gain redesign needs one output y = x1")
+        # the slides' high-gain part is continuous time, with y = x1: a discrete spec was
+        # certified with the continuous ℓ-bound and crashed in simulate, and another C was
+        # ignored (the observer measured x1 whatever C said) — stubborn review
+        if s.discrete:
+            raise SpecError(
+                spec.file,
+                "system.time",
+                "is 'discrete', but mode = 'high-gain' is the continuous-time high-gain "
+                "redesign of the slides: use time = 'continuous'",
+            )
+        if s.C is not None and not all(
+            v == (1 if j == 0 else 0) for j, v in enumerate(np.asarray(s.C.q).reshape(-1))
+        ):
+            raise SpecError(
+                spec.file,
+                "system.C",
+                "must be [[1, 0, …, 0]] in mode = 'high-gain' (the high-gain observer measures "
+                "y = x1 of the triangular form); omit C or reorder the states",
+            )
         K = table.vector("K", n=n).q
         lip = table.scalar("lipschitz", min=0).q
         e = table.scalar("ell", default=None, min=1)

@@ -389,7 +389,14 @@ def _plant(
 def simulate(
     spec: Spec, params: Parameters, study: str = "none", runs: int = 0, observer: str = "stubborn"
 ) -> SimResult:
-    """``simulate``: one run (default) or the outlier study (``--option study=outliers``)."""
+    """``simulate``: one run (default) or the outlier study (``--option study=outliers``).
+    ``runs`` (> 0) is the study's number of Monte Carlo runs per amplitude; asked without the
+    study it is refused (it was silently ignored: one run printed — stubborn review)."""
+    if runs and study == "none":
+        raise InputError(
+            f"--runs {runs}: the stubborn method's Monte Carlo runs are those of the outlier "
+            "study (linear modes): add --study outliers; without it simulate makes one run"
+        )
     if spec.options.mode == "high-gain":
         from obsdesign.methods.stubborn.highgain import simulate as hg
 
