@@ -852,3 +852,19 @@ def test_outlier_study_run_r_does_not_depend_on_the_number_of_runs(ex1: Report) 
     assert a.shape[2] == 3 and b.shape[2] == 5
     np.testing.assert_array_equal(a, b[:, :, :3])
     assert not np.array_equal(b[:, :, 3], b[:, :, 4])  # the runs differ
+
+
+def test_design_notes_how_fast_the_unsaturated_error_decays() -> None:
+    """The LMIs bound no decay rate for e (λ is σ̄'s): criterion K on A = 0 gives K ≈ −2.4·10⁻⁷,
+    certified, and the error hardly moves (stubborn review). The note states the spectral
+    abscissa of A − KC, as computed from the reported K."""
+    text = (
+        '[system]\ntime = "continuous"\nA = [[0]]\nC = [[-1.06729423297199477]]\n'
+        '[method]\nkey = "stubborn"\nlambda = 2.5\ngain_bound = 0.5\ncriterion = "K"\n'
+    )
+    rep = api.design(api.load_spec_text(text, "k.toml"))
+    K = rep.parameters.float("K").ravel()[0]
+    want = -K * -1.06729423297199477
+    (note,) = [n for n in rep.notes if n.startswith("A − KC: spectral abscissa")]
+    got = float(note.split("≈ ")[1].split(" ")[0])
+    assert got == pytest.approx(want, rel=1e-3) and abs(got) < 1e-3
