@@ -317,6 +317,20 @@ TAMPERS: list[tuple[str, str, Callable, set[str]]] = [
         {"alpha_best-bracket"},
     ),
     ("iss-gain", "sec5", _tamper_mu_edge, {"iss-gain"}),
+    # an asymmetric P (2⁻⁶⁰ on one off-diagonal entry): V = eᵀPe needs P = Pᵀ; the decay and
+    # ISS claims were recomputed as certified (lyapunov review)
+    (
+        "asymmetric P",
+        "sec5",
+        _set("P", lambda P, s: P + qmat([[0, EPS], [0, 0]])),
+        {"P-positive-definite", "decay-lmi", "iss-gain"},
+    ),
+    (
+        "asymmetric P_best",
+        "cont",
+        _set("P_best", lambda P, s: P + qmat([[0, 0], [EPS, 0]])),
+        {"P_best-positive-definite", "decay-lmi_best"},
+    ),
     (
         "L-matches-spec",
         "sec5",
