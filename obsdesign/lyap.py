@@ -938,7 +938,7 @@ def certified_P(
     return _certified_P_hp(Am, r, discrete, margin, memo, Af, guide)
 
 
-def margin_scale(Pf: np.ndarray, margin: Any) -> fmpq:
+def margin_scale(Pf: np.ndarray, margin: Any, Pm: fmpq_mat | None = None) -> fmpq:
     """The power of two c by which the Lyapunov-equation P (decay matrix I, eq. (4)-(6) of
     the constrained-redesign paper, Astolfi et al., NOLCOS 2019, with Q = I) is scaled so
     that both strict checks can hold with the margin δ: c·I ⪰ 2δ·I and c·λ_min(P) ≥ 2δ
@@ -947,20 +947,45 @@ def margin_scale(Pf: np.ndarray, margin: Any) -> fmpq:
     with λ_min(P) = ⅙ and δ = 0.4 was refused (exit 4) with a valid P = diag(½, 1) at hand
     (random-spec fuzzer).
 
-    :param Pf: the float P; :param margin: δ."""
+    With the exact P (``Pm``) and a float λ_min that floats cannot resolve (at most 10⁻¹²·
+    λ_max), λ_min = 1/λ_max(P⁻¹) from the exact inverse, whose largest eigenvalue floats get
+    right: a non-normal continuous plant's high-precision P had entries up to 4.6·10²⁴ and
+    λ_min ≈ 0.07, float eigvalsh gave −8.9·10⁷, P was not scaled and missed margin = 0.1
+    (exit 4 with a certificate at hand — lyapunov review).
+
+    :param Pf: the float P; :param margin: δ; :param Pm: the exact P, when at hand."""
     d = Q(margin)
     c = fmpq(1)
     if d <= 0:
         return c
     with np.errstate(all="ignore"):
         try:
-            lmin = float(np.linalg.eigvalsh((Pf + Pf.T) / 2)[0])
+            ev = np.linalg.eigvalsh((Pf + Pf.T) / 2)
+            lmin = float(ev[0])
+            if Pm is not None and not lmin > 1e-12 * float(ev[-1]):
+                lmin = _lambda_min_by_inverse(Pm, lmin)
         except np.linalg.LinAlgError:
             lmin = 0.0
     need = 2 * d if not lmin > 0 else 2 * d / Q(min(1.0, lmin))
     while c < need:
         c *= 2
     return c
+
+
+def _lambda_min_by_inverse(Pm: fmpq_mat, fallback: float) -> float:
+    """λ_min(P) = 1/λ_max(P⁻¹) for a positive definite P, P⁻¹ exact (flint), its largest
+    eigenvalue in floats (well resolved, while P⁻¹'s smallest may not be: P⁻¹ is as
+    ill-conditioned as P); a guide for :func:`margin_scale` only (for a P that is not positive
+    definite it may mislead; the exact checks decide). ``fallback`` when P is singular or
+    λ_max(P⁻¹) is not a positive float."""
+    try:
+        inv = mat_float(Pm.inv())
+        top = float(np.linalg.eigvalsh((inv + inv.T) / 2)[-1])
+    except (ZeroDivisionError, np.linalg.LinAlgError, OverflowError):
+        return fallback
+    if not (math.isfinite(top) and top > 0):
+        return fallback
+    return 1.0 / top
 
 
 def _certified_P_hp(
@@ -998,7 +1023,7 @@ def _certified_P_hp(
         Pm = lyap_hp.lyapunov_P_hp(Am, r, discrete, prec)
         if Pm is None:
             continue
-        Pm = Pm * margin_scale(mat_float(Pm), margin)
+        Pm = Pm * margin_scale(mat_float(Pm), margin, Pm)
         P = as_array(Pm)
         if (
             pd_verdict(P, margin, memo, Pm, None)

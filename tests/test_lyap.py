@@ -261,7 +261,7 @@ def test_certified_P_scales_for_a_large_margin(margin: fmpq, monkeypatch) -> Non
     M = lyap.decay_matrix(A, C, L, P, fmpq(1), False)
     assert check_pd(P, margin) and check_pd(M, margin)
     assert not check_pd(P, 100 * margin)  # c is the least power of two: λ_min(P) < 4δ
-    monkeypatch.setattr(lyap, "margin_scale", lambda Pf, m: fmpq(1))
+    monkeypatch.setattr(lyap, "margin_scale", lambda Pf, m, Pm=None: fmpq(1))
     assert certified_P(A, C, L, False, fmpq(1), margin) is None
 
 

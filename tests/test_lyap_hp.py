@@ -12,7 +12,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from obsdesign import api, lyap, lyap_hp
-from obsdesign.certify.exact import qmat
+from obsdesign.certify.exact import Q, qmat
 from obsdesign.spectrum import Spectrum
 
 #: the soundness audit's spec (session 11): a Riccati gain makes A − LC entries of ~1e5
@@ -156,3 +156,23 @@ def test_float_spectrum_far_off_does_not_skip_the_fallback(tmp_path: Path) -> No
     out = tmp_path / "r.json"
     out.write_text(rep.to_json())
     assert api.verify(out).exit_code() == 0
+
+
+@pytest.mark.parametrize("margin", ["0.1", "1"])
+def test_margin_scale_sees_lambda_min_of_an_ill_conditioned_P(margin: str) -> None:
+    """The same audit example with a margin: the high-precision P has entries up to ~10²⁶ and
+    λ_min ≈ 0.07, which float eigvalsh cannot resolve (it gave −8.9·10⁷), so P was not scaled
+    and missed the margin (exit 4 with a certificate at hand — lyapunov review). λ_min now
+    comes from the exact inverse; margin_scale without it keeps the old guess."""
+    text = (Path(__file__).parent / "specs" / "lyapunov-nonnormal-continuous.toml").read_text()
+    sp = api.load_spec_text(text + f"margin = {margin}\n", "nn.toml")
+    rep = api.design(sp)
+    assert rep.exit_code() == 0
+    assert all(c.status.value == "certified" for c in rep.claims)
+    P = rep.parameters["P"]
+    Pm = lyap.fmat(P)
+    Pf = lyap.mat_float(Pm)
+    # the guide: with the exact P the scale is at least 2δ/λ_min, without it only 2δ
+    lmin = lyap._lambda_min_by_inverse(Pm, -1.0)
+    assert lmin > 0
+    assert lyap.margin_scale(Pf, Q(margin), Pm) >= lyap.margin_scale(Pf, Q(margin))
