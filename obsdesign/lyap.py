@@ -1230,8 +1230,9 @@ def best_rate(
         if checks > MAX_EXACT_CHECKS:
             raise InconclusiveError(
                 f"best-rate search: more than {MAX_EXACT_CHECKS} exact checks without a bracket "
-                f"of width rate_tol = {float(tol_q):.3g} (a width near or below the float "
-                "resolution of the rate, ~1e-16, cannot be reached: raise rate_tol)"
+                f"of width rate_tol = {float(tol_q):.3g}: near the best rate the rounded "
+                "certificates keep failing their exact checks (A − LC ill-conditioned there, or "
+                "a width near the float resolution of the rate, ~1e-16 relative): raise rate_tol"
             )
         return certified_P(
             A,

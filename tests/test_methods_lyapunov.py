@@ -523,7 +523,7 @@ def test_designed_gain_random_observable_systems(n: int, seed: int, time: str):
     rng = np.random.default_rng(seed)
     A = rng.standard_normal((n, n)) * 1.2 / np.sqrt(n)
     C = rng.standard_normal((1, n))
-    text = _designed(A, C, time, "rate_cap = 2\n")
+    text = _designed(A, C, time)
     rep = api.design(load_spec_text(text))
     assert all(c.status == ClaimStatus.CERTIFIED for c in rep.claims)
     L = rep.parameters.float("L")
@@ -792,6 +792,14 @@ def test_place_needs_observability() -> None:
         ('design = "place"\npoles = [0.1, 1.0]\n', "poles", "modulus < 1"),
         ("riccati_Q = [[1, 2], [0, 1]]\n", "riccati_Q", "symmetric"),
         ('design = "magic"\n', "design", "one of"),
+        # lyapunov review: accepted and ignored, or exit 4, before
+        ("L = [1, 1]\nrate_cap = 5\n", "rate_cap", "designs L"),
+        ('design = "lmi"\nrate_cap = 5\n', "rate_cap", "continuous-time LMI gain design only"),
+        ("rate_cap = 5\n", "rate_cap", "continuous-time LMI gain design only"),
+        ("riccati_R = [[-1]]\n", "riccati_R", "positive definite"),
+        ("riccati_R = [[0]]\n", "riccati_R", "positive definite"),
+        ("riccati_Q = [[1, 0], [0, -1e-30]]\n", "riccati_Q", "positive semidefinite"),
+        ('design = "place"\npoles = [0.1, 0.1]\n', "poles", "more than rank(C) = 1"),
     ],
 )
 def test_design_option_errors(extra: str, key: str, why: str) -> None:
@@ -823,6 +831,40 @@ def test_place_poles_the_rate_excludes_are_refused(time, rate, slow, fast) -> No
     assert ei.value.exit_code == 2
     rep = api.design(load_spec_text(_designed(A, C_UO, time, extra + fast + "\n")))
     assert rep.exit_code() == 0
+
+
+def test_design_option_boundaries_are_accepted() -> None:
+    """The smallest admissible values next to the refused ones: a PSD (singular) Q, an R of
+    10⁻³⁰, distinct poles, rate_cap with the continuous LMI design."""
+    for extra in (
+        "riccati_Q = [[1, 0], [0, 0]]\n",
+        "riccati_R = [[1e-30]]\n",
+        'design = "place"\npoles = [0.1, 0.1000001]\n',
+    ):
+        load_spec_text(_designed(A_UO, C_UO, extra=extra))
+    load_spec_text(
+        _designed(
+            np.array([[1.3, 0.5], [-0.3, 0.8]]),
+            C_UO,
+            "continuous",
+            'design = "lmi"\nrate_cap = 5\n',
+        )
+    )
+
+
+def test_place_with_a_repeated_output_row() -> None:
+    """C = [[1, 0], [1, 0]] (rank 1, (C, A) observable): scipy refused the placement (exit 4
+    — lyapunov review); it now runs on the independent rows and L's other column is 0."""
+    A = np.array([[0.0, 1.0], [2.0, 3.0]])
+    C = np.array([[1.0, 0.0], [1.0, 0.0]])
+    rep = api.design(
+        load_spec_text(_designed(A, C, extra='design = "place"\npoles = [-0.12, -0.02]\n'))
+    )
+    assert rep.exit_code() == 0
+    L = rep.parameters.float("L")
+    assert np.all(L[:, 1] == 0)
+    ev = np.sort(np.linalg.eigvals(A - L @ C).real)
+    assert np.allclose(ev, [-0.12, -0.02], atol=1e-9)
 
 
 def test_riccati_weights_change_the_gain() -> None:

@@ -395,11 +395,21 @@ def placed_gain(A: np.ndarray, C: np.ndarray, poles: np.ndarray) -> np.ndarray:
     (floats): the error dynamics of the linear observer of Section 5 of the constrained-redesign
     paper (Astolfi et al., NOLCOS 2019) with prescribed poles.
 
+    Placement needs independent outputs: with a C of lower row rank (a repeated row) scipy
+    refused (exit 4 — lyapunov review), so it runs on a maximal set of independent rows of C
+    and the other columns of L are 0 (A − LC is the same matrix).
+
     :param A, C: float plant ((C, A) observable); :param poles: n real poles (a pole may
-    repeat at most p times)."""
+    repeat at most rank(C) times)."""
     from scipy.signal import place_poles
 
-    return np.asarray(place_poles(A.T, C.T, poles).gain_matrix, dtype=float).T
+    keep: list[int] = []
+    for i in range(C.shape[0]):
+        if np.linalg.matrix_rank(C[[*keep, i]]) > len(keep):
+            keep.append(i)
+    L = np.zeros((A.shape[0], C.shape[0]))
+    L[:, keep] = np.asarray(place_poles(A.T, C[keep].T, poles).gain_matrix, dtype=float).T
+    return L
 
 
 def design_gain(

@@ -8,6 +8,8 @@ from typing import Any
 import numpy as np
 from flint import fmpq
 
+from obsdesign.certify.exact import Q
+from obsdesign.certify.psd import check_pd, check_psd
 from obsdesign.spec.models import Spec
 from obsdesign.spec.reader import Table
 
@@ -61,6 +63,31 @@ def _poles_meet_the_rate(table: Any, poles: Any, rate: Any, discrete: bool) -> N
         )
 
 
+def _poles_placeable(table: Any, poles: Any, C: Any) -> None:
+    """Refuse a pole repeated more than rank(C) times: pole placement (the dual of placing
+    the eigenvalues of A − BK with B = Cᵀ) can give an eigenvalue at most rank(C) independent
+    eigenvectors, and scipy's place_poles refuses it (exit 4 before — lyapunov review).
+
+    :param table: ``[method]``; :param poles: the exact poles; :param C: the exact C."""
+    if C is None:
+        return
+    from flint import fmpq_mat
+
+    Ca = np.asarray(C, dtype=object)
+    rank = fmpq_mat(Ca.shape[0], Ca.shape[1], [Q(v) for v in Ca.ravel()]).rank()
+    counts: dict[Any, int] = {}
+    for z in poles:
+        counts[Q(z)] = counts.get(Q(z), 0) + 1
+    over = [z for z, k in counts.items() if k > rank]
+    if over:
+        raise table.error(
+            "poles",
+            f"repeats the pole {float(over[0]):g} {counts[over[0]]} times, more than rank(C) = "
+            f"{rank}: placement cannot give it that many independent eigenvectors; make the "
+            "poles distinct",
+        )
+
+
 def parse_options(table: Table, spec: Spec) -> Options:
     """:class:`Options` from ``[method]``; λ in (0, 1) is discrete-only, α > 0
     continuous-only (the other one is an error naming the key).
@@ -84,9 +111,16 @@ def parse_options(table: Table, spec: Spec) -> Options:
     margin = table.scalar("margin", default=fmpq(1, 10**9), min=0)
     design = table.str("design", default="riccati", choices=DESIGNS)
     if L is not None:
-        for k in ("design", "riccati_Q", "riccati_R", "poles"):
+        for k in ("design", "riccati_Q", "riccati_R", "poles", "rate_cap"):
             if table.has(k):
                 raise table.error(k, "designs L: omit L, or omit this key")
+    if table.has("rate_cap") and (s.discrete or design != "lmi"):
+        # it caps the continuous LMI gain search only; accepted and ignored before (review)
+        raise table.error(
+            "rate_cap",
+            'is used by the continuous-time LMI gain design only (design = "lmi", '
+            'time = "continuous"): omit it',
+        )
     keys = {"riccati": ("riccati_Q", "riccati_R"), "place": ("poles",), "lmi": ()}
     for k in ("riccati_Q", "riccati_R", "poles"):
         if table.has(k) and k not in keys[design]:
@@ -96,10 +130,14 @@ def parse_options(table: Table, spec: Spec) -> Options:
         wq = table.matrix("riccati_Q", rows=s.n, cols=s.n).q
         if not all(wq[i, j] == wq[j, i] for i in range(s.n) for j in range(s.n)):
             raise table.error("riccati_Q", "expected a symmetric matrix")
+        if not check_psd(wq).ok:  # the Riccati weights' premise, exactly (exit 4 before)
+            raise table.error("riccati_Q", "expected a positive semidefinite matrix")
     if table.has("riccati_R"):
         wr = table.matrix("riccati_R", rows=s.p, cols=s.p).q
         if not all(wr[i, j] == wr[j, i] for i in range(s.p) for j in range(s.p)):
             raise table.error("riccati_R", "expected a symmetric matrix")
+        if not check_pd(wr).ok:
+            raise table.error("riccati_R", "expected a positive definite matrix")
     if table.has("poles"):
         poles = table.vector("poles", n=s.n).q
         if s.discrete and any(abs(z) >= 1 for z in poles):
@@ -108,6 +146,7 @@ def parse_options(table: Table, spec: Spec) -> Options:
             raise table.error("poles", "expected negative poles in continuous time")
         if rate is not None:
             _poles_meet_the_rate(table, poles, rate.q, s.discrete)
+        _poles_placeable(table, poles, s.C.q if s.C is not None else None)
     table.done()
     return Options(
         L,
