@@ -935,7 +935,7 @@ def certified_P(
             and decay_verdict(Am, P, r, discrete, margin, memo, Pm, Af, None)[0]
         ):
             return P
-    return _certified_P_hp(Am, r, discrete, margin, memo, Af, guide)
+    return _certified_P_hp(Am, r, discrete, margin, memo, Af, guide, Pf if bits < 53 else None)
 
 
 def margin_scale(Pf: np.ndarray, margin: Any, Pm: fmpq_mat | None = None) -> fmpq:
@@ -996,16 +996,22 @@ def _certified_P_hp(
     memo: ExactMemo | None,
     Af: np.ndarray | None,
     guide: Spectrum | None = None,
+    Pf: np.ndarray | None = None,
 ) -> np.ndarray | None:
-    """:func:`certified_P`'s fallback when the float P fails: the Lyapunov-equation P in
-    high precision (:mod:`obsdesign.lyap_hp`, n ≤ its ``MAX_N``), scaled by
-    :func:`margin_scale` (its decay matrix is c·I), checked by the same exact tests. Skipped for a rate the spectrum (:func:`obsdesign.spectrum.spectrum`: float
+    """:func:`certified_P`'s fallback when the rounded float P fails: first the float P
+    itself (``Pf``, every double exact: 53 bits, when the rounding was shorter), then the
+    Lyapunov-equation P in high precision (:mod:`obsdesign.lyap_hp`, n ≤ its ``MAX_N``),
+    each scaled by :func:`margin_scale` (its decay matrix is c·I), checked by the same exact
+    tests. Skipped for a rate the spectrum (:func:`obsdesign.spectrum.spectrum`: float
     eigenvalues when their error bound is small, else high-precision ones) puts clearly on
-    the infeasible side (the exact check would refuse it: the solve would be wasted)."""
+    the infeasible side (the exact check would refuse it: the solve would be wasted). The
+    unrounded P: a random 100-state continuous plant's P (max |P| ≈ 2·10⁷, ‖A − LC‖ ≈ 7·10⁴)
+    failed at 40 bits and passed at 53 — beyond MAX_N there was no other fallback, exit 4
+    (lyapunov review)."""
     from obsdesign import lyap_hp
 
     n = Am.nrows()
-    if n > lyap_hp.MAX_N:
+    if n > lyap_hp.MAX_N and Pf is None:
         return None
     Af = mat_float(Am) if Af is None else Af
     if guide is None:
@@ -1018,6 +1024,17 @@ def _certified_P_hp(
     slack = 1e-8 * max(1.0, float(np.max(np.abs(Af))) * n)
     bound = guide.bound(discrete)
     if (bound - rf if discrete else bound + rf) > slack:
+        return None
+    if Pf is not None:
+        Pm, _ = dyadic_fmat(Pf * float(margin_scale(Pf, margin)), 53)
+        Pm = Pm if Pm == Pm.transpose() else _sym(Pm)
+        P = as_array(Pm)
+        if (
+            pd_verdict(P, margin, memo, Pm, None)
+            and decay_verdict(Am, P, r, discrete, margin, memo, Pm, Af, None)[0]
+        ):
+            return P
+    if n > lyap_hp.MAX_N:
         return None
     for prec in lyap_hp.PRECISIONS:
         Pm = lyap_hp.lyapunov_P_hp(Am, r, discrete, prec)

@@ -234,18 +234,24 @@ def test_best_rate_not_schur_and_not_certifiable() -> None:
 
 def test_certified_P_checks_the_decay_matrix(monkeypatch: pytest.MonkeyPatch) -> None:
     """λ = 0.95 + 10⁻¹⁰ is feasible, and the rounded Lyapunov-equation P is ≻ 0, but the
-    rounding breaks the decay LMI: without the high-precision fallback no P is returned (not
-    certifiable); with it, the 128-bit P certifies."""
+    rounding to BITS breaks the decay LMI: the unrounded float P (53 bits) certifies instead
+    (without the high-precision fallback), and with neither fallback no P is returned (not
+    certifiable); the high-precision P certifies too."""
     from obsdesign import lyap_hp
 
     lam = fmpq(19, 20) + fmpq(1, 10**10)
     assert rate_feasible(closed_loop(A5, C5, L5), lam, True)
     assert certified_P(A5, C5, L5, True, lam, MARGIN) is not None
-    monkeypatch.setattr(lyap_hp, "MAX_N", 0)
-    assert certified_P(A5, C5, L5, True, lam, MARGIN) is None
     Pf = lyap.lyapunov_P(*(np.asarray(x, dtype=float) for x in (A5, C5, L5)), float(lam), True)
     P = lyap.symmetrize(dyadic(Pf, lyap.BITS))
     assert check_pd(P, MARGIN)
+    assert not check_pd(lyap.decay_matrix(A5, C5, L5, P, lam, True), MARGIN)
+    monkeypatch.setattr(lyap_hp, "MAX_N", 0)
+    P53 = certified_P(A5, C5, L5, True, lam, MARGIN)
+    assert P53 is not None and np.all(P53 == lyap.symmetrize(dyadic(Pf, 53)))
+    real = lyap._certified_P_hp
+    monkeypatch.setattr(lyap, "_certified_P_hp", lambda *a: real(*a[:7]))  # no float P
+    assert certified_P(A5, C5, L5, True, lam, MARGIN) is None
 
 
 @pytest.mark.parametrize("margin", [fmpq(2, 5), fmpq(1), fmpq(50)])

@@ -556,12 +556,13 @@ def test_asked_rate_feasible_but_not_certifiable_is_inconclusive(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     """λ = 0.9500000001 > ρ = 0.95: feasible (exact test) but the 40-bit P fails: the
-    high-precision P certifies it; without that fallback, exit 4 naming both causes."""
-    from obsdesign import lyap_hp
+    unrounded float P or the high-precision P certifies it; without those fallbacks, exit 4
+    naming both causes."""
+    from obsdesign import lyap
 
     text = SEC5.read_text().replace("lambda = 0.955", "lambda = 0.9500000001")
     assert api.design(load_spec_text(text, "x.toml")).exit_code() == 0
-    monkeypatch.setattr(lyap_hp, "MAX_N", 0)
+    monkeypatch.setattr(lyap, "_certified_P_hp", lambda *a: None)
     with pytest.raises(InconclusiveError, match="feasible.*too close.*badly conditioned") as ei:
         api.design(load_spec_text(text, "x.toml"))
     assert ei.value.exit_code == 4
