@@ -946,3 +946,19 @@ def test_rate_tol_below_float_resolution_exit_2(tmp_path: Path, tol: str) -> Non
     assert not out.exists()
     spec.write_text(_designed("[[0.5, 1], [0, 0.9]]", "[[1, 0]]", extra="rate_tol = 1e-15\n"))
     assert runner.invoke(app, ["design", str(spec), "-o", str(out)]).exit_code == 0
+
+
+def test_failed_lmi_gain_search_points_at_the_default_design() -> None:
+    """A badly scaled 3-state plant (entries up to 5.6·10²): the SDP solver finds no gain, the
+    default Riccati design certifies (lyapunov review: 9 of 70 LMI designs were exit 4). The
+    exit-4 message says so."""
+    spec = (
+        '[system]\ntime = "discrete"\n'
+        "A = [[1.6637, 0.052256, 9.4787e-05], [-17.734, 4.0692, 555.38], "
+        "[336.33, -5.5198, -57.150]]\nC = [[-1, -1, 2]]\n"
+        '[method]\nkey = "lyapunov"\nrate_tol = 1e-10\n'
+    )
+    assert api.design(load_spec_text(spec)).exit_code() == 0
+    with pytest.raises(InconclusiveError, match="omit design") as ei:
+        api.design(load_spec_text(spec + 'design = "lmi"\n'))
+    assert ei.value.exit_code == 4 and "LMI solver found no gain" in ei.value.message

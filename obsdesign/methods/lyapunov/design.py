@@ -567,6 +567,11 @@ def weights_text(o: Options) -> str:
     return "Q, R from riccati_Q / riccati_R"
 
 
+#: the way out of a failed LMI gain search (the SDP solver's conditioning, not the plant:
+#: the default Riccati design certified 9 specs where design = "lmi" was exit 4 — review)
+_LMI_HINT = '; the default design = "riccati" (or "place") needs no SDP solver: omit design'
+
+
 def lmi_gain(
     spec: Spec, o: Options, reason: str, Au: Any, progress: Progress | None
 ) -> tuple[np.ndarray, SolverResult]:
@@ -649,7 +654,7 @@ def lmi_gain(
         if not feasible(slack) and not feasible(float(o.rate)):
             raise InconclusiveError(
                 f"the LMI solver found no gain at rate {fmt_exact(o.rate)}, although (C, A) "
-                f"allows it ({reason})"
+                f"allows it ({reason})" + _LMI_HINT
             )
     elif s.discrete:
         lo = float(np.abs(ueig).max()) if len(ueig) else 0.0
@@ -660,7 +665,7 @@ def lmi_gain(
                 hi = start
         if not feasible(hi):
             raise InconclusiveError(
-                f"the LMI solver found no gain with λ ≤ {1.0 - tol:g} ({reason})"
+                f"the LMI solver found no gain with λ ≤ {1.0 - tol:g} ({reason})" + _LMI_HINT
             )
         while hi - lo > tol:
             mid = (lo + hi) / 2
@@ -680,7 +685,9 @@ def lmi_gain(
             if start > lo and feasible(start):
                 lo = start
         if not feasible(lo):
-            raise InconclusiveError(f"the LMI solver found no gain with α ≥ {tol:g} ({reason})")
+            raise InconclusiveError(
+                f"the LMI solver found no gain with α ≥ {tol:g} ({reason})" + _LMI_HINT
+            )
         if feasible(hi):
             lo = hi
         while hi - lo > tol:
