@@ -920,22 +920,53 @@ def certified_P(
         Pm, Pq_f = _sym(Pm), None
     P = as_array(Pm)
     Am = closed_loop_fmat(A, C, L) if Acl is None else Acl
-    if (
-        pd_verdict(P, margin, memo, Pm, Pq_f)
-        and decay_verdict(Am, P, r, discrete, margin, memo, Pm, Af, Pq_f)[0]
-    ):
+    if _passes(Am, P, Pm, r, discrete, margin, memo, Af, Pq_f):
         return P
     c = margin_scale(Pf, margin)
     if c != 1:  # the margin asks for a larger P (its decay matrix is c·I)
-        Pm, Pq_f = dyadic_fmat(Pf * float(c), bits)
-        Pm = Pm if Pm == Pm.transpose() else _sym(Pm)
-        P = as_array(Pm)
-        if (
-            pd_verdict(P, margin, memo, Pm, None)
-            and decay_verdict(Am, P, r, discrete, margin, memo, Pm, Af, None)[0]
-        ):
+        P = _dyadic_certified(Am, Pf * float(c), bits, r, discrete, margin, memo, Af)
+        if P is not None:
             return P
     return _certified_P_hp(Am, r, discrete, margin, memo, Af, guide, Pf if bits < 53 else None)
+
+
+def _dyadic_certified(
+    Am: fmpq_mat,
+    Pf: np.ndarray,
+    bits: int,
+    r: fmpq,
+    discrete: bool,
+    margin: Any,
+    memo: ExactMemo | None,
+    Af: np.ndarray | None,
+) -> np.ndarray | None:
+    """The float P rounded to ``bits`` (53: the floats themselves), symmetrized, when it passes
+    both exact checks of eq. (4)-(6) (constrained-redesign paper, Astolfi et al., NOLCOS 2019)
+    — P − δI ≻ 0 and the decay matrix − δI ≻ 0 — else None."""
+    Pm, _ = dyadic_fmat(Pf, bits)
+    Pm = Pm if Pm == Pm.transpose() else _sym(Pm)
+    P = as_array(Pm)
+    return P if _passes(Am, P, Pm, r, discrete, margin, memo, Af) else None
+
+
+def _passes(
+    Am: fmpq_mat,
+    P: np.ndarray,
+    Pm: fmpq_mat,
+    r: fmpq,
+    discrete: bool,
+    margin: Any,
+    memo: ExactMemo | None,
+    Af: np.ndarray | None,
+    Pq_f: np.ndarray | None = None,
+) -> bool:
+    """Both exact checks of a candidate P, eq. (4)-(6) (constrained-redesign paper, Astolfi
+    et al., NOLCOS 2019): P − δI ≻ 0 and the decay matrix − δI ≻ 0 (``Pq_f``: P's correctly
+    rounded float copy, when at hand)."""
+    return bool(
+        pd_verdict(P, margin, memo, Pm, Pq_f)
+        and decay_verdict(Am, P, r, discrete, margin, memo, Pm, Af, Pq_f)[0]
+    )
 
 
 def margin_scale(Pf: np.ndarray, margin: Any, Pm: fmpq_mat | None = None) -> fmpq:
@@ -1026,13 +1057,10 @@ def _certified_P_hp(
     if (bound - rf if discrete else bound + rf) > slack:
         return None
     if Pf is not None:
-        Pm, _ = dyadic_fmat(Pf * float(margin_scale(Pf, margin)), 53)
-        Pm = Pm if Pm == Pm.transpose() else _sym(Pm)
-        P = as_array(Pm)
-        if (
-            pd_verdict(P, margin, memo, Pm, None)
-            and decay_verdict(Am, P, r, discrete, margin, memo, Pm, Af, None)[0]
-        ):
+        P = _dyadic_certified(
+            Am, Pf * float(margin_scale(Pf, margin)), 53, r, discrete, margin, memo, Af
+        )
+        if P is not None:
             return P
     if n > lyap_hp.MAX_N:
         return None
@@ -1042,10 +1070,7 @@ def _certified_P_hp(
             continue
         Pm = Pm * margin_scale(mat_float(Pm), margin, Pm)
         P = as_array(Pm)
-        if (
-            pd_verdict(P, margin, memo, Pm, None)
-            and decay_verdict(Am, P, r, discrete, margin, memo, Pm, Af, None)[0]
-        ):
+        if _passes(Am, P, Pm, r, discrete, margin, memo, Af):
             return P
     return None
 
