@@ -255,8 +255,8 @@ def lmi_claims(
 
 def lambda_max_claims(spec: Spec, pr: Parameters) -> list[Claim]:
     """The best λ: certified at λ_max (a second certificate P, K, U, W, Y, R ``*_at_max``), and
-    bracketed: λ_other within lambda_tol of λ_max where the solver does not find the LMIs
-    feasible (re-solved here: numerical)."""
+    bracketed: [λ_max, λ_other] with the solver's status ``infeasible`` at λ_other (re-solved
+    here: numerical); a bracket wider than lambda_tol is said in the detail."""
     from obsdesign.methods.stubborn.design import INFEASIBLE, Feasibility, Plant
 
     o: Options = spec.options
@@ -298,7 +298,7 @@ def lambda_max_claims(spec: Spec, pr: Parameters) -> list[Claim]:
         id="lambda-max-bracket",
         statement=f"the {word} λ with LMIs {eqs} feasible lies between λ_max = {fmt_exact(lo)} "
         f"and {fmt_exact(hi)}"
-        + (f" (relative width {float(width):.3g})" if width is not None else "")
+        + (f" (relative width {float_or_inf(width):.3g})" if width is not None else "")
         + f": the solver finds them infeasible at {fmt_exact(hi)}",
         reference=f"{PAPER}, optimized parameter selection (first maximize λ)",
         check="exact side; feasibility SDP re-solved at the far end (Clarabel, cold start): "
