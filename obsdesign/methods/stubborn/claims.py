@@ -254,7 +254,8 @@ def lmi_claims(
 
 
 def lambda_max_claims(spec: Spec, pr: Parameters) -> list[Claim]:
-    """The best λ: certified at λ_max (a second certificate P, K, U, W, Y, R ``*_at_max``), and
+    """The best λ of LMIs (1)-(3) / (7)-(9) (the slides' optimized parameter selection, "first
+    maximize λ"): certified at λ_max (a second certificate P, K, U, W, Y, R ``*_at_max``), and
     bracketed: [λ_max, λ_other] with the solver's status ``infeasible`` at λ_other (re-solved
     here: numerical); a bracket wider than lambda_tol is said in the detail."""
     from obsdesign.methods.stubborn.design import INFEASIBLE, Feasibility, Plant
