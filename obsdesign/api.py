@@ -376,7 +376,10 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
     tracked.read.clear()
     notes: list[str] = []
     with captured_warnings(notes):
-        fresh = certify(sp, tracked)
+        try:
+            fresh = certify(sp, tracked)
+        except InputError as e:  # a method's "report: …" names the file
+            raise _report_named(e, named) from None
     claims += fresh
     claims += compare_claims(old_claims, fresh)
     rep.unverified = [k for k in rep.parameters if k not in tracked.read]

@@ -421,3 +421,19 @@ def test_negative_direction_with_random_guides_on_pd_matrices(entries: list[int]
     R = np.array(entries, dtype=float).reshape(3, 3)
     for guide in (-Ff, R + R.T):
         assert negative_direction(F, guide) is None
+
+
+def test_asymmetric_names_the_matrix_and_the_entry() -> None:
+    """psd.asymmetric: None for an exactly symmetric square matrix; a failed result naming the
+    matrix and the first asymmetric entry for 2⁻¹⁰⁰ off (the smallest false margin at this
+    size); a non-square matrix fails too."""
+    from obsdesign.certify.psd import asymmetric
+
+    S = qmat([[2, 1], [1, 3]])
+    assert asymmetric(S, "P") is None
+    T = S.copy()
+    T[1, 0] = T[1, 0] + fmpq(1, 2**100)
+    r = asymmetric(T, "P")
+    assert r is not None and not r.ok and r.detail == "P is not symmetric at (0, 1)"
+    r = asymmetric(qmat([[1, 2, 3], [2, 1, 0]]), "Q")
+    assert r is not None and not r.ok and "Q is not a square matrix" in r.detail

@@ -718,3 +718,21 @@ def test_cmin_equal_to_xhat_is_included() -> None:
     eps = fmpq(9, 25)
     assert CL.cmin_in_xhat(cm, eps, Ellipsoid(qeye(2) * fmpq(1, 4), zero))[0]
     assert not CL.cmin_in_xhat(cm, eps, Ellipsoid(qeye(2) * (fmpq(1, 4) + TINY), zero))[0]
+
+
+@pytest.mark.parametrize("skew", [fmpq(1, 2**60), fmpq(2**20)])
+def test_asymmetric_P_fails_every_claim_built_from_P(sec5: Report, skew: fmpq) -> None:
+    """P + t·[[0, 1], [−1, 0]] leaves V(e) = eᵀPe unchanged but the claims built from P itself
+    (the ISS cross term, P⁻¹ of the level sets) were recomputed as certified; with t = 2²⁰ and
+    v_min × 1000 that certified a false v_min (audit: x̂ leaves C_min). Every P-built claim
+    now fails with P-positive-definite; the claims that do not read P stay certified."""
+    from obsdesign.methods.constrained.claims import P_CLAIMS
+
+    P = np.array(sec5.parameters["P"], dtype=object)
+    J = np.array([[0, skew], [-skew, 0]], dtype=object)
+    d = tamper(sec5, P=P + J, v_min=sec5.parameters["v_min"] * 1000)
+    ids = {c.id for c in sec5.claims}
+    failed = failed_ids(d)
+    assert {"P-positive-definite", "v_min-bound"} <= failed
+    assert (P_CLAIMS & ids) <= failed
+    assert not ({"c-convex", "eps-order", "delta-bound"} & failed)

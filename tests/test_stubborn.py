@@ -868,3 +868,51 @@ def test_design_notes_how_fast_the_unsaturated_error_decays() -> None:
     (note,) = [n for n in rep.notes if n.startswith("A − KC: spectral abscissa")]
     got = float(note.split("≈ ")[1].split(" ")[0])
     assert got == pytest.approx(want, rel=1e-3) and abs(got) < 1e-3
+
+
+def test_asymmetric_P_fails_every_LMI_that_carries_it(ex1: Report) -> None:
+    """Continuous LMI (2) is He(PA − XC)-shaped: symmetric whatever P is, so P + 2⁻⁸⁰ on one
+    off-diagonal entry (X = P K kept exact) left lmi-regional certified (audit). Every LMI
+    carrying P now fails with P-positive."""
+    d = ex1.to_dict()
+    P, K = _get(d, "P"), _get(d, "K")
+    P[0, 1] += TINY
+    _set(d, "P", P)
+    _set(d, "X", P @ K)
+    assert {"P-positive", "lmi-global", "lmi-regional", "lmi-sector"} <= _failed(d)
+
+
+def test_asymmetric_P_fails_the_l2_gain() -> None:
+    """Criterion l2, continuous: the bounded-real-lemma matrix with PBd and its transpose is
+    symmetric for any P; an asymmetric P certified γ² ≤ 1 against a true 19.6 (audit). A
+    2⁻⁸⁰ asymmetry now fails l2-gain."""
+    text = (
+        EX1.read_text()
+        .replace('criterion = "R"', 'criterion = "l2"')
+        .replace("C = [[1, 1]]", "C = [[1, 1]]\nBd = [[0], [1]]")
+    )
+    rep = api.design(api.load_spec_text(text, "l2.toml"))
+    assert rep.exit_code() == 0
+    d = rep.to_dict()
+    P, K = _get(d, "P"), _get(d, "K")
+    P[1, 0] += TINY
+    _set(d, "P", P)
+    _set(d, "X", P @ K)
+    assert "l2-gain" in _failed(d)
+
+
+@pytest.mark.parametrize("key", ["lambda", "lambda_max"])
+def test_a_scalar_given_as_two_numbers_is_refused(ex1: Report, tmp_path: Path, key: str) -> None:
+    """λ = [x, anything] was cut to x and verified with exit 0 (audit): exit 2 naming the
+    report and the key."""
+    d = ex1.to_dict()
+    x = d["parameters"]["exact"][key]
+    d["parameters"]["exact"][key] = [x, "12345"]
+    d["parameters"][key] = [d["parameters"][key], 12345.0]
+    out = tmp_path / "two.json"
+    out.write_text(json.dumps(d))
+    r = CliRunner().invoke(app, ["verify", str(out)])
+    assert r.exit_code == 2, r.output
+    assert f"{out}: parameters.exact.{key}: expected one number, got 2" in r.output.replace(
+        "\n", ""
+    )

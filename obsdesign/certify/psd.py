@@ -55,6 +55,21 @@ def _symmetric(arr: np.ndarray) -> str:
     return ""
 
 
+def asymmetric(M: Any, name: str) -> PSDResult | None:
+    """A failed result naming ``name`` when M is not an exactly symmetric square matrix, else
+    None. For the claims built from a Lyapunov matrix P: V(e) = eᵀPe is a quadratic form of
+    a symmetric P, and an inequality assembled from an asymmetric P (a product such as AᵀP·B,
+    an inverse P⁻¹) is not the inequality of V — a report tampered that way had such claims
+    recomputed as certified, some false (lyapunov, constrained and stubborn reviews)."""
+    arr = np.asarray(M, dtype=object)
+    if arr.ndim != 2 or arr.shape[0] != arr.shape[1]:
+        return PSDResult(False, float("nan"), f"{name} is not a square matrix", "symmetry")
+    bad = _symmetric(arr)
+    if bad:
+        return PSDResult(False, float("nan"), f"{name} is {bad}", "symmetry")
+    return None
+
+
 def ldl_pivots(M: Any) -> list[fmpq]:
     """Pivots of the LDLᵀ factorization of a symmetric rational matrix, no pivoting.
 

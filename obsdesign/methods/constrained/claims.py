@@ -13,6 +13,7 @@ exact or rounded in the direction that keeps the statement true
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -20,11 +21,11 @@ from flint import fmpq
 from mpmath import iv
 
 from obsdesign import lyap
-from obsdesign.certify.claim import Claim, Claims
+from obsdesign.certify.claim import Claim, Claims, ClaimStatus
 from obsdesign.certify.exact import Q, qeye, to_float
 from obsdesign.certify.interval import sqrt_upper, upper
 from obsdesign.certify.printing import fmt_down, fmt_exact, fmt_up
-from obsdesign.certify.psd import check_pd, check_psd
+from obsdesign.certify.psd import asymmetric, check_pd, check_psd
 from obsdesign.methods.constrained import bounds as B
 from obsdesign.methods.constrained.cmap import ConstraintMap
 from obsdesign.methods.constrained.design import v_max_breve, xhat_set
@@ -241,7 +242,38 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     if o.X0 is not None and o.Xhat0 is not None:
         _initial_sets(c, o.X0, o.X, o.Xhat0, Xhat)
         _breve(c, params, o, P, rho, mu, W, v_max, v_min, gamma, eps_min)
+    _fail_if_asymmetric(c, P)
     return c
+
+
+#: the claims built from P itself (a product with P, P⁻¹, or P's eigenvalues)
+P_CLAIMS = frozenset(
+    {
+        "decay-lmi",
+        "iss-bound",
+        "v_max-bound",
+        "Xhat_max-in-Cmax",
+        "lambda_min-bound",
+        "gamma-bound",
+        "gamma_max-bound",
+        "v_min-bound",
+        "v_max_breve-bound",
+    }
+)
+
+
+def _fail_if_asymmetric(c: Claims, P: Any) -> None:
+    """Every claim of :data:`P_CLAIMS` fails when P is not exactly symmetric: V(e) = eᵀPe of
+    eq. (4) is a quadratic form of a symmetric P, while the ISS block's cross term, the level
+    sets' P⁻¹ (eqs. (13), (15), (21)) use P itself — a report with P made asymmetric (a skew
+    part, V unchanged) had iss-bound, v_min-bound and Xhat_max-in-Cmax certified with false
+    values (audit); ``P-positive-definite`` already failed it."""
+    bad = asymmetric(P, "P")
+    if bad is None:
+        return
+    for i, cl in enumerate(c):
+        if cl.id in P_CLAIMS and cl.status is not ClaimStatus.FAILED:
+            c[i] = replace(cl, status=ClaimStatus.FAILED, detail=bad.detail, float_ok=False)
 
 
 def _initial_sets(

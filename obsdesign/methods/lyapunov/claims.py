@@ -19,7 +19,7 @@ from obsdesign.certify import vchol
 from obsdesign.certify.claim import Claim, Claims
 from obsdesign.certify.exact import Q
 from obsdesign.certify.printing import fmt_exact, fmt_up
-from obsdesign.certify.psd import PSDResult, check_pd_fast, check_text
+from obsdesign.certify.psd import PSDResult, asymmetric, check_pd_fast, check_text
 from obsdesign.methods.lyapunov.design import rate_name
 from obsdesign.methods.lyapunov.options import Options
 from obsdesign.params import Parameters
@@ -101,23 +101,12 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
 
 
 def _unless_asymmetric(P: np.ndarray, name: str) -> tuple[PSDResult, bool] | None:
-    """A failed verdict when P is not exactly symmetric, else None. V(e) = eᵀPe of eq. (4)
-    (constrained-redesign paper, Astolfi et al., NOLCOS 2019) is a quadratic form of a
-    symmetric P: the decay and ISS matrices built from an asymmetric P do not state the
-    inequality of V (the ISS block matrix's cross term uses P, the quadratic form sym(P)), and
-    a report with one had them recomputed as certified (lyapunov review; the verdict was
-    already "failed" by P-positive-definite)."""
-    Pa = np.asarray(P, dtype=object)
-    if Pa.ndim != 2 or Pa.shape[0] != Pa.shape[1]:
-        return PSDResult(False, float("nan"), f"{name} is not square", "symmetry"), False
-    bad = np.argwhere(Pa != Pa.T)
-    if bad.size:
-        i, j = (int(v) for v in bad[0])
-        return (
-            PSDResult(False, float("nan"), f"{name} is not symmetric at ({i}, {j})", "symmetry"),
-            False,
-        )
-    return None
+    """A failed verdict when P is not exactly symmetric (:func:`obsdesign.certify.psd.
+    asymmetric`), else None: the decay and ISS matrices built from an asymmetric P do not state
+    the inequality of V(e) = eᵀPe, eq. (4) (constrained-redesign paper, Astolfi et al., NOLCOS
+    2019; the ISS block's cross term uses P, the quadratic form sym(P))."""
+    bad = asymmetric(P, name)
+    return None if bad is None else (bad, False)
 
 
 def linear_plant_claim(c: Claims, spec: Spec) -> None:

@@ -20,7 +20,8 @@ from flint import fmpq
 from obsdesign.certify.claim import Claim, Claims
 from obsdesign.certify.exact import Q, float_or_inf, qmat
 from obsdesign.certify.printing import fmt_exact, fmt_up
-from obsdesign.certify.psd import PSDResult, check_pd, check_psd
+from obsdesign.certify.psd import PSDResult, asymmetric, check_pd, check_psd
+from obsdesign.errors import InputError
 from obsdesign.methods.stubborn import lmis
 from obsdesign.methods.stubborn.options import Options
 from obsdesign.params import Parameters
@@ -40,8 +41,15 @@ def _vec(v: Any, n: int) -> np.ndarray:
     return np.array([Q(x) for x in arr], dtype=object)
 
 
-def _scalar(v: Any) -> fmpq:
-    return v if isinstance(v, fmpq) else Q(np.asarray(v, dtype=object).reshape(-1)[0])
+def _scalar(v: Any, key: str) -> fmpq:
+    """One number of the report (``key``: its name); a list of several is bad input — it was
+    cut to its first entry and a report with λ = [x, anything] verified (audit)."""
+    if isinstance(v, fmpq):
+        return v
+    arr = np.asarray(v, dtype=object).reshape(-1)
+    if arr.size != 1:
+        raise InputError(f"report: parameters.exact.{key}: expected one number, got {arr.size}")
+    return Q(arr[0])
 
 
 def _sign(v: np.ndarray) -> PSDResult:
@@ -81,6 +89,12 @@ def point_checks(
         if not (r := check_pd(lmis.sector(P, Y, w, i)))
     ]
     out["lmi-sector"] = PSDResult(not bad, 0.0, "; ".join(bad) or f"{s.p} block(s), all pivots > 0")
+    asym = asymmetric(P, "P")
+    if asym is not None:
+        # continuous (2) is He(PA − XC) etc.: symmetric whatever P is, and passed with an
+        # asymmetric P (audit); every LMI carrying P fails with it
+        for k in ("P-positive", "lmi-global", "lmi-regional", "lmi-sector"):
+            out[k] = asym
     if o.K is None and o.gain_bound is not None:
         out["gain-bound"] = check_psd(_scaled_eye(K.shape[1], o.gain_bound**2) - K.T @ K)
     if o.r_bound is not None:
@@ -181,7 +195,7 @@ def lmi_claims(
     lam = pr.exact("lambda", c)
     if pt is None or Xr is None or lam is None:
         return c
-    lam = _scalar(lam)
+    lam = _scalar(lam, "lambda")
     Xr = _mat(Xr, (n, p))
     if o.K is not None:
         c.matches("K", pt["K"], np.asarray(o.K, dtype=object), "[method].K")
@@ -239,14 +253,18 @@ def lmi_claims(
     if o.criterion == "l2":
         g = pr.exact("gamma2", c)
         if g is not None:
-            M3 = lmis.l2_gain(s.A.q, s.C.q, s.Bd.q, P, X, _scalar(g), disc)
+            g = _scalar(g, "gamma2")
+            # an asymmetric P certified a false gain bound (γ² ≤ 1 against 19.6: audit)
+            asym = asymmetric(P, "P")
             c.checked(
                 id="l2-gain",
                 statement="the L2 gain from d to e of the Luenberger part (gain K) is ≤ γ with "
-                f"γ² ≤ {fmt_up(_scalar(g), 8)}",
+                f"γ² ≤ {fmt_up(g, 8)}",
                 reference=f"{PAPER}, criterion 4 (bounded real lemma)",
                 check="exact LDLᵀ of the bounded-real-lemma matrix",
-                result=check_pd(-M3),
+                result=asym
+                if asym is not None
+                else check_pd(-lmis.l2_gain(s.A.q, s.C.q, s.Bd.q, P, X, g, disc)),
             )
     if full_check and o.lam is None:
         c += lambda_max_claims(spec, pr)
@@ -267,7 +285,7 @@ def lambda_max_claims(spec: Spec, pr: Parameters) -> list[Claim]:
     pt = _read_point(pr, c, spec, "_at_max")
     if lm is None or pt is None:
         return c
-    lm = _scalar(lm)
+    lm = _scalar(lm, "lambda_max")
     res = point_checks(spec, pt["P"], pt["K"], pt["U"], pt["W"], pt["Y"], pt["R"], lm)
     bad = [f"{k}: {r.detail}" for k, r in res.items() if not r.ok]
     eqs = "(7)-(9)" if disc else "(1)-(3)"
@@ -327,7 +345,7 @@ def _lambda_choice(c: Claims, o: Options, pr: Parameters, lam: fmpq, disc: bool)
     lm = pr.exact("lambda_max", c)
     if lm is None:
         return
-    lm = _scalar(lm)
+    lm = _scalar(lm, "lambda_max")
     want = o.fraction * lm if not disc else 1 - o.fraction * (1 - lm)
     ok = want == lam
     rule = "λ = fraction·λ_max" if not disc else "1 − λ = fraction·(1 − λ_best)"
