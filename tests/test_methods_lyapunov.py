@@ -777,9 +777,16 @@ def test_a_designed_gain_that_fails_is_inconclusive_not_infeasible(
 
 
 def test_place_needs_observability() -> None:
+    """An unobservable (detectable) plant cannot have its poles placed: decided exactly, so
+    exit 2 naming [method.design] (it was exit 4); the default Riccati design works."""
+    from obsdesign.errors import SpecError
+
     A = np.array([[0.5, 0.0], [0.0, 0.9]])
-    with pytest.raises(InconclusiveError, match="pole placement needs"):
+    with pytest.raises(
+        SpecError, match=r"\[method\.design\] 'place' needs \(C, A\) observable"
+    ) as ei:
         api.design(load_spec_text(_designed(A, C_UO, extra='design = "place"\n')))
+    assert ei.value.exit_code == 2
     rep = api.design(load_spec_text(_designed(A, C_UO)))  # detectable: riccati works
     assert rep.exit_code() == 0
 

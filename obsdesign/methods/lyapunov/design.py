@@ -464,9 +464,13 @@ def design_gain(
             else np.array([float(z) for z in o.poles])
         )
         if not det.observable:
-            raise InconclusiveError(
-                f"pole placement needs (C, A) observable, but it is {det.reason}; "
-                'use design = "riccati" or "lmi"'
+            # decided exactly: a request this plant cannot meet, bad input naming the key
+            # (it was exit 4, "inconclusive" — lyapunov review)
+            raise SpecError(
+                spec.file,
+                "method.design",
+                f"'place' needs (C, A) observable, but it is {det.reason} (an unobservable "
+                'mode cannot be placed): use design = "riccati" (the default) or "lmi"',
             )
         try:
             Lf = placed_gain(A, C, poles)
