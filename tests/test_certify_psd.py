@@ -437,3 +437,15 @@ def test_asymmetric_names_the_matrix_and_the_entry() -> None:
     assert r is not None and not r.ok and r.detail == "P is not symmetric at (0, 1)"
     r = asymmetric(qmat([[1, 2, 3], [2, 1, 0]]), "Q")
     assert r is not None and not r.ok and "Q is not a square matrix" in r.detail
+
+
+def test_asymmetric_takes_a_flint_matrix() -> None:
+    """The fmpq_mat path (flint's own comparison) decides as the array path: symmetric is
+    None, one entry 2⁻¹⁰⁰ off fails at that entry."""
+    from obsdesign.certify.psd import asymmetric
+
+    S = fmpq_mat([[2, 1], [1, 3]])
+    assert asymmetric(S, "P") is None
+    T = fmpq_mat([[2, 1], [fmpq(1) + fmpq(1, 2**100), 3]])
+    r = asymmetric(T, "P")
+    assert r is not None and not r.ok and r.detail == "P is not symmetric at (0, 1)"

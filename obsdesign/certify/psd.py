@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from flint import fmpq
+from flint import fmpq, fmpq_mat
 
 from obsdesign.certify import vchol
 from obsdesign.certify.exact import Q, float_or_inf, qeye, qmat
@@ -56,18 +56,21 @@ def _symmetric(arr: np.ndarray) -> str:
 
 
 def asymmetric(M: Any, name: str) -> PSDResult | None:
-    """A failed result naming ``name`` when M is not an exactly symmetric square matrix, else
-    None. For the claims built from a Lyapunov matrix P: V(e) = eᵀPe is a quadratic form of
+    """A failed result naming ``name`` when M (an array, or a flint ``fmpq_mat``) is not an
+    exactly symmetric square matrix, else None. For the claims built from a Lyapunov matrix P: V(e) = eᵀPe is a quadratic form of
     a symmetric P, and an inequality assembled from an asymmetric P (a product such as AᵀP·B,
     an inverse P⁻¹) is not the inequality of V — a report tampered that way had such claims
     recomputed as certified, some false (lyapunov, constrained and stubborn reviews)."""
+    if isinstance(M, fmpq_mat) and M.nrows() == M.ncols():
+        if M == M.transpose():  # flint, C level: ~0.2 ms at n = 100 (entrywise: ~1.3 ms)
+            return None
+        M = np.array(M.tolist(), dtype=object)
     arr = np.asarray(M, dtype=object)
     if arr.ndim != 2 or arr.shape[0] != arr.shape[1]:
         return PSDResult(False, float("nan"), f"{name} is not a square matrix", "symmetry")
-    bad = _symmetric(arr)
-    if bad:
-        return PSDResult(False, float("nan"), f"{name} is {bad}", "symmetry")
-    return None
+    if bool(np.all(arr == arr.T)):
+        return None
+    return PSDResult(False, float("nan"), f"{name} is {_symmetric(arr)}", "symmetry")
 
 
 def ldl_pivots(M: Any) -> list[fmpq]:

@@ -71,7 +71,7 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     Pm = lyap.fmat(P)  # converted once for both checks, with its correctly rounded copy
     Pf = None if memo is not None else vchol.to_float(Pm)
     pd = lyap.pd_verdict(P, o.margin, memo, Pm, Pf)
-    dec = _unless_asymmetric(P, "P") or decay_check(
+    dec = _unless_asymmetric(Pm, "P") or decay_check(
         A, C, L, P, rate, s.discrete, o.margin, memo, Acl, Pm, Af, Pf
     )
     # the asked rate omitted, (P, λ) is (P_best, λ_best): one exact check serves both claims
@@ -100,7 +100,7 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     return list(c)
 
 
-def _unless_asymmetric(P: np.ndarray, name: str) -> tuple[PSDResult, bool] | None:
+def _unless_asymmetric(P: Any, name: str) -> tuple[PSDResult, bool] | None:
     """A failed verdict when P is not exactly symmetric (:func:`obsdesign.certify.psd.
     asymmetric`), else None: the decay and ISS matrices built from an asymmetric P do not state
     the inequality of V(e) = eᵀPe, eq. (4) (constrained-redesign paper, Astolfi et al., NOLCOS
