@@ -930,14 +930,16 @@ def test_an_expression_plant_fails_linear_plant_and_still_simulates() -> None:
 
 def test_rate_cap_caps_the_gain_design_not_the_reported_rate() -> None:
     """docs/methods/lyapunov.md: rate_cap bounds the LMI bisection that picks L; the best
-    certified α of that L may exceed it (the double integrator: α_best ≈ 1.43 > 1)."""
+    certified α of that L may exceed it (the double integrator: α_best ≈ 1.28 > 1; the first
+    LMI answer's gain already passes the cap, which ends the search after one solve)."""
     text = (
         '[system]\ntime = "continuous"\nA = [[0, 1], [0, 0]]\nC = [[1, 0]]\n'
         '[method]\nkey = "lyapunov"\ndesign = "lmi"\nrate_cap = 1\n'
     )
     rep = api.design(load_spec_text(text, "cap.toml"))
     assert rep.exit_code() == 0
-    assert 1.4 < float(rep.parameters.float("alpha_best")) < 1.5
+    assert 1.0 < float(rep.parameters.float("alpha_best")) < 1.5
+    assert rep.solver["lmi_solves"] == 1
 
 
 @pytest.mark.parametrize("tol", ["1e-17", "1e-300"])
@@ -955,16 +957,54 @@ def test_rate_tol_below_float_resolution_exit_2(tmp_path: Path, tol: str) -> Non
     assert runner.invoke(app, ["design", str(spec), "-o", str(out)]).exit_code == 0
 
 
-def test_failed_lmi_gain_search_points_at_the_default_design() -> None:
-    """A badly scaled 3-state plant (entries up to 5.6·10²): the SDP solver finds no gain, the
-    default Riccati design certifies (lyapunov review: 9 of 70 LMI designs were exit 4). The
-    exit-4 message says so."""
-    spec = (
-        '[system]\ntime = "discrete"\n'
-        "A = [[1.6637, 0.052256, 9.4787e-05], [-17.734, 4.0692, 555.38], "
-        "[336.33, -5.5198, -57.150]]\nC = [[-1, -1, 2]]\n"
-        '[method]\nkey = "lyapunov"\nrate_tol = 1e-10\n'
+#: a badly scaled 3-state plant (entries up to 5.6·10², lyapunov review): Clarabel finds no
+#: LMI gain at any rate, the Riccati gain certifies λ ≈ 0.0099
+SCALED = (
+    '[system]\ntime = "discrete"\n'
+    "A = [[1.6637, 0.052256, 9.4787e-05], [-17.734, 4.0692, 555.38], "
+    "[336.33, -5.5198, -57.150]]\nC = [[-1, -1, 2]]\n"
+    '[method]\nkey = "lyapunov"\nrate_tol = 1e-10\n'
+)
+
+
+def test_lmi_design_keeps_the_riccati_start_when_no_lmi_answer_beats_it() -> None:
+    """design = "lmi" on SCALED: every SDP solve fails, and the design returns the Riccati
+    gain that started the bisection, saying so (it was exit 4 "found no gain with λ ≤ 1";
+    lyapunov review: 9 of 70 LMI designs were exit 4 where the default design certifies)."""
+    rep = api.design(load_spec_text(SCALED + 'design = "lmi"\n'))
+    assert rep.exit_code() == 0 and rep.solver["gain_design"] == "lmi"
+    assert rep.solver["name"] == "Riccati gain (LMI bisection start)"
+    assert "none beat the float rate 0.0099" in rep.solver["message"]
+    assert float(rep.parameters.float("lambda_best")) < 0.01
+    assert api.verify(rep).exit_code() == 0
+
+
+def test_lmi_candidate_rates_take_inaccurate_answers_and_refuse_broken_ones() -> None:
+    """_candidate_rate: an "optimal_inaccurate" answer proposes L = P⁻¹X with its float rate
+    (the rate of the rounded L is certified exactly later); any other status, a missing value
+    or a singular P proposes nothing."""
+    from obsdesign.methods.lyapunov.design import _candidate_rate
+
+    A, C = np.array([[0.5, 1.0], [0.0, 0.9]]), np.array([[1.0, 0.0]])
+    P, L = np.eye(2), np.array([[1.0], [0.5]])
+    for status in ("optimal", "optimal_inaccurate"):
+        got = _candidate_rate(status, P, P @ L, A, C, True)
+        assert got is not None and np.allclose(got[0], L)
+        assert got[1] == pytest.approx(np.abs(np.linalg.eigvals(A - L @ C)).max())
+    cont = _candidate_rate("optimal", P, P @ L, A - 2 * np.eye(2), C, False)
+    assert cont is not None and cont[1] == pytest.approx(
+        -np.linalg.eigvals(A - 2 * np.eye(2) - L @ C).real.max()
     )
+    assert _candidate_rate("infeasible", P, P @ L, A, C, True) is None
+    assert _candidate_rate("optimal", None, P @ L, A, C, True) is None
+    assert _candidate_rate("optimal", np.zeros((2, 2)), P @ L, A, C, True) is None
+
+
+def test_failed_lmi_gain_search_points_at_the_default_design() -> None:
+    """SCALED with an asked rate λ = 0.5 (no Riccati start then): the SDP solver finds no gain
+    at 2 % slack nor at the rate, while the default Riccati design certifies. The exit-4
+    message points at the default design."""
+    spec = SCALED + "lambda = 0.5\n"
     assert api.design(load_spec_text(spec)).exit_code() == 0
     with pytest.raises(InconclusiveError, match="omit design") as ei:
         api.design(load_spec_text(spec + 'design = "lmi"\n'))

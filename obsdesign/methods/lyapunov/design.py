@@ -571,6 +571,9 @@ def weights_text(o: Options) -> str:
     return "Q, R from riccati_Q / riccati_R"
 
 
+#: the solver name of :func:`lmi_gain`'s result when no LMI answer beat the Riccati start
+RICCATI_START = "Riccati gain (LMI bisection start)"
+
 #: the way out of a failed LMI gain search (the SDP solver's conditioning, not the plant:
 #: the default Riccati design certified 9 specs where design = "lmi" was exit 4 — review)
 _LMI_HINT = '; the default design = "riccati" (or "place") needs no SDP solver: omit design'
@@ -587,6 +590,14 @@ def lmi_gain(
     minimal t. The bisection is bracketed by spectral bounds: the unobservable modes bound
     every rate (no solve beyond them), and the Riccati gain's rate is a feasible start; each
     rate is solved once (no re-solve of the final point).
+
+    An answer is a candidate gain whenever its float closed loop has the rate,
+    "optimal_inaccurate" included (the gain only proposes L: the rate of the rounded gain is
+    certified exactly afterwards); a candidate whose float rate beats the solved rate moves
+    that end of the bracket to it. Without an asked rate the Riccati gain (Q = I, R = I) is
+    the first candidate, so the LMI design returns it when no LMI answer beats its float rate
+    (the SDP solver fails on badly scaled plants where the Riccati gain certifies: 7 of 80
+    random LMI designs were exit 4); the solver message then says so.
 
     :param spec: the bound spec; :param o: its options; :param reason: the detectability
     verdict (for messages); :param Au: the exact unobservable restriction of A;
@@ -630,19 +641,23 @@ def lmi_gain(
             seen[rate] = False
             return False
         total += res.seconds
-        ok = False
-        if res.optimal:
-            Lc = np.linalg.solve(P.value, X.value)
-            eig = np.linalg.eigvals(A - Lc @ C)
-            # the decay LMI at `rate` implies this; a solver answer that breaks it is not trusted
-            if s.discrete:
-                ok = bool(np.abs(eig).max() <= rate * (1 + 1e-6))
-            else:
-                ok = bool(-eig.real.max() >= rate * (1 - 1e-6))
-            if ok:
-                best = (Lc, res.solver, rate)
+        got = _candidate_rate(res.status, P.value, X.value, A, C, s.discrete)
+        # the decay LMI at `rate` implies this rate; a solver answer that breaks it is not
+        # trusted (an inaccurate answer that keeps it is a candidate: L is certified later)
+        ok = got is not None and (
+            got[1] <= rate * (1 + 1e-6) if s.discrete else got[1] >= rate * (1 - 1e-6)
+        )
+        if ok and got is not None:
+            better = best is None or (got[1] < best[2] if s.discrete else got[1] > best[2])
+            if better:
+                best = (got[0], res.solver, got[1])
         seen[rate] = ok
         return ok
+
+    def achieved() -> float:
+        """The best float rate of a candidate so far (a bracket end the gain reaches)."""
+        assert best is not None
+        return best[2]
 
     # spectral bounds: every L keeps the unobservable modes; the Riccati gain is a start
     ueig = np.linalg.eigvals(np.asarray(lyap.as_qarray(Au), dtype=float)) if Au.nrows() else []
@@ -652,6 +667,10 @@ def lmi_gain(
         reig = np.linalg.eigvals(A - Lr @ C)
     except (np.linalg.LinAlgError, ValueError):
         reig = None
+    if reig is not None and np.isfinite(reig).all() and np.isfinite(Lr).all():
+        ric = float(np.abs(reig).max()) if s.discrete else float(-reig.real.max())
+        if o.rate is None and (ric < 1.0 if s.discrete else ric > 0.0):
+            best = (Lr, RICCATI_START, ric)
     if o.rate is not None:
         # design with some slack (2 %) so the rounded gain certifies robustly at the asked rate
         slack = float(o.rate) * (SLACK_DISCRETE if s.discrete else SLACK_CONTINUOUS)
@@ -667,16 +686,17 @@ def lmi_gain(
             start = min(hi, float(np.abs(reig).max()) + tol)
             if start > lo and feasible(start):
                 hi = start
-        if not feasible(hi):
+        if best is None and not feasible(hi):
             raise InconclusiveError(
                 f"the LMI solver found no gain with λ ≤ {1.0 - tol:g} ({reason})" + _LMI_HINT
             )
+        hi = min(hi, achieved())
         while hi - lo > tol:
             mid = (lo + hi) / 2
             if progress:
                 progress(f"bisection λ = {mid:.6f}")
             if feasible(mid):
-                hi = mid
+                hi = min(mid, achieved())
             else:
                 lo = mid
     else:
@@ -688,26 +708,56 @@ def lmi_gain(
             start = min(hi, -float(reig.real.max()) - tol)
             if start > lo and feasible(start):
                 lo = start
-        if not feasible(lo):
+        if best is None and not feasible(lo):
             raise InconclusiveError(
                 f"the LMI solver found no gain with α ≥ {tol:g} ({reason})" + _LMI_HINT
             )
-        if feasible(hi):
+        lo = max(lo, min(hi, achieved()))
+        if lo < hi and feasible(hi):
             lo = hi
         while hi - lo > tol:
             mid = (lo + hi) / 2
             if progress:
                 progress(f"bisection α = {mid:.6f}")
             if feasible(mid):
-                lo = mid
+                lo = max(mid, min(hi, achieved()))
             else:
                 hi = mid
     assert best is not None
     Lf, name, rate = best
+    msg = f"LMI bisection: {solves} solves, best float rate {rate:.6g}"
+    if name == RICCATI_START:
+        msg = (
+            f"LMI bisection: {solves} solves, none beat the float rate {rate:.6g} of the "
+            "Riccati gain (Q = I, R = I, the bisection's start): L is that gain"
+        )
     return Lf, SolverResult(
         name,
         SolverStatus.OPTIMAL,
-        f"LMI bisection: {solves} solves, best float rate {rate:.6g}",
+        msg,
         seconds=total,
         extra={"gain_design": "lmi", "lmi_solves": solves},
     )
+
+
+def _candidate_rate(
+    status: str, Pv: Any, Xv: Any, A: np.ndarray, C: np.ndarray, discrete: bool
+) -> tuple[np.ndarray, float] | None:
+    """(L = P⁻¹X, its float rate: max |eig(A − LC)| discrete, −max Re eig continuous) of an
+    SDP answer of the decay LMI (eq. (4)-(6), constrained-redesign paper, Astolfi et al.,
+    NOLCOS 2019, Section 5), for "optimal" and "optimal_inaccurate" answers with finite
+    values; None otherwise.
+
+    :param status: the solver status; :param Pv, Xv: the values of P and X = P L;
+    :param A, C: the plant; :param discrete: time domain."""
+    if status not in ("optimal", "optimal_inaccurate") or Pv is None or Xv is None:
+        return None
+    try:
+        with np.errstate(all="ignore"):
+            Lc = np.linalg.solve(np.asarray(Pv, dtype=float), np.asarray(Xv, dtype=float))
+            eig = np.linalg.eigvals(A - Lc @ C)
+    except (np.linalg.LinAlgError, ValueError):
+        return None
+    if not (np.all(np.isfinite(Lc)) and np.all(np.isfinite(eig))):
+        return None
+    return Lc, float(np.abs(eig).max()) if discrete else float(-eig.real.max())
