@@ -335,3 +335,14 @@ def test_a_report_with_T_min_above_T_max_is_named_in_the_error(tmp_path: Path) -
         api.simulate(sp, report=rp)
     msg = str(e.value)
     assert msg.startswith(f"{rp}: expected 0 < T_min ≤ T_max") and "\n" not in msg
+
+
+def test_a_plant_that_leaves_the_float_range_is_said_in_words() -> None:
+    """x1 = 10³⁰⁰ on the unstable plant: every run escapes; one worded warning (no numpy
+    overflow warnings, no "All-NaN slice"), and worst_eps_after is None, not NaN (review 19)."""
+    info = _sim(A="[[1, 0], [0, -3]]", C="[[1, 0]]", M="[[0, 1]]", horizon=30, x1="1e300")
+    assert info["plant_escaped_runs"] == 3
+    assert info["worst_eps_after_t15"] is None
+    texts = info.get("warnings", [])
+    assert not any("RuntimeWarning" in t for t in texts), texts
+    assert any("the plant leaves the float range in 3 of 3 noisy runs" in t for t in texts), texts

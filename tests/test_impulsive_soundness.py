@@ -546,3 +546,54 @@ def test_simulate_option_errors_exit_2(tmp_path: Path) -> None:
     for opt in ("runs=abc", "runs=0", "nosuchkey=1", "rtol=abc"):
         res = runner.invoke(app, ["simulate", str(spec), "--option", opt])
         assert res.exit_code == 2, (opt, res.output)
+
+
+def test_a_plant_entry_of_1e308_is_inconclusive_not_an_internal_failure(tmp_path: Path) -> None:
+    """A = [[1e308, …]] overflows the float ssd rate of Lemma 2 (Ā + Āᵀ): exit 4, one line, an
+    error report (it was exit 3, "cannot round a non-finite number": review 19)."""
+    text = SPEC3.read_text(encoding="utf-8").replace("A = [[0, 0.01, 0]", "A = [[1e308, 0.01, 0]")
+    assert "1e308" in text
+    spec = tmp_path / "s.toml"
+    spec.write_text(text, encoding="utf-8")
+    out = tmp_path / "r.json"
+    res = runner.invoke(app, ["design", str(spec), "-o", str(out)])
+    assert res.exit_code == 4, res.output
+    assert "overflows float64" in res.output and "Traceback" not in res.output
+    err = json.loads(out.read_text(encoding="utf-8"))  # the error report of a stopped design
+    assert err["verdict"] == "error" and err["error"]["exit_code"] == 4
+
+
+@pytest.mark.parametrize("gamma_exp", [300, 100, 30])
+def test_window_bounds_stay_sound_and_positive_for_a_tiny_gamma(gamma_exp: int) -> None:
+    """T_max_lower (26b) and T_min_upper (26c) at γ = 10^-k: positive, on the safe side of
+    the value at 400 digits and within 10⁻⁹ of it (the interval's lower end of (26b) was
+    negative at γ = 10⁻³⁰⁰, and the empty-window message printed T_max = −2.4·10⁻³⁴)."""
+    from obsdesign.methods.impulsive.window import T_max_lower, T_min_upper
+
+    g = fmpq(1, 10**gamma_exp)
+    varpi, kappa, lam_no, lam_on = Q("0.5"), Q("0.9"), Q("0.3"), Q("0.2")
+    beta = 1 / ((1 - g) * (1 - g))
+    lo = T_max_lower(g, varpi, kappa, lam_no, lam_on, beta)
+    hi = T_min_upper(Q(3), g, kappa)
+    with mpmath.workdps(400):
+        f = lambda q: mpmath.mpf(int(q.p)) / int(q.q)  # noqa: E731
+        den = f(varpi) + f(kappa) + f(lam_no) + f(beta) * f(lam_on)
+        t_max = -mpmath.log((1 - f(g)) ** 2) / den
+        t_min = -mpmath.log((3 - f(g)) / 3) / f(kappa)
+        assert 0 < f(lo) <= t_max and f(lo) >= t_max * (1 - mpmath.mpf(10) ** -9)
+        assert t_min <= f(hi) <= t_min * (1 + mpmath.mpf(10) ** -9)
+
+
+def test_a_window_too_narrow_for_its_digits_says_so() -> None:
+    """L = 1e-300: the window (3.4·10⁻³⁰¹, 8.4·10⁻³⁰¹) is not empty but holds no pair of
+    4-decimal bounds: exit 1 saying so and naming digits (it said "empty window: T_min ≥ T_max"
+    with a negative T_max)."""
+    from obsdesign.errors import InfeasibleError
+
+    text = SPEC3.read_text(encoding="utf-8").replace("L = [0.8]", "L = [1e-300]")
+    assert "1e-300" in text
+    with pytest.raises(InfeasibleError) as ei:
+        api.design(load_spec_text(text, "tiny.toml"))
+    msg = ei.value.message
+    assert "is not empty, but it holds no pair of 4-decimal bounds" in msg
+    assert "raise [method] digits" in msg and "T_max = -" not in msg

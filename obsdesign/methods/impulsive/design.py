@@ -9,6 +9,7 @@ and is certified again, from the spec and these numbers only, by :mod:`.claims`.
 
 from __future__ import annotations
 
+import math
 import time
 from typing import Any
 
@@ -17,8 +18,9 @@ from flint import fmpq
 
 from obsdesign.certify.exact import Q, dyadic, to_float
 from obsdesign.certify.linalg import norm_upper
+from obsdesign.certify.printing import fmt_exact
 from obsdesign.certify.psd import check_pd, check_psd
-from obsdesign.errors import InfeasibleError
+from obsdesign.errors import InconclusiveError, InfeasibleError
 from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
 from obsdesign.params import Parameters
 from obsdesign.spec.models import Spec
@@ -158,14 +160,23 @@ def certified_rate(Ablk: np.ndarray, qsr: QSR, theta: fmpq, rate_f: float) -> fm
     eq. (7), Lemma 1; Lemma 2 with r = −ϖ_o): κ_n is rounded down, ϖ_o up.
 
     ``Ablk``: the exact diagonal block Ā_n or Ā_o; ``qsr``: its data of Assumption 1;
-    ``theta``: the scaling of the QSR triple; ``rate_f``: the float optimum."""
+    ``theta``: the scaling of the QSR triple; ``rate_f``: the float optimum. A float optimum
+    that is not finite (the block's float data overflow float64, e.g. an entry 1e308 of A)
+    raises :class:`~obsdesign.errors.InconclusiveError` (exit 4; it was a ValueError, exit 3);
+    the steps below it are exact, so they never overflow."""
+    if not math.isfinite(rate_f):
+        raise InconclusiveError(
+            f"the float optimum of the ssd rate (Lemma 1 / Lemma 2) is {rate_f}: the block "
+            "Ā + Āᵀ of the spec's A overflows float64; scale the plant's numbers down"
+        )
     q = qsr.scaled(theta)
-    step = 2.0**-30 * max(1.0, abs(rate_f))
-    r = Q(dyadic(rate_f - step, 40))
+    step_f = 2.0**-30 * max(1.0, abs(rate_f))
+    r = Q(dyadic(rate_f - step_f, 40))
+    step = Q(dyadic(step_f, 40))
     for _ in range(60):
         if check_psd(-ssd_matrix(Ablk, q, r)):
             return r
-        r = r - Q(dyadic(step, 40))
+        r = r - step
         step *= 4
     raise Infeasible(
         "the ssd LMI could not be certified near its float optimum (ill-conditioned data)"
@@ -255,6 +266,14 @@ def design_window(p: Problem) -> tuple[dict[str, Any], list[str]]:
     T_max = T_max_lower(gamma, varpi, kappa, lam_no, lam_on, beta)
     T_min = T_min_upper(p.alpha, gamma, kappa)
     T_max_r, T_min_r = safe_window(T_max, T_min, p.digits)
+    if not T_min_r < T_max_r and T_min < T_max:
+        raise Infeasible(
+            f"the window T_min = {float(T_min):.6g} < T_max = {float(T_max):.6g} (κ = "
+            f"{float(kappa):.6g}) is not empty, but it holds no pair of {p.digits}-decimal "
+            f"bounds (T_max rounded down to {fmt_exact(T_max_r)}, T_min up to "
+            f"{fmt_exact(T_min_r)}); raise [method] digits (at most 30) or widen the window "
+            "(γ = min L_ii raises the numerator of (26b))"
+        )
     if not T_min_r < T_max_r:
         raise Infeasible(
             f"empty window: T_min = {float(T_min):.6g} ≥ T_max = {float(T_max):.6g} "

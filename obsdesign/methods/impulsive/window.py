@@ -63,22 +63,31 @@ def kappa_widest(varpi_o: float, coup: float, gamma: float, alpha: float) -> flo
 def T_max_lower(gamma: Any, varpi_o: Any, kappa: Any, lam_no: Any, lam_on: Any, beta: Any) -> fmpq:
     """Rational lower bound of T_max = −ln((1−γ)²)/(ϖ_o + κ + λ*_no + β λ*_on) (26b).
 
-    The denominator is exact; requires it > 0."""
+    The denominator is exact; requires it > 0. The bound is the larger of the interval
+    enclosure's lower end and the exact 2γ/den (−ln(1−γ) = γ + γ²/2 + … ≥ γ for γ ∈ [0, 1)):
+    for a tiny γ (L = 1e-300) the interval's working precision cannot resolve 1 − γ and its
+    lower end was negative, so an empty-window message printed T_max = −2.4·10⁻³⁴ where
+    T_max ≈ 7.6·10⁻³⁰¹ (review)."""
     den = Q(varpi_o) + Q(kappa) + coupling(lam_no, lam_on, beta)
     if den <= 0:
         raise ValueError("the denominator of (26b) is not positive")
     g = Q(gamma)
     lo, _ = bounds(lambda om, d: -iv.log(om * om) / d, fmpq(1) - g, den)
-    return lo
+    return max(lo, 2 * g / den) if 0 <= g < 1 else lo
 
 
 def T_min_upper(alpha: Any, gamma: Any, kappa: Any) -> fmpq:
-    """Rational upper bound of T_min = −ln((α − γ)/α)/κ (26c); requires α > γ, κ > 0."""
+    """Rational upper bound of T_min = −ln((α − γ)/α)/κ (26c); requires α > γ, κ > 0.
+
+    The bound is the smaller of the interval enclosure's upper end and the exact
+    x/((1 − x)κ), x = γ/α (−ln(1−x) ≤ x/(1−x) for x ∈ [0, 1)): tight where the interval's
+    working precision cannot resolve 1 − x (a tiny γ/α)."""
     a, g, k = Q(alpha), Q(gamma), Q(kappa)
     if not (a > g and k > 0):
         raise ValueError("(26c) needs α > γ and κ > 0")
     _, hi = bounds(lambda r, kk: -iv.log(r) / kk, (a - g) / a, k)
-    return hi
+    x = g / a
+    return min(hi, x / ((1 - x) * k)) if x >= 0 else hi
 
 
 def radius_upper(alpha: Any, w_bar: Any) -> fmpq:
