@@ -117,11 +117,14 @@ class Parameters:
         for k, v in self._v.items():
             hit = done.get(id(v)) if isinstance(v, np.ndarray) else None
             if hit is None:
-                both = qstr_floats(v) if _is_exact(v) and isinstance(v, np.ndarray) else None
-                if both is not None:
-                    hit = (both[1], both[0])
-                else:
-                    hit = (_floats(v), qstr(v) if _is_exact(v) else None)
+                try:
+                    both = qstr_floats(v) if _is_exact(v) and isinstance(v, np.ndarray) else None
+                    if both is not None:
+                        hit = (both[1], both[0])
+                    else:
+                        hit = (_floats(v), qstr(v) if _is_exact(v) else None)
+                except OverflowError as e:
+                    raise OverflowError(f"parameter '{k}': {e}") from e
                 if isinstance(v, np.ndarray):
                     done[id(v)] = hit
                     out[k], ex = hit

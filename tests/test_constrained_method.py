@@ -429,3 +429,26 @@ def test_simulate_with_a_report_missing_a_parameter_names_the_report(tmp_path) -
     with pytest.raises(InputError) as e:
         api.simulate(p, report=rp)
     assert str(e.value) == f"{rp}: parameter 'theta' is missing"
+
+
+def test_a_tiny_eps_min_is_a_spec_error_naming_it() -> None:
+    """eps_min = 1e-300 makes θ ≈ 10⁶¹¹ (eq. (22)), beyond a report's float view: exit 2
+    naming [method.eps_min] and θ's size (it was exit 4 "the spec's numbers are too large",
+    naming neither file nor key: review 19). eps_min = 1e-100 still designs (θ ≈ 10²⁰⁷)."""
+    tiny = variant(replace=(("eps_min = 0.01", "eps_min = 1e-300"),))
+    with pytest.raises(SpecError) as e:
+        api.design(load_spec_text(tiny, "tiny.toml"))
+    msg = str(e.value)
+    assert "tiny.toml: [method.eps_min]" in msg and "θ ≈ 10^" in msg and e.value.exit_code == 2
+    ok = api.design(load_spec_text(variant(replace=(("eps_min = 0.01", "eps_min = 1e-100"),))))
+    assert ok.exit_code() == 0 and float(ok.parameters.float("theta")) > 1e200
+
+
+def test_a_parameter_beyond_the_float_range_is_named() -> None:
+    """A huge eps_min (1e308) puts δ² beyond the float range: exit 4 naming the parameter
+    ('delta_sq'), not only "the spec's numbers are too large"."""
+    from obsdesign.errors import InconclusiveError
+
+    huge = variant(replace=(("eps_min = 0.01", "eps_min = 1e308"),))
+    with pytest.raises(InconclusiveError, match="parameter 'delta_sq'"):
+        api.design(load_spec_text(huge, "huge.toml")).to_dict()

@@ -188,8 +188,9 @@ class Report:
             params = self.parameters.to_json()
         except OverflowError as e:
             raise InconclusiveError(
-                "a parameter's exact value lies beyond the float range, so the report cannot "
-                f"give its float view ({e}): the spec's numbers are too large"
+                "an exact value lies beyond the float range, so the report cannot give its "
+                f"float view ({e}): the spec's numbers are too large or too small for one "
+                "report (e.g. an eps_min of 1e-300 makes the constrained method's θ ≈ 10⁶⁰⁰)"
             ) from e
         d = {
             "schema_version": self.schema_version,

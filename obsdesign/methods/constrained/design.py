@@ -14,7 +14,7 @@ import numpy as np
 from flint import fmpq
 
 from obsdesign import lyap
-from obsdesign.certify.exact import Q
+from obsdesign.certify.exact import Q, float_or_inf
 from obsdesign.certify.interval import sqrt_upper
 from obsdesign.errors import InconclusiveError, InfeasibleError, SpecError
 from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
@@ -173,6 +173,21 @@ def design_params(spec: Spec) -> tuple[dict[str, Any], list[str]]:
     vmin = B.v_min_lower(o.cmap, P, Pinv, o.X, o.eps_min)
     notes.append(f"v_min (21): {vmin.how}")
     theta = B.theta_of(vmax.value, vmin.value, gamma, o.eps_min)
+    if not _has_float(theta):  # no float view in the report (a tiny eps_min: review, 1e-300)
+        size = f"θ ≈ 10^{int(theta.bit_length() * 0.30103)}"
+        if _has_float(int(theta * o.eps_min * o.eps_min)):  # ε_min alone makes it so
+            raise SpecError(
+                spec.file,
+                "method.eps_min",
+                f"eps_min = {float(o.eps_min):g} gives {size} refining steps (eq. (22): "
+                "θ ≥ (v_max − v_min)/(γ ε_min²)), beyond the float range of a report; "
+                "expected a larger eps_min",
+            )
+        raise InconclusiveError(
+            f"{size} refining steps (eq. (22): θ ≥ (v_max − v_min)/(γ ε_min²) with v_max ≈ "
+            f"{float_or_inf(vmax.value):.3g}, γ ≈ {float_or_inf(gamma):.3g}) is beyond the "
+            "float range of a report: the spec's numbers are too large"
+        )
     if theta == 0:
         notes.append(
             "Remark 2: v_max ≤ v_min, the estimate never leaves X̂ after a jump: θ = 0, no refining needed"
@@ -236,3 +251,15 @@ def _over(value: Any, bound: Any) -> str:
     "1e-06 (relative) above it" when the ratio would print as 1× (a γ just past (24))."""
     r = float(Q(value) / Q(bound))
     return f"{r:.3g}× too large" if r >= 1.01 else f"{r - 1:.2g} (relative) above it"
+
+
+def _has_float(k: int) -> bool:
+    """Whether the integer θ of eq. (22) (constrained-redesign paper) has a float view (the
+    report writes one beside every exact value).
+
+    :param k: the integer."""
+    try:
+        float(k)
+    except OverflowError:
+        return False
+    return True
