@@ -223,3 +223,22 @@ def test_rounding_property(x: fmpq, d: int):
     step = F(1, 10**d)
     assert down <= x <= up and up - down <= step and (up * 10**d).q == 1
     assert (down * 10**d).q == 1
+
+
+def test_raw_to_q_refuses_an_exponent_beyond_exact_arithmetic() -> None:
+    """An interval end 2^(2^26 + 1) is a MagnitudeError (exit 4, and an ArithmeticError for
+    the enclosures that treat it as "bounds nothing"); python-flint died with SIGFPE on such
+    powers (review 19). 2^(2^26) itself converts."""
+    import mpmath
+
+    from obsdesign.certify.interval import MAX_EXPONENT, MagnitudeError, raw_to_q
+    from obsdesign.errors import EXIT_INCONCLUSIVE
+
+    big = mpmath.ldexp(mpmath.mpf(1), MAX_EXPONENT + 1)
+    with pytest.raises(MagnitudeError) as ei:
+        raw_to_q(big._mpf_)
+    assert isinstance(ei.value, ArithmeticError) and ei.value.exit_code == EXIT_INCONCLUSIVE
+    with pytest.raises(MagnitudeError):
+        raw_to_q(mpmath.ldexp(mpmath.mpf(1), -MAX_EXPONENT - 2)._mpf_)
+    ok = raw_to_q(mpmath.ldexp(mpmath.mpf(1), MAX_EXPONENT - 1)._mpf_)
+    assert ok.p.bit_length() == MAX_EXPONENT

@@ -17,6 +17,7 @@ from mpmath import iv
 from mpmath.libmp import finf, fnan, fninf
 
 from obsdesign.certify.exact import Q
+from obsdesign.errors import InconclusiveError
 
 PREC = 113  # bits of the interval endpoints (quad precision); widths far below 1e-30
 
@@ -39,11 +40,29 @@ def q_to_iv(x: Any) -> Any:
         return iv.mpf(int(q.p)) / iv.mpf(int(q.q))
 
 
+#: largest |binary exponent| of an interval end turned into an exact rational (2^(2^26) is an
+#: 8 MB integer, formed in milliseconds); beyond it python-flint refused the power
+#: ("exponent too large") or died with SIGFPE (e^(L_f Δτ) for K = 10¹⁵, review 19)
+MAX_EXPONENT = 2**26
+
+
+class MagnitudeError(InconclusiveError, ArithmeticError):
+    """An interval end beyond :data:`MAX_EXPONENT`: exit 4 (numerically inconclusive) where
+    it surfaces; an ArithmeticError for the enclosures that treat a failed evaluation as
+    "bounds nothing"."""
+
+
 def raw_to_q(x: tuple) -> fmpq:
-    """Exact rational value of a finite raw mpmath float (sign, man, exp, bc)."""
+    """Exact rational value of a finite raw mpmath float (sign, man, exp, bc).
+    :class:`MagnitudeError` when its binary exponent exceeds :data:`MAX_EXPONENT`."""
     if x in (finf, fninf, fnan):
         raise ArithmeticError("interval evaluation did not give a finite enclosure")
-    sign, man, exp, _ = x
+    sign, man, exp, bc = x
+    if abs(int(exp)) > MAX_EXPONENT or abs(int(exp) + int(bc)) > MAX_EXPONENT:
+        raise MagnitudeError(
+            f"an interval bound of magnitude 2^{int(exp) + int(bc)} is beyond exact arithmetic "
+            "(the spec's numbers are too large or too small)"
+        )
     v = fmpq(int(man)) * fmpq(2) ** int(exp)
     return -v if sign else v
 
