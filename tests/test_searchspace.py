@@ -432,3 +432,69 @@ def test_input_range_claim_exit_codes(u: str, lo: str, hi: str, status: str, cod
     claim = next(c for c in rep.claims if c.id == "input-range")
     assert claim.status.value == status
     assert rep.exit_code() == code
+
+
+@pytest.mark.parametrize(("est", "status"), [(1.0, "certified"), (1.0 + 2e-6, "failed")])
+def test_a_sampled_value_above_the_bound_fails_the_claim(
+    example, monkeypatch: pytest.MonkeyPatch, est: float, status: str
+) -> None:
+    """The safety net of _constant: an enclosure that "proves" L_h ≤ 1 while a sample of the
+    run-time evaluator reaches 1 + 2·10⁻⁶ (beyond float error, 10⁻⁶ relative) fails L_h-bound
+    (the two evaluators disagreed on sat(x, r < 0) and a false sup |f| was certified: review
+    19); a sample at the bound itself does not."""
+    from obsdesign.methods.searchspace import claims as C
+    from obsdesign.methods.searchspace.bounds import Bound
+
+    sp, rep = example
+    real = C.interval_bound
+
+    def fake(k: str, spec):  # noqa: ANN001, ANN202
+        return Bound(1.0, est, 1) if k == "L_h" else real(k, spec)
+
+    monkeypatch.setattr(C, "interval_bound", fake)
+    got = {c.id: c.status.value for c in api.certify(sp, rep.parameters)}
+    assert got["L_h-bound"] == status
+
+
+@pytest.mark.parametrize("K", [10**15, 10**20])
+def test_tamper_K_huge_fails_the_schedule_without_forming_the_exponential(
+    example, tmp_path: Path, K: int
+) -> None:
+    """K = 10¹⁵ with Δτ = KΔT kept consistent: verify fails Lemma 2 and the schedule
+    (L_f Δτ ≥ 1, so e^(L_f Δτ)/2 ≥ 1) and returns; it died with SIGFPE in python-flint while
+    forming the 113-bit enclosure of e^(L_f Δτ) (review 19). design.schedule stops at γ₀."""
+    sp, rep = example
+    v = _consistent(sp, K=K)
+    assert v["gamma_schedule"] == [sp.options.gamma0]
+    failed = _failed(_report_with(rep, v, tmp_path))
+    assert {"lemma2-consistency", "gamma-schedule"} <= failed
+    ver = api.verify(tmp_path / "tampered.json")
+    detail = next(c.detail for c in ver.claims if c.id == "gamma-schedule")
+    assert "≥ 1, so e^(L_f Δτ)/2 ≥ (1 + L_f Δτ)/2 ≥ 1" in detail
+
+
+def test_digits_beyond_30_is_bad_input(tmp_path: Path) -> None:
+    """digits = 31 is exit 2 naming [method.digits] (100000 was an internal failure: Python's
+    4300-digit limit of int-to-string conversion, review 19); 30 designs."""
+    spec = tmp_path / "s.toml"
+    spec.write_text(TEXT.replace('key = "search-space"', 'key = "search-space"\ndigits = 31'))
+    res = CliRunner().invoke(app, ["design", str(spec), "-o", str(tmp_path / "r.json")])
+    assert res.exit_code == 2 and "[method.digits] expected at most 30" in res.output
+    sp = api.load_spec_text(
+        TEXT.replace('key = "search-space"', 'key = "search-space"\ndigits = 30')
+    )
+    assert api.design(sp).exit_code() == 0
+
+
+def test_a_schedule_cut_by_the_cap_says_so(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A schedule that needs more entries than the design lists (MAX_SCHEDULE, here 5 for the
+    example's 12) fails gamma-schedule with the cap and the way out named (it read only "ends
+    at …, not at γ⋆", though every listed entry keeps the rule: review 19, κ near 2L_h)."""
+    from obsdesign.methods.searchspace import claims as C
+
+    monkeypatch.setattr(D, "MAX_SCHEDULE", 5)
+    monkeypatch.setattr(C, "MAX_SCHEDULE", 5)
+    rep = api.design(api.load_spec(SPEC))
+    bad = {c.id: c.detail for c in rep.failed}
+    assert list(bad) == ["gamma-schedule"]
+    assert "at most 5 entries" in bad["gamma-schedule"] and "a smaller K" in bad["gamma-schedule"]

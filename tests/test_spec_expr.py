@@ -131,3 +131,35 @@ def test_literal_beyond_the_exponent_limit_is_refused(text: str, msg: str) -> No
 def test_literal_at_the_exponent_limit_is_kept() -> None:
     ex = parse_expr("1e-1000*t + 1e300 + x1e5", ["t", "x1e5"])
     assert float(ex(t=1.0, x1e5=0.0)) == 1e300
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(-40, 40), st.integers(-40, 40))
+def test_sat_means_the_same_at_run_time_in_sympy_and_in_both_enclosures(x: int, r: int) -> None:
+    """sat(x, r) = max(−r, min(r, x)) for every evaluator, a negative radius included (run
+    time: numpy's clip gave r for r < 0, the enclosures and sympy −r, and search-space
+    certified a false sup |f|: review 19)."""
+    from fractions import Fraction
+
+    import sympy
+
+    from obsdesign.methods.searchspace.intervals import ONE, Dual, I, evaluate
+    from obsdesign.methods.searchspace.qintervals import QI, evaluate_q
+
+    xv, rv = x / 8, r / 8  # exact in binary
+    want = max(-rv, min(rv, xv))
+    e = parse_expr("sat(x1, r1)", ["x1", "r1"])
+    assert float(e(x1=xv, r1=rv)) == want
+    assert e.sympy().subs(
+        {sympy.Symbol("x1"): Fraction(x, 8), sympy.Symbol("r1"): Fraction(r, 8)}
+    ) == Fraction(want)
+    env = {k: Dual(I(v, v), (ONE, ONE)) for k, v in (("x1", xv), ("r1", rv))}
+    d = evaluate(e.tree, env, {}, 2, e.source)
+    assert d.v.lo <= want <= d.v.hi
+    q = evaluate_q(
+        e.tree,
+        {"x1": QI(Fraction(x, 8), Fraction(x, 8)), "r1": QI(Fraction(r, 8), Fraction(r, 8))},
+        {},
+        e.source,
+    )
+    assert q.lo == q.hi == Fraction(want)

@@ -9,7 +9,8 @@ or ``sympify``: it is compiled into numpy closures walking the checked tree, and
 expression built node by node (for exact Jacobians). ``^`` means power.
 
 Functions: sin cos tan exp log sqrt abs tanh atan sinh cosh min max sat sign step heaviside
-floor mod. ``sat(x) = clip(x, -1, 1)``, ``sat(x, r) = clip(x, -r, r)``, ``step(x) =
+floor mod. ``sat(x) = clip(x, -1, 1)``, ``sat(x, r) = max(-r, min(r, x))`` (``clip(x, -r, r)``
+for r >= 0, the constant -r for r < 0), ``step(x) =
 heaviside(x) = 1 if x > 0 else 0``, ``mod(a, b) = a - b*floor(a/b)``. Constants ``pi``, ``e``.
 """
 
@@ -33,7 +34,10 @@ Fn = Callable[[Env], Any]
 
 
 def _sat(x: Any, r: Any = 1.0) -> Any:
-    return np.clip(x, -r, r)
+    """max(−r, min(r, x)): clip(x, −r, r) for r ≥ 0, and −r for r < 0, as the interval and
+    sympy evaluators take it (numpy's clip gave r there: sat(x1, −1) ≡ −1 at run time but +1
+    in the certified enclosures, and search-space certified a false sup |f|, review 19)."""
+    return np.maximum(np.negative(r), np.minimum(r, x))
 
 
 def _step(x: Any) -> Any:

@@ -21,6 +21,7 @@ from obsdesign.certify.exact import Q
 from obsdesign.certify.printing import fmt_down, fmt_exact, fmt_up
 from obsdesign.methods.searchspace import bounds
 from obsdesign.methods.searchspace.design import (
+    MAX_SCHEDULE,
     SCHEDULE_RTOL,
     exp_lower,
     exp_upper,
@@ -246,11 +247,20 @@ def _first_bad_eps(eps: list[fmpq], gam: list[fmpq], kappa: fmpq) -> str:
 
 def _schedule(c: Claims, gam: list[fmpq], g_star: fmpq, L_f: fmpq, dtau: fmpq) -> None:
     """γ_{i+1} = max(γ_i e^{L_f Δτ}/2, γ⋆) for every listed entry, rounded up by at most
-    SCHEDULE_RTOL; the list ends at γ⋆, which the rule keeps fixed (e^{L_f Δτ}/2 ≤ 1)."""
+    SCHEDULE_RTOL; the list ends at γ⋆, which the rule keeps fixed (e^{L_f Δτ}/2 ≤ 1).
+    For L_f Δτ ≥ 1 the last condition fails without forming e^{L_f Δτ} (e^x ≥ 1 + x ≥ 2;
+    a report with K = 10¹⁵ crashed verify with SIGFPE in python-flint, review 19)."""
     x = L_f * dtau
-    e_hi, e_lo = exp_upper(x), exp_lower(x)
     bad = ""
-    for i in range(len(gam) - 1):
+    if x >= 1:
+        bad = (
+            f"L_f Δτ = {fmt_up(x)} ≥ 1, so e^(L_f Δτ)/2 ≥ (1 + L_f Δτ)/2 ≥ 1: γ⋆ is not a fixed "
+            "point of the rule (Δτ too long)"
+        )
+        e_hi = e_lo = fmpq(0)
+    else:
+        e_hi, e_lo = exp_upper(x), exp_lower(x)
+    for i in range(len(gam) - 1 if not bad else 0):
         g, nxt = gam[i], gam[i + 1]
         low = max(g * e_hi / 2, g_star)
         high = max(g * e_lo / 2 * (1 + SCHEDULE_RTOL), g_star)
@@ -262,6 +272,12 @@ def _schedule(c: Claims, gam: list[fmpq], g_star: fmpq, L_f: fmpq, dtau: fmpq) -
             break
     if not bad and gam[-1] != g_star:
         bad = f"the schedule ends at {fmt_exact(gam[-1])}, not at γ⋆ = {fmt_exact(g_star)}"
+        if len(gam) >= MAX_SCHEDULE:  # the rule holds so far: the design's cap cut it
+            bad += (
+                f" (the design lists at most {MAX_SCHEDULE:,} entries, and γ_i e^(L_f Δτ)/2 "
+                "shrinks too slowly to reach γ⋆ within them: a smaller K (shorter Δτ), a larger "
+                "γ⋆ or a smaller γ₀)"
+            )
     if not bad and e_hi > 2:
         bad = "e^(L_f Δτ)/2 > 1: γ⋆ is not a fixed point of the rule (Δτ too long)"
     _verdict(
@@ -346,7 +362,12 @@ def _constant(c: Claims, spec: Spec, k: str, val: fmpq) -> None:
     o: Options = spec.options
     b = interval_bound(k, spec)
     given = getattr(o, k) is not None
-    proved = b.finite and Q(b.upper) <= val
+    # a sampled value above the value (beyond float evaluation error) refutes it, whatever
+    # the enclosure says: were the enclosure and the run-time evaluator of the spec's
+    # expressions ever to disagree (sat with a negative radius did, review 19), the claim
+    # fails instead of certifying a false bound
+    refuted = b.lower_est > float(val) * (1 + 1e-6) + 1e-300
+    proved = b.finite and Q(b.upper) <= val and not refuted
     est = f"sampled lower estimate {b.lower_est:.6g}" + (
         f", interval bound {fmt_up(b.upper, 8)}" if b.finite else ", no finite interval bound"
     )
@@ -374,7 +395,7 @@ def _constant(c: Claims, spec: Spec, k: str, val: fmpq) -> None:
                     else "the interval bound"
                 )
             ),
-            float_ok=b.finite and float(val) >= b.upper,
+            float_ok=b.finite and float(val) >= b.upper and not refuted,
         )
     else:
         c.numerical(

@@ -163,9 +163,14 @@ def K_rule(kappa: fmpq, L_h: fmpq, L_f: fmpq, dT: fmpq) -> int:
 def schedule(gamma0: fmpq, gamma_star: fmpq, L_f: fmpq, dtau: fmpq) -> list[fmpq]:
     """γ_{i+1} = max(γ_i e^{L_f Δτ}/2, γ⋆) (Theorem 1, hypothesis 2), each entry rounded up
     to SCHEDULE_DIGITS significant digits, listed until it reaches γ⋆ (constant after).
-    Stops early (without reaching γ⋆) when e^{L_f Δτ}/2 ≥ 1 or after MAX_SCHEDULE entries."""
-    r = exp_upper(L_f * dtau) / 2
+    Stops early (without reaching γ⋆) when e^{L_f Δτ}/2 ≥ 1 or after MAX_SCHEDULE entries.
+    For L_f Δτ ≥ 1 that is known without e^{L_f Δτ} (e^x ≥ 1 + x ≥ 2), which is never
+    formed there: a huge K (10¹⁵) made its 113-bit enclosure an integer of 10¹⁵ bits and
+    python-flint died with SIGFPE in design and in verify (review 19)."""
     out = [gamma0]
+    if L_f * dtau >= 1:
+        return out
+    r = exp_upper(L_f * dtau) / 2
     g = gamma0
     while g != gamma_star and len(out) < MAX_SCHEDULE:
         if r >= 1:

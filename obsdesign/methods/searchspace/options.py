@@ -157,7 +157,7 @@ def parse_options(table: Table, spec: Spec) -> Options:
         f_sup=_opt_pos(table, "f_sup"),
         bound_boxes=table.int("bound_boxes", default=300, min=1),
         bound_rtol=float(table.scalar("bound_rtol", default=fmpq(1, 1000), min=0).f),
-        digits=table.int("digits", default=6, min=2),
+        digits=_digits(table),
         t0=table.scalar("t0", default=fmpq(0)).q,
     )
     table.done()
@@ -213,7 +213,7 @@ def options_schema(key: str) -> dict[str, Any]:
             "f_sup": pos,
             "bound_boxes": {"type": "integer", "minimum": 1},
             "bound_rtol": {"type": "number", "minimum": 0},
-            "digits": {"type": "integer", "minimum": 2},
+            "digits": {"type": "integer", "minimum": 2, "maximum": MAX_DIGITS},
         },
     }
 
@@ -227,3 +227,18 @@ def simulate_schema() -> dict[str, Any]:
         "store_every": {"type": "integer", "minimum": 1},
         "time_limit": {"type": "number", "exclusiveMinimum": 0},
     }
+
+
+#: most significant digits of the reported constants (``digits``): 100000 ended in Python's
+#: 4300-digit limit of int-to-string conversion, exit 3 (review 19); 30 is the impulsive
+#: method's limit too
+MAX_DIGITS = 30
+
+
+def _digits(table: Any) -> int:
+    """``[method] digits``: an integer in [2, MAX_DIGITS] (the constants of Lemmas 1-2 and
+    Theorem 1 are rounded up to that many significant digits)."""
+    digits: int = table.int("digits", default=6, min=2)
+    if digits > MAX_DIGITS:
+        raise table.error("digits", f"expected at most {MAX_DIGITS} digits, got {digits}")
+    return digits
