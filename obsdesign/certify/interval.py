@@ -23,11 +23,15 @@ PREC = 113  # bits of the interval endpoints (quad precision); widths far below 
 
 
 class _prec:
-    """Context manager: run mpmath's interval context at PREC bits, then restore."""
+    """Context manager: run mpmath's interval context at ``bits`` (default PREC), then
+    restore."""
+
+    def __init__(self, bits: int = PREC) -> None:
+        self.bits = bits
 
     def __enter__(self) -> None:
         self.saved = iv.prec
-        iv.prec = PREC
+        iv.prec = self.bits
 
     def __exit__(self, *exc: object) -> None:
         iv.prec = self.saved
@@ -117,6 +121,19 @@ def sqrt_lower(x: Any) -> fmpq:
 
 log_upper: Callable[[Any], fmpq] = partial(upper, iv.log)
 log_lower: Callable[[Any], fmpq] = partial(lower, iv.log)
+
+
+def log_bounds(x: Any, bits: int = PREC) -> tuple[fmpq, fmpq]:
+    """Rational (lower, upper) enclosing ln x (x > 0 exact) at ``bits`` ≥ PREC bits of
+    working precision: more where a decision needs it (the K of Theorem 1, search-space
+    paper, compares K·ΔT·L_f with ln(κ/L_h) when K ≈ 10³⁰⁰)."""
+    q = Q(x)
+    with _prec(max(PREC, bits)):
+        r = iv.log(iv.mpf(int(q.p)) / iv.mpf(int(q.q)))
+        lo, hi = r._mpi_
+    return raw_to_q(lo), raw_to_q(hi)
+
+
 exp_upper: Callable[[Any], fmpq] = partial(upper, iv.exp)
 exp_lower: Callable[[Any], fmpq] = partial(lower, iv.exp)
 

@@ -23,6 +23,7 @@ from obsdesign.methods.searchspace import bounds
 from obsdesign.methods.searchspace.design import (
     MAX_SCHEDULE,
     SCHEDULE_RTOL,
+    K_bits,
     exp_lower,
     exp_upper,
     interval_bound,
@@ -143,7 +144,7 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     ratio = kappa / L_h
     if o.K is None:
         if ratio > 1:
-            hi = ivq.log_upper(ratio)
+            hi = ivq.log_bounds(ratio, K_bits(dT * L_f))[1]
             ok = bool(k_int and ((K + 1) * dT * L_f >= hi or K == 1 and dT * L_f >= hi))
         else:
             hi, ok = None, bool(K == 1)
@@ -153,13 +154,14 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
             f"K = {fmt_exact(K)} is the largest integer with K ΔT < log(κ/L_h^E)/L_f^E "
             "(at least 1, the paper's max{·, 1})",
             "Theorem 1, hypothesis 1",
-            "(K+1)·ΔT·L_f ≥ upper bound of log(κ/L_h) (outward rounding, 113 bits)",
+            "(K+1)·ΔT·L_f ≥ upper bound of log(κ/L_h) (outward rounding, 113 bits plus those "
+            "of 1/(ΔT·L_f))",
             ok,
             "a larger K also keeps Lemma 2's horizon",
             margin=0 if hi is None else (K + 1) * dT * L_f - hi,
         )
     if ratio > 1:
-        lo = ivq.log_lower(ratio)
+        lo = ivq.log_bounds(ratio, K_bits(dT * L_f))[0]
         ok2 = bool(L_f * dtau < lo)
         stmt_bound = f" (log(κ/L_h^E)/L_f^E ≥ {fmt_down(lo / L_f, 8)})"
         excess = fmt_down(L_f * dtau - ivq.log_upper(ratio))
@@ -170,7 +172,7 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         "lemma2-consistency",
         f"Δτ = {fmt_exact(dtau)} < log(κ/L_h^E)/L_f^E{stmt_bound}",
         "Lemma 2 (consistency) with γ_i/ε_i = κ, Theorem 1",
-        "L_f·Δτ < lower bound of log(κ/L_h) (outward rounding, 113 bits)",
+        "L_f·Δτ < lower bound of log(κ/L_h) (outward rounding, 113 bits plus those of 1/(ΔT·L_f))",
         ok2,
         f"L_f Δτ exceeds log(κ/L_h) by at least {excess}"
         + (" (K = 1 already too long: decrease α or γ⋆)" if K == 1 else ""),

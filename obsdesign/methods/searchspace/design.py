@@ -155,9 +155,17 @@ def K_rule(kappa: fmpq, L_h: fmpq, L_f: fmpq, dT: fmpq) -> int:
     Δτ = KΔT keeps Lemma 2's consistency horizon; at least 1 (the paper's max{·, 1})."""
     if kappa <= L_h:
         return 1
-    lo = ivq.log_lower(kappa / L_h)
+    lo, _ = ivq.log_bounds(kappa / L_h, K_bits(L_f * dT))
     k = int((lo / (L_f * dT)).ceil()) - 1
     return max(k, 1)
+
+
+def K_bits(step: fmpq) -> int:
+    """Working bits for ln(κ/L_h) in the K of Theorem 1 (K ≈ ln(κ/L_h)/(L_f ΔT), ``step`` =
+    L_f ΔT): 113 plus the bits of 1/step, so that K and K + 1 are told apart even when K is
+    10³⁰⁰ (γ⋆ = 1e-300: at 113 bits the K-rule claim failed for the design's own K, review 19).
+    """
+    return ivq.PREC + max(0, int((1 / step).ceil()).bit_length()) if step > 0 else ivq.PREC
 
 
 def schedule(gamma0: fmpq, gamma_star: fmpq, L_f: fmpq, dtau: fmpq) -> list[fmpq]:
