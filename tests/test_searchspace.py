@@ -500,29 +500,15 @@ def test_a_schedule_cut_by_the_cap_says_so(monkeypatch: pytest.MonkeyPatch) -> N
     assert "at most 5 entries" in bad["gamma-schedule"] and "a smaller K" in bad["gamma-schedule"]
 
 
-TINY_STAR = """[system]
-time = "continuous"
-states = ["x1", "x2"]
-f = ["x2", "-x1"]
-h = ["x1"]
-[method]
-key = "search-space"
-alpha = 0.9
-gamma_star = 1e-300
-gamma0 = 0.5
-[method.E]
-lower = [-1, -1]
-upper = [1, 1]
-[method.D]
-lower = [-0.5, -0.5]
-upper = [0.5, 0.5]
-"""
+#: the example with γ⋆ = 1e-300
+TINY_STAR = TEXT.replace("gamma_star = 0.05 ", "gamma_star = 1e-300 ")
 
 
 def test_K_rule_decides_a_K_of_10_to_the_300(tmp_path: Path) -> None:
     """γ⋆ = 1e-300 gives K ≈ 1.3·10³⁰⁰: the design's own K certifies K-rule and Lemma 2 (at
     113 bits ln(κ/L_h) cannot tell K from K + 1 and K-rule failed for it, exit 1: review 19),
     verify agrees, and K − 1 (not the largest) and K + 1 (breaks Lemma 2) fail."""
+    assert "1e-300" in TINY_STAR
     sp = api.load_spec_text(TINY_STAR, "tiny.toml")
     rep = api.design(sp)
     assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
