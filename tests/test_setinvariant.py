@@ -4,6 +4,7 @@ bad input, and property tests (Proposition 4.1) on random systems."""
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -522,3 +523,60 @@ def test_a_set_too_thin_for_float_hulls_is_inconclusive_naming_the_file_and_sets
     msg = str(e.value)
     assert msg.startswith("thin.toml: a float polytope computation failed")
     assert "[sets.omega], [sets.D]" in msg and "\n" not in msg
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "key", "says"),
+    [
+        (  # Ω of dimension 3 for 2 states (explicit dim): numpy matmul failure, exit 3
+            'type = "symmetric-polytope"\nQ = [[1, 0], [0, 1]]',
+            'type = "box"\ndim = 3\nlower = [-1, -1, -1]\nupper = [1, 1, 1]',
+            "method.omega",
+            "expected a set of dimension 2 (the states), got [sets.omega] of dimension 3",
+        ),
+        (  # Ω names the 1-dimensional D
+            'omega = "omega"',
+            'omega = "D"',
+            "method.omega",
+            "got [sets.D] of dimension 1",
+        ),
+        (  # D of dimension 2 for one column of B1: the message printed "set dim = 1"
+            "dim = 1\nlower = [-0.1]\nupper = [0.1]",
+            "dim = 2\nlower = [-0.1, -0.1]\nupper = [0.1, 0.1]",
+            "method.disturbance",
+            "expected a set of dimension 1 (columns of B1), got [sets.D] of dimension 2",
+        ),
+        (  # no B1 but a disturbance set: it said "expected a set of dimension 0"
+            "B1 = [1, 1]\n",
+            "",
+            "method.disturbance",
+            "the system has no disturbance input B1: remove disturbance",
+        ),
+    ],
+)
+def test_set_dimensions_are_checked_against_the_plant(old, new, key, says) -> None:
+    """Set-invariant review 19: Ω and D of the wrong dimension are exit 2 naming the key and
+    the set, for every algorithm (Ω's was an internal failure in numpy, exit 3)."""
+    text = spec_text()
+    assert old in text
+    text = text.replace(old, new, 1)
+    for alg in ("symmetric", "general", "none"):
+        with pytest.raises(SpecError) as e:
+            load_spec_text(
+                text.replace('algorithm = "symmetric"', f'algorithm = "{alg}"'), "s.toml"
+            )
+        assert f"[{key}]" in str(e.value) and says in str(e.value), str(e.value)
+
+
+def test_an_excess_below_float_resolution_is_not_printed_as_equal_numbers() -> None:
+    """Example 7.1 with A₁₁ = 0.7 + 10⁻⁶¹: the symmetric polyhedron misses Theorem 3.1 by
+    ~10⁻⁶² (exact); the note said "max ε(z) = 0.9 > λ = 0.9" (review 19), it now says the
+    floats cannot show the excess."""
+    path = Path(__file__).resolve().parents[1] / "specs" / "dorea-pimenta-7-1.toml"
+    text = path.read_text(encoding="utf-8").replace(
+        "A = [[0.7, 0.7]", "A = [[0.7" + "0" * 60 + "1, 0.7]"
+    )
+    rep = api.design(load_spec_text(text, "long.toml"))
+    notes = " ".join(rep.notes)
+    assert "max ε(z) = λ = 0.9 in floats, exceeded in exact arithmetic" in notes
+    assert "0.9 > λ = 0.9" not in notes

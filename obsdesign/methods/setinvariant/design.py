@@ -174,9 +174,15 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
                 symmetric_iterations=r.iterations,
                 symmetric_contractivity=sym_eps,
             )
+            # floats may not resolve the excess (A₁₁ = 0.7 + 1e-61 printed "0.9 > λ = 0.9")
+            excess = (
+                f"max ε(z) = {sym_eps:.6g} > λ = {lam:g}"
+                if f"{sym_eps:.6g}" != f"{lam:.6g}" and sym_eps > lam
+                else f"max ε(z) = λ = {lam:g} in floats, exceeded in exact arithmetic"
+            )
             msg = (
                 f"the symmetric C_K^∞ meets condition (14) after {r.iterations} iterations but "
-                f"not Theorem 3.1: max ε(z) = {sym_eps:.6g} > λ = {lam:g}"
+                f"not Theorem 3.1: {excess}"
             )
             run.notes.append(msg)
             if progress:
@@ -312,8 +318,8 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
         sets = f"[sets.{o.omega}]" + (f", [sets.{o.disturbance}]" if o.disturbance else "")
         raise InconclusiveError(
             f"{spec.file}: a float polytope computation failed: {first} (a set of the spec, "
-            f"{sets} or the noise bound eta_bar, may be too thin or too large for float "
-            "arithmetic)"
+            f"{sets}, the noise bound eta_bar, the plant's A or [method] lambda = "
+            f"{float(o.lam):.3g} may be too thin, too small or too large for float arithmetic)"
         ) from e
     notes = list(run.notes)
     params = polytope_params(spec, data, run.stage, notes)

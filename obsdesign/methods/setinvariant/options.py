@@ -96,10 +96,16 @@ def parse_disturbance(table: Table, spec: Spec) -> tuple[str | None, Box | Polyt
             f'has moved: declare D under [sets.D] with dim = {max(nd, 1)} and write disturbance = "D"',
         )
     name, D = _named_set(table, spec, "disturbance", (Box, Polytope), "D must be a polyhedron")
+    if nd == 0:
+        raise table.error(
+            "disturbance",
+            "the system has no disturbance input B1: remove disturbance (or give [system] B1)",
+        )
     if D.dim != nd:
         raise table.error(
             "disturbance",
-            f"expected a set of dimension {nd} (columns of B1), got {D.dim} (set dim = {nd})",
+            f"expected a set of dimension {nd} (columns of B1), got [sets.{name}] of "
+            f"dimension {D.dim}",
         )
     return name, D
 
@@ -130,6 +136,12 @@ def parse_options(table: Table, spec: Spec) -> Options:
             spec, "system.time", "expected time = 'discrete' (the method is discrete-time)"
         )
     omega, om = _named_set(table, spec, "omega", (Box, Polytope), "Ω must be a polyhedron")
+    if om.dim != s.n:  # a set with an explicit dim other than n (it was exit 3 in numpy)
+        raise table.error(
+            "omega",
+            f"expected a set of dimension {s.n} (the states), got [sets.{omega}] of dimension "
+            f"{om.dim}",
+        )
     try:
         omega_rows(om)
     except ValueError as e:
