@@ -163,3 +163,68 @@ def test_sat_means_the_same_at_run_time_in_sympy_and_in_both_enclosures(x: int, 
         e.source,
     )
     assert q.lo == q.hi == Fraction(want)
+
+
+POINTWISE = [
+    "mod(x1, r1)",
+    "x1 % r1",
+    "floor(x1)",
+    "sign(x1)",
+    "step(x1)",
+    "heaviside(x1)",
+    "abs(x1)",
+    "min(x1, r1)",
+    "max(x1, r1)",
+    "sat(x1)",
+    "sat(x1, r1)",
+    "x1^3",
+    "r1^x1",
+    "x1/r1",
+    "x1 - r1",
+]
+
+
+@pytest.mark.parametrize("text", POINTWISE)
+@settings(max_examples=40, deadline=None)
+@given(st.integers(-48, 48), st.integers(-48, 48))
+def test_the_run_time_value_lies_in_every_certified_enclosure(text: str, x: int, r: int) -> None:
+    """At a rational point (a degenerate box), the run-time closure's finite value equals
+    sympy's and lies in the float and the exact-end-point enclosures (to float rounding), for the non-smooth and
+    sign-sensitive functions (negative radii and divisors included): the evaluators must not
+    disagree as sat(x, r < 0) did (review 19). A point where an evaluator refuses (division
+    by 0, a negative base) is skipped."""
+    import math
+    from fractions import Fraction
+
+    import sympy
+
+    from obsdesign.methods.searchspace.intervals import ONE, ZERO, Dual, I, evaluate
+    from obsdesign.methods.searchspace.qintervals import QI, evaluate_q
+
+    e = parse_expr(text, ["x1", "r1"])
+    xq, rq = Fraction(x, 8), Fraction(r, 8)
+    with np.errstate(all="ignore"):
+        run = float(e(x1=float(xq), r1=float(rq)))
+    if not math.isfinite(run):
+        return
+    sy = e.sympy().subs({sympy.Symbol("x1"): xq, sympy.Symbol("r1"): rq})
+    if sy.is_real:
+        assert abs(float(sy) - run) <= 1e-12 * max(1.0, abs(run)), (text, x, r)
+    env = {
+        "x1": Dual(I(float(xq), float(xq)), (ONE, ZERO)),
+        "r1": Dual(I(float(rq), float(rq)), (ZERO, ONE)),
+    }
+    try:
+        d = evaluate(e.tree, env, {}, 2, e.source)
+    except (ArithmeticError, ValueError):
+        d = None
+    if d is not None:
+        tol_f = 1e-12 * max(1.0, abs(run))
+        assert d.v.lo - tol_f <= run <= d.v.hi + tol_f, (text, x, r, d.v)
+    try:
+        q = evaluate_q(e.tree, {"x1": QI(xq, xq), "r1": QI(rq, rq)}, {}, e.source)
+    except (ArithmeticError, ValueError, ZeroDivisionError):
+        q = None
+    if q is not None:  # exact ends; the float run is within rounding of the exact value
+        tol = Fraction(1, 10**12) * max(1, abs(Fraction(run)))
+        assert q.lo - tol <= Fraction(run) <= q.hi + tol, (text, x, r, q)
