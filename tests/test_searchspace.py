@@ -518,3 +518,12 @@ def test_K_rule_decides_a_K_of_10_to_the_300(tmp_path: Path) -> None:
     for k, claim in ((K - 1, "K-rule"), (K + 1, "lemma2-consistency")):
         v = _consistent(sp, K=k)
         assert claim in _failed(_report_with(rep, v, tmp_path)), k
+
+
+def test_K_bits_grow_with_K_and_are_capped() -> None:
+    """K_bits: 113 for K ≈ 10, 113 + ~1000 for K ≈ 10³⁰⁰, MAX_K_BITS for a hostile ΔT of
+    10⁻¹⁰⁰⁰⁰⁰ (a report cannot make verify compute a logarithm to millions of bits)."""
+    assert D.K_bits(fmpq(1, 10)) == 113 + 4
+    assert 113 + 990 < D.K_bits(fmpq(1, 10**300)) < 113 + 1010
+    assert D.K_bits(fmpq(1, 10**100000)) == D.MAX_K_BITS
+    assert D.K_bits(fmpq(0)) == 113

@@ -164,8 +164,16 @@ def K_bits(step: fmpq) -> int:
     """Working bits for ln(κ/L_h) in the K of Theorem 1 (K ≈ ln(κ/L_h)/(L_f ΔT), ``step`` =
     L_f ΔT): 113 plus the bits of 1/step, so that K and K + 1 are told apart even when K is
     10³⁰⁰ (γ⋆ = 1e-300: at 113 bits the K-rule claim failed for the design's own K, review 19).
-    """
-    return ivq.PREC + max(0, int((1 / step).ceil()).bit_length()) if step > 0 else ivq.PREC
+    At most :data:`MAX_K_BITS` (0.7 s for one logarithm): a report's ΔT of 10⁻¹⁰⁰⁰⁰⁰⁰ cannot
+    make ``verify`` spend minutes; beyond, the claims may fail (never certify) for lack of
+    precision."""
+    if step <= 0:
+        return ivq.PREC
+    return min(MAX_K_BITS, ivq.PREC + max(0, int((1 / step).ceil()).bit_length()))
+
+
+#: the most working bits :func:`K_bits` gives (K up to about 10¹⁹⁷⁰⁰ is decided)
+MAX_K_BITS = 65536
 
 
 def schedule(gamma0: fmpq, gamma_star: fmpq, L_f: fmpq, dtau: fmpq) -> list[fmpq]:
