@@ -434,6 +434,23 @@ def test_input_range_claim_exit_codes(u: str, lo: str, hi: str, status: str, cod
     assert rep.exit_code() == code
 
 
+@pytest.mark.parametrize(("u", "at"), [("sqrt(-1 - t)", "t = 0"), ("log(t - 7)", "t = 0")])
+def test_an_input_undefined_on_the_horizon_is_hinted(u: str, at: str) -> None:
+    """u undefined at t = 0: input-range stays inconclusive (exit 4; floats prove nothing),
+    and the detail names the expression and the first time its float value is not finite
+    (it said only "leaves U by up to inf": review 19). A finite input gets no such hint."""
+    from obsdesign.api import load_spec_text
+
+    rep = api.design(load_spec_text(_INPUT_SPEC.format(u=u, lo="-1", hi="1"), "u.toml"))
+    claim = next(c for c in rep.claims if c.id == "input-range")
+    assert rep.exit_code() == 4
+    assert f"u1(t) = {u} is not finite at {at} in floats" in claim.detail
+    rep = api.design(
+        load_spec_text(_INPUT_SPEC.format(u="0.3*sin(t) + 1e-30", lo="-0.3", hi="0.3"))
+    )
+    assert "not finite" not in next(c for c in rep.claims if c.id == "input-range").detail
+
+
 @pytest.mark.parametrize(("est", "status"), [(1.0, "certified"), (1.0 + 2e-6, "failed")])
 def test_a_sampled_value_above_the_bound_fails_the_claim(
     example, monkeypatch: pytest.MonkeyPatch, est: float, status: str

@@ -329,6 +329,7 @@ def _input_range(c: Claims, spec: Spec) -> None:
             if outside
             else (
                 f"an enclosure leaves U by up to {excess:.3g} (not proved either way)"
+                + _undefined_at(s.u_signal, o.t0, t1)
                 if excess > 1e-300
                 else "an enclosure leaves U by less than 1e-300 (below the float "
                 "resolution; not proved either way)"
@@ -336,6 +337,24 @@ def _input_range(c: Claims, spec: Spec) -> None:
         ),
         float_ok=ok or not outside,
     )
+
+
+def _undefined_at(exprs: Any, t0: fmpq, t1: fmpq) -> str:
+    """A hint for an inconclusive input range (Remark 2.5): the first of 65 equally spaced
+    times of the horizon where u evaluates to a non-finite float (sqrt(−1 − t) gave
+    "leaves U by up to inf" and nothing else, review 19); "" when every sample is finite.
+    Floats only: a hint, never the verdict."""
+    ts = [float(t0 + (t1 - t0) * fmpq(k, 64)) for k in range(65)]
+    with np.errstate(all="ignore"):
+        for i, ex in enumerate(exprs):
+            v = np.broadcast_to(np.asarray(ex(t=np.array(ts)), dtype=float), (len(ts),))
+            bad = np.nonzero(~np.isfinite(v))[0]
+            if bad.size:
+                return (
+                    f"; u{i + 1}(t) = {ex.source} is not finite at t = {ts[bad[0]]:.6g} in "
+                    "floats (not defined there?)"
+                )
+    return ""
 
 
 def _box(lo: Any, hi: Any) -> str:
