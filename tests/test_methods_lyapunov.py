@@ -1000,12 +1000,50 @@ def test_lmi_candidate_rates_take_inaccurate_answers_and_refuse_broken_ones() ->
     assert _candidate_rate("optimal", np.zeros((2, 2)), P @ L, A, C, True) is None
 
 
-def test_failed_lmi_gain_search_points_at_the_default_design() -> None:
-    """SCALED with an asked rate λ = 0.5 (no Riccati start then): the SDP solver finds no gain
-    at 2 % slack nor at the rate, while the default Riccati design certifies. The exit-4
-    message points at the default design."""
-    spec = SCALED + "lambda = 0.5\n"
-    assert api.design(load_spec_text(spec)).exit_code() == 0
+def test_a_failed_lmi_search_falls_back_to_the_riccati_design() -> None:
+    """SCALED with an asked rate λ = 0.5 (no Riccati start in the bisection then): the SDP
+    solver finds no gain at 2 % slack nor at the rate; the design falls back on the default
+    Riccati design and says so (exit 4 before: review 19 found 15 of 167 LMI designs exit 4
+    where the default certifies). Also BAD_A without a rate: the float Riccati start is not
+    Schur there, the high-precision Riccati gain certifies."""
+    rep = api.design(load_spec_text(SCALED + 'lambda = 0.5\ndesign = "lmi"\n'))
+    assert rep.exit_code() == 0 and api.verify(rep).exit_code() == 0
+    assert rep.solver["gain_design"] == "lmi" and rep.solver["lmi_fallback"] == "riccati"
+    assert rep.solver["message"].startswith("LMI found no certified gain; the discrete Riccati")
+    assert "the LMI solver found no gain at rate 0.5" in rep.notes[0]
+    assert rep.notes[0].endswith("L is the Riccati gain")
+    rep = api.design(load_spec_text(_designed(BAD_A, BAD_C, extra='design = "lmi"\n')))
+    assert rep.exit_code() == 0 and rep.solver["lmi_fallback"] == "riccati"
+    assert "at 128 bits" in rep.solver["name"]
+
+
+def test_failed_lmi_gain_search_points_at_the_default_design(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """When the Riccati fallback fails too (here: no Riccati gain at all, patched), the LMI's
+    own exit-4 error is raised, pointing at the default design."""
+    from obsdesign.methods.lyapunov import design as LD
+
+    def no_gain(*a, **k):  # noqa: ANN002, ANN003, ANN202
+        raise np.linalg.LinAlgError("patched")
+
+    monkeypatch.setattr(LD, "riccati_gain", no_gain)
+    monkeypatch.setattr(LD, "riccati_gain_hp", lambda *a, **k: None)
     with pytest.raises(InconclusiveError, match="omit design") as ei:
-        api.design(load_spec_text(spec + 'design = "lmi"\n'))
+        api.design(load_spec_text(SCALED + 'lambda = 0.5\ndesign = "lmi"\n'))
     assert ei.value.exit_code == 4 and "LMI solver found no gain" in ei.value.message
+
+
+def test_rate_cap_with_an_asked_alpha_is_refused() -> None:
+    """rate_cap caps the bisection for the best rate, which an asked α skips: alpha = 4 with
+    rate_cap = 1 certified α_best = 4.9 and ignored the cap (review 19); exit 2 naming it."""
+    from obsdesign.errors import SpecError
+
+    text = (
+        '[system]\ntime = "continuous"\nA = [[0, 1], [0, 0]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\ndesign = "lmi"\nrate_cap = 1\n'
+    )
+    with pytest.raises(SpecError, match=r"\[method.rate_cap\] caps the LMI bisection") as ei:
+        load_spec_text(text + "alpha = 4\n", "cap.toml")
+    assert ei.value.exit_code == 2
+    assert api.design(load_spec_text(text, "cap.toml")).exit_code() == 0

@@ -60,28 +60,71 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
         extra={"gain_design": "given"},
     )
     if o.L is None:
-        asked = o.rate is not None
-        first: InconclusiveError
         try:
-            Lf, solver, how = design_gain(spec, o, progress)
-        except NoRiccatiGain as e:  # no float gain at all
-            first = e
-        else:
-            Lm, _ = lyap.dyadic_fmat(Lf, lyap.BITS)  # = dyadic(Lf, BITS), in flint
-            try:
-                return _design_rounded(spec, Lm, lyap.BITS, solver, how, progress)
-            except InfeasibleError as e:
-                first = designed_gain_failed(e, how, Lm, asked)
-        # the float Riccati gain is missing or failed the exact tests: the high-precision one
-        hp = riccati_retry_hp(spec, o)
-        if hp is None:
-            raise first from None
-        Lm, bits, solver, how = hp
-        try:
-            return _design_rounded(spec, Lm, bits, solver, how, progress)
-        except InfeasibleError as e2:
-            raise designed_gain_failed(e2, how, Lm, asked) from None
+            return _designed(spec, o, progress)
+        except InconclusiveError as e:
+            if o.design != "lmi":
+                raise
+            return _lmi_fallback(spec, o, e, progress)
     return _design_for(spec, o.L, None, solver, notes, progress)
+
+
+def _designed(spec: Spec, o: Options, progress: Progress | None) -> Design:
+    """The design with a designed gain (``o.design``): the float gain rounded to 40 bits,
+    else the high-precision Riccati gain (discrete ``riccati`` only), each certified by
+    :func:`_design_for` (eq. (4)-(6), constrained-redesign paper, Section 5).
+
+    :param spec: the bound spec; :param o: the options to design by (``o.design``);
+    :param progress: callback."""
+    asked = o.rate is not None
+    first: InconclusiveError
+    try:
+        Lf, solver, how = design_gain(spec, o, progress)
+    except NoRiccatiGain as e:  # no float gain at all
+        first = e
+    else:
+        Lm, _ = lyap.dyadic_fmat(Lf, lyap.BITS)  # = dyadic(Lf, BITS), in flint
+        try:
+            return _design_rounded(spec, Lm, lyap.BITS, solver, how, progress)
+        except InfeasibleError as e:
+            first = designed_gain_failed(e, how, Lm, asked)
+    # the float Riccati gain is missing or failed the exact tests: the high-precision one
+    hp = riccati_retry_hp(spec, o)
+    if hp is None:
+        raise first from None
+    Lm, bits, solver, how = hp
+    try:
+        return _design_rounded(spec, Lm, bits, solver, how, progress)
+    except InfeasibleError as e2:
+        raise designed_gain_failed(e2, how, Lm, asked) from None
+
+
+def _lmi_fallback(
+    spec: Spec, o: Options, lmi_error: InconclusiveError, progress: Progress | None
+) -> Design:
+    """design = "lmi" when the LMI gave no gain that certifies (Clarabel fails on badly
+    scaled or badly conditioned plants; review 19: 15 of 167 LMI designs were exit 4 where
+    the default design certifies): the default Riccati design (its float and high-precision
+    gains, shifted to an asked rate), reported as such — ``solver.gain_design`` stays
+    ``"lmi"`` with ``lmi_fallback = "riccati"``, and a note gives the LMI's failure. The
+    LMI's own error is raised when the Riccati design fails too. Decay LMI eq. (4)-(6),
+    Section 5 of the constrained-redesign paper (Astolfi et al., NOLCOS 2019).
+
+    :param spec: the bound spec; :param o: its options; :param lmi_error: why the LMI design
+    failed; :param progress: callback."""
+    import dataclasses
+
+    ric = dataclasses.replace(o, design="riccati", riccati_Q=None, riccati_R=None)
+    try:
+        d = _designed(spec, ric, progress)
+    except (InconclusiveError, InfeasibleError):
+        raise lmi_error from None
+    why = lmi_error.message.split(_LMI_HINT)[0]
+    d.notes.insert(0, f"the LMI gain design gave no certified gain ({why}): L is the Riccati gain")
+    if isinstance(d.solver, SolverResult):
+        d.solver.extra.update(gain_design="lmi", lmi_fallback="riccati")
+        d.solver.message = "LMI found no certified gain; " + d.solver.message
+    return d
 
 
 def _design_rounded(

@@ -121,6 +121,14 @@ def parse_options(table: Table, spec: Spec) -> Options:
             'is used by the continuous-time LMI gain design only (design = "lmi", '
             'time = "continuous"): omit it',
         )
+    if table.has("rate_cap") and rate is not None:
+        # an asked α is solved directly, no bisection to cap (alpha = 4 with rate_cap = 1
+        # certified α_best = 4.9 silently: review 19)
+        raise table.error(
+            "rate_cap",
+            "caps the LMI bisection for the best rate, which does not run with an asked "
+            "alpha: omit rate_cap or alpha",
+        )
     keys = {"riccati": ("riccati_Q", "riccati_R"), "place": ("poles",), "lmi": ()}
     for k in ("riccati_Q", "riccati_R", "poles"):
         if table.has(k) and k not in keys[design]:
