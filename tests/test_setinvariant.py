@@ -109,6 +109,8 @@ def test_example_71_verify_and_simulate(rep71, tmp_path):
     # the paper's linear gain gives a trajectory in the polyhedron too
     res2 = api.simulate(spec, out, law="linear")
     assert res2.info["error_in_polyhedron"]
+    # the law is named as the option names it (it printed the class, LinearLaw: docs audit)
+    assert res.info["law"] == "interpolated" and res2.info["law"] == "linear"
 
 
 def test_verify_rejects_tampered_breakpoint(rep71, tmp_path):

@@ -107,7 +107,8 @@ def simulate(spec: Spec, params: Parameters, law: str | None = None, **kwargs: A
     res.extra["gauge"] = gauge
     res.info.update(
         {
-            "law": getattr(f, "mode", None) or type(f).__name__,
+            # the option's name (it printed the class: LinearLaw, OnlineLPLaw; docs audit)
+            "law": law or ("interpolated" if "breakpoints" in params else "linear"),
             "max_gauge": float(gauge.max()),
             "error_in_polyhedron": inside,
             "e0_in_omega": e0_in,
