@@ -562,7 +562,8 @@ def init(
 ) -> None:
     """Print a commented template spec (TOML) for METHOD, e.g. obsdesign init lyapunov > my.toml.
 
-    Every commented line "# key = value" is a valid alternative once uncommented."""
+    Every commented line "# key = value" is an optional key; some go together or need values
+    that fit your plant (the template's comments say which)."""
 
     _run(lambda cmd: cmd.init(method))
 
