@@ -255,3 +255,36 @@ def test_an_existing_scheduler_runs_the_sweep_and_a_dead_address_is_bad_input(
                     p.kill()
     r = CliRunner().invoke(app, [*args, "--scheduler", "tcp://127.0.0.1:9", "-q"])
     assert r.exit_code == 2 and "cannot connect" in r.stderr
+
+
+def test_dask_logs_are_quiet_here_and_in_the_workers(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The LocalCluster obsdesign starts silences Dask's logs up to CRITICAL in the workers,
+    and the client process's "distributed" logger too: a worker's heartbeat error at shutdown
+    printed a 30-line traceback under `check --workers 2` (docs audit)."""
+    import logging
+
+    from obsdesign import distributed as dist
+
+    seen: dict[str, object] = {}
+
+    class FakeCluster:
+        def __init__(self, **kw: object) -> None:
+            seen.update(kw)
+
+        def close(self) -> None:
+            seen["closed"] = True
+
+    class FakeClient:
+        def __init__(self, cluster: object) -> None:
+            pass
+
+        def close(self) -> None:
+            pass
+
+    import dask.distributed as dd
+
+    monkeypatch.setattr(dd, "LocalCluster", FakeCluster)
+    monkeypatch.setattr(dd, "Client", FakeClient)
+    with dist.dask_client(workers=2):
+        assert logging.getLogger("distributed").level == logging.CRITICAL
+    assert seen["silence_logs"] == logging.CRITICAL and seen["closed"] is True
