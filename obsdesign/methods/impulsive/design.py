@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 from flint import fmpq
 
-from obsdesign.certify.exact import Q, dyadic, to_float
+from obsdesign.certify.exact import Q, dyadic, float_or_inf, to_float
 from obsdesign.certify.linalg import norm_upper
 from obsdesign.certify.printing import fmt_exact
 from obsdesign.certify.psd import check_pd, check_psd
@@ -268,7 +268,8 @@ def design_window(p: Problem) -> tuple[dict[str, Any], list[str]]:
     T_max_r, T_min_r = safe_window(T_max, T_min, p.digits)
     if not T_min_r < T_max_r and T_min < T_max:
         raise Infeasible(
-            f"the window T_min = {float(T_min):.6g} < T_max = {float(T_max):.6g} (κ = "
+            f"the window T_min = {float_or_inf(T_min):.6g} < T_max = "
+            f"{float_or_inf(T_max):.6g} (κ = "
             f"{float(kappa):.6g}) is not empty, but it holds no pair of {p.digits}-decimal "
             f"bounds (T_max rounded down to {fmt_exact(T_max_r)}, T_min up to "
             f"{fmt_exact(T_min_r)}); raise [method] digits (at most 30) or widen the window "
@@ -276,7 +277,8 @@ def design_window(p: Problem) -> tuple[dict[str, Any], list[str]]:
         )
     if not T_min_r < T_max_r:
         raise Infeasible(
-            f"empty window: T_min = {float(T_min):.6g} ≥ T_max = {float(T_max):.6g} "
+            f"empty window: T_min = {float_or_inf(T_min):.6g} ≥ T_max = "
+            f"{float_or_inf(T_max):.6g} "
             f"(κ = {float(kappa):.6g}); a larger α lowers T_min (26c); another L changes "
             "both ends (γ = min L_ii raises T_min and the numerator of (26b), β = 1/(1 − γ)² "
             "its denominator), another κ or M may help"
