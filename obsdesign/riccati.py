@@ -234,26 +234,78 @@ def dare_sda_hp(A: fmpq_mat, B: fmpq_mat, Q: fmpq_mat, R: fmpq_mat, prec: int) -
     :param prec: working precision in bits (the caller sets ``flint.ctx.prec`` to it)."""
     from flint import arb_mat  # noqa: F811 (the runtime import of the type-checking name)
 
+    Bh = arb_mat(B)
+    G = (Bh * arb_mat(R).solve(Bh.transpose())).mid()
+    return _doubling_hp(arb_mat(A), G, arb_mat(Q), prec)
+
+
+def care_sda_hp(A: fmpq_mat, B: fmpq_mat, Q: fmpq_mat, R: fmpq_mat, prec: int) -> arb_mat | None:
+    """:func:`care_sda` in python-flint ``arb_mat`` arithmetic at ``prec`` bits (midpoints
+    only; the caller checks what it proposes exactly): the Cayley transform of SDA-1 (Chu,
+    Fan & Lin 2005, see :func:`care_sda`) formed at that precision, then the doubling of
+    :func:`dare_sda_hp`. For continuous plants where scipy and the float doubling give no
+    solution at all (an integer companion matrix of order 10 with one output: "Failed to find
+    a finite solution", review 19). γ is chosen in floats as in :func:`care_sda` (any γ above
+    the spectral radius of A works). None when the transform is singular or the doubling does
+    not converge.
+
+    :param A: n×n; :param B: n×m; :param Q: n×n; :param R: m×m (``fmpq_mat``, exact);
+    :param prec: working precision in bits (the caller sets ``flint.ctx.prec`` to it)."""
+    from flint import arb_mat  # noqa: F811
+
     n = A.nrows()
     eye = arb_mat([[1 if i == j else 0 for j in range(n)] for i in range(n)])
-    Ak, Bh = arb_mat(A), arb_mat(B)
-    Gk = (Bh * arb_mat(R).solve(Bh.transpose())).mid()
-    Hk = arb_mat(Q)
+    Ah, Bh, Qh = arb_mat(A), arb_mat(B), arb_mat(Q)
+    G = (Bh * arb_mat(R).solve(Bh.transpose())).mid()
+
+    def fro(M: arb_mat) -> float:
+        return math.sqrt(
+            sum(float(M[i, j].mid()) ** 2 for i in range(M.nrows()) for j in range(M.ncols()))
+        )
+
+    gam = max(1.05 * fro(Ah), math.sqrt(fro(G) * fro(Qh)))
+    if not (math.isfinite(gam) and gam > 0):
+        return None
+    g = arb_mat([[gam]])[0, 0]
+    Ag = Ah - eye * g
+    AgiG = Ag.solve(G)
+    Wi = (Ag.transpose() + Qh * AgiG).inv()
+    E0 = (eye + Wi.transpose() * (2 * g)).mid()
+    G0 = (AgiG * Wi * (2 * g)).mid()
+    H0 = (Wi * Ag.transpose().solve(Qh.transpose()).transpose() * (2 * g)).mid()
+    return _doubling_hp(E0, G0, H0, prec)
+
+
+def _doubling_hp(E: arb_mat, G: arb_mat, H: arb_mat, prec: int) -> arb_mat | None:
+    """:func:`doubling` in ``arb_mat`` midpoint arithmetic at ``prec`` bits (module docstring;
+    Huang, Li & Lin 2018, Alg. 3.1): the limit of Hₖ, or None when it does not converge
+    within :data:`MAX_STEPS` steps, a value leaves the float range, a solve is singular, or
+    Eₖ does not vanish.
+
+    :param E, G, H: n×n ``arb_mat``; :param prec: the working precision (bits)."""
+    from flint import arb_mat  # noqa: F811
+
+    n = E.nrows()
+    eye = arb_mat([[1 if i == j else 0 for j in range(n)] for i in range(n)])
+    Ak, Gk, Hk = E, G, H
     tol = 2.0 ** (-(prec // 2))
-    for _ in range(MAX_STEPS):
-        W = eye + Gk * Hk
-        SA = W.solve(Ak)
-        SG = W.solve(Gk)
-        Hn = (Hk + Ak.transpose() * (Hk * SA)).mid()
-        Gk = (Gk + Ak * SG * Ak.transpose()).mid()
-        Ak = (Ak * SA).mid()
-        step = _max_abs(Hn - Hk)
-        Hk = Hn
-        top = _max_abs(Hk)
-        if not (math.isfinite(step) and math.isfinite(top)):
-            return None
-        if step <= tol * top:
-            return Hk if _max_abs(Ak) <= 1e-3 else None
+    try:
+        for _ in range(MAX_STEPS):
+            W = eye + Gk * Hk
+            SA = W.solve(Ak)
+            SG = W.solve(Gk)
+            Hn = (Hk + Ak.transpose() * (Hk * SA)).mid()
+            Gk = (Gk + Ak * SG * Ak.transpose()).mid()
+            Ak = (Ak * SA).mid()
+            step = _max_abs(Hn - Hk)
+            Hk = Hn
+            top = _max_abs(Hk)
+            if not (math.isfinite(step) and math.isfinite(top)):
+                return None
+            if step <= tol * top:
+                return Hk if _max_abs(Ak) <= 1e-3 else None
+    except (ZeroDivisionError, ValueError):
+        return None
     return None
 
 

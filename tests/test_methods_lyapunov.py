@@ -1047,3 +1047,23 @@ def test_rate_cap_with_an_asked_alpha_is_refused() -> None:
         load_spec_text(text + "alpha = 4\n", "cap.toml")
     assert ei.value.exit_code == 2
     assert api.design(load_spec_text(text, "cap.toml")).exit_code() == 0
+
+
+def test_a_continuous_companion_plant_takes_the_high_precision_riccati() -> None:
+    """An integer companion plant of order 10, one output, continuous time: scipy and the float
+    doubling give no CARE solution ("Failed to find a finite solution", exit 4 with every
+    design: review 19); the doubling after the Cayley transform in 128-bit arb_mat gives a
+    gain that certifies and verifies."""
+    row = "[-3, 9, -1, 9, -2, 0, -9, 7, 4, 6]"
+    A = [[int(j == i + 1) for j in range(10)] for i in range(9)]
+    text = (
+        '[system]\ntime = "continuous"\nA = ['
+        + ", ".join(str(r) for r in A)
+        + f", {row}]\nC = [[1, 0, 0, 0, 0, 0, 0, 0, 0, 0]]\n"
+        '[method]\nkey = "lyapunov"\n'
+    )
+    rep = api.design(load_spec_text(text, "companion.toml"))
+    assert rep.exit_code() == 0, [c.detail for c in rep.failed]
+    assert rep.solver["name"] == "structure-preserving doubling at 128 bits (python-flint arb_mat)"
+    assert float(rep.parameters.float("alpha_best")) > 0.5
+    assert api.verify(rep).exit_code() == 0

@@ -177,3 +177,43 @@ def test_care_residual_is_relative_to_the_terms() -> None:
     one = np.array([[1.0]])
     assert riccati.care_residual(one, one, one, one, np.array([[x]])) < 1e-15
     assert riccati.care_residual(one, one, one, one, np.array([[x * (1 + 1e-6)]])) > 1e-8
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(1, 6), m=st.integers(1, 3))
+def test_care_by_high_precision_doubling_matches_scipy(seed: int, n: int, m: int) -> None:
+    """care_sda_hp at 128 bits (the Cayley transform and the doubling in arb_mat midpoints)
+    on the exact rationals of a random well-posed CARE: X is scipy's to 10⁻⁷ relative."""
+    from flint import ctx, fmpq_mat
+
+    from obsdesign.certify.exact import Q as q
+
+    A, B, Qw, R = _problem(seed, n, min(m, n), 1.0)
+
+    def exact(M: np.ndarray) -> fmpq_mat:
+        return fmpq_mat(M.shape[0], M.shape[1], [q(float(v)) for v in M.ravel()])
+
+    old = ctx.prec
+    ctx.prec = 128
+    try:
+        X = riccati.care_sda_hp(exact(A), exact(B), exact(Qw), exact(R), 128)
+    finally:
+        ctx.prec = old
+    Xs = sl.solve_continuous_are(A, B, Qw, R)
+    assert X is not None
+    Xf = np.array([[float(X[i, j].mid()) for j in range(n)] for i in range(n)])
+    assert np.abs(Xf - Xs).max() <= 1e-7 * max(1.0, np.abs(Xs).max())
+
+
+def test_care_high_precision_refuses_q_zero_with_an_unstable_a() -> None:
+    """Q = 0 with an unstable A: the doubling cannot leave X = 0 (Eₖ does not vanish): None."""
+    from flint import ctx, fmpq_mat
+
+    old = ctx.prec
+    ctx.prec = 128
+    try:
+        A = fmpq_mat([[1, 1], [0, 2]])
+        B = fmpq_mat([[0], [1]])
+        assert riccati.care_sda_hp(A, B, fmpq_mat(2, 2), fmpq_mat([[1]]), 128) is None
+    finally:
+        ctx.prec = old

@@ -342,7 +342,8 @@ def riccati_gain(
 
 
 def _gain_certifies(s: Any, Lm: fmpq_mat, rate: fmpq) -> bool:
-    """Whether the exact gain ``Lm`` gives decay rate ``rate`` (discrete time), proved as the
+    """Whether the exact gain ``Lm`` gives decay rate ``rate`` (λ, or α in continuous time: α = 0
+    for Hurwitz), proved as the
     design proves it (:func:`obsdesign.lyap.certified_P`: the Lyapunov-equation P, in high
     precision for a badly conditioned A − LC, checked exactly; eq. (4)-(6), Section 5 of the
     constrained-redesign paper). Only a proof accepts: float eigenvalues of such a closed loop
@@ -351,17 +352,25 @@ def _gain_certifies(s: Any, Lm: fmpq_mat, rate: fmpq) -> bool:
     :param s: the spec's system; :param Lm: the gain (exact); :param rate: λ (exact)."""
     Acl = lyap.closed_loop_fmat(s.A.q, s.C.q, Lm)
     L = lyap.as_array(Lm)
-    return lyap.certified_P(s.A.q, s.C.q, L, True, rate, fmpq(0), Acl=Acl) is not None
+    return lyap.certified_P(s.A.q, s.C.q, L, s.discrete, rate, fmpq(0), Acl=Acl) is not None
 
 
 def riccati_gain_hp(
-    A: Any, C: Any, Qw: Any, Rw: Any, rate: float | None, good: Callable[[fmpq_mat], bool]
+    A: Any,
+    C: Any,
+    Qw: Any,
+    Rw: Any,
+    rate: float | None,
+    good: Callable[[fmpq_mat], bool],
+    discrete: bool = True,
 ) -> tuple[fmpq_mat, int, str] | None:
-    """:func:`riccati_gain` (discrete time) with the DARE solved by the doubling algorithm in
-    high precision (:func:`obsdesign.riccati.dare_sda_hp`, python-flint ``arb_mat``) from the
-    exact A, C, weights and shift, and the gain L = A X Cᵀ (R + C X Cᵀ)⁻¹ formed at the same
-    precision: for badly conditioned plants whose float Riccati solution gives no gain or a
-    wrong one. The precisions of :data:`obsdesign.riccati.HP_PRECISIONS` are
+    """:func:`riccati_gain` with the Riccati equation solved by the doubling algorithm in
+    high precision (python-flint ``arb_mat``) from the exact A, C, weights and shift, and the
+    gain formed at the same precision: discrete, :func:`obsdesign.riccati.dare_sda_hp` and
+    L = λₛ Ā X Cᵀ (R + C X Cᵀ)⁻¹ (Ā = A/λₛ); continuous, :func:`obsdesign.riccati.care_sda_hp`
+    on ((A + αₛI)ᵀ, Cᵀ) and L = X Cᵀ R⁻¹ (an integer companion plant of order 10 had no float
+    solution at all: review 19). For badly conditioned plants whose float Riccati solution
+    gives no gain or a wrong one. The precisions of :data:`obsdesign.riccati.HP_PRECISIONS` are
     tried in turn, and at each the gain rounded to each of :data:`GAIN_BITS` significant bits
     (no more than the precision) until it is ``good``: at too low a precision the doubling can
     meet its step criterion far from the solution, and the closed loop of such a plant can be
@@ -371,11 +380,12 @@ def riccati_gain_hp(
     :data:`obsdesign.riccati.HP_MAX_N` states or when nothing is good.
 
     :param A, C: exact plant (object arrays); :param Qw, Rw: exact weights or None (I);
-    :param rate: λₛ or None (1); :param good: the acceptance test of a rounded gain."""
+    :param rate: λₛ or αₛ, or None (1, resp. 0); :param good: the acceptance test of a
+    rounded gain; :param discrete: time domain."""
     from flint import arb_mat, ctx
 
     from obsdesign.certify.exact import Q
-    from obsdesign.riccati import HP_MAX_N, HP_PRECISIONS, dare_sda_hp
+    from obsdesign.riccati import HP_MAX_N, HP_PRECISIONS, care_sda_hp, dare_sda_hp
 
     Aq, Cq = lyap.fmat(A), lyap.fmat(C)
     n, p = Aq.nrows(), Cq.nrows()
@@ -388,17 +398,28 @@ def riccati_gain_hp(
     if Rw is not None:
         Rq = lyap.fmat(Rw)
     sq = fmpq(1) if rate is None else Q(rate)
+    shifted = (
+        Aq / sq
+        if discrete
+        else Aq
+        + fmpq_mat(n, n, [int(i == j) for i in range(n) for j in range(n)])
+        * (fmpq(0) if rate is None else Q(rate))
+    )
     old = ctx.prec
     try:
         for prec in HP_PRECISIONS:
             ctx.prec = prec
             try:
-                X = dare_sda_hp((Aq / sq).transpose(), Cq.transpose(), Qq, Rq, prec)
+                solve = dare_sda_hp if discrete else care_sda_hp
+                X = solve(shifted.transpose(), Cq.transpose(), Qq, Rq, prec)
                 if X is None:
                     continue
                 Ch = arb_mat(Cq)
                 XC = X * Ch.transpose()
-                L = arb_mat(Aq) * (arb_mat(Rq) + Ch * XC).solve(XC.transpose()).transpose()
+                if discrete:
+                    L = arb_mat(Aq) * (arb_mat(Rq) + Ch * XC).solve(XC.transpose()).transpose()
+                else:
+                    L = arb_mat(Rq).solve(XC.transpose()).transpose()  # X Cᵀ R⁻¹
             except (ZeroDivisionError, ValueError):
                 continue
             mids = [L[i, j].mid().man_exp() for i in range(n) for j in range(p)]
@@ -574,12 +595,13 @@ def _riccati_result(
 
 
 def riccati_retry_hp(spec: Spec, o: Options) -> tuple[fmpq_mat, int, SolverResult, str] | None:
-    """After a float Riccati gain failed the exact tests (discrete time): the gain of the
+    """After a float Riccati gain failed the exact tests (or gave none): the gain of the
     same equation solved in high precision (:func:`riccati_gain_hp`) at the first shift the
-    float design tries (0.98 λ with an asked rate, else none), rounded to the fewest bits of
-    :data:`GAIN_BITS` with which it provably gives the asked rate (λ = 1, i.e. Schur, without
-    one: :func:`_gain_certifies`); the design's exact tests then run on it. Returns (the rounded gain, its bits, the solver result, the path's note).
-    None when there is none (continuous time has no high-precision path). The error
+    float design tries (0.98 λ / 1.02 α with an asked rate, else none), rounded to the
+    fewest bits of :data:`GAIN_BITS` with which it provably gives the asked rate (λ = 1, i.e.
+    Schur, or α = 0, Hurwitz, without one: :func:`_gain_certifies`); the design's exact tests
+    then run on it. Returns (the rounded gain, its bits, the solver result, the path's note).
+    None when there is none (not the Riccati design, or nothing certifies). The error
     dynamics e⁺ = (A − LC)e are those of the linear observer of Section 5 of the
     constrained-redesign paper (Astolfi et al., NOLCOS 2019), eq. (4)-(6).
 
@@ -587,19 +609,26 @@ def riccati_retry_hp(spec: Spec, o: Options) -> tuple[fmpq_mat, int, SolverResul
     import time as _time
 
     s = spec.system
-    if not s.discrete or o.design != "riccati":
+    if o.design != "riccati":
         return None
     t0 = _time.perf_counter()
-    shift = None if o.rate is None else float(o.rate) * SLACK_DISCRETE
-    need = fmpq(1) if o.rate is None else o.rate
+    slack = SLACK_DISCRETE if s.discrete else SLACK_CONTINUOUS
+    shift = None if o.rate is None else float(o.rate) * slack
+    need = (fmpq(1) if s.discrete else fmpq(0)) if o.rate is None else o.rate
     hp = riccati_gain_hp(
-        s.A.q, s.C.q, o.riccati_Q, o.riccati_R, shift, lambda L: _gain_certifies(s, L, need)
+        s.A.q,
+        s.C.q,
+        o.riccati_Q,
+        o.riccati_R,
+        shift,
+        lambda L: _gain_certifies(s, L, need),
+        s.discrete,
     )
     if hp is None:
         return None
     Lm, bits, are = hp
     _, res, how = _riccati_result(
-        None, are, True, weights_text(o), shift, _time.perf_counter() - t0
+        None, are, s.discrete, weights_text(o), shift, _time.perf_counter() - t0
     )
     return Lm, bits, res, how
 
