@@ -1,7 +1,7 @@
 """The algebraic Riccati equations in floats: the structure-preserving doubling algorithm
 (SDA) first — directly for the discrete equation, after a Cayley transform for the continuous
 one — and scipy's ``solve_discrete_are`` / ``solve_continuous_are`` when SDA does not pass its
-own checks; the discrete one also in python-flint ``arb_mat`` high precision.
+own checks; both also in python-flint ``arb_mat`` high precision (:func:`dare_sda_hp`, :func:`care_sda_hp`).
 
 Why not scipy alone (issue 12, item 1): scipy's solver (an ordered QZ of a 2n×2n pencil) is
 ~90 % of the float baseline and of the lyapunov design's float work at n = 100 (90 ms); SDA
