@@ -101,3 +101,19 @@ def test_markdown_renders_claims():
     md = render_markdown(_report([_c(True), _c(False)]))
     assert "| c | **certified** |" in md and "**failed**" in md
     assert np.isfinite(1.0)
+
+
+@pytest.mark.parametrize("code", [1, 3, 4, 0, 2, -1, -9, 5, 130, 141, 10**11, 10**100])
+def test_an_error_report_carries_only_a_design_stop_code(code: int) -> None:
+    """verify exits with an error report's exit_code, so only the codes a stopped design
+    writes (1, 3, 4) are accepted; anything else is bad input naming error.exit_code (the
+    report fuzz made verify exit 255, 247, 141 or 130 by editing it)."""
+    rep = Report("lyapunov", "spec text", "s.toml", "0" * 64, Parameters(), [])
+    d = rep.to_dict()
+    d["verdict"], d["error"] = "error", {"exit_code": code, "message": "stopped"}
+    if code in (1, 3, 4):
+        back, _ = Report.from_dict(d)
+        assert back.exit_code() == code
+    else:
+        with pytest.raises(InputError, match=r"key 'error.exit_code': expected one of 1, 3, 4"):
+            Report.from_dict(d)

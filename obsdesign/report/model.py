@@ -20,6 +20,7 @@ from obsdesign.errors import (
     EXIT_INCONCLUSIVE,
     EXIT_INFEASIBLE,
     EXIT_OK,
+    EXIT_SOLVER,
     InconclusiveError,
     InputError,
 )
@@ -45,6 +46,9 @@ TOP_KEYS = (
 #: ``verdict`` of a report: what ``design`` concluded (``error``: the design stopped with an
 #: error before any claim was made; ``error`` then holds its exit code and message)
 VERDICTS = {EXIT_OK: "ok", EXIT_INFEASIBLE: "failed", EXIT_INCONCLUSIVE: "inconclusive"}
+#: the exit codes an error report can carry: a design that stopped infeasible, with a solver
+#: or internal failure, or inconclusive (bad input, exit 2, writes no report)
+ERROR_REPORT_CODES = (EXIT_INFEASIBLE, EXIT_SOLVER, EXIT_INCONCLUSIVE)
 DEPS = ("numpy", "scipy", "cvxpy", "clarabel", "pycddlib", "python-flint", "mpmath")
 
 
@@ -286,6 +290,13 @@ class Report:
             ):
                 raise InputError(
                     f"{file}: an error report has verdict 'error' and error.exit_code/message"
+                )
+            if err["exit_code"] not in ERROR_REPORT_CODES:
+                # verify exits with it: -1, 141, 10¹¹ became exit 255, 141, … (report fuzz)
+                raise InputError(
+                    f"{file}: key 'error.exit_code': expected one of "
+                    f"{', '.join(map(str, ERROR_REPORT_CODES))} (the codes a stopped design "
+                    f"writes), got {err['exit_code']}"
                 )
         params, problems = Parameters.from_json(d["parameters"], file)
         try:
