@@ -226,7 +226,10 @@ def same_bits(a: Any, b: Any) -> bool:
         return False
     if not isinstance(a, (int, float)) or not isinstance(b, (int, float)):
         return False
-    return float(a) == float(b)
+    try:
+        return float(a) == float(b)
+    except OverflowError:  # a JSON integer beyond the float range is no double (report fuzz)
+        return False
 
 
 def _same(a: Any, b: Any) -> bool:
@@ -249,7 +252,10 @@ def _same(a: Any, b: Any) -> bool:
         return a == b
     if not isinstance(b, (int, float)):
         return False
-    return math.isclose(float(a), float(b), rel_tol=1e-12, abs_tol=1e-300)
+    try:
+        return math.isclose(float(a), float(b), rel_tol=1e-12, abs_tol=1e-300)
+    except OverflowError:  # a JSON integer beyond the float range (report fuzz: exit 3)
+        return False
 
 
 def _plain_array(x: list[Any]) -> np.ndarray | None:

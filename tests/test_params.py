@@ -206,3 +206,17 @@ def test_from_json_parses_the_largest_float_range_values() -> None:
     """2¹⁰²³ (inside the float range) still parses, consistent with its float."""
     back, problems = Parameters.from_json({"v": float(2**1023), "exact": {"v": str(2**1023)}})
     assert back["v"] == fmpq(2**1023) and not problems
+
+
+def test_a_float_view_beyond_the_float_range_is_a_consistency_problem() -> None:
+    """A JSON integer of 401 digits where the float of an exact "3" belongs (scalar and in a
+    list): not equal as doubles, a parameters-consistent problem, not an OverflowError (exit
+    3 in verify: report fuzz, review 19)."""
+    from obsdesign.params import Parameters, same_bits
+
+    big = 10**400
+    assert not same_bits(big, 3.0) and not same_bits([big, 1.0], [3.0, 1.0])
+    vals, problems = Parameters.from_json({"beta": big, "exact": {"beta": "3"}}, "r.json")
+    assert problems == ["parameter 'beta': float value differs from its exact value"]
+    vals, problems = Parameters.from_json({"v": [big, 1.0], "exact": {"v": ["3", "1"]}}, "r.json")
+    assert problems == ["parameter 'v': float value differs from its exact value"]
