@@ -149,6 +149,13 @@ APPENDED = [
         "simulate.noise.kind",
         "one of",
     ),
+    (  # numpy refused it at run time: exit 3 (simulate review 19)
+        "signal seed negative",
+        "[simulate]\nhorizon = 5\nx0=[0,0]\nxhat0=[0,0]\n[simulate.noise]\nkind='uniform'\n"
+        "bound=0.1\nseed=-3\n",
+        "simulate.noise.seed",
+        ">= 0",
+    ),
     ("unknown top-level", "[extra]\na = 1\n", "extra", "not a known key"),
 ]
 #: (test id, ψ₁ of the impulsive spec, [key], words)

@@ -69,7 +69,7 @@ def parse_signal(t: Table | None, dim: int) -> Signal:
     if t is None:
         return Signal.zero(dim)
     kind = t.str("kind", choices=KINDS)
-    seed = t.int("seed", default=None)
+    seed = t.int("seed", default=None, min=0)  # numpy refuses a negative one (was exit 3)
     s = Signal(kind, dim, seed=seed)
     if dim == 0 and kind != "zero":
         raise t.error("kind", "this signal has dimension 0 in [system]; only kind = 'zero' fits")
