@@ -117,3 +117,27 @@ def test_an_error_report_carries_only_a_design_stop_code(code: int) -> None:
     else:
         with pytest.raises(InputError, match=r"key 'error.exit_code': expected one of 1, 3, 4"):
             Report.from_dict(d)
+
+
+@pytest.mark.parametrize("where", ["top", "nested"])
+def test_a_report_with_a_repeated_key_is_refused(tmp_path: Path, where: str) -> None:
+    """A key twice in one JSON object (Python keeps the last copy, other readers the first):
+    exit 2 naming the key (a duplicated "spec_sha256" or "claims" verified silently: report
+    fuzz, review 19). The same report without the repeat loads."""
+    text = _report([_c(True)]).to_json()
+    Report.load(_write(tmp_path / "ok.json", text))
+    if where == "top":
+        bad = text.replace('"method":', '"method": "stubborn", "method":', 1)
+        key = "method"
+    else:
+        bad = text.replace('"exact": {', '"exact": {"it": "4",', 1).replace(
+            '"it": 3', '"it": 3, "it": 4', 1
+        )
+        key = "it"
+    with pytest.raises(InputError, match=f"key '{key}' appears twice in one JSON object"):
+        Report.load(_write(tmp_path / "bad.json", bad))
+
+
+def _write(path: Path, text: str) -> Path:
+    path.write_text(text, encoding="utf-8")
+    return path
