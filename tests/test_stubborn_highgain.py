@@ -156,3 +156,24 @@ def test_a_step_too_large_for_the_high_gain_is_warned() -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         _check_step(np.array([2.0, 1.0]), 10.0, 1e-3)  # dt·ℓ·|root| = 0.01
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "key"),
+    [
+        ("impulse_time = ", "impulse_time = 100 # ", "simulate.impulse_time"),
+        ("hf_stop = ", "hf_stop = 0.1 # ", "simulate.hf_stop"),
+    ],
+)
+def test_simulate_times_outside_the_run_are_bad_input(old: str, new: str, key: str) -> None:
+    """impulse_time past the horizon indexed past the time grid (IndexError, exit 3) and
+    hf_stop < hf_start gave an empty noise window silently (simulate review 19): exit 2
+    naming the key."""
+    from obsdesign.errors import InputError, SpecError
+
+    text = DUFFING.read_text(encoding="utf-8")
+    assert old in text
+    with pytest.raises((InputError, SpecError)) as ei:
+        sp = api.load_spec_text(text.replace(old, new, 1), "d.toml")
+        api.simulate(sp)
+    assert ei.value.exit_code == 2 and f"[{key}]" in str(ei.value)

@@ -26,6 +26,7 @@ from obsdesign.certify.claim import Claim, Claims
 from obsdesign.certify.exact import Q, qeye, qmat, qzeros, to_float
 from obsdesign.certify.printing import fmt_exact, fmt_up
 from obsdesign.certify.psd import check_pd, check_psd
+from obsdesign.errors import InputError
 from obsdesign.methods.base import SolverResult, SolverStatus
 from obsdesign.methods.stubborn.claims import identity_claim
 from obsdesign.methods.stubborn.options import ELL_FACTOR, Options, SimOptions
@@ -256,7 +257,13 @@ def simulate(spec: Spec, params: Parameters, observer: str = "stubborn") -> SimR
     bound = o.state_bound
     nu = np.zeros(steps + 1)
     if so.impulse_time is not None:
-        nu[int(round(so.impulse_time / dt))] += so.impulse_value
+        i = int(round(so.impulse_time / dt))
+        if i > steps:  # it indexed past the time grid: IndexError, exit 3 (review 19)
+            raise InputError(
+                f"{spec.file}: [simulate.impulse_time] expected a time within the horizon "
+                f"{float(sim.horizon.f):g}, got {so.impulse_time:g}"
+            )
+        nu[i] += so.impulse_value
     win = (t >= so.hf_start) & (t < so.hf_stop)
     nu[win] += rng.uniform(-so.hf_amplitude, so.hf_amplitude, size=int(win.sum()))
     fu = [e.on(["t"]) for e in s.u_signal] if s.u_signal is not None else []

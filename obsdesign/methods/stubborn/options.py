@@ -206,6 +206,10 @@ def parse_simulate(table: Table, spec: Spec) -> SimOptions:
         o.hf_start = float(table.scalar("hf_start", min=0).f)
         o.hf_stop = float(table.scalar("hf_stop", min=0).f)
         o.hf_amplitude = float(table.scalar("hf_amplitude", min=0).f)
+        if o.hf_stop < o.hf_start:  # an empty window added no noise, silently (review 19)
+            raise table.error(
+                "hf_stop", f"expected hf_stop >= hf_start = {o.hf_start:g} (the noise window)"
+            )
     return o
 
 
