@@ -582,3 +582,18 @@ def test_an_excess_below_float_resolution_is_not_printed_as_equal_numbers() -> N
     notes = " ".join(rep.notes)
     assert "max ε(z) = λ = 0.9 in floats, exceeded in exact arithmetic" in notes
     assert "0.9 > λ = 0.9" not in notes
+
+
+def test_simulated_error_keeps_its_digits_for_a_large_state() -> None:
+    """Example 7.1 shifted to x0 = x̂0 = (10¹⁷, 10¹⁷): the error dynamics do not depend on the
+    state, so the metrics equal those from the origin (final |e| 2.17 both ways); they were
+    computed as x − (x − e) and read 1.0 (simulate review 19)."""
+    path = Path(__file__).resolve().parents[1] / "specs" / "dorea-pimenta-7-1.toml"
+    text = path.read_text(encoding="utf-8")
+    base = api.simulate(load_spec_text(text, "a.toml")).metrics()
+    far = text.replace("x0 = [0, 0]", "x0 = [1e17, 1e17]").replace(
+        "xhat0 = [0, 0]", "xhat0 = [1e17, 1e17]"
+    )
+    assert "1e17" in far
+    shifted = api.simulate(load_spec_text(far, "b.toml")).metrics()
+    assert shifted["final_error_norm"] == pytest.approx(base["final_error_norm"], rel=1e-12)

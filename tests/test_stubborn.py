@@ -916,3 +916,14 @@ def test_a_scalar_given_as_two_numbers_is_refused(ex1: Report, tmp_path: Path, k
     assert f"{out}: parameters.exact.{key}: expected one number, got 2" in r.output.replace(
         "\n", ""
     )
+
+
+def test_the_single_run_reports_the_error_from_its_recursion() -> None:
+    """The single run's metrics and CSV take x̂ − x from the error recursion (res.error), not
+    x − (x − E): that lost the error's digits for a large state (x0 = 1e17 printed final |e|
+    0.0 for 0.0052: simulate review 19). At an ordinary state both agree."""
+    from obsdesign import api
+
+    res = api.simulate(EX1)
+    assert res.error is not None
+    np.testing.assert_allclose(res.error, res.xhat - res.x, atol=1e-12)

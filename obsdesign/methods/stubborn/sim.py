@@ -341,6 +341,9 @@ def single_run(spec: Spec, params: Parameters, observer: str = "stubborn") -> Si
         list(s.states),
         extra={"sigma_bar": S, "sigma": sig},
         info={"observer": observer},
+        # x̂ − x from the error recursion itself (x − (x − E) printed 0.0 for 0.0052 at
+        # x0 = 1e17: simulate review 19)
+        error=-E,
     )
 
 
