@@ -452,3 +452,47 @@ def test_a_parameter_beyond_the_float_range_is_named() -> None:
     huge = variant(replace=(("eps_min = 0.01", "eps_min = 1e308"),))
     with pytest.raises(InconclusiveError, match="parameter 'delta_sq'"):
         api.design(load_spec_text(huge, "huge.toml")).to_dict()
+
+
+def test_simulate_names_an_estimate_that_starts_outside_xhat(tmp_path) -> None:
+    """x̂_0 ∉ X̂ breaks Corollary 1's premise: simulate printed "premises …: hold" beside
+    "x̂_k in X̂ for all k ≥ 1: False" for x̂_0 = (10⁶, −10⁶) (independent simulate review)."""
+    p = tmp_path / "far.toml"
+    p.write_text(R2.replace("xhat0 = [-1.2, 1.2]", "xhat0 = [1e6, -1e6]"))
+    info = api.simulate(p).info
+    premises = info["premises of Theorem 1 (25b)"]
+    assert premises.startswith("the estimate starts outside X̂ (x̂_0 ∉ X̂")
+    assert premises in " ".join(info["warnings"])
+
+
+def test_simulate_time_limit_stops_a_run_with_exit_3(tmp_path, monkeypatch) -> None:
+    """``[simulate] time_limit`` (and ``--option time_limit``) bound a constrained simulation:
+    θ_m ≤ θ may be astronomically large (θ_m = 10⁵ ran past 120 s; review). Past the limit the
+    run stops with a SolverError naming the key, the observer and the sample; an unknown key
+    before this change, the key is now accepted, and a non-positive value is exit 2."""
+    from obsdesign.errors import SolverError
+    from obsdesign.methods.constrained import sim as csim
+
+    p = tmp_path / "tl.toml"
+    p.write_text(R2.replace("seed = 4", "seed = 4\ntime_limit = 1e-9"))
+    with pytest.raises(
+        SolverError, match=r"not finished within 1e-09 s \(\[simulate\] time_limit\)"
+    ):
+        api.simulate(p)
+    p.write_text(R2)
+    clock = iter(range(0, 10**6, 1000))  # every look at the clock is 1000 s later
+
+    class Slow:
+        @staticmethod
+        def perf_counter() -> float:
+            return float(next(clock))
+
+    monkeypatch.setattr(csim, "time", Slow)
+    with pytest.raises(SolverError, match="the modified θ_m=3 observer runs at sample 0 of 60"):
+        api.simulate(p, options={"time_limit": "1000.5", "theta_m": "3"})
+    monkeypatch.undo()
+    res = api.simulate(p, options={"time_limit": "1000.5", "theta_m": "3"})
+    assert res.info["modified θ_m=3: steps (total, max per sample)"]
+    p.write_text(R2.replace("seed = 4", "seed = 4\ntime_limit = 0"))
+    with pytest.raises(SpecError, match="time_limit"):
+        api.simulate(p)

@@ -4,6 +4,7 @@ vectorized batch and the saturation (29)."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from flint import fmpq
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -150,3 +151,42 @@ def test_at_most_one_face_per_class_is_violated(rows, points):
     for cls in cm.classes:
         assert len(cls) <= 2
         assert np.all((phi[:, cls] > 0).sum(axis=1) <= 1)
+
+
+def test_path_log_keeps_sup_and_v_increase_past_its_cap(monkeypatch):
+    """The iterates x̂_{k,i} are kept up to MAX_KEPT_ITERATES (θ_m = 10⁷ kept every one:
+    gigabytes); the sup over (k, i) and the largest V increase over a refining step are taken
+    over all of them, as from the full path, and the time budget is looked at every
+    CHECK_EVERY refining steps."""
+    from obsdesign.methods.constrained import observer as obs
+
+    A = np.array([[0.9, 0.2], [0.0, 0.8]])
+    C = np.array([[1.0, 0.0]])
+    F = LinearF(A, np.zeros((2, 0)), C, np.zeros((1, 0)), np.array([[0.5], [0.1]]))
+    ref = Refiner(MAPS[0], np.array([[0.3, 0.05], [0.05, 0.2]]), 0.05, 0.01, 50.0)
+    rng = np.random.default_rng(3)
+    N = 15
+    Y = rng.uniform(-4, 4, (N + 1, 1))
+    U = np.zeros((N + 1, 0))
+    x = rng.uniform(-1, 1, (N + 1, 2))
+    P = np.array([[2.0, 0.3], [0.3, 1.0]])
+    full = Observer(F, ref, 6).run(U, Y, np.array([3.0, -3.0]), x, P)
+    assert not full.truncated and sum(map(len, full.iterates)) > 20
+    worst = -np.inf
+    for k, path in enumerate(full.iterates):
+        E = np.asarray(path) - x[k + 1]
+        V = np.einsum("ij,jk,ik->i", E, P, E)
+        if len(V) > 1:
+            worst = max(worst, float(np.max(np.diff(V) / V[:-1])))
+    assert full.v_increase == pytest.approx(worst, rel=1e-12)
+    monkeypatch.setattr(obs, "MAX_KEPT_ITERATES", 5)
+    calls = []
+    monkeypatch.setattr(obs, "CHECK_EVERY", 3)
+    cut = Observer(F, ref, 6).run(
+        U, Y, np.array([3.0, -3.0]), x, P, lambda k, n: calls.append((k, n))
+    )
+    assert cut.truncated and sum(map(len, cut.iterates)) == 5
+    np.testing.assert_array_equal(cut.sup_ki(), full.sup_ki())
+    assert cut.v_increase == full.v_increase
+    steps = sum(map(len, full.iterates))
+    assert len(calls) == steps // 3 + (N + 2) // 3 and all(n == N for _, n in calls)

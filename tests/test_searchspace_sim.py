@@ -5,6 +5,7 @@ literal Definition 7 and the "consistency lost" diagnosis."""
 from __future__ import annotations
 
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -155,6 +156,38 @@ def test_time_limit_stops_the_simulation_with_a_clear_message(example, tmp_path,
     with pytest.raises(S.TimeBudget, match="refinement"):
         S.recover(C, 0.3, 0.1, 10**6, (_time.perf_counter() - 1, 5.0))
     assert len(S.recover(C, 0.3, 0.1, 10**6, (_time.perf_counter() + 60, 60.0)))
+
+
+def test_time_limit_is_checked_inside_one_sample_flow(example):
+    """``substeps = 10⁶`` ran past 8× its time_limit: the budget was looked at only between
+    samples (independent simulate review). It is now looked at every BUDGET_EVERY RK4
+    substeps: 10⁵ substeps of the first sample (seconds) stop at the budget, inside it."""
+    import time as _time
+
+    from obsdesign.methods.searchspace import sim as S
+
+    sp, rep, _ = example
+    t0 = _time.perf_counter()
+    with pytest.raises(
+        S.TimeBudget, match=r"in the RK4 flow \(100,000 substeps a sample\) of sample 1 of"
+    ):
+        api.simulate(sp, rep, time_limit=0.3, substeps=100_000)
+    assert _time.perf_counter() - t0 < 30
+
+
+def test_unused_simulate_keys_are_warned(tmp_path):
+    """noise, seed and dt gave the same numbers as without them, with no word (review): the
+    observer samples y = h(x) exactly. Each given key is named in one warning."""
+    p = tmp_path / "s.toml"
+    text = TEXT.replace("[simulate]", "[simulate]\nseed = 3\ndt = 0.5", 1)
+    p.write_text(text + '\n[simulate.noise]\nkind = "uniform"\nbound = 0.01\n', encoding="utf-8")
+    from obsdesign.methods.searchspace import sim as S
+
+    with pytest.warns(UserWarning, match=r"\[simulate\] noise, seed, dt not used by the search"):
+        S._warn_unused(api.load_spec(p))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        S._warn_unused(api.load_spec(SPEC))
 
 
 def test_consistency_lost_after_leaving_E_blames_E_not_L_h(tmp_path):

@@ -46,6 +46,7 @@ class Constrained(Method):
         ),
         SimOption("gamma", "float", None, "simulation-only γ (UNCERTIFIED above (24))", min=0),
         SimOption("saturation_r", "float", None, "also run the saturated observer (29)", min=0),
+        SimOption("time_limit", "float", None, "seconds the simulation may run", min=1e-3),
     )
 
     def plot_simulation(self, spec: Spec, result: SimResult, path: Any) -> Any:  # type: ignore[override]

@@ -15,7 +15,8 @@ x̂⁺ = sat_r(F(x̂)), is here for comparison.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -63,7 +64,7 @@ class Refiner:
         return np.where(act[..., None], xh + self.M(xh), xh)
 
     def refine(
-        self, xh: np.ndarray, theta_m: int, path: list[np.ndarray] | None = None
+        self, xh: np.ndarray, theta_m: int, path: PathLog | list[np.ndarray] | None = None
     ) -> tuple[np.ndarray, int]:
         """Apply G at most θ_m times to one point; stop when G is the identity.
 
@@ -124,13 +125,77 @@ def sat(x: np.ndarray, r: np.ndarray | float) -> np.ndarray:
     return np.clip(x, -r, r)
 
 
+#: iterates x̂_{k,i} kept per observer (for the path of Fig. 3c); past them only the running
+#: sup and the largest V increase are kept (θ_m = 10⁷ kept every iterate: gigabytes)
+MAX_KEPT_ITERATES = 200_000
+#: the time budget is looked at every this many refining steps (and samples)
+CHECK_EVERY = 4096
+
+
+@dataclass
+class PathLog:
+    """What one observer run keeps of its iterates x̂_{k,1}, x̂_{k,2}, … (eq. (8)-(10),
+    constrained-redesign paper): the first :data:`MAX_KEPT_ITERATES` of them, the running sup
+    of |x̂_{k,i}| over all of them (Table 1), and the largest relative increase of
+    V(x̂_{k,i} − x_{k+1}) over a refining step (Lemma 3 says it is ≤ 0) when the plant's
+    x_{k+1} and P are given. ``check`` (the time budget) is called every
+    :data:`CHECK_EVERY` iterates."""
+
+    n: int
+    x_next: np.ndarray | None = None
+    P: np.ndarray | None = None
+    check: Callable[[], None] | None = None
+    kept: list[list[np.ndarray]] = field(default_factory=list)
+    count: int = 0
+    sup: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    worst: float = -np.inf
+    truncated: bool = False
+    _V: float | None = None
+    _k: int = 0
+
+    def __post_init__(self) -> None:
+        self.sup = np.zeros(self.n)
+
+    def start(self, k: int, x1: np.ndarray) -> None:
+        """Sample k begins at x̂_{k,1} = F(x̂_k, u_k, y_k), eq. (8)."""
+        self._k = k
+        self._V = None
+        self.kept.append([])
+        self.append(x1)
+
+    def append(self, x: np.ndarray) -> None:
+        """The next iterate x̂_{k,i} of sample k (eq. (10))."""
+        self.sup = np.maximum(self.sup, np.abs(x))
+        if self.count < MAX_KEPT_ITERATES:
+            self.kept[-1].append(x)
+        else:
+            self.truncated = True
+        self.count += 1
+        if self.x_next is not None and self.P is not None:
+            e = x - self.x_next[self._k + 1]
+            with np.errstate(over="ignore", invalid="ignore"):
+                V = float(e @ self.P @ e)
+                if self._V is not None:
+                    inc = (V - self._V) / max(self._V, 1e-300)
+                    self.worst = max(self.worst, inc) if np.isfinite(inc) else np.inf
+            self._V = V
+        if self.check is not None and self.count % CHECK_EVERY == 0:
+            self.check()
+
+
 @dataclass
 class Trace:
-    """One observer run: estimates x̂_k (N+1, n), all iterates x̂_{k,i} per sample, steps per sample."""
+    """One observer run: estimates x̂_k (N+1, n), the iterates x̂_{k,i} per sample (the first
+    :data:`MAX_KEPT_ITERATES`; ``truncated`` when more were made), steps per sample, the sup
+    of |x̂_{k,i}| over every iterate and the largest V increase over a refining step
+    (−inf when none was measured)."""
 
     xhat: np.ndarray
     iterates: list[list[np.ndarray]]
     steps: np.ndarray
+    sup_iterates: np.ndarray | None = None
+    v_increase: float = -np.inf
+    truncated: bool = False
 
     def sup_k(self) -> np.ndarray:
         """sup over k of |x̂_k^i| per component (Table 1, first row of each block)."""
@@ -138,6 +203,8 @@ class Trace:
 
     def sup_ki(self) -> np.ndarray:
         """sup over (k, i) of |x̂_{k,i}^j|: x̂_k and every intermediate iterate (Table 1)."""
+        if self.sup_iterates is not None:
+            return np.maximum(self.sup_k(), self.sup_iterates)
         pts = [self.xhat] + [np.array(p) for p in self.iterates if p]
         return np.max(np.abs(np.vstack(pts)), axis=0)
 
@@ -154,25 +221,38 @@ class Observer:
     theta_m: int = 0
     sat_r: np.ndarray | float | None = None
 
-    def run(self, u: np.ndarray, y: np.ndarray, xhat0: np.ndarray) -> Trace:
+    def run(
+        self,
+        u: np.ndarray,
+        y: np.ndarray,
+        xhat0: np.ndarray,
+        x: np.ndarray | None = None,
+        P: np.ndarray | None = None,
+        check: Callable[[int, int], None] | None = None,
+    ) -> Trace:
         """One trajectory: inputs and outputs in rows k = 0..N; the estimate has N+1 rows
-        (x̂_0 … x̂_N), every iterate x̂_{k,i} and the steps per sample are kept."""
+        (x̂_0 … x̂_N); the iterates x̂_{k,i} are kept as :class:`PathLog` keeps them, the steps
+        per sample all. With the plant's states ``x`` and P, the largest V increase over a
+        refining step is measured (Lemma 3); ``check(k, N)`` (the time budget) is called every
+        :data:`CHECK_EVERY` samples and refining steps."""
         N = len(y) - 1
         n = len(xhat0)
         xh = np.zeros((N + 1, n))
         xh[0] = xhat0
-        its: list[list[np.ndarray]] = []
+        k = 0
+        log = PathLog(n, x, P, None if check is None else (lambda: check(k, N)))
         steps = np.zeros(N, dtype=np.int64)
         for k in range(N):
+            if check is not None and k % CHECK_EVERY == 0:
+                check(k, N)
             x1 = self.F(xh[k], u[k], y[k])
-            path = [x1]
+            log.start(k, x1)
             if self.refiner is not None and self.theta_m > 0:
-                x1, steps[k] = self.refiner.refine(x1, self.theta_m, path)
+                x1, steps[k] = self.refiner.refine(x1, self.theta_m, log)
             if self.sat_r is not None:
                 x1 = sat(x1, self.sat_r)
-            its.append(path)
             xh[k + 1] = x1
-        return Trace(xh, its, steps)
+        return Trace(xh, log.kept, steps, log.sup, log.worst, log.truncated)
 
     def run_batch(
         self, U: np.ndarray, Y: np.ndarray, Xh0: np.ndarray
@@ -196,7 +276,7 @@ class Observer:
         return out, steps
 
 
-def _record(path: list | None, x: np.ndarray) -> bool:
+def _record(path: PathLog | list | None, x: np.ndarray) -> bool:
     """Append the iterate x̂_{k,i} to ``path`` (when kept); True when it is no longer finite
     (the refining loop then stops)."""
     if path is not None:

@@ -65,11 +65,13 @@ class Options:
 class SimOptions:
     """Method keys of ``[simulate]`` (Section 5, Table 1 of the constrained-redesign paper,
     Astolfi et al., NOLCOS 2019): the step budgets θ_m (one modified observer each), a
-    simulation-only γ, and the saturation level r of the naive observer (29)."""
+    simulation-only γ, the saturation level r of the naive observer (29), and the seconds the
+    simulation may run (``time_limit``, exit 3 past it)."""
 
     theta_m: list[int] = field(default_factory=list)
     gamma: fmpq | None = None
     saturation_r: np.ndarray | None = None
+    time_limit: float = 300.0
 
 
 def parse_options(table: Table, spec: Spec) -> Options:
@@ -279,8 +281,8 @@ def parse_cmap(t: Table, n: int) -> ConstraintMap:
 
 
 def parse_simulate(table: Table, spec: Spec) -> SimOptions:
-    """``[simulate]`` keys of this method: theta_m (int or list), gamma, saturation_r
-    (Section 5 / Table 1 and eq. (29) of the constrained-redesign paper, Astolfi et al.,
+    """``[simulate]`` keys of this method: theta_m (int or list), gamma, saturation_r,
+    time_limit (Section 5 / Table 1 and eq. (29) of the constrained-redesign paper, Astolfi et al.,
     NOLCOS 2019).
 
     :param table: the raw ``[simulate]`` table; :param spec: the spec (for n). Returns the
@@ -303,6 +305,7 @@ def parse_simulate(table: Table, spec: Spec) -> SimOptions:
             raise table.error(
                 "saturation_r", f"expected a positive number or {spec.system.n} positive numbers"
             )
+    out.time_limit = float(table.scalar("time_limit", default=fmpq(300), min=0, strict_min=True).f)
     return out
 
 
@@ -400,6 +403,11 @@ def simulate_schema() -> dict[str, Any]:
         "saturation_r": {
             "anyOf": [NUM, VEC],
             "description": "level r of the saturated observer (29)",
+        },
+        "time_limit": {
+            "type": "number",
+            "exclusiveMinimum": 0,
+            "description": "seconds the simulation may run (exit 3 past it)",
         },
     }
 

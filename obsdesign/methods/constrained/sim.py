@@ -4,13 +4,15 @@ the naive saturated observer (29), on the same plant trajectory."""
 
 from __future__ import annotations
 
+import time
 import warnings
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
 from obsdesign.certify.exact import Q, to_float
-from obsdesign.errors import InputError
+from obsdesign.errors import InputError, SolverError
 from obsdesign.methods.constrained import bounds as B
 from obsdesign.methods.constrained.design import xhat_set
 from obsdesign.methods.constrained.observer import LinearF, Observer, Refiner, Trace
@@ -60,14 +62,25 @@ def _first(bad: np.ndarray) -> int:
 
 
 def _outside_premises(
-    o: Options, x: np.ndarray, u: np.ndarray, d: np.ndarray, v: np.ndarray
+    o: Options,
+    x: np.ndarray,
+    u: np.ndarray,
+    d: np.ndarray,
+    v: np.ndarray,
+    xhat0: np.ndarray | None = None,
+    Xhat: Any = None,
 ) -> list[str]:
     """The premises of Theorem 1 (constrained-redesign paper) that the simulated run breaks,
-    one phrase each: w_k = (d_k, v_k) ∈ D for every k, x_k ∈ X (Assumption 1), and u_k in the
-    input range of an expression model. Without them "x̂_k ∈ X̂ for all k" may fail with the
-    design intact (independent simulate review: noise ±3 against D = [−0.3, 0.3] printed
-    "False" with no word of why)."""
+    one phrase each: the estimate starts in X̂ (Corollary 1: (25b) holds from
+    (x_k, x̂_k) ∈ X × X̂), w_k = (d_k, v_k) ∈ D for every k, x_k ∈ X (Assumption 1), and u_k in
+    the input range of an expression model. Without them "x̂_k ∈ X̂ for all k" may fail with
+    the design intact (independent simulate review: noise ±3 against D = [−0.3, 0.3] printed
+    "False" with no word of why; x̂_0 = (10⁶, −10⁶) printed "hold")."""
     out: list[str] = []
+    if xhat0 is not None and Xhat is not None:
+        inside = np.asarray(Xhat.contains(np.asarray(xhat0, float)[None, :], tol=1e-9))
+        if not bool(inside.reshape(-1)[0]):
+            out.append("the estimate starts outside X̂ (x̂_0 ∉ X̂; Corollary 1 needs x̂_0 ∈ X̂)")
     K = len(x)
     w = np.hstack([np.asarray(d, float).reshape(K, -1), np.asarray(v, float).reshape(K, -1)])
     lo, hi = np.asarray(o.D_lower, float), np.asarray(o.D_upper, float)
@@ -96,6 +109,7 @@ def simulate(
     theta_m: str | None = None,
     gamma: float | None = None,
     saturation_r: float | None = None,
+    time_limit: float | None = None,
 ) -> SimResult:
     """Run the plant and three observers on one trajectory: the unmodified observer (2), the
     modified observer (8)-(10) with G of eq. (23) and a budget θ_m per sample, and the naive
@@ -106,11 +120,16 @@ def simulate(
     :param params: the design's parameters (P, γ, θ, ε_min, ε_max, δ²);
     :param theta_m: ``--option theta_m`` (comma list), overrides ``[simulate] theta_m``;
     :param gamma: ``--option gamma``, a simulation-only γ (reported UNCERTIFIED above (24));
-    :param saturation_r: ``--option saturation_r``, the level r of (29)."""
+    :param saturation_r: ``--option saturation_r``, the level r of (29);
+    :param time_limit: ``--option time_limit``, overrides ``[simulate] time_limit``: past it
+    (all observers together) the run stops with :class:`SolverError` (exit 3) saying how far
+    it got."""
     o: Options = spec.options
     s, sm = spec.system, spec.simulate
     assert sm is not None
     so: SimOptions = sm.options if isinstance(sm.options, SimOptions) else SimOptions()
+    limit = so.time_limit if time_limit is None else _positive(time_limit, "time_limit")
+    deadline = time.perf_counter() + limit
     theta = int(Q(_exact(params, "theta")))
     from_option = theta_m is not None
     thetas = theta_list(theta_m) if theta_m is not None else (so.theta_m or [min(theta, THETA_CAP)])
@@ -167,7 +186,10 @@ def simulate(
         observers[f"modified θ_m={tm}"] = Observer(F, ref, tm)
     if sat_r is not None:
         observers[f"saturated r={_fmt(sat_r)}"] = Observer(F, sat_r=sat_r)
-    traces: dict[str, Trace] = {k: ob.run(u, y, sm.xhat0.f) for k, ob in observers.items()}
+    traces: dict[str, Trace] = {
+        name: ob.run(u, y, sm.xhat0.f, x, Pf, _budget(name, deadline, limit))
+        for name, ob in observers.items()
+    }
 
     info: dict[str, Any] = {
         "theta (22)": theta,
@@ -194,10 +216,11 @@ def simulate(
             info[f"{name}: x̂_k in X̂ for all k ≥ 1"] = bool(
                 np.all(Xhat.contains(tr.xhat[1:], tol=1e-9))
             )
-            info[f"{name}: max V increase over a refining step"] = f"{_v_increase(tr, x, Pf):.3g}"
+            worst = tr.v_increase if tr.v_increase > -np.inf else 0.0
+            info[f"{name}: max V increase over a refining step"] = f"{worst:.3g}"
         if name.startswith("saturated"):
             info[f"{name}: final x̂"] = _fmt(tr.xhat[-1])
-    outside = _outside_premises(o, x, u, d, v)
+    outside = _outside_premises(o, x, u, d, v, sm.xhat0.f, Xhat)
     # θ_m < θ matters only where a sample spent its whole budget (Lemma 3: the refining
     # ends within θ steps; a budget never reached ran as θ would)
     spent = [
@@ -234,22 +257,21 @@ def _fmt(a: np.ndarray) -> str:
     return "[" + ", ".join(f"{float(v):.6g}" for v in np.atleast_1d(a)) + "]"
 
 
-def _v_increase(tr: Trace, x: np.ndarray, P: np.ndarray) -> float:
-    """Largest V(x̂_{k,i+1} − x_{k+1}) − V(x̂_{k,i} − x_{k+1}) over refining steps (Lemma 3: ≤ 0),
-    relative to V(x̂_{k,i} − x_{k+1})."""
-    worst = -np.inf
-    for kk, path in enumerate(tr.iterates):
-        if len(path) < 2:
-            continue
-        E = np.asarray(path) - x[kk + 1]
-        V = np.einsum("ij,jk,ik->i", E, P, E)
-        with np.errstate(invalid="ignore", over="ignore"):
-            inc = np.diff(V) / np.maximum(V[:-1], 1e-300)
-        if inc.size and np.all(np.isfinite(inc)):
-            worst = max(worst, float(inc.max()))
-        elif inc.size:
-            worst = np.inf
-    return worst if worst > -np.inf else 0.0
+def _budget(name: str, deadline: float, limit: float) -> Callable[[int, int], None]:
+    """The time budget of one observer's run (``[simulate] time_limit``): a check that raises
+    :class:`SolverError` (exit 3) naming the observer and the sample it got to, once
+    ``deadline`` (a ``time.perf_counter`` value) has passed. A large θ_m had no bound but
+    :data:`MAX_REFINING_STEPS` (about 17 minutes; independent simulate review)."""
+
+    def check(k: int, N: int) -> None:
+        if time.perf_counter() > deadline:
+            raise SolverError(
+                f"simulation not finished within {limit:g} s ([simulate] time_limit): the "
+                f"{name} observer runs at sample {k:,} of {N:,} (raise time_limit, or a "
+                "smaller theta_m or horizon)"
+            )
+
+    return check
 
 
 def plot(spec: Spec, res: SimResult, path: Any) -> Any:
@@ -292,7 +314,10 @@ def plot(spec: Spec, res: SimResult, path: Any) -> Any:
         grid = np.zeros((300, 300, res.x.shape[1]))
         grid[..., 0], grid[..., 1] = gx, gy
         ax[2].contour(gx, gy, ref.cm.norm_c(grid), levels=[ref.eps_min], colors="b", linewidths=1)
-        ax[2].set_title("c) x̂_{k,i} and C_min (blue)")
+        kept = sum(len(q) for q in tr.iterates)
+        ax[2].set_title(
+            "c) x̂_{k,i} and C_min (blue)" + (f", first {kept:,} iterates" if tr.truncated else "")
+        )
         ax[2].legend(fontsize=7)
     fig.tight_layout()
     return save_figure(fig, path)
