@@ -622,6 +622,9 @@ def simulate(
     left = _left_float_range(res)
     if left is not None:
         notes.insert(0, left)
+    step = _step_note(sp)
+    if step is not None:
+        notes.insert(0, step)
     if notes:
         res.info["warnings"] = notes
     return res
@@ -636,6 +639,22 @@ def _report_named(e: InputError, where: str) -> InputError:
     return e
 
 
+def _step_note(sp: Spec) -> str | None:
+    """The note that ``[simulate] dt`` was lowered so that the grid ends at the horizon
+    (:func:`obsdesign.spec.loader._whole_steps`), else None.
+
+    :param sp: the bound spec."""
+    sim = sp.simulate
+    if sim is None or sim.dt_given is None or sim.dt is None:
+        return None
+    steps = sim.horizon.q / sim.dt.q
+    return (
+        f"[simulate] dt = {float(sim.dt_given.f):g} does not divide horizon = "
+        f"{float(sim.horizon.f):g}: the grid steps by dt = {float(sim.dt.f):.6g} ({steps} "
+        f"step{'' if steps == 1 else 's'}), so that it ends at the horizon"
+    )
+
+
 def _left_float_range(res: SimResult) -> str | None:
     """A plain warning when the shown trajectory leaves the float range (an unstable plant or
     observer over a long horizon): where it does, instead of numpy's overflow warnings alone;
@@ -648,6 +667,14 @@ def _left_float_range(res: SimResult) -> str | None:
     first = min((int(b[0]) for b in bad if b.size), default=None)
     if first is None:
         return None
+    if first == 0:
+        # x0 = 1e308, xhat0 = -1e308: the error xhat0 - x0 overflows at once, and "the plant or
+        # the observer diverges" was false (independent simulate review)
+        return (
+            "the trajectory is not finite at its start: x0, xhat0 or the error xhat0 − x0 the "
+            "simulation steps is beyond the float range (about 1.8e308), so the metrics are not "
+            "finite; take smaller initial states"
+        )
     at = float(res.t[first]) if first < len(res.t) else float(first)
     return (
         f"the trajectory leaves the float range at t = {at:g} (sample {first} of {len(res.t)}): "

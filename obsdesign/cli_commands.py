@@ -202,10 +202,31 @@ def _kv(items: list[str]) -> dict[str, str]:
 
 
 def _dumps(obj: Any, **kw: Any) -> str:
-    """``json.dumps`` (json loads only on the paths that print JSON)."""
+    """``json.dumps`` of :func:`_finite` ``obj``, so the text is valid JSON: a non-finite
+    metric printed as ``NaN`` / ``Infinity``, which JSON has not (independent simulate
+    review). json loads only on the paths that print JSON."""
     import json
 
-    return json.dumps(obj, **kw)
+    return json.dumps(_finite(obj, kw.pop("default", None)), allow_nan=False, **kw)
+
+
+def _finite(o: Any, default: Callable[[Any], Any] | None) -> Any:
+    """``o`` with every non-finite float written as the string ``"nan"``, ``"inf"`` or
+    ``"-inf"`` (Python's own spelling, which ``float()`` reads back), containers walked, and
+    what JSON cannot hold passed through ``default`` first."""
+    import math
+
+    if isinstance(o, bool) or o is None or isinstance(o, (int, str)):
+        return o
+    if isinstance(o, float):
+        return o if math.isfinite(o) else repr(o)
+    if isinstance(o, dict):
+        return {k: _finite(v, default) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [_finite(v, default) for v in o]
+    if default is None:
+        return o
+    return _finite(default(o), None)
 
 
 def _jsonable(o: Any) -> Any:
@@ -324,9 +345,55 @@ def _metrics_markdown(m: dict[str, Any]) -> str:
         )
     lines += ["", f"final \\|e\\| = {m['final_error_norm']:.6g}"]
     for k, v in m.items():
-        if k not in ("sup_abs_error", "rmse", "final_error_norm", "sup_abs_estimate", "exit_code"):
+        if k not in (*_MAIN_METRICS, "quantiles"):
             lines.append(f"- {_md_cell(k)}: {_md_cell(v)}")
+    head, rows = _quantile_rows(m.get("quantiles"))
+    if rows:
+        lines += ["", "| quantiles | " + " | ".join(head) + " |", "| --- " * (len(head) + 1) + "|"]
+        lines += ["| " + " | ".join(_md_cell(c) for c in r) + " |" for r in rows]
     return "\n".join(lines) + "\n"
+
+
+#: the metrics printed in the table; the rest, one line each
+_MAIN_METRICS = ("sup_abs_error", "rmse", "final_error_norm", "sup_abs_estimate", "exit_code")
+_METRIC_NAMES = {
+    "sup_abs_error": "sup |e_{}|",
+    "rmse": "RMSE e_{}",
+    "sup_abs_estimate": "sup |x̂_{}|",
+    "final_error_norm": "final |e|",
+}
+
+
+def _num(v: Any) -> str:
+    """A number as ``.6g``; anything else as its text."""
+    return f"{v:.6g}" if isinstance(v, (int, float)) and not isinstance(v, bool) else str(v)
+
+
+def _quantile_rows(q: Any) -> tuple[list[str], list[list[str]]]:
+    """The Monte Carlo quantiles (``{metric: {state: {q05: …}}}`` or ``{metric: {q05: …}}``)
+    as a table: the quantile names, then one row per metric and state (the raw dict was
+    printed before; independent simulate review). Empty when ``q`` is not of that shape."""
+    if not isinstance(q, dict):
+        return [], []
+    head: list[str] = []
+    rows: list[list[str]] = []
+
+    def add(label: str, qs: dict[str, Any]) -> None:
+        for k in qs:
+            if k not in head:
+                head.append(k)
+        rows.append([label, *(_num(qs[k]) if k in qs else "" for k in head)])
+
+    for metric, v in q.items():
+        if not isinstance(v, dict) or not v:
+            continue
+        name = _METRIC_NAMES.get(metric, metric + " {}")
+        if all(isinstance(x, dict) for x in v.values()):
+            for state, qs in v.items():
+                add(name.format(state), qs)
+        else:
+            add(name.replace("_{}", "").replace(" {}", ""), v)
+    return head, [r + [""] * (len(head) + 1 - len(r)) for r in rows]
 
 
 def _md_cell(v: Any) -> str:
@@ -350,8 +417,16 @@ def _print_metrics(m: dict[str, Any]) -> None:
     c.print(t)
     c.print(f"final |e| = {m['final_error_norm']:.6g}")
     for k, v in m.items():
-        if k not in ("sup_abs_error", "rmse", "final_error_norm", "sup_abs_estimate", "exit_code"):
+        if k not in (*_MAIN_METRICS, "quantiles"):
             c.print(esc(f"{k}: {v}"))
+    head, rows = _quantile_rows(m.get("quantiles"))
+    if rows:
+        q = Table(title=f"quantiles over {m.get('runs', 'the')} runs")
+        for h in ("metric", *head):
+            q.add_column(h)
+        for r in rows:
+            q.add_row(*(esc(c) for c in r))
+        c.print(q)
 
 
 def design(

@@ -205,3 +205,42 @@ def test_simulate_csv_writes_the_trajectories(tmp_path: Path) -> None:
     gone = tmp_path / "none.csv"
     r = CliRunner().invoke(app, ["simulate", str(spec), "--csv", str(gone), "--option", "bogus=1"])
     assert r.exit_code == 2 and not gone.exists()
+
+
+def test_simulate_json_is_valid_with_non_finite_metrics(tmp_path: Path) -> None:
+    """x0 = 1e308, xhat0 = −1e308 gives non-finite metrics, which ``--format json`` printed
+    as NaN / Infinity: not JSON (independent simulate review). They are the strings "nan",
+    "inf", "-inf" now, and a strict parser reads the output."""
+    spec = tmp_path / "huge.toml"
+    spec.write_text(
+        '[system]\ntime = "discrete"\nA = [[0.5, 1], [0, 0.8]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\nL = [0.6, 0.1]\n'
+        "[simulate]\nhorizon = 5\nx0 = [1e308, 0]\nxhat0 = [-1e308, 0]\n"
+    )
+    r = CliRunner().invoke(app, ["simulate", str(spec), "--format", "json"])
+    assert r.exit_code == 0, r.output
+
+    def refuse(name: str) -> None:
+        raise AssertionError(f"{name} is not JSON")
+
+    m = json.loads(r.output, parse_constant=refuse)
+    assert m["final_error_norm"] == "nan" and float(m["final_error_norm"]) != 0
+
+
+def test_simulate_prints_quantiles_as_a_table(tmp_path: Path) -> None:
+    """``--runs N`` printed the quantiles as a raw Python dict in text and Markdown (review):
+    one row per metric and state, one column per quantile now."""
+    spec = tmp_path / "mc.toml"
+    spec.write_text(
+        '[system]\ntime = "discrete"\nA = [[0.5, 1], [0, 0.8]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\nL = [0.6, 0.1]\n'
+        "[simulate]\nhorizon = 20\nx0 = [1, 0]\nxhat0 = [0, 0]\n"
+        '[simulate.noise]\nkind = "uniform"\nbound = 0.1\n'
+    )
+    r = CliRunner().invoke(app, ["simulate", str(spec), "--runs", "4", "--format", "md"])
+    assert r.exit_code == 0, r.output
+    assert "{'" not in r.output
+    assert "| quantiles | q05 | q50 | q95 | max |" in r.output
+    assert "| sup \\|e_x1\\| |" in r.output and "| final \\|e\\| |" in r.output
+    r = CliRunner().invoke(app, ["simulate", str(spec), "--runs", "4"])
+    assert r.exit_code == 0 and "{'" not in r.output and "quantiles over 4 runs" in r.output

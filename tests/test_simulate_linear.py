@@ -144,3 +144,71 @@ def test_the_single_run_keeps_the_error_of_an_unstable_plant() -> None:
     )
     r = simulate_linear_observer(cont, np.array([[3.0]]))
     np.testing.assert_allclose(r.e[:, 0], np.exp(-2 * r.t), rtol=1e-9)
+
+
+CONT = """[system]
+time = "continuous"
+A = [[0, 1], [-2, -0.3]]
+C = [[1, 0]]
+[method]
+key = "lyapunov"
+L = [1, 1]
+[simulate]
+x0 = [1, 0]
+xhat0 = [0, 0]
+"""
+
+
+def test_the_continuous_grid_ends_at_the_horizon() -> None:
+    """dt = 0.3 over horizon 1 stopped at t = 0.9, dt = 5 > horizon simulated t = 0 alone
+    (independent simulate review): dt is lowered to horizon / ⌈horizon / dt⌉ and the API says
+    so; a dt that divides the horizon (to 10⁻⁹, 10 / 0.1 included) is kept as given."""
+    from obsdesign import api
+    from obsdesign.simulate.linear import sim_grid
+
+    for dt, want in (("0.3", [0, 0.25, 0.5, 0.75, 1]), ("5", [0, 1]), ("0.25", None)):
+        sp = load_spec_text(CONT + f"horizon = 1\ndt = {dt}\n")
+        grid = sim_grid(sp)
+        if want is None:
+            np.testing.assert_array_equal(grid, [0, 0.25, 0.5, 0.75, 1])
+            assert sp.simulate.dt_given is None
+            continue
+        np.testing.assert_allclose(grid, want, rtol=0, atol=1e-15)
+        res = api.simulate(sp)
+        assert res.t[-1] == 1.0
+        note = res.info["warnings"][0]
+        assert note.startswith(f"[simulate] dt = {dt} does not divide horizon = 1: the grid")
+    sp = load_spec_text(CONT + "horizon = 10\ndt = 0.1\n")
+    assert sp.simulate.dt_given is None and len(sim_grid(sp)) == 101
+    assert float(sp.simulate.dt.f) == 0.1
+
+
+def test_a_dt_beyond_the_exact_discretization_is_bad_input() -> None:
+    """horizon = 1e50 (dt = horizon / 1000) printed NaN metrics and "the plant or the observer
+    diverges" for a stable plant and observer (review): expm overflows; it is exit 2 naming
+    [simulate] dt now. 1e20 still simulates."""
+    import pytest
+
+    from obsdesign import api
+    from obsdesign.errors import InputError
+
+    with pytest.raises(InputError, match=r"\[simulate\] dt = 1e\+47 is too large"):
+        api.simulate(load_spec_text(CONT + "horizon = 1e50\n"))
+    m = api.simulate(load_spec_text(CONT + "horizon = 1e20\n")).metrics()
+    assert np.isfinite(m["final_error_norm"])
+
+
+def test_a_start_beyond_the_float_range_is_said_so() -> None:
+    """x0 = 1e308, xhat0 = −1e308: the error overflows at once; the warning said "the plant or
+    the observer diverges", which is false, beside numpy's overflow warnings (review)."""
+    from obsdesign import api
+
+    text = CONT.replace("x0 = [1, 0]", "x0 = [1e308, 0]").replace(
+        "xhat0 = [0, 0]", "xhat0 = [-1e308, 0]"
+    )
+    res = api.simulate(load_spec_text(text + "horizon = 1\n"))
+    assert res.info["warnings"] == [
+        "the trajectory is not finite at its start: x0, xhat0 or the error xhat0 − x0 the "
+        "simulation steps is beyond the float range (about 1.8e308), so the metrics are not "
+        "finite; take smaller initial states"
+    ]

@@ -322,19 +322,37 @@ def _simulate(t: Table, system: System) -> SimulateSpec:
     n = system.n
     if system.discrete:
         horizon = Value.of(_pos_int(t, "horizon"))
-        dt = None
+        dt = given = None
     else:
         horizon = t.scalar("horizon", min=0, strict_min=True)
         dt = t.scalar("dt", default=None, min=0, strict_min=True)
         if dt is None:
             dt = system.sample_time or Value.of(horizon.q / 1000)
+        dt, given = _whole_steps(horizon, dt)
     x0 = t.vector("x0", n=n)
     xhat0 = t.vector("xhat0", n=n)
     seed = t.int("seed", default=0, min=0)
     u = parse_signal(t.table("u"), system.m)
     d = parse_signal(t.table("disturbance"), system.nd)
     v = parse_signal(t.table("noise"), system.nv)
-    return SimulateSpec(horizon, dt, x0, xhat0, u, d, v, seed, t)
+    sim = SimulateSpec(horizon, dt, x0, xhat0, u, d, v, seed, t)
+    sim.dt_given = given
+    return sim
+
+
+def _whole_steps(horizon: Value, dt: Value) -> tuple[Value, Value | None]:
+    """The output step of a continuous-time simulation: ``dt`` when the horizon is a whole
+    number K of steps (to 10⁻⁹ relative, so that 10 / 0.1 counts as 100 although the double
+    0.1 is not 1/10), else horizon / ⌈horizon / dt⌉, the largest step below ``dt`` that ends
+    the grid at the horizon: with dt = 0.3 the grid of horizon 1 stopped at 0.9, and with
+    dt = 5 it held t = 0 alone (independent simulate review). Returns the step and the
+    given ``dt`` when it was changed (else None)."""
+    r = horizon.q / dt.q
+    k = int(round(float(r))) if r < 2**52 else None
+    if r.q == 1 or (k is not None and k >= 1 and abs(r - k) <= r / 10**9):
+        return dt, None
+    K = max(int(r.p // r.q) + 1, 1)  # ⌈r⌉ for r not an integer
+    return Value.of(horizon.q / K), dt
 
 
 def _pos_int(t: Table, k: str) -> Any:

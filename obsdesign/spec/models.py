@@ -96,6 +96,9 @@ class SimulateSpec:
     table: Table
     #: what the method's ``parse_simulate`` returned for its own ``[simulate]`` keys
     options: Any = None
+    #: the ``dt`` the spec gave when it does not divide the horizon (``dt`` is then
+    #: horizon / ⌈horizon / dt⌉, so that the grid ends at the horizon); None otherwise
+    dt_given: Value | None = None
 
 
 @dataclass

@@ -84,16 +84,19 @@ class Lyapunov(Method):
         """One run of the spec's scenario, or ``runs`` batched Monte Carlo runs (per-run
         metrics and quantiles; :func:`obsdesign.simulate.linear.simulate_linear_observer_batch`);
         ``span = (a, b)``: only runs a..b-1 of them (``simulate --workers``, see
-        :func:`obsdesign.simulate.montecarlo.run_batch`)."""
+        :func:`obsdesign.simulate.montecarlo.run_batch`). ``runs`` given, even 1, is the Monte
+        Carlo study: its run 0 is run 0 of any N (``--runs 1`` was the single scenario, drawn
+        from ``default_rng(seed)``, not from child 0 of ``SeedSequence(seed)``; review)."""
         from obsdesign.simulate.linear import (
             simulate_linear_observer,
             simulate_linear_observer_batch,
         )
 
         so = spec.simulate.options if spec.simulate is not None else None
-        n = runs if runs is not None else (so.runs if so is not None else 1)
+        given = runs if runs is not None else (so.runs if so is not None else None)
+        n = given or 1
         ie = so.initial_error if so is not None else None
-        if n == 1 and ie is None and batch is None and span is None:
+        if given is None and ie is None and batch is None and span is None:
             return simulate_linear_observer(spec, params.float("L"))
         return simulate_linear_observer_batch(spec, params.float("L"), n, ie, batch, span)
 

@@ -172,11 +172,12 @@ def parse_options(table: Table, spec: Spec) -> Options:
 
 @dataclass
 class SimOptions:
-    """The ``lyapunov`` method's own ``[simulate]`` keys: ``runs`` Monte Carlo runs (default
-    1: the spec's single scenario) and ``initial_error``, the name of a set of ``[sets]`` each
-    run draws its initial error x̂0 − x0 from (None: xhat0 − x0 for every run)."""
+    """The ``lyapunov`` method's own ``[simulate]`` keys: ``runs`` Monte Carlo runs (None, not
+    given: the spec's single scenario; 1 is one Monte Carlo run, run 0 of any N) and
+    ``initial_error``, the name of a set of ``[sets]`` each run draws its initial error
+    x̂0 − x0 from (None: xhat0 − x0 for every run)."""
 
-    runs: int = 1
+    runs: int | None = None
     initial_error: str | None = None
 
 
@@ -187,7 +188,7 @@ def parse_simulate(table: Table, spec: Spec) -> SimOptions:
     :param table: the ``[simulate]`` table; :param spec: the spec."""
     from obsdesign.simulate.montecarlo import parse_initial_error
 
-    runs = table.int("runs", default=1, min=1)
+    runs = table.int("runs", default=None, min=1)
     return SimOptions(runs, parse_initial_error(table, spec))
 
 
