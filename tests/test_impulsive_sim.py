@@ -135,6 +135,38 @@ def test_simulation_memory_is_checked_before_allocating(tmp_path: Path) -> None:
     )
     assert res.exit_code == 2 and "GiB" in res.output
     assert time.perf_counter() - t0 < 5
+    assert res.output.startswith(f"obsdesign: error: {spec}: simulating 100000 run(s)")
+
+
+def test_an_astronomic_horizon_is_refused_in_a_few_digits() -> None:
+    """horizon = 1e300 printed a 295-digit number of GiB and named no file (review); a sample
+    count beyond the float range (1e310) is refused, not an OverflowError."""
+    from obsdesign.errors import InputError
+    from obsdesign.methods.impulsive.sim import check_memory
+
+    with pytest.raises(
+        InputError, match=r"^s\.toml: the simulation would need about 5\.5\de\+294 GiB"
+    ):
+        check_memory(1, 6.45e300, 2, file="s.toml")
+    with pytest.raises(InputError, match=r"about inf GiB \(3 runs × inf samples"):
+        check_memory(3, float("inf"), 2, file="s.toml")
+    check_memory(3, 100.0, 2, file="s.toml")
+
+
+def test_rtol_has_the_same_bounds_in_the_spec_as_as_an_option(tmp_path: Path) -> None:
+    """``[simulate] rtol = 1`` was accepted while ``--option rtol=1`` was refused (review):
+    both take 1e-14 … 1e-2 now."""
+    from obsdesign.errors import SpecError
+
+    text = SPEC3.read_text(encoding="utf-8")
+    assert "[simulate]\n" in text
+    for bad in ("1", "0.011", "1e-15"):
+        with pytest.raises(SpecError, match=r"\[simulate\.rtol\]"):
+            api.load_spec_text(
+                text.replace("[simulate]\n", f"[simulate]\nrtol = {bad}\n"), "s.toml"
+            )
+    for good in ("0.01", "1e-14"):
+        api.load_spec_text(text.replace("[simulate]\n", f"[simulate]\nrtol = {good}\n"), "s.toml")
 
 
 IMP = """[system]

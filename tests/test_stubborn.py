@@ -927,3 +927,16 @@ def test_the_single_run_reports_the_error_from_its_recursion() -> None:
     res = api.simulate(EX1)
     assert res.error is not None
     np.testing.assert_allclose(res.error, res.xhat - res.x, atol=1e-12)
+
+
+def test_a_single_run_is_not_refused_by_the_study_memory_estimate() -> None:
+    """A single run of 10⁶ steps was refused by the memory estimate of the outlier study's
+    100 runs ("100 run(s) … 8.94 GiB"; independent simulate review): without ``study`` the
+    estimate is one run's; with it, the study's runs, refused as before."""
+    from obsdesign.errors import InputError
+
+    text = (SPECS / "astolfi-stubborn-example1.toml").read_text()
+    sp = api.load_spec_text(text.replace("horizon = 10\n", "horizon = 1000\n"), "long.toml")
+    api.check_sim_memory(sp, {})
+    with pytest.raises(InputError, match=r"long\.toml: simulating 100 run\(s\)"):
+        api.check_sim_memory(sp, {"study": "outliers"})

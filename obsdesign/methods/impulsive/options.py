@@ -194,7 +194,10 @@ def parse_simulate(table: Table, spec: Spec) -> SimOptions:
     if table.has("sampling_file"):
         p = Path(table.str("sampling_file"))
         sf = p if p.is_absolute() else Path(spec.file).resolve().parent / p
-    rtol = float(table.scalar("rtol", default=fmpq(1, 10**7), min=0, strict_min=True).f)
+    # the bounds of ``--option rtol`` (1e-14 … 1e-2): rtol = 1 was accepted here (review)
+    rtol = float(
+        table.scalar("rtol", default=fmpq(1, 10**7), min=fmpq(1, 10**14), max=fmpq(1, 100)).f
+    )
     limit = float(table.scalar("time_limit", default=fmpq(300), min=0, strict_min=True).f)
     return SimOptions(runs, sf, rtol, limit)
 
@@ -268,6 +271,6 @@ def simulate_schema() -> dict[str, Any]:
     return {
         "runs": {"type": "integer", "minimum": 1},
         "sampling_file": {"type": "string"},
-        "rtol": {"type": "number", "exclusiveMinimum": 0},
+        "rtol": {"type": "number", "minimum": 1e-14, "maximum": 0.01},
         "time_limit": {"type": "number", "exclusiveMinimum": 0},
     }

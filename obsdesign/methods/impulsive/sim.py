@@ -53,19 +53,26 @@ def read_intervals(path: Path) -> np.ndarray:
     return vals
 
 
-def check_memory(runs: int, samples: int, n: int, dense: int = 8) -> None:
+def check_memory(runs: int, samples: float, n: int, dense: int = 8, file: str = "") -> None:
     """Refuse (:class:`InputError`) a simulation whose arrays would exceed the
     ``max_sim_bytes`` limit: two batches of ``runs`` trajectories with ``samples`` intervals
-    of ``dense`` points, each point holding t, x, ẑ (n each) and flags, as float64."""
+    of ``dense`` points, each point holding t, x, ẑ (n each) and flags, as float64. Counted
+    in floats, so that horizon = 1e300 is a clear refusal (it printed a 295-digit number of
+    GiB, with no file named; independent simulate review).
+
+    :param runs: runs; :param samples: sampling intervals per run; :param n: states;
+    :param dense: points per interval; :param file: the spec file, for the message."""
     from obsdesign.limits import limits
 
-    need = 2 * runs * (samples * dense + 1) * (2 * n + 3) * 8 + runs * samples * 8 * 3
+    r, k = float(runs), float(samples)
+    need = 2.0 * r * (k * dense + 1.0) * (2 * n + 3) * 8.0 + r * k * 8.0 * 3
     cap = limits().max_sim_bytes
-    if need > cap:
+    if not need <= cap:  # NaN or inf included
+        where = f"{file}: " if file else ""
         raise InputError(
-            f"the simulation would need about {need / 2**30:.1f} GiB "
-            f"({runs} runs × {samples} samples × {n} states); the limit is "
-            f"{cap / 2**30:.1f} GiB (fewer runs, a shorter horizon, or "
+            f"{where}the simulation would need about {need / 2**30:.3g} GiB "
+            f"({runs:,} runs × {k:.3g} samples × {n} states); the limit is "
+            f"{cap / 2**30:.3g} GiB (fewer runs, a shorter horizon, or "
             "obsdesign --limit max_sim_bytes=...)"
         )
 
@@ -105,14 +112,14 @@ def simulate(
     if sampling_file is not None:
         h = read_intervals(sampling_file)
         runs = 1
-        check_memory(1, h.size, n)
+        check_memory(1, h.size, n, file=spec.file)
         H = pad_to_horizon(h[None, :], horizon)
         if H.shape[1] == 0 or np.sum(H) < horizon * 0.999:
             raise InputError(f"{sampling_file}: the intervals do not cover the horizon {horizon:g}")
     else:
         if not 0 < t_lo <= t_hi:
             raise InputError(f"report: expected 0 < T_min ≤ T_max, got {t_lo:g}, {t_hi:g}")
-        check_memory(runs, int(np.ceil(horizon / t_lo)) + 1, n)
+        check_memory(runs, np.ceil(horizon / t_lo) + 1, n, file=spec.file)
         H = draw_intervals(rng, runs, t_lo, t_hi, horizon)
     K = H.shape[1]
     Dn = spec.system.Dn.f

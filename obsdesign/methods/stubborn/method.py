@@ -51,6 +51,17 @@ class Stubborn(Method):
         ),
     )
 
+    def sim_bytes(self, spec: Spec, runs: int, steps: float, options: dict[str, Any]) -> float:
+        """One run's trajectories without ``study`` (the spec's ``runs`` are the outlier
+        study's: a single run of 10⁶ steps was refused by the memory estimate of 100 runs;
+        independent simulate review), else the study's runs (the default estimate).
+
+        :param spec: the bound spec; :param runs: the study's runs; :param steps: steps per
+        run; :param options: the typed ``simulate`` options (``study``)."""
+        if options.get("study", "none") == "none":
+            runs = 1
+        return super().sim_bytes(spec, runs, steps, options)
+
     def plot_simulation(self, spec: Spec, result: Any, path: Any) -> Any:
         from obsdesign.methods.stubborn import plots
 
