@@ -187,3 +187,21 @@ def test_an_unstable_expression_plant_keeps_its_error() -> None:
     late = np.abs(r.e[r.t >= 10, 0])  # e^{-20} of the start is left by t = 10
     assert late.max() <= 0.05 + 1e-8
     np.testing.assert_allclose(r.xhat, r.x + r.e, rtol=1e-15)
+
+
+def test_a_signal_the_expressions_do_not_name_is_warned() -> None:
+    """``[system] h`` is the whole output map: noise that h does not name reaches nothing and
+    gave the same numbers as without it, with no word (review). Named (v1 in h), no warning;
+    the same for a disturbance and ``f``."""
+    base = PLANT.replace("Bd = [[1], [0]]", "Bd = [[1], [0]]\nDn = [[1]]")
+    cases = {
+        'h = ["x1"]': ("noise", True),
+        'h = ["x1 + v1"]': ("noise", False),
+        'f = ["0.5*x1 + x2", "0.8*x2"]': ("disturbance", True),
+        'f = ["0.5*x1 + x2 + d1", "0.8*x2"]': ("disturbance", False),
+    }
+    for line, (sig, warned) in cases.items():
+        text = scenario(base.replace("[method]", line + "\n[method]"), horizon=5, **{sig: UNIFORM})
+        notes = api.simulate(load_spec_text(text)).info.get("warnings", [])
+        said = any(f"[simulate.{sig}] reaches nothing" in w for w in notes)
+        assert said is warned, (line, notes)

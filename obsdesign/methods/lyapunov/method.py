@@ -92,6 +92,7 @@ class Lyapunov(Method):
             simulate_linear_observer_batch,
         )
 
+        _warn_unused_signals(spec)
         so = spec.simulate.options if spec.simulate is not None else None
         given = runs if runs is not None else (so.runs if so is not None else None)
         n = given or 1
@@ -119,6 +120,32 @@ class Lyapunov(Method):
 
     def options_schema(self) -> dict[str, Any]:
         return schema(self.key)
+
+
+def _warn_unused_signals(spec: Spec) -> None:
+    """Warn when ``[simulate.noise]`` (``[simulate.disturbance]``) is given but the plant's
+    ``[system] h`` (``f``), being the whole output (state) map, names no v1… (d1…): the signal
+    then reaches nothing (independent simulate review: ``h = ["x1 + 0.01*x2^2"]`` gave the
+    same numbers with and without noise, without a word). Section 5 of the
+    constrained-redesign paper (Astolfi et al., NOLCOS 2019) has y = Cx + v."""
+    import warnings
+
+    s, sim = spec.system, spec.simulate
+    if sim is None:
+        return
+    for sig, exprs, names, what, key in (
+        (sim.noise, s.h, s.noises, "h", "noise"),
+        (sim.disturbance, s.f, s.disturbances, "f", "disturbance"),
+    ):
+        if exprs is None or sig.kind == "zero":
+            continue
+        if not any(ex.uses(v) for ex in exprs for v in names):
+            warnings.warn(
+                f"[simulate.{key}] reaches nothing: [system] {what} is the whole "
+                f"{'output' if what == 'h' else 'state'} map and names none of "
+                f"{', '.join(names) or 'its variables'}",
+                stacklevel=3,
+            )
 
 
 METHOD = Lyapunov()
