@@ -306,7 +306,16 @@ def data_problem(data: Any, exact_strings: bool = False) -> tuple[str, str] | No
         if depth > max_depth:
             return _too_deep(node, max_depth)
         if isinstance(v, dict):
+            if v and depth + 1 > max_depth:
+                return _too_deep((node, next(reversed(v)), True), max_depth)
             for k, x in v.items():
+                t = type(x)
+                if t is float or t is bool:
+                    continue  # never a problem: not pushed (a report's claims hold ~10² such)
+                if t is str and (
+                    not exact_strings or (len(x) <= short and "e" not in x and "E" not in x)
+                ):
+                    continue  # number_text_problem's own first test, inline
                 stack.append(((node, k, True), x, depth + 1))
             continue
         if isinstance(v, list):

@@ -277,12 +277,21 @@ def test_data_problem_names_the_path_and_sees_floats_past_the_depth_limit() -> N
         == "p.exact.P[0][1]"
     )
     assert data_problem({"p": {"exact": {"P": [["1/2", "9" * 10**5]]}}}) is None
+    assert data_problem({"p": {"q": "9" * 10**5}}, exact_strings=True)[0] == "p.q"
+    assert data_problem({"p": {"q": "1e99999999"}}, exact_strings=True)[0] == "p.q"
+    assert data_problem({"p": {"q": "9" * 10**5}}) is None
     old = set_limits(max_depth=3)
     try:
         assert data_problem({"a": [[1.0]]}) is None
         assert data_problem({"a": [[[1.0]]]})[0] == "a"
         assert data_problem({"a": [[["text"]]]})[0] == "a"
         assert data_problem({"a": [["text"]]}) is None
+        # a dict's float, bool and string values are not walked one by one (a report's
+        # claims): their depth is still checked, at the dict
+        assert data_problem({"a": {"b": {"c": "x", "f": 1.5, "t": True}}}) is None
+        for leaf in ("x", 1.5, True, 7):
+            assert data_problem({"a": {"b": {"c": {"d": leaf}}}})[0] == "a.b.c.d"
+        assert data_problem({"a": {"b": {"c": {}}}}) is None
     finally:
         reset_limits(old)
     assert [p for p, _, _ in walk({"a": [1.0, {"b": 2}]})] == ["", "a", "a[1]", "a[1].b", "a[0]"]

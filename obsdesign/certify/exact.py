@@ -203,7 +203,7 @@ def _qparse(s: Any, floats: list[float] | None) -> Any:
         return Q(s)
     if isinstance(s, list):
         arr = np.array(s, dtype=object)
-        if arr.size == 0 or any(isinstance(v, list) for v in arr.flat):
+        if arr.size == 0:
             raise ValueError("ragged or empty exact array")
         flat = arr.reshape(-1)
         vals: list[fmpq] = []
@@ -217,6 +217,8 @@ def _qparse(s: Any, floats: list[float] | None) -> Any:
                 if floats is not None:
                     floats.append(p / q)  # int / int: correctly rounded, as _qfloat
                 continue
+            if isinstance(v, list):  # a ragged nesting: numpy keeps the shorter rows as lists
+                raise ValueError("ragged or empty exact array")
             if isinstance(v, bool) or not isinstance(v, (str, int, float)):
                 raise ValueError(f"not an exact value: {v!r}")
             x = Q(v)
