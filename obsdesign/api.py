@@ -647,11 +647,12 @@ def _step_note(sp: Spec) -> str | None:
     sim = sp.simulate
     if sim is None or sim.dt_given is None or sim.dt is None:
         return None
-    steps = sim.horizon.q / sim.dt.q
+    k = int(sim.horizon.q / sim.dt.q)  # a whole number of steps (the loader's choice)
+    steps = f"{k:,}" if k < 10**15 else f"about 1e{len(str(k)) - 1}"
     return (
         f"[simulate] dt = {float(sim.dt_given.f):g} does not divide horizon = "
         f"{float(sim.horizon.f):g}: the grid steps by dt = {float(sim.dt.f):.6g} ({steps} "
-        f"step{'' if steps == 1 else 's'}), so that it ends at the horizon"
+        f"step{'' if k == 1 else 's'}), so that it ends at the horizon"
     )
 
 

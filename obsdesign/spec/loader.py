@@ -342,14 +342,16 @@ def _simulate(t: Table, system: System) -> SimulateSpec:
 
 def _whole_steps(horizon: Value, dt: Value) -> tuple[Value, Value | None]:
     """The output step of a continuous-time simulation: ``dt`` when the horizon is a whole
-    number K of steps (to 10⁻⁹ relative, so that 10 / 0.1 counts as 100 although the double
-    0.1 is not 1/10), else horizon / ⌈horizon / dt⌉, the largest step below ``dt`` that ends
+    number K of steps (to 10⁻⁹ relative and 10⁻⁶ of a step, so that 10 / 0.1 counts as 100
+    although the double 0.1 is not 1/10), else horizon / ⌈horizon / dt⌉, the largest step below ``dt`` that ends
     the grid at the horizon: with dt = 0.3 the grid of horizon 1 stopped at 0.9, and with
     dt = 5 it held t = 0 alone (independent simulate review). Returns the step and the
     given ``dt`` when it was changed (else None)."""
+    from flint import fmpq
+
     r = horizon.q / dt.q
     k = int(round(float(r))) if r < 2**52 else None
-    if r.q == 1 or (k is not None and k >= 1 and abs(r - k) <= r / 10**9):
+    if r.q == 1 or (k is not None and k >= 1 and abs(r - k) <= min(r / 10**9, fmpq(1, 10**6))):
         return dt, None
     K = max(int(r.p // r.q) + 1, 1)  # ⌈r⌉ for r not an integer
     return Value.of(horizon.q / K), dt
