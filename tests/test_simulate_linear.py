@@ -181,6 +181,13 @@ def test_the_continuous_grid_ends_at_the_horizon() -> None:
     sp = load_spec_text(CONT + "horizon = 10\ndt = 0.1\n")
     assert sp.simulate.dt_given is None and len(sim_grid(sp)) == 101
     assert float(sp.simulate.dt.f) == 0.1
+    # an astronomic step count is said in a few digits (it overflowed float() once)
+    from obsdesign.api import _step_note
+
+    note = _step_note(load_spec_text(CONT + "horizon = 1e300\ndt = 3e-300\n"))
+    assert "(about 1e599 steps)" in note
+    # 1.43e9 steps and a fraction: not a whole number (the relative 1e-9 alone said it was)
+    assert load_spec_text(CONT + "horizon = 1e300\ndt = 7e290\n").simulate.dt_given is not None
 
 
 def test_a_dt_beyond_the_exact_discretization_is_bad_input() -> None:
