@@ -471,7 +471,7 @@ def test_simulate_time_limit_stops_a_run_with_exit_3(tmp_path, monkeypatch) -> N
     run stops with a SolverError naming the key, the observer and the sample; an unknown key
     before this change, the key is now accepted, and a non-positive value is exit 2."""
     from obsdesign.errors import SolverError
-    from obsdesign.methods.constrained import sim as csim
+    from obsdesign.simulate import budget as sim_budget
 
     p = tmp_path / "tl.toml"
     p.write_text(R2.replace("seed = 4", "seed = 4\ntime_limit = 1e-9"))
@@ -487,7 +487,7 @@ def test_simulate_time_limit_stops_a_run_with_exit_3(tmp_path, monkeypatch) -> N
         def perf_counter() -> float:
             return float(next(clock))
 
-    monkeypatch.setattr(csim, "time", Slow)
+    monkeypatch.setattr(sim_budget, "time", Slow)
     with pytest.raises(SolverError, match="the modified θ_m=3 observer runs at sample 0 of 60"):
         api.simulate(p, options={"time_limit": "1000.5", "theta_m": "3"})
     monkeypatch.undo()

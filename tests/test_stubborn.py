@@ -940,3 +940,61 @@ def test_a_single_run_is_not_refused_by_the_study_memory_estimate() -> None:
     api.check_sim_memory(sp, {})
     with pytest.raises(InputError, match=r"long\.toml: simulating 100 run\(s\)"):
         api.check_sim_memory(sp, {"study": "outliers"})
+
+
+STUDY = {"study": "outliers", "runs": "2"}
+
+
+@pytest.mark.parametrize(
+    "spec, options, still, where",
+    [
+        ("astolfi-stubborn-example1.toml", {}, 1, "the plant at step 0 of 10,000"),
+        ("astolfi-stubborn-example1.toml", {}, 11, "the stubborn observer at step 0 of 10,000"),
+        (
+            "astolfi-stubborn-example1.toml",
+            STUDY,
+            21,
+            "the nominal run of the outlier study at step 0 of 10,000",
+        ),
+        (
+            "astolfi-stubborn-example1.toml",
+            STUDY,
+            31,
+            r"the outlier study \(2 runs an amplitude\) at step 0 of 10,000",
+        ),
+        ("astolfi-stubborn-duffing.toml", {}, 1, "the high-gain observers at step 0 of 10,000"),
+    ],
+)
+def test_simulate_time_limit_stops_every_scenario(spec, options, still, where, monkeypatch):
+    """``[simulate] time_limit`` / ``--option time_limit`` bound the single run (plant and
+    observer), the outlier study (its nominal run and its runs) and the high-gain scenario: a
+    single run of 10⁶ steps took 114 s with no way to stop it (review 19). The clock stands
+    still for the first ``still`` looks (the budget's start and the loops before the one
+    tested: one look per 1024 steps, per chunk in the study), then jumps past the budget:
+    exit 3 naming the key and how far the run got."""
+    from obsdesign.errors import SolverError
+    from obsdesign.simulate import budget as sim_budget
+
+    sp = api.load_spec(SPECS / spec)
+    rep = api.design(sp)
+    clock = iter([0] * still + list(range(1000, 10**6, 1000)))
+
+    class Slow:
+        @staticmethod
+        def perf_counter() -> float:
+            return float(next(clock))
+
+    monkeypatch.setattr(sim_budget, "time", Slow)
+    with pytest.raises(SolverError, match=rf"within 999 s \(\[simulate\] time_limit\): {where}"):
+        api.simulate(sp, rep, options={**options, "time_limit": "999"})
+
+
+def test_simulate_time_limit_key_is_read_and_checked() -> None:
+    """``[simulate] time_limit`` is a key of the method (it was an unknown key), > 0."""
+    from obsdesign.errors import SpecError
+
+    text = (SPECS / "astolfi-stubborn-example1.toml").read_text()
+    sp = api.load_spec_text(text.replace("[simulate]\n", "[simulate]\ntime_limit = 12.5\n"))
+    assert sp.simulate.options.time_limit == 12.5
+    with pytest.raises(SpecError, match=r"\[simulate\.time_limit\]"):
+        api.load_spec_text(text.replace("[simulate]\n", "[simulate]\ntime_limit = 0\n"))

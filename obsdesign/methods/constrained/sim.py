@@ -4,7 +4,6 @@ the naive saturated observer (29), on the same plant trajectory."""
 
 from __future__ import annotations
 
-import time
 import warnings
 from collections.abc import Callable
 from typing import Any
@@ -12,12 +11,13 @@ from typing import Any
 import numpy as np
 
 from obsdesign.certify.exact import Q, to_float
-from obsdesign.errors import InputError, SolverError
+from obsdesign.errors import InputError
 from obsdesign.methods.constrained import bounds as B
 from obsdesign.methods.constrained.design import xhat_set
 from obsdesign.methods.constrained.observer import LinearF, Observer, Refiner, Trace
 from obsdesign.methods.constrained.options import Options, SimOptions
 from obsdesign.params import Parameters
+from obsdesign.simulate.budget import TimeBudget
 from obsdesign.simulate.result import SimResult
 from obsdesign.simulate.runner import signals
 from obsdesign.spec.models import Spec
@@ -129,7 +129,7 @@ def simulate(
     assert sm is not None
     so: SimOptions = sm.options if isinstance(sm.options, SimOptions) else SimOptions()
     limit = so.time_limit if time_limit is None else _positive(time_limit, "time_limit")
-    deadline = time.perf_counter() + limit
+    budget = TimeBudget(limit, "raise time_limit, or a smaller theta_m or horizon")
     theta = int(Q(_exact(params, "theta")))
     from_option = theta_m is not None
     thetas = theta_list(theta_m) if theta_m is not None else (so.theta_m or [min(theta, THETA_CAP)])
@@ -187,7 +187,7 @@ def simulate(
     if sat_r is not None:
         observers[f"saturated r={_fmt(sat_r)}"] = Observer(F, sat_r=sat_r)
     traces: dict[str, Trace] = {
-        name: ob.run(u, y, sm.xhat0.f, x, Pf, _budget(name, deadline, limit))
+        name: ob.run(u, y, sm.xhat0.f, x, Pf, _budget(name, budget))
         for name, ob in observers.items()
     }
 
@@ -257,19 +257,14 @@ def _fmt(a: np.ndarray) -> str:
     return "[" + ", ".join(f"{float(v):.6g}" for v in np.atleast_1d(a)) + "]"
 
 
-def _budget(name: str, deadline: float, limit: float) -> Callable[[int, int], None]:
-    """The time budget of one observer's run (``[simulate] time_limit``): a check that raises
-    :class:`SolverError` (exit 3) naming the observer and the sample it got to, once
-    ``deadline`` (a ``time.perf_counter`` value) has passed. A large θ_m had no bound but
-    :data:`MAX_REFINING_STEPS` (about 17 minutes; independent simulate review)."""
+def _budget(name: str, budget: TimeBudget) -> Callable[[int, int], None]:
+    """The time budget of one observer's run (``[simulate] time_limit``): ``check(k, N)``
+    raises :class:`SolverError` (exit 3) naming the observer and the sample it got to, past the
+    deadline. A large θ_m had no bound but :data:`MAX_REFINING_STEPS` (about 17 minutes;
+    independent simulate review)."""
 
     def check(k: int, N: int) -> None:
-        if time.perf_counter() > deadline:
-            raise SolverError(
-                f"simulation not finished within {limit:g} s ([simulate] time_limit): the "
-                f"{name} observer runs at sample {k:,} of {N:,} (raise time_limit, or a "
-                "smaller theta_m or horizon)"
-            )
+        budget.check(f"the {name} observer runs at sample {k:,} of {N:,}")
 
     return check
 

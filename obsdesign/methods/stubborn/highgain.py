@@ -31,6 +31,7 @@ from obsdesign.methods.base import SolverResult, SolverStatus
 from obsdesign.methods.stubborn.claims import identity_claim
 from obsdesign.methods.stubborn.options import ELL_FACTOR, Options, SimOptions
 from obsdesign.params import Parameters
+from obsdesign.simulate.budget import TimeBudget
 from obsdesign.simulate.result import SimResult
 from obsdesign.spec.models import Spec
 
@@ -236,9 +237,13 @@ def _check_step(k: np.ndarray, ell: float, dt: float) -> None:
     heun_warning(dt, rate, f"the high gain ℓ = {ell:.4g}: dt·ℓ·max|root|")
 
 
-def simulate(spec: Spec, params: Parameters, observer: str = "stubborn") -> SimResult:
+def simulate(
+    spec: Spec, params: Parameters, observer: str = "stubborn", budget: TimeBudget | None = None
+) -> SimResult:
     """Plant, standard and stubborn high-gain observers (Heun, step dt); ν: the spec's
-    impulsive outlier and high-frequency noise window. Reports |x̂ − x| of both."""
+    impulsive outlier and high-frequency noise window. Reports |x̂ − x| of both (high-gain
+    observer of the stubborn-observer slides, Astolfi, Alessandri, Zaccarian, WUDS 2017).
+    ``budget`` (the time budget) is looked at every 1024 steps."""
     s = spec.system
     sim = spec.simulate
     so: SimOptions = sim.options or SimOptions()
@@ -294,6 +299,8 @@ def simulate(spec: Spec, params: Parameters, observer: str = "stubborn") -> SimR
         return dx, ds
 
     for i in range(steps):
+        if budget is not None and i % 1024 == 0:
+            budget.check(f"the high-gain observers at step {i:,} of {steps:,}")
         ti, u = t[i], u_at(t[i])
         u2 = u_at(t[i] + dt)
         y = x[i, 0] + nu[i]

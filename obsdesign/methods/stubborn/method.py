@@ -49,6 +49,7 @@ class Stubborn(Method):
             "observer of the single run",
             choices=("stubborn", "luenberger", "standard"),
         ),
+        SimOption("time_limit", "float", None, "seconds the simulation may run", min=1e-3),
     )
 
     def sim_bytes(self, spec: Spec, runs: int, steps: float, options: dict[str, Any]) -> float:

@@ -70,7 +70,8 @@ class SimOptions:
     noise_std: standard deviation of the Gaussian measurement noise; outlier_rate:
     probability that a sample carries an outlier; amplitudes: maximal absolute values of the
     outliers (uniform in [−a, a]); runs: Monte Carlo runs per amplitude; sigma0: σ̄(0)
-    (None: max_i w_i (C e(0))_i², so that the injection starts unsaturated)."""
+    (None: max_i w_i (C e(0))_i², so that the injection starts unsaturated); time_limit:
+    seconds the simulation may run (exit 3 past it)."""
 
     noise_std: float = 0.05
     outlier_rate: float = 0.01
@@ -84,6 +85,8 @@ class SimOptions:
     hf_start: float = 0.0
     hf_stop: float = 0.0
     hf_amplitude: float = 0.0
+    #: seconds the simulation may run (exit 3 past it)
+    time_limit: float = 300.0
 
 
 def parse_options(table: Table, spec: Spec) -> Options:
@@ -210,6 +213,8 @@ def parse_simulate(table: Table, spec: Spec) -> SimOptions:
             raise table.error(
                 "hf_stop", f"expected hf_stop >= hf_start = {o.hf_start:g} (the noise window)"
             )
+    if table.has("time_limit"):
+        o.time_limit = float(table.scalar("time_limit", min=0, strict_min=True).f)
     return o
 
 
@@ -255,4 +260,5 @@ def simulate_schema() -> dict[str, Any]:
         "hf_start": {**num, "minimum": 0},
         "hf_stop": {**num, "minimum": 0},
         "hf_amplitude": {**num, "minimum": 0},
+        "time_limit": {**num, "exclusiveMinimum": 0},
     }

@@ -22,6 +22,7 @@ dt (the measurement is sampled every dt).
 from __future__ import annotations
 
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -30,6 +31,7 @@ import numpy as np
 from obsdesign.errors import InputError
 from obsdesign.methods.stubborn.options import SimOptions
 from obsdesign.params import Parameters
+from obsdesign.simulate.budget import TimeBudget
 from obsdesign.simulate.result import SimResult
 from obsdesign.spec.models import Spec
 
@@ -73,6 +75,7 @@ def run_errors(
     adaptive: np.ndarray,
     sigma0: float,
     dist: Any = None,
+    check: Callable[[int, int], None] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Integrate the errors of a batch of observers: the error dynamics of the stubborn-observer
     slides (Astolfi, Alessandri, Zaccarian, WUDS 2017), ė = Ae + B_d d − K sat_σ(Ce + ν),
@@ -85,7 +88,8 @@ def run_errors(
     0..steps (for the RMSE, shape (..., n)), the final e and the final σ̄ (trajectories are
     not kept: :func:`single_run` steps one at a time to record them). ``dist(k0, k1)`` ->
     (k1 − k0, n): the plant's disturbance term B_d d of steps k0..k1−1 (held over each step),
-    the same for every observer (None: no disturbance)."""
+    the same for every observer (None: no disturbance). ``check(k0, steps)``, the time budget,
+    is called before every chunk of steps."""
     e = np.broadcast_to(e0, adaptive.shape + (g.A.shape[0],)).astype(float).copy()
     sb = np.where(adaptive, sigma0, 0.0)
     sq = e**2
@@ -100,6 +104,8 @@ def run_errors(
 
     chunk = 2000
     for k0 in range(0, steps, chunk):
+        if check is not None:
+            check(k0, steps)
         k1 = min(steps, k0 + chunk)
         V = nu(k0, k1)
         Dd = dist(k0, k1) if dist is not None else None
@@ -125,6 +131,9 @@ def run_errors(
             sq += e**2
     return sq, e, sb
 
+
+#: the time budget is looked at every this many steps of a one-run loop
+CHECK_EVERY = 1024
 
 #: Heun's method is stable for dt·|z| up to about 2 on the negative real axis
 HEUN_LIMIT = 2.0
@@ -212,9 +221,17 @@ def run_noise_fn(
 
 
 def sigma_levels(
-    g: Gains, e0: np.ndarray, so: SimOptions, steps: int, dt: float, seed: int
+    g: Gains,
+    e0: np.ndarray,
+    so: SimOptions,
+    steps: int,
+    dt: float,
+    seed: int,
+    budget: TimeBudget | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Nominal run of the stubborn observer (noise, no outliers): σ_i(t), its mean and max."""
+    """Nominal run of the stubborn observer (noise, no outliers): σ_i(t), its mean and max
+    (the adaptive level of the stubborn-observer slides, Astolfi, Alessandri, Zaccarian,
+    WUDS 2017); ``budget`` is looked at every :data:`CHECK_EVERY` steps."""
     rng = np.random.default_rng(seed)
     p = g.C.shape[0]
     nom = SimOptions(so.noise_std, 0.0, (0.0,), 1, so.sigma0)
@@ -224,6 +241,8 @@ def sigma_levels(
     sig = np.empty((steps, p))
     e, sb = e0.astype(float), s0
     for k in range(steps):  # one run: plain loop, keeps σ(t)
+        if budget is not None and k % CHECK_EVERY == 0:
+            budget.check(f"the nominal run of the outlier study at step {k:,} of {steps:,}")
         _, e, sb = run_errors(
             g, e, lambda a, b, V=V, k=k: V[k : k + 1], 1, dt, np.zeros(p), np.array(True), sb
         )
@@ -231,9 +250,12 @@ def sigma_levels(
     return sig, sig.mean(axis=0), sig.max(axis=0)
 
 
-def study(spec: Spec, params: Parameters, runs: int | None = None) -> dict[str, Any]:
+def study(
+    spec: Spec, params: Parameters, runs: int | None = None, budget: TimeBudget | None = None
+) -> dict[str, Any]:
     """The outlier study: medians over Monte Carlo runs of the RMSE of each state, for each
-    observer and each outlier amplitude (slides, Examples 1-3 tables)."""
+    observer and each outlier amplitude (slides, Examples 1-3 tables); ``budget``, the time
+    budget, is looked at during the nominal run and before every chunk of steps."""
     so: SimOptions = spec.simulate.options or SimOptions()
     g = Gains.of(spec, params)
     sim = spec.simulate
@@ -241,7 +263,7 @@ def study(spec: Spec, params: Parameters, runs: int | None = None) -> dict[str, 
     steps, dt = _grid(spec)
     runs = runs or so.runs
     p = g.C.shape[0]
-    _, mean_l, max_l = sigma_levels(g, e0, so, steps, dt, sim.seed)
+    _, mean_l, max_l = sigma_levels(g, e0, so, steps, dt, sim.seed, budget)
     amps = np.asarray(so.amplitudes, float)
     no, na = len(OBSERVERS), len(amps)
     levels = np.empty((no, na, runs, p))
@@ -260,7 +282,11 @@ def study(spec: Spec, params: Parameters, runs: int | None = None) -> dict[str, 
     def nu(k0: int, k1: int) -> np.ndarray:
         return base(k0, k1)[:, None]  # same noise for every observer
 
-    sq, _, _ = run_errors(g, e0, nu, steps, dt, levels, adaptive, s0)
+    def check(k: int, K: int) -> None:
+        if budget is not None:
+            budget.check(f"the outlier study ({runs:,} runs an amplitude) at step {k:,} of {K:,}")
+
+    sq, _, _ = run_errors(g, e0, nu, steps, dt, levels, adaptive, s0, check=check)
     rmse = np.sqrt(sq / (steps + 1))  # (observers, amplitudes, runs, n)
     med = np.median(rmse, axis=2)
     names = spec.system.states
@@ -291,9 +317,13 @@ def format_table(st: dict[str, Any], states: list[str]) -> str:
     return "\n".join(rows)
 
 
-def single_run(spec: Spec, params: Parameters, observer: str = "stubborn") -> SimResult:
+def single_run(
+    spec: Spec, params: Parameters, observer: str = "stubborn", budget: TimeBudget | None = None
+) -> SimResult:
     """One run: plant, the chosen observer, σ(t); noise from the spec's [simulate.noise]
-    (through Dn) when given, else the outlier model with amplitude 10 (the slides' runs)."""
+    (through Dn) when given, else the outlier model with amplitude 10 (the slides' runs;
+    stubborn-observer slides, Astolfi, Alessandri, Zaccarian, WUDS 2017). ``budget`` is looked
+    at every :data:`CHECK_EVERY` steps."""
     so: SimOptions = spec.simulate.options or SimOptions()
     s = spec.system
     sim = spec.simulate
@@ -308,7 +338,7 @@ def single_run(spec: Spec, params: Parameters, observer: str = "stubborn") -> Si
         V = v @ np.asarray(s.Dn.f, float).T
     else:
         V = noise_fn(rng, (), p, so, np.asarray(10.0))(0, steps + 1)
-    x, Dd = _plant(spec, steps, dt, rng)
+    x, Dd = _plant(spec, steps, dt, rng, budget)
     e0 = x[0] - np.asarray(sim.xhat0.f, float)
     s0 = so.sigma0 if so.sigma0 is not None else default_sigma0(g, e0)
     E = np.empty((steps + 1, n))
@@ -318,6 +348,8 @@ def single_run(spec: Spec, params: Parameters, observer: str = "stubborn") -> Si
     lev = np.full(p, np.inf)
     e, sb = e0, s0
     for k in range(steps):
+        if budget is not None and k % CHECK_EVERY == 0:
+            budget.check(f"the {observer} observer at step {k:,} of {steps:,}")
         _, e, sb = run_errors(
             g,
             e,
@@ -348,7 +380,11 @@ def single_run(spec: Spec, params: Parameters, observer: str = "stubborn") -> Si
 
 
 def _plant(
-    spec: Spec, steps: int, dt: float, rng: np.random.Generator
+    spec: Spec,
+    steps: int,
+    dt: float,
+    rng: np.random.Generator,
+    budget: TimeBudget | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Plant trajectory x (steps+1, n): ẋ = A x + B u(t) + Bd d (RK4, u from [system] u or
     [simulate.u], d from [simulate.disturbance] held over each step); x⁺ = ... in discrete
@@ -373,6 +409,8 @@ def _plant(
     x = np.empty((steps + 1, s.n))
     x[0] = np.asarray(sim.x0.f, float)
     for k in range(steps):
+        if budget is not None and k % CHECK_EVERY == 0:
+            budget.check(f"the plant at step {k:,} of {steps:,}")
         tk, xk, d = grid[k], x[k], Bd @ D[k]
         if s.discrete:
             x[k + 1] = A @ xk + B @ u(tk) + d
@@ -390,11 +428,23 @@ def _plant(
 
 
 def simulate(
-    spec: Spec, params: Parameters, study: str = "none", runs: int = 0, observer: str = "stubborn"
+    spec: Spec,
+    params: Parameters,
+    study: str = "none",
+    runs: int = 0,
+    observer: str = "stubborn",
+    time_limit: float | None = None,
 ) -> SimResult:
     """``simulate``: one run (default) or the outlier study (``--option study=outliers``).
     ``runs`` (> 0) is the study's number of Monte Carlo runs per amplitude; asked without the
-    study it is refused (it was silently ignored: one run printed — stubborn review)."""
+    study it is refused (it was silently ignored: one run printed — stubborn review).
+    ``time_limit`` (else ``[simulate] time_limit``, 300 s): past it, exit 3 saying how far
+    the run got (a single run of 10⁶ steps took 114 s with no way to stop it; review 19)."""
+    so: SimOptions = spec.simulate.options or SimOptions()
+    budget = TimeBudget(
+        so.time_limit if time_limit is None else float(time_limit),
+        "raise time_limit, or a shorter horizon, a larger dt or fewer runs",
+    )
     if runs and study == "none":
         raise InputError(
             f"--runs {runs}: the stubborn method's Monte Carlo runs are those of the outlier "
@@ -409,12 +459,12 @@ def simulate(
                 "redesign); the high-gain scenario is the spec's impulse and noise window"
             )
 
-        return hg(spec, params, observer=observer)
+        return hg(spec, params, observer=observer, budget=budget)
     if spec.system.A is None:
         raise InputError("stubborn simulation needs the linear model")
-    res = single_run(spec, params, observer if observer != "standard" else "luenberger")
+    res = single_run(spec, params, observer if observer != "standard" else "luenberger", budget)
     if study == "outliers":
-        st = _study(spec, params, runs or None)
+        st = _study(spec, params, runs or None, budget)
         res.info["outlier_study"] = "\n" + format_table(st, spec.system.states)
         res.info["constant_sat_levels"] = st["constant_levels"]
         res.info["runs"] = st["runs"]
