@@ -259,3 +259,66 @@ def test_runs_1_is_run_0_of_any_run_count(tmp_path) -> None:
     p.write_text(RANDOM.replace("seed = 11", "seed = 11\nruns = 1"))
     spec_one = api.simulate(p)
     np.testing.assert_array_equal(spec_one.extra["per_run"]["rmse"], one.extra["per_run"]["rmse"])
+
+
+EXPR = PLANT.replace("[method]", 'f = ["0.5*x1 + x2 + 0.01*sin(x1)", "0.8*x2"]\n[method]')
+
+
+@pytest.mark.parametrize(
+    "text, options, where",
+    [
+        (RANDOM, {}, "the run at step 0 of 600"),
+        (RANDOM, {"runs": "3"}, "0 of 3 Monte Carlo runs done"),
+        (scenario(EXPR, noise=UNIFORM), {}, "the expression plant at step 0 of 600"),
+        (scenario(EXPR, noise=UNIFORM), {"runs": "3"}, "0 of 3 Monte Carlo runs done"),
+    ],
+)
+def test_lyapunov_simulate_has_a_time_budget(text, options, where, monkeypatch, tmp_path):
+    """``[simulate] time_limit`` / ``--option time_limit`` (default 300 s) bound the lyapunov
+    simulation: 10⁶ steps of an expression plant took ~70 s and the memory limit allowed 20
+    times more, with no way to stop it. A clock past the budget stops the single run and the
+    Monte Carlo study, linear or not, with exit 3 naming the key and where it got to."""
+    from obsdesign import api
+    from obsdesign.errors import SolverError
+    from obsdesign.simulate import budget as sim_budget
+
+    clock = iter(range(0, 10**6, 1000))  # every look at the clock is 1000 s later
+
+    class Slow:
+        @staticmethod
+        def perf_counter() -> float:
+            return float(next(clock))
+
+    p = tmp_path / "s.toml"
+    p.write_text(text)
+    api.simulate(p, options={**options, "time_limit": "999"})  # the real clock: finished
+    monkeypatch.setattr(sim_budget, "time", Slow)
+    with pytest.raises(SolverError, match=rf"within 999 s \(\[simulate\] time_limit\): {where}"):
+        api.simulate(p, options={**options, "time_limit": "999"})
+    p.write_text(text.replace("seed = 11", "seed = 11\ntime_limit = 999"))
+    with pytest.raises(SolverError, match="within 999 s"):
+        api.simulate(p, options=options)
+
+
+def test_a_batch_checks_its_budget_between_chunks(monkeypatch) -> None:
+    """The Monte Carlo stepping looks at the budget before every chunk of CHUNK steps, not only
+    between batches (one batch of 512 runs × 10⁶ steps is the long part)."""
+    from obsdesign.errors import SolverError
+    from obsdesign.simulate.budget import TimeBudget
+
+    monkeypatch.setattr(mc, "CHUNK", 160)  # a multiple of BLOCK
+    sp = load_spec_text(RANDOM)
+    looks = []
+    budget = TimeBudget(60, "advice")
+    real = budget.check
+
+    def check(where: str) -> None:
+        looks.append(where)
+        if len(looks) == 4:
+            budget.deadline = -1.0
+        real(where)
+
+    budget.check = check
+    with pytest.raises(SolverError, match=r"a batch of 2 runs at step 320 of 600"):
+        mc.run_batch(sp, joint_system(sp, L), 2, "E0", budget=budget)
+    assert looks[:2] == ["0 of 2 Monte Carlo runs done", "a batch of 2 runs at step 0 of 600"]

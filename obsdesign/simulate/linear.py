@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from obsdesign.errors import InputError
+from obsdesign.simulate.budget import TimeBudget
 from obsdesign.simulate.result import SimResult
 from obsdesign.spec.models import Spec
 
@@ -120,15 +121,20 @@ def exogenous(u: np.ndarray, d: np.ndarray, v: np.ndarray) -> np.ndarray:
 CHUNK = 1 << 16
 
 
-def step_all(js: JointSystem, z0: np.ndarray, S: np.ndarray) -> np.ndarray:
+def step_all(
+    js: JointSystem, z0: np.ndarray, S: np.ndarray, budget: TimeBudget | None = None
+) -> np.ndarray:
     """The trajectory z_0 .. z_K of z_{k+1} = M z_k + E s_k for the signals ``S`` ((K, ·):
-    s_0 .. s_{K-1}); E s_k is computed :data:`CHUNK` steps at a time, one product each."""
+    s_0 .. s_{K-1}); E s_k is computed :data:`CHUNK` steps at a time, one product each;
+    ``budget`` is looked at before every chunk."""
     K = len(S)
     Z = np.empty((K + 1, len(z0)))
     Z[0] = z0
     M, ET = js.M, js.E.T
     mm = np.matmul
     for k0 in range(0, K, CHUNK):
+        if budget is not None:
+            budget.check(f"the run at step {k0:,} of {K:,}")
         k1 = min(K, k0 + CHUNK)
         W = S[k0:k1] @ ET
         for k in range(k0, k1):
@@ -138,18 +144,20 @@ def step_all(js: JointSystem, z0: np.ndarray, S: np.ndarray) -> np.ndarray:
     return Z
 
 
-def simulate_linear_observer(spec: Spec, L: np.ndarray) -> SimResult:
+def simulate_linear_observer(
+    spec: Spec, L: np.ndarray, budget: TimeBudget | None = None
+) -> SimResult:
     """Simulate the linear Luenberger observer with gain L against the spec's plant over
     the ``[simulate]`` scenario (x0, xhat0, signals from ``seed``); one run. A plant given by
     expressions (``[system] f / psi / h``) runs through
-    :func:`obsdesign.simulate.nonlinear.simulate_one`."""
+    :func:`obsdesign.simulate.nonlinear.simulate_one`. ``budget``: the time budget."""
     from obsdesign.simulate.runner import signals
 
     s = spec.system
     if not s.linear:
         from obsdesign.simulate.nonlinear import simulate_one
 
-        return simulate_one(spec, L)
+        return simulate_one(spec, L, budget)
     js = joint_system(spec, L, error=True)
     u, d, v = signals(spec, js.grid)
     sim = spec.simulate
@@ -158,7 +166,7 @@ def simulate_linear_observer(spec: Spec, L: np.ndarray) -> SimResult:
     # (:func:`obsdesign.api._left_float_range`), not by numpy's overflow warnings
     with np.errstate(over="ignore", invalid="ignore"):
         z0 = np.concatenate([sim.x0.f, sim.xhat0.f - sim.x0.f])
-        Z = step_all(js, z0, exogenous(u, d, v)[:-1])
+        Z = step_all(js, z0, exogenous(u, d, v)[:-1], budget)
         x, e = Z[:, : js.n], Z[:, js.n :]
         y = x @ s.C.f.T + u @ s.D.f.T + v @ s.Dn.f.T
         xhat = x + e
@@ -172,6 +180,7 @@ def simulate_linear_observer_batch(
     initial_error: str | None = None,
     batch: int | None = None,
     span: tuple[int, int] | None = None,
+    budget: TimeBudget | None = None,
 ) -> SimResult:
     """N Monte Carlo runs of the linear observer with gain L (see
     :func:`obsdesign.simulate.montecarlo.run_batch`; a plant given by expressions:
@@ -182,13 +191,14 @@ def simulate_linear_observer_batch(
     ``montecarlo.BATCH_BYTES``). Per-run metrics in ``extra["per_run"]``,
     quantiles in ``info["quantiles"]``; the trajectory shown is run 0's. ``span = (a, b)``:
     only runs a..b-1 (``simulate --workers``, see :func:`~obsdesign.simulate.montecarlo.merge`).
+    ``budget``: the time budget, looked at per batch and per chunk of steps.
     """
     from obsdesign.simulate import montecarlo as mc
 
     if spec.system.linear:
         js = joint_system(spec, L, error=True)
-        return mc.run_batch(spec, js, runs, initial_error, batch=batch, span=span)
+        return mc.run_batch(spec, js, runs, initial_error, batch=batch, span=span, budget=budget)
     from obsdesign.simulate.nonlinear import batch_stepper
 
-    grid, per_run, step = batch_stepper(spec, L)
-    return mc.study(spec, grid, runs, initial_error, batch, span, per_run, step)
+    grid, per_run, step = batch_stepper(spec, L, budget)
+    return mc.study(spec, grid, runs, initial_error, batch, span, per_run, step, budget)

@@ -39,6 +39,7 @@ import numpy as np
 
 from obsdesign.errors import InputError
 from obsdesign.sets.base import ConvexSet
+from obsdesign.simulate.budget import TimeBudget
 from obsdesign.simulate.result import SimResult
 from obsdesign.spec.models import Spec
 from obsdesign.spec.reader import Table
@@ -303,8 +304,8 @@ def run_batch(
 ) -> SimResult:
     """``runs`` runs of ``js`` (a :class:`~obsdesign.simulate.linear.JointSystem` of the
     bound ``spec``); ``initial_error``: a set name of ``[sets]`` (None: xhat0 − x0);
-    ``study_options``: ``batch`` (runs stepped together) and ``span`` (only runs a..b-1),
-    see :func:`study`.
+    ``study_options``: ``batch`` (runs stepped together), ``span`` (only runs a..b-1) and
+    ``budget`` (the time budget), see :func:`study`.
 
     Linearity does the work: the deterministic signals (and the plant trajectory x when no
     random signal reaches it: only the estimate is then stepped per run) enter as one
@@ -321,10 +322,12 @@ def run_batch(
     plan = _plan(js, sigs, grid, sim.x0.f, sim.seed)
     w = sum(sigs[i].dim for i in plan.rand)
 
+    budget = study_options.get("budget")
+
     def step(rngs: list[np.random.Generator], e0: np.ndarray, keep: bool) -> Any:
         draws = _Draws(plan.rand, plan.fast, sigs, rngs, grid) if plan.rand else None
         traj0 = np.empty((K + 1, len(plan.idx))) if keep else None
-        m = _run(plan, draws, sim.x0.f, e0, K, n, traj0)
+        m = _run(plan, draws, sim.x0.f, e0, K, n, traj0, budget)
         if traj0 is None:
             return m, None
         x, e = _trajectory(plan, traj0, n)
@@ -332,7 +335,7 @@ def run_batch(
 
     per_run = (CHUNK if plan.fast else K + 1) * w * 8
     batch, span = study_options.get("batch"), study_options.get("span")
-    res = study(spec, grid, runs, initial_error, batch, span, per_run, step)
+    res = study(spec, grid, runs, initial_error, batch, span, per_run, step, budget)
     s = spec.system
     eset = spec.sets[initial_error] if initial_error is not None else None
     child = np.random.SeedSequence(sim.seed, spawn_key=(span[0] if span else 0,))
@@ -356,6 +359,7 @@ def study(
     span: tuple[int, int] | None,
     per_run_bytes: int,
     step: Any,
+    budget: TimeBudget | None = None,
 ) -> SimResult:
     """The Monte Carlo study of the bound ``spec`` on ``grid``: the child seeds, the batches
     (``batch`` runs, default :data:`BATCH_RUNS` or fewer when ``per_run_bytes`` each do not
@@ -364,7 +368,7 @@ def study(
     :func:`merge` joins spans; None: all), each run's generator and initial error, then
     ``step(rngs, e0, keep)`` → (per-run metrics of the batch, run 0's (x, x̂), (x, x̂, y) or
     (x, x̂, y or None, e) when ``keep``) (the generators stand just after the initial errors'
-    draws).
+    draws). ``budget`` (the time budget) is looked at before every batch.
 
     Returns run 0's trajectory with ``info`` = runs, where the
     initial errors come from and the quantiles of every per-run metric, and
@@ -389,6 +393,8 @@ def study(
     e0_all = np.zeros((runs, n))
     traj: Any = None
     for b0 in range(0, runs, B):
+        if budget is not None:
+            budget.check(f"{b0:,} of {runs:,} Monte Carlo runs done")
         rngs = [np.random.default_rng(c) for c in children[b0 : b0 + B]]
         e0 = initial_errors(eset, rngs, sim.xhat0.f - sim.x0.f)
         e0_all[b0 : b0 + len(rngs)] = e0
@@ -418,6 +424,7 @@ def _run(
     K: int,
     n: int,
     traj0: np.ndarray | None,
+    budget: TimeBudget | None = None,
 ) -> dict[str, np.ndarray]:
     """Step one batch (initial errors ``e0`` (R, n)) over K steps; per-run metrics.
 
@@ -430,7 +437,8 @@ def _run(
     the batching. E is stepped; H = E + x (shared x: its block term; else the stepped X).
     The metrics are running elementwise max / min / sum of squares over the blocks (whole
     contiguous arrays), reduced over the m positions once at the end. ``traj0`` (K + 1, N)
-    receives run 0's stepped states ([x; e], or e) when given."""
+    receives run 0's stepped states ([x; e], or e) when given; ``budget`` (the time budget)
+    is looked at before every chunk of :data:`CHUNK` steps."""
     R, N = len(e0), len(plan.idx)
     Rr = max(R, 2)
     shared_x = plan.x_sh is not None
@@ -460,6 +468,8 @@ def _run(
     mm = _matmul_for(Rr, max(N + 1, BLOCK * max(dims, default=1)), BLOCK * n)
     PH, PE, PX = bm.PH, bm.PE, bm.PX
     for c0 in range(0, K, CHUNK):
+        if budget is not None:
+            budget.check(f"a batch of {R:,} runs at step {c0:,} of {K:,}")
         c1 = min(K, c0 + CHUNK)
         raw = draws.chunk(c0, c1) if draws is not None else []
         for k0 in range(c0, c1, BLOCK):

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from obsdesign.simulate import montecarlo as mc
+from obsdesign.simulate.budget import TimeBudget
 from obsdesign.simulate.linear import sim_grid
 from obsdesign.simulate.result import SimResult
 from obsdesign.spec.models import Spec
@@ -109,10 +110,11 @@ def step_runs(
     XH0: np.ndarray,
     at: Signals,
     keep: bool,
+    budget: TimeBudget | None = None,
 ) -> tuple[dict[str, np.ndarray], tuple[np.ndarray, ...] | None]:
     """Step R ≥ 2 runs (rows of ``X0``, ``XH0``) over ``grid``; per-run metrics (as
     :func:`obsdesign.simulate.montecarlo.study` names them) and, when ``keep``, run 0's
-    (x, x̂, y) trajectories."""
+    (x, x̂, y) trajectories. ``budget`` (the time budget) is looked at every 1024 steps."""
     K = len(grid) - 1
     X, E = X0.copy(), XH0 - X0
     XH = X + E
@@ -120,6 +122,8 @@ def step_runs(
     traj = [np.empty((K + 1, plant.n)) for _ in range(3)] + [np.empty((K + 1, plant.s.p))]
     dt = float(grid[1] - grid[0]) if K else 0.0
     for k in range(K + 1):
+        if budget is not None and k % 1024 == 0:
+            budget.check(f"the expression plant at step {k:,} of {K:,}")
         U, Dd, V = at(k)
         if keep:
             traj[0][k], traj[1][k], traj[2][k] = X[0], XH[0], E[0]
@@ -176,7 +180,7 @@ def _rk4(
     return X, E
 
 
-def simulate_one(spec: Spec, L: np.ndarray) -> SimResult:
+def simulate_one(spec: Spec, L: np.ndarray, budget: TimeBudget | None = None) -> SimResult:
     """The spec's scenario once (x0, xhat0, signals from ``seed``), stepped as two equal rows
     (so that it is run 0 of a batch to the bit)."""
     from obsdesign.simulate.runner import signals
@@ -187,13 +191,22 @@ def simulate_one(spec: Spec, L: np.ndarray) -> SimResult:
     pair = [np.stack([a, a], axis=1) for a in sig]  # (K + 1, 2, ·)
     X0, XH0 = np.tile(sim.x0.f, (2, 1)), np.tile(sim.xhat0.f, (2, 1))
     _, traj = step_runs(
-        Plant(spec, L), spec, grid, X0, XH0, lambda k: (pair[0][k], pair[1][k], pair[2][k]), True
+        Plant(spec, L),
+        spec,
+        grid,
+        X0,
+        XH0,
+        lambda k: (pair[0][k], pair[1][k], pair[2][k]),
+        True,
+        budget,
     )
     assert traj is not None
     return SimResult(grid, traj[0], traj[1], traj[2], spec.system.states, error=traj[3])
 
 
-def batch_stepper(spec: Spec, L: np.ndarray) -> tuple[np.ndarray, int, Any]:
+def batch_stepper(
+    spec: Spec, L: np.ndarray, budget: TimeBudget | None = None
+) -> tuple[np.ndarray, int, Any]:
     """What :func:`obsdesign.simulate.montecarlo.study` needs to run Monte Carlo runs of the
     observer with gain ``L`` against the expression plant, stepped together: the grid, the
     memory of a run's random draws, and the batch step (draws as the linear path makes them,
@@ -230,7 +243,7 @@ def batch_stepper(spec: Spec, L: np.ndarray) -> tuple[np.ndarray, int, Any]:
 
         X0 = np.tile(sim.x0.f, (rows, 1))
         XH0 = X0 + np.concatenate([e0, e0[:1]]) if R == 1 else X0 + e0
-        m, traj = step_runs(plant, spec, grid, X0, XH0, at, keep)
+        m, traj = step_runs(plant, spec, grid, X0, XH0, at, keep, budget)
         return {k: a[:R] for k, a in m.items()}, traj
 
     return grid, (mc.CHUNK if fast else len(grid)) * w * 8, step

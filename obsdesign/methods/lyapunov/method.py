@@ -56,6 +56,7 @@ class Lyapunov(Method):
         SimOption(
             "batch", "int", None, "runs stepped together (default: as many as fit in memory)", min=1
         ),
+        SimOption("time_limit", "float", None, "seconds the simulation may run", min=1e-3),
     )
 
     def parse_options(self, table: Table, spec: Spec) -> Options:
@@ -80,13 +81,17 @@ class Lyapunov(Method):
         runs: int | None = None,
         batch: int | None = None,
         span: tuple[int, int] | None = None,
+        time_limit: float | None = None,
     ) -> Any:
         """One run of the spec's scenario, or ``runs`` batched Monte Carlo runs (per-run
         metrics and quantiles; :func:`obsdesign.simulate.linear.simulate_linear_observer_batch`);
         ``span = (a, b)``: only runs a..b-1 of them (``simulate --workers``, see
         :func:`obsdesign.simulate.montecarlo.run_batch`). ``runs`` given, even 1, is the Monte
         Carlo study: its run 0 is run 0 of any N (``--runs 1`` was the single scenario, drawn
-        from ``default_rng(seed)``, not from child 0 of ``SeedSequence(seed)``; review)."""
+        from ``default_rng(seed)``, not from child 0 of ``SeedSequence(seed)``; review).
+        ``time_limit`` (else ``[simulate] time_limit``, 300 s): past it, exit 3 (10⁶ steps of
+        an expression plant took ~70 s, and memory allowed 20 times more)."""
+        from obsdesign.simulate.budget import TimeBudget
         from obsdesign.simulate.linear import (
             simulate_linear_observer,
             simulate_linear_observer_batch,
@@ -97,9 +102,11 @@ class Lyapunov(Method):
         given = runs if runs is not None else (so.runs if so is not None else None)
         n = given or 1
         ie = so.initial_error if so is not None else None
+        limit = time_limit if time_limit is not None else (so.time_limit if so else 300.0)
+        budget = TimeBudget(limit, "raise time_limit, or fewer runs or a shorter horizon")
         if given is None and ie is None and batch is None and span is None:
-            return simulate_linear_observer(spec, params.float("L"))
-        return simulate_linear_observer_batch(spec, params.float("L"), n, ie, batch, span)
+            return simulate_linear_observer(spec, params.float("L"), budget)
+        return simulate_linear_observer_batch(spec, params.float("L"), n, ie, batch, span, budget)
 
     def sim_bytes(self, spec: Spec, runs: int, steps: float, options: dict[str, Any]) -> float:
         """One run keeps its trajectories; several runs keep run 0's trajectories, per-run

@@ -179,6 +179,8 @@ class SimOptions:
 
     runs: int | None = None
     initial_error: str | None = None
+    #: seconds the simulation may run (exit 3 past it)
+    time_limit: float = 300.0
 
 
 def parse_simulate(table: Table, spec: Spec) -> SimOptions:
@@ -189,12 +191,18 @@ def parse_simulate(table: Table, spec: Spec) -> SimOptions:
     from obsdesign.simulate.montecarlo import parse_initial_error
 
     runs = table.int("runs", default=None, min=1)
-    return SimOptions(runs, parse_initial_error(table, spec))
+    ie = parse_initial_error(table, spec)
+    limit = table.scalar("time_limit", default=None, min=0, strict_min=True)
+    return SimOptions(runs, ie, 300.0 if limit is None else float(limit.f))
 
 
 def simulate_schema() -> dict[str, Any]:
     """JSON-schema properties of the ``lyapunov`` method's own ``[simulate]`` keys."""
-    return {"runs": {"type": "integer", "minimum": 1}, "initial_error": {"type": "string"}}
+    return {
+        "runs": {"type": "integer", "minimum": 1},
+        "initial_error": {"type": "string"},
+        "time_limit": {"type": "number", "exclusiveMinimum": 0},
+    }
 
 
 def schema(key: str) -> dict[str, Any]:
