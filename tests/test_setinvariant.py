@@ -597,3 +597,37 @@ def test_simulated_error_keeps_its_digits_for_a_large_state() -> None:
     assert "1e17" in far
     shifted = api.simulate(load_spec_text(far, "b.toml")).metrics()
     assert shifted["final_error_norm"] == pytest.approx(base["final_error_norm"], rel=1e-12)
+
+
+@pytest.mark.parametrize("law", [None, "online-lp", "linear"])
+def test_simulate_time_limit_stops_the_run(rep71, law, monkeypatch) -> None:
+    """``[simulate] time_limit`` / ``--option time_limit`` (default 300 s) bound the
+    simulation (online-lp solves an LP at every step: a long horizon ran for hours). A clock
+    past the budget stops it with exit 3 naming the key, the law and the step; the key is read
+    from the spec (it was unknown) and must be > 0."""
+    from pathlib import Path
+
+    from obsdesign.errors import SolverError, SpecError
+    from obsdesign.simulate import budget as sim_budget
+
+    _, out = rep71
+    path = Path(__file__).resolve().parents[1] / "specs" / "dorea-pimenta-7-1.toml"
+    text = path.read_text()
+    timed = api.load_spec_text(text.replace("[simulate]", "[simulate]\ntime_limit = 999", 1))
+    assert timed.simulate.options.time_limit == 999
+    spec = api.load_spec(path)  # the report's own spec; the budget as an option
+    clock = iter(range(0, 10**6, 1000))  # every look at the clock is 1000 s later
+
+    class Slow:
+        @staticmethod
+        def perf_counter() -> float:
+            return float(next(clock))
+
+    monkeypatch.setattr(sim_budget, "time", Slow)
+    name = law or "interpolated"
+    with pytest.raises(SolverError, match=rf"within 999 s .*: the {name} law at step 0 of 17"):
+        api.simulate(spec, out, law=law, time_limit=999)
+    monkeypatch.undo()
+    assert api.simulate(spec, out, law=law, time_limit=999).info["law"] == name
+    with pytest.raises(SpecError, match=r"\[simulate\.time_limit\]"):
+        api.load_spec_text(text.replace("[simulate]", "[simulate]\ntime_limit = -1", 1))

@@ -18,7 +18,7 @@ from obsdesign.params import Parameters
 from obsdesign.simulate.result import SimResult
 from obsdesign.spec.models import Spec
 
-from .options import LAWS, Options
+from .options import LAWS, Options, SimOptions
 
 
 class SetInvariant(Method):
@@ -31,7 +31,7 @@ class SetInvariant(Method):
         "discrete-time systems, IEEE CDC-ECC 2005"
     )
     Options = Options
-    SimOptions = None
+    SimOptions = SimOptions
     needs_linear = True
     required_params = ("G", "V", "lambda", "converged")
     summary_fields = (
@@ -49,6 +49,7 @@ class SetInvariant(Method):
             "(eq. (10)), online-lp (LP (9) at each step) or linear (v = L z)",
             choices=LAWS,
         ),
+        SimOption("time_limit", "float", None, "seconds the simulation may run", min=1e-3),
     )
 
     # parse_options, design, certify, simulate, options_schema: the base class's defaults

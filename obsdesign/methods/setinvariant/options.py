@@ -242,3 +242,31 @@ def options_schema(key: str) -> dict[str, Any]:
             },
         },
     }
+
+
+@dataclass
+class SimOptions:
+    """The method's own ``[simulate]`` key: ``time_limit``, the seconds the simulation may run
+    (exit 3 past it; the ``online-lp`` law solves LP (9) of Dórea and Pimenta (CDC-ECC 2005)
+    at every step, so a long horizon ran for hours)."""
+
+    time_limit: float = 300.0
+
+
+def parse_simulate(table: Table, spec: Spec) -> SimOptions:
+    """``[simulate] time_limit`` (> 0, default 300 s).
+
+    :param table: the ``[simulate]`` table; :param spec: the spec (unused)."""
+    limit = table.scalar("time_limit", default=None, min=0, strict_min=True)
+    return SimOptions(300.0 if limit is None else float(limit.f))
+
+
+def simulate_schema() -> dict[str, Any]:
+    """JSON-schema properties of the method's own ``[simulate]`` keys."""
+    return {
+        "time_limit": {
+            "type": "number",
+            "exclusiveMinimum": 0,
+            "description": "seconds the simulation may run (exit 3 past it)",
+        }
+    }

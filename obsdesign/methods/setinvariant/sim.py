@@ -16,11 +16,13 @@ from obsdesign.errors import InputError
 from obsdesign.params import Parameters
 from obsdesign.sets import Box
 from obsdesign.sets import polytope_ops as po
+from obsdesign.simulate.budget import TimeBudget
 from obsdesign.simulate.result import SimResult
 from obsdesign.simulate.runner import _need, signals
 from obsdesign.spec.models import Spec
 
 from . import laws
+from .options import SimOptions
 from .problem import build
 
 
@@ -59,14 +61,17 @@ def _admissible(spec: Spec, d: np.ndarray, v: np.ndarray) -> bool:
     return ok
 
 
-def _run(spec: Spec, f: Any, single: bool) -> tuple[SimResult, np.ndarray, np.ndarray, np.ndarray]:
+def _run(
+    spec: Spec, f: Any, single: bool, budget: TimeBudget | None = None, what: str = "the run"
+) -> tuple[SimResult, np.ndarray, np.ndarray, np.ndarray]:
     """Plant and observer (2) stepped in error coordinates: the plant x⁺ = A x + B u + B1 d,
     the error e = x − x̂ by its own recursion e⁺ = A e + B1 d + v(z), z = C e + η (eq. (3):
     the innovation y − C x̂ − D u is C e + η exactly), and x̂ = x − e. The same trajectory as
     stepping x̂ itself, but the error the guarantee is about never comes from subtracting two
     large numbers: on an unstable plant x and x̂ reach 10¹⁶ within 40 steps and x − x̂ lost
     every digit (a certified design 'left' its polyhedron in simulation; random-spec fuzzer).
-    Returns (the result, e, the disturbances d(k), the noise η(k))."""
+    Returns (the result, e, the disturbances d(k), the noise η(k)). ``budget`` (the time
+    budget) is looked at every 1024 steps."""
     _need(spec)
     s, sim = spec.system, spec.simulate
     assert sim is not None
@@ -79,6 +84,8 @@ def _run(spec: Spec, f: Any, single: bool) -> tuple[SimResult, np.ndarray, np.nd
     x[0] = sim.x0.f
     e[0] = sim.x0.f - sim.xhat0.f
     for i in range(N):
+        if budget is not None and i % 1024 == 0:
+            budget.check(f"{what} at step {i:,} of {N:,}")
         z = C @ e[i] + Dn @ v[i]
         vk = f(float(z[0]) if single else z, i)
         e[i + 1] = A @ e[i] + Bd @ d[i] + vk
@@ -91,15 +98,30 @@ def _run(spec: Spec, f: Any, single: bool) -> tuple[SimResult, np.ndarray, np.nd
     return res, e, d, v
 
 
-def simulate(spec: Spec, params: Parameters, law: str | None = None, **kwargs: Any) -> Any:
+def simulate(
+    spec: Spec,
+    params: Parameters,
+    law: str | None = None,
+    time_limit: float | None = None,
+    **kwargs: Any,
+) -> Any:
     """Run the spec's scenario with the injection law ``law`` (interpolated eq. (12),
     time-varying eq. (10), online-lp LP (9), linear v = L z; default: the table for one
-    output, else L)."""
+    output, else L). ``time_limit`` (else ``[simulate] time_limit``, 300 s): past it, exit 3
+    saying how far the run got."""
     if kwargs:
-        raise InputError(f"unknown simulation option(s): {', '.join(sorted(kwargs))} (known: law)")
+        raise InputError(
+            f"unknown simulation option(s): {', '.join(sorted(kwargs))} (known: law, time_limit)"
+        )
     s = spec.system
     f = make_law(spec, params, law)
-    res, e, dd, vv = _run(spec, f, s.p == 1 and not isinstance(f, laws.LinearLaw))
+    sm = spec.simulate
+    so = sm.options if sm is not None and isinstance(sm.options, SimOptions) else SimOptions()
+    limit = so.time_limit if time_limit is None else float(time_limit)
+    budget = TimeBudget(limit, "raise time_limit, or a shorter horizon or another law")
+    name = law or ("interpolated" if "breakpoints" in params else "linear")
+    single = s.p == 1 and not isinstance(f, laws.LinearLaw)
+    res, e, dd, vv = _run(spec, f, single, budget, f"the {name} law")
     G = params.float("G").reshape(-1, s.n)
     gauge = (e @ G.T).max(axis=1)
     om = spec.sets[spec.options.omega]
@@ -112,7 +134,7 @@ def simulate(spec: Spec, params: Parameters, law: str | None = None, **kwargs: A
     res.info.update(
         {
             # the option's name (it printed the class: LinearLaw, OnlineLPLaw; docs audit)
-            "law": law or ("interpolated" if "breakpoints" in params else "linear"),
+            "law": name,
             "max_gauge": float(gauge.max()),
             "error_in_polyhedron": inside,
             "e0_in_omega": e0_in,
