@@ -382,3 +382,28 @@ def test_zero_dynamics_floor_is_said_and_a_run_without_samples_warns(tmp_path):
     assert "L_f: interval bound 0" in said and "the bound is 0, so 0.000001" in said
     res = api.simulate(sp, rep)
     assert any("takes no sample" in w for w in res.info.get("warnings", []))
+
+
+def test_substeps_are_bounded_and_a_hopeless_flow_error_is_not_halved_forever(example):
+    """``substeps = 10⁹`` built one tuple per substep and took the machine's memory: it is at
+    most MAX_SUBSTEPS (exit 2 naming the key). x0 = (0, 1e300) made partition() halve every
+    substep 48 levels deep (2⁴⁸ pieces a sample) until time_limit: a non-finite flow-error
+    estimate is not halved and one sample makes at most MAX_EXTRA_PIECES halvings."""
+    from obsdesign.errors import SpecError
+    from obsdesign.methods.searchspace import options as O
+    from obsdesign.methods.searchspace import sim as S
+
+    r = CliRunner().invoke(app, ["simulate", str(SPEC), "--option", "substeps=100001"])
+    assert r.exit_code == 2 and "expected a value <= 100000" in r.output
+    with pytest.raises(SpecError, match=r"\[simulate\.substeps\] expected at most 100,000"):
+        api.load_spec_text(TEXT.replace("[simulate]", "[simulate]\nsubsteps = 100001", 1))
+    assert O.MAX_SUBSTEPS == 100_000
+    sp, _, _ = example
+    plant = S.Plant(sp)
+    P = np.array([[0.0, 1e300]])
+    with np.errstate(all="ignore"):
+        steps, err = S.partition(plant, P, 0.0, 0.1, 4, 1e-12)
+    assert len(steps) == 4 and not np.isfinite(err)  # not halved: the estimate is not finite
+    P = np.array([[0.0, 1.5]])
+    steps, _ = S.partition(plant, P, 0.0, 0.1, 4, 0.0)  # a tolerance no halving meets
+    assert len(steps) == 4 + S.MAX_EXTRA_PIECES

@@ -322,3 +322,31 @@ def test_a_batch_checks_its_budget_between_chunks(monkeypatch) -> None:
     with pytest.raises(SolverError, match=r"a batch of 2 runs at step 320 of 600"):
         mc.run_batch(sp, joint_system(sp, L), 2, "E0", budget=budget)
     assert looks[:2] == ["0 of 2 Monte Carlo runs done", "a batch of 2 runs at step 0 of 600"]
+
+
+def test_an_initial_error_set_without_volume_is_bad_input() -> None:
+    """A polytope of (almost) no volume (|x1 − x2| ≤ 1e-12) as ``initial_error``: rejection
+    sampling accepted nothing and ``--runs`` hung, ignoring time_limit (review). It is exit 2
+    naming the key now; the sampler itself gives up after MAX_SAMPLE_ROUNDS rounds."""
+    from obsdesign.errors import InputError
+    from obsdesign.sets import base
+
+    thin = toml(
+        "sets.T", type="polytope", G=[[1, -1], [-1, 1], [1, 0], [-1, 0]], g=[1e-12, 1e-12, 1, 1]
+    )
+    text = (
+        PLANT
+        + SETS
+        + thin
+        + toml("simulate", horizon=10, x0=[1, -1], xhat0=[0, 0], initial_error="T", runs=3)
+    )
+    with pytest.raises(
+        SpecError, match=r"\[simulate\.initial_error\] set 'T': rejection sampling kept 0 of"
+    ):
+        load_spec_text(text)
+    sp = load_spec_text(text.replace('initial_error = "T"', 'initial_error = "E0"'))
+    with pytest.raises(InputError, match="it has \\(almost\\) no volume"):
+        sp.sets["T"].sample(np.random.default_rng(1), 1)
+    assert base.MAX_SAMPLE_ROUNDS == 1000
+    pts = sp.sets["E0"].sample(np.random.default_rng(1), 5)
+    assert pts.shape == (5, 2) and np.all(sp.sets["E0"].contains(pts))

@@ -9,6 +9,9 @@ import numpy as np
 
 from obsdesign.certify.exact import to_float
 
+#: rounds of :meth:`ConvexSet.sample`'s rejection sampler before it gives up
+MAX_SAMPLE_ROUNDS = 1000
+
 
 class ConvexSet(ABC):
     """A compact convex set in R^n with exact data."""
@@ -28,12 +31,27 @@ class ConvexSet(ABC):
         """Float (lower, upper) of the smallest enclosing box."""
 
     def sample(self, rng: np.random.Generator, k: int) -> np.ndarray:
-        """k points of the set (rejection sampling from the bounding box)."""
+        """k points of the set (rejection sampling from the bounding box), in at most
+        :data:`MAX_SAMPLE_ROUNDS` rounds: a set of (almost) no volume, a segment in the plane,
+        accepted nothing and the loop ran forever (independent simulate review). Raises
+        :class:`~obsdesign.errors.InputError` then."""
         lo, hi = self.bounding_box()
         out: list[np.ndarray] = []
-        while sum(len(o) for o in out) < k:
+        got = 0
+        for _ in range(MAX_SAMPLE_ROUNDS):
+            if got >= k:
+                break
             pts = rng.uniform(lo, hi, size=(max(4 * k, 64), self.dim))
             out.append(pts[np.asarray(self.contains(pts))])
+            got += len(out[-1])
+        if got < k:
+            from obsdesign.errors import InputError
+
+            draws = MAX_SAMPLE_ROUNDS * max(4 * k, 64)
+            raise InputError(
+                f"rejection sampling kept {got:,} of {draws:,} points drawn in the bounding box "
+                f"of the {self.kind or 'set'} (wanted {k:,}): it has (almost) no volume"
+            )
         return np.concatenate(out)[:k]
 
 

@@ -77,6 +77,10 @@ def parse_initial_error(table: Table, spec: Spec) -> str | None:
         raise table.error(
             "initial_error", f"expected a set of dimension {spec.system.n} (states), got {dim}"
         )
+    try:  # a set the runs cannot draw from (no volume) is bad input here, not a hang later
+        spec.sets[name].sample(np.random.default_rng(0), 1)
+    except InputError as e:
+        raise table.error("initial_error", f"set {name!r}: {e}") from None
     return name
 
 

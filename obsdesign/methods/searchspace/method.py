@@ -50,7 +50,9 @@ class SearchSpace(Method):
     sim_options = (
         SimOption("max_centres", "int", None, "memory cap: live centres (fails, never drops)", 1),
         SimOption("refine", "str", None, "refinement at switches", choices=_opts.REFINE),
-        SimOption("substeps", "int", None, "RK4 steps per sample (0: automatic)", 0),
+        SimOption(
+            "substeps", "int", None, "RK4 steps per sample (0: automatic)", 0, _opts.MAX_SUBSTEPS
+        ),
         SimOption("store_every", "int", None, "store the centres every k samples", 1),
         SimOption("time_limit", "float", None, "seconds the simulation may run", 1e-3),
         SimOption("progress", "bool", False, "show a progress bar"),

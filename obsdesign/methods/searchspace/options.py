@@ -164,12 +164,25 @@ def parse_options(table: Table, spec: Spec) -> Options:
     return opts
 
 
+#: RK4 substeps a sample at most (``[simulate] substeps``): 10⁹ built one Python tuple per
+#: substep and took the machine's memory (independent simulate review)
+MAX_SUBSTEPS = 100_000
+
+
+def _substeps(table: Table) -> int:
+    """``[simulate] substeps``: 0 (automatic) … :data:`MAX_SUBSTEPS`."""
+    n = int(table.int("substeps", default=0, min=0))
+    if n > MAX_SUBSTEPS:
+        raise table.error("substeps", f"expected at most {MAX_SUBSTEPS:,} RK4 steps a sample")
+    return n
+
+
 def parse_sim(table: Table, spec: Spec) -> SimOptions:
     """The method's own ``[simulate]`` keys."""
     return SimOptions(
         max_centres=table.int("max_centres", default=2_000_000, min=1),
         refine=table.str("refine", default="recover", choices=REFINE),
-        substeps=table.int("substeps", default=0, min=0),
+        substeps=_substeps(table),
         store_every=table.int("store_every", default=1, min=1),
         time_limit=float(table.scalar("time_limit", default=fmpq(300), min=0, strict_min=True).q),
     )
@@ -223,7 +236,7 @@ def simulate_schema() -> dict[str, Any]:
     return {
         "max_centres": {"type": "integer", "minimum": 1},
         "refine": {"enum": list(REFINE)},
-        "substeps": {"type": "integer", "minimum": 0},
+        "substeps": {"type": "integer", "minimum": 0, "maximum": MAX_SUBSTEPS},
         "store_every": {"type": "integer", "minimum": 1},
         "time_limit": {"type": "number", "exclusiveMinimum": 0},
     }

@@ -183,6 +183,10 @@ FLOW_TOL = 1e-6
 #: how many times one RK4 substep of a sample may be halved by :func:`partition`
 MAX_SPLITS = 48
 
+#: halvings of :func:`partition` in one sample at most (beyond the ``nsub`` substeps): a state
+#: whose flow error never meets the tolerance (x0 = 1e300) made up to 2⁴⁸ pieces a sample
+MAX_EXTRA_PIECES = 64 * MAX_SPLITS
+
 
 def partition(
     plant: Plant, P: np.ndarray, t: float, dT: float, nsub: int, tol: float
@@ -199,8 +203,11 @@ def partition(
     that contains the jump shrinks its error in proportion, so a few dozen halvings reach
     ``tol``, on the probe rows only; all centres then follow the same substeps. A jump that
     depends on the state (a ``step`` or ``sign`` of x in f) is seen only where a probe row
-    crosses it."""
+    crosses it. A non-finite estimate is not halved (halving cannot make it finite), and at
+    most :data:`MAX_EXTRA_PIECES` halvings are made in one sample (independent simulate
+    review: x0 = 1e300 ran until time_limit, up to 2⁴⁸ pieces a sample)."""
     h = dT / nsub
+    splits = 0
     todo = [(t + (nsub - 1 - j) * h, h, 0) for j in range(nsub)]  # a stack: earliest last
     out: list[tuple[float, float]] = []
     total = 0.0
@@ -209,7 +216,8 @@ def partition(
         one = rk4(plant, P, a, w, 1)
         two = rk4(plant, P, a, w, 2)
         err = float(np.max(np.linalg.norm(one - two, axis=1))) * 16 / 15 if len(P) else 0.0
-        if err > tol and depth < MAX_SPLITS:
+        if err > tol and depth < MAX_SPLITS and splits < MAX_EXTRA_PIECES and math.isfinite(err):
+            splits += 1
             todo += [(a + w / 2, w / 2, depth + 1), (a, w / 2, depth + 1)]
             continue
         out.append((a, w))
