@@ -488,8 +488,11 @@ def test_simulate_time_limit_stops_a_run_with_exit_3(tmp_path, monkeypatch) -> N
             return float(next(clock))
 
     monkeypatch.setattr(sim_budget, "time", Slow)
-    with pytest.raises(SolverError, match="the modified θ_m=3 observer runs at sample 0 of 60"):
+    with pytest.raises(SolverError, match="the unmodified observer runs at sample 0 of 60"):
         api.simulate(p, options={"time_limit": "1000.5", "theta_m": "3"})
+    clock = iter(range(0, 10**6, 1000))
+    with pytest.raises(SolverError, match="the plant at sample 0 of 60"):  # its loop too
+        api.simulate(p, options={"time_limit": "999", "theta_m": "3"})
     monkeypatch.undo()
     res = api.simulate(p, options={"time_limit": "1000.5", "theta_m": "3"})
     assert res.info["modified θ_m=3: steps (total, max per sample)"]

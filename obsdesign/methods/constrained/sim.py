@@ -14,7 +14,13 @@ from obsdesign.certify.exact import Q, to_float
 from obsdesign.errors import InputError
 from obsdesign.methods.constrained import bounds as B
 from obsdesign.methods.constrained.design import xhat_set
-from obsdesign.methods.constrained.observer import LinearF, Observer, Refiner, Trace
+from obsdesign.methods.constrained.observer import (
+    CHECK_EVERY,
+    LinearF,
+    Observer,
+    Refiner,
+    Trace,
+)
 from obsdesign.methods.constrained.options import Options, SimOptions
 from obsdesign.params import Parameters
 from obsdesign.simulate.budget import TimeBudget
@@ -171,6 +177,8 @@ def simulate(
     x = np.zeros((N + 1, s.n))
     x[0] = sm.x0.f
     for i in range(N):
+        if i % CHECK_EVERY == 0:  # the plant loop too (horizon 2·10⁷ ran past 90 s; review)
+            budget.check(f"the plant at sample {i:,} of {N:,}")
         x[i + 1] = f(x[i], u[i], d[i])
     y = h(x, u, v)
     if model.F is not None:
