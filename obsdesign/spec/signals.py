@@ -49,8 +49,7 @@ class Signal:
         if self.kind == "constant":
             out[:] = self.value
         elif self.kind == "windows":
-            for w in self.windows:
-                out[(grid >= w.start) & (grid <= w.stop)] += w.value
+            _add_windows(out, np.asarray(grid, dtype=float), self.windows)
         elif self.kind == "uniform":
             out = rng.uniform(-self.bound, self.bound, size=(k, self.dim))
         elif self.kind == "outliers":
@@ -62,6 +61,36 @@ class Signal:
             m = min(k, len(self.values))
             out[:m] = self.values[:m]
         return out
+
+
+def _add_windows(out: np.ndarray, grid: np.ndarray, windows: list[Window]) -> None:
+    """Add each window's value on the grid points start ≤ t ≤ stop, in the windows' order.
+
+    A sorted grid (every grid the simulations make) takes each window as one slice found by
+    binary search: one full pass over the grid per window made 12,000 windows over 5·10⁶
+    samples run past 90 s, ignoring time_limit (independent simulate review). When the
+    slices together would still cover more than 64 grids, the windows go through a running
+    sum of their start and end jumps (one pass; its rounding may differ in the last bits
+    where windows overlap). An unsorted grid keeps the mask per window."""
+    if not windows:
+        return
+    if grid.size > 1 and not bool(np.all(grid[1:] >= grid[:-1])):
+        for w in windows:
+            out[(grid >= w.start) & (grid <= w.stop)] += w.value
+        return
+    a = np.searchsorted(grid, [float(w.start) for w in windows], side="left")
+    b = np.searchsorted(grid, [float(w.stop) for w in windows], side="right")
+    if int(np.maximum(b - a, 0).sum()) <= 64 * max(len(grid), 1):
+        for w, i, j in zip(windows, a, b, strict=True):
+            if j > i:
+                out[i:j] += w.value
+        return
+    jumps = np.zeros((len(grid) + 1, out.shape[1]))
+    for w, i, j in zip(windows, a, b, strict=True):
+        if j > i:
+            jumps[i] += w.value
+            jumps[j] -= w.value
+    out += np.cumsum(jumps, axis=0)[:-1]
 
 
 def parse_signal(t: Table | None, dim: int) -> Signal:
