@@ -597,6 +597,10 @@ def sweep(
     return sw.exit_code(rows)
 
 
+#: grid points of a run that ``simulate --plot`` draws at most
+MAX_PLOT_POINTS = 1_000_000
+
+
 def simulate(
     spec: Path,
     report: Path | None,
@@ -631,6 +635,16 @@ def simulate(
     if study is not None:
         opts["study"] = study
     res = api.simulate(sp, report, options=opts, workers=workers, scheduler=scheduler)
+    if plot is not None and len(res.t) > MAX_PLOT_POINTS:
+        from obsdesign.errors import InputError
+
+        # matplotlib took 5.6 GB for a 2·10⁷-step run the memory estimate had let through
+        # (independent simulate review); refused before anything is printed or written
+        raise InputError(
+            f"--plot {plot}: the run has {len(res.t):,} grid points, above the "
+            f"{MAX_PLOT_POINTS:,} a plot takes (a shorter horizon or a larger dt; --csv writes "
+            "any length)"
+        )
     m = res.metrics()
     if fmt == Fmt.json:
         print(_dumps(m, indent=2, default=_jsonable))
@@ -643,9 +657,13 @@ def simulate(
         if fmt == Fmt.text:
             _say(f"plot written to {plot}")
     if csv is not None:
-        from obsdesign.report.model import write_atomic
+        from obsdesign.report.model import write_via
 
-        write_atomic(csv, res.csv_text(), force)
+        def rows(tmp: Path) -> None:  # streamed: never the whole text in memory
+            with open(tmp, "w", encoding="utf-8") as f:
+                f.writelines(res.csv_chunks())
+
+        write_via(csv, rows, force)
         if fmt == Fmt.text:
             _say(f"trajectories written to {csv}")
     return int(res.info.get("exit_code", 0))

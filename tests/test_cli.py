@@ -244,3 +244,25 @@ def test_simulate_prints_quantiles_as_a_table(tmp_path: Path) -> None:
     assert "| sup \\|e_x1\\| |" in r.output and "| final \\|e\\| |" in r.output
     r = CliRunner().invoke(app, ["simulate", str(spec), "--runs", "4"])
     assert r.exit_code == 0 and "{'" not in r.output and "quantiles over 4 runs" in r.output
+
+
+def test_simulate_plot_of_a_huge_run_is_refused_before_output(tmp_path: Path, monkeypatch) -> None:
+    """matplotlib took 5.6 GB for a 2·10⁷-step run (review): a run longer than
+    MAX_PLOT_POINTS is refused (exit 2) before any metric is printed or file written."""
+    from obsdesign import cli_commands
+
+    monkeypatch.setattr(cli_commands, "MAX_PLOT_POINTS", 50)
+    spec = tmp_path / "s.toml"
+    spec.write_text(
+        '[system]\ntime = "discrete"\nA = [[0.5, 1], [0, 0.8]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\nL = [0.6, 0.1]\n'
+        "[simulate]\nhorizon = 60\nx0 = [1, 0]\nxhat0 = [0, 0]\n"
+    )
+    png, out = tmp_path / "p.png", tmp_path / "t.csv"
+    r = CliRunner().invoke(app, ["simulate", str(spec), "--plot", str(png), "--csv", str(out)])
+    assert r.exit_code == 2, r.output
+    assert "the run has 61 grid points, above the 50 a plot takes" in r.output
+    assert "final |e|" not in r.output and not png.exists() and not out.exists()
+    spec.write_text(spec.read_text().replace("horizon = 60", "horizon = 40"))
+    r = CliRunner().invoke(app, ["simulate", str(spec), "--plot", str(png)])
+    assert r.exit_code == 0 and png.exists()

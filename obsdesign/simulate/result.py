@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -43,6 +44,12 @@ class SimResult:
         ``xhat_<state>``, ``e_<state>`` (the error the metrics use) and ``y<j>``; floats by
         their shortest round-trip repr, so a reader gets the simulated doubles back. For a
         Monte Carlo run, the trajectory the method keeps (its run 0)."""
+        return "".join(self.csv_chunks())
+
+    def csv_chunks(self, rows: int = 4096) -> Iterator[str]:
+        """:meth:`csv_text` in pieces of ``rows`` rows (the header first), so that a file of
+        10⁷ rows is written without the whole text in memory (``--csv`` of a 2·10⁷-step run
+        passed 3.4 GB; independent simulate review)."""
         n = self.x.shape[1]
         names = self.states or [f"x{i + 1}" for i in range(n)]
         cols = [np.asarray(self.t, dtype=float).reshape(-1, 1), self.x, self.xhat, self.e]
@@ -52,10 +59,10 @@ class SimResult:
             y = np.asarray(self.y, dtype=float).reshape(len(self.t), -1)
             cols.append(y)
             head += [f"y{j + 1}" for j in range(y.shape[1])]
-        table = np.hstack([np.asarray(c, dtype=float) for c in cols])
-        lines = [",".join(_csv_name(h) for h in head)]
-        lines += [",".join(repr(float(v)) for v in row) for row in table]
-        return "\n".join(lines) + "\n"
+        yield ",".join(_csv_name(h) for h in head) + "\n"
+        for a in range(0, len(self.t), rows):
+            table = np.hstack([np.asarray(c, dtype=float)[a : a + rows] for c in cols])
+            yield "".join(",".join(map(repr, row)) + "\n" for row in table.tolist())
 
 
 def _csv_name(name: str) -> str:
