@@ -126,3 +126,24 @@ def test_theorem2_property(n: int, seed: int) -> None:
     clean = simulate_hybrid(f, np.eye(n), np.array([0.7]), x0, xh0, Hc, Wc, dense=4)
     end = np.array([clean.eps[j, np.nonzero(clean.valid[j])[0][-1]] for j in range(runs)])
     assert np.all(end < 1e-2 * max(clean.eps[0, 0], 1e-9))
+
+
+def test_a_field_that_is_not_finite_stops_its_run_not_the_solver() -> None:
+    """ψ of the example is inf/inf = NaN at x2 = 1e160: RK45 shrank its step on the NaN field
+    until time_limit (review). The run whose field is not finite stops in that interval as
+    escaped (the plant's field) or diverged (the observer's); the other runs go on unchanged,
+    and a start beyond ESCAPE is escaped before the first interval."""
+    N = 3
+    H = np.full((N, 6), 0.3)
+    W = np.zeros((N, 6, 1))
+    T = np.array([[1.0, 0], [-3, 1]])
+    x0 = np.array([[1.0, 1.0], [1.0, 1e160], [1.0, 1.0]])
+    xh0 = np.array([[0.0, 0.5], [0.0, 0.5], [0.0, 1e160]])
+    b = simulate_hybrid(_example_field, T, np.array([0.8]), x0, xh0, H, W)
+    assert b.escaped.tolist() == [False, True, False]
+    assert b.diverged.tolist() == [False, False, True]
+    ok = simulate_hybrid(_example_field, T, np.array([0.8]), x0[:1], xh0[:1], H[:1], W[:1])
+    np.testing.assert_allclose(b.x[0], ok.x[0], atol=1e-6)  # one joint RK45: its tolerance
+    x0[1, 1] = 1e120  # below ESCAPE, but ψ is inf/inf = NaN there: frozen in interval 0
+    b = simulate_hybrid(_example_field, T, np.array([0.8]), x0, xh0, H, W)
+    assert b.escaped[1] and not b.valid[1, -1]

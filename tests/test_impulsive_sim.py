@@ -331,9 +331,11 @@ def test_sampling_file_must_be_a_regular_file(tmp_path: Path) -> None:
 
 @pytest.mark.filterwarnings("ignore::RuntimeWarning")
 def test_time_limit_holds_inside_one_sampling_interval(tmp_path: Path) -> None:
-    """ψ = sqrt(−1) (NaN dynamics): RK45 shrinks its step without end inside the first
-    interval, where the budget used to be checked only between intervals (time_limit = 5 ran
-    past 120 s: CLI fuzzer). The budget is now also checked inside the right-hand side."""
+    """ψ = sqrt(−1) (NaN dynamics): RK45 shrank its step without end inside the first
+    interval (time_limit = 5 ran past 120 s: CLI fuzzer). A run whose field is not finite now
+    stops there as escaped, at once. A finite but stiff interval (one sampling interval of
+    10³⁰⁰ from a file) still meets the budget inside the right-hand side, and the message
+    gives the interval's length."""
     import time
 
     from obsdesign.errors import SolverError
@@ -342,8 +344,15 @@ def test_time_limit_holds_inside_one_sampling_interval(tmp_path: Path) -> None:
     sp = load_spec_text(txt, str(tmp_path / "s.toml"))
     rep = api.design(load_spec_text(_spec3(), str(tmp_path / "ok.toml")))
     t0 = time.perf_counter()
-    with pytest.raises(SolverError, match="not finished within 1 s"):
-        get_method("impulsive").simulate(sp, rep.parameters, time_limit=1)
+    res = get_method("impulsive").simulate(sp, rep.parameters, time_limit=60)
+    assert res.info["plant_escaped_runs"] == res.info["runs"]
+    assert time.perf_counter() - t0 < 20
+    big = tmp_path / "h.txt"
+    big.write_text("1e300\n")
+    ok = load_spec_text(_spec3(), str(tmp_path / "ok.toml"))
+    t0 = time.perf_counter()
+    with pytest.raises(SolverError, match=r"not finished within 1 s .* of length up to 1e\+300"):
+        get_method("impulsive").simulate(ok, rep.parameters, sampling_file=big, time_limit=1)
     assert time.perf_counter() - t0 < 20
 
 

@@ -114,7 +114,9 @@ def simulate_hybrid(
     with np.errstate(all="ignore"):
         e0 = np.nan_to_num(np.linalg.norm(Z - X @ T.T, axis=1), posinf=np.inf)
     diverged = np.zeros(N, dtype=bool)
-    escaped = np.zeros(N, dtype=bool)
+    with np.errstate(all="ignore"):  # a start already beyond ESCAPE (or not finite)
+        escaped = ~np.all(np.isfinite(X), axis=1) | (np.abs(X).max(axis=1) > ESCAPE)
+        diverged = ~escaped & ~np.all(np.isfinite(Z), axis=1)
     s_eval = np.linspace(0.0, 1.0, dense + 1)[1:]
     tk = np.zeros(N)
     sample_times = np.full((N, K), np.nan)
@@ -127,9 +129,21 @@ def simulate_hybrid(
             break
 
         calls = [0]
+        # runs whose field is not finite in this interval: frozen (derivative 0), then
+        # stopped as escaped (the plant's field) or diverged (the observer's). RK45 shrank its
+        # step on a NaN field until time_limit (ψ of the shipped example at x0 = 1e160, or a
+        # sampling interval of 1e300; independent simulate review)
+        bad_x = np.zeros(N, dtype=bool)
+        bad_z = np.zeros(N, dtype=bool)
 
         def rhs(
-            _s: float, u: np.ndarray, h: np.ndarray = h, k: int = k, calls: list[int] = calls
+            _s: float,
+            u: np.ndarray,
+            h: np.ndarray = h,
+            k: int = k,
+            calls: list[int] = calls,
+            bad_x: np.ndarray = bad_x,
+            bad_z: np.ndarray = bad_z,
         ) -> np.ndarray:
             # the time budget inside the interval too: with NaN or huge dynamics RK45
             # shrinks its step without end (time_limit = 5 ran past 60 s: CLI fuzzer)
@@ -137,8 +151,13 @@ def simulate_hybrid(
             if check is not None and calls[0] % 256 == 0:
                 check(k, K)
             U = u.reshape(N, 2, n)
-            d = np.stack([f(U[:, 0]), fz(U[:, 1])], axis=1)
-            return (h[:, None, None] * d).ravel()
+            with np.errstate(all="ignore"):
+                d = np.stack([f(U[:, 0]), fz(U[:, 1])], axis=1)
+                d *= h[:, None, None]
+            bad_x |= ~np.all(np.isfinite(d[:, 0]), axis=1)
+            bad_z |= ~np.all(np.isfinite(d[:, 1]), axis=1)
+            d[bad_x | bad_z] = 0.0
+            return d.ravel()
 
         sol = solve_ivp(
             rhs,
@@ -152,6 +171,11 @@ def simulate_hybrid(
         if sol.status != 0 or sol.y.shape[1] != dense:
             raise ArithmeticError(f"integration failed on interval {k}: {sol.message}")
         U = sol.y.reshape(N, 2, n, dense)
+        frozen = bad_x | bad_z
+        active = active & ~frozen
+        escaped |= bad_x
+        diverged |= bad_z & ~bad_x
+        X[frozen], Z[frozen] = 0.0, 0.0
         cols = slice(1 + k * dense, 1 + (k + 1) * dense)
         t[:, cols] = tk[:, None] + h[:, None] * s_eval[None, :]
         xs[:, cols] = np.moveaxis(U[:, 0], 2, 1)
@@ -180,8 +204,9 @@ def simulate_hybrid(
             X[stop], Z[stop] = 0.0, 0.0
         # the post-jump value is what the next interval starts from; the stored point at t_k
         # is the pre-jump (left-continuous) value, as in the paper.
-    xhat = zs @ Ti.T
-    eps = np.linalg.norm(zs - xs @ T.T, axis=2)
+    with np.errstate(all="ignore"):  # runs that escaped: their values are not finite
+        xhat = zs @ Ti.T
+        eps = np.linalg.norm(zs - xs @ T.T, axis=2)
     return HybridBatch(t, xs, xhat, eps, valid, sample_times, diverged, escaped)
 
 

@@ -142,10 +142,12 @@ def simulate(
     def budget(name: str) -> Callable[[int, int], None]:
         def check(k: int, K: int) -> None:
             if time.perf_counter() > deadline:
+                longest = float(np.max(H[:, k])) if k < H.shape[1] else 0.0
                 raise SolverError(
                     f"simulation not finished within {limit:g} s ([simulate] time_limit): "
-                    f"the {name} runs at sampling interval {k:,} of {K:,} (raise time_limit, "
-                    "or fewer runs, a shorter horizon, a looser rtol)"
+                    f"the {name} runs at sampling interval {k:,} of {K:,}, of length up to "
+                    f"{longest:.4g} (raise time_limit, or fewer runs, a shorter horizon, a "
+                    "looser rtol, or intervals within the window [T_min, T_max])"
                 )
 
         return check
