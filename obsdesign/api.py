@@ -759,11 +759,13 @@ def check_sim_memory(sp: Spec, kwargs: dict[str, Any]) -> None:
         steps = horizon
     else:
         steps = horizon / max(float(sim.dt.f), 1e-300)
-    need = get_method(sp.method).sim_bytes(sp, int(runs), steps, kwargs)
+    method = get_method(sp.method)
+    need = method.sim_bytes(sp, int(runs), steps, kwargs)
     cap = limits().max_sim_bytes
     if need > cap:
+        shown = method.sim_run_count(int(runs), kwargs)
         raise InputError(
-            f"{sp.file}: simulating {int(runs)} run(s) × {steps:.3g} steps × {sp.system.n} "
+            f"{sp.file}: simulating {shown} run(s) × {steps:.3g} steps × {sp.system.n} "
             f"states needs about {need / 2**30:.3g} GiB, above the limit of "
             f"{cap / 2**30:.3g} GiB (fewer runs, a shorter horizon, or --limit max_sim_bytes=N)"
         )

@@ -938,7 +938,15 @@ def test_a_single_run_is_not_refused_by_the_study_memory_estimate() -> None:
     text = (SPECS / "astolfi-stubborn-example1.toml").read_text()
     sp = api.load_spec_text(text.replace("horizon = 10\n", "horizon = 1000\n"), "long.toml")
     api.check_sim_memory(sp, {})
-    with pytest.raises(InputError, match=r"long\.toml: simulating 100 run\(s\)"):
+    api.check_sim_memory(sp, {"study": "outliers"})  # the study keeps no trajectories
+    # ... but steps 4 observers × amplitudes × runs at once: 10,000 amplitudes took 4.3 GB
+    huge = api.load_spec_text(text.replace("horizon = 10\n", "horizon = 100000\n"), "h.toml")
+    with pytest.raises(InputError, match=r"h\.toml: simulating 1 run\(s\) × 1e\+08 steps"):
+        api.check_sim_memory(huge, {})  # one run, as the estimate (it said "100 run(s)")
+    many = "amplitudes = [" + ", ".join(["1"] * 10_000) + "]"
+    sp = api.load_spec_text(text.replace("amplitudes = [", many + "\n#", 1), "many.toml")
+    api.check_sim_memory(sp, {})
+    with pytest.raises(InputError, match=r"many\.toml: simulating 100 run\(s\)"):
         api.check_sim_memory(sp, {"study": "outliers"})
 
 

@@ -246,6 +246,13 @@ class Method:
             raise InputError(f"method '{self.key}' has no simulation") from None
         return sim.simulate(spec, params, **options)
 
+    def sim_run_count(self, runs: int, options: dict[str, Any]) -> int:
+        """The runs a simulation with these typed ``simulate`` options makes, for messages
+        (default: ``runs``, the option's or the spec's).
+
+        :param runs: the run count asked; :param options: the typed options."""
+        return runs
+
     def sim_bytes(self, spec: Spec, runs: int, steps: float, options: dict[str, Any]) -> float:
         """Bytes a simulation of ``runs`` runs × ``steps`` steps needs, estimated before
         anything is allocated (checked by the API against ``max_sim_bytes``). Default: every

@@ -52,16 +52,30 @@ class Stubborn(Method):
         SimOption("time_limit", "float", None, "seconds the simulation may run", min=1e-3),
     )
 
+    def sim_run_count(self, runs: int, options: dict[str, Any]) -> int:
+        """One run without ``study`` (the spec's ``runs`` are the study's; the refusal of a
+        single run said "100 run(s)": review)."""
+        return runs if options.get("study", "none") != "none" else 1
+
     def sim_bytes(self, spec: Spec, runs: int, steps: float, options: dict[str, Any]) -> float:
         """One run's trajectories without ``study`` (the spec's ``runs`` are the outlier
         study's: a single run of 10⁶ steps was refused by the memory estimate of 100 runs;
-        independent simulate review), else the study's runs (the default estimate).
+        independent simulate review); with it, also the study's batch of 4 observers ×
+        amplitudes × runs and its chunks of noise.
 
         :param spec: the bound spec; :param runs: the study's runs; :param steps: steps per
         run; :param options: the typed ``simulate`` options (``study``)."""
+        one = super().sim_bytes(spec, 1, steps, options)
         if options.get("study", "none") == "none":
-            runs = 1
-        return super().sim_bytes(spec, runs, steps, options)
+            return one
+        # the study steps 4 observers × amplitudes × runs at once, its noise drawn 2,000 steps
+        # at a time: 10,000 amplitudes reached 4.3 GB, the estimate counting neither the
+        # amplitudes nor the observers (independent simulate review)
+        so = spec.simulate.options if spec.simulate is not None else None
+        na = len(getattr(so, "amplitudes", ())) or 1
+        s = spec.system
+        batch = 4.0 * na * runs
+        return one + 8.0 * (3 * 2000 * na * runs * s.p + 12 * batch * max(s.n, s.p))
 
     def plot_simulation(self, spec: Spec, result: Any, path: Any) -> Any:
         from obsdesign.methods.stubborn import plots
