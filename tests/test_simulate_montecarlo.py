@@ -350,3 +350,23 @@ def test_an_initial_error_set_without_volume_is_bad_input() -> None:
     assert base.MAX_SAMPLE_ROUNDS == 1000
     pts = sp.sets["E0"].sample(np.random.default_rng(1), 5)
     assert pts.shape == (5, 2) and np.all(sp.sets["E0"].contains(pts))
+
+
+def test_metrics_and_quantiles_of_huge_or_infinite_errors() -> None:
+    """Errors near 1e300 printed RMSE and final |e| as inf (e² overflowed), and quantiles of
+    metrics that are all inf printed nan beside a max of inf (review): the RMSE and norm are
+    scaled where they overflow, and a quantile between two equal infinities is that infinity."""
+    from obsdesign.simulate.result import metrics
+
+    e = np.array([[1e300, -1e300], [2e300, 0.0]])
+    m = metrics(e, ["a", "b"])
+    assert m["rmse"]["a"] == pytest.approx(np.sqrt(2.5) * 1e300)
+    assert m["final_error_norm"] == 2e300
+    small = np.array([[0.1, 3.0], [2.0, -1.0]])
+    m = metrics(small)  # the unscaled numbers, to the bit
+    assert m["rmse"]["x1"] == float(np.sqrt(np.mean(small[:, 0] ** 2)))
+    assert m["final_error_norm"] == float(np.linalg.norm(small[-1]))
+    q = mc._q(np.array([np.inf, np.inf, np.inf]))
+    assert all(v == np.inf for v in q.values())
+    q = mc._q(np.array([1.0, 2.0, 3.0]))
+    assert q["q50"] == 2.0 and q["max"] == 3.0

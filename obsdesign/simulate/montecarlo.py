@@ -628,6 +628,13 @@ def quantiles(per_run: dict[str, np.ndarray], states: list[str]) -> dict[str, An
 
 
 def _q(a: np.ndarray) -> dict[str, float]:
-    d = {name: float(np.quantile(a, p)) for name, p in QUANTILES.items()}
+    """numpy's (linear) quantiles and the max of ``a``; a quantile between two infinite
+    values of the same sign is that infinity (the interpolation gave inf − inf = nan beside a
+    max of inf when every run's metric overflowed; independent simulate review)."""
+    with np.errstate(invalid="ignore"):
+        d = {name: float(np.quantile(a, p)) for name, p in QUANTILES.items()}
+    for name, p in QUANTILES.items():
+        if np.isnan(d[name]) and not np.isnan(a).any():
+            d[name] = float(np.quantile(a, p, method="lower"))
     d["max"] = float(a.max())
     return d

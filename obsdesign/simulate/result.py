@@ -73,11 +73,29 @@ def _csv_name(name: str) -> str:
 
 
 def metrics(e: np.ndarray, states: list[str] | None = None) -> dict[str, Any]:
-    """sup_k |e_i(k)|, RMSE of each e_i, and the final Euclidean |e|."""
+    """sup_k |e_i(k)|, RMSE of each e_i, and the final Euclidean |e|; the RMSE and the norm
+    scaled by the largest entry, so that errors near 10³⁰⁰ do not overflow to inf in e²
+    (independent simulate review)."""
     e = np.asarray(e, dtype=float)
     names = states or [f"x{i + 1}" for i in range(e.shape[1])]
     return {
         "sup_abs_error": {s: float(np.max(np.abs(e[:, i]))) for i, s in enumerate(names)},
-        "rmse": {s: float(np.sqrt(np.mean(e[:, i] ** 2))) for i, s in enumerate(names)},
-        "final_error_norm": float(np.linalg.norm(e[-1])),
+        "rmse": {s: _rms(e[:, i]) for i, s in enumerate(names)},
+        "final_error_norm": _scaled(e[-1], lambda v: float(np.linalg.norm(v))),
     }
+
+
+def _rms(v: np.ndarray) -> float:
+    """sqrt(mean(v²)) without overflow of v² (scaled by max |v|)."""
+    return _scaled(v, lambda w: float(np.sqrt(np.mean(w * w))))
+
+
+def _scaled(v: np.ndarray, f: Any) -> float:
+    """``f(v)`` for a norm-like ``f``; where that overflows though every entry is finite,
+    ``f(v / s) · s`` with s = max |v| (the same value, without the overflow of v²)."""
+    with np.errstate(all="ignore"):
+        out = f(v)
+        if np.isfinite(out) or not np.all(np.isfinite(v)):
+            return out
+        s = float(np.max(np.abs(v)))
+        return f(v / s) * s
