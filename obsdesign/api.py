@@ -650,8 +650,8 @@ def _step_note(sp: Spec) -> str | None:
     k = int(sim.horizon.q / sim.dt.q)  # a whole number of steps (the loader's choice)
     steps = f"{k:,}" if k < 10**15 else f"about 1e{len(str(k)) - 1}"
     return (
-        f"[simulate] dt = {float(sim.dt_given.f):g} does not divide horizon = "
-        f"{float(sim.horizon.f):g}: the grid steps by dt = {float(sim.dt.f):.6g} ({steps} "
+        f"[simulate] dt = {float(sim.dt_given.f)!r} does not divide horizon = "
+        f"{float(sim.horizon.f)!r}: the grid steps by dt = {float(sim.dt.f)!r} ({steps} "
         f"step{'' if k == 1 else 's'}), so that it ends at the horizon"
     )
 

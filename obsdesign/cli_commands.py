@@ -631,6 +631,13 @@ def simulate(
     sp = _load_spec(spec)
     opts = _kv(option or [])
     if runs is not None:
+        if "runs" in opts and opts["runs"] != str(runs):
+            from obsdesign.errors import InputError
+
+            # --runs silently won over --option runs=..., unchecked (review)
+            raise InputError(
+                f"--runs {runs} and --option runs={opts['runs']}: give the run count once"
+            )
         opts["runs"] = str(runs)
     if study is not None:
         opts["study"] = study

@@ -266,3 +266,20 @@ def test_simulate_plot_of_a_huge_run_is_refused_before_output(tmp_path: Path, mo
     spec.write_text(spec.read_text().replace("horizon = 60", "horizon = 40"))
     r = CliRunner().invoke(app, ["simulate", str(spec), "--plot", str(png)])
     assert r.exit_code == 0 and png.exists()
+
+
+def test_dash_is_not_an_output_and_runs_is_given_once(tmp_path: Path, monkeypatch) -> None:
+    """``-o -`` / ``--csv -`` wrote a file named '-' (review): '-' is refused as an output
+    (exit 2, nothing written; a path with a folder names such a file). ``--runs 3 --option runs=5`` silently
+    took 3: two different counts are exit 2; the same count twice is fine."""
+    monkeypatch.chdir(tmp_path)
+    for args in (["design", str(SPEC), "-o", "-"], ["simulate", str(SPEC), "--csv", "-"]):
+        r = CliRunner().invoke(app, args)
+        assert r.exit_code == 2 and "-: outputs go to files, not to stdout" in r.output
+        assert not (tmp_path / "-").exists()
+    r = CliRunner().invoke(app, ["design", str(SPEC), "-o", str(tmp_path / "-"), "-q"])
+    assert r.exit_code == 0 and (tmp_path / "-").exists()
+    r = CliRunner().invoke(app, ["simulate", str(SPEC), "--runs", "3", "--option", "runs=5"])
+    assert r.exit_code == 2 and "give the run count once" in r.output
+    r = CliRunner().invoke(app, ["simulate", str(SPEC), "--runs", "3", "--option", "runs=3", "-q"])
+    assert r.exit_code == 0

@@ -387,3 +387,18 @@ def test_a_plant_that_leaves_the_float_range_is_said_in_words() -> None:
     texts = info.get("warnings", [])
     assert not any("RuntimeWarning" in t for t in texts), texts
     assert any("the plant leaves the float range in 3 of 3 noisy runs" in t for t in texts), texts
+
+
+def test_runs_and_time_limit_have_the_option_bounds_in_the_spec() -> None:
+    """``[simulate] runs`` took any count and ``time_limit`` any positive number while the
+    options stop at 100,000 runs and 1 ms (review): the same bounds now."""
+    from obsdesign.errors import SpecError
+
+    text = SPEC3.read_text(encoding="utf-8")
+    assert "runs = 20\n" in text
+    for lines in ("runs = 100001\n", "runs = 20\ntime_limit = 0.0009\n"):
+        key = lines.split(" =")[0] if "time_limit" not in lines else "time_limit"
+        with pytest.raises(SpecError, match=rf"\[simulate\.{key}\]"):
+            api.load_spec_text(text.replace("runs = 20\n", lines), "s.toml")
+    ok = text.replace("runs = 20\n", "runs = 100000\ntime_limit = 0.001\n")
+    api.load_spec_text(ok, "s.toml")

@@ -177,7 +177,7 @@ def test_the_continuous_grid_ends_at_the_horizon() -> None:
         res = api.simulate(sp)
         assert res.t[-1] == 1.0
         note = res.info["warnings"][0]
-        assert note.startswith(f"[simulate] dt = {dt} does not divide horizon = 1: the grid")
+        assert note.startswith(f"[simulate] dt = {float(dt)!r} does not divide horizon = 1.0: the")
     sp = load_spec_text(CONT + "horizon = 10\ndt = 0.1\n")
     assert sp.simulate.dt_given is None and len(sim_grid(sp)) == 101
     assert float(sp.simulate.dt.f) == 0.1

@@ -378,7 +378,14 @@ def check_output(path: str | Path, force: bool = False, inputs: tuple[Path, ...]
     one of ``inputs`` (the spec itself), a symbolic link, an existing file that is not a
     regular file (device, FIFO, socket), or a write-protected file, unless ``force``; a
     directory, a path given for two outputs, or a directory that cannot take a new file
-    always. Nothing is written here (an empty probe file is created and removed)."""
+    always. Nothing is written here (an empty probe file is created and removed). ``-``
+    (stdin for a spec) is refused as an output: it wrote a file named ``-`` (a path with a
+    folder, ``$PWD/-``, still names one)."""
+    if str(path) == "-":
+        raise InputError(
+            "-: outputs go to files, not to stdout (which carries the results); name a file "
+            "(\"$PWD/-\" for a file called '-')"
+        )
     p = Path(path)
     for i in inputs:  # an output given twice (-o X --plot X) is one file written twice
         if not os.path.exists(i) and os.path.realpath(p) == os.path.realpath(i):

@@ -190,6 +190,8 @@ def parse_simulate(table: Table, spec: Spec) -> SimOptions:
 
     ``table``: the ``[simulate]`` table; ``spec``: the spec (for the file's folder)."""
     runs = table.int("runs", default=20, min=1)
+    if runs > 100_000:  # the bound of --option runs
+        raise table.error("runs", "expected at most 100,000 runs")
     sf = None
     if table.has("sampling_file"):
         p = Path(table.str("sampling_file"))
@@ -198,7 +200,8 @@ def parse_simulate(table: Table, spec: Spec) -> SimOptions:
     rtol = float(
         table.scalar("rtol", default=fmpq(1, 10**7), min=fmpq(1, 10**14), max=fmpq(1, 100)).f
     )
-    limit = float(table.scalar("time_limit", default=fmpq(300), min=0, strict_min=True).f)
+    # the bound of --option time_limit (1 ms)
+    limit = float(table.scalar("time_limit", default=fmpq(300), min=fmpq(1, 1000)).f)
     return SimOptions(runs, sf, rtol, limit)
 
 
@@ -269,8 +272,8 @@ def options_schema(key: str) -> dict[str, Any]:
 def simulate_schema() -> dict[str, Any]:
     """JSON-schema properties of the method's own ``[simulate]`` keys."""
     return {
-        "runs": {"type": "integer", "minimum": 1},
+        "runs": {"type": "integer", "minimum": 1, "maximum": 100_000},
         "sampling_file": {"type": "string"},
         "rtol": {"type": "number", "minimum": 1e-14, "maximum": 0.01},
-        "time_limit": {"type": "number", "exclusiveMinimum": 0},
+        "time_limit": {"type": "number", "minimum": 0.001},
     }
