@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import math
 import signal
 import threading
 import time
@@ -764,6 +765,12 @@ def check_sim_memory(sp: Spec, kwargs: dict[str, Any]) -> None:
     cap = limits().max_sim_bytes
     if need > cap:
         shown = method.sim_run_count(int(runs), kwargs)
+        if not math.isfinite(steps) or not math.isfinite(need):
+            raise InputError(
+                f"{sp.file}: simulating {shown} run(s) of horizon / dt = "
+                f"{float(sim.horizon.f):g} / {float(sim.dt.f) if sim.dt else 1:g} steps: more "
+                "than a float can count (a shorter horizon or a larger dt)"
+            )
         raise InputError(
             f"{sp.file}: simulating {shown} run(s) × {steps:.3g} steps × {sp.system.n} "
             f"states needs about {need / 2**30:.3g} GiB, above the limit of "

@@ -640,6 +640,10 @@ def simulate(
             )
         opts["runs"] = str(runs)
     if study is not None:
+        if "study" in opts and opts["study"] != study:
+            from obsdesign.errors import InputError
+
+            raise InputError(f"--study {study} and --option study={opts['study']}: give it once")
         opts["study"] = study
     res = api.simulate(sp, report, options=opts, workers=workers, scheduler=scheduler)
     if plot is not None and len(res.t) > MAX_PLOT_POINTS:

@@ -283,3 +283,21 @@ def test_dash_is_not_an_output_and_runs_is_given_once(tmp_path: Path, monkeypatc
     assert r.exit_code == 2 and "give the run count once" in r.output
     r = CliRunner().invoke(app, ["simulate", str(SPEC), "--runs", "3", "--option", "runs=3", "-q"])
     assert r.exit_code == 0
+
+
+def test_study_is_given_once_and_an_uncountable_horizon_is_said_plainly(tmp_path: Path) -> None:
+    """``--study outliers --option study=none`` took the flag silently; horizon 1e300 over
+    dt 1e-300 printed "inf steps … inf GiB" (review)."""
+    stub = Path(__file__).resolve().parents[1] / "specs" / "astolfi-stubborn-example1.toml"
+    r = CliRunner().invoke(
+        app, ["simulate", str(stub), "--study", "outliers", "--option", "study=none"]
+    )
+    assert r.exit_code == 2 and "give it once" in r.output
+    spec = tmp_path / "c.toml"
+    spec.write_text(
+        '[system]\ntime = "continuous"\nA = [[0, 1], [-2, -0.3]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\nL = [1, 1]\n'
+        "[simulate]\nhorizon = 1e300\ndt = 1e-300\nx0 = [1, 0]\nxhat0 = [0, 0]\n"
+    )
+    r = CliRunner().invoke(app, ["simulate", str(spec)])
+    assert r.exit_code == 2 and "more than a float can count" in r.output and "inf" not in r.output

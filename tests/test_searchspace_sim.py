@@ -407,3 +407,17 @@ def test_substeps_are_bounded_and_a_hopeless_flow_error_is_not_halved_forever(ex
     P = np.array([[0.0, 1.5]])
     steps, _ = S.partition(plant, P, 0.0, 0.1, 4, 0.0)  # a tolerance no halving meets
     assert len(steps) == 4 + S.MAX_EXTRA_PIECES
+
+
+def test_max_centres_beyond_the_memory_limit_is_refused() -> None:
+    """``max_centres = 10⁹`` was accepted and the run grew past 1 GB until time_limit
+    (review): a cap whose centres would not fit in max_sim_bytes is exit 2 naming the key;
+    the default (2·10⁶) fits."""
+    r = CliRunner().invoke(app, ["simulate", str(SPEC), "--option", "max_centres=1000000000"])
+    assert r.exit_code == 2
+    assert (
+        "[simulate] max_centres = 1,000,000,000 centres of 2 states may need about 82" in r.output
+    )
+    from obsdesign.methods.searchspace import sim as S
+
+    S._check_centres(api.load_spec(SPEC), 2_000_000)

@@ -350,6 +350,27 @@ class Run:
     switches: list[float] = field(default_factory=list)
 
 
+#: bytes a live centre may take at the peak of a refinement (the centres, their children and
+#: the flowed copy, 8 bytes a coordinate each, plus masks and indices)
+CENTRE_BYTES = 32
+
+
+def _check_centres(spec: Spec, max_centres: int) -> None:
+    """Refuse (InputError, exit 2, naming the key) a ``max_centres`` whose centres would not
+    fit in ``max_sim_bytes``: 10⁹ were accepted and the run grew past 1 GB until time_limit
+    (independent simulate review).
+
+    :param spec: the bound spec; :param max_centres: the cap in force."""
+    need = float(max_centres) * (CENTRE_BYTES * spec.system.n + 24)
+    cap = limits().max_sim_bytes
+    if need > cap:
+        raise InputError(
+            f"{spec.file}: [simulate] max_centres = {max_centres:,} centres of "
+            f"{spec.system.n} states may need about {need / 2**30:.3g} GiB, above the limit of "
+            f"{cap / 2**30:.3g} GiB (a smaller max_centres, or --limit max_sim_bytes=N)"
+        )
+
+
 def _options(spec: Spec, kw: dict[str, Any]) -> SimOptions:
     base = spec.simulate.options if spec.simulate and spec.simulate.options else SimOptions()
     vals = {k: v for k, v in kw.items() if v is not None and hasattr(base, k)}
@@ -363,6 +384,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
     assert spec.simulate is not None
     plant = Plant(spec)
     n = spec.system.n
+    _check_centres(spec, so.max_centres)
     dT = params.float("dT")
     K = int(round(params.float("K")))
     gam = [float(g) for g in params.float("gamma_schedule")]
