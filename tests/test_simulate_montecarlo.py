@@ -370,3 +370,20 @@ def test_metrics_and_quantiles_of_huge_or_infinite_errors() -> None:
     assert all(v == np.inf for v in q.values())
     q = mc._q(np.array([1.0, 2.0, 3.0]))
     assert q["q50"] == 2.0 and q["max"] == 3.0
+
+
+def test_runs_whose_metrics_overflow_are_said_in_words(tmp_path) -> None:
+    """x0 = 1e300: every run's RMSE overflows; the only word was numpy's "overflow
+    encountered in multiply" (review). One worded warning counts the runs."""
+    from obsdesign import api
+
+    p = tmp_path / "s.toml"
+    p.write_text(RANDOM.replace("x0 = [1, -1]", "x0 = [1e300, -1e300]"))
+    notes = api.simulate(p, options={"runs": "3"}).info["warnings"]
+    assert any(
+        w.startswith("warning: UserWarning: the metrics of 3 of 3 runs are not finite")
+        for w in notes
+    )
+    assert not any("RuntimeWarning" in w for w in notes)
+    p.write_text(RANDOM)
+    assert "warnings" not in api.simulate(p, options={"runs": "3"}).info

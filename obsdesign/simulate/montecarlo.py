@@ -32,6 +32,7 @@ calls from its ``parse_simulate``.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -402,7 +403,8 @@ def study(
         rngs = [np.random.default_rng(c) for c in children[b0 : b0 + B]]
         e0 = initial_errors(eset, rngs, sim.xhat0.f - sim.x0.f)
         e0_all[b0 : b0 + len(rngs)] = e0
-        m, t0 = step(rngs, e0, b0 == 0)
+        with np.errstate(over="ignore", invalid="ignore"):  # said in words below
+            m, t0 = step(rngs, e0, b0 == 0)
         traj = t0 if b0 == 0 else traj
         for k, a in m.items():
             out[k][b0 : b0 + len(rngs)] = a
@@ -417,6 +419,15 @@ def study(
     if span is not None:
         res.info["span"] = [first, last]
     res.info["quantiles"] = quantiles(out, s.states)
+    bad = ~np.all(np.isfinite(np.hstack([a.reshape(runs, -1) for a in out.values()])), axis=1)
+    if bad.any():
+        # numpy's "overflow encountered in multiply" was the only word (review)
+        warnings.warn(
+            f"the metrics of {int(bad.sum()):,} of {runs:,} runs are not finite: their errors "
+            "or estimates leave the float range (an RMSE overflows from errors near 1e154), "
+            "so their quantiles are inf or nan; smaller initial errors or a shorter horizon",
+            stacklevel=2,
+        )
     return res
 
 
