@@ -164,7 +164,8 @@ def simulate(
         )
     if noisy.escaped.any() or clean.escaped.any() or open_.escaped.any():
         warnings.warn(
-            f"the plant leaves the float range in {int(noisy.escaped.sum())} of {runs} noisy "
+            "the plant leaves the float range (or its field is not finite) in "
+            f"{int(noisy.escaped.sum())} of {runs} noisy "
             f"runs and {int(clean.escaped.sum())} noise-free runs (from x0 = "
             f"{np.array2string(sim.x0.f, precision=4)}): those runs stop there, the error is "
             "not defined beyond (plant_escaped_runs); a smaller x0 or horizon keeps it finite",
