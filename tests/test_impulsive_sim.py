@@ -387,7 +387,10 @@ def test_a_plant_that_leaves_the_float_range_is_said_in_words() -> None:
     assert info["worst_eps_after_t15"] is None
     texts = info.get("warnings", [])
     assert not any("RuntimeWarning" in t for t in texts), texts
-    assert any("the plant leaves the float range (or its field is not finite) in 3 of 3 noisy runs" in t for t in texts), texts
+    assert any(
+        "the plant leaves the float range (or its field is not finite) in 3 of 3 noisy runs" in t
+        for t in texts
+    ), texts
 
 
 def test_runs_and_time_limit_have_the_option_bounds_in_the_spec() -> None:

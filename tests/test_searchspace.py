@@ -544,3 +544,77 @@ def test_K_bits_grow_with_K_and_are_capped() -> None:
     assert 113 + 990 < D.K_bits(fmpq(1, 10**300)) < 113 + 1010
     assert D.K_bits(fmpq(1, 10**100000)) == D.MAX_K_BITS
     assert D.K_bits(fmpq(0)) == 113
+
+
+def test_the_safety_net_refutes_only_beyond_float_error(example, monkeypatch) -> None:
+    """Mutation review 20: _constant refutes a value only when a sample exceeds it by more
+    than float error. A sample exactly at val·(1 + 10⁻⁶) + 10⁻³⁰⁰ does not refute a proved
+    L_h (≥ would), and a constant h (interval bound 0, sample 0) has the bound 0 proved (the
+    10⁻³⁰⁰ is what keeps 0 > −10⁻³⁰⁰ from refuting it)."""
+    from obsdesign.api import bind
+    from obsdesign.certify.claim import Claims
+    from obsdesign.methods.searchspace import claims as C
+    from obsdesign.methods.searchspace.bounds import Bound
+
+    sp, rep = example
+    bsp = bind(sp)
+    val = rep.parameters["L_h"]
+    at = float(val) * (1 + 1e-6) + 1e-300
+    cases = [(Bound(float(val) / 2, at, 1), val), (Bound(0.0, 0.0, 1), fmpq(0))]
+    for bound, v in cases:
+        monkeypatch.setattr(C, "interval_bound", lambda k, spec, b=bound: b)
+        c = Claims()
+        C._constant(c, bsp, "L_h", v)
+        (claim,) = c
+        assert claim.id == "L_h-bound" and claim.status == ClaimStatus.CERTIFIED, claim.detail
+
+
+def test_an_unproved_constant_fails_unless_the_user_gave_it(example, monkeypatch) -> None:
+    """Mutation review 20: which branch of _constant decides. A computed constant (not in the
+    spec) that the interval bound does not prove fails exactly, even with every sample below
+    it; a value the user gave, unproved and not refuted (a sample equal to it is not above
+    it), is a numerical pass."""
+    from obsdesign.api import bind
+    from obsdesign.certify.claim import Claims
+    from obsdesign.methods.searchspace import claims as C
+    from obsdesign.methods.searchspace.bounds import Bound
+
+    sp, _ = example
+    given = bind(api.load_spec_text(TEXT.replace("gamma0 = 1 ", "gamma0 = 1\nL_h = 1 "), "g.toml"))
+    assert given.options.L_h == 1 and bind(sp).options.L_h is None
+    cases = [
+        (bind(sp), Bound(2.0, 0.5, 1), ClaimStatus.FAILED),
+        (given, Bound(2.0, 0.5, 1), ClaimStatus.NUMERICAL),
+        (given, Bound(2.0, 1.0, 1), ClaimStatus.NUMERICAL),
+    ]
+    for spec, bound, want in cases:
+        monkeypatch.setattr(C, "interval_bound", lambda k, s, b=bound: b)
+        c = Claims()
+        C._constant(c, spec, "L_h", fmpq(1))
+        (claim,) = c
+        assert claim.status == want, (bound, claim.detail)
+
+
+def test_schedule_checks_every_transition_and_the_fixed_point() -> None:
+    """Mutation review 20: _schedule on exact inputs (L_f = 1, Δτ = 1/10, γ⋆ = 1/100). The
+    rule's own schedule passes; an entry 1.45× the rule's value (allowed: 10⁻¹² relative)
+    fails; dropping the second-to-last entry (the last transition then jumps to γ⋆ early)
+    fails; a schedule [γ⋆] with e^(L_f Δτ)/2 > 1 (L_f Δτ = 4/5) fails."""
+    from obsdesign.certify.claim import Claims
+    from obsdesign.methods.searchspace import claims as C
+
+    L_f, dtau, g_star = fmpq(1), fmpq(1, 10), fmpq(1, 100)
+
+    def status(gam, dt=dtau):  # noqa: ANN001, ANN202
+        c = Claims()
+        C._schedule(c, list(gam), g_star, L_f, dt)
+        (claim,) = c
+        assert claim.id == "gamma-schedule"
+        return claim.status
+
+    good = D.schedule(fmpq(1), g_star, L_f, dtau)
+    assert len(good) >= 4 and good[-1] == g_star and good[-2] > g_star
+    assert status(good) == ClaimStatus.CERTIFIED
+    assert status([fmpq(1), *D.schedule(fmpq(4, 5), g_star, L_f, dtau)]) == ClaimStatus.FAILED
+    assert status([*good[:-2], g_star]) == ClaimStatus.FAILED
+    assert status([g_star], fmpq(4, 5)) == ClaimStatus.FAILED

@@ -1006,3 +1006,109 @@ def test_simulate_time_limit_key_is_read_and_checked() -> None:
     assert sp.simulate.options.time_limit == 12.5
     with pytest.raises(SpecError, match=r"\[simulate\.time_limit\]"):
         api.load_spec_text(text.replace("[simulate]\n", "[simulate]\ntime_limit = 0\n"))
+
+
+# -- mutation review 20: conditions that no test decided before --------------------------
+def _always_infeasible(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The far end's solver answer forced to 'infeasible': the side conditions of the bracket
+    must decide on their own (a solver that says infeasible anywhere must not widen them)."""
+    from obsdesign.methods.stubborn import design as dz
+
+    monkeypatch.setattr(dz, "Feasibility", lambda pl, o: lambda lam: (False, dz.INFEASIBLE))
+
+
+def _bracket_claim(d: dict[str, Any]) -> Any:
+    rep, problems = Report.from_dict(json.loads(json.dumps(d)))
+    assert not problems
+    (claim,) = [c for c in api.verify(rep).claims if c.id == "lambda-max-bracket"]
+    return claim
+
+
+@pytest.mark.parametrize(
+    "which, lam_max, bracket, ok",
+    [
+        # continuous: the far end strictly above λ_max, λ_max strictly above 0
+        ("ex1", None, lambda lo: [lo, lo], False),
+        ("ex1", fmpq(0), lambda lo: [fmpq(0), fmpq(1)], False),
+        # a continuous λ_max ≤ 1 is a valid rate: the side check must accept it
+        ("ex1", fmpq(1, 2), lambda lo: [fmpq(1, 2), fmpq(1)], True),
+        # discrete: the far end strictly between 0 and λ_max
+        ("ex4", None, lambda lo: [lo, lo], False),
+        ("ex4", None, lambda lo: [lo, fmpq(0)], False),
+    ],
+    ids=["cont-equal", "cont-zero", "cont-below-one", "disc-equal", "disc-zero"],
+)
+def test_bracket_sides_are_strict_whatever_the_solver_says(
+    ex1: Report,
+    ex4: Report,
+    monkeypatch: pytest.MonkeyPatch,
+    which: str,
+    lam_max: Any,
+    bracket: Any,
+    ok: bool,
+) -> None:
+    """0 < λ_max < far (continuous), 0 < far < λ_max (discrete), each strict, with the
+    solver's answer forced to 'infeasible'; a continuous λ_max below 1 is on the right side."""
+    _always_infeasible(monkeypatch)
+    d = (ex1 if which == "ex1" else ex4).to_dict()
+    if lam_max is not None:
+        _set(d, "lambda_max", lam_max)
+    lo = _get(d, "lambda_max")
+    _set(d, "lambda_bracket", np.array(bracket(lo), dtype=object))
+    claim = _bracket_claim(d)
+    if ok:
+        assert claim.status == ClaimStatus.NUMERICAL, claim.detail
+    else:
+        assert claim.status == ClaimStatus.FAILED and "far end on the wrong side" in claim.detail
+
+
+def test_a_reported_X_of_the_wrong_shape_is_refused(ex1: Report) -> None:
+    """X = P K must be n × p: an extra column (P K beside zeros) is malformed, not a match of
+    its first p columns."""
+    d = ex1.to_dict()
+    X = _get(d, "X")
+    n, p = X.shape
+    wide = np.array(
+        [[X[i, j] if j < p else fmpq(0) for j in range(p + 1)] for i in range(n)], dtype=object
+    )
+    _set(d, "X", wide)
+    assert _failed(d) == {"parameters-wellformed"}
+
+
+def test_point_failures_names_each_failed_check(ex1: Report, ex4: Report) -> None:
+    """The design's self-check (a rounded candidate is kept only when it names no failure)
+    lists the failed checks: none for a certified point, U-positive and lmi-global for u₁ = 0,
+    l2-gain for a γ² below the certified one."""
+    from obsdesign.api import bind
+    from obsdesign.methods.stubborn.claims import point_failures
+
+    def cand(rep: Report) -> dict[str, Any]:
+        p = rep.parameters
+        out = {k: np.asarray(p[k], dtype=object) for k in ("P", "K", "Y", "R")}
+        out["U"] = np.asarray(p["U"], dtype=object).reshape(-1)
+        out["W"] = np.asarray(p["W"], dtype=object).reshape(-1)
+        out["lambda"] = p["lambda"]
+        if "gamma2" in p:
+            out["gamma2"] = p["gamma2"]
+        return out
+
+    sp1, sp4 = bind(api.load_spec(EX1)), bind(api.load_spec(EX4))
+    c1 = cand(ex1)
+    assert point_failures(sp1, c1, False) == []
+    c1["U"] = c1["U"].copy()
+    c1["U"][0] = fmpq(0)
+    assert point_failures(sp1, c1, False) == ["U-positive", "lmi-global"]
+    c4 = cand(ex4)
+    assert point_failures(sp4, c4, True) == []
+    c4["gamma2"] = c4["gamma2"] * fmpq(9, 10)
+    assert point_failures(sp4, c4, True) == ["l2-gain"]
+
+
+def test_the_reported_r_bound_is_the_specs() -> None:
+    """The report's copy of [method].r_bound is compared with the spec (like gain_bound): a
+    report claiming another bound fails r_bound-matches-spec."""
+    text = EX1.read_text().replace("gain_bound = 100", "r_bound = 100\nlambda_tol = 0.01")
+    rep = api.design(api.load_spec_text(text, "r.toml"))
+    d = rep.to_dict()
+    _set(d, "r_bound", fmpq(101))
+    assert _failed(d) == {"r_bound-matches-spec"}
