@@ -61,3 +61,24 @@ def dask_client(request: pytest.FixtureRequest):
         finally:
             client.close()
             cluster.close()
+
+
+@pytest.fixture
+def slow_clock(monkeypatch: pytest.MonkeyPatch):
+    """``slow_clock(still=0)``: the simulations' time budget (obsdesign.simulate.budget) reads
+    a clock that stands at 0 for its first ``still`` looks, then is 1000 s later at every look
+    — a budget of 999 s (or 1000.5) runs out at a chosen look, deterministically. Calling it
+    again restarts the clock; ``monkeypatch.undo()`` gives the real clock back."""
+    from obsdesign.simulate import budget
+
+    def start(still: int = 0) -> None:
+        ticks = iter([0] * still + list(range(0, 10**6, 1000)))
+
+        class Clock:
+            @staticmethod
+            def perf_counter() -> float:
+                return float(next(ticks))
+
+        monkeypatch.setattr(budget, "time", Clock)
+
+    return start

@@ -465,13 +465,12 @@ def test_simulate_names_an_estimate_that_starts_outside_xhat(tmp_path) -> None:
     assert premises in " ".join(info["warnings"])
 
 
-def test_simulate_time_limit_stops_a_run_with_exit_3(tmp_path, monkeypatch) -> None:
+def test_simulate_time_limit_stops_a_run_with_exit_3(tmp_path, monkeypatch, slow_clock) -> None:
     """``[simulate] time_limit`` (and ``--option time_limit``) bound a constrained simulation:
     θ_m ≤ θ may be astronomically large (θ_m = 10⁵ ran past 120 s; review). Past the limit the
     run stops with a SolverError naming the key, the observer and the sample; an unknown key
     before this change, the key is now accepted, and a non-positive value is exit 2."""
     from obsdesign.errors import SolverError
-    from obsdesign.simulate import budget as sim_budget
 
     p = tmp_path / "tl.toml"
     p.write_text(R2.replace("seed = 4", "seed = 4\ntime_limit = 1e-9"))
@@ -480,17 +479,10 @@ def test_simulate_time_limit_stops_a_run_with_exit_3(tmp_path, monkeypatch) -> N
     ):
         api.simulate(p)
     p.write_text(R2)
-    clock = iter(range(0, 10**6, 1000))  # every look at the clock is 1000 s later
-
-    class Slow:
-        @staticmethod
-        def perf_counter() -> float:
-            return float(next(clock))
-
-    monkeypatch.setattr(sim_budget, "time", Slow)
+    slow_clock()  # every look at the clock is 1000 s later
     with pytest.raises(SolverError, match="the unmodified observer runs at sample 0 of 60"):
         api.simulate(p, options={"time_limit": "1000.5", "theta_m": "3"})
-    clock = iter(range(0, 10**6, 1000))
+    slow_clock()
     with pytest.raises(SolverError, match="the plant at sample 0 of 60"):  # its loop too
         api.simulate(p, options={"time_limit": "999", "theta_m": "3"})
     monkeypatch.undo()

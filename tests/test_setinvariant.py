@@ -600,7 +600,7 @@ def test_simulated_error_keeps_its_digits_for_a_large_state() -> None:
 
 
 @pytest.mark.parametrize("law", [None, "online-lp", "linear"])
-def test_simulate_time_limit_stops_the_run(rep71, law, monkeypatch) -> None:
+def test_simulate_time_limit_stops_the_run(rep71, law, monkeypatch, slow_clock) -> None:
     """``[simulate] time_limit`` / ``--option time_limit`` (default 300 s) bound the
     simulation (online-lp solves an LP at every step: a long horizon ran for hours). A clock
     past the budget stops it with exit 3 naming the key, the law and the step; the key is read
@@ -608,7 +608,6 @@ def test_simulate_time_limit_stops_the_run(rep71, law, monkeypatch) -> None:
     from pathlib import Path
 
     from obsdesign.errors import SolverError, SpecError
-    from obsdesign.simulate import budget as sim_budget
 
     _, out = rep71
     path = Path(__file__).resolve().parents[1] / "specs" / "dorea-pimenta-7-1.toml"
@@ -616,14 +615,7 @@ def test_simulate_time_limit_stops_the_run(rep71, law, monkeypatch) -> None:
     timed = api.load_spec_text(text.replace("[simulate]", "[simulate]\ntime_limit = 999", 1))
     assert timed.simulate.options.time_limit == 999
     spec = api.load_spec(path)  # the report's own spec; the budget as an option
-    clock = iter(range(0, 10**6, 1000))  # every look at the clock is 1000 s later
-
-    class Slow:
-        @staticmethod
-        def perf_counter() -> float:
-            return float(next(clock))
-
-    monkeypatch.setattr(sim_budget, "time", Slow)
+    slow_clock()  # every look at the clock is 1000 s later
     name = law or "interpolated"
     with pytest.raises(SolverError, match=rf"within 999 s .*: the {name} law at step 0 of 17"):
         api.simulate(spec, out, law=law, time_limit=999)

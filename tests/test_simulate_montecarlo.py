@@ -273,28 +273,21 @@ EXPR = PLANT.replace("[method]", 'f = ["0.5*x1 + x2 + 0.01*sin(x1)", "0.8*x2"]\n
         (scenario(EXPR, noise=UNIFORM), {"runs": "3"}, "0 of 3 Monte Carlo runs done"),
     ],
 )
-def test_lyapunov_simulate_has_a_time_budget(text, options, where, monkeypatch, tmp_path):
+def test_lyapunov_simulate_has_a_time_budget(text, options, where, slow_clock, tmp_path):
     """``[simulate] time_limit`` / ``--option time_limit`` (default 300 s) bound the lyapunov
     simulation: 10⁶ steps of an expression plant took ~70 s and the memory limit allowed 20
     times more, with no way to stop it. A clock past the budget stops the single run and the
     Monte Carlo study, linear or not, with exit 3 naming the key and where it got to."""
     from obsdesign import api
     from obsdesign.errors import SolverError
-    from obsdesign.simulate import budget as sim_budget
-
-    clock = iter(range(0, 10**6, 1000))  # every look at the clock is 1000 s later
-
-    class Slow:
-        @staticmethod
-        def perf_counter() -> float:
-            return float(next(clock))
 
     p = tmp_path / "s.toml"
     p.write_text(text)
     api.simulate(p, options={**options, "time_limit": "999"})  # the real clock: finished
-    monkeypatch.setattr(sim_budget, "time", Slow)
+    slow_clock()  # every look at the clock is 1000 s later
     with pytest.raises(SolverError, match=rf"within 999 s \(\[simulate\] time_limit\): {where}"):
         api.simulate(p, options={**options, "time_limit": "999"})
+    slow_clock()
     p.write_text(text.replace("seed = 11", "seed = 11\ntime_limit = 999"))
     with pytest.raises(SolverError, match="within 999 s"):
         api.simulate(p, options=options)

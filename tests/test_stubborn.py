@@ -973,7 +973,7 @@ STUDY = {"study": "outliers", "runs": "2"}
         ("astolfi-stubborn-duffing.toml", {}, 1, "the high-gain observers at step 0 of 10,000"),
     ],
 )
-def test_simulate_time_limit_stops_every_scenario(spec, options, still, where, monkeypatch):
+def test_simulate_time_limit_stops_every_scenario(spec, options, still, where, slow_clock):
     """``[simulate] time_limit`` / ``--option time_limit`` bound the single run (plant and
     observer), the outlier study (its nominal run and its runs) and the high-gain scenario: a
     single run of 10⁶ steps took 114 s with no way to stop it (review 19). The clock stands
@@ -981,18 +981,10 @@ def test_simulate_time_limit_stops_every_scenario(spec, options, still, where, m
     tested: one look per 1024 steps, per chunk in the study), then jumps past the budget:
     exit 3 naming the key and how far the run got."""
     from obsdesign.errors import SolverError
-    from obsdesign.simulate import budget as sim_budget
 
     sp = api.load_spec(SPECS / spec)
     rep = api.design(sp)
-    clock = iter([0] * still + list(range(1000, 10**6, 1000)))
-
-    class Slow:
-        @staticmethod
-        def perf_counter() -> float:
-            return float(next(clock))
-
-    monkeypatch.setattr(sim_budget, "time", Slow)
+    slow_clock(still - 1)
     with pytest.raises(SolverError, match=rf"within 999 s \(\[simulate\] time_limit\): {where}"):
         api.simulate(sp, rep, options={**options, "time_limit": "999"})
 
