@@ -145,6 +145,9 @@ def test_symmetrize_qstr_qparse_qmax_abs():
             qparse(bad)
     with pytest.raises(ValueError, match=r"^ragged or empty exact array$"):
         qparse([])
+    for ragged in ([[1, 2], [3]], [[1], [[2]]], [["1/2", "1"], ["3"]]):  # found in the entries
+        with pytest.raises(ValueError, match=r"^ragged or empty exact array$"):
+            qparse(ragged)
     with pytest.raises(ValueError, match=r"^not an exact value: "):
         qparse([1, None])
     with pytest.raises(ValueError, match=r"^not an exact value: "):

@@ -288,9 +288,9 @@ def test_dash_is_not_an_output_and_runs_is_given_once(tmp_path: Path, monkeypatc
 def test_study_is_given_once_and_an_uncountable_horizon_is_said_plainly(tmp_path: Path) -> None:
     """``--study outliers --option study=none`` took the flag silently; horizon 1e300 over
     dt 1e-300 printed "inf steps … inf GiB" (review)."""
-    stub = Path(__file__).resolve().parents[1] / "specs" / "astolfi-stubborn-example1.toml"
+    example1 = Path(__file__).resolve().parents[1] / "specs" / "astolfi-stubborn-example1.toml"
     r = CliRunner().invoke(
-        app, ["simulate", str(stub), "--study", "outliers", "--option", "study=none"]
+        app, ["simulate", str(example1), "--study", "outliers", "--option", "study=none"]
     )
     assert r.exit_code == 2 and "give it once" in r.output
     spec = tmp_path / "c.toml"
