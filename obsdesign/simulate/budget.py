@@ -10,6 +10,7 @@ A ``theta_m`` of 10⁵ (constrained) ran past 120 s and a stubborn single run of
 from __future__ import annotations
 
 import time
+from typing import Any
 
 from obsdesign.errors import SolverError
 
@@ -36,3 +37,26 @@ class TimeBudget:
                 f"simulation not finished within {self.limit:g} s ([simulate] time_limit): "
                 f"{where} ({self.advice})"
             )
+
+
+#: the smallest budget a spec or ``--option time_limit`` may give, in seconds
+MIN_LIMIT = 0.001
+
+
+def parse_time_limit(table: Any) -> float:
+    """``[simulate] time_limit`` of any method: seconds, at least :data:`MIN_LIMIT` (the bound
+    of ``--option time_limit``), default :data:`DEFAULT_LIMIT`; an error names the key.
+
+    :param table: the ``[simulate]`` table (:class:`obsdesign.spec.reader.Table`)."""
+    from flint import fmpq
+
+    v = table.scalar("time_limit", default=None, min=fmpq(1, 1000))
+    return DEFAULT_LIMIT if v is None else float(v.f)
+
+
+#: the JSON schema of ``[simulate] time_limit`` (every method's)
+TIME_LIMIT_SCHEMA: dict[str, Any] = {
+    "type": "number",
+    "minimum": MIN_LIMIT,
+    "description": "seconds the simulation may run (exit 3 past it)",
+}

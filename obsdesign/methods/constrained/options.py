@@ -21,6 +21,7 @@ from obsdesign.methods.constrained.cmap import (
 )
 from obsdesign.sets import Box, Ellipsoid, Polytope, vertices_exact
 from obsdesign.sets.base import ConvexSet
+from obsdesign.simulate.budget import DEFAULT_LIMIT, TIME_LIMIT_SCHEMA, parse_time_limit
 from obsdesign.spec.models import Spec
 from obsdesign.spec.reader import Table
 
@@ -71,7 +72,7 @@ class SimOptions:
     theta_m: list[int] = field(default_factory=list)
     gamma: fmpq | None = None
     saturation_r: np.ndarray | None = None
-    time_limit: float = 300.0
+    time_limit: float = DEFAULT_LIMIT
 
 
 def parse_options(table: Table, spec: Spec) -> Options:
@@ -305,7 +306,7 @@ def parse_simulate(table: Table, spec: Spec) -> SimOptions:
             raise table.error(
                 "saturation_r", f"expected a positive number or {spec.system.n} positive numbers"
             )
-    out.time_limit = float(table.scalar("time_limit", default=fmpq(300), min=0, strict_min=True).f)
+    out.time_limit = parse_time_limit(table)
     return out
 
 
@@ -404,11 +405,7 @@ def simulate_schema() -> dict[str, Any]:
             "anyOf": [NUM, VEC],
             "description": "level r of the saturated observer (29)",
         },
-        "time_limit": {
-            "type": "number",
-            "exclusiveMinimum": 0,
-            "description": "seconds the simulation may run (exit 3 past it)",
-        },
+        "time_limit": TIME_LIMIT_SCHEMA,
     }
 
 

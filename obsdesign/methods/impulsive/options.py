@@ -21,6 +21,7 @@ from obsdesign.certify.linalg import qrank
 from obsdesign.certify.psd import check_pd, check_psd
 from obsdesign.errors import SpecError
 from obsdesign.methods.base import table_schema
+from obsdesign.simulate.budget import DEFAULT_LIMIT, TIME_LIMIT_SCHEMA, parse_time_limit
 from obsdesign.spec.models import Spec
 from obsdesign.spec.reader import Table
 
@@ -62,7 +63,7 @@ class SimOptions:
     runs: int = 20
     sampling_file: Path | None = None
     rtol: float = 1e-7
-    time_limit: float = 300.0
+    time_limit: float = DEFAULT_LIMIT
 
 
 def parse_options(table: Table, spec: Spec) -> Options:
@@ -200,8 +201,7 @@ def parse_simulate(table: Table, spec: Spec) -> SimOptions:
     rtol = float(
         table.scalar("rtol", default=fmpq(1, 10**7), min=fmpq(1, 10**14), max=fmpq(1, 100)).f
     )
-    # the bound of --option time_limit (1 ms)
-    limit = float(table.scalar("time_limit", default=fmpq(300), min=fmpq(1, 1000)).f)
+    limit = parse_time_limit(table)  # the bound of --option time_limit (1 ms)
     return SimOptions(runs, sf, rtol, limit)
 
 
@@ -275,5 +275,5 @@ def simulate_schema() -> dict[str, Any]:
         "runs": {"type": "integer", "minimum": 1, "maximum": 100_000},
         "sampling_file": {"type": "string"},
         "rtol": {"type": "number", "minimum": 1e-14, "maximum": 0.01},
-        "time_limit": {"type": "number", "minimum": 0.001},
+        "time_limit": TIME_LIMIT_SCHEMA,
     }

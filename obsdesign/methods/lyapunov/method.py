@@ -91,7 +91,7 @@ class Lyapunov(Method):
         from ``default_rng(seed)``, not from child 0 of ``SeedSequence(seed)``; review).
         ``time_limit`` (else ``[simulate] time_limit``, 300 s): past it, exit 3 (10⁶ steps of
         an expression plant took ~70 s, and memory allowed 20 times more)."""
-        from obsdesign.simulate.budget import TimeBudget
+        from obsdesign.simulate.budget import DEFAULT_LIMIT, TimeBudget
         from obsdesign.simulate.linear import (
             simulate_linear_observer,
             simulate_linear_observer_batch,
@@ -102,7 +102,7 @@ class Lyapunov(Method):
         given = runs if runs is not None else (so.runs if so is not None else None)
         n = given or 1
         ie = so.initial_error if so is not None else None
-        limit = time_limit if time_limit is not None else (so.time_limit if so else 300.0)
+        limit = time_limit if time_limit is not None else (so.time_limit if so else DEFAULT_LIMIT)
         budget = TimeBudget(limit, "raise time_limit, or fewer runs or a shorter horizon")
         if given is None and ie is None and batch is None and span is None:
             return simulate_linear_observer(spec, params.float("L"), budget)

@@ -10,6 +10,7 @@ from flint import fmpq
 
 from obsdesign.certify.exact import Q
 from obsdesign.certify.psd import check_pd, check_psd
+from obsdesign.simulate.budget import DEFAULT_LIMIT, TIME_LIMIT_SCHEMA, parse_time_limit
 from obsdesign.spec.models import Spec
 from obsdesign.spec.reader import Table
 
@@ -180,7 +181,7 @@ class SimOptions:
     runs: int | None = None
     initial_error: str | None = None
     #: seconds the simulation may run (exit 3 past it)
-    time_limit: float = 300.0
+    time_limit: float = DEFAULT_LIMIT
 
 
 def parse_simulate(table: Table, spec: Spec) -> SimOptions:
@@ -192,8 +193,7 @@ def parse_simulate(table: Table, spec: Spec) -> SimOptions:
 
     runs = table.int("runs", default=None, min=1)
     ie = parse_initial_error(table, spec)
-    limit = table.scalar("time_limit", default=None, min=0, strict_min=True)
-    return SimOptions(runs, ie, 300.0 if limit is None else float(limit.f))
+    return SimOptions(runs, ie, parse_time_limit(table))
 
 
 def simulate_schema() -> dict[str, Any]:
@@ -201,7 +201,7 @@ def simulate_schema() -> dict[str, Any]:
     return {
         "runs": {"type": "integer", "minimum": 1},
         "initial_error": {"type": "string"},
-        "time_limit": {"type": "number", "exclusiveMinimum": 0},
+        "time_limit": TIME_LIMIT_SCHEMA,
     }
 
 

@@ -18,6 +18,7 @@ import numpy as np
 from flint import fmpq
 
 from obsdesign.sets import Box
+from obsdesign.simulate.budget import DEFAULT_LIMIT, TIME_LIMIT_SCHEMA, parse_time_limit
 from obsdesign.spec.models import Spec
 from obsdesign.spec.reader import Table
 
@@ -59,7 +60,7 @@ class SimOptions:
     refine: str = "recover"
     substeps: int = 0
     store_every: int = 1
-    time_limit: float = 300.0
+    time_limit: float = DEFAULT_LIMIT
 
 
 def _box(table: Table, k: str, spec: Spec, dim: int, strict: bool) -> tuple[Box, str]:
@@ -184,7 +185,7 @@ def parse_sim(table: Table, spec: Spec) -> SimOptions:
         refine=table.str("refine", default="recover", choices=REFINE),
         substeps=_substeps(table),
         store_every=table.int("store_every", default=1, min=1),
-        time_limit=float(table.scalar("time_limit", default=fmpq(300), min=0, strict_min=True).q),
+        time_limit=parse_time_limit(table),
     )
 
 
@@ -238,7 +239,7 @@ def simulate_schema() -> dict[str, Any]:
         "refine": {"enum": list(REFINE)},
         "substeps": {"type": "integer", "minimum": 0, "maximum": MAX_SUBSTEPS},
         "store_every": {"type": "integer", "minimum": 1},
-        "time_limit": {"type": "number", "exclusiveMinimum": 0},
+        "time_limit": TIME_LIMIT_SCHEMA,
     }
 
 

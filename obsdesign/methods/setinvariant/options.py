@@ -16,6 +16,7 @@ from flint import fmpq
 
 from obsdesign.errors import SpecError
 from obsdesign.sets import Box, Polytope
+from obsdesign.simulate.budget import DEFAULT_LIMIT, TIME_LIMIT_SCHEMA, parse_time_limit
 from obsdesign.spec.models import Spec
 from obsdesign.spec.reader import Table
 
@@ -250,23 +251,16 @@ class SimOptions:
     (exit 3 past it; the ``online-lp`` law solves LP (9) of Dórea and Pimenta (CDC-ECC 2005)
     at every step, so a long horizon ran for hours)."""
 
-    time_limit: float = 300.0
+    time_limit: float = DEFAULT_LIMIT
 
 
 def parse_simulate(table: Table, spec: Spec) -> SimOptions:
     """``[simulate] time_limit`` (> 0, default 300 s).
 
     :param table: the ``[simulate]`` table; :param spec: the spec (unused)."""
-    limit = table.scalar("time_limit", default=None, min=0, strict_min=True)
-    return SimOptions(300.0 if limit is None else float(limit.f))
+    return SimOptions(parse_time_limit(table))
 
 
 def simulate_schema() -> dict[str, Any]:
     """JSON-schema properties of the method's own ``[simulate]`` keys."""
-    return {
-        "time_limit": {
-            "type": "number",
-            "exclusiveMinimum": 0,
-            "description": "seconds the simulation may run (exit 3 past it)",
-        }
-    }
+    return {"time_limit": TIME_LIMIT_SCHEMA}

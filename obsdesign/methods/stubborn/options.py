@@ -11,6 +11,7 @@ from flint import fmpq
 
 from obsdesign.errors import SpecError
 from obsdesign.methods.base import table_schema
+from obsdesign.simulate.budget import DEFAULT_LIMIT, TIME_LIMIT_SCHEMA, parse_time_limit
 from obsdesign.spec.models import Spec
 from obsdesign.spec.reader import Table
 
@@ -86,7 +87,7 @@ class SimOptions:
     hf_stop: float = 0.0
     hf_amplitude: float = 0.0
     #: seconds the simulation may run (exit 3 past it)
-    time_limit: float = 300.0
+    time_limit: float = DEFAULT_LIMIT
 
 
 def parse_options(table: Table, spec: Spec) -> Options:
@@ -213,8 +214,7 @@ def parse_simulate(table: Table, spec: Spec) -> SimOptions:
             raise table.error(
                 "hf_stop", f"expected hf_stop >= hf_start = {o.hf_start:g} (the noise window)"
             )
-    if table.has("time_limit"):
-        o.time_limit = float(table.scalar("time_limit", min=0, strict_min=True).f)
+    o.time_limit = parse_time_limit(table)
     return o
 
 
@@ -260,5 +260,5 @@ def simulate_schema() -> dict[str, Any]:
         "hf_start": {**num, "minimum": 0},
         "hf_stop": {**num, "minimum": 0},
         "hf_amplitude": {**num, "minimum": 0},
-        "time_limit": {**num, "exclusiveMinimum": 0},
+        "time_limit": TIME_LIMIT_SCHEMA,
     }
