@@ -41,17 +41,34 @@ def test_windows_match_the_mask_per_window(ws, integer_grid, k) -> None:
     np.testing.assert_array_equal(sig.evaluate(rev, np.random.default_rng(0)), _mask(rev, wins, 2))
 
 
-def test_many_overlapping_windows_take_one_pass() -> None:
+def test_many_overlapping_windows_are_summed_per_segment_exactly() -> None:
     """12,000 windows over 5·10⁶ samples made one full pass each (past 90 s; review). Windows
-    that together cover more than 64 grids go through one running sum: the mask's numbers
-    to rounding, quickly."""
+    that together cover more than 64 grids are summed once per segment between their ends,
+    in order: the mask's numbers to the bit — a running sum of jumps lost 70 unit windows
+    beside one of 10³⁰⁰ (re-check review) — and more than MAX_OVERLAPPING_WINDOWS such
+    windows are refused."""
+    import pytest
+
+    from obsdesign.errors import InputError
+
     grid = np.arange(1000, dtype=float)
-    wins = [S.Window(float(i % 7), 990.0 - i % 5, np.array([0.25 * (i % 3)])) for i in range(100)]
+    wins = [S.Window(float(i % 7), 990.0 - i % 5, np.array([0.1 * (i % 3)])) for i in range(100)]
     out = np.zeros((1000, 1))
     S._add_windows(out, grid, wins)
-    np.testing.assert_allclose(out, _mask(grid, wins, 1), rtol=1e-12, atol=1e-12)
-    big = np.arange(5 * 10**6, dtype=float)
-    many = [S.Window(float(i), float(5 * 10**6), np.array([1.0])) for i in range(12_000)]
-    out = np.zeros((big.size, 1))
-    S._add_windows(out, big, many)  # seconds at most (the per-window mask: minutes)
-    assert out[-1, 0] == 12_000 and out[0, 0] == 1
+    np.testing.assert_array_equal(out, _mask(grid, wins, 1))
+    big = [S.Window(0.0, 999.0, np.array([1e300]))]
+    unit = [S.Window(10.0, 999.0, np.array([1.0])) for _ in range(70)]
+    neg = [S.Window(0.0, 999.0, np.array([-1e300]))]
+    for ws in (big + unit + neg, big + neg + unit):
+        out = np.zeros((1000, 1))
+        S._add_windows(out, grid, ws)
+        np.testing.assert_array_equal(out, _mask(grid, ws, 1))
+    assert out[-1, 0] == 70.0  # ±1e300 first, then the 70 units
+    many = [S.Window(float(i), 5e6, np.array([1.0])) for i in range(5_000)]
+    huge = np.arange(5 * 10**6, dtype=float)
+    out = np.zeros((huge.size, 1))
+    S._add_windows(out, huge, many)  # seconds at most (a mask per window: minutes)
+    assert out[-1, 0] == 5_000 and out[0, 0] == 1 and out[4_999, 0] == 5_000
+    too_many = [S.Window(0.0, 999.0, np.array([1.0]))] * (S.MAX_OVERLAPPING_WINDOWS + 1)
+    with pytest.raises(InputError, match=r"windows: 10,001 windows that together cover"):
+        S._add_windows(np.zeros((1000, 1)), grid, too_many)
