@@ -631,7 +631,7 @@ def simulate(
     sp = _load_spec(spec)
     opts = _kv(option or [])
     if runs is not None:
-        if "runs" in opts and opts["runs"] != str(runs):
+        if "runs" in opts and opts["runs"].strip().lstrip("+").lstrip("0") != str(runs):
             from obsdesign.errors import InputError
 
             # --runs silently won over --option runs=..., unchecked (review)

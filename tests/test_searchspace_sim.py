@@ -416,7 +416,7 @@ def test_max_centres_beyond_the_memory_limit_is_refused() -> None:
     r = CliRunner().invoke(app, ["simulate", str(SPEC), "--option", "max_centres=1000000000"])
     assert r.exit_code == 2
     assert (
-        "[simulate] max_centres = 1,000,000,000 centres of 2 states may need about 82" in r.output
+        "[simulate] max_centres = 1,000,000,000 centres of 2 states may need about 156" in r.output
     )
     from obsdesign.methods.searchspace import sim as S
 

@@ -340,7 +340,7 @@ def test_an_initial_error_set_without_volume_is_bad_input() -> None:
     sp = load_spec_text(text.replace('initial_error = "T"', 'initial_error = "E0"'))
     with pytest.raises(InputError, match="it has \\(almost\\) no volume"):
         sp.sets["T"].sample(np.random.default_rng(1), 1)
-    assert base.MAX_SAMPLE_ROUNDS == 1000
+    assert base.MAX_SAMPLE_ROUNDS == 20_000
     pts = sp.sets["E0"].sample(np.random.default_rng(1), 5)
     assert pts.shape == (5, 2) and np.all(sp.sets["E0"].contains(pts))
 
@@ -380,3 +380,26 @@ def test_runs_whose_metrics_overflow_are_said_in_words(tmp_path) -> None:
     assert not any("RuntimeWarning" in w for w in notes)
     p.write_text(RANDOM)
     assert "warnings" not in api.simulate(p, options={"runs": "3"}).info
+
+
+def test_a_thin_set_that_a_run_cannot_draw_from_is_named(monkeypatch) -> None:
+    """A thin but sampleable initial-error set passed the load-time draw, then a run's draw
+    gave up with a message naming neither file nor key (re-check review): the study names
+    both. Shown with the sampler's rounds cut to 1 after loading (a band |x1 − x2| ≤ 10⁻³:
+    about one draw in 2,000 of its bounding box is inside)."""
+    from obsdesign import api
+    from obsdesign.errors import InputError
+    from obsdesign.sets import base
+
+    band = [[1, -1], [-1, 1], [1, 0], [-1, 0]]
+    thin = toml("sets.T", type="polytope", G=band, g=[1e-3, 1e-3, 1, 1])
+    text = (
+        PLANT
+        + SETS
+        + thin
+        + toml("simulate", horizon=10, x0=[1, -1], xhat0=[0, 0], initial_error="T", runs=50)
+    )
+    sp = load_spec_text(text, "thin.toml")
+    monkeypatch.setattr(base, "MAX_SAMPLE_ROUNDS", 1)
+    with pytest.raises(InputError, match=r"^thin\.toml: \[simulate\.initial_error\] set 'T': "):
+        api.simulate(sp)

@@ -10,7 +10,7 @@ import numpy as np
 from obsdesign.certify.exact import to_float
 
 #: rounds of :meth:`ConvexSet.sample`'s rejection sampler before it gives up
-MAX_SAMPLE_ROUNDS = 1000
+MAX_SAMPLE_ROUNDS = 20_000
 
 
 class ConvexSet(ABC):

@@ -401,7 +401,12 @@ def study(
         if budget is not None:
             budget.check(f"{b0:,} of {runs:,} Monte Carlo runs done")
         rngs = [np.random.default_rng(c) for c in children[b0 : b0 + B]]
-        e0 = initial_errors(eset, rngs, sim.xhat0.f - sim.x0.f)
+        try:
+            e0 = initial_errors(eset, rngs, sim.xhat0.f - sim.x0.f)
+        except InputError as e:  # a thin set a run could not draw from: name file and key
+            raise InputError(
+                f"{spec.file}: [simulate.initial_error] set {initial_error!r}: {e}"
+            ) from None
         e0_all[b0 : b0 + len(rngs)] = e0
         with np.errstate(over="ignore", invalid="ignore"):  # said in words below
             m, t0 = step(rngs, e0, b0 == 0)

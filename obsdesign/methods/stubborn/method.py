@@ -75,7 +75,8 @@ class Stubborn(Method):
         na = len(getattr(so, "amplitudes", ())) or 1
         s = spec.system
         batch = 4.0 * na * runs
-        return one + 8.0 * (3 * 2000 * na * runs * s.p + 12 * batch * max(s.n, s.p))
+        chunk = min(2000.0, steps)  # the study draws its noise 2,000 steps at a time
+        return one + 8.0 * (3 * chunk * na * runs * s.p + 12 * batch * max(s.n, s.p))
 
     def plot_simulation(self, spec: Spec, result: Any, path: Any) -> Any:
         from obsdesign.methods.stubborn import plots
