@@ -492,3 +492,232 @@ def test_simulate_time_limit_stops_a_run_with_exit_3(tmp_path, monkeypatch, slow
         p.write_text(R2.replace("seed = 4", f"seed = 4\ntime_limit = {bad}"))
         with pytest.raises(SpecError, match=r"\[simulate\.time_limit\]"):
             api.simulate(p)
+
+
+# -- mutation review 2026-11-27 (constrained/claims.py): conditions no test decided ----------
+def _mr_design(text: str) -> Report:
+    rep = api.design(load_spec_text(text, "t.toml"))
+    assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
+    return rep
+
+
+def _mr_failed(rep: Report, *, drop_exact: tuple = (), **new: fmpq) -> dict:
+    """Recomputed claims of ``rep`` with parameters replaced (exact string and float) and the
+    exact strings of ``drop_exact`` removed (float kept): {claim id: status}, ``report-*``
+    (stored-vs-recomputed) claims left out."""
+    from obsdesign.certify.exact import qstr
+
+    d = rep.to_dict()
+    for k, v in new.items():
+        d["parameters"]["exact"][k] = qstr(v)
+        d["parameters"][k] = float(v)
+    for k in drop_exact:
+        del d["parameters"]["exact"][k]
+    rep2, problems = Report.from_dict(d)
+    assert not problems, problems
+    return {c.id: c.status for c in api.verify(rep2).claims if not c.id.startswith("report-")}
+
+
+_MR_BREVE_SETS = (
+    '[sets.X0]\ntype = "box"\nlower = [-1, -1]\nupper = [-0.9, -0.9]\n\n'
+    '[sets.Xhat0]\ntype = "box"\nlower = [0.9, 0.9]\nupper = [1, 1]\n\n[method]'
+)
+
+
+@pytest.fixture(scope="module")
+def mr_best_rate() -> Report:
+    """λ omitted (best certified rate: ρ(A − LC) = 0.95 exactly), ρ = 0.955 given."""
+    return _mr_design(variant(replace=[("lambda = 0.955\n", "")]))
+
+
+@pytest.fixture(scope="module")
+def mr_breve_rho_reported() -> Report:
+    """Section 4 (X0, X̂0) with neither λ nor ρ in the spec: ρ = λ² is a report value."""
+    return _mr_design(
+        variant(
+            add='X0 = "X0"\nXhat0 = "Xhat0"',
+            replace=[
+                ("lambda = 0.955\n", ""),
+                ("rho = 0.955\n", ""),
+                ("[method]", _MR_BREVE_SETS),
+            ],
+        )
+    )
+
+
+def test_float_only_breve_values_are_refused(mr_breve_rho_reported) -> None:
+    """v̆_max / θ̆ with their exact value removed: a failed ``<key>-exact`` claim (kills
+    ``params.exact(key, None)`` in ``_breve``, which dropped the v̆_max / θ̆ claims silently
+    and certified the report)."""
+    rep = mr_breve_rho_reported
+    assert _mr_failed(rep) and all(s != ClaimStatus.FAILED for s in _mr_failed(rep).values())
+    for k in ("v_max_breve", "theta_breve"):
+        st = _mr_failed(rep, drop_exact=(k,))
+        assert st.get(f"{k}-exact") == ClaimStatus.FAILED, st
+
+
+def test_float_only_lambda_infeasible_is_refused(mr_best_rate) -> None:
+    """λ_infeasible with its exact value removed: ``lambda_infeasible-exact`` fails (kills
+    ``params.exact("lambda_infeasible", None)``: no claim, the report certified)."""
+    st = _mr_failed(mr_best_rate, drop_exact=("lambda_infeasible",))
+    assert st.get("lambda_infeasible-exact") == ClaimStatus.FAILED, st
+
+
+def test_lambda_bracket_of_zero_width_is_true(mr_best_rate) -> None:
+    """λ = λ_infeasible = ρ(A − LC) = 0.95: the bracket claim (0.95 infeasible, width 0 ≤
+    rate_tol) is true and passes; decay-lmi fails (λ = 0.95 is not a certified rate). Kills
+    ``0 <= width`` → ``0 < width`` (fails a true bracket claim)."""
+    lam = fmpq(19, 20)
+    st = _mr_failed(mr_best_rate, **{"lambda": lam, "lambda_infeasible": lam})
+    assert st["lambda-bracket"] == ClaimStatus.CERTIFIED
+    assert {k for k, s in st.items() if s == ClaimStatus.FAILED} == {"decay-lmi"}
+
+
+def test_v_max_breve_bound_needs_rho_below_one(mr_breve_rho_reported) -> None:
+    """A reported ρ = 3/2: v̆_max = V0 + μ|w|²/(1 − ρ) is meaningless (no contraction); the
+    v̆_max claim fails however large v̆_max is (kills ``rho < 1`` → ``rho < 2``)."""
+    st = _mr_failed(mr_breve_rho_reported, rho=fmpq(3, 2))
+    assert st["v_max_breve-bound"] == ClaimStatus.FAILED
+    assert st["iss-bound"] == ClaimStatus.FAILED
+
+
+def test_nonlinear_plant_with_the_linear_observer() -> None:
+    """f, h given as expressions but no F: the sampled ISS check builds the linear observer
+    x̂⁺ = Ax̂ + Bu + L(y − Cx̂) from [system] and L (kills every mutant of that branch of
+    ``_iss_sampled``: each made the claim crash, failing a true report)."""
+    from test_constrained_nonlinear import NL
+
+    text = (
+        NL.replace('F = ["x2_hat + 0.2*(y1 - x1_hat)", "0.5*sin(x1_hat)"]\n', "L = [0.2, 0.5]\n")
+        .replace("mu = 0.2", "mu = 5")
+        .replace('f = ["x2", "0.5*sin(x1)"]', 'f = ["x2", "0.5*x1"]')
+        .replace("A = [[0, 1], [0, 0]]", "A = [[0, 1], [0.5, 0]]")
+    )
+    sp = load_spec_text(text, "nl.toml")
+    assert sp.options.model.F is None and sp.options.model.nonlinear
+    rep = api.design(sp)
+    st = {c.id: c.status for c in rep.claims}
+    assert st["iss-bound"] == ClaimStatus.NUMERICAL
+    assert not [c.id for c in rep.claims if c.status == ClaimStatus.FAILED]
+
+
+def test_contains_q_of_an_ellipsoid_off_the_origin() -> None:
+    """The vertex test against an ellipsoid not centred at 0 uses v − centre (kills
+    ``v + S.center_q``, which e.g. put X0's vertices in an off-centre X̂ wrongly)."""
+    from obsdesign.methods.constrained.claims import contains_q
+    from obsdesign.sets import Ellipsoid
+
+    E = np.array([[fmpq(1), fmpq(0)], [fmpq(0), fmpq(1)]], dtype=object)
+    S = Ellipsoid(E, np.array([fmpq(2), fmpq(0)], dtype=object))
+    assert contains_q(S, np.array([fmpq(2), fmpq(0)], dtype=object))
+    assert contains_q(S, np.array([fmpq(3), fmpq(0)], dtype=object))
+    assert not contains_q(S, np.array([fmpq(0), fmpq(0)], dtype=object))
+
+
+@pytest.fixture(scope="module")
+def mr_sec5() -> Report:
+    """λ = 0.955 and ρ = 0.955 given (the Section 5 design without [simulate])."""
+    return _mr_design(spec_text())
+
+
+@pytest.mark.parametrize("key", ["theta", "P", "L"])
+def test_float_only_required_or_copied_value_is_refused(mr_sec5, key) -> None:
+    """A required parameter (θ, P) or the report's copy of the spec's L with its exact value
+    removed: ``<key>-exact`` fails (kills ``params.exact(k, None)`` in ``certify``: with it, a
+    float-only θ made certify return no claim at all, and a float-only L copy was never
+    compared)."""
+    st = _mr_failed(mr_sec5, drop_exact=(key,))
+    assert st.get(f"{key}-exact") == ClaimStatus.FAILED, st
+
+
+def _mr_q(rows) -> np.ndarray:
+    return np.array([[fmpq(x) for x in r] for r in rows], dtype=object)
+
+
+def _mr_v(xs) -> np.ndarray:
+    return np.array([fmpq(x) for x in xs], dtype=object)
+
+
+def test_cmin_in_xhat_box_map_keeps_each_upper_bound_on_its_axis() -> None:
+    """Box map with different upper bounds per axis (x1 ≤ 1, x2 ≤ 3), ε_min = 1/100 (t =
+    1/10): the outer box of C_min is [−1.1, 1.1] × [−1.1, 3.1]. X̂ = [−2, 2] × [−2, 3.2]
+    contains it, X̂ = [−2, 3.2] × [−2, 2] does not (kills ``h_q[2i − 1]``, which swapped the
+    upper bounds between the axes and certified the second)."""
+    from obsdesign.methods.constrained.claims import cmin_in_xhat
+    from obsdesign.methods.constrained.cmap import box_map
+    from obsdesign.sets import Box
+
+    cm = box_map(_mr_v([-1, -1]), _mr_v([1, 3]))
+    eps = fmpq(1, 100)
+    assert cmin_in_xhat(cm, eps, Box(_mr_v([-2, -2]), _mr_v([2, fmpq(16, 5)])))[0]
+    assert not cmin_in_xhat(cm, eps, Box(_mr_v([-2, -2]), _mr_v([fmpq(16, 5), 2])))[0]
+
+
+def test_cmin_in_xhat_refuses_an_unbounded_outer_set() -> None:
+    """A polytope map {x1 ≤ 1, x2 ≤ 1} (a wedge: one vertex, unbounded): C_min is unbounded
+    and lies in no bounded X̂, whatever its vertex does (kills ``not bounded and len(V) == 0``
+    and ``return True`` for an unbounded outer set)."""
+    from obsdesign.methods.constrained.claims import cmin_in_xhat
+    from obsdesign.methods.constrained.cmap import polytope_map
+    from obsdesign.sets import Box
+
+    cm = polytope_map(_mr_q([[1, 0], [0, 1]]), _mr_v([1, 1]))
+    ok, detail = cmin_in_xhat(cm, fmpq(1, 100), Box(_mr_v([-5, -5]), _mr_v([5, 5])))
+    assert not ok and "unbounded" in detail
+
+
+def test_cmin_in_xhat_ellipsoid_map_support_function() -> None:
+    """Ellipsoid map Q = I/4, r = 10/11, ε_min = 1/100 (t = 1/10): the outer set of C_min is
+    {xᵀx/4 ≤ 1}, the disc of radius 2, whose support in ±e_i is √(R·e_iᵀQ⁻¹e_i) = 2 exactly.
+    X̂ = [−2, 2]² contains it (a face touching: ``>`` not ``>=``), X̂ = [−1.9, 1.9]² does not
+    (``√(R/w)`` = 1/2 certified it)."""
+    from obsdesign.methods.constrained.claims import cmin_in_xhat
+    from obsdesign.methods.constrained.cmap import ellipsoid_map
+    from obsdesign.sets import Box
+
+    cm = ellipsoid_map(_mr_q([[fmpq(1, 4), 0], [0, fmpq(1, 4)]]), fmpq(10, 11))
+    eps = fmpq(1, 100)
+    assert cmin_in_xhat(cm, eps, Box(_mr_v([-2, -2]), _mr_v([2, 2])))[0]
+    assert not cmin_in_xhat(cm, eps, Box(_mr_v([fmpq(-19, 10)] * 2), _mr_v([fmpq(19, 10)] * 2)))[0]
+
+
+@pytest.mark.parametrize("add", ["eps_max = 140098", "gamma = 0.00002"])
+def test_a_spec_fixed_eps_max_or_gamma_verifies(add) -> None:
+    """ε_max or γ fixed by the spec: the design's report (its copy equal to the spec's) has no
+    failed claim (kills ``c.matches(key, None, …)`` / ``(…, key_value, None, …)``, which
+    failed ``<key>-matches-spec`` on every such report)."""
+    rep = _mr_design(variant(add=add))
+    assert not [c.id for c in api.verify(rep).claims if c.status == ClaimStatus.FAILED]
+
+
+@pytest.mark.parametrize("drop", ["all", "exact"])
+def test_a_missing_lambda_is_refused(mr_best_rate, drop) -> None:
+    """λ omitted by the spec is a design output; a report without it (or float-only) fails
+    ``lambda-present`` / ``lambda-exact`` (kills ``params.exact("lambda", None)``: the decay
+    LMI and the bracket were then silently skipped and the report certified)."""
+    d = mr_best_rate.to_dict()
+    del d["parameters"]["exact"]["lambda"]
+    if drop == "all":
+        del d["parameters"]["lambda"]
+    rep2, problems = Report.from_dict(d)
+    assert not problems, problems
+    failed = {c.id for c in api.verify(rep2).claims if c.status == ClaimStatus.FAILED}
+    assert ("lambda-present" if drop == "all" else "lambda-exact") in failed, failed
+
+
+def test_delta_bound_below_one_and_at_equality(mr_sec5) -> None:
+    """δ-bound is true for a δ below 1 (ε_max = 0.02 given: δ = 2√ε_max ≈ 0.28; kills
+    ``delta >= 1``) and for δ·δ = δ² exactly (kills ``delta * delta > dsq``)."""
+    rep = api.design(load_spec_text(variant(add="eps_max = 0.02"), "t.toml"))
+    st = {c.id: c.status for c in rep.claims}
+    assert rep.parameters["delta"] < 1 and st["delta-bound"] == ClaimStatus.CERTIFIED
+    delta = mr_sec5.parameters["delta"]
+    assert _mr_failed(mr_sec5, delta_sq=delta * delta)["delta-bound"] == ClaimStatus.CERTIFIED
+
+
+def test_v_min_zero_is_a_true_bound(mr_sec5) -> None:
+    """v_min = 0 (V ≤ 0 means x̂ = x ∈ X ⊂ C_min): v_min-bound holds (kills ``v_min > 0``,
+    which failed it); θ must then cover v_max − 0, so only theta-covers may fail."""
+    st = _mr_failed(mr_sec5, v_min=fmpq(0))
+    assert st["v_min-bound"] == ClaimStatus.CERTIFIED
+    assert {k for k, s in st.items() if s == ClaimStatus.FAILED} <= {"theta-covers"}
