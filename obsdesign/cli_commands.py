@@ -345,7 +345,9 @@ def _metrics_markdown(m: dict[str, Any]) -> str:
         )
     lines += ["", f"final \\|e\\| = {m['final_error_norm']:.6g}"]
     for k, v in m.items():
-        if k not in (*_MAIN_METRICS, "quantiles"):
+        if k == "warnings" and isinstance(v, list):
+            lines += [f"- warning: {_md_cell(str(w).removeprefix('warning: '))}" for w in v]
+        elif k not in (*_MAIN_METRICS, "quantiles"):
             lines.append(f"- {_md_cell(k)}: {_md_cell(v)}")
     head, rows = _quantile_rows(m.get("quantiles"))
     if rows:
@@ -417,7 +419,10 @@ def _print_metrics(m: dict[str, Any]) -> None:
     c.print(t)
     c.print(f"final |e| = {m['final_error_norm']:.6g}")
     for k, v in m.items():
-        if k not in (*_MAIN_METRICS, "quantiles"):
+        if k == "warnings" and isinstance(v, list):  # one per line, not a Python list repr
+            for w in v:
+                c.print(esc(f"warning: {str(w).removeprefix('warning: ')}"))
+        elif k not in (*_MAIN_METRICS, "quantiles"):
             c.print(esc(f"{k}: {v}"))
     head, rows = _quantile_rows(m.get("quantiles"))
     if rows:

@@ -301,3 +301,21 @@ def test_study_is_given_once_and_an_uncountable_horizon_is_said_plainly(tmp_path
     )
     r = CliRunner().invoke(app, ["simulate", str(spec)])
     assert r.exit_code == 2 and "more than a float can count" in r.output and "inf" not in r.output
+
+
+def test_simulate_text_prints_warnings_one_per_line(tmp_path: Path) -> None:
+    """The simulation's warnings printed as a Python list repr in text mode (re-check review):
+    one "warning: …" line each now."""
+    spec = tmp_path / "w.toml"
+    spec.write_text(
+        '[system]\ntime = "continuous"\nA = [[0, 1], [-2, -0.3]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\nL = [1, 1]\n'
+        "[simulate]\nhorizon = 1\ndt = 0.3\nx0 = [1, 0]\nxhat0 = [0, 0]\n"
+    )
+    r = CliRunner().invoke(app, ["simulate", str(spec)])
+    assert r.exit_code == 0, r.output
+    assert "warnings: [" not in r.output
+    assert "warning: [simulate] dt = 0.3 does not divide horizon = 1.0" in r.output
+    r = CliRunner().invoke(app, ["simulate", str(spec), "--format", "md"])
+    assert r.exit_code == 0 and "warnings: [" not in r.output
+    assert "- warning: [simulate] dt = 0.3 does not divide horizon = 1.0" in r.output
