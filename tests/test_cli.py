@@ -285,6 +285,18 @@ def test_dash_is_not_an_output_and_runs_is_given_once(tmp_path: Path, monkeypatc
     assert r.exit_code == 0
 
 
+def _continuous(tmp_path: Path, grid: str) -> Path:
+    """A continuous-time lyapunov spec (stable plant, given L) with ``grid`` lines (horizon,
+    dt) in its [simulate] table."""
+    spec = tmp_path / "c.toml"
+    spec.write_text(
+        '[system]\ntime = "continuous"\nA = [[0, 1], [-2, -0.3]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\nL = [1, 1]\n'
+        f"[simulate]\n{grid}\nx0 = [1, 0]\nxhat0 = [0, 0]\n"
+    )
+    return spec
+
+
 def test_study_is_given_once_and_an_uncountable_horizon_is_said_plainly(tmp_path: Path) -> None:
     """``--study outliers --option study=none`` took the flag silently; horizon 1e300 over
     dt 1e-300 printed "inf steps … inf GiB" (review)."""
@@ -293,12 +305,7 @@ def test_study_is_given_once_and_an_uncountable_horizon_is_said_plainly(tmp_path
         app, ["simulate", str(example1), "--study", "outliers", "--option", "study=none"]
     )
     assert r.exit_code == 2 and "give it once" in r.output
-    spec = tmp_path / "c.toml"
-    spec.write_text(
-        '[system]\ntime = "continuous"\nA = [[0, 1], [-2, -0.3]]\nC = [[1, 0]]\n'
-        '[method]\nkey = "lyapunov"\nL = [1, 1]\n'
-        "[simulate]\nhorizon = 1e300\ndt = 1e-300\nx0 = [1, 0]\nxhat0 = [0, 0]\n"
-    )
+    spec = _continuous(tmp_path, "horizon = 1e300\ndt = 1e-300")
     r = CliRunner().invoke(app, ["simulate", str(spec)])
     assert r.exit_code == 2 and "more than a float can count" in r.output and "inf" not in r.output
 
@@ -306,12 +313,7 @@ def test_study_is_given_once_and_an_uncountable_horizon_is_said_plainly(tmp_path
 def test_simulate_text_prints_warnings_one_per_line(tmp_path: Path) -> None:
     """The simulation's warnings printed as a Python list repr in text mode (re-check review):
     one "warning: …" line each now."""
-    spec = tmp_path / "w.toml"
-    spec.write_text(
-        '[system]\ntime = "continuous"\nA = [[0, 1], [-2, -0.3]]\nC = [[1, 0]]\n'
-        '[method]\nkey = "lyapunov"\nL = [1, 1]\n'
-        "[simulate]\nhorizon = 1\ndt = 0.3\nx0 = [1, 0]\nxhat0 = [0, 0]\n"
-    )
+    spec = _continuous(tmp_path, "horizon = 1\ndt = 0.3")
     r = CliRunner().invoke(app, ["simulate", str(spec)])
     assert r.exit_code == 0, r.output
     assert "warnings: [" not in r.output
