@@ -18,6 +18,11 @@ from obsdesign.errors import SolverError
 DEFAULT_LIMIT = 300.0
 
 
+class TimeExceeded(SolverError):
+    """A simulation ran past its ``[simulate] time_limit`` (exit 3, as a design past its
+    own ``time_limit``)."""
+
+
 class TimeBudget:
     """A deadline ``limit`` seconds from now; :meth:`check` raises past it.
 
@@ -29,11 +34,15 @@ class TimeBudget:
         self.deadline = time.perf_counter() + self.limit
         self.advice = advice
 
+    def expired(self) -> bool:
+        """Whether the deadline has passed."""
+        return time.perf_counter() > self.deadline
+
     def check(self, where: str) -> None:
-        """Raise :class:`SolverError` naming ``[simulate] time_limit`` and ``where`` (what
+        """Raise :class:`TimeExceeded` naming ``[simulate] time_limit`` and ``where`` (what
         runs and how far it got) once the deadline has passed."""
-        if time.perf_counter() > self.deadline:
-            raise SolverError(
+        if self.expired():
+            raise TimeExceeded(
                 f"simulation not finished within {self.limit:g} s ([simulate] time_limit): "
                 f"{where} ({self.advice})"
             )

@@ -13,14 +13,13 @@ B = {‖ε‖ ≤ √(α‖w‖∞)} and the last time it was outside.
 
 from __future__ import annotations
 
-import time
 import warnings
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
-from obsdesign.errors import InputError, SolverError
+from obsdesign.errors import InputError
 from obsdesign.methods.impulsive.hybrid import (
     ball_report,
     draw_intervals,
@@ -30,6 +29,7 @@ from obsdesign.methods.impulsive.hybrid import (
 from obsdesign.methods.impulsive.options import SimOptions
 from obsdesign.methods.impulsive.plant import plant_field
 from obsdesign.params import Parameters
+from obsdesign.simulate.budget import TimeBudget
 from obsdesign.simulate.result import SimResult
 from obsdesign.spec.models import Spec
 
@@ -89,7 +89,7 @@ def simulate(
     """Run the three scenarios. ``runs``, ``seed``, ``sampling_file``, ``rtol``,
     ``time_limit`` (typed values of ``simulate --option``, validated by the API) override the
     spec's ``[simulate]``. Past ``time_limit`` seconds (all three scenarios together) the
-    simulation stops with :class:`SolverError` (exit 3) saying how far it got."""
+    simulation stops with :class:`~obsdesign.simulate.budget.TimeExceeded` (exit 3) saying how far it got."""
     o = spec.options
     sim = spec.simulate
     if sim is None:
@@ -99,8 +99,11 @@ def simulate(
     seed = sim.seed if seed is None else int(seed)
     sampling_file = so.sampling_file if sampling_file is None else Path(sampling_file)
     rtol = so.rtol if rtol is None else float(rtol)
-    limit = so.time_limit if time_limit is None else float(time_limit)
-    deadline = time.perf_counter() + limit
+    budget = TimeBudget(
+        so.time_limit if time_limit is None else float(time_limit),
+        "raise time_limit, or fewer runs, a shorter horizon, a looser rtol, or intervals "
+        "within the window [T_min, T_max]",
+    )
     horizon = float(sim.horizon.f)
     T = np.asarray(params.float("T"), dtype=float)
     Ld = np.array([float(v) for v in o.problem.L])
@@ -139,15 +142,13 @@ def simulate(
     x0 = np.tile(sim.x0.f, (runs, 1))
     xh0 = np.tile(sim.xhat0.f, (runs, 1))
 
-    def budget(name: str) -> Callable[[int, int], None]:
+    def stage(name: str) -> Callable[[int, int], None]:
         def check(k: int, K: int) -> None:
-            if time.perf_counter() > deadline:
+            if budget.expired():
                 longest = float(np.max(H[:, k])) if k < H.shape[1] else 0.0
-                raise SolverError(
-                    f"simulation not finished within {limit:g} s ([simulate] time_limit): "
+                budget.check(
                     f"the {name} runs at sampling interval {k:,} of {K:,}, of length up to "
-                    f"{longest:.4g} (raise time_limit, or fewer runs, a shorter horizon, a "
-                    "looser rtol, or intervals within the window [T_min, T_max])"
+                    f"{longest:.4g}"
                 )
 
         return check
@@ -155,12 +156,12 @@ def simulate(
     # a plant that leaves the float range stops its run (``escaped``), counted in the metrics
     # and said once below in words, not as numpy's overflow warnings (review: x0 = 1e300)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        noisy = simulate_hybrid(f, T, Ld, x0, xh0, H, W, rtol=rtol, check=budget("noisy"))
+        noisy = simulate_hybrid(f, T, Ld, x0, xh0, H, W, rtol=rtol, check=stage("noisy"))
         clean = simulate_hybrid(
-            f, T, Ld, x0, xh0, H, np.zeros_like(W), rtol=rtol, check=budget("noise-free")
+            f, T, Ld, x0, xh0, H, np.zeros_like(W), rtol=rtol, check=stage("noise-free")
         )
         open_ = simulate_hybrid(
-            f, T, np.zeros(m), x0[:1], xh0[:1], H[:1], W[:1], rtol=rtol, check=budget("open-loop")
+            f, T, np.zeros(m), x0[:1], xh0[:1], H[:1], W[:1], rtol=rtol, check=stage("open-loop")
         )
     if noisy.escaped.any() or clean.escaped.any() or open_.escaped.any():
         warnings.warn(

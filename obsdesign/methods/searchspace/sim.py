@@ -39,10 +39,11 @@ from typing import Any
 
 import numpy as np
 
-from obsdesign.errors import InfeasibleError, InputError, SolverError
+from obsdesign.errors import InfeasibleError, InputError
 from obsdesign.limits import limits
 from obsdesign.methods.searchspace.options import Options, SimOptions
 from obsdesign.params import Parameters
+from obsdesign.simulate.budget import TimeBudget
 from obsdesign.simulate.result import SimResult
 from obsdesign.spec.models import Spec
 
@@ -59,22 +60,11 @@ class MemoryCap(InfeasibleError):
     """The search space needs more live centres than the cap allows."""
 
 
-class TimeBudget(SolverError):
-    """The simulation ran past ``[simulate] time_limit`` (exit 3, as a set-invariant design
-    past its ``time_limit``)."""
-
-
-def _check_time(deadline: float, limit: float, where: str) -> None:
-    """Raise :class:`TimeBudget` when ``deadline`` (a ``time.perf_counter`` value) has passed.
-
-    :param deadline: the end of the budget; :param limit: the budget in seconds (for the
-    message); :param where: what was running and how far it got."""
-    if time.perf_counter() > deadline:
-        raise TimeBudget(
-            f"simulation not finished within {limit:g} s ([simulate] time_limit): {where} "
-            "(raise time_limit, or lower max_centres, start from a smaller D or a larger γ₀, "
-            "or shorten the horizon)"
-        )
+#: what to change when the simulation runs past ``[simulate] time_limit``
+ADVICE = (
+    "raise time_limit, or lower max_centres, start from a smaller D or a larger γ₀, or shorten "
+    "the horizon"
+)
 
 
 @dataclass
@@ -285,11 +275,11 @@ def recover(
     eta: float,
     s: float,
     cap: int,
-    budget: tuple[float, float] | None = None,
+    budget: TimeBudget | None = None,
 ) -> np.ndarray:
     """Centres of the grid 2sℤⁿ whose cells meet some ball B(c, η), c a row of C (merged:
     each cell once). Raises :class:`MemoryCap` when more than ``cap`` cells are needed, and
-    :class:`TimeBudget` past ``budget`` = (deadline, seconds) (checked per chunk of rows)."""
+    :class:`~obsdesign.simulate.budget.TimeExceeded` past ``budget`` (checked per chunk of rows)."""
     n = C.shape[1]
     eta = eta * (1 + INFLATE) + INFLATE * s
     R = math.ceil((eta + s) / (2 * s) + 0.5)
@@ -300,7 +290,7 @@ def recover(
     total = 0
     for a in range(0, C.shape[0], step):
         if budget is not None:
-            _check_time(*budget, f"refinement ({a:,} of {C.shape[0]:,} centres done)")
+            budget.check(f"refinement ({a:,} of {C.shape[0]:,} centres done)")
         idx = base[a : a + step, None, :] + offs[None, :, :]
         g = idx * (2 * s)
         d = np.maximum(np.abs(C[a : a + step, None, :] - g) - s, 0.0)
@@ -424,15 +414,11 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
     left_E: float | None = None
     left_U = _left_U(plant, o, t0, dT, 0)
     t_start = time.perf_counter()
-    deadline = t_start + so.time_limit
+    budget = TimeBudget(so.time_limit, ADVICE)
     k = 0
 
     def flow_budget() -> None:
-        _check_time(
-            deadline,
-            so.time_limit,
-            f"in the RK4 flow ({nsub:,} substeps a sample) of sample {k:,} of {N:,}",
-        )
+        budget.check(f"in the RK4 flow ({nsub:,} substeps a sample) of sample {k:,} of {N:,}")
 
     plant.budget = flow_budget
     if not len(C):
@@ -486,7 +472,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
                     )
             else:
                 eta = e_old * math.exp(L_f * K * dT) + K * flow_err
-                C = recover(C, eta, s, so.max_centres, (deadline, so.time_limit))
+                C = recover(C, eta, s, so.max_centres, budget)
             C = C[_consistent(plant, C, y, L_h * e_new) & _meets(C, s, E_lo, E_hi)]
             run.switches.append(t)
             tau = t
@@ -508,9 +494,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
         if bar is not None:
             bar(k, len(C))
         if k < N:
-            _check_time(
-                deadline, so.time_limit, f"{k:,} of {N:,} samples done, {len(C):,} live centres"
-            )
+            budget.check(f"{k:,} of {N:,} samples done, {len(C):,} live centres")
     secs = time.perf_counter() - t_start
     if bar is not None:
         bar(None, 0)
