@@ -158,17 +158,25 @@ def test_a_step_too_large_for_the_high_gain_is_warned() -> None:
         _check_step(np.array([2.0, 1.0]), 10.0, 1e-3)  # dt·ℓ·|root| = 0.01
 
 
+#: the noise window of the shipped Duffing spec (dt = 0.001, horizon 10)
+HF_WINDOW = "hf_start = 5                 # high-frequency noise on [5, 10)\nhf_stop = 10"
+
+
 @pytest.mark.parametrize(
     ("old", "new", "key"),
     [
         ("impulse_time = ", "impulse_time = 100 # ", "simulate.impulse_time"),
         ("hf_stop = ", "hf_stop = 0.1 # ", "simulate.hf_stop"),
+        (HF_WINDOW, "hf_start = 11\nhf_stop = 12", "simulate.hf_start"),  # past horizon 10
+        (HF_WINDOW, "hf_start = 5\nhf_stop = 5", "simulate.hf_start"),  # zero width
+        (HF_WINDOW, "hf_start = 5.0001\nhf_stop = 5.0002", "simulate.hf_start"),  # no step
     ],
 )
 def test_simulate_times_outside_the_run_are_bad_input(old: str, new: str, key: str) -> None:
     """impulse_time past the horizon indexed past the time grid (IndexError, exit 3) and
-    hf_stop < hf_start gave an empty noise window silently (simulate review 19): exit 2
-    naming the key."""
+    hf_stop < hf_start gave an empty noise window silently (simulate review 19), as did a
+    window past the horizon, of zero width or between two grid steps: exit 2 naming the
+    key."""
     from obsdesign.errors import InputError, SpecError
 
     text = DUFFING.read_text(encoding="utf-8")

@@ -270,6 +270,14 @@ def simulate(
             )
         nu[i] += so.impulse_value
     win = (t >= so.hf_start) & (t < so.hf_stop)
+    if so.hf_amplitude > 0 and not win.any():
+        # a window past the horizon, or of zero width, or between two steps added no noise,
+        # silently, while an impulse_time past the horizon was refused (review 20)
+        raise InputError(
+            f"{spec.file}: [simulate.hf_start] expected a noise window [hf_start, hf_stop) "
+            f"holding a step of the time grid (dt = {dt:g}, horizon "
+            f"{float(sim.horizon.f):g}), got [{so.hf_start:g}, {so.hf_stop:g})"
+        )
     nu[win] += rng.uniform(-so.hf_amplitude, so.hf_amplitude, size=int(win.sum()))
     fu = [e.on(["t"]) for e in s.u_signal] if s.u_signal is not None else []
 
