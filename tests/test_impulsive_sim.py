@@ -45,8 +45,14 @@ def test_sampling_file(tmp_path: Path) -> None:
     assert res.info["runs"] == 1
     assert res.info["interval_min_max"] == [0.5, 1.2]
     (tmp_path / "h.txt").write_text("0.5 -1", encoding="utf-8")
-    with pytest.raises(InputError, match="positive"):
+    key = rf"\(the sampling file of \[simulate\.sampling_file\] of {tmp_path / 's.toml'}\)$"
+    with pytest.raises(InputError, match=rf"h\.txt: expected positive sampling intervals {key}"):
         get_method("impulsive").simulate(spec, rep.parameters)
+    (tmp_path / "h.txt").write_text("0.5", encoding="utf-8")  # short of the horizon
+    with pytest.raises(InputError, match=rf"do not cover the horizon .*{key}"):
+        get_method("impulsive").simulate(spec, rep.parameters)
+    with pytest.raises(InputError, match=r"no such .* \(the sampling file of --option samp"):
+        get_method("impulsive").simulate(spec, rep.parameters, sampling_file=tmp_path / "no")
 
 
 def test_template_designs() -> None:

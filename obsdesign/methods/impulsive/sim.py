@@ -97,6 +97,12 @@ def simulate(
     so: SimOptions = sim.options if isinstance(sim.options, SimOptions) else SimOptions()
     runs = so.runs if runs is None else int(runs)
     seed = sim.seed if seed is None else int(seed)
+    # where the path came from, for its errors (they named the file only: review 20)
+    given_by = (
+        f"[simulate.sampling_file] of {spec.file}"
+        if sampling_file is None
+        else "--option sampling_file"
+    )
     sampling_file = so.sampling_file if sampling_file is None else Path(sampling_file)
     rtol = so.rtol if rtol is None else float(rtol)
     budget = TimeBudget(
@@ -113,12 +119,18 @@ def simulate(
     rng = np.random.default_rng(seed)
     n = spec.system.n
     if sampling_file is not None:
-        h = read_intervals(sampling_file)
+        try:
+            h = read_intervals(sampling_file)
+        except InputError as e:
+            raise InputError(f"{e} (the sampling file of {given_by})") from None
         runs = 1
         check_memory(1, h.size, n, file=spec.file)
         H = pad_to_horizon(h[None, :], horizon)
         if H.shape[1] == 0 or np.sum(H) < horizon * 0.999:
-            raise InputError(f"{sampling_file}: the intervals do not cover the horizon {horizon:g}")
+            raise InputError(
+                f"{sampling_file}: the intervals do not cover the horizon {horizon:g} (the "
+                f"sampling file of {given_by})"
+            )
     else:
         if not 0 < t_lo <= t_hi:
             raise InputError(f"report: expected 0 < T_min ≤ T_max, got {t_lo:g}, {t_hi:g}")
