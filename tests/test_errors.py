@@ -54,12 +54,18 @@ def test_a_key_with_a_newline_and_escape_gives_one_line(tmp_path: Path) -> None:
 def test_a_5000_digit_schema_version_is_one_short_line(tmp_path: Path) -> None:
     """Found by the CLI fuzzer: with --limit max_digits=10000 a report whose schema_version
     has 5000 digits was an internal failure (exit 3, Python's int-string limit); it is now
-    exit 2 with the number shortened."""
+    exit 2 with the number shortened. A numeric schema_version is refused as such, the
+    number not printed; a 5000-digit string is shortened."""
     rep = api.design(api.load_spec(ROOT / "tests" / "specs" / "lyapunov-minimal.toml"))
     d = rep.to_dict()
     d["schema_version"] = "SV"
     bad = tmp_path / "r.json"
     bad.write_text(json.dumps(d).replace('"SV"', "9" * 5000))
+    r = runner.invoke(app, ["--limit", "max_digits=10000", "verify", str(bad)])
+    assert r.exit_code == 2, r.stderr
+    assert r.stderr.count("\n") == 1 and len(r.stderr) < 300
+    assert 'schema_version must be a string like "1.1", got a number' in r.stderr
+    bad.write_text(json.dumps(d).replace('"SV"', '"' + "9" * 5000 + '"'))
     r = runner.invoke(app, ["--limit", "max_digits=10000", "verify", str(bad)])
     assert r.exit_code == 2, r.stderr
     assert r.stderr.count("\n") == 1 and len(r.stderr) < 300

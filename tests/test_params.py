@@ -215,3 +215,22 @@ def test_a_float_view_beyond_the_float_range_is_a_consistency_problem() -> None:
     assert problems == ["parameter 'beta': float value differs from its exact value"]
     vals, problems = Parameters.from_json({"v": [big, 1.0], "exact": {"v": ["3", "1"]}}, "r.json")
     assert problems == ["parameter 'v': float value differs from its exact value"]
+
+
+@pytest.mark.parametrize("exact", [0.5, [["1/2", 0.25]], [[0.5, "1/4"]], [0.1, "1/3"], -0.0, 1e300])
+def test_from_json_refuses_a_float_as_an_exact_value(exact: object) -> None:
+    """A report's exact value is a string: a JSON number such as 0.1 does not say whether
+    1/10 or the double nearest to it is meant (verify took the double's binary value and
+    certified that). Bad input naming the key; integers and decimal strings are exact."""
+    from fractions import Fraction
+
+    from obsdesign.errors import InputError
+
+    def fl(x: object) -> object:
+        return [fl(v) for v in x] if isinstance(x, list) else float(Fraction(x))
+
+    with pytest.raises(InputError) as e:
+        Parameters.from_json({"v": fl(exact), "exact": {"v": exact}}, "r.json")
+    assert str(e.value).startswith("r.json: parameters.exact.v: not an exact value (the float")
+    back, problems = Parameters.from_json({"v": [0.5, 3.0], "exact": {"v": ["0.5", 3]}})
+    assert list(back["v"]) == [fmpq(1, 2), fmpq(3)] and not problems

@@ -67,6 +67,15 @@ def test_edited_float_is_reported():
     [
         [],
         {"schema_version": "1.0"},
+        {  # a numeric schema_version (1.1 was read as "1.1")
+            "schema_version": 1.1,
+            "method": "x",
+            "spec": "",
+            "spec_sha256": "",
+            "parameters": {},
+            "claims": [],
+            "verdict": "ok",
+        },
         {
             "schema_version": "9",
             "method": "x",

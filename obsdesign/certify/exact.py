@@ -179,6 +179,13 @@ def qstr_floats(a: np.ndarray) -> tuple[list[Any], list[Any]] | None:
     return out.reshape(a.shape).tolist(), np.array(fls, dtype=float).reshape(a.shape).tolist()
 
 
+#: why a float is not a report's exact value (:func:`qparse_floats`)
+_FLOAT_ENTRY = (
+    'the float {!r} is not an exact value: write it as a string such as "1/10" or '
+    '"0.1" (a JSON number does not say whether the decimal or the nearest double is meant)'
+)
+
+
 def qparse(s: Any) -> Any:
     """Inverse of :func:`qstr`: a string (or nested lists of them, any depth) back to ``fmpq``
     (an object array for lists)."""
@@ -188,17 +195,24 @@ def qparse(s: Any) -> Any:
 def qparse_floats(s: Any) -> tuple[Any, Any]:
     """(:func:`qparse` of ``s``, its :func:`to_float` as a float or nested lists) with each
     canonical "p/q" string's integers converted once (a report's exact parameters and the
-    floats its consistency check compares). OverflowError beyond the float range."""
+    floats its consistency check compares). OverflowError beyond the float range.
+
+    A report's exact value is a string (or an integer): a float (a JSON number such as 0.1)
+    is refused with ValueError, since it does not say whether 1/10 or the double nearest to
+    it is meant (verify took the double's binary value)."""
     if isinstance(s, list):
         fls: list[float] = []
-        q = _qparse(s, fls)
+        q = _qparse(s, fls, strict=True)
         return q, np.array(fls, dtype=float).reshape(q.shape).tolist()
-    q = _qparse(s, None)
+    q = _qparse(s, None, strict=True)
     return q, _qfloat(q)
 
 
-def _qparse(s: Any, floats: list[float] | None) -> Any:
-    """:func:`qparse`; with ``floats``, each entry's nearest float appended to it."""
+def _qparse(s: Any, floats: list[float] | None, strict: bool = False) -> Any:
+    """:func:`qparse`; with ``floats``, each entry's nearest float appended to it; ``strict``:
+    a float entry is refused (:func:`qparse_floats`)."""
+    if strict and isinstance(s, float):
+        raise ValueError(_FLOAT_ENTRY.format(s))
     if isinstance(s, (str, int, float)) and not isinstance(s, bool):
         return Q(s)
     if isinstance(s, list):
@@ -221,6 +235,8 @@ def _qparse(s: Any, floats: list[float] | None) -> Any:
                 raise ValueError("ragged or empty exact array")
             if isinstance(v, bool) or not isinstance(v, (str, int, float)):
                 raise ValueError(f"not an exact value: {v!r}")
+            if strict and isinstance(v, float):
+                raise ValueError(_FLOAT_ENTRY.format(v))
             x = Q(v)
             vals.append(x)
             if floats is not None:

@@ -272,7 +272,12 @@ class Report:
         for k in ("schema_version", "method", "spec", "spec_sha256", "parameters", "claims"):
             if k not in d:
                 raise InputError(f"{file}: key '{k}' is missing (not an obsdesign report?)")
-        if str(d["schema_version"]).split(".")[0] != SCHEMA_VERSION.split(".")[0]:
+        if not isinstance(d["schema_version"], str):  # 1.1 as a JSON number was accepted
+            raise InputError(
+                f'{file}: schema_version must be a string like "{SCHEMA_VERSION}", got '
+                f"{_json_kind(d['schema_version'])}"
+            )
+        if d["schema_version"].split(".")[0] != SCHEMA_VERSION.split(".")[0]:
             raise InputError(
                 f"{file}: schema_version {d['schema_version']} is not supported (expected {SCHEMA_VERSION})"
             )
@@ -328,6 +333,18 @@ class Report:
             ),
             problems,
         )
+
+
+def _json_kind(v: Any) -> str:
+    """What a JSON value is, in words, for an error (never its text: a 5000-digit number
+    would pass Python's int-string limit)."""
+    if v is None:
+        return "null"
+    if isinstance(v, bool):
+        return "a boolean"
+    if isinstance(v, (int, float)):
+        return "a number"
+    return "an array" if isinstance(v, list) else "an object"
 
 
 def _version(v: Any) -> tuple[int, ...]:
