@@ -18,6 +18,22 @@ ROOT = Path(__file__).resolve().parents[1]
 SPECS = ROOT / "specs"
 
 
+@pytest.fixture(autouse=True)
+def _fresh_interval_bounds():
+    """Under mutmut (``MUTANT_UNDER_TEST`` set), each test computes the search-space interval
+    bounds afresh: ``design._CACHE`` keeps them per process, and mutmut forks each mutant's
+    run from a process that had already filled it with correct bounds, so no mutant of
+    ``searchspace/bounds.py`` was ever seen (mutation review 21). Outside mutmut the cache is
+    kept (about 6 s of the search-space tests)."""
+    if os.environ.get("MUTANT_UNDER_TEST"):
+        import sys
+
+        mod = sys.modules.get("obsdesign.methods.searchspace.design")
+        if mod is not None:
+            mod._CACHE.clear()
+    yield
+
+
 @pytest.fixture
 def specs_dir() -> Path:
     return SPECS

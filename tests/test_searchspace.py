@@ -618,3 +618,174 @@ def test_schedule_checks_every_transition_and_the_fixed_point() -> None:
     assert status([fmpq(1), *D.schedule(fmpq(4, 5), g_star, L_f, dtau)]) == ClaimStatus.FAILED
     assert status([*good[:-2], g_star]) == ClaimStatus.FAILED
     assert status([g_star], fmpq(4, 5)) == ClaimStatus.FAILED
+
+
+# -- mutation review 21: bounds.sup_norm / bounds.lipschitz and claims.certify -----------------
+# To be appended to tests/test_searchspace.py (uses its TEXT, example, _consistent,
+# _report_with, _failed, D, api, fmpq, ClaimStatus, pytest).
+
+
+def _constant_status(text: str, k: str, val: fmpq) -> ClaimStatus:
+    """Status of the claim <k>-bound that claims._constant gives ``val`` on the spec ``text``,
+    with the real interval bound (computed afresh: design's cache cleared)."""
+    from obsdesign.api import bind
+    from obsdesign.certify.claim import Claims
+    from obsdesign.methods.searchspace import claims as C
+
+    D._CACHE.clear()
+    c = Claims()
+    C._constant(c, bind(api.load_spec_text(text, "c.toml")), k, val)
+    (claim,) = c
+    assert claim.id == f"{k}-bound"
+    return claim.status
+
+
+def _given(text: str, k: str, value: str) -> str:
+    return text.replace("gamma0 = 1 ", f"gamma0 = 1\n{k} = {value} ")
+
+
+def test_a_given_f_sup_below_a_sampled_value_fails() -> None:
+    """Mutation review 21 (bounds.sup_norm): the sampled lower estimate of ‖f_u‖_E is what
+    fails a user-given f_sup that the interval bound does not prove. The example's
+    ‖f_u‖_E = 2.5·√2 ≈ 3.536 (attained at a corner of E × U): f_sup = 3 given fails, 3.6 is
+    proved. (A lower estimate stuck at 0 let the false 3 pass as numerical.)"""
+    assert _constant_status(_given(TEXT, "f_sup", "3"), "f_sup", fmpq(3)) == ClaimStatus.FAILED
+    good = _given(TEXT, "f_sup", "3.6")
+    assert _constant_status(good, "f_sup", fmpq(18, 5)) == ClaimStatus.CERTIFIED
+
+
+def test_sup_norm_estimate_ignores_boxes_where_f_is_undefined() -> None:
+    """Mutation review 21 (bounds.sup_norm): a sub-box where f has no finite sample (sqrt of a
+    negative x1) adds nothing to the sampled lower estimate: no exception (a box without a
+    finite sample crashed the bound) and no invented value (1.0 refuted a true given bound
+    below 1). sup |√x − x/2| over the part of [−2.5, 2.5] where it is defined is 1/2 (x = 1);
+    the budget goes to the undefined half, so the estimate is only near it."""
+    from obsdesign.methods.searchspace import bounds as B
+    from obsdesign.spec.expr import parse_expr
+
+    ex = [parse_expr("sqrt(x1) - x1/2", ["x1"])]
+    b = B.sup_norm(ex, ["x1"], [fmpq(-5, 2)], [fmpq(5, 2)], 64, 1e-6)
+    assert not b.finite  # the sub-boxes with x1 < 0 bound nothing
+    assert 0.4 < b.lower_est <= 0.5 * (1 + 1e-9)
+
+
+@pytest.mark.parametrize(
+    ("h", "E", "value", "want"),
+    [
+        # L_h = 1 comes from x2 only: the estimate must follow the Jacobian's direction, not
+        # a fixed axis (finite differences of zero length left the direction x1, estimate 0)
+        ("x2", None, "0.9", ClaimStatus.FAILED),
+        # E away from 0 (every |x| > 1): the finite-difference step 10⁻⁶·(1 + max|x|) is
+        # positive (with 1 − max|x| it was negative and the estimate negative)
+        ("x1", ("[2, 2]", "[4, 4]"), "0.9", ClaimStatus.FAILED),
+        # E at 10⁶: the step grows with |x| (10⁻⁶/(1 + max|x|) is below the float spacing
+        # there: the quotient was 0, or a rounding jump far above 1)
+        ("x1", ("[1000000, 1000000]", "[1000001, 1000001]"), "0.9", ClaimStatus.FAILED),
+        ("x1", ("[1000000, 1000000]", "[1000001, 1000001]"), "1", ClaimStatus.CERTIFIED),
+        # (x1 + 5/2)^1.5/10 has L_h = 1.5·√5/10 ≈ 0.3354 on E but no finite interval bound
+        # (the derivative's enclosure at x1 = −5/2); the corner x1 = −5/2 has no finite
+        # difference quotient (x1 − step is outside the domain): that box adds nothing to
+        # the estimate (1.0 refuted the true given 0.34)
+        ("(x1 + 2.5)^1.5/10", None, "0.34", ClaimStatus.NUMERICAL),
+    ],
+)
+def test_a_given_L_h_is_refuted_only_by_a_true_difference_quotient(
+    h: str, E: tuple[str, str] | None, value: str, want: ClaimStatus
+) -> None:
+    """Mutation review 21 (bounds.lipschitz): the sampled lower estimate of L_h^E is a true
+    difference quotient near the constant, whatever the box and the direction; it alone
+    decides a user-given L_h that the interval bound does not prove (FAILED when a sample
+    exceeds it, NUMERICAL otherwise) and refutes a proved one."""
+    text = TEXT.replace('h = ["x1*step(x1)"]', f'h = ["{h}"]')
+    if E is not None:
+        text = text.replace(
+            "lower = [-2.5, -2.5]\nupper = [2.5, 2.5]", f"lower = {E[0]}\nupper = {E[1]}"
+        )
+        assert E[0] in text
+    assert _constant_status(_given(text, "L_h", value), "L_h", Q(value)) == want
+
+
+def test_a_report_without_the_exact_value_is_not_verified_on_its_float(example, tmp_path) -> None:
+    """Mutation review 21 (certify): every parameter is read with accept_float=False. A report
+    whose exact strings for L_f and K were removed (their floats 1.0 and 63.0 are exactly the
+    certified values) fails L_f-exact and K-exact; accepting the floats verified it."""
+    sp, rep = example
+    d = rep.to_dict()
+    del d["parameters"]["exact"]["L_f"], d["parameters"]["exact"]["K"]
+    assert d["parameters"]["L_f"] == 1.0 and d["parameters"]["K"] == 63.0
+    out = tmp_path / "floats.json"
+    out.write_text(json.dumps(d))
+    assert _failed(out) == {"L_f-exact", "K-exact"}
+
+
+@pytest.mark.parametrize(("K", "K_rule"), [(None, set()), (5, {"K-rule"})])
+def test_tamper_kappa_at_the_lower_end(example, tmp_path, K, K_rule) -> None:
+    """Mutation review 21 (certify): κ = L_h, the open interval's lower end, fails
+    kappa-range (L_h ≤ κ passed it) and names the end point; Lemma 2 fails too (log(κ/L_h)
+    = 0). K-rule then asks K = 1 (the paper's max{·, 1}): K = 5 fails it (with κ/L_h ≥ 1
+    sent to the logarithm, any K passed)."""
+    sp, rep = example
+    path = _report_with(rep, _consistent(sp, kappa=fmpq(1), K=K), tmp_path)
+    assert _failed(path) == {"kappa-range", "lemma2-consistency"} | K_rule
+    detail = next(c.detail for c in api.verify(path).failed if c.id == "kappa-range")
+    assert "κ = L_h = 1, and the interval is open" in detail
+
+
+def test_tamper_K_not_an_integer(example, tmp_path) -> None:
+    """Mutation review 21 (certify): K = 127/2 with Δτ = KΔT and the schedule recomputed
+    keeps Lemma 2 (63.5·ΔT < log 1.5) but is no integer: dtau-rule and K-rule fail (with
+    "K.q == 1 or K ≥ 1" every claim passed)."""
+    sp, rep = example
+    o = sp.options
+    v = _consistent(sp)
+    v["K"] = fmpq(127, 2)
+    v["dtau"] = v["K"] * v["dT"]
+    v["gamma_schedule"] = D.schedule(o.gamma0, v["gamma_star"], v["L_f"], v["dtau"])
+    v["eps_schedule"] = [g / v["kappa"] for g in v["gamma_schedule"]]
+    assert _failed(_report_with(rep, v, tmp_path)) == {"dtau-rule", "K-rule"}
+
+
+def test_K_one_is_the_rule_when_one_step_exceeds_lemma2s_horizon(tmp_path) -> None:
+    """Mutation review 21 (certify): K-rule's branch for K = 1 compares ΔT·L_f with log(κ/L_h).
+    With L_f = 100 given, ΔT·L_f ≈ 7 ≥ log 1.001 > ΔT/L_f: K = 1 keeps K-rule (only Lemma 2
+    fails, and the schedule: L_f Δτ ≥ 1; ΔT/L_f failed K-rule too)."""
+    text = TEXT.replace("# kappa = 1.5 ", "kappa = 1.001 ").replace("alpha = 0.9 ", "alpha = 0.99 ")
+    text = text.replace("gamma_star = 0.05 ", "gamma_star = 0.5\nL_f = 100 ")
+    rep = api.design(api.load_spec_text(text, "k1.toml"))
+    assert rep.parameters["K"] == 1 and rep.parameters["L_f"] == 100
+    assert {c.id for c in rep.failed} == {"lemma2-consistency", "gamma-schedule"}
+
+
+def _certified(sp, v: dict) -> dict:
+    from obsdesign.params import Parameters
+
+    return {c.id: c.status for c in api.certify(sp, Parameters(v))}
+
+
+def test_lemma2_and_K_rule_use_the_safe_side_of_the_logarithm(example) -> None:
+    """Mutation review 21 (certify): Lemma 2 compares L_f Δτ with a LOWER bound of
+    log(κ/L_h), K-rule (K+1)ΔT L_f with an UPPER bound, each reaching it (≥) or not (<)
+    exactly. Δτ a hair above log 1.5 (a 400-bit upper bound, below the 113-bit one) fails
+    Lemma 2 (it passed against the upper bound); ΔT = hi/64, so that 64 ΔT equals the
+    113-bit upper bound hi, keeps K = 63 (">" failed it)."""
+    sp, _ = example
+    v = _consistent(sp)
+    assert v["L_f"] == 1 and v["L_h"] == 1 and v["kappa"] == fmpq(3, 2) and v["K"] == 63
+    bits = D.K_bits(v["dT"] * v["L_f"])
+    lo, hi = ivq.log_bounds(fmpq(3, 2), bits)
+    tight = ivq.log_bounds(fmpq(3, 2), 400)[1]
+    assert lo < tight < hi
+    w = dict(v, dtau=tight)
+    assert _certified(sp, w)["lemma2-consistency"] == ClaimStatus.FAILED
+    dT = hi / 64
+    assert D.K_bits(dT) == bits
+    w = dict(v, dT=dT, dtau=63 * dT)
+    assert _certified(sp, w)["K-rule"] == ClaimStatus.CERTIFIED
+
+
+def test_tamper_K_one_is_not_the_rule(example, tmp_path) -> None:
+    """Mutation review 21 (certify): K = 1 is allowed only when one step already reaches
+    log(κ/L_h)/L_f; the example's rule gives 63, so K = 1 (consistent otherwise) fails K-rule
+    ("K == 1 or …" passed it)."""
+    sp, rep = example
+    assert _failed(_report_with(rep, _consistent(sp, K=1), tmp_path)) == {"K-rule"}
