@@ -406,8 +406,40 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
         notes.append(
             "not verified (no check reads them; informational only): " + ", ".join(rep.unverified)
         )
+    if spec is None:
+        moved = _named_file_differs(rep.spec_file, sha)
+        if moved:
+            notes.append(moved)
     rep.notes += notes
     return _replace_claims(rep, claims, time.perf_counter() - t0)
+
+
+def _named_file_differs(spec_file: str, sha: str) -> str | None:
+    """A note when the report's ``spec_file`` is a readable regular file whose text is not
+    the embedded spec (sha256 ``sha``) that ``verify`` checked, else None: a report whose
+    embedded spec was edited (its hash updated) verified with the header naming an unchanged
+    file, for which its claims were false (review 21). Never a verdict: the file may have been
+    edited after the design, and ``--spec`` checks against it. A path that is not a regular
+    file within the input limits (a FIFO, a device) is not read."""
+    from obsdesign.limits import read_input
+
+    if not spec_file:
+        return None
+    p = Path(spec_file)
+    try:
+        if not p.is_file():
+            return None
+        raw = read_input(p, "spec")
+    except (OSError, ValueError, InputError):
+        return None
+    have = hashlib.sha256(raw).hexdigest()
+    if have == sha:
+        return None
+    return (
+        f"the spec embedded in the report was verified, not the file {spec_file}: that file "
+        f"differs from it (sha256 {have[:12]}… here, {sha[:12]}… embedded); "
+        f"'obsdesign verify REPORT --spec {spec_file}' checks the report against the file"
+    )
 
 
 def _verdict_of(claims: list[Claim]) -> str:

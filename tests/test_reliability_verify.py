@@ -192,3 +192,33 @@ def test_verify_refuses_a_parameter_whose_exact_value_was_removed(
     ver = api.verify(out)
     assert ver.exit_code() == 1
     assert any(c.id == f"{key}-exact" and not c.ok for c in ver.claims)
+
+
+def test_a_spec_file_that_differs_from_the_embedded_spec_is_named(tmp_path: Path) -> None:
+    """verify checks the embedded spec; a report whose embedded spec was edited (its hash
+    updated) verified while the header named an unchanged file, for which the claims were
+    false (review 21). A note now says the file differs and how to check against it; none
+    when the file is the embedded text, is missing, or is not a regular file (a FIFO is
+    not opened: no hang)."""
+    import os
+
+    spec = tmp_path / "s.toml"
+    spec.write_text(SPEC.read_text(encoding="utf-8"), encoding="utf-8")
+    rep = api.design(api.load_spec(spec))
+    out = tmp_path / "r.json"
+    out.write_text(rep.to_json(), encoding="utf-8")
+
+    def moved(path: Path) -> list[str]:
+        return [n for n in api.verify(path).notes if "differs from it" in n]
+
+    assert moved(out) == []
+    spec.write_text(SPEC.read_text(encoding="utf-8") + "# edited\n", encoding="utf-8")
+    (note,) = moved(out)
+    assert f"not the file {spec}" in note and f"--spec {spec}'" in note
+    assert api.verify(out).exit_code() == 0  # a note, not a verdict
+    r = CliRunner().invoke(app, ["verify", str(out)])
+    assert r.exit_code == 0 and "differs from it" in r.output
+    spec.unlink()
+    assert moved(out) == []
+    os.mkfifo(spec)
+    assert moved(out) == []
