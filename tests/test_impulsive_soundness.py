@@ -597,3 +597,36 @@ def test_a_window_too_narrow_for_its_digits_says_so() -> None:
     msg = ei.value.message
     assert "is not empty, but it holds no pair of 4-decimal bounds" in msg
     assert "raise [method] digits" in msg and "T_max = -" not in msg
+
+
+# -- falsification: rounding is not a violation (review 21) -----------------------------------
+TIGHT = Path(__file__).resolve().parent / "specs" / "impulsive-tight-cross.toml"
+
+
+@pytest.mark.parametrize(("cross", "code"), [("1.55", 0), ("1.5499999", 1), ("1.54", 1)])
+def test_falsification_allows_rounding_not_a_violation(cross: str, code: int) -> None:
+    """ψ linear with c_n = −1.55·ε_o exactly (in z = T x, T = [C; M]): ‖c_n‖ = ℓ_no‖ε_o‖ holds
+    with equality, and the design with cross = 1.55 and on_violation = "fail" failed with a
+    "violation" of 2.5e-9 — the rounding of a difference of ψ̄ values at a pair with tiny ε_o
+    (review 21). Each pair's tolerance now adds its first-order rounding; a bound 10⁻⁷ too
+    small (relative) is still found, at most pairs."""
+    txt = TIGHT.read_text(encoding="utf-8").replace("cross = 1.55", f"cross = {cross}")
+    rep = api.design(api.load_spec_text(txt, "tight.toml"))
+    assert rep.exit_code() == code
+    c = next(c for c in rep.claims if c.id == "assumption1-falsification")
+    if code == 0:
+        assert c.status.value == "numerical" and "no violation" in c.detail
+    else:
+        assert not c.ok and "cross bound ‖c_n‖ ≤ ℓ_no‖ε_o‖" in c.detail
+
+
+@pytest.mark.parametrize(("ell", "violated"), [(3.0, False), (3.0 * (1 - 1e-6), True)])
+def test_lipschitz_x_falsification_allows_rounding(ell: float, violated: bool) -> None:
+    """ψ = 3x on [10⁶, 10⁶ + 1]: ‖ψ(x̂) − ψ(x)‖/‖x̂ − x‖ = 3 exactly, but in floats the
+    difference of two values near 3·10⁶ over |x̂ − x| ≈ 10⁻⁴ is off by ~10⁻⁵: it was a
+    violation of ℓ = 3. A bound 10⁻⁶ too small (relative) is still a violation."""
+    from obsdesign.methods.impulsive.falsify import falsify_lipschitz_x
+
+    lo, hi = np.array([1e6]), np.array([1e6 + 1])
+    f = falsify_lipschitz_x(lambda X: 3.0 * X, ell, lo, hi, 2000, 0)
+    assert bool(f.violated) == violated
