@@ -18,20 +18,19 @@ ROOT = Path(__file__).resolve().parents[1]
 SPECS = ROOT / "specs"
 
 
-@pytest.fixture(autouse=True)
-def _fresh_interval_bounds():
-    """Under mutmut (``MUTANT_UNDER_TEST`` set), each test computes the search-space interval
-    bounds afresh: ``design._CACHE`` keeps them per process, and mutmut forks each mutant's
-    run from a process that had already filled it with correct bounds, so no mutant of
-    ``searchspace/bounds.py`` was ever seen (mutation review 21). Outside mutmut the cache is
-    kept (about 6 s of the search-space tests)."""
+def pytest_sessionstart(session: pytest.Session) -> None:
+    """Under mutmut (``MUTANT_UNDER_TEST`` set) the search-space interval bounds are computed
+    afresh: ``design._CACHE`` keeps them per process, and mutmut forks each mutant's pytest
+    session from a process whose cache already held the correct bounds, so no mutant of
+    ``searchspace/bounds.py`` was seen (mutation review 21). Cleared at the session's start,
+    before any fixture (a module-scoped fixture built before a per-test clearing still used
+    the old bounds); within the session every bound is the mutant's own."""
     if os.environ.get("MUTANT_UNDER_TEST"):
         import sys
 
         mod = sys.modules.get("obsdesign.methods.searchspace.design")
         if mod is not None:
             mod._CACHE.clear()
-    yield
 
 
 @pytest.fixture

@@ -789,3 +789,51 @@ def test_tamper_K_one_is_not_the_rule(example, tmp_path) -> None:
     ("K == 1 or …" passed it)."""
     sp, rep = example
     assert _failed(_report_with(rep, _consistent(sp, K=1), tmp_path)) == {"K-rule"}
+
+
+# -- mutation review 21b: claims.certify, Lemma 2 and ε⋆ (the mutants not run in review 21) ------
+# To be appended to tests/test_searchspace.py (uses its example, _consistent, _certified, D,
+# ivq, fmpq, ClaimStatus).
+
+
+def test_lemma2_is_strict_at_the_working_precision_of_L_f_dT(example) -> None:
+    """Mutation review 21b (certify): Lemma 2 needs L_f Δτ strictly below the lower bound lo of
+    log(κ/L_h), computed at K_bits(ΔT·L_f) bits. With L_f = 2²⁰ (ΔT·L_f ≈ 6.7·10³: 114 bits;
+    ΔT/L_f ≈ 6·10⁻⁹ would give 141, a tighter lo), Δτ = lo/L_f fails ("≤" passed it, and so
+    did lo at the bits of ΔT/L_f) and Δτ = (lo − 2⁻²⁰⁰)/L_f passes."""
+    sp, _ = example
+    v = _consistent(sp, L_f=fmpq(2**20))
+    L_f, ratio = v["L_f"], v["kappa"] / v["L_h"]
+    assert ratio == fmpq(3, 2)
+    bits = D.K_bits(v["dT"] * L_f)
+    assert bits == 114 and D.K_bits(v["dT"] / L_f) > bits + 20
+    lo = ivq.log_bounds(ratio, bits)[0]
+    assert lo < ivq.log_bounds(ratio, D.K_bits(v["dT"] / L_f))[0]
+    assert _certified(sp, dict(v, dtau=lo / L_f))["lemma2-consistency"] == ClaimStatus.FAILED
+    w = dict(v, dtau=(lo - fmpq(1, 2**200)) / L_f)
+    assert _certified(sp, w)["lemma2-consistency"] == ClaimStatus.CERTIFIED
+
+
+def test_lemma2_fails_at_kappa_equal_L_h_whatever_dtau(example) -> None:
+    """Mutation review 21b (certify): κ = L_h (log(κ/L_h) = 0) fails Lemma 2 without a
+    logarithm, even for a report's Δτ < 0 (with κ/L_h ≥ 1 sent to the logarithm, whose bounds
+    at 1 are exactly 0, L_f Δτ < 0 passed it)."""
+    sp, _ = example
+    v = _consistent(sp, kappa=fmpq(1))
+    assert v["L_h"] == 1 and v["dtau"] > 0
+    w = dict(v, dtau=-v["dtau"])
+    assert _certified(sp, w)["lemma2-consistency"] == ClaimStatus.FAILED
+
+
+def test_eps_star_off_by_a_hair_holds_in_floats(example) -> None:
+    """Mutation review 21b (certify): ε⋆ = γ⋆/κ + 2⁻⁸⁰ fails eps-star exactly (the only failed
+    claim) but holds in float64 (float(ε⋆) == 0.05/1.5): float_ok is True, so such a run is
+    inconclusive (exit 4), not infeasible (without float_ok it was None: exit 1)."""
+    from obsdesign.params import Parameters
+
+    sp, _ = example
+    v = _consistent(sp)
+    v["eps_star"] += fmpq(1, 2**80)
+    bad = [c for c in api.certify(sp, Parameters(v)) if c.status == ClaimStatus.FAILED]
+    assert [c.id for c in bad] == ["eps-star"]
+    assert bad[0].float_ok is True
