@@ -682,3 +682,293 @@ def test_row_bounds_contain_the_exact_phi_on_random_polytopes(seed: int) -> None
             phi = max(ce.po.qdot(sl.GA[i], p) for p in exact_pts)
             assert low[i] <= float(phi) <= up[i]
             assert phis[i] == phi
+
+
+# -- mutation review 21: certificate.py (kills the verdict-changing survivors) -----------------
+
+
+def test_exact_lp9_known_answer() -> None:
+    """LP (9) min ε s.t. φ + G v + δ <= ε 1 on the unit box rows, φ = (1, 0, 0, 0),
+    δ = (0, 0, 1/2, 1/2): the unique optimum is v = (−1/2, 0), ε = 1/2 (1 + v₁ = −v₁,
+    v₂ + 1/2 = −v₂ + 1/2), and the returned v attains ε."""
+    q = fmpq
+    G = np.array([[q(1), q(0)], [q(-1), q(0)], [q(0), q(1)], [q(0), q(-1)]], dtype=object)
+    phi = [q(1), q(0), q(0), q(0)]
+    dl = [q(0), q(0), q(1, 2), q(1, 2)]
+    e, v = ce.exact_lp9(G, phi, dl)
+    assert (e, v) == (q(1, 2), [q(-1, 2), q(0)])
+    assert max(phi[i] + ce.po.qdot(G[i], v) + dl[i] for i in range(len(G))) == e
+    # one dimension, max(2v − 1, −2v − 1, v, −v): the epigraph has the vertices (±1, 1) and
+    # (0, 0); only the objective picks the minimum (0, 0), not just a feasible vertex
+    G = np.array([[q(2)], [q(-2)], [q(1)], [q(-1)]], dtype=object)
+    assert ce.exact_lp9(G, [q(-1), q(-1), q(0), q(0)], [q(0)] * 4) == (q(0), [q(0)])
+
+
+def test_noise_vertices_are_every_sign_pattern() -> None:
+    """The noise box {|η_k| <= η̄} has the 2^p vertices (±η̄, ..., ±η̄); the admissible gains
+    (linear.gain_vertices) are constrained at each of them."""
+    q = fmpq
+    eta = q(1, 10)
+    got = ce.noise_vertices(2, eta)
+    assert len(got) == 4
+    assert set(map(tuple, got)) == {(a, b) for a in (-eta, eta) for b in (-eta, eta)}
+    assert ce.noise_vertices(1, eta) == [(-eta,), (eta,)]
+
+
+def test_lp9_on_fewer_rows_without_disturbance(base_nodist: dict[str, Any]) -> None:
+    """The design's LP (9) on the float hull's merged rows (``v_rows``, fewer than the exact
+    G) must work without a disturbance (B1 with no columns, no D vertices: δ = 0 on those
+    rows): the example without disturbance, one row dropped, still certifies λ = 9/10."""
+    from obsdesign.methods.setinvariant import lps
+
+    ex = build(api.load_spec_text(base_nodist["spec"], "nodist.toml")).ex
+    assert ex.B1.shape[1] == 0 and len(ex.Dv) == 0
+    G = exact(base_nodist, "G")
+    vrep = ce.po.exact_h_to_v(G)
+    res = ce.theorem31(ex, G, v_solver=lps.eps_batch, vrep=vrep, v_rows=ce.po.qfloat(G)[:-1])
+    assert res.ok and res.factor == fmpq(9, 10)
+
+
+def test_theorem31_missing_breakpoint_is_not_ok(base71: dict[str, Any]) -> None:
+    """ce.theorem31 itself (not only the claim, which reads the note) says not ok when a
+    point of Z_d is missing from the table."""
+    ex = build(api.load_spec(SPEC71)).ex
+    G, zs, vs = exact(base71, "G"), exact(base71, "breakpoints"), exact(base71, "v_breakpoints")
+    keep = [0, 1, 3, 4]
+    res = ce.theorem31(
+        ex,
+        G,
+        vs=[list(vs[k]) for k in keep],
+        zs_given=[zs[k] for k in keep],
+        vrep=ce.po.exact_h_to_v(G),
+    )
+    assert res.ok is False and res.notes and "missing" in res.notes[0]
+
+
+def _interval(lam: fmpq, d: tuple[fmpq, fmpq] | None) -> ce.ExactProblem:
+    """e⁺ = 0·e + d + v, z = e, |η| <= 1/2, on the interval {|e| <= 1} (G = (1, −1)):
+    φ = 0 exactly (A = 0: no float radius), δ = (d_hi, −d_lo) for D = [d_lo, d_hi], so the
+    level at z^l is max(v^l + δ₁, −v^l + δ₂) and the float tolerance of a row is
+    _FILTER·(|G_i||v| + |δ_i| + 1)."""
+    q = fmpq
+    return ce.ExactProblem(
+        A=np.array([[q(0)]], dtype=object),
+        B1=np.array([[q(1)]] if d else np.zeros((1, 0)), dtype=object),
+        C=np.array([[q(1)]], dtype=object),
+        G0=np.array([[q(1)], [q(-1)]], dtype=object),
+        Vo=np.array([[q(1)], [q(-1)]], dtype=object),
+        Dv=np.array([[d[0]], [d[1]]] if d else np.zeros((0, 0)), dtype=object),
+        eta=q(1, 2),
+        lam=lam,
+    )
+
+
+def _interval_theorem31(ex: ce.ExactProblem, v_at: dict[fmpq, fmpq]) -> ce.Theorem31Result:
+    """Theorem 3.1 (verify) on the interval with v^l given at some points of Z_d; elsewhere
+    the lowest level, v = (δ₂ − δ₁)/2; Z_d = {±1/2, ±3/2}."""
+    G = np.array([[fmpq(1)], [fmpq(-1)]], dtype=object)
+    vrep = ce.po.exact_h_to_v(G)
+    zs, _ = ce.exact_zd(vrep.V, ex.C[0], ex.eta)
+    assert zs == [fmpq(-3, 2), fmpq(-1, 2), fmpq(1, 2), fmpq(3, 2)]
+    d1, d2 = ce.delta_exact(G, ex.B1, ex.Dv)
+    vs = [[v_at.get(z, (d2 - d1) / 2)] for z in zs]
+    return ce.theorem31(ex, G, vs=vs, zs_given=zs, vrep=vrep)
+
+
+TINY_LEVEL = fmpq(1, 10**10)  # far below the float prefilter's margin (~10⁻⁷ relative)
+
+
+@pytest.mark.parametrize(
+    "lam, d, v",
+    [
+        # no disturbance, λ = 1/2: level |v| = 1/2 + 10⁻¹⁰ (|G||v| + 1 < 2 |v| + ...)
+        (fmpq(1, 2), None, -(fmpq(1, 2) + TINY_LEVEL)),
+        # no disturbance, λ = 3: the term |G||v| = 3 is larger than everything else
+        (fmpq(3), None, -(fmpq(3) + TINY_LEVEL)),
+        # D = [−7/2, 1/10], λ = 2: row 2 tight, −v + 7/2 = 2 + 10⁻¹⁰, |δ₂| = 7/2 > |v| + 1
+        (fmpq(2), (fmpq(-7, 2), fmpq(1, 10)), fmpq(3, 2) - TINY_LEVEL),
+    ],
+)
+def test_theorem31_float_bracket_holds_at_a_level_just_above_lambda(
+    lam: fmpq, d: tuple[fmpq, fmpq] | None, v: fmpq
+) -> None:
+    """One breakpoint's exact level exceeds λ by 10⁻¹⁰: the float bracket of every row
+    (up = φ_up + G v + δ + tol, low = φ_low + G v + δ − tol, tol = _FILTER·(|φ_up| + |G||v|
+    + |δ| + 1) >= 0) must reach it, so the breakpoint is evaluated exactly and fails,
+    whatever term of tol is the largest."""
+    ex = _interval(lam, d)
+    res = _interval_theorem31(ex, {fmpq(1, 2): v})
+    assert not res.ok
+    assert res.factor == lam + TINY_LEVEL and res.zs[res.worst] == fmpq(1, 2)
+
+
+def test_theorem31_skips_only_breakpoints_bracketed_below_the_others() -> None:
+    """D = [−3/2, 1/10], λ = 1: at z = 1/2 the level is 1 + 10⁻¹⁰ (row 2 tight, tol ≈
+    3·10⁻⁷), at z = −1/2 it is 1 − 10⁻¹⁰ (row 1 tight, tol ≈ 2·10⁻⁷): an upper float bound
+    that does not add its tolerance would leave z = 1/2 below λ and below the other
+    breakpoint's lower bound, skip it and certify λ."""
+    q = fmpq
+    ex = _interval(q(1), (q(-3, 2), q(1, 10)))
+    res = _interval_theorem31(ex, {q(1, 2): q(1, 2) - TINY_LEVEL, q(-1, 2): q(9, 10) - TINY_LEVEL})
+    assert not res.ok and res.factor == 1 + TINY_LEVEL
+
+
+def test_theorem31_factor_is_exact_when_a_larger_tolerance_sits_just_below() -> None:
+    """The certified factor (contractivity-value) is the exact maximum, also far below λ = 2
+    (no breakpoint evaluated for reaching λ): at z = −1/2 the level is 1 − 10⁻¹⁰ (row 1
+    tight, tol ≈ 2·10⁻⁷), at z = 1/2 it is 1 − 2·10⁻¹⁰ (row 2 tight, tol ≈ 3·10⁻⁷); a
+    lower float bound raised by its tolerance would put z = 1/2's above z = −1/2's upper
+    bound, skip z = −1/2 and report 1 − 2·10⁻¹⁰."""
+    q = fmpq
+    ex = _interval(q(2), (q(-3, 2), q(1, 10)))
+    res = _interval_theorem31(
+        ex, {q(1, 2): q(1, 2) + 2 * TINY_LEVEL, q(-1, 2): q(9, 10) - TINY_LEVEL}
+    )
+    assert res.ok and res.factor == 1 - TINY_LEVEL and res.zs[res.worst] == q(-1, 2)
+
+
+@pytest.mark.parametrize("shift", [1e-12, -1e-12])
+def test_design_repairs_a_rounded_v_with_the_exact_lp9(
+    base71: dict[str, Any], shift: float
+) -> None:
+    """Design mode: Example 7.1's float LP (9) optimum is λ = 0.9 at every breakpoint; with
+    every float v^l moved by 10⁻¹² the rounded v misses λ at some breakpoint, and the exact
+    LP (9) (cdd.gmp) must replace it there: certified with factor 9/10, and verify (the
+    table recomputed from the returned v^l) agrees."""
+    from obsdesign.methods.setinvariant import lps
+
+    ex = build(api.load_spec(SPEC71)).ex
+    G = exact(base71, "G")
+    vrep = ce.po.exact_h_to_v(G)
+
+    def solver(Gf: np.ndarray, phi: np.ndarray, dl: np.ndarray, deadline: Any = None) -> Any:
+        er = lps.eps_batch(Gf, phi, dl, deadline=deadline)
+        assert abs(float(er.eps.max()) - float(ex.lam)) < 1e-12  # tight: the exact LP is needed
+        er.v = er.v + shift
+        return er
+
+    res = ce.theorem31(ex, G, v_solver=solver, vrep=vrep)
+    assert res.exact_lp >= 1 and res.ok and res.factor == fmpq(9, 10)
+    again = ce.theorem31(ex, G, vs=res.vs, zs_given=res.zs, vrep=vrep)
+    assert again.ok and again.factor == res.factor and again.eps == res.eps
+
+
+def test_omega_contained_prefilter_keeps_pairs_within_float_error() -> None:
+    """Ω ⊆ {G e <= 1}: two rows of size ~10⁶ whose products with Ω's vertex are exactly
+    1 + 10⁻¹³ (row 0: not contained) and 1 − 10⁻¹³ (row 1), while in floats (error ~10⁻¹⁰
+    from rounding entries of size 10⁶) row 1 is ~7·10⁻¹⁰ above row 0: the prefilter's margin
+    (relative to max |G||V|) must keep row 0, so the exact max is 1 + 10⁻¹³."""
+    q = fmpq
+    x, y = q(7, 3), q(7, 3) + q(1, 10**6)
+    a, c = q(1000000713587629, 1000000007), q(1000000997137014, 1000000007)
+    b, d = (a * x - 1 - q(1, 10**13)) / y, (c * x - 1 + q(1, 10**13)) / y
+    G = np.array([[a, -b], [c, -d]], dtype=object)
+    Vo = np.array([[x, y]], dtype=object)
+    M = ce.po.qfloat(G) @ ce.po.qfloat(Vo).T
+    assert M[1, 0] - M[0, 0] > 1e-10  # the float order is the wrong way round
+    assert ce.omega_contained(G, Vo) == (False, 1 + q(1, 10**13))
+
+
+def test_theorem31_float_bracket_covers_the_rounding_of_large_cancelling_terms() -> None:
+    """A thin parallelogram (rows ±(10⁶, −10⁶ + 1/3), ±(1, 1)), A = 0, λ = 1: at one
+    breakpoint row 0 gives exactly 1 + 10⁻¹³ from terms of size ~10⁶ whose float sum is
+    ~1 − 7·10⁻¹¹, at another exactly 1 − 10⁻¹³ computed as ~1 + 9·10⁻¹¹. The float bracket's
+    margin must grow with the size of the terms (_FILTER·|G||v|), or the first breakpoint is
+    bracketed below the second, skipped, and λ certified."""
+    q = fmpq
+    K = q(10**6)
+    G = np.array([[K, -K + q(1, 3)], [-K, K - q(1, 3)], [q(1), q(1)], [q(-1), q(-1)]], dtype=object)
+    ex = _undisturbed(np.zeros((2, 2), dtype=object) + q(0), [q(1), q(0)], G, q(1, 10))
+    vrep = ce.po.exact_h_to_v(G)
+    zs, _ = ce.exact_zd(vrep.V, ex.C[0], ex.eta)
+
+    def v_for(level: fmpq, y: fmpq) -> list[fmpq]:  # row 0 reaches ``level`` exactly
+        return [y + (level - y / 3) / K, y]
+
+    t = q(1, 10**13)
+    vs = [[q(0), q(0)] for _ in zs]
+    vs[0] = v_for(1 + t, q(276899738, 1000000007))
+    vs[1] = v_for(1 - t, q(367919309, 1000000007))
+    Gf = ce.po.qfloat(G)
+    fl = [float(Gf[0] @ ce.po.qfloat(np.array(v, dtype=object))) for v in vs[:2]]
+    assert fl[0] < 1 - 5e-11 and fl[1] > 1 + 5e-11  # the floats order them the wrong way
+    res = ce.theorem31(ex, G, vs=vs, zs_given=zs, vrep=vrep)
+    assert not res.ok and res.factor == 1 + t
+
+
+def test_delta_of_a_single_point_disturbance_set() -> None:
+    """A disturbance set D = {1/4} (a polytope of one point, accepted by the spec) has one
+    vertex, and δ_i = G_i B1 (1/4) must still count it (it is not "no disturbance")."""
+    text = SPEC71.read_text().replace(
+        'type = "box"\ndim = 1\nlower = [-1]\nupper = [1]',
+        'type = "polytope"\ndim = 1\nG = [[1], [-1]]\ng = [0.25, -0.25]',
+    )
+    ex = build(api.load_spec_text(text, "point.toml")).ex
+    assert ex.Dv.shape == (1, 1) and ex.Dv[0, 0] == fmpq(1, 4)
+    G = ex.G0
+    want = [ce.po.qdot(G[i], ex.B1[:, 0]) * fmpq(1, 4) for i in range(len(G))]
+    assert ce.delta_exact(G, ex.B1, ex.Dv) == want
+    assert max(want) == fmpq(1, 4)
+
+
+def test_row_bounds_hold_for_a_sure_crossing_on_an_edge_nearly_level_in_c() -> None:
+    """The quadrilateral (−1, −1), (1 − δ, −1), (1 + δ, 1), (−1, 1) with δ = 2·10⁻⁹: its
+    right edge spans 4·10⁻⁹ in c = (1, 0), too level for a precise float weight (error bound
+    > _PRECISE: its own radius), yet crossed strictly by z = 1 (the crossing (1, 0) certainly
+    exists), and neither end is within the vertex tolerance of z. The slice at z = 1 is the
+    segment (1, 0)–(1, 1); for the row −y the maximum 0 is only at that crossing. The bounds
+    must contain every exact φ_i and phi_exact must be it."""
+    q = fmpq
+    d = q(2, 10**9)
+    G = np.array([[q(0), q(-1)], [q(-1), q(0)], [q(0), q(1)], [q(1), -d]], dtype=object)
+    ex = _undisturbed(np.array([[q(1), q(0)], [q(0), q(1)]], dtype=object), [q(1), q(0)], G, q(0))
+    vrep = ce.po.exact_h_to_v(G)
+    assert sorted(map(tuple, vrep.V)) == sorted(
+        [(q(-1), q(-1)), (1 - d, q(-1)), (1 + d, q(1)), (q(-1), q(1))]
+    )
+    _, cv = ce.exact_zd(vrep.V, ex.C[0], ex.eta)
+    sl = ce._Slices(ex, G, vrep, [q(1)], cv)
+    _, err, sure = sl.ends[0]
+    assert (err > ce._PRECISE).any() and (sure & (err > ce._PRECISE)).any()
+    up, low = sl.row_bounds(0)
+    pts = [(q(1), q(0)), (q(1), q(1))]
+    for i in range(len(G)):
+        phi = max(ce.po.qdot(sl.GA[i], p) for p in pts)
+        assert low[i] <= float(phi) <= up[i], (i, low[i], float(phi), up[i])
+    assert sl.phi_exact(0) == {i: max(ce.po.qdot(sl.GA[i], p) for p in pts) for i in range(len(G))}
+
+
+@pytest.mark.parametrize(
+    "sign, K, d",
+    [(1, 1, fmpq(1, 10**12)), (-1, 1, fmpq(1, 10**12)), (1, 10**4, fmpq(1, 10**13))],
+)
+def test_phi_ignores_a_vertex_just_outside_the_slab(sign: int, K: int, d: fmpq) -> None:
+    """The quadrilateral K·(−1, −1), K·(1, −1), (K + d, K), K·(−1, 1), η̄ = K/10,
+    c = ±(1, 0): at the breakpoint whose slab ends exactly at the vertex (K + d, K) (from
+    above for c = (1, 0), from below for c = (−1, 0)) the slice is that vertex alone, and
+    (K, −K) lies d outside the slab (inside the float tolerance, so a float candidate; for
+    K = 10⁴, d = 10⁻¹³ even the same float as the slab's end), but it must not count as
+    certainly in the slice: its G_i A e is 2 above the slice's for the row −y/K. φ_i is
+    G_i A (K + d, K) for every row."""
+    q = fmpq
+    K = q(K)
+    P3 = (K + d, K)
+    # rows (rhs 1): bottom, left, top, and the right edge through (K, −K) and (K + d, K)
+    r = K + d / 2
+    G = np.array(
+        [[q(0), -1 / K], [-1 / K, q(0)], [q(0), 1 / K], [1 / r, -(d / 2) / K / r]],
+        dtype=object,
+    )
+    ex = _undisturbed(
+        np.array([[q(1), q(0)], [q(0), q(1)]], dtype=object), [q(sign), q(0)], G, K / 10
+    )
+    vrep = ce.po.exact_h_to_v(G)
+    assert sorted(map(tuple, vrep.V)) == sorted([(-K, -K), (K, -K), P3, (-K, K)])
+    zs, cv = ce.exact_zd(vrep.V, ex.C[0], ex.eta)
+    l = zs.index(sign * (K + d) + sign * ex.eta)  # the slab beyond (K + d, K)
+    sl = ce._Slices(ex, G, vrep, zs, cv)
+    up, low = sl.row_bounds(l)
+    want = {i: ce.po.qdot(sl.GA[i], P3) for i in range(len(G))}
+    for i in range(len(G)):
+        assert low[i] <= float(want[i]) <= up[i], (i, low[i], float(want[i]), up[i])
+    assert sl.phi_exact(l) == want
