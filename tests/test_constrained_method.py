@@ -721,3 +721,43 @@ def test_v_min_zero_is_a_true_bound(mr_sec5) -> None:
     st = _mr_failed(mr_sec5, v_min=fmpq(0))
     assert st["v_min-bound"] == ClaimStatus.CERTIFIED
     assert {k for k, s in st.items() if s == ClaimStatus.FAILED} <= {"theta-covers"}
+
+
+# -- mutation review 2026-11-27b (constrained/claims.py): the key / id string mutants ----------
+# (to append to tests/test_constrained_method.py: uses _mr_q / _mr_v of "mutation review
+# 2026-11-27" above)
+
+
+def test_cmin_in_xhat_near_tight_off_centre_ellipsoid() -> None:
+    """Ellipsoid map Q = I, r = 10/11, ε_min = 1/100 (t = 1/10): the outer set of C_min is the
+    unit disc. X̂ = {((x1 − 1/2)/s)² + (x2/2)² ≤ 1} with s = 3/2 + 10⁻¹⁴ contains it, touching
+    it nearly at (−1, 0); the S-lemma multipliers τ that prove it form a window of width
+    ≈ 10⁻⁷, which the bounded search finds only with its tolerance xatol = 10⁻¹²·(1 − cᵀEc)
+    (kills ``options={"XXxatolXX": …}`` / ``{"XATOL": …}`` in ``ellipsoid_in_ellipsoid``:
+    scipy ignores the unknown option, searches to its default xatol = 10⁻⁵, and a true
+    C_min ⊂ X̂ fails). With s = 3/2 − 10⁻¹⁴ the inclusion is false and is not proved."""
+    from obsdesign.methods.constrained.claims import cmin_in_xhat
+    from obsdesign.methods.constrained.cmap import ellipsoid_map
+    from obsdesign.sets import Ellipsoid
+
+    cm = ellipsoid_map(_mr_q([[1, 0], [0, 1]]), fmpq(10, 11))
+    eps = fmpq(1, 100)
+    for s, inside in ((fmpq(3, 2) + fmpq(1, 10**14), True), (fmpq(3, 2) - fmpq(1, 10**14), False)):
+        X = Ellipsoid(_mr_q([[1 / (s * s), 0], [0, fmpq(1, 4)]]), _mr_v([fmpq(1, 2), 0]))
+        ok, detail = cmin_in_xhat(cm, eps, X)
+        assert bool(ok) == inside, (s, detail)
+
+
+def test_cmin_in_xhat_box_map_uses_the_closed_form() -> None:
+    """Box map, X̂ a box: C_min ⊂ X̂ is decided in closed form over the outer box (n faces
+    per side), not by enumerating its 2ⁿ vertices with cdd.gmp. Not a verdict: kills
+    ``cm.kind == "XXboxXX"`` / ``"BOX"`` in ``cmin_in_xhat``, which gave the same answer by
+    vertex enumeration (n = 13: 2.4 s instead of 0.5 s; exponential in n, and an exception
+    where cdd.gmp is unavailable)."""
+    from obsdesign.methods.constrained.claims import cmin_in_xhat
+    from obsdesign.methods.constrained.cmap import box_map
+    from obsdesign.sets import Box
+
+    cm = box_map(_mr_v([-1, -1]), _mr_v([1, 3]))
+    ok, detail = cmin_in_xhat(cm, fmpq(1, 100), Box(_mr_v([-2, -2]), _mr_v([2, fmpq(16, 5)])))
+    assert ok and "outer box" in detail, detail
