@@ -837,3 +837,19 @@ def test_eps_star_off_by_a_hair_holds_in_floats(example) -> None:
     bad = [c for c in api.certify(sp, Parameters(v)) if c.status == ClaimStatus.FAILED]
     assert [c.id for c in bad] == ["eps-star"]
     assert bad[0].float_ok is True
+
+
+@pytest.mark.parametrize(
+    ("value", "want"),
+    [("0.5", ClaimStatus.NUMERICAL), ("0.4999", ClaimStatus.FAILED)],
+)
+def test_a_given_constant_equal_to_the_true_one_is_not_refuted(value: str, want) -> None:
+    """h = x1^1.5/3 on E = [0, 1]²: L_h = 1/2 exactly (at x1 = 1), not proved by the interval
+    bound. The given 1/2 failed on a sampled estimate 1e-11 above it (a strict comparison
+    without the float tolerance the refutation uses; review 21): it is numerical now, and a
+    value 2·10⁻⁴ below the constant is still refuted."""
+    text = TEXT.replace('h = ["x1*step(x1)"]', 'h = ["x1^1.5/3"]').replace(
+        "lower = [-2.5, -2.5]\nupper = [2.5, 2.5]", "lower = [0, 0]\nupper = [1, 1]"
+    )
+    assert "x1^1.5/3" in text and "lower = [0, 0]" in text
+    assert _constant_status(_given(text, "L_h", value), "L_h", Q(value)) == want
