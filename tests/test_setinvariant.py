@@ -16,7 +16,13 @@ from obsdesign import api
 from obsdesign.api import load_spec_text
 from obsdesign.certify.claim import ClaimStatus
 from obsdesign.certify.exact import qmat
-from obsdesign.errors import InconclusiveError, InfeasibleError, SolverError, SpecError
+from obsdesign.errors import (
+    InconclusiveError,
+    InfeasibleError,
+    InputError,
+    SolverError,
+    SpecError,
+)
 from obsdesign.methods.setinvariant import laws
 from obsdesign.methods.setinvariant.spectext import spec_text as matrix_spec_text
 
@@ -623,3 +629,24 @@ def test_simulate_time_limit_stops_the_run(rep71, law, monkeypatch, slow_clock) 
     assert api.simulate(spec, out, law=law, time_limit=999).info["law"] == name
     with pytest.raises(SpecError, match=r"\[simulate\.time_limit\]"):
         api.load_spec_text(text.replace("[simulate]", "[simulate]\ntime_limit = -1", 1))
+
+
+@pytest.mark.parametrize("law", ["online-lp", "interpolated", "time-varying"])
+def test_one_output_laws_with_two_outputs_are_input_errors(law: str) -> None:
+    """p = n − 1 = 2 (outsider trial, session 22): `--option law=online-lp` crashed inside
+    slice_points with a broadcast error (exit 3, internal failure); LP (9) slices Ω along a
+    scalar output. Each one-output law is now exit 2 naming the output count; the linear law
+    runs."""
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.1, 0, 0.2], [0, 0.1, 0], [0, 0, 0.4]]\n'
+        'C = [[1, 0, 0], [0, 1, 0]]\n[sets.omega]\ntype = "box"\nlower = [-1, -1, -1]\n'
+        'upper = [1, 1, 1]\n[method]\nkey = "set-invariant"\nomega = "omega"\nlambda = 0.9\n'
+        "[simulate]\nhorizon = 5\nx0 = [0.5, -0.5, 0.5]\nxhat0 = [0, 0, 0]\n"
+    )
+    spec = load_spec_text(text, "p2.toml")
+    rep = api.design(spec)
+    assert rep.exit_code() == 0
+    with pytest.raises(InputError, match="one output") as e:
+        api.simulate(spec, report=rep, law=law)
+    assert e.value.exit_code == 2
+    assert api.simulate(spec, report=rep, law="linear").info["law"] == "linear"

@@ -46,6 +46,14 @@ def make_law(spec: Spec, params: Parameters, law: str | None) -> Any:
             raise InputError("the report has no linear gain L and the spec gives none")
         return laws.LinearLaw(po.qfloat(spec.options.L).reshape(s.n, s.p))
     if law == "online-lp":
+        if s.p != 1:
+            # LP (9) is posed on the slices {e ∈ Ω : |c e − z| ≤ η̄} of a scalar output z
+            # (Section IV of the paper); with p ≥ 2 it crashed inside slice_points (exit 3;
+            # outsider trial, session 22)
+            raise InputError(
+                f"law 'online-lp' needs one output (LP (9) slices Ω along a scalar z); this "
+                f"spec has p = {s.p}: use law=linear"
+            )
         d = build(spec).fl
         return laws.OnlineLPLaw(params.float("G").reshape(-1, s.n), d.A, d.B1, d.C[0], d.Dv, d.eta)
     raise InputError(
