@@ -5,6 +5,7 @@ study's qualitative result, bad input."""
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -18,6 +19,7 @@ from obsdesign.certify.claim import ClaimStatus
 from obsdesign.certify.exact import Q, qparse, qstr, to_float
 from obsdesign.cli import app
 from obsdesign.errors import InfeasibleError, SpecError
+from obsdesign.methods.stubborn.sim import study
 from obsdesign.report import Report
 
 SPECS = Path(__file__).resolve().parents[1] / "specs"
@@ -1104,3 +1106,47 @@ def test_the_reported_r_bound_is_the_specs() -> None:
     d = rep.to_dict()
     _set(d, "r_bound", fmpq(101))
     assert _failed(d) == {"r_bound-matches-spec"}
+
+
+def test_the_search_cap_is_said_with_the_right_side_and_no_bracket() -> None:
+    """n = 1, C = 1 (outsider trial, session 22): the LMIs hold for every λ, so the search
+    stops at its cap. Continuous time: 'best λ ≥ 524288', no bracket; discrete time, where the
+    best λ is the smallest, the note said '≥ 1e-06' — it is '≤'. Both say the search stopped at
+    its cap, and every claim is still certified."""
+    for time, A, side, at in (("continuous", 1, "≥", "524288"), ("discrete", 2, "≤", "1e-06")):
+        text = (
+            f'[system]\ntime = "{time}"\nA = [[{A}]]\nC = [[1]]\n[method]\nkey = "stubborn"\n'
+            "gain_bound = 10\n"
+        )
+        rep = api.design(api.load_spec_text(text, f"cap-{time}.toml"))
+        assert rep.exit_code() == 0
+        note = next(n for n in rep.notes if n.startswith("best λ"))
+        assert note.startswith(f"best λ {side} {at} ") and "stops at its cap" in note, note
+        assert "lambda_bracket" not in rep.parameters
+        assert "lambda-max-bracket" not in {c.id for c in rep.claims}
+
+
+def test_a_step_too_large_for_the_adaptive_level_is_warned() -> None:
+    """λ = 1000 given, ‖K‖ small, dt = 10⁻² (outsider trial, session 22): dt·λ = 10 > 2, so
+    the Heun step of σ̄' = −λσ̄ + e_yᵀRe_y is unstable (at λ = 262144, dt = 10⁻³ it sent σ̄ to 0
+    at once and the outlier study's constant levels were 0), while dt·|eig(A − KC)| = 0.03 is
+    fine. The single run and the outlier study both warn, naming λ; at dt = 10⁻³ neither."""
+    base = (
+        '[system]\ntime = "continuous"\nA = [[-1]]\nC = [[1]]\n[method]\nkey = "stubborn"\n'
+        'mode = "redesign"\nK = [[2]]\nlambda = 1000\n[simulate]\nhorizon = 0.05\n'
+        "dt = {dt}\nx0 = [1]\nxhat0 = [0]\nnoise_std = 0\noutlier_rate = 0\nruns = 2\n"
+    )
+    for dt, warned in ((0.01, True), (0.001, False)):
+        sp = api.load_spec_text(base.format(dt=dt), "lam.toml")
+        rep = api.design(sp)
+        assert rep.exit_code() == 0
+        notes = api.simulate(sp, rep).info.get("warnings", [])
+        hit = [w for w in notes if "the rate λ of the adaptive level" in w]
+        assert bool(hit) is warned, notes
+        if warned:
+            assert "dt·λ ≈ 10 > 2" in hit[0] and "use dt ≤ 0.002" in hit[0]
+        with warnings.catch_warnings(record=True) as caught:  # the study on its own
+            warnings.simplefilter("always")
+            study(sp, rep.parameters, runs=2)
+        said = [str(w.message) for w in caught if "adaptive level" in str(w.message)]
+        assert bool(said) is warned, said

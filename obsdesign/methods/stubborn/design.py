@@ -337,9 +337,18 @@ def design_params(
         if other is not None:
             vals["lambda_bracket"] = np.array([best, other], dtype=object)
         lam_q = _chosen(o, best, pl.discrete)
+        # at a search cap the best λ is only bounded on one side: ≥ in continuous time (the
+        # LMIs held up to the cap, and may for every λ, e.g. C invertible), ≤ in discrete
+        # time, where the best λ is the smallest (the note said ≥: outsider trial, session 22)
+        cap = f"{LAMBDA_CAP:g}" if not pl.discrete else f"1/{LAMBDA_CAP:g}"
         notes.append(
-            f"best λ {'≈' if other is not None else '≥'} {float(best):.6g} (certified there"
-            + (f"; solver: {st} at {float(bad):.6g})" if other is not None else ", search cap)")
+            f"best λ {'≈' if other is not None else ('≤' if pl.discrete else '≥')} "
+            f"{float(best):.6g} (certified there"
+            + (
+                f"; solver: {st} at {float(bad):.6g})"
+                if other is not None
+                else f"; the search stops at its cap λ = {cap}, so there is no bracket)"
+            )
             + f"; λ = {'fraction·λ_max' if not pl.discrete else '1 − fraction·(1 − λ_best)'}"
         )
         if other is not None and abs(other - best) > o.lambda_tol * abs(best):

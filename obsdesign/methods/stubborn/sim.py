@@ -141,18 +141,24 @@ HEUN_LIMIT = 2.0
 
 def check_step(g: Gains, dt: float) -> None:
     """Warn when the continuous-time step ``dt`` is too large for Heun's method on the
-    unsaturated error dynamics ė = (A − KC)e (stubborn-observer slides): dt·max|eig(A − KC)|
-    above :data:`HEUN_LIMIT` makes the simulated error grow although the design is certified
-    (a gain ‖K‖ ≈ 10⁶ at dt = 5·10⁻⁴: random-spec fuzzer). The saturated dynamics are slower,
-    so this is the worst case."""
+    unsaturated error dynamics ė = (A − KC)e or on the adaptive level σ̄' = −λσ̄ + e_yᵀRe_y
+    (stubborn-observer slides): dt·max|eig(A − KC)| or dt·λ above :data:`HEUN_LIMIT` makes
+    the simulation wrong although the design is certified (a gain ‖K‖ ≈ 10⁶ at dt = 5·10⁻⁴:
+    random-spec fuzzer; λ = 262144 at dt = 10⁻³, where the Heun step sent σ̄ to 0 at once and
+    the outlier study's constant levels were 0: outsider trial, session 22). The saturated
+    error dynamics are slower, so these are the worst cases."""
     if g.discrete:
         return
     with np.errstate(all="ignore"):
         try:
             rate = float(np.max(np.abs(np.linalg.eigvals(g.A - g.K @ g.C))))
         except np.linalg.LinAlgError:
-            return
-    heun_warning(dt, rate, "this gain: dt·max|eig(A − KC)|")
+            rate = float("nan")
+    lam = abs(float(g.lam))
+    if np.isfinite(lam) and not (lam <= rate):  # λ dominates (or the eigenvalues failed)
+        heun_warning(dt, lam, "the rate λ of the adaptive level σ̄: dt·λ")
+    else:
+        heun_warning(dt, rate, "this gain: dt·max|eig(A − KC)|")
 
 
 def heun_warning(dt: float, rate: float, what: str) -> None:
@@ -261,6 +267,7 @@ def study(
     sim = spec.simulate
     e0 = np.asarray(sim.x0.f, float) - np.asarray(sim.xhat0.f, float)
     steps, dt = _grid(spec)
+    check_step(g, dt)
     runs = runs or so.runs
     p = g.C.shape[0]
     _, mean_l, max_l = sigma_levels(g, e0, so, steps, dt, sim.seed, budget)
