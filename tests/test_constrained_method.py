@@ -761,3 +761,20 @@ def test_cmin_in_xhat_box_map_uses_the_closed_form() -> None:
     cm = box_map(_mr_v([-1, -1]), _mr_v([1, 3]))
     ok, detail = cmin_in_xhat(cm, fmpq(1, 100), Box(_mr_v([-2, -2]), _mr_v([2, fmpq(16, 5)])))
     assert ok and "outer box" in detail, detail
+
+
+def test_rho_below_the_best_rate_squared_names_the_key() -> None:
+    """λ omitted, ρ given (outsider trial, session 22): A − LC = 0.2, so any ρ needs ρ ≥ 0.04,
+    but ρ = 0.03 ran on to μ of eq. (5) and ended exit 4 ("inconclusive") for a request no P
+    can meet. Now exit 2 naming [method.rho] with λ_best²; ρ = 0.05 ≥ λ_best² designs."""
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.5]]\nC = [[1]]\n[sets.X]\ntype = "box"\n'
+        'lower = [-1]\nupper = [1]\n[method]\nkey = "constrained"\nL = [0.3]\nrho = {rho}\n'
+        'X = "X"\neps_min = 0.01\n[method.c]\ntype = "box"\nlower = [-1.1]\nupper = [1.1]\n'
+        "[method.D]\nlower = [-0.1]\nupper = [0.1]\n"
+    )
+    with pytest.raises(SpecError, match=r"\[method\.rho\] expected rho >= λ_best² = 0\.04") as e:
+        api.design(load_spec_text(text.format(rho="0.03"), "rho.toml"))
+    assert e.value.exit_code == 2 and "spectral radius 0.2" in e.value.message
+    rep = api.design(load_spec_text(text.format(rho="0.05"), "rho.toml"))
+    assert rep.exit_code() == 0

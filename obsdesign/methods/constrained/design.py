@@ -69,6 +69,18 @@ def lyapunov_data(spec: Spec) -> LyapData:
             raise SpecError(spec.file, "method.rate_tol", e.hint()) from None
         lam, P = br.best, br.P
         bracket = (br.other, br.kind)
+        if o.rho is not None and Q(o.rho) < lam * lam:
+            # ρ ≥ λ² is needed (eq. (6)); with λ given this is a spec check, with λ omitted
+            # it is known only now: it ran on to μ of eq. (5) and ended "inconclusive"
+            # (exit 4) for a request no P can meet when ρ ≤ ρ(A − LC)² (outsider trial)
+            raise SpecError(
+                spec.file,
+                "method.rho",
+                f"expected rho >= λ_best² = {float(lam * lam):.6g} (λ omitted: the best "
+                f"certified rate λ_best = {float(lam):.6g}, A − LC has spectral radius "
+                f"{rad:.6g}; β(v, d) = ρv + μ|d|² needs ρ ≥ λ²): give a larger rho, or "
+                "lambda with rho >= lambda²",
+            )
     else:
         lam = o.lam
         P = lyap.certified_P(A, C, o.L, True, lam, o.margin)
