@@ -778,3 +778,31 @@ def test_rho_below_the_best_rate_squared_names_the_key() -> None:
     assert e.value.exit_code == 2 and "spectral radius 0.2" in e.value.message
     rep = api.design(load_spec_text(text.format(rho="0.05"), "rho.toml"))
     assert rep.exit_code() == 0
+
+
+def test_simulate_names_the_largest_certified_gamma_rounded_down() -> None:
+    """An uncertified simulation γ (outsider trial, session 22): the text said "certified γ =
+    10" for the spec's own γ = 10 (gamma_uncertified = true; the bound (24) is γ_max ≈
+    0.0433), and "certified γ = 6980" for γ_max = 348983/50 = 6979.66 (rounded up: not
+    certified). It now names γ_max rounded down; every γ up to the printed value is
+    certified, checked exactly against the report's γ_max."""
+    from obsdesign.certify.exact import Q
+
+    base = (
+        '[system]\ntime = "discrete"\nA = [[0.5]]\nC = [[1]]\n[sets.X]\ntype = "box"\n'
+        'lower = [-1]\nupper = [1]\n[method]\nkey = "constrained"\nL = [0.3]\nX = "X"\n'
+        'eps_min = 0.01\n{extra}[method.c]\ntype = "box"\nlower = [-1.1]\nupper = [1.1]\n'
+        "[method.D]\nlower = [-0.1]\nupper = [0.1]\n[simulate]\nhorizon = 5\nx0 = [1]\n"
+        "xhat0 = [1.2]\ntheta_m = 2\n"
+    )
+    for extra, opts, shown in (
+        ("", {"gamma": "100000"}, "6979"),
+        ("gamma = 7000\ngamma_uncertified = true\n", {}, "6979"),
+    ):
+        spec = load_spec_text(base.format(extra=extra), "g.toml")
+        rep = api.design(spec)
+        g_max = Q(rep.parameters["gamma_max"])
+        assert g_max == fmpq(348983, 50)
+        text = api.simulate(spec, rep, options=opts).info["gamma (simulation)"]
+        assert text.endswith(f"certified γ ≤ {shown})"), text
+        assert Q(shown) <= g_max

@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from obsdesign.certify.exact import Q, to_float
+from obsdesign.certify.printing import fmt_down
 from obsdesign.errors import InputError
 from obsdesign.methods.constrained import bounds as B
 from obsdesign.methods.constrained.design import xhat_set
@@ -142,13 +143,16 @@ def simulate(
     P = _exact(params, "P")
     Pinv = np.asarray(to_float(B.qinv(P)), dtype=float)  # exact inverse of the exact P, then float
     gamma_c = Q(_exact(params, "gamma"))
+    # the largest γ (24) certifies: the report's γ_max — its γ is the user's own, maybe
+    # uncertified (the text printed that γ as "certified γ"; outsider trial, session 22)
+    dsq = Q(_exact(params, "delta_sq"))
+    gamma_top = Q(_exact(params, "gamma_max")) if "gamma_max" in params else B.gamma_bound(P, dsq)
     if gamma is not None:
         gamma_q = Q(_positive(gamma, "gamma"))
     elif so.gamma is not None:
         gamma_q = so.gamma
     else:
         gamma_q = gamma_c
-    dsq = Q(_exact(params, "delta_sq"))
     g_ok, _ = B.gamma_ok(P, gamma_q, dsq)
     eps_min = float(Q(_exact(params, "eps_min")))
     eps_max = float(Q(_exact(params, "eps_max")))
@@ -211,7 +215,9 @@ def simulate(
         + (
             " (certified by (24))"
             if g_ok
-            else f" (UNCERTIFIED: above the bound (24), certified γ = {float(gamma_c):.4g})"
+            # rounded down: every γ up to the printed value is certified (README: printed
+            # numbers keep their statement true; :.4g printed 6980 for γ_max = 6979.66)
+            else f" (UNCERTIFIED: above the bound (24), certified γ ≤ {fmt_down(gamma_top, 4)})"
         ),
     }
     for name, tr in traces.items():
