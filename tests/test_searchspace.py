@@ -325,7 +325,11 @@ def test_bad_inputs(tmp_path):
 
     p = tmp_path / "s.toml"
     p.write_text(TEXT.replace('f = ["u1*x2", "-u1*x1"]', 'f = ["u1*x2 + t", "-u1*x1"]'))
-    with pytest.raises(SpecError, match="time enters through u"):
+    # the key is where the term is (it named [method.key]: outsider trial, session 22)
+    with pytest.raises(SpecError, match=r"\[system\.f\] f\[0\] uses t: .*time enters through u"):
+        api.load_spec(p)
+    p.write_text(TEXT.replace('h = ["x1*step(x1)"]', 'h = ["x1*step(x1) + t"]'))
+    with pytest.raises(SpecError, match=r"\[system\.h\] h\[0\] uses t"):
         api.load_spec(p)
     p.write_text(TEXT.replace("gamma_star = 0.05 ", "eps_star = 0.05\ngamma_star = 0.05 "))
     with pytest.raises(SpecError, match="exactly one of gamma_star and eps_star"):

@@ -228,3 +228,17 @@ def test_the_run_time_value_lies_in_every_certified_enclosure(text: str, x: int,
     if q is not None:  # exact ends; the float run is within rounding of the exact value
         tol = Fraction(1, 10**12) * max(1, abs(Fraction(run)))
         assert q.lo - tol <= Fraction(run) <= q.hi + tol, (text, x, r, q)
+
+
+def test_a_variable_named_like_a_constant_is_the_variable_in_every_evaluator() -> None:
+    """A state named e (or pi) shadows the constant in the numeric closure and the interval
+    enclosures, but the sympy form (exact derivatives, exact comparisons) read it as Euler's
+    number, so ∂(e²)/∂e was 0 there (found reviewing reserved state names, session 22)."""
+    import sympy as sp
+
+    e = parse_expr("e^2 + pi", ["e", "pi"])
+    assert float(e(e=3.0, pi=1.0)) == 10.0
+    assert e.sympy() == sp.Symbol("e") ** 2 + sp.Symbol("pi")
+    assert float(e.derivative("e")(e=3.0, pi=1.0)) == 6.0
+    c = parse_expr("e^2 + pi", ["x1"])  # not variables: the constants
+    assert c.sympy() == sp.E**2 + sp.pi

@@ -263,3 +263,29 @@ def test_parse_memo_gives_fresh_copies_and_keys_on_the_limits(monkeypatch) -> No
         assert len(calls) == 4
     finally:
         reset_limits(old)
+
+
+@pytest.mark.parametrize(
+    ("states", "what"),
+    [
+        ('["e", "t"]', "the time t"),
+        ('["sin", "x2"]', "a function"),
+        ('["x1", "u1"]', "an input"),
+        ('["v1", "x2"]', "an input, disturbance or noise"),
+    ],
+)
+def test_reserved_state_names_are_refused(states: str, what: str) -> None:
+    """A state named t was accepted, and its uses in f were then refused as "uses t" under
+    [method.key] (outsider trial, session 22): t, a function name and this plant's signal
+    names (u1 with one input, v1 the noise of the one output) mean something else in an
+    expression. Exit 2 naming [system.states]; 'e' (also a constant, which a state shadows
+    in every evaluator) is not refused."""
+    text = (
+        f'[system]\ntime = "discrete"\nstates = {states}\nA = [[0.5, 0], [0, 0.5]]\n'
+        'B = [[1], [0]]\nC = [[1, 0]]\n[method]\nkey = "lyapunov"\n'
+    )
+    with pytest.raises(SpecError, match=r"\[system\.states\] the state name .* is reserved") as e:
+        load_spec_text(text, "names.toml")
+    assert e.value.exit_code == 2 and what in e.value.message
+    ok = text.replace(f"states = {states}", 'states = ["e", "w"]')
+    assert load_spec_text(ok, "names.toml").system.states == ["e", "w"]

@@ -427,6 +427,8 @@ def _to_sympy(node: ast.AST, ex: Expr) -> Any:
 
             q = Q(ex.parameters[node.id])
             return sp.Rational(int(q.p), int(q.q))
+        if node.id in ex.variables:  # a state named e or pi shadows the constant, as in the
+            return sp.Symbol(node.id)  # numeric closures and the interval enclosures
         if node.id == "pi":
             return sp.pi
         if node.id == "e":

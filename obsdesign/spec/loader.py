@@ -164,6 +164,30 @@ def _old_spelling(root: Table, mt: Table) -> None:
 
 
 # -- [system] -----------------------------------------------------------------------------
+def _state_names(t: Table, sys: System) -> None:
+    """Refuse a state name that an expression would read as something else: ``t`` (a state
+    named t was accepted, then its uses in f reported as "uses t" under [method.key]:
+    outsider trial, session 22), a function (``sin``), or the name of one of this plant's
+    inputs, disturbances or noises (``u1``, ``d2``, ``v1``: the state and the signal would
+    share one name; ``v1`` is a free state name when the plant has no noise input)."""
+    from obsdesign.spec.expr import FUNCTIONS
+
+    signals = {*sys.inputs, *sys.disturbances, *sys.noises}
+    for s in sys.states:
+        if s == "t" or s in FUNCTIONS or s in signals:
+            what = (
+                "the time t"
+                if s == "t"
+                else ("a function" if s in FUNCTIONS else "an input, disturbance or noise")
+            )
+            raise t.error(
+                "states",
+                f"the state name {s!r} is reserved: expressions read it as {what} (reserved: "
+                "t, the function names, and this plant's inputs u1…, disturbances d1…, "
+                "noises v1…)",
+            )
+
+
 def _system(t: Table) -> System:
     time = t.str("time", choices=("discrete", "continuous"))
     _check_dimension(t)
@@ -223,6 +247,7 @@ def _system(t: Table) -> System:
                 raise pt.error(k, "expected an identifier as parameter name")
             params[k] = pt.scalar(k)
     sys = System(time, A, B, C, D, Bd, Dn, sample_time, list(states), n, p, params)
+    _state_names(t, sys)
     if has_f and t.has("psi"):
         raise t.error(
             "psi", "give the plant as f (whole right-hand side) or as A x + psi, not both"

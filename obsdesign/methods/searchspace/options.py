@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 from flint import fmpq
 
+from obsdesign.errors import SpecError
 from obsdesign.sets import Box
 from obsdesign.simulate.budget import DEFAULT_LIMIT, TIME_LIMIT_SCHEMA, parse_time_limit
 from obsdesign.spec.models import Spec
@@ -109,15 +110,19 @@ def parse_options(table: Table, spec: Spec) -> Options:
     for i, ex in enumerate(s.f):
         for v in (*s.disturbances, "t"):
             if ex.uses(v):
-                raise table.error(
-                    "key",
-                    f"[system] f[{i}] uses {v}: the search-space method takes ẋ = f(x, u) (time enters through u(t))",
+                # the key is [system.f], where the term is (it named [method.key]: outsider
+                # trial, session 22)
+                raise SpecError(
+                    spec.file,
+                    "system.f",
+                    f"f[{i}] uses {v}: the search-space method takes ẋ = f(x, u) (time enters "
+                    "through u(t))",
                 )
     for i, ex in enumerate(s.h):
         for v in (*s.inputs, *s.noises, "t"):
             if ex.uses(v):
-                raise table.error(
-                    "key", f"[system] h[{i}] uses {v}: the paper's output is y = h(x)"
+                raise SpecError(
+                    spec.file, "system.h", f"h[{i}] uses {v}: the paper's output is y = h(x)"
                 )
     if s.m > 0 and s.u_signal is None:
         raise table.error(
