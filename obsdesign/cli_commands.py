@@ -635,6 +635,10 @@ def simulate(
         check_output(csv, force, _inputs(spec, report))
     sp = _load_spec(spec)
     opts = _kv(option or [])
+    if runs is not None or study is not None:
+        from obsdesign.methods import get_method
+
+        _flags_known(get_method(sp.method), runs, study)
     if runs is not None:
         if "runs" in opts and opts["runs"].strip().lstrip("+").lstrip("0") != str(runs):
             from obsdesign.errors import InputError
@@ -683,6 +687,23 @@ def simulate(
         if fmt == Fmt.text:
             _say(f"trajectories written to {csv}")
     return int(res.info.get("exit_code", 0))
+
+
+def _flags_known(method: Any, runs: int | None, study: str | None) -> None:
+    """``--runs`` / ``--study`` on a method without that simulation option: an error naming
+    the flag the user typed (it said "--option runs: not an option", a flag they had not
+    typed; outsider trial, session 22) and the methods that have it."""
+    from obsdesign.errors import InputError
+    from obsdesign.methods import get_method, method_keys
+
+    known = {o.name for o in method.sim_options}
+    for flag, name, val in (("--runs", "runs", runs), ("--study", "study", study)):
+        if val is not None and name not in known:
+            have = [k for k in method_keys() if name in {o.name for o in get_method(k).sim_options}]
+            raise InputError(
+                f"{flag} {val}: method '{method.key}' has no {name} option (simulate makes "
+                f"one run; {flag} is for {', '.join(have)})"
+            )
 
 
 def schema() -> int:

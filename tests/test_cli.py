@@ -321,3 +321,18 @@ def test_simulate_text_prints_warnings_one_per_line(tmp_path: Path) -> None:
     r = CliRunner().invoke(app, ["simulate", str(spec), "--format", "md"])
     assert r.exit_code == 0 and "warnings: [" not in r.output
     assert "- warning: [simulate] dt = 0.3 does not divide horizon = 1.0" in r.output
+
+
+@pytest.mark.parametrize(
+    ("flag", "value", "have"),
+    [("--runs", "2", "impulsive, lyapunov, stubborn"), ("--study", "outliers", "stubborn")],
+)
+def test_a_flag_the_method_lacks_is_named_as_typed(flag: str, value: str, have: str) -> None:
+    """``simulate --runs 2`` on a constrained spec said "--option runs: not an option of
+    method 'constrained'", a flag the user had not typed (outsider trial, session 22): the
+    error names the flag and the methods that take it (exit 2)."""
+    spec = SPEC.parent / "constrained-redesign-sec5.toml"
+    r = CliRunner().invoke(app, ["simulate", str(spec), flag, value])
+    assert r.exit_code == 2, r.output
+    assert f"{flag} {value}: method 'constrained' has no" in r.output
+    assert f"{flag} is for {have})" in r.output and "--option" not in r.output
