@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+import os
 import signal
 import threading
 import time
@@ -180,7 +181,7 @@ def design(
     ``"verdict": "error"`` and the error, which ``verify`` reports as such. Bad input (exit 2)
     writes nothing and leaves ``out`` untouched."""
     if out is not None:
-        check_output(out, force, inputs=(Path(spec),) if isinstance(spec, (str, Path)) else ())
+        check_output(out, force, inputs=_spec_inputs(spec))
     t0 = time.perf_counter()
     sp = _spec(spec)
     t1 = time.perf_counter()
@@ -214,6 +215,16 @@ def design(
             text = report.to_json()
         write_atomic(out, text, force)
     return report
+
+
+def _spec_inputs(spec: str | Path | Spec) -> tuple[Path, ...]:
+    """The spec's own file, which an output must never replace: the path given, or the file
+    a loaded :class:`Spec` was read from when it is one (``design(load_spec("s.toml"),
+    out="s.toml")`` replaced the spec with the report: outsider trial, session 22)."""
+    if isinstance(spec, (str, Path)):
+        return (Path(spec),)
+    f = getattr(spec, "file", None)
+    return (Path(f),) if isinstance(f, str) and f != "-" and os.path.isfile(f) else ()
 
 
 @contextmanager

@@ -354,3 +354,22 @@ def test_lone_surrogate_escapes_and_a_closed_stdin_are_bad_input(spec: Path, tmp
     )  # fmt: skip
     assert r.returncode == 2 and "standard input is closed" in r.stderr, r.stderr
     assert len(r.stderr.strip().splitlines()) == 1
+
+
+def test_the_api_never_writes_a_report_over_a_loaded_specs_file(tmp_path: Path) -> None:
+    """``design(load_spec("s.toml"), out="s.toml")`` replaced the spec with the report
+    (outsider trial, session 22): only a spec given as a path was protected. A loaded spec's
+    own file is now an input too (exit 2, the spec untouched); a spec from text whose name is
+    no file still writes to that name."""
+    from obsdesign import api
+    from obsdesign.errors import InputError
+
+    src = Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+    spec = tmp_path / "s.toml"
+    spec.write_bytes(src.read_bytes())
+    with pytest.raises(InputError, match="is the input file itself") as e:
+        api.design(api.load_spec(spec), out=spec)
+    assert e.value.exit_code == 2 and spec.read_bytes() == src.read_bytes()
+    out = tmp_path / "virtual.toml"
+    api.design(api.load_spec_text(src.read_text(encoding="utf-8"), str(out)), out=out)
+    assert out.read_text(encoding="utf-8").lstrip().startswith("{")
