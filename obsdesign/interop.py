@@ -140,10 +140,12 @@ def spec_text_from_statespace(
     system: dict[str, Any] = {"time": time, "A": A, "C": C}
     if B.size and np.any(B != 0):
         system["B"] = B
-        if D.size and np.any(D != 0):
-            system["D"] = D
     elif B.shape[1]:
         system["inputs"] = B.shape[1]
+    if D.size and np.any(D != 0):
+        # also with B = 0: the feedthrough still enters y, so the observer's u-column is −L D
+        # (a nonzero D was dropped with a zero B: outsider trial, session 22)
+        system["D"] = D
     if Bd is not None:
         system["Bd"] = np.asarray(Bd, dtype=float).reshape(A.shape[0], -1)
     if sample_time is not None:

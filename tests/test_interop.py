@@ -204,3 +204,17 @@ def test_stubborn_luenberger_part():
     np.testing.assert_allclose(obs.A, A - K @ np.array([[1.0, 1.0]]), rtol=0, atol=1e-15)
     np.testing.assert_allclose(obs.B[:, 1:], K, rtol=0, atol=0)
     assert max(abs(np.linalg.eigvals(obs.A))) < 1  # the Luenberger part alone is stable
+
+
+def test_a_feedthrough_with_a_zero_B_is_kept() -> None:
+    """(A, B, C, D) = (0.5, 0, 1, 2) (outsider trial, session 22): the spec had `inputs = 1`
+    and no D, so the designed observer's u-column was 0 instead of −L D. D is written
+    whenever it is not all zero, and the observer's u-column is −L D."""
+    from obsdesign import interop
+
+    plant = (np.array([[0.5]]), np.array([[0.0]]), np.array([[1.0]]), np.array([[2.0]]), 0.1)
+    text = interop.spec_text_from_statespace(plant, "lyapunov")
+    assert "inputs = 1" in text and "D = [[2" in text
+    rep = api.design(interop.spec_from_statespace(plant, "lyapunov"))
+    L = rep.parameters.float("L").reshape(1, 1)
+    np.testing.assert_allclose(rep.observer_statespace().B[:, 0], -2.0 * L[:, 0])
