@@ -57,9 +57,27 @@ def _num(x: Any) -> str:
     return repr(f)
 
 
+def _tstr(v: str) -> str:
+    """A TOML basic string of ``v``: backslash, quote and every control character escaped
+    (a file name with ESC or CR in it gave a title TOML refuses: outsider trial, session
+    22); a lone surrogate, which no UTF-8 text holds, becomes U+FFFD."""
+    out = []
+    for ch in v:
+        o = ord(ch)
+        if ch in '"\\':
+            out.append("\\" + ch)
+        elif o < 0x20 or o == 0x7F:
+            out.append({"\n": "\\n", "\t": "\\t", "\r": "\\r"}.get(ch, f"\\u{o:04X}"))
+        elif 0xD800 <= o <= 0xDFFF:  # a lone surrogate (a file name's undecodable byte)
+            out.append("\\uFFFD")
+        else:
+            out.append(ch)
+    return '"' + "".join(out) + '"'
+
+
 def _value(v: Any) -> str:
     if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
+        return _tstr(v)
     if isinstance(v, (bool, np.bool_, int, float, np.integer, np.floating)):
         return _num(v)
     arr = np.asarray(v)

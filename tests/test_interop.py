@@ -10,6 +10,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 import obsdesign
@@ -218,3 +220,20 @@ def test_a_feedthrough_with_a_zero_B_is_kept() -> None:
     rep = api.design(interop.spec_from_statespace(plant, "lyapunov"))
     L = rep.parameters.float("L").reshape(1, 1)
     np.testing.assert_allclose(rep.observer_statespace().B[:, 0], -2.0 * L[:, 0])
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.text())
+def test_a_title_is_always_valid_toml(title: str) -> None:
+    """Any title (a .mat file's name with ESC or CR in it wrote a raw control character, and
+    the spec `import` printed was not TOML: outsider trial, session 22) reads back as itself,
+    a lone surrogate as U+FFFD."""
+    from obsdesign import interop
+
+    plant = (np.array([[0.5]]), np.zeros((1, 0)), np.array([[1.0]]), np.zeros((1, 0)), 0.1)
+    text = interop.spec_text_from_statespace(plant, "lyapunov", title=title)
+    want = "".join("\ufffd" if 0xD800 <= ord(c) <= 0xDFFF else c for c in title)
+    if title:
+        assert tomllib.loads(text)["title"] == want
+    else:
+        assert "title" not in tomllib.loads(text)
