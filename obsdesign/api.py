@@ -839,9 +839,13 @@ class CheckRow:
     claims: list[dict[str, Any]] = field(default_factory=list)
 
 
-def spec_files(paths: list[str | Path]) -> list[Path]:
+def spec_files(paths: list[str | Path] | str | Path) -> list[Path]:
     """Expand the folders among ``paths`` to their ``*.toml`` files, subfolders included (sorted; hidden
-    folders skipped); keep files as given."""
+    folders skipped); keep files as given. One path (a string or a Path) is one path:
+    ``check("specs/")`` iterated the string's characters, and its "/" searched the whole
+    file system (outsider trial, session 22)."""
+    if isinstance(paths, (str, Path)):
+        paths = [paths]
     out: list[Path] = []
     for p in map(Path, paths):
         if p.is_dir():
@@ -944,7 +948,7 @@ def _check_one(path: Path, t0: float) -> CheckRow:
 
 
 def check(
-    paths: list[str | Path],
+    paths: list[str | Path] | str | Path,
     on_start: Any = None,
     *,
     workers: int | None = None,
@@ -961,6 +965,8 @@ def check(
     the same files) or ``client`` (a ``dask.distributed.Client``) run the specs on Dask
     (:mod:`obsdesign.distributed`): the rows are the serial run's (but ``seconds``).
     ``on_row(row)`` is called as each row arrives."""
+    if isinstance(paths, (str, Path)):
+        paths = [paths]
     files = spec_files(paths)
     if not files:
         raise InputError(f"no spec files (*.toml) in {', '.join(map(str, paths))}")

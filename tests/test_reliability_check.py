@@ -124,3 +124,13 @@ def test_warnings_become_notes(monkeypatch):
         rep = api.design(SPEC)
     assert any("divide by zero" in n for n in rep.notes)
     assert any("ill-conditioned matrix" in n for n in rep.notes)
+
+
+def test_check_takes_one_path_as_a_string_or_a_path(tmp_path: Path) -> None:
+    """``obsdesign.check("specs/")`` iterated the string's characters, and its "/" searched the
+    whole file system (outsider trial, session 22). One str or Path is one path."""
+    shutil.copy(SPEC, tmp_path / "x.toml")
+    for one in (str(tmp_path), tmp_path, str(tmp_path / "x.toml")):
+        rows = api.check(one)
+        assert [Path(r.spec).name for r in rows] == ["x.toml"] and rows[0].code == 0
+    assert api.spec_files(str(tmp_path)) == [tmp_path / "x.toml"]
