@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+import numbers
 import os
 import signal
 import threading
@@ -611,6 +612,10 @@ def simulate(
     """
     sp = _spec(spec)
     kwargs = {**get_method(sp.method).parse_sim_options(options or {}), **kwargs}
+    r = kwargs.get("runs")
+    if r is not None and (isinstance(r, bool) or not isinstance(r, numbers.Integral) or r < 1):
+        # runs=0 ran once (``runs or 1``) while the CLI refuses --runs 0 (outsider trial)
+        raise InputError(f"runs: expected a whole number of runs, at least 1, got {r!r}")
     if sp.simulate is None:
         raise InputError(f"{sp.file}: [simulate] is missing: nothing to simulate")
     check_sim_memory(sp, kwargs)

@@ -403,3 +403,16 @@ def test_a_thin_set_that_a_run_cannot_draw_from_is_named(monkeypatch) -> None:
     monkeypatch.setattr(base, "MAX_SAMPLE_ROUNDS", 1)
     with pytest.raises(InputError, match=r"^thin\.toml: \[simulate\.initial_error\] set 'T': "):
         api.simulate(sp)
+
+
+@pytest.mark.parametrize("runs", [0, -3, 2.0, True])
+def test_the_api_refuses_a_run_count_below_one_or_not_whole(runs: object) -> None:
+    """``simulate(spec, runs=0)`` ran once (``runs or 1``) while the CLI refuses ``--runs 0``
+    (outsider trial, session 22): a run count is a whole number ≥ 1 (numpy integers too)."""
+    from obsdesign import api
+    from obsdesign.errors import InputError
+
+    spec = Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+    with pytest.raises(InputError, match="at least 1"):
+        api.simulate(spec, runs=runs)
+    assert api.simulate(spec, runs=np.int64(2)).metrics()["runs"] == 2
