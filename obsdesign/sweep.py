@@ -178,14 +178,29 @@ def _split_list(key: str, spec: str) -> list[str]:
     return items
 
 
+#: a run of digits in a value's text (:func:`_literal` bounds each by ``max_digits``)
+_DIGIT_RUN = re.compile(r"[0-9][0-9_]*")
+
+
 def _literal(key: str, text: str) -> str:
     """``text`` as a TOML value literal: as written when it is one, else a quoted string
-    (a bare word). A number is written as given (its decimal text is the exact value)."""
+    (a bare word). A number is written as given (its decimal text is the exact value). A
+    number of more than ``max_digits`` digits is refused here, naming the key (a 5000-digit
+    value was an internal failure: Python's int-to-text limit; outsider trial, session 22)."""
+    from obsdesign.limits import limits
+
+    cap = limits().max_digits
+    if not text.lstrip().startswith(("'", '"')) and any(
+        len(m.group(0).replace("_", "")) > cap for m in _DIGIT_RUN.finditer(text)
+    ):
+        raise InputError(f"--set {key}: a number of more than {cap} digits (--limit max_digits=N)")
     try:
         tomllib.loads(f"x = {text}")
         return text
     except tomllib.TOMLDecodeError:
         pass
+    except ValueError as e:  # e.g. an integer past Python's conversion limit
+        raise InputError(f"--set {key}: not a usable TOML value ({e})") from None
     if re.match(r"^[A-Za-z_][A-Za-z0-9_.+-]*$", text):
         return json.dumps(text)
     raise InputError(f"--set {key}: {text!r} is not a TOML value")
@@ -226,6 +241,12 @@ def _py_literal(x: Any) -> str:
     if isinstance(x, (int, float, Decimal, Fraction)):
         if isinstance(x, float) and not math.isfinite(x):
             raise InputError(f"sweep: {x!r} is not a finite number")
+        if isinstance(x, int):
+            from obsdesign.limits import int_problem
+
+            why = int_problem(x)  # str() of a 5000-digit int is a ValueError (outsider trial)
+            if why is not None:
+                raise InputError(f"sweep: an integer value {why}")
         if isinstance(x, Fraction):
             x = Decimal(x.numerator) / Decimal(x.denominator)
         return repr(x) if isinstance(x, float) else str(x)
@@ -364,11 +385,24 @@ def _check_edit_parsed(old: str, new: str, parts: list[str], literal: str, file:
             raise InputError(f"{file}: cannot set {key}: {p} is not a table")
         d = nxt
     d[parts[-1]] = want
-    if before != after:
+    if not _same_toml(before, after):
         raise InputError(
             f"{file}: cannot set {key} in the spec text (an inline table or an array of "
             f"tables holds it: write it as a [table] key)"
         )
+
+
+def _same_toml(a: Any, b: Any) -> bool:
+    """Equality of parsed TOML with nan equal to nan (``--set method.lambda=nan`` was refused
+    as "an inline table holds it", since nan != nan; outsider trial, session 22: the spec
+    loader now refuses the nan, as any non-finite number, in that point's row)."""
+    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
+        return True
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(_same_toml(a[k], b[k]) for k in a)
+    if isinstance(a, list) and isinstance(b, list):
+        return len(a) == len(b) and all(_same_toml(x, y) for x, y in zip(a, b, strict=True))
+    return type(a) is type(b) and a == b
 
 
 def point_text(text: str, values: dict[str, str], file: str = "<spec>") -> str:

@@ -286,3 +286,27 @@ def test_a_spec_too_deep_to_edit_is_bad_input(tmp_path: Path):
     r = runner.invoke(app, ["sweep", str(spec), "--set", "method.lambda=0.96"])
     assert r.exit_code == 2, r.output
     assert "nested too deeply" in r.stderr and str(spec) in r.stderr
+
+
+def test_a_value_of_too_many_digits_is_bad_input_naming_the_key() -> None:
+    """A 5000-digit ``--set`` value (CLI) or integer (API) was an internal failure: Python's
+    int-to-text limit raised a plain ValueError (exit 3; outsider trial, session 22). Both
+    are InputError (exit 2) naming the key or the limit; 1000 digits still parse."""
+    with pytest.raises(InputError, match=r"--set method\.lambda: a number of more than 1000"):
+        sw.parse_axis("method.lambda=" + "7" * 5000)
+    with pytest.raises(InputError, match=r"--set method\.lambda: a number of more than 1000"):
+        sw.parse_axis("method.lambda=[0.5, 0." + "7" * 1001 + "]")
+    with pytest.raises(InputError, match="about 5000 digits, above the limit of 1000"):
+        sw.parse_grid({"method.lambda": [10**5000]})
+    assert sw.parse_axis("method.lambda=0." + "9" * 999).values == ("0." + "9" * 999,)
+
+
+def test_a_nan_value_is_set_and_refused_by_the_spec_loader_in_its_row() -> None:
+    """``--set method.lambda=nan`` said "an inline table or an array of tables holds it" for a
+    plain key (the edit check compared nan != nan; outsider trial, session 22). The nan is
+    set, and its point is a bad-input row, as inf is."""
+    text = SPEC.read_text(encoding="utf-8")
+    assert "lambda = nan" in sw.point_text(text, {"method.lambda": "nan"}, "s.toml")
+    rows = sw.sweep_rows(SPEC, ["method.lambda=[nan, 0.98]"])
+    assert [r["exit_code"] for r in rows] == [2, 0]
+    assert "inline table" not in rows[0]["message"]
