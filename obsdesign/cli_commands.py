@@ -399,8 +399,10 @@ def _quantile_rows(q: Any) -> tuple[list[str], list[list[str]]]:
 
 
 def _md_cell(v: Any) -> str:
-    """A Markdown table cell: pipes escaped, one line."""
-    return str(v).replace("|", "\\|").replace("\n", " ")
+    """A Markdown table cell: pipes escaped, one line (:func:`obsdesign.report.render.md_cell`)."""
+    from obsdesign.report.render import md_cell
+
+    return md_cell(v)
 
 
 def _print_metrics(m: dict[str, Any]) -> None:

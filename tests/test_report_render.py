@@ -67,3 +67,25 @@ def test_dependency_versions_match_importlib_metadata() -> None:
     info = model.tool_info()
     assert info["version"] == metadata.version("obsdesign")
     assert set(info["dependencies"]) == set(model.DEPS)
+
+
+def test_markdown_rows_keep_their_columns_whatever_the_text() -> None:
+    """The lyapunov/constrained statement V(e⁺) ≤ λ²V(e) + μ|w|² split its claims row at the
+    pipes in ``design --format md`` (outsider trial, session 22; the other commands' tables
+    escaped them). Every row of both tables has as many unescaped pipes as its header, and a
+    note with a newline stays one list item."""
+    import re
+
+    from obsdesign import api
+    from obsdesign.report.render import render_markdown
+
+    spec = Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+    rep = api.design(spec)
+    assert any("|" in c.statement for c in rep.claims)
+    rep.claims[0].detail = "a | b\nc"
+    rep.notes.append("first | line\nsecond line")
+    text = render_markdown(rep)
+    rows = [ln for ln in text.splitlines() if ln.startswith("|")]
+    pipes = [len(re.findall(r"(?<!\\)\|", ln)) for ln in rows]
+    assert set(pipes) == {4, 7}, pipes  # 3 and 6 columns
+    assert "- first \\| line second line" in text.splitlines()

@@ -164,18 +164,25 @@ def render_text(report: Report, title: str = "") -> None:
     )
 
 
+def md_cell(v: Any) -> str:
+    """A Markdown table cell (or list item): pipes escaped, one line."""
+    return str(v).replace("|", "\\|").replace("\r", " ").replace("\n", " ")
+
+
 def render_markdown(report: Report) -> str:
-    """The report as Markdown."""
+    """The report as Markdown. Every cell goes through :func:`md_cell`: the statement
+    V(e⁺) ≤ λ²V(e) + μ|w|² split its row at the pipes (outsider trial, session 22)."""
+    c_ = md_cell
     lines = [
-        f"# obsdesign report: {report.method}",
+        f"# obsdesign report: {c_(report.method)}",
         "",
-        f"- spec: `{report.spec_file}`",
-        f"- spec sha256: `{report.spec_sha256}`",
-        f"- tool: {report.tool.get('version', '')}",
+        f"- spec: `{c_(report.spec_file)}`",
+        f"- spec sha256: `{c_(report.spec_sha256)}`",
+        f"- tool: {c_(report.tool.get('version', ''))}",
         "",
     ]
     lines += ["## Parameters", "", "| symbol | value | form |", "| --- | --- | --- |"]
-    lines += [f"| {k} | `{v}` | {f} |" for k, v, f in _param_rows(report)]
+    lines += [f"| {c_(k)} | `{c_(v)}` | {c_(f)} |" for k, v, f in _param_rows(report)]
     lines += [
         "",
         "## Claims",
@@ -184,9 +191,8 @@ def render_markdown(report: Report) -> str:
         "| --- | --- | --- | --- | --- | --- |",
     ]
     for c in report.claims:
-        lines.append(
-            f"| {c.id} | **{c.status.value}** | {c.statement} | {c.reference} | {c.check} | {c.detail} |"
-        )
+        cells = [c.id, f"**{c.status.value}**", c.statement, c.reference, c.check, c.detail]
+        lines.append("| " + " | ".join(c_(x) for x in cells) + " |")
     if report.notes:
-        lines += ["", "## Notes", ""] + [f"- {n}" for n in report.notes]
+        lines += ["", "## Notes", ""] + [f"- {c_(n)}" for n in report.notes]
     return "\n".join(lines) + "\n"
