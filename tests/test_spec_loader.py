@@ -289,3 +289,16 @@ def test_reserved_state_names_are_refused(states: str, what: str) -> None:
     assert e.value.exit_code == 2 and what in e.value.message
     ok = text.replace(f"states = {states}", 'states = ["e", "w"]')
     assert load_spec_text(ok, "names.toml").system.states == ["e", "w"]
+
+
+def test_a_byte_order_mark_is_named(tmp_path: Path) -> None:
+    """A spec saved as "UTF-8 with BOM" got "is not valid TOML (Invalid statement (at line 1,
+    column 1))" (outsider trial, session 22): the BOM is named, exit 2."""
+    from obsdesign.api import load_spec
+
+    src = Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+    p = tmp_path / "bom.toml"
+    p.write_bytes(b"\xef\xbb\xbf" + src.read_bytes())
+    with pytest.raises(SpecError, match="byte-order mark") as e:
+        load_spec(p)
+    assert e.value.exit_code == 2 and str(p) in e.value.message

@@ -50,6 +50,13 @@ def read_spec_text(text: str, file: str = "<spec>") -> Spec:
 
     Returns a :class:`Spec` whose ``method_table`` (and ``simulate.table``) are raw: the API
     binds the method, which reads its own keys."""
+    if text.startswith("\ufeff"):  # tomllib said "Invalid statement (line 1, column 1)"
+        raise SpecError(
+            file,
+            "",
+            "starts with a byte-order mark (U+FEFF, 'UTF-8 with BOM'): TOML is UTF-8 without "
+            "one; save the file as plain UTF-8",
+        )
     data = _parse_toml(text, file)
     sha = hashlib.sha256(text.encode("utf-8")).hexdigest()
     root = Table(data, file, checked=True)  # _parse_toml walked every number
