@@ -498,6 +498,14 @@ def check(
     """The body of ``obsdesign check`` (see :func:`obsdesign.cli.check`)."""
     from obsdesign import api, interrupt
 
+    if any(str(p) == "-" for p in paths):
+        from obsdesign.errors import InputError
+
+        # it gave a row "-: no such spec file" (outsider trial, session 22)
+        raise InputError(
+            "-: check takes spec files and folders, not stdin (design -, verify -, simulate - "
+            "and sweep - read a spec from stdin)"
+        )
     if junit is not None:
         from obsdesign.report.model import check_output
 

@@ -336,3 +336,11 @@ def test_a_flag_the_method_lacks_is_named_as_typed(flag: str, value: str, have: 
     assert r.exit_code == 2, r.output
     assert f"{flag} {value}: method 'constrained' has no" in r.output
     assert f"{flag} is for {have})" in r.output and "--option" not in r.output
+
+
+def test_check_refuses_stdin_plainly() -> None:
+    """``cat s.toml | obsdesign check -`` gave a row "-: no such spec file" (outsider trial,
+    session 22): check takes files and folders; '-' is exit 2 saying which commands read
+    stdin."""
+    r = CliRunner().invoke(app, ["check", "-"], input=SPEC.read_text(encoding="utf-8"))
+    assert r.exit_code == 2 and "check takes spec files and folders, not stdin" in r.output
