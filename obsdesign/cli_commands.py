@@ -573,8 +573,11 @@ def sweep(
         src = types.SimpleNamespace(text=_read_stdin("spec"), file=STDIN_NAME)
     axes = sw.parse_grid(sets)
     _, tasks = sw.plan(src, sets, simulate, _kv(option or []))
+    cols = None
     if plot is not None:
         cols = sw.expected_columns(tasks[0].text, axes, simulate)
+        if y in sw.TEXT_COLUMNS:
+            raise InputError(f"--y {y}: a column of text; --y takes a column of numbers")
         if x is not None and x not in [a.key for a in axes]:
             raise InputError(f"--x {x}: not a swept key")
         if cols is not None and y not in cols:
@@ -592,7 +595,7 @@ def sweep(
     if output is not None:
         sw.write_table(output, rows, force)
     if plot is not None:
-        sw.check_plot_column(rows, axes, y or "", x)
+        sw.check_plot_column(rows, axes, y or "", x, cols)
         _write_plot(plot, lambda tmp: sw.plot_sweep(rows, axes, y or "", tmp, x), force)
     if fmt == Fmt.json:
         print(_dumps(rows, indent=2, ensure_ascii=False, default=_jsonable))

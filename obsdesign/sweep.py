@@ -790,14 +790,26 @@ def expected_columns(text: str, axes: list[Axis], simulate: bool) -> set[str] | 
     return fixed | {a.key for a in axes} | {f.param for f in m.summary_fields}
 
 
-def check_plot_column(rows: list[dict[str, Any]], axes: list[Axis], y: str, x: str | None) -> None:
+#: columns of text, which ``--y`` cannot plot (an empty plot and exit 0: outsider trial)
+TEXT_COLUMNS = frozenset({"verdict", "message", "method"})
+
+
+def check_plot_column(
+    rows: list[dict[str, Any]],
+    axes: list[Axis],
+    y: str,
+    x: str | None,
+    expected: set[str] | None = None,
+) -> None:
     """--y must be a column of the table and --x a swept key (after the run: columns
-    depend on the method)."""
+    depend on the method). A column in ``expected`` (known before the run) is one even when
+    no point was ok: the plot is then all gaps (it was exit 2 "not a column" after the whole
+    sweep had run: outsider trial, session 22)."""
     keys = [a.key for a in axes]
     if x is not None and x not in keys:
         raise InputError(f"--x {x}: not a swept key (swept: {', '.join(keys)})")
     cols = columns(rows)
-    if y not in cols:
+    if y not in cols and not (expected is not None and y in expected):
         raise InputError(f"--y {y}: not a column of the table (columns: {', '.join(cols)})")
 
 

@@ -310,3 +310,18 @@ def test_a_nan_value_is_set_and_refused_by_the_spec_loader_in_its_row() -> None:
     rows = sw.sweep_rows(SPEC, ["method.lambda=[nan, 0.98]"])
     assert [r["exit_code"] for r in rows] == [2, 0]
     assert "inline table" not in rows[0]["message"]
+
+
+def test_a_plot_of_a_sweep_with_no_ok_point_is_all_gaps(tmp_path: Path) -> None:
+    """Every point infeasible with ``--plot --y mu`` (outsider trial, session 22): the whole
+    sweep ran, then "--y mu: not a column" and exit 2. A column known before the run is a
+    column: the plot is written (all gaps) and the exit code is the worst row's (1). A text
+    column (--y message) is refused before any work."""
+    plot = tmp_path / "p.png"
+    args = ["sweep", str(SPEC), "--set", "method.lambda=0.90:0.93:2", "--plot", str(plot)]
+    r = CliRunner().invoke(app, [*args, "--y", "mu", "-q"])
+    assert r.exit_code == 1, r.output
+    assert plot.exists() and "worst exit 1" in r.output
+    plot.unlink()
+    r = CliRunner().invoke(app, [*args, "--y", "message", "-q"])
+    assert r.exit_code == 2 and "a column of text" in r.output and not plot.exists()
