@@ -76,3 +76,27 @@ def test_schema_marks_expression_keys_and_covers_nonlinearity():
     bad.setdefault("nonlinearity", {})["lipschitz_y"] = 1
     with pytest.raises(jsonschema.ValidationError):
         jsonschema.validate(bad, sch)
+
+
+@pytest.mark.parametrize(
+    ("edit", "where"),
+    [
+        (("\n[system]\n", "\nbogus = 1\n[system]\n"), "top level"),
+        (("\n[system]\n", "\n[system]\nBdd = [[1], [0]]\n"), "[system]"),
+        (("\n[simulate]\n", "\n[simulate]\nhorizn = 30\n"), "[simulate]"),
+        (('type = "box"', 'type = "box"\ncentre = [0, 0]'), "a set"),
+    ],
+)
+def test_the_schema_refuses_the_unknown_keys_the_tool_refuses(edit, where) -> None:
+    """Unknown keys are errors in the tool (exit 2), but the schema accepted them at the top
+    level, in [system], [simulate] and in the sets (outsider trial, session 22). Both refuse
+    them now."""
+    from obsdesign.errors import SpecError
+
+    text = (SPECS[0].parent / "constrained-redesign-sec5.toml").read_text(encoding="utf-8")
+    assert edit[0] in text, where
+    bad = text.replace(edit[0], edit[1], 1)
+    with pytest.raises(jsonschema.ValidationError):
+        jsonschema.validate(tomllib.loads(bad), api.schema())
+    with pytest.raises(SpecError):
+        api.load_spec_text(bad, "typo.toml")

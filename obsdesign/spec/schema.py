@@ -140,24 +140,28 @@ def spec_schema(
                 "type": "object",
                 "required": ["type", "lower", "upper"],
                 "properties": {"type": {"const": "box"}, "lower": VEC, "upper": VEC, "dim": DIM},
+                "additionalProperties": False,
             },
             {
                 "type": "object",
                 "required": ["type", "G", "g"],
                 "description": "{x : G x <= g}, bounded and non-empty",
                 "properties": {"type": {"const": "polytope"}, "G": MAT, "g": VEC, "dim": DIM},
+                "additionalProperties": False,
             },
             {
                 "type": "object",
                 "required": ["type", "Q"],
                 "description": "{x : |Q x| <= 1}",
                 "properties": {"type": {"const": "symmetric-polytope"}, "Q": MAT, "dim": DIM},
+                "additionalProperties": False,
             },
             {
                 "type": "object",
                 "required": ["type", "E"],
                 "description": "{x : (x-c)' E (x-c) <= 1}, E symmetric positive definite",
                 "properties": {"type": {"const": "ellipsoid"}, "E": MAT, "center": VEC, "dim": DIM},
+                "additionalProperties": False,
             },
         ]
     }
@@ -166,6 +170,9 @@ def spec_schema(
         "title": "obsdesign spec",
         "type": "object",
         "required": ["system", "method"],
+        # unknown keys are errors in the tool, so in the schema too: the top level, [system],
+        # [simulate] and the sets were open (a typo validated; outsider trial, session 22)
+        "additionalProperties": False,
         "properties": {
             "title": {"type": "string"},
             "description": {"type": "string"},
@@ -173,6 +180,7 @@ def spec_schema(
             "system": {
                 "type": "object",
                 "required": ["time"],
+                "additionalProperties": False,
                 "description": "the plant: linear data (A, C, ...), expressions (f or psi, h), or both",
                 "properties": {
                     "time": {"enum": ["discrete", "continuous"]},
@@ -218,6 +226,7 @@ def spec_schema(
             "simulate": {
                 "type": "object",
                 "required": ["horizon", "x0", "xhat0"],
+                "additionalProperties": False,
                 "properties": {
                     "horizon": {**NUM, "description": "samples (discrete) or seconds (continuous)"},
                     "dt": {**NUM, "exclusiveMinimum": 0},
