@@ -72,8 +72,8 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
         params["falsification"] = fr.summary()
         if fr.violated and o.falsify.on_violation == "warn":
             notes.append(
-                "WARNING: Assumption 1 as declared is violated on the falsification region — "
-                f"{fr.summary()}; literal reading (cross terms) sup ‖c_o‖/‖ε_n‖ = "
+                "WARNING: Assumption 1 as declared is "  # the summary begins "violated — …"
+                f"{fr.summary()} (on the falsification region); literal reading (cross terms) sup ‖c_o‖/‖ε_n‖ = "
                 f"{fr.literal_cross.get('o', 0):.4g}, sup ‖c_n‖/‖ε_o‖ = "
                 f"{fr.literal_cross.get('n', 0):.4g}. The window is certified only *given* the "
                 "declared data."
