@@ -11,7 +11,8 @@ from __future__ import annotations
 import os
 import stat
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -453,7 +454,8 @@ def design(
     sp = _load_spec(spec)
     if plot is not None and api.method(sp.method).plot_design is None:
         raise InputError(f"--plot: method '{sp.method}' has no design plot")
-    rep = api.design(sp, output, progress=progress, force=force)
+    with _naming_the_spec(sp.file):
+        rep = api.design(sp, output, progress=progress, force=force)
     if not quiet or fmt == Fmt.json:
         _print_report(rep, fmt)
     if plot is not None:
@@ -463,6 +465,22 @@ def design(
     if output is not None and fmt == Fmt.text:
         _say(f"report written to {output}")
     return rep.exit_code()
+
+
+@contextmanager
+def _naming_the_spec(file: str) -> Iterator[None]:
+    """Prefix an error's message with the spec's file when it does not name it: a method's
+    "Lemma 1 fails …" (exit 1, 3 or 4) did not say which spec, so a loop over many specs in
+    CI could not tell which one failed (outsider trial, session 22)."""
+    from obsdesign.errors import ObsdesignError
+
+    try:
+        yield
+    except ObsdesignError as e:
+        if file and not e.message.startswith(file):
+            e.message = f"{file}: {e.message}"
+            e.args = (e.message,)
+        raise
 
 
 def verify(report: Path, spec: Path | None, fmt: Fmt, quiet: bool) -> int:
@@ -667,7 +685,8 @@ def simulate(
 
             raise InputError(f"--study {study} and --option study={opts['study']}: give it once")
         opts["study"] = study
-    res = api.simulate(sp, report, options=opts, workers=workers, scheduler=scheduler)
+    with _naming_the_spec(sp.file):
+        res = api.simulate(sp, report, options=opts, workers=workers, scheduler=scheduler)
     if plot is not None and len(res.t) > MAX_PLOT_POINTS:
         from obsdesign.errors import InputError
 

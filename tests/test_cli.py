@@ -344,3 +344,21 @@ def test_check_refuses_stdin_plainly() -> None:
     stdin."""
     r = CliRunner().invoke(app, ["check", "-"], input=SPEC.read_text(encoding="utf-8"))
     assert r.exit_code == 2 and "check takes spec files and folders, not stdin" in r.output
+
+
+def test_a_method_error_names_the_spec_file(tmp_path: Path) -> None:
+    """A method's error (exit 1 here: not detectable) did not name the spec, so a CI loop over
+    many specs could not tell which failed (outsider trial, session 22). design and simulate
+    prefix it with the file; a message that already names it is not prefixed twice."""
+    spec = tmp_path / "und.toml"
+    spec.write_text(
+        '[system]\ntime = "discrete"\nA = [[0.5, 0], [0, 1.2]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\n[simulate]\nhorizon = 3\nx0 = [1, 1]\nxhat0 = [0, 0]\n'
+    )
+    for cmd in ("design", "simulate"):
+        r = CliRunner().invoke(app, [cmd, str(spec), "-q"])
+        assert r.exit_code == 1, r.output
+        assert f"error: {spec}: no gain L makes A − LC Schur" in " ".join(r.output.split())
+    spec.write_text(spec.read_text().replace("[[1, 0]]", "[[1, 0, 0]]"))
+    r = CliRunner().invoke(app, ["design", str(spec), "-q"])
+    assert r.exit_code == 2 and " ".join(r.output.split()).count(str(spec)) == 1
