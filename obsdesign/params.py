@@ -3,14 +3,14 @@
 In a report, ``parameters`` maps each of the paper's symbols to a float (a matrix is a list of
 rows of floats); the exact form sits beside it under ``parameters["exact"]`` as strings like
 ``"-187/100"``. Reading a report back, the exact strings are what the checks use, and
-:meth:`Parameters.consistency` says whether each float still matches its exact value (an
+:meth:`Parameters.from_json` says whether each float still matches its exact value (an
 edited float is caught there).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from typing import Any
 
 import numpy as np
@@ -44,8 +44,10 @@ def _floats(v: Any) -> Any:
     return v
 
 
-class Parameters:
-    """Ordered mapping symbol → value (fmpq / exact object array / float / ndarray / misc)."""
+class Parameters(Mapping[str, Any]):
+    """Ordered mapping symbol → value (fmpq / exact object array / float / ndarray / misc):
+    a read-only ``collections.abc.Mapping`` (``len``, ``keys``, ``values``, ``dict(p)``; it
+    said "mapping" but had none of these: outsider trial, session 22) with item assignment."""
 
     def __init__(self, values: dict[str, Any] | None = None) -> None:
         self._v: dict[str, Any] = dict(values or {})
@@ -65,6 +67,14 @@ class Parameters:
 
     def __iter__(self) -> Iterator[str]:
         return iter(self._v)
+
+    def __len__(self) -> int:
+        return len(self._v)
+
+    # identity, as before it was a Mapping: Mapping's value equality would compare numpy
+    # arrays (ambiguous truth value) and make the object unhashable
+    __eq__ = object.__eq__
+    __hash__ = object.__hash__
 
     def get(self, k: str, default: Any = None) -> Any:
         return self._v.get(k, default)

@@ -234,3 +234,20 @@ def test_from_json_refuses_a_float_as_an_exact_value(exact: object) -> None:
     assert str(e.value).startswith("r.json: parameters.exact.v: not an exact value (the float")
     back, problems = Parameters.from_json({"v": [0.5, 3.0], "exact": {"v": ["0.5", 3]}})
     assert list(back["v"]) == [fmpq(1, 2), fmpq(3)] and not problems
+
+
+def test_parameters_are_a_read_only_mapping_with_identity_equality() -> None:
+    """Parameters said "ordered mapping" but len(p), dict(p) and p.keys() failed (outsider
+    trial, session 22). It is a collections.abc.Mapping now; equality and hashing stay by
+    identity (value equality would compare numpy arrays)."""
+    from collections.abc import Mapping
+
+    import numpy as np
+
+    from obsdesign.params import Parameters
+
+    p = Parameters({"a": np.eye(2), "b": 1.5})
+    assert isinstance(p, Mapping) and len(p) == 2 and list(p.keys()) == ["a", "b"]
+    assert dict(p)["b"] == 1.5 and list(p.values())[1] == 1.5
+    q = Parameters({"a": np.eye(2), "b": 1.5})
+    assert p != q and p == p and len({p, q}) == 2
