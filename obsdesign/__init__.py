@@ -12,7 +12,7 @@ from __future__ import annotations
 import _signal  # the C module: ``signal`` itself spends milliseconds building its enums
 import os as _os
 import sys as _sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 
 def _early_interrupt(signum: int, frame: object) -> None:  # pragma: no cover - timing
@@ -35,32 +35,52 @@ if _signal.getsignal(_signal.SIGINT) is _signal.default_int_handler and _os.path
 __version__ = "0.1.0"
 
 
-def design(*args: Any, **kwargs: Any) -> Any:
-    """See :func:`obsdesign.api.design`."""
-    from obsdesign import api
+if TYPE_CHECKING:  # the real signatures for type checkers and IDEs (outsider trial)
+    from obsdesign.api import check, design, load_spec, simulate, verify
+    from obsdesign.interop import observer_statespace, spec_from_statespace
+else:  # at run time thin wrappers: ``import obsdesign`` stays light (``--help`` is fast)
 
-    return api.design(*args, **kwargs)
+    def design(*args: Any, **kwargs: Any) -> Any:
+        """See :func:`obsdesign.api.design`."""
+        from obsdesign import api
 
+        return api.design(*args, **kwargs)
 
-def verify(*args: Any, **kwargs: Any) -> Any:
-    """See :func:`obsdesign.api.verify`."""
-    from obsdesign import api
+    def verify(*args: Any, **kwargs: Any) -> Any:
+        """See :func:`obsdesign.api.verify`."""
+        from obsdesign import api
 
-    return api.verify(*args, **kwargs)
+        return api.verify(*args, **kwargs)
 
+    def simulate(*args: Any, **kwargs: Any) -> Any:
+        """See :func:`obsdesign.api.simulate`."""
+        from obsdesign import api
 
-def simulate(*args: Any, **kwargs: Any) -> Any:
-    """See :func:`obsdesign.api.simulate`."""
-    from obsdesign import api
+        return api.simulate(*args, **kwargs)
 
-    return api.simulate(*args, **kwargs)
+    def check(*args: Any, **kwargs: Any) -> Any:
+        """See :func:`obsdesign.api.check`."""
+        from obsdesign import api
 
+        return api.check(*args, **kwargs)
 
-def check(*args: Any, **kwargs: Any) -> Any:
-    """See :func:`obsdesign.api.check`."""
-    from obsdesign import api
+    def load_spec(*args: Any, **kwargs: Any) -> Any:
+        """See :func:`obsdesign.api.load_spec`."""
+        from obsdesign.api import load_spec as _load
 
-    return api.check(*args, **kwargs)
+        return _load(*args, **kwargs)
+
+    def spec_from_statespace(*args: Any, **kwargs: Any) -> Any:
+        """See :func:`obsdesign.interop.spec_from_statespace` (needs ``obsdesign[control]``)."""
+        from obsdesign.interop import spec_from_statespace as _from
+
+        return _from(*args, **kwargs)
+
+    def observer_statespace(*args: Any, **kwargs: Any) -> Any:
+        """See :func:`obsdesign.interop.observer_statespace` (needs ``obsdesign[control]``)."""
+        from obsdesign.interop import observer_statespace as _obs
+
+        return _obs(*args, **kwargs)
 
 
 def __getattr__(name: str) -> Any:
@@ -72,24 +92,3 @@ def __getattr__(name: str) -> Any:
 
         return importlib.import_module("obsdesign.sweep")
     raise AttributeError(f"module 'obsdesign' has no attribute {name!r}")
-
-
-def load_spec(*args: Any, **kwargs: Any) -> Any:
-    """See :func:`obsdesign.api.load_spec`."""
-    from obsdesign.api import load_spec as _load
-
-    return _load(*args, **kwargs)
-
-
-def spec_from_statespace(*args: Any, **kwargs: Any) -> Any:
-    """See :func:`obsdesign.interop.spec_from_statespace` (needs ``obsdesign[control]``)."""
-    from obsdesign.interop import spec_from_statespace as _from
-
-    return _from(*args, **kwargs)
-
-
-def observer_statespace(*args: Any, **kwargs: Any) -> Any:
-    """See :func:`obsdesign.interop.observer_statespace` (needs ``obsdesign[control]``)."""
-    from obsdesign.interop import observer_statespace as _obs
-
-    return _obs(*args, **kwargs)
