@@ -222,3 +222,19 @@ def test_a_spec_file_that_differs_from_the_embedded_spec_is_named(tmp_path: Path
     assert moved(out) == []
     os.mkfifo(spec)
     assert moved(out) == []
+
+
+def test_a_huge_integer_in_a_report_names_the_digit_limit(tmp_path: Path) -> None:
+    """A 5000-digit integer in a report said "more than 4300 digits" (Python's int-string
+    limit) beside the 1000 every other digit message names (outsider trial, session 22)."""
+    from obsdesign import api
+    from obsdesign.errors import InputError
+    from obsdesign.report.model import Report
+
+    spec = Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+    text = api.design(spec).to_json()
+    p = tmp_path / "r.json"
+    p.write_text(text.replace('"lambda": 0.955', '"lambda": ' + "7" * 5000, 1), encoding="utf-8")
+    assert "7" * 5000 in p.read_text(encoding="utf-8")
+    with pytest.raises(InputError, match="more than 1000 digits"):
+        Report.load(p)
