@@ -108,9 +108,18 @@ def _table(name: str, data: Mapping[str, Any]) -> list[str]:
 # -- StateSpace → spec -----------------------------------------------------------------------
 def _matrices(sys: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, Any]:
     if isinstance(sys, tuple):
+        if len(sys) not in (4, 5):
+            raise InputError(f"expected (A, B, C, D) or (A, B, C, D, dt), got {len(sys)} items")
         A, B, C, D, dt = (*sys, 0)[:5] if len(sys) == 4 else sys
-    else:
+    elif all(hasattr(sys, k) for k in ("A", "B", "C", "D")):
         A, B, C, D, dt = sys.A, sys.B, sys.C, sys.D, getattr(sys, "dt", 0)
+    else:
+        # a transfer function (control.tf) raised AttributeError: 'TransferFunction' has no
+        # attribute 'A' (outsider trial, session 22)
+        raise InputError(
+            f"expected a state-space system (control.StateSpace or (A, B, C, D[, dt])), got "
+            f"{type(sys).__name__}: convert it first, e.g. control.ss(sys)"
+        )
     A = np.atleast_2d(np.asarray(A, dtype=float))
     C = np.atleast_2d(np.asarray(C, dtype=float))
     n = A.shape[0]

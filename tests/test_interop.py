@@ -237,3 +237,17 @@ def test_a_title_is_always_valid_toml(title: str) -> None:
         assert tomllib.loads(text)["title"] == want
     else:
         assert "title" not in tomllib.loads(text)
+
+
+def test_a_transfer_function_or_a_short_tuple_is_input_error() -> None:
+    """``spec_from_statespace(control.tf(...))`` raised AttributeError (outsider trial,
+    session 22): anything but a state-space system or a 4/5-tuple is InputError (exit 2)
+    saying what to pass."""
+    from obsdesign import interop
+
+    with pytest.raises(InputError, match=r"TransferFunction: convert it first, e\.g\. control\.ss"):
+        interop.spec_from_statespace(control.tf([1], [1, 2]), "lyapunov")
+    with pytest.raises(InputError, match="got 3 items"):
+        interop.spec_from_statespace((np.eye(1), np.eye(1), np.eye(1)), "lyapunov")
+    sys_ = control.ss(control.tf([1], [1, 2]))
+    assert interop.spec_from_statespace(sys_, "lyapunov").system.n == 1
