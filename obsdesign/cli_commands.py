@@ -338,6 +338,12 @@ def _read_report(report: Path) -> Any:
     return Report.from_dict(d, STDIN_NAME)[0]
 
 
+def _json_only(v: Any) -> bool:
+    """A metric that is nested data (a mapping of mappings, e.g. the outlier study's medians
+    by observer, amplitude and state): JSON shows it; text and Markdown show its table."""
+    return isinstance(v, dict) and bool(v) and all(isinstance(x, dict) for x in v.values())
+
+
 def _metrics_markdown(m: dict[str, Any]) -> str:
     lines = ["| state | sup \\|e_i\\| | RMSE | sup \\|x̂_i\\| |", "| --- | --- | --- | --- |"]
     for st, v in m["sup_abs_error"].items():
@@ -348,6 +354,12 @@ def _metrics_markdown(m: dict[str, Any]) -> str:
     for k, v in m.items():
         if k == "warnings" and isinstance(v, list):
             lines += [f"- warning: {_md_cell(str(w).removeprefix('warning: '))}" for w in v]
+        elif _json_only(v):
+            continue
+        elif isinstance(v, str) and "\n" in v.strip():
+            # a preformatted table (the stubborn outlier study) collapsed onto one line
+            # (outsider trial, session 22): a fenced block keeps its rows
+            lines += [f"- {_md_cell(k)}:", "", "```", v.strip("\n"), "```", ""]
         elif k not in (*_MAIN_METRICS, "quantiles"):
             lines.append(f"- {_md_cell(k)}: {_md_cell(v)}")
     head, rows = _quantile_rows(m.get("quantiles"))
@@ -425,6 +437,10 @@ def _print_metrics(m: dict[str, Any]) -> None:
         if k == "warnings" and isinstance(v, list):  # one per line, not a Python list repr
             for w in v:
                 c.print(esc(f"warning: {str(w).removeprefix('warning: ')}"))
+        elif _json_only(v):
+            continue
+        elif isinstance(v, str) and "\n" in v.strip():  # a preformatted table: no wrapping
+            c.print(esc(f"{k}: {v}"), soft_wrap=True)
         elif k not in (*_MAIN_METRICS, "quantiles"):
             c.print(esc(f"{k}: {v}"))
     head, rows = _quantile_rows(m.get("quantiles"))

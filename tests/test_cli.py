@@ -362,3 +362,27 @@ def test_a_method_error_names_the_spec_file(tmp_path: Path) -> None:
     spec.write_text(spec.read_text().replace("[[1, 0]]", "[[1, 0, 0]]"))
     r = CliRunner().invoke(app, ["design", str(spec), "-q"])
     assert r.exit_code == 2 and " ".join(r.output.split()).count(str(spec)) == 1
+
+
+def test_a_preformatted_table_and_nested_data_print_by_format() -> None:
+    """The stubborn outlier study (outsider trial, session 22): JSON held only a text table,
+    Markdown collapsed it onto one line, text wrapped it mid-row. The medians are data in
+    JSON (``outlier_study_median_rmse``), text/Markdown skip that nested mapping, and
+    Markdown keeps the table's rows in a fenced block."""
+    from obsdesign import api
+    from obsdesign.cli_commands import _json_only, _metrics_markdown
+
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.5]]\nC = [[1]]\n[method]\nkey = "stubborn"\n'
+        "[simulate]\nhorizon = 20\nx0 = [1]\nxhat0 = [0]\nruns = 2\namplitudes = [1, 10]\n"
+    )
+    sp = api.load_spec_text(text, "s.toml")
+    m = api.simulate(sp, study="outliers").metrics()
+    med = m["outlier_study_median_rmse"]
+    assert set(med) == {"luenberger", "mean-constant-sat", "max-constant-sat", "stubborn"}
+    assert set(med["stubborn"]) == {"1", "10"} and _json_only(med)
+    assert not _json_only(m["constant_sat_levels"])
+    md = _metrics_markdown(m)
+    assert "outlier_study_median_rmse" not in md
+    block = md.split("```")[1].strip("\n").splitlines()
+    assert block[0].startswith("observer") and block[-1].startswith("stubborn")

@@ -473,6 +473,8 @@ def simulate(
     if study == "outliers":
         st = _study(spec, params, runs or None, budget)
         res.info["outlier_study"] = "\n" + format_table(st, spec.system.states)
+        # the same medians as data (JSON held only the text table: outsider trial)
+        res.info["outlier_study_median_rmse"] = st["median_rmse"]
         res.info["constant_sat_levels"] = st["constant_levels"]
         res.info["runs"] = st["runs"]
         res.extra["study"] = st
