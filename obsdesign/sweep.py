@@ -185,29 +185,19 @@ def _split_list(key: str, spec: str) -> list[str]:
     return items
 
 
-#: a run of digits in a value's text (:func:`_literal` bounds each by ``max_digits``)
-_DIGIT_RUN = re.compile(r"[0-9][0-9_]*")
-
-
 def _literal(key: str, text: str) -> str:
     """``text`` as a TOML value literal: as written when it is one, else a quoted string
-    (a bare word). A number is written as given (its decimal text is the exact value). A
-    number of more than ``max_digits`` digits is refused here, naming the key (a 5000-digit
-    value was an internal failure: Python's int-to-text limit; outsider trial, session 22)."""
-    from obsdesign.limits import limits
-
-    cap = limits().max_digits
-    if not text.lstrip().startswith(("'", '"')) and any(
-        len(m.group(0).replace("_", "")) > cap for m in _DIGIT_RUN.finditer(text)
-    ):
-        raise InputError(f"--set {key}: a number of more than {cap} digits (--limit max_digits=N)")
+    (a bare word). A number is written as given (its decimal text is the exact value); one
+    too long for Python's int-to-text limit is kept as written, and its point becomes a
+    bad-input row like any number past ``max_digits`` (a 5000-digit value was an internal
+    failure; outsider trial, session 22)."""
     try:
         tomllib.loads(f"x = {text}")
         return text
     except tomllib.TOMLDecodeError:
         pass
-    except ValueError as e:  # e.g. an integer past Python's conversion limit
-        raise InputError(f"--set {key}: not a usable TOML value ({e})") from None
+    except ValueError:  # an integer past Python's int-string limit: TOML, but too long
+        return text
     if re.match(r"^[A-Za-z_][A-Za-z0-9_.+-]*$", text):
         return json.dumps(text)
     raise InputError(f"--set {key}: {text!r} is not a TOML value")
@@ -296,13 +286,13 @@ def _value_span(lines: list[str], i: int, col: int) -> tuple[int, str]:
         try:
             tomllib.loads("x = " + rest[: m.start()])
             return i, rest[m.start() :]
-        except tomllib.TOMLDecodeError:
+        except ValueError:  # TOMLDecodeError, or an integer past the int-string limit
             continue
     for j in range(i, len(lines)):
         try:
             tomllib.loads("x = " + "\n".join([rest, *lines[i + 1 : j + 1]]))
             return j, ""
-        except tomllib.TOMLDecodeError:
+        except ValueError:
             continue
     return i, ""
 
@@ -375,13 +365,20 @@ def _check_edit_parsed(old: str, new: str, parts: list[str], literal: str, file:
         raise InputError(f"{file}: is not valid TOML ({e})") from None
     try:
         after = tomllib.loads(new)
-    except tomllib.TOMLDecodeError as e:
+        want = tomllib.loads(f"x = {literal}")["x"]
+    except ValueError as e:
+        if not isinstance(e, tomllib.TOMLDecodeError):  # Python's int-string limit
+            from obsdesign.limits import limits
+
+            raise InputError(
+                f"{file}: [{key}] has a number with more than {limits().max_digits} digits "
+                "(--limit max_digits=N)"
+            ) from None
         raise InputError(
             f"{file}: cannot set {key} = {literal} ({e}"
             + ("; an inline table holds it: write it as a [table]" if "immutable" in str(e) else "")
             + ")"
         ) from None
-    want = tomllib.loads(f"x = {literal}")["x"]
     d = before
     for p in parts[:-1]:
         nxt = d.get(p) if isinstance(d, dict) else None
@@ -436,7 +433,12 @@ _VERDICTS = {0: "ok", 1: "failed", 2: "bad input", 3: "error", 4: "inconclusive"
 
 
 def _value(lit: str) -> Any:
-    v = tomllib.loads(f"x = {lit}")["x"]
+    """A row's cell for a swept literal: its value when a scalar, else (or when Python
+    cannot hold it as text: an integer past the int-string limit) the literal itself."""
+    try:
+        v = tomllib.loads(f"x = {lit}")["x"]
+    except ValueError:
+        return lit
     return v if isinstance(v, (int, float, str, bool)) else lit
 
 
