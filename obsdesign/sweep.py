@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import json
 import math
+import numbers
 import re
 import sys
 import time
@@ -517,6 +518,11 @@ def run_point(task: PointTask) -> dict[str, Any]:
 
 
 def _scalar(params: Any, key: str) -> Any:
+    """A summary parameter's cell: an integer stays one (``facets`` 6, not 6.0: outsider
+    trial, session 22), a number is its float, anything else its JSON text."""
+    v0 = params[key]
+    if isinstance(v0, numbers.Integral) and not isinstance(v0, bool):
+        return int(v0)
     try:
         return float(params.float(key))
     except (TypeError, ValueError):

@@ -338,3 +338,12 @@ def test_a_list_item_with_an_escaped_quote_is_one_item() -> None:
     axis = sw.parse_axis(r'title=["a\"b", c, "x\\", ' + r"'lit\', 2]")
     assert axis.values == (r'"a\"b"', '"c"', r'"x\\"', r"'lit\'", "2")
     assert [tomllib.loads(f"v = {v}")["v"] for v in axis.values] == ['a"b', "c", "x\\", "lit\\", 2]
+
+
+def test_integer_summary_parameters_stay_integers() -> None:
+    """Sweep rows (so CSV and parquet) gave set-invariant's ``facets`` as 6.0 and
+    ``iterations`` as 2.0 (outsider trial, session 22): an integer parameter is an int."""
+    rows = sw.sweep_rows(ROOT / "specs" / "dorea-pimenta-7-1.toml", ["method.lambda=[0.9]"])
+    assert rows[0]["exit_code"] == 0
+    assert type(rows[0]["facets"]) is int and type(rows[0]["iterations"]) is int
+    assert type(rows[0]["contractivity"]) is float
