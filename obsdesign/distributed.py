@@ -123,22 +123,34 @@ def dask_client(
         "distributed.scheduler.worker-saturation": 1.0,
         "distributed.worker.profile.enabled": False,
     }
-    with dask.config.set(cfg):
-        cluster = LocalCluster(
-            n_workers=workers or 1,
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=None,
-            silence_logs=QUIET,
-        )
+    from obsdesign import WORKER_ENV
+
+    # the worker processes inherit this: they ignore Ctrl-C (obsdesign/__init__.py), which
+    # stops the command here, and cluster.close() ends them
+    before = os.environ.get(WORKER_ENV)
+    os.environ[WORKER_ENV] = "1"
     try:
-        c = Client(cluster)
+        with dask.config.set(cfg):
+            cluster = LocalCluster(
+                n_workers=workers or 1,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=None,
+                silence_logs=QUIET,
+            )
         try:
-            yield c
+            c = Client(cluster)
+            try:
+                yield c
+            finally:
+                c.close()
         finally:
-            c.close()
+            cluster.close()
     finally:
-        cluster.close()
+        if before is None:
+            os.environ.pop(WORKER_ENV, None)
+        else:
+            os.environ[WORKER_ENV] = before
 
 
 def _limits_state() -> tuple[Any, tuple[str, ...]]:
