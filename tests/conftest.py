@@ -24,13 +24,19 @@ def pytest_sessionstart(session: pytest.Session) -> None:
     session from a process whose cache already held the correct bounds, so no mutant of
     ``searchspace/bounds.py`` was seen (mutation review 21). Cleared at the session's start,
     before any fixture (a module-scoped fixture built before a per-test clearing still used
-    the old bounds); within the session every bound is the mutant's own."""
+    the old bounds); within the session every bound is the mutant's own. Likewise the
+    set-invariant method's exact vertices of Ω (an lru_cache of ``exact_h_to_v``)."""
     if os.environ.get("MUTANT_UNDER_TEST"):
         import sys
 
         mod = sys.modules.get("obsdesign.methods.searchspace.design")
         if mod is not None:
             mod._CACHE.clear()
+        # the exact vertices of Ω (``po.exact_h_to_v``), kept per process by an lru_cache:
+        # a mutant of polytope_ops would else be handed the clean run's vertices
+        prob = sys.modules.get("obsdesign.methods.setinvariant.problem")
+        if prob is not None:
+            prob._omega_vertices.cache_clear()
 
 
 @pytest.fixture

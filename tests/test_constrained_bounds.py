@@ -238,3 +238,227 @@ def test_faces_with_the_same_direction_are_bounded_together():
     xs = np.linspace(-3, 3, 60001)[:, None]
     J = _jacobian_norms(cm, xs[cm.norm_c(xs) <= float(sup)])
     assert J.max() ** 2 <= float(dsq.value) * (1 + 1e-12)
+
+
+# -- mutation review 22 (bounds.py, cmap.py) ---------------------------------------------------
+
+
+def test_antipodal_classes_pair_only_opposite_faces():
+    """Each face is in exactly one class, paired only with the first unpaired face whose
+    normal is a negative multiple of its own (any factor, e.g. 2x <= 1 with −x <= 1): the
+    triangle's three faces stay single; the square's opposite sides pair up; a face with
+    the same direction as a paired one (−x, −2x) stays single; a positive multiple (x, 2x)
+    or a factor in (0, 1) never pairs; a zero row pairs with nothing."""
+    from obsdesign.methods.constrained.cmap import _negative_multiple, antipodal_classes
+
+    tri = qmat([[1, 0], [-1, 2], [-1, -2]])
+    assert antipodal_classes(tri) == [[0], [1], [2]]
+    sq = qmat([[1, 0], [0, 1], [-1, 0], [0, -1]])
+    assert antipodal_classes(sq) == [[0, 2], [1, 3]]
+    assert antipodal_classes(qmat([[1, 0], [-1, 0], [-2, 0]])) == [[0, 1], [2]]
+    assert antipodal_classes(qmat([[0, 0], [1, 0], [-1, 0]])) == [[0], [1, 2]]
+    q = qmat([[2, 0], [-1, 0], [1, 0], [2, 0], [fmpq(1, 2), 0], [0, 1], [-1, 1]])
+    assert _negative_multiple(q[0], q[1]) and _negative_multiple(q[1], q[0])
+    assert _negative_multiple(q[1], q[2])  # b[k] == 1: still a negative multiple
+    assert not _negative_multiple(q[2], q[3])  # x and 2x: the same direction
+    assert not _negative_multiple(q[0], q[4])  # 2x and x/2: a factor in (0, 1)
+    assert not _negative_multiple(q[2], q[5])  # b[k] == 0
+    assert not _negative_multiple(q[5], q[6])  # same leading sign pattern, not parallel
+    assert not _negative_multiple(qmat([[0, 0]])[0], q[1])  # a zero row
+
+
+def _fake_eigh_low(monkeypatch, factor):
+    """The float eigenvalue solvers return ``factor`` times the true value (a float error
+    far beyond the first candidate's 10⁻⁹ margin)."""
+    import scipy.linalg as sl
+
+    real_sl, real_np = sl.eigh, np.linalg.eigvalsh
+    monkeypatch.setattr(sl, "eigh", lambda a, b=None, **kw: real_sl(a, b, **kw) * factor)
+    monkeypatch.setattr(np.linalg, "eigvalsh", lambda a: real_np(a) * factor)
+
+
+@pytest.mark.parametrize("low", [5e-7, 5e-4, 0.05, 0.4])
+def test_gen_eig_upper_is_proved_and_tight_when_the_float_estimate_is_low(monkeypatch, low):
+    """κ with A ⪯ κB: each candidate is proved by the exact LDLᵀ of κB − A, so an estimate
+    that is too low (here by a factor 1 − low) is passed over, and the first candidate of the
+    ladder 1 + 10⁻⁹, 10⁻⁶, 10⁻³, 10⁻¹, 1 above the true value is taken. A = diag(1, 2), B = I:
+    λ_max = 2."""
+    _fake_eigh_low(monkeypatch, 1 - low)
+    A, Bm = qmat([[1, 0], [0, 2]]), qeye(2)
+    kap = B.gen_eig_upper(A, Bm)
+    assert kap >= 2  # the proof: κB − A ⪰ 0
+    step = next(f for f in (1e-9, 1e-6, 1e-3, 1e-1, 1.0) if (1 - low) * (1 + f) >= 1)
+    assert float(kap) <= 2 * (1 - low) * (1 + step) * (1 + 1e-8)
+
+
+def test_gen_eig_upper_is_tight_for_small_and_large_eigenvalues():
+    """κ is within 10⁻⁸ (relative) of λ_max(B⁻¹A) above it, also below 1 (no floor at 1) and
+    never 2× or +1 off: A = diag(1/4, 1/8), B = diag(1, 1/2) (λ_max = 1/4)."""
+    kap = B.gen_eig_upper(qmat([[fmpq(1, 4), 0], [0, fmpq(1, 8)]]), qmat([[1, 0], [0, fmpq(1, 2)]]))
+    assert fmpq(1, 4) <= kap <= fmpq(1, 4) * (1 + fmpq(1, 10**8))
+
+
+@pytest.mark.parametrize("low", [5e-7, 5e-4, 0.05, 0.4])
+def test_lambda_min_lower_is_proved_and_tight_when_the_float_estimate_is_high(monkeypatch, low):
+    """ℓ ≤ λ_min(P) proved by the exact LDLᵀ of P − ℓI: a float estimate too high by a factor
+    1 + low is passed over down the ladder 1 − 10⁻⁹, 10⁻⁶, 10⁻³, 10⁻¹, ½, and the first proved
+    candidate is taken. P = diag(3, 5): λ_min = 3."""
+    _fake_eigh_low(monkeypatch, 1 + low)
+    ell = B.lambda_min_lower(qmat([[3, 0], [0, 5]]))
+    assert ell <= 3  # the proof: P − ℓI ⪰ 0
+    step = next(f for f in (1e-9, 1e-6, 1e-3, 1e-1, 0.5) if (1 + low) * (1 - f) <= 1)
+    assert float(ell) >= 3 * (1 + low) * (1 - step) * (1 - 1e-8)
+    assert B.lambda_min_lower(qmat([[1, 0], [0, -1]])) == 0  # not positive definite
+
+
+def test_box_quad_bound_and_the_outer_box_fallback(monkeypatch):
+    """max (x̂ − x)ᵀP(x̂ − x) over X̂ × X with P = [[2, 1], [1, 3]], A = [−1, 0] × [−2, −1],
+    B = [1, 2] × [1, 3]: exact at the vertices of the box X̂ − X (boxes), or of the vertex
+    pairs (polytopes): 123 at ±(3, 5), in both roles; above MAX_PAIRS pairs (forced to 0) the
+    bound Σ|P_ij| m_i m_j with m = max(|lo|, |hi|) over the enclosing box of X̂ − X, from the
+    polytopes' exact vertices: m = (3, 5), 2·9 + 2·15 + 3·25 = 123 again, flagged as a bound;
+    and _box_quad_bound by hand with m = (2, 3): 2·4 + 2·6 + 3·9 = 47."""
+    from obsdesign.sets import Polytope
+
+    P = qmat([[2, 1], [1, 3]])
+    b = B._box_quad_bound(P, [Q(-2), Q(-1)], [Q(1), Q(3)])
+    assert b.value == 47 and b.exact is False
+    G = qmat([[1, 0], [-1, 0], [0, 1], [0, -1]])
+    boxes = {"A": _box([-1, -2], [0, -1]), "B": _box([1, 1], [2, 3])}
+    polys = {
+        "A": Polytope(G, np.array([Q(0), Q(1), Q(-1), Q(2)], dtype=object)),
+        "B": Polytope(G, np.array([Q(2), Q(-1), Q(3), Q(-1)], dtype=object)),
+    }
+    lo, hi = B.outer_box_q(polys["A"])
+    assert list(lo) == [-1, -2] and list(hi) == [0, -1]
+    for x, xh in (("A", "B"), ("B", "A")):
+        for sets in (boxes, polys):
+            r = B.max_V_diff(P, sets[x], sets[xh])
+            assert r.exact and r.value == 123, (x, xh)
+    monkeypatch.setattr(B, "MAX_PAIRS", 0)
+    for x, xh in (("A", "B"), ("B", "A")):
+        r = B.max_V_diff(P, polys[x], polys[xh])
+        assert r.value == 123 and not r.exact, (x, xh)
+
+
+def test_v_max_over_an_ellipsoid_is_the_triangle_bound():
+    """X̂ an ellipsoid: max V(x̂ − x) ≤ max over the vertices v of X of (√V(c − v) + √κ)²,
+    κ ≥ λ_max(E⁻¹P) (here 1). P = E = I: the bound is the true maximum (|c − v| + 1)²; with
+    c = (2, 0) and X = [0, 1]² the farthest vertex is (0, 1), |c − v|² = 5, so 6 + 2√5; and
+    (√2/4 + 1/4)² < 1 for the ball of radius 1/4 at 0 and X = [0, 1/4]²."""
+    from obsdesign.sets import Ellipsoid
+
+    far = np.array([Q(2), Q(0)], dtype=object)
+    zero = np.array([Q(0), Q(0)], dtype=object)
+    cases = [
+        (far, qeye(2), _box([0, 0], [1, 1]), 6 + 2 * 5**0.5),
+        (zero, qeye(2) * 16, _box([0, 0], [fmpq(1, 4)] * 2), ((2**0.5 + 1) / 4) ** 2),
+    ]
+    for c, E, X, want in cases:
+        r = B.max_V_diff(qeye(2), X, Ellipsoid(E, c))
+        assert not r.exact
+        assert want * (1 - 1e-12) <= float(r.value) <= want * (1 + 1e-7)
+
+
+def test_gamma_ok_refuses_a_nonpositive_gamma():
+    """Eq. (24) needs γ > 0: γ = 0 or γ < 0 is a failed check (P − γδ²I ⪰ 0 would hold);
+    γδ² = λ_min(P) passes, above it fails."""
+    P = qmat([[3, 0], [0, 5]])
+    assert B.gamma_ok(P, fmpq(3, 4), Q(4))[0]
+    assert not B.gamma_ok(P, fmpq(3, 4) + fmpq(1, 10**9), Q(4))[0]
+    for g in (Q(0), Q(-1)):
+        ok, detail = B.gamma_ok(P, g, Q(4))
+        assert not ok and "must be > 0" in detail
+
+
+def test_delta_sq_valid_refuses_a_nonpositive_eps_max():
+    """δ² is checked as (δ²/(4 ε_max))·I − H ⪰ 0 only for ε_max > 0; ε_max = 0 or < 0 is a
+    failed check, never a pass or a division by zero."""
+    cm = box_map([Q(-1), Q(-1)], [Q(1), Q(1)])
+    assert B.delta_sq_valid(cm, Q(1), Q(4))[0]
+    assert not B.delta_sq_valid(cm, Q(1), fmpq(39, 10))[0]
+    for e in (Q(0), Q(-1)):
+        ok, detail = B.delta_sq_valid(cm, e, Q(4))
+        assert not ok and detail == "ε_max must be > 0"
+
+
+def test_phi_and_norm_c_exactly_at_rational_points():
+    """φ and |c|² at rational points, by hand: the ellipsoid map xᵀQx/r − 1 with
+    Q = diag(1, 4), r = 2 (−1 at the centre, 3/2 at (1, 1)); the box map of [−1, 1]² at
+    (3/2, 5/4), where two faces are violated by 1/2 and 1/4: |c|² = (1/2)⁴ + (1/4)⁴ = 17/256
+    (Euclidean) or max = 1/16 (max-norm), and 0 inside."""
+    from obsdesign.methods.constrained.cmap import ellipsoid_map
+
+    em = ellipsoid_map(qmat([[1, 0], [0, 4]]), 2)
+    assert em.phi_q(np.array([Q(0), Q(0)], dtype=object)) == [-1]
+    assert em.phi_q(np.array([Q(1), Q(1)], dtype=object)) == [fmpq(3, 2)]
+    assert em.norm_c_sq_q(np.array([Q(1), Q(1)], dtype=object)) == fmpq(3, 2) ** 4
+    x = np.array([fmpq(3, 2), fmpq(5, 4)], dtype=object)
+    inside = np.array([Q(0), fmpq(1, 2)], dtype=object)
+    eu = box_map([Q(-1), Q(-1)], [Q(1), Q(1)])
+    mx = box_map([Q(-1), Q(-1)], [Q(1), Q(1)], norm="max")
+    assert eu.phi_q(x) == [fmpq(-5, 2), fmpq(1, 2), fmpq(-9, 4), fmpq(1, 4)]
+    assert eu.norm_c_sq_q(x) == fmpq(17, 256) and mx.norm_c_sq_q(x) == fmpq(1, 16)
+    assert eu.norm_c_sq_q(inside) == 0 and mx.norm_c_sq_q(inside) == 0
+
+
+def test_the_eigenvalue_ladders_end_safely(monkeypatch):
+    """When no candidate of its ladder is proved (the float estimate 3× off), λ_min's lower
+    bound is 0 (safe, never 1) and κ's upper bound is refused (ArithmeticError)."""
+    _fake_eigh_low(monkeypatch, 3.0)
+    assert B.lambda_min_lower(qmat([[3, 0], [0, 5]])) == 0
+    monkeypatch.undo()
+    _fake_eigh_low(monkeypatch, 0.3)
+    with pytest.raises(ArithmeticError):
+        B.gen_eig_upper(qmat([[1, 0], [0, 2]]), qeye(2))
+
+
+def test_v_min_condition_at_its_exact_boundaries():
+    """Eq. (21) by hand. Affine: the box map of [−1, 1] over X = [−½, ½] with P = 1 and
+    v = 1 gives max φ + √v = ½ and |c|² = (½)⁴ = ε_min² for ε_min = ¼: equality holds
+    (≤, not <). Ellipsoid map |x|² ≤ 4 over X = [−½, ½]² with P = 4I (κ = ¼):
+    (√½ + √(v/4))² ≤ 4(1 + √ε_min) with ε_min = ¼ holds up to v* = 4(√6 − √½)² ≈ 12.1436."""
+    from obsdesign.methods.constrained.cmap import ellipsoid_map
+
+    cm = box_map([Q(-1)], [Q(1)])
+    P = qmat([[1]])
+    X = _box([fmpq(-1, 2)], [fmpq(1, 2)])
+    assert B.v_min_condition(cm, P, qinv(P), X, fmpq(1, 4), Q(1))
+    assert not B.v_min_condition(cm, P, qinv(P), X, fmpq(1, 4), Q(1) + fmpq(1, 10**6))
+    em = ellipsoid_map(qeye(2), 4)
+    P4 = qeye(2) * 4
+    X2 = _box([fmpq(-1, 2)] * 2, [fmpq(1, 2)] * 2)
+    assert B.v_min_condition(em, P4, qinv(P4), X2, fmpq(1, 4), fmpq(1214, 100))
+    assert not B.v_min_condition(em, P4, qinv(P4), X2, fmpq(1, 4), fmpq(1215, 100))
+
+
+def test_max_phi_over_a_box_and_delta_matrix_by_hand():
+    """b_i = max over the box X of φ_i: for φ = −x − 2y − 1 over [−2, 3] × [−1, ½] the corner
+    (−2, −1) gives 3 (the closed form Σ_j max(g_j l_j, g_j u_j) − h agrees with the vertices);
+    H of δ takes the longest normal of each antipodal class: rows (2, 0) and (−1, 0) form one
+    class, H = (2, 0)ᵀ(2, 0) = diag(4, 0), whatever the order of the rows."""
+    cm = polytope_map(qmat([[-1, -2]]), np.array([Q(1)], dtype=object))
+    X = _box([-2, -1], [3, fmpq(1, 2)])
+    assert B.max_phi_over(cm, X) == [3]
+    assert max(cm.phi_q(v)[0] for v in X.vertices_q()) == 3
+    for rows in ([[2, 0], [-1, 0]], [[-1, 0], [2, 0]]):
+        cm2 = polytope_map(qmat(rows), np.array([Q(1), Q(1)], dtype=object))
+        assert cm2.classes == [[0, 1]]
+        assert B.delta_matrix(cm2).tolist() == [[4, 0], [0, 0]]
+
+
+def test_max_phi_of_the_ellipsoid_map_over_a_large_box(monkeypatch):
+    """Over a box with more than MAX_PAIRS vertices (forced to 0 here) the ellipsoid map's
+    max xᵀQx/r − 1 is bounded by Σ|Q_ij| m_i m_j / r − 1: Q = [[2, 1], [1, 2]], r = 3,
+    X = [−1, 1] × [0, 1] (m = (1, 1)) give 6/3 − 1 = 1, the exact maximum at the corner
+    (1, 1) here (and at (−1, 1) for the off-diagonal −1)."""
+    from obsdesign.methods.constrained.cmap import ellipsoid_map
+
+    cm = ellipsoid_map(qmat([[2, 1], [1, 2]]), 3)
+    X = _box([-1, 0], [1, 1])
+    exact = B.max_phi_over(cm, X)
+    assert exact == [1]
+    monkeypatch.setattr(B, "MAX_PAIRS", 0)
+    assert B.max_phi_over(cm, X) == [1]
+    cm2 = ellipsoid_map(qmat([[2, -1], [-1, 2]]), 3)  # the same maximum, at (−1, 1)
+    assert B.max_phi_over(cm2, X) == [1]

@@ -345,3 +345,240 @@ def test_slice_points_sees_a_crossing_whose_product_underflows() -> None:
     with np.errstate(over="raise"):
         big = po.slice_points(W, np.array([[0, 1]]), np.array([1.0, 0.0]), 0.0, 0.0)
     assert big.shape == (1, 2) and big[0, 1] == pytest.approx(0.5)
+
+
+# -- mutation review 22 (polytope_ops's exact kernel) ------------------------------------------
+
+
+def test_hull_certificate_refuses_degenerate_input_and_takes_plain_numbers():
+    """hull_certificate's contract on its own (the callers guard these cases): one
+    dimension, no rows or no points give a reason, never a proof or an exception; rows and
+    points given as Python integers are read exactly, like fmpq ones."""
+    sq = po.qarray([[1, 1], [1, -1], [-1, 1], [-1, -1]])
+    assert isinstance(po.hull_certificate(po.qarray([[1], [-1]]), po.qarray([[1], [-1]])), str)
+    assert isinstance(po.hull_certificate(np.zeros((0, 2), dtype=object), sq), str)
+    assert isinstance(po.hull_certificate(po.qarray([[1, 0]]), np.zeros((0, 2), dtype=object)), str)
+    cert = po.hull_certificate([[1, 0], [0, 1], [-1, 0], [0, -1]], sq)
+    assert not isinstance(cert, str) and cert.keep == [0, 1, 2, 3]
+    plain = po.hull_certificate([[1, 0], [-1, 2], [-1, -2]], [[1, 1], [1, -1], [-1, 0]])
+    assert not isinstance(plain, str) and plain.keep == [0, 1, 2]
+    # a square's four corners, each on two of its four sides: the edges are the sides
+    assert sorted(cert.edges) == [(0, 1), (0, 2), (1, 3), (2, 3)]
+
+
+def test_hull_certificate_names_the_one_violated_row():
+    """A single (row, point) pair with G_i p > 1 is a reason (exact_hull then repairs), not
+    an exception: the square with one corner pushed out of one side only."""
+    G = po.qarray([[1, 0], [0, 1], [-1, 0], [0, -1]])
+    P = po.qarray([[1, 1], [1, -1], [-1, 1], [-1, -1]])
+    P[0, 0] = fmpq(1)  # (1, 1): on the rows x = 1 and y = 1
+    P[0, 1] = fmpq(101, 100)  # (1, 1.01): outside y <= 1 only
+    assert po.hull_certificate(G, P) == "point 0 violates row 1 (conv(P) is not inside {G e <= 1})"
+
+
+def test_a_point_inside_an_edge_of_four_facets_is_no_vertex():
+    """A vertex needs rows of rank n, not just n rows: in the 4-D pyramid over an octahedron
+    the edge from the apex to an octahedron corner lies on four facets (rank 3), and its
+    midpoint, on those four rows, is not a vertex: the hull is still proved, with the seven
+    true vertices, and a V listing the midpoint is refused."""
+    base = [[1, 0, 0, -1], [-1, 0, 0, -1], [0, 1, 0, -1], [0, -1, 0, -1], [0, 0, 1, -1]]
+    P = po.qarray([*base, [0, 0, -1, -1], [0, 0, 0, 3]])
+    G, idx, _ = po._cdd_hull(P)
+    assert idx == list(range(7)) and len(G) == 9
+    mid = np.vstack([P, po.qarray([[fmpq(1, 2), 0, 0, 1]])])
+    cert = po.hull_certificate(G, mid)
+    assert not isinstance(cert, str) and cert.keep == list(range(7))
+    ok, detail, _ = po.exact_check_forms(G, mid)
+    assert not ok and detail == "1 of the reported vertices are not vertices"
+
+
+def test_gift_wrapping_rebuilds_the_facets_qhull_merged(monkeypatch):
+    """A point 10⁻¹⁵ beyond the centre of one face of the octahedron: qhull keeps that face
+    (the point is coplanar for it), whose exact row the point violates. The repair drops the
+    row and wraps each of its three ridges to the point: the three thin triangles, 10 facets
+    in all, are then proved by the incidences alone (cdd.gmp, switched off here, is not
+    needed) and are cdd.gmp's hull; with a deadline already past the repair stops."""
+    octa = po.qarray(np.vstack([np.eye(3), -np.eye(3)]))
+    e = fmpq(1, 3) + fmpq(1, 10**15)
+    P = np.vstack([octa, np.array([[e, e, e]], dtype=object)])
+    F = po._float_facets(P)
+    assert len(F) == 8 and "violates" in po.hull_certificate(F, P)
+    G1, idx, edges = po._cdd_hull(P)
+    assert len(G1) == 10 and idx == list(range(7))
+    with pytest.raises(po.HullTimeout) as stop:
+        po._repair(F, P, deadline=time.perf_counter() - 1)
+    assert stop.value.args == (0.0,)
+
+    def no_cdd(P):
+        raise AssertionError("cdd.gmp was called")
+
+    monkeypatch.setattr(po, "_cdd_hull", no_cdd)
+    R = po._repair(F, P)
+    assert [tuple(r) for r in R] == [tuple(r) for r in G1]
+    G, vr = po.exact_hull(P)
+    assert [tuple(r) for r in G] == [tuple(r) for r in G1]
+    assert [tuple(v) for v in vr.V] == [tuple(v) for v in P] and vr.edges == edges
+
+
+def test_exact_check_forms_in_the_plane_and_on_the_line():
+    """The forms claim: in 2-D by the incidences (a facet listed twice is refused, as in any
+    dimension >= 2; the detail counts vertices and facets); in 1-D by the exact hull, where V
+    without the origin inside, a V listing a point that is no vertex, and rows that are not
+    the facets of conv(V) are each refused, never accepted."""
+    sq = po.qarray([[1, 1], [1, -1], [-1, 1], [-1, -1]])
+    G = po.qarray([[-1, 0], [0, -1], [0, 1], [1, 0]])
+    ok, detail, rep = po.exact_check_forms(G, sq)
+    assert ok and detail == "4 exact vertices, 4 facets (V- and H-forms agree)"
+    assert sorted(rep.edges) == [(0, 1), (0, 2), (1, 3), (2, 3)]
+    ok, detail, rep = po.exact_check_forms(np.vstack([G, G[:1]]), sq)
+    assert not ok and rep is None and "repeated row" in detail
+    seg = po.qarray([[-2], [1]])
+    ok, detail, rep = po.exact_check_forms(po.qarray([[fmpq(-1, 2)], [1]]), seg)
+    assert ok and detail == "2 exact vertices, 2 facets (V- and H-forms agree)"
+    ok, detail, rep = po.exact_check_forms(po.qarray([[1], [fmpq(1, 2)]]), po.qarray([[1], [2]]))
+    assert not ok and rep is None and "origin" in detail
+    inner = po.qarray([[-2], [0], [1]])  # 0 is no vertex of [−2, 1]
+    ok, detail, rep = po.exact_check_forms(po.qarray([[fmpq(-1, 2)], [1]]), inner)
+    assert not ok and rep is None and detail == "1 of the reported vertices are not vertices"
+    ok, detail, rep = po.exact_check_forms(po.qarray([[fmpq(-1, 2)], [2]]), seg)
+    assert not ok and rep is None and detail == "the rows of G are not the facets of conv(V)"
+
+
+def _cube(n: int) -> np.ndarray:
+    return po.qarray(np.array(np.meshgrid(*[[-1, 1]] * n)).reshape(n, -1).T)
+
+
+def test_exact_hull_proves_by_incidences_without_cdd(monkeypatch):
+    """exact_hull's first path, in two dimensions as in three: qhull's facets made exact and
+    proved by the incidences; cdd.gmp (switched off here) is only the fallback. The square's
+    and the cube's facets are the 2n rows ±e_i."""
+
+    def no_cdd(P):
+        raise AssertionError("cdd.gmp was called")
+
+    monkeypatch.setattr(po, "_cdd_hull", no_cdd)
+    for n in (2, 3):
+        G, vr = po.exact_hull(_cube(n))
+        assert sorted(tuple(r) for r in G) == sorted(
+            tuple(s * fmpq(int(i == k)) for i in range(n)) for k in range(n) for s in (1, -1)
+        )
+        assert len(vr.V) == 2**n and len(vr.edges) == n * 2 ** (n - 1)
+
+
+def test_exact_hull_falls_back_to_cdd_when_the_repair_finds_nothing():
+    """All eight faces of the octahedron pushed out by 10⁻¹⁵: every qhull row is violated, the
+    repair keeps no row (None), and cdd.gmp decides: the hull is still returned (14 vertices,
+    24 thin facets), not an exception; past a deadline the repair of the one-face case stops
+    the hull with HullTimeout."""
+    e = fmpq(1, 3) + fmpq(1, 10**15)
+    octa = po.qarray(np.vstack([np.eye(3), -np.eye(3)]))
+    signs = [(a, b, c) for a in (1, -1) for b in (1, -1) for c in (1, -1)]
+    P = np.vstack([octa, np.array([[a * e, b * e, c * e] for a, b, c in signs], dtype=object)])
+    assert po._repair(po._float_facets(P), P) is None
+    G, vr = po.exact_hull(P)
+    G1, idx, edges = po._cdd_hull(P)
+    assert [tuple(r) for r in G] == [tuple(r) for r in G1] and len(G) == 24
+    assert len(vr.V) == 14 and vr.edges == edges
+    one = np.vstack([octa, np.array([[e, e, e]], dtype=object)])
+    with pytest.raises(po.HullTimeout):
+        po.exact_hull(one, deadline=time.perf_counter() - 1)
+
+
+def test_canonical_reads_plain_integers_exactly():
+    """canonical divides each row by its right-hand side exactly, also when rows and
+    right-hand sides are Python integers (1/3, not the float 0.333…), merges duplicates and
+    sorts; a right-hand side 0 is refused."""
+    G = np.array([[1, 0], [0, 3], [2, 0]], dtype=object)
+    g = np.array([3, 3, 6], dtype=object)
+    C = po.canonical(G, g)
+    assert [tuple(r) for r in C] == [(0, 1), (fmpq(1, 3), 0)]
+    assert all(isinstance(x, fmpq) for x in C.reshape(-1))
+    C2 = po.canonical([[1, 0], [0, 3]], po.qarray([3, 3]))
+    assert [tuple(r) for r in C2] == [(0, 1), (fmpq(1, 3), 0)]
+    assert [tuple(r) for r in po.canonical(G)] == [(0, 3), (1, 0), (2, 0)]
+    with pytest.raises(po.PolytopeError, match="origin"):
+        po.canonical(G, np.array([3, 0, 6], dtype=object))
+
+
+def test_exact_outward_fix_scales_only_the_rows_a_point_exceeds():
+    """Each row is divided by max_p G_i p exactly when that exceeds 1 (then the points satisfy
+    G p <= 1, the largest with equality); a row already valid, even tight, is kept; the input
+    is not changed; the count of rescaled rows is returned."""
+    G = po.qarray([[1, 0], [0, 1], [-1, 0], [0, -1]])
+    P = po.qarray([[3, 0], [0, fmpq(1, 2)], [-1, 0], [0, -2], [1, 1]])
+    F, fixed = po.exact_outward_fix(G, P)
+    assert fixed == 2
+    assert [tuple(r) for r in F] == [(fmpq(1, 3), 0), (0, 1), (-1, 0), (0, fmpq(-1, 2))]
+    assert [tuple(r) for r in G] == [(1, 0), (0, 1), (-1, 0), (0, -1)]
+    assert max(po.qdot(r, p) for r in F for p in P) == 1
+    F2, fixed2 = po.exact_outward_fix([[1, 0], [0, 1], [-1, 0], [0, -1]], P)  # Python ints
+    assert fixed2 == 2 and [tuple(r) for r in F2] == [tuple(r) for r in F]
+
+
+def test_exact_forms_refuse_flat_sets_and_an_origin_on_the_boundary():
+    """exact_h_to_v refuses a flat polyhedron (the segment {0} × [−1, 1]: 2 vertices < n + 1);
+    exact_v_to_h and the cdd.gmp hull refuse points whose hull has the origin on a facet
+    (a PolytopeError, which exact_check_forms turns into a failed claim, not a division by
+    zero); qdot refuses vectors of different lengths."""
+    with pytest.raises(po.PolytopeError, match="not full-dimensional"):
+        po.exact_h_to_v(po.qarray([[1, 0], [-1, 0], [0, 1], [0, -1]]), po.qarray([0, 0, 1, 1]))
+    corner = po.qarray([[0, 0], [1, 0], [0, 1]])
+    with pytest.raises(po.PolytopeError, match="origin"):
+        po.exact_v_to_h(corner)
+    with pytest.raises(po.PolytopeError, match="origin"):
+        po._cdd_hull(corner)
+    ok, detail, rep = po.exact_check_forms(po.qarray([[1]]), po.qarray([[0], [1]]))
+    assert not ok and rep is None and "origin" in detail
+    with pytest.raises(ValueError):
+        po.qdot(po.qarray([1, 2]), po.qarray([1, 2, 3]))
+
+
+def test_exact_slices_contain_every_vertex_of_the_slice():
+    """ExactSlicer.points and exact_slice_points against cdd.gmp's vertices of the slice
+    {G e <= 1, lo <= c·e <= hi} (exact_vertices_of_slice): every vertex of the slice is
+    among the points, and every point lies in the slice. Slabs of the cube in the direction
+    (1, 1, 1): a plane through the centre (a hexagon from edge crossings), a plane through
+    three vertices (vertices on the plane, no crossing), a slab, a slab reaching the corner
+    c·e = 3, one beyond the cube (empty); in the direction (1, 2, 0) with a plane lo = hi
+    given as a linearity; and the centre plane for c = ±(1, 1, 1)/4 (crossings of both
+    orientations, at distances below 1)."""
+    cube = _cube(3)
+    G, vr = po.exact_hull(cube)
+    third, q = fmpq(1, 3), fmpq(1, 4)
+    cases = [
+        ((1, 1, 1), 0, 0),
+        ((1, 1, 1), 1, 1),
+        ((1, 1, 1), fmpq(-1, 2), fmpq(1, 2)),
+        ((1, 1, 1), 2, 3),
+        ((1, 1, 1), 4, 5),
+        ((1, 2, 0), third, third),
+        ((1, 2, 0), -3, fmpq(-5, 2)),
+        ((q, q, q), 0, 0),  # signed distances of the crossing edges: ±1/4 (below 1)
+        ((-q, -q, -q), 0, 0),
+    ]
+    for cc, lo, hi in cases:
+        c = po.qarray(cc)
+        lo, hi = fmpq(lo), fmpq(hi)
+        cv = [po.qdot(c, v) for v in vr.V]
+        slicer = po.ExactSlicer(vr.V, vr.edges, c)
+        a = po.exact_slice_points(vr.V, vr.edges, cv, lo, hi)
+        b = slicer.points(lo, hi)
+        if lo > 3:
+            assert a == [] and b == []
+            continue
+        W = po.exact_vertices_of_slice(G, c.reshape(1, 3), [lo], [hi])
+        for pts in (a, b):
+            got = {tuple(p) for p in pts}
+            assert {tuple(w) for w in W} <= got, (cc, lo, hi)
+            for p in pts:
+                assert lo <= po.qdot(c, p) <= hi and max(po.qdot(r, p) for r in G) <= 1
+
+
+def test_round_half_even_is_pythons_round_of_the_fraction():
+    """_round_half_even(num, den) = round(Fraction(num, den)): nearest integer, ties to the
+    even one, for either sign (the dyadic grid of rationalize)."""
+    from fractions import Fraction
+
+    for num in range(-13, 14):
+        for den in (1, 2, 3, 4, 6):
+            assert po._round_half_even(num, den) == round(Fraction(num, den)), (num, den)

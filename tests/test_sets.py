@@ -43,7 +43,9 @@ def test_sampling_stays_inside(seed: int):
     pts = E.sample(rng, 30)
     assert np.all(E.contains(pts))
     lo, hi = E.bounding_box()
-    np.testing.assert_allclose(lo, [0.5, -1]) and np.testing.assert_allclose(hi, [1.5, 1])
+    # two statements: assert_allclose returns None, so `a and b` never checked hi (helper)
+    np.testing.assert_allclose(lo, [0.5, -1])
+    np.testing.assert_allclose(hi, [1.5, 1])
 
 
 def test_float_views_are_rounded_cached_and_read_only():
@@ -56,3 +58,65 @@ def test_float_views_are_rounded_cached_and_read_only():
     assert P.g.shape == (3,) and P.G.shape == (3, 2)  # g is flat even from a column
     E = Ellipsoid(qmat([[4, 0], [0, 1]]), qvec([fmpq(1, 10), 0]))
     assert E.center.tolist() == [0.1, 0.0] and not E.E.flags.writeable
+
+
+# -- mutation review 22 (exact vertices, H-forms) ----------------------------------------------
+
+
+def test_vertices_exact_of_an_offset_triangle_and_the_unbounded_cases():
+    """cdd.gmp's exact vertices of {G x <= g} with right-hand sides other than 1 (the
+    triangle x + 2y <= 4, x >= 1, y >= 1/2: vertices (1, 1/2), (3, 1/2), (1, 3/2)); a
+    polyhedron with a ray (a quadrant) or a line (a slab) is unbounded; an empty one has no
+    vertex. check_polytope_q: (non-empty, bounded, exact) for each, and for a single point."""
+    from obsdesign.sets.polytope import check_polytope_q
+
+    G = qmat([[1, 2], [-1, 0], [0, -1]])
+    g = qvec([4, -1, fmpq(-1, 2)])
+    V, bounded = vertices_exact(G, g)
+    assert bounded and V.shape == (3, 2)
+    assert {tuple(v) for v in V} == {(1, fmpq(1, 2)), (3, fmpq(1, 2)), (1, fmpq(3, 2))}
+    assert all(isinstance(x, fmpq) for x in V.reshape(-1))
+    assert check_polytope_q(G, g) == (True, True, True)
+    assert {tuple(v) for v in Polytope(G, g).vertices_q()} == {tuple(v) for v in V}
+    quadrant = (qmat([[-1, 0], [0, -1]]), qvec([1, 1]))
+    V, bounded = vertices_exact(*quadrant)
+    assert not bounded and {tuple(v) for v in V} == {(-1, -1)}
+    assert check_polytope_q(*quadrant) == (True, False, True)
+    slab = (qmat([[1, 0], [-1, 0]]), qvec([1, 1]))
+    V, bounded = vertices_exact(*slab)
+    assert not bounded  # (cdd lists points of the slab besides its line)
+    assert check_polytope_q(*slab) == (True, False, True)
+    empty = (qmat([[1, 0], [-1, 0], [0, 1], [0, -1]]), qvec([-1, 0, 1, 1]))
+    V, bounded = vertices_exact(*empty)
+    assert V.shape == (0, 2)
+    assert check_polytope_q(*empty) == (False, False, True)
+    point = (qmat([[1], [-1]]), qvec([fmpq(1, 4), fmpq(-1, 4)]))  # D = {1/4}: one vertex
+    assert check_polytope_q(*point) == (True, True, True)
+
+
+def test_box_vertices_h_form_and_describe_exactly():
+    """A box's 2ⁿ exact vertices (every combination of the bounds, in product order) and its
+    H-form rows e_i ≤ u_i then −e_i ≤ −l_i; describe names the exact bounds; a point on
+    a face is inside (float membership)."""
+    b = Box(qvec([-1, fmpq(1, 3)]), qvec([2, fmpq(1, 2)]))
+    V = b.vertices_q()
+    third, half = fmpq(1, 3), fmpq(1, 2)
+    assert [tuple(v) for v in V] == [(-1, third), (-1, half), (2, third), (2, half)]
+    G, g = b.h_form_q()
+    assert G.tolist() == [[1, 0], [0, 1], [-1, 0], [0, -1]]
+    assert g.tolist() == [2, half, 1, -third]
+    assert b.describe() == "[-1, 2] × [1/3, 1/2]"
+    assert b.contains([2, 0.5]) and b.contains([-1, 0.4]) and not b.contains([2.001, 0.4])
+    assert b.contains(np.array([[0, 0.4], [0, 0.6]])).tolist() == [True, False]
+
+
+def test_ellipsoid_membership_and_bounding_box():
+    """(x − c)ᵀE(x − c) <= 1 (+ 10⁻¹² for rounding) with E = diag(4, 1), c = (1, 0): the
+    boundary points (1.5, 0) and (1, 1) are inside, (0.4, 0) (value 1.44) and (1, 1.01) are
+    not; the bounding box is c ± (1/2, 1), both of its corners checked."""
+    E = Ellipsoid(qmat([[4, 0], [0, 1]]), qvec([1, 0]))
+    pts = np.array([[1.5, 0], [1, 1], [0.4, 0], [1, 1.01]])
+    assert E.contains(pts).tolist() == [True, True, False, False]
+    assert E.contains([1.5, 0]) and not E.contains([0.4, 0])
+    lo, hi = E.bounding_box()
+    assert np.allclose(lo, [0.5, -1]) and np.allclose(hi, [1.5, 1])
