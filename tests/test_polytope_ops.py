@@ -582,3 +582,21 @@ def test_round_half_even_is_pythons_round_of_the_fraction():
     for num in range(-13, 14):
         for den in (1, 2, 3, 4, 6):
             assert po._round_half_even(num, den) == round(Fraction(num, den)), (num, den)
+
+
+def test_exact_check_forms_refuses_a_repeated_facet_in_one_dimension() -> None:
+    """In one dimension the facets were compared as sets, so G = [[-1], [1], [1]] (a facet
+    listed twice) passed while every dimension ≥ 2 refuses a repeated row (mutation review,
+    session 22)."""
+    ok, why, _ = po.exact_check_forms(po.qarray([[-1], [1], [1]]), po.qarray([[-1], [1]]))
+    assert not ok and "not the facets" in why
+    assert po.exact_check_forms(po.qarray([[-1], [1]]), po.qarray([[-1], [1]]))[0]
+
+
+def test_canonical_takes_a_numpy_integer_right_hand_side() -> None:
+    """``canonical(G, np.array([2, 3]))`` raised TypeError: Fraction(np.int64) kept a numpy
+    numerator that fmpq refuses (mutation review, session 22)."""
+    from flint import fmpq
+
+    H = po.canonical(po.qarray([[1, 0], [0, 1]]), np.array([2, 3]))
+    assert {tuple(r) for r in H} == {(fmpq(1, 2), fmpq(0)), (fmpq(0), fmpq(1, 3))}

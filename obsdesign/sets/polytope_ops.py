@@ -306,6 +306,8 @@ def _fr(x: Any) -> Fraction:
         return Fraction(int(x.p), int(x.q))
     if isinstance(x, (float, np.floating)):
         return Fraction(float(x))
+    if isinstance(x, np.integer):  # Fraction(np.int64) keeps a numpy numerator, which fmpq
+        return Fraction(int(x))  # refuses (canonical with an integer array; mutation review)
     return Fraction(x)
 
 
@@ -1066,7 +1068,9 @@ def exact_check_forms(G: np.ndarray, V: np.ndarray) -> tuple[bool, str, ExactVRe
         return False, str(e), None
     if len(vrep.V) != len(V):
         return False, f"{len(V) - len(vrep.V)} of the reported vertices are not vertices", None
-    if {tuple(r) for r in H} != {tuple(r) for r in G}:
+    if len(G) != len(H) or {tuple(r) for r in H} != {tuple(r) for r in G}:
+        # the length too: a set comparison accepted a G that lists a facet twice in one
+        # dimension, which every higher dimension refuses (mutation review 22)
         return False, "the rows of G are not the facets of conv(V)", None
     return True, forms_detail(len(V), len(H)), vrep
 
