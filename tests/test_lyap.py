@@ -687,3 +687,285 @@ def test_decay_pd_small_not_dominant_goes_to_the_ldlt() -> None:
     assert res.ok and res.path == "fraction-free" and H is None
     res, H = lyap.decay_pd(A, P, fmpq(1, 2), True, 0)  # (1/4 − 1/4)·P = 0
     assert not res.ok and H is not None
+
+
+# -- mutation review 22 (obsdesign/lyap.py): each test names the mutant it kills ----------------
+def _scalar_decay(discrete: bool) -> tuple[np.ndarray, np.ndarray, fmpq, fmpq]:
+    """A = ±I/3, P = diag(1, 2) and a rate 10⁻¹⁰ inside the spectral bound: the decay matrix
+    is μ·diag(1, 2) with μ > 0 exact and tiny, while the products behind it are of size 1, so
+    the enclosure's error bound e (~10⁻¹⁶, rigorous) is far above the float error of the
+    verified Cholesky of the enclosed matrix (~10⁻²⁶)."""
+    s = fmpq(1, 3)
+    P = qmat([[1, 0], [0, 2]])
+    if discrete:
+        rate = s + fmpq(1, 10**10)
+        return qmat([[s, 0], [0, s]]), P, rate, rate * rate - s * s
+    rate = s - fmpq(1, 10**10)
+    return qmat([[-s, 0], [0, -s]]), P, rate, 2 * (s - rate)
+
+
+@pytest.mark.parametrize("discrete", [True, False])
+def test_decay_pd_enclosure_raises_the_margin_by_its_error_bound(
+    discrete: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Kills `_enclosure_pd` 45 (`verified_pd_float(H, m + e)` → `m − e`): at δ = μ the exact
+    decay matrix − δI is singular, but the float matrix H − (δ − e)I is clearly positive
+    definite, so the mutant certified a false decay claim through the float enclosure (the
+    small-n exact path is switched off, as at n > FFLU_MAX_N). δ slightly below μ is still
+    proved by the enclosure."""
+    monkeypatch.setattr(lyap, "FFLU_MAX_N", 0)
+    A, P, rate, mu = _scalar_decay(discrete)
+    for m in (mu, mu + TINY):
+        res, _ = lyap.decay_pd(A, P, rate, discrete, m)
+        assert not res.ok and res.path != "float-enclosure", (m, res)
+    res, _ = lyap.decay_pd(A, P, rate, discrete, mu - mu / 1000)
+    assert res.ok and res.path == "float-enclosure"
+
+
+@pytest.mark.parametrize("discrete", [True, False])
+def test_decay_pd_exact_fallback_below_the_enclosures_resolution(
+    discrete: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Kills `decay_pd` 68 (`decay_int(Am, Pm, rate, discrete)` → `…, None)` in the exact
+    fallback: a discrete check decided on the continuous decay matrix): δ = μ − 10⁻³⁰ is
+    within the enclosure's error bound of λ_min, so only the final exact test proves it; on
+    the continuous matrix of A = I/3 (−(2/3 + 2λ)·P ≺ 0) the mutant refused it."""
+    monkeypatch.setattr(lyap, "FFLU_MAX_N", 0)
+    A, P, rate, mu = _scalar_decay(discrete)
+    res, _ = lyap.decay_pd(A, P, rate, discrete, mu - TINY)
+    assert res.ok and res.path != "float-enclosure", res
+
+
+@pytest.mark.parametrize("discrete", [True, False])
+def test_decay_pd_ignores_a_float_copy_of_P_of_another_shape(
+    discrete: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Kills `_enclosure_pd` 17 (`shape != … or not finite` → `and`) and 20 (`!=` → `==`): a
+    float copy of P of the wrong shape is replaced by P's own correctly rounded copy, never
+    used in the enclosure (the mutants used a 3×3 identity that proves nothing about this P,
+    or crashed). The decay matrix of P = diag(1, −1) is indefinite: refused either way."""
+    monkeypatch.setattr(lyap, "FFLU_MAX_N", 0)
+    A, _, rate, _ = _scalar_decay(discrete)
+    P = qmat([[1, 0], [0, -1]])
+    res, _ = lyap.decay_pd(A, P, rate, discrete, 0, None, np.eye(3))
+    assert not res.ok
+    A, P, rate, mu = _scalar_decay(discrete)
+    res, _ = lyap.decay_pd(A, P, rate, discrete, mu / 2, None, np.eye(3))
+    assert res.ok and res.path == "float-enclosure"
+
+
+@pytest.mark.parametrize("discrete", [True, False])
+def test_decay_pd_of_a_P_beyond_the_float_range_is_decided_exactly(
+    discrete: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Kills `_enclosure_pd` 26 (`Af is None or Pf is None` → `and`): P = 2¹¹⁰⁰·diag(1, 2) has
+    no float copy; the enclosure is skipped and the exact test decides (the mutant passed None
+    to the enclosure and raised): δ = 2¹¹⁰⁰·μ/2 is proved, δ = 2¹¹⁰⁰·μ refused."""
+    monkeypatch.setattr(lyap, "FFLU_MAX_N", 0)
+    A, P, rate, mu = _scalar_decay(discrete)
+    big = fmpq(2**1100)
+    P = P * big
+    assert lyap.decay_pd(A, P, rate, discrete, big * mu / 2)[0].ok
+    assert not lyap.decay_pd(A, P, rate, discrete, big * mu)[0].ok
+
+
+def test_decay_factor_is_lambda_squared_or_two_alpha() -> None:
+    """Kills `decay_factor` 4 (`r * r if discrete or True`): ρ of eq. (6) is λ² in discrete
+    time but 2α in continuous time (V̇ ≤ −2αV + μ|w|²); the mutant gave α², with which the
+    ISS claim of a continuous report checked a weaker inequality than it states (α < 2)."""
+    assert lyap.decay_factor(fmpq(1, 2), True) == fmpq(1, 4)
+    assert lyap.decay_factor(fmpq(1, 2), False) == 1
+    assert lyap.decay_factor(3, False) == 6
+
+
+def test_pd_verdict_never_proves_with_a_float_copy_of_another_matrix(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Kills `_pd_float` 3 (`n == 0 or Pf.shape != (n, n)` → `and`), 11 (`not (finite and
+    symmetric)` → `(finite and symmetric)`) and 12 (`and` → `or`): P = [[1, 2], [2, 1]] is
+    indefinite; a float copy that is not P's (another shape, or not symmetric) must not be
+    given to the verified Cholesky, which proves that copy positive definite (the mutants
+    certified P ≻ 0). The exact test decides instead."""
+    monkeypatch.setattr(lyap, "FFLU_MAX_N", 0)
+    P = qmat([[1, 2], [2, 1]])
+    Pm = lyap.fmat(P)
+    for Pf in (np.eye(3), np.array([[1.0, 0.0], [0.5, 1.0]])):
+        assert lyap._pd_float(Pm, fmpq(0), Pf) is None
+        r = lyap.pd_verdict(P, 0, None, Pm, Pf)
+        assert not r.ok and r.path != "verified-float"
+    good = lyap.pd_verdict(qeye(2), fmpq(1, 2), None, None, np.eye(2))
+    assert good.ok and good.path == "verified-float"
+
+
+def test_observable_mod_p_edge_cases() -> None:
+    """Kills `observable_mod_p` 6 (`n == 0` → `n == 1`), 7 (n = 0 → False) and 10 (no output →
+    True): an empty state is observable; a plant without outputs is not proved observable
+    (the mutant "proved" it, skipping the detectability test of the design); a 1-state plant
+    is proved observable only when its output sees the state."""
+    assert lyap.observable_mod_p(
+        qmat(np.zeros((0, 0), dtype=int)), qmat(np.zeros((1, 0), dtype=int))
+    )
+    assert not lyap.observable_mod_p(qmat([[2, 1], [0, 3]]), qmat(np.zeros((0, 2), dtype=int)))
+    assert not lyap.observable_mod_p(qmat([[2]]), qmat([[0]]))
+    assert lyap.observable_mod_p(qmat([[2]]), qmat([["1/3"]]))
+
+
+def test_memo_of_only_returns_an_exact_memo() -> None:
+    """Kills `memo_of` 8 (`isinstance(m, ExactMemo) or True`): an attribute of that name
+    that is not an :class:`ExactMemo` is not taken for the design's verdicts."""
+
+    class Spec:
+        pass
+
+    s = Spec()
+    assert lyap.memo_of(s) is None
+    setattr(s, lyap.MEMO_ATTR, {"decay": True})
+    assert lyap.memo_of(s) is None
+    memo = lyap.ExactMemo()
+    lyap.attach_memo(s, memo)
+    assert lyap.memo_of(s) is memo
+
+
+@pytest.mark.parametrize("discrete", [True, False])
+def test_iss_matrix_two_disturbance_channels_known_answer(discrete: bool) -> None:
+    """Kills `iss_matrix` 66 (continuous: the off-diagonal entries of μI → 1): with two
+    channels w the lower-right block is μI − B_wᵀPB_w (discrete) or μI (continuous), entry by
+    entry, against the block matrix built independently in object arrays."""
+    Acl = qmat([["1/2", "1/3"], [0, "-1/4"]]) if discrete else qmat([[-1, "1/3"], [0, -2]])
+    Bw = qmat([[1, 0], [0, 2]])
+    P = qmat([[2, "1/2"], ["1/2", 1]])
+    rho, mu = fmpq(1, 2), fmpq(7)
+    M = iss_matrix(Acl, Bw, P, rho, mu, discrete)
+    if discrete:
+        S = P * rho - Acl.T @ P @ Acl
+        off = -(Acl.T @ P @ Bw)
+        low = qeye(2) * mu - Bw.T @ P @ Bw
+    else:
+        S = -(Acl.T @ P + P @ Acl + P * rho)
+        off = -(P @ Bw)
+        low = qeye(2) * mu
+    want = np.block([[(S + S.T) * fmpq(1, 2), off], [off.T, low]])
+    assert M.tolist() == want.tolist()
+    assert M[3, 2] == M[2, 3] == (-(Bw.T @ P @ Bw)[0, 1] if discrete else 0)
+
+
+@pytest.mark.parametrize("rate, feasible", [(fmpq(3, 5), True), (fmpq(2, 5), False)])
+def test_rate_feasibility_without_a_float_solution_takes_the_polynomial_test(
+    rate: fmpq, feasible: bool
+) -> None:
+    """Kills `_rate_feasibility` 15 (`X is not None and …` → `or`): A − LC = [[1/2, 10²⁰⁰],
+    [0, 1/2]] overflows the float Lyapunov operator (no X), so the inertia certificate is
+    skipped and the exact Schur–Cohn test decides (eigenvalue 1/2); the mutant rounded X =
+    None and raised."""
+    A = qmat([["1/2", 10**200], [0, "1/2"]])
+    ok, how = lyap.rate_feasibility(A, rate, True)
+    assert ok is feasible and how == lyap.stability_test(True)
+
+
+def test_margin_scale_is_the_least_power_of_two_at_an_exact_power() -> None:
+    """Kills `margin_scale` 52 (`while c < need` → `c <= need`): when 2δ/λ_min(P) is itself a
+    power of two, c is that power (P = I, δ = 1/2: c = 1; δ = 2: c = 4), not twice it."""
+    assert lyap.margin_scale(np.eye(2), fmpq(1, 2)) == 1
+    assert lyap.margin_scale(np.eye(2), fmpq(2)) == 4
+    assert lyap.margin_scale(np.diag([0.5, 3.0]), fmpq(1, 2)) == 2
+
+
+def test_rate_feasibility_edge_cases_known_answers() -> None:
+    """Kills `rate_feasibility` 7 (`n == 0` → `n == 1`: every 1-state A − LC "feasible"),
+    8 (the empty matrix infeasible), 12 (`r <= 0` → `r < 0`: λ = 0 reached the Schur–Cohn
+    test of (A − LC)/λ and divided by zero) and 14 (λ ≤ 0 feasible): the scalar error
+    dynamics z is feasible exactly when |z| < λ (discrete) or z < −α (continuous, α of any
+    sign); no λ ≤ 0 is feasible, and the empty matrix always is."""
+    empty = qmat(np.zeros((0, 0), dtype=int))
+    assert lyap.rate_feasibility(empty, fmpq(1, 2), True) == (True, "empty matrix")
+    z = qmat([["1/2"]])
+    assert lyap.rate_feasibility(z, fmpq(3, 5), True)[0]
+    assert not lyap.rate_feasibility(z, fmpq(1, 2), True)[0]
+    assert not lyap.rate_feasibility(z, fmpq(2, 5), True)[0]
+    for lam in (fmpq(0), fmpq(-1, 2), fmpq(-1)):
+        assert lyap.rate_feasibility(z, lam, True) == (False, "λ ≤ 0")
+        assert not lyap.rate_feasibility(qmat([[0, 0], [0, 0]]), lam, True)[0]
+    assert lyap.rate_feasibility(z, fmpq(-3, 5), False)[0]  # 1/2 < 3/5 = −α
+    assert not lyap.rate_feasibility(z, fmpq(-1, 2), False)[0]
+    assert not lyap.rate_feasibility(qmat([["-1/2"]]), fmpq(1, 2), False)[0]
+    assert lyap.rate_feasibility(qmat([["-1/2"]]), fmpq(2, 5), False)[0]
+
+
+def test_passes_takes_the_exact_decay_verdict_not_the_float_one() -> None:
+    """Kills `_passes` 31 (`decay_verdict(…)[0]` → `[1]`: the float verdict beside the exact
+    one accepted the candidate P). Random 3-state A − LC and the rounded Lyapunov P; the
+    margin δ is bracketed to 2⁻¹²⁰ around λ_min of the exact decay matrix by exact
+    bisection: just below it both checks pass, just above it the exact check refuses while
+    the float matrix (rounded from the exact one) cannot see the difference and often calls
+    it positive definite, which the mutant then certified."""
+    from obsdesign.certify.psd import check_pd
+
+    for seed in range(8):
+        rng = np.random.default_rng(seed)
+        A = qmat([[fmpq(int(v), 9) for v in row] for row in rng.integers(-4, 5, (3, 3))])
+        Af = np.asarray(A, dtype=float)
+        r = dyadic(float(np.max(np.abs(np.linalg.eigvals(Af)))) * 1.2 + 0.05, 20)
+        Pm, _ = lyap.dyadic_fmat(lyap.solve_lyapunov(Af, float(r), True), 40)
+        Pm = lyap._sym(Pm)
+        P, Am = lyap.as_array(Pm), lyap.fmat(A)
+        M = lyap.as_array(lyap.decay_fmat(Am, Pm, r, True))
+        lmin = float(np.linalg.eigvalsh(np.asarray(M, dtype=float))[0])
+        lo, hi = dyadic(lmin * 0.99, 50), dyadic(lmin * 1.01, 50)
+        while hi - lo > lo / 2**120:
+            mid = (lo + hi) / 2
+            lo, hi = (mid, hi) if check_pd(M, mid).ok else (lo, mid)
+        assert check_pd(P, hi).ok  # P − δI ≻ 0: only the decay check decides
+        assert lyap._passes(Am, P, Pm, r, True, lo, None, None)
+        assert not lyap._passes(Am, P, Pm, r, True, hi, None, None)
+
+
+def test_closed_loop_fmat_of_flint_matrices_and_of_no_output() -> None:
+    """Kills `closed_loop_fmat` 3 (`A − L C` → `A + L C` for flint inputs), 4 (`L C` →
+    `L / C`) and 14/16/18 (the no-output branch): A − LC is the same exact matrix for flint
+    and for object-array inputs, and A itself when there is no output (p = 0)."""
+    A = qmat([["1/2", 1], [0, "-1/3"]])
+    C = qmat([[1, "2/3"]])
+    L = qmat([["1/5"], [-2]])
+    want = lyap.fmat(A - L @ C)
+    assert lyap.closed_loop_fmat(A, C, L) == want
+    assert lyap.closed_loop_fmat(lyap.fmat(A), lyap.fmat(C), lyap.fmat(L)) == want
+    C0 = np.zeros((0, 2), dtype=object)
+    L0 = np.zeros((2, 0), dtype=object)
+    assert lyap.closed_loop_fmat(A, C0, L0) == lyap.fmat(A)
+    assert lyap.as_array(lyap.closed_loop_fmat(A, C0, L0)).tolist() == A.tolist()
+
+
+@pytest.mark.parametrize(("lam", "feasible"), [(fmpq(1, 4), False), (fmpq(3, 4), True)])
+def test_inertia_certificate_is_sound_for_any_candidate_X(
+    lam: fmpq, feasible: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Kills `_rate_feasibility` 40 (`decay_pd(Am, Xq, r, discrete, 0, Af, Xq_f)` →
+    `decay_pd(…, 0, Xq_f)`: X's float copy taken for A − LC's in the float enclosure of
+    D(X)). The float Lyapunov solution is only a candidate; here it is replaced by X = I/8
+    with A − LC = I/2 (spectral radius 1/2). At λ = 1/4, D(X) = (1/8)(1/16 − 1/4)·I ≺ 0, so
+    the inertia certificate does not apply and the Schur–Cohn test refuses λ; the mutant's
+    enclosure of λ²X − XᵀXX ≻ 0 "proved" D(X) ≻ 0 and, X ≻ 0, called λ = 1/4 feasible. At
+    λ = 3/4, D(X) ≻ 0 and X ≻ 0 prove λ feasible."""
+    monkeypatch.setattr(lyap, "FFLU_MAX_N", 0)  # the float enclosure runs first, as at n > 10
+    monkeypatch.setattr(lyap, "_lyap_solution", lambda Af, r, discrete: np.eye(2) / 8)
+    A = qmat([["1/2", 0], [0, "1/2"]])
+    ok, how = lyap.rate_feasibility(A, lam, True)
+    assert ok is feasible
+    assert ("inertia" in how) is feasible
+
+
+def test_dyadic_fmat_at_the_int64_shift_limit() -> None:
+    """Kills `dyadic_fmat` 63 (`sh ≤ 62 − bits` → `≤ 63 − bits` for the int64 shift) and 4
+    (`bits ≤ 62` → `< 62`): 1 − 2⁻⁴⁵ rounds up to 2⁴⁰·2⁻⁴⁰ at 40 bits, and beside 2⁻²⁴ it
+    needs a shift of 23 = 63 − 40, so 2⁴⁰ ≪ 23 = 2⁶³ overflows int64 (the mutant wrapped it to
+    −2⁶³: the exact matrix no longer matched its float copy, which the float enclosure of
+    the inertia certificate relies on). The result is `dyadic` entry by entry, with its float
+    copy; 62 bits are allowed."""
+    from obsdesign.certify import vchol
+
+    x = np.array([[1 - 2.0**-45, 2.0**-24], [-(1 - 2.0**-45), 0.0]])
+    for bits in (40, 62):
+        F, fl = lyap.dyadic_fmat(x, bits)
+        assert F == lyap.fmat(dyadic(x, bits))
+        assert (vchol.to_float(F) == fl).all()
+    assert lyap.dyadic_fmat(x, 40)[0][0, 0] == 1

@@ -176,3 +176,24 @@ def test_margin_scale_sees_lambda_min_of_an_ill_conditioned_P(margin: str) -> No
     lmin = lyap._lambda_min_by_inverse(Pm, -1.0)
     assert lmin > 0
     assert lyap.margin_scale(Pf, Q(margin), Pm) >= lyap.margin_scale(Pf, Q(margin))
+
+
+# -- mutation review 22 (obsdesign/lyap_hp.py) -------------------------------------------------
+@pytest.mark.parametrize(
+    "acl, rate, discrete, want",
+    [
+        ([[0, 0], [0, 0]], fmpq(1, 2), True, [[4, 0], [0, 4]]),
+        ([[0, 0], [0, 0]], 1, True, [[1, 0], [0, 1]]),
+        ([["-17/8", 0], [0, "-9/4"]], 2, False, [[4, 0], [0, 2]]),
+    ],
+)
+def test_hp_P_with_integer_entries_is_exact(acl: list, rate: object, discrete: bool, want: list):
+    """Kills `lyapunov_P_hp` 51 (`m << e` → `m >> e`: an entry m·2^e with e > 0, an even
+    integer, lost its exponent: 4 became 0) and 11 (a rate given as a Python int converted as
+    fmpq(None)): the Lyapunov P with decay matrix I of a diagonal Acl, at rates where it is
+    an integer matrix (λ = 1/2, Acl = 0: 4I; continuous, F = Acl + 2I = diag(−1/8, −1/4):
+    diag(4, 2)), comes back exactly, and its decay matrix is I exactly."""
+    Am = lyap.fmat(qmat(acl))
+    P = lyap_hp.lyapunov_P_hp(Am, rate, discrete, 128)
+    assert P == fmpq_mat(want)
+    assert lyap.decay_fmat(Am, P, Q(rate), discrete) == fmpq_mat([[1, 0], [0, 1]])

@@ -1067,3 +1067,26 @@ def test_a_continuous_companion_plant_takes_the_high_precision_riccati() -> None
     assert rep.solver["name"] == "structure-preserving doubling at 128 bits (python-flint arb_mat)"
     assert float(rep.parameters.float("alpha_best")) > 0.5
     assert api.verify(rep).exit_code() == 0
+
+
+# -- mutation review 22 (obsdesign/lyap.py) ---------------------------------------------------
+@pytest.mark.parametrize(
+    ("name", "which", "tamper", "expected"), TAMPERS, ids=[t[0] for t in TAMPERS]
+)
+def test_tamper_fails_with_the_designs_memo_at_hand(
+    name: str, which: str, tamper: Callable, expected: set[str], tmp_path: Path
+) -> None:
+    """Every tamper test again, certified on the very spec object the design ran on, so that
+    the design's exact verdicts (`ExactMemo`) are at hand: they must be looked up by every
+    input of the check, not only by the matrices. Kills `decay_verdict` 6 (the key ("decay",
+    rate, margin, time) → None: λ tampered alone past the edge of the decay LMI, P unchanged,
+    got the verdict the design recorded for P at its own rate and was certified) and
+    `rate_feasibility` 17 (the key ("feasible", rate, time) → None: the bracket's end moved to
+    a feasible rate got the design's verdict at another rate, same A − LC)."""
+    spec = api.load_spec(_case_spec(which, tmp_path))
+    rep = api.design(spec)
+    assert rep.exit_code() == 0 and lyap.memo_of(spec) is not None
+    assert all(c.ok for c in api.certify(spec, rep.parameters))
+    tamper(rep.parameters, spec)
+    failed = {c.id for c in api.certify(spec, rep.parameters) if not c.ok}
+    assert failed == expected
