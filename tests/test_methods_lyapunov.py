@@ -1090,3 +1090,37 @@ def test_tamper_fails_with_the_designs_memo_at_hand(
     tamper(rep.parameters, spec)
     failed = {c.id for c in api.certify(spec, rep.parameters) if not c.ok}
     assert failed == expected
+
+
+@pytest.mark.parametrize("time", ["discrete", "continuous"])
+def test_a_rate_that_is_not_positive_is_no_decay_rate(time: str) -> None:
+    """λ_best = −λ passed the discrete decay LMI (λ² keeps no sign) and the claim was
+    certified "with λ_best = −0.9501" through the API (mutation review, session 22). A decay
+    claim needs the rate > 0, exactly; the true rate still certifies."""
+    A = "[[0.5, 1.0], [0.0, 0.3]]" if time == "discrete" else "[[-1.0, 1.0], [0.0, -2.0]]"
+    text = f'[system]\ntime = "{time}"\nA = {A}\nC = [[1.0, 0.0]]\n[method]\nkey = "lyapunov"\n'
+    spec = api.load_spec_text(text, "x.toml")
+    p = api.design(spec).parameters
+    name = "lambda" if time == "discrete" else "alpha"
+    ok = {c.id: c for c in api.certify(api.load_spec_text(text, "x.toml"), p)}
+    assert ok["decay-lmi_best"].status == ClaimStatus.CERTIFIED
+    p[f"{name}_best"] = -p[f"{name}_best"]
+    got = {c.id: c for c in api.certify(api.load_spec_text(text, "x.toml"), p)}
+    assert got["decay-lmi_best"].status == ClaimStatus.FAILED
+    assert "is not positive" in got["decay-lmi_best"].detail
+
+
+def test_certify_decides_a_gain_beyond_the_float_range() -> None:
+    """``certify`` with an exact L = 10⁴⁰⁰ raised OverflowError in ``lyap.mat_float`` (its
+    fallback called float() on the entries; mutation review, session 22) instead of failing
+    the claims: the float copy is ±inf there and the exact checks decide."""
+    from obsdesign.certify.exact import qmat
+
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.5, 1.0], [0.0, 0.3]]\nC = [[1.0, 0.0]]\n'
+        '[method]\nkey = "lyapunov"\n'
+    )
+    p = api.design(api.load_spec_text(text, "x.toml")).parameters
+    p["L"] = qmat([[fmpq(10**400)], [0]])
+    got = {c.id: c.status for c in api.certify(api.load_spec_text(text, "x.toml"), p)}
+    assert got["decay-lmi"] == ClaimStatus.FAILED and got["decay-lmi_best"] == ClaimStatus.FAILED

@@ -172,15 +172,18 @@ def decay_claim(
         stmt = f"(A−LC)ᵀP{suffix}(A−LC) ⪯ λ{suffix}²·P{suffix} with λ{suffix} = {x}"
     else:
         stmt = f"(A−LC)ᵀP{suffix} + P{suffix}(A−LC) ⪯ −2α{suffix}·P{suffix} with α{suffix} = {x}"
+    # a rate is positive: λ = −0.95 passed the LMI (λ² keeps no sign) and was certified as a
+    # decay rate through the API (mutation review 22); the spec's own rate is checked > 0
+    positive = Q(rate) > 0
     return c.exact(
         id=f"decay-lmi{suffix}",
         statement=stmt,
         reference=REF,
-        check=f"{check_text(r)}, of the matrix rebuilt from the spec",
-        passed=r.ok,
+        check=f"{check_text(r)}, of the matrix rebuilt from the spec; the rate > 0 exactly",
+        passed=r.ok and positive,
         margin=margin,
-        detail=r.detail,
-        float_ok=fl,
+        detail=r.detail if positive else f"the rate {x} is not positive (a decay rate is > 0)",
+        float_ok=fl if positive else False,
     )
 
 
