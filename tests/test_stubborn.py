@@ -679,20 +679,26 @@ def test_the_disturbance_enters_the_simulated_error(time: str) -> None:
     assert np.abs(err).max() > 0.01  # d moves the plant; the estimate cannot follow at once
 
 
+def _redesign_run(K: float, lam: float, dt: float) -> tuple[Any, Any, list[str]]:
+    """A certified continuous redesign of ẋ = −x, y = x with the given K and λ, and the
+    warnings of its noise-free single run at step ``dt``: (spec, report, warnings)."""
+    text = (
+        '[system]\ntime = "continuous"\nA = [[-1]]\nC = [[1]]\n[method]\nkey = "stubborn"\n'
+        f'mode = "redesign"\nK = [[{K}]]\nlambda = {lam}\n[simulate]\nhorizon = 0.05\n'
+        f"dt = {dt}\nx0 = [1]\nxhat0 = [0]\nnoise_std = 0\noutlier_rate = 0\nruns = 2\n"
+    )
+    sp = api.load_spec_text(text, "h.toml")
+    rep = api.design(sp)
+    assert rep.exit_code() == 0
+    return sp, rep, api.simulate(sp, rep).info.get("warnings", [])
+
+
 def test_a_step_too_large_for_heun_is_warned() -> None:
     """K = 10⁴ (given), dt = 10⁻³: dt·|eig(A − KC)| ≈ 10 > 2, so Heun's method is unstable
     and the simulated error may grow although the design is certified: simulate says so and
     gives the largest safe dt. At dt = 10⁻⁵ no warning."""
-    base = (
-        '[system]\ntime = "continuous"\nA = [[-1]]\nC = [[1]]\n[method]\nkey = "stubborn"\n'
-        'mode = "redesign"\nK = [[10000]]\nlambda = 1\n[simulate]\nhorizon = 0.05\n'
-        "dt = {dt}\nx0 = [1]\nxhat0 = [0]\nnoise_std = 0\noutlier_rate = 0\n"
-    )
     for dt, warned in ((0.001, True), (0.00001, False)):
-        sp = api.load_spec_text(base.format(dt=dt), "h.toml")
-        rep = api.design(sp)
-        assert rep.exit_code() == 0
-        notes = api.simulate(sp, rep).info.get("warnings", [])
+        _, _, notes = _redesign_run(10000, 1, dt)
         hit = [w for w in notes if "too large for this gain" in w]
         assert bool(hit) is warned, notes
         if warned:
@@ -1131,16 +1137,8 @@ def test_a_step_too_large_for_the_adaptive_level_is_warned() -> None:
     the Heun step of σ̄' = −λσ̄ + e_yᵀRe_y is unstable (at λ = 262144, dt = 10⁻³ it sent σ̄ to 0
     at once and the outlier study's constant levels were 0), while dt·|eig(A − KC)| = 0.03 is
     fine. The single run and the outlier study both warn, naming λ; at dt = 10⁻³ neither."""
-    base = (
-        '[system]\ntime = "continuous"\nA = [[-1]]\nC = [[1]]\n[method]\nkey = "stubborn"\n'
-        'mode = "redesign"\nK = [[2]]\nlambda = 1000\n[simulate]\nhorizon = 0.05\n'
-        "dt = {dt}\nx0 = [1]\nxhat0 = [0]\nnoise_std = 0\noutlier_rate = 0\nruns = 2\n"
-    )
     for dt, warned in ((0.01, True), (0.001, False)):
-        sp = api.load_spec_text(base.format(dt=dt), "lam.toml")
-        rep = api.design(sp)
-        assert rep.exit_code() == 0
-        notes = api.simulate(sp, rep).info.get("warnings", [])
+        sp, rep, notes = _redesign_run(2, 1000, dt)
         hit = [w for w in notes if "the rate λ of the adaptive level" in w]
         assert bool(hit) is warned, notes
         if warned:
