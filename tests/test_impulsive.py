@@ -323,11 +323,12 @@ def test_kappa_widest_with_a_huge_alpha_designs_and_verifies(tmp_path: Path) -> 
 
 
 def test_the_violation_warning_says_violated_once() -> None:
-    """The template's falsification warning read "… violated on the falsification region —
+    """The paper spec's falsification warning read "… violated on the falsification region —
     violated — (15) …" (outsider trial, session 22): the summary already begins with
     "violated — ". The note says it once."""
     from obsdesign import api
 
-    rep = api.design(api.load_spec_text(api.template("impulsive"), "template.toml"))
+    spec = Path(__file__).resolve().parents[1] / "specs" / "schaum-impulsive-example.toml"
+    rep = api.design(api.load_spec(spec))
     note = next(n for n in rep.notes if n.startswith("WARNING: Assumption 1"))
     assert note.count("violated") == 1, note

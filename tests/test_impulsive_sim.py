@@ -56,9 +56,18 @@ def test_sampling_file(tmp_path: Path) -> None:
 
 
 def test_template_designs() -> None:
-    """`obsdesign init impulsive` writes a spec that loads and designs."""
+    """`obsdesign init impulsive` writes a spec that loads and designs, and whose declared
+    Assumption 1 data hold: the falsification pass (``on_violation = "fail"``) finds no
+    violation. The template used to be the paper's example, whose sector data its ψ violates,
+    run with ``on_violation = "warn"``: a user's starting point that warned on first run."""
     spec = load_spec_text(get_method("impulsive").template(), "template.toml")
-    assert api.design(spec).exit_code() == 0
+    rep = api.design(spec)
+    assert rep.exit_code() == 0
+    assert not any("WARNING" in n for n in rep.notes), rep.notes
+    (fals,) = [c for c in rep.claims if c.id == "assumption1-falsification"]
+    assert fals.status.value == "numerical", fals
+    # the window docs/tutorial.md prints
+    assert (float(rep.parameters["T_min"]), float(rep.parameters["T_max"])) == (0.0748, 0.5549)
 
 
 def test_M_choices_with_lipschitz_x() -> None:
