@@ -422,3 +422,14 @@ def test_max_centres_beyond_the_memory_limit_is_refused() -> None:
     from obsdesign.methods.searchspace import sim as S
 
     S._check_centres(api.load_spec(SPEC), 2_000_000)
+
+
+def test_svg_plot_rasterizes_the_search_space(example, tmp_path):
+    """The centres are drawn as one embedded raster in a vector format: each was its own path
+    before, and the template's ``simulate --plot x.svg`` wrote 87 MB. The lines stay vectors."""
+    sp, _, res = example
+    n_centres = sum(len(c) for _, c in res.extra["stored"])
+    out = api.plot_simulation(sp, res, tmp_path / "figs.svg")
+    text = Path(out).read_text(encoding="utf-8")
+    assert n_centres > 20_000 and "<image" in text
+    assert len(text) < 2_000_000, (len(text), n_centres)

@@ -29,7 +29,11 @@ def plot_simulation(spec: Spec, res: SimResult, path: str | Path) -> Path:
     cs = np.concatenate([c for _, c in stored]) if stored else np.zeros((0, n))
     names = res.states or [f"x{i + 1}" for i in range(n)]
     for i, ax in enumerate(axes[:n]):
-        ax.scatter(ts, cs[:, i], s=1, c="tab:blue", alpha=0.35, lw=0, label="search space")
+        # rasterized: in a vector format (svg, pdf) each of up to millions of centres was its
+        # own path (the template's svg was 87 MB); the lines stay vectors
+        ax.scatter(
+            ts, cs[:, i], s=1, c="tab:blue", alpha=0.35, lw=0, label="search space", rasterized=True
+        )
         ax.plot(res.t, res.x[:, i], "k", lw=1.2, label=f"true {names[i]}")
         ax.plot(res.t, res.xhat[:, i], "tab:red", lw=0.8, label="centroid estimate")
         if i == 0 and res.y is not None:
