@@ -52,7 +52,23 @@ def method(key: str) -> Method:
 def bind(spec: Spec) -> Spec:
     """Bind the spec's method: parse ``[method]`` into ``spec.options`` and the method's own
     ``[simulate]`` keys into ``spec.simulate.options``; check the generic contract (linear
-    model present where the method needs it, no table the method does not read)."""
+    model present where the method needs it, no table the method does not read). An error
+    carries the spec's method key (``ObsdesignError.method_key``)."""
+    try:
+        return _bind(spec)
+    except ObsdesignError as e:
+        if e.method_key is None:
+            e.method_key = spec.method
+        raise
+
+
+def error_method(e: ObsdesignError) -> str | None:
+    """The method an error's spec declares (``[method].key``), when it names a known method."""
+    return e.method_key if e.method_key in method_keys() else None
+
+
+def _bind(spec: Spec) -> Spec:
+    """:func:`bind`."""
     if spec.options is not None:
         return spec
     mt = spec.method_table
@@ -897,14 +913,14 @@ def check_one(path: Path, timeout: float | None = None) -> CheckRow:
     ``timeout``: seconds for the whole spec (in the main thread; None: no limit), past which
     the row is exit 3 "not finished" (one spec that hung cost every row: CLI fuzzer)."""
     t0 = time.perf_counter()
-    method_key = "?"
+    seen = ["?"]  # the method, once the spec is loaded
     try:
         with _time_budget(timeout):
-            return _check_one(path, t0)
+            return _check_one(path, t0, seen)
     except SpecTimeout:
         return _error_row(
             path,
-            method_key,
+            seen[0],
             EXIT_SOLVER,
             t0,
             f"not finished within {timeout:g} s (check --timeout SECONDS; 0: no limit)",
@@ -918,11 +934,13 @@ def _error_row(path: Path, method_key: str, code: int, t0: float, message: str) 
     return CheckRow(str(path), method_key, code, 0, 0, 0, "", t, one_line(message))
 
 
-def _check_one(path: Path, t0: float) -> CheckRow:
+def _check_one(path: Path, t0: float, seen: list[str]) -> CheckRow:
+    """:func:`check_one` without the time budget; ``seen[0]`` becomes the spec's method once it
+    is loaded (the budget's row names it: a spec stopped by ``--timeout`` showed "?")."""
     method_key = "?"
     try:
         sp = load_spec(path)
-        method_key = sp.method
+        method_key = seen[0] = sp.method
         rep = design(sp)
         ver = verify(Report.from_dict(rep.to_dict())[0])
         code = ver.exit_code()
@@ -946,6 +964,7 @@ def _check_one(path: Path, t0: float) -> CheckRow:
             claims,
         )
     except ObsdesignError as e:
+        method_key = error_method(e) or method_key
         return _error_row(path, method_key, e.exit_code, t0, e.message)
     except Exception as e:  # noqa: BLE001 - one row per spec, whatever happened in it
         msg = f"internal failure: {type(e).__name__}: {e}"

@@ -44,6 +44,10 @@ class ObsdesignError(Exception):
     by :func:`one_line`)."""
 
     exit_code: int = EXIT_SOLVER
+    #: the ``[method].key`` of the spec the error arose in, when the spec was parsed far
+    #: enough to say it (set by the loader and the method binding): ``check`` and ``sweep``
+    #: rows of bad input name the method instead of "?"
+    method_key: str | None = None
 
     def __init__(self, message: str) -> None:
         message = one_line(message)

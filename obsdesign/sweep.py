@@ -510,7 +510,7 @@ def run_point(task: PointTask) -> dict[str, Any]:
         row["seconds"] = round(time.perf_counter() - t0, 4)
         return row
     except ObsdesignError as e:
-        row = failure_row(task, e.exit_code, e.message, method)
+        row = failure_row(task, e.exit_code, e.message, method or api.error_method(e) or "")
     except Exception as e:  # noqa: BLE001 - one row per point, whatever happened in it
         row = failure_row(task, EXIT_SOLVER, f"internal failure: {type(e).__name__}: {e}", method)
     row["seconds"] = round(time.perf_counter() - t0, 4)

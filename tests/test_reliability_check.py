@@ -69,6 +69,7 @@ def test_a_spec_past_its_time_budget_keeps_every_row(tmp_path: Path, monkeypatch
     rows = _rows(res.output)
     assert [r["code"] for r in rows] == [0, 3, 0]
     assert "not finished within 1 s" in rows[1]["message"]
+    assert rows[1]["method"] == "lyapunov"  # it was loaded: the row showed "?"
     assert res.exit_code == 3
 
 
@@ -134,3 +135,22 @@ def test_check_takes_one_path_as_a_string_or_a_path(tmp_path: Path) -> None:
         rows = api.check(one)
         assert [Path(r.spec).name for r in rows] == ["x.toml"] and rows[0].code == 0
     assert api.spec_files(str(tmp_path)) == [tmp_path / "x.toml"]
+
+
+def test_a_bad_input_row_names_the_declared_method(tmp_path: Path) -> None:
+    """A spec refused as bad input showed method "?" in check's rows (JSON, JUnit) even when
+    its TOML declared a known method (session 22's note). The row now names the method the
+    spec declares, whether the error came from the generic sections or the method's own keys;
+    an unknown or missing key, or a file that is not TOML, stays "?"."""
+    text = SPEC.read_text()
+    (tmp_path / "a.toml").write_text(text.replace("[system]", "[system]\nbogus = 1", 1))
+    (tmp_path / "b.toml").write_text(text.replace("[method]", "[method]\nbogus = 1", 1))
+    (tmp_path / "c.toml").write_text(text.replace('key = "lyapunov"', 'key = "lyapunv"'))
+    (tmp_path / "d.toml").write_text("not = [valid")
+    rows = {Path(r.spec).name: r for r in api.check(tmp_path)}
+    assert {k: (r.code, r.method) for k, r in rows.items()} == {
+        "a.toml": (2, "lyapunov"),
+        "b.toml": (2, "lyapunov"),
+        "c.toml": (2, "?"),
+        "d.toml": (2, "?"),
+    }, {k: r.message for k, r in rows.items()}

@@ -147,6 +147,8 @@ def test_mixed_good_and_bad_points_each_get_their_row_and_exit_code():
     assert [r["verdict"] for r in rows] == ["failed", "failed", "ok", "bad input", "ok"]
     assert "spectral radius" in rows[0]["message"]
     assert "[point 3]" in rows[3]["message"] and "lambda" in rows[3]["message"]
+    # a bad-input row names the spec's method (it was "": session 22's note)
+    assert [r["method"] for r in rows] == ["lyapunov"] * 5
     ok = rows[2]
     assert (ok["certified"], ok["numerical"], ok["failed"], ok["message"]) == (6, 0, 0, "")
     assert ok["lambda"] == 0.96 and 0.95 < ok["lambda_best"] < 0.951 and ok["mu"] > 0

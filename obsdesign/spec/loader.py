@@ -18,7 +18,7 @@ import numpy as np
 
 from obsdesign.certify.exact import qeye, qzeros
 from obsdesign.certify.psd import check_pd
-from obsdesign.errors import SpecError
+from obsdesign.errors import ObsdesignError, SpecError
 from obsdesign.limits import data_problem, int_digits, limits, read_input
 from obsdesign.sets import Box, Ellipsoid, Polytope, SymmetricPolytope
 from obsdesign.sets.base import ConvexSet
@@ -58,6 +58,18 @@ def read_spec_text(text: str, file: str = "<spec>") -> Spec:
             "one; save the file as plain UTF-8",
         )
     data = _parse_toml(text, file)
+    method = data.get("method")
+    declared = method.get("key") if isinstance(method, dict) else None
+    try:
+        return _spec(data, text, file)
+    except ObsdesignError as e:
+        if isinstance(declared, str) and e.method_key is None:
+            e.method_key = declared
+        raise
+
+
+def _spec(data: dict[str, Any], text: str, file: str) -> Spec:
+    """:func:`read_spec_text` on the parsed ``data`` of ``text``."""
     sha = hashlib.sha256(text.encode("utf-8")).hexdigest()
     root = Table(data, file, checked=True)  # _parse_toml walked every number
     title = root.str("title", default="")
