@@ -63,7 +63,9 @@ def bind(spec: Spec) -> Spec:
 
 
 def error_method(e: ObsdesignError) -> str | None:
-    """The method an error's spec declares (``[method].key``), when it names a known method."""
+    """The method an error's spec declares (``[method].key``), when it names a known method.
+
+    :param e: an error raised while loading or binding a spec."""
     return e.method_key if e.method_key in method_keys() else None
 
 
