@@ -857,3 +857,25 @@ def test_a_given_constant_equal_to_the_true_one_is_not_refuted(value: str, want)
     )
     assert "x1^1.5/3" in text and "lower = [0, 0]" in text
     assert _constant_status(_given(text, "L_h", value), "L_h", Q(value)) == want
+
+
+@pytest.mark.parametrize(
+    ("h", "L_h"),
+    [("2*x1*step(x1)", 2), ("1.001*x1*step(x1)", Q("1.001")), ("x1*step(-x1)", 1)],
+)
+def test_switch_products_in_h_design_and_verify(h: str, L_h, tmp_path) -> None:
+    """The shipped example with y = 2·x1·[x1 > 0], 1.001·x1·[x1 > 0] or x1·[x1 < 0]: each
+    was refused ("L_h^E has no finite interval bound on E … a jump?", exit 1) because only
+    X*step(X) and -X*step(X) were read as ramps (session 22's note). Now designed with a
+    tight L_h and verified."""
+    text = TEXT.replace('h = ["x1*step(x1)"]', f'h = ["{h}"]')
+    assert h in text
+    p = tmp_path / "s.toml"
+    p.write_text(text, encoding="utf-8")
+    rep = api.design(api.load_spec(p))
+    assert rep.exit_code() == 0, [c.detail for c in rep.failed]
+    # a valid constant, tight (1.001 has no float: its enclosure is rounded outward and up)
+    assert L_h <= rep.parameters["L_h"] <= L_h * Q("1.0001")
+    out = tmp_path / "r.json"
+    out.write_text(json.dumps(rep.to_dict()), encoding="utf-8")
+    assert api.verify(out).exit_code() == 0

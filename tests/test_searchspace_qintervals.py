@@ -29,6 +29,10 @@ TEMPLATES = [
     "{a}/(t + {k})",
     "(t - {c})*step(t - {c})",
     "-(t - {c})*step(t - {c})",
+    "{a}*(t - {c})*step({k}*(t - {c}))",
+    "(t - {c})*step(-(t - {c}))*{a}",
+    "(t - {c})*sign(t - {c})*{k}",
+    "t*(t - {c})*step(t - {c})",
     "sign(t - {c}) * {a}",
     "atan(t - {c}/3) * {a}",
     "sinh((t - {k})/4) + tanh(t - {c}/3)",
@@ -86,6 +90,11 @@ def test_enclosure_contains_the_exact_value(
         ("0.1*t^2 - t", -1, 2, (Fraction(-2), Fraction(7, 5))),  # no dependency tracking
         ("floor(t) - t + 1", Fraction(1, 2), 3, (Fraction(0), Fraction(1))),
         ("(t - 1)*step(t - 1)", 0, 2, (Fraction(0), Fraction(1))),
+        # the switch readings (switches.split): exact, where the product as written gave
+        # [-2, 2], [-1, 1] and [-1, 2]
+        ("2*(t - 1)*step(t - 1)", 0, 2, (Fraction(0), Fraction(2))),
+        ("(t - 1)*step(1 - t)", 0, 2, (Fraction(-1), Fraction(0))),
+        ("(t - 1)*sign(t - 1)", 0, 3, (Fraction(0), Fraction(2))),
         ("t/(t + 1)", 1, 3, (Fraction(1, 4), Fraction(3, 2))),
     ],
 )

@@ -22,8 +22,11 @@ Clarke's generalized gradient (``abs``: [−1, 1]·∇a where a may vanish; ``ma
 hull of the gradients of the operands that may be active), so by Clarke's mean-value theorem
 the magnitude of the enclosure bounds the Lipschitz constant on a convex box. A discontinuity
 (``step``, ``sign``, ``floor`` where they jump) gives an unbounded derivative: the function is
-not Lipschitz on that box. Two patterns are recognized exactly: ``X*step(X)`` (= max(X, 0),
-the paper's y = x₁·[x₁ > 0]; also ``-X*step(X)``, which parses as ``(-X)*step(X)``) and ``X - floor(X)`` / ``mod(X, c)`` (the sawtooth input; ``floor(X) - X`` is its negative).
+not Lipschitz on that box. Products that vanish where their step or sign switches are read
+as the continuous functions they are (:mod:`~obsdesign.methods.searchspace.switches`:
+``X*step(X)`` = max(X, 0), the paper's y = x₁·[x₁ > 0]; ``-X*step(X)``, ``2*X*step(X)``,
+``X*step(-X)`` = min(X, 0), ``X*sign(X)`` = |X|, …), and ``X - floor(X)`` / ``mod(X, c)``
+as the sawtooth input (``floor(X) - X`` is its negative).
 """
 
 from __future__ import annotations
@@ -36,6 +39,8 @@ from typing import Any
 
 from mpmath import iv
 from mpmath.libmp import to_float
+
+from obsdesign.methods.searchspace import switches
 
 INF = math.inf
 _SPLIT = 134217729.0  # 2^27 + 1 (Veltkamp)
@@ -498,19 +503,8 @@ def evaluate(
     if isinstance(node, ast.BinOp):
         op = type(node.op)
         left, right = node.left, node.right
-        if op is ast.Mult:
-            for x, s in ((left, right), (right, left)):
-                if _is_call(s, "step", "heaviside") and _same(s.args[0], x):
-                    a = evaluate(x, env, params, nd, src)
-                    return d_max(a, _const(ZERO, nd))  # X*step(X) = max(X, 0)
-                if (
-                    _is_call(s, "step", "heaviside")
-                    and isinstance(x, ast.UnaryOp)
-                    and isinstance(x.op, ast.USub)
-                    and _same(s.args[0], x.operand)
-                ):  # -X*step(X) parses as (-X)*step(X) = -max(X, 0)
-                    a = evaluate(x.operand, env, params, nd, src)
-                    return d_neg(d_max(a, _const(ZERO, nd)))
+        if op is ast.Mult and (sp := switches.split(node)) is not None:
+            return _split_dual(sp, env, params, nd, src)  # X*step(X) = max(X, 0), …
         if op is ast.Sub and _is_call(right, "floor") and _same(right.args[0], left):
             return d_frac(evaluate(left, env, params, nd, src))
         if op is ast.Sub and _is_call(left, "floor") and _same(left.args[0], right):
@@ -558,6 +552,32 @@ def evaluate(
         if name == "mod":
             return _mod(args[0], args[1], nd)
     raise ValueError(f"cannot enclose {ast.dump(node)[:60]}")
+
+
+def _split_dual(
+    sp: switches.Split, env: dict[str, Dual], params: dict[str, I], nd: int, src: str | None
+) -> Dual:
+    """Enclosure of a product with its switches taken out (:func:`switches.split`): the
+    remaining factors times max(B, 0), min(B, 0) or |B| of each switch's core B, each an
+    enclosure of a continuous function with Clarke's gradient (an identity of real functions,
+    so the product's enclosure contains the product's values and generalized gradients)."""
+
+    def prod(nodes: tuple[ast.AST, ...]) -> Dual | None:
+        acc: Dual | None = None
+        for f in nodes:
+            v = evaluate(f, env, params, nd, src)
+            acc = v if acc is None else d_mul(acc, v)
+        return acc
+
+    acc = prod(sp.rest)
+    for sw in sp.switches:
+        core = prod(sw.core)
+        assert core is not None  # split never takes a switch with an empty core
+        zero = _const(ZERO, nd)
+        v = d_abs(core) if sw.kind == "abs" else (d_max if sw.kind == "max" else d_min)(core, zero)
+        acc = v if acc is None else d_mul(acc, v)
+    assert acc is not None
+    return d_neg(acc) if sp.sign < 0 else acc
 
 
 def _lit(c: float, nd: int) -> Dual:

@@ -8,8 +8,10 @@ U = [−0.3, 0.3] gives 0.3 (the nearest double, below 0.3) times [−1, 1], rou
 ``Fraction`` and is exact wherever the arithmetic is rational:
 
 - decimal literals at their exact value, ``+ − × ÷`` and integer powers exactly (÷ refuses a
-  divisor interval that contains 0), ``abs max min sat step heaviside sign floor mod`` and the
-  patterns ``X*step(X)``, ``-X*step(X)``, ``X - floor(X)``, ``floor(X) - X`` exactly;
+  divisor interval that contains 0), ``abs max min sat step heaviside sign floor mod``, the
+  switch readings of :mod:`~obsdesign.methods.searchspace.switches` (``X*step(X)`` =
+  max(X, 0), ``X*step(-X)`` = min(X, 0), ``X*sign(X)`` = |X|, …) and ``X - floor(X)``,
+  ``floor(X) - X`` exactly;
 - the smooth functions (``sin cos tan exp log sqrt atan tanh sinh cosh``) through the float
   enclosure of their argument (:func:`~obsdesign.methods.searchspace.intervals.d_fn`,
   rigorous) intersected with the exact range of the function: [−1, 1] for sin, cos and tanh,
@@ -32,6 +34,7 @@ import operator
 from dataclasses import dataclass
 from fractions import Fraction
 
+from obsdesign.methods.searchspace import switches
 from obsdesign.methods.searchspace.intervals import (
     _CONSTS,
     Dual,
@@ -269,17 +272,8 @@ def evaluate_q(node: ast.AST, env: dict[str, QI], params: dict[str, QI], src: st
 def _binop(node: ast.BinOp, env: dict[str, QI], params: dict[str, QI], src: str | None) -> QI:
     op = type(node.op)
     left, right = node.left, node.right
-    if op is ast.Mult:
-        for x, s in ((left, right), (right, left)):
-            if _is_call(s, "step", "heaviside") and _same(s.args[0], x):
-                return qmax(evaluate_q(x, env, params, src), ZERO_Q)  # X*step(X) = max(X, 0)
-            if (
-                _is_call(s, "step", "heaviside")
-                and isinstance(x, ast.UnaryOp)
-                and isinstance(x.op, ast.USub)
-                and _same(s.args[0], x.operand)
-            ):  # -X*step(X) parses as (-X)*step(X) = -max(X, 0)
-                return -qmax(evaluate_q(x.operand, env, params, src), ZERO_Q)
+    if op is ast.Mult and (sp := switches.split(node)) is not None:
+        return _split_q(sp, env, params, src)  # X*step(X) = max(X, 0), …
     if op is ast.Sub and _is_call(right, "floor") and _same(right.args[0], left):
         return qfrac(evaluate_q(left, env, params, src))
     if op is ast.Sub and _is_call(left, "floor") and _same(left.args[0], right):
@@ -298,6 +292,27 @@ def _binop(node: ast.BinOp, env: dict[str, QI], params: dict[str, QI], src: str 
     if fn is None:
         raise ValueError(f"operator {op.__name__}")
     return fn(evaluate_q(left, env, params, src), evaluate_q(right, env, params, src))
+
+
+def _split_q(sp: switches.Split, env: dict[str, QI], params: dict[str, QI], src: str | None) -> QI:
+    """Exact enclosure of a product with its switches taken out (:func:`switches.split`):
+    the remaining factors times max(B, 0), min(B, 0) or |B| of each switch's core B."""
+
+    def prod(nodes: tuple[ast.AST, ...]) -> QI | None:
+        acc: QI | None = None
+        for f in nodes:
+            v = evaluate_q(f, env, params, src)
+            acc = v if acc is None else _cap(acc * v)
+        return acc
+
+    acc = prod(sp.rest)
+    for sw in sp.switches:
+        core = prod(sw.core)
+        assert core is not None  # split never takes a switch with an empty core
+        v = core.abs() if sw.kind == "abs" else (qmax if sw.kind == "max" else qmin)(core, ZERO_Q)
+        acc = v if acc is None else _cap(acc * v)
+    assert acc is not None
+    return -acc if sp.sign < 0 else acc
 
 
 #: the exact binary operations on :class:`QI`
