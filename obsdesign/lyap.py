@@ -64,9 +64,15 @@ def closed_loop_fmat(A: Any, C: Any, L: Any) -> fmpq_mat:
     :param A: n×n state matrix; :param C: p×n output matrix; :param L: n×p gain."""
     if isinstance(A, fmpq_mat) and isinstance(C, fmpq_mat) and isinstance(L, fmpq_mat):
         return A - L * C
-    if np.shape(A)[0] == 0 or np.shape(C)[0] == 0:
-        return fmat(np.asarray(A, dtype=object) - np.asarray(L) @ np.asarray(C))
+    if _rows(A) == 0 or _rows(C) == 0:  # no states or no outputs: L C = 0
+        return fmat(A)
     return fmat(A) - fmat(L) * fmat(C)
+
+
+def _rows(M: Any) -> int:
+    """Rows of a flint matrix or of anything numpy reads as a matrix (a mix of the two
+    raised IndexError in :func:`closed_loop_fmat`)."""
+    return M.nrows() if isinstance(M, (fmpq_mat, fmpz_mat)) else int(np.shape(M)[0])
 
 
 def dyadic_fmat(x: Any, bits: int) -> tuple[fmpq_mat, np.ndarray]:

@@ -969,3 +969,14 @@ def test_dyadic_fmat_at_the_int64_shift_limit() -> None:
         assert F == lyap.fmat(dyadic(x, bits))
         assert (vchol.to_float(F) == fl).all()
     assert lyap.dyadic_fmat(x, 40)[0][0, 0] == 1
+
+
+def test_closed_loop_fmat_takes_flint_and_numpy_matrices_mixed() -> None:
+    """A − L C for a flint A with object-array C and L (IndexError before: ``np.shape`` of an
+    ``fmpq_mat`` is ()), and a flint A with no outputs (L C = 0)."""
+    A = lyap.fmat(qmat([[1, 2], [3, 4]]))
+    C = qmat([[1, 0]])
+    L = qmat([[1], ["1/2"]])
+    assert lyap.closed_loop_fmat(A, C, L) == lyap.fmat(qmat([[0, 2], ["5/2", 4]]))
+    C0 = np.zeros((0, 2), dtype=object)
+    assert lyap.closed_loop_fmat(A, C0, C0.T) == A
