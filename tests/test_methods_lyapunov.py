@@ -136,7 +136,10 @@ def test_printed_numbers_are_exact_or_safe(extra: str) -> None:
             if sym == "μ":
                 mu = Q(rep.parameters["mu"])
                 assert Q(val) == mu and (not up or Q(up) >= mu), c.statement
-            elif "gives" not in c.statement.split(f"{sym} = {val}")[0]:
+            elif not any(  # else the bracket's other end
+                w in c.statement.split(f"{sym} = {val}")[0]
+                for w in ("gives", "strictly at", "not proven")
+            ):
                 assert Q(val) == Q(rep.parameters[key[sym]]), c.statement
     assert seen >= 4
 
@@ -1124,3 +1127,67 @@ def test_certify_decides_a_gain_beyond_the_float_range() -> None:
     p["L"] = qmat([[fmpq(10**400)], [0]])
     got = {c.id: c.status for c in api.certify(api.load_spec_text(text, "x.toml"), p)}
     assert got["decay-lmi"] == ClaimStatus.FAILED and got["decay-lmi_best"] == ClaimStatus.FAILED
+
+
+_GIVEN_L = (
+    '[system]\ntime = "discrete"\nA = [[0, 1], [1, 0]]\nC = [[1, 0]]\n'
+    '[method]\nkey = "lyapunov"\nL = [-1.87, 1.874]\n'
+)
+
+
+def test_a_not_certifiable_bracket_never_certifies_optimality(tmp_path: Path) -> None:
+    """Independent soundness trial (session 23): A − LC has the eigenvalues 0.95 and 0.92, so
+    the best rate is 0.95. A report tampered to λ = λ_best = 0.99 (its P still valid there)
+    with a bracket end 0.9899 of kind ``not-certifiable`` and verify's own claim list
+    verified with "λ_best = 0.99 is best to within 0.0001 … certified": a feasible other end
+    proves only that a better rate exists. The claim is now numerical, never certified, and
+    says that optimality is not proven; the decay claims at 0.99 stay certified (true)."""
+    spec = load_spec_text(_GIVEN_L, "given.toml")
+    rep = api.design(spec)
+    assert rep.exit_code() == 0 and rep.parameters["lambda_bracket_kind"] == "infeasible"
+    # strict: at an eigenvalue of modulus exactly λ a P ≻ 0 may satisfy the non-strict LMI
+    (honest,) = [c for c in rep.claims if c.id == "lambda_best-bracket"]
+    assert "no P ≻ 0 satisfies the decay LMI strictly at λ = 0.95" in honest.statement
+    p = rep.parameters
+    for k in ("lambda", "lambda_best"):
+        p[k] = fmpq(99, 100)
+    p["lambda_bracket"] = fmpq(9899, 10000)
+    p["lambda_bracket_kind"] = "not-certifiable"
+    claims = {c.id: c for c in api.certify(load_spec_text(_GIVEN_L, "given.toml"), p)}
+    br = claims["lambda_best-bracket"]
+    assert br.status == ClaimStatus.NUMERICAL and br.ok, br
+    assert "λ_best = 0.99 is not proven best to within 0.0001" in br.statement
+    assert "is best to within" not in br.statement
+    assert "ρ(A − LC) ≈ 0.95" in br.detail
+    assert all(c.status == ClaimStatus.CERTIFIED for i, c in claims.items() if i != br.id)
+    # the whole tampered report with the recomputed claims: nothing false is certified
+    d = rep.to_dict()
+    d["claims"] = [c.to_dict() for c in claims.values()]
+    out = tmp_path / "t.json"
+    out.write_text(json.dumps(d), encoding="utf-8")
+    ver = api.verify(out)
+    got = {c.id: c.status for c in ver.claims}
+    assert got["lambda_best-bracket"] == ClaimStatus.NUMERICAL
+
+
+def test_the_designs_own_not_certifiable_bracket_is_numerical(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """When no rate below 0.9502 certifies (the rounded P refused there), the search's other end
+    is feasible but not certifiable: the design's bracket claim is numerical (exit 0: every
+    claim holds, optimality to within rate_tol is not claimed) and the report verifies."""
+    real = lyap.certified_P
+    below = fmpq(9502, 10000)
+
+    def refusing(A, C, L, discrete, r, *a, **k):  # type: ignore[no-untyped-def]
+        return None if Q(r) < below else real(A, C, L, discrete, r, *a, **k)
+
+    monkeypatch.setattr(lyap, "certified_P", refusing)
+    rep = api.design(load_spec_text(_GIVEN_L, "given.toml"))
+    assert rep.parameters["lambda_bracket_kind"] == "not-certifiable"
+    (br,) = [c for c in rep.claims if c.id == "lambda_best-bracket"]
+    assert br.status == ClaimStatus.NUMERICAL and rep.exit_code() == 0
+    assert any(n.startswith("best certified rate lambda = ") for n in rep.notes), rep.notes
+    out = tmp_path / "r.json"
+    out.write_text(rep.to_json(), encoding="utf-8")
+    assert api.verify(out).exit_code() == 0

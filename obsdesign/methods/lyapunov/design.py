@@ -265,12 +265,14 @@ def _design_for(
         rho = lyap.decay_factor(rate, s.discrete)
         params["mu"] = lyap.iss_mu(lyap.as_array(Acl), Bw, P, rho, s.discrete, strict=True)
     why = (
-        "no P ≻ 0 exists there (proved exactly, see the bracket claim)"
+        "no P ≻ 0 gives strict decay there (proved exactly, see the bracket claim)"
         if br.kind == lyap.INFEASIBLE
-        else "feasible, but the rounded Lyapunov-equation P fails the exact check there"
+        else "feasible, but the rounded Lyapunov-equation P fails the exact check there, so "
+        "the best rate is not proven to within the tolerance"
     )
+    best = "best rate" if br.kind == lyap.INFEASIBLE else "best certified rate"
     notes.append(
-        f"best rate {name} = {fmt_exact(br.best)} for this L (bracket tolerance "
+        f"{best} {name} = {fmt_exact(br.best)} for this L (bracket tolerance "
         f"{fmt_exact(o.rate_tol)}); {name} = {fmt_exact(br.other)} is {br.kind}: {why}; "
         + (f"infimum ≈ {bound:.6g}" if s.discrete else f"supremum ≈ {-bound:.6g}")
         + f" ({guide.source})"
