@@ -958,3 +958,30 @@ def test_parameters_and_literals_reach_every_rule(text: str) -> None:
         env = {"x": Dual(I(*box), (ONE,))}
         with_k = evaluate(ex.tree, env, {"k": I.of_q(Fraction(1, 10))}, 1, ex.source)
         assert with_k == _enc(text.replace("k", "0.1"), {"x": box}), box
+
+
+@given(
+    st.floats(min_value=-1e6, max_value=1e6, allow_nan=False),
+    st.floats(min_value=-1e6, max_value=1e6, allow_nan=False),
+    st.booleans(),
+)
+def test_a_product_with_an_unbounded_operand_rounds_outward(x: float, y: float, up: bool) -> None:
+    """Mutation review 23 (a source defect): with one operand unbounded the finite end-point
+    products were rounded to nearest, so [3, ∞)·[0.1, 0.1] began one ulp above 3·fl(0.1).
+    Every finite end-point product now lies inside the enclosure."""
+    a = I(x, math.inf) if up else I(-math.inf, x)
+    p = a * I(y, y)
+    exact = Fraction(x) * Fraction(y)  # the product at the finite end point
+    assert p.lo == -math.inf or Fraction(p.lo) <= exact
+    assert p.hi == math.inf or exact <= Fraction(p.hi)
+    lo = (I(3.0, math.inf) * I(0.1, 0.1)).lo
+    assert Fraction(lo) <= 3 * Fraction(0.1)
+
+
+def test_floor_of_an_interval_unbounded_below() -> None:
+    """Mutation review 23 (a source defect): ``d_floor`` of [−∞, 0.5] raised OverflowError
+    (``math.floor(-inf)``) before its unbounded branch; it is [−∞, 0] with a jump."""
+    from obsdesign.methods.searchspace.intervals import d_floor
+
+    d = d_floor(Dual(I(-math.inf, 0.5), (ONE,)))
+    assert d.v == I(-math.inf, 0.0) and d.g[0].hi == math.inf
