@@ -74,6 +74,13 @@ def _reading(sp: switches.Split, env: dict[str, Fraction]) -> Fraction:
         ("x1*x2*step(x1*x2)", ["max"], 1),
         ("(x1 - 1)*step(1 - x1)", ["max"], -1),  # = −max(1 − x1, 0)
         ("(x2 - x1)*sign(x1 - x2)", ["abs"], -1),
+        # mutation review 23 (switches.py): constants in (0, 1] and 1/c inside the step,
+        # unary plus, a constant switch or an unmatched one before the matched one
+        ("x1*step(0.5*x1)", ["max"], 1),
+        ("x1*step(x1/2)", ["max"], 1),
+        ("+x1*step(x1)", ["max"], 1),
+        ("step(2)*x1*step(x1)", ["max"], 1),
+        ("x1*step(x2)*x1*step(x1)", ["max"], 1),
     ],
 )
 def test_products_that_vanish_at_their_switch_are_read(text: str, kinds: list, sign: int) -> None:
@@ -92,6 +99,7 @@ def test_products_that_vanish_at_their_switch_are_read(text: str, kinds: list, s
         "x1*floor(x1)",
         "x1 + step(x1)",
         "x1*step(x1/0)",  # not a positive literal divisor: left as written
+        "step(x1)",  # not a product
     ],
 )
 def test_products_that_keep_their_jump_are_not_read(text: str) -> None:
@@ -102,7 +110,7 @@ def test_products_that_keep_their_jump_are_not_read(text: str) -> None:
         assert sp is None
 
 
-_ATOMS = ["x1", "x2", "(x1 - x2)", "(x2 - x1)", "2", "0.5", "3"]
+_ATOMS = ["x1", "x2", "(x1 - x2)", "(x2 - x1)", "2", "0.5", "3", "x1/2", "(x1 - x2)/3"]
 
 
 @st.composite
