@@ -12,7 +12,12 @@ from hypothesis import strategies as st
 from obsdesign.certify.exact import Q, dyadic, qeye, qmat, symmetrize, to_float
 from obsdesign.certify.linalg import qinv
 from obsdesign.methods.constrained import bounds as B
-from obsdesign.methods.constrained.cmap import box_map, ellipsoid_map, polytope_map
+from obsdesign.methods.constrained.cmap import (
+    ConstraintMap,
+    box_map,
+    ellipsoid_map,
+    polytope_map,
+)
 from obsdesign.sets import Box
 
 
@@ -462,3 +467,280 @@ def test_max_phi_of_the_ellipsoid_map_over_a_large_box(monkeypatch):
     assert B.max_phi_over(cm, X) == [1]
     cm2 = ellipsoid_map(qmat([[2, -1], [-1, 2]]), 3)  # the same maximum, at (−1, 1)
     assert B.max_phi_over(cm2, X) == [1]
+
+
+# -- mutation review 23 -----------------------------------------------------------------------
+def _count_v_min_conditions(monkeypatch: pytest.MonkeyPatch, limit: int = 400) -> list[fmpq]:
+    """Route v_min_lower's calls of :func:`B.v_min_condition` and :func:`B.round_sig` through
+    a counter that fails the test after ``limit`` calls (a loop that never ends fails at once
+    instead of hanging); returns the list of the values of v asked about."""
+    real, real_round = B.v_min_condition, B.round_sig
+    asked: list[fmpq] = []
+    rounded: list[int] = []
+
+    def counted(
+        cm: ConstraintMap, P: np.ndarray, Pinv: np.ndarray, X: Box, eps_min: fmpq, v: fmpq
+    ) -> bool:
+        asked.append(Q(v))
+        assert len(asked) <= limit, "v_min_lower does not end"
+        return real(cm, P, Pinv, X, eps_min, v)
+
+    def counted_round(x: fmpq, digits: int, up: bool) -> fmpq:
+        rounded.append(1)
+        assert len(rounded) <= limit, "v_min_lower does not end"
+        return real_round(x, digits, up)
+
+    monkeypatch.setattr(B, "v_min_condition", counted)
+    monkeypatch.setattr(B, "round_sig", counted_round)
+    return asked
+
+
+def test_v_min_lower_is_zero_when_X_leaves_or_touches_C_min(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """v_min of eq. (21) is 0 — a safe lower bound, flagged as such — when X ⊄ int C_min
+    (mutation review 23). X = [−2, 2]² and the box map of [−1, 1]² with ε_min = 1/100: the
+    vertex (2, 2) of X has |c| = √2 > ε_min, so no v > 0 (nor v = 0) keeps x̂ = x in C_min.
+    X = [−3/2, 3/2] and the box map of [−1, 1] with ε_min = 1/4: |c| = (1/2)² = ε_min at the
+    vertices of X (the condition holds at v = 0 with equality and fails for every v > 0), so
+    the bisection never leaves 0 and v_min = 0 exactly — not 1, not an error, and the
+    function ends (at most a few dozen exact checks)."""
+    asked = _count_v_min_conditions(monkeypatch)
+    P = qmat([[2, 1], [1, 3]])
+    cm = box_map([Q(-1)] * 2, [Q(1)] * 2)
+    X = _box([-2, -2], [2, 2])
+    assert max(cm.norm_c_sq_q(v) for v in X.vertices_q()) == 2 > fmpq(1, 100) ** 2
+    vb = B.v_min_lower(cm, P, qinv(P), X, fmpq(1, 100))
+    assert vb.value == 0 and vb.exact is False
+    P1 = qmat([[1]])
+    cm1 = box_map([Q(-1)], [Q(1)])
+    X1 = _box([fmpq(-3, 2)], [fmpq(3, 2)])
+    assert B.v_min_condition(cm1, P1, qinv(P1), X1, fmpq(1, 4), Q(0))
+    assert not B.v_min_condition(cm1, P1, qinv(P1), X1, fmpq(1, 4), fmpq(1, 10**30))
+    asked.clear()
+    vb = B.v_min_lower(cm1, P1, qinv(P1), X1, fmpq(1, 4))
+    assert vb.value == 0
+    assert len(asked) <= 70
+
+
+def test_v_min_lower_grows_its_bracket_past_one(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The bisection of v_min_lower first grows its bracket (×4 from 1) until the condition
+    fails, so a v_min far above 1 is found, in a few dozen exact checks (mutation review 23).
+    One class, P = 1, X = [−1, 1], the box map of [−10, 10], ε_min = 1/4: max_X φ = −9, and
+    −9 + √v ≤ √ε_min = 1/2 ⟺ v ≤ 9.5² = 90.25, the exact v_min (the 8-digit rounding down of
+    the bisection's end); the ellipsoid map's bound is flagged as a bound."""
+    asked = _count_v_min_conditions(monkeypatch)
+    P = qmat([[1]])
+    cm = box_map([Q(-10)], [Q(10)])
+    vb = B.v_min_lower(cm, P, qinv(P), _box([-1], [1]), fmpq(1, 4))
+    assert vb.exact
+    assert fmpq(9025, 100) * (1 - fmpq(1, 10**7)) <= vb.value <= fmpq(9025, 100)
+    assert len(asked) <= 100
+    # the ellipsoid map x²/100 − 1 (κ = 1): (1 + √v)² ≤ 100(1 + √(1/4)) ⟺ v ≤ (√150 − 1)²,
+    # a certified lower bound of v_min, not its exact value (the triangle inequality)
+    asked.clear()
+    vb = B.v_min_lower(ellipsoid_map(P, 100), P, qinv(P), _box([-1], [1]), fmpq(1, 4))
+    want = (150**0.5 - 1) ** 2
+    assert vb.exact is False
+    assert want * (1 - 1e-7) <= float(vb.value) <= want * (1 + 1e-12)
+    assert len(asked) <= 100
+
+
+def test_v_min_lower_steps_down_when_its_rounded_candidate_is_refused(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The bisection's end, rounded down to 8 digits, is re-checked by the exact condition;
+    if refused (the outward rounding need not be monotone in v), v_min_lower steps down by
+    ×999/1000 and rounds down again until a candidate is proved (mutation review 23). The
+    max-norm box map of [−3/2, 3/2]² over X = [−1, 1]², P = [[2, 1], [1, 3]], ε_min = 1/100:
+    v_min = (√ε_min + 1/2)²/max_i g_iᵀP⁻¹g_i = 0.6²/(3/5) = 3/5 exactly; refusing the clean
+    candidate r0 (and nothing else) must give round_sig(r0·999/1000, 8, down), proved."""
+    P = qmat([[2, 1], [1, 3]])
+    cm = box_map([fmpq(-3, 2)] * 2, [fmpq(3, 2)] * 2, norm="max")
+    X = _box([-1, -1], [1, 1])
+    eps = fmpq(1, 100)
+    real = B.v_min_condition
+    asked = _count_v_min_conditions(monkeypatch)
+    counted = B.v_min_condition
+    r0 = B.v_min_lower(cm, P, qinv(P), X, eps).value
+    assert fmpq(3, 5) * (1 - fmpq(1, 10**7)) <= r0 <= fmpq(3, 5) and r0 < 1
+    asked.clear()
+
+    def refuse_r0(
+        cm: ConstraintMap, P: np.ndarray, Pinv: np.ndarray, X: Box, eps_min: fmpq, v: fmpq
+    ) -> bool:
+        ok = counted(cm, P, Pinv, X, eps_min, v)
+        return ok and Q(v) != r0
+
+    monkeypatch.setattr(B, "v_min_condition", refuse_r0)
+    r1 = B.v_min_lower(cm, P, qinv(P), X, eps).value
+    assert r1 == B.round_sig(r0 * fmpq(999, 1000), 8, up=False)
+    assert real(cm, P, qinv(P), X, eps, r1)
+    assert len(asked) <= 100
+
+
+def test_a_max_norm_polytope_map_keeps_its_norm() -> None:
+    """``polytope_map(G, h, norm)`` keeps the norm of eq. (16) (mutation review 23): the
+    polytope {|x_i| ≤ 3/2} is the box [−3/2, 3/2]², and with the same norm the two maps give
+    the same |c| and the same v_min. With the max norm, C_min is exactly the polytope
+    {φ_i ≤ √ε_min}, so v_min = min_i (√ε_min − max_X φ_i)²/g_iᵀP⁻¹g_i = (√(1/10) + 1/2)²/(3/5)
+    for X = [−1, 1]², P = [[2, 1], [1, 3]] (P⁻¹ = [[3, −1], [−1, 2]]/5), exact up to the
+    8-digit rounding down; the Euclidean norm gives a smaller v_min (about 1.0953 < 1.1104)."""
+    import mpmath
+
+    G = qmat([[1, 0], [-1, 0], [0, 1], [0, -1]])
+    h = np.array([fmpq(3, 2)] * 4, dtype=object)
+    P = qmat([[2, 1], [1, 3]])
+    X = _box([-1, -1], [1, 1])
+    eps = fmpq(1, 10)
+    x = np.array([fmpq(2), fmpq(7, 4)], dtype=object)
+    got = {}
+    for norm in ("max", "euclidean"):
+        pm = polytope_map(G, h, norm)
+        bm = box_map([fmpq(-3, 2)] * 2, [fmpq(3, 2)] * 2, norm)
+        assert pm.norm == norm
+        assert pm.norm_c_sq_q(x) == bm.norm_c_sq_q(x)
+        a = B.v_min_lower(pm, P, qinv(P), X, eps)
+        assert a == B.v_min_lower(bm, P, qinv(P), X, eps)
+        got[norm] = a
+    assert polytope_map(G, h, "max").norm_c_sq_q(x) == fmpq(1, 2) ** 4
+    with mpmath.workdps(40):
+        want = (mpmath.sqrt(mpmath.mpf(1) / 10) + mpmath.mpf(1) / 2) ** 2 / (mpmath.mpf(3) / 5)
+    v = got["max"].value
+    assert got["max"].exact
+    assert float(want) * (1 - 1e-7) <= float(v) and mpmath.mpf(int(v.p)) / int(v.q) <= want
+    assert got["euclidean"].value < v * fmpq(99, 100)
+    assert got["euclidean"].exact is False  # two classes: a bound, not the exact v_min
+
+
+def test_sup_norm_c_over_a_box_exact_at_vertices_or_per_face(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """sup |c| over a box X̂ (mutation review 23): exact at its vertices up to 2^dim ≤
+    MAX_PAIRS vertices, else the per-face bound √(Σ_classes max (b_i⁺)⁴). The map
+    φ = (x + y, x − y) over [0, 1]² peaks at different vertices: |c|² is 16 at (1, 1) and 2 at
+    (1, 0), so sup |c| = 4 exactly, while the per-face maxima b = (2, 1) give √17. In 3-D
+    ([0, 1]³, 8 vertices) with MAX_PAIRS = 6 the per-face bound √17 (rounded up) is taken,
+    still ≥ the true 4. The ellipsoid map |x|²·3/4 − 1 over [−1, 1]² (max φ = 1/2 at the
+    corners) gives (1/2)² = 1/4 either way; a box inside C_0 gives 0."""
+    from mpmath import iv
+
+    from obsdesign.certify.interval import upper
+
+    cm = polytope_map(qmat([[1, 1], [1, -1]]), np.array([Q(0), Q(0)], dtype=object))
+    S = _box([0, 0], [1, 1])
+    assert max(cm.norm_c_sq_q(v) for v in S.vertices_q()) == 16
+    root17 = upper(iv.sqrt, fmpq(17))
+    assert 17 <= root17**2 <= 17 * (1 + fmpq(1, 10**20))
+    for pairs in (4096, 6, 4):  # 4 vertices: exact while 2^dim ≤ MAX_PAIRS
+        monkeypatch.setattr(B, "MAX_PAIRS", pairs)
+        assert B.sup_norm_c_over_set(cm, S) == 4, pairs
+    cm3 = polytope_map(qmat([[1, 1, 0], [1, -1, 0]]), np.array([Q(0), Q(0)], dtype=object))
+    S3 = _box([0, 0, 0], [1, 1, 1])
+    monkeypatch.setattr(B, "MAX_PAIRS", 8)
+    assert B.sup_norm_c_over_set(cm3, S3) == 4
+    monkeypatch.setattr(B, "MAX_PAIRS", 6)  # 8 > 6 vertices: the per-face bound
+    assert B.sup_norm_c_over_set(cm3, S3) == root17
+    em = ellipsoid_map(qeye(2), fmpq(4, 3))
+    S2 = _box([-1, -1], [1, 1])
+    for pairs in (4096, 0):
+        monkeypatch.setattr(B, "MAX_PAIRS", pairs)
+        assert B.sup_norm_c_over_set(em, S2) == fmpq(1, 4), pairs
+        assert B.sup_norm_c_over_set(box_map([Q(-2)] * 2, [Q(2)] * 2), S2) == 0, pairs
+
+
+def test_sup_norm_c_of_an_affine_map_over_an_ellipsoid() -> None:
+    """sup |c| over an ellipsoid X̂ = {(x − c)ᵀE(x − c) ≤ 1} for an affine map
+    (mutation review 23): φ_i ≤ g_iᵀc − h_i + √(g_iᵀE⁻¹g_i) (the support function), then the
+    per-class sum. The box map of [−1, 1]² over the disk of radius 2 centred at (1, 0): the rows
+    (−x, x, −y, y) give b = (−2 + 2, 0 + 2, −1 + 2, −1 + 2) = (0, 2, 1, 1), so per antipodal
+    class |c|² ≤ 2⁴ + 1⁴ = 17; the true sup is 4 (|c| = (3 − 1)² at (3, 0)), below the bound,
+    as samples of the circle agree."""
+    from mpmath import iv
+
+    from obsdesign.certify.interval import upper
+    from obsdesign.sets import Ellipsoid
+
+    cm = box_map([Q(-1)] * 2, [Q(1)] * 2)
+    S = Ellipsoid(qeye(2) * fmpq(1, 4), np.array([Q(1), Q(0)], dtype=object))
+    got = B.sup_norm_c_over_set(cm, S)
+    assert got == upper(iv.sqrt, fmpq(17))
+    t = np.linspace(0, 2 * np.pi, 2001)
+    pts = np.c_[1 + 2 * np.cos(t), 2 * np.sin(t)]
+    assert 4 - 1e-9 <= cm.norm_c(pts).max() <= float(got)
+
+
+def test_sup_norm_c_of_the_ellipsoid_map_over_an_off_centre_ellipsoid() -> None:
+    """sup |c| of the ellipsoid map φ = |x|²/r − 1 over the unit disk centred at (2, 0)
+    (mutation review 23): |x| ≤ |centre| + 1 = 3 (the triangle bound √(cᵀQc) + √κ, κ = 1, is
+    attained at (3, 0)), so sup |c| = (9/r − 1)⁺², exact up to κ's proof slack: 3.5² = 12.25
+    for r = 2, (1/8)² = 1/64 for r = 8, and 0 for r = 10 (the disk inside C_0)."""
+    from obsdesign.sets import Ellipsoid
+
+    S = Ellipsoid(qeye(2), np.array([Q(2), Q(0)], dtype=object))
+    for r, want in ((2, fmpq(49, 4)), (8, fmpq(1, 64))):
+        em = ellipsoid_map(qeye(2), r)
+        assert em.norm_c_sq_q(np.array([Q(3), Q(0)], dtype=object)) == want**2
+        got = B.sup_norm_c_over_set(em, S)
+        assert want <= got <= want * (1 + fmpq(1, 10**7)), r
+    assert B.sup_norm_c_over_set(ellipsoid_map(qeye(2), 10), S) == 0
+
+
+def test_delta_sq_upper_by_hand() -> None:
+    """δ² = sup over C_max of |dc/dx|² (Assumption 3(4)), by hand (mutation review 23).
+    Polytope rows (2, 0), (−1, 0) (one antipodal class, longest normal (2, 0)) and (0, 1):
+    H = diag(4, 1), δ² ≤ 4 ε_max λ_max(H) = 16 ε_max, a bound (not flagged exact), tight up
+    to λ's proof slack. Ellipsoid map Q = diag(1, 3), r = 1/2, ε_max = 1/4: the bound
+    16 ε_max λ_max(Q)(1 + √ε_max)/r = 36 is attained at x = (0, 1/2) on ∂C_max (φ = 1/2,
+    |dc/dx| = 2φ·2|Qx|/r = 6)."""
+    cm = polytope_map(qmat([[2, 0], [-1, 0], [0, 1]]), np.array([Q(1)] * 3, dtype=object))
+    assert cm.classes == [[0, 1], [2]]
+    d = B.delta_sq_upper(cm, fmpq(1, 4))
+    assert d.exact is False
+    assert 4 <= d.value <= 4 * (1 + fmpq(1, 10**7))
+    em = ellipsoid_map(qmat([[1, 0], [0, 3]]), fmpq(1, 2))
+    x = np.array([0.0, 0.5])
+    phi = float(em.phi(x)[0])
+    assert phi == 0.5
+    J = 2 * phi * 2 * np.linalg.norm(em.Qf @ x) / em.r
+    assert J == 6.0
+    d = B.delta_sq_upper(em, fmpq(1, 4))
+    assert d.exact is False
+    assert 36 <= d.value <= 36 * (1 + fmpq(1, 10**7))
+
+
+def test_sup_norm_c_over_Xhat_max_by_hand() -> None:
+    """sup |c| over X̂_max = {x + e : x ∈ X, V(e) ≤ v_max}, eq. (15), by hand
+    (mutation review 23). Affine: the box map of [−1, 1]² over X = [−½, ½]², P = diag(4, 1), v = 4:
+    φ_i ≤ max_X φ_i + √(v g_iᵀP⁻¹g_i) = −½ + √(4·¼) = ½ (x faces), −½ + √4 = 3/2 (y faces),
+    so |c|² ≤ (½)⁴ + (3/2)⁴ = 41/8 (Euclidean, the sum over the two classes) or (3/2)⁴ (max
+    norm: sup |c| = 9/4 exactly, at x = (0, ½) + (0, 2)); with v = 0, sup |c| over X ⊂ C_0 is 0.
+    Ellipsoid map |x|²/r − 1 over X = [0, 1]², P = 2I, v = 4 (|e| ≤ √2, κ = ½): |x + e| ≤
+    √2 + √(vκ) = 2√2, attained at (1, 1) + (1, 1), so sup |c| = (8/r − 1)⁺²: 9 for r = 2,
+    1/9 for r = 6, 0 for r = 9 — exact up to κ's proof slack; samples stay below."""
+    from mpmath import iv
+
+    from obsdesign.certify.interval import upper
+
+    rng = np.random.default_rng(23)
+    X = _box([fmpq(-1, 2)] * 2, [fmpq(1, 2)] * 2)
+    P = qmat([[4, 0], [0, 1]])
+    for norm, want in (("euclidean", upper(iv.sqrt, fmpq(41, 8))), ("max", fmpq(9, 4))):
+        cm = box_map([Q(-1)] * 2, [Q(1)] * 2, norm)
+        got = B.sup_norm_c_over_Xhat_max(cm, P, qinv(P), X, Q(4))
+        assert got == want, norm
+        assert B.sup_norm_c_over_Xhat_max(cm, P, qinv(P), X, Q(0)) == 0
+        xs = rng.uniform(-0.5, 0.5, (400, 2))
+        xs[:4] = [[-0.5, -0.5], [-0.5, 0.5], [0.5, -0.5], [0.5, 0.5]]
+        pts = xs + _ellipsoid_samples(rng, np.diag([4.0, 1.0]), 4.0, 400)
+        assert cm.norm_c(pts).max() <= float(got)
+    cm = box_map([Q(-1)] * 2, [Q(1)] * 2, "max")
+    assert cm.norm_c_sq_q(np.array([Q(0), fmpq(5, 2)], dtype=object)) == fmpq(9, 4) ** 2
+    X01 = _box([0, 0], [1, 1])
+    P2 = qeye(2) * 2
+    for r, want in ((2, fmpq(9)), (6, fmpq(1, 9))):
+        em = ellipsoid_map(qeye(2), r)
+        assert em.norm_c_sq_q(np.array([Q(2), Q(2)], dtype=object)) == want**2
+        got = B.sup_norm_c_over_Xhat_max(em, P2, qinv(P2), X01, Q(4))
+        assert want <= got <= want * (1 + fmpq(1, 10**7)), r
+    assert B.sup_norm_c_over_Xhat_max(ellipsoid_map(qeye(2), 9), P2, qinv(P2), X01, Q(4)) == 0
