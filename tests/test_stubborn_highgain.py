@@ -15,6 +15,7 @@ from flint import fmpq
 from obsdesign import api
 from obsdesign.certify.claim import ClaimStatus
 from obsdesign.certify.exact import Q, qparse, qstr, to_float
+from obsdesign.errors import SpecError
 from obsdesign.report import Report
 
 DUFFING = Path(__file__).resolve().parents[1] / "specs" / "astolfi-stubborn-duffing.toml"
@@ -185,3 +186,67 @@ def test_simulate_times_outside_the_run_are_bad_input(old: str, new: str, key: s
         sp = api.load_spec_text(text.replace(old, new, 1), "d.toml")
         api.simulate(sp)
     assert ei.value.exit_code == 2 and f"[{key}]" in str(ei.value)
+
+
+_HG = """[system]
+time = "continuous"
+states = ["x1", "x2", "x3"]
+A = {A}
+psi = {psi}
+C = [[1, 0, 0]]
+[method]
+key = "stubborn"
+mode = "high-gain"
+K = [3, 3, 1]
+lipschitz = {L}
+"""
+_CHAIN = "[[0, 1, 0], [0, 0, 1], [0, 0, 0]]"
+
+
+@pytest.mark.parametrize(
+    ("A", "psi", "key"),
+    [
+        ("[[0, 1, 0], [0, 0, 1], [0, 0.5, 0]]", '["0", "0", "0"]', None),  # below: φ's
+        ("[[0, -1, 0], [0, 0, 1], [0, 0, 0]]", '["0", "0", "0"]', "system.A"),
+        ("[[0, 1, 0.1], [0, 0, 1], [0, 0, 0]]", '["0", "0", "0"]', "system.A"),
+        (_CHAIN, '["0.1*sin(x2)", "0", "0"]', "system.psi"),
+        (_CHAIN, '["0", "x1*x3", "0"]', "system.psi"),
+        (_CHAIN, '["x2 - x2", "sin(x1)*x2", "x1*x2*x3"]', None),  # cancels; φ_3 any x
+    ],
+)
+def test_high_gain_needs_the_triangular_form(A: str, psi: str, key: str | None) -> None:
+    """Independent soundness trial (session 23): the certificate is about A₀ − KC, A₀ the chain
+    of integrators, and never read the spec's A: A = [[0, 1], [5, 0]] was certified "A − KC is
+    Hurwitz" though the spec's A − KC is not, and the simulated error grew to 10⁶. The spec's
+    A must be A₀ above the diagonal and ψ_i (f_i − x_{i+1}) must not depend on x_{i+1}..x_n;
+    anything else is bad input naming the key."""
+    spec = _HG.format(A=A, psi=psi, L=1)
+    if key is None:
+        assert api.design(api.load_spec_text(spec, "hg.toml")).exit_code() == 0
+    else:
+        with pytest.raises(SpecError) as ei:
+            api.load_spec_text(spec, "hg.toml")
+        assert ei.value.key == key, ei.value.message
+
+
+def test_high_gain_f_form_is_checked_too() -> None:
+    """The f form: f_1 − x2 depending on x2 (x2 + x2²) is refused naming [system.f]; the
+    shipped Duffing spec (f_1 = x2) is accepted."""
+    text = DUFFING.read_text().replace('f = ["x2",', 'f = ["x2 + x2**2",')
+    assert "x2 + x2**2" in text
+    with pytest.raises(SpecError) as ei:
+        api.load_spec_text(text, "d.toml")
+    assert ei.value.key == "system.f" and "depends on x2" in ei.value.message
+    api.load_spec(DUFFING)
+
+
+def test_high_gain_warns_when_L_misses_the_linear_part_of_A() -> None:
+    """A = A₀ + 5·e₂e₁ᵀ with L = 0.1 (the ψ's constant, not φ's): the design says that L does
+    not cover A's terms below the chain, and its statements name A₀, not the spec's A."""
+    text = _HG.format(A="[[0, 1, 0], [0, 0, 1], [5, 0, 0]]", psi='["0", "0", "0"]', L="0.1")
+    rep = api.design(api.load_spec_text(text, "hg.toml"))
+    assert any(n.startswith("WARNING: the terms of [system].A") for n in rep.notes), rep.notes
+    (pos,) = [c for c in rep.claims if c.id == "P-positive"]
+    assert "A₀ − KC is Hurwitz" in pos.statement
+    quiet = api.design(api.load_spec_text(text.replace("lipschitz = 0.1", "lipschitz = 6"), "h"))
+    assert not any(n.startswith("WARNING") for n in quiet.notes)

@@ -8,8 +8,10 @@ K = (k_1..k_n): x̂_i' = x̂_{i+1} + φ̂_i(x̂) + k_i ℓ^i sat_σ̄(y − x̂_
 P(A − KC) + (A − KC)ᵀP = −I, and convergence holds for ℓ > ℓ* = 2L|P| (L the Lipschitz bound of
 the scaled Δ_φ, given by the user).
 
+A₀ is the chain of integrators (ones on the superdiagonal); a spec's A must equal it above
+the diagonal (options check), its terms on and below the diagonal are part of φ and of L.
 Certified exactly: P solves the Lyapunov equation (rational solution of the linear system),
-P ≻ 0 (hence A − KC is Hurwitz), 2L|P| ≤ ℓ* (ℓ*·I − 2L P ⪰ 0) and ℓ > 2L|P| (ℓ I − 2L P ≻ 0,
+P ≻ 0 (hence A₀ − KC is Hurwitz), 2L|P| ≤ ℓ* (ℓ*·I − 2L P ⪰ 0) and ℓ > 2L|P| (ℓ I − 2L P ≻ 0,
 |P| = λ_max(P) for P ≻ 0). ε is the user's (default 1): the slides prove that some ε* exists
 but give no formula, so ε > ε* is not claimed.
 """
@@ -117,6 +119,13 @@ def design_params(
         f"ℓ* = 2L|P| ≤ {fmt_up(ell_star, 6)} (L = {fmt_exact(o.lipschitz)}); ℓ = {fmt_exact(ell)}",
         "ε is the user's choice (default 1): the slides give no formula for ε*",
     ]
+    lin = _linear_part_norm(spec)
+    if lin > float(o.lipschitz):
+        notes.append(
+            f"WARNING: the terms of [system].A on and below its diagonal (part of φ = ẋ − A₀x) "
+            f"have norm ≈ {lin:.6g} > L = {fmt_exact(o.lipschitz)}: unless ψ cancels them, "
+            "[method].lipschitz does not bound the scaled Δ_φ and convergence is not implied"
+        )
     sr = SolverResult(
         "exact Lyapunov equation (python-flint)",
         SolverStatus.CLOSED_FORM,
@@ -124,6 +133,19 @@ def design_params(
         time.perf_counter() - t0,
     )
     return vals, sr, notes
+
+
+def _linear_part_norm(spec: Spec) -> float:
+    """‖M‖₂ (floats) for M = A − A₀, the terms of the spec's A on and below its diagonal (the
+    options check that above it A is A₀): their contribution to the Lipschitz constant of the
+    scaled Δ_φ at ℓ = 1 (the scaling only shrinks it for ℓ ≥ 1); 0 without A (the f form).
+    Information for a warning, never a claim."""
+    s = spec.system
+    if s.A is None:
+        return 0.0
+    A0, _ = chain(s.n)
+    M = np.asarray(to_float(np.asarray(s.A.q, dtype=object) - A0), dtype=float)
+    return float(np.linalg.norm(M, 2)) if M.size else 0.0
 
 
 def certify(spec: Spec, params: Parameters) -> list[Claim]:
@@ -148,7 +170,8 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     identity_claim(
         c,
         "lyapunov-equation",
-        "P(A − KC) + (A − KC)ᵀP = −I with K = (k_1..k_n) of [method].K",
+        "P(A₀ − KC) + (A₀ − KC)ᵀP = −I with A₀ the chain of integrators (ones on the "
+        "superdiagonal) and K = (k_1..k_n) of [method].K",
         f"{PAPER}, scaled error dynamics",
         "exact matrix equation",
         ok,
@@ -156,7 +179,7 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     )
     c.checked(
         id="P-positive",
-        statement="P ≻ 0 (with the Lyapunov equation: A − KC is Hurwitz)",
+        statement="P ≻ 0 (with the Lyapunov equation: A₀ − KC is Hurwitz)",
         reference=f"{PAPER}, scaled error dynamics",
         check="exact LDLᵀ",
         result=check_pd(P),
@@ -174,7 +197,8 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         ),
         (
             "ell-bound",
-            f"ℓ = {fmt_exact(ell)} > 2L|P| (the high-gain observer converges)",
+            f"ℓ = {fmt_exact(ell)} > 2L|P| (the high-gain observer converges when L bounds "
+            "the scaled Δ_φ, φ = ẋ − A₀x: the spec's declaration)",
             "exact LDLᵀ of ℓ·I − 2L·P (≻ 0; |P| = λ_max(P) for P ≻ 0)",
             ell,
             check_pd,

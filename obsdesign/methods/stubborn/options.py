@@ -90,6 +90,47 @@ class SimOptions:
     time_limit: float = DEFAULT_LIMIT
 
 
+def _check_triangular(spec: Spec) -> None:
+    """The high-gain certificate is about ẋ = A₀x + φ(x) with A₀ the chain of integrators (ones
+    on the superdiagonal) and φ in the triangular form of the slides (φ_i of x_1..x_i for
+    i < n): [system.A] above its diagonal must be A₀'s, and ψ_i (or f_i − x_{i+1}) must not
+    depend on x_{i+1}..x_n (sympy, after expansion: a dependence sympy cannot cancel is
+    refused). A spec's A was never read by the certificate: A = [[0, 1], [5, 0]] was
+    certified "A − KC is Hurwitz" for A₀ − KC while the spec's A − KC is not, and the
+    simulated error grew to 10⁶ (independent soundness trial, session 23). The terms of A on
+    and below the diagonal belong to φ: [method].lipschitz must cover them."""
+    import sympy
+
+    s = spec.system
+    n = s.n
+    if s.A is not None:
+        A = np.asarray(s.A.q, dtype=object)
+        for i in range(n):
+            for j in range(i + 1, n):
+                if A[i, j] != (1 if j == i + 1 else 0):
+                    raise SpecError(
+                        spec.file,
+                        "system.A",
+                        f"has {A[i, j]} at ({i + 1}, {j + 1}): mode = 'high-gain' needs the "
+                        "triangular form ẋ_i = x_{i+1} + φ_i(x_1..x_i), so A must be 1 on the "
+                        "superdiagonal and 0 above it (its entries on and below the diagonal "
+                        "are part of φ, and [method].lipschitz must cover them)",
+                    )
+    exprs, key = (s.f, "system.f") if s.f is not None else (s.psi, "system.psi")
+    for i, e in enumerate((exprs or [])[: n - 1]):
+        phi = e.sympy() - (sympy.Symbol(s.states[i + 1]) if s.f is not None else 0)
+        later = {str(v) for v in sympy.expand(phi).free_symbols} & set(s.states[i + 1 :])
+        if later:
+            what = f"{key}[{i}]" + (f" − {s.states[i + 1]}" if s.f is not None else "")
+            raise SpecError(
+                spec.file,
+                key,
+                f"{what} depends on {', '.join(sorted(later))}: mode = 'high-gain' needs the "
+                f"triangular form ẋ_i = x_{{i+1}} + φ_i(x_1..x_i) (φ_{i + 1} of "
+                f"{', '.join(s.states[: i + 1])} only)",
+            )
+
+
 def parse_options(table: Table, spec: Spec) -> Options:
     """Read and validate ``[method]`` (every error names file and key)."""
     s = spec.system
@@ -119,6 +160,7 @@ def parse_options(table: Table, spec: Spec) -> Options:
                 "must be [[1, 0, …, 0]] in mode = 'high-gain' (the high-gain observer measures "
                 "y = x1 of the triangular form); omit C or reorder the states",
             )
+        _check_triangular(spec)
         K = table.vector("K", n=n).q
         lip = table.scalar("lipschitz", min=0).q
         e = table.scalar("ell", default=None, min=1)
