@@ -19,6 +19,7 @@ from obsdesign.certify import interval as ivq
 from obsdesign.certify.claim import ClaimStatus
 from obsdesign.certify.exact import Q
 from obsdesign.cli import app
+from obsdesign.errors import SpecError
 from obsdesign.methods.searchspace import design as D
 from obsdesign.params import Parameters
 
@@ -879,3 +880,14 @@ def test_switch_products_in_h_design_and_verify(h: str, L_h, tmp_path) -> None:
     out = tmp_path / "r.json"
     out.write_text(json.dumps(rep.to_dict()), encoding="utf-8")
     assert api.verify(out).exit_code() == 0
+
+
+@pytest.mark.parametrize(("key", "line"), [("A", "A = [[0, 1], [-1, 0]]"), ("C", "C = [[1, 0]]")])
+def test_a_linear_model_beside_f_and_h_is_refused(key: str, line: str) -> None:
+    """A search-space spec with f, h and also A (or C) was accepted and A silently ignored
+    (independent soundness trial, session 23): it is bad input naming the key."""
+    text = TEXT.replace("[system]\n", f"[system]\n{line}\n", 1)
+    assert line in text
+    with pytest.raises(SpecError) as ei:
+        api.load_spec_text(text, "s.toml")
+    assert ei.value.key == f"system.{key}"

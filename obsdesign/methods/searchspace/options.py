@@ -107,6 +107,14 @@ def parse_options(table: Table, spec: Spec) -> Options:
         )
     if s.f is None or s.h is None:
         raise table.error("key", "the search-space method needs the plant as [system] f and h")
+    for k, v in (("A", s.A), ("C", s.C)):
+        if v is not None:  # was accepted and silently ignored (soundness trial, session 23)
+            raise SpecError(
+                spec.file,
+                f"system.{k}",
+                "is not read by the search-space method (the plant is ẋ = f(x, u), y = h(x)): "
+                "remove it, or write its terms into f / h",
+            )
     for i, ex in enumerate(s.f):
         for v in (*s.disturbances, "t"):
             if ex.uses(v):
