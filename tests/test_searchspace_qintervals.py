@@ -57,6 +57,16 @@ def _exact(text: str, t: Fraction) -> sympy.Expr:
     return ex.sympy().subs(sympy.Symbol("t"), sympy.Rational(t.numerator, t.denominator))
 
 
+def _assert_contains(q: QI, v: sympy.Expr, where: object) -> None:
+    """The exact value v (rational, else to 60 digits) lies in the enclosure q."""
+    if v.is_Rational:
+        assert q.lo <= Fraction(int(v.p), int(v.q)) <= q.hi, where
+    else:
+        x = sympy.Float(v.evalf(60), 60)
+        assert sympy.Rational(q.lo.numerator, q.lo.denominator) <= x, where
+        assert x <= sympy.Rational(q.hi.numerator, q.hi.denominator), where
+
+
 @settings(max_examples=120, deadline=None)
 @given(
     st.sampled_from(TEMPLATES),
@@ -79,13 +89,7 @@ def test_enclosure_contains_the_exact_value(
     assert q.lo <= q.hi
     for f in [0, 1000, *fracs]:
         t = lo + (hi - lo) * Fraction(f, 1000)
-        v = _exact(text, t)
-        if v.is_Rational:
-            assert q.lo <= Fraction(int(v.p), int(v.q)) <= q.hi, (text, t)
-        else:
-            x = sympy.Float(v.evalf(60), 60)
-            assert sympy.Rational(q.lo.numerator, q.lo.denominator) <= x, (text, t)
-            assert x <= sympy.Rational(q.hi.numerator, q.hi.denominator), (text, t)
+        _assert_contains(q, _exact(text, t), (text, t))
 
 
 @pytest.mark.parametrize(
@@ -384,13 +388,7 @@ def test_exact_enclosures_contain_the_value(text: str) -> None:
         assert q.lo <= q.hi
         for f in (0, 1, 2, 3, 4):
             t = lo + (hi - lo) * Fraction(f, 4)
-            v = _exact(text, t)
-            if v.is_Rational:
-                assert q.lo <= Fraction(int(v.p), int(v.q)) <= q.hi, (text, t)
-            else:
-                x = sympy.Float(v.evalf(60), 60)
-                assert sympy.Rational(q.lo.numerator, q.lo.denominator) <= x, (text, t)
-                assert x <= sympy.Rational(q.hi.numerator, q.hi.denominator), (text, t)
+            _assert_contains(q, _exact(text, t), (text, t))
 
 
 @pytest.mark.parametrize(
