@@ -120,18 +120,56 @@ def _matrices(sys: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
             f"expected a state-space system (control.StateSpace or (A, B, C, D[, dt])), got "
             f"{type(sys).__name__}: convert it first, e.g. control.ss(sys)"
         )
-    A = np.atleast_2d(np.asarray(A, dtype=float))
-    C = np.atleast_2d(np.asarray(C, dtype=float))
+    A = np.atleast_2d(_real(A, "A"))
+    C = np.atleast_2d(_real(C, "C"))
     n = A.shape[0]
-    B = np.asarray(B, dtype=float).reshape(n, -1) if np.size(B) else np.zeros((n, 0))
-    D = (
-        np.asarray(D, dtype=float).reshape(C.shape[0], -1)
-        if np.size(D)
-        else np.zeros((C.shape[0], 0))
-    )
-    if A.shape != (n, n) or C.shape[1] != n:
+    if A.shape != (n, n) or C.ndim != 2 or C.shape[1] != n:
         raise InputError(f"state-space shapes do not fit: A {A.shape}, C {C.shape}")
+    B = _columns(B, n, "B", "n, the states")
+    p, m = C.shape[0], B.shape[1]
+    Dr = _real(D, "D")
+    if Dr.size == 0:
+        D = np.zeros((p, m))
+    elif Dr.shape == (p, m) or (Dr.ndim == 1 and Dr.size == p * m and 1 in (p, m)):
+        D = Dr.reshape(p, m)  # a vector is D's one row (p = 1) or one column (m = 1)
+    else:
+        # a wrongly shaped B or D was reshaped row-major into another matrix, then certified
+        # (independent soundness trial, session 23)
+        raise InputError(f"D has shape {Dr.shape}: expected p×m = {p}×{m} (C's rows, B's columns)")
     return A, B, C, D, dt
+
+
+def _real(M: Any, name: str) -> np.ndarray:
+    """A real matrix: integer entries stay integers (exact: an int64 above 2⁵³ was rounded by
+    a conversion to float, soundness trial, session 23), anything else as floats; complex
+    entries are refused (they were cast to their real part)."""
+    arr = np.asarray(M)
+    if arr.dtype.kind == "c" or (
+        arr.dtype == object and any(isinstance(x, complex) for x in arr.flat)
+    ):
+        raise InputError(f"{name} has complex entries: a spec's matrices are real")
+    if arr.dtype.kind in "iu":
+        return arr
+    if arr.dtype == object and all(
+        isinstance(x, (int, np.integer)) and not isinstance(x, bool) for x in arr.flat
+    ):
+        return arr
+    return arr.astype(float)
+
+
+def _columns(M: Any, rows: int, name: str, what: str) -> np.ndarray:
+    """``M`` as a matrix of ``rows`` rows (B, Bd): a matrix with that many rows as it is, a
+    vector of that length (1-D, or one row when rows > 1) as one column, nothing as rows×0;
+    any other shape is refused (it was reshaped row-major into another matrix: a 2×3 B of a
+    3-state plant became [[1, 2], [3, 4], [5, 6]] and was certified)."""
+    arr = _real(M, name)
+    if arr.size == 0:
+        return np.zeros((rows, 0))
+    if arr.ndim == 2 and arr.shape[0] == rows:
+        return arr
+    if (arr.ndim == 1 and arr.shape[0] == rows) or (arr.ndim == 2 and arr.shape == (1, rows)):
+        return arr.reshape(rows, 1)
+    raise InputError(f"{name} has shape {arr.shape}: expected {rows} rows ({what})")
 
 
 def spec_text_from_statespace(
@@ -154,7 +192,11 @@ def spec_text_from_statespace(
     ``sample_time = dt``. ``B`` and ``D`` are written when they are not all zero. ``sets``,
     ``nonlinearity`` and ``simulate`` are written as tables (nested mappings → sub-tables),
     ``Bd`` as the disturbance input. Floats are written by their shortest repr, so the spec
-    reads back as the same doubles."""
+    reads back as the same doubles; the spec's exact values, and so its certificate, are those
+    decimals (0.1 is 1/10, not the double's binary value), which a certificate with a margin
+    near 10⁻¹⁶ relative can tell apart (docs/quickstart.md). Integer entries are written
+    exactly; B and Bd must have n rows and D p×m (a vector is one column, D's one row or
+    column), else InputError."""
     A, B, C, D, dt = _matrices(sys)
     if dt is None or (dt is not True and float(dt) == 0):
         time, sample_time = "continuous", None
@@ -174,7 +216,7 @@ def spec_text_from_statespace(
         # (a nonzero D was dropped with a zero B: outsider trial, session 22)
         system["D"] = D
     if Bd is not None:
-        system["Bd"] = np.asarray(Bd, dtype=float).reshape(A.shape[0], -1)
+        system["Bd"] = _columns(Bd, A.shape[0], "Bd", "n, the states")
     if sample_time is not None:
         system["sample_time"] = sample_time
     if states is not None:
@@ -342,8 +384,7 @@ def spec_text_from_mat(
             raise InputError(f"{path}: variable '{v}' ({key}) is not a real numeric matrix")
         if arr.ndim > 2:
             raise InputError(f"{path}: variable '{v}' ({key}) has {arr.ndim} dimensions, not 2")
-        arr = arr.astype(float)
-        if not np.all(np.isfinite(arr)):
+        if arr.dtype.kind == "f" and not np.all(np.isfinite(arr)):
             raise InputError(f"{path}: variable '{v}' ({key}) has a non-finite entry (inf or nan)")
         return arr
 
@@ -367,8 +408,9 @@ def spec_text_from_mat(
                 f"{path}: variable '{dt_name}' (the sample time) is {dt:g}; expected a finite "
                 "number >= 0 (0: continuous time)"
             )
-    Bm = B if B is not None else np.zeros((n, 0))
-    Dm = D if D is not None else np.zeros((C.shape[0], Bm.shape[1]))
+    # D without B: the inputs enter y only (the spec had D with no input and was refused)
+    Bm = B if B is not None else np.zeros((n, 0 if D is None else np.atleast_2d(D).shape[-1]))
+    Dm = D if D is not None else np.zeros((C.shape[0], 0))
     try:
         return spec_text_from_statespace(
             (A, Bm, C, Dm, dt if dt else 0), method, Bd=Bd, title=f"imported from {Path(path).name}"

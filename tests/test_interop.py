@@ -251,3 +251,58 @@ def test_a_transfer_function_or_a_short_tuple_is_input_error() -> None:
         interop.spec_from_statespace((np.eye(1), np.eye(1), np.eye(1)), "lyapunov")
     sys_ = control.ss(control.tf([1], [1, 2]))
     assert interop.spec_from_statespace(sys_, "lyapunov").system.n == 1
+
+
+@pytest.mark.parametrize(
+    ("B", "D", "Bd", "bad"),
+    [
+        ([[1, 2, 3], [4, 5, 6]], None, None, "B has shape (2, 3)"),  # 3 states
+        (np.eye(3)[:, :1], [[1, 2, 3, 4]], None, "D has shape (1, 4)"),
+        (None, None, [[1, 2, 3], [4, 5, 6]], "Bd has shape (2, 3)"),
+        ([1, 2, 3], [0.5], None, None),  # a vector: one column
+        ([[1, 2, 3]], [[0.5]], [[1, 0, 0]], None),  # one row of n: one column
+    ],
+)
+def test_wrongly_shaped_B_D_Bd_are_refused(B, D, Bd, bad) -> None:
+    """Independent soundness trial (session 23): a 2×3 B for 3 states was reshaped row-major to
+    [[1, 2], [3, 4], [5, 6]] (neither B nor Bᵀ) and the design certified that plant; D and Bd
+    alike. Now B and Bd need n rows (a vector is one column) and D must be p×m."""
+    A = np.diag([0.5, 0.2, 0.1])
+    C = np.array([[1.0, 1.0, 1.0]])
+    m = 0 if B is None else np.atleast_2d(np.asarray(B)).size // 3
+    plant = (A, np.zeros((3, 0)) if B is None else B, C, np.zeros((1, m)) if D is None else D)
+    if bad is None:
+        text = spec_text_from_statespace(plant, "lyapunov", Bd=Bd)
+        sp = api.load_spec_text(text, "<s>")
+        assert np.asarray(sp.system.B.f).tolist() == [[1.0], [2.0], [3.0]]
+        return
+    with pytest.raises(InputError, match=bad.replace("(", r"\(").replace(")", r"\)")):
+        spec_text_from_statespace(plant, "lyapunov", Bd=Bd)
+
+
+def test_integers_are_written_exactly_and_complex_is_refused(tmp_path: Path) -> None:
+    """An int64 entry 2⁵³ + 1 of a .mat file was written as 9007199254740992.0 (a conversion to
+    float) and certified (soundness trial, session 23): integers are written exactly. A
+    complex entry was cast to its real part through the tuple path: refused."""
+    from scipy.io import savemat
+
+    mat = tmp_path / "big.mat"
+    savemat(mat, {"A": np.array([[0.5]]), "C": np.array([[2**53 + 1]], dtype=np.int64)})
+    r = CliRunner().invoke(app, ["import", str(mat), "--A", "A", "--C", "C"])
+    assert r.exit_code == 0, r.stderr
+    assert tomllib.loads(r.stdout)["system"]["C"] == [[2**53 + 1]]
+    with pytest.raises(InputError, match="complex"):
+        spec_text_from_statespace((np.array([[0.5 + 1j]]), [], [[1.0]], []), "lyapunov")
+
+
+def test_mat_import_D_without_B_gives_a_spec_that_designs(tmp_path: Path) -> None:
+    """`obsdesign import --D` without `--B` wrote a spec that design refused ("[system.D]
+    expected shape 1×0"): the inputs enter y only, so B is n×m zeros."""
+    from scipy.io import savemat
+
+    mat = tmp_path / "d.mat"
+    savemat(mat, {"Ad": np.array(A_D), "Cm": np.array([[1.0, 0.0]]), "Dm": np.array([[2.0]])})
+    r = CliRunner().invoke(app, ["import", str(mat), "--A", "Ad", "--C", "Cm", "--D", "Dm"])
+    assert r.exit_code == 0, r.stderr
+    rep = api.design(api.load_spec_text(r.stdout, "d.toml"))
+    assert rep.exit_code() == 0 and "D = [[2]]" in r.stdout
