@@ -701,6 +701,14 @@ def lyapunov_solver_name(n: int, discrete: bool) -> str:
     return f"Lyapunov equation: scipy solve_{'discrete' if discrete else 'continuous'}_lyapunov"
 
 
+def sym_part(M: np.ndarray) -> np.ndarray:
+    """(M + Mᵀ)/2 of a float matrix as M/2 + Mᵀ/2: no overflow for entries near the float
+    range (M + Mᵀ overflowed to inf there: a plant with entries of 1e150 made the Lyapunov
+    solution X of eq. (4)-(6), constrained-redesign paper, non-finite and exit 3; unusual-spec
+    trial, session 24); the same bits as (M + Mᵀ)/2 unless an entry is subnormal."""
+    return M / 2 + M.T / 2
+
+
 def _lyap_solution(Acl: np.ndarray, rate: float, discrete: bool) -> np.ndarray | None:
     """Float X of :func:`solve_lyapunov`, whatever the stability of Acl (an unstable Acl
     gives an indefinite X); None when the solver fails."""
@@ -715,7 +723,8 @@ def _lyap_solution(Acl: np.ndarray, rate: float, discrete: bool) -> np.ndarray |
         return None
     if not np.all(np.isfinite(X)):
         return None
-    return (X + X.T) / 2
+    S = sym_part(X)
+    return S if np.all(np.isfinite(S)) else None
 
 
 def rate_feasibility(
@@ -869,7 +878,7 @@ def lyapunov_P(
 
     :param A, C, L: float matrices; :param rate: λ or α; :param discrete: time domain."""
     P = solve_lyapunov(A - L @ C, rate, discrete)
-    return (P + P.T) / 2
+    return sym_part(P)
 
 
 def _float_P(
@@ -1001,7 +1010,7 @@ def margin_scale(Pf: np.ndarray, margin: Any, Pm: fmpq_mat | None = None) -> fmp
         return c
     with np.errstate(all="ignore"):
         try:
-            ev = np.linalg.eigvalsh((Pf + Pf.T) / 2)
+            ev = np.linalg.eigvalsh(sym_part(Pf))
             lmin = float(ev[0])
             if Pm is not None and not lmin > 1e-12 * float(ev[-1]):
                 lmin = _lambda_min_by_inverse(Pm, lmin)
@@ -1021,7 +1030,7 @@ def _lambda_min_by_inverse(Pm: fmpq_mat, fallback: float) -> float:
     λ_max(P⁻¹) is not a positive float."""
     try:
         inv = mat_float(Pm.inv())
-        top = float(np.linalg.eigvalsh((inv + inv.T) / 2)[-1])
+        top = float(np.linalg.eigvalsh(sym_part(inv))[-1])
     except (ZeroDivisionError, np.linalg.LinAlgError, OverflowError):
         return fallback
     if not (math.isfinite(top) and top > 0):
@@ -1123,7 +1132,8 @@ class _Forecast:
             P = (self.Vi.conj().T @ Y @ self.Vi).real
         if not np.all(np.isfinite(P)):
             return None
-        return (P + P.T) / 2
+        P = sym_part(P)
+        return P if np.all(np.isfinite(P)) else None
 
     def __call__(self, r: fmpq) -> bool:
         """Whether :func:`certified_P` is expected to succeed at the rate ``r``."""
@@ -1138,7 +1148,7 @@ class _Forecast:
             M = rf * rf * Pf - Acl.T @ Pf @ Acl
         else:
             M = -(Acl.T @ Pf + Pf @ Acl + 2 * rf * Pf)
-        M = (M + M.T) / 2
+        M = sym_part(M)
         m = self.m
         gap = 1e-6
         wp = np.linalg.eigvalsh(Pf)

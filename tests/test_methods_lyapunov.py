@@ -1191,3 +1191,27 @@ def test_the_designs_own_not_certifiable_bracket_is_numerical(
     out = tmp_path / "r.json"
     out.write_text(rep.to_json(), encoding="utf-8")
     assert api.verify(out).exit_code() == 0
+
+
+_TINY_RATE = """[system]
+time = "discrete"
+A = [[0, 1], [0, 0]]
+C = [[1, 0]]
+[method]
+key = "lyapunov"
+L = [0, 0]
+lambda = 1e-300
+"""
+
+
+def test_entries_near_the_float_range_do_not_overflow_the_lyapunov_solution() -> None:
+    """A = [[0, 1e150], [0, 0]]: the float Lyapunov solutions have entries near 10³⁰⁷, and
+    (X + Xᵀ)/2 overflowed to inf (exit 3 "cannot round a non-finite number" for entries 1e147
+    to 1e150; unusual-spec trial, session 24). Now it designs, and verify agrees."""
+    text = _TINY_RATE.replace("[[0, 1], [0, 0]]", "[[0, 1e150], [0, 0]]")
+    text = text.replace("L = [0, 0]\nlambda = 1e-300\n", "iss_gain = true\n")
+    rep = api.design(load_spec_text(text, "big.toml"))
+    assert rep.exit_code() == 0
+    assert api.verify(rep).exit_code() == 0
+    X = np.array([[1e308, 1e308], [1e308, 1e308]])
+    assert np.all(np.isfinite(lyap.sym_part(X))) and lyap.sym_part(X)[0, 1] == 1e308
