@@ -233,6 +233,11 @@ def design(
         with _error_report_on_failure(sp, out, force):  # e.g. a value beyond the float range
             text = report.to_json()
         write_atomic(out, text, force)
+    else:
+        # the same exit 4 without an output file: a report with no float view is no report
+        # (a λ of 1e-300 gave P ≈ 10¹²⁰⁰: exit 4 with -o or --format json, 3 from the text
+        # table, 0 with -q; unusual-spec trial, session 24)
+        report.float_view()
     return report
 
 

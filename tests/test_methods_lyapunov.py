@@ -1204,6 +1204,20 @@ lambda = 1e-300
 """
 
 
+@pytest.mark.parametrize("flags", [[], ["-q"], ["--format", "md"], ["--format", "json"]])
+def test_a_report_with_no_float_view_is_exit_4_in_every_output_mode(tmp_path, flags) -> None:
+    """λ = 10⁻³⁰⁰ gives a true certificate with P ≈ 10¹²⁰⁰, beyond a report's float view:
+    exit 4 naming P whatever the output mode (it was 3 from the text table's float
+    conversion, 4 with -o or --format json, and 0 with -q; unusual-spec trial, session 24)."""
+    p = tmp_path / "tiny.toml"
+    p.write_text(_TINY_RATE)
+    with pytest.raises(InconclusiveError, match="parameter 'P'"):
+        api.design(p)
+    res = CliRunner().invoke(app, ["design", str(p), *flags])
+    assert res.exit_code == 4, res.output
+    assert "float view" in res.output and "Traceback" not in res.output
+
+
 def test_entries_near_the_float_range_do_not_overflow_the_lyapunov_solution() -> None:
     """A = [[0, 1e150], [0, 0]]: the float Lyapunov solutions have entries near 10³⁰⁷, and
     (X + Xᵀ)/2 overflowed to inf (exit 3 "cannot round a non-finite number" for entries 1e147

@@ -184,18 +184,24 @@ class Report:
             return "error"
         return VERDICTS.get(self.exit_code(), "failed")
 
-    def to_dict(self) -> dict[str, Any]:
-        """The report as JSON data. A parameter whose exact value lies beyond the float range
-        has no float view (e.g. v_max from a set's edge at 1e300): InconclusiveError (exit 4)
-        naming it, not an internal failure."""
+    def float_view(self) -> dict[str, Any]:
+        """The ``parameters`` object of the JSON report (floats with the exact strings beside
+        them). A parameter whose exact value lies beyond the float range has no float view
+        (e.g. v_max from a set's edge at 1e300): InconclusiveError (exit 4) naming it, not an
+        internal failure."""
         try:
-            params = self.parameters.to_json()
+            return self.parameters.to_json()
         except OverflowError as e:
             raise InconclusiveError(
                 "an exact value lies beyond the float range, so the report cannot give its "
                 f"float view ({e}): the spec's numbers are too large or too small for one "
                 "report (e.g. an eps_min of 1e-300 makes the constrained method's θ ≈ 10⁶⁰⁰)"
             ) from e
+
+    def to_dict(self) -> dict[str, Any]:
+        """The report as JSON data (:meth:`float_view` for its parameters: exit 4 when one
+        has no float view)."""
+        params = self.float_view()
         d = {
             "schema_version": self.schema_version,
             "tool": self.tool,
