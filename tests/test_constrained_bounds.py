@@ -409,9 +409,13 @@ def test_phi_and_norm_c_exactly_at_rational_points():
 
 def test_the_eigenvalue_ladders_end_safely(monkeypatch):
     """When no candidate of its ladder is proved (the float estimate 3× off), λ_min's lower
-    bound is 0 (safe, never 1) and κ's upper bound is refused (ArithmeticError)."""
+    bound comes from P's exact inverse, proved (the ladder on P⁻¹'s float λ_max passes at
+    ≈ 1, and 1/‖P⁻¹‖_∞ = 3 would too): never above λ_min = 3, and 0 (never 1) for a P that
+    is not definite; κ's upper bound is refused (ArithmeticError)."""
     _fake_eigh_low(monkeypatch, 3.0)
-    assert B.lambda_min_lower(qmat([[3, 0], [0, 5]])) == 0
+    ell = B.lambda_min_lower(qmat([[3, 0], [0, 5]]))
+    assert 0 < ell <= 3
+    assert B.lambda_min_lower(qmat([[3, 0], [0, -5]])) == 0
     monkeypatch.undo()
     _fake_eigh_low(monkeypatch, 0.3)
     with pytest.raises(ArithmeticError):
@@ -744,3 +748,18 @@ def test_sup_norm_c_over_Xhat_max_by_hand() -> None:
         got = B.sup_norm_c_over_Xhat_max(em, P2, qinv(P2), X01, Q(4))
         assert want <= got <= want * (1 + fmpq(1, 10**7)), r
     assert B.sup_norm_c_over_Xhat_max(ellipsoid_map(qeye(2), 9), P2, qinv(P2), X01, Q(4)) == 0
+
+
+def test_lambda_min_lower_beyond_float_resolution() -> None:
+    """P = R diag(10²⁰, 1) Rᵀ (R an exact rotation) is positive definite with λ_min = 1, but
+    its float λ_min is 0: lambda_min_lower returned 0 and the design said "no γ > 0
+    satisfies (24)" (exit 1) for λ near ρ(A − LC) (unusual-spec trial, session 24). The
+    bound now comes from P's exact inverse and is proved by P − ℓI ⪰ 0; an indefinite or
+    singular P still gets 0."""
+    R = qmat([[fmpq(3, 5), fmpq(4, 5)], [fmpq(-4, 5), fmpq(3, 5)]])
+    P = R.dot(qmat([[10**20, 0], [0, 1]])).dot(R.T)
+    assert np.linalg.eigvalsh(np.asarray(P, dtype=float)).min() <= 0  # the float view fails
+    ell = B.lambda_min_lower(P)
+    assert fmpq(1, 2) <= ell <= 1
+    assert B.lambda_min_lower(R.dot(qmat([[10**20, 0], [0, -1]])).dot(R.T)) == 0
+    assert B.lambda_min_lower(R.dot(qmat([[10**20, 0], [0, 0]])).dot(R.T)) == 0

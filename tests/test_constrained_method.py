@@ -806,3 +806,38 @@ def test_simulate_names_the_largest_certified_gamma_rounded_down() -> None:
         text = api.simulate(spec, rep, options=opts).info["gamma (simulation)"]
         assert text.endswith(f"certified γ ≤ {shown})"), text
         assert Q(shown) <= g_max
+
+
+_DEFECTIVE = """[system]
+time = "discrete"
+A = [[1, 1], [0, 1]]
+C = [[1, 0]]
+[sets.X]
+type = "box"
+lower = [-1, -1]
+upper = [1, 1]
+[method]
+key = "constrained"
+L = [1, 0.25]
+X = "X"
+eps_min = 0.01
+lambda = 0.500000000001
+[method.c]
+type = "box"
+lower = [-1.1, -1.1]
+upper = [1.1, 1.1]
+[method.D]
+lower = [-0.01]
+upper = [0.01]
+"""
+
+
+def test_a_rate_just_above_a_defective_eigenvalue_certifies() -> None:
+    """A − LC has the defective eigenvalue 1/2 and λ = 1/2 + 10⁻¹²: P ≻ 0 holds exactly but
+    its float λ_min is ≤ 0, and the design said "no γ > 0 satisfies (24)" (exit 1,
+    infeasible) although the lyapunov method certifies the same P (unusual-spec trial,
+    session 24). Now γ comes from an exact lower bound of λ_min(P), and verify agrees."""
+    rep = api.design(load_spec_text(_DEFECTIVE, "defective.toml"))
+    assert rep.exit_code() == 0, [c.detail for c in rep.claims if not c.passed]
+    assert float(rep.parameters.float("gamma")) > 0
+    assert api.verify(rep).exit_code() == 0

@@ -79,13 +79,40 @@ def quad_lin(g: np.ndarray, x: np.ndarray) -> fmpq:
 
 
 def lambda_min_lower(P: np.ndarray) -> fmpq:
-    """A rational ℓ ≤ λ_min(P), proved by P − ℓ I ⪰ 0 (exact LDLᵀ); used in eq. (24)."""
+    """A rational ℓ ≤ λ_min(P), proved by P − ℓ I ⪰ 0 (exact LDLᵀ); used in eq. (24).
+
+    The float λ_min(P) guides; when it is not positive or no candidate below it passes (a
+    P ≻ 0 whose condition number is beyond float resolution: λ near ρ(A − LC) made it ≤ 0
+    and the design "infeasible", unusual-spec trial, session 24), the candidates come from
+    P's exact inverse: λ_min(P) = 1/λ_max(P⁻¹), guided by the float λ_max(P⁻¹) and last
+    1/‖P⁻¹‖_∞ ≤ λ_min(P), which for P ≻ 0 always passes. So 0 means P is not positive
+    definite (singular, or a failed exact LDLᵀ)."""
+    n = P.shape[0]
     lam = float(np.linalg.eigvalsh(np.asarray(P, dtype=float)).min())
-    if lam <= 0:
+    if lam > 0:
+        for f in (1e-9, 1e-6, 1e-3, 1e-1, 0.5):
+            ell = dyadic(lam * (1 - f), 30)
+            if check_psd(P - qeye(n) * ell):
+                return ell
+    try:
+        Pinv = qinv(P)
+    except (ZeroDivisionError, ValueError, np.linalg.LinAlgError):
         return fmpq(0)
-    for f in (1e-9, 1e-6, 1e-3, 1e-1, 0.5):
-        ell = dyadic(lam * (1 - f), 30)
-        if check_psd(P - qeye(P.shape[0]) * ell):
+    norm_inf = max(sum((abs(v) for v in row), fmpq(0)) for row in Pinv)
+    if norm_inf <= 0:
+        return fmpq(0)
+    cands: list[fmpq] = []
+    try:
+        with np.errstate(all="ignore"):
+            top = float(np.linalg.eigvalsh(np.asarray(Pinv, dtype=float)).max())
+    except (OverflowError, np.linalg.LinAlgError):  # a guide only
+        top = float("nan")
+    if np.isfinite(top) and top > 0:
+        cands += [dyadic((1 - f) / top, 30) for f in (1e-9, 1e-6, 1e-3, 1e-1)]
+    bound = 1 / norm_inf  # λ_max(P⁻¹) ≤ ‖P⁻¹‖_∞
+    cands.append(round_sig(bound, 6, up=False) if bound > 0 else fmpq(0))
+    for ell in cands:
+        if ell > 0 and check_psd(P - qeye(n) * ell):
             return ell
     return fmpq(0)
 

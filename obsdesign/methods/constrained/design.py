@@ -166,7 +166,8 @@ def design_params(spec: Spec) -> tuple[dict[str, Any], list[str]]:
         gamma = g_max
         if gamma <= 0:
             raise InfeasibleError(
-                "no γ > 0 satisfies (24): λ_min(P) could not be bounded away from 0"
+                "no γ > 0 satisfies (24): P is not positive definite (λ_min(P) ≤ 0; for a "
+                "P ≻ 0 the bound 1/‖P⁻¹‖_∞ ≤ λ_min(P) is always proved)"
             )
     else:
         gamma = o.gamma
