@@ -1148,3 +1148,32 @@ def test_a_step_too_large_for_the_adaptive_level_is_warned() -> None:
             study(sp, rep.parameters, runs=2)
         said = [str(w.message) for w in caught if "adaptive level" in str(w.message)]
         assert bool(said) is warned, said
+
+
+def test_a_slow_continuous_plant_finds_its_best_lambda_below_1e_6() -> None:
+    """A plant at time scale 10⁹ (A, C of size 10⁻⁹): the best λ is about 10⁻⁹. The search
+    stopped at 10⁻⁶ and said "LMIs (1)-(3) infeasible for every λ tried: raise gain_bound"
+    (exit 1), though λ = 10⁻¹¹ certifies (unusual-spec trial, session 24). It now goes down
+    by 10⁴ a step (to 10⁻³⁰) and certifies λ_max ≈ 10⁻⁹; verify agrees."""
+    text = (
+        '[system]\ntime = "continuous"\nA = [[0, 1e-9], [-1e-9, -1e-9]]\nC = [[1e-9, 0]]\n'
+        '[method]\nkey = "stubborn"\n'
+    )
+    rep = api.design(api.load_spec_text(text, "slow.toml"))
+    assert rep.exit_code() == 0
+    lam_max = float(rep.parameters.float("lambda_max"))
+    assert 1e-10 < lam_max < 1e-8
+    assert api.verify(rep).exit_code() == 0
+
+
+def test_a_gain_bound_too_small_for_every_lambda_is_infeasible() -> None:
+    """The downward search ends at its floor: A = 1, C = 1 needs |K| > 1 for A − KC
+    Hurwitz, so with gain_bound = 1/2 no λ > 0 is feasible; exit 1 naming the bound."""
+    from obsdesign.errors import InfeasibleError
+
+    text = (
+        '[system]\ntime = "continuous"\nA = [[1]]\nC = [[1]]\n'
+        '[method]\nkey = "stubborn"\ngain_bound = 0.5\n'
+    )
+    with pytest.raises(InfeasibleError, match="every λ tried.*gain_bound"):
+        api.design(api.load_spec_text(text, "bound.toml"))

@@ -35,6 +35,9 @@ from obsdesign.spec.models import Spec
 BITS = 40
 #: the λ search stops at these caps (continuous: λ ≤ LAMBDA_CAP; discrete: λ ≥ 1/LAMBDA_CAP)
 LAMBDA_CAP = 1e6
+#: continuous time: below λ = 10⁻⁶ the search goes down by LOW_STEP a step to LAMBDA_FLOOR
+LOW_STEP = 1e4
+LAMBDA_FLOOR = 1e-30
 
 
 @dataclass
@@ -220,8 +223,16 @@ def search_lambda(pl: Plant, o: Options) -> tuple[float, float, str]:
             ok, st = feasible(pl, o, hi)
         if lo == 0.0:
             lo = 1e-6
-            if not feasible(pl, o, lo)[0]:
-                return 0.0, lo, st
+            ok, st_lo = feasible(pl, o, lo)
+            while not ok:
+                # a slow plant (time scale beyond 10⁶): down by 10⁴ a step to LAMBDA_FLOOR
+                # (a plant at scale 1e-9 needs λ ≈ 1e-11: the search stopped at 1e-6 and
+                # said "infeasible for every λ tried"; unusual-spec trial, session 24)
+                hi, st = lo, st_lo
+                lo /= LOW_STEP
+                if lo < LAMBDA_FLOOR:
+                    return 0.0, hi, st
+                ok, st_lo = feasible(pl, o, lo)
         lo, hi, st, known = _bisect(feas, lo, hi, st, tol)
         return (lo, *_far_end(feas, lo, hi, st, known, False))
     top = 1 - 1e-6
