@@ -985,3 +985,32 @@ def test_floor_of_an_interval_unbounded_below() -> None:
 
     d = d_floor(Dual(I(-math.inf, 0.5), (ONE,)))
     assert d.v == I(-math.inf, 0.0) and d.g[0].hi == math.inf
+
+
+@pytest.mark.parametrize("x", [-1000.0, -800.0, -745.5, -740.0, -710.0, -700.0])
+def test_exp_enclosure_holds_in_the_subnormal_and_underflow_range(x: float) -> None:
+    """mpmath's ``to_float(·, rnd="c")`` gave 0.0 below the subnormal range and ignored the
+    direction inside it: exp([−1000, −800]) was [0, 0], so f = exp(x)·10⁴⁰⁰ got a certified
+    bound 0 (search-space trial, session 24). Both ends are now compared exactly and
+    stepped outward."""
+    r = IV.exp(IV.I(x, x))
+    with mpmath.workprec(300):
+        true = mpmath.exp(mpmath.mpf(x))
+        assert mpmath.mpf(r.lo) <= true <= mpmath.mpf(r.hi)
+    assert r.hi > 0.0
+
+
+def test_a_near_integer_exponent_literal_is_not_an_integer_power() -> None:
+    """``x1^2.0000000000000001`` parses to the exponent 2.0: it was enclosed as x1², the
+    point 100 at x1 = 10, though 10^2.0000000000000001 > 100 (an input bound U = [0, 100]
+    was certified; search-space trial, session 24). Its exact decimal is not an integer, so
+    it goes through exp(b·log x), whose enclosure reaches above 100."""
+    text = "x1**2.0000000000000001"
+    node = ast.parse(text, mode="eval")
+    ten = IV.Dual(IV.I(10.0, 10.0), (IV.I(1.0, 1.0),))
+    r = IV.evaluate(node, {"x1": ten}, {}, 1, text)
+    assert r.v.hi > 100.0
+    exact = IV.evaluate(ast.parse("x1**2", mode="eval"), {"x1": ten}, {}, 1, "x1**2")
+    assert exact.v.lo == exact.v.hi == 100.0
+    assert IV.int_literal(node.body.right, text) is None
+    assert IV.int_literal(ast.parse("x**3.0", mode="eval").body.right, "x**3.0") == 3

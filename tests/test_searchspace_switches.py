@@ -16,7 +16,7 @@ from obsdesign.methods.searchspace import switches
 
 
 def _split(text: str) -> switches.Split | None:
-    return switches.split(ast.parse(text, mode="eval").body)
+    return switches.split(ast.parse(text, mode="eval").body, text)
 
 
 def _value(node: ast.AST, env: dict[str, Fraction]) -> Fraction:
@@ -141,6 +141,20 @@ def test_every_reading_is_an_identity(text: str, point: list[int]) -> None:
     half-integer points (so x1 = 0, x2 = 0 and x1 = x2, where the switches switch, occur)."""
     env = {"x1": Fraction(point[0], 2), "x2": Fraction(point[1], 2)}
     node = ast.parse(text, mode="eval").body
-    sp = switches.split(node)
+    sp = switches.split(node, text)
     if sp is not None:
         assert _reading(sp, env) == _value(node, env), text
+
+
+def test_literals_match_at_their_exact_value() -> None:
+    """0.1 and 0.10000000000000001 are one double but two numbers: ``(x1 - 0.1)*step(x1 -
+    0.10000000000000001)`` jumps by 10⁻¹⁷ and was read as max(x1 − 0.1, 0), certified
+    Lipschitz (search-space trial, session 24). Literals now match by their source text's
+    exact value; the same literal still matches."""
+    assert _split("(x1 - 0.1)*step(x1 - 0.10000000000000001)") is None
+    assert _split("(x1 - 0.1)*step(x1 - 0.1)") is not None
+    assert _split("(x1 - 0.10)*step(x1 - 0.1)") is not None  # 0.10 = 0.1 exactly
+    a = ast.parse("x1 - 0.1", mode="eval").body
+    b = ast.parse("x1 - 0.10000000000000001", mode="eval").body
+    assert ast.dump(a) == ast.dump(b)  # what the old match compared
+    assert switches.exact_key(a, "x1 - 0.1") != switches.exact_key(b, "x1 - 0.10000000000000001")

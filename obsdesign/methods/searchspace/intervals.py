@@ -38,7 +38,7 @@ from fractions import Fraction
 from typing import Any
 
 from mpmath import iv
-from mpmath.libmp import to_float
+from mpmath.libmp import from_float, mpf_cmp, to_float
 
 from obsdesign.methods.searchspace import switches
 
@@ -248,8 +248,24 @@ def _iv_call(fn: Any, x: I) -> I:
         lo, hi = r._mpi_
     finally:
         iv.prec = saved
-    # mpmath's enclosure is rigorous; converting its end points with floor/ceiling keeps it so
-    return I(to_float(lo, rnd="f"), to_float(hi, rnd="c"))
+    # mpmath's enclosure is rigorous; its end points are converted outward
+    return I(_mpf_down(lo), _mpf_up(hi))
+
+
+def _mpf_down(v: Any) -> float:
+    """The largest float ≤ the raw mpmath number v. ``to_float(v, rnd="f")`` alone is not
+    one: in the subnormal range it ignores the direction (exp(−740)'s lower end came out
+    above the true value), so the result is compared exactly and stepped down."""
+    f = to_float(v, rnd="f")
+    return f if math.isnan(f) or mpf_cmp(from_float(f), v) <= 0 else _down(f)
+
+
+def _mpf_up(v: Any) -> float:
+    """The smallest float ≥ the raw mpmath number v (see :func:`_mpf_down`): below the
+    subnormal range ``to_float(v, rnd="c")`` gave 0.0, so exp of [−1000, −800] was [0, 0] and
+    f = exp(x)·10⁴⁰⁰ had a certified bound 0 (search-space trial, session 24)."""
+    f = to_float(v, rnd="c")
+    return f if math.isnan(f) or mpf_cmp(from_float(f), v) >= 0 else _up(f)
 
 
 def _arb_point(fn: str, x: float) -> tuple[float, float]:
@@ -478,8 +494,29 @@ def d_fn(a: Dual, name: str) -> Dual:
     return Dual(v, _scale(a.g, d) if a.g else ())
 
 
-def _same(a: ast.AST, b: ast.AST) -> bool:
-    return ast.dump(a) == ast.dump(b)
+def _same(a: ast.AST, b: ast.AST, src: str | None) -> bool:
+    """The same tree, literals compared at their exact value (:func:`switches.exact_key`):
+    ``X - floor(X)`` = frac(X) needs both X to be one function."""
+    return switches.exact_key(a, src) == switches.exact_key(b, src)
+
+
+def int_literal(node: ast.AST, src: str | None) -> int | None:
+    """The integer value of a literal whose exact decimal (its source text) is an integer,
+    else None. The double alone is not enough: ``t^2.0000000000000001`` parses to the
+    exponent 2.0, and was enclosed as t², so u(10) ≤ 100 was certified although
+    u(10) > 100 (search-space trial, session 24)."""
+    if not isinstance(node, ast.Constant) or isinstance(node.value, bool):
+        return None
+    if isinstance(node.value, int):
+        return node.value
+    seg = ast.get_source_segment(src, node) if src is not None else None
+    if seg is None:
+        return None
+    try:
+        q = Fraction(seg)
+    except (ValueError, ZeroDivisionError):
+        return None
+    return int(q) if q.denominator == 1 else None
 
 
 def _is_call(node: ast.AST, *names: str) -> bool:
@@ -516,16 +553,17 @@ def evaluate(
     if isinstance(node, ast.BinOp):
         op = type(node.op)
         left, right = node.left, node.right
-        if op is ast.Mult and (sp := switches.split(node)) is not None:
+        if op is ast.Mult and (sp := switches.split(node, src)) is not None:
             return _split_dual(sp, env, params, nd, src)  # X*step(X) = max(X, 0), …
-        if op is ast.Sub and _is_call(right, "floor") and _same(right.args[0], left):
+        if op is ast.Sub and _is_call(right, "floor") and _same(right.args[0], left, src):
             return d_frac(evaluate(left, env, params, nd, src))
-        if op is ast.Sub and _is_call(left, "floor") and _same(left.args[0], right):
+        if op is ast.Sub and _is_call(left, "floor") and _same(left.args[0], right, src):
             return d_neg(d_frac(evaluate(right, env, params, nd, src)))  # floor(X) - X
         a = evaluate(left, env, params, nd, src)
         if op in (ast.Pow, ast.BitXor):
-            if isinstance(right, ast.Constant) and float(right.value) == int(right.value):
-                return d_pow_int(a, int(right.value))
+            k = int_literal(right, src)
+            if k is not None:
+                return d_pow_int(a, k)
             b = evaluate(right, env, params, nd, src)
             if a.v.lo <= 0.0:
                 raise ArithmeticError("non-integer power of a base that may be ≤ 0")

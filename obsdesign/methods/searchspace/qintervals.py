@@ -44,6 +44,7 @@ from obsdesign.methods.searchspace.intervals import (
     _same,
     d_fn,
     evaluate,
+    int_literal,
 )
 
 _SMOOTH = ("exp", "log", "sqrt", "sin", "cos", "tan", "atan", "tanh", "sinh", "cosh")
@@ -272,21 +273,18 @@ def evaluate_q(node: ast.AST, env: dict[str, QI], params: dict[str, QI], src: st
 def _binop(node: ast.BinOp, env: dict[str, QI], params: dict[str, QI], src: str | None) -> QI:
     op = type(node.op)
     left, right = node.left, node.right
-    if op is ast.Mult and (sp := switches.split(node)) is not None:
+    if op is ast.Mult and (sp := switches.split(node, src)) is not None:
         return _split_q(sp, env, params, src)  # X*step(X) = max(X, 0), …
-    if op is ast.Sub and _is_call(right, "floor") and _same(right.args[0], left):
+    if op is ast.Sub and _is_call(right, "floor") and _same(right.args[0], left, src):
         return qfrac(evaluate_q(left, env, params, src))
-    if op is ast.Sub and _is_call(left, "floor") and _same(left.args[0], right):
+    if op is ast.Sub and _is_call(left, "floor") and _same(left.args[0], right, src):
         return -qfrac(evaluate_q(right, env, params, src))  # floor(X) - X = -frac(X)
     if op in (ast.Pow, ast.BitXor):
-        if (
-            isinstance(right, ast.Constant)
-            and float(right.value) == int(right.value)
-            and abs(int(right.value)) <= MAX_EXACT_POWER
-        ):
+        k = int_literal(right, src)
+        if k is not None and abs(k) <= MAX_EXACT_POWER:
             a = evaluate_q(left, env, params, src)
-            if _bits(a) * abs(int(right.value)) <= MAX_BITS:
-                return qpow_int(a, int(right.value))
+            if _bits(a) * abs(k) <= MAX_BITS:
+                return qpow_int(a, k)
         return _float_q(node, env, params, src)
     fn = _ARITH.get(op)
     if fn is None:

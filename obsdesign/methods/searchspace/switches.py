@@ -29,6 +29,8 @@ from __future__ import annotations
 
 import ast
 from dataclasses import dataclass
+from fractions import Fraction
+from typing import Any
 
 #: the switches: step(b) = heaviside(b) = [b > 0], sign(b)
 _SWITCHES = ("step", "heaviside", "sign")
@@ -105,22 +107,48 @@ def _is_constant(node: ast.AST) -> bool:
     )
 
 
-def _negated(node: ast.AST) -> str | None:
-    """The dump of ``R - L`` for a subtraction ``L - R`` (= −(L − R) exactly), else None."""
+def exact_key(node: Any, src: str | None) -> str:
+    """A dump of the tree ``node`` in which every literal stands for its exact decimal value
+    (its text in ``src``): two trees are the same function iff their keys are equal (as far
+    as the syntax shows). ``ast.dump`` alone shows a literal's double, so 0.1 and
+    0.10000000000000001 looked alike, and ``(x1 - 0.1)*step(x1 - 0.10000000000000001)``,
+    which jumps by 10⁻¹⁷, was read as max(x1 − 0.1, 0) and certified Lipschitz
+    (search-space trial, session 24). A literal without a position in ``src`` (the ``1`` of
+    a ``1/c`` factor) shows its Python value."""
+    if isinstance(node, ast.Constant):
+        seg = ast.get_source_segment(src, node) if src is not None else None
+        if seg is not None:
+            try:
+                return f"Q({Fraction(seg.replace('_', ''))})"
+            except (ValueError, ZeroDivisionError):
+                pass
+        return f"C({node.value!r})"
+    if isinstance(node, ast.AST):
+        inner = ",".join(exact_key(getattr(node, f, None), src) for f in node._fields)
+        return f"{type(node).__name__}({inner})"
+    if isinstance(node, list):
+        return "[" + ",".join(exact_key(x, src) for x in node) + "]"
+    return repr(node)
+
+
+def _negated(node: ast.AST, src: str | None) -> str | None:
+    """The key of ``R - L`` for a subtraction ``L - R`` (= −(L − R) exactly), else None."""
     if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Sub):
-        return ast.dump(ast.BinOp(node.right, ast.Sub(), node.left))
+        return exact_key(ast.BinOp(node.right, ast.Sub(), node.left), src)
     return None
 
 
-def _match(others: list[ast.AST], core: list[ast.AST]) -> tuple[list[ast.AST], int] | None:
+def _match(
+    others: list[ast.AST], core: list[ast.AST], src: str | None
+) -> tuple[list[ast.AST], int] | None:
     """``others`` without one factor for each factor of ``core`` (the same tree, or the
-    swapped subtraction ``R - L`` of a core factor ``L - R``), in order, and the sign
-    (−1)^(swapped ones) that the taken factors' product has against the core's; None when a
-    core factor has no partner."""
-    left = [(x, ast.dump(x)) for x in others]
+    swapped subtraction ``R - L`` of a core factor ``L - R``; literals compared at their
+    exact value in ``src``), in order, and the sign (−1)^(swapped ones) that the taken
+    factors' product has against the core's; None when a core factor has no partner."""
+    left = [(x, exact_key(x, src)) for x in others]
     sign = 1
     for c in core:
-        want, neg = ast.dump(c), _negated(c)
+        want, neg = exact_key(c, src), _negated(c, src)
         j = next((k for k, (_, d) in enumerate(left) if d == want), None)
         if j is None and neg is not None:
             j = next((k for k, (_, d) in enumerate(left) if d == neg), None)
@@ -131,10 +159,11 @@ def _match(others: list[ast.AST], core: list[ast.AST]) -> tuple[list[ast.AST], i
     return [x for x, _ in left], sign
 
 
-def split(node: ast.AST) -> Split | None:
+def split(node: ast.AST, src: str | None) -> Split | None:
     """The reading of the product ``node`` with every switch whose argument's factors are
     among the other factors taken out (see the module docstring); None when there is none
-    (the product is then enclosed as written)."""
+    (the product is then enclosed as written). ``src`` is the text the tree was parsed from:
+    literals match at their exact decimal value (:func:`exact_key`)."""
     if not (isinstance(node, ast.BinOp) and isinstance(node.op, ast.Mult)):
         return None
     f = factors(node)
@@ -156,7 +185,7 @@ def split(node: ast.AST) -> Split | None:
             core = [x for x in b.factors if not _is_constant(x)]
             if not core:
                 continue
-            m = _match(rest[:i] + rest[i + 1 :], core)
+            m = _match(rest[:i] + rest[i + 1 :], core, src)
             if m is None:
                 continue
             kept, flip = m
