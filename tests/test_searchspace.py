@@ -891,3 +891,56 @@ def test_a_linear_model_beside_f_and_h_is_refused(key: str, line: str) -> None:
     with pytest.raises(SpecError) as ei:
         api.load_spec_text(text, "s.toml")
     assert ei.value.key == f"system.{key}"
+
+
+_ONE_STATE = """[system]
+time = "continuous"
+states = ["x1"]
+{system}
+[method]
+key = "search-space"
+alpha = 0.9
+gamma_star = 0.05
+gamma0 = 1
+{method}
+[simulate]
+horizon = 5
+x0 = [{x0}]
+xhat0 = [0]
+"""
+
+
+def test_a_constant_input_taken_in_floats_is_not_certified_inside_U() -> None:
+    """u = 0.5^20001 = 2⁻²⁰⁰⁰¹ > 0 is too large to take exactly (expr._sympy_pow) and became
+    the float 0.0, which "u ∈ U = [−1, 0]" compared as exact and certified (search-space
+    trial, session 24). A float value is now undecided: the claim is not certified."""
+    text = _ONE_STATE.format(
+        system='f = ["u1 - x1"]\nh = ["x1"]\nu = ["0.5^20001"]',
+        method="[method.E]\nlower = [-2]\nupper = [2]\n[method.D]\nlower = [-1]\nupper = [1]\n"
+        "[method.U]\nlower = [-1]\nupper = [0]",
+        x0="0.5",
+    )
+    rep = api.design(api.load_spec_text(text, "powu.toml"))
+    claim = next(c for c in rep.claims if c.id == "input-range")
+    assert claim.status != ClaimStatus.CERTIFIED and rep.exit_code() != 0
+
+
+def test_exp_below_the_underflow_range_gets_a_true_bound() -> None:
+    """f = exp(x)·10⁴⁰⁰ on E = [−1000, −800]: exp's enclosure was [0, 0] there, and L_f and
+    ‖f‖ were certified at 10⁻⁶ although both are f(−800) ≈ 3.67·10⁵² (search-space trial,
+    session 24). Whatever the design does now, a certified constant is ≥ the true one."""
+    import mpmath
+
+    text = _ONE_STATE.format(
+        system='f = ["exp(x1)*1e200*1e200"]\nh = ["x1"]',
+        method="[method.E]\nlower = [-1000]\nupper = [-800]\n"
+        "[method.D]\nlower = [-900]\nupper = [-850]",
+        x0="-870",
+    )
+    rep = api.design(api.load_spec_text(text, "underflow.toml"))
+    true = mpmath.exp(-800) * mpmath.mpf(10) ** 400
+    for k in ("L_f", "f_sup"):
+        claim = next(c for c in rep.claims if c.id == f"{k}-bound")
+        if claim.status == ClaimStatus.CERTIFIED:
+            v = Q(rep.parameters[k])
+            assert mpmath.mpf(int(v.p)) / int(v.q) >= true, k

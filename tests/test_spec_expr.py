@@ -242,3 +242,16 @@ def test_a_variable_named_like_a_constant_is_the_variable_in_every_evaluator() -
     assert float(e.derivative("e")(e=3.0, pi=1.0)) == 6.0
     c = parse_expr("e^2 + pi", ["x1"])  # not variables: the constants
     assert c.sympy() == sp.E**2 + sp.pi
+
+
+def test_a_huge_exact_power_of_a_rational_is_taken_in_floats() -> None:
+    """(1 + 1/10⁶)^(10⁸) is only e¹⁰⁰ in size but has 2·10⁹ bits exactly: sympy computed it
+    and never returned (the search-space design hung; trial, session 24). The size now
+    counts the base's bits; the float result is a sympy Float (inexact, never compared as
+    exact), while small powers stay exact Rationals."""
+    import sympy as sp
+
+    big = parse_expr("(1 + 1/10^6)^(10^8)", []).sympy()
+    assert isinstance(big, sp.Float) and abs(float(big) / float(sp.exp(100)) - 1) < 1e-3  # e^(100 - 5e-5)
+    small = parse_expr("(1 + 1/10^6)^100", []).sympy()
+    assert isinstance(small, sp.Rational) and small == sp.Rational(1000001, 1000000) ** 100

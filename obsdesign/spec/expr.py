@@ -468,7 +468,11 @@ def _to_sympy(node: ast.AST, ex: Expr) -> Any:
 def _sympy_pow(a: Any, b: Any) -> Any:
     """``a**b``, except that a constant power whose exact value would have more than 10^4
     bits (``9**9**9``) is taken in floating point (inf when it overflows): sympy would
-    otherwise compute the huge integer exactly and never return."""
+    otherwise compute the huge integer exactly and never return. A rational base counts the
+    bits of its numerator and denominator, not its magnitude: (1 + 1/10^6)^(10^8) is only
+    e¹⁰⁰ but has 2·10⁹ bits exactly (it hung the search-space design; trial, session 24).
+    The float fallback is a ``sympy.Float``, which exact comparisons must treat as
+    undecided (:func:`obsdesign.methods.searchspace.bounds._constant_inside`)."""
     import math
 
     import sympy as sp
@@ -476,6 +480,8 @@ def _sympy_pow(a: Any, b: Any) -> Any:
     if getattr(a, "is_Number", False) and getattr(b, "is_Number", False):
         fa, fb = abs(float(a)), abs(float(b))
         size = fb * abs(math.log2(fa)) if fa not in (0.0, 1.0) and math.isfinite(fa) else 0.0
+        if getattr(a, "is_Rational", False) and abs(a) not in (0, 1):
+            size = max(size, fb * max(abs(int(a.p)).bit_length(), int(a.q).bit_length()))
         if not math.isfinite(fb) or size > 10_000:
             with np.errstate(all="ignore"):
                 return sp.Float(float(np.power(float(a), float(b))))

@@ -424,11 +424,17 @@ def _enclose_q(
 def _constant_inside(ex: Expr, lo: Fraction, hi: Fraction) -> tuple[bool, bool]:
     """(proved lo ≤ value ≤ hi, proved outside) for an expression without the variable,
     compared exactly through sympy (rationals exactly; other real constants by sympy's
-    own decision, which is exact or undecided). Undecided: (False, False)."""
+    own decision, which is exact or undecided; a float anywhere in it is undecided).
+    Undecided: (False, False)."""
     import sympy
 
     try:
         v = ex.sympy()
+        if v.has(sympy.Float):
+            # a power too large to take exactly was taken in floats (expr._sympy_pow): its
+            # value is not exact (0.5^20001 became 0.0 and "u ∈ [−1, 0]" was certified;
+            # search-space trial, session 24)
+            return False, False
         a, b = (
             sympy.Rational(lo.numerator, lo.denominator),
             sympy.Rational(hi.numerator, hi.denominator),
