@@ -252,6 +252,8 @@ def test_a_huge_exact_power_of_a_rational_is_taken_in_floats() -> None:
     import sympy as sp
 
     big = parse_expr("(1 + 1/10^6)^(10^8)", []).sympy()
-    assert isinstance(big, sp.Float) and abs(float(big) / float(sp.exp(100)) - 1) < 1e-3  # e^(100 - 5e-5)
+    assert (
+        isinstance(big, sp.Float) and abs(float(big) / float(sp.exp(100)) - 1) < 1e-3
+    )  # e^(100 - 5e-5)
     small = parse_expr("(1 + 1/10^6)^100", []).sympy()
     assert isinstance(small, sp.Rational) and small == sp.Rational(1000001, 1000000) ** 100
