@@ -286,11 +286,22 @@ def lipschitz(
         _, _, vt = np.linalg.svd(J)
         v = np.zeros_like(M)
         v[:, idx] = vt[:, 0, :]
-        d = _eval(exprs, names, M + scale * v) - _eval(exprs, names, M - scale * v)
-        q = np.linalg.norm(d, axis=-1) / (2 * scale)
-        q = q[np.isfinite(q)]
+        # the quotient's two points are kept in the box and in E: from a corner, m ± δv
+        # left E and crossed a jump just outside it (floor(x2) at x2 = 0 with E's x2 ∈
+        # [0, 1/2] gave 2.5·10⁵ and failed a true L_f = 1; search-space trial, session 24)
+        a = np.maximum([iv.lo for iv in b], inner_lo)
+        c = np.minimum([iv.hi for iv in b], inner_hi)
+        Pp, Pm = np.clip(M + scale * v, a, c), np.clip(M - scale * v, a, c)
+        d = _eval(exprs, names, Pp) - _eval(exprs, names, Pm)
+        dist = np.linalg.norm(Pp - Pm, axis=-1)
+        with np.errstate(all="ignore"):
+            q = np.linalg.norm(d, axis=-1) / dist
+        q = q[np.isfinite(q) & (dist > 0)]
         return float(q.max()) if q.size else 0.0
 
+    # floats inside the exact box [lo, hi] (its own float box is rounded outward)
+    inner_lo = np.array([I.of_q(x).hi for x in lo])
+    inner_hi = np.array([I.of_q(x).lo for x in hi])
     return branch_and_bound(_box(lo, hi), upper_of, lower_of, budget, rtol)
 
 
