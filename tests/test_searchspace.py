@@ -951,12 +951,16 @@ def test_the_sampled_estimate_stays_inside_E() -> None:
     difference quotient stepped from E's corner x2 = 0 across the jump just outside E
     (2.5·10⁵) and failed the true L_f-bound claim (search-space trial, session 24). The
     quotient's points are now kept in E, and the design certifies."""
-    text = _ONE_STATE.replace('states = ["x1"]', 'states = ["x1", "x2"]').format(
-        system='f = ["x2 - floor(x2)", "-x1"]\nh = ["x1"]',
-        method="[method.E]\nlower = [-1, 0]\nupper = [1, 0.5]\n"
-        "[method.D]\nlower = [-0.5, 0.1]\nupper = [0.5, 0.4]",
-        x0="0, 0.2",
-    ).replace("xhat0 = [0]", "xhat0 = [0, 0]")
+    text = (
+        _ONE_STATE.replace('states = ["x1"]', 'states = ["x1", "x2"]')
+        .format(
+            system='f = ["x2 - floor(x2)", "-x1"]\nh = ["x1"]',
+            method="[method.E]\nlower = [-1, 0]\nupper = [1, 0.5]\n"
+            "[method.D]\nlower = [-0.5, 0.1]\nupper = [0.5, 0.4]",
+            x0="0, 0.2",
+        )
+        .replace("xhat0 = [0]", "xhat0 = [0, 0]")
+    )
     rep = api.design(api.load_spec_text(text, "inside.toml"))
     assert rep.exit_code() == 0, [c.detail for c in rep.failed]
     assert Q(rep.parameters["L_f"]) >= 1
