@@ -650,3 +650,69 @@ def test_one_output_laws_with_two_outputs_are_input_errors(law: str) -> None:
         api.simulate(spec, report=rep, law=law)
     assert e.value.exit_code == 2
     assert api.simulate(spec, report=rep, law="linear").info["law"] == "linear"
+
+
+def _scaled_71(c: str, q: str = "1", b: str = "1", algorithm: str = "symmetric") -> str:
+    """Example 7.1 (without its L) with C = [[c, c]], Ω = {|q e|∞ <= 1}, B1 = [b, b]: the
+    reviewer's spec of the C-scaling report is c = 1e-9."""
+    return f"""
+[system]
+time = "discrete"
+A = [[0.7, 0.7], [-0.7, 0.7]]
+B1 = [{b}, {b}]
+C = [[{c}, {c}]]
+[sets.omega]
+type = "symmetric-polytope"
+Q = [[{q}, 0], [0, {q}]]
+[sets.D]
+type = "box"
+dim = 1
+lower = [-1]
+upper = [1]
+[method]
+key = "set-invariant"
+omega = "omega"
+disturbance = "D"
+eta_bar = 0
+lambda = 0.9
+algorithm = "{algorithm}"
+"""
+
+
+@pytest.mark.parametrize(
+    ("c", "q", "b", "algorithm"),
+    [
+        ("1e-9", "1", "1", "symmetric"),  # the reviewer's spec
+        ("1e-15", "1", "1", "symmetric"),
+        ("1e-15", "1", "1", "general"),
+        ("1e9", "1", "1", "symmetric"),
+        ("1", "1e9", "1e-9", "symmetric"),  # the state in units 1e9 (Ω of size 1e-9)
+        ("1e-9", "1e-9", "1e9", "symmetric"),  # the state in units 1e-9, C unchanged
+    ],
+)
+def test_a_pure_scaling_of_C_or_of_the_state_certifies_the_same_lambda(
+    c: str, q: str, b: str, algorithm: str
+) -> None:
+    """Without noise, C and c·C (z scaled by c), or the state in other units (Ω, B1 and C
+    rescaled), give the same estimator. C = [[1e-9, 1e-9]] failed Theorem 3.1 (1.18 > 0.9:
+    the slices' float prefilter had an absolute floor of 1 on the scale of z); C = 1e-15
+    with the general algorithm merged all of Z_d (absolute 1e-12); the state scaled by 1e±9
+    failed with 2.15 (HiGHS drops LP (9)'s entries ~1e-9) or 0.98 (an absolute 1e-9 took
+    the new vertices of an Ω of size 1e-9 for copies of Ω's). Now Theorem 3.1 is certified
+    with λ = 9/10 in each; where only C changed, the polyhedron, the claims and the factor
+    are those of C = [[1, 1]] and the linear gains scale by 1/c."""
+    base = api.design(load_spec_text(_scaled_71("1", algorithm=algorithm), "base.toml"))
+    rep = api.design(load_spec_text(_scaled_71(c, q, b, algorithm), "scaled.toml"))
+    status = {x.id: x.status for x in rep.claims}
+    assert status["theorem-3.1"] == ClaimStatus.CERTIFIED
+    assert rep.parameters["contractivity"] <= fmpq(9, 10)
+    if q == "1":  # only C scaled: the same polyhedron, claims and factor; L scales by 1/c
+        assert status == {x.id: x.status for x in base.claims}
+        for key in ("G", "V", "contractivity"):
+            assert np.array_equal(rep.parameters[key], base.parameters[key]), key
+        if algorithm == "symmetric":
+            assert rep.parameters["contractivity"] == fmpq(9, 10)
+            k = fmpq(1) / qmat([[c]])[0, 0]
+            assert np.array_equal(rep.parameters["L"], base.parameters["L"] * k)
+    else:  # the state rescaled: vertices rationalized at another scale, factor <= λ
+        assert rep.exit_code() == 0 and set(status.values()) == {ClaimStatus.CERTIFIED}

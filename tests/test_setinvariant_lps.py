@@ -104,3 +104,58 @@ def test_linear_gain_lp_beyond_float_range_is_not_an_internal_failure() -> None:
     with pytest.raises(InconclusiveError, match="beyond the float range") as e:
         api.design(api.load_spec_text(text.replace("eta_bar = 0", "eta_bar = 1e300"), "t.toml"))
     assert e.value.exit_code == 4
+
+
+@pytest.mark.parametrize("s", [1e-9, 1e9])
+def test_epsilon_profile_does_not_depend_on_the_units_of_the_state(s: float) -> None:
+    """ε(z) (LP (9)) of Example 7.1's unit box, with the state in other units: Ω = {|e|∞ <=
+    s}, B1 = s·B1 (G = rows / s; φ, δ, ε are gauge values and do not change, z = s·z).
+    Unscaled, HiGHS dropped G's entries ~1e-9 as zeros (``small_matrix_value``) and gave
+    ε = 2.4 at both ends of Z_d, where it is 1."""
+    A = np.array([[0.7, 0.7], [-0.7, 0.7]])
+    G1 = np.vstack([np.eye(2), -np.eye(2)])
+    c, Dv = np.array([1.0, 1.0]), np.array([[-1.0], [1.0]])
+    z1, e1 = lps.epsilon_profile(G1, A, np.ones((2, 1)), c, Dv, 0.0)
+    zs, es = lps.epsilon_profile(G1 / s, A, s * np.ones((2, 1)), c, Dv, 0.0)
+    assert np.allclose(z1, [-2, 0, 2]) and np.allclose(e1, [1, 2.4, 1], rtol=1e-12)
+    assert np.allclose(zs, s * z1, rtol=1e-12) and np.allclose(es, e1, rtol=1e-12)
+
+
+@pytest.mark.parametrize("s", [1e-9, 1e9, 2.0**-40, 3e12, 1e-30, 1e30])
+def test_lp9_does_not_depend_on_the_units_of_the_state(s: float) -> None:
+    """LP (9) with G / s (the same polyhedron, the state in units 1/s of the original):
+    the same ε and v scaled by s, whatever s (its columns are scaled to 1 for HiGHS)."""
+    G1 = np.vstack([np.eye(2), -np.eye(2), [[0.5, 0.5], [-0.5, -0.5]]])
+    phi = np.array([[1.4, 0.0, 0.0, -1.4, 0.7, -0.7], [0.7, 0.7, -0.7, -0.7, 0.7, -0.7]])
+    dl = np.full(6, 0.5)
+    r1 = lps.eps_batch(G1, phi, dl)
+    rs = lps.eps_batch(G1 / s, phi, dl)
+    assert np.allclose(r1.eps, [1.2, 0.5], rtol=1e-12)
+    assert np.allclose(rs.eps, r1.eps, rtol=1e-12)
+    # v^l may differ where LP (9) has several optima; its level on every row may not
+    assert np.allclose((phi + dl + rs.v @ (G1 / s).T).max(axis=1), r1.eps, rtol=1e-12)
+
+
+@pytest.mark.parametrize("c", [1e-15, 1e-200])
+def test_zd_merges_near_duplicates_relative_to_the_scale_of_z(c: float) -> None:
+    """Z_d of the float iterations merges points within 1e-12 of the largest |z| (relative):
+    with z = c·e on the unit box, c = 1e-15 had all of Z_d merged into one point (an
+    absolute floor of 1e-12), so the general algorithm saw only the worst slice's neighbour
+    and stopped on a polyhedron failing Theorem 3.1 (2.23 where c = 1 gives 9/10)."""
+    V = np.array([[1.0, 1], [-1, 1], [-1, -1], [1, -1], [1, 0.5]])
+    cvec = np.array([1.0, 0.0])
+    assert np.array_equal(lps.z_d(V, c * cvec, 0.0), c * lps.z_d(V, cvec, 0.0))
+    assert len(lps.z_d(V, c * cvec, 0.0)) == 2
+    assert len(lps.z_d(V, c * np.array([1.0, 1.0]), 0.0)) == 4
+
+
+def test_slice_of_ker_C_does_not_depend_on_the_scale_of_C() -> None:
+    """φ_q(0) of Lemma 6.1 (η̄ = 0) slices Ω along ker C; C's rank is counted relative to its
+    largest singular value, so C = 1e-13·[1, 1] has the kernel of [1, 1] (an absolute floor
+    1e-12 counted rank 0 and sliced nothing off)."""
+    A = np.array([[0.7, 0.7], [-0.7, 0.7]])
+    G = np.vstack([np.eye(2), -np.eye(2)])
+    C = np.array([[1.0, 1.0]])
+    phi1, S1 = lps.phi_slice_general(G, A, C, 0.0)
+    phis, Ss = lps.phi_slice_general(G, A, 1e-13 * C, 0.0)
+    assert np.allclose(phis, phi1) and np.allclose(np.abs(Ss @ C.T), 0.0, atol=1e-12)

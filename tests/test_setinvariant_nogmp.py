@@ -275,3 +275,19 @@ def test_float_backend_linear_gain_lp_beyond_float_range(nogmp):
     rep = api.design(SPEC71.parents[1] / "tests" / "specs" / "setinvariant-huge-C.toml")
     assert "L" not in rep.parameters
     assert any("beyond a float LP's range" in n for n in rep.notes)
+
+
+def test_float_stage_keeps_the_new_vertices_of_a_small_omega(nogmp):
+    """Example 7.1 with the state in units 1e9 (Ω = {|e|∞ <= 1e-9}, B1 = 1e-9·[1, 1]): the
+    float stage took every new vertex within an absolute 1e-9 of one of Ω's for a copy of
+    it and proved Ω itself (factor 0.98 > 0.9); the threshold is now relative to Ω's
+    extent, and the polyhedron is Example 7.1's Q², scaled by 1e-9, with factor 0.9."""
+    text = SPEC71.read_text(encoding="utf-8")
+    old = ("B1 = [1, 1]", "Q = [[1, 0], [0, 1]]", "\nL = [-0.7, -0.2212]")
+    assert all(o in text for o in old)
+    text = text.replace(old[0], "B1 = [1e-9, 1e-9]").replace(old[1], "Q = [[1e9, 0], [0, 1e9]]")
+    rep = api.design(load_spec_text(text.replace(old[2], ""), "small.toml"))
+    assert rep.exit_code() == 0
+    assert all(c.status == ClaimStatus.NUMERICAL for c in rep.claims)
+    assert _rows_up_to_sign(1e-9 * rep.parameters.float("G")) == _rows_up_to_sign(Q2)
+    assert abs(rep.parameters.float("contractivity") - 0.9) <= 1e-9

@@ -729,6 +729,32 @@ def test_lp9_on_fewer_rows_without_disturbance(base_nodist: dict[str, Any]) -> N
     assert res.ok and res.factor == fmpq(9, 10)
 
 
+@pytest.mark.parametrize("c", [1e-9, 1e-15, 1e-300, 1e9])
+def test_theorem31_does_not_depend_on_the_scale_of_C(base71: dict[str, Any], c: float) -> None:
+    """Without noise, C and c·C give the same estimator (z scales by c, v^l does not): on
+    Example 7.1's polyhedron the design-mode check certifies 9/10 with the same v^l at
+    Z_d = c·Z_d. The slices' float prefilter had an absolute floor (1e-9·max(1, |c·V|)):
+    with C = [[1e-9, 1e-9]] every vertex fell in every slab, the float φ and so the LP (9)
+    injections came from the whole polytope, and the factor was 1.18 (reviewer's report)."""
+    from obsdesign.methods.setinvariant import lps
+
+    G = exact(base71, "G")
+    vrep = ce.po.exact_h_to_v(G)
+    text = base71["spec"]
+    assert "\nC = [[1, 1]]\n" in text
+    ex1 = build(api.load_spec_text(text, "c1.toml")).ex
+    exc = build(
+        api.load_spec_text(text.replace("C = [[1, 1]]", f"C = [[{c!r}, {c!r}]]"), "c.toml")
+    ).ex
+    q = exc.C[0][0]  # the spec's decimal, exactly
+    r1 = ce.theorem31(ex1, G, v_solver=lps.eps_batch, vrep=vrep)
+    rc = ce.theorem31(exc, G, v_solver=lps.eps_batch, vrep=vrep)
+    assert r1.ok and r1.factor == fmpq(9, 10) and r1.exact_lp == 0
+    assert rc.ok and rc.factor == fmpq(9, 10) and rc.exact_lp == 0
+    assert rc.zs == [q * z for z in r1.zs]
+    assert rc.vs == r1.vs
+
+
 def test_theorem31_missing_breakpoint_is_not_ok(base71: dict[str, Any]) -> None:
     """ce.theorem31 itself (not only the claim, which reads the note) says not ok when a
     point of Z_d is missing from the table."""

@@ -26,6 +26,7 @@ from itertools import product
 import numpy as np
 from flint import fmpq
 
+from obsdesign.errors import InconclusiveError, SolverError
 from obsdesign.sets import polytope_ops as po
 
 from .budget import Timeout
@@ -136,11 +137,11 @@ class _Slices:
     """Slices of {G e <= 1} at each z^l: float candidates, exact points on demand.
 
     For each slab ``|c·e − z| <= η̄`` the candidates are the vertices and edge crossings
-    that the float prefilter cannot exclude (threshold 1e-9 relative, far above the float
-    error); a candidate's exact point is computed only when a row of φ needs it, and only
-    if it exists exactly (vertex inside the slab, or strict crossing). The true maximizer
-    of every needed row is among the candidates within the float tolerance of the float
-    max, so the exact φ_i is exact."""
+    that the float prefilter cannot exclude (threshold 1e-9 relative to the largest compared
+    value, far above the float error); a candidate's exact point is computed only when a row
+    of φ needs it, and only if it exists exactly (vertex inside the slab, or strict
+    crossing). The true maximizer of every needed row is among the candidates within the
+    float tolerance of the float max, so the exact φ_i is exact."""
 
     def __init__(
         self, ex: ExactProblem, G: np.ndarray, vrep: po.ExactVRep, zs: list[fmpq], cv: list[fmpq]
@@ -159,7 +160,6 @@ class _Slices:
         self.ea, self.eb = e[:, 0], e[:, 1]
         ca, cb = self.cvf[self.ea], self.cvf[self.eb]
         emin, emax = np.minimum(ca, cb), np.maximum(ca, cb)
-        tol = 1e-9 * max(1.0, float(np.abs(self.cvf).max()))
         dV = self.Vf[self.eb] - self.Vf[self.ea]
         #: per z^l: (vertex indices, [edge indices crossing z − η̄, z + η̄]) of the candidates
         self.cands: list[tuple[np.ndarray, list[np.ndarray]]] = []
@@ -173,6 +173,18 @@ class _Slices:
         # breakpoint: vertices first, then the crossings of z − η̄, then of z + η̄
         lo = np.array([float(z - ex.eta) for z in zs])
         hi = np.array([float(z + ex.eta) for z in zs])
+        # the prefilter's tolerance, relative to the compared floats (c·v, z ± η̄), each the
+        # nearest double of its exact value: a comparison errs by at most 2⁻⁵² of the largest
+        # of them, far below 1e-9 of it (subnormals: the absolute 2⁻¹⁰⁷⁰). Its old floor of 1
+        # put every vertex in every slab when z ~ 1e-9 (C = [[1e-9, 1e-9]]): the float φ and
+        # LP (9)'s v^l came from the whole polytope, and Theorem 3.1 failed with 1.18 where
+        # C = [[1, 1]] gives 9/10 (unusual-spec trial, session 24)
+        scale = max(
+            float(np.abs(self.cvf).max(initial=0.0)),
+            float(np.abs(lo).max(initial=0.0)),
+            float(np.abs(hi).max(initial=0.0)),
+        )
+        tol = 1e-9 * scale + 2.0**-1070
         nz, n = len(zs), ex.n
         vm = (self.cvf[None, :] >= lo[:, None] - tol) & (self.cvf[None, :] <= hi[:, None] + tol)
         lv, jv = np.nonzero(vm)
@@ -392,7 +404,12 @@ def _solve_v(
     GmA = v_rows @ Af
     phim = np.array([(GmA @ sl.ptsf[l].T).max(axis=1) for l in range(len(phif))])
     dlm = (v_rows @ B1f @ Dvf.T).max(axis=1) if B1f.shape[1] and len(Dvf) else np.zeros(len(v_rows))
-    er = v_solver(v_rows, phim.reshape(len(phif), len(v_rows)), dlm, deadline=deadline)
+    try:
+        er = v_solver(v_rows, phim.reshape(len(phif), len(v_rows)), dlm, deadline=deadline)
+    except (SolverError, InconclusiveError):
+        # the float hull's rows do not bound a polytope HiGHS can use (B1 = [1e50, 1]: one
+        # row; LP (9) on it is unbounded): all rows of G decide, and raise if they fail too
+        return v_solver(Gf, phif, dlf, deadline=deadline)
     er.eps = (phif + dlf[None, :] + er.v @ Gf.T).max(axis=1)
     lamf = float(ex.lam)
     tight = np.nonzero(er.eps > lamf * (1 - 1e-9))[0]

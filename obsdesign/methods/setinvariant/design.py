@@ -66,7 +66,10 @@ def final_stage(
         return Stage(Gf, vrf, resf)
     Vo_f = po.qfloat(ex.Vo)
     P = np.asarray(P, dtype=float).reshape(-1, fl.n)
-    near = np.array([np.abs(Vo_f - p).max(axis=1).min() <= 1e-9 for p in P], dtype=bool)
+    # float copies of Ω's vertices: within 1e-9 of Ω's extent per coordinate (an absolute
+    # 1e-9 dropped every new point of an Ω of size 1e-9, and no copy of one of size 1e9)
+    tol = 1e-9 * np.abs(Vo_f).max(axis=0)
+    near = np.array([(np.abs(Vo_f - p) <= tol).all(axis=1).any() for p in P], dtype=bool)
     Pq = np.vstack([ex.Vo, po.rationalize(P[~near])]) if (~near).any() else ex.Vo
     limit = f"{o.time_limit:g} s ([method] time_limit)" if o is not None else "the budget"
     if deadline is not None and time.perf_counter() > deadline:

@@ -26,7 +26,7 @@ from scipy.optimize import linprog
 from obsdesign.sets import polytope_ops as po
 
 from .certificate import ExactProblem, delta_exact, linear_law, noise_vertices, qmatmul
-from .lps import lp_in_range
+from .lps import lp_in_range, unit_columns
 
 
 @dataclass
@@ -146,17 +146,22 @@ def admissible_gains(
     Af = po.qfloat(np.array(rows, dtype=object))
     bf = po.qfloat(np.array(rhs, dtype=object))
     nl = n * p
-    # max-margin LP: max t s.t. A x + t·‖a‖ <= b, t <= 1
+    # max-margin LP: max t s.t. A x + t·‖a‖ <= b, t <= 1, in x = vec(L) / s: the columns of A
+    # scaled to 1 (lps.unit_columns), so neither HiGHS nor the margin t depends on the units
+    # of e and z (C = 1e-9·C had an "empty" admissible set that C has not: HiGHS infeasible)
+    As, s = unit_columns(Af)
     with np.errstate(over="ignore", invalid="ignore"):
-        norms = np.linalg.norm(Af, axis=1)
+        norms = np.linalg.norm(As, axis=1)
     c = np.zeros(nl + 1)
     c[-1] = -1.0
-    A_lp = np.hstack([Af, norms[:, None]])
+    A_lp = np.hstack([As, norms[:, None]])
     res = None
     if lp_in_range(A_lp, bf):
         res = linprog(
             c, A_ub=A_lp, b_ub=bf, bounds=[(None, None)] * nl + [(None, 1.0)], method="highs"
         )
+        if res.status == 0:
+            res.x[:nl] *= s
     prop = prop71_gains(ex, G)
     if res is not None and (res.status != 0 or res.x[-1] < -1e-9):
         return GainSet(None, None, "the admissible set of linear gains is empty", prop71=prop)

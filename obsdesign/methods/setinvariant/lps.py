@@ -40,7 +40,7 @@ def z_d(V: np.ndarray, c: np.ndarray, eta: float) -> np.ndarray:
     z = np.sort(np.concatenate([cv - eta, cv + eta]) if eta > 0 else cv)
     if len(z) == 0:
         return z
-    tol = 1e-12 * max(1.0, float(np.abs(z).max()))
+    tol = 1e-12 * float(np.abs(z).max())  # relative: z = C e has the scale of C (not of 1)
     return z[np.concatenate([[True], np.diff(z) > tol])]
 
 
@@ -152,8 +152,9 @@ def _eps_block(
     nz, g = phi.shape
     n = G.shape[1]
     b_ub = (-dlt[None, :] - phi).reshape(-1)
-    check_lp_range(G, b_ub, "LP (9)")
-    Ablk = sp.kron(sp.eye(nz, format="csr"), sp.csr_matrix(G))
+    Gs, s = unit_columns(G)
+    check_lp_range(Gs, b_ub, "LP (9)")
+    Ablk = sp.kron(sp.eye(nz, format="csr"), sp.csr_matrix(Gs))
     Eblk = -sp.kron(sp.eye(nz, format="csr"), sp.csr_matrix(np.ones((g, 1))))
     A_ub = sp.hstack([Ablk, Eblk]).tocsr()
     cost = np.concatenate([np.zeros(nz * n), np.ones(nz)])
@@ -174,9 +175,21 @@ def _eps_block(
     if res.status != 0:
         check_deadline(deadline)  # stopped by the time limit: the budget's, not a failure
         raise SolverError(f"HiGHS failed on LP (9): {res.message}")
-    v = res.x[: nz * n].reshape(nz, n)
+    v = res.x[: nz * n].reshape(nz, n) * s
     eps = (phi + dlt[None, :] + v @ G.T).max(axis=1)
     return EpsResult(eps, v)
+
+
+def unit_columns(G: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(G·diag(s), s)`` with s_k a power of two (exact) that brings the largest |G_ik| of
+    each column into [1/2, 1) (s_k = 1 for a zero column): LP (9) is solved for u = v / s.
+    Its rows (right-hand side 1) and φ, δ, ε are gauge values, free of units, but G's columns
+    carry 1 / (the state's units): with Ω = {|e_k| <= 1e9} the entries are ~1e-9, which HiGHS
+    drops as zeros (``small_matrix_value``), and its tolerances are absolute; LP (9) then gave
+    ε(z) = 2.4 where it is 1 (a pure rescaling of the state changed the design)."""
+    cmax = np.abs(G).max(axis=0) if len(G) else np.ones(G.shape[1])
+    s = np.ldexp(1.0, -np.frexp(np.where(cmax > 0, cmax, 1.0))[1])
+    return G * s, s
 
 
 def _linprog(
@@ -222,7 +235,7 @@ def phi_slice_general(
         S = po.h_to_v(H).V
     else:
         _, s, Vt = np.linalg.svd(C)
-        rank = int((s > 1e-12 * max(1.0, s.max())).sum())
+        rank = int((s > 1e-12 * s.max()).sum())  # relative: C = 1e-13·C has C's kernel
         N = Vt[rank:].T  # n × (n - rank)
         if N.shape[1] == 0:
             S = np.zeros((1, n))

@@ -110,7 +110,8 @@ def float_stage(
     (outward-fixed, so it contains both) and, for one output, Theorem 3.1 in float64."""
     Vo = omega_vertices(fl)
     P = np.asarray(P, dtype=float).reshape(-1, fl.n)
-    near = np.array([np.abs(Vo - p).max(axis=1).min() <= 1e-9 for p in P], dtype=bool)
+    tol = 1e-9 * np.abs(Vo).max(axis=0)  # relative to Ω's extent, as in design.final_stage
+    near = np.array([(np.abs(Vo - p) <= tol).all(axis=1).any() for p in P], dtype=bool)
     st = po.hull(np.vstack([Vo, P[~near]]))
     vrep = FloatVRep(st.V, st.edges)
     if fl.p != 1:
