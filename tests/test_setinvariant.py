@@ -324,6 +324,10 @@ def test_necessary_condition_and_not_converged():
     rep = api.design(load_spec_text(spec_text(alg="general", maxit=1), "cap.toml"))
     assert rep.parameters["converged"] is False and "G" in rep.parameters
     assert rep.exit_code() == 1
+    # the count is over every algorithm that ran, the cap per algorithm ("after 150
+    # iterations (max_iterations = 100)" read as a broken cap; unusual-spec trial, session 24)
+    conv = next(c for c in rep.claims if c.id == "converged")
+    assert "iterations in all (max_iterations = 1 for each algorithm that ran)" in conv.detail
 
 
 # -- property tests (Proposition 4.1) ------------------------------------------------------

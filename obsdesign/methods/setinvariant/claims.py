@@ -421,8 +421,8 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         emit(
             "converged",
             False,
-            f"not converged after {params.get('iterations')} iterations "
-            f"(max_iterations = {o.max_iterations})",
+            f"not converged after {params.get('iterations')} iterations in all "
+            f"(max_iterations = {o.max_iterations} for each algorithm that ran)",
             float_ok=False,
         )
     return c

@@ -336,8 +336,8 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     params["history_eps"] = [h["eps"] for h in run.history]
     if not run.converged:
         notes.append(
-            f"NOT CONVERGED after {run.iterations} iterations (max_iterations = "
-            f"{o.max_iterations}); the last polyhedron is reported"
+            f"NOT CONVERGED after {run.iterations} iterations in all (max_iterations = "
+            f"{o.max_iterations} for each algorithm that ran); the last polyhedron is reported"
         )
     name = "HiGHS (scipy) LPs + qhull hulls; " + (
         "cdd.gmp exact" if data.ex is not None else "float64 only (no cdd.gmp)"
