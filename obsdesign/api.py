@@ -892,12 +892,22 @@ class SpecTimeout(BaseException):
     inside a method swallows it)."""
 
 
+#: a time budget above this many seconds (about 31 years) is no budget
+MAX_BUDGET_S = 1e9
+
+
 @contextmanager
 def _time_budget(seconds: float | None) -> Any:
     """Raise :class:`SpecTimeout` in the main thread after ``seconds`` of wall time (SIGALRM;
     None, 0 or another thread: no budget). A long C call (a solver) is interrupted when it
-    returns to Python."""
-    if not seconds or threading.current_thread() is not threading.main_thread():
+    returns to Python. A budget beyond :data:`MAX_BUDGET_S` (``--timeout inf``, 1e300) is no
+    budget: the timer takes no such value (OverflowError from setitimer: exit 3; hostile-input
+    trial, session 24)."""
+    if (
+        not seconds
+        or not seconds <= MAX_BUDGET_S
+        or threading.current_thread() is not threading.main_thread()
+    ):
         yield
         return
 

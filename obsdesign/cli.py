@@ -381,8 +381,8 @@ def check(
             "--timeout",
             metavar="SECONDS",
             min=0,
-            help="Time budget per spec (0: none); a spec past it gets exit 3 and the others "
-            "still run. In-process runs only.",
+            help="Time budget per spec (0 or inf: none); a spec past it gets exit 3 and the "
+            "others still run. In-process runs only.",
         ),
     ] = 600.0,
 ) -> None:

@@ -154,3 +154,16 @@ def test_a_bad_input_row_names_the_declared_method(tmp_path: Path) -> None:
         "c.toml": (2, "?"),
         "d.toml": (2, "?"),
     }, {k: r.message for k, r in rows.items()}
+
+
+def test_check_timeout_beyond_the_timer_range_is_no_limit(tmp_path: Path) -> None:
+    """``check --timeout inf`` (or 1e300, 1e10) made setitimer raise OverflowError: exit 3
+    "timestamp out of range" for a good spec (hostile-input trial, session 24). A budget
+    beyond about 31 years is no budget."""
+    spec = tmp_path / "s.toml"
+    shutil.copy(ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml", spec)
+    for t in ("inf", "1e300", "1e10"):
+        res = runner.invoke(app, ["check", str(spec), "--timeout", t, "-q"])
+        assert res.exit_code == 0, (t, res.output)
+    with api._time_budget(1e300):
+        pass
