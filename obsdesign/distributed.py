@@ -65,6 +65,10 @@ def _require_dask() -> None:
 MAX_LOCAL_WORKERS = max(64, 4 * (os.cpu_count() or 1))
 
 
+#: the address schemes of dask.distributed's comm backends
+SCHEMES = ("tcp", "tls", "inproc", "ucx", "ws", "wss")
+
+
 def check_workers(workers: int | None, scheduler: str | None) -> None:
     """Refuse (exit 2) a bad ``--workers``/``--scheduler`` pair, or Dask missing, before any
     work starts."""
@@ -79,9 +83,14 @@ def check_workers(workers: int | None, scheduler: str | None) -> None:
             f"(4 × its {os.cpu_count() or 1} CPUs, at least 64); for more, start a Dask "
             "cluster and give --scheduler"
         )
-    if scheduler is not None and "://" not in scheduler:
+    if scheduler is not None and (
+        "://" not in scheduler or scheduler.split("://", 1)[0] not in SCHEMES
+    ):
+        # junk://x reached distributed's "unknown address scheme" (exit 3; hostile-input
+        # trial, session 24)
         raise InputError(
-            f"--scheduler: expected an address such as tcp://HOST:8786, got {scheduler!r}"
+            f"--scheduler: expected an address such as tcp://HOST:8786 (schemes: "
+            f"{', '.join(SCHEMES)}), got {scheduler!r}"
         )
     if workers is not None or scheduler is not None:
         _require_dask()

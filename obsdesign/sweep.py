@@ -79,6 +79,13 @@ def parse_axis(text: str) -> Axis:
     if not spec:
         raise InputError(f"--set {key}: no value")
     m = _RANGE_RE.match(spec)
+    if m and len(m.group(3).lstrip("0")) > 12:
+        # int() of a 5000-digit count raised past Python's int-string limit: exit 3
+        # (hostile-input trial, session 24)
+        raise InputError(
+            f"--set {key}: {len(m.group(3))}-digit number of values, above the "
+            f"limit of {MAX_POINTS} points"
+        )
     if m:
         return Axis(
             key,
@@ -199,6 +206,8 @@ def _literal(key: str, text: str) -> str:
         pass
     except ValueError:  # an integer past Python's int-string limit: TOML, but too long
         return text
+    except RecursionError:  # [[[…]]] 3000 deep: exit 3 (hostile-input trial, session 24)
+        raise InputError(f"--set {key}: the value is nested too deeply") from None
     if re.match(r"^[A-Za-z_][A-Za-z0-9_.+-]*$", text):
         return json.dumps(text)
     raise InputError(f"--set {key}: {text!r} is not a TOML value")

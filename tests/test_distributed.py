@@ -292,3 +292,14 @@ def test_dask_logs_are_quiet_here_and_in_the_workers(monkeypatch: pytest.MonkeyP
     with dist.dask_client(workers=2):
         assert logging.getLogger("distributed").level == logging.CRITICAL
     assert seen["silence_logs"] == logging.CRITICAL and seen["closed"] is True
+
+
+def test_an_unknown_scheduler_scheme_is_bad_input() -> None:
+    """``--scheduler junk://x`` reached distributed's "unknown address scheme" (exit 3;
+    hostile-input trial, session 24): the scheme is checked first, exit 2."""
+    from obsdesign.distributed import check_workers
+    from obsdesign.errors import InputError
+
+    with pytest.raises(InputError, match="schemes: tcp"):
+        check_workers(None, "junk://x")
+    check_workers(None, "tcp://127.0.0.1:8786")  # no connection is made here

@@ -349,3 +349,14 @@ def test_integer_summary_parameters_stay_integers() -> None:
     assert rows[0]["exit_code"] == 0
     assert type(rows[0]["facets"]) is int and type(rows[0]["iterations"]) is int
     assert type(rows[0]["contractivity"]) is float
+
+
+def test_hostile_set_values_are_bad_input() -> None:
+    """A 3000-deep list value (RecursionError in the TOML parser) and a 5000-digit number of
+    values (past Python's int-string limit) were internal failures, exit 3 (hostile-input
+    trial, session 24): both are InputError naming the --set key."""
+    with pytest.raises(InputError, match="method.L: the value is nested too deeply"):
+        sw.parse_axis("method.L=" + "[" * 3000 + "1" + "]" * 3000)
+    with pytest.raises(InputError, match="5000-digit number of values"):
+        sw.parse_axis("method.lambda=0.9:0.99:" + "1" * 5000)
+    assert len(sw.parse_axis("method.lambda=0.9:0.99:0000000000000003").values) == 3
