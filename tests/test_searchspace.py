@@ -964,3 +964,22 @@ def test_the_sampled_estimate_stays_inside_E() -> None:
     rep = api.design(api.load_spec_text(text, "inside.toml"))
     assert rep.exit_code() == 0, [c.detail for c in rep.failed]
     assert Q(rep.parameters["L_f"]) >= 1
+
+
+@pytest.mark.parametrize(
+    "u", ["pi**1000000/10**100000", "e**e**e**e*10**-100000", "floor(e**e**e**e)"]
+)
+def test_a_constant_input_beyond_exact_arithmetic_is_never_certified(u: str) -> None:
+    """A constant power taken in floats is inf or 0.0, which sympy absorbs (X/oo = 0): u =
+    π^(10⁶)/10^(10⁵) ≈ 10^397150 was certified inside U = [0, 1]; and sympy's evalf of
+    floor(e^e^e^e) never returned (hostile-input trial, session 24). Only rational
+    arithmetic taken exactly is decided by sympy now; these are left to the enclosures."""
+    text = _ONE_STATE.format(
+        system=f'f = ["u1 - x1"]\nh = ["x1"]\nu = ["{u}"]',
+        method="[method.E]\nlower = [-2]\nupper = [2]\n[method.D]\nlower = [-1]\nupper = [1]\n"
+        "[method.U]\nlower = [0]\nupper = [1]",
+        x0="0.5",
+    )
+    rep = api.design(api.load_spec_text(text, "u.toml"))
+    claim = next(c for c in rep.claims if c.id == "input-range")
+    assert claim.status != ClaimStatus.CERTIFIED

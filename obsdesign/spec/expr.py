@@ -130,6 +130,12 @@ class Expr:
         """The expression as a sympy object, built node by node (parameters exact)."""
         return _to_sympy(self.tree.body, self)
 
+    def exact_sympy(self) -> Any:
+        """:meth:`sympy` with every constant power taken exactly: :class:`InexactPower` where
+        it would be taken in floats (for exact decisions: a float inf or 0.0 is absorbed by
+        sympy, ``pi**1000000/10**100000`` became an exact 0)."""
+        return _to_sympy(self.tree.body, self, strict=True)
+
     def derivative(self, name: str) -> Callable[..., Any]:
         """∂/∂name as a vectorized callable of the same variables (exact symbolic derivative)."""
         import sympy as sp
@@ -407,7 +413,12 @@ def _numpy_of_sympy() -> dict[Any, Callable[[Any], Any]]:
     return {**alike, sp.Abs: np.abs, sp.atan: np.arctan}
 
 
-def _to_sympy(node: ast.AST, ex: Expr) -> Any:
+class InexactPower(ArithmeticError):
+    """A constant power too large to take exactly (:func:`_sympy_pow`), met by
+    :meth:`Expr.exact_sympy`."""
+
+
+def _to_sympy(node: ast.AST, ex: Expr, strict: bool = False) -> Any:
     import sympy as sp
 
     if isinstance(node, ast.Constant):
@@ -435,10 +446,10 @@ def _to_sympy(node: ast.AST, ex: Expr) -> Any:
             return sp.E
         return sp.Symbol(node.id)
     if isinstance(node, ast.UnaryOp):
-        a = _to_sympy(node.operand, ex)
+        a = _to_sympy(node.operand, ex, strict)
         return -a if isinstance(node.op, ast.USub) else a
     if isinstance(node, ast.BinOp):
-        a, b = _to_sympy(node.left, ex), _to_sympy(node.right, ex)
+        a, b = _to_sympy(node.left, ex, strict), _to_sympy(node.right, ex, strict)
         op = type(node.op)
         if op is ast.Add:
             return a + b
@@ -449,10 +460,10 @@ def _to_sympy(node: ast.AST, ex: Expr) -> Any:
         if op is ast.Div:
             return a / b
         if op in (ast.Pow, ast.BitXor):
-            return _sympy_pow(a, b)
+            return _sympy_pow(a, b, strict)
         return a - b * sp.floor(a / b)
     assert isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
-    args = [_to_sympy(a, ex) for a in node.args]
+    args = [_to_sympy(a, ex, strict) for a in node.args]
     name = node.func.id
     table = _sympy_functions()
     if name in table:
@@ -465,14 +476,14 @@ def _to_sympy(node: ast.AST, ex: Expr) -> Any:
     return args[0] - args[1] * sp.floor(args[0] / args[1])  # mod
 
 
-def _sympy_pow(a: Any, b: Any) -> Any:
+def _sympy_pow(a: Any, b: Any, strict: bool = False) -> Any:
     """``a**b``, except that a constant power whose exact value would have more than 10^4
     bits (``9**9**9``) is taken in floating point (inf when it overflows): sympy would
     otherwise compute the huge integer exactly and never return. A rational base counts the
     bits of its numerator and denominator, not its magnitude: (1 + 1/10^6)^(10^8) is only
     e¹⁰⁰ but has 2·10⁹ bits exactly (it hung the search-space design; trial, session 24).
-    The float fallback is a ``sympy.Float``, which exact comparisons must treat as
-    undecided (:func:`obsdesign.methods.searchspace.bounds._constant_inside`)."""
+    The float fallback is a ``sympy.Float``, which sympy may absorb (X/oo = 0): exact
+    decisions use ``strict``, which raises :class:`InexactPower` instead."""
     import math
 
     import sympy as sp
@@ -481,8 +492,10 @@ def _sympy_pow(a: Any, b: Any) -> Any:
         fa, fb = abs(float(a)), abs(float(b))
         size = fb * abs(math.log2(fa)) if fa not in (0.0, 1.0) and math.isfinite(fa) else 0.0
         if getattr(a, "is_Rational", False) and abs(a) not in (0, 1):
-            size = max(size, fb * max(abs(int(a.p)).bit_length(), int(a.q).bit_length()))
+            size = max(size, fb * max(math.log2(abs(int(a.p))), math.log2(int(a.q))))
         if not math.isfinite(fb) or size > 10_000:
+            if strict:
+                raise InexactPower(f"{a}**{b} is too large to take exactly")
             with np.errstate(all="ignore"):
                 return sp.Float(float(np.power(float(a), float(b))))
     return a**b

@@ -18,6 +18,7 @@ certified upper bounds keep every conclusion of the paper.
 
 from __future__ import annotations
 
+import ast
 import heapq
 import math
 from collections.abc import Callable, Sequence
@@ -432,26 +433,48 @@ def _enclose_q(
         return None
 
 
+def _rational_arithmetic(ex: Expr) -> bool:
+    """Whether the expression is built from numeric literals and the spec's parameters (exact
+    rationals) by + − × ÷ and powers only: its exact value is a rational that sympy computes
+    without evaluating any function (:func:`_constant_inside`)."""
+    ok_ops = (ast.Add, ast.Sub, ast.Mult, ast.Div, ast.Pow, ast.BitXor, ast.USub, ast.UAdd)
+    for node in ast.walk(ex.tree):
+        if isinstance(node, (ast.Expression, ast.BinOp, ast.UnaryOp, *ok_ops)):
+            continue
+        if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)):
+            continue
+        if isinstance(node, ast.Name) and node.id in ex.parameters:
+            continue
+        if isinstance(node, ast.Load):
+            continue
+        return False
+    return True
+
+
 def _constant_inside(ex: Expr, lo: Fraction, hi: Fraction) -> tuple[bool, bool]:
     """(proved lo ≤ value ≤ hi, proved outside) for an expression without the variable,
-    compared exactly through sympy (rationals exactly; other real constants by sympy's
-    own decision, which is exact or undecided; a float anywhere in it is undecided).
-    Undecided: (False, False)."""
+    compared exactly when it is rational arithmetic on literals and parameters (+ − × ÷ and
+    integer powers, each power small enough to take exactly); anything else (a function, π,
+    e, a power taken in floats) is undecided here, (False, False), and left to the interval
+    enclosures. sympy used to decide every constant: ``floor(e**e**e**e)`` hung in its
+    evalf, and ``pi**1000000/10**100000``, whose power was taken in floats (inf), became an
+    exact 0 and was certified inside U = [0, 1] (hostile-input trial, session 24)."""
     import sympy
 
+    from obsdesign.spec.expr import InexactPower
+
+    if not _rational_arithmetic(ex):
+        return False, False
     try:
-        v = ex.sympy()
-        if v.has(sympy.Float):
-            # a power too large to take exactly was taken in floats (expr._sympy_pow): its
-            # value is not exact (0.5^20001 became 0.0 and "u ∈ [−1, 0]" was certified;
-            # search-space trial, session 24)
+        v = ex.exact_sympy()
+        if not v.is_Rational:
             return False, False
         a, b = (
             sympy.Rational(lo.numerator, lo.denominator),
             sympy.Rational(hi.numerator, hi.denominator),
         )
         ge, le = (v >= a), (v <= b)
-    except (TypeError, ValueError, ArithmeticError, AttributeError):
+    except (InexactPower, TypeError, ValueError, ArithmeticError, AttributeError):
         return False, False
     if ge is sympy.true and le is sympy.true:
         return True, False
