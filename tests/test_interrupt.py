@@ -87,3 +87,25 @@ def test_check_stops_before_the_next_spec_once_an_interrupt_is_recorded(tmp_path
     with pytest.raises(KeyboardInterrupt):
         check([tmp_path], Fmt.text, None, True, None, None)
     assert seen == ["a.toml"]
+
+
+def test_a_recorded_interrupt_keeps_the_output_file_untouched(tmp_path) -> None:
+    """A Ctrl-C whose KeyboardInterrupt a library swallowed (mpmath's from_float has a bare
+    except) let ``design -o`` finish and write the report before exit 130 (hostile-input
+    trial, session 24). write_via checks the record before it puts the file in place: the
+    old file stays, and no temp file is left."""
+    from obsdesign.report.model import write_atomic
+
+    out = tmp_path / "out.json"
+    out.write_text("SENTINEL\n")
+    interrupt.reset()
+    with pytest.raises(KeyboardInterrupt):
+        interrupt.handler(2, None)  # recorded, and its exception "lost"
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            write_atomic(out, "{}")
+    finally:
+        interrupt.reset()
+    assert out.read_text() == "SENTINEL\n" and [p.name for p in tmp_path.iterdir()] == ["out.json"]
+    write_atomic(out, "{}")  # with no interrupt recorded it writes
+    assert out.read_text() == "{}\n"

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from obsdesign import interrupt
 from obsdesign.certify.claim import Claim, ClaimStatus
 from obsdesign.errors import (
     EXIT_INCONCLUSIVE,
@@ -489,6 +490,7 @@ def write_via(path: str | Path, writer: Callable[[Path], Any], force: bool = Fal
         if force and p.is_symlink():
             p = Path(os.path.realpath(p))
         if force and p.exists() and not p.is_file() and not p.is_dir():
+            interrupt.check()
             writer(p)  # a FIFO or a device: write into it, never replace it
             return p
         p.parent.mkdir(parents=True, exist_ok=True)
@@ -501,6 +503,10 @@ def write_via(path: str | Path, writer: Callable[[Path], Any], force: bool = Fal
         try:
             writer(Path(tmp))
             os.chmod(tmp, mode)
+            # a Ctrl-C whose KeyboardInterrupt some library swallowed (mpmath's from_float has
+            # a bare except) is still recorded: never put the file in place after it (exit
+            # 130 with the report written; hostile-input trial, session 24)
+            interrupt.check()
             os.replace(tmp, p)
         finally:
             if os.path.exists(tmp):
