@@ -16,7 +16,7 @@ Checked where the input enters:
 - expressions: at most ``max_expr_chars`` characters and ``max_expr_depth`` levels of the
   syntax tree (walked iteratively, before anything recursive runs);
 - state dimension: at most ``max_states`` (the method's own ``max_states`` when it declares
-  one, else the default);
+  one, else the default); inputs, outputs and disturbances at most ``max_states`` each;
 - simulation memory: ``runs × steps × states`` doubles estimated before allocating, at most
   ``max_sim_bytes``.
 """

@@ -302,3 +302,27 @@ def test_a_byte_order_mark_is_named(tmp_path: Path) -> None:
     with pytest.raises(SpecError, match="byte-order mark") as e:
         load_spec(p)
     assert e.value.exit_code == 2 and str(p) in e.value.message
+
+
+@pytest.mark.parametrize(
+    ("line", "key"),
+    [
+        ("inputs = 1000000000000", "system.inputs"),
+        ("disturbances = 10000000", "system.disturbances"),
+        ("disturbances = 101", "system.disturbances"),
+        ("B = [[" + ", ".join(["1"] * 101) + "], [" + ", ".join(["0"] * 101) + "]]", "system.B"),
+    ],
+)
+def test_signal_counts_are_bounded_before_anything_is_allocated(line: str, key: str) -> None:
+    """``inputs = 10¹²`` asked numpy for 14.6 TiB (exit 3) and ``disturbances = 10⁹`` ran to
+    15.7 GB (hostile-input trial, session 24): inputs, outputs and disturbances are bounded
+    by max_states (100) like the states, exit 2 naming the key. 100 are accepted."""
+    base = (
+        '[system]\ntime = "discrete"\nA = [[0, 1], [1, 0]]\nC = [[1, 0]]\n{}\n'
+        '[method]\nkey = "lyapunov"\nL = [-1.87, 1.874]\n'
+    )
+    with pytest.raises(SpecError) as e:
+        load_spec_text(base.format(line), "big.toml")
+    assert f"[{key}]" in str(e.value) and "--limit max_states" in str(e.value)
+    ok = load_spec_text(base.format("disturbances = 100"), "ok.toml")
+    assert ok.system.Bd.shape == (2, 100)
