@@ -116,7 +116,9 @@ def dask_client(
     if scheduler is not None:
         try:
             c = Client(scheduler, timeout="10s")
-        except OSError as e:
+        except (OSError, ValueError) as e:
+            # ValueError: an address distributed cannot parse, e.g. tcp:// without a port
+            # (exit 3 "missing port number"; hostile-input trial, session 24)
             raise InputError(f"--scheduler {scheduler}: cannot connect ({e})") from None
         try:
             yield c

@@ -303,3 +303,14 @@ def test_an_unknown_scheduler_scheme_is_bad_input() -> None:
     with pytest.raises(InputError, match="schemes: tcp"):
         check_workers(None, "junk://x")
     check_workers(None, "tcp://127.0.0.1:8786")  # no connection is made here
+
+
+def test_a_scheduler_address_without_a_port_is_bad_input() -> None:
+    """``--scheduler tcp://`` raised distributed's ValueError "missing port number" (exit 3;
+    hostile-input trial, session 24): exit 2 naming the option."""
+    from obsdesign.distributed import dask_client
+    from obsdesign.errors import InputError
+
+    with pytest.raises(InputError, match="--scheduler tcp://: cannot connect"):
+        with dask_client(scheduler="tcp://"):
+            pass
