@@ -41,6 +41,7 @@ from pathlib import Path
 from typing import Any
 
 from obsdesign.errors import EXIT_BAD_INPUT, EXIT_OK, EXIT_SOLVER, InputError, ObsdesignError
+from obsdesign.limits import limits
 
 #: at most this many points in one sweep (a typo such as 1:2:1000000000 is refused at once)
 MAX_POINTS = 100_000
@@ -74,6 +75,12 @@ def parse_axis(text: str) -> Axis:
     if "=" not in text:
         raise InputError(f"--set expects KEY=VALUES (e.g. method.lambda=0.9:0.99:10), got {text!r}")
     key, spec = (s.strip() for s in text.split("=", 1))
+    if key.count(".") >= limits().max_depth:
+        # 3000 parts ran past 60 s before any other check (hostile-input trial, session 24)
+        raise InputError(
+            f"--set: the key has {key.count('.') + 1} parts, deeper than a spec may nest "
+            f"({limits().max_depth})"
+        )
     if not _KEY_RE.match(key):
         raise InputError(f"--set {text!r}: {key!r} is not a dotted spec key (e.g. method.lambda)")
     if not spec:
@@ -378,8 +385,6 @@ def _check_edit_parsed(old: str, new: str, parts: list[str], literal: str, file:
         want = tomllib.loads(f"x = {literal}")["x"]
     except ValueError as e:
         if not isinstance(e, tomllib.TOMLDecodeError):  # Python's int-string limit
-            from obsdesign.limits import limits
-
             raise InputError(
                 f"{file}: [{key}] has a number with more than {limits().max_digits} digits "
                 "(--limit max_digits=N)"

@@ -360,3 +360,10 @@ def test_hostile_set_values_are_bad_input() -> None:
     with pytest.raises(InputError, match="5000-digit number of values"):
         sw.parse_axis("method.lambda=0.9:0.99:" + "1" * 5000)
     assert len(sw.parse_axis("method.lambda=0.9:0.99:0000000000000003").values) == 3
+
+
+def test_a_set_key_deeper_than_a_spec_may_nest_is_refused_at_once() -> None:
+    """A 3000-part dotted key ran past 60 s before any check (hostile-input trial, session
+    24): more parts than max_depth is bad input, before anything else."""
+    with pytest.raises(InputError, match="3000 parts, deeper than a spec may nest"):
+        sw.parse_axis(".".join(["a"] * 3000) + "=1")
