@@ -362,13 +362,29 @@ def spec_text_from_mat(
     """Spec text from the matrices of a MATLAB ``.mat`` file: ``names`` maps ``A``, ``B``,
     ``C``, ``D``, ``Bd`` to variable names in the file (``None``: absent). The sample time is
     ``dt`` or the scalar variable ``dt_name`` (none: continuous time)."""
-    from scipy.io import loadmat
+    from scipy.io import loadmat, whosmat
 
-    from obsdesign.limits import read_input
+    from obsdesign.limits import limits, read_input
 
     read_input(path, "MATLAB")  # a regular file within the size limit
+    wanted = [v for v in (*names.values(), dt_name) if v is not None]
     try:
-        data = loadmat(str(path))
+        # the declared shapes first, and only the named variables loaded: a 7.5 MB file of
+        # compressed zeros inflated to 11 GB before any check (hostile-input trial, session 24)
+        shapes = {name: shape for name, shape, _ in whosmat(str(path))}
+        for key, v in (*names.items(), ("the sample time", dt_name)):
+            if v is None or v not in shapes:
+                continue
+            size = int(np.prod(shapes[v], dtype=object))
+            if size > limits().max_values or max(shapes[v], default=0) > limits().max_states:
+                raise InputError(
+                    f"{path}: variable '{v}' ({key}) is {'×'.join(map(str, shapes[v]))}, above "
+                    f"{limits().max_states} states or {limits().max_values:,} values "
+                    "(--limit max_states / max_values)"
+                )
+        data = loadmat(str(path), variable_names=[v for v in wanted if v in shapes])
+    except InputError:
+        raise
     except Exception as e:  # noqa: BLE001 - scipy raises several kinds on a bad file
         raise InputError(f"{path}: not a readable .mat file ({type(e).__name__}: {e})") from None
 
@@ -377,7 +393,7 @@ def spec_text_from_mat(
         if v is None:
             return None
         if v not in data:
-            known = ", ".join(sorted(k for k in data if not k.startswith("__")))
+            known = ", ".join(sorted(k for k in shapes if not k.startswith("__")))
             raise InputError(f"{path}: no variable '{v}' for {key} (variables: {known})")
         arr = np.asarray(data[v])
         if arr.dtype.kind not in "fiu":

@@ -306,3 +306,33 @@ def test_mat_import_D_without_B_gives_a_spec_that_designs(tmp_path: Path) -> Non
     assert r.exit_code == 0, r.stderr
     rep = api.design(api.load_spec_text(r.stdout, "d.toml"))
     assert rep.exit_code() == 0 and "D = [[2]]" in r.stdout
+
+
+def test_import_checks_declared_shapes_before_loading(tmp_path) -> None:
+    """A 70 kB .mat holding a 3000×3000 A was imported into a 9-million-value spec (exit 0,
+    8.8 s) that every command refused, and a 7.5 MB file of compressed zeros inflated to
+    11 GB (hostile-input trial, session 24). The declared shapes are checked first
+    (scipy's whosmat), and only the named variables are loaded: a large unrelated variable
+    costs nothing."""
+    import scipy.io as sio
+
+    from obsdesign.errors import InputError
+    from obsdesign.interop import spec_text_from_mat
+
+    big = tmp_path / "big.mat"
+    sio.savemat(big, {"A": np.zeros((3000, 3000)), "C": np.ones((1, 3000))}, do_compression=True)
+    with pytest.raises(InputError, match="variable 'A' \\(A\\) is 3000×3000, above 100 states"):
+        spec_text_from_mat(big, {"A": "A", "C": "C"})
+    ok = tmp_path / "ok.mat"
+    sio.savemat(
+        ok,
+        {
+            "A": np.array([[0.0, 1], [1, 0]]),
+            "C": np.array([[1.0, 0]]),
+            "junk": np.zeros((999, 999)),
+        },
+        do_compression=True,
+    )
+    assert "A = [[0, 1], [1, 0]]" in spec_text_from_mat(ok, {"A": "A", "C": "C"})
+    with pytest.raises(InputError, match="variables: A, C, junk"):
+        spec_text_from_mat(ok, {"A": "X", "C": "C"})
