@@ -101,9 +101,13 @@ def _load_spec(spec: Path) -> Any:
 
 
 def _say(text: str) -> None:
-    """An informational line on stdout (text format), unless --quiet."""
+    """An informational line on stdout (text format), unless --quiet; made one line as
+    errors are (a file name with ESC and a newline reached the terminal raw in "report
+    written to …"; hostile-input trial, session 24)."""
     if not _state["quiet"]:
-        print(text)
+        from obsdesign.errors import one_line
+
+        print(one_line(text))
 
 
 def _distinct_outputs(a: Path | None, b: Path | None) -> None:

@@ -32,11 +32,21 @@ def one_line(message: str) -> str:
     Unicode line/paragraph separators from user-given names (TOML keys, file names) are
     written as escapes, so a key cannot break the line or drive the terminal; a run of 100 or
     more digits (a 5000-digit number from a file) is shortened to its first 20 digits and
-    its length. Idempotent on ordinary text."""
+    its length; a line longer than :data:`MAX_LINE` characters keeps its start and end
+    around "…(N characters)…" (a 5-million-character TOML key was echoed whole;
+    hostile-input trial, session 24). Idempotent on ordinary text."""
     out = "".join(
         _escape_char(c) if unicodedata.category(c) in ("Cc", "Zl", "Zp") else c for c in message
     )
-    return _LONG_DIGITS.sub(lambda m: f"{m[0][:20]}…({len(m[0])} digits)", out)
+    out = _LONG_DIGITS.sub(lambda m: f"{m[0][:20]}…({len(m[0])} digits)", out)
+    if len(out) > MAX_LINE:
+        cut = len(out) - MAX_LINE // 2 - MAX_LINE // 4
+        out = f"{out[: MAX_LINE // 2]}…({cut} characters)…{out[-(MAX_LINE // 4) :]}"
+    return out
+
+
+#: the longest message line printed whole (:func:`one_line`)
+MAX_LINE = 2000
 
 
 class ObsdesignError(Exception):

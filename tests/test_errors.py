@@ -70,3 +70,24 @@ def test_a_5000_digit_schema_version_is_one_short_line(tmp_path: Path) -> None:
     assert r.exit_code == 2, r.stderr
     assert r.stderr.count("\n") == 1 and len(r.stderr) < 300
     assert "schema_version 99999999999999999999…(5000 digits) is not supported" in r.stderr
+
+
+def test_one_line_shortens_a_huge_message_and_success_lines_are_one_line(tmp_path) -> None:
+    """An unknown TOML key of 5·10⁶ characters was echoed whole (a 5 MB error "line"), and
+    "report written to …" printed a file name's ESC and newline raw (hostile-input trial,
+    session 24)."""
+    from typer.testing import CliRunner
+
+    from obsdesign.cli import app
+    from obsdesign.errors import MAX_LINE
+
+    long = one_line("k" * 5_000_000)
+    assert len(long) < MAX_LINE + 40 and long.startswith("k" * 100) and "characters)…" in long
+    assert one_line("x" * MAX_LINE) == "x" * MAX_LINE  # up to the limit: whole
+    spec = tmp_path / "s.toml"
+    spec.write_text(
+        '[system]\ntime = "discrete"\nA = [[0.5]]\nC = [[1]]\n[method]\nkey = "lyapunov"\n'
+    )
+    out = tmp_path / "o\x1b[31m\nx.json"
+    res = CliRunner().invoke(app, ["design", str(spec), "-o", str(out)])
+    assert res.exit_code == 0 and "\x1b" not in res.stdout and "o\\x1b[31m\\nx.json" in res.stdout
