@@ -385,7 +385,17 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
     named = "report" if isinstance(report, Report) else str(report)
     if rep.method not in method_keys():
         raise InputError(f"{named}: unknown method '{rep.method}'")
-    sp = load_spec_text(text, file)
+    try:
+        sp = load_spec_text(text, file)
+    except SpecError as e:
+        if spec is not None or not isinstance(report, (str, Path)):
+            raise
+        # the embedded copy is at fault, not the file it was written from ("s.toml: is not
+        # valid TOML" while s.toml on disk was fine; hostile-input trial, session 24)
+        where = f"[{e.key}] " if e.key else ""
+        raise SpecError(
+            str(report), "", f"the embedded spec (from {file}): {where}{e.expected}"
+        ) from None
     if sp.method != rep.method:
         raise InputError(f"{named}: method '{rep.method}' but the spec says '{sp.method}'")
     if rep.error is not None:

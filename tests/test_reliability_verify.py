@@ -238,3 +238,25 @@ def test_a_huge_integer_in_a_report_names_the_digit_limit(tmp_path: Path) -> Non
     assert "7" * 5000 in p.read_text(encoding="utf-8")
     with pytest.raises(InputError, match="more than 1000 digits"):
         Report.load(p)
+
+
+def test_an_error_in_the_embedded_spec_names_the_report(tmp_path: Path) -> None:
+    """A broken embedded spec (sha256 updated) was reported against the report's spec_file
+    ("s.toml: is not valid TOML") while s.toml on disk was fine (hostile-input trial,
+    session 24): the message names the report and says the embedded spec is at fault."""
+    import hashlib
+
+    from obsdesign import api
+    from obsdesign.errors import SpecError
+
+    src = Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+    rep = api.design(src)
+    d = rep.to_dict()
+    d["spec"] = d["spec"].replace("[system]", "[system\n", 1)
+    d["spec_sha256"] = hashlib.sha256(d["spec"].encode()).hexdigest()
+    p = tmp_path / "r.json"
+    p.write_text(json.dumps(d))
+    with pytest.raises(SpecError) as e:
+        api.verify(p)
+    msg = str(e.value)
+    assert msg.startswith(f"{p}: the embedded spec (from ") and "is not valid TOML" in msg
