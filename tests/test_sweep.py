@@ -367,3 +367,15 @@ def test_a_set_key_deeper_than_a_spec_may_nest_is_refused_at_once() -> None:
     24): more parts than max_depth is bad input, before anything else."""
     with pytest.raises(InputError, match="3000 parts, deeper than a spec may nest"):
         sw.parse_axis(".".join(["a"] * 3000) + "=1")
+
+
+def test_set_key_finds_the_comment_after_a_value_full_of_hashes() -> None:
+    """The value's end was searched with one TOML parse per '#', quadratic (20,000 '#' in a
+    string ran past 60 s; hostile-input trial, session 24): a binary search now, since
+    every '#' after the value's end lies in the comment. The comment is kept, '#' inside
+    strings are not taken for it."""
+    text = '[method]\nkey = "x"\nlam = "a#b#' + "#" * 3000 + '"  # keep # this\nz = 1\n'
+    out = sw.set_key(text, "method.lam", "5")
+    assert 'lam = 5  # keep # this\nz = 1' in out
+    assert sw.set_key('[m]\nv = 1#c\n', "m.v", "2") == '[m]\nv = 2  #c\n'
+    assert sw.set_key('[m]\nv = "#"\n', "m.v", "2") == '[m]\nv = 2\n'
