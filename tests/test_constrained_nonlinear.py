@@ -56,3 +56,171 @@ def test_bad_expression_rejected():
     with pytest.raises(SpecError) as e:
         load_spec_text(text, "nl.toml")
     assert "system.f" in str(e.value)
+
+
+# -- constrained trial, session 24: v̆_max and the sampled (5) --------------------------------
+_SAT_P = """[system]
+time = "discrete"
+states = ["x1"]
+f = ["0.5*x1"]
+h = ["x1 + v1"]
+[sets.X]
+type = "box"
+lower = [-1]
+upper = [1]
+[sets.X0]
+type = "box"
+lower = [-0.01]
+upper = [0.01]
+[sets.Xhat0]
+type = "box"
+lower = [-0.01]
+upper = [0.01]
+[method]
+key = "constrained"
+F = ["0.5*x1_hat + 1.4*sat(x1_hat - y1)"]
+P = [[1e-8]]
+rho = 0.7
+mu = 1e-8
+X = "X"
+X0 = "X0"
+Xhat0 = "Xhat0"
+eps_min = 0.01
+[method.c]
+type = "box"
+lower = [-1.1]
+upper = [1.1]
+[method.D]
+lower = [-0.01]
+upper = [0.01]
+"""
+_LIN_MU = """[system]
+time = "discrete"
+A = [[0.5]]
+C = [[1]]
+[sets.X]
+type = "box"
+lower = [-1]
+upper = [1]
+[sets.X0]
+type = "box"
+lower = [0]
+upper = [0.001]
+[sets.Xhat0]
+type = "box"
+lower = [0]
+upper = [0.001]
+[method]
+key = "constrained"
+L = [0.1]
+P = [[1]]
+rho = 0.5
+mu = 0.001
+X = "X"
+X0 = "X0"
+Xhat0 = "Xhat0"
+eps_min = 0.01
+[method.c]
+type = "box"
+lower = [-1.1]
+upper = [1.1]
+[method.D]
+lower = [-0.5]
+upper = [0.5]
+"""
+_BAND = """[system]
+time = "discrete"
+states = ["x1"]
+f = ["0.5*x1"]
+h = ["x1 + v1"]
+[sets.X]
+type = "box"
+lower = [-1]
+upper = [1]
+[method]
+key = "constrained"
+F = ["0.5*x1_hat + 0.5*(x1_hat - y1)*step((x1_hat - y1)^2 - 0.0057)*step(0.00577 - (x1_hat - y1)^2)"]
+P = [[1]]
+rho = 0.5
+mu = 0
+X = "X"
+eps_min = 1
+[method.c]
+type = "box"
+lower = [-1.1]
+upper = [1.1]
+[method.D]
+lower = [0]
+upper = [0]
+"""
+_NL1 = """[system]
+time = "discrete"
+states = ["x1", "x2"]
+f = ["0.5*x1 + 0.1*sin(x2)", "0.4*x2 + d1"]
+h = ["x1 + v1"]
+disturbances = 1
+[sets.X]
+type = "box"
+lower = [-1, -1]
+upper = [1, 1]
+[sets.X0]
+type = "box"
+lower = [-0.5, -0.5]
+upper = [0.5, 0.5]
+[sets.Xhat0]
+type = "box"
+lower = [-1, -1]
+upper = [1, 1]
+[method]
+key = "constrained"
+F = ["0.5*x1_hat + 0.1*sin(x2_hat)", "0.4*x2_hat"]
+P = [[1, 0], [0, 1]]
+rho = 0.5
+mu = 2
+X = "X"
+X0 = "X0"
+Xhat0 = "Xhat0"
+eps_min = 0.01
+[method.c]
+type = "box"
+lower = [-1.1, -1.1]
+upper = [1.1, 1.1]
+[method.D]
+lower = [-0.1, -0.1]
+upper = [0.1, 0.1]
+"""
+
+
+def _claim(rep, cid):
+    return next(c for c in rep.claims if c.id == cid)
+
+
+def test_v_max_breve_rests_on_inequality_5() -> None:
+    """v̆_max bounds V along solutions only where (5) holds, yet its claim was certified on
+    the arithmetic alone: with (5) failing exactly (linear, μ too small) and with (5) false
+    but only sampled (F with a saturated high gain, P = 1e-8) it stayed certified and
+    false; with (5) sampled and passing it is now numerical (constrained trial, session 24)."""
+    for text in (_LIN_MU, _SAT_P):
+        rep = api.design(load_spec_text(text, "f.toml"))
+        assert _claim(rep, "iss-bound").status is ClaimStatus.FAILED
+        assert _claim(rep, "v_max_breve-bound").status is ClaimStatus.FAILED
+        assert rep.exit_code() == 1
+    rep = api.design(load_spec_text(_NL1, "nl1.toml"))
+    assert _claim(rep, "iss-bound").status is ClaimStatus.NUMERICAL
+    assert _claim(rep, "v_max_breve-bound").status is ClaimStatus.NUMERICAL
+    assert rep.exit_code() == 0
+
+
+def test_the_sampled_inequality_5_is_scaled_by_the_spec_not_the_report() -> None:
+    """(5) was sampled on V-shells up to 10·v_max with the report's v_max and an absolute
+    floor of 1e-6: a report with v_max raised to 10⁶ moved the samples off a violation and
+    verify accepted a spec whose design failed; with P = 1e-8 the shells lay beyond every
+    reachable error (constrained trial, session 24). The scale is now the v_max bound
+    recomputed from the spec, with shells twelve decades below it."""
+    from flint import fmpq
+
+    rep = api.design(load_spec_text(_BAND, "band.toml"))
+    assert _claim(rep, "iss-bound").status is ClaimStatus.FAILED
+    rep.parameters["v_max"] = fmpq(10**6)
+    again = api.certify(load_spec_text(_BAND, "band.toml"), rep.parameters)
+    assert next(c for c in again if c.id == "iss-bound").status is ClaimStatus.FAILED
