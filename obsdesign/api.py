@@ -237,7 +237,7 @@ def design(
         # the same exit 4 without an output file: a report with no float view is no report
         # (a λ of 1e-300 gave P ≈ 10¹²⁰⁰: exit 4 with -o or --format json, 3 from the text
         # table, 0 with -q; unusual-spec trial, session 24)
-        report.float_view()
+        report.check_float_view()
     return report
 
 

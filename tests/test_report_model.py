@@ -150,3 +150,46 @@ def test_a_report_with_a_repeated_key_is_refused(tmp_path: Path, where: str) -> 
 def _write(path: Path, text: str) -> Path:
     path.write_text(text, encoding="utf-8")
     return path
+
+
+@pytest.mark.parametrize(
+    "value",
+    [
+        fmpq(10**400),
+        fmpq(1, 10**400),  # underflows to 0.0: a float view exists
+        10**400,
+        np.array([fmpq(1), fmpq(10**400, 3)], dtype=object),
+        np.array([fmpq(1, 3), fmpq(-(2**1023) * 3, 2)], dtype=object),  # rounds past the range
+        np.array([fmpq(2**1023 * 2 - 2**970, 1), fmpq(1)], dtype=object),  # the largest double
+        np.array([fmpq(1, 10**400)], dtype=object),
+        [fmpq(10**400)],  # anything unusual: the JSON form decides
+    ],
+)
+def test_check_float_view_agrees_with_the_float_view(value) -> None:
+    """design checks the float view without building it (numpy's float conversion, ~10×
+    faster than the JSON strings at n = 100, session 24): it must raise exactly when
+    :meth:`Report.float_view` does, with the same exit-4 message."""
+    from obsdesign.errors import InconclusiveError
+    from obsdesign.params import Parameters
+
+    rep = Report(
+        method="lyapunov",
+        spec="",
+        spec_file="s.toml",
+        spec_sha256="",
+        parameters=Parameters({"x": value}),
+        claims=[],
+    )
+    try:
+        rep.float_view()
+        want = None
+    except InconclusiveError as e:
+        want = e.message
+    try:
+        rep.check_float_view()
+        got = None
+    except InconclusiveError as e:
+        got = e.message
+    assert (got is None) == (want is None)
+    if want is not None:
+        assert "parameter 'x'" in got and "float view" in got
