@@ -334,33 +334,21 @@ def _breve(
     # certified iss-bound (the sampled one of expression-defined maps, or a failed exact one,
     # left it certified and false; constrained trial, session 24)
     iss = next((cl for cl in c if cl.id == "iss-bound"), None)
-    if iss is not None and iss.status is ClaimStatus.FAILED:
-        c.exact(
-            id="v_max_breve-bound",
-            statement=statement,
-            reference=_ref("Section 4"),
-            check=check,
-            passed=False,
-            detail=f"{detail}; rests on inequality (5), and iss-bound fails",
-        )
-    elif iss is not None and iss.status is ClaimStatus.NUMERICAL:
-        c.numerical(
-            id="v_max_breve-bound",
-            statement=statement,
-            reference=_ref("Section 4"),
-            check=check + "; along solutions only where (5) holds, which is sampled",
-            passed=ok,
-            detail=detail + " (exact); (5) is sampled (iss-bound numerical), not proved",
-        )
-    else:
-        c.exact(
-            id="v_max_breve-bound",
-            statement=statement,
-            reference=_ref("Section 4"),
-            check=check,
-            passed=ok,
-            detail=detail,
-        )
+    status = None if iss is None else iss.status
+    sampled = status is ClaimStatus.NUMERICAL
+    if status is ClaimStatus.FAILED:
+        ok, detail = False, f"{detail}; rests on inequality (5), and iss-bound fails"
+    elif sampled:
+        check += "; along solutions only where (5) holds, which is sampled"
+        detail += " (exact); (5) is sampled (iss-bound numerical), not proved"
+    (c.numerical if sampled else c.exact)(
+        id="v_max_breve-bound",
+        statement=statement,
+        reference=_ref("Section 4"),
+        check=check,
+        passed=ok,
+        detail=detail,
+    )
     top = min(vbr, v_max)
     _theta_covers(
         c, "theta_breve", tb, "min(v_max, v̆_max)", top, v_min, gamma, eps_min, "Section 4, eq. (22)"
