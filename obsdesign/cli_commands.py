@@ -507,6 +507,14 @@ def verify(report: Path, spec: Path | None, fmt: Fmt, quiet: bool) -> int:
     """The body of ``obsdesign verify`` (see :func:`obsdesign.cli.verify`)."""
     from obsdesign.limits import precheck_spec, read_input
 
+    if spec is not None and _is_stdin(spec):
+        from obsdesign.errors import InputError
+
+        # "-: no such spec file" (hostile-input trial, session 24)
+        raise InputError(
+            "--spec -: verify reads the spec from a file (the report may come from stdin, "
+            "the spec cannot)"
+        )
     if not _is_stdin(report):
         read_input(report, "report")  # before the heavy imports (regular file, size)
     if spec is not None:

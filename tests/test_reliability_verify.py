@@ -260,3 +260,21 @@ def test_an_error_in_the_embedded_spec_names_the_report(tmp_path: Path) -> None:
         api.verify(p)
     msg = str(e.value)
     assert msg.startswith(f"{p}: the embedded spec (from ") and "is not valid TOML" in msg
+
+
+def test_verify_says_what_is_wrong_with_claims_and_a_stdin_spec(tmp_path: Path) -> None:
+    """A "claims" object gave "malformed claims (string indices must be integers, not
+    'str')", and ``verify - --spec -`` said "-: no such spec file" (hostile-input trial,
+    session 24): both now say what is expected."""
+    from obsdesign import api
+    from obsdesign.cli import app
+
+    src = Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+    d = api.design(src).to_dict()
+    d["claims"] = {"a": 1}
+    p = tmp_path / "r.json"
+    p.write_text(json.dumps(d))
+    res = CliRunner().invoke(app, ["verify", str(p)])
+    assert res.exit_code == 2 and "key 'claims': expected a list of claim objects" in res.output
+    res = CliRunner().invoke(app, ["verify", "-", "--spec", "-"], input="")
+    assert res.exit_code == 2 and "--spec -: verify reads the spec from a file" in res.output

@@ -348,6 +348,10 @@ class Report:
                     f"writes), got {err['exit_code']}"
                 )
         params, problems = Parameters.from_json(d["parameters"], file)
+        if not isinstance(d["claims"], list) or not all(isinstance(c, dict) for c in d["claims"]):
+            # a "claims" object gave "malformed claims (string indices must be integers…)"
+            # (hostile-input trial, session 24)
+            raise InputError(f"{file}: key 'claims': expected a list of claim objects")
         try:
             claims = [Claim.from_dict(c) for c in d["claims"]]
         except (KeyError, TypeError, ValueError) as e:
