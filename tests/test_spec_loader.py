@@ -311,6 +311,7 @@ def test_a_byte_order_mark_is_named(tmp_path: Path) -> None:
         ("disturbances = 10000000", "system.disturbances"),
         ("disturbances = 101", "system.disturbances"),
         ("B = [[" + ", ".join(["1"] * 101) + "], [" + ", ".join(["0"] * 101) + "]]", "system.B"),
+        ("Dn = [[" + ", ".join(["1"] * 101) + "]]", "system.Dn"),
     ],
 )
 def test_signal_counts_are_bounded_before_anything_is_allocated(line: str, key: str) -> None:

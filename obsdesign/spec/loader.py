@@ -277,6 +277,9 @@ def _system(t: Table) -> System:
         Bd = Value.of(qzeros((n, nd)))
     t.mark("B1", "Bd")
     Dn = t.matrix("Dn", rows=p, vector_as="column") if t.has("Dn") else Value.of(qeye(p))
+    if t.has("Dn"):
+        # 40,000 noise channels were blamed on [simulate.noise.windows] (hostile-input trial)
+        _signal_count(t, "Dn", Dn.shape[1])
     sample_time = t.scalar("sample_time", default=None, min=0, strict_min=True)
     params: dict[str, Value] = {}
     pt = t.table("parameters")
