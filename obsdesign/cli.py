@@ -445,6 +445,16 @@ def sweep(
     ] = False,
     quiet: QuietOpt = False,
     width: WidthOpt = None,
+    timeout: Annotated[
+        float,
+        typer.Option(
+            "--timeout",
+            metavar="SECONDS",
+            min=0,
+            help="Time budget per point (0 or inf: none); a point past it gets exit 3 and the "
+            "others still run. In-process runs only.",
+        ),
+    ] = 600.0,
 ) -> None:
     """Design and verify SPEC at every point of a grid of spec keys; one row per point.
 
@@ -453,7 +463,20 @@ def sweep(
 
     _run(
         lambda cmd: cmd.sweep(
-            spec, sets, simulate, option, output, plot, y, x, fmt, workers, scheduler, force, quiet
+            spec,
+            sets,
+            simulate,
+            option,
+            output,
+            plot,
+            y,
+            x,
+            fmt,
+            workers,
+            scheduler,
+            force,
+            quiet,
+            timeout,
         ),
         quiet,
         width,

@@ -596,6 +596,7 @@ def sweep(
     scheduler: str | None,
     force: bool,
     quiet: bool,
+    timeout: float | None = None,
 ) -> int:
     """The body of ``obsdesign sweep`` (see :func:`obsdesign.cli.sweep`)."""
     _precheck(spec)
@@ -637,6 +638,7 @@ def sweep(
             workers=workers,
             scheduler=scheduler,
             on_row=lambda r: advance(r["exit_code"] != 0),
+            timeout=timeout,
         )
     if output is not None:
         sw.write_table(output, rows, force)

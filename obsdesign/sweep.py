@@ -457,6 +457,8 @@ class PointTask:
     file: str
     simulate: bool = False
     sim_options: dict[str, str] = field(default_factory=dict)
+    #: seconds this point may run (in the main thread; None: no limit), as ``check --timeout``
+    timeout: float | None = None
 
 
 _VERDICTS = {0: "ok", 1: "failed", 2: "bad input", 3: "error", 4: "inconclusive"}
@@ -489,11 +491,30 @@ def failure_row(task: PointTask, code: int, message: str, method: str = "") -> d
 
 def run_point(task: PointTask) -> dict[str, Any]:
     """Design, serialize, reload and verify one point (and simulate it when asked): its
-    row. Never raises (but KeyboardInterrupt): an error is the row's exit code and message."""
+    row. Never raises (but KeyboardInterrupt): an error is the row's exit code and message;
+    a point past ``task.timeout`` is exit 3 "not finished" (one hanging point cost every
+    row of the sweep; hostile-input trial, session 24)."""
+    from obsdesign import api
+
+    t0 = time.perf_counter()
+    try:
+        with api._time_budget(task.timeout):
+            return _run_point(task, t0)
+    except api.SpecTimeout:
+        row = failure_row(
+            task,
+            EXIT_SOLVER,
+            f"not finished within {task.timeout:g} s (sweep --timeout SECONDS; 0: no limit)",
+        )
+        row["seconds"] = round(time.perf_counter() - t0, 4)
+        return row
+
+
+def _run_point(task: PointTask, t0: float) -> dict[str, Any]:
+    """:func:`run_point` without the time budget."""
     from obsdesign import api
     from obsdesign.report.model import Report
 
-    t0 = time.perf_counter()
     method = ""
     name = f"{task.file}[point {task.index}]"
     try:
@@ -597,6 +618,7 @@ def plan(
     grid: Sequence[str] | dict[str, Any],
     simulate: bool = False,
     options: dict[str, str] | None = None,
+    timeout: float | None = None,
 ) -> tuple[list[Axis], list[PointTask]]:
     """The axes and one task per grid point; bad input that concerns every point (a bad
     ``--set``, a key that cannot be written, a spec without ``[simulate]`` for
@@ -613,7 +635,8 @@ def plan(
         if "simulate" not in doc and not any(k.startswith("simulate.") for k in points[0]):
             raise InputError(f"{file}: [simulate] is missing: nothing to simulate (--simulate)")
     tasks = [
-        PointTask(i, p, text, file, simulate, dict(options or {})) for i, p in enumerate(points)
+        PointTask(i, p, text, file, simulate, dict(options or {}), timeout or None)
+        for i, p in enumerate(points)
     ]
     return axes, tasks
 
@@ -628,10 +651,12 @@ def sweep_rows(
     workers: int | None = None,
     scheduler: str | None = None,
     on_row: Callable[[dict[str, Any]], None] | None = None,
+    timeout: float | None = None,
 ) -> list[dict[str, Any]]:
     """One row per grid point, in grid order (see the module docstring); ``on_row(row)`` is
-    called as each row arrives (completion order)."""
-    _, tasks = plan(spec, grid, simulate, options)
+    called as each row arrives (completion order); ``timeout``: seconds per point (in-process
+    runs), past which the point's row is exit 3."""
+    _, tasks = plan(spec, grid, simulate, options, timeout)
 
     def lost(task: PointTask, message: str) -> dict[str, Any]:
         return failure_row(task, EXIT_SOLVER, message)

@@ -379,3 +379,15 @@ def test_set_key_finds_the_comment_after_a_value_full_of_hashes() -> None:
     assert "lam = 5  # keep # this\nz = 1" in out
     assert sw.set_key("[m]\nv = 1#c\n", "m.v", "2") == "[m]\nv = 2  #c\n"
     assert sw.set_key('[m]\nv = "#"\n', "m.v", "2") == "[m]\nv = 2\n"
+
+
+def test_a_point_past_the_timeout_gets_its_row_and_the_others_keep_theirs() -> None:
+    """One hanging point cost every row of a sweep (hostile-input trial, session 24):
+    ``timeout`` bounds each point as ``check --timeout`` does each spec; the slow point is
+    exit 3 "not finished", the fast one keeps its row."""
+    spec = Path(__file__).resolve().parents[1] / "specs" / "hernandez-garcia-example.toml"
+    slow = "sin(" * 10 + "t" + ")" * 10
+    grid = [f'system.u=[["t/3 - floor(t/3)"], ["{slow}"]]']
+    rows = sw.sweep_rows(spec, grid, timeout=1.0)
+    assert [r["exit_code"] for r in rows] == [0, 3]
+    assert rows[1]["message"].startswith("not finished within 1 s")
