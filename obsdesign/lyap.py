@@ -1321,7 +1321,9 @@ def best_rate(
     bound = guide.bound(discrete)
     resolution = Q(abs(bound)) / 2**52  # about one ulp of the rate
     if tol_q < resolution:  # no bisection in float midpoints gets there
-        raise RateResolutionError(tol_q, resolution, Q(bound))
+        # the rate as the user writes it: α = −(spectral abscissa) in continuous time (the
+        # message said "near the rate -10293.1"; lyapunov trial, session 24)
+        raise RateResolutionError(tol_q, resolution, rate(Q(bound)))
     lo = _snap(Q(max(bound, 0.0)) if discrete else Q(bound), grid, False)
     # float error put the spectral bound above a feasible grid point. That error is about
     # u·ρ for a simple eigenvalue but u^(1/k) for a k-fold one (a triple pole at 0.5: 3·10⁻⁶),

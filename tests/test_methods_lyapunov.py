@@ -1229,3 +1229,17 @@ def test_entries_near_the_float_range_do_not_overflow_the_lyapunov_solution() ->
     assert api.verify(rep).exit_code() == 0
     X = np.array([[1e308, 1e308], [1e308, 1e308]])
     assert np.all(np.isfinite(lyap.sym_part(X))) and lyap.sym_part(X)[0, 1] == 1e308
+
+
+def test_rate_tol_below_the_float_resolution_names_the_rate_with_its_sign() -> None:
+    """Continuous time: the refusal of a rate_tol below the float resolution said "near the
+    rate -10293.1", the spectral abscissa, where the rate α is +10293.1 (lyapunov trial,
+    session 24)."""
+    from obsdesign.errors import SpecError
+
+    text = (
+        '[system]\ntime = "continuous"\nA = [[-10293.1]]\nC = [[1]]\n'
+        '[method]\nkey = "lyapunov"\nL = [0]\nrate_tol = 1e-12\n'
+    )
+    with pytest.raises(SpecError, match="near the rate 10293.1 "):
+        api.design(load_spec_text(text, "rt.toml"))
