@@ -346,6 +346,24 @@ WorkersOpt = Annotated[
         "the output is the serial run's.",
     ),
 ]
+
+
+def _timeout_opt(unit: str) -> Any:
+    """``--timeout SECONDS`` of ``check`` (per spec) and ``sweep`` (per point)."""
+    return Annotated[
+        float,
+        typer.Option(
+            "--timeout",
+            metavar="SECONDS",
+            min=0,
+            help=f"Time budget per {unit} (0 or inf: none); a {unit} past it gets exit 3 and "
+            "the others still run. In-process runs only.",
+        ),
+    ]
+
+
+SpecTimeoutOpt = _timeout_opt("spec")
+PointTimeoutOpt = _timeout_opt("point")
 SchedulerOpt = Annotated[
     str | None,
     typer.Option(
@@ -375,16 +393,7 @@ def check(
     width: WidthOpt = None,
     workers: WorkersOpt = None,
     scheduler: SchedulerOpt = None,
-    timeout: Annotated[
-        float,
-        typer.Option(
-            "--timeout",
-            metavar="SECONDS",
-            min=0,
-            help="Time budget per spec (0 or inf: none); a spec past it gets exit 3 and the "
-            "others still run. In-process runs only.",
-        ),
-    ] = 600.0,
+    timeout: SpecTimeoutOpt = 600.0,
 ) -> None:
     """Design and verify every spec; one row per spec; non-zero exit if any fails.
 
@@ -445,16 +454,7 @@ def sweep(
     ] = False,
     quiet: QuietOpt = False,
     width: WidthOpt = None,
-    timeout: Annotated[
-        float,
-        typer.Option(
-            "--timeout",
-            metavar="SECONDS",
-            min=0,
-            help="Time budget per point (0 or inf: none); a point past it gets exit 3 and the "
-            "others still run. In-process runs only.",
-        ),
-    ] = 600.0,
+    timeout: PointTimeoutOpt = 600.0,
 ) -> None:
     """Design and verify SPEC at every point of a grid of spec keys; one row per point.
 
