@@ -55,6 +55,21 @@ class Limits:
 _current = Limits()
 _overridden: set[str] = set()
 
+#: the largest value ``--limit`` / :func:`set_limits` accepts for a limit whose raised value
+#: would let one number or one nesting hang the tool or exhaust Python's recursion (measured
+#: from the CLI, session 25): converting a number's text is quadratic in its digits (10⁶ digits
+#: took 45 s, 10⁵ take ~1 s); ``1e-30000000`` took 45 s to reach its "below the float range"
+#: refusal (10⁶ take 0.7 s); TOML nested ~500 deep and an expression ~1000 deep ran into
+#: RecursionError (the expression as exit 3 inside sympy), reported as "nested more than
+#: <the raised limit> levels". The other limits bound sizes the user may raise at will
+#: (memory and time grow with them, not without bound for one value).
+CEILINGS: dict[str, int] = {
+    "max_digits": 100_000,
+    "max_exponent": 2**20,  # "1M" on the command line
+    "max_depth": 256,
+    "max_expr_depth": 400,
+}
+
 #: per-method practical state-dimension limits (a method may declare ``max_states`` itself).
 #: stubborn: its LMIs (1)-(3) / (7)-(9) go to an interior-point SDP solver many times (the λ
 #: search): ~1 min at n = 24 on 2 cores, and n = 100 ran past 300 s with 9.7 GB (stubborn
@@ -72,12 +87,23 @@ def set_limits(**values: int) -> Limits:
     global _current
     old = _current
     known = {f.name for f in fields(Limits)}
-    for k in values:
+    for k, v in values.items():
         if k not in known:
             raise InputError(f"--limit {k}: unknown limit (known: {', '.join(sorted(known))})")
+        _check_ceiling(k, v)
     _current = replace(_current, **values)
     _overridden.update(values)
     return old
+
+
+def _check_ceiling(k: str, v: int) -> None:
+    """An :class:`InputError` when ``v`` is above the limit's :data:`CEILINGS` entry."""
+    cap = CEILINGS.get(k)
+    if cap is not None and v > cap:
+        raise InputError(
+            f"--limit {k}: at most {cap} (above it one value can take minutes or exhaust "
+            f"Python's recursion), got {v}"
+        )
 
 
 def reset_limits(old: Limits | None = None) -> None:
@@ -108,6 +134,7 @@ def parse_limit(text: str) -> tuple[str, int]:
     if k not in {f.name for f in fields(Limits)}:
         known = ", ".join(sorted(f.name for f in fields(Limits)))
         raise InputError(f"--limit {k}: unknown limit (known: {known})")
+    _check_ceiling(k, int(num) * mult)
     return k, int(num) * mult
 
 

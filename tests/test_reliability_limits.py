@@ -160,6 +160,51 @@ def test_limits_are_overridable(tmp_path: Path):
     assert res.exit_code == 2 and "positive integer" in res.output
 
 
+@pytest.mark.parametrize("key", ["max_digits", "max_exponent", "max_depth", "max_expr_depth"])
+def test_limits_stop_at_their_ceiling(key: str) -> None:
+    """A limit raised past its ceiling is refused (exit 2 naming it) — the ceiling itself
+    is accepted, one above it is not, through the CLI's parser and the API alike."""
+    from obsdesign.errors import InputError
+    from obsdesign.limits import CEILINGS, parse_limit
+
+    cap = CEILINGS[key]
+    assert parse_limit(f"{key}={cap}") == (key, cap)
+    set_limits(**{key: cap})
+    for bad in (f"{key}={cap + 1}", f"{key}={cap * 1000}"):
+        with pytest.raises(InputError, match=f"--limit {key}: at most {cap}"):
+            parse_limit(bad)
+    with pytest.raises(InputError, match=f"at most {cap}"):
+        set_limits(**{key: cap + 1})
+    res = runner.invoke(app, ["--limit", f"{key}={cap + 1}", "methods"])
+    assert res.exit_code == 2 and f"at most {cap}" in res.output, res.output
+
+
+def test_raised_exponent_limit_cannot_hang_on_one_number(tmp_path: Path) -> None:
+    """``--limit max_exponent=1000000000`` let A = [[0, 1], [1, 1e-30000000]] take 45 s
+    (1e-100000000: past 60 s) before its "below the float range" refusal: now the raised
+    limit itself is refused, and the largest accepted exponent is refused fast."""
+    spec = tmp_path / "s.toml"
+    spec.write_text(_edit("A = [[0, 1], [1, 0]]", "A = [[0, 1], [1, 1e-30000000]]"))
+    res = runner.invoke(app, ["--limit", "max_exponent=1000000000", "design", str(spec)])
+    assert res.exit_code == 2 and "at most" in res.output, res.output
+    spec.write_text(_edit("A = [[0, 1], [1, 0]]", "A = [[0, 1], [1, 1e-1048576]]"))
+    t0 = time.perf_counter()
+    res = runner.invoke(app, ["--limit", "max_exponent=1M", "design", str(spec)])
+    assert res.exit_code == 2 and "below the float range" in res.output, res.output
+    assert time.perf_counter() - t0 < 20
+
+
+def test_recursion_backstops_do_not_blame_the_limit(tmp_path: Path) -> None:
+    """A nesting that exhausts the TOML reader's recursion is named as that, not as "more
+    than <max_depth> levels" (with a raised limit it said 'more than 1000000 levels' of a
+    500-deep array)."""
+    spec = tmp_path / "s.toml"
+    spec.write_text(_edit("C = [[1, 0]]", "C = [[1, 0]]\nzz = " + "[" * 3000 + "]" * 3000))
+    res = runner.invoke(app, ["--limit", "max_depth=256", "design", str(spec)])
+    assert res.exit_code == 2, res.output
+    assert "too deeply" in res.output and "256" not in res.output, res.output
+
+
 def test_max_states_override_message(tmp_path: Path):
     set_limits(max_states=1)
     spec = tmp_path / "s.toml"

@@ -195,7 +195,9 @@ def parse_expr(
     except SyntaxError as e:
         raise SpecError(file, key, f"is not a valid expression ({e.msg})") from None
     except (RecursionError, MemoryError):  # a backstop: nesting_depth bounds the depth first
-        raise SpecError(file, key, _too_deep(depth)) from None
+        raise SpecError(
+            file, key, "expression is nested too deeply to parse (Python's recursion limit)"
+        ) from None
     except ValueError as e:  # e.g. an integer literal beyond the int-string limit
         raise SpecError(file, key, f"is not a valid expression ({e})") from None
     tree_depth = _tree_depth(tree)

@@ -147,7 +147,11 @@ def _parse_toml_fresh(text: str, file: str) -> dict[str, Any]:
         raise SpecError(file, "", f"is not valid TOML ({e})") from None
     except RecursionError:
         raise SpecError(
-            file, "", f"is nested more than {lim.max_depth} levels deep (--limit max_depth=N)"
+            file,
+            "",
+            # not "more than max_depth levels": the parser's recursion ran out first, which
+            # with a raised limit was below it ("more than 1000000 levels" at 500 levels)
+            "is nested too deeply for the TOML reader (Python's recursion limit)",
         ) from None
     except ValueError:  # an integer beyond Python's int-string limit (4300 digits)
         raise SpecError(file, _long_number_line(text), _too_many_digits()) from None
