@@ -272,6 +272,8 @@ def test_parse_memo_gives_fresh_copies_and_keys_on_the_limits(monkeypatch) -> No
         ('["sin", "x2"]', "a function"),
         ('["x1", "u1"]', "an input"),
         ('["v1", "x2"]', "an input, disturbance or noise"),
+        ('["lambda", "x2"]', "a Python keyword"),
+        ('["None", "x2"]', "a Python keyword"),
     ],
 )
 def test_reserved_state_names_are_refused(states: str, what: str) -> None:
@@ -289,6 +291,25 @@ def test_reserved_state_names_are_refused(states: str, what: str) -> None:
     assert e.value.exit_code == 2 and what in e.value.message
     ok = text.replace(f"states = {states}", 'states = ["e", "w"]')
     assert load_spec_text(ok, "names.toml").system.states == ["e", "w"]
+
+
+@pytest.mark.parametrize(
+    ("name", "what"),
+    [("cos", "a function"), ("t", "the time t"), ("None", "a Python keyword"), ("if", "keyword")],
+)
+def test_reserved_parameter_names_are_refused(name: str, what: str) -> None:
+    """A parameter named cos made ``cos(cos*t)`` valid, one named None failed under
+    [system.f] as "the constant None is not allowed" (hostile-input trial, session 24): exit
+    2 naming [system.parameters.<name>]. pi and e may be named (they shadow the constant in
+    every evaluator, as a state of that name does)."""
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "specs" / "astolfi-stubborn-duffing.toml").read_text()
+    bad = text.replace("delta = 0.3", f"delta = 0.3\n{name} = 1.5")
+    with pytest.raises(SpecError, match=rf"\[system\.parameters\.{name}\] the parameter name") as e:
+        load_spec_text(bad, "names.toml")
+    assert e.value.exit_code == 2 and what in e.value.message
+    ok = text.replace("delta = 0.3", "delta = 0.3\npi = 1.5\ne = 0.5")
+    assert {"delta", "pi", "e"} <= set(load_spec_text(ok, "names.toml").system.parameters)
 
 
 def test_a_byte_order_mark_is_named(tmp_path: Path) -> None:

@@ -193,22 +193,37 @@ def _state_names(t: Table, sys: System) -> None:
     outsider trial, session 22), a function (``sin``), or the name of one of this plant's
     inputs, disturbances or noises (``u1``, ``d2``, ``v1``: the state and the signal would
     share one name; ``v1`` is a free state name when the plant has no noise input)."""
-    from obsdesign.spec.expr import FUNCTIONS
-
     signals = {*sys.inputs, *sys.disturbances, *sys.noises}
     for s in sys.states:
-        if s == "t" or s in FUNCTIONS or s in signals:
-            what = (
-                "the time t"
-                if s == "t"
-                else ("a function" if s in FUNCTIONS else "an input, disturbance or noise")
-            )
+        what = _reserved_name(s) or ("an input, disturbance or noise" if s in signals else None)
+        if what is not None:
             raise t.error(
                 "states",
                 f"the state name {s!r} is reserved: expressions read it as {what} (reserved: "
-                "t, the function names, and this plant's inputs u1…, disturbances d1…, "
-                "noises v1…)",
+                "t, the function names, Python's keywords, and this plant's inputs "
+                "u1…, disturbances d1…, noises v1…)",
             )
+
+
+def _reserved_name(name: str) -> str | None:
+    """What an expression reads ``name`` as when it cannot name a state or a parameter (None
+    when it can): the time ``t``, a function (``sin``) or a Python keyword (``lambda``,
+    ``None``). A parameter named ``cos`` made ``cos(cos*t)`` valid; a state named ``lambda``
+    failed as "invalid syntax" under [system.f] (hostile-input trial, session 24). The
+    constants ``pi`` and ``e`` may be named: a state or parameter of that name shadows the
+    constant in every evaluator (the numeric closures, sympy, the interval enclosures), and
+    ``e`` is a natural name for an error state."""
+    import keyword
+
+    from obsdesign.spec.expr import FUNCTIONS
+
+    if name == "t":
+        return "the time t"
+    if name in FUNCTIONS:
+        return "a function"
+    if keyword.iskeyword(name):
+        return "a Python keyword"
+    return None
 
 
 def _signal_count(t: Any, key: str, count: int) -> None:
@@ -291,6 +306,11 @@ def _system(t: Table) -> System:
         for k in list(pt.data):
             if not k.isidentifier():
                 raise pt.error(k, "expected an identifier as parameter name")
+            why = _reserved_name(k)
+            if why is not None:
+                raise pt.error(
+                    k, f"the parameter name {k!r} is reserved: expressions read it as {why}"
+                )
             params[k] = pt.scalar(k)
     sys = System(time, A, B, C, D, Bd, Dn, sample_time, list(states), n, p, params)
     _state_names(t, sys)
