@@ -381,6 +381,29 @@ def test_set_key_finds_the_comment_after_a_value_full_of_hashes() -> None:
     assert sw.set_key('[m]\nv = "#"\n', "m.v", "2") == "[m]\nv = 2\n"
 
 
+def test_set_key_finds_the_end_of_a_long_multiline_value_by_bisection(monkeypatch) -> None:
+    """A multi-line value's end was searched with one TOML parse per line, quadratic (3.4 s
+    for a 100-row A written a row per line; 3000 lines of one number each: 3000 parses of a
+    growing text). A binary search over the lines now; the value is replaced whole and the
+    keys after it kept."""
+    calls = []
+    real = tomllib.loads
+    monkeypatch.setattr(sw.tomllib, "loads", lambda t, **k: calls.append(1) or real(t, **k))
+    rows = ",\n".join(f"  {k}.5" for k in range(3000))
+    text = f'[system]\nA = [\n{rows}\n]\nC = [[1]]\n[method]\nkey = "lyapunov"\n'
+    out = sw.set_key(text, "system.A", "[[0.25]]")
+    assert len(calls) < 60, len(calls)  # ~log2(3000) for the span, plus set_key's own checks
+    assert real(out) == {"system": {"A": [[0.25]], "C": [[1]]}, "method": {"key": "lyapunov"}}
+
+
+def test_set_key_multiline_span_falls_back_when_a_later_line_breaks_the_bisection() -> None:
+    """The bisection assumes every line after the value parses after it; a later line that
+    redefines the key the span is parsed under breaks that, and the linear scan decides."""
+    text = '[m]\nv = [\n  1,\n  2,\n]\nw = 3\n"obsdesign-sweep-value-span" = 4\nz = [\n 5\n]\n'
+    out = sw.set_key(text, "m.v", "7")
+    assert tomllib.loads(out) == {"m": {"v": 7, "w": 3, "obsdesign-sweep-value-span": 4, "z": [5]}}
+
+
 def test_a_point_past_the_timeout_gets_its_row_and_the_others_keep_theirs() -> None:
     """One hanging point cost every row of a sweep (hostile-input trial, session 24):
     ``timeout`` bounds each point as ``check --timeout`` does each spec; the slow point is
