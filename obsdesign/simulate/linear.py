@@ -27,6 +27,7 @@ import numpy as np
 
 from obsdesign.errors import InputError
 from obsdesign.simulate.budget import TimeBudget
+from obsdesign.simulate.grid import time_grid
 from obsdesign.simulate.result import SimResult
 from obsdesign.spec.models import Spec
 
@@ -65,8 +66,7 @@ def sim_grid(spec: Spec) -> np.ndarray:
     if spec.system.discrete:
         return np.arange(int(sim.horizon.f) + 1, dtype=float)
     assert sim.dt is not None
-    T, dt = float(sim.horizon.f), float(sim.dt.f)
-    return np.arange(0.0, T + dt / 2, dt)
+    return time_grid(sim.horizon.q, sim.dt.q)
 
 
 def joint_system(spec: Spec, L: np.ndarray, error: bool = False) -> JointSystem:

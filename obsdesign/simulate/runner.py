@@ -13,6 +13,7 @@ from collections.abc import Callable
 import numpy as np
 
 from obsdesign.errors import InputError
+from obsdesign.simulate.grid import time_grid
 from obsdesign.simulate.result import SimResult
 from obsdesign.spec.models import Spec
 
@@ -67,8 +68,8 @@ def run_continuous(
     _need(spec)
     s, sim = spec.system, spec.simulate
     assert sim is not None and sim.dt is not None
-    T, dt = float(sim.horizon.f), float(sim.dt.f)
-    grid = np.arange(0.0, T + dt / 2, dt)
+    dt = float(sim.dt.f)
+    grid = time_grid(sim.horizon.q, sim.dt.q)
     u, d, v = signals(spec, grid)
     A, B, C, D, Bd, Dn = s.A.f, s.B.f, s.C.f, s.D.f, s.Bd.f, s.Dn.f
     n = s.n

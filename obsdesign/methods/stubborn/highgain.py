@@ -34,6 +34,7 @@ from obsdesign.methods.stubborn.claims import identity_claim
 from obsdesign.methods.stubborn.options import ELL_FACTOR, Options, SimOptions
 from obsdesign.params import Parameters
 from obsdesign.simulate.budget import TimeBudget
+from obsdesign.simulate.grid import time_grid
 from obsdesign.simulate.result import SimResult
 from obsdesign.spec.models import Spec
 
@@ -282,8 +283,8 @@ def simulate(
     so: SimOptions = sim.options or SimOptions()
     n = s.n
     dt = float(sim.dt.f)
-    steps = int(round(float(sim.horizon.f) / dt))
-    t = np.arange(steps + 1) * dt
+    t = time_grid(sim.horizon.q, sim.dt.q)
+    steps = len(t) - 1
     rng = np.random.default_rng(sim.seed)
     F = _rhs(spec)
     ell = float(params.float("ell"))
