@@ -1177,3 +1177,59 @@ def test_a_gain_bound_too_small_for_every_lambda_is_infeasible() -> None:
     )
     with pytest.raises(InfeasibleError, match="every λ tried.*gain_bound"):
         api.design(api.load_spec_text(text, "bound.toml"))
+
+
+U_PULSE = """
+[system]
+time = "continuous"
+A = [[0, 1], [-1, -0.5]]
+B = [[0], [1]]
+C = [[1, 0]]
+[method]
+key = "stubborn"
+K = [[1], [1]]
+lambda = 1
+[simulate]
+horizon = 1
+dt = 0.1
+x0 = [0, 0]
+xhat0 = [0, 0]
+[simulate.u]
+kind = "windows"
+windows = [{ start = START, stop = STOP, value = [10] }]
+[simulate.noise]
+kind = "zero"
+"""
+
+
+@pytest.mark.parametrize("k", [4, 5, 6, 7])
+def test_a_sampled_input_is_held_over_its_step(k: int) -> None:
+    """[simulate.u] in continuous time: the sample u_k drives the plant over [t_k, t_{k+1})
+    in every RK4 stage (the stages looked up round(t/dt), and round-half-even gave a
+    one-sample pulse its full impulse at an even index and a third of it at an odd one:
+    x₂(1) = 0.996 / 0.225 / 0.725 / 0.797 for k = 4..7 against 0.637 / 0.713 / 0.785 / 0.854;
+    simulate-correctness trial, session 25). Compared with the exact zero-order hold."""
+    from scipy.linalg import expm
+
+    text = U_PULSE.replace("START", f"{k / 10 - 0.05:.2f}").replace("STOP", f"{k / 10 + 0.05:.2f}")
+    res = api.simulate(api.load_spec_text(text, "pulse.toml"))
+    A, B, dt = np.array([[0, 1], [-1, -0.5]]), np.array([[0.0], [1.0]]), 0.1
+    G = expm(np.block([[A, B], [np.zeros((1, 3))]]) * dt)
+    x = np.zeros(2)
+    for j in range(10):
+        x = G[:2, :2] @ x + G[:2, 2] * (10.0 if j == k else 0.0)
+        assert np.allclose(res.x[j + 1], x, atol=1e-5), (j, res.x[j + 1], x)
+
+
+def test_an_explicit_zero_noise_is_zero() -> None:
+    """[simulate.noise] kind = "zero" given: y = C x exactly (it was taken for a missing
+    table and replaced by the outlier noise of amplitude 10; simulate-correctness trial,
+    session 25). Without the table the outlier model still runs."""
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.9, 0.2], [-0.1, 0.8]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "stubborn"\n[simulate]\nhorizon = 20\nx0 = [1, 0]\nxhat0 = [0, 0]\n'
+    )
+    zero = api.simulate(api.load_spec_text(text + '[simulate.noise]\nkind = "zero"\n', "z.toml"))
+    assert np.array_equal(zero.y[:, 0], zero.x[:, 0])
+    default = api.simulate(api.load_spec_text(text, "z.toml"))
+    assert not np.array_equal(default.y[:, 0], default.x[:, 0])

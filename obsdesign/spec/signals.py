@@ -35,6 +35,9 @@ class Signal:
     rate: float = 0.0
     values: np.ndarray | None = None
     seed: int | None = None
+    #: whether the spec gave this signal's table (False: the zero default of a missing one,
+    #: which a method may replace by its own scenario, as stubborn's outlier noise does)
+    given: bool = True
 
     @classmethod
     def zero(cls, dim: int) -> Signal:
@@ -111,7 +114,9 @@ def _add_windows(out: np.ndarray, grid: np.ndarray, windows: list[Window]) -> No
 def parse_signal(t: Table | None, dim: int) -> Signal:
     """Parse ``[simulate.<name>]`` (``kind`` plus the keys that kind needs)."""
     if t is None:
-        return Signal.zero(dim)
+        out = Signal.zero(dim)
+        out.given = False
+        return out
     kind = t.str("kind", choices=KINDS)
     seed = t.int("seed", default=None, min=0)  # numpy refuses a negative one (was exit 3)
     s = Signal(kind, dim, seed=seed)

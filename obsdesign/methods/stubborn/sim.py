@@ -32,6 +32,7 @@ from obsdesign.errors import InputError
 from obsdesign.methods.stubborn.options import SimOptions
 from obsdesign.params import Parameters
 from obsdesign.simulate.budget import TimeBudget
+from obsdesign.simulate.grid import steps_of, time_grid
 from obsdesign.simulate.result import SimResult
 from obsdesign.spec.models import Spec
 
@@ -178,8 +179,7 @@ def _grid(spec: Spec) -> tuple[int, float]:
     assert sim is not None
     if spec.system.discrete:
         return int(sim.horizon.f), 1.0
-    dt = float(sim.dt.f)
-    return int(round(float(sim.horizon.f) / dt)), dt
+    return steps_of(sim.horizon.q, sim.dt.q), float(sim.dt.f)
 
 
 def default_sigma0(g: Gains, e0: np.ndarray) -> float:
@@ -339,9 +339,11 @@ def single_run(
     check_step(g, dt)
     n, p = s.n, s.p
     rng = np.random.default_rng(sim.seed)
-    t = np.arange(steps + 1) * dt
-    if sim.noise.kind != "zero":
-        v = sim.noise.evaluate(np.arange(steps + 1) if s.discrete else t, rng)
+    t = np.arange(steps + 1, dtype=float) if s.discrete else time_grid(sim.horizon.q, sim.dt.q)
+    if sim.noise.given:
+        # the spec's noise, kind = "zero" included (it was taken for a missing table, and
+        # the outlier noise replaced it: simulate-correctness trial, session 25)
+        v = sim.noise.evaluate(t, rng)
         V = v @ np.asarray(s.Dn.f, float).T
     else:
         V = noise_fn(rng, (), p, so, np.asarray(10.0))(0, steps + 1)
@@ -393,25 +395,30 @@ def _plant(
     rng: np.random.Generator,
     budget: TimeBudget | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Plant trajectory x (steps+1, n): ẋ = A x + B u(t) + Bd d (RK4, u from [system] u or
-    [simulate.u], d from [simulate.disturbance] held over each step); x⁺ = ... in discrete
+    """Plant trajectory x (steps+1, n): ẋ = A x + B u(t) + Bd d (RK4; u from [system] u
+    evaluated at each stage's time, or the [simulate.u] sample u_k and the
+    [simulate.disturbance] sample d_k held over [t_k, t_{k+1})); x⁺ = ... in discrete
     time. Also returns the disturbance term Bd d_k (steps+1, n), which the observer does not
     know: it enters the error dynamics."""
     s = spec.system
     sim = spec.simulate
     A, B, Bd = (np.asarray(M.f, float) for M in (s.A, s.B, s.Bd))
-    grid = np.arange(steps + 1) * (1.0 if s.discrete else dt)
-    D = sim.disturbance.evaluate(np.arange(steps + 1) if s.discrete else grid, rng)
+    grid = np.arange(steps + 1, dtype=float) if s.discrete else time_grid(sim.horizon.q, sim.dt.q)
+    D = sim.disturbance.evaluate(grid, rng)
     if s.u_signal is not None:
         fs = [ex.on(["t"]) for ex in s.u_signal]
 
-        def u(tt: float) -> np.ndarray:
+        def u(tt: float, k: int) -> np.ndarray:
             return np.array([float(f(np.array([tt]))) for f in fs])
     else:
-        Uv = sim.u.evaluate(np.arange(steps + 1) if s.discrete else grid, rng)
+        Uv = sim.u.evaluate(grid, rng)
 
-        def u(tt: float) -> np.ndarray:
-            return Uv[min(int(round(tt / (1.0 if s.discrete else dt))), steps)]
+        def u(tt: float, k: int) -> np.ndarray:
+            # the sample u_k, held over [t_k, t_{k+1}) as d_k is (every RK4 stage of step
+            # k): the stages looked up round(t/dt), whose round-half-even gave a one-sample
+            # pulse its full, a third of or none of its impulse by the parity of its index
+            # (simulate-correctness trial, session 25)
+            return Uv[k]
 
     x = np.empty((steps + 1, s.n))
     x[0] = np.asarray(sim.x0.f, float)
@@ -420,11 +427,11 @@ def _plant(
             budget.check(f"the plant at step {k:,} of {steps:,}")
         tk, xk, d = grid[k], x[k], Bd @ D[k]
         if s.discrete:
-            x[k + 1] = A @ xk + B @ u(tk) + d
+            x[k + 1] = A @ xk + B @ u(tk, k) + d
             continue
 
-        def f(tt: float, z: np.ndarray, d: np.ndarray = d) -> np.ndarray:
-            return A @ z + B @ u(tt) + d
+        def f(tt: float, z: np.ndarray, d: np.ndarray = d, k: int = k) -> np.ndarray:
+            return A @ z + B @ u(tt, k) + d
 
         k1 = f(tk, xk)
         k2 = f(tk + dt / 2, xk + dt / 2 * k1)
