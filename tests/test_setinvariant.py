@@ -720,3 +720,23 @@ def test_a_pure_scaling_of_C_or_of_the_state_certifies_the_same_lambda(
             assert np.array_equal(rep.parameters["L"], base.parameters["L"] * k)
     else:  # the state rescaled: vertices rationalized at another scale, factor <= λ
         assert rep.exit_code() == 0 and set(status.values()) == {ClaimStatus.CERTIFIED}
+
+
+def test_simulate_plot_of_a_one_state_plant(tmp_path: Path) -> None:
+    """n = 1 has no coordinate pair: simulate --plot was exit 3 ("Number of columns must be a
+    positive integer, not 0"; simulate-correctness trial, session 25). It draws e(k)
+    against k between the interval's ends."""
+    from typer.testing import CliRunner
+
+    from obsdesign.cli import app
+
+    spec = tmp_path / "n1.toml"
+    spec.write_text(
+        '[system]\ntime = "discrete"\nA = [[1.1]]\nC = [[1]]\n[sets.omega]\ntype = "box"\n'
+        'lower = [-1]\nupper = [1]\n[method]\nkey = "set-invariant"\nomega = "omega"\n'
+        "eta_bar = 0.1\nlambda = 0.9\n[simulate]\nhorizon = 10\nx0 = [0.5]\nxhat0 = [0]\n"
+    )
+    png = tmp_path / "n1.png"
+    res = CliRunner().invoke(app, ["simulate", str(spec), "--plot", str(png)])
+    assert res.exit_code == 0, res.output
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

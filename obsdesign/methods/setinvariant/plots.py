@@ -68,10 +68,30 @@ def plot_simulation(spec: Spec, res: Any, path: str | Path) -> Path:
     from obsdesign.simulate.plot import save_figure
 
     n = spec.system.n
+    e = res.extra["e_paper"]
+    if n == 1:
+        # one state: no coordinate pair to project on (it was exit 3, "Number of columns
+        # must be a positive integer, not 0": simulate-correctness trial, session 25); e(k)
+        # against k between the ends of the interval {G e <= 1} and of Ω
+        fig, axes = _figure(1)
+        ax = axes[0]
+        ax.plot(np.arange(len(e)), e[:, 0], "r.-", lw=0.8, ms=4, label="error e(k)")
+        for V, kw in (
+            (po.h_to_v(res.extra["G"]).V, {"color": "C0", "lw": 1.6, "label": "{G e <= 1}"}),
+            (po.h_to_v(build(spec).fl.G0).V, {"color": "k", "lw": 1.0, "ls": "--", "label": "Ω"}),
+        ):
+            for i, v in enumerate((V[:, 0].min(), V[:, 0].max())):
+                ax.axhline(v, **(kw if i == 0 else {**kw, "label": None}))
+        ax.set_xlabel("k")
+        ax.set_ylabel("e1")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8, loc="best")
+        fig.suptitle(f"{spec.title or spec.file}: max gauge {res.info['max_gauge']:.4f}")
+        fig.tight_layout()
+        return save_figure(fig, path)
     pairs = _axes(n)
     fig, axes = _figure(len(pairs))
     draw_sets(axes, pairs, spec, res.extra["G"])
-    e = res.extra["e_paper"]
     for ax, (i, j) in zip(axes, pairs, strict=False):
         ax.plot(e[:, i], e[:, j], "r.-", lw=0.8, ms=4, label="error e(k)")
         ax.legend(fontsize=8, loc="best")
