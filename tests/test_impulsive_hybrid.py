@@ -49,7 +49,7 @@ def test_batch_matches_one_by_one() -> None:
 
 def test_padding_and_sample_times() -> None:
     rng = np.random.default_rng(0)
-    H = draw_intervals(rng, 4, 0.3, 0.6, 5.0)
+    H = draw_intervals([rng] * 4, 0.3, 0.6, 5.0)
     start = np.cumsum(H, 1) - H
     assert np.all(start[H > 0] < 5.0) and np.all(H[H > 0] >= 0.3)
     assert np.all(np.sum(H, 1) >= 5.0)
@@ -111,7 +111,7 @@ def test_theorem2_property(n: int, seed: int) -> None:
         return X @ A.T + ell * np.sin(X + phase)
 
     runs, horizon = 50, 25.0
-    H = draw_intervals(rng, runs, t_lo, t_hi, horizon)
+    H = draw_intervals([rng] * runs, t_lo, t_hi, horizon)
     W = rng.uniform(-W_amp, W_amp, (runs, H.shape[1], 1))
     x0 = np.tile(rng.uniform(-1, 1, n), (runs, 1))
     xh0 = np.zeros((runs, n))
@@ -121,7 +121,7 @@ def test_theorem2_property(n: int, seed: int) -> None:
     # without noise: exponential decay (Theorem 1). The certified rate can be slow, so the
     # noise-free runs get a longer horizon (80) than the noisy ones (at t = 25 the ratio was
     # only 0.065 for n = 2, seed = 189).
-    Hc = draw_intervals(rng, runs, t_lo, t_hi, 80.0)
+    Hc = draw_intervals([rng] * runs, t_lo, t_hi, 80.0)
     Wc = np.zeros((runs, Hc.shape[1], 1))
     clean = simulate_hybrid(f, np.eye(n), np.array([0.7]), x0, xh0, Hc, Wc, dense=4)
     end = np.array([clean.eps[j, np.nonzero(clean.valid[j])[0][-1]] for j in range(runs)])

@@ -14,7 +14,7 @@ trajectory and interval.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -50,13 +50,24 @@ class HybridBatch:
 ESCAPE = 1e150
 
 
+def intervals_drawn(t_lo: float, horizon: float) -> int:
+    """How many intervals each run draws: ⌈horizon / t_lo⌉ + 1, enough to pass the horizon
+    whatever the draws (the same for every run, so a run's draws do not depend on the others).
+
+    :param t_lo: the shortest interval (> 0); :param horizon: the simulated time."""
+    return int(np.ceil(horizon / t_lo)) + 1
+
+
 def draw_intervals(
-    rng: np.random.Generator, runs: int, t_lo: float, t_hi: float, horizon: float
+    rngs: Sequence[np.random.Generator], t_lo: float, t_hi: float, horizon: float
 ) -> np.ndarray:
-    """Sampling intervals uniform in [t_lo, t_hi) until each run passes ``horizon``; (runs, K),
-    padded with zeros (K = the longest run)."""
-    k = int(np.ceil(horizon / t_lo)) + 1
-    H = rng.uniform(t_lo, t_hi, size=(runs, k))
+    """Sampling intervals uniform in [t_lo, t_hi) until each run passes ``horizon``, run r
+    drawing :func:`intervals_drawn` of them from ``rngs[r]``; (runs, K), padded with zeros
+    (K = the longest run).
+
+    :param rngs: one generator per run (the same one repeated draws the runs in turn)."""
+    k = intervals_drawn(t_lo, horizon)
+    H = np.array([g.uniform(t_lo, t_hi, size=k) for g in rngs]).reshape(len(rngs), k)
     return pad_to_horizon(H, horizon)
 
 
