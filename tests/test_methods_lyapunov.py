@@ -914,6 +914,24 @@ def test_simulate_runs_and_initial_error_from_the_spec() -> None:
         load_spec_text(text.replace('initial_error = "E0"', 'initial_error = "F"'), "mc.toml")
 
 
+def test_initial_error_without_a_run_count_is_one_monte_carlo_run() -> None:
+    """As documented (lyapunov.md, spec.md; the docs said otherwise until the session-25
+    simulate trial): initial_error without runs is the Monte Carlo study of one run, run 0
+    of any N, its initial error drawn from the set (xhat0 not used); without initial_error
+    the spec's single scenario starts from xhat0 − x0."""
+    text = SEC5.read_text().replace("[simulate]\n", '[simulate]\ninitial_error = "E0"\n')
+    text += '\n[sets.E0]\ntype = "box"\nlower = [-0.5, -0.5]\nupper = [0.5, 0.5]\n'
+    spec = load_spec_text(text, "mc.toml")
+    one = api.simulate(spec)
+    assert one.info["runs"] == 1 and one.info["initial_error"] == "E0"
+    assert np.all(np.abs(one.extra["initial_errors"]) <= 0.5)  # not xhat0 − x0 = (2, 2)
+    three = api.simulate(spec, runs=3)
+    assert np.array_equal(one.extra["initial_errors"][0], three.extra["initial_errors"][0])
+    assert one.metrics()["final_error_norm"] == three.metrics()["final_error_norm"]
+    single = api.simulate(load_spec_text(SEC5.read_text(), "s.toml"))
+    assert "runs" not in single.info and np.array_equal(single.e[0], [2, 2])
+
+
 def test_an_expression_plant_fails_linear_plant_and_still_simulates() -> None:
     """[system] psi makes the plant nonlinear: the decay certificate covers A − LC only, so
     design and verify fail the claim linear-plant (and only it), and simulate still runs the
