@@ -404,6 +404,16 @@ def test_simulate_says_when_a_run_is_outside_the_premises_of_theorem_1(tmp_path)
     premises, said = run(R2.replace("bound = 0.5", "bound = 0.6"))
     assert premises.startswith("w_k = (d_k, v_k) leaves D at k = ")
     assert "outside the premises of the guarantee x̂_k ∈ X̂" in said
+    # a sample the run never uses (w_60 at the horizon: x̂_60 comes from w_59) breaks no
+    # premise; the one before it does (simulate-correctness trial, session 25)
+    for k, ok in ((60, True), (59, False)):
+        last = R2.replace(
+            'kind = "uniform"\nbound = 0.5\n',
+            f'kind = "windows"\nwindows = [{{ start = {k}, stop = {k}, value = [3, 0] }}]\n',
+        )
+        premises, said = run(last)
+        assert (premises == "hold") is ok, premises
+        assert ok or premises.startswith(f"w_k = (d_k, v_k) leaves D at k = {k} (1 of 60 samples")
     premises, said = run(R2, theta_m="1")
     assert premises == "θ_m = 1 < θ = 704,498 steps, all spent at some sample" and premises in said
     premises, said = run(

@@ -740,3 +740,19 @@ def test_simulate_plot_of_a_one_state_plant(tmp_path: Path) -> None:
     res = CliRunner().invoke(app, ["simulate", str(spec), "--plot", str(png)])
     assert res.exit_code == 0, res.output
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("k,admissible", [(17, True), (16, False)])
+def test_admissibility_counts_only_the_samples_the_run_uses(k: int, admissible: bool) -> None:
+    """η_17 at the horizon (17) enters no step of e; counted, it made admissible_scenario
+    False and turned the exit-1 guard off (simulate-correctness trial, session 25). η_16
+    > η̄ is inadmissible."""
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "specs" / "dorea-pimenta-7-1.toml").read_text()
+    assert "horizon = 17" in text and "[simulate.noise]" not in text
+    text += (
+        f'\n[simulate.noise]\nkind = "windows"\nwindows = [{{ start = {k}, stop = {k}, '
+        "value = [0.5] }]\n"
+    )
+    res = api.simulate(load_spec_text(text, "last.toml"))
+    assert res.info["admissible_scenario"] is admissible

@@ -89,21 +89,26 @@ def _outside_premises(
         if not bool(inside.reshape(-1)[0]):
             out.append("the estimate starts outside X̂ (x̂_0 ∉ X̂; Corollary 1 needs x̂_0 ∈ X̂)")
     K = len(x)
+    # w_k and u_k of k < K − 1 only: the run steps to x̂_{K−1} from the samples before it, and
+    # an inadmissible last sample, which nothing uses, was reported as a broken premise (with
+    # sup_k |x̂_k| unchanged; simulate-correctness trial, session 25)
+    used = max(K - 1, 1)
     w = np.hstack([np.asarray(d, float).reshape(K, -1), np.asarray(v, float).reshape(K, -1)])
+    w = w[:used]
     lo, hi = np.asarray(o.D_lower, float), np.asarray(o.D_upper, float)
     if w.shape[1] == lo.size and lo.size:
         bad = np.any((w < lo - 1e-12) | (w > hi + 1e-12), axis=1)
         if bad.any():
             k = _first(bad)
             out.append(
-                f"w_k = (d_k, v_k) leaves D at k = {k} ({int(bad.sum())} of {K} samples; "
+                f"w_k = (d_k, v_k) leaves D at k = {k} ({int(bad.sum())} of {used} samples; "
                 f"w_{k} = {np.round(w[k], 6).tolist()})"
             )
     bad = ~np.asarray(o.X.contains(x, tol=1e-9), dtype=bool).reshape(-1)
     if bad.any():
         out.append(f"the plant leaves X at k = {_first(bad)} (Assumption 1)")
     if o.model is not None and o.U_lower.size:
-        U = np.asarray(u, float).reshape(K, -1)
+        U = np.asarray(u, float).reshape(K, -1)[:used]
         bad = np.any((U < o.U_lower.astype(float)) | (U > o.U_upper.astype(float)), axis=1)
         if U.shape[1] == o.U_lower.size and bad.any():
             out.append(f"u_k leaves the input range U at k = {_first(bad)}")

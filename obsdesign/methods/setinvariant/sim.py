@@ -134,7 +134,10 @@ def simulate(
     gauge = (e @ G.T).max(axis=1)
     om = spec.sets[spec.options.omega]
     e0_in = bool(om.contains(e[0], 1e-12))
-    adm = _admissible(spec, dd[:-1], vv)
+    # d_k and η_k of k < N only: e_N comes from the samples before it, and an inadmissible
+    # η_N, which nothing uses, turned admissible_scenario False and with it the exit-1 guard
+    # below off (simulate-correctness trial, session 25)
+    adm = _admissible(spec, dd[:-1], vv[:-1])
     inside = bool(np.all(gauge <= 1 + 1e-9))
     res.extra["G"] = G
     res.extra["e_paper"] = e
