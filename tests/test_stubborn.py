@@ -1233,3 +1233,21 @@ def test_an_explicit_zero_noise_is_zero() -> None:
     assert np.array_equal(zero.y[:, 0], zero.x[:, 0])
     default = api.simulate(api.load_spec_text(text, "z.toml"))
     assert not np.array_equal(default.y[:, 0], default.x[:, 0])
+
+
+def test_constant_levels_are_taken_after_the_first_step(ex1: Report) -> None:
+    """The constant-saturation levels of the outlier study are the mean and max of σ_i(t)
+    over t = dt … T (a documented choice, docs/methods/stubborn.md): σ(0) = sigma0 is the
+    initialization, and a huge sigma0 does not become the max level."""
+    from obsdesign.methods.stubborn.options import SimOptions
+    from obsdesign.methods.stubborn.sim import Gains, sigma_levels
+
+    sp = api.load_spec_text(EX1.read_text(), "ex1.toml")
+    g = Gains.of(sp, ex1.parameters)
+    so = sp.simulate.options or SimOptions()
+    e0 = np.asarray(sp.simulate.x0.f, float) - np.asarray(sp.simulate.xhat0.f, float)
+    big = SimOptions(so.noise_std, so.outlier_rate, so.amplitudes, so.runs, 1e6)
+    sig, mean, mx = sigma_levels(g, e0, big, 200, 0.01, 0)
+    assert sig.shape == (200, g.C.shape[0])
+    assert np.all(mx < np.sqrt(1e6 / g.w))  # σ_i(0) = √(σ̄(0)/w_i) is not among them
+    assert np.array_equal(mx, sig.max(axis=0)) and np.array_equal(mean, sig.mean(axis=0))

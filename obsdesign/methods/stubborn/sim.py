@@ -237,7 +237,9 @@ def sigma_levels(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Nominal run of the stubborn observer (noise, no outliers): σ_i(t), its mean and max
     (the adaptive level of the stubborn-observer slides, Astolfi, Alessandri, Zaccarian,
-    WUDS 2017); ``budget`` is looked at every :data:`CHECK_EVERY` steps."""
+    WUDS 2017) over t = dt … T, after each step: σ(0) is the initialization ``sigma0``, not a
+    level the law reached (a documented choice; the slides do not say); ``budget`` is looked
+    at every :data:`CHECK_EVERY` steps."""
     rng = np.random.default_rng(seed)
     p = g.C.shape[0]
     nom = SimOptions(so.noise_std, 0.0, (0.0,), 1, so.sigma0)
