@@ -414,6 +414,17 @@ def test_simulate_says_when_a_run_is_outside_the_premises_of_theorem_1(tmp_path)
         premises, said = run(last)
         assert (premises == "hold") is ok, premises
         assert ok or premises.startswith(f"w_k = (d_k, v_k) leaves D at k = {k} (1 of 60 samples")
+    # θ_m = 0 binds only where a sample needed refining (it was flagged always)
+    premises, said = run(R2, theta_m="0")
+    assert premises == "θ_m = 0 < θ = 704,498 steps, all spent at some sample"
+    sec5 = (Path(__file__).resolve().parents[1] / "specs" / SEC5).read_text()
+    quiet = sec5.replace("xhat0 = [1, 1]", "xhat0 = [-1, -1]").replace("gamma = 17\n", "")
+    quiet = quiet.replace(
+        'kind = "windows"\nwindows = [{ start = 151, stop = 153, value = [3] }]', 'kind = "zero"'
+    )
+    assert "xhat0 = [-1, -1]" in quiet and "x0 = [-1, -1]" in quiet  # x̂0 = x0, no noise
+    premises, said = run(quiet, theta_m="0,10")
+    assert premises == "hold" and said == "", premises
     premises, said = run(R2, theta_m="1")
     assert premises == "θ_m = 1 < θ = 704,498 steps, all spent at some sample" and premises in said
     premises, said = run(

@@ -196,6 +196,9 @@ class Trace:
     sup_iterates: np.ndarray | None = None
     v_increase: float = -np.inf
     truncated: bool = False
+    #: whether the budget θ_m stopped a refining that G would have continued at some sample
+    #: (the point still in C_max \ C_min after θ_m steps; θ_m = 0 included)
+    cut: bool = False
 
     def sup_k(self) -> np.ndarray:
         """sup over k of |x̂_k^i| per component (Table 1, first row of each block)."""
@@ -242,6 +245,7 @@ class Observer:
         k = 0
         log = PathLog(n, x, P, None if check is None else (lambda: check(k, N)))
         steps = np.zeros(N, dtype=np.int64)
+        cut = False
         for k in range(N):
             if check is not None and k % CHECK_EVERY == 0:
                 check(k, N)
@@ -249,10 +253,12 @@ class Observer:
             log.start(k, x1)
             if self.refiner is not None and self.theta_m > 0:
                 x1, steps[k] = self.refiner.refine(x1, self.theta_m, log)
+            if self.refiner is not None and not cut and steps[k] >= self.theta_m:
+                cut = bool(np.all(np.isfinite(x1))) and bool(self.refiner.active(x1))
             if self.sat_r is not None:
                 x1 = sat(x1, self.sat_r)
             xh[k + 1] = x1
-        return Trace(xh, log.kept, steps, log.sup, log.worst, log.truncated)
+        return Trace(xh, log.kept, steps, log.sup, log.worst, log.truncated, cut)
 
     def run_batch(
         self, U: np.ndarray, Y: np.ndarray, Xh0: np.ndarray

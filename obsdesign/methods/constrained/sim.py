@@ -240,13 +240,11 @@ def simulate(
         if name.startswith("saturated"):
             info[f"{name}: final x̂"] = _fmt(tr.xhat[-1])
     outside = _outside_premises(o, x, u, d, v, sm.xhat0.f, Xhat)
-    # θ_m < θ matters only where a sample spent its whole budget (Lemma 3: the refining
-    # ends within θ steps; a budget never reached ran as θ would)
-    spent = [
-        tm
-        for tm in thetas
-        if tm < theta and int(traces[f"modified θ_m={tm}"].steps.max(initial=0)) >= tm
-    ]
+    # θ_m < θ matters only where the budget stopped a refining that G would have continued
+    # (Lemma 3: the refining ends within θ steps; a budget never reached ran as θ would). A
+    # sample that merely spent its whole budget was flagged before, so θ_m = 0 always was,
+    # even where no sample needed refining (simulate-correctness trial, session 25)
+    spent = [tm for tm in thetas if tm < theta and traces[f"modified θ_m={tm}"].cut]
     if spent or not g_ok:
         outside.append(
             "; ".join(
