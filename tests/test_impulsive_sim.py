@@ -449,3 +449,18 @@ def test_run_r_does_not_depend_on_the_number_of_runs(tmp_path: Path) -> None:
     assert min(finals) < max(finals)  # the runs differ
     assert set(q) == {"sup_abs_error", "rmse", "sup_abs_estimate", "final_error_norm"}
     assert q["sup_abs_error"]["x1"]["max"] >= m5["sup_abs_error"]["x1"]
+
+
+def test_noise_max_norm_counts_only_the_samples_a_jump_uses(tmp_path: Path) -> None:
+    """A shorter run's padded positions draw noise that no jump uses; noise_max_norm was
+    their max too (simulate-correctness trial, session 25)."""
+    spec = load_spec_text(_spec3(), str(tmp_path / "s.toml"))
+    params = api.design(spec).parameters
+    for seed in range(20):
+        res = get_method("impulsive").simulate(spec, params, runs=4, seed=seed)
+        W, H = res.extra["noise"], res.extra["intervals"]
+        norms = np.linalg.norm(W, axis=-1)
+        assert res.info["noise_max_norm"] == float(norms[H > 0].max())
+        if norms.max() > norms[H > 0].max():
+            return  # a padded position held the largest draw, and was not counted
+    raise AssertionError("no seed put the largest draw on a padded position")

@@ -152,7 +152,10 @@ def simulate(
     # noise_bound bounds the Euclidean norm of w_k (docs/methods/impulsive.md, "Noise"): the
     # largest component alone let w = (0.09, −0.09), ‖w‖ = 0.127, pass a bound of 0.1
     # (independent simulate review)
-    w_max = float(np.max(np.linalg.norm(W, axis=-1))) if W.size else 0.0
+    # (over the samples that end an interval of their run, H > 0: a shorter run's padded
+    # positions draw noise that no jump uses; simulate-correctness trial, session 25)
+    used = np.linalg.norm(W, axis=-1)[H > 0] if W.size else np.zeros(0)
+    w_max = float(np.max(used)) if used.size else 0.0
     w_bar = params.float("w_bar")
     if w_max > w_bar:
         warnings.warn(
@@ -232,7 +235,15 @@ def simulate(
         {},
         info,
     )
-    res.extra = {"noisy": noisy, "clean": clean, "open": open_, "radius": radius, "after": after}
+    res.extra = {
+        "noisy": noisy,
+        "clean": clean,
+        "open": open_,
+        "radius": radius,
+        "after": after,
+        "intervals": H,  # (runs, K) sampling intervals, 0 past a run's end
+        "noise": W,  # (runs, K, m) w_k at the sample ending interval k
+    }
     return res
 
 
