@@ -18,7 +18,7 @@ from obsdesign import api
 from obsdesign.certify.claim import ClaimStatus
 from obsdesign.certify.exact import Q, qparse, qstr, to_float
 from obsdesign.cli import app
-from obsdesign.errors import InfeasibleError, SpecError
+from obsdesign.errors import InconclusiveError, InfeasibleError, SpecError
 from obsdesign.methods.stubborn.sim import study
 from obsdesign.report import Report
 
@@ -1251,3 +1251,92 @@ def test_constant_levels_are_taken_after_the_first_step(ex1: Report) -> None:
     assert sig.shape == (200, g.C.shape[0])
     assert np.all(mx < np.sqrt(1e6 / g.w))  # σ_i(0) = √(σ̄(0)/w_i) is not among them
     assert np.array_equal(mx, sig.max(axis=0)) and np.array_equal(mean, sig.mean(axis=0))
+
+
+def test_no_bracket_without_an_infeasible_far_end(monkeypatch) -> None:
+    """A far end the solver answered other than 'infeasible' (infeasible_inaccurate up to the
+    cap) was still reported as the bracket, and the design failed its own
+    lambda-max-bracket claim: exit 1 on a valid design (soundness trial, session 25). Such
+    a search now reports λ_max with no bracket and says why."""
+    from obsdesign.methods.stubborn import design as D
+
+    real = D.search_lambda
+
+    def inaccurate(pl, o):  # noqa: ANN001, ANN202
+        good, bad, _ = real(pl, o)
+        return good, bad, "infeasible_inaccurate"
+
+    monkeypatch.setattr(D, "search_lambda", inaccurate)
+    rep = api.design(api.load_spec_text(EX1.read_text(), "ex1.toml"))
+    assert rep.exit_code() == 0 and "lambda_bracket" not in rep.parameters
+    assert "lambda-max-bracket" not in {c.id for c in rep.claims}
+    assert any("infeasible nowhere up to the cap" in n for n in rep.notes), rep.notes
+    assert api.verify(rep).exit_code() == 0
+
+
+def test_a_given_lambda_the_solver_is_unsure_of_is_no_infeasibility_verdict() -> None:
+    """Example 1 at λ = 7.53: Clarabel answers inaccurately there, and the design said "LMIs
+    (1)-(3) infeasible at the given λ" (exit 1), where a certificate exists (the method
+    page's own reproduced numbers; soundness trial, session 25). Only the solver's
+    'infeasible' is a verdict; the certification decides otherwise (here: certified)."""
+    text = (
+        '[system]\ntime = "continuous"\nA = [[0, 1], [-1, 0]]\nC = [[1, 1]]\n'
+        '[method]\nkey = "stubborn"\nlambda = 7.53\n'
+    )
+    try:
+        rep = api.design(api.load_spec_text(text, "ex1.toml"))
+    except InfeasibleError as e:
+        raise AssertionError(f"a false infeasibility verdict: {e}") from None
+    except InconclusiveError:
+        return  # honest: no verdict
+    assert rep.exit_code() == 0 and api.verify(rep).exit_code() == 0
+
+
+L2_BIG_BD = """
+[system]
+time = "continuous"
+A = [[0.346, -0.582, -0.521, -1.923], [-1.174, -0.674, 0.108, 1.52],
+     [0.269, 0.091, 0.348, -1.401], [0.048, -0.868, -0.574, 2.036]]
+C = [[1.847, 0.977, 0.543, 0.504]]
+Bd = [[-965.1, -1255], [334.7, -447.2], [-776.7, -80.32], [-72.47, 189.2]]
+[method]
+key = "stubborn"
+criterion = "l2"
+gain_bound = 1000
+lambda_fraction = 0.9
+"""
+
+
+def test_an_infeasible_criterion_step_falls_back_on_the_feasibility_point() -> None:
+    """Criterion l2 with B_d ~ 10³: the criterion step's SDP (He(G) + I ≺ 0 with ‖X‖ ≤
+    gain_bound) came back infeasible and the design said "LMIs (1)-(3) infeasible at λ = …
+    with the criterion step" (exit 1), at a λ below the certified λ_max (soundness trial,
+    session 25). As documented, the certified feasibility point at that λ is reported, with
+    a certified γ² for it."""
+    try:
+        rep = api.design(api.load_spec_text(L2_BIG_BD, "l2.toml"))
+    except InfeasibleError as e:
+        raise AssertionError(f"a false infeasibility verdict: {e}") from None
+    except InconclusiveError:
+        return
+    assert rep.exit_code() == 0 and "gamma2" in rep.parameters
+    assert api.verify(rep).exit_code() == 0
+
+
+def test_a_slow_plant_is_no_infeasibility_verdict() -> None:
+    """A, C of size 10⁻⁹ with the default gain bound: the fixed margin δ = 10⁻⁶ needs P ~ 10³
+    to lift LMI entries of size 10⁻⁹ above it, and X = PK then passes the gain bound; every
+    λ was 'infeasible' and the design said exit 1, where exact certificates exist (soundness
+    trial, session 25). The margin is now δ·min(1, λ) in continuous time; what the solver
+    does not settle is exit 4, never exit 1."""
+    text = (
+        '[system]\ntime = "continuous"\nA = [[1e-9, 2e-9], [-3e-9, 1e-9]]\nC = [[1e-9, 0]]\n'
+        '[method]\nkey = "stubborn"\n'
+    )
+    try:
+        rep = api.design(api.load_spec_text(text, "slow.toml"))
+    except InfeasibleError as e:
+        raise AssertionError(f"a false infeasibility verdict: {e}") from None
+    except InconclusiveError:
+        return
+    assert rep.exit_code() == 0 and api.verify(rep).exit_code() == 0

@@ -60,7 +60,7 @@ class Plant:
         )
 
 
-def _problem(pl: Plant, o: Options, lam: Any, criterion: str | None, margin: float) -> Any:
+def _problem(pl: Plant, o: Options, lam: Any, criterion: str | None, margin: Any) -> Any:
     """cvxpy problem of LMIs (1)-(3) / (7)-(9) at a fixed λ, normalized P ⪰ I, W ⪰ I.
 
     ``criterion`` None: feasibility; ``R``: minimize λ_max(R); ``K``: minimize ‖X‖₂;
@@ -140,6 +140,20 @@ def _problem(pl: Plant, o: Options, lam: Any, criterion: str | None, margin: flo
     return prob, dict(P=P, X=X, u=u, w=w, Y=Y, R=R, **extra)
 
 
+def margin_at(o: Options, pl: Plant, lam: float) -> float:
+    """The solver's strictness margin δ at λ (every strict LMI F ≺ 0 is solved as F ⪯ −δI):
+    ``[method] margin``, times min(1, λ) in continuous time. LMI (1) holds with at most about
+    (λ_max − λ)·‖P‖ to spare, and P ⪰ I fixes the scale, so a fixed δ = 10⁻⁶ made every λ
+    infeasible for a plant whose rates are 10⁻⁹ (A, C of size 10⁻⁹; a mode at −10⁻²⁰) and
+    the design said "infeasible for every λ tried" where exact certificates exist
+    (stubborn soundness trial, session 25). Discrete time: λ ∈ (0, 1) and the LMIs are
+    scale-free in P, δ as given.
+
+    :param o: the options; :param pl: the plant; :param lam: the rate λ > 0."""
+    m = float(o.margin)
+    return m if pl.discrete else m * min(1.0, float(lam))
+
+
 def solve_cold(prob: Any) -> tuple[bool, str]:
     """Solve one LMI problem of the λ search (LMIs (1)-(3) / (7)-(9)) with Clarabel without warm
     start (cvxpy's default warm start reuses the solver object of the
@@ -171,12 +185,15 @@ class Feasibility:
         self.pl, self.o = pl, o
         self.calls = 0
         self.lam = cp.Parameter(nonneg=True)
-        self.prob, _ = _problem(pl, o, self.lam, None, float(o.margin))
+        self.margin = cp.Parameter(nonneg=True)
+        self.prob, _ = _problem(pl, o, self.lam, None, self.margin)
 
     def __call__(self, lam: float) -> tuple[bool, str]:
-        """Whether the solver finds the LMIs feasible at λ, and its status."""
+        """Whether the solver finds the LMIs feasible at λ (margin :func:`margin_at`), and
+        its status."""
         self.calls += 1
         self.lam.value = float(lam)
+        self.margin.value = margin_at(self.o, self.pl, lam)
         return solve_cold(self.prob)
 
 
@@ -332,19 +349,33 @@ def design_params(
     _require_detectable(spec, pl)
     if o.lam is not None:
         lam_q = o.lam  # a rate the user asks for is checked directly, before any search
-        if not feasible(pl, o, float(lam_q))[0]:
+        ok, st = feasible(pl, o, float(lam_q))
+        if not ok and st == INFEASIBLE:
             _infeasible(spec, pl, o, f"at the given λ = {float(lam_q):g}")
+        # any other answer (inaccurate, a failure) is no verdict: the certification below
+        # decides, and says exit 4 when it finds no point (Example 1 at λ = 7.53, where a
+        # certificate exists, was exit 1 "infeasible at the given λ"; soundness trial)
     else:
         if progress:
             progress("searching the best λ")
         good, bad, st = search_lambda(pl, o)
         if good == (0.0 if not pl.discrete else 1.0):
+            if st != INFEASIBLE:
+                raise InconclusiveError(
+                    f"stubborn: the solver found LMIs {_refs(pl)} feasible at no λ tried "
+                    f"(down to {bad:g}), but did not report them infeasible there either "
+                    f"(status {st}): not a verdict; a smaller [method] margin (now "
+                    f"{float(o.margin):g}) or a rescaled plant may help"
+                )
             _infeasible(spec, pl, o, "for every λ tried")
         best, cert = _certified_best(spec, pl, o, good)
         vals["lambda_max"] = best
         for k in POINT_KEYS:
             vals[f"{k}_at_max"] = cert[k]
-        other = Q(bad) if np.isfinite(bad) and bad != 0.0 else None
+        # a bracket only where the solver reports the LMIs infeasible: a far end it answered
+        # otherwise (infeasible_inaccurate up to the cap) made the design fail its own
+        # lambda-max-bracket claim, exit 1 on a valid design (soundness trial, session 25)
+        other = Q(bad) if np.isfinite(bad) and bad != 0.0 and st == INFEASIBLE else None
         if other is not None:
             vals["lambda_bracket"] = np.array([best, other], dtype=object)
         lam_q = _chosen(o, best, pl.discrete)
@@ -358,7 +389,12 @@ def design_params(
             + (
                 f"; solver: {st} at {float(bad):.6g})"
                 if other is not None
-                else f"; the search stops at its cap λ = {cap}, so there is no bracket)"
+                else (
+                    f"; the search stops at its cap λ = {cap}, so there is no bracket)"
+                    if not np.isfinite(bad) or bad == 0.0
+                    else f"; the solver reports the LMIs infeasible nowhere up to the cap — "
+                    f"its last answer: {st} at {float(bad):.6g} — so there is no bracket)"
+                )
             )
             + f"; λ = {'fraction·λ_max' if not pl.discrete else '1 − fraction·(1 − λ_best)'}"
         )
@@ -410,12 +446,22 @@ POINT_KEYS = ("K", "P", "U", "W", "Y", "R")
 
 def _certified_best(spec: Spec, pl: Plant, o: Options, good: float) -> tuple[fmpq, dict[str, Any]]:
     """A certified point at (or just inside) the solver's best λ: λ_max rounded to 20 bits
-    towards the feasible side, then stepped back by tol/8 (up to 3 times) until the rounded
-    solution passes the exact checks (the bracket [λ_max, λ_other] widens by at most 3/8 of
-    lambda_tol: the search's own bracket is half of it)."""
+    towards the feasible side, then stepped back by tol/8 (up to 3 times), then by 2ᵏ·tol
+    (relative, up to a tenth) until the rounded solution passes the exact checks (the
+    bracket [λ_max, λ_other] widens by at most 3/8 of lambda_tol in the first steps — the
+    search's own bracket is half of it — and the bracket claim says when it is wider)."""
     step = float(o.lambda_tol) / 8 * abs(good)
-    for i in range(4):
-        g = good - i * step if not pl.discrete else good + i * step
+    # then back-offs of 2^k·lambda_tol up to about a tenth of the gap to 0 (continuous) or
+    # to 1 (discrete): at a plant's time scale 10⁻⁹ the solver's answers near the boundary
+    # stay inaccurate over more than 3/8 of lambda_tol (the bracket then says it is wider)
+    span = abs(good) if not pl.discrete else abs(1 - good)
+    offs = [i * step for i in range(4)]
+    k = 0
+    while (2**k) * float(o.lambda_tol) * span <= 0.1 * span and k < 60:
+        offs.append((2**k) * float(o.lambda_tol) * span)
+        k += 1
+    for off in offs:
+        g = good - off if not pl.discrete else good + off
         best = dyadic(g, 20)
         if (not pl.discrete and best > Q(g)) or (pl.discrete and best < Q(g)):
             best = Q(g)
@@ -432,9 +478,9 @@ def _certify_point(
 ) -> tuple[dict[str, Any] | None, float, str]:
     """Solve at λ (with the criterion, or feasibility), round, check exactly; raise the solver
     margin ×10 on failure. Returns (candidate or None, margin, solver name or last problem)."""
-    margin = float(o.margin)
+    margin = margin_at(o, pl, float(lam_q))
     last = ""
-    for attempt in range(attempts):
+    for _attempt in range(attempts):
         prob, v = _problem(pl, o, float(lam_q), criterion, margin)
         try:
             r = solve(prob, ("CLARABEL",))
@@ -443,8 +489,12 @@ def _certify_point(
             margin *= 10
             continue
         if not r.optimal:
-            if attempt == 0 and r.infeasible and criterion is not None:
-                _infeasible(spec, pl, o, f"at λ = {float(lam_q):g} with the criterion step")
+            # never an "infeasible" verdict here: λ is one the feasibility problem passed
+            # (the search's certified λ_max scaled, or the spec's λ), and the criterion
+            # step's extra constraints (l2: He(G) + I ≺ 0 with ‖X‖ ≤ gain_bound) can be
+            # infeasible where the design is not; the caller falls back on the feasibility
+            # point (the l2 criterion with B_d ~ 10³ ended in exit 1 "infeasible at λ with
+            # the criterion step" although the fallback certifies; soundness trial, session 25)
             last = f"solver status {r.status}"
             margin *= 10
             continue
