@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 from obsdesign import api
 from obsdesign.api import load_spec_text
 from obsdesign.certify.claim import ClaimStatus
-from obsdesign.certify.exact import qmat
+from obsdesign.certify.exact import Q, qmat
 from obsdesign.errors import (
     InconclusiveError,
     InfeasibleError,
@@ -311,6 +311,47 @@ def test_unobservable_mode_at_lambda_goes_on_to_the_algorithm() -> None:
     with pytest.raises(InfeasibleError, match="λ"):
         check_detectable(A, qmat([[1, 0]]), fmpq(19, 20) - fmpq(1, 10**6))
     check_detectable(A, qmat([[1, 1]]), fmpq(1, 10))  # observable: nothing to refuse
+
+
+@pytest.mark.parametrize(
+    "diag",
+    [
+        ["3/10", "9/10", "9/10"],  # a double unobservable mode at λ
+        ["3/10", "-9/10", "-9/10"],
+        ["3/10", "9/10", "9/10", "9/10"],  # triple: np.roots split it by ~1e-5
+    ],
+)
+def test_a_repeated_diagonal_unobservable_mode_at_lambda_is_not_refused(diag: list[str]) -> None:
+    """A = diag(0.3, 0.9, 0.9), C = (1, 0, 0), λ = 0.9: the float roots of χ split the double
+    root by ~10⁻⁸ and the design was refused, "|μ| = 0.9 > λ = 0.9", though the box Ω is
+    0.9-contractive with L = (−0.3, 0, 0) (set-invariant soundness trial, session 25). The
+    rigorous root balls of the minimal polynomial (0.9 is a simple root there) pass it on."""
+    from obsdesign.methods.setinvariant.problem import check_detectable
+
+    n = len(diag)
+    A = qmat([[Q(diag[i]) if i == j else 0 for j in range(n)] for i in range(n)])
+    C = qmat([[1] + [0] * (n - 1)])
+    check_detectable(A, C, fmpq(9, 10))
+    with pytest.raises(InfeasibleError, match="λ"):
+        check_detectable(A, C, fmpq(9, 10) - fmpq(1, 10**30))  # just below: refused
+
+
+def test_a_defective_unobservable_mode_at_lambda_is_refused_and_named() -> None:
+    """A Jordan block at μ = λ = 0.9 (unobservable) has powers k·0.9ᵏ: no polyhedron is
+    0.9-contractive; refused exactly (multiplicity 2 in the minimal polynomial). μ =
+    0.9000001 is refused with its modulus to 17 digits (the message said "|μ| = 0.9 >
+    λ = 0.9")."""
+    from obsdesign.methods.setinvariant.problem import check_detectable
+
+    nine = fmpq(9, 10)
+    J = qmat([[fmpq(3, 10), 0, 0], [0, nine, 1], [0, 0, nine]])
+    C = qmat([[1, 0, 0]])
+    with pytest.raises(InfeasibleError, match="defective"):
+        check_detectable(J, C, nine)
+    check_detectable(J, C, nine + fmpq(1, 10**6))  # λ above the block's |μ|: passed on
+    B = qmat([[fmpq(3, 10), 0], [0, fmpq(9000001, 10**7)]])
+    with pytest.raises(InfeasibleError, match=r"\|μ\| ≈ 0\.900000099"):
+        check_detectable(B, qmat([[1, 0]]), nine)
 
 
 def test_necessary_condition_and_not_converged():

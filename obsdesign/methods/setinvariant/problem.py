@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 from flint import fmpq
 
+from obsdesign.certify.printing import fmt_exact
 from obsdesign.errors import InfeasibleError
 from obsdesign.sets import Box, Polytope
 from obsdesign.sets import polytope_ops as po
@@ -121,19 +122,24 @@ def build(spec: Spec) -> Data:
 def check_detectable(A: Any, C: Any, lam: Any) -> None:
     """Refuse (InfeasibleError) only a mode the output cannot see that is provably faster
     than λ (Section II: the injection cannot act on an unobservable mode, so a λ-contractive
-    set needs |μ| <= λ for each).
+    set needs |μ| <= λ for each), or a defective one at μ = ±λ.
 
     Exact first: the unobservable modes are the roots of the characteristic polynomial of A
     restricted to the unobservable subspace (:func:`obsdesign.certify.detect.unobservable_restriction`);
     none (observable) or all with |μ| < λ (exact Schur–Cohn test of χ(λz)) pass. Otherwise
-    some unobservable |μ| >= λ exactly, and the design is refused only when its float modulus
-    is clearly above λ (by 10⁻⁹ relative). A mode with |μ| = λ (e.g. μ = 1 with λ = 1, not
-    excited by the disturbance: the soundness audit's example, whose box Ω is invariant)
-    goes on to the algorithm, which decides. The message says "(C, A) is not detectable"
-    when |μ| > 1.
+    the distinct roots of the restriction's minimal polynomial are enclosed in rigorous balls
+    (python-flint ``complex_roots``, 64 to 1024 bits): a root whose modulus is certainly above
+    λ is refused. np.roots of the float polynomial was used before, and split a repeated root
+    by 10⁻⁸ (double) to 10⁻⁵ (triple): A = diag(0.3, 0.9, 0.9), C = (1, 0, 0), λ = 0.9 was
+    refused as "|μ| = 0.9 > λ = 0.9" although its box Ω certifies (set-invariant soundness
+    trial, session 25). A root ±λ of multiplicity ≥ 2 in the minimal polynomial (a Jordan
+    block at |μ| = λ: its powers grow like k·λᵏ) is refused, decided exactly; any other mode
+    with |μ| = λ (e.g. μ = 1 with λ = 1, not excited by the disturbance: the soundness
+    audit's example, whose box Ω is invariant) goes on to the algorithm, which decides. The
+    message says "(C, A) is not detectable" when |μ| > 1.
 
     :param A, C: exact plant matrices (object arrays); :param lam: λ (exact)."""
-    from flint import fmpq_poly
+    from flint import arb, ctx, fmpq_poly
 
     from obsdesign.certify.detect import schur_stable, unobservable_restriction
     from obsdesign.certify.exact import Q
@@ -148,21 +154,39 @@ def check_detectable(A: Any, C: Any, lam: Any) -> None:
     scaled = fmpq_poly([c * lq**i for i, c in enumerate(chi.coeffs())])
     if lq > 0 and schur_stable(scaled)[0]:
         return
-    coeffs = [float(c) for c in chi.coeffs()][::-1]
-    mus = np.roots(coeffs) if k > 0 else np.zeros(0)
-    lf = float(lq)
-    for mu in sorted(mus, key=abs, reverse=True):
-        if abs(mu) <= lf * (1 + 1e-9):
-            return
-        if abs(mu) > 1:
+    minp = Au.minpoly()
+    for prec in (64, 256, 1024):
+        with ctx.workprec(prec):
+            lam_b = arb(lq)
+            over = [(r, abs(r)) for r, _ in minp.complex_roots() if abs(r) > lam_b]
+            if over:
+                r, a = max(over, key=lambda t: float(t[1].mid()))
+                _refuse(complex(float(r.real.mid()), float(r.imag.mid())), a, lq)
+    for sign in (1, -1):
+        mu = sign * lq
+        if minp(mu) == 0 and minp.derivative()(mu) == 0:
             raise InfeasibleError(
-                f"(C, A) is not detectable: the mode μ = {mu:.6g} (|μ| = {abs(mu):.6g} > 1) "
-                "is unobservable, so no bounded set is D-(C,A)-invariant"
+                f"the unobservable mode μ = {fmt_exact(mu)} (|μ| = λ) is defective (a Jordan "
+                "block: its powers grow like k·λᵏ): no polyhedron is λ-contractive (choose "
+                "λ > |μ|)"
             )
+
+
+def _refuse(mu: complex, modulus: Any, lam: Any) -> None:
+    """The InfeasibleError of an unobservable mode with |μ| certainly above λ (``modulus``
+    an arb ball of |μ|, printed to 17 digits: "|μ| = 0.9 > λ = 0.9" was said of
+    |μ| = 0.9000001)."""
+    m = float(modulus.mid())
+    shown = f"{mu.real:.17g}" if mu.imag == 0 else f"{mu:.17g}"
+    if modulus > 1:
         raise InfeasibleError(
-            f"the unobservable mode μ = {mu:.6g} has |μ| = {abs(mu):.6g} > λ = {lf:g}: "
-            "no polyhedron is λ-contractive (choose λ >= |μ|)"
+            f"(C, A) is not detectable: the mode μ ≈ {shown} (|μ| ≈ {m:.17g} > 1) "
+            "is unobservable, so no bounded set is D-(C,A)-invariant"
         )
+    raise InfeasibleError(
+        f"the unobservable mode μ ≈ {shown} has |μ| ≈ {m:.17g} > λ = {fmt_exact(lam)}: "
+        "no polyhedron is λ-contractive (choose λ >= |μ|)"
+    )
 
 
 def necessary_condition(
