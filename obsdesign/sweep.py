@@ -24,6 +24,7 @@ failure, an internal error) is a row with its exit code and message, never a los
 
 from __future__ import annotations
 
+import bisect
 import json
 import math
 import numbers
@@ -311,13 +312,7 @@ def _value_span(lines: list[str], i: int, col: int) -> tuple[int, str]:
     # the value ends before the first '#' whose prefix parses; every later '#' lies in the
     # comment, so its prefix parses too: a binary search (one parse per '#' was quadratic,
     # a string of 20,000 '#' ran past 60 s; hostile-input trial, session 24)
-    lo, hi = 0, len(hashes)
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if ends_before(mid):
-            hi = mid
-        else:
-            lo = mid + 1
+    lo = _first_true(ends_before, 0, len(hashes))
     if lo < len(hashes) and ends_before(lo):
         return i, rest[hashes[lo] :]
 
@@ -333,19 +328,21 @@ def _value_span(lines: list[str], i: int, col: int) -> tuple[int, str]:
     # (one parse per line was quadratic: 3.4 s for a 100-row A written a row per line). A
     # line that parses only in its table's context makes the search land late; the linear
     # scan then decides, and set_key's comparison with the original catches any wrong span.
-    lo, hi = i, len(lines)
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if ends_by(mid):
-            hi = mid
-        else:
-            lo = mid + 1
+    lo = _first_true(ends_by, i, len(lines))
     if lo < len(lines) and ends_by(lo) and (lo == i or not ends_by(lo - 1)):
         return lo, ""
     for j in range(i, len(lines)):
         if ends_by(j):
             return j, ""
     return i, ""
+
+
+def _first_true(pred: Callable[[int], bool], lo: int, hi: int) -> int:
+    """The first k in [lo, hi) with ``pred(k)`` (``hi`` when none), by binary search: ``pred``
+    must be False then True over the range (monotone).
+
+    :param pred: the test; :param lo, hi: the range."""
+    return bisect.bisect_left(range(lo, hi), True, key=pred) + lo
 
 
 #: the key the value's text is parsed under (not one a spec would hold, so a later line of
