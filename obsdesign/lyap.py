@@ -727,6 +727,33 @@ def _lyap_solution(Acl: np.ndarray, rate: float, discrete: bool) -> np.ndarray |
     return S if np.all(np.isfinite(S)) else None
 
 
+def infeasible_head(margin: Any) -> str:
+    """How an "infeasible rate" message starts: "no P ≻ 0 gives" (strict decay, margin > 0),
+    or "no P ≻ 0 from the Lyapunov equation gives" when the margin is 0 and some P might
+    meet the non-strict claim (:func:`nonstrict_note`).
+
+    :param margin: the spec's margin (exact)."""
+    return "no P ≻ 0 gives" if margin != 0 else "no P ≻ 0 from the Lyapunov equation gives"
+
+
+def nonstrict_note(margin: Any, discrete: bool) -> str:
+    """The clause an "infeasible rate" message adds when the margin is 0: the decay claim is
+    then non-strict (⪰ 0), which a P can meet at an eigenvalue exactly on the limit (a
+    diagonalizable A − LC with ρ = λ: the constrained soundness trial's exact P, session 25),
+    while the design's P solves the Lyapunov equation, which needs every eigenvalue strictly
+    inside; "" for a positive margin.
+
+    :param margin: the spec's margin (exact); :param discrete: the time domain."""
+    if margin != 0:
+        return ""
+    where = "|z| = λ" if discrete else "Re z = −α"
+    return (
+        f" (with margin = 0 the decay claim is non-strict, and a P may meet it at an eigenvalue "
+        f"with {where} when A − LC is diagonalizable there; the design's P solves the "
+        "Lyapunov equation, which needs every eigenvalue strictly inside)"
+    )
+
+
 def rate_feasibility(
     Acl: Any,
     rate: Any,

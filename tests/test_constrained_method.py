@@ -862,3 +862,69 @@ def test_a_rate_just_above_a_defective_eigenvalue_certifies() -> None:
     assert rep.exit_code() == 0, [c.detail for c in rep.claims if not c.passed]
     assert float(rep.parameters.float("gamma")) > 0
     assert api.verify(rep).exit_code() == 0
+
+
+RHO_HALF = """[system]
+time = "discrete"
+A = [[0, 1], [1, 0]]
+C = [[1, 0]]
+[sets.X]
+type = "box"
+lower = [-1, -1]
+upper = [1, 1]
+[method]
+key = "constrained"
+L = [-0.2, 0.85]
+lambda = LAM
+rho = LAM
+margin = MARGIN
+X = "X"
+eps_min = 0.01
+[method.c]
+type = "box"
+lower = [-1.1, -1.1]
+upper = [1.1, 1.1]
+[method.D]
+lower = [-0.1]
+upper = [0.1]
+"""
+
+
+@pytest.mark.parametrize(
+    ("lam", "margin", "head"),
+    [
+        ("0.5", "0", "no P ≻ 0 from the Lyapunov equation gives"),
+        ("0.5", "1e-9", "no P ≻ 0 gives"),
+        ("0.49", "0", "no P ≻ 0 from the Lyapunov equation gives"),
+    ],
+)
+def test_a_rate_at_or_below_the_radius_is_decided_exactly_and_said_truly(lam, margin, head):
+    """A − LC = [[1/5, 1], [3/20, 0]] has the eigenvalues 1/2 and −3/10. λ = ρ = 1/2 with
+    margin 0 was refused "no P ≻ 0 gives decay rate λ = 0.5", which is false there: P =
+    [[17/32, 5/16], [5/16, 25/8]] meets the non-strict claim (constrained soundness trial,
+    session 25); the message now says the Lyapunov equation gives none and why."""
+    from obsdesign.errors import InfeasibleError
+
+    text = RHO_HALF.replace("LAM", lam).replace("MARGIN", margin)
+    with pytest.raises(InfeasibleError) as e:
+        api.design(load_spec_text(text, "rho.toml"))
+    assert e.value.message.startswith(head) or f": {head}" in str(e.value), str(e.value)
+    assert ("non-strict" in str(e.value)) == (margin == "0")
+
+
+def test_a_rate_a_hair_above_the_radius_is_no_infeasibility() -> None:
+    """λ = 1/2 + 10⁻²⁰ is above ρ = 1/2: the refusal compared float(λ) with the float radius,
+    which at this distance could fall either way (here the float radius came out just below
+    0.5); the exact test now decides, and the rounded P's exact check settles the rest (here:
+    exit 4, the rate is too close to the limit), never exit 1."""
+    from obsdesign.errors import InconclusiveError, InfeasibleError
+
+    lam = "0.50000000000000000001"
+    text = RHO_HALF.replace("LAM", lam).replace("MARGIN", "0")
+    try:
+        rep = api.design(load_spec_text(text, "rho.toml"))
+    except InfeasibleError as e:
+        raise AssertionError(f"a false infeasibility verdict: {e}") from None
+    except InconclusiveError:
+        return
+    assert rep.exit_code() in (0, 4)

@@ -16,6 +16,7 @@ from flint import fmpq
 from obsdesign import lyap
 from obsdesign.certify.exact import Q, float_or_inf
 from obsdesign.certify.interval import sqrt_upper
+from obsdesign.certify.printing import fmt_exact
 from obsdesign.errors import InconclusiveError, InfeasibleError, SpecError
 from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
 from obsdesign.methods.constrained import bounds as B
@@ -85,9 +86,14 @@ def lyapunov_data(spec: Spec) -> LyapData:
         lam = o.lam
         P = lyap.certified_P(A, C, o.L, True, lam, o.margin)
         if P is None:
-            if float(lam) <= rad:
+            # decided exactly (a float comparison of λ with the float radius decided before)
+            ok, how = lyap.rate_feasibility(lyap.closed_loop(A, C, o.L), lam, True)
+            if not ok:
                 raise InfeasibleError(
-                    f"no P ≻ 0 gives decay rate λ = {float(lam):g}: A − LC has spectral radius {rad:.6g}"
+                    f"{lyap.infeasible_head(o.margin)} decay rate λ = {fmt_exact(lam)}: A − LC "
+                    "has an eigenvalue "
+                    f"of modulus ≥ λ ({how}; spectral radius ≈ {rad:.6g})"
+                    + lyap.nonstrict_note(o.margin, True)
                 )
             raise InconclusiveError(
                 f"decay rate λ = {float(lam):g} holds in floats but the exact check failed"

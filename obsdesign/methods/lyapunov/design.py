@@ -215,9 +215,10 @@ def _design_for(
             ok, how = lyap.rate_feasibility(Acl, o.rate, s.discrete, memo, Af)
             if not ok:
                 raise InfeasibleError(
-                    f"no P ≻ 0 gives decay rate {sym} = {fmt_exact(o.rate)}: A − LC has an "
+                    f"{lyap.infeasible_head(o.margin)} decay rate {sym} = {fmt_exact(o.rate)}: "
+                    "A − LC has an "
                     f"eigenvalue {'of modulus ≥ λ' if s.discrete else 'with real part ≥ −α'} "
-                    f"({how}; {lim})"
+                    f"({how}; {lim})" + lyap.nonstrict_note(o.margin, s.discrete)
                 )
             raise InconclusiveError(
                 f"decay rate {sym} = {fmt_exact(o.rate)} is feasible "
