@@ -763,3 +763,42 @@ def test_lambda_min_lower_beyond_float_resolution() -> None:
     assert fmpq(1, 2) <= ell <= 1
     assert B.lambda_min_lower(R.dot(qmat([[10**20, 0], [0, -1]])).dot(R.T)) == 0
     assert B.lambda_min_lower(R.dot(qmat([[10**20, 0], [0, 0]])).dot(R.T)) == 0
+
+
+def test_v_min_is_found_at_any_scale() -> None:
+    """The Section 5 plant with X, c, D scaled by 10⁻¹⁰ and ε_min by 10⁻²⁰: v_min scales by
+    10⁻²⁰ (V is quadratic in the error). The bisection started on [0, 1] and stopped after 60
+    halvings near 10⁻¹⁸, reporting v_min = 0 under a note saying "exact closed form"
+    (constrained soundness trial, session 25)."""
+    from obsdesign import api
+
+    text = """[system]
+time = "discrete"
+A = [[0, 1], [1, 0]]
+C = [[1, 0]]
+[sets.X]
+type = "box"
+lower = [-S, -S]
+upper = [S, S]
+[method]
+key = "constrained"
+L = [-1.87, 1.874]
+lambda = 0.955
+rho = 0.955
+X = "X"
+eps_min = E
+[method.c]
+type = "box"
+norm = "max"
+lower = [-1.1eK, -1.1eK]
+upper = [1.1eK, 1.1eK]
+[method.D]
+lower = [-3eK]
+upper = [3eK]
+"""
+    one = text.replace("S", "1").replace("E", "0.01").replace("eK", "")
+    small = text.replace("S", "1e-10").replace("E", "1e-22").replace("eK", "e-10")
+    v1 = api.design(api.load_spec_text(one, "one.toml")).parameters["v_min"]
+    vs = api.design(api.load_spec_text(small, "small.toml")).parameters["v_min"]
+    assert v1 > 0 and vs > 0
+    assert abs(vs * 10**20 / v1 - 1) < fmpq(1, 10**6), (v1, vs)

@@ -309,13 +309,25 @@ def v_min_lower(
     rounded down to 8 significant digits and decided by :func:`v_min_condition`."""
     if not v_min_condition(cm, P, Pinv, X, eps_min, fmpq(0)):
         return Bound(fmpq(0), False, "X ⊄ int C_min: v_min = 0")
-    hi = 1.0
-    while v_min_condition(cm, P, Pinv, X, eps_min, dyadic(hi, 30)):
-        hi *= 4
-        if hi > 1e300:
-            break
-    lo = 0.0
-    for _ in range(60):
+
+    def holds(v: float) -> bool:
+        return v_min_condition(cm, P, Pinv, X, eps_min, dyadic(v, 30))
+
+    # bracket [lo, hi] by factors of 4 from 1, up or down: a bisection from [0, 1] stopped
+    # after 60 halvings near 10⁻¹⁸ and reported v_min = 0 for the Section 5 plant scaled by
+    # 10⁻¹⁰ (true 1.03·10⁻²⁰; θ came out 8.2·10¹⁴ instead of its value; constrained
+    # soundness trial, session 25)
+    lo, hi = 0.0, 1.0
+    if holds(hi):
+        while holds(hi) and hi <= 1e300:
+            lo, hi = hi, hi * 4
+    else:  # down by 2³² a step (31 steps to 10⁻³⁰⁰), then bisect the bracket
+        while hi > 1e-300 and not holds(hi / 2.0**32):
+            hi /= 2.0**32
+        if hi <= 1e-300:
+            return Bound(fmpq(0), False, "v_min < 10⁻³⁰⁰: reported as 0 (a safe lower bound)")
+        lo = hi / 2.0**32
+    for _ in range(100):
         mid = (lo + hi) / 2
         if v_min_condition(cm, P, Pinv, X, eps_min, dyadic(mid, 30)):
             lo = mid
