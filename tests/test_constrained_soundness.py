@@ -736,3 +736,42 @@ def test_asymmetric_P_fails_every_claim_built_from_P(sec5: Report, skew: fmpq) -
     assert {"P-positive-definite", "v_min-bound"} <= failed
     assert (P_CLAIMS & ids) <= failed
     assert not ({"c-convex", "eps-order", "delta-bound"} & failed)
+
+
+@pytest.mark.parametrize(
+    ("face", "k", "failed", "code"),
+    [
+        ("[1, 1]", "2.38", set(), 0),
+        ("[1, 1]", "2.36", {"Cmin-in-Xhat"}, 1),
+        ("[1, 2]", "3.56", set(), 0),  # support 3.3 + 0.1·(1 + 2^{4/3})^{3/4} ≈ 3.5569: balls
+        ("[1, 2]", "3.55", {"Cmin-in-Xhat"}, 1),
+        # the smallest margins: the supports are 2.368179283050742908… and 3.556975894282596662…
+        ("[1, 1]", "2.3681792830507429087", set(), 0),
+        ("[1, 1]", "2.3681792830507429085", {"Cmin-in-Xhat"}, 1),
+        ("[1, 2]", "3.5569758942825966622", set(), 0),
+        ("[1, 2]", "3.5569758942825966620", {"Cmin-in-Xhat"}, 1),
+    ],
+)
+def test_Cmin_in_Xhat_euclidean_box_map_is_decided_exactly(
+    face: str, k: str, failed: set, code: int
+) -> None:
+    """Euclidean box map: |c|² = Σ dist(x_i, R_i)⁴, so C_min = R ⊕ {‖d‖₄ ≤ √ε_min} and its
+    support along (1, 1) is 2.2 + 0.1·2^{3/4} ≈ 2.3682, not the outer box's 2.4: a face
+    x1 + x2 ≤ 2.38 holds (it was refused on the outer box's corner, exit 1; constrained
+    soundness trial, session 25), x1 + x2 ≤ 2.36 is refuted (exit 1)."""
+    poly = (
+        f'[sets.Xh]\ntype = "polytope"\nG = [[1, 0], [-1, 0], [0, 1], [0, -1], {face}]\n'
+        f"g = [1.2, 1.2, 1.2, 1.2, {k}]\n\n[method]"
+    )
+    rep = _design(variant(add='Xhat = "Xh"', replace=[("[method]", poly)]), "xh.toml")
+    assert {c.id for c in rep.failed} == failed and rep.exit_code() == code
+
+
+def test_Cmin_in_Xhat_undecided_by_its_outer_set_is_inconclusive() -> None:
+    """X̂ the disk |x|² ≤ 2.85 contains C_min (max |x|² over it 2(1.1 + (5·10⁻⁵)^¼)² ≈
+    2.804), but the outer box's corners (|x|² = 2.88) are outside and a Euclidean C_min has
+    no corners there: the claim is not proved, and that is exit 4 (inconclusive), not exit 1
+    (it was exit 1: constrained soundness trial, session 25)."""
+    disk = '[sets.Xh]\ntype = "ellipsoid"\nE = [[0.3508771929824561, 0], [0, 0.3508771929824561]]\n\n[method]'
+    rep = _design(variant(add='Xhat = "Xh"', replace=[("[method]", disk)]), "disk.toml")
+    assert {c.id for c in rep.failed} == {"Cmin-in-Xhat"} and rep.exit_code() == 4

@@ -511,6 +511,16 @@ def _inclusions(c: Claims, o: Options, Xhat: ConvexSet, eps_min: fmpq, eps_max: 
     cm = o.cmap
     worst = max(B.max_phi_over(cm, o.X))
     ok, det = cmin_in_xhat(cm, eps_min, Xhat)
+    # a failure is a proof when the outer set is C_min itself, or when a vertex of X (in
+    # C_0 ⊂ C_min once X-in-C0 holds) lies outside X̂
+    proof = ok or failure_refutes(cm, eps_min, Xhat)
+    if not proof and worst <= 0 and hasattr(o.X, "vertices_q"):
+        proof = any(not contains_q(Xhat, v) for v in o.X.vertices_q())
+    if not proof:
+        det += (
+            " — not a proof that C_min ⊄ X̂: the outer set is larger than C_min (or the bound "
+            "is not tight), so the inclusion is undecided (inconclusive, not false)"
+        )
     sup = B.sup_norm_c_over_set(cm, Xhat)
     chain = (
         # id, statement, check, passed, detail
@@ -544,6 +554,8 @@ def _inclusions(c: Claims, o: Options, Xhat: ConvexSet, eps_min: fmpq, eps_max: 
             check=check,
             passed=passed,
             detail=detail,
+            # an outer-set test that fails without refuting the inclusion: exit 4, not 1
+            **({"float_ok": not proof} if cid == "Cmin-in-Xhat" and not passed else {}),
         )
 
 
@@ -567,7 +579,10 @@ def cmin_in_xhat(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet) -> tuple[bool
             for j in range(G.shape[0])
         ]
         worst = max(faces)
-        return worst <= 0, f"max over the outer box of C_min of (H x − k) ≤ {fmt_up(worst, 10)}"
+        if worst <= 0 or cm.norm == "max":
+            return worst <= 0, f"max over the outer box of C_min of (H x − k) ≤ {fmt_up(worst, 10)}"
+        verdict, how = box_l4_faces(cm, eps_min, G, g)
+        return verdict is True, how
     if cm.affine:
         V, bounded = vertices_exact(cm.G_q, np.array([h + t for h in cm.h_q], dtype=object))
         if not bounded or len(V) == 0:
@@ -590,6 +605,96 @@ def cmin_in_xhat(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet) -> tuple[bool
     if bad_faces:
         return False, f"faces {bad_faces}: support of the outer ellipsoid above the face"
     return True, f"support function of the outer ellipsoid below all {G.shape[0]} faces of X̂"
+
+
+def box_l4_faces(
+    cm: ConstraintMap, eps_min: Any, G: np.ndarray, g: np.ndarray
+) -> tuple[bool | None, str]:
+    """C_min ⊂ {G x ≤ g} for the box map (19) with the Euclidean norm, decided face by face:
+    c_i = (φ_i⁺)², so |c|² = Σ_i dist(x_i, [r̲_i, r̄_i])⁴ and C_min = R ⊕ {d : ‖d‖₄ ≤ √ε_min}
+    (R the box of the map), whose support in the direction h is max_R h·x + √ε_min·‖h‖_{4/3}
+    (Hölder). A face holds iff a = g_j − max_R h·x ≥ 0 and ε_min²·(Σ|h_i|^{4/3})³ ≤ a⁴,
+    compared in rigorous balls (python-flint arb, 64 to 1024 bits): True when every face
+    holds, False when one is violated (a proof: R or the support point is in C_min), None
+    when a tie stays undecided. The outer box's corners are not in C_min with this norm: the
+    Section 5 plant with X̂ the disk |x|² ≤ 2.85 was refused on them (constrained soundness
+    trial, session 25).
+
+    :param cm: the box map; :param eps_min: ε_min; :param G, g: X̂'s faces (exact).
+    Returns (verdict, detail)."""
+    from flint import arb, ctx
+
+    n = cm.dim
+    lo = [-cm.h_q[2 * i] for i in range(n)]
+    hi = [cm.h_q[2 * i + 1] for i in range(n)]
+    e = Q(eps_min)
+    open_faces = []
+    for j in range(G.shape[0]):
+        a = g[j] - sum((max(G[j, i] * lo[i], G[j, i] * hi[i]) for i in range(n)), fmpq(0))
+        if a < 0:
+            return False, f"face {j} of X̂ cuts the box R ⊂ C_min of the map (by {fmt_up(-a, 10)})"
+        open_faces.append((j, a))
+    undecided = []
+    for j, a in open_faces:
+        verdict = None
+        mags = {abs(G[j, i]) for i in range(n) if G[j, i] != 0}
+        if len(mags) <= 1:
+            # m equal nonzero |h_i| = w (an axis face: m = 1): (Σ|h_i|^{4/3})³ = m³w⁴, rational
+            m = sum(1 for i in range(n) if G[j, i] != 0)
+            w = next(iter(mags), fmpq(0))
+            if e * e * m**3 * w**4 <= a**4:
+                continue
+            return False, (
+                f"face {j} of X̂: the support of C_min (R ⊕ the 4-norm ball of radius "
+                "√ε_min) is above it (exact)"
+            )
+        for prec in (64, 256, 1024):
+            with ctx.workprec(prec):
+                s43 = sum(
+                    (arb(abs(G[j, i])) ** arb(fmpq(4, 3)) for i in range(n) if G[j, i] != 0), arb(0)
+                )
+                lhs, rhs = arb(e * e) * s43**3, arb(a**4)
+                if lhs < rhs:
+                    verdict = True
+                elif lhs > rhs:
+                    verdict = False
+            if verdict is not None:
+                break
+        if verdict is False:
+            return False, (
+                f"face {j} of X̂: the support of C_min (R ⊕ the 4-norm ball of radius √ε_min) "
+                "is above it (rigorous balls)"
+            )
+        if verdict is None:
+            undecided.append(j)
+    if undecided:
+        return None, f"faces {undecided} of X̂ touch C_min to 1024 bits: undecided"
+    return True, (
+        f"support of C_min = R ⊕ {{‖d‖₄ ≤ √ε_min}} below all {G.shape[0]} faces of X̂ "
+        "(Hölder, rigorous balls)"
+    )
+
+
+def failure_refutes(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet) -> bool:
+    """Whether a failure of :func:`cmin_in_xhat` proves C_min ⊄ X̂ (Assumption 3(1)): its
+    outer set {φ_i ≤ t} is C_min itself only when t = √ε_min exactly (ε_min a rational
+    square) and |c| is decided by one face at a time (the max norm, or one antipodal class;
+    the ellipsoid map (18)), and the test is exact (not the S-lemma's float τ or the
+    support function's upper bound). Otherwise a failing corner may lie outside C_min: the
+    Euclidean box map's C_min has rounded corners, and the Section 5 plant with X̂ the disk
+    |x|² ≤ 2.85 ⊇ C_min (max 2.804) was refused, exit 1 (constrained soundness trial,
+    session 25).
+
+    :param cm: the map c; :param eps_min: ε_min; :param Xhat: the set X̂."""
+    if cm.kind == "box" and cm.norm != "max" and isinstance(Xhat, (Box, Polytope)):
+        G, g = Xhat.h_form_q()
+        return box_l4_faces(cm, eps_min, G, g)[0] is False
+    t = sqrt_upper(Q(eps_min))
+    if t * t != Q(eps_min):
+        return False
+    if cm.affine:
+        return cm.norm == "max" or len(cm.classes) == 1
+    return isinstance(Xhat, Ellipsoid) and all(x == 0 for x in Xhat.center_q)
 
 
 #: bits of the S-lemma multiplier τ of :func:`ellipsoid_in_ellipsoid`
