@@ -770,34 +770,26 @@ def test_v_min_is_found_at_any_scale() -> None:
     10⁻²⁰ (V is quadratic in the error). The bisection started on [0, 1] and stopped after 60
     halvings near 10⁻¹⁸, reporting v_min = 0 under a note saying "exact closed form"
     (constrained soundness trial, session 25)."""
+    from pathlib import Path
+
     from obsdesign import api
 
-    text = """[system]
-time = "discrete"
-A = [[0, 1], [1, 0]]
-C = [[1, 0]]
-[sets.X]
-type = "box"
-lower = [-S, -S]
-upper = [S, S]
-[method]
-key = "constrained"
-L = [-1.87, 1.874]
-lambda = 0.955
-rho = 0.955
-X = "X"
-eps_min = E
-[method.c]
-type = "box"
-norm = "max"
-lower = [-1.1eK, -1.1eK]
-upper = [1.1eK, 1.1eK]
-[method.D]
-lower = [-3eK]
-upper = [3eK]
-"""
-    one = text.replace("S", "1").replace("E", "0.01").replace("eK", "")
-    small = text.replace("S", "1e-10").replace("E", "1e-22").replace("eK", "e-10")
+    one = (
+        Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5.toml"
+    ).read_text()
+    one = one.split("\n[simulate]\n")[0]
+    small = one
+    for a, b in (
+        ("[-1, -1]", "[-1e-10, -1e-10]"),
+        ("[1, 1]", "[1e-10, 1e-10]"),
+        ("[-1.1, -1.1]", "[-1.1e-10, -1.1e-10]"),
+        ("[1.1, 1.1]", "[1.1e-10, 1.1e-10]"),
+        ("[-3]", "[-3e-10]"),
+        ("[3]", "[3e-10]"),
+        ("eps_min = 0.01", "eps_min = 1e-22"),
+    ):
+        assert a in small
+        small = small.replace(a, b)
     v1 = api.design(api.load_spec_text(one, "one.toml")).parameters["v_min"]
     vs = api.design(api.load_spec_text(small, "small.toml")).parameters["v_min"]
     assert v1 > 0 and vs > 0

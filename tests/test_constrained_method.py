@@ -864,30 +864,16 @@ def test_a_rate_just_above_a_defective_eigenvalue_certifies() -> None:
     assert api.verify(rep).exit_code() == 0
 
 
-RHO_HALF = """[system]
-time = "discrete"
-A = [[0, 1], [1, 0]]
-C = [[1, 0]]
-[sets.X]
-type = "box"
-lower = [-1, -1]
-upper = [1, 1]
-[method]
-key = "constrained"
-L = [-0.2, 0.85]
-lambda = LAM
-rho = LAM
-margin = MARGIN
-X = "X"
-eps_min = 0.01
-[method.c]
-type = "box"
-lower = [-1.1, -1.1]
-upper = [1.1, 1.1]
-[method.D]
-lower = [-0.1]
-upper = [0.1]
-"""
+#: the Section 5 spec with L = (−0.2, 0.85): A − LC = [[1/5, 1], [3/20, 0]], eigenvalues 1/2
+#: and −3/10 (λ, ρ and the margin filled in by each test)
+RHO_HALF = (
+    (Path(__file__).resolve().parents[1] / "specs" / SEC5)
+    .read_text()
+    .split("\n[simulate]\n")[0]
+    .replace("L = [-1.87, 1.874]", "L = [-0.2, 0.85]")
+    .replace("lambda = 0.955", "lambda = LAM\nmargin = MARGIN")
+    .replace("rho = 0.955", "rho = LAM")
+)
 
 
 @pytest.mark.parametrize(
