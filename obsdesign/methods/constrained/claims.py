@@ -534,7 +534,8 @@ def _inclusions(c: Claims, o: Options, Xhat: ConvexSet, eps_min: fmpq, eps_max: 
         (
             "Cmin-in-Xhat",
             "C_min ⊂ X̂",
-            "exact: the outer set {φ_i ≤ t}, t ≥ √ε_min, lies in X̂",
+            "exact: the outer set {φ_i ≤ t}, t ≥ √ε_min, lies in X̂ (box map with the "
+            "Euclidean norm: C_min's own support per face of X̂, Hölder)",
             ok,
             det,
         ),
