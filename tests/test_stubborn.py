@@ -1336,3 +1336,26 @@ def test_a_slow_plant_is_no_infeasibility_verdict() -> None:
         '[method]\nkey = "stubborn"\n'
     )
     _certified_or_inconclusive(text)
+
+
+def test_outliers_near_the_float_range_give_inf_not_nan() -> None:
+    """Outliers of amplitude 10³⁰⁰ at every sample: the squares overflow, and the study
+    printed numpy's RuntimeWarnings and a NaN RMSE (inf − inf) for the stubborn observer
+    (soundness trial, session 25). The error left the float range: inf, said once."""
+    from obsdesign.methods.stubborn.sim import study
+
+    text = (
+        '[system]\ntime = "continuous"\nA = [[0, 1], [0, 0]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "stubborn"\n[simulate]\nhorizon = 1\ndt = 0.001\nx0 = [1, 0]\n'
+        "xhat0 = [0, 0]\nsigma0 = 0\nnoise_std = 0\noutlier_rate = 1\namplitudes = [1e300]\n"
+        "runs = 2\n"
+    )
+    sp = api.load_spec_text(text, "amp.toml")
+    rep = api.design(sp)
+    with warnings.catch_warnings(record=True) as got:
+        warnings.simplefilter("always")
+        st = study(sp, rep.parameters)
+    assert not [w for w in got if issubclass(w.category, RuntimeWarning)], got
+    assert any("left the float range" in str(w.message) for w in got)
+    vals = [v for ob in st["median_rmse"].values() for a in ob.values() for v in a.values()]
+    assert not any(np.isnan(v) for v in vals) and np.inf in vals

@@ -295,8 +295,22 @@ def study(
         if budget is not None:
             budget.check(f"the outlier study ({runs:,} runs an amplitude) at step {k:,} of {K:,}")
 
-    sq, _, _ = run_errors(g, e0, nu, steps, dt, levels, adaptive, s0, check=check)
-    rmse = np.sqrt(sq / (steps + 1))  # (observers, amplitudes, runs, n)
+    # outliers near the float range (amplitude 1e300) overflow the squares: numpy's
+    # warnings and a NaN RMSE (inf − inf) were printed (soundness trial, session 25); such
+    # an error left the float range, so its RMSE is inf, said once in words
+    with np.errstate(over="ignore", invalid="ignore"):
+        sq, _, _ = run_errors(g, e0, nu, steps, dt, levels, adaptive, s0, check=check)
+        rmse = np.sqrt(sq / (steps + 1))  # (observers, amplitudes, runs, n)
+    gone = ~np.isfinite(rmse)
+    if gone.any():
+        rmse = np.where(gone, np.inf, rmse)
+        which = sorted({OBSERVERS[j] for j in np.nonzero(gone.any(axis=(1, 2, 3)))[0]})
+        at = sorted({f"{amps[k]:g}" for k in np.nonzero(gone.any(axis=(0, 2, 3)))[0]})
+        warnings.warn(
+            f"the outlier study: the error of the {', '.join(which)} observer(s) left the float "
+            f"range at amplitude(s) {', '.join(at)} in some runs; their RMSE is inf",
+            stacklevel=2,
+        )
     med = np.median(rmse, axis=2)
     names = spec.system.states
     table = {
