@@ -142,10 +142,11 @@ def test_example_72_symmetric_fails_general_certifies(rep72, tmp_path):
     )  # paper: "ε(z) > 1 for some z", Fig. 2 ≈ 1.06
     assert p["converged"] is True
     assert p["contractivity"] <= 1
-    # reproduced: 3 symmetric + 30 general checks, 56 facets, 30 vertices, factor 0.999999654
-    assert (p["iterations"], p["facets"], p["vertices"]) == (33, 56, 30)
-    assert len(np.asarray(p["G"]).reshape(-1, 3)) == 56 and len(np.asarray(p["V"])) == 30
-    assert fmpq(999999653, 10**9) < p["contractivity"] < fmpq(999999654, 10**9)
+    # reproduced (in Ω-unit coordinates, design.scaling): 3 symmetric + 32 general checks,
+    # 60 facets, 32 vertices, factor 0.99999967 (33, 56, 30 and 0.999999654 in the spec's)
+    assert (p["iterations"], p["facets"], p["vertices"]) == (35, 60, 32)
+    assert len(np.asarray(p["G"]).reshape(-1, 3)) == 60 and len(np.asarray(p["V"])) == 32
+    assert fmpq(999999669, 10**9) < p["contractivity"] < fmpq(999999670, 10**9)
     assert p["symmetric_iterations"] == 3 and len(np.asarray(p["symmetric_G"])) == 70
     assert all(c.status == ClaimStatus.CERTIFIED for c in rep.claims)
     assert api.verify(out).exit_code() == 0
@@ -561,14 +562,16 @@ def test_simulated_error_of_an_unstable_plant_keeps_its_digits() -> None:
 THIN_OMEGA = spec_text(
     A="[[0.5, 0.2], [0.1, 0.4]]",
     B1="[0.01, 0]",
-    omega='type = "polytope"\nG = [[1, 0], [-1, 0], [0, 1], [0, -1]]\ng = [1e-9, 1e-9, 1, 1]',
+    omega='type = "polytope"\nG = [[1, -1], [-1, 1], [1, 1], [-1, -1]]\ng = [1e-12, 1e-12, 1, 1]',
     alg="general",
 )
 
 
 def test_a_set_too_thin_for_float_hulls_is_inconclusive_naming_the_file_and_sets() -> None:
-    """Ω = {|e₁| ≤ 10⁻⁹, |e₂| ≤ 1}: qhull cannot build the float hull, exit 4 with one line
-    naming the spec file and the sets (it named neither; fuzz report, session 17)."""
+    """Ω = {|e₁ − e₂| ≤ 10⁻¹², |e₁ + e₂| ≤ 1}: qhull cannot build the float hull, exit 4
+    with one line naming the spec file and the sets (it named neither; fuzz report, session
+    17). (The session-17 Ω, {|e₁| ≤ 10⁻⁹, |e₂| ≤ 1}, is thin only along an axis: the design
+    now runs it in Ω-unit coordinates, scaling.py; a diagonal sliver stays too thin.)"""
     from obsdesign.errors import InconclusiveError
 
     with pytest.raises(InconclusiveError) as e:

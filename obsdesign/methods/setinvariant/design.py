@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from flint import fmpq
 
 from obsdesign.errors import InconclusiveError, SolverError
 from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
@@ -25,7 +26,7 @@ from obsdesign.spec.models import Spec
 
 from . import algorithms as al
 from . import certificate as ce
-from . import laws, lps, memo, numerical
+from . import laws, lps, memo, numerical, scaling
 from .linear import admissible_gains
 from .options import Options
 from .problem import Data, build, check_detectable
@@ -233,6 +234,18 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
     return run
 
 
+def _unscale(run: _Run, s: list[fmpq]) -> None:
+    """Map what the iterations proved in ẽ = S⁻¹e (:mod:`.scaling`) back to the spec's
+    coordinates, exactly: G̃S⁻¹, SṼ (same order, so the edges stand), v^l = S ṽ^l."""
+    st = run.stage
+    vrep = None
+    if st.vrep is not None:
+        vrep = dataclasses.replace(st.vrep, V=scaling.unscale_points(st.vrep.V, s))
+    run.stage = Stage(scaling.unscale_rows(st.G, s), vrep, scaling.unscale_result(st.res, s))
+    if "symmetric_G" in run.extra:
+        run.extra["symmetric_G"] = scaling.unscale_rows(run.extra["symmetric_G"], s)
+
+
 def _vec_text(M: np.ndarray) -> str:
     """An exact matrix as a flat list of 4 significant digits for a note (a fixed number of
     decimals showed a gain of 10⁻³⁰¹ as 0.0)."""
@@ -304,6 +317,9 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     """Design for a bound spec: the algorithm of Section V or VI, the exact final stage, the
     injection table (Proposition 4.1) and linear gains (Proposition 7.1).
 
+    Every stage runs in Ω-unit coordinates (:mod:`.scaling`: ẽ = S⁻¹e, S = diag of Ω's
+    exact extents) and the proved polytope is mapped back exactly (:func:`_unscale`).
+
     ``spec``: the bound spec; ``progress``: optional callback for progress lines. Raises
     InfeasibleError when (C, A) has a mode faster than λ that the output cannot see
     (Section II)."""
@@ -312,7 +328,10 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     try:
         data = build(spec)
         check_detectable(spec.system.A.q, spec.system.C.q, o.lam)
-        run = _iterate(spec, data, progress)
+        work, s = scaling.scaled(data)
+        run = _iterate(spec, work, progress)
+        if s is not None:
+            _unscale(run, s)
     except po.PolytopeError as e:
         # a float hull or vertex enumeration that qhull cannot do (a set thinner or larger
         # than float arithmetic resolves, e.g. Q = [[1e50, 0], [0, 1]]): numerically
