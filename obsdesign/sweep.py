@@ -13,9 +13,10 @@ The grid is the product of the axes (the last axis varies fastest); point ``i`` 
 ``i``. Each point's spec is the spec's TOML text with the values written in place as
 decimals (``0.93``, ``0.0031622776601684``: linear values exactly when they have at most 15
 significant digits, log values rounded to 15), so the spec of every point is exact and
-self-contained: the design certifies that text. The key's line is replaced (a trailing
-comment kept), or added to its table when absent; the edit is checked by parsing the new
-text and comparing it with the old one with only that key changed.
+self-contained: the design certifies that text. The key's value is replaced in place (found
+by the lexer of :mod:`obsdesign.spec.tomltext`; a trailing comment kept), or the key is
+added to its table when absent; the edit is checked by parsing the new text and comparing
+it with the old one with only that key changed.
 
 Every point is designed, serialized, reloaded and verified (as ``obsdesign check`` does),
 and simulated with ``simulate=True``. A point that fails (bad input, infeasible, solver
@@ -24,7 +25,6 @@ failure, an internal error) is a row with its exit code and message, never a los
 
 from __future__ import annotations
 
-import bisect
 import json
 import math
 import numbers
@@ -43,6 +43,7 @@ from typing import Any
 
 from obsdesign.errors import EXIT_BAD_INPUT, EXIT_OK, EXIT_SOLVER, InputError, ObsdesignError
 from obsdesign.limits import limits
+from obsdesign.spec import tomltext
 
 #: at most this many points in one sweep (a typo such as 1:2:1000000000 is refused at once)
 MAX_POINTS = 100_000
@@ -57,8 +58,6 @@ TIMING_COLUMNS = ("design_s", "verify_s", "simulate_s", "seconds")
 _KEY_RE = re.compile(r"^[A-Za-z0-9_-]+(\.[A-Za-z0-9_-]+)*$")
 _NUM = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
 _RANGE_RE = re.compile(rf"^({_NUM}):({_NUM}):(\d+)(?::(lin|log))?$")
-_HEADER_RE = re.compile(r"^\s*\[\s*([^\[\]#]+?)\s*\]\s*(?:#.*)?$")
-_AOT_RE = re.compile(r"^\s*\[\[")
 
 
 # -- axes and grid --------------------------------------------------------------------------
@@ -271,130 +270,53 @@ def _py_literal(x: Any) -> str:
 
 
 # -- editing the spec text --------------------------------------------------------------------
-def _sections(lines: list[str]) -> list[tuple[str | None, int, int]]:
-    """``(table, first_line, end_line)`` of each section: the root (None) and every
-    ``[table]`` header; array-of-tables sections are named ``[[...]]`` (never matched)."""
-    out: list[tuple[str | None, int, int]] = []
-    name: str | None = None
-    start = 0
-    in_ml = False
-    for i, line in enumerate(lines):
-        if line.count('"""') % 2 == 1 or line.count("'''") % 2 == 1:
-            in_ml = not in_ml
-            continue
-        if in_ml:
-            continue
-        if _AOT_RE.match(line):
-            out.append((name, start, i))
-            name, start = "[[...]]", i + 1
-            continue
-        m = _HEADER_RE.match(line)
-        if m:
-            out.append((name, start, i))
-            name, start = re.sub(r"\s*\.\s*", ".", m.group(1).strip()), i + 1
-    out.append((name, start, len(lines)))
+def _tables(stmts: list[tomltext.Statement]) -> list[tuple[tuple[str, ...] | None, int]]:
+    """For each statement, the table it belongs to (``()`` for the root; None inside an
+    array of tables or under a header that does not parse: never edited) and its index."""
+    out: list[tuple[tuple[str, ...] | None, int]] = []
+    table: tuple[str, ...] | None = ()
+    for k, s in enumerate(stmts):
+        if s.kind == "table":
+            table = s.key
+        elif s.kind == "aot":
+            table = None
+        out.append((table, k))
     return out
 
 
-def _value_span(lines: list[str], i: int, col: int) -> tuple[int, str]:
-    """The last line of the value that starts at ``lines[i][col:]`` and the comment after it
-    (when the value is on one line)."""
-    rest = lines[i][col:]
-    hashes = [m.start() for m in re.finditer("#", rest)]
-
-    def ends_before(k: int) -> bool:
-        try:
-            tomllib.loads("x = " + rest[: hashes[k]])
-            return True
-        except ValueError:  # TOMLDecodeError, or an integer past the int-string limit
-            return False
-
-    # the value ends before the first '#' whose prefix parses; every later '#' lies in the
-    # comment, so its prefix parses too: a binary search (one parse per '#' was quadratic,
-    # a string of 20,000 '#' ran past 60 s; hostile-input trial, session 24)
-    lo = _first_true(ends_before, 0, len(hashes))
-    if lo < len(hashes) and ends_before(lo):
-        return i, rest[hashes[lo] :]
-
-    def ends_by(j: int) -> bool:  # the value closes on or before line j
-        try:
-            tomllib.loads(f"{_SPAN_KEY} = " + "\n".join([rest, *lines[i + 1 : j + 1]]))
-            return True
-        except ValueError:
-            return False
-
-    # a multi-line value ends on the first line j whose prefix parses; the lines after it are
-    # whole TOML lines of the spec, so later prefixes parse too, and a binary search finds j
-    # (one parse per line was quadratic: 3.4 s for a 100-row A written a row per line). A
-    # line that parses only in its table's context makes the search land late; the linear
-    # scan then decides, and set_key's comparison with the original catches any wrong span.
-    lo = _first_true(ends_by, i, len(lines))
-    if lo < len(lines) and ends_by(lo) and (lo == i or not ends_by(lo - 1)):
-        return lo, ""
-    for j in range(i, len(lines)):
-        if ends_by(j):
-            return j, ""
-    return i, ""
-
-
-def _first_true(pred: Callable[[int], bool], lo: int, hi: int) -> int:
-    """The first k in [lo, hi) with ``pred(k)`` (``hi`` when none), by binary search: ``pred``
-    must be False then True over the range (monotone).
-
-    :param pred: the test; :param lo, hi: the range."""
-    return bisect.bisect_left(range(lo, hi), True, key=pred) + lo
-
-
-#: the key the value's text is parsed under (not one a spec would hold, so a later line of
-#: the spec cannot redefine it)
-_SPAN_KEY = "obsdesign-sweep-value-span"
-
-
 def set_key(text: str, key: str, literal: str, file: str = "<spec>") -> str:
-    """The TOML ``text`` with dotted ``key`` set to the TOML ``literal``: the key's line is
-    replaced (its trailing comment kept), or the key is added at the end of its deepest
-    existing table. The result is parsed and compared with the original: exactly that key
-    changed, or :class:`InputError`."""
-    parts = key.split(".")
-    lines = text.split("\n")
-    secs = _sections(lines)
-    done = False
-    for j in range(len(parts) - 1, -1, -1):
-        table = ".".join(parts[:j]) if j else None
-        rest = parts[j:]
-        pat = re.compile(r"^(\s*)" + r"\s*\.\s*".join(re.escape(p) for p in rest) + r"\s*=\s*")
-        for name, a, b in secs:
-            if name != table:
-                continue
-            for i in range(a, b):
-                m = pat.match(lines[i])
-                if m:
-                    last, comment = _value_span(lines, i, m.end())
-                    new = f"{lines[i][: m.end()]}{literal}" + (f"  {comment}" if comment else "")
-                    lines[i : last + 1] = [new]
-                    done = True
-                    break
-            if done:
+    """The TOML ``text`` with dotted ``key`` set to the TOML ``literal``: the key's value is
+    replaced in place (whatever follows it on its line kept), or the key is added after the
+    last statement of its deepest existing table. The statements and the value's span come
+    from a lexer (:mod:`obsdesign.spec.tomltext`); the result is parsed and compared with
+    the original: exactly that key changed, or :class:`InputError`."""
+    parts = tuple(key.split("."))
+    stmts = tomltext.statements(text)
+    owner = _tables(stmts)
+    new_text = None
+    for j in range(len(parts) - 1, -1, -1):  # the value: [a.b] c = ..., [a] b.c = ..., a.b.c
+        for table, k in owner:
+            s = stmts[k]
+            if s.kind == "keyval" and table == parts[:j] and s.key == parts[j:]:
+                new_text = text[: s.value_start] + literal + text[s.value_end :]
                 break
-        if done:
+        if new_text is not None:
             break
-    if not done:
+    if new_text is None:  # a new key, after the last statement of its deepest table
         for j in range(len(parts) - 1, -1, -1):
-            table = ".".join(parts[:j]) if j else None
-            hit = [(a, b) for name, a, b in secs if name == table]
-            if not hit:
+            mine = [k for table, k in owner if table == parts[:j]]
+            if j and not any(stmts[k].kind == "table" for k in mine):
                 continue
-            a, b = hit[0]
-            at = b
-            while at > a and not lines[at - 1].strip():
-                at -= 1
-            lines.insert(at, f"{'.'.join(parts[j:])} = {literal}")
-            done = True
+            line = f"{'.'.join(parts[j:])} = {literal}"
+            if not mine:  # the root holds no statement: the key goes first
+                new_text = f"{line}\n{text}"
+            else:
+                at = stmts[mine[-1]].end
+                new_text = f"{text[:at]}\n{line}{text[at:]}"
             break
-    new_text = "\n".join(lines)
-    if not done:
+    if new_text is None:
         new_text = f"{'.'.join(parts)} = {literal}\n" + text
-    _check_edit(text, new_text, parts, literal, file)
+    _check_edit(text, new_text, list(parts), literal, file)
     return new_text
 
 
