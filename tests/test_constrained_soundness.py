@@ -365,6 +365,10 @@ def test_delta_bound(sec5, tmp_path) -> None:
     delta = p_exact(sec5, "delta")
     ok, bad = bisect(delta, fmpq(0), lambda x: x * x >= dsq)
     assert_only(sec5, tmp_path, {"delta-bound"}, {"delta": ok}, {"delta": bad})
+    # ... and be √δ² rounded up, not any larger number: δ = 10⁶ was accepted beside the γ
+    # claims it makes false (γδ² = 2.4·10⁷ > λ_min(P) = 13.4; report-edit trial, session 26)
+    assert_only(sec5, tmp_path, {"delta-bound"}, {"delta": delta}, {"delta": delta + TINY})
+    assert failed_ids(tamper(sec5, delta=fmpq(10**6))) == {"delta-bound"}
 
 
 @pytest.mark.parametrize("key, cid", [("gamma", "gamma-bound"), ("gamma_max", "gamma_max-bound")])

@@ -202,12 +202,19 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
 
     # -- δ (Assumption 3(4)), γ (24) -------------------------------------------------------
     ok, det = B.delta_sq_valid(o.cmap, eps_max, dsq)
+    # the reported δ is √δ² rounded up, pinned from both sides: δ·δ ≥ δ² and δ ≤ the
+    # outward-rounded √δ² (design's own value); a larger δ, e.g. 10⁶, was accepted beside
+    # the γ claims it makes false, γδ² ≤ λ_min(P) (report-edit trial, session 26)
+    pinned = delta >= 0 and delta * delta >= dsq and delta <= sqrt_upper(dsq)
+    if ok and not pinned:
+        det = f"{det}; the reported δ ≈ {fmt_up(delta, 10)} is not √δ² rounded up"
     c.exact(
         id="delta-bound",
         statement=f"sup over C_max of |dc/dx|² ≤ δ² ≤ {fmt_up(dsq, 8)}",
         reference=_ref("Assumption 3(4)"),
-        check="exact: δ² ≥ the bound recomputed from ε_max, and the reported δ has δ·δ ≥ δ²",
-        passed=ok and delta >= 0 and delta * delta >= dsq,
+        check="exact: δ² ≥ the bound recomputed from ε_max, and the reported δ is √δ² "
+        "rounded up (δ·δ ≥ δ², δ ≤ the outward-rounded √δ²)",
+        passed=ok and pinned,
         detail=det,
     )
     ell = Q(val["lambda_min_P"])
