@@ -190,6 +190,9 @@ def test_q_of_text_rejects_zero_denominator_and_keeps_fraction_forms() -> None:
     assert Q("1.25") == fmpq(5, 4) and Q(" -2/4 ") == fmpq(-1, 2) and Q("1e2") == 100
     with pytest.raises(ValueError):
         Q("1/2/3")
+    for text in ("١", "1/٢", "٣.5", "1\u00a0"):  # digits and spaces beyond ASCII
+        with pytest.raises(ValueError, match="non-ASCII"):
+            Q(text)
 
 
 @given(

@@ -44,6 +44,9 @@ def Q(x: Any) -> fmpq:  # noqa: N802 - Q for the rationals
         m = _RATIO.fullmatch(x)
         if m:  # the canonical "p/q" or "p" of qstr: integer parsing, no Fraction round trip
             return fmpq(int(m[1]), int(m[2])) if m[2] else fmpq(int(m[1]))
+        if not x.isascii():  # Fraction reads "١" (Arabic-Indic one) as 1: a report's or
+            # spec's number is ASCII (report-edit trial, session 26)
+            raise ValueError(f"not a number: {x!r} (non-ASCII characters)")
         fr = Fraction(x.strip())
         return fmpq(fr.numerator, fr.denominator)
     raise TypeError(f"cannot convert {type(x).__name__} to a rational")
