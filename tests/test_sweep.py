@@ -477,3 +477,15 @@ def test_every_key_of_every_shipped_spec_can_be_set(path: Path) -> None:
         assert d == tomllib.loads(f"x = {lit}")["x"]
         n += 1
     assert n >= 10
+
+
+def test_a_swept_value_a_double_cannot_hold_keeps_its_digits_in_the_row() -> None:
+    """λ = 0.9999999999999999999999 certifies as written, but its row showed the nearest
+    double, 1.0, which the spec loader refuses (outsider trial, session 26): a value the
+    double's shortest repr does not equal is shown as its literal; others as numbers."""
+    assert sw._value("0.9999999999999999999999") == "0.9999999999999999999999"
+    assert sw._value("0.1") == 0.1 and isinstance(sw._value("0.1"), float)
+    assert sw._value("1_000.5") == 1000.5 and sw._value("1e-3") == 0.001
+    assert sw._value("7") == 7 and sw._value('"x"') == "x"
+    rows = sw.sweep_rows(SPEC, ["method.lambda=[0.9999999999999999999999, 0.97]"])
+    assert [r["method.lambda"] for r in rows] == ["0.9999999999999999999999", 0.97]
