@@ -562,7 +562,9 @@ def check(
     def each(f: Path) -> None:
         interrupt.check()  # a Ctrl-C whose exception was lost in the last spec stops here
         if fmt == Fmt.text and not quiet:
-            sys.stderr.write(f"checking {f} ...\n")
+            from obsdesign.errors import escape_controls
+
+            sys.stderr.write(f"checking {escape_controls(str(f))} ...\n")
 
     if workers is None and scheduler is None:
         rows = api.check(list(paths), on_start=each, timeout=timeout or None)

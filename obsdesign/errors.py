@@ -7,7 +7,6 @@
 from __future__ import annotations
 
 import re
-import unicodedata
 
 EXIT_OK = 0
 EXIT_INFEASIBLE = 1
@@ -27,6 +26,17 @@ def _escape_char(c: str) -> str:
     return f"\\x{o:02x}" if o < 0x100 else f"\\u{o:04x}"
 
 
+def escape_controls(text: str) -> str:
+    """``text`` with control characters (newline, ESC, …) and Unicode line/paragraph
+    separators written as escapes (``\\n``, ``\\x1b``), everything else as it is: for
+    user-given names in tables and progress lines (:func:`one_line` for messages)."""
+    return _CONTROLS.sub(lambda m: _escape_char(m[0]), text)
+
+
+#: the characters of Unicode categories Cc, Zl and Zp (what :func:`escape_controls` escapes)
+_CONTROLS = re.compile("[\x00-\x1f\x7f-\x9f\u2028\u2029]")
+
+
 def one_line(message: str) -> str:
     """``message`` safe to print as one line: control characters (newline, ESC, …) and
     Unicode line/paragraph separators from user-given names (TOML keys, file names) are
@@ -35,9 +45,7 @@ def one_line(message: str) -> str:
     its length; a line longer than :data:`MAX_LINE` characters keeps its start and end
     around "…(N characters)…" (a 5-million-character TOML key was echoed whole;
     hostile-input trial, session 24). Idempotent on ordinary text."""
-    out = "".join(
-        _escape_char(c) if unicodedata.category(c) in ("Cc", "Zl", "Zp") else c for c in message
-    )
+    out = escape_controls(message)
     out = _LONG_DIGITS.sub(lambda m: f"{m[0][:20]}…({len(m[0])} digits)", out)
     if len(out) > MAX_LINE:
         cut = len(out) - MAX_LINE // 2 - MAX_LINE // 4

@@ -386,3 +386,16 @@ def test_a_preformatted_table_and_nested_data_print_by_format() -> None:
     assert "outlier_study_median_rmse" not in md
     block = md.split("```")[1].strip("\n").splitlines()
     assert block[0].startswith("observer") and block[-1].startswith("stubborn")
+
+
+def test_check_and_design_print_control_characters_in_file_names_as_escapes(tmp_path: Path):
+    """A spec named ``a<ESC>[31mRED.toml`` reached the terminal raw from check's table (text
+    and md), its progress lines and design's title (outsider trial, session 26)."""
+    bad = tmp_path / "a\x1b[31mRED.toml"
+    shutil.copy(SPEC, bad)
+    for fmt in ("text", "md"):
+        res = CliRunner().invoke(app, ["check", str(bad), "--format", fmt, "--width", "200"])
+        assert res.exit_code == 0, res.output
+        assert "\x1b" not in res.output and "\\x1b" in res.output
+    res = CliRunner().invoke(app, ["design", str(bad), "--width", "200"])
+    assert res.exit_code == 0 and "\x1b" not in res.output and "\\x1b" in res.output

@@ -41,10 +41,14 @@ def _param_rows(report: Report) -> list[tuple[str, str, str]]:
 
 
 def esc(text: Any) -> str:
-    """Text with rich markup escaped: ``[system.A]`` prints as it is."""
+    """Text with rich markup escaped: ``[system.A]`` prints as it is; control characters
+    as escapes (a spec file named with ESC drove the terminal from ``check``'s table and
+    ``design``'s title; outsider trial, session 26)."""
     from rich.markup import escape
 
-    return escape(str(text))
+    from obsdesign.errors import escape_controls
+
+    return escape(escape_controls(str(text)))
 
 
 def _numeric(v: Any) -> bool:
@@ -165,8 +169,12 @@ def render_text(report: Report, title: str = "") -> None:
 
 
 def md_cell(v: Any) -> str:
-    """A Markdown table cell (or list item): pipes escaped, one line."""
-    return str(v).replace("|", "\\|").replace("\r", " ").replace("\n", " ")
+    """A Markdown table cell (or list item): pipes escaped, one line, other control
+    characters as escapes (:func:`obsdesign.errors.escape_controls`)."""
+    from obsdesign.errors import escape_controls
+
+    one = str(v).replace("|", "\\|").replace("\r", " ").replace("\n", " ")
+    return escape_controls(one)
 
 
 def render_markdown(report: Report) -> str:
