@@ -611,7 +611,9 @@ def import_mat(
     dt: Annotated[
         float | None,
         typer.Option(
-            "--dt", metavar="SECONDS", help="Sample time: discrete time (default: continuous)."
+            "--dt",
+            metavar="SECONDS",
+            help="Sample time: discrete time (default, or 0: continuous; not with --dt-var).",
         ),
     ] = None,
     dt_var: Annotated[

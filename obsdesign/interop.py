@@ -123,6 +123,8 @@ def _matrices(sys: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
     A = np.atleast_2d(_real(A, "A"))
     C = np.atleast_2d(_real(C, "C"))
     n = A.shape[0]
+    if A.size == 0:  # a 0×0 plant printed "A = []", which no spec accepts (outsider trial)
+        raise InputError(f"A has shape {A.shape}: a plant needs at least one state")
     if A.shape != (n, n) or C.ndim != 2 or C.shape[1] != n:
         raise InputError(f"state-space shapes do not fit: A {A.shape}, C {C.shape}")
     B = _columns(B, n, "B", "n, the states")
@@ -154,7 +156,15 @@ def _real(M: Any, name: str) -> np.ndarray:
         isinstance(x, (int, np.integer)) and not isinstance(x, bool) for x in arr.flat
     ):
         return arr
-    return arr.astype(float)
+    out = arr.astype(float)
+    tiny = (out != 0) & (np.abs(out) < np.finfo(float).tiny)
+    if tiny.any():  # written as 5e-324, then refused by the spec loader (outsider trial)
+        x = float(out[tiny].reshape(-1)[0])
+        raise InputError(
+            f"{name} has the entry {x!r}, a nonzero number below the float range (subnormal), "
+            "which a spec refuses: rescale the model or write it as 0"
+        )
+    return out
 
 
 def _columns(M: Any, rows: int, name: str, what: str) -> np.ndarray:
@@ -365,6 +375,9 @@ def spec_text_from_mat(
     from scipy.io import loadmat, whosmat
 
     from obsdesign.limits import limits, read_input
+
+    if dt is not None and dt_name is not None:  # --dt was ignored (outsider trial, session 26)
+        raise InputError(f"{path}: give the sample time by --dt or by --dt-var, not both")
 
     read_input(path, "MATLAB")  # a regular file within the size limit
     wanted = [v for v in (*names.values(), dt_name) if v is not None]

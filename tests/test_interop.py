@@ -176,6 +176,11 @@ def test_mat_import_round_trip(tmp_path: Path):
         ({"Ad": np.array([[np.inf, 0], [0, 1]])}, [], "'Ad' (A) has a non-finite entry"),
         ({"Ad": np.zeros((2, 2, 2))}, [], "'Ad' (A) has 3 dimensions, not 2"),
         ({"Ad": np.zeros((2, 3))}, [], "plant.mat: state-space shapes do not fit"),
+        # outsider trial, session 26: a 0×0 plant and a subnormal entry were printed into a
+        # spec the loader refuses; --dt beside --dt-var was ignored
+        ({"Ad": np.zeros((0, 0)), "Cm": np.zeros((0, 0))}, [], "A has shape (0, 0): a plant"),
+        ({"Ad": np.array([[5e-324, 0], [0, 1]])}, [], "the entry 5e-324, a nonzero number below"),
+        ({"Ts": 0.1}, ["--dt-var", "Ts", "--dt", "0.2"], "by --dt or by --dt-var, not both"),
     ],
 )
 def test_mat_import_bad_variables_are_exit_2_naming_file_and_variable(
