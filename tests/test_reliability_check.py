@@ -167,3 +167,15 @@ def test_check_timeout_beyond_the_timer_range_is_no_limit(tmp_path: Path) -> Non
         assert res.exit_code == 0, (t, res.output)
     with api._time_budget(1e300):
         pass
+
+
+def test_a_spec_named_twice_gets_one_row(tmp_path: Path) -> None:
+    """``check d d/ d/a.toml`` gave each of d's specs two rows and a third for a.toml, so the
+    verdict counted them twice (outsider trial, session 26); a symlink to a spec is the spec."""
+    d = tmp_path / "d"
+    d.mkdir()
+    (d / "a.toml").write_text("x = 1\n")
+    (d / "b.toml").write_text("x = 1\n")
+    (tmp_path / "link.toml").symlink_to(d / "a.toml")
+    got = api.spec_files([d, f"{d}/", d / "a.toml", tmp_path / "link.toml"])
+    assert got == [d / "a.toml", d / "b.toml"]
