@@ -77,7 +77,8 @@ def _bound(rep: Report) -> fmpq:
     "name, expected",
     [
         ("lyapunov-equation", {"lyapunov-equation"}),
-        ("P-positive", {"P-positive", "lyapunov-equation"}),
+        # a singular P also has a smaller |P|: ℓ* is then more than 2L|P| rounded up
+        ("P-positive", {"P-positive", "lyapunov-equation", "ell-star-bound"}),
         ("ell-bound", {"ell-bound"}),
         ("ell-star-bound", {"ell-star-bound"}),
         ("K", {"K-matches-spec"}),
@@ -294,3 +295,21 @@ def test_high_gain_warns_when_L_misses_the_linear_part_of_A() -> None:
     assert "A₀ − KC is Hurwitz" in pos.statement
     quiet = api.design(api.load_spec_text(text.replace("lipschitz = 0.1", "lipschitz = 6"), "h"))
     assert not any(n.startswith("WARNING") for n in quiet.notes)
+
+
+def test_ell_star_is_2L_norm_P_rounded_up_not_any_larger_bound(rep: Report) -> None:
+    """ℓ* = 100 for 2L|P| = 32(1 + 1/√2) ≈ 54.63 was accepted: the statement reads
+    ℓ* = 2L|P| (report-edit trial, session 26). ℓ* may exceed 2L|P| by a factor 1 + 10⁻⁶ at
+    most (the design's is within ~10⁻¹¹); each side of that line is checked exactly:
+    ℓ* ≤ (1 + 10⁻⁶)·2L|P| ⇔ (ℓ*/(32(1 + 10⁻⁶)) − 1)² ≤ 1/2."""
+    s = 1 + fmpq(1, 10**6)
+    top = Q(32 * (1 + np.sqrt(0.5)) * (1 + 1e-6))
+    below, above = top * (1 - fmpq(1, 10**12)), top * (1 + fmpq(1, 10**12))
+    assert (below / (32 * s) - 1) ** 2 < fmpq(1, 2) < (above / (32 * s) - 1) ** 2
+    for value, fails in ((below, False), (above, True), (fmpq(100), True)):
+        d = rep.to_dict()
+        _set(d, "ell_star", value)
+        r, _ = Report.from_dict(json.loads(json.dumps(d)))
+        ver = api.verify(r)
+        failed = {c.id for c in ver.claims if c.status == ClaimStatus.FAILED}
+        assert ("ell-star-bound" in failed) == fails, (value, failed)

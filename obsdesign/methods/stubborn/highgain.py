@@ -18,6 +18,7 @@ but give no formula, so ε > ε* is not claimed.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from typing import Any
 
@@ -206,14 +207,36 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         ),
     )
     for cid, statement, check, v, sign in bounds:
+        res = sign(qeye(n) * v - P * (2 * L))
+        if cid == "ell-star-bound" and res.ok:
+            res = _pinned(res, ell_star, P, L)
+            check += "; ℓ* is 2L|P| rounded up: ℓ*/(1 + 10⁻⁶)·I − 2L·P is not ≻ 0"
         c.checked(
             id=cid,
             statement=statement,
             reference=f"{PAPER}, convergence for ℓ > ℓ* = 2L|P|",
             check=check,
-            result=sign(qeye(n) * v - P * (2 * L)),
+            result=res,
         )
     return c
+
+
+#: how far above 2L|P| the reported ℓ* may lie (the design's is within ~10⁻¹¹)
+ELL_STAR_SLACK = fmpq(1, 10**6)
+
+
+def _pinned(res: Any, ell_star: fmpq, P: np.ndarray, L: fmpq) -> Any:
+    """``res`` (ℓ*·I − 2L·P ⪰ 0 passed) also failed unless ℓ* is 2L|P| rounded up: the
+    statement reads ℓ* = 2L|P|, and ℓ* = 100 for 2L|P| = 54.6 was accepted (report-edit
+    trial, session 26). 2L|P| ≥ ℓ*/(1 + slack) ⇔ ℓ*/(1 + slack)·I − 2L·P is not ≻ 0."""
+    n = P.shape[0]
+    if not check_pd(qeye(n) * (ell_star / (1 + ELL_STAR_SLACK)) - P * (2 * L)).ok:
+        return res
+    return dataclasses.replace(
+        res,
+        ok=False,
+        detail=f"ℓ* ≈ {fmt_up(ell_star, 8)} is more than (1 + 10⁻⁶)·2L|P|: not 2L|P| rounded up",
+    )
 
 
 # -- simulation ----------------------------------------------------------------------------
