@@ -136,3 +136,16 @@ def test_norm_upper_gives_up_after_40_candidates(monkeypatch):
         norm_upper(X)
     monkeypatch.setattr(np.linalg, "norm", lambda *a, **k: hi)
     assert norm_upper(X) >= 1
+
+
+def test_not_above_accepts_the_norm_rounded_up_and_refuses_more() -> None:
+    """u ≤ (1 + 10⁻⁶)‖X‖₂ + 10⁻⁹ exactly: ‖diag(3, 4)‖ = 4."""
+    from flint import fmpq
+
+    from obsdesign.certify.linalg import not_above
+
+    X = [[3, 0], [0, 4]]
+    line = 4 * (1 + fmpq(1, 10**6)) + fmpq(1, 10**9)
+    assert not_above(X, 4) and not_above(X, line) and not not_above(X, line + fmpq(1, 2**100))
+    assert not_above([[0, 0]], fmpq(1, 10**9)) and not not_above([[0, 0]], fmpq(2, 10**9))
+    assert not_above(X, -1)  # below the norm: not above it (norm_bound_holds refuses it)

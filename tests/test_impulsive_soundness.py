@@ -630,3 +630,18 @@ def test_lipschitz_x_falsification_allows_rounding(ell: float, violated: bool) -
     lo, hi = np.array([1e6]), np.array([1e6 + 1])
     f = falsify_lipschitz_x(lambda X: 3.0 * X, ell, lo, hi, 2000, 0)
     assert bool(f.violated) == violated
+
+
+@pytest.mark.parametrize(
+    ("key", "norm", "ell"), [("lambda_no", 1, "0.05"), ("lambda_on", "0.01", "0.05")]
+)
+def test_lambda_star_is_the_norm_rounded_up_not_any_larger_bound(key, norm, ell) -> None:
+    """λ*_no = ‖Ā_no‖ + ℓ_no is stated as an equality (rounded up); a larger λ* is
+    conservative everywhere else but made that statement false, and was accepted
+    (report-edit trial, session 26). On the "cross" plant (‖Ā_no‖ = 1, ‖Ā_on‖ = 0.01 exactly)
+    λ* may be at most (1 + 10⁻⁶)‖Ā‖ + 10⁻⁹ + ℓ: the line itself passes, one 2⁻¹⁰⁰ above fails."""
+    spec, rep = designed("cross")
+    top = (1 + fmpq(1, 10**6)) * Q(norm) + fmpq(1, 10**9) + Q(ell)
+    assert Q(rep.parameters[key]) <= top
+    assert key not in failed_ids(spec, _with(rep.parameters, {key: top}))
+    assert key in failed_ids(spec, _with(rep.parameters, {key: top + TINY}))

@@ -8,7 +8,7 @@ import numpy as np
 from flint import fmpq, fmpq_mat
 
 from obsdesign.certify.exact import Q, dyadic, qeye, qmat, to_float
-from obsdesign.certify.psd import check_psd
+from obsdesign.certify.psd import check_pd, check_psd
 
 
 def qinv(M: Any) -> np.ndarray:
@@ -36,6 +36,25 @@ def norm_bound_holds(X: Any, u: Any) -> bool:
         return True
     G = X.T @ X
     return bool(check_psd(qeye(len(G)) * (u * u) - G))
+
+
+#: how far above ‖X‖₂ a bound may lie and still be "‖X‖₂ rounded up" (:func:`not_above`):
+#: relative 10⁻⁶ and absolute 10⁻⁹ (:func:`norm_upper` gives f(1 + 2⁻³⁰) + 2⁻⁴⁰)
+ROUNDED_UP_REL = fmpq(1, 10**6)
+ROUNDED_UP_ABS = fmpq(1, 10**9)
+
+
+def not_above(X: Any, u: Any) -> bool:
+    """Exact check of u ≤ (1 + 10⁻⁶)‖X‖₂ + 10⁻⁹: the bound u is ‖X‖₂ rounded up, not any
+    larger number. With w = (u − 10⁻⁹)/(1 + 10⁻⁶): true when w ≤ 0, else when w²I − XᵀX is
+    not positive definite (‖X‖₂ ≥ w)."""
+    X = qmat(X)
+    w = (Q(u) - ROUNDED_UP_ABS) / (1 + ROUNDED_UP_REL)
+    if w <= 0:
+        return True
+    if X.size == 0:
+        return False
+    return not check_pd(qeye(X.shape[1]) * (w * w) - X.T @ X).ok
 
 
 def norm_upper(X: Any) -> fmpq:
