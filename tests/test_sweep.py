@@ -489,3 +489,58 @@ def test_a_swept_value_a_double_cannot_hold_keeps_its_digits_in_the_row() -> Non
     assert sw._value("7") == 7 and sw._value('"x"') == "x"
     rows = sw.sweep_rows(SPEC, ["method.lambda=[0.9999999999999999999999, 0.97]"])
     assert [r["method.lambda"] for r in rows] == ["0.9999999999999999999999", 0.97]
+
+
+def _random_document():
+    """A strategy of TOML documents: tables of keys whose values are strings of every kind
+    (with '#', brackets, quotes and newlines inside), numbers and nested multi-line arrays
+    with comments; comment and blank lines between; header-like text inside values."""
+    from hypothesis import strategies as st
+
+    from tests.test_spec_tomltext import _values
+
+    names = st.sampled_from(["a", "b", "c", "system", "method"])
+    stmt = st.tuples(names, _values).map(lambda kv: f"{kv[0]} = {kv[1]}")
+    filler = st.sampled_from(["", "# [not.a.table]", "  # x = 1", ""])
+    body = st.lists(st.one_of(stmt, filler), max_size=5)
+    section = st.tuples(st.sampled_from(["", "[t]", "[u]", "[t.v]", "[[w]]"]), body)
+    return st.lists(section, min_size=1, max_size=4).map(
+        lambda secs: (
+            "\n".join(h + "\n" + "\n".join(b) if h else "\n".join(b) for h, b in secs) + "\n"
+        )
+    )
+
+
+def _leaves(d: dict, pre: tuple = ()):
+    for k, v in d.items():
+        if isinstance(v, dict):
+            yield from _leaves(v, (*pre, k))
+        elif not (isinstance(v, list) and v and all(isinstance(x, dict) for x in v)):
+            yield (*pre, k)
+
+
+def test_set_key_on_random_documents_changes_exactly_that_key() -> None:
+    """Property: in any valid document, setting any existing key (outside arrays of tables)
+    or a new key of an existing table gives exactly the document with that change."""
+    from hypothesis import HealthCheck, assume, given, settings
+
+    @settings(max_examples=200, deadline=None, suppress_health_check=list(HealthCheck))
+    @given(text=_random_document())
+    def run(text: str) -> None:
+        try:
+            doc = tomllib.loads(text)
+        except tomllib.TOMLDecodeError:
+            assume(False)
+            return
+        for parts in [*_leaves(doc), ("t", "fresh"), ("fresh",)]:
+            if parts[0] == "t" and "t" not in doc:
+                continue
+            out = tomllib.loads(sw.set_key(text, ".".join(parts), "[7, 'x # y']"))
+            want = json.loads(json.dumps(doc))
+            d = want
+            for p in parts[:-1]:
+                d = d.setdefault(p, {})
+            d[parts[-1]] = [7, "x # y"]
+            assert json.loads(json.dumps(out)) == want, (text, parts)
+
+    run()
