@@ -914,3 +914,27 @@ def test_a_rate_a_hair_above_the_radius_is_no_infeasibility() -> None:
     except InconclusiveError:
         return
     assert rep.exit_code() in (0, 4)
+
+
+def _jordan_spec(A: str, n: int) -> str:
+    box = lambda b: f"lower = {[-b] * n}\nupper = {[b] * n}"  # noqa: E731
+    return (
+        f'[system]\ntime = "discrete"\nA = {A}\nC = [{[1] + [0] * (n - 1)}]\n'
+        f'[sets.X]\ntype = "box"\n{box(1)}\n[sets.Xh]\ntype = "box"\n{box(1.5)}\n'
+        f'[method]\nkey = "constrained"\nL = {[0] * n}\nX = "X"\nXhat = "Xh"\neps_min = 0.01\n'
+        f'[method.c]\ntype = "box"\n{box(1.1)}\n[method.D]\nlower = [-0.1]\nupper = [0.1]\n'
+    )
+
+
+def test_a_schur_gain_with_a_float_radius_above_one_is_decided_exactly() -> None:
+    """A − LC similar to a 4×4 Jordan block at 0.99999 is Schur, but its float spectral
+    radius is 1.00017 and the design refused it, "not Schur" (exit 1), before any exact test
+    (edge-shape trial, session 26; lyapunov certified λ = 0.999999 for the same A − LC). The
+    float radius now only raises the question; an exact test decides both ways."""
+    A = "[[0.99999, 1, 0, 0], [0, 0.99999, 1, 0], [-1, 1, -0.00001, 1], [-1, 2, -2, 1.99999]]"
+    assert max(abs(np.linalg.eigvals(np.array(eval(A))))) > 1  # the float radius misleads
+    rep = api.design(load_spec_text(_jordan_spec(A, 4), "jordan.toml"))
+    assert rep.exit_code() == 0 and all(c.status == ClaimStatus.CERTIFIED for c in rep.claims)
+    assert api.verify(rep).exit_code() == 0
+    with pytest.raises(InfeasibleError, match=r"not Schur \(an eigenvalue of modulus ≥ 1, exact"):
+        api.design(load_spec_text(_jordan_spec("[[0, 1], [-1, 0]]", 2), "rot.toml"))
