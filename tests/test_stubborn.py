@@ -1359,3 +1359,32 @@ def test_outliers_near_the_float_range_give_inf_not_nan() -> None:
     assert any("left the float range" in str(w.message) for w in got)
     vals = [v for ob in st["median_rmse"].values() for a in ob.values() for v in a.values()]
     assert not any(np.isnan(v) for v in vals) and np.inf in vals
+
+
+@pytest.mark.parametrize(
+    "time, A, C, lam",
+    [
+        ("discrete", "[[1e-8, 1], [0, 1e-8]]", "[[1e8, 0]]", None),
+        ("discrete", "[[0, 1], [0, 0]]", "[[1000000, 0]]", None),
+        ("continuous", "[[1e-8, 1e8], [-1e-8, 1e-8]]", "[[1, 0]]", None),
+        ("continuous", "[[1e-8, 1e8], [-1e-8, 1e-8]]", "[[1, 0]]", 0.1),
+    ],
+)
+def test_solver_infeasible_on_badly_scaled_data_is_no_verdict(
+    time: str, A: str, C: str, lam: float | None
+) -> None:
+    """Clarabel answered `infeasible` on these feasible LMIs (exit 1): A = [[1e-8, 1],
+    [0, 1e-8]] is Schur, and K = 0 with P = diag(2c², 6c²), U = R = W = 1, Y = −WC, λ = 1/2
+    satisfies (7)-(9) exactly for C = [[c, 0]] (edge-shape trial, session 26, its exact
+    witness). With the nonzero entries of A and C spanning more than 10⁵ the status is no
+    proof: exit 4 (inconclusive), saying so; well-scaled plants keep their exit-1 verdicts
+    (the test above)."""
+    text = f'[system]\ntime = "{time}"\nA = {A}\nC = {C}\n[method]\nkey = "stubborn"\n' + (
+        f"lambda = {lam}\n" if lam is not None else ""
+    )
+    try:
+        rep = api.design(api.load_spec_text(text, "s.toml"))
+    except InconclusiveError as e:
+        assert "no proof of infeasibility" in e.message
+    else:  # a solver that copes certifies it
+        assert rep.exit_code() == 0

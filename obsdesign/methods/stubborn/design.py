@@ -625,16 +625,51 @@ def _infeasible(spec: Spec, pl: Plant, o: Options, where: str) -> None:
             f"numerically inconclusive ({det.detail})"
         )
     if o.K is not None and not _stable_gain(spec, o.K, pl.discrete):
-        # the (1,1) block of (2) / (8) needs A − KC Hurwitz (Schur): no λ or R can help (the
-        # hint used to say "try a smaller λ or raise gain_bound", a key the redesign refuses —
-        # stubborn review)
-        kind = "Schur (spectral radius < 1)" if pl.discrete else "Hurwitz"
-        raise InfeasibleError(
-            f"stubborn: LMIs {_refs(pl)} infeasible {where}: A − KC is not {kind} for the "
-            "given K (exact test), which LMI "
-            f"{'(8)' if pl.discrete else '(2)'} requires for every λ: give a K that makes A − KC "
-            f"{kind}, or omit K to let the design choose it"
+        _unstable_gain(pl, where)
+    spread = _data_spread(pl)
+    if spread > SPREAD_MAX:
+        # Clarabel answered "infeasible" on feasible LMIs of plants such as A = [[1e-8, 1],
+        # [0, 1e-8]], C = [[1e8, 0]] (K = 0 and an exact P certify them) and A = [[0, 1],
+        # [0, 0]], C = [[1e6, 0]] (edge-shape trial, session 26): on data this badly scaled
+        # the status is no proof
+        raise InconclusiveError(
+            f"stubborn: the solver reports LMIs {_refs(pl)} infeasible {where}, but (C, A) is "
+            f"detectable and the nonzero entries of A and C span a factor {spread:.3g} (above "
+            f"{SPREAD_MAX:g}): on data this badly scaled that status is no proof of "
+            "infeasibility (rescale the states or the outputs)"
         )
+    _bounds_too_tight(pl, o, where, det.verdict)
+
+
+#: the spread of the plant's nonzero |entries| (A and C) above which a solver's `infeasible`
+#: is not taken as a verdict (exit 4 instead of 1); the edge-shape trial's false verdicts
+#: had 10⁶ … 10¹⁶, plants that certified 10⁴
+SPREAD_MAX = 1e5
+
+
+def _data_spread(pl: Plant) -> float:
+    """max / min of the nonzero |entries| of A and C (1 when there are none)."""
+    v = np.abs(np.concatenate([np.asarray(pl.A, float).ravel(), np.asarray(pl.C, float).ravel()]))
+    v = v[(v > 0) & np.isfinite(v)]
+    return float(v.max() / v.min()) if v.size else 1.0
+
+
+def _unstable_gain(pl: Plant, where: str) -> None:
+    """Exit 1: the given K does not make A − KC Hurwitz (Schur), decided exactly: the (1,1)
+    block of (2) / (8) needs it, so no λ or R can help (the hint used to say "try a smaller λ
+    or raise gain_bound", a key the redesign refuses — stubborn review)."""
+    kind = "Schur (spectral radius < 1)" if pl.discrete else "Hurwitz"
+    raise InfeasibleError(
+        f"stubborn: LMIs {_refs(pl)} infeasible {where}: A − KC is not {kind} for the "
+        "given K (exact test), which LMI "
+        f"{'(8)' if pl.discrete else '(2)'} requires for every λ: give a K that makes A − KC "
+        f"{kind}, or omit K to let the design choose it"
+    )
+
+
+def _bounds_too_tight(pl: Plant, o: Options, where: str, verdict: bool | None) -> None:
+    """Exit 1 naming the bounds of the design to relax (the solver's `infeasible` on
+    well-scaled data of a detectable plant)."""
     # the gain bound applies in full mode only (redesign keeps the given K)
     bounds = ", ".join(
         f"{k} (now {float(v):g})"
@@ -656,7 +691,7 @@ def _infeasible(spec: Spec, pl: Plant, o: Options, where: str) -> None:
         )
     else:
         why = "(C, A) is detectable: " + (" or ".join(hints) or "no bound or λ to relax")
-        if det.verdict is True and pl.discrete:
+        if verdict is True and pl.discrete:
             free = replace(o, gain_bound=None, r_bound=None)
             if not feasible(pl, free, 1 - 1e-6)[0]:
                 without = f" even without {bounds} and at any λ < 1" if bounds else " at any λ < 1"
