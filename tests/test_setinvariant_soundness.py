@@ -998,3 +998,63 @@ def test_phi_ignores_a_vertex_just_outside_the_slab(sign: int, K: int, d: fmpq) 
     for i in range(len(G)):
         assert low[i] <= float(want[i]) <= up[i], (i, low[i], float(want[i]), up[i])
     assert sl.phi_exact(l) == want
+
+
+ASYMMETRIC_OMEGA = """[system]
+time = "discrete"
+A = [[5495e-4, 393e-4], [-1466e-3, 9347e-4]]
+C = [[62e-2, 184e-2]]
+B1 = [-175e-5, -236e-5]
+[sets.omega]
+type = "box"
+lower = [-118e-5, -694e-4]
+upper = [325e-4, 254e-4]
+[sets.D]
+type = "box"
+dim = 1
+lower = [-1]
+upper = [1]
+[method]
+key = "set-invariant"
+omega = "omega"
+disturbance = "D"
+eta_bar = 0
+lambda = 0.9369
+algorithm = "general"
+mirror = true
+delta_tol = 1e-3
+max_iterations = 25
+"""
+
+
+def test_an_asymmetric_polyhedron_needs_only_a_translate_of_B1_D_inside() -> None:
+    """Ω = [−0.00118, 0.0325] × [−0.0694, 0.0254] is contractive (Theorem 3.1 certified,
+    factor 0.68), but max_i δ_i = 175/118 > λ: the centred inclusion λΩ ⊇ B1·D is necessary
+    only for a polyhedron symmetric about 0, and the design ended with exit 1 (set-invariant
+    scaling trial, session 26). Only a translate must fit (the injection at e = 0 may shift
+    B1·D): the claim then says so and is decided by an exact LP."""
+    rep = api.design(api.load_spec_text(ASYMMETRIC_OMEGA, "asym.toml"))
+    assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
+    (nc,) = [c for c in rep.claims if c.id == "necessary-condition"]
+    assert "B1·D + v for some v" in nc.statement and nc.status == ClaimStatus.CERTIFIED
+    assert api.verify(rep).exit_code() == 0
+
+
+@pytest.mark.parametrize(("lam", "holds"), [(fmpq(19, 20), True), (fmpq(19, 20) - TINY, False)])
+def test_the_translated_necessary_condition_at_its_exact_boundary(lam: fmpq, holds: bool) -> None:
+    """P = [−1, 3] × [−1, 1], B1·D = [−1.9, 1.9] × {0}: the centred inclusion needs
+    1.9 <= λ (fails at λ = 0.95), a translate needs width 3.8 <= 4λ: min over v of
+    max_i (G_i v + δ_i) = 0.95 exactly (v = 0.95); 10⁻¹² below λ fails."""
+    from obsdesign.methods.setinvariant.claims import ExactBackend
+
+    q = fmpq
+    G = np.array([[q(1, 3), q(0)], [q(-1), q(0)], [q(0), q(1)], [q(0), q(-1)]], dtype=object)
+    B1 = np.array([[q(19, 10)], [q(0)]], dtype=object)
+    Dv = np.array([[q(-1)], [q(1)]], dtype=object)
+    A = np.array([[q(0), q(0)], [q(0), q(0)]], dtype=object)
+    C = np.array([[q(1), q(0)]], dtype=object)
+    ex = ce.ExactProblem(A, B1, C, G, ce.po.exact_h_to_v(G).V, Dv, q(0), lam)
+    b = ExactBackend(ex, None)
+    assert b.necessary(G) == (False, q(19, 10))
+    ok, eps = b.necessary_shifted(G)
+    assert eps == q(19, 20) and ok is holds

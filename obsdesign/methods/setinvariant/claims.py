@@ -135,6 +135,21 @@ TABLE: dict[str, ClaimDef] = {
 
 
 # ============================================================================== backends
+#: the necessary condition of Section II for a polyhedron whose centred inclusion fails: at
+#: e = 0 the injection v(z) may shift B1·D, so only a translate of it must fit in λ·{G e <= 1}
+#: (the centred inclusion is necessary only for a polyhedron symmetric about 0; an asymmetric
+#: Ω with a certified Theorem 3.1 failed it and ended with exit 1: set-invariant scaling
+#: trial, session 26)
+SHIFTED_NECESSARY = ClaimDef(
+    "necessary-condition",
+    "λ·{{G e <= 1}} ⊇ B1·D + v for some v, with λ = {lam} (necessary condition of Section II: "
+    "the injection at e = 0 may shift B1·D)",
+    f"{REF}, Section II",
+    "exact LP (cdd.gmp): min over v of max_i (G_i v + δ_i) <= λ, δ_i = max over D's vertices "
+    "of G_i B1 d",
+)
+
+
 class ExactBackend:
     """Rational checks (cdd.gmp): certified or failed."""
 
@@ -166,6 +181,11 @@ class ExactBackend:
 
     def necessary(self, G: np.ndarray) -> tuple[bool, Any]:
         return necessary_condition(G, self.ex.B1, self.ex.Dv, self.ex.lam)
+
+    def necessary_shifted(self, G: np.ndarray) -> tuple[bool, Any]:
+        dl = ce.delta_exact(G, self.ex.B1, self.ex.Dv)
+        eps, _ = ce.exact_lp9(G, [fmpq(0)] * len(G), dl)
+        return eps <= self.ex.lam, eps
 
     def zd(self, vrep: Any) -> list[Any]:
         return ce.exact_zd(vrep.V, self.ex.C[0], self.ex.eta)[0]
@@ -266,6 +286,18 @@ class FloatBackend:
         m = float(dl.max()) if len(dl) else 0.0
         return m <= self.lam * (1 + numerical.TOL), m
 
+    def necessary_shifted(self, G: np.ndarray) -> tuple[bool, Any]:
+        from scipy.optimize import linprog
+
+        dl = lps.delta(G, self.fl.B1, self.fl.Dv)
+        n = G.shape[1]
+        c = np.zeros(n + 1)
+        c[-1] = 1.0
+        A = np.hstack([G, -np.ones((len(G), 1))])
+        res = linprog(c, A_ub=A, b_ub=-dl, bounds=[(None, None)] * (n + 1), method="highs")
+        eps = float(res.x[-1]) if res.status == 0 else float("inf")
+        return eps <= self.lam * (1 + numerical.TOL), eps
+
     def zd(self, vrep: Any) -> list[Any]:
         return list(lps.z_d(vrep.V, self.fl.C[0], self.fl.eta))
 
@@ -341,9 +373,15 @@ class _Emit:
         self.fields = {"lam": fmt_exact(o.lam), "L": L}
 
     def __call__(
-        self, cid: str, passed: bool, detail: str, margin: Any = 0, float_ok: bool | None = None
+        self,
+        cid: str,
+        passed: bool,
+        detail: str,
+        margin: Any = 0,
+        float_ok: bool | None = None,
+        d: ClaimDef | None = None,
     ) -> None:
-        d = TABLE[cid]
+        d = d or TABLE[cid]
         statement = d.statement.format(**self.fields)
         if self.b.exact:
             self.c.exact(
@@ -407,13 +445,24 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         b.leq(m, 1)[1],
     )
     ok, m = b.necessary(G)
-    emit(
-        "necessary-condition",
-        ok,
-        f"max_i δ_i = {b.show(m)}",
-        b.margin(o.lam, m),
-        b.leq(m, b.lam)[1],
-    )
+    if ok:
+        emit(
+            "necessary-condition",
+            ok,
+            f"max_i δ_i = {b.show(m)}",
+            b.margin(o.lam, m),
+            b.leq(m, b.lam)[1],
+        )
+    else:  # the centred inclusion fails: only a translate of B1·D must fit
+        ok, eps = b.necessary_shifted(G)
+        emit(
+            "necessary-condition",
+            ok,
+            f"max_i δ_i = {b.show(m)} > λ; min over v of max_i (G_i v + δ_i) = {b.show(eps)}",
+            b.margin(o.lam, eps),
+            b.leq(eps, b.lam)[1],
+            d=SHIFTED_NECESSARY,
+        )
     if s.p == 1:
         _single_output(spec, params, b, emit, G, vrep)
     _linear(spec, params, b, emit, G, V)
