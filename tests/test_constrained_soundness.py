@@ -367,7 +367,9 @@ def test_delta_bound(sec5, tmp_path) -> None:
     assert_only(sec5, tmp_path, {"delta-bound"}, {"delta": ok}, {"delta": bad})
     # ... and be √δ² rounded up, not any larger number: δ = 10⁶ was accepted beside the γ
     # claims it makes false (γδ² = 2.4·10⁷ > λ_min(P) = 13.4; report-edit trial, session 26)
-    assert_only(sec5, tmp_path, {"delta-bound"}, {"delta": delta}, {"delta": delta + TINY})
+    top = dsq * (1 + fmpq(1, 10**6)) ** 2
+    ok, bad = bisect(delta, delta * 2, lambda x: x * x <= top)
+    assert_only(sec5, tmp_path, {"delta-bound"}, {"delta": ok}, {"delta": bad})
     assert failed_ids(tamper(sec5, delta=fmpq(10**6))) == {"delta-bound"}
 
 

@@ -24,6 +24,7 @@ from obsdesign import lyap
 from obsdesign.certify.claim import Claim, Claims, ClaimStatus
 from obsdesign.certify.exact import Q, qeye, to_float
 from obsdesign.certify.interval import sqrt_upper, upper
+from obsdesign.certify.linalg import ROUNDED_UP_REL
 from obsdesign.certify.printing import fmt_down, fmt_exact, fmt_up
 from obsdesign.certify.psd import asymmetric, check_pd, check_psd
 from obsdesign.methods.constrained import bounds as B
@@ -202,10 +203,10 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
 
     # -- δ (Assumption 3(4)), γ (24) -------------------------------------------------------
     ok, det = B.delta_sq_valid(o.cmap, eps_max, dsq)
-    # the reported δ is √δ² rounded up, pinned from both sides: δ·δ ≥ δ² and δ ≤ the
-    # outward-rounded √δ² (design's own value); a larger δ, e.g. 10⁶, was accepted beside
+    # the reported δ is √δ² rounded up, pinned from both sides: δ² ≤ δ·δ ≤ (1 + 10⁻⁶)²δ²
+    # (the design's sqrt_upper is far closer); a larger δ, e.g. 10⁶, was accepted beside
     # the γ claims it makes false, γδ² ≤ λ_min(P) (report-edit trial, session 26)
-    pinned = delta >= 0 and delta * delta >= dsq and delta <= sqrt_upper(dsq)
+    pinned = delta >= 0 and dsq <= delta * delta <= dsq * (1 + ROUNDED_UP_REL) ** 2
     if ok and not pinned:
         det = f"{det}; the reported δ ≈ {fmt_up(delta, 10)} is not √δ² rounded up"
     c.exact(
@@ -213,7 +214,7 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         statement=f"sup over C_max of |dc/dx|² ≤ δ² ≤ {fmt_up(dsq, 8)}",
         reference=_ref("Assumption 3(4)"),
         check="exact: δ² ≥ the bound recomputed from ε_max, and the reported δ is √δ² "
-        "rounded up (δ·δ ≥ δ², δ ≤ the outward-rounded √δ²)",
+        "rounded up (δ² ≤ δ·δ ≤ (1 + 10⁻⁶)²δ²)",
         passed=ok and pinned,
         detail=det,
     )
