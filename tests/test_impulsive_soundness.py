@@ -645,3 +645,16 @@ def test_lambda_star_is_the_norm_rounded_up_not_any_larger_bound(key, norm, ell)
     assert Q(rep.parameters[key]) <= top
     assert key not in failed_ids(spec, _with(rep.parameters, {key: top}))
     assert key in failed_ids(spec, _with(rep.parameters, {key: top + TINY}))
+
+
+def test_ball_radius_is_the_root_rounded_up_not_any_larger_radius() -> None:
+    """r_B was only checked from below (r_B² ≥ α w̄): with α = 2, w̄ = 3 the design's
+    r_B ≈ √6 fails the escape test (r_B < w̄, exit 1), but a report with r_B = 3 silenced it
+    and verified, and simulate used that ball (parameter audit, session 26). r_B may exceed
+    √(α w̄) by a factor 1 + 10⁻⁶ at most: on "square" (α w̄ = 0.36, √ = 0.6 exactly) the line
+    itself passes, 2⁻¹⁰⁰ above it fails."""
+    spec, rep = designed("square")
+    line = fmpq(3, 5) * (1 + fmpq(1, 10**6))
+    assert failed_ids(spec, _with(rep.parameters, {"ball_radius": line})) == set()
+    assert failed_ids(spec, _with(rep.parameters, {"ball_radius": line + TINY})) == {"ball_radius"}
+    assert failed_ids(spec, _with(rep.parameters, {"ball_radius": fmpq(10)})) == {"ball_radius"}

@@ -23,7 +23,7 @@ from flint import fmpq
 
 from obsdesign.certify.claim import Claim, Claims
 from obsdesign.certify.exact import Q
-from obsdesign.certify.linalg import norm_bound_holds, not_above
+from obsdesign.certify.linalg import ROUNDED_UP_REL, norm_bound_holds, not_above
 from obsdesign.certify.printing import fmt_down, fmt_exact, fmt_up
 from obsdesign.certify.psd import check_pd, check_psd
 from obsdesign.params import Parameters
@@ -322,6 +322,18 @@ def _ball(c: Claims, rad: fmpq, alpha: fmpq, w_bar: fmpq) -> None:
     text = {"id": "ball_radius", "statement": statement, "reference": _ref("Theorem 2")}
     if not (rad >= 0 and rad * rad >= aw):
         c.exact(**text, check="exact r_B ≥ 0 and r_B² ≥ α w̄", passed=False, margin=rad * rad - aw)
+        return
+    if rad * rad > aw * (1 + ROUNDED_UP_REL) ** 2:
+        # r_B is √(α w̄) rounded up (the design's radius_upper), not any larger number: r_B = 3
+        # for √6 silenced the escape test below and a failing design verified (parameter
+        # audit, session 26; simulate then used that ball)
+        c.exact(
+            **text,
+            check="exact r_B² ≤ (1 + 10⁻⁶)² α w̄ (r_B is √(α w̄) rounded up)",
+            passed=False,
+            margin=aw * (1 + ROUNDED_UP_REL) ** 2 - rad * rad,
+            detail=f"r_B ≈ {fmt_up(rad)} is more than (1 + 10⁻⁶)·√(α w̄): not √(α w̄) rounded up",
+        )
         return
     escapes = rad < w_bar
     detail = (
