@@ -127,8 +127,8 @@ def test_a_scaled_entry_beyond_the_float_range_keeps_the_spec_units() -> None:
 def test_unscale_maps_rows_points_and_injections_exactly() -> None:
     s = [fmpq(2), fmpq(1, 3)]
     G = np.array([[fmpq(1), fmpq(3)], [fmpq(-1, 2), fmpq(0)]], dtype=object)
-    # {G ẽ <= 1} in e = Sẽ: rows G S⁻¹, canonical (sorted)
-    assert scaling.unscale_rows(G, s).tolist() == [[fmpq(-1, 4), 0], [fmpq(1, 2), fmpq(9)]]
+    # {G ẽ <= 1} in e = Sẽ: rows G S⁻¹, in the same order (row indices keep their facet)
+    assert scaling.unscale_rows(G, s).tolist() == [[fmpq(1, 2), fmpq(9)], [fmpq(-1, 4), 0]]
     V = np.array([[fmpq(1), fmpq(3)]], dtype=object)
     assert scaling.unscale_points(V, s).tolist() == [[fmpq(2), fmpq(1)]]
 
@@ -142,3 +142,53 @@ def test_any_diagonal_power_of_ten_gives_the_unit_design(unit, k1: int, k2: int)
     assert rep.exit_code() == 0
     assert rep.parameters["contractivity"] == unit.parameters["contractivity"]
     assert rep.parameters["facets"] == unit.parameters["facets"]
+
+
+_POLY = """[system]
+time = "discrete"
+A = {A}
+C = {C}
+[sets.omega]
+type = "polytope"
+G = {G}
+g = [12e-1, 628e-3, 599e-3, 184e-3, 283e-2]
+[method]
+key = "set-invariant"
+omega = "omega"
+eta_bar = 1e-3
+lambda = 0.9349
+algorithm = "symmetric"
+strict = true
+delta_tol = 1e-3
+fallback = "general"
+linear_law = true
+max_iterations = 25
+"""
+
+
+def test_the_designed_linear_gain_maps_with_the_coordinates() -> None:
+    """p = n − 1: the admissible gains are found in the design's coordinates and mapped back
+    (L = S L̃). The max-margin pick was made in the spec's coordinates and a rescaled spec,
+    S = diag(10⁻⁸, 10⁵), got L = [−6.07e7; 1.83e−6] instead of S⁻¹L = [−4.87e7; 1.81e−6]
+    (scaling trial, session 26)."""
+    unit = _POLY.format(
+        A="[[7018e-4, -3243e-4], [-1918e-4, -176e-3]]",
+        C="[[105e-2, 694e-3]]",
+        G="[[116e-2, -305e-1], [-245e-3, -154e-1], [-476e-3, 170e-0], [-152e-2, -142e-0], "
+        "[-924e-3, 978e-1]]",
+    )
+    scaled = _POLY.format(
+        A="[[7018e-4, -3243000000000], [-1918e-17, -176e-3]]",
+        C="[[105e-10, 69400]]",
+        G="[[116e-10, -3050000], [-245e-11, -1540000], [-476e-11, 17000000], "
+        "[-152e-10, -14200000], [-924e-11, 9780000]]",
+    )
+    a = api.design(load_spec_text(unit, "unit.toml"))
+    b = api.design(load_spec_text(scaled, "scaled.toml"))
+    assert a.exit_code() == 0 and b.exit_code() == 0
+    s = [1 / fmpq(10**8), fmpq(10**5)]
+    La = np.asarray(a.parameters["L"], dtype=object)
+    Lb = np.asarray(b.parameters["L"], dtype=object)
+    assert [[Lb[i, 0] * s[i]] for i in range(2)] == [[La[i, 0]] for i in range(2)]
+    assert a.parameters["L_factor"] == b.parameters["L_factor"]
+    assert api.verify(b).exit_code() == 0

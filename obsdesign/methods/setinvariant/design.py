@@ -254,13 +254,21 @@ def _vec_text(M: np.ndarray) -> str:
     )
 
 
-def polytope_params(spec: Spec, data: Data, stage: Stage, notes: list[str]) -> Parameters:
+def polytope_params(
+    spec: Spec,
+    data: Data,
+    stage: Stage,
+    notes: list[str],
+    scaled: tuple[Data, Stage, list[fmpq]] | None = None,
+) -> Parameters:
     """Every reported quantity derived from a proved polytope: G, V, the certified factor and
     the injection table of Proposition 4.1 (breakpoints = Z_d, v^l, and the interpolation (12)
     L^j, w^j) for one output, and the admissible linear gains of Proposition 7.1 (p = n − 1).
 
     ``spec``: the bound spec; ``data``: its float/exact problem; ``stage``: the polytope;
-    ``notes``: report notes (appended to)."""
+    ``notes``: report notes (appended to); ``scaled``: the design's coordinates (data, the
+    same polytope there, s of :mod:`.scaling`), where the linear gains are chosen and mapped
+    back (L = S L̃)."""
     o: Options = spec.options
     s = spec.system
     exact = data.ex is not None
@@ -285,11 +293,13 @@ def polytope_params(spec: Spec, data: Data, stage: Stage, notes: list[str]) -> P
                 f"{res.exact_lp} breakpoint injections came from the exact (cdd.gmp) LP (9)"
             )
     if o.linear_law and s.p == s.n - 1:
-        gs = (
-            admissible_gains(data.ex, G, V)
-            if data.ex is not None
-            else numerical.float_gains(data.fl, float(o.lam), G, V)
-        )
+        if data.ex is None:
+            gs = numerical.float_gains(data.fl, float(o.lam), G, V)
+        elif scaled is not None:
+            work, found, sc = scaled
+            gs = scaling.unscale_gains(admissible_gains(work.ex, found.G, found.vrep.V), sc)
+        else:
+            gs = admissible_gains(data.ex, G, V)
         if gs.L is not None:
             params["L"] = gs.L
             params["L_factor"] = gs.factor
@@ -330,6 +340,7 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
         check_detectable(spec.system.A.q, spec.system.C.q, o.lam)
         work, s = scaling.scaled(data)
         run = _iterate(spec, work, progress)
+        found = run.stage  # in the design's coordinates
         if s is not None:
             _unscale(run, s)
     except po.PolytopeError as e:
@@ -344,7 +355,9 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
             f"{float(o.lam):.3g} may be too thin, too small or too large for float arithmetic)"
         ) from e
     notes = list(run.notes)
-    params = polytope_params(spec, data, run.stage, notes)
+    # the linear gains are chosen where the polytope was found (the max-margin LP is not
+    # scale-free: a diagonally rescaled spec got another L; scaling trial, session 26)
+    params = polytope_params(spec, data, run.stage, notes, None if s is None else (work, found, s))
     params["iterations"] = run.iterations
     params["converged"] = bool(run.converged)
     for k, v in run.extra.items():

@@ -28,6 +28,7 @@ from obsdesign.sets import polytope_ops as po
 
 from .algorithms import Problem
 from .certificate import ExactProblem, Theorem31Result
+from .linear import GainSet
 from .problem import Data
 
 
@@ -83,8 +84,27 @@ def scale_columns(G: np.ndarray, s: list[fmpq]) -> np.ndarray:
 
 
 def unscale_rows(G: np.ndarray, s: list[fmpq]) -> np.ndarray:
-    """The canonical rows G̃S⁻¹ of {G̃ ẽ <= 1} in the spec's coordinates e = Sẽ."""
-    return po.canonical(scale_columns(G, [1 / x for x in s]))
+    """The rows G̃S⁻¹ of {G̃ ẽ <= 1} in the spec's coordinates e = Sẽ, in the same order (so
+    a row index, e.g. Proposition 7.1's Q_I, names the same facet in both)."""
+    return scale_columns(G, [1 / x for x in s])
+
+
+def unscale_gain(L: np.ndarray, s: list[fmpq]) -> np.ndarray:
+    """A gain of v = L z in the spec's coordinates: v = S ṽ, so L = S L̃ (row i times s_i)."""
+    L = np.asarray(L, dtype=object)
+    out = np.array([[x * s[i] for x in row] for i, row in enumerate(L)], dtype=object)
+    return out.reshape(L.shape)
+
+
+def unscale_gains(gs: GainSet, s: list[fmpq]) -> GainSet:
+    """The admissible linear gains (Proposition 7.1) found in ẽ, in the spec's coordinates:
+    every gain L = S L̃; the factor, the dimension and the row indices are unchanged."""
+    return dataclasses.replace(
+        gs,
+        L=None if gs.L is None else unscale_gain(gs.L, s),
+        vertices=[unscale_gain(v, s) for v in gs.vertices],
+        prop71=[(i, unscale_gain(Lp, s)) for i, Lp in gs.prop71],
+    )
 
 
 def unscale_points(V: np.ndarray, s: list[fmpq]) -> np.ndarray:
