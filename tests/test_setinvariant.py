@@ -800,3 +800,40 @@ def test_admissibility_counts_only_the_samples_the_run_uses(k: int, admissible: 
     )
     res = api.simulate(load_spec_text(text, "last.toml"))
     assert res.info["admissible_scenario"] is admissible
+
+
+DIVERGING = """[system]
+time = "discrete"
+A = [[-1534e-4, -6418e-4, -604e-3], [1031e-4, 2395e-4, 5455e-4], [-3251e-4, -3657e-5, 6603e-4]]
+C = [[452e-3, -203e-2, 463e-3]]
+B1 = [-146e-4, -388e-4, 569e-4]
+[sets.omega]
+type = "box"
+lower = [-173e-3, -94e-2, -421e-5]
+upper = [705e-3, 147e-3, 17e-4]
+[sets.D]
+type = "box"
+dim = 1
+lower = [-1]
+upper = [1]
+[method]
+key = "set-invariant"
+omega = "omega"
+disturbance = "D"
+eta_bar = 0
+lambda = 0.9914
+algorithm = "general"
+mirror = false
+delta_tol = 1e-3
+max_iterations = 25
+time_limit = 60
+"""
+
+
+def test_a_diverging_iteration_is_not_converged_exit_1_not_a_solver_failure() -> None:
+    """The general algorithm grows this polyhedron to ~10⁹ Ω-units, where HiGHS fails on LP
+    (9): that ended with exit 3 "HiGHS failed on LP (9)" (scaling trial, session 26). An LP
+    failure past algorithms.LP_GROWTH times Ω's size is the iteration diverging, and a final
+    stage that cannot finish for a run that did not converge is "not converged", exit 1."""
+    with pytest.raises(InfeasibleError, match="not converged: the iteration diverges after"):
+        api.design(load_spec_text(DIVERGING, "diverging.toml"))

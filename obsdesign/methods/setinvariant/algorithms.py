@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from obsdesign.errors import SolverError
 from obsdesign.sets import polytope_ops as po
 
 from . import lps
@@ -64,8 +65,11 @@ class IterResult:
     history: list[dict[str, float]] = field(default_factory=list)
     #: stopped at the time budget (``deadline``), not at the iteration cap
     timed_out: bool = False
-    #: stopped because the polyhedron grew past :data:`GROWTH_MAX` times Ω's size
+    #: stopped because the polyhedron grew past :data:`GROWTH_MAX` times Ω's size, or past
+    #: :data:`LP_GROWTH` times it with LP (9) failing there
     diverged: bool = False
+    #: why it was stopped as diverging (for the report's note)
+    why: str = ""
 
 
 #: the general algorithm stops, not converged, when a new vertex lies more than this many
@@ -73,6 +77,10 @@ class IterResult:
 #: audit's A = [[0.14, 0], [726.54, 0.12]] grew to 10²⁰ and ended with exit 4 "out of a float
 #: LP's range"); a polyhedron that size is beyond what the float LPs and hulls resolve anyway
 GROWTH_MAX = 1e10
+#: a failure of HiGHS on LP (9) while the polyhedron lies more than this many times Ω's size
+#: from the origin is the iteration diverging, not a solver failure (a 3-state system at
+#: 3·10⁹ Ω-units ended with exit 3 "HiGHS failed on LP (9)"; scaling trial, session 26)
+LP_GROWTH = 1e6
 
 
 def _drop_inside(
@@ -170,6 +178,12 @@ def general(
             er = _eps_screened(G, phi, dl, zs, prev, lam_stop, deadline)  # step 4b
         except Timeout:  # the budget ran out inside the iteration
             return IterResult(G, P, eps_l, it - 1, False, hist, timed_out=True)
+        except SolverError as e:
+            size = float(np.max(np.linalg.norm(P, axis=1)))
+            if not size > LP_GROWTH * float(np.max(np.linalg.norm(Vo, axis=1))):
+                raise
+            why = f"LP (9) failed ({e.message}) on a polyhedron {size:.3g} from the origin"
+            return IterResult(G, P, eps_l, it - 1, False, hist, diverged=True, why=why)
         prev = (zs, er.v)
         l = int(np.argmax(er.eps))  # step 5
         eps_l = float(er.eps[l])

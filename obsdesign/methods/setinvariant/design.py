@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 from flint import fmpq
 
-from obsdesign.errors import InconclusiveError, SolverError
+from obsdesign.errors import InconclusiveError, InfeasibleError, SolverError
 from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
 from obsdesign.params import Parameters
 from obsdesign.sets import polytope_ops as po
@@ -101,6 +101,27 @@ def final_stage(
     return Stage(Gq, vrep, res)
 
 
+def _final_of(
+    r: al.IterResult, data: Data, single: bool, lam: float, dl: float, o: Options
+) -> Stage:
+    """:func:`final_stage` of an iteration's last cloud. For a run that did not converge, a
+    final stage that cannot finish (the budget, an LP beyond HiGHS) ends the design as not
+    converged, exit 1, not as a solver failure (a diverging run whose last 381-facet
+    polyhedron plainly failed Theorem 3.1 used the budget on it and ended with exit 3;
+    scaling trial, session 26)."""
+    try:
+        return final_stage(data, r.P, single, lam, dl, o)
+    except SolverError as e:
+        if r.converged:
+            raise
+        how = "diverges" if r.diverged else "did not converge"
+        raise InfeasibleError(
+            f"not converged: the iteration {how} after {r.iterations} iterations (last ε = "
+            f"{r.eps:.6g} > λ = {lam:g}), and the exact check of its last polyhedron did not "
+            f"finish ({e.message}), so it is not reported"
+        ) from None
+
+
 def _merged(Pq: np.ndarray) -> np.ndarray | None:
     """The float hull's rows of the exact points (near-coplanar facets merged: 492 rows
     where the exact hull has 548 on a random 3-state system), for LP (9); None if qhull
@@ -129,9 +150,11 @@ def _budget(r: al.IterResult, o: Options, run: _Run) -> None:
     diverged (:data:`algorithms.GROWTH_MAX`) gets a note saying so (it is reported not
     converged, exit 1, with its last polyhedron)."""
     if r.diverged:
+        where = (
+            r.why or f"a new vertex lies more than {al.GROWTH_MAX:g} times Ω's size from the origin"
+        )
         run.notes.append(
-            f"the general algorithm diverges: after {r.iterations} iterations a new vertex lies "
-            f"more than {al.GROWTH_MAX:g} times Ω's size from the origin (last ε = "
+            f"the general algorithm diverges: after {r.iterations} iterations {where} (last ε = "
             f"{r.eps:.6g} > λ = {float(o.lam):g}); stopped there, not converged"
         )
     if r.timed_out:
@@ -167,7 +190,7 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
         )
         _budget(r, o, run)
         run.iterations, run.converged = r.iterations, r.converged
-        run.stage = final_stage(data, r.P, single, lam, dl, o)
+        run.stage = _final_of(r, data, single, lam, dl, o)
         res = run.stage.res
         if r.converged and single and res is not None and not res.ok:
             sym_failed = True
@@ -199,7 +222,7 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
                 )  # fmt: skip
                 _budget(r, o, run)
                 run.iterations, run.converged = r.iterations, r.converged
-                run.stage = final_stage(data, r.P, single, lam, dl, o)
+                run.stage = _final_of(r, data, single, lam, dl, o)
                 run.notes.append(
                     f"general algorithm (Section V) continued from C_K^∞: {r.iterations} "
                     "iterations in all"
@@ -213,7 +236,7 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
         )  # fmt: skip
         _budget(r, o, run)
         run.iterations, run.converged = r.iterations, r.converged
-        run.stage = final_stage(data, r.P, single, lam, dl, o)
+        run.stage = _final_of(r, data, single, lam, dl, o)
     res = run.stage.res
     if single and o.strict and run.converged and res is not None and not res.ok:
         if o.algorithm != "none" and float(res.factor) <= lam * (1 + 2 * dd):
@@ -230,7 +253,7 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
                 )  # fmt: skip
                 _budget(r, o, run)
                 run.iterations, run.converged = r.iterations, r.converged
-                run.stage = final_stage(data, r.P, single, lam, dl, o)
+                run.stage = _final_of(r, data, single, lam, dl, o)
     return run
 
 
