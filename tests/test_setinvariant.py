@@ -802,32 +802,12 @@ def test_admissibility_counts_only_the_samples_the_run_uses(k: int, admissible: 
     assert res.info["admissible_scenario"] is admissible
 
 
-DIVERGING = """[system]
-time = "discrete"
-A = [[-1534e-4, -6418e-4, -604e-3], [1031e-4, 2395e-4, 5455e-4], [-3251e-4, -3657e-5, 6603e-4]]
-C = [[452e-3, -203e-2, 463e-3]]
-B1 = [-146e-4, -388e-4, 569e-4]
-[sets.omega]
-type = "box"
-lower = [-173e-3, -94e-2, -421e-5]
-upper = [705e-3, 147e-3, 17e-4]
-[sets.D]
-type = "box"
-dim = 1
-lower = [-1]
-upper = [1]
-[method]
-key = "set-invariant"
-omega = "omega"
-disturbance = "D"
-eta_bar = 0
-lambda = 0.9914
-algorithm = "general"
-mirror = false
-delta_tol = 1e-3
-max_iterations = 25
-time_limit = 60
-"""
+DIVERGING = matrix_spec_text(
+    [[-0.1534, -0.6418, -0.604], [0.1031, 0.2395, 0.5455], [-0.3251, -0.03657, 0.6603]],
+    [-0.0146, -0.0388, 0.0569], [[0.452, -2.03, 0.463]], 0.9914, eta_bar=0,
+    omega=([-0.173, -0.94, -0.00421], [0.705, 0.147, 0.0017]), algorithm="general",
+    mirror=False, delta_tol=0.001, max_iterations=25, time_limit=60,
+)  # fmt: skip
 
 
 def test_a_diverging_iteration_is_not_converged_exit_1_not_a_solver_failure() -> None:

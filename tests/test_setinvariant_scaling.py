@@ -15,6 +15,7 @@ from obsdesign import api
 from obsdesign.api import load_spec_text
 from obsdesign.methods.setinvariant import scaling
 from obsdesign.methods.setinvariant.problem import build
+from obsdesign.methods.setinvariant.spectext import spec_text
 
 # a random 2-state system (seed 3 of the session-26 scale study): 10 facets certified in
 # the spec's units, and "not converged" (8 facets, exit 1) once rescaled by 10⁶ before
@@ -23,49 +24,19 @@ B1 = [Fraction(-29, 2500), Fraction(-433, 10000)]
 C = [Fraction(-539, 2500), Fraction(-101, 50)]
 
 
-def _dec(q: Fraction) -> str:
-    """Exact decimal text of a rational whose denominator divides a power of 10."""
-    sign, q, k = ("-" if q < 0 else ""), abs(q), 0
-    while q.denominator != 1:
-        q, k = q * 10, k + 1
-    return f"{sign}{q.numerator}e-{k}"
-
-
-def _spec(ks: tuple[int, ...], lam: str = "0.7712") -> str:
+def _spec(ks: tuple[int, ...], lam: float = 0.7712) -> str:
     """The system in the coordinates x' = S⁻¹x, S = diag(10^k): A' = S⁻¹AS, B1' = S⁻¹B1,
-    C' = CS, Ω' = S⁻¹[-1, 1]², written exactly."""
+    C' = CS, Ω' = S⁻¹[-1, 1]² (every entry has at most 4 significant digits, so its
+    shortest float repr is the exact decimal)."""
     s = [Fraction(10) ** k for k in ks]
-    Ap = [[A[i][j] * s[j] / s[i] for j in range(2)] for i in range(2)]
-    rows = ", ".join("[" + ", ".join(_dec(x) for x in r) + "]" for r in Ap)
-    b = ", ".join(_dec(B1[i] / s[i]) for i in range(2))
-    c = ", ".join(_dec(C[j] * s[j]) for j in range(2))
-    lo = ", ".join(_dec(-1 / x) for x in s)
-    up = ", ".join(_dec(1 / x) for x in s)
-    return f"""[system]
-time = "discrete"
-A = [{rows}]
-B1 = [{b}]
-C = [[{c}]]
-[sets.omega]
-type = "box"
-lower = [{lo}]
-upper = [{up}]
-[sets.D]
-type = "box"
-dim = 1
-lower = [-1]
-upper = [1]
-[method]
-key = "set-invariant"
-omega = "omega"
-disturbance = "D"
-eta_bar = 0.01
-lambda = {lam}
-algorithm = "general"
-mirror = true
-delta_tol = 0.001
-max_iterations = 60
-"""
+    Ap = [[float(A[i][j] * s[j] / s[i]) for j in range(2)] for i in range(2)]
+    Bp = [float(B1[i] / s[i]) for i in range(2)]
+    Cp = [[float(C[j] * s[j]) for j in range(2)]]
+    omega = ([float(-1 / x) for x in s], [float(1 / x) for x in s])
+    return spec_text(
+        Ap, Bp, Cp, lam, omega=omega, algorithm="general", mirror=True, delta_tol=0.001,
+        max_iterations=60,
+    )  # fmt: skip
 
 
 @pytest.fixture(scope="module")
@@ -116,9 +87,7 @@ def test_the_extents_are_exact_and_the_scaled_omega_has_unit_extent() -> None:
 
 def test_a_scaled_entry_beyond_the_float_range_keeps_the_spec_units() -> None:
     """Ω's extents 10⁻²⁰⁰ and 10²⁰⁰: S⁻¹AS would hold 10⁴⁰⁰, so the data stay as they are."""
-    text = _spec((0, 0)).replace("lower = [-1e-0, -1e-0]", "lower = [-1e-200, -1e200]")
-    text = text.replace("upper = [1e-0, 1e-0]", "upper = [1e-200, 1e200]")
-    assert "1e200" in text
+    text = spec_text(A, B1, [C], 0.7712, omega=([-1e-200, -1e200], [1e-200, 1e200]))
     data = build(api.bind(load_spec_text(text, "far.toml")))
     same, s = scaling.scaled(data)
     assert s is None and same is data

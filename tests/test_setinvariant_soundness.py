@@ -1000,31 +1000,11 @@ def test_phi_ignores_a_vertex_just_outside_the_slab(sign: int, K: int, d: fmpq) 
     assert sl.phi_exact(l) == want
 
 
-ASYMMETRIC_OMEGA = """[system]
-time = "discrete"
-A = [[5495e-4, 393e-4], [-1466e-3, 9347e-4]]
-C = [[62e-2, 184e-2]]
-B1 = [-175e-5, -236e-5]
-[sets.omega]
-type = "box"
-lower = [-118e-5, -694e-4]
-upper = [325e-4, 254e-4]
-[sets.D]
-type = "box"
-dim = 1
-lower = [-1]
-upper = [1]
-[method]
-key = "set-invariant"
-omega = "omega"
-disturbance = "D"
-eta_bar = 0
-lambda = 0.9369
-algorithm = "general"
-mirror = true
-delta_tol = 1e-3
-max_iterations = 25
-"""
+ASYMMETRIC_OMEGA = spec_text(
+    [[0.5495, 0.0393], [-1.466, 0.9347]], [-0.00175, -0.00236], [[0.62, 1.84]], 0.9369,
+    eta_bar=0, omega=([-0.00118, -0.0694], [0.0325, 0.0254]), algorithm="general",
+    mirror=True, delta_tol=0.001, max_iterations=25,
+)  # fmt: skip
 
 
 def test_an_asymmetric_polyhedron_needs_only_a_translate_of_B1_D_inside() -> None:

@@ -445,24 +445,19 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         b.leq(m, 1)[1],
     )
     ok, m = b.necessary(G)
-    if ok:
-        emit(
-            "necessary-condition",
-            ok,
-            f"max_i δ_i = {b.show(m)}",
-            b.margin(o.lam, m),
-            b.leq(m, b.lam)[1],
-        )
-    else:  # the centred inclusion fails: only a translate of B1·D must fit
-        ok, eps = b.necessary_shifted(G)
-        emit(
-            "necessary-condition",
-            ok,
-            f"max_i δ_i = {b.show(m)} > λ; min over v of max_i (G_i v + δ_i) = {b.show(eps)}",
-            b.margin(o.lam, eps),
-            b.leq(eps, b.lam)[1],
-            d=SHIFTED_NECESSARY,
-        )
+    detail, level, d = f"max_i δ_i = {b.show(m)}", m, None
+    if not ok:  # the centred inclusion fails: only a translate of B1·D must fit
+        ok, level = b.necessary_shifted(G)
+        detail += f" > λ; min over v of max_i (G_i v + δ_i) = {b.show(level)}"
+        d = SHIFTED_NECESSARY
+    emit(
+        "necessary-condition",
+        ok,
+        detail,
+        b.margin(o.lam, level),
+        b.leq(level, b.lam)[1],
+        d=d,
+    )
     if s.p == 1:
         _single_output(spec, params, b, emit, G, vrep)
     _linear(spec, params, b, emit, G, V)

@@ -26,6 +26,11 @@ def matrix_text(M: np.ndarray | Sequence[Sequence[float]]) -> str:
     return "[" + ", ".join("[" + ", ".join(repr(float(v)) for v in r) + "]" for r in rows) + "]"
 
 
+def _row_text(v: Sequence[float]) -> str:
+    """A vector as a TOML array, each entry ``repr(float(x))``."""
+    return "[" + ", ".join(repr(float(x)) for x in v) + "]"
+
+
 def _value_text(v: object) -> str:
     """A TOML value: bool → true/false, str → quoted, int as is, other numbers ``repr(float)``."""
     if isinstance(v, (bool, np.bool_)):
@@ -44,11 +49,12 @@ def spec_text(
     lam: float,
     bound: float = 1,
     eta_bar: float | None = 0.01,
+    omega: tuple[Sequence[float], Sequence[float]] | None = None,
     **method_keys: object,
 ) -> str:
     """The TOML spec of a set-invariant design for the plant (A, B1, C).
 
-    Ω is the box [-1, 1]ⁿ, the disturbance set D = [-bound, bound] (one disturbance through
+    Ω is the box [-1, 1]ⁿ (or ``omega``), the disturbance set D = [-bound, bound] (one disturbance through
     the column B1), λ the contraction rate of eq. (5) and η̄ the noise bound of eq. (2).
 
     Args:
@@ -58,6 +64,7 @@ def spec_text(
         lam: λ in (0, 1), written as ``lambda = <lam>``.
         bound: the disturbance bound (D = [-bound, bound]).
         eta_bar: η̄ (``None`` leaves ``eta_bar`` out: no noise).
+        omega: Ω's box as (lower, upper) bounds; default [-1, 1]ⁿ.
         **method_keys: further ``[method]`` keys in order, e.g. ``algorithm="general",
             mirror=True, delta_tol=0.001, max_iterations=60`` (bool → true/false, str →
             quoted, numbers by ``repr``).
@@ -75,8 +82,8 @@ def spec_text(
         f"C = {matrix_text(C)}",
         "[sets.omega]",
         'type = "box"',
-        f"lower = {[-1.0] * n}",
-        f"upper = {[1.0] * n}",
+        f"lower = {_row_text(omega[0] if omega else [-1.0] * n)}",
+        f"upper = {_row_text(omega[1] if omega else [1.0] * n)}",
         "[sets.D]",
         'type = "box"',
         "dim = 1",
