@@ -748,14 +748,31 @@ def write_table(path: Path, rows: list[dict[str, Any]], force: bool = False) -> 
             import pyarrow as pa
             import pyarrow.parquet as pq
 
-            data = {c: [_parquet_cell(r.get(c)) for r in rows] for c in cols}
+            data = {c: _parquet_column([r.get(c) for r in rows]) for c in cols}
             pq.write_table(pa.table(data), str(tmp))
 
     write_via(path, w, force)
 
 
-def _parquet_cell(v: Any) -> Any:
-    return v
+def _kind(v: Any) -> str:
+    if isinstance(v, bool):
+        return "bool"
+    if isinstance(v, numbers.Real):
+        return "number"
+    return type(v).__name__
+
+
+def _parquet_column(values: list[Any]) -> list[Any]:
+    """A column Arrow can type: as it is when its values (None aside) are of one kind
+    (numbers of both int and float become doubles), else every value as its text (a swept
+    value a double cannot show is text beside numbers, and pyarrow raised ArrowTypeError:
+    exit 3; re-run trial, session 26)."""
+    kinds = {_kind(v) for v in values if v is not None}
+    if len(kinds) <= 1:
+        return values
+    return [
+        None if v is None else (v if isinstance(v, str) else json.dumps(_cell(v))) for v in values
+    ]
 
 
 def plot_sweep(

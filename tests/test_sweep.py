@@ -544,3 +544,20 @@ def test_set_key_on_random_documents_changes_exactly_that_key() -> None:
             assert json.loads(json.dumps(out)) == want, (text, parts)
 
     run()
+
+
+def test_parquet_of_a_column_mixing_text_and_numbers(tmp_path: Path) -> None:
+    """A swept value a double cannot show is text beside numbers; pyarrow refused that
+    column (ArrowTypeError, exit 3; re-run trial, session 26). Such a column is written as
+    text; one-kind columns keep their type."""
+    pq = pytest.importorskip("pyarrow.parquet")
+    rows = [
+        {"point": 0, "method.lambda": "0.9999999999999999999999", "exit_code": 0},
+        {"point": 1, "method.lambda": 0.97, "exit_code": 0},
+        {"point": 2, "method.lambda": None, "exit_code": 2},
+    ]
+    out = tmp_path / "t.parquet"
+    sw.write_table(out, rows)
+    got = pq.read_table(out).to_pydict()
+    assert got["method.lambda"] == ["0.9999999999999999999999", "0.97", None]
+    assert got["exit_code"] == [0, 0, 2] and got["point"] == [0, 1, 2]
