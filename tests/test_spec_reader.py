@@ -89,3 +89,14 @@ def test_number_beyond_the_float_range_is_bad_input(tmp_path, key: str) -> None:
         res.output
     )
     assert "Traceback" not in res.output and not out.exists()
+
+
+@pytest.mark.parametrize("empty", [[], [[], []]])
+def test_an_empty_matrix_says_to_leave_the_key_out(empty: list) -> None:
+    """B = [] (or [[], []]) for a plant without inputs said only "of shape 2×?" (edge-shape
+    trial, session 26); the message now says an empty matrix is not one and what to do."""
+    with pytest.raises(SpecError, match=r"t.toml.*\[B\].*not matrices .*leaves B, D or Bd out"):
+        Table({"B": empty}, "t.toml", checked=True).matrix("B", rows=2)
+    with pytest.raises(SpecError) as e:  # a malformed, non-empty matrix: no such hint
+        Table({"B": [[1], "x"]}, "t.toml", checked=True).matrix("B", rows=2)
+    assert "leave" not in str(e.value)

@@ -216,8 +216,17 @@ class Table:
         if isinstance(v, list) and v and all(_is_number(x) for x in v):
             v = [v] if vector_as == "row" else [[x] for x in v]
         if not isinstance(v, list) or not v or not all(isinstance(r, list) and r for r in v):
+            empty = isinstance(v, list) and all(isinstance(r, list) and not r for r in v)
+            # B = [] or [[], []] for a plant without inputs said only "of shape 2×?" (edge-
+            # shape trial, session 26): an empty matrix is no matrix, omit the key
+            hint = (
+                "; [] and [[], ...] are not matrices (a plant without inputs or disturbances "
+                "leaves B, D or Bd out)"
+                if empty
+                else ""
+            )
             raise self.error(
-                k, f"expected a matrix (a list of rows of numbers){_shape(rows, cols)}"
+                k, f"expected a matrix (a list of rows of numbers){_shape(rows, cols)}{hint}"
             )
         widths = {len(r) for r in v}
         if len(widths) != 1:
