@@ -324,22 +324,9 @@ def _read_report(report: Path) -> Any:
     """The report path, or for ``-`` the report read from stdin (a Report)."""
     if not _is_stdin(report):
         return report
-    import json
+    from obsdesign.report.model import Report
 
-    from obsdesign.errors import InputError
-    from obsdesign.limits import int_digits
-    from obsdesign.report.model import Report, no_lone_surrogates
-
-    text = _read_stdin("report")
-    try:
-        with int_digits():
-            d = json.loads(text)
-    except json.JSONDecodeError as e:
-        raise InputError(f"{STDIN_NAME}: not a readable JSON report ({e})") from None
-    except RecursionError:
-        raise InputError(f"{STDIN_NAME}: JSON nested too deeply") from None
-    no_lone_surrogates(text, d, STDIN_NAME)
-    return Report.from_dict(d, STDIN_NAME)[0]
+    return Report.from_text(_read_stdin("report"), STDIN_NAME)[0]
 
 
 def _json_only(v: Any) -> bool:

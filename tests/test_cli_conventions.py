@@ -88,6 +88,26 @@ def test_stdin_spec_quiet_and_verdict(tmp_path: Path):
     assert code == 1 and out.startswith("NOT verified: ")
 
 
+def test_stdin_report_is_parsed_like_a_file(tmp_path: Path):
+    """``verify -`` refuses a key repeated in one JSON object, as ``verify FILE`` does, with
+    exit 2 naming <stdin> and the key: stdin skipped the duplicate-key check and verified the
+    last of two "parameters" copies (session 27), while other readers take the first."""
+    out_json = tmp_path / "r.json"
+    assert _run("design", "-", "-q", "-o", str(out_json), input=SPEC)[0] == 0
+    text = out_json.read_text()
+    bad = text.replace('"parameters":', '"parameters": {}, "parameters":', 1)
+    for args in (("verify", "-"), ("verify", str(_write(tmp_path / "bad.json", bad)))):
+        code, out, err = _run(*args, "-q", input=bad)
+        assert code == 2 and out == "", err
+        assert "key 'parameters' appears twice in one JSON object" in err
+        assert ("<stdin>" in err) == (args[1] == "-")
+
+
+def _write(p: Path, text: str) -> Path:
+    p.write_text(text)
+    return p
+
+
 def test_stdin_output_checks_still_refuse(tmp_path: Path):
     target = tmp_path / "t.json"
     target.write_text("{}")
