@@ -308,6 +308,29 @@ def test_junit_over_a_spec_inside_a_checked_folder(spec: Path):
     assert spec.read_bytes() == before
 
 
+def test_an_existing_toml_file_is_never_an_output(spec: Path, tmp_path: Path):
+    """No output is TOML, so an existing .toml is somebody's spec: refused for -o, --csv and
+    check --junit (a .toml in a hidden folder, which check skips, was replaced by the JUnit XML:
+    session 26), byte-for-byte intact; design -o --force still replaces it, and a new .toml
+    name is written."""
+    hidden = tmp_path / ".old"
+    hidden.mkdir()
+    other = hidden / "other.toml"
+    shutil.copy(SPEC, other)
+    before = other.read_bytes()
+    for args in (
+        ["check", str(tmp_path), "--junit", str(other)],
+        ["design", str(spec), "-o", str(other)],
+        ["simulate", str(spec), "--csv", str(other)],
+    ):
+        _refused(runner.invoke(app, args), str(other), "is a spec file (.toml)")
+        assert other.read_bytes() == before
+    res = runner.invoke(app, ["design", str(spec), "-q", "-o", str(other), "--force"])
+    assert res.exit_code == 0 and json.loads(other.read_text())["verdict"] == "ok"
+    new = tmp_path / "new.toml"
+    assert runner.invoke(app, ["design", str(spec), "-q", "-o", str(new)]).exit_code == 0
+
+
 def test_an_output_folder_that_takes_no_file_is_refused_before_the_work(
     spec: Path, tmp_path: Path, monkeypatch
 ):

@@ -450,7 +450,8 @@ def no_lone_surrogates(raw: bytes | str, d: Any, file: str) -> None:
 def check_output(path: str | Path, force: bool = False, inputs: tuple[Path, ...] = ()) -> None:
     """Refuse (:class:`InputError`, one line) an output path that would destroy something:
     one of ``inputs`` (the spec itself), a symbolic link, an existing file that is not a
-    regular file (device, FIFO, socket), or a write-protected file, unless ``force``; a
+    regular file (device, FIFO, socket), a write-protected file, or an existing ``.toml``
+    file (no output is TOML), unless ``force``; a
     directory, a path given for two outputs, or a directory that cannot take a new file
     always. Nothing is written here (an empty probe file is created and removed). ``-``
     (stdin for a spec) is refused as an output: it wrote a file named ``-`` (a path with a
@@ -498,6 +499,10 @@ def check_output(path: str | Path, force: bool = False, inputs: tuple[Path, ...]
             f"{p}: is not a regular file (device, FIFO or socket); refusing to replace it "
             f"(--force writes into it)"
         )
+    if stat.S_ISREG(st.st_mode) and p.suffix.lower() == ".toml" and not force:
+        # no output of this tool is TOML: an existing .toml is somebody's spec (check --junit
+        # x/.hidden/s.toml replaced a spec the run skipped: session 26)
+        raise InputError(f"{p}: is a spec file (.toml); refusing to replace it (--force)")
     protected = not os.access(p, os.W_OK) or not st.st_mode & 0o222  # (root ignores access)
     if stat.S_ISREG(st.st_mode) and protected and not force:
         raise InputError(f"{p}: is write-protected; refusing to replace it (--force)")
