@@ -89,3 +89,23 @@ def test_markdown_rows_keep_their_columns_whatever_the_text() -> None:
     pipes = [len(re.findall(r"(?<!\\)\|", ln)) for ln in rows]
     assert set(pipes) == {4, 7}, pipes  # 3 and 6 columns
     assert "- first \\| line second line" in text.splitlines()
+
+
+def test_parameter_tables_mark_rounded_values(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The text and Markdown parameter tables show "≈" before a value rounded for display
+    and nothing before one shown exactly (the certified rate α = 43333331/20000000 showed as
+    "2.16667 exact", above the end its bracket proves infeasible: rendering trial, session
+    27); the continuous lyapunov spec of that trial."""
+    spec = api.load_spec_text(
+        '[system]\ntime = "continuous"\nA = [[0, 1], [-2, -3]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\nL = [1.3333333, 0.7777777]\nrate_tol = 0.0000001\n',
+        "alpha.toml",
+    )
+    rep = api.design(spec)
+    assert rep.exit_code() == 0 and str(rep.parameters["alpha"]) == "43333331/20000000"
+    rows = {k: v for k, v, _ in render._param_rows(rep)}
+    assert rows["alpha"] == "≈ 2.16667" and rows["L"] == "≈ [1.33333; 0.777778]"
+    md = render.render_markdown(rep)
+    assert "| alpha | `≈ 2.16667` | exact |" in md
+    assert "≈ 2.16667" in _rendered(monkeypatch, rep)
+    assert rows["alpha_bracket"].startswith("≈ ")

@@ -266,24 +266,24 @@ class Method:
     # -- generic parts ----------------------------------------------------------------------
     def summary(self, params: Parameters) -> str:
         """One short line of the key results (from ``summary_fields``): scalars formatted, a
-        vector or matrix as ``[a, b; c, d]`` (rows separated by ';')."""
-        import numpy as np
+        vector or matrix as ``[a, b; c, d]`` (rows separated by ';'); ``label ≈ …`` when the
+        decimal shown is not the value held (:mod:`obsdesign.report.shown`: "κ = 2, κ_n = 2"
+        for κ = 1.99999185 < κ_n = 1.99999385 read as condition (22) failing; rendering
+        trial, session 27)."""
+        from obsdesign.report.shown import item
 
         out = []
         for f in self.summary_fields:
             if f.param not in params:
                 continue
             fmt = f.fmt or self.summary_format
+            raw = params[f.param]
             try:
-                v = np.asarray(params.float(f.param), dtype=float)
-                if v.ndim == 0:
-                    text = format(float(v), fmt)
-                else:
-                    rows = v if v.ndim == 2 else v.reshape(1, -1)
-                    text = "[" + "; ".join(", ".join(format(x, fmt) for x in r) for r in rows) + "]"
+                if isinstance(raw, (bool, str, bytes)):
+                    raise TypeError("not a number")
+                out.append(item(f.label, raw, params.float(f.param), fmt))
             except (TypeError, ValueError):
-                text = str(params[f.param])
-            out.append(f"{f.label} = {text}")
+                out.append(f"{f.label} = {raw}")
         return ", ".join(out)
 
     def parse_sim_options(self, raw: dict[str, str]) -> dict[str, Any]:

@@ -8,6 +8,7 @@ import numpy as np
 
 from obsdesign.certify.claim import ClaimStatus
 from obsdesign.report.model import Report
+from obsdesign.report.shown import cell
 
 STYLE = {
     ClaimStatus.CERTIFIED: "green",
@@ -32,11 +33,14 @@ def fmt_value(v: Any, digits: int = 6) -> str:
 def _param_rows(report: Report) -> list[tuple[str, str, str]]:
     rows = []
     for k in report.parameters:
-        v = report.parameters.float(k) if _numeric(report.parameters[k]) else report.parameters[k]
+        raw = report.parameters[k]
+        # a rounded number is marked "≈" (a certified α = 2.16666655 showed as "2.16667",
+        # a proven-infeasible rate: rendering trial, session 27)
+        text = cell(raw, report.parameters.float(k)) if _numeric(raw) else fmt_value(raw)
         form = "exact" if report.parameters.is_exact(k) else "float"
         if k in report.unverified:
             form = "not verified"
-        rows.append((k, fmt_value(v), form))
+        rows.append((k, text, form))
     return rows
 
 
@@ -52,6 +56,9 @@ def esc(text: Any) -> str:
 
 
 def _numeric(v: Any) -> bool:
+    """A number or an array of numbers (not a bool, not text that reads as one)."""
+    if isinstance(v, (bool, np.bool_, str, bytes)):
+        return False
     try:
         np.asarray(
             v if not isinstance(v, np.ndarray) or v.dtype != object else v.astype(float),

@@ -1,0 +1,62 @@
+"""Parameter values in tables and summaries (:mod:`obsdesign.report.shown`): "≈" exactly when
+the decimal shown is not the value held (rendering trial, session 27: a certified rate
+α = 43333331/20000000 showed as "2.16667 exact", a rate its bracket proves infeasible)."""
+
+from __future__ import annotations
+
+import numpy as np
+from flint import fmpq
+from hypothesis import given
+from hypothesis import strategies as st
+
+from obsdesign.certify.exact import Q
+from obsdesign.methods import get_method
+from obsdesign.params import Parameters
+from obsdesign.report.shown import cell, item, shown
+
+
+def _exact(*vals: fmpq) -> tuple[np.ndarray, np.ndarray]:
+    raw = np.array(vals, dtype=object)
+    return raw, np.array([float(v) for v in vals])
+
+
+def test_a_rounded_exact_value_is_marked() -> None:
+    alpha = fmpq(43333331, 20000000)  # 2.16666655; 2.16667 is above the proven bracket end
+    assert cell(alpha, float(alpha)) == "≈ 2.16667"
+    assert item("alpha", alpha, float(alpha), ".6g") == "alpha ≈ 2.16667"
+    assert cell(fmpq(3, 2), 1.5) == "1.5"  # exact: no mark
+    assert item("L", fmpq(-187, 100), -1.87, ".6g") == "L = -1.87"
+    # one ulp of the sixth digit away either way is rounded, in both directions
+    for q in (fmpq(1000001, 10**6), fmpq(999999, 10**6) + fmpq(1, 10**12)):
+        assert cell(q, float(q)).startswith("≈ ")
+
+
+def test_a_matrix_is_marked_when_any_entry_is_rounded() -> None:
+    raw, fl = _exact(fmpq(1), fmpq(2), fmpq(1, 3), fmpq(4))
+    assert cell(raw.reshape(2, 2), fl.reshape(2, 2)) == "≈ [1, 2; 0.333333, 4]"
+    raw, fl = _exact(fmpq(1), fmpq(-5, 2))
+    assert cell(raw, fl) == "[1, -2.5]"
+    big = fmpq(10) ** 400  # beyond the float range: shown as inf, which it is not
+    assert cell(big, float("inf")) == "≈ inf"
+
+
+def test_a_float_parameter_is_exact_when_its_text_reads_back() -> None:
+    assert cell(0.1, 0.1) == "0.1"  # the float 0.1 is what the report holds
+    assert cell(0.1 + 2**-40, 0.1 + 2**-40) == "≈ 0.1"
+    assert cell(float("inf"), float("inf")) == "inf"
+    assert cell(float("nan"), float("nan")) == "nan"
+
+
+@given(st.fractions(min_value=-1e6, max_value=1e6, max_denominator=10**9))
+def test_the_mark_is_there_iff_the_text_is_not_the_value(x) -> None:
+    q = Q(x)
+    text, same = shown(q, float(q), ".6g")
+    assert same == (Q(text) == q)
+
+
+def test_the_check_summary_marks_rounded_values() -> None:
+    """κ = 1.99999185 < κ_n = 1.99999385 were summarized "κ = 2, κ_n = 2", condition (22)
+    (κ_n > λ* + κ) read as failing."""
+    p = Parameters({"T_min": fmpq(1551, 10000), "kappa": fmpq(199999185, 10**8)})
+    s = get_method("impulsive").summary(p)
+    assert "T_min = 0.1551" in s and "κ ≈ 2" in s
