@@ -938,3 +938,20 @@ def test_a_schur_gain_with_a_float_radius_above_one_is_decided_exactly() -> None
     assert api.verify(rep).exit_code() == 0
     with pytest.raises(InfeasibleError, match=r"not Schur \(an eigenvalue of modulus ≥ 1, exact"):
         api.design(load_spec_text(_jordan_spec("[[0, 1], [-1, 0]]", 2), "rot.toml"))
+
+
+def test_rho_and_lambda_are_printed_exactly_in_their_statements():
+    """ρ and λ appear in `iss-bound` and `decay-lmi` exactly: rounded up to 10 digits,
+    ρ = 0.99999999999 read "ρ = 1, …, ρ < 1", a certified statement contradicting itself
+    (rendering trial, session 27). verify recomputes the same statements."""
+    from obsdesign.certify.exact import Q
+
+    text = variant(replace=(("rho = 0.955", "rho = 0.99999999999"),))
+    rep = api.design(load_spec_text(text, "rho.toml"))
+    st = {c.id: c for c in rep.claims}
+    iss = st["iss-bound"]
+    assert iss.status == ClaimStatus.CERTIFIED
+    assert "with ρ = 0.99999999999, " in iss.statement and "ρ = 1," not in iss.statement
+    lam = st["decay-lmi"].statement.rsplit("with λ = ", 1)[1]
+    assert Q(lam) == rep.parameters["lambda"]
+    assert api.verify(rep).exit_code() == 0

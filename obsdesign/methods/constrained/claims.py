@@ -405,7 +405,9 @@ def _linear_claims(c: Claims, spec: Spec, P: Any, rho: fmpq, mu: fmpq, lam: fmpq
     if o.P is None and lam is not None:
         c.checked(
             id="decay-lmi",
-            statement=f"(A−LC)ᵀP(A−LC) ⪯ λ²P with λ = {fmt_up(lam, 10)}",
+            # λ and ρ exactly: rounded up, ρ = 0.99999999999 printed "ρ = 1, …, ρ < 1", a
+            # certified statement contradicting itself (rendering trial, session 27)
+            statement=f"(A−LC)ᵀP(A−LC) ⪯ λ²P with λ = {fmt_exact(lam)}",
             reference=_ref("Section 5"),
             check="exact LDLᵀ over Q of λ²P − (A−LC)ᵀP(A−LC) − margin·I",
             result=check_pd(lyap.decay_matrix(A, C, L, P, lam, True), o.margin),
@@ -424,9 +426,7 @@ def _linear_claims(c: Claims, spec: Spec, P: Any, rho: fmpq, mu: fmpq, lam: fmpq
     r = check_psd(lyap.iss_matrix(Acl, Bw, P, rho, mu))
     c.exact(
         id="iss-bound",
-        statement=(
-            f"V(e⁺) ≤ ρV(e) + μ|w|² with ρ = {fmt_up(rho, 10)}, μ = {fmt_up(mu, 10)}, ρ < 1"
-        ),
+        statement=(f"V(e⁺) ≤ ρV(e) + μ|w|² with ρ = {fmt_exact(rho)}, μ = {fmt_up(mu, 10)}, ρ < 1"),
         reference=_ref("Assumption 2, eq. (5)-(6)"),
         check="exact LDLᵀ over Q (linear error dynamics)",
         passed=r.ok and rho < 1,
