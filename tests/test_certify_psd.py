@@ -140,7 +140,7 @@ def test_details_and_pivots():
     r = check_pd(np.empty((0, 0), dtype=object))
     assert r == PSDResult(True, float("inf"), "empty matrix")
     r = check_pd([[2, 1], [1, 2]])
-    assert r == PSDResult(True, 1.5, "all 2 LDLᵀ pivots > 0 (min 1.5)")
+    assert r == PSDResult(True, 1.5, "all 2 LDLᵀ pivots > 0 (min ≥ 1.5)")
     r = check_pd([[1, 0, 0], [0, 1, 0], [0, 0, 0]])
     assert r == PSDResult(False, 0.0, "LDLᵀ pivot 2 = 0 <= 0")
     r = check_pd([[1, 2], [2, 1]])
@@ -317,7 +317,7 @@ def test_pd_fast_paths_and_details():
     big = F(10) ** 400
     r = check_pd_fast([[big, 0], [0, 1]])
     assert r == PSDResult(
-        True, 1.0, "fraction-free LDLᵀ: all 2 leading principal minors > 0 (min pivot 1)"
+        True, 1.0, "fraction-free LDLᵀ: all 2 leading principal minors > 0 (min pivot ≥ 1)"
     )
     r = check_pd_fast([[big, 0], [0, -1]])
     assert r == PSDResult(False, -1.0, "fraction-free LDLᵀ: pivot 1 = -1 <= 0 (leading minor ≤ 0)")

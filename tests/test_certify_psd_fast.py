@@ -168,6 +168,26 @@ def test_check_text_of_an_unknown_path_lists_every_test() -> None:
     assert psd.check_text(psd.PSDResult(True, 1.0, "", "no-such-path")) == psd.FAST_CHECK
 
 
+def test_every_lower_bound_in_a_detail_is_rounded_down() -> None:
+    """A detail's "λ_min ≥ x" / "min ≥ x" never shows x above the exact bound: `.3g` of the
+    float below λ_min = 0.9999998 printed "λ_min ≥ 1" on a shipped spec (rendering trial,
+    session 27). Each case sits just below a 3-digit decimal, the smallest false margin of
+    round-to-nearest."""
+    from obsdesign.certify import vchol
+    from obsdesign.certify.printing import fmt_down
+
+    just_below = fmpq(9999999, 10**7)  # shown as "1" by `.3g`
+    r = psd.diag_dominant_int(fmpz_mat([[3, 1], [1, 3]]), just_below / 2)  # bound = slack·c
+    assert r is not None and "λ_min ≥ 0.999 > 0" in r.detail
+    r = psd.check_pd([[just_below, 0], [0, 2]])
+    assert r.ok and r.detail.endswith("(min ≥ 0.999)")
+    r = psd.fraction_free_int(fmpz_mat([[9999999, 0], [0, 10**7]]), fmpq(1, 10**7))
+    assert r.ok and r.detail.endswith("(min pivot ≥ 0.999)")
+    v = vchol.VCholResult(just_below, 0.5, 2)
+    assert "λ_min(M − δI) ≥ 0.999 > 0" in v.detail
+    assert fmt_down(just_below, 3) == "0.999"
+
+
 def test_diag_dominant_int_proves_only_strict_dominance() -> None:
     """Gershgorin over Z: strict dominance with positive diagonal proves scale·Z ≻ 0 with
     λ_min ≥ scale·min slack; a row exactly balanced (the smallest false margin), a

@@ -17,6 +17,7 @@ from flint import fmpq, fmpq_mat
 
 from obsdesign.certify import vchol
 from obsdesign.certify.exact import Q, float_or_inf, qeye, qmat
+from obsdesign.certify.printing import fmt_down
 
 
 @dataclass(frozen=True)
@@ -117,7 +118,7 @@ def check_pd(M: Any, margin: Any = 0) -> PSDResult:
     mn = min(pivots)
     if mn > 0:
         return PSDResult(
-            True, float_or_inf(mn), f"all {n} LDLᵀ pivots > 0 (min {float_or_inf(mn):.3g})"
+            True, float_or_inf(mn), f"all {n} LDLᵀ pivots > 0 (min ≥ {fmt_down(mn, 3)})"
         )
     k = next(i for i, p in enumerate(pivots) if p <= 0)
     return PSDResult(
@@ -304,8 +305,10 @@ def diag_dominant_int(Z: Any, scale: Any = 1) -> PSDResult | None:
     return PSDResult(
         True,
         shown,
+        # rounded down (`.3g` of the float below it printed "λ_min ≥ 1" for 0.9999998:
+        # rendering trial, session 27)
         f"strictly diagonally dominant with positive diagonal (exact): λ_min ≥ "
-        f"{shown:.3g} > 0 by Gershgorin (n = {n})",
+        f"{fmt_down(bound, 3)} > 0 by Gershgorin (n = {n})",
         "diagonal-dominance",
     )
 
@@ -348,7 +351,7 @@ def fraction_free_int(Z: Any, scale: Any = 1) -> PSDResult:
     return PSDResult(
         True,
         float_or_inf(mn),
-        f"fraction-free LDLᵀ: all {n} leading principal minors > 0 (min pivot {float_or_inf(mn):.3g})",
+        f"fraction-free LDLᵀ: all {n} leading principal minors > 0 (min pivot ≥ {fmt_down(mn, 3)})",
         "fraction-free",
     )
 

@@ -52,7 +52,7 @@ from typing import Any
 import numpy as np
 from flint import fmpq, fmpq_mat
 
-from obsdesign.certify.exact import float_or_inf
+from obsdesign.certify.printing import fmt_down
 
 #: unit roundoff u = 2⁻⁵³ and the smallest subnormal η = 2⁻¹⁰⁷⁴, exactly
 U = fmpq(1, 2**53)
@@ -81,8 +81,8 @@ class VCholResult:
     def detail(self) -> str:
         """One line for the claim's detail."""
         return (
-            f"verified float Cholesky: λ_min(M − δI) ≥ {float_or_inf(self.bound):.3g} > 0 "
-            f"(shift c = {self.shift:.3g}, n = {self.n})"
+            f"verified float Cholesky: λ_min(M − δI) ≥ {fmt_down(self.bound, 3)} > 0 "
+            f"(shift c ≈ {self.shift:.3g}, n = {self.n})"
         )
 
 
