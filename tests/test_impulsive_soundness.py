@@ -599,6 +599,39 @@ def test_a_window_too_narrow_for_its_digits_says_so() -> None:
     assert "raise [method] digits" in msg and "T_max = -" not in msg
 
 
+@pytest.mark.parametrize("alpha", ["3.3", "2.7"])
+def test_the_window_details_round_their_bounds_the_safe_way(alpha: str) -> None:
+    """The T_min / T_max details print the interval bound rounded up / down: with `.10g` to
+    nearest, digits = 14 and α = 3.3 printed "T_min = 0.13881643365317 ≥ 0.1388164337", false
+    as printed though the claim holds (rendering trial, session 27). Checked against mpmath
+    at 50 digits, and the detail's own inequality exactly."""
+    text = (
+        (ROOT / "specs" / "schaum-impulsive-example.toml")
+        .read_text(encoding="utf-8")
+        .replace("alpha = 3\n", f"alpha = {alpha}\ndigits = 14\n", 1)
+    )
+    assert "digits = 14" in text
+    rep = api.design(load_spec_text(text, "digits14.toml"))
+    assert rep.exit_code() == 0
+    mpmath.mp.dps = 50
+    for cid, sign in (("T_min", 1), ("T_max", -1)):
+        c = next(c for c in rep.claims if c.id == cid)
+        m = re.fullmatch(rf"{cid} = (\S+) (≥|≤) (\S+) \(rounded (up|down)\)", c.detail)
+        assert m, c.detail
+        t, bound = Q(m[1]), Q(m[3])
+        assert (t >= bound) if sign > 0 else (t <= bound)
+    hi = next(c for c in rep.claims if c.id == "T_min").detail.split("≥ ")[1].split(" ")[0]
+    kappa, gamma = rep.parameters["kappa"], rep.parameters["gamma"]
+    a = mpmath.mpf(alpha)
+
+    def f(q: object) -> mpmath.mpf:
+        qq = Q(q)
+        return mpmath.mpf(int(qq.p)) / int(qq.q)
+
+    t_min = -mpmath.log((a - f(gamma)) / a) / f(kappa)
+    assert f(hi) >= t_min  # the printed bound is above the exact one
+
+
 # -- falsification: rounding is not a violation (review 21) -----------------------------------
 TIGHT = Path(__file__).resolve().parent / "specs" / "impulsive-tight-cross.toml"
 

@@ -266,7 +266,8 @@ def certify_window(p: Problem, P: dict[str, Any], c: Claims | None = None) -> Cl
     T_max, T_min = Q(P["T_max"]), Q(P["T_min"])
     try:
         lo = T_max_lower(gamma, varpi, kappa, lam_no, lam_on, beta)
-        ok, det = 0 < T_max <= lo, f"T_max = {T_max} ≤ {float(lo):.10g} (outward-rounded)"
+        ok = 0 < T_max <= lo
+        det = _window_detail("T_max", T_max, lo, ok, up=False)
     except (ValueError, ArithmeticError) as e:
         ok, det = False, str(e)
     c.exact(
@@ -279,7 +280,8 @@ def certify_window(p: Problem, P: dict[str, Any], c: Claims | None = None) -> Cl
     )
     try:
         hi = T_min_upper(p.alpha, gamma, kappa)
-        ok, det = T_min >= hi, f"T_min = {T_min} ≥ {float(hi):.10g} (outward-rounded)"
+        ok = T_min >= hi
+        det = _window_detail("T_min", T_min, hi, ok, up=True)
     except (ValueError, ArithmeticError) as e:
         ok, det = False, str(e)
     c.exact(
@@ -359,3 +361,24 @@ def _ssd(Ablk: np.ndarray, qsr: Any, theta: fmpq, rate: fmpq, name: str) -> tupl
         return False, f"{name} = {theta} is not positive"
     r = check_psd(-ssd_matrix(Ablk, qsr.scaled(theta), rate))
     return r.ok, r.detail
+
+
+def _window_detail(name: str, t: fmpq, bound: fmpq, ok: bool, up: bool) -> str:
+    """The detail of the T_min (``up``: ``bound`` is an upper enclosure of −ln((α − γ)/α)/κ,
+    eq. (26c)) or T_max claim (a lower enclosure of the bound of eq. (26b)), Theorem 2 of the
+    impulsive paper: the bound rounded the safe way (up for T_min, down for T_max) to the
+    fewest digits, at least 10, with which the printed inequality still holds, else exactly.
+    `.10g` to nearest printed "T_min = 0.13881643365317 ≥ 0.1388164337", false as printed,
+    and 10 digits rounded the safe way can still be too coarse for 14-digit bounds (rendering
+    trial, session 27). A failed claim prints the strict opposite inequality."""
+    rnd = fmt_up if up else fmt_down
+    how = "rounded up" if up else "rounded down"
+    if not ok and not up and t <= bound:
+        return f"{name} = {fmt_exact(t)} is not > 0"
+    if not ok:
+        return f"{name} = {fmt_exact(t)} {'<' if up else '>'} {rnd(bound, 10)} ({how})"
+    for digits in range(10, 41):
+        shown = rnd(bound, digits)
+        if (Q(shown) <= t) if up else (Q(shown) >= t):
+            return f"{name} = {fmt_exact(t)} {'≥' if up else '≤'} {shown} ({how})"
+    return f"{name} = {fmt_exact(t)} {'≥' if up else '≤'} {fmt_exact(bound)} (exact)"
