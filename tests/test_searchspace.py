@@ -209,10 +209,13 @@ def test_tamper_K_smaller_is_not_the_rule(example, tmp_path):
     assert _failed(_report_with(rep, v, tmp_path)) == {"K-rule"}
 
 
-def test_tamper_K_larger_breaks_lemma2(example, tmp_path):
+def test_tamper_K_larger_breaks_lemma2_and_the_K_rule(example, tmp_path):
+    """K = 64 for the example's 63: 64·ΔT > log(1.5) (L_f = 1), so K is not an integer with
+    KΔT < log(κ/L_h)/L_f at all, let alone the largest; K-rule was certified beside the failed
+    Lemma 2, checking only that K + 1 fails (search-space trial, session 27)."""
     sp, rep = example
     v = _consistent(sp, K=64)
-    assert _failed(_report_with(rep, v, tmp_path)) == {"lemma2-consistency"}
+    assert _failed(_report_with(rep, v, tmp_path)) == {"lemma2-consistency", "K-rule"}
 
 
 def test_tamper_schedule_entry(example, tmp_path):
@@ -537,9 +540,9 @@ def test_K_rule_decides_a_K_of_10_to_the_300(tmp_path: Path) -> None:
     K = int(rep.parameters.get("K"))
     assert 10**300 < K < 10**301
     assert api.verify(rep).exit_code() == 0
-    for k, claim in ((K - 1, "K-rule"), (K + 1, "lemma2-consistency")):
+    for k, claims in ((K - 1, {"K-rule"}), (K + 1, {"lemma2-consistency", "K-rule"})):
         v = _consistent(sp, K=k)
-        assert claim in _failed(_report_with(rep, v, tmp_path)), k
+        assert _failed(_report_with(rep, v, tmp_path)) == claims, k
 
 
 def test_K_bits_grow_with_K_and_are_capped() -> None:

@@ -144,8 +144,15 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     ratio = kappa / L_h
     if o.K is None:
         if ratio > 1:
-            hi = ivq.log_bounds(ratio, K_bits(dT * L_f))[1]
-            ok = bool(k_int and ((K + 1) * dT * L_f >= hi or K == 1 and dT * L_f >= hi))
+            lo_k, hi = ivq.log_bounds(ratio, K_bits(dT * L_f))
+            # K itself must satisfy the rule (or be the floor 1): only K + 1 failing was
+            # checked, and K = 64 for the example's 63 read "certified" (search-space trial,
+            # session 27; Lemma 2's claim failed beside it)
+            ok = bool(
+                k_int
+                and ((K + 1) * dT * L_f >= hi or K == 1 and dT * L_f >= hi)
+                and (K == 1 or K * dT * L_f < lo_k)
+            )
         else:
             hi, ok = None, bool(K == 1)
         _verdict(
@@ -154,8 +161,8 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
             f"K = {fmt_exact(K)} is the largest integer with K ΔT < log(κ/L_h^E)/L_f^E "
             "(at least 1, the paper's max{·, 1})",
             "Theorem 1, hypothesis 1",
-            "(K+1)·ΔT·L_f ≥ upper bound of log(κ/L_h) (outward rounding, 113 bits plus those "
-            "of 1/(ΔT·L_f))",
+            "(K+1)·ΔT·L_f ≥ upper bound of log(κ/L_h), and K = 1 or K·ΔT·L_f < its lower "
+            "bound (outward rounding, 113 bits plus those of 1/(ΔT·L_f))",
             ok,
             "a larger K also keeps Lemma 2's horizon",
             margin=0 if hi is None else (K + 1) * dT * L_f - hi,
