@@ -19,7 +19,7 @@ from obsdesign.certify import interval as ivq
 from obsdesign.certify.claim import ClaimStatus
 from obsdesign.certify.exact import Q
 from obsdesign.cli import app
-from obsdesign.errors import SpecError
+from obsdesign.errors import InfeasibleError, SpecError
 from obsdesign.methods.searchspace import design as D
 from obsdesign.params import Parameters
 
@@ -986,3 +986,50 @@ def test_a_constant_input_beyond_exact_arithmetic_is_never_certified(u: str) -> 
     rep = api.design(api.load_spec_text(text, "u.toml"))
     claim = next(c for c in rep.claims if c.id == "input-range")
     assert claim.status != ClaimStatus.CERTIFIED
+
+
+_SQRT_U = """[system]
+time = "continuous"
+states = ["x1"]
+f = ["-x1+u1"]
+h = ["x1"]
+u = ["sqrt(1 - t)"]
+[method]
+key = "search-space"
+alpha = 0.9
+gamma_star = 0.05
+gamma0 = 1
+[method.E]
+lower = [-1]
+upper = [1]
+[method.D]
+lower = [0.2]
+upper = [0.5]
+[method.U]
+lower = [0]
+upper = [1]
+[simulate]
+horizon = 5
+x0 = [0.2]
+xhat0 = [0]
+"""
+
+
+def test_a_function_undefined_on_part_of_its_interval_proves_nothing() -> None:
+    """sqrt and log of an enclosure reaching below 0 are refused, not enclosed on their
+    defined part: u = sqrt(1 − t), undefined for t > 1, was certified in U = [0, 1] over
+    t ∈ [0, 5], and f = −x1 + sqrt(u1) with U = [−1/2, 1/2] had certified L_f and ‖f_u‖ bounds
+    (search-space trial, session 27). A u defined on the whole horizon still certifies."""
+    rep = api.design(api.load_spec_text(_SQRT_U, "sqrt-u.toml"))
+    c = next(c for c in rep.claims if c.id == "input-range")
+    assert not c.ok and rep.exit_code() == 4
+    ok = api.design(api.load_spec_text(_SQRT_U.replace("sqrt(1 - t)", "sqrt(5 - t)/3"), "ok"))
+    assert ok.exit_code() == 0, [(c.id, c.detail) for c in ok.failed]
+    text = (
+        _SQRT_U.replace('f = ["-x1+u1"]', 'f = ["-x1+sqrt(u1)"]')
+        .replace('u = ["sqrt(1 - t)"]', 'u = ["0.5*sin(t)"]')
+        .replace("lower = [0]\nupper = [1]", "lower = [-0.5]\nupper = [0.5]")
+    )
+    assert "sqrt(u1)" in text and "lower = [-0.5]" in text
+    with pytest.raises(InfeasibleError, match="no finite interval bound on E"):
+        api.design(api.load_spec_text(text, "sqrt-f.toml"))

@@ -290,8 +290,13 @@ def exp(x: I) -> I:
 
 
 def log(x: I) -> I:
+    """log over x; refused (ArithmeticError) when x reaches below 0, where log is undefined
+    (the enclosure of the defined part alone proved claims about an undefined function: see
+    :func:`sqrt`); x reaching 0 gives an enclosure unbounded below."""
     if x.hi <= 0.0:
         raise ArithmeticError("log of a non-positive interval")
+    if x.lo < 0.0:
+        raise ArithmeticError("log of an interval reaching below 0 (undefined there)")
     if x.lo <= 0.0:
         return I(-INF, _iv_call(iv.log, I(x.hi, x.hi)).hi)
     return _iv_call(iv.log, x)
@@ -310,8 +315,15 @@ def tan(x: I) -> I:
 
 
 def sqrt(x: I) -> I:
+    """√ over x; refused (ArithmeticError) when x reaches below 0, where √ is undefined: the
+    enclosure [0, √hi] of the defined part certified u = sqrt(1 − t) in U = [0, 1] over
+    t ∈ [0, 5] and bounds of f = −x1 + sqrt(u1) for u1 < 0 (search-space trial, session 27).
+    An argument whose outward-rounded enclosure dips below an exact 0 is refused too (the
+    price of soundness: write sqrt(max(·, 0)) where the set's edge is the domain's)."""
     if x.hi < 0.0:
         raise ArithmeticError("sqrt of a negative interval")
+    if x.lo < 0.0:
+        raise ArithmeticError("sqrt of an interval reaching below 0 (undefined there)")
     lo = 0.0 if x.lo <= 0.0 else sqrt_lo(x.lo)
     return I(lo, sqrt_hi(x.hi) if math.isfinite(x.hi) else INF)
 
@@ -574,6 +586,9 @@ def evaluate(
         if op is ast.Sub:
             return d_add(a, d_neg(b))
         if op is ast.Mult:
+            if _same(left, right, src):  # X*X = X² ≥ 0 (the product's enclosure of [−1, 2]
+                # is [−2, 4], and sqrt(x*x + 1) must not reach below 0: sqrt refuses that)
+                return d_pow_int(a, 2)
             return d_mul(a, b)
         if op is ast.Div:
             return d_div(a, b)
