@@ -32,6 +32,7 @@ from obsdesign.methods.searchspace.intervals import (
     ZERO,
     Dual,
     I,
+    _up,
     add_hi,
     evaluate,
     mul_hi,
@@ -124,16 +125,50 @@ def _dot(a: Sequence[I], b: Sequence[I]) -> I:
     return acc
 
 
+def hypot_hi(xs: Sequence[float]) -> float:
+    """A float ≥ √(Σ x_i²) for magnitudes x_i ≥ 0, squared after scaling by the power of two
+    2^e just above max x_i (exact, each quotient that underflows rounded up), so that the
+    squares neither overflow nor vanish: squared as they were, entries above ~1.3·10¹⁵⁴ gave
+    +∞ and L_h = 10¹⁶⁰ was refused as "not Lipschitz (a jump?)" (search-space trial,
+    session 27), and 10⁻³⁰⁰ was bounded by 2.2·10⁻¹⁶² (the least subnormal's root)."""
+    m = max(xs, default=0.0)
+    if m == 0.0 or not math.isfinite(m):
+        return m
+    e = math.frexp(m)[1]  # m < 2^e
+    terms = []
+    for x in xs:
+        t = math.ldexp(x, -e)
+        if math.ldexp(t, e) != x:  # the quotient underflowed: rounded, so take the next up
+            t = _up(t)
+        terms.append(mul_hi(t, t))
+    r = sqrt_hi(_sum_hi(terms))
+    try:
+        out = math.ldexp(r, e)  # exact unless subnormal (then rounded: stepped up)
+    except OverflowError:  # beyond the float range
+        return math.inf
+    return out if math.ldexp(out, -e) >= r else _up(out)
+
+
 def norm_upper(M: Sequence[Sequence[float]]) -> float:
     """A float ≥ ‖A‖₂ for every matrix A with |A_ij| ≤ M_ij (min of Frobenius and
-    √(‖M‖₁‖M‖_∞)), rounded upward."""
+    √(‖M‖₁‖M‖_∞)), rounded upward, without squaring an entry or the product unscaled."""
     if any(not math.isfinite(v) for row in M for v in row):
         return math.inf
-    fro = sqrt_hi(_sum_hi([mul_hi(v, v) for row in M for v in row]))
+    fro = hypot_hi([v for row in M for v in row])
     rows = [_sum_hi(list(r)) for r in M]
     cols = [_sum_hi([r[j] for r in M]) for j in range(len(M[0]))]
-    prod = sqrt_hi(mul_hi(max(rows), max(cols)))
+    prod = mul_hi(sqrt_hi(max(rows)), sqrt_hi(max(cols)))
     return min(fro, prod)
+
+
+def _norms(V: np.ndarray) -> np.ndarray:
+    """Euclidean norms along the last axis, without overflow of the squares (sampled lower
+    estimates: np.linalg.norm of entries near 10²⁰⁰ is +∞, and an infinite estimate would
+    refute any given constant)."""
+    with np.errstate(all="ignore"):
+        m = np.max(np.abs(V), axis=-1, keepdims=True)
+        safe = np.where((m > 0) & np.isfinite(m), m, 1.0)
+        return (safe * np.linalg.norm(V / safe, axis=-1, keepdims=True))[..., 0]
 
 
 def _split(box: Box, widths0: Sequence[float]) -> tuple[Box, Box] | None:
@@ -243,10 +278,10 @@ def sup_norm(
 
     def upper_of(b: Box) -> float:
         vs = _enclose(exprs, names, b, ())
-        return sqrt_hi(_sum_hi([mul_hi(d.v.mag, d.v.mag) for d in vs]))
+        return hypot_hi([d.v.mag for d in vs])
 
     def lower_of(b: Box) -> float:
-        v = np.linalg.norm(_eval(exprs, names, _samples(b)), axis=-1)
+        v = _norms(_eval(exprs, names, _samples(b)))
         v = v[np.isfinite(v)]
         return float(v.max()) if v.size else 0.0
 
@@ -296,7 +331,7 @@ def lipschitz(
         d = _eval(exprs, names, Pp) - _eval(exprs, names, Pm)
         dist = np.linalg.norm(Pp - Pm, axis=-1)
         with np.errstate(all="ignore"):
-            q = np.linalg.norm(d, axis=-1) / dist
+            q = _norms(d) / dist
         q = q[np.isfinite(q) & (dist > 0)]
         return float(q.max()) if q.size else 0.0
 

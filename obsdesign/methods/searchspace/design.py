@@ -109,9 +109,11 @@ def constants(spec: Spec) -> Constants:
                 raise InfeasibleError(
                     f"{_NAMES[k]} has no finite interval bound on E ({b.boxes} sub-boxes): "
                     + (
-                        "h is not Lipschitz there (a jump?)"
+                        # h = log(x1) across 0 read "(a jump?)": undefined is the other cause
+                        "h is not Lipschitz there or not defined on all of it (a jump, a "
+                        "pole, sqrt or log of an argument reaching below 0?)"
                         if k == "L_h"
-                        else "f is not Lipschitz/bounded there"
+                        else "f is not Lipschitz/bounded there or not defined on all of it"
                     )
                     + f"; give [method].{k} to use your own value"
                 )
