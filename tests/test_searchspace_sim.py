@@ -433,3 +433,40 @@ def test_svg_plot_rasterizes_the_search_space(example, tmp_path):
     text = Path(out).read_text(encoding="utf-8")
     assert n_centres > 20_000 and "<image" in text
     assert len(text) < 2_000_000, (len(text), n_centres)
+
+
+_CUBE = """[system]
+time = "continuous"
+states = ["x1"]
+f = ["0.01*(0.95 - x1)"]
+h = ["x1^3"]
+[method]
+key = "search-space"
+alpha = 0.9
+gamma_star = 0.05
+gamma0 = 4.05
+[method.E]
+lower = [-1]
+upper = [1]
+[method.D]
+lower = [0.95]
+upper = [0.95]
+[simulate]
+horizon = 5
+x0 = [0.95]
+xhat0 = [0]
+"""
+
+
+def test_a_cell_centred_outside_E_is_named_as_the_cause(tmp_path):
+    """y = x1³, E = [−1, 1], x0 = 0.95 inside E: the grid 1.8ℤ puts the true state's cell at
+    centre 1.8, outside E, where x³ is steeper than the certified L_h = 3, and the filter drops
+    it at t₀. The message said only "consistency lost"; it names the centre outside E now
+    (search-space trial, session 27). A D well inside E (centre 0) does not lose it."""
+    sp, rep = _load(_CUBE, tmp_path)
+    assert rep.exit_code() == 0
+    with pytest.raises(ConsistencyLost, match=r"nearest the true state, \[1\.8\], lies outside E"):
+        api.simulate(sp, rep)
+    inner = _CUBE.replace("0.95", "0.1")
+    sp, rep = _load(inner, tmp_path)
+    assert api.simulate(sp, rep).info["final_error"] >= 0

@@ -401,8 +401,8 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
     y = plant.out(x)[0]
     i = 0
     s = eps[0] / math.sqrt(n)
-    C = cover_box(o.D.lower, o.D.upper, s)
-    C = C[_consistent(plant, C, y, L_h * eps[0]) & _meets(C, s, E_lo, E_hi)]
+    cover = cover_box(o.D.lower, o.D.upper, s)
+    C = cover[_consistent(plant, cover, y, L_h * eps[0]) & _meets(cover, s, E_lo, E_hi)]
     if len(C) > so.max_centres:
         raise MemoryCap(
             f"the ε₀-cover of D needs {len(C):,} centres, above max_centres = {so.max_centres:,}"
@@ -422,7 +422,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
 
     plant.budget = flow_budget
     if not len(C):
-        raise ConsistencyLost(_diagnose(run, x0[0], o, "the output filter at t₀", None))
+        raise ConsistencyLost(_diagnose(run, x0[0], o, "the output filter at t₀", None, cover))
     _record(run, t, x[0], y, C, eps[0], 0.0, L_f, gam[0], so, 0)
     if so.substeps == 0:
         nsub, flow_err = _auto_substeps(plant, C, t, dT, nsub, eps[0])
@@ -652,12 +652,19 @@ def _record(
         run.stored.append((t, sub.copy()))
 
 
-def _diagnose(run: Run, x: np.ndarray, o: Options, where: str, ctx: Any) -> str:
-    """'consistency lost': which assumption or bound failed, from the true trajectory."""
+def _diagnose(
+    run: Run, x: np.ndarray, o: Options, where: str, ctx: Any, cells: np.ndarray | None = None
+) -> str:
+    """'consistency lost': which assumption or bound failed, from the true trajectory.
+    ``cells``: the centres before the filter when ``ctx`` (the discarding or refinement
+    context) is None."""
     msg = [f"consistency lost: every centre was discarded by {where}."]
     x0 = run.x[0] if run.x else x
     if not np.all(o.D.contains(x0)):
         msg.append(f"x0 = {np.round(x0, 6).tolist()} is not in D = {o.D.describe()}.")
+    outside = _centre_outside_E(cells if ctx is None else ctx[0], x, o)
+    if outside is not None and ctx is None:
+        msg.append(outside)
     if ctx is not None:
         C, eps, L_f, since, left_E, flow_err, left_U = ctx
         if left_U is not None and (not run.t or left_U <= run.t[-1] + 1e-12):
@@ -671,6 +678,9 @@ def _diagnose(run: Run, x: np.ndarray, o: Options, where: str, ctx: Any) -> str:
             )
             # outside E the constants are not Lipschitz constants there: that is the cause,
             # the bound checks below would only blame L_h or L_f for it
+            return " ".join(msg)
+        if outside is not None:
+            msg.append(outside)
             return " ".join(msg)
         bound = eps * math.exp(L_f * since) + flow_err
         d = float(np.min(np.linalg.norm(C - x, axis=1))) if len(C) else math.inf
@@ -693,6 +703,24 @@ def _diagnose(run: Run, x: np.ndarray, o: Options, where: str, ctx: Any) -> str:
                 "horizon Δτ < log(κ/L_h)/L_f does not hold."
             )
     return " ".join(msg)
+
+
+def _centre_outside_E(C: np.ndarray | None, x: np.ndarray, o: Options) -> str | None:
+    """The cause when the centre nearest the true state lies outside E: h and f were evaluated
+    there, where the constants on E need not hold (y = x1³ with E = [−1, 1]: the true state's
+    cell had its centre at 1.8 and was dropped at t₀, with a message that named no cause;
+    search-space trial, session 27)."""
+    if C is None or not len(C):
+        return None
+    c = C[int(np.argmin(np.max(np.abs(C - x), axis=1)))]
+    if np.all(c >= o.E.lower) and np.all(c <= o.E.upper):
+        return None
+    return (
+        f"The centre of the cell nearest the true state, {np.round(c, 6).tolist()}, lies "
+        f"outside E = {o.E.describe()}: h and f are evaluated there, where the constants on E "
+        "need not hold (the guarantee needs E to contain the cells around the trajectories: "
+        "enlarge E by the cell radius ε₀, or move x0 or D away from E's edge)."
+    )
 
 
 def _progress(on: bool, N: int) -> Any:
