@@ -10,7 +10,7 @@ import signal
 import threading
 import time
 import warnings
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -1097,26 +1097,43 @@ def schema() -> dict[str, Any]:
     return spec_schema([m.options_schema() for m in ms], sim)
 
 
-def plot_design(spec: str | Path | Spec, params: Parameters, path: str | Path) -> Any:
+def plot_design(
+    spec: str | Path | Spec, params: Parameters, path: str | Path, atomic: bool = True
+) -> Any:
     """The method's design plot of ``spec`` with ``params`` (a report's parameters), written
-    to ``path`` (InputError when the method has none)."""
+    to ``path`` (InputError when the method has none): atomically (temp file and rename,
+    :func:`obsdesign.report.model.write_via`), or with ``atomic=False`` straight into
+    ``path`` (for a caller that made it a temp file, FIFO or device itself)."""
     sp = _spec(spec)
     m = get_method(sp.method)
     if m.plot_design is None:
         raise InputError(f"method '{sp.method}' has no design plot")
-    return m.plot_design(sp, params, path)
+    draw = m.plot_design
+    return _plot_to(path, lambda p: draw(sp, params, p), atomic)
 
 
-def plot_simulation(spec: str | Path | Spec, result: SimResult, path: str | Path) -> Any:
+def plot_simulation(
+    spec: str | Path | Spec, result: SimResult, path: str | Path, atomic: bool = True
+) -> Any:
     """The method's simulation plot of ``spec`` and ``result`` written to ``path``, or the
-    generic one (estimation error over time)."""
+    generic one (estimation error over time); ``atomic`` as for :func:`plot_design`."""
     sp = _spec(spec)
     m = get_method(sp.method)
     if m.plot_simulation is not None:
-        return m.plot_simulation(sp, result, path)
+        draw = m.plot_simulation
+        return _plot_to(path, lambda p: draw(sp, result, p), atomic)
     from obsdesign.simulate.plot import plot_result
 
-    return plot_result(result, path, title=sp.title or sp.file)
+    return _plot_to(path, lambda p: plot_result(result, p, title=sp.title or sp.file), atomic)
+
+
+def _plot_to(path: str | Path, draw: Callable[[Path], Any], atomic: bool) -> Any:
+    """``draw(path)``, through a temp file and a rename when ``atomic``."""
+    if not atomic:
+        return draw(Path(path))
+    from obsdesign.report.model import write_via
+
+    return write_via(path, draw)
 
 
 __all__ = [

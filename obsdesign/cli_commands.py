@@ -466,7 +466,7 @@ def design(
     if not quiet or fmt == Fmt.json:
         _print_report(rep, fmt)
     if plot is not None:
-        _write_plot(plot, lambda tmp: api.plot_design(sp, rep.parameters, tmp), force)
+        _write_plot(plot, lambda tmp: api.plot_design(sp, rep.parameters, tmp, atomic=False), force)
         if fmt == Fmt.text:
             _say(f"plot written to {plot}")
     if output is not None and fmt == Fmt.text:
@@ -724,7 +724,7 @@ def simulate(
     elif not quiet:
         _print_metrics(m)
     if plot is not None:
-        _write_plot(plot, lambda tmp: api.plot_simulation(sp, res, tmp), force)
+        _write_plot(plot, lambda tmp: api.plot_simulation(sp, res, tmp, atomic=False), force)
         if fmt == Fmt.text:
             _say(f"plot written to {plot}")
     if csv is not None:

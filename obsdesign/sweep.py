@@ -809,9 +809,12 @@ def plot_sweep(
             ax.legend(fontsize="small")
         ax.grid(True, alpha=0.3)
         fig.tight_layout()
-        fig.savefig(path, format=path.suffix.lstrip(".").lower() or "png")
-    finally:
+    except BaseException:
         plt.close(fig)
+        raise
+    from obsdesign.simulate.plot import save_figure
+
+    save_figure(fig, path, dpi=100)
 
 
 def expected_columns(text: str, axes: list[Axis], simulate: bool) -> set[str] | None:

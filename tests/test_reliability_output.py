@@ -73,6 +73,32 @@ def test_output_fifo_and_directory(spec: Path, tmp_path: Path):
     _refused(runner.invoke(app, ["design", str(spec), "-o", str(d), "--force"]), "directory")
 
 
+@pytest.mark.parametrize("through_link", [False, True])
+def test_plot_force_writes_into_a_fifo_and_keeps_it(
+    spec: Path, tmp_path: Path, through_link: bool
+) -> None:
+    """``simulate --plot FIFO --force`` writes the PNG into the FIFO (a reader gets it) and
+    leaves a FIFO: the plot writer made its own temp file and renamed it over the FIFO, or
+    through a link over a device node (simulate trial, session 27). The link case is a FIFO
+    too: a device node here would be the machine's own."""
+    import threading
+
+    fifo = tmp_path / "f.png"
+    os.mkfifo(fifo)
+    target = fifo
+    if through_link:
+        target = tmp_path / "link.png"
+        target.symlink_to(fifo)
+    got: list[bytes] = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_bytes()), daemon=True)
+    reader.start()
+    res = runner.invoke(app, ["simulate", str(spec), "-q", "--plot", str(target), "--force"])
+    reader.join(timeout=20)
+    assert res.exit_code == 0, res.output
+    assert stat.S_ISFIFO(os.lstat(fifo).st_mode)
+    assert got and got[0].startswith(b"\x89PNG")
+
+
 def test_output_dev_null_is_not_replaced(spec: Path):
     _refused(runner.invoke(app, ["design", str(spec), "-o", os.devnull]), "not a regular file")
     assert stat.S_ISCHR(os.stat(os.devnull).st_mode)

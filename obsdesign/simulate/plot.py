@@ -2,15 +2,14 @@
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 from obsdesign.simulate.result import SimResult
 
 
 def plot_result(res: SimResult, path: str | Path, title: str = "") -> Path:
-    """Write a PNG/SVG (by suffix) with x vs x̂ per state and the errors; atomic write."""
+    """Write a PNG/SVG (by suffix) with x vs x̂ per state and the errors (:func:`save_figure`:
+    not atomic by itself)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -40,19 +39,23 @@ def plot_result(res: SimResult, path: str | Path, title: str = "") -> Path:
     return save_figure(fig, path)
 
 
-def save_figure(fig: object, path: str | Path) -> Path:
-    """Save a matplotlib figure atomically (temp file + rename) and close it."""
+def save_figure(fig: object, path: str | Path, dpi: int = 110) -> Path:
+    """Render a matplotlib figure in the format its suffix names (PNG without one), write the
+    bytes into ``path`` and close the figure. The bytes are made in memory first, so a FIFO or
+    a device receives one write and nothing is left half-made; atomic replacement is the
+    caller's (:func:`obsdesign.report.model.write_via`). This used its own temp file and
+    rename, so ``--plot FIFO --force`` replaced the FIFO (or, through a link, a device node)
+    with a regular file (simulate trial, session 27)."""
+    import io
+
     import matplotlib.pyplot as plt
 
     p = Path(path)
-    p.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=p.parent, suffix=p.suffix or ".png")
-    os.close(fd)
+    buf = io.BytesIO()
     try:
-        fig.savefig(tmp, dpi=110)  # type: ignore[attr-defined]
-        os.replace(tmp, p)
+        fig.savefig(buf, dpi=dpi, format=p.suffix.lstrip(".").lower() or "png")  # type: ignore[attr-defined]
     finally:
         plt.close(fig)  # type: ignore[arg-type]
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+    with open(p, "wb") as f:
+        f.write(buf.getvalue())
     return p

@@ -60,10 +60,9 @@ def plot_simulation(spec: Spec, res: SimResult, path: str | Path) -> Path:
     ax.legend(loc="upper right", fontsize=7)
     fig.suptitle(spec.title or spec.file, fontsize=9)
     fig.tight_layout()
-    out = Path(path)
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
-    return out
+    from obsdesign.simulate.plot import save_figure
+
+    return save_figure(fig, path, dpi=120)
 
 
 def _switches(ax: Any, res: SimResult) -> None:

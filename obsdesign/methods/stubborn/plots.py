@@ -46,7 +46,6 @@ def plot_simulation(spec: Spec, res: SimResult, path: str | Path) -> Path:
         a2.set_xlabel("t")
         a1.set_title(spec.title or "stubborn observer")
     fig.tight_layout()
-    p = Path(path)
-    fig.savefig(p)
-    plt.close(fig)
-    return p
+    from obsdesign.simulate.plot import save_figure
+
+    return save_figure(fig, path, dpi=100)
