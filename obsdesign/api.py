@@ -689,18 +689,32 @@ def simulate(
             )
         params = rep.parameters
     notes: list[str] = []
-    if distributed:
-        try:
-            res = _simulate_spans(sp, params, kwargs, workers, scheduler, client, batches)
-        except InputError as e:
-            raise _report_named(e, where) from None
-        notes = list(res.info.pop("warnings", []))
-    else:
-        with captured_warnings(notes):
+    if report is not None and rep.computed_verdict() != "ok":
+        # simulate does not verify a report; one whose own claims fail is run, but said so
+        # (simulate trial, session 27: a failed report ran with exit 0 and no word)
+        notes.append(
+            f"{where}: its claims give the verdict '{rep.computed_verdict()}', not 'ok': the "
+            "parameters simulated are not certified (obsdesign verify says which claim fails)"
+        )
+    try:
+        if distributed:
             try:
-                res = get_method(sp.method).simulate(sp, params, **kwargs)
+                res = _simulate_spans(sp, params, kwargs, workers, scheduler, client, batches)
             except InputError as e:
                 raise _report_named(e, where) from None
+            notes += list(res.info.pop("warnings", []))
+        else:
+            with captured_warnings(notes):
+                try:
+                    res = get_method(sp.method).simulate(sp, params, **kwargs)
+                except InputError as e:
+                    raise _report_named(e, where) from None
+    except ObsdesignError:
+        raise
+    except (KeyError, ValueError, IndexError, TypeError) as e:
+        if report is None:  # the design's own parameters: a defect, exit 3
+            raise
+        raise _unfit_report(e, where, sp.method) from None
     left = _left_float_range(res)
     if left is not None:
         notes.insert(0, left)
@@ -710,6 +724,20 @@ def simulate(
     if notes:
         res.info["warnings"] = notes
     return res
+
+
+def _unfit_report(e: Exception, where: str, method: str) -> InputError:
+    """Bad input (exit 2): a report's parameters that the method's simulation cannot use — a
+    parameter missing (KeyError) or of the wrong shape or kind. These were exit 3 "internal
+    failure: KeyError: 'L'" for every method (simulate trial, session 27)."""
+    if isinstance(e, KeyError) and e.args and isinstance(e.args[0], str):
+        what = f"has no parameter '{e.args[0]}'"
+    else:
+        what = f"has parameters of the wrong shape or kind ({type(e).__name__}: {e})"
+    return InputError(
+        f"{where}: {what} for a {method} simulation of this spec (obsdesign verify says which "
+        "claim the report breaks)"
+    )
 
 
 def _report_named(e: InputError, where: str) -> InputError:

@@ -294,6 +294,64 @@ def test_simulate_refuses_an_error_report(spec: Path, tmp_path: Path):
     assert f"{out}: records a design that stopped" in res.output  # names the report file
 
 
+@pytest.mark.parametrize(
+    ("name", "key"),
+    [
+        ("constrained-redesign-sec5-lyapunov", "L"),
+        ("astolfi-stubborn-example1", "K"),
+        ("dorea-pimenta-7-1", "G"),
+        ("hernandez-garcia-example", "L_h"),
+        ("schaum-impulsive-example", "T_max"),
+    ],
+)
+def test_simulate_a_report_missing_a_parameter_is_bad_input(
+    tmp_path: Path, name: str, key: str
+) -> None:
+    """A report without a parameter the simulation reads, or with one of the wrong shape:
+    exit 2 naming the report and the key, not exit 3 "internal failure: KeyError" (simulate
+    trial, session 27)."""
+    src = SPEC.parent / f"{name}.toml"
+    rep = tmp_path / "r.json"
+    assert runner.invoke(app, ["design", str(src), "-q", "-o", str(rep)]).exit_code == 0
+    d = json.loads(rep.read_text())
+    del d["parameters"][key]
+    d["parameters"]["exact"].pop(key, None)
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(d))
+    res = runner.invoke(app, ["simulate", str(src), "-q", "--report", str(bad)])
+    _refused(res, "bad.json", f"has no parameter '{key}'")
+
+
+def test_simulate_a_report_with_a_parameter_of_the_wrong_shape_is_bad_input(
+    spec: Path, tmp_path: Path
+) -> None:
+    rep = tmp_path / "r.json"
+    assert runner.invoke(app, ["design", str(spec), "-q", "-o", str(rep)]).exit_code == 0
+    d = json.loads(rep.read_text())
+    d["parameters"]["L"] = [[-1.87], [1.874], [3.0]]
+    d["parameters"]["exact"]["L"] = [["-187/100"], ["937/500"], ["3"]]
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(d))
+    res = runner.invoke(app, ["simulate", str(spec), "-q", "--report", str(bad)])
+    _refused(res, "bad.json", "wrong shape or kind")
+
+
+def test_simulate_says_when_a_report_does_not_hold(spec: Path, tmp_path: Path) -> None:
+    """A report whose own claims fail is simulated with a note saying so (it ran with exit 0
+    and no word: simulate trial, session 27)."""
+    rep = tmp_path / "r.json"
+    assert runner.invoke(app, ["design", str(spec), "-q", "-o", str(rep)]).exit_code == 0
+    d = json.loads(rep.read_text())
+    d["claims"][0]["status"] = "failed"
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(d))
+    from obsdesign import api
+
+    res = api.simulate(spec, bad)
+    assert any("verdict 'failed'" in w for w in res.info["warnings"])
+    assert "warnings" not in api.simulate(spec, rep).info
+
+
 def test_a_spec_on_stdin_is_not_overwritten(spec: Path):
     """``design - -o s.toml < s.toml`` replaced the spec with the report (CLI fuzzer): stdin
     that is a regular file counts as the input file."""
