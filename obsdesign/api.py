@@ -1148,11 +1148,42 @@ def plot_simulation(
     sp = _spec(spec)
     m = get_method(sp.method)
     if m.plot_simulation is not None:
-        draw = m.plot_simulation
-        return _plot_to(path, lambda p: draw(sp, result, p), atomic)
-    from obsdesign.simulate.plot import plot_result
+        method_draw = m.plot_simulation
 
-    return _plot_to(path, lambda p: plot_result(result, p, title=sp.title or sp.file), atomic)
+        def draw(p: Path) -> Any:
+            return method_draw(sp, result, p)
+    else:
+        from obsdesign.simulate.plot import plot_result
+
+        def draw(p: Path) -> Any:
+            return plot_result(result, p, title=sp.title or sp.file)
+
+    try:
+        return _plot_to(path, draw, atomic)
+    except (ValueError, OverflowError) as e:
+        # matplotlib's tick locator fails on data near the float limit (x0 = 1.7e308, or a
+        # run that diverges there): "internal failure: arange: cannot compute length", exit 3
+        # (simulate trial, session 27); nothing is written
+        big = _largest_finite(result)
+        if big < 1e300:
+            raise
+        raise InconclusiveError(
+            f"plot: cannot draw values as large as {big:.3g} (matplotlib: {e}); the plot is not "
+            "written (take smaller initial states or a shorter horizon)"
+        ) from None
+
+
+def _largest_finite(result: SimResult) -> float:
+    """The largest finite |value| of the run's states, estimates and errors (0 when none)."""
+    import numpy as np
+
+    best = 0.0
+    for a in (result.x, result.xhat, result.e):
+        v = np.abs(np.asarray(a, dtype=float))
+        v = v[np.isfinite(v)]
+        if v.size:
+            best = max(best, float(v.max()))
+    return best
 
 
 def _plot_to(path: str | Path, draw: Callable[[Path], Any], atomic: bool) -> Any:

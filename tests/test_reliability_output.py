@@ -352,6 +352,26 @@ def test_simulate_says_when_a_report_does_not_hold(spec: Path, tmp_path: Path) -
     assert "warnings" not in api.simulate(spec, rep).info
 
 
+def test_a_plot_of_values_near_the_float_limit_is_exit_4_and_writes_nothing(
+    spec: Path, tmp_path: Path
+) -> None:
+    """x0 = xhat0 = ±1.7e308 (every value finite): matplotlib's tick locator fails, which was
+    exit 3 "internal failure: arange" (simulate trial, session 27). Now exit 4 saying so, and
+    no file (nor temp file) is left; 1e300 still plots."""
+    text = spec.read_text().replace("x0 = [-1, -1]", "x0 = [1.7e308, -1.7e308]")
+    text = text.replace("xhat0 = [1, 1]", "xhat0 = [1.7e308, -1.7e308]")
+    assert "1.7e308" in text
+    src = tmp_path / "huge.toml"
+    src.write_text(text)
+    out = tmp_path / "p.png"
+    res = runner.invoke(app, ["simulate", str(src), "-q", "--plot", str(out)])
+    assert res.exit_code == 4, res.output
+    assert "cannot draw values as large as 1.7e+308" in res.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["huge.toml", "s.toml"]
+    src.write_text(text.replace("1.7e308", "1e300"))
+    assert runner.invoke(app, ["simulate", str(src), "-q", "--plot", str(out)]).exit_code == 0
+
+
 def test_a_spec_on_stdin_is_not_overwritten(spec: Path):
     """``design - -o s.toml < s.toml`` replaced the spec with the report (CLI fuzzer): stdin
     that is a regular file counts as the input file."""
