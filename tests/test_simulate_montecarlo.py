@@ -366,18 +366,23 @@ def test_metrics_and_quantiles_of_huge_or_infinite_errors() -> None:
 
 
 def test_runs_whose_metrics_overflow_are_said_in_words(tmp_path) -> None:
-    """x0 = 1e300: every run's RMSE overflows; the only word was numpy's "overflow
-    encountered in multiply" (review). One worded warning counts the runs."""
+    """x0 = ±1.7e308: the runs leave the float range; the only word was numpy's "overflow
+    encountered in multiply" (review). One worded warning counts the runs. At x0 = ±1e300
+    every value is finite and so is every metric now: the RMSE's running sum of e² overflowed
+    (inf, with that warning) and is measured again from the run's trajectory (session 27)."""
     from obsdesign import api
 
     p = tmp_path / "s.toml"
-    p.write_text(RANDOM.replace("x0 = [1, -1]", "x0 = [1e300, -1e300]"))
+    p.write_text(RANDOM.replace("x0 = [1, -1]", "x0 = [1.7e308, -1.7e308]"))
     notes = api.simulate(p, options={"runs": "3"}).info["warnings"]
     assert any(
         w.startswith("warning: UserWarning: the metrics of 3 of 3 runs are not finite")
         for w in notes
     )
-    assert not any("RuntimeWarning" in w for w in notes)
+    p.write_text(RANDOM.replace("x0 = [1, -1]", "x0 = [1e300, -1e300]"))
+    info = api.simulate(p, options={"runs": "3"}).info
+    assert "warnings" not in info
+    assert 1e298 < info["quantiles"]["rmse"]["x1"]["max"] < 1e300
     p.write_text(RANDOM)
     assert "warnings" not in api.simulate(p, options={"runs": "3"}).info
 
@@ -416,3 +421,56 @@ def test_the_api_refuses_a_run_count_below_one_or_not_whole(runs: object) -> Non
     with pytest.raises(InputError, match="at least 1"):
         api.simulate(spec, runs=runs)
     assert api.simulate(spec, runs=np.int64(2)).metrics()["runs"] == 2
+
+
+_SCALE_SPEC = """[system]
+time = "discrete"
+A = [[0, 1], [1, 0]]
+C = [[1, 0]]
+[method]
+key = "lyapunov"
+L = [-1.87, 1.874]
+lambda = 0.955
+[simulate]
+horizon = 300
+x0 = [0, 0]
+xhat0 = [S, S]
+"""
+
+
+def _exact_metrics(s: str) -> tuple[list[float], float]:
+    """RMSE of e_1, e_2 and the final |e| of e⁺ = (A − LC)e from e(0) = (s, s), exactly."""
+    from fractions import Fraction as F
+
+    L = [F(-187, 100), F(1874, 1000)]
+    e = [F(s), F(s)]
+    traj = [e]
+    for _ in range(300):
+        e = [e[1] - L[0] * e[0], e[0] - L[1] * e[0]]
+        traj.append(e)
+    scale = 1 / F(s)
+    rms = [
+        float(sum((v[i] * scale) ** 2 for v in traj) / len(traj)) ** 0.5 / float(scale)
+        for i in range(2)
+    ]
+    fin = float(sum((v * scale) ** 2 for v in traj[-1])) ** 0.5 / float(scale)
+    return rms, fin
+
+
+@pytest.mark.parametrize("s", ["1e-200", "1e200"])
+def test_metrics_of_errors_near_the_ends_of_the_float_range(s: str) -> None:
+    """RMSE and final |e| of errors near 10⁻²⁰⁰ and 10²⁰⁰, single run and Monte Carlo, match
+    the exact values (Fractions) to 10⁻¹⁰: the single run printed RMSE 0.0 for 10⁻²⁰⁰, the
+    Monte Carlo quantiles 0.0 and inf, beside run 0's finite table (simulate trial, session
+    27)."""
+    from obsdesign import api
+
+    spec = load_spec_text(_SCALE_SPEC.replace("S", s), "scale.toml")
+    rms, fin = _exact_metrics(s)
+    one = api.simulate(spec).metrics()
+    mc_q = api.simulate(spec, runs=2).info["quantiles"]
+    for got in (
+        [one["rmse"]["x1"], one["rmse"]["x2"], one["final_error_norm"]],
+        [mc_q["rmse"]["x1"]["max"], mc_q["rmse"]["x2"]["max"], mc_q["final_error_norm"]["max"]],
+    ):
+        np.testing.assert_allclose(got, [*rms, fin], rtol=1e-10)

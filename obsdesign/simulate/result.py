@@ -91,11 +91,12 @@ def _rms(v: np.ndarray) -> float:
 
 
 def _scaled(v: np.ndarray, f: Any) -> float:
-    """``f(v)`` for a norm-like ``f``; where that overflows though every entry is finite,
-    ``f(v / s) · s`` with s = max |v| (the same value, without the overflow of v²)."""
+    """``f(v)`` for a norm-like ``f`` as ``f(v / s) · s`` with s = max |v| (the same value,
+    without the overflow of v² near 10¹⁵⁴ nor its underflow near 10⁻¹⁵⁴: errors of 10⁻²⁰⁰ had
+    RMSE 0.0 beside sup |e| = 1.2·10⁻¹⁹⁹, simulate trial, session 27); ``f(v)`` when an entry
+    is not finite or all are 0."""
     with np.errstate(all="ignore"):
-        out = f(v)
-        if np.isfinite(out) or not np.all(np.isfinite(v)):
-            return out
-        s = float(np.max(np.abs(v)))
+        s = float(np.max(np.abs(v))) if np.size(v) else 0.0
+        if s == 0.0 or not np.isfinite(s):
+            return f(v)
         return f(v / s) * s
