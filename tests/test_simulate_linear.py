@@ -219,3 +219,28 @@ def test_a_start_beyond_the_float_range_is_said_so() -> None:
         "simulation steps is beyond the float range (about 1.8e308), so the metrics are not "
         "finite; take smaller initial states"
     ]
+
+
+def test_an_overflowing_plant_leaves_a_decoupled_error_finite() -> None:
+    """A = [[1.1, 1], [0, 1.2]] (unstable) with L making A − LC = eigenvalues 0.5, 0.6: x
+    overflows near k = 3881, but e⁺ = (A − LC)e does not read x. The joint step M·[x; e]
+    multiplied the zero block by inf and the error became nan (simulate trial, session 27);
+    it is stepped apart now, and matches its own recursion (which reaches exactly 0)."""
+    from obsdesign import api
+
+    spec = load_spec_text(
+        '[system]\ntime = "discrete"\nA = [[1.1, 1], [0, 1.2]]\nC = [[1, 0]]\n[method]\n'
+        'key = "lyapunov"\nL = [1.2, 0.42]\nlambda = 0.9\n[simulate]\nhorizon = 5000\n'
+        "x0 = [1, 1]\nxhat0 = [0, 0]\n",
+        "unstable.toml",
+    )
+    res = api.simulate(spec)
+    assert not np.all(np.isfinite(res.x))  # the plant does leave the float range
+    Acl = np.array([[1.1 - 1.2, 1.0], [-0.42, 1.2]])
+    e = np.empty((5001, 2))
+    e[0] = [-1.0, -1.0]
+    for k in range(5000):
+        e[k + 1] = Acl @ e[k]
+    np.testing.assert_allclose(res.e, e, rtol=1e-12, atol=1e-300)
+    m = res.metrics()
+    assert m["sup_abs_error"] == {"x1": 1.0, "x2": 1.0} and m["final_error_norm"] == 0.0
