@@ -430,8 +430,9 @@ def _print_metrics(m: dict[str, Any]) -> None:
                 c.print(esc(f"warning: {str(w).removeprefix('warning: ')}"))
         elif _json_only(v):
             continue
-        elif isinstance(v, str) and "\n" in v.strip():  # a preformatted table: no wrapping
-            c.print(esc(f"{k}: {v}"), soft_wrap=True)
+        elif isinstance(v, str) and "\n" in v.strip():  # a preformatted table: no wrapping,
+            # each line escaped (escaped whole, its newlines printed as "\n": simulate trial)
+            c.print("\n".join(esc(line) for line in f"{k}: {v}".split("\n")), soft_wrap=True)
         elif k not in (*_MAIN_METRICS, "quantiles"):
             c.print(esc(f"{k}: {v}"))
     head, rows = _quantile_rows(m.get("quantiles"))

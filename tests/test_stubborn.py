@@ -509,6 +509,21 @@ def test_study_option_via_cli_json(tmp_path: Path, how: list[str]) -> None:
     assert "outlier_study" in out and "stubborn" in out["outlier_study"]
 
 
+def test_study_table_prints_as_lines_in_text(tmp_path: Path) -> None:
+    """The median-RMSE table of the outlier study is printed one row per line in text: each
+    line escaped on its own (escaped whole, its newlines printed as a literal \\n and the
+    table as one line: simulate trial, session 27)."""
+    text = EX1.read_text().replace("runs = 100", "runs = 3").replace("horizon = 10", "horizon = 2")
+    f = tmp_path / "s.toml"
+    f.write_text(text)
+    r = CliRunner().invoke(app, ["simulate", str(f), "--study", "outliers", "--width", "200"])
+    assert r.exit_code == 0, r.output
+    lines = r.output.splitlines()
+    assert "\\n" not in r.output
+    assert any(line.startswith("luenberger ") for line in lines)
+    assert any(line.startswith("stubborn ") for line in lines)
+
+
 def test_study_unknown_to_the_method_is_bad_input(tmp_path: Path) -> None:
     r = CliRunner().invoke(app, ["simulate", str(EX1), "--study", "nonesuch"])
     assert r.exit_code == 2
