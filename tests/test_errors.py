@@ -91,3 +91,14 @@ def test_one_line_shortens_a_huge_message_and_success_lines_are_one_line(tmp_pat
     out = tmp_path / "o\x1b[31m\nx.json"
     res = CliRunner().invoke(app, ["design", str(spec), "-o", str(out)])
     assert res.exit_code == 0 and "\x1b" not in res.stdout and "o\\x1b[31m\\nx.json" in res.stdout
+
+
+def test_bidirectional_controls_are_escaped() -> None:
+    """U+202E (RIGHT-TO-LEFT OVERRIDE) and the other bidi controls in a file name reordered
+    the rest of a printed line in bidi-aware viewers (rendering trial, session 27): escaped
+    like the other controls; a soft hyphen or a joiner (also Cf) stays as it is."""
+    from obsdesign.errors import escape_controls
+
+    for ch in "\u200e\u200f\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069":
+        assert escape_controls(f"a{ch}b") == f"a\\u{ord(ch):04x}b"
+    assert escape_controls("soft\u00adhy\u200dphen") == "soft\u00adhy\u200dphen"
