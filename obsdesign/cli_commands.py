@@ -705,6 +705,8 @@ def simulate(
 
             raise InputError(f"--study {study} and --option study={opts['study']}: give it once")
         opts["study"] = study
+    if quiet and "progress" in opts:  # -q: no progress, whatever --option asked
+        opts["progress"] = "false"
     with _naming_the_spec(sp.file):
         res = api.simulate(sp, report, options=opts, workers=workers, scheduler=scheduler)
     if plot is not None and len(res.t) > MAX_PLOT_POINTS:

@@ -470,3 +470,17 @@ def test_a_cell_centred_outside_E_is_named_as_the_cause(tmp_path):
     inner = _CUBE.replace("0.95", "0.1")
     sp, rep = _load(inner, tmp_path)
     assert api.simulate(sp, rep).info["final_error"] >= 0
+
+
+def test_progress_goes_to_stderr_and_quiet_silences_it(tmp_path):
+    """--option progress=true drew its bar on stdout, before --format json's JSON, and -q did
+    not silence it (simulate trial, session 27)."""
+    import json
+
+    runner = CliRunner()
+    args = ["simulate", str(SPEC), "--option", "progress=true", "--format", "json"]
+    r = runner.invoke(app, args)
+    assert r.exit_code == 0, r.output
+    json.loads(r.stdout)  # stdout holds the JSON alone
+    r = runner.invoke(app, [*args[:4], "-q"])
+    assert r.exit_code == 0 and r.stdout == "" and "centres" not in r.stderr
