@@ -666,6 +666,17 @@ def simulate(
             )
         if batches is not None and batches < 1:
             raise InputError(f"batches: expected a positive number, got {batches}")
+        so = sp.simulate.options
+        if kwargs.get("runs") is None and all(
+            getattr(so, k, None) is None for k in ("runs", "initial_error")
+        ):
+            # the single scenario silently became a one-run Monte Carlo study, whose noise is
+            # child 0 of the seed's: other numbers than the serial run's (simulate trial,
+            # session 27)
+            raise InputError(
+                f"{sp.file}: --workers/--scheduler distribute Monte Carlo runs, and this spec "
+                "asks for one scenario (no run count): give --runs N, or run it without them"
+            )
         check_workers(workers, scheduler)
     where = "report"
     if report is None:

@@ -104,6 +104,18 @@ def test_method_without_monte_carlo_refuses_workers():
     assert "no Monte Carlo runs to distribute" in r.output
 
 
+def test_the_single_scenario_is_not_distributed() -> None:
+    """A spec without a run count (nor initial_error) asks for one scenario: --workers made it
+    a one-run Monte Carlo study with other noise than the serial run's (simulate trial,
+    session 27); now exit 2 before any cluster starts, and the API says the same."""
+    r = CliRunner().invoke(app, ["simulate", str(SPEC), "--workers", "2"])
+    assert r.exit_code == 2, r.output
+    assert "give --runs N" in r.output
+    with pytest.raises(InputError, match="give --runs N"):
+        api.simulate(SPEC, batches=2)
+    assert api.simulate(SPEC, batches=2, runs=1).info["runs"] == 1
+
+
 def test_workers_without_dask_say_how_to_install(monkeypatch, spec_and_report):
     path, _, _ = spec_and_report
     monkeypatch.setattr(distributed, "dask_available", lambda: False)
