@@ -51,8 +51,8 @@ def test_shipped_spec_exact_numbers() -> None:
     assert p["theta"] == 1109771083258944  # 1.11e15
     summary = api.method("constrained").summary(p)
     assert summary == (
-        "γ = 2.396e-05, γ_max = 2.396e-05, δ = 748.6, v_max = 2.66e+06, v_min = 0.9075, "
-        "θ = 1.11e+15"
+        "γ ≈ 2.396e-05, γ_max ≈ 2.396e-05, δ ≈ 748.6, v_max ≈ 2.66e+06, v_min ≈ 0.9075, "
+        "θ ≈ 1.11e+15"
     )
 
 

@@ -32,7 +32,7 @@ def test_summary_formats_scalars_vectors_and_matrices() -> None:
             "count": 6,
         }
     )
-    assert _Plain().summary(p) == "λ = 0.3333, v_max = 2, K = [0.333, 0; 2, -0.143], n = 6"
+    assert _Plain().summary(p) == "λ ≈ 0.3333, v_max = 2, K ≈ [0.333, 0; 2, -0.143], n = 6"
     vec = Parameters({"K": np.array([fmpq(1, 2), 3], dtype=object)})
     assert _Plain().summary(vec) == "K = [0.5, 3]"
 
