@@ -611,7 +611,11 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
 
 
 def _replace_claims(rep: Report, claims: list[Claim], seconds: float) -> Report:
+    """``rep`` with the verified ``claims``, its verdict the one they give: the report's own
+    verdict stayed, so ``verify --format json`` printed "verdict": "ok" beside a failed
+    ``report-alters`` claim and exit 1 (rendering trial, session 27)."""
     rep.claims = claims
+    rep.verdict = rep.computed_verdict()
     rep.timings = {**rep.timings, "verify_s": round(seconds, 4)}
     return rep
 

@@ -108,6 +108,25 @@ def _write(p: Path, text: str) -> Path:
     return p
 
 
+def test_verify_json_verdict_is_the_verification(tmp_path: Path):
+    """``verify --format json`` carries the verdict its recomputed claims give, not the
+    report's stored one: a tampered statement printed "verdict": "ok" beside a failed
+    report-alters claim and exit 1 (rendering trial, session 27); a CI job reading the field
+    would have passed it. The stored verdict edited to "inconclusive" is likewise replaced."""
+    out_json = tmp_path / "r.json"
+    assert _run("design", "-", "-q", "-o", str(out_json), input=SPEC)[0] == 0
+    d = json.loads(out_json.read_text())
+    code, out, _ = _run("verify", "-", "--format", "json", input=json.dumps(d))
+    assert code == 0 and json.loads(out)["verdict"] == "ok"
+    d["claims"][0]["statement"] += " (edited)"
+    for stored in ("ok", "inconclusive"):
+        d["verdict"] = stored
+        code, out, _ = _run("verify", "-", "--format", "json", input=json.dumps(d))
+        v = json.loads(out)
+        assert code == 1 and v["verdict"] == "failed", stored
+        assert any(c["id"].startswith("report-alters:") for c in v["claims"])
+
+
 def test_stdin_output_checks_still_refuse(tmp_path: Path):
     target = tmp_path / "t.json"
     target.write_text("{}")
