@@ -591,9 +591,12 @@ def row_norms(a: np.ndarray) -> np.ndarray:
     """Euclidean norm of each row, scaled by the row's largest |entry| (no overflow of the
     squares near 10¹⁵⁴ nor underflow near 10⁻¹⁵⁴: a final |e| of 1.8·10¹⁹⁵ was inf, and of
     1.8·10⁻²⁰⁵ was 0; simulate trial, session 27)."""
+    from obsdesign.simulate.result import SAFE_HI, SAFE_LO
+
     with np.errstate(all="ignore"):
         m = np.max(np.abs(a), axis=1, keepdims=True) if a.size else np.zeros((len(a), 1))
-        s = np.where((m > 0) & np.isfinite(m), m, 1.0)
+        # rows in the safe range unscaled (bit for bit the plain norm), the others scaled
+        s = np.where((m > 0) & np.isfinite(m) & ((m < SAFE_LO) | (m > SAFE_HI)), m, 1.0)
         return np.asarray(np.linalg.norm(a / s, axis=1) * s[:, 0])
 
 

@@ -97,6 +97,12 @@ def _scaled(v: np.ndarray, f: Any) -> float:
     is not finite or all are 0."""
     with np.errstate(all="ignore"):
         s = float(np.max(np.abs(v))) if np.size(v) else 0.0
-        if s == 0.0 or not np.isfinite(s):
-            return f(v)
-        return f(v / s) * s
+        if not SAFE_LO <= s <= SAFE_HI:  # 0 and non-finite entries fail both: as they are
+            if s == 0.0 or not np.isfinite(s):
+                return f(v)
+            return f(v / s) * s
+        return f(v)  # squares safe: unscaled, bit for bit what it always was
+
+
+#: the range of max |v| in which v² neither overflows nor loses digits to underflow
+SAFE_LO, SAFE_HI = 1e-150, 1e150
