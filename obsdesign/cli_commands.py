@@ -269,13 +269,20 @@ def _print_report(rep: Any, fmt: Fmt) -> None:
         render_text(rep)
 
 
+def _result_text(r: Any) -> str:
+    """A check row's result cell: the summary of a row that passed, else why it did not (the
+    Markdown table showed the summary of rows that exited 1 or 4 with claims, the text table
+    the reason: rendering trial, session 27)."""
+    return str(r.summary if r.code == 0 else (r.message or r.summary))
+
+
 def _print_rows(rows: list[Any], fmt: Fmt) -> None:
     if fmt == Fmt.md:
         print("| spec | method | exit | certified | numerical | failed | result | seconds |")
         print("| --- | --- | --- | --- | --- | --- | --- | --- |")
         for r in rows:
             cells = [r.spec, r.method, r.code, r.certified, r.numerical, r.failed]
-            cells += [r.summary or r.message, f"{r.seconds:.2f}"]
+            cells += [_result_text(r), f"{r.seconds:.2f}"]
             print("| " + " | ".join(_md_cell(c) for c in cells) + " |")
         return
     from rich.table import Table
@@ -298,7 +305,7 @@ def _print_rows(rows: list[Any], fmt: Fmt) -> None:
             esc(r.method),
             verdict,
             f"{r.certified}/{r.numerical}/{r.failed}",
-            esc(r.summary if r.code == 0 else r.message),
+            esc(_result_text(r)),
             f"{r.seconds:.2f}",
         )
     console().print(t)

@@ -171,6 +171,17 @@ def test_check_verdict_line_and_md(spec: Path, tmp_path: Path):
     assert out.rstrip().splitlines()[-1].startswith("**NOT all checked: 2 specs, 1 ok, 1 failed;")
 
 
+def test_check_md_says_why_a_row_failed(tmp_path: Path):
+    """A row that exits 1 with claims shows its failure in Markdown as in text: the md table
+    showed the summary (rendering trial, session 27). A nonlinear psi fails linear-plant."""
+    nonlin = tmp_path / "nonlin.toml"
+    nonlin.write_text(SPEC.replace("C = [[1, 0]]", 'C = [[1, 0]]\npsi = ["0", "0.01*sin(x1)"]'))
+    for fmt in ("md", "text"):
+        code, out, _ = _run("check", str(nonlin), "--format", fmt, "--width", "300")
+        assert code == 1, out
+        assert "linear-plant: [system] psi make(s) the plant nonlinear" in out, fmt
+
+
 def test_did_you_mean(tmp_path: Path):
     # an unknown key next to an optional one
     code, _, err = _run("design", "-", input=SPEC.replace("[simulate]", "[simulat]"))
