@@ -278,3 +278,21 @@ def test_verify_says_what_is_wrong_with_claims_and_a_stdin_spec(tmp_path: Path) 
     assert res.exit_code == 2 and "key 'claims': expected a list of claim objects" in res.output
     res = CliRunner().invoke(app, ["verify", "-", "--spec", "-"], input="")
     assert res.exit_code == 2 and "--spec -: verify reads the spec from a file" in res.output
+
+
+def test_a_huge_edited_statement_or_id_is_quoted_clipped() -> None:
+    """A report's 4 MB statement (or 3 MB claim id) was echoed whole in the report-alters /
+    report-adds detail, and rendering took 85 s (rendering trial, session 27): quoted to at
+    most 2,000 characters, its length said; the verdict is unchanged (failed)."""
+    d = api.design(SPEC).to_dict()
+    d["claims"][0]["statement"] = "A " * 2_000_000
+    ver = api.verify(Report.from_dict(d)[0])
+    bad = [c for c in ver.claims if c.id.startswith("report-alters:")]
+    assert ver.exit_code() == 1 and bad and len(bad[0].detail) < 5000
+    assert "characters)" in bad[0].detail
+    d["claims"][0]["statement"] = "P ≻ 0"
+    d["claims"][0]["id"] = "x" * 3_000_000
+    ver = api.verify(Report.from_dict(d)[0])
+    adds = [c for c in ver.claims if c.id.startswith("report-adds:")]
+    assert ver.exit_code() == 1 and adds
+    assert len(adds[0].id) < 2100 and len(adds[0].detail) < 5000
