@@ -109,3 +109,24 @@ def test_parameter_tables_mark_rounded_values(monkeypatch: pytest.MonkeyPatch) -
     assert "| alpha | `≈ 2.16667` | exact |" in md
     assert "≈ 2.16667" in _rendered(monkeypatch, rep)
     assert rows["alpha_bracket"].startswith("≈ ")
+
+
+@pytest.mark.parametrize("width", [40, 47, 59])
+def test_narrow_tables_fold_instead_of_cropping(width: int, tmp_path: Path) -> None:
+    """At --width 40–59 the claims table kept the id column as wide as the longest id (25
+    characters here), so rich cropped the statements with no mark: "T_max = 1." for
+    "T_max = 1.3452 ≤ …" (rendering trial, session 27). Every table row keeps its right
+    border now, and the statement's number is printed whole."""
+    from typer.testing import CliRunner
+
+    from obsdesign.cli import app
+
+    spec = ROOT / "specs" / "impulsive-sector-3state.toml"
+    rep = tmp_path / "r.json"
+    r = CliRunner().invoke(app, ["design", str(spec), "-q", "-o", str(rep)])
+    assert r.exit_code == 0
+    r = CliRunner().invoke(app, ["verify", str(rep), "--width", str(width)])
+    assert r.exit_code == 0, r.output
+    rows = [ln for ln in r.output.splitlines() if ln.startswith("│")]
+    assert rows and all(ln.rstrip().endswith("│") for ln in rows)
+    assert "1.3452" in r.output

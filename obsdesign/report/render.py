@@ -142,6 +142,10 @@ def render_text(report: Report, title: str = "") -> None:
     # the detail go under the statement (two columns), so nothing is cropped at 80.
     id_w = min(max((len(cl.id) for cl in report.claims), default=2), 32)
     if out.width < NARROW:
+        # and never so wide that the prose column is squeezed below 24 columns: a 25-column id
+        # at --width 40 made rich crop the statements with no mark ("T_max = 1." for
+        # "T_max = 1.3452 ≤ …"; rendering trial, session 27); an id then folds
+        id_w = max(4, min(id_w, out.width - 7 - 24))
         c.add_column("id / status", overflow="fold", min_width=id_w)
         c.add_column("statement / check / detail", overflow="fold")
         for cl in report.claims:
