@@ -160,6 +160,8 @@ def _run(fn: Callable[[Any], int], quiet: bool = False, width: int | None = None
     try:
         if owned:
             signal.signal(signal.SIGINT, interrupt.handler)
+            if signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
+                signal.signal(signal.SIGTERM, interrupt.handler)
         from obsdesign import cli_commands
 
         cli_commands.setup(quiet, width)
@@ -208,6 +210,8 @@ def _settle(owned: bool) -> None:
 
     if owned:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
+        if signal.getsignal(signal.SIGTERM) is interrupt.handler:
+            signal.signal(signal.SIGTERM, signal.SIG_IGN)
     if interrupt.requested():
         _interrupted()
 
@@ -217,9 +221,10 @@ def _interrupted() -> None:
     ``except typer.Exit`` branch of :func:`_run` settles again and must not say it twice)."""
     from obsdesign import interrupt
 
+    term = interrupt.signal_number() == signal.SIGTERM
     interrupt.reset()
-    _err("interrupted")
-    raise typer.Exit(130) from None
+    _err("terminated" if term else "interrupted")
+    raise typer.Exit(143 if term else 130) from None
 
 
 def _quiet_broken_pipe() -> None:

@@ -13,12 +13,18 @@ covered in :func:`obsdesign.lmi.solve`.
 from __future__ import annotations
 
 _requested = False
+#: the signal recorded (SIGINT 2 or SIGTERM 15), 0 when none
+_signum = 0
 
 
 def handler(signum: int, frame: object) -> None:
-    """SIGINT handler of a command body: record the interrupt, then raise as Python does."""
-    global _requested
+    """SIGINT and SIGTERM handler of a command body: record the interrupt, then raise
+    KeyboardInterrupt as Python does for SIGINT, so the same cleanup runs (temp files
+    removed). SIGTERM (what ``timeout`` sends) killed the process at once and left a hidden
+    half-written ``.NAME.XXXX.csv`` beside the output (simulate trial, session 27)."""
+    global _requested, _signum
     _requested = True
+    _signum = signum
     raise KeyboardInterrupt
 
 
@@ -27,10 +33,16 @@ def requested() -> bool:
     return _requested
 
 
+def signal_number() -> int:
+    """The signal :func:`handler` recorded (0 when none): the exit code is 128 + it."""
+    return _signum
+
+
 def reset() -> None:
     """Forget a recorded interrupt (at the start of each command body)."""
-    global _requested
+    global _requested, _signum
     _requested = False
+    _signum = 0
 
 
 def check() -> None:

@@ -284,6 +284,37 @@ def test_ctrl_c_is_one_line_no_traceback(delay: float):
     assert err.strip().splitlines()[-1].endswith("interrupted")
 
 
+@pytest.mark.parametrize("delay", [0.5, 1.5, 3.0])
+def test_sigterm_cleans_up_like_ctrl_c(spec: Path, tmp_path: Path, delay: float) -> None:
+    """SIGTERM (what ``timeout`` sends) during ``simulate --csv`` killed the process at once
+    and left a hidden half-written ``.out.csv.XXXX.csv`` beside the output (simulate trial,
+    session 27). It is handled as Ctrl-C is now: cleanup runs, one line "terminated", exit
+    143 (128 + 15); the file is there whole or not at all."""
+    import signal
+    import time
+
+    exe = Path(sys.executable).parent / "obsdesign"
+    spec.write_text(spec.read_text().replace("horizon = 300", "horizon = 400000"))
+    out = tmp_path / "out.csv"
+    p = subprocess.Popen(
+        [str(exe), "simulate", str(spec), "-q", "--csv", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    time.sleep(delay)
+    p.send_signal(signal.SIGTERM)
+    _, err = p.communicate(timeout=120)
+    assert "Traceback" not in err
+    assert p.returncode in (0, 143), err
+    if p.returncode == 143:
+        assert err.strip().splitlines()[-1].endswith("terminated")
+        assert not out.exists()
+    else:
+        assert out.read_text().count("\n") == 400001 + 1  # the header and every step
+    assert not [f.name for f in tmp_path.iterdir() if f.name.startswith(".")]
+
+
 def test_simulate_refuses_an_error_report(spec: Path, tmp_path: Path):
     bad = tmp_path / "bad.toml"
     bad.write_text(spec.read_text().replace("L = [-1.87, 1.874]", "L = [5, 5]"))
