@@ -4,6 +4,7 @@ search give the per-window mask's numbers, on any grid."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -72,3 +73,22 @@ def test_many_overlapping_windows_are_summed_per_segment_exactly() -> None:
     too_many = [S.Window(0.0, 999.0, np.array([1.0]))] * (S.MAX_OVERLAPPING_WINDOWS + 1)
     with pytest.raises(InputError, match=r"windows: 10,001 windows that together cover"):
         S._add_windows(np.zeros((1000, 1)), grid, too_many)
+
+
+@pytest.mark.parametrize(("kind", "key"), [("uniform", "bound"), ("outliers", "amplitude")])
+def test_a_uniform_bound_whose_width_overflows_is_bad_input(kind: str, key: str) -> None:
+    """bound = 1e308: numpy draws from the width 2b, which overflows; that was exit 4 naming
+    neither the key nor the number (simulate trial, session 27). Exit 2 naming the key; the
+    largest bound that works, max/2, loads."""
+    from obsdesign.api import load_spec_text
+    from obsdesign.errors import SpecError
+    from obsdesign.spec.signals import MAX_UNIFORM
+
+    base = (
+        '[system]\ntime = "discrete"\nA = [[0.5]]\nC = [[1]]\n[method]\nkey = "lyapunov"\n'
+        f'[simulate]\nhorizon = 5\nx0 = [1]\nxhat0 = [0]\n[simulate.noise]\nkind = "{kind}"\n'
+        + ("rate = 0.1\n" if kind == "outliers" else "")
+    )
+    with pytest.raises(SpecError, match=rf"\[simulate\.noise\.{key}\] expected at most"):
+        load_spec_text(base + f"{key} = 1e308\n", "s.toml")
+    load_spec_text(base + f"{key} = {MAX_UNIFORM!r}\n", "s.toml")

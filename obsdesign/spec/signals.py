@@ -149,9 +149,20 @@ def parse_signal(t: Table | None, dim: int) -> Signal:
     return s
 
 
+#: the largest bound (or amplitude) of a uniform draw on [−b, b]: numpy draws from the width
+#: 2b, which must be a float (bound = 1e308 was exit 4 "a number is beyond the float range
+#: (Range exceeds valid bounds)", naming neither key nor number: simulate trial, session 27)
+MAX_UNIFORM = float(np.finfo(float).max) / 2
+
+
 def _nonneg(t: Table, key: str, dim: int) -> np.ndarray:
     v = t.vector(key, n=dim) if isinstance(t.data.get(key), list) else t.scalar(key)
     arr = np.broadcast_to(np.asarray(v.f, dtype=float), (dim,)).copy()
     if np.any(arr < 0):
         raise t.error(key, "expected non-negative bounds")
+    if np.any(arr > MAX_UNIFORM):
+        raise t.error(
+            key,
+            f"expected at most {MAX_UNIFORM:.6g} (draws on [−b, b] need the width 2b as a float)",
+        )
     return arr
