@@ -802,6 +802,26 @@ def test_admissibility_counts_only_the_samples_the_run_uses(k: int, admissible: 
     assert res.info["admissible_scenario"] is admissible
 
 
+@pytest.mark.parametrize("law", ["time-varying", "interpolated"])
+def test_the_time_varying_law_is_judged_only_without_disturbance(law: str) -> None:
+    """Example 7.1 with e(0) = (1, −1) ∈ Ω and d_k = 1 ∈ D: the time-varying law (10), proved
+    for d = η = 0 only, leaves Ω (gauge 1.057) and exited 1 beside "admissible_scenario: True"
+    (simulate trial, session 27); that scenario is not admissible for it now. The interpolated
+    law (12), proved for admissible d, stays inside."""
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "specs" / "dorea-pimenta-7-1.toml").read_text()
+    old = "values = [1, -1, -1, 1, 1, -1, 1, -1, -1, -1, 1, -1, 1, -1, -1, -1, 1]"
+    assert old in text and "xhat0 = [0, 0]" in text
+    text = text.replace(old, "values = [" + ", ".join(["1"] * 17) + "]")
+    text = text.replace("xhat0 = [0, 0]", "xhat0 = [-1, 1]")
+    res = api.simulate(load_spec_text(text, "tv.toml"), options={"law": law})
+    if law == "time-varying":
+        assert res.info["max_gauge"] > 1.05 and not res.info["admissible_scenario"]
+        assert res.info.get("exit_code", 0) == 0
+    else:
+        assert res.info["error_in_polyhedron"] and res.info["admissible_scenario"]
+
+
 DIVERGING = matrix_spec_text(
     [[-0.1534, -0.6418, -0.604], [0.1031, 0.2395, 0.5455], [-0.3251, -0.03657, 0.6603]],
     [-0.0146, -0.0388, 0.0569], [[0.452, -2.03, 0.463]], 0.9914, eta_bar=0,

@@ -138,6 +138,10 @@ def simulate(
     # η_N, which nothing uses, turned admissible_scenario False and with it the exit-1 guard
     # below off (simulate-correctness trial, session 25)
     adm = _admissible(spec, dd[:-1], vv[:-1])
+    if name == "time-varying" and (np.any(dd[:-1] != 0) or np.any(vv[:-1] != 0)):
+        # eq. (10) is proved for d = η = 0 only: a disturbed run proves nothing, and leaving
+        # Ω there was exit 1 beside "admissible_scenario: True" (simulate trial, session 27)
+        adm = False
     inside = bool(np.all(gauge <= 1 + 1e-9))
     res.extra["G"] = G
     res.extra["e_paper"] = e
