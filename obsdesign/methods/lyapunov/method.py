@@ -13,7 +13,7 @@ from __future__ import annotations
 from typing import Any
 
 from obsdesign.certify.claim import Claim
-from obsdesign.methods.base import Design, Method, Progress, SimOption, SummaryField
+from obsdesign.methods.base import Design, Method, Progress, SimOption, SummaryField, sim_width
 from obsdesign.methods.lyapunov import claims as _claims
 from obsdesign.methods.lyapunov import design as _design
 from obsdesign.methods.lyapunov.options import (
@@ -120,7 +120,7 @@ class Lyapunov(Method):
         one = super().sim_bytes(spec, 1, steps, options)
         if runs == 1:
             return one
-        width = 4 * s.n + s.p + s.m + 2
+        width = sim_width(s)
         batch = options.get("batch") or mc.BATCH_RUNS
         blocks = 8.0 * min(batch, runs) * (mc.CHUNK + mc.BLOCK + 1) * width
         return one + 8.0 * runs * (5 * s.n + 1) + blocks
