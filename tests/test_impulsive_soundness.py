@@ -357,8 +357,36 @@ def test_claim_ids_of_the_example() -> None:
         "T_min",
         "window",
         "ball_radius",
+        "assumption1-falsification",
     ]
-    assert [c.status.value for c in rep.claims] == ["certified"] * 14 + ["numerical"]
+    assert [c.status.value for c in rep.claims] == ["certified"] * 14 + ["numerical"] * 2
+
+
+def test_a_warned_violation_of_assumption_1_is_a_claim_verify_recomputes() -> None:
+    """on_violation = "warn" with Assumption 1 violated (the shipped example): the violation
+    was only a note, and a report whose note was deleted verified with nothing saying the
+    window holds only given the declared data (rendering trial, session 27). It is a numerical
+    claim now, whose statement says so; a report that drops it, or rewrites it to "holds",
+    fails verify."""
+    from obsdesign.report.model import Report
+
+    _, rep = designed("example")
+    c = next(c for c in rep.claims if c.id == "assumption1-falsification")
+    assert "violated" in c.statement and c.status.value == "numerical"
+    assert api.verify(Report.from_dict(rep.to_dict())[0]).exit_code() == 0
+    d = rep.to_dict()
+    d["claims"] = [x for x in d["claims"] if x["id"] != "assumption1-falsification"]
+    d["notes"] = []
+    ver = api.verify(Report.from_dict(d)[0])
+    assert ver.exit_code() == 1
+    assert any(x.id == "report-omits:assumption1-falsification" for x in ver.claims)
+    d = rep.to_dict()
+    for x in d["claims"]:
+        if x["id"] == "assumption1-falsification":
+            x["statement"] = (
+                "Assumption 1 (split reading) holds at every sampled pair of the region"
+            )
+    assert api.verify(Report.from_dict(d)[0]).exit_code() == 1
 
 
 def test_ball_invariance_is_never_certified_and_fails_when_a_jump_leaves_B() -> None:
