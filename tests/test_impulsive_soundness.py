@@ -719,3 +719,39 @@ def test_ball_radius_is_the_root_rounded_up_not_any_larger_radius() -> None:
     assert failed_ids(spec, _with(rep.parameters, {"ball_radius": line})) == set()
     assert failed_ids(spec, _with(rep.parameters, {"ball_radius": line + TINY})) == {"ball_radius"}
     assert failed_ids(spec, _with(rep.parameters, {"ball_radius": fmpq(10)})) == {"ball_radius"}
+
+
+# -- mutation review 27: the T_min / T_max details ------------------------------------------
+def test_window_details_print_true_inequalities_rounded_the_safe_way() -> None:
+    """mutation review 27 (kills impulsive.claims.x__window_detail__mutmut_3, 14, 15, 16, 19,
+    20, 25, 47, 50, 51, 52, 55). The detail of each branch, exactly: a passed T_min (T_max)
+    shows its bound rounded up (down) to 10 digits under ≥ (≤) — mutant 3 rounded T_max's up,
+    47 printed T_max ≥; a failed one the strict opposite inequality — 19 / 20 printed the
+    wrong one, 25 printed "10" for the bound; a T_max not above 0 says so — 14 / 15 sent
+    T_max = −0.1 and T_max = bound = 0 to "T_max = 0 > 0", 16 raised; within 10⁻⁵⁰ of the
+    bound no 10–40-digit decimal is on the safe side and the bound is printed exactly —
+    50 / 55 raised there, 51 / 52 printed the wrong inequality. No test reached the
+    "is not > 0" or the exact branch, nor checked the inequality sign of a passed T_max."""
+    from obsdesign.certify.printing import fmt_exact
+    from obsdesign.methods.impulsive.claims import _window_detail as wd
+
+    third = fmpq(1, 3)
+    assert wd("T_min", fmpq(1, 2), third, True, up=True) == (
+        "T_min = 0.5 ≥ 0.3333333334 (rounded up)"
+    )
+    assert wd("T_max", fmpq(3, 10), third, True, up=False) == (
+        "T_max = 0.3 ≤ 0.3333333333 (rounded down)"
+    )
+    assert wd("T_min", fmpq(3, 10), third, False, up=True) == (
+        "T_min = 0.3 < 0.3333333334 (rounded up)"
+    )
+    assert wd("T_max", fmpq(1, 2), third, False, up=False) == (
+        "T_max = 0.5 > 0.3333333333 (rounded down)"
+    )
+    assert wd("T_max", fmpq(-1, 10), third, False, up=False) == "T_max = -0.1 is not > 0"
+    assert wd("T_max", fmpq(0), fmpq(0), False, up=False) == "T_max = 0 is not > 0"
+    eps = fmpq(1, 10**50)
+    t = third + eps
+    assert wd("T_min", t, third, True, up=True) == f"T_min = {fmt_exact(t)} ≥ 1/3 (exact)"
+    t = third - eps
+    assert wd("T_max", t, third, True, up=False) == f"T_max = {fmt_exact(t)} ≤ 1/3 (exact)"

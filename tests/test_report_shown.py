@@ -60,3 +60,16 @@ def test_the_check_summary_marks_rounded_values() -> None:
     p = Parameters({"T_min": fmpq(1551, 10000), "kappa": fmpq(199999185, 10**8)})
     s = get_method("impulsive").summary(p)
     assert "T_min = 0.1551" in s and "κ ≈ 2" in s
+
+
+def test_a_float_vector_held_as_a_list_is_shown() -> None:
+    """mutation review 27 (kills shown.x_shown__mutmut_9: the raw value used as given, not
+    as an array, `if f.ndim` → `if f.ndim and False`). A float vector parameter is held as a
+    Python list: it has no reshape, and the table cell and the summary item raised
+    AttributeError. Its entries read back as the floats held: no mark; a rounded one: "≈"."""
+    p = Parameters({"v": [1.5, 2.5], "w": [0.1 + 2**-40, 2.0], "n": [1, 2]})
+    assert isinstance(p["v"], list)
+    assert cell(p["v"], p.float("v")) == "[1.5, 2.5]"
+    assert cell(p["w"], p.float("w")) == "≈ [0.1, 2]"
+    assert cell(p["n"], p.float("n")) == "[1, 2]"
+    assert item("v", p["v"], p.float("v"), ".4g") == "v = [1.5, 2.5]"

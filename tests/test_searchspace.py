@@ -1033,3 +1033,56 @@ def test_a_function_undefined_on_part_of_its_interval_proves_nothing() -> None:
     assert "sqrt(u1)" in text and "lower = [-0.5]" in text
     with pytest.raises(InfeasibleError, match="no finite interval bound on E"):
         api.design(api.load_spec_text(text, "sqrt-f.toml"))
+
+
+# -- mutation review 27: the K-rule's new condition (K itself satisfies the rule) -------------
+def test_K_rule_needs_K_strictly_below_the_lower_bound(example) -> None:
+    """mutation review 27 (kills claims.x_certify__mutmut_415: `K·ΔT·L_f < lo` → `≤`).
+    ΔT = lo/63, lo the 113-bit lower bound of log 1.5 at the K-rule's precision: 63·ΔT·L_f
+    equals lo exactly, so K = 63 is not proved to satisfy KΔT < log(κ/L_h)/L_f and K-rule
+    fails (while 64·ΔT ≥ hi, the K + 1 side, holds); with `≤` it was certified."""
+    sp, _ = example
+    v = _consistent(sp)
+    assert v["L_f"] == 1 and v["kappa"] == fmpq(3, 2) and v["K"] == 63
+    bits = D.K_bits(v["dT"] * v["L_f"])
+    lo, hi = ivq.log_bounds(fmpq(3, 2), bits)
+    dT = lo / 63
+    assert D.K_bits(dT) == bits and 64 * dT >= hi
+    w = dict(v, dT=dT, dtau=63 * dT)
+    assert _certified(sp, w)["K-rule"] == ClaimStatus.FAILED
+    # a hair below lo, K = 63 is proved: the claim turns on the strict inequality alone
+    dT = lo / 63 - fmpq(1, 2**200)
+    assert D.K_bits(dT) == bits
+    w = dict(v, dT=dT, dtau=63 * dT)
+    assert _certified(sp, w)["K-rule"] == ClaimStatus.CERTIFIED
+
+
+def test_K_rule_K_one_with_a_small_L_f_is_not_the_rule(example) -> None:
+    """mutation review 27 (kills claims.x_certify__mutmut_408: `K == 1 and ΔT·L_f ≥ hi` →
+    `ΔT/L_f ≥ hi`). With L_f = 2⁻¹⁰, ΔT·L_f ≈ 6·10⁻⁶ is far below log 1.5, so the rule's K
+    is about 6.5·10⁴ and K = 1 fails K-rule; ΔT/L_f ≈ 6.5 ≥ log 1.5 certified it."""
+    sp, _ = example
+    L_f = fmpq(1, 1024)
+    v = _consistent(sp, L_f=L_f, K=1)
+    assert v["K"] == 1 and 2 * v["dT"] * L_f < fmpq(2, 5) < v["dT"] / L_f
+    assert _certified(sp, v)["K-rule"] == ClaimStatus.FAILED
+
+
+def test_K_rule_works_at_the_precision_of_dT_times_L_f(example) -> None:
+    """mutation review 27 (kills claims.x_certify__mutmut_394: `K_bits(ΔT·L_f)` →
+    `K_bits(ΔT/L_f)`). With L_f = 2⁻¹⁰ the rule's K is ≈ 6.5·10⁴ and K_bits(ΔT·L_f) = 131;
+    ΔT is set so that (K+1)·ΔT·L_f equals the 131-bit upper bound hi of log 1.5 exactly, so
+    K-rule holds (≥) and is certified. At the precision of ΔT/L_f (114 bits) the upper
+    bound is above hi, and the same true claim failed."""
+    sp, _ = example
+    L_f = fmpq(1, 1024)
+    v = _consistent(sp, L_f=L_f)
+    K = int(v["K"])
+    assert K > 60000
+    bits = D.K_bits(v["dT"] * L_f)
+    lo, hi = ivq.log_bounds(fmpq(3, 2), bits)
+    dT = hi / ((K + 1) * L_f)
+    assert D.K_bits(dT * L_f) == bits and K * dT * L_f < lo
+    assert ivq.log_bounds(fmpq(3, 2), D.K_bits(dT / L_f))[1] > hi  # the mutant's bound
+    w = dict(v, dT=dT, dtau=K * dT)
+    assert _certified(sp, w)["K-rule"] == ClaimStatus.CERTIFIED

@@ -82,3 +82,29 @@ def test_a_constant_above_1e154_is_certified() -> None:
     assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
     L_h = Fraction(str(rep.parameters["L_h"]))
     assert 10**160 <= L_h <= Fraction(100001, 100000) * 10**160
+
+
+# -- mutation review 27: hypot_hi stays exact where it can, _norms scales small rows ----------
+def test_hypot_hi_is_exact_when_the_root_is_a_float() -> None:
+    """mutation review 27 (kills bounds.x_hypot_hi__mutmut_26: a quotient stepped up when it
+    is exact instead of when it underflowed; x_hypot_hi__mutmut_42: the result always
+    stepped up; x_hypot_hi__mutmut_49: `ldexp(out, −e) >= r` → `>`). The power-of-two
+    scaling is exact, so a root that is a float is returned as it is (3-4-5, a single entry,
+    a subnormal pair); each mutant returned a larger float. An entry whose quotient
+    underflows still moves the bound above the root."""
+    assert B.hypot_hi([3.0, 4.0]) == 5.0
+    assert B.hypot_hi([1.0]) == 1.0 and B.hypot_hi([2.0**600]) == 2.0**600
+    assert B.hypot_hi([3e200, 4e200]) == B.hypot_hi([4e200, 3e200])
+    assert B.hypot_hi([3.0 * 2**-1074, 4.0 * 2**-1074]) == 5.0 * 2**-1074
+    r = B.hypot_hi([1.0, 2.0**-1074])  # 2⁻¹⁰⁷⁵ underflows: rounded up, not to 0
+    assert r > 1.0 and Fraction(r) ** 2 >= 1 + Fraction(2) ** -2148
+
+
+def test_sampled_norms_of_tiny_rows_do_not_underflow() -> None:
+    """mutation review 27 (kills bounds.x__norms__mutmut_24: rows scaled only when their
+    largest entry is above 1, `m > 0` → `m > 1`). The squares of 3·10⁻²⁰⁰ and 4·10⁻²⁰⁰
+    underflow to 0: unscaled, the sampled estimate of ‖(3, 4)·10⁻²⁰⁰‖ was 0, not 5·10⁻²⁰⁰
+    (a given constant below the true value could not be refuted)."""
+    n = B._norms(np.array([[3e-200, 4e-200], [0.0, 3e-170], [0.5, 0.0]]))
+    assert math.isclose(n[0], 5e-200, rel_tol=1e-15)
+    assert n[1] == 3e-170 and n[2] == 0.5

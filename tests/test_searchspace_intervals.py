@@ -1018,3 +1018,31 @@ def test_a_near_integer_exponent_literal_is_not_an_integer_power() -> None:
     assert exact.v.lo == exact.v.hi == 100.0
     assert IV.int_literal(node.body.right, text) is None
     assert IV.int_literal(ast.parse("x**3.0", mode="eval").body.right, "x**3.0") == 3
+
+
+# -- mutation review 27: log / sqrt refusals and the X*X → X² branch -------------------------
+def test_log_of_the_point_zero_is_refused() -> None:
+    """mutation review 27 (kills intervals.x_log__mutmut_1: `x.hi <= 0` → `x.hi < 0`). log
+    over [0, 0] is undefined at every point: refused. With `<` it returned [−∞, −∞], and
+    exp(log(0*x)) got the derivative enclosure [0, 0] (L_f = 0 for a function defined
+    nowhere). An interval reaching 0 from above stays defined, unbounded below."""
+    with pytest.raises(ArithmeticError):
+        IV.log(I(0.0, 0.0))
+    with pytest.raises(ArithmeticError):
+        _enc("exp(log(0*x))", {"x": (-1.0, 1.0)})
+    r = IV.log(I(0.0, 2.0))
+    assert r.lo == -math.inf and Fraction(r.hi) >= Fraction(math.log(2.0))
+
+
+def test_a_product_of_two_different_literals_is_not_a_square() -> None:
+    """mutation review 27 (kills intervals.x_evaluate__mutmut_208: `_same(left, right, src)`
+    → `_same(left, right, None)`). In (x + 0.1)*(x + 0.10000000000000001) the literals are
+    one double but two decimals: the factors differ (the product is negative between −0.1
+    and −0.10000000000000001), so it is enclosed as a product reaching below 0 and sqrt of it
+    is refused. Compared without the source text the literals looked equal and the product
+    was enclosed as X² ≥ 0 (sqrt accepted)."""
+    text = "(x + 0.1)*(x + 0.10000000000000001)"
+    assert _enc(text, {"x": (-1.0, 1.0)}).v.lo < 0.0
+    with pytest.raises(ArithmeticError):
+        _enc(f"sqrt({text})", {"x": (-1.0, 1.0)})
+    assert _enc("(x + 0.1)*(x + 0.1)", {"x": (-1.0, 1.0)}).v.lo == 0.0  # one factor: X²
