@@ -130,3 +130,16 @@ def test_narrow_tables_fold_instead_of_cropping(width: int, tmp_path: Path) -> N
     rows = [ln for ln in r.output.splitlines() if ln.startswith("│")]
     assert rows and all(ln.rstrip().endswith("│") for ln in rows)
     assert "1.3452" in r.output
+
+
+def test_a_backtick_in_the_spec_file_name_stays_inside_its_code_span() -> None:
+    """`- spec: \\`…\\`` ended at a backtick in the file name (rendering trial, session 27): the
+    fence is one backtick longer than the longest run in the text."""
+    from obsdesign.report.render import md_code
+
+    assert md_code("plain.toml") == "`plain.toml`"
+    assert md_code("a`b.toml") == "`` a`b.toml ``"
+    assert md_code("a``b|c.toml") == "``` a``b\\|c.toml ```"
+    rep = api.design(SPEC)
+    rep.spec_file = "we`ird.toml"
+    assert "- spec: `` we`ird.toml ``" in render.render_markdown(rep).splitlines()

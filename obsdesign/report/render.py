@@ -188,6 +188,19 @@ def md_cell(v: Any) -> str:
     return escape_controls(one)
 
 
+def md_code(v: Any) -> str:
+    """An inline code span of :func:`md_cell`'s text that a backtick inside cannot end: the
+    fence is one backtick longer than the longest run inside (a backtick in a spec's file name
+    ended the span of "- spec: `…`": rendering trial, session 27)."""
+    import re
+
+    text = md_cell(v)
+    if "`" not in text:
+        return f"`{text}`"
+    fence = "`" * (max(len(m) for m in re.findall("`+", text)) + 1)
+    return f"{fence} {text} {fence}"
+
+
 def render_markdown(report: Report) -> str:
     """The report as Markdown. Every cell goes through :func:`md_cell`: the statement
     V(e⁺) ≤ λ²V(e) + μ|w|² split its row at the pipes (outsider trial, session 22)."""
@@ -195,13 +208,13 @@ def render_markdown(report: Report) -> str:
     lines = [
         f"# obsdesign report: {c_(report.method)}",
         "",
-        f"- spec: `{c_(report.spec_file)}`",
-        f"- spec sha256: `{c_(report.spec_sha256)}`",
+        f"- spec: {md_code(report.spec_file)}",
+        f"- spec sha256: {md_code(report.spec_sha256)}",
         f"- tool: {c_(report.tool.get('version', ''))}",
         "",
     ]
     lines += ["## Parameters", "", "| symbol | value | form |", "| --- | --- | --- |"]
-    lines += [f"| {c_(k)} | `{c_(v)}` | {c_(f)} |" for k, v, f in _param_rows(report)]
+    lines += [f"| {c_(k)} | {md_code(v)} | {c_(f)} |" for k, v, f in _param_rows(report)]
     lines += [
         "",
         "## Claims",
