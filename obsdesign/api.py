@@ -1100,10 +1100,57 @@ def check(
         return rows
     from obsdesign.sweep import run_rows
 
-    def lost(f: Path, message: str) -> CheckRow:
-        return CheckRow(str(f), "?", EXIT_SOLVER, 0, 0, 0, "", 0.0, message)
+    items = [_remote_item(f) for f in files]
 
-    return run_rows(check_one, files, lost, workers, scheduler, client, on_row)
+    def lost(item: tuple[str, str, str | None], message: str) -> CheckRow:
+        return CheckRow(item[0], "?", EXIT_SOLVER, 0, 0, 0, "", 0.0, one_line(message))
+
+    return run_rows(check_remote, items, lost, workers, scheduler, client, on_row)
+
+
+def _remote_item(f: Path) -> tuple[str, str, str | None]:
+    """What a Dask worker gets for the spec file ``f``: the path as given (for the row), the
+    absolute path (a worker resolved a relative one in its own working directory and checked
+    another file of that name: an infeasible spec was "ok", exit 0; distributed trial,
+    session 27) and the sha256 of the bytes here (None when they cannot be read here: the
+    worker then meets the same error)."""
+    from obsdesign.limits import read_input
+
+    try:
+        sha: str | None = hashlib.sha256(read_input(f, "spec")).hexdigest()
+    except ObsdesignError:
+        sha = None
+    return str(f), os.path.abspath(f), sha
+
+
+def check_remote(item: tuple[str, str, str | None]) -> CheckRow:
+    """:func:`check_one` on a Dask worker for an item of :func:`_remote_item`: the file at the
+    absolute path, refused (exit 2) when its bytes are not those read where ``check`` ran
+    (workers must see the same files; a stale or different copy was checked silently); the
+    row names the path as given."""
+    from obsdesign.limits import read_input
+
+    shown, path, sha = item
+    t0 = time.perf_counter()
+    if sha is not None:
+        try:
+            here = hashlib.sha256(read_input(path, "spec")).hexdigest()
+        except ObsdesignError as e:
+            return _error_row(Path(shown), "?", e.exit_code, t0, e.message.replace(path, shown))
+        if here != sha:
+            return _error_row(
+                Path(shown),
+                "?",
+                EXIT_BAD_INPUT,
+                t0,
+                f"{shown}: the worker's copy ({path}) is not the file check read (sha256 "
+                f"{here[:12]}… vs {sha[:12]}…): the workers must see the same files",
+            )
+    row = check_one(Path(path))
+    row.spec = shown
+    if path != shown:
+        row.message = row.message.replace(path, shown)
+    return row
 
 
 def sweep(

@@ -138,6 +138,36 @@ def test_check_on_dask_equals_serial_on_the_fast_specs(dask_client):
     assert all(r.code == 0 for r in dist)
 
 
+def test_check_on_dask_reads_relative_paths_here_and_refuses_another_copy(
+    dask_client, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A relative spec path was sent as typed, and a worker resolved it in its own working
+    directory: it checked another file of that name, and an infeasible spec was "ok", exit 0
+    (distributed trial, session 27). The worker gets the absolute path and the sha256 of the
+    bytes read here; the row names the path as given, and equals the serial row. A copy that
+    differs on the worker is refused (exit 2), not checked."""
+    bad = SPEC.read_text().replace("lambda = 0.955", "lambda = 0.5")
+    assert "lambda = 0.5" in bad
+    (tmp_path / "s.toml").write_text(bad)
+    other = tmp_path / "w"
+    other.mkdir()
+    (other / "s.toml").write_text(SPEC.read_text())  # a feasible spec of the same name
+    monkeypatch.chdir(tmp_path)
+    dask_client.run(os.chdir, str(other))  # where the workers stand
+    try:
+        serial = api.check([Path("s.toml")])
+        dist = api.check([Path("s.toml")], client=dask_client)
+    finally:
+        dask_client.run(os.chdir, str(ROOT))
+    assert serial[0].code == 1 and _check_rows(dist) == _check_rows(serial)
+    assert dist[0].spec == "s.toml"
+    item = api._remote_item(Path("s.toml"))
+    (tmp_path / "s.toml").write_text(SPEC.read_text())  # the "worker's" copy differs now
+    row = api.check_remote(item)
+    assert row.code == 2 and "the workers must see the same files" in row.message
+    assert row.spec == "s.toml"
+
+
 @pytest.mark.slow
 def test_cli_check_workers_2_on_specs_equals_serial():
     runner = CliRunner()
