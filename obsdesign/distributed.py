@@ -26,6 +26,7 @@ from __future__ import annotations
 import logging
 import os
 import sys
+import time
 import uuid
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
@@ -96,6 +97,10 @@ def check_workers(workers: int | None, scheduler: str | None) -> None:
         _require_dask()
 
 
+#: seconds a --scheduler address has to complete Dask's handshake
+CONNECT_S = 20.0
+
+
 @contextmanager
 def dask_client(
     workers: int | None = None, scheduler: str | None = None, client: Any = None
@@ -114,13 +119,36 @@ def dask_client(
     # `check --workers 2` (docs audit); failures that matter come back as task results
     logging.getLogger("distributed").setLevel(QUIET)
     if scheduler is not None:
+        from obsdesign.api import SpecTimeout, _time_budget
+
         try:
-            c = Client(scheduler, timeout="10s")
-        except (OSError, ValueError) as e:
+            # Client's timeout bounds the TCP connect, not the handshake: a TCP service that
+            # is not Dask (python3 -m http.server) hung forever (distributed trial, session 27)
+            with _time_budget(CONNECT_S):
+                c = Client(scheduler, timeout="10s")
+        except SpecTimeout:
+            raise InputError(
+                f"--scheduler {scheduler}: no Dask scheduler answered within {CONNECT_S:g} s "
+                "(is it a Dask scheduler's address?)"
+            ) from None
+        except (OSError, ValueError, TypeError, MemoryError) as e:
             # ValueError: an address distributed cannot parse, e.g. tcp:// without a port
-            # (exit 3 "missing port number"; hostile-input trial, session 24)
-            raise InputError(f"--scheduler {scheduler}: cannot connect ({e})") from None
+            # (exit 3 "missing port number"; hostile-input trial, session 24); TypeError: a
+            # tls:// or ucx:// address without its setup; MemoryError: a service that answers
+            # bytes read as a frame length of exabytes (an HTTP server; session 27)
+            raise InputError(
+                f"--scheduler {scheduler}: cannot connect ({type(e).__name__}: {e})"
+            ) from None
         try:
+            try:
+                # a scheduler without workers took the tasks and waited forever, silently
+                # (distributed trial, session 27)
+                c.wait_for_workers(1, timeout=CONNECT_S)
+            except TimeoutError:
+                raise InputError(
+                    f"--scheduler {scheduler}: no worker joined within {CONNECT_S:g} s "
+                    "(start some: dask worker ADDRESS)"
+                ) from None
             yield c
         finally:
             c.close()
@@ -258,8 +286,9 @@ def run_tasks(
             spans[f.key] = (a, b, False)
             futures.append(f)
         ac = as_completed(futures)
+        watch = _Workers(c)
         try:
-            for fut in ac:
+            for fut in _arrivals(ac, watch):
                 a, b, single = spans[fut.key]
                 try:
                     out = fut.result()
@@ -289,6 +318,52 @@ def run_tasks(
             c.cancel(futures)
             raise
     return results
+
+
+#: seconds a run may go on with no worker at all before it stops
+NO_WORKERS_S = 60.0
+
+
+class _Workers:
+    """The scheduler's worker count, asked at most once a second, and since when it is 0."""
+
+    def __init__(self, client: Any) -> None:
+        self.client = client
+        self.asked = 0.0
+        self.none_since: float | None = None
+
+    def gone_for(self) -> float:
+        """Seconds the scheduler has had no worker (0 while it has one)."""
+        now = time.monotonic()
+        if now - self.asked >= 1.0:
+            self.asked = now
+            try:
+                n = len(self.client.scheduler_info().get("workers", {}))
+            except Exception:  # noqa: BLE001 - a scheduler that went away: as_completed says so
+                n = 1
+            self.none_since = None if n else (self.none_since or now)
+        return 0.0 if self.none_since is None else now - self.none_since
+
+
+def _arrivals(ac: Any, watch: _Workers) -> Iterator[Any]:
+    """The futures of ``ac`` as they complete; :class:`obsdesign.errors.SolverError` (exit 3)
+    when the scheduler has had no worker for :data:`NO_WORKERS_S` (the last worker of an
+    external cluster died, and the run waited forever with no message: distributed trial,
+    session 27). A LocalCluster's nanny restarts its workers, so this is an external
+    cluster's case."""
+    from obsdesign.errors import SolverError
+
+    while not ac.is_empty():
+        batch = ac.next_batch(block=False)
+        if batch:
+            yield from batch
+            continue
+        if watch.gone_for() > NO_WORKERS_S:
+            raise SolverError(
+                f"the Dask scheduler has had no worker for {NO_WORKERS_S:g} s: the rows not "
+                "done are lost (start workers and run again)"
+            )
+        time.sleep(0.02)
 
 
 @contextmanager

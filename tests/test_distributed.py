@@ -344,3 +344,95 @@ def test_a_scheduler_address_without_a_port_is_bad_input() -> None:
     with pytest.raises(InputError, match="--scheduler tcp://: cannot connect"):
         with dask_client(scheduler="tcp://"):
             pass
+
+
+def test_a_tcp_service_that_is_not_dask_is_bad_input_not_a_hang(monkeypatch) -> None:
+    """--scheduler at a service that accepts TCP and never answers Dask's handshake (python3 -m
+    http.server) hung forever: Client's timeout bounds the connect only (distributed trial,
+    session 27). Exit 2 after CONNECT_S; an HTTP-like reply (read as an exabyte frame,
+    MemoryError) and a tls:// address without its setup (TypeError) are exit 2 too."""
+    import socket
+    import threading
+
+    from obsdesign import distributed
+    from obsdesign.errors import InputError
+
+    monkeypatch.setattr(distributed, "CONNECT_S", 2.0)
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen(8)
+    port = srv.getsockname()[1]
+    conns: list[socket.socket] = []
+
+    def serve() -> None:
+        while True:
+            try:
+                c, _ = srv.accept()
+            except OSError:
+                return
+            conns.append(c)  # accepted, never answered
+
+    threading.Thread(target=serve, daemon=True).start()
+    t0 = time.monotonic()
+    try:
+        with pytest.raises(InputError, match="no Dask scheduler answered within 2 s"):
+            run_tasks(abs, [1, 2], scheduler=f"tcp://127.0.0.1:{port}")
+    finally:
+        srv.close()
+        for c in conns:
+            c.close()
+    assert time.monotonic() - t0 < 30
+    with pytest.raises(InputError, match="cannot connect"):
+        run_tasks(abs, [1], scheduler="tls://127.0.0.1:9")
+
+
+def test_a_scheduler_without_workers_is_bad_input(monkeypatch) -> None:
+    """A scheduler with no worker took the tasks and waited forever, silently (distributed
+    trial, session 27): exit 2 after CONNECT_S naming the scheduler."""
+    from dask.distributed import LocalCluster
+
+    from obsdesign import distributed
+    from obsdesign.errors import InputError
+
+    monkeypatch.setattr(distributed, "CONNECT_S", 2.0)
+    with LocalCluster(n_workers=0, processes=False, dashboard_address=None) as cluster:
+        with pytest.raises(InputError, match="no worker joined within 2 s"):
+            run_tasks(abs, [1], scheduler=cluster.scheduler_address)
+
+
+def test_a_run_whose_workers_are_all_gone_stops() -> None:
+    """The last worker of an external cluster died mid-run and the run waited forever with no
+    message (distributed trial, session 27): after NO_WORKERS_S without a worker it stops
+    (exit 3). Shown on the loop itself with a stand-in for as_completed and the count."""
+    from obsdesign import distributed
+    from obsdesign.errors import SolverError
+
+    class Never:
+        def is_empty(self) -> bool:
+            return False
+
+        def next_batch(self, block: bool = True) -> list[object]:
+            return []
+
+    class Gone:
+        def gone_for(self) -> float:
+            return distributed.NO_WORKERS_S + 1
+
+    with pytest.raises(SolverError, match="no worker for"):
+        next(distributed._arrivals(Never(), Gone()))  # type: ignore[arg-type]
+    got = list(distributed._arrivals(_Ready([1, 2]), Gone()))  # type: ignore[arg-type]
+    assert got == [1, 2]
+
+
+class _Ready:
+    """as_completed's stand-in holding futures already done."""
+
+    def __init__(self, items: list[object]) -> None:
+        self.items = items
+
+    def is_empty(self) -> bool:
+        return not self.items
+
+    def next_batch(self, block: bool = True) -> list[object]:
+        out, self.items = self.items, []
+        return out
