@@ -97,6 +97,17 @@ def check_workers(workers: int | None, scheduler: str | None) -> None:
         _require_dask()
 
 
+def _quiet_logs() -> None:
+    """distributed's loggers at CRITICAL: the parent and every child that has its own level
+    (``distributed.client`` is set to WARNING by dask's config, so a scheduler killed mid-run
+    printed ~35 lines of traceback through it; distributed trial, session 27)."""
+    import distributed  # noqa: F401 - its loggers exist once it is imported
+
+    for name in ["distributed", *logging.root.manager.loggerDict]:
+        if name == "distributed" or name.startswith("distributed."):
+            logging.getLogger(name).setLevel(QUIET)
+
+
 #: seconds a --scheduler address has to complete Dask's handshake
 CONNECT_S = 20.0
 
@@ -117,7 +128,7 @@ def dask_client(
     # CRITICAL, not ERROR: a worker's "Failed to communicate with scheduler during heartbeat"
     # (CommClosedError, ~30 lines) reached stderr at cluster shutdown in 1 of 3 runs of
     # `check --workers 2` (docs audit); failures that matter come back as task results
-    logging.getLogger("distributed").setLevel(QUIET)
+    _quiet_logs()
     if scheduler is not None:
         from obsdesign.api import SpecTimeout, _time_budget
 
@@ -227,10 +238,14 @@ CHUNKS_PER_THREAD = 8
 
 
 def _lost_message(e: BaseException) -> str:
+    """The one-line message of a row whose task was lost (a scheduler's multi-line error
+    text kept its raw newline in the row: distributed trial, session 27)."""
+    from obsdesign.errors import one_line
+
     name = type(e).__name__
     if name == "KilledWorker":
-        return f"internal failure: the task killed every worker it ran on ({e})"
-    return f"internal failure: {name}: {e}"
+        return one_line(f"internal failure: the task killed every worker it ran on ({e})")
+    return one_line(f"internal failure: {name}: {e}")
 
 
 def run_tasks(

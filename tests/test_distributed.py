@@ -436,3 +436,19 @@ class _Ready:
     def next_batch(self, block: bool = True) -> list[object]:
         out, self.items = self.items, []
         return out
+
+
+def test_every_distributed_logger_is_quieted_and_lost_rows_are_one_line() -> None:
+    """distributed.client has its own level (WARNING) from dask's config, so quieting the
+    parent logger left ~35 lines of traceback on stderr when the scheduler was killed mid-run;
+    and the lost row's message kept the error's raw newline (distributed trial, session 27)."""
+    import logging
+
+    from obsdesign import distributed
+
+    logging.getLogger("distributed.client").setLevel(logging.WARNING)
+    distributed._quiet_logs()
+    assert logging.getLogger("distributed.client").level == distributed.QUIET
+    assert logging.getLogger("distributed").level == distributed.QUIET
+    msg = distributed._lost_message(RuntimeError("cancelled.\nClient lost the connection"))
+    assert "\n" not in msg and "\\n" in msg
