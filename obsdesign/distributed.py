@@ -23,6 +23,7 @@ is an :class:`InputError` that says how to install it (exit 2).
 
 from __future__ import annotations
 
+import functools
 import logging
 import os
 import sys
@@ -108,6 +109,41 @@ def _quiet_logs() -> None:
             logging.getLogger(name).setLevel(QUIET)
 
 
+@functools.cache
+def code_fingerprint() -> str:
+    """sha256 of the obsdesign package's Python sources (relative path and bytes of each
+    ``*.py``, sorted): what a worker must share with the caller."""
+    import hashlib
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent
+    h = hashlib.sha256()
+    for f in sorted(root.rglob("*.py")):
+        h.update(str(f.relative_to(root)).encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+def _same_code(c: Any, scheduler: str) -> None:
+    """Refuse (exit 2) a cluster whose workers run other obsdesign code than this process: a
+    worker on an older checkout (the same version number) gave 5 of 13 check rows different
+    from the serial run, silently (distributed trial, session 27)."""
+    mine = code_fingerprint()
+    try:
+        theirs = c.run(code_fingerprint)
+    except Exception as e:  # noqa: BLE001 - a worker without this function runs other code
+        raise InputError(
+            f"--scheduler {scheduler}: a worker cannot report its obsdesign code "
+            f"({type(e).__name__}); start the workers from this installation"
+        ) from None
+    other = sorted(w for w, fp in theirs.items() if fp != mine)
+    if other:
+        raise InputError(
+            f"--scheduler {scheduler}: {len(other)} of {len(theirs)} worker(s) run other "
+            f"obsdesign code than this one (e.g. {other[0]}); start them from this installation"
+        )
+
+
 #: seconds a --scheduler address has to complete Dask's handshake
 CONNECT_S = 20.0
 
@@ -160,6 +196,7 @@ def dask_client(
                     f"--scheduler {scheduler}: no worker joined within {CONNECT_S:g} s "
                     "(start some: dask worker ADDRESS)"
                 ) from None
+            _same_code(c, scheduler)
             yield c
         finally:
             c.close()

@@ -452,3 +452,31 @@ def test_every_distributed_logger_is_quieted_and_lost_rows_are_one_line() -> Non
     assert logging.getLogger("distributed").level == distributed.QUIET
     msg = distributed._lost_message(RuntimeError("cancelled.\nClient lost the connection"))
     assert "\n" not in msg and "\\n" in msg
+
+
+def test_workers_running_other_code_are_refused(monkeypatch) -> None:
+    """A worker on an older checkout (same version number) gave 5 of 13 check rows that
+    differ from the serial run, silently (distributed trial, session 27): a --scheduler whose
+    workers report another fingerprint of the obsdesign sources is exit 2; the same code runs."""
+    from dask.distributed import LocalCluster
+
+    from obsdesign import distributed
+    from obsdesign.errors import InputError
+
+    class Fake:
+        def __init__(self, fps: dict[str, str] | Exception) -> None:
+            self.fps = fps
+
+        def run(self, fn: object) -> dict[str, str]:
+            if isinstance(self.fps, Exception):
+                raise self.fps
+            return self.fps
+
+    mine = distributed.code_fingerprint()
+    distributed._same_code(Fake({"w1": mine, "w2": mine}), "tcp://x:1")
+    with pytest.raises(InputError, match="1 of 2 worker"):
+        distributed._same_code(Fake({"w1": mine, "w2": "0" * 64}), "tcp://x:1")
+    with pytest.raises(InputError, match="cannot report its obsdesign code"):
+        distributed._same_code(Fake(AttributeError("no such function")), "tcp://x:1")
+    with LocalCluster(n_workers=1, processes=False, dashboard_address=None) as cluster:
+        assert run_tasks(abs, [-1, -2], scheduler=cluster.scheduler_address) == [1, 2]
