@@ -395,7 +395,7 @@ def test_a_scheduler_without_workers_is_bad_input(monkeypatch) -> None:
     from obsdesign.errors import InputError
 
     monkeypatch.setattr(distributed, "CONNECT_S", 2.0)
-    with LocalCluster(n_workers=0, processes=False, dashboard_address=None) as cluster:
+    with LocalCluster(n_workers=0, processes=False, dashboard_address=":0") as cluster:
         with pytest.raises(InputError, match="no worker joined within 2 s"):
             run_tasks(abs, [1], scheduler=cluster.scheduler_address)
 
@@ -478,5 +478,5 @@ def test_workers_running_other_code_are_refused(monkeypatch) -> None:
         distributed._same_code(Fake({"w1": mine, "w2": "0" * 64}), "tcp://x:1")
     with pytest.raises(InputError, match="cannot report its obsdesign code"):
         distributed._same_code(Fake(AttributeError("no such function")), "tcp://x:1")
-    with LocalCluster(n_workers=1, processes=False, dashboard_address=None) as cluster:
+    with LocalCluster(n_workers=1, processes=False, dashboard_address=":0") as cluster:
         assert run_tasks(abs, [-1, -2], scheduler=cluster.scheduler_address) == [1, 2]
