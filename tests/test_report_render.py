@@ -143,3 +143,27 @@ def test_a_backtick_in_the_spec_file_name_stays_inside_its_code_span() -> None:
     rep = api.design(SPEC)
     rep.spec_file = "we`ird.toml"
     assert "- spec: `` we`ird.toml ``" in render.render_markdown(rep).splitlines()
+
+
+@pytest.mark.parametrize("width", [58, 64, 69])
+def test_a_long_word_in_a_verify_detail_does_not_crop_the_table(width: int, tmp_path) -> None:
+    """A verify-only claim quoting a 28-character id ('assumption1-falsification') at --width
+    58–69: rich measures a column's minimum by its longest word, the forced minimum of the
+    id column left no room, and the whole claims table was cropped (re-check trial, session
+    27). The id column now yields to the prose's longest word."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from obsdesign.cli import app
+
+    rep = tmp_path / "r.json"
+    spec = ROOT / "specs" / "schaum-impulsive-example.toml"
+    assert CliRunner().invoke(app, ["design", str(spec), "-q", "-o", str(rep)]).exit_code == 0
+    d = json.loads(rep.read_text())
+    d["claims"] = [c for c in d["claims"] if c["id"] != "assumption1-falsification"]
+    rep.write_text(json.dumps(d))
+    r = CliRunner().invoke(app, ["verify", str(rep), "--width", str(width)])
+    assert r.exit_code == 1
+    rows = [ln for ln in r.output.splitlines() if ln.startswith("│")]
+    assert rows and all(ln.rstrip().endswith("│") for ln in rows)

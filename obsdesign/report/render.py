@@ -145,8 +145,18 @@ def render_text(report: Report, title: str = "") -> None:
         # and never so wide that the prose column is squeezed below 24 columns: a 25-column id
         # at --width 40 made rich crop the statements with no mark ("T_max = 1." for
         # "T_max = 1.3452 ≤ …"; rendering trial, session 27); an id then folds
-        id_w = max(4, min(id_w, out.width - 7 - 24))
-        c.add_column("id / status", overflow="fold", min_width=id_w)
+        # nor below its longest word (a 28-character quoted id in a verify detail at --width
+        # 60 cropped the whole table: rich measures a column's minimum by its longest word,
+        # and a forced minimum on the id column then left no room; re-check, session 27)
+        words = (
+            w
+            for cl in report.claims
+            for t in (cl.statement, cl.check, cl.detail)
+            for w in esc(t).split()
+        )
+        prose = max(24, max((len(w) for w in words), default=0) + 8)  # + "detail: "
+        id_w = max(4, min(id_w, out.width - 7 - prose))
+        c.add_column("id / status", overflow="fold", min_width=id_w, max_width=id_w)
         c.add_column("statement / check / detail", overflow="fold")
         for cl in report.claims:
             c.add_row(
