@@ -160,8 +160,10 @@ def _run(fn: Callable[[Any], int], quiet: bool = False, width: int | None = None
     try:
         if owned:
             signal.signal(signal.SIGINT, interrupt.handler)
-            if signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
-                signal.signal(signal.SIGTERM, interrupt.handler)
+        # SIGTERM whoever owns SIGINT: a script's background job starts with SIGINT ignored,
+        # and `timeout` there still left a half-written temp file (re-check trial, session 27)
+        if _main_thread() and signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
+            signal.signal(signal.SIGTERM, interrupt.handler)
         from obsdesign import cli_commands
 
         cli_commands.setup(quiet, width)
@@ -210,10 +212,18 @@ def _settle(owned: bool) -> None:
 
     if owned:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
-        if signal.getsignal(signal.SIGTERM) is interrupt.handler:
-            signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    if _main_thread() and signal.getsignal(signal.SIGTERM) is interrupt.handler:
+        # the work is done and written: back to the default (an in-process caller keeps its
+        # own SIGTERM behaviour after the command)
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
     if interrupt.requested():
         _interrupted()
+
+
+def _main_thread() -> bool:
+    import threading
+
+    return threading.current_thread() is threading.main_thread()
 
 
 def _interrupted() -> None:

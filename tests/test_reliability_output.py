@@ -284,23 +284,34 @@ def test_ctrl_c_is_one_line_no_traceback(delay: float):
     assert err.strip().splitlines()[-1].endswith("interrupted")
 
 
-@pytest.mark.parametrize("delay", [0.5, 1.5, 3.0])
-def test_sigterm_cleans_up_like_ctrl_c(spec: Path, tmp_path: Path, delay: float) -> None:
+@pytest.mark.parametrize(
+    ("delay", "background"), [(0.5, False), (1.5, False), (3.0, False), (1.5, True)]
+)
+def test_sigterm_cleans_up_like_ctrl_c(
+    spec: Path, tmp_path: Path, delay: float, background: bool
+) -> None:
     """SIGTERM (what ``timeout`` sends) during ``simulate --csv`` killed the process at once
     and left a hidden half-written ``.out.csv.XXXX.csv`` beside the output (simulate trial,
     session 27). It is handled as Ctrl-C is now: cleanup runs, one line "terminated", exit
-    143 (128 + 15); the file is there whole or not at all."""
+    143 (128 + 15); the file is there whole or not at all. ``background``: started with
+    SIGINT ignored, as a script's background job is (the handler was installed only with
+    SIGINT's: re-check trial, session 27)."""
     import signal
     import time
 
     exe = Path(sys.executable).parent / "obsdesign"
     spec.write_text(spec.read_text().replace("horizon = 300", "horizon = 400000"))
     out = tmp_path / "out.csv"
+
+    def as_a_background_job() -> None:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+
     p = subprocess.Popen(
         [str(exe), "simulate", str(spec), "-q", "--csv", str(out)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        preexec_fn=as_a_background_job if background else None,  # noqa: PLW1509
     )
     time.sleep(delay)
     p.send_signal(signal.SIGTERM)
