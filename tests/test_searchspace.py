@@ -216,6 +216,14 @@ def test_tamper_K_larger_breaks_lemma2_and_the_K_rule(example, tmp_path):
     sp, rep = example
     v = _consistent(sp, K=64)
     assert _failed(_report_with(rep, v, tmp_path)) == {"lemma2-consistency", "K-rule"}
+    from obsdesign.params import Parameters
+
+    rule = next(c for c in api.certify(sp, Parameters(v)) if c.id == "K-rule")
+    # the detail names the side that fails (it said "a larger K also keeps Lemma 2's horizon")
+    assert "K itself breaks the rule" in rule.detail and rule.margin.startswith("-")
+    v = _consistent(sp, K=62)
+    rule = next(c for c in api.certify(sp, Parameters(v)) if c.id == "K-rule")
+    assert rule.detail == "a larger K also keeps Lemma 2's horizon"
 
 
 def test_tamper_schedule_entry(example, tmp_path):

@@ -148,13 +148,19 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
             # K itself must satisfy the rule (or be the floor 1): only K + 1 failing was
             # checked, and K = 64 for the example's 63 read "certified" (search-space trial,
             # session 27; Lemma 2's claim failed beside it)
-            ok = bool(
-                k_int
-                and ((K + 1) * dT * L_f >= hi or K == 1 and dT * L_f >= hi)
-                and (K == 1 or K * dT * L_f < lo_k)
-            )
+            larger_fails = (K + 1) * dT * L_f >= hi or K == 1 and dT * L_f >= hi
+            itself_holds = K == 1 or K * dT * L_f < lo_k
+            ok = bool(k_int and larger_fails and itself_holds)
+            if not k_int:
+                why, margin = "K is not an integer ≥ 1", fmpq(-1)
+            elif not itself_holds:  # the detail named the other side (re-check, session 27)
+                why = "K ΔT L_f is not below log(κ/L_h): K itself breaks the rule (too large)"
+                margin = lo_k - K * dT * L_f
+            else:
+                why, margin = "a larger K also keeps Lemma 2's horizon", (K + 1) * dT * L_f - hi
         else:
-            hi, ok = None, bool(K == 1)
+            ok = bool(K == 1)
+            why, margin = "κ ≤ L_h: the rule's K is 1", fmpq(0 if ok else -1)
         _verdict(
             c,
             "K-rule",
@@ -164,8 +170,8 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
             "(K+1)·ΔT·L_f ≥ upper bound of log(κ/L_h), and K = 1 or K·ΔT·L_f < its lower "
             "bound (outward rounding, 113 bits plus those of 1/(ΔT·L_f))",
             ok,
-            "a larger K also keeps Lemma 2's horizon",
-            margin=0 if hi is None else (K + 1) * dT * L_f - hi,
+            why,
+            margin=margin,
         )
     if ratio > 1:
         lo = ivq.log_bounds(ratio, K_bits(dT * L_f))[0]
