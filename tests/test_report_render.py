@@ -167,3 +167,18 @@ def test_a_long_word_in_a_verify_detail_does_not_crop_the_table(width: int, tmp_
     assert r.exit_code == 1
     rows = [ln for ln in r.output.splitlines() if ln.startswith("│")]
     assert rows and all(ln.rstrip().endswith("│") for ln in rows)
+
+
+def test_odd_parameter_values_render_as_text() -> None:
+    """A report's ragged list parameter made verify's text and md tables end in exit 3
+    ("internal failure" from numpy), and a null one showed as "≈ nan" (re-check trial,
+    session 27): both are shown as the text they are."""
+    from obsdesign.params import Parameters
+
+    rep = api.design(SPEC)
+    rep.parameters = Parameters(
+        {**dict(rep.parameters.items()), "odd": [[1, 2], [3]], "none": None}
+    )
+    rows = {k: v for k, v, _ in render._param_rows(rep)}
+    assert rows["odd"] == "[[1, 2], [3]]" and rows["none"] == "None"
+    assert "| odd | `[[1, 2], [3]]` |" in render.render_markdown(rep)

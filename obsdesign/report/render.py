@@ -21,7 +21,10 @@ def fmt_value(v: Any, digits: int = 6) -> str:
     """Compact float rendering of a parameter (matrices row by row)."""
     if isinstance(v, (int, float, np.floating, np.integer)) and not isinstance(v, bool):
         return f"{float(v):.{digits}g}"
-    arr = np.asarray(v)
+    try:
+        arr = np.asarray(v)
+    except (ValueError, TypeError):  # a ragged list from a report: exit 3 in verify's table
+        arr = np.asarray(None)  # (re-check trial, session 27): shown as text below
     if arr.dtype.kind in "fiu" and arr.ndim in (1, 2):
         if arr.ndim == 1:
             return "[" + ", ".join(f"{x:.{digits}g}" for x in arr) + "]"
@@ -57,7 +60,7 @@ def esc(text: Any) -> str:
 
 def _numeric(v: Any) -> bool:
     """A number or an array of numbers (not a bool, not text that reads as one)."""
-    if isinstance(v, (bool, np.bool_, str, bytes)):
+    if v is None or isinstance(v, (bool, np.bool_, str, bytes)):  # None read as nan: "≈ nan"
         return False
     try:
         np.asarray(
