@@ -41,7 +41,7 @@ import numpy as np
 from obsdesign.errors import InputError
 from obsdesign.sets.base import ConvexSet
 from obsdesign.simulate.budget import TimeBudget
-from obsdesign.simulate.result import SimResult
+from obsdesign.simulate.result import SimResult, norms
 from obsdesign.spec.models import Spec
 from obsdesign.spec.reader import Table
 
@@ -583,21 +583,8 @@ def _run(
         "sup_abs_error": np.maximum(sup_e, np.abs(e)),
         "rmse": np.sqrt((e * e + sq[:R].reshape(R, BLOCK, n).sum(axis=1)) / (K + 1)),
         "sup_abs_estimate": np.maximum(sup_h, np.abs(xh0)),
-        "final_error_norm": row_norms(e_end),
+        "final_error_norm": norms(e_end),
     }
-
-
-def row_norms(a: np.ndarray) -> np.ndarray:
-    """Euclidean norm of each row, scaled by the row's largest |entry| (no overflow of the
-    squares near 10¹⁵⁴ nor underflow near 10⁻¹⁵⁴: a final |e| of 1.8·10¹⁹⁵ was inf, and of
-    1.8·10⁻²⁰⁵ was 0; simulate trial, session 27)."""
-    from obsdesign.simulate.result import SAFE_HI, SAFE_LO
-
-    with np.errstate(all="ignore"):
-        m = np.max(np.abs(a), axis=1, keepdims=True) if a.size else np.zeros((len(a), 1))
-        # rows in the safe range unscaled (bit for bit the plain norm), the others scaled
-        s = np.where((m > 0) & np.isfinite(m) & ((m < SAFE_LO) | (m > SAFE_HI)), m, 1.0)
-        return np.asarray(np.linalg.norm(a / s, axis=1) * s[:, 0])
 
 
 def _matmul_for(rows: int, inner: int, cols: int) -> Any:

@@ -39,6 +39,7 @@ from obsdesign.methods.searchspace.intervals import (
     sqrt_hi,
 )
 from obsdesign.methods.searchspace.qintervals import QI, evaluate_q
+from obsdesign.simulate.result import norms as _norms
 from obsdesign.spec.expr import Expr
 
 
@@ -159,16 +160,6 @@ def norm_upper(M: Sequence[Sequence[float]]) -> float:
     cols = [_sum_hi([r[j] for r in M]) for j in range(len(M[0]))]
     prod = mul_hi(sqrt_hi(max(rows)), sqrt_hi(max(cols)))
     return min(fro, prod)
-
-
-def _norms(V: np.ndarray) -> np.ndarray:
-    """Euclidean norms along the last axis, without overflow of the squares (sampled lower
-    estimates: np.linalg.norm of entries near 10²⁰⁰ is +∞, and an infinite estimate would
-    refute any given constant)."""
-    with np.errstate(all="ignore"):
-        m = np.max(np.abs(V), axis=-1, keepdims=True)
-        safe = np.where((m > 0) & np.isfinite(m), m, 1.0)
-        return (safe * np.linalg.norm(V / safe, axis=-1, keepdims=True))[..., 0]
 
 
 def _split(box: Box, widths0: Sequence[float]) -> tuple[Box, Box] | None:
