@@ -533,24 +533,27 @@ def compare_claims(reported: list[Claim], fresh: list[Claim]) -> list[Claim]:
     for c in fresh:
         by_id.setdefault(c.id, []).append(c)
     seen: dict[str, int] = {}
+    # a report's ids and statements are quoted through one_line (at most MAX_LINE characters):
+    # a 4 MB edited statement was echoed whole and took 85 s to render (rendering trial,
+    # session 27)
     for c in reported:
         i = seen.get(c.id, 0)
         seen[c.id] = i + 1
         mine = by_id.get(c.id, [])
-        cid = _clipped(c.id)
+        cid = one_line(c.id)
         if i >= len(mine) or c.id in VERIFY_ONLY:
             out.append(
                 _diff_claim(
                     f"report-adds:{cid}",
                     f"the report lists claim '{cid}' ({c.status.value}: "
-                    f"{_clipped(repr(c.statement))}), which the recomputation does not make",
+                    f"{one_line(repr(c.statement))}), which the recomputation does not make",
                 )
             )
             continue
         f = mine[i]
         what = []
         if c.statement != f.statement:
-            what.append(f"statement {_clipped(repr(c.statement))} vs recomputed {f.statement!r}")
+            what.append(f"statement {one_line(repr(c.statement))} vs recomputed {f.statement!r}")
         if c.status != f.status:
             what.append(f"status {c.status.value} vs recomputed {f.status.value}")
         if what:
@@ -565,14 +568,6 @@ def compare_claims(reported: list[Claim], fresh: list[Claim]) -> list[Claim]:
                 )
             )
     return out
-
-
-def _clipped(text: str) -> str:
-    """A report's text as a verify claim quotes it: at most :data:`~obsdesign.errors.MAX_LINE`
-    characters (start and end kept, the length said; :func:`~obsdesign.errors.one_line`). A
-    4 MB edited statement was echoed whole and took 85 s to render (rendering trial,
-    session 27)."""
-    return one_line(text)
 
 
 def _diff_claim(cid: str, detail: str) -> Claim:
