@@ -706,7 +706,7 @@ def simulate(
                 f"{where}: records a design that stopped with an error "
                 f"({rep.error.get('message', '')}): no parameters to simulate"
             )
-        params = rep.parameters
+        params = rep.parameters.traced()
     notes: list[str] = []
     if report is not None and rep.computed_verdict() != "ok":
         # simulate does not verify a report; one whose own claims fail is run, but said so
@@ -733,7 +733,7 @@ def simulate(
     except (KeyError, ValueError, IndexError, TypeError) as e:
         if report is None:  # the design's own parameters: a defect, exit 3
             raise
-        raise _unfit_report(e, where, sp.method) from None
+        raise _unfit_report(e, where, sp.method, params) from None
     left = _left_float_range(res)
     if left is not None:
         notes.insert(0, left)
@@ -745,14 +745,24 @@ def simulate(
     return res
 
 
-def _unfit_report(e: Exception, where: str, method: str) -> InputError:
+def _unfit_report(e: Exception, where: str, method: str, params: Parameters) -> InputError:
     """Bad input (exit 2): a report's parameters that the method's simulation cannot use — a
     parameter missing (KeyError) or of the wrong shape or kind. These were exit 3 "internal
-    failure: KeyError: 'L'" for every method (simulate trial, session 27)."""
+    failure: KeyError: 'L'" for every method (simulate trial, session 27). For a wrong shape
+    or kind the message lists the parameters the simulation read before it failed, each with
+    its shape (:class:`obsdesign.params.ReadTrace`): numpy's "cannot reshape array of size
+    15" named none, and the last one read need not be the culprit (impulsive reads T_min,
+    T_max and ball_radius before it compares T_min with T_max)."""
     if isinstance(e, KeyError) and e.args and isinstance(e.args[0], str):
         what = f"has no parameter '{e.args[0]}'"
     else:
-        what = f"has parameters of the wrong shape or kind ({type(e).__name__}: {e})"
+        read = list(dict.fromkeys(getattr(params, "read", [])))[-6:]
+        seen = (
+            "; read before the failure: " + ", ".join(f"{k} ({params.shape_of(k)})" for k in read)
+            if read
+            else ""
+        )
+        what = f"has parameters of the wrong shape or kind ({type(e).__name__}: {e}{seen})"
     return InputError(
         f"{where}: {what} for a {method} simulation of this spec (obsdesign verify says which "
         "claim the report breaks)"

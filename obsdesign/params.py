@@ -147,6 +147,32 @@ class Parameters(Mapping[str, Any]):
         out["exact"] = exact
         return out
 
+    def shape_of(self, k: str) -> str:
+        """What parameter ``k`` holds, in words for an error message: "a number", "3×1
+        array", "text", "missing"."""
+        if k not in self._v:
+            return "missing"
+        v = self._v[k]
+        if isinstance(v, str):
+            return "text"
+        if isinstance(v, bool):
+            return "a boolean"
+        if isinstance(v, dict):
+            return "an object"
+        if v is None:
+            return "null"
+        try:
+            shape = np.shape(v)
+        except ValueError:  # ragged lists
+            return "a ragged list"
+        return "a number" if shape == () else "×".join(map(str, shape)) + " array"
+
+    def traced(self) -> ReadTrace:
+        """A copy that records the keys read, in order (:class:`ReadTrace`)."""
+        t = ReadTrace(self._v)
+        t._fj = dict(self._fj)
+        return t
+
     @classmethod
     def from_json(cls, d: dict[str, Any], file: str = "report") -> tuple[Parameters, list[str]]:
         """Parameters from a report's ``parameters`` object, and a list of inconsistencies
@@ -322,3 +348,35 @@ def exact_param(params: Parameters, k: str, claims: list[Any], accept_float: boo
         return None
     arr = np.asarray(v, dtype=float)
     return Q(float(arr)) if arr.ndim == 0 else dyadic(arr, 60)
+
+
+class ReadTrace(Parameters):
+    """Parameters that record which keys were read, in order (``read``): a report's parameter
+    that a method's simulation cannot use is then named by the last key read before the
+    failure, where numpy's "cannot reshape array of size 6 into shape (2,1)" named none
+    (noticed in session 27, fixed in session 28)."""
+
+    def __init__(self, values: dict[str, Any] | None = None) -> None:
+        super().__init__(values)
+        #: keys read (``[]``, ``get``, ``float``, ``exact``, ``is_exact``), in order
+        self.read: list[str] = []
+
+    def __getitem__(self, k: str) -> Any:
+        self.read.append(k)
+        return super().__getitem__(k)
+
+    def get(self, k: str, default: Any = None) -> Any:
+        self.read.append(k)
+        return super().get(k, default)
+
+    def float(self, k: str) -> Any:
+        self.read.append(k)
+        return super().float(k)
+
+    def is_exact(self, k: str) -> bool:
+        self.read.append(k)
+        return super().is_exact(k)
+
+    def exact(self, k: str, claims: list[Any], accept_float: bool = False) -> Any:
+        self.read.append(k)
+        return super().exact(k, claims, accept_float)

@@ -251,3 +251,33 @@ def test_parameters_are_a_read_only_mapping_with_identity_equality() -> None:
     assert dict(p)["b"] == 1.5 and list(p.values())[1] == 1.5
     q = Parameters({"a": np.eye(2), "b": 1.5})
     assert p != q and p == p and len({p, q}) == 2
+
+
+def test_shape_of_says_what_a_parameter_holds() -> None:
+    """The words of simulate's wrong-shape error (session 28)."""
+    from obsdesign.params import Parameters
+
+    p = Parameters(
+        {"a": 1.5, "b": [[1.0], [2.0]], "c": "x", "d": True, "e": [[1.0], [1.0, 2.0]], "f": None}
+    )
+    assert [p.shape_of(k) for k in "abcdefg"] == [
+        "a number",
+        "2×1 array",
+        "text",
+        "a boolean",
+        "a ragged list",
+        "null",
+        "missing",
+    ]
+
+
+def test_traced_parameters_record_reads_in_order() -> None:
+    from obsdesign.params import Parameters
+
+    t = Parameters({"L": [[1.0]], "P": [[2.0]], "x": 3.0}).traced()
+    t.float("P")
+    t["L"]
+    t.get("x")
+    t.get("nope")
+    assert t.read == ["P", "L", "x", "nope"]
+    assert t.float("P").tolist() == [[2.0]]

@@ -375,7 +375,35 @@ def test_simulate_a_report_with_a_parameter_of_the_wrong_shape_is_bad_input(
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps(d))
     res = runner.invoke(app, ["simulate", str(spec), "-q", "--report", str(bad)])
-    _refused(res, "bad.json", "wrong shape or kind")
+    _refused(res, "bad.json", "wrong shape or kind", "read before the failure: L (3×1 array)")
+
+
+@pytest.mark.parametrize(
+    ("name", "key"),
+    [
+        ("constrained-redesign-sec5-lyapunov", "L"),
+        ("astolfi-stubborn-example1", "K"),
+        ("dorea-pimenta-7-1", "G"),
+        ("hernandez-garcia-example", "L_h"),
+        ("schaum-impulsive-example", "T_max"),
+    ],
+)
+def test_simulate_names_the_report_parameter_of_the_wrong_shape(
+    tmp_path: Path, name: str, key: str
+) -> None:
+    """Every method: a parameter of the wrong shape (a 5 × 3 array, float only) is listed with
+    its shape among those read before the failure; numpy's "cannot reshape array of size 15"
+    named none (session 27's note, fixed in session 28)."""
+    src = SPEC.parent / f"{name}.toml"
+    rep = tmp_path / "r.json"
+    assert runner.invoke(app, ["design", str(src), "-q", "-o", str(rep)]).exit_code == 0
+    d = json.loads(rep.read_text())
+    d["parameters"][key] = [[1.0, 2.0, 3.0]] * 5
+    d["parameters"]["exact"].pop(key, None)
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(d))
+    res = runner.invoke(app, ["simulate", str(src), "-q", "--report", str(bad)])
+    _refused(res, "bad.json", "wrong shape or kind", f"{key} (5×3 array)")
 
 
 def test_simulate_says_when_a_report_does_not_hold(spec: Path, tmp_path: Path) -> None:
