@@ -370,8 +370,17 @@ class ReadTrace(Parameters):
         return super().get(k, default)
 
     def float(self, k: str) -> Any:
+        """The float view, refused (exit 2, naming the key) when a number in it is not
+        finite: a report's L = [[inf], [1]] with its exact value removed was simulated with
+        exit 0 and nan metrics (session 27's note); no design writes a non-finite value that
+        a simulation reads."""
         self.read.append(k)
-        return super().float(k)
+        f = super().float(k)
+        a = np.asarray(f) if isinstance(f, (np.ndarray, float)) else None
+        if a is not None and a.dtype.kind == "f" and not np.isfinite(a).all():
+            bad = a.ravel()[~np.isfinite(a.ravel())][0]
+            raise InputError(f"report: parameters.{k}: a value is not a finite number ({bad})")
+        return f
 
     def is_exact(self, k: str) -> bool:
         self.read.append(k)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import errno
 import json
+import math
 import os
 import shutil
 import stat
@@ -570,3 +571,36 @@ def test_the_api_never_writes_a_report_over_a_loaded_specs_file(tmp_path: Path) 
     out = tmp_path / "virtual.toml"
     api.design(api.load_spec_text(src.read_text(encoding="utf-8"), str(out)), out=out)
     assert out.read_text(encoding="utf-8").lstrip().startswith("{")
+
+
+@pytest.mark.parametrize(
+    ("name", "key"),
+    [
+        ("constrained-redesign-sec5-lyapunov", "L"),
+        ("astolfi-stubborn-example1", "K"),
+        ("dorea-pimenta-7-1", "G"),
+        ("hernandez-garcia-example", "L_h"),
+        ("schaum-impulsive-example", "T_max"),
+    ],
+)
+@pytest.mark.parametrize("bad_value", [math.inf, math.nan])
+def test_simulate_refuses_a_report_parameter_that_is_not_finite(
+    tmp_path: Path, name: str, key: str, bad_value: float
+) -> None:
+    """A report parameter with a non-finite number (exact value removed) was simulated with
+    exit 0 and nan metrics (session 27's note); now exit 2 naming the key."""
+    src = SPEC.parent / f"{name}.toml"
+    rep = tmp_path / "r.json"
+    assert runner.invoke(app, ["design", str(src), "-q", "-o", str(rep)]).exit_code == 0
+    d = json.loads(rep.read_text())
+    v = d["parameters"][key]
+    if isinstance(v, list):
+        row = v[0] if isinstance(v[0], list) else v
+        row[0] = bad_value
+    else:
+        d["parameters"][key] = bad_value
+    d["parameters"]["exact"].pop(key, None)
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(d))
+    res = runner.invoke(app, ["simulate", str(src), "-q", "--report", str(bad)])
+    _refused(res, "bad.json", f"parameters.{key}", "not a finite number")
