@@ -292,9 +292,28 @@ def _call(fn: Callable[[T], R], state: tuple[Any, tuple[str, ...]], item: T) -> 
         lim._overridden.update(old_over)
 
 
-def _call_many(fn: Callable[[T], R], state: tuple[Any, tuple[str, ...]], items: list[T]) -> list[R]:
-    """``[fn(x) for x in items]`` in a worker, with the caller's limits in force."""
-    return [_call(fn, state, it) for it in items]
+def _call_many(
+    fn: Callable[[T], R], state: tuple[Any, tuple[str, ...]], items: list[T]
+) -> tuple[str, list[R]]:
+    """``[fn(x) for x in items]`` in a worker, with the caller's limits in force, beside the
+    worker's :func:`code_fingerprint`: a worker that joins after :func:`_same_code` checked
+    the cluster is checked by its results (:func:`_own_code`)."""
+    return code_fingerprint(), [_call(fn, state, it) for it in items]
+
+
+def _own_code(out: Any, where: str) -> list[Any]:
+    """The results of a :func:`_call_many` task, refused (exit 2) when the worker that ran it
+    has other obsdesign code than this process: a worker that joined a ``--scheduler``
+    cluster after the check at the start ran the tasks it got with its own code, silently
+    (session 27's note). A worker with code older than this check returns a bare list.
+
+    :param out: the task's result; :param where: the cluster, for the message."""
+    if isinstance(out, tuple) and len(out) == 2 and out[0] == code_fingerprint():
+        return list(out[1])
+    raise InputError(
+        f"{where}: a worker (one that joined after the check at the start) ran other obsdesign "
+        "code than this one; start the workers from this installation"
+    )
 
 
 #: chunks per worker thread when ``chunk`` is not given: enough to balance uneven tasks,
@@ -371,7 +390,7 @@ def run_tasks(
             for fut in _arrivals(ac, watch):
                 a, b, single = spans[fut.key]
                 try:
-                    out = fut.result()
+                    got = fut.result()
                 except Exception as e:  # noqa: BLE001 - KilledWorker, or fn raised
                     if not single and b - a > 1:  # again item by item: only the bad one is lost
                         for i in range(a, b):
@@ -390,6 +409,8 @@ def run_tasks(
                     if lost is None:
                         raise
                     out = [lost(items[a], _lost_message(e))]
+                else:
+                    out = _own_code(got, f"--scheduler {scheduler}" if scheduler else "the cluster")
                 for i, r in zip(range(a, b), out, strict=True):
                     results[i] = r
                     if on_result is not None:

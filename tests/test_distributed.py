@@ -482,3 +482,33 @@ def test_workers_running_other_code_are_refused(monkeypatch) -> None:
         distributed._same_code(Fake(AttributeError("no such function")), "tcp://x:1")
     with LocalCluster(n_workers=1, processes=False, dashboard_address=":0") as cluster:
         assert run_tasks(abs, [-1, -2], scheduler=cluster.scheduler_address) == [1, 2]
+
+
+def test_results_from_a_worker_with_other_code_are_refused(monkeypatch: pytest.MonkeyPatch):
+    """A worker that joined after the check at the start ran its tasks with its own code,
+    silently (session 27's note): each task's results carry the worker's code fingerprint,
+    and one that differs from the caller's is exit 2."""
+    from dask.distributed import Client, LocalCluster, get_worker
+
+    from obsdesign import distributed
+    from obsdesign.errors import InputError
+
+    real = distributed.code_fingerprint
+
+    def in_worker_other() -> str:
+        try:
+            get_worker()
+        except ValueError:
+            return real()
+        return "0" * 64
+
+    with (
+        LocalCluster(n_workers=1, processes=False, dashboard_address=":0") as cluster,
+        Client(cluster) as c,
+    ):
+        assert run_tasks(abs, [-1, -2], client=c) == [1, 2]
+        monkeypatch.setattr(distributed, "code_fingerprint", in_worker_other)
+        with pytest.raises(InputError, match="ran other obsdesign code"):
+            run_tasks(abs, [-1, -2], client=c)
+    with pytest.raises(InputError, match="ran other obsdesign code"):
+        distributed._own_code([1, 2], "the cluster")  # a worker older than the check
