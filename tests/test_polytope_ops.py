@@ -600,3 +600,22 @@ def test_canonical_takes_a_numpy_integer_right_hand_side() -> None:
 
     H = po.canonical(po.qarray([[1, 0], [0, 1]]), np.array([2, 3]))
     assert {tuple(r) for r in H} == {(fmpq(1, 2), fmpq(0)), (fmpq(0), fmpq(1, 3))}
+
+
+def test_incidences_prefilter_margin_scales_with_the_terms() -> None:
+    """Mutation review 22 left `_incidences` 16 open (the prefilter margin divided instead of
+    multiplied by the size of the terms). Rows of size ~10⁴–10⁵ whose terms cancel: the
+    float product is 6.6·10⁻¹³ (resp. 10⁻¹¹) below 1 for a point exactly on the row, so a
+    margin of 10⁻⁹/size missed the incidence, and a point just beyond the row (session 28)."""
+    from obsdesign.sets.polytope_ops import _incidences
+
+    for S, u, v in [
+        (10**4, fmpq(519502, 25623625), fmpq(495186, 22106659)),
+        (10**5, fmpq(29725, 22619719), fmpq(45379, 310600)),
+    ]:
+        G = np.array([[fmpq(S) + u, -fmpq(S) + v, 1 - u - v]], dtype=object)
+        beyond = fmpq(1) + fmpq(1, 10**20)
+        P = np.array([[fmpq(1)] * 3, [beyond, fmpq(1), fmpq(1)]], dtype=object)
+        _, _, on, bad = _incidences(G, P)
+        assert on == [{0}]
+        assert bad == [(0, 1)]
