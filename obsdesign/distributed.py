@@ -245,14 +245,21 @@ def dask_client(
     before = os.environ.get(WORKER_ENV)
     os.environ[WORKER_ENV] = "1"
     try:
-        with dask.config.set(cfg):
-            cluster = LocalCluster(
-                n_workers=workers or 1,
-                threads_per_worker=1,
-                processes=True,
-                dashboard_address=None,
-                silence_logs=QUIET,
-            )
+        from distributed.deploy.spec import SpecCluster
+
+        started = set(SpecCluster._instances)
+        try:
+            with dask.config.set(cfg):
+                cluster = LocalCluster(
+                    n_workers=workers or 1,
+                    threads_per_worker=1,
+                    processes=True,
+                    dashboard_address=None,
+                    silence_logs=QUIET,
+                )
+        except BaseException:
+            _abandon(set(SpecCluster._instances) - started)
+            raise
         try:
             c = Client(cluster)
             try:
@@ -266,6 +273,22 @@ def dask_client(
             os.environ.pop(WORKER_ENV, None)
         else:
             os.environ[WORKER_ENV] = before
+
+
+def _abandon(clusters: set[Any]) -> None:
+    """Close clusters whose start was interrupted (Ctrl-C, SIGTERM while ``LocalCluster``
+    starts its workers), and take them out of Dask's registry: left there, Dask's exit hook
+    closed them again and printed a 29-line AssertionError traceback (a worker still
+    "starting") after "interrupted" (session 27's note)."""
+    from distributed.deploy.spec import SpecCluster
+
+    for cluster in clusters:
+        try:
+            cluster.close(timeout=10)
+        except BaseException:  # noqa: BLE001, S110 - best effort; the interrupt goes on
+            pass
+        finally:
+            SpecCluster._instances.discard(cluster)
 
 
 def _limits_state() -> tuple[Any, tuple[str, ...]]:
