@@ -101,11 +101,14 @@ def check_workers(workers: int | None, scheduler: str | None) -> None:
 def _quiet_logs() -> None:
     """distributed's loggers at CRITICAL: the parent and every child that has its own level
     (``distributed.client`` is set to WARNING by dask's config, so a scheduler killed mid-run
-    printed ~35 lines of traceback through it; distributed trial, session 27)."""
+    printed ~35 lines of traceback through it; distributed trial, session 27), and asyncio's:
+    a Ctrl-C or SIGTERM while LocalCluster starts its nannies left a failed task that asyncio
+    reported at exit as "Task exception was never retrieved … Nanny failed to start" (22
+    lines after "terminated", session 28)."""
     import distributed  # noqa: F401 - its loggers exist once it is imported
 
-    for name in ["distributed", *logging.root.manager.loggerDict]:
-        if name == "distributed" or name.startswith("distributed."):
+    for name in ["distributed", "asyncio", *logging.root.manager.loggerDict]:
+        if name in ("distributed", "asyncio") or name.startswith("distributed."):
             logging.getLogger(name).setLevel(QUIET)
 
 

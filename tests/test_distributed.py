@@ -452,6 +452,7 @@ def test_every_distributed_logger_is_quieted_and_lost_rows_are_one_line() -> Non
     distributed._quiet_logs()
     assert logging.getLogger("distributed.client").level == distributed.QUIET
     assert logging.getLogger("distributed").level == distributed.QUIET
+    assert logging.getLogger("asyncio").level == distributed.QUIET  # session 28
     msg = distributed._lost_message(RuntimeError("cancelled.\nClient lost the connection"))
     assert "\n" not in msg and "\\n" in msg
 
