@@ -945,11 +945,7 @@ def spec_files(paths: list[str | Path] | str | Path) -> list[Path]:
     out: list[Path] = []
     for p in map(Path, paths):
         if p.is_dir():
-            out += sorted(
-                f
-                for f in p.rglob("*.toml")
-                if not any(part.startswith(".") for part in f.relative_to(p).parts[:-1])
-            )
+            out += _toml_files(p)
         else:
             out.append(p)
     # one row per file: "check d d/ d/a.toml" checked and counted d's specs twice (outsider
@@ -962,6 +958,40 @@ def spec_files(paths: list[str | Path] | str | Path) -> list[Path]:
             seen.add(key)
             unique.append(f)
     return unique
+
+
+def _toml_files(root: Path) -> list[Path]:
+    """The ``*.toml`` files under the folder ``root``, sorted: subfolders searched (not
+    hidden ones, not links to folders), and a subfolder that cannot be listed given as itself
+    so that its row says so (:func:`obsdesign.limits.read_input`).
+
+    An explicit walk with a stack: ``Path.rglob`` recursed once per level, so a folder 1,100
+    levels deep stopped ``check`` with exit 3 (RecursionError) and no row at all; and it
+    matched a folder named ``v1.toml``, a failed "spec" row in a tree of good specs (sweep,
+    import and check trial, session 28)."""
+    found: list[Path] = []
+    stack = [root]
+    while stack:
+        d = stack.pop()
+        try:
+            with os.scandir(d) as it:
+                entries = list(it)
+        except OSError:
+            if d != root:
+                found.append(d)
+            continue
+        for e in entries:
+            try:
+                real_dir = e.is_dir(follow_symlinks=False)
+                any_dir = real_dir or e.is_dir()
+            except OSError:
+                real_dir = any_dir = False
+            if real_dir:
+                if not e.name.startswith("."):
+                    stack.append(Path(e.path))
+            elif e.name.endswith(".toml") and not any_dir:
+                found.append(Path(e.path))
+    return sorted(found)
 
 
 class SpecTimeout(BaseException):

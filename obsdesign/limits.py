@@ -152,6 +152,12 @@ def read_input(path: str | Path, what: str) -> bytes:
     except OSError as e:
         raise InputError(f"{p}: cannot read {what} ({e.strerror})") from None
     if stat.S_ISDIR(st.st_mode):
+        try:
+            os.scandir(p).close()
+        except OSError as e:  # a subfolder of check's that cannot be listed (api._toml_files)
+            raise InputError(
+                f"{p}: a folder that cannot be read ({e.strerror}): its specs are not checked"
+            ) from None
         raise InputError(f"{p}: is a directory, not a {what} file")
     if not stat.S_ISREG(st.st_mode):
         raise InputError(f"{p}: is not a regular file (refusing to read a {what} from it)")

@@ -4,10 +4,12 @@ subfolders searched, rich markup escaped; warnings become notes (item 9)."""
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import warnings
 from pathlib import Path
 
+import pytest
 from typer.testing import CliRunner
 
 from obsdesign import api
@@ -203,3 +205,65 @@ def test_a_time_budget_whose_first_alarm_is_swallowed_fires_again() -> None:
                         raise
     assert swallowed == 2 and time.perf_counter() - t0 < 2
     time.sleep(0.3)  # the alarm was cleared on leaving the block: nothing fires here
+
+
+def _deep_folder(top: Path, levels: int) -> None:
+    """``top/a/a/…/a`` (``levels`` deep), made without recursion (os.makedirs recurses)."""
+    top.mkdir()
+    fd = os.open(top, os.O_RDONLY)
+    try:
+        for _ in range(levels):
+            os.mkdir("a", dir_fd=fd)
+            nxt = os.open("a", os.O_RDONLY, dir_fd=fd)
+            os.close(fd)
+            fd = nxt
+    finally:
+        os.close(fd)
+
+
+def test_a_very_deep_folder_costs_no_other_row(tmp_path: Path) -> None:
+    """``check good deep`` with a folder 1,100 levels deep stopped with exit 3
+    (RecursionError in Path.rglob) and printed no row, the good spec's included (sweep,
+    import and check trial, session 28)."""
+    good = tmp_path / "good"
+    good.mkdir()
+    shutil.copy(SPEC, good / "s.toml")
+    _deep_folder(tmp_path / "deep", 1100)
+    res = runner.invoke(app, ["check", str(good), str(tmp_path / "deep"), "-q"])
+    assert res.exit_code == 0, res.output
+    assert api.spec_files([good, tmp_path / "deep"]) == [good / "s.toml"]
+
+
+def test_folders_named_toml_are_searched_not_checked(tmp_path: Path) -> None:
+    """A folder named ``v1.toml`` (or a link to a folder, named ``l.toml``) was a failed
+    "is a directory" row beside the specs inside it (session 28); hidden folders and links to
+    folders are not searched, hidden files are checked as before."""
+    (tmp_path / "v1.toml").mkdir()
+    shutil.copy(SPEC, tmp_path / "v1.toml" / "spec.toml")
+    (tmp_path / "l.toml").symlink_to(tmp_path / "v1.toml")
+    (tmp_path / ".hid").mkdir()
+    (tmp_path / ".hid" / "x.toml").write_text("x = 1\n")
+    (tmp_path / ".h.toml").write_text("x = 1\n")
+    assert api.spec_files(tmp_path) == [tmp_path / ".h.toml", tmp_path / "v1.toml" / "spec.toml"]
+
+
+def test_a_folder_that_cannot_be_listed_gets_a_row(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Path.rglob skipped a folder it could not read, silently: its specs had no row
+    (session 28). The folder is a row saying it cannot be read."""
+    (tmp_path / "shut").mkdir()
+    shutil.copy(SPEC, tmp_path / "shut" / "s.toml")
+    shutil.copy(SPEC, tmp_path / "ok.toml")
+    real = os.scandir
+
+    def scandir(p: object = ".") -> object:
+        if Path(str(p)).name == "shut":
+            raise PermissionError(13, "Permission denied")
+        return real(p)
+
+    monkeypatch.setattr(os, "scandir", scandir)
+    rows = {Path(r.spec).name: r for r in api.check(tmp_path)}
+    assert rows["ok.toml"].code == 0
+    assert rows["shut"].code == 2
+    assert "a folder that cannot be read (Permission denied)" in rows["shut"].message
