@@ -775,6 +775,25 @@ def _parquet_column(values: list[Any]) -> list[Any]:
     ]
 
 
+def plot_groups(
+    rows: list[dict[str, Any]], others: list[str], x: str, y: str
+) -> dict[tuple[Any, ...], list[tuple[float, float]]]:
+    """The points of :func:`plot_sweep`: per value of the ``others`` keys, (x, y) pairs, y
+    nan (a gap) where the row is not ok (exit code 0). An inconclusive row (exit 4) was
+    drawn as a value although nothing in it is certified, against docs/sweeps.md's "points
+    that are not ok are gaps" (sweep, import and check trial, session 28)."""
+    groups: dict[tuple[Any, ...], list[tuple[float, float]]] = {}
+    for r in rows:
+        g = tuple(r.get(k) for k in others)
+        try:
+            xv = float(r[x])
+            yv = float(r[y]) if r.get(y) is not None and r.get("exit_code") == 0 else math.nan
+        except (TypeError, ValueError, KeyError):
+            continue
+        groups.setdefault(g, []).append((xv, yv))
+    return groups
+
+
 def plot_sweep(
     rows: list[dict[str, Any]], axes: list[Axis], y: str, path: Path, x: str | None = None
 ) -> None:
@@ -788,15 +807,7 @@ def plot_sweep(
     keys = [a.key for a in axes]
     x = x or keys[0]
     others = [k for k in keys if k != x]
-    groups: dict[tuple[Any, ...], list[tuple[float, float]]] = {}
-    for r in rows:
-        g = tuple(r.get(k) for k in others)
-        try:
-            xv = float(r[x])
-            yv = float(r[y]) if r.get(y) is not None and r.get("exit_code") in (0, 4) else math.nan
-        except (TypeError, ValueError, KeyError):
-            continue
-        groups.setdefault(g, []).append((xv, yv))
+    groups = plot_groups(rows, others, x, y)
     fig, ax = plt.subplots(figsize=(7, 4.5))
     try:
         for g, pts in groups.items():

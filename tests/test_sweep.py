@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import csv
 import json
+import math
 import tomllib
 from pathlib import Path
 
@@ -561,3 +562,15 @@ def test_parquet_of_a_column_mixing_text_and_numbers(tmp_path: Path) -> None:
     got = pq.read_table(out).to_pydict()
     assert got["method.lambda"] == ["0.9999999999999999999999", "0.97", None]
     assert got["exit_code"] == [0, 0, 2] and got["point"] == [0, 1, 2]
+
+
+def test_a_plot_leaves_inconclusive_points_as_gaps() -> None:
+    """An exit-4 row (nothing certified) was drawn as a value (session 28): only exit 0 is."""
+    rows = [
+        {"method.lambda": 0.96, "mu": 10.0, "exit_code": 0},
+        {"method.lambda": 0.97, "mu": 99.0, "exit_code": 4},
+        {"method.lambda": 0.98, "mu": 5.0, "exit_code": 1},
+    ]
+    pts = sw.plot_groups(rows, [], "method.lambda", "mu")[()]
+    assert pts[0] == (0.96, 10.0)
+    assert [math.isnan(p[1]) for p in pts] == [False, True, True]
