@@ -552,7 +552,7 @@ def check(
 
         # every spec the folders hold, not only the paths named (check DIR --junit DIR/x.toml
         # replaced a spec with the JUnit XML: CLI fuzzer)
-        check_output(junit, False, _inputs(*paths, *api.spec_files(list(paths))))
+        check_output(junit, False, _inputs(*paths, *api.spec_files(list(paths))), forceable=False)
 
     def each(f: Path) -> None:
         interrupt.check()  # a Ctrl-C whose exception was lost in the last spec stops here

@@ -267,3 +267,15 @@ def test_a_folder_that_cannot_be_listed_gets_a_row(
     assert rows["ok.toml"].code == 0
     assert rows["shut"].code == 2
     assert "a folder that cannot be read (Permission denied)" in rows["shut"].message
+
+
+def test_check_junit_refusals_do_not_suggest_force(tmp_path: Path) -> None:
+    """``check --junit`` refusals ended "(--force)", an option check does not have
+    (session 28)."""
+    shutil.copy(SPEC, tmp_path / "a.toml")
+    for target in (tmp_path / "a.toml", Path("/dev/null")):
+        res = runner.invoke(app, ["check", str(tmp_path), "--junit", str(target)])
+        assert res.exit_code == 2, res.output
+        assert "refusing" in res.output and "--force" not in res.output, res.output
+    res = runner.invoke(app, ["design", str(SPEC), "-o", "/dev/null"])
+    assert res.exit_code == 2 and "(--force writes into it)" in res.output

@@ -447,7 +447,9 @@ def no_lone_surrogates(raw: bytes | str, d: Any, file: str) -> None:
         pass
 
 
-def check_output(path: str | Path, force: bool = False, inputs: tuple[Path, ...] = ()) -> None:
+def check_output(
+    path: str | Path, force: bool = False, inputs: tuple[Path, ...] = (), forceable: bool = True
+) -> None:
     """Refuse (:class:`InputError`, one line) an output path that would destroy something:
     one of ``inputs`` (the spec itself), a symbolic link, an existing file that is not a
     regular file (device, FIFO, socket), a write-protected file, or an existing ``.toml``
@@ -455,7 +457,19 @@ def check_output(path: str | Path, force: bool = False, inputs: tuple[Path, ...]
     directory, a path given for two outputs, or a directory that cannot take a new file
     always. Nothing is written here (an empty probe file is created and removed). ``-``
     (stdin for a spec) is refused as an output: it wrote a file named ``-`` (a path with a
-    folder, ``$PWD/-``, still names one)."""
+    folder, ``$PWD/-``, still names one). ``forceable=False`` (a command without
+    ``--force``: ``check --junit``) drops the "(--force …)" hint from the messages: it
+    pointed to an option ``check`` does not have (session 28)."""
+    try:
+        _check_output(path, force, inputs)
+    except InputError as e:
+        if forceable:
+            raise
+        raise InputError(re.sub(r" \(--force[^)]*\)$", "", str(e))) from None
+
+
+def _check_output(path: str | Path, force: bool, inputs: tuple[Path, ...]) -> None:
+    """:func:`check_output`, with the "(--force …)" hints."""
     if str(path) == "-":
         raise InputError(
             "-: outputs go to files, not to stdout (which carries the results); name a file "
