@@ -221,6 +221,17 @@ def _deep_folder(top: Path, levels: int) -> None:
         os.close(fd)
 
 
+def _remove_deep_folder(top: Path) -> None:
+    """Remove what :func:`_deep_folder` made, without recursion: pytest's own clean-up of old
+    temporary folders (shutil.rmtree, recursive) stopped the session with a RecursionError."""
+    depth = 0
+    p = top
+    while (p / "a").is_dir():
+        p, depth = p / "a", depth + 1
+    for k in range(depth, -1, -1):  # bottom-up, by path (about 2,200 characters at most)
+        os.rmdir(os.path.join(str(top), *(["a"] * k)))
+
+
 def test_a_very_deep_folder_costs_no_other_row(tmp_path: Path) -> None:
     """``check good deep`` with a folder 1,100 levels deep stopped with exit 3
     (RecursionError in Path.rglob) and printed no row, the good spec's included (sweep,
@@ -229,9 +240,13 @@ def test_a_very_deep_folder_costs_no_other_row(tmp_path: Path) -> None:
     good.mkdir()
     shutil.copy(SPEC, good / "s.toml")
     _deep_folder(tmp_path / "deep", 1100)
-    res = runner.invoke(app, ["check", str(good), str(tmp_path / "deep"), "-q"])
-    assert res.exit_code == 0, res.output
-    assert api.spec_files([good, tmp_path / "deep"]) == [good / "s.toml"]
+    try:
+        res = runner.invoke(app, ["check", str(good), str(tmp_path / "deep"), "-q"])
+        assert res.exit_code == 0, res.output
+        assert api.spec_files([good, tmp_path / "deep"]) == [good / "s.toml"]
+    finally:
+        _remove_deep_folder(tmp_path / "deep")
+    assert not (tmp_path / "deep").exists()
 
 
 def test_folders_named_toml_are_searched_not_checked(tmp_path: Path) -> None:
