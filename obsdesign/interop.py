@@ -20,7 +20,10 @@
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping
+from decimal import Decimal, localcontext
+from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
@@ -43,12 +46,52 @@ def _control() -> Any:
 
 
 # -- TOML writing ---------------------------------------------------------------------------
+def _exact(x: Any) -> Decimal | None:
+    """The exact decimal a spec writes for an exact input (session 28: these were rounded
+    to doubles, so the certificate was about another matrix), else None:
+
+    - a ``Decimal``: its own digits;
+    - a ``Fraction`` (any non-integer ``numbers.Rational``): its finite decimal expansion;
+      one without (1/3) is refused, as a spec's numbers are decimals;
+    - a long double (``np.longdouble`` wider than a double): its shortest repr at its own
+      precision, which reads back as the same long double (as a double's repr does)."""
+    if isinstance(x, Decimal):
+        if not x.is_finite():
+            raise InputError(f"cannot write the non-finite number {x} into a spec")
+        return x
+    if isinstance(x, Fraction):
+        d, twos, fives = x.denominator, 0, 0
+        while d % 2 == 0:
+            d, twos = d // 2, twos + 1
+        while d % 5 == 0:
+            d, fives = d // 5, fives + 1
+        if d != 1:
+            raise InputError(
+                f"the exact number {x} has no finite decimal form, which a spec's numbers "
+                "are: round it (e.g. float(x)) or rescale the model"
+            )
+        with localcontext() as ctx:
+            ctx.prec = len(str(abs(x.numerator))) + max(twos, fives) + 2
+            return Decimal(x.numerator) / Decimal(x.denominator)
+    if isinstance(x, np.floating) and x.dtype.itemsize > 8:
+        if not np.isfinite(x):
+            raise InputError(f"cannot write the non-finite number {x} into a spec")
+        return Decimal(np.format_float_scientific(x, unique=True))
+    return None
+
+
 def _num(x: Any) -> str:
-    """A number as TOML: integers as they are, floats by their shortest repr (exact decimal)."""
+    """A number as TOML: integers as they are, floats by their shortest repr (exact decimal),
+    exact inputs (Decimal, Fraction, long double) exactly (:func:`_exact`)."""
     if isinstance(x, (bool, np.bool_)):
         return "true" if x else "false"
     if isinstance(x, (int, np.integer)):
         return str(int(x))
+    q = _exact(x)
+    if q is not None:
+        if q == q.to_integral_value() and abs(q) < 10**18:
+            return str(int(q))
+        return str(q).replace("E", "e")
     f = float(x)
     if not math.isfinite(f):
         raise InputError(f"cannot write the non-finite number {f!r} into a spec")
@@ -75,14 +118,31 @@ def _tstr(v: str) -> str:
     return '"' + "".join(out) + '"'
 
 
+def _key(k: Any) -> str:
+    """A TOML key: bare when it can be, else a quoted string."""
+    k = str(k)
+    return k if re.fullmatch(r"[A-Za-z0-9_-]+", k) else _tstr(k)
+
+
 def _value(v: Any) -> str:
+    """A TOML value: a string, a number (:func:`_num`), an array, or an inline table (a
+    mapping inside an array, as ``[simulate.noise] windows = [{...}]``). A mapping or None
+    inside an array went to ``np.asarray`` as a 0-d object array whose item is itself: a
+    RecursionError (sweep, import and check trial, session 28)."""
     if isinstance(v, str):
         return _tstr(v)
-    if isinstance(v, (bool, np.bool_, int, float, np.integer, np.floating)):
+    if isinstance(v, (bool, np.bool_, int, float, np.integer, np.floating, Decimal, Fraction)):
         return _num(v)
+    if v is None:
+        raise InputError("a missing value (None) cannot be written into a spec")
+    if isinstance(v, Mapping):
+        return "{" + ", ".join(f"{_key(k)} = {_value(x)}" for k, x in v.items()) + "}"
     arr = np.asarray(v)
     if arr.ndim == 0:
-        return _value(arr.item())
+        item = arr.item()
+        if item is v:
+            raise InputError(f"cannot write a {type(v).__name__} into a spec")
+        return _value(item)
     if arr.dtype.kind in "fiub":
         if arr.ndim == 1:
             return "[" + ", ".join(_num(x) for x in arr) + "]"
@@ -91,14 +151,17 @@ def _value(v: Any) -> str:
 
 
 def _table(name: str, data: Mapping[str, Any]) -> list[str]:
-    """``[name]`` with its plain keys first, then its sub-tables."""
+    """``[name]`` with its plain keys first, then its sub-tables; an error names the key."""
     lines = [f"[{name}]"]
     subs = []
     for k, v in data.items():
         if isinstance(v, Mapping):
             subs.append((k, v))
         elif v is not None:
-            lines.append(f"{k} = {_value(v)}")
+            try:
+                lines.append(f"{_key(k)} = {_value(v)}")
+            except InputError as e:
+                raise InputError(f"[{name}] {k}: {e}") from None
     out = lines + [""]
     for k, v in subs:
         out += _table(f"{name}.{k}", v)
@@ -156,6 +219,29 @@ def _real(M: Any, name: str) -> np.ndarray:
         isinstance(x, (int, np.integer)) and not isinstance(x, bool) for x in arr.flat
     ):
         return arr
+    if (arr.dtype.kind == "f" and arr.dtype.itemsize > 8) or (
+        arr.dtype == object and any(isinstance(x, (Decimal, Fraction)) for x in arr.flat)
+    ):
+        # exact inputs kept exact (written by _num through _exact): they were rounded to
+        # doubles (sweep, import and check trial, session 28)
+        out = np.empty(arr.shape, dtype=object)
+        for idx, x in np.ndenumerate(arr):
+            if isinstance(x, bool) or not isinstance(
+                x, (int, float, np.integer, np.floating, Decimal, Fraction)
+            ):
+                raise InputError(f"{name} has the entry {x!r}, which is not a number")
+            try:
+                q = _exact(x)
+            except InputError as e:
+                raise InputError(f"{name}{list(idx)}: {e}") from None
+            out[idx] = x if q is None else q
+            f = float(out[idx])
+            if not math.isfinite(f) or (f == 0) != (out[idx] == 0):
+                raise InputError(
+                    f"{name}{list(idx)} = {x}: outside the float range, which a spec refuses: "
+                    "rescale the model"
+                )
+        return out
     out = arr.astype(float)
     tiny = (out != 0) & (np.abs(out) < np.finfo(float).tiny)
     if tiny.any():  # written as 5e-324, then refused by the spec loader (outsider trial)

@@ -341,3 +341,59 @@ def test_import_checks_declared_shapes_before_loading(tmp_path) -> None:
     assert "A = [[0, 1], [1, 0]]" in spec_text_from_mat(ok, {"A": "A", "C": "C"})
     with pytest.raises(InputError, match="variables: A, C, junk"):
         spec_text_from_mat(ok, {"A": "X", "C": "C"})
+
+
+def test_exact_inputs_are_written_exactly_or_refused() -> None:
+    """Decimal, Fraction and long double entries were rounded to doubles: the certificate
+    was about another matrix (sweep, import and check trial, session 28). A Decimal keeps its
+    digits, a Fraction its finite decimal (1/3 is refused), a long double its shortest repr
+    at its own precision."""
+    from decimal import Decimal
+    from fractions import Fraction
+
+    from obsdesign.api import load_spec_text
+    from obsdesign.errors import InputError
+    from obsdesign.interop import spec_text_from_statespace
+
+    z, c = np.zeros((2, 0)), np.array([[1.0, 0.0]])
+    A = np.array(
+        [[Decimal("0.1000000000000000000001"), Fraction(-1, 8)], [Decimal("1E-7"), 2]],
+        dtype=object,
+    )
+    t = spec_text_from_statespace((A, z, c, np.zeros((1, 0)), True))
+    assert "A = [[0.1000000000000000000001, -0.125], [1e-7, 2]]" in t
+    got = load_spec_text(t, "x.toml").system.A.q
+    assert [[Fraction(int(x.p), int(x.q)) for x in row] for row in got] == [
+        [Fraction("0.1000000000000000000001"), Fraction(-1, 8)],
+        [Fraction(1, 10**7), 2],
+    ]
+    L = np.array([[np.longdouble(1) / 3, np.longdouble(0.5)], [0, 1]], dtype=np.longdouble)
+    t = spec_text_from_statespace((L, z, c, np.zeros((1, 0)), True))
+    row = next(ln for ln in t.splitlines() if ln.startswith("A ="))
+    if np.finfo(np.longdouble).nmant > 52:  # x86: 80-bit long double
+        assert row == "A = [[0.33333333333333333334, 0.5], [0, 1]]"
+    with pytest.raises(InputError, match=r"A\[0, 0\]: the exact number 1/3 has no finite"):
+        spec_text_from_statespace(
+            (np.array([[Fraction(1, 3)]], dtype=object), np.zeros((1, 0)), [[1.0]], [], True)
+        )
+
+
+def test_lists_of_tables_and_missing_values() -> None:
+    """A list of tables (``windows = [{...}]``) or a None in a list raised RecursionError
+    (session 28): tables are inline tables, None is refused naming the key."""
+    from obsdesign.api import load_spec_text
+    from obsdesign.errors import InputError
+    from obsdesign.interop import spec_text_from_statespace
+
+    plant = (np.array([[0.5]]), np.zeros((1, 0)), np.array([[1.0]]), np.zeros((1, 0)), True)
+    sim = {
+        "horizon": 10,
+        "x0": [1],
+        "xhat0": [0],
+        "noise": {"kind": "windows", "windows": [{"start": 1, "stop": 2, "value": [3]}]},
+    }
+    t = spec_text_from_statespace(plant, "lyapunov", simulate=sim)
+    assert "windows = [{start = 1, stop = 2, value = [3]}]" in t
+    load_spec_text(t, "x.toml")
+    with pytest.raises(InputError, match=r"\[method\] L: a missing value \(None\)"):
+        spec_text_from_statespace(plant, "lyapunov", L=[None, 1])
