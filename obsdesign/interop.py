@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from obsdesign.errors import InputError
+from obsdesign.errors import InputError, SpecError
 
 #: methods whose designed observer is linear (a control.StateSpace)
 LINEAR = ("lyapunov", "set-invariant", "stubborn")
@@ -506,9 +506,20 @@ def spec_text_from_mat(
     A, C = var("A"), var("C")
     if A is None or C is None:
         raise InputError("--A and --C are required")
+    if C.size == 0:  # printed "C = []", which no spec accepts (session 28)
+        raise InputError(
+            f"{path}: variable '{names['C']}' (C) is {'×'.join(map(str, C.shape))}: a plant "
+            "needs at least one output"
+        )
     n = A.shape[0]
     B, D, Bd = var("B"), var("D"), var("Bd")
+    if Bd is not None and Bd.size == 0:
+        Bd = None  # no disturbance input: "Bd = [[], []]" was refused by the loader
+    given = "--dt"
+    if dt is not None and not (math.isfinite(dt) and dt >= 0):
+        raise InputError(f"--dt {dt!r}: expected a finite number >= 0 (0: continuous time)")
     if dt_name is not None:
+        given = f"{path}: variable '{dt_name}' (the sample time)"
         t = data.get(dt_name)
         if t is None:
             raise InputError(f"{path}: no variable '{dt_name}' for the sample time")
@@ -523,12 +534,25 @@ def spec_text_from_mat(
                 f"{path}: variable '{dt_name}' (the sample time) is {dt:g}; expected a finite "
                 "number >= 0 (0: continuous time)"
             )
+    if dt is not None and 0 < dt < np.finfo(float).tiny:
+        # written as sample_time = 5e-324, then refused by the spec loader (session 28)
+        raise InputError(
+            f"{given} is {dt!r}, a nonzero number below the float range (subnormal), which a "
+            "spec refuses: rescale time"
+        )
     # D without B: the inputs enter y only (the spec had D with no input and was refused)
     Bm = B if B is not None else np.zeros((n, 0 if D is None else np.atleast_2d(D).shape[-1]))
     Dm = D if D is not None else np.zeros((C.shape[0], 0))
     try:
-        return spec_text_from_statespace(
+        text = spec_text_from_statespace(
             (A, Bm, C, Dm, dt if dt else 0), method, Bd=Bd, title=f"imported from {Path(path).name}"
         )
     except InputError as e:  # e.g. shapes that do not fit: name the file
         raise InputError(f"{path}: {e}") from None
+    from obsdesign.api import load_spec_text
+
+    try:  # what import prints, the spec loader accepts (session 28: C = [] exit 0, then 2)
+        load_spec_text(text, f"{Path(path).name} (imported)")
+    except (InputError, SpecError) as e:
+        raise InputError(f"{path}: the imported spec would be refused: {e}") from None
+    return text

@@ -397,3 +397,58 @@ def test_lists_of_tables_and_missing_values() -> None:
     load_spec_text(t, "x.toml")
     with pytest.raises(InputError, match=r"\[method\] L: a missing value \(None\)"):
         spec_text_from_statespace(plant, "lyapunov", L=[None, 1])
+
+
+@pytest.mark.parametrize(
+    ("extra", "args", "message", "names_file"),
+    [
+        ({"C0": np.zeros((0, 2))}, ["--C", "C0"], "'C0' (C) is 0×2: a plant needs", True),
+        ({"ts": 5e-324}, ["--dt-var", "ts"], "'ts' (the sample time) is 5e-324, a nonzero", True),
+        ({}, ["--dt", "1e-320"], "--dt is 1e-320, a nonzero number below", False),
+        ({}, ["--dt", "inf"], "--dt inf: expected a finite number", False),
+    ],
+)
+def test_mat_import_refuses_what_the_loader_would_refuse(
+    tmp_path: Path, extra: dict, args: list[str], message: str, names_file: bool
+) -> None:
+    """import printed specs the loader refuses (C = [], sample_time = 5e-324) with exit 0,
+    and --dt inf was an error that did not name --dt (sweep, import and check trial,
+    session 28)."""
+    from scipy.io import savemat
+
+    mat = tmp_path / "plant.mat"
+    savemat(mat, {"Ad": np.array(A_D), "Cm": np.array([[1.0, 0.0]]), **extra})
+    r = CliRunner().invoke(app, ["import", str(mat), "--A", "Ad", "--C", "Cm", *args])
+    assert r.exit_code == 2 and len(r.stderr.splitlines()) == 1, r.stderr
+    assert message in r.stderr and (str(mat) in r.stderr) == names_file, r.stderr
+
+
+def test_mat_import_of_an_empty_Bd_has_no_disturbance(tmp_path: Path) -> None:
+    """A Bd with no columns was written "Bd = [[], []]", which the loader refuses."""
+    from scipy.io import savemat
+
+    mat = tmp_path / "plant.mat"
+    savemat(mat, {"Ad": np.array(A_D), "Cm": np.array([[1.0, 0.0]]), "E": np.zeros((2, 0))})
+    r = CliRunner().invoke(app, ["import", str(mat), "--A", "Ad", "--C", "Cm", "--Bd", "E"])
+    assert r.exit_code == 0, r.stderr
+    assert "Bd" not in r.stdout
+    api.load_spec_text(r.stdout, "x.toml")
+
+
+def test_mat_import_checks_its_spec_with_the_loader(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Whatever spec text import makes, the loader accepts, or import is exit 2 with the
+    loader's reason."""
+    from scipy.io import savemat
+
+    from obsdesign import interop
+
+    mat = tmp_path / "plant.mat"
+    savemat(mat, {"Ad": np.array(A_D), "Cm": np.array([[1.0, 0.0]])})
+    monkeypatch.setattr(
+        interop, "spec_text_from_statespace", lambda *a, **k: "[system]\nA = [[1]]\n"
+    )
+    r = CliRunner().invoke(app, ["import", str(mat), "--A", "Ad", "--C", "Cm"])
+    assert r.exit_code == 2 and "the imported spec would be refused" in r.stderr, r.stderr
+    assert r.stdout == ""
