@@ -506,7 +506,7 @@ def spec_text_from_mat(
     A, C = var("A"), var("C")
     if A is None or C is None:
         raise InputError("--A and --C are required")
-    if C.size == 0:  # printed "C = []", which no spec accepts (session 28)
+    if C.size == 0 and A.size:  # printed "C = []", which no spec accepts (session 28)
         raise InputError(
             f"{path}: variable '{names['C']}' (C) is {'×'.join(map(str, C.shape))}: a plant "
             "needs at least one output"
