@@ -342,7 +342,7 @@ def _names(prefix: str, k: int) -> list[str]:
     return [f"{prefix}[{i}]" for i in range(k)]
 
 
-def observer_statespace(report: Any, law: str | None = None) -> Any:
+def observer_statespace(report: Any, law: str | None = None, verify: bool = False) -> Any:
     """The designed observer of ``report`` (a :class:`obsdesign.report.model.Report` or a path
     to one) as a python-control system with inputs ``u[0..m-1]``, ``y[0..p-1]`` and outputs
     (and states) ``xhat[0..n-1]``: a ``control.StateSpace`` for the linear observers
@@ -350,15 +350,44 @@ def observer_statespace(report: Any, law: str | None = None) -> Any:
     injection (``law="interpolated"`` or ``"time-varying"``; the default for one output when
     the report has a breakpoint table is still the linear law when it has one: pass ``law``
     to choose). Continuous-time plants give continuous-time observers, discrete ones
-    discrete (``dt`` = ``sample_time``, else True)."""
+    discrete (``dt`` = ``sample_time``, else True).
+
+    The report's claims are not recomputed unless ``verify`` (then a report that
+    :func:`obsdesign.api.verify` does not find ok is refused, :class:`InputError`). Always
+    refused: a float parameter that differs from its exact value, and an embedded spec whose
+    sha256 is not the report's ``spec_sha256``; a report whose stored claims give a verdict
+    other than ok gives a ``UserWarning``. A report with L edited to an unstable gain gave
+    an observer with no word (sweep, import and check trial, session 28)."""
+    import hashlib
+    import warnings
+
     from obsdesign.api import load_spec_text
     from obsdesign.report.model import Report
 
     ct = _control()
-    if not isinstance(report, Report):
-        report = Report.load(report)[0]
+    where = "report" if isinstance(report, Report) else str(report)
+    report, problems = (
+        Report.from_dict(report.to_dict()) if isinstance(report, Report) else Report.load(report)
+    )
+    if problems:
+        raise InputError(f"{where}: {problems[0]}")
     if report.error is not None:
         raise InputError("the report records a design that stopped with an error: no observer")
+    if hashlib.sha256(report.spec.encode()).hexdigest() != report.spec_sha256:
+        raise InputError(f"{where}: its embedded spec does not match its spec_sha256")
+    if verify:
+        from obsdesign.api import verify as recheck
+
+        got = recheck(report).computed_verdict()
+        if got != "ok":
+            raise InputError(f"{where}: obsdesign verify gives '{got}', not 'ok': no observer")
+    elif report.computed_verdict() != "ok":
+        warnings.warn(
+            f"{where}: its claims give the verdict '{report.computed_verdict()}', not 'ok': "
+            "the observer's parameters are not certified",
+            UserWarning,
+            stacklevel=2,
+        )
     sp = load_spec_text(report.spec, report.spec_file or "<report>")
     s, params = sp.system, report.parameters
     n, p = s.n, s.p

@@ -452,3 +452,47 @@ def test_mat_import_checks_its_spec_with_the_loader(
     r = CliRunner().invoke(app, ["import", str(mat), "--A", "Ad", "--C", "Cm"])
     assert r.exit_code == 2 and "the imported spec would be refused" in r.stderr, r.stderr
     assert r.stdout == ""
+
+
+def test_observer_statespace_checks_the_report(tmp_path: Path) -> None:
+    """A report with L edited to [100, 3] (float and exact alike), which verify rejects,
+    gave an unstable observer with no word (sweep, import and check trial, session 28).
+    verify=True recomputes the claims; a float/exact mismatch or an edited embedded spec is
+    always refused; a stored verdict other than ok warns."""
+    import json
+    import warnings
+
+    from obsdesign.errors import InputError
+    from obsdesign.interop import observer_statespace
+
+    spec = Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+    rep = tmp_path / "r.json"
+    assert CliRunner().invoke(app, ["design", str(spec), "-q", "-o", str(rep)]).exit_code == 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        observer_statespace(rep, verify=True)  # the genuine report: no word
+    d = json.loads(rep.read_text())
+
+    def edited(name: str, change) -> Path:
+        e = json.loads(json.dumps(d))
+        change(e)
+        out = tmp_path / name
+        out.write_text(json.dumps(e))
+        return out
+
+    def set_L(e: dict) -> None:
+        e["parameters"]["L"] = [[100.0], [3.0]]
+        e["parameters"]["exact"]["L"] = [["100"], ["3"]]
+
+    consistent = edited("a.json", set_L)
+    with pytest.raises(InputError, match="verify gives 'failed'"):
+        observer_statespace(consistent, verify=True)
+    mismatch = edited("b.json", lambda e: e["parameters"]["L"][0].__setitem__(0, 100.0))
+    with pytest.raises(InputError, match="float value differs from its exact value"):
+        observer_statespace(mismatch)
+    respec = edited("c.json", lambda e: e.__setitem__("spec", e["spec"] + "\n"))
+    with pytest.raises(InputError, match="does not match its spec_sha256"):
+        observer_statespace(respec)
+    failed = edited("d.json", lambda e: e["claims"][0].__setitem__("status", "failed"))
+    with pytest.warns(UserWarning, match="verdict 'failed'"):
+        observer_statespace(failed)

@@ -253,12 +253,12 @@ class Report:
             d["unverified_parameters"] = self.unverified
         return d
 
-    def observer_statespace(self, law: str | None = None) -> Any:
+    def observer_statespace(self, law: str | None = None, verify: bool = False) -> Any:
         """The designed observer as a python-control system (``obsdesign[control]``); see
         :func:`obsdesign.interop.observer_statespace`."""
         from obsdesign.interop import observer_statespace
 
-        return observer_statespace(self, law)
+        return observer_statespace(self, law, verify)
 
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), indent=2, ensure_ascii=False)
