@@ -172,7 +172,7 @@ def _print_sweep(rows: list[dict[str, Any]], fmt: Fmt) -> None:
         print("| " + " | ".join(cols) + " |")
         print("|" + " --- |" * len(cols))
         for r in rows:
-            print("| " + " | ".join(_md_cell(r.get(c, "")) for c in cols) + " |")
+            print("| " + " | ".join(_md_cell(_md_value(r.get(c, ""))) for c in cols) + " |")
         return
     from rich.table import Table
 
@@ -187,11 +187,32 @@ def _print_sweep(rows: list[dict[str, Any]], fmt: Fmt) -> None:
 
 
 def _sweep_cell(v: Any) -> str:
+    """A sweep table's cell: a float in 6 significant digits, marked "≈" when that text is
+    not the value (its decimal is not the float, or the float is not the exact parameter:
+    :class:`obsdesign.sweep.Inexact`); an ISS bound 24842821.6875 showed as a bare
+    "2.48428e+07", below the bound (session 28)."""
+    from obsdesign.report.shown import APPROX
+    from obsdesign.sweep import Inexact
+
     if v is None:
         return ""
     if isinstance(v, float):
-        return format(v, ".6g")
+        text = format(v, ".6g")
+        same = v.shows(text) if isinstance(v, Inexact) else (float(text) == v or v != v)
+        return text if same else APPROX + text
     return str(v)
+
+
+def _md_value(v: Any) -> Any:
+    """A Markdown sweep cell's value: the float's repr, marked "≈" when that decimal is not
+    the exact parameter (:class:`obsdesign.sweep.Inexact`)."""
+    from obsdesign.report.shown import APPROX
+    from obsdesign.sweep import Inexact
+
+    if isinstance(v, Inexact):
+        text = repr(float(v))
+        return text if v.shows(text) else APPROX + text
+    return v
 
 
 def _kv(items: list[str]) -> dict[str, str]:

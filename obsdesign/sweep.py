@@ -523,17 +523,55 @@ def _run_point(task: PointTask, t0: float) -> dict[str, Any]:
     return row
 
 
+class Inexact(float):
+    """A summary parameter's float whose exact value (``exact``, "p/q") is not this double:
+    tables compare the decimal they show with the exact value and mark it "≈" when it is not
+    that value (:func:`obsdesign.cli_commands._sweep_cell`); CSV, JSON and Parquet cells are
+    the float. A certified λ = 0.9999999999999999999999 was shown as a bare "1" (sweep,
+    import and check trial, session 28)."""
+
+    __slots__ = ("exact",)
+    exact: str
+
+    def __new__(cls, value: float, exact: str) -> Inexact:
+        self = super().__new__(cls, value)
+        self.exact = exact
+        return self
+
+    def __reduce__(self) -> tuple[Any, ...]:  # pickles (Dask) as itself
+        return (Inexact, (float(self), self.exact))
+
+    def shows(self, text: str) -> bool:
+        """Whether the decimal ``text`` is the exact value."""
+        from obsdesign.certify.exact import Q
+
+        return Q(text) == Q(self.exact)
+
+
 def _scalar(params: Any, key: str) -> Any:
     """A summary parameter's cell: an integer stays one (``facets`` 6, not 6.0: outsider
-    trial, session 22), a number is its float, anything else its JSON text."""
+    trial, session 22), a number is its float (:class:`Inexact` when that double is not
+    the exact value held), a matrix the JSON list of its floats (K, R, W of stubborn were
+    numpy's text of an object array, with literal "\\n": session 28), anything else its
+    JSON text."""
+    from flint import fmpq
+
     v0 = params[key]
     if isinstance(v0, numbers.Integral) and not isinstance(v0, bool):
         return int(v0)
     try:
-        return float(params.float(key))
+        f = float(params.float(key))
     except (TypeError, ValueError):
         v = params[key]
-        return v if isinstance(v, (int, str, bool)) else json.dumps(v, default=str)
+        if isinstance(v, (int, str, bool)):
+            return v
+        try:
+            return json.dumps(params.float_json(key), allow_nan=False)
+        except (TypeError, ValueError):
+            return json.dumps(v, default=str)
+    if isinstance(v0, fmpq) and math.isfinite(f) and fmpq(*f.as_integer_ratio()) != v0:
+        return Inexact(f, str(v0))
+    return f
 
 
 def _flat_metrics(m: dict[str, Any], prefix: str = "") -> dict[str, Any]:

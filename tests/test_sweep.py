@@ -349,7 +349,7 @@ def test_integer_summary_parameters_stay_integers() -> None:
     rows = sw.sweep_rows(ROOT / "specs" / "dorea-pimenta-7-1.toml", ["method.lambda=[0.9]"])
     assert rows[0]["exit_code"] == 0
     assert type(rows[0]["facets"]) is int and type(rows[0]["iterations"]) is int
-    assert type(rows[0]["contractivity"]) is float
+    assert isinstance(rows[0]["contractivity"], float)
 
 
 def test_hostile_set_values_are_bad_input() -> None:
@@ -574,3 +574,30 @@ def test_a_plot_leaves_inconclusive_points_as_gaps() -> None:
     pts = sw.plot_groups(rows, [], "method.lambda", "mu")[()]
     assert pts[0] == (0.96, 10.0)
     assert [math.isnan(p[1]) for p in pts] == [False, True, True]
+
+
+def test_sweep_tables_mark_rounded_values_and_matrices_are_json_lists() -> None:
+    """A certified λ = 0.9999999999999999999999 was a bare "1" in the sweep table, the ISS
+    bound 24842821.6875 a bare "2.48428e+07" (below the bound), and stubborn's K a quoted
+    numpy text with literal "\\n" (sweep, import and check trial, session 28)."""
+    import pickle
+
+    from obsdesign.cli_commands import _md_value, _sweep_cell
+
+    lyap = ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+    rows = sw.sweep_rows(lyap, ["method.lambda=[0.96, 0.9999999999999999999999]"])
+    exact, near = rows
+    assert isinstance(near["lambda"], sw.Inexact) and near["lambda"] == 1.0
+    assert _sweep_cell(near["lambda"]) == "≈1" and _md_value(near["lambda"]) == "≈1.0"
+    assert _sweep_cell(exact["lambda"]) == "0.96"  # 24/25 shown as itself
+    assert _md_value(exact["lambda"]) == "0.96"
+    assert _sweep_cell(exact["mu"]) == "≈2.48428e+07" and exact["mu"] == 24842821.6875
+    assert _sweep_cell(1.5) == "1.5" and _sweep_cell(float("nan")) == "nan"
+    again = pickle.loads(pickle.dumps(near["lambda"]))
+    assert isinstance(again, sw.Inexact) and again.exact == near["lambda"].exact
+    assert json.dumps(near["lambda"]) == "1.0"
+    stub = sw.sweep_rows(
+        ROOT / "specs" / "astolfi-stubborn-example1.toml", ["method.lambda_fraction=[0.5]"]
+    )[0]
+    assert stub["exit_code"] == 0
+    assert json.loads(stub["K"]) == [[-2.5623020538914716], [8.402663141750963]]
