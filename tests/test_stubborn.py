@@ -1403,3 +1403,22 @@ def test_solver_infeasible_on_badly_scaled_data_is_no_verdict(
         assert "no proof of infeasibility" in e.message
     else:  # a solver that copes certifies it
         assert rep.exit_code() == 0
+
+
+@pytest.mark.parametrize(
+    ("A", "C", "K", "time"),
+    [
+        ("[[0, 1], [0, 0]]", "[[1, 0]]", "[1, 0]", "continuous"),  # s(s + 1): an eigenvalue 0
+        ("[[0, 1], [-1, 0]]", "[[1, 0]]", "[0, 0.5]", "continuous"),  # s² + 3/2: ±i√(3/2)
+        ("[[0.5, 1], [0, 0.5]]", "[[1, 0]]", "[1.5, 0]", "discrete"),  # eigenvalue −1
+    ],
+)
+def test_a_given_gain_on_the_stability_boundary_is_infeasible(
+    A: str, C: str, K: str, time: str
+) -> None:
+    """A given K with A − KC on the stability boundary ended with exit 4 ("the solver's
+    best λ ≈ 0.0018 could not be certified"): the exact Hurwitz test ran only after a solver
+    said "infeasible" (constrained/stubborn soundness trial, session 28). It runs first."""
+    text = f'[system]\ntime = "{time}"\nA = {A}\nC = {C}\n[method]\nkey = "stubborn"\nK = {K}\n'
+    with pytest.raises(InfeasibleError, match="A − KC is not (Hurwitz|Schur).*for the given K"):
+        api.design(api.load_spec_text(text, "marginal.toml"))

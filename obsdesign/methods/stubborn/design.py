@@ -347,6 +347,12 @@ def design_params(
     notes: list[str] = []
     vals: dict[str, Any] = {}
     _require_detectable(spec, pl)
+    if o.K is not None and not _stable_gain(spec, o.K, pl.discrete):
+        # exact, before any solve: with A − KC on the stability boundary (s(s + 1), the
+        # double integrator with K = [1, 0]) the solver answered "optimal" or "inaccurate" at
+        # a tiny λ, not "infeasible", and the design ended with exit 4 "could not be
+        # certified" (constrained/stubborn soundness trial, session 28)
+        _unstable_gain(pl, "at every λ")
     if o.lam is not None:
         lam_q = o.lam  # a rate the user asks for is checked directly, before any search
         ok, st = feasible(pl, o, float(lam_q))
