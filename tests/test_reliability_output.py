@@ -12,6 +12,7 @@ import stat
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import pytest
 from typer.testing import CliRunner
@@ -337,31 +338,38 @@ def test_simulate_refuses_an_error_report(spec: Path, tmp_path: Path):
     assert f"{out}: records a design that stopped" in res.output  # names the report file
 
 
-@pytest.mark.parametrize(
-    ("name", "key"),
-    [
-        ("constrained-redesign-sec5-lyapunov", "L"),
-        ("astolfi-stubborn-example1", "K"),
-        ("dorea-pimenta-7-1", "G"),
-        ("hernandez-garcia-example", "L_h"),
-        ("schaum-impulsive-example", "T_max"),
-    ],
-)
+#: a shipped spec per method and a parameter its simulation reads
+SIM_PARAMS = [
+    ("constrained-redesign-sec5-lyapunov", "L"),
+    ("astolfi-stubborn-example1", "K"),
+    ("dorea-pimenta-7-1", "G"),
+    ("hernandez-garcia-example", "L_h"),
+    ("schaum-impulsive-example", "T_max"),
+]
+
+
+def _simulate_edited(tmp_path: Path, name: str, key: str, edit: Any) -> Any:
+    """Design the shipped spec ``name``, apply ``edit(parameters)`` to its report with the
+    exact value of ``key`` removed, and simulate the spec with that report."""
+    src = SPEC.parent / f"{name}.toml"
+    rep = tmp_path / "r.json"
+    assert runner.invoke(app, ["design", str(src), "-q", "-o", str(rep)]).exit_code == 0
+    d = json.loads(rep.read_text())
+    d["parameters"]["exact"].pop(key, None)
+    edit(d["parameters"])
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(d))
+    return runner.invoke(app, ["simulate", str(src), "-q", "--report", str(bad)])
+
+
+@pytest.mark.parametrize(("name", "key"), SIM_PARAMS)
 def test_simulate_a_report_missing_a_parameter_is_bad_input(
     tmp_path: Path, name: str, key: str
 ) -> None:
     """A report without a parameter the simulation reads, or with one of the wrong shape:
     exit 2 naming the report and the key, not exit 3 "internal failure: KeyError" (simulate
     trial, session 27)."""
-    src = SPEC.parent / f"{name}.toml"
-    rep = tmp_path / "r.json"
-    assert runner.invoke(app, ["design", str(src), "-q", "-o", str(rep)]).exit_code == 0
-    d = json.loads(rep.read_text())
-    del d["parameters"][key]
-    d["parameters"]["exact"].pop(key, None)
-    bad = tmp_path / "bad.json"
-    bad.write_text(json.dumps(d))
-    res = runner.invoke(app, ["simulate", str(src), "-q", "--report", str(bad)])
+    res = _simulate_edited(tmp_path, name, key, lambda p: p.pop(key))
     _refused(res, "bad.json", f"has no parameter '{key}'")
 
 
@@ -379,31 +387,14 @@ def test_simulate_a_report_with_a_parameter_of_the_wrong_shape_is_bad_input(
     _refused(res, "bad.json", "wrong shape or kind", "read before the failure: L (3×1 array)")
 
 
-@pytest.mark.parametrize(
-    ("name", "key"),
-    [
-        ("constrained-redesign-sec5-lyapunov", "L"),
-        ("astolfi-stubborn-example1", "K"),
-        ("dorea-pimenta-7-1", "G"),
-        ("hernandez-garcia-example", "L_h"),
-        ("schaum-impulsive-example", "T_max"),
-    ],
-)
+@pytest.mark.parametrize(("name", "key"), SIM_PARAMS)
 def test_simulate_names_the_report_parameter_of_the_wrong_shape(
     tmp_path: Path, name: str, key: str
 ) -> None:
     """Every method: a parameter of the wrong shape (a 5 × 3 array, float only) is listed with
     its shape among those read before the failure; numpy's "cannot reshape array of size 15"
     named none (session 27's note, fixed in session 28)."""
-    src = SPEC.parent / f"{name}.toml"
-    rep = tmp_path / "r.json"
-    assert runner.invoke(app, ["design", str(src), "-q", "-o", str(rep)]).exit_code == 0
-    d = json.loads(rep.read_text())
-    d["parameters"][key] = [[1.0, 2.0, 3.0]] * 5
-    d["parameters"]["exact"].pop(key, None)
-    bad = tmp_path / "bad.json"
-    bad.write_text(json.dumps(d))
-    res = runner.invoke(app, ["simulate", str(src), "-q", "--report", str(bad)])
+    res = _simulate_edited(tmp_path, name, key, lambda p: p.__setitem__(key, [[1.0, 2.0, 3.0]] * 5))
     _refused(res, "bad.json", "wrong shape or kind", f"{key} (5×3 array)")
 
 
@@ -573,34 +564,21 @@ def test_the_api_never_writes_a_report_over_a_loaded_specs_file(tmp_path: Path) 
     assert out.read_text(encoding="utf-8").lstrip().startswith("{")
 
 
-@pytest.mark.parametrize(
-    ("name", "key"),
-    [
-        ("constrained-redesign-sec5-lyapunov", "L"),
-        ("astolfi-stubborn-example1", "K"),
-        ("dorea-pimenta-7-1", "G"),
-        ("hernandez-garcia-example", "L_h"),
-        ("schaum-impulsive-example", "T_max"),
-    ],
-)
+@pytest.mark.parametrize(("name", "key"), SIM_PARAMS)
 @pytest.mark.parametrize("bad_value", [math.inf, math.nan])
 def test_simulate_refuses_a_report_parameter_that_is_not_finite(
     tmp_path: Path, name: str, key: str, bad_value: float
 ) -> None:
     """A report parameter with a non-finite number (exact value removed) was simulated with
     exit 0 and nan metrics (session 27's note); now exit 2 naming the key."""
-    src = SPEC.parent / f"{name}.toml"
-    rep = tmp_path / "r.json"
-    assert runner.invoke(app, ["design", str(src), "-q", "-o", str(rep)]).exit_code == 0
-    d = json.loads(rep.read_text())
-    v = d["parameters"][key]
-    if isinstance(v, list):
-        row = v[0] if isinstance(v[0], list) else v
-        row[0] = bad_value
-    else:
-        d["parameters"][key] = bad_value
-    d["parameters"]["exact"].pop(key, None)
-    bad = tmp_path / "bad.json"
-    bad.write_text(json.dumps(d))
-    res = runner.invoke(app, ["simulate", str(src), "-q", "--report", str(bad)])
+
+    def edit(p: dict) -> None:
+        v = p[key]
+        if isinstance(v, list):
+            row = v[0] if isinstance(v[0], list) else v
+            row[0] = bad_value
+        else:
+            p[key] = bad_value
+
+    res = _simulate_edited(tmp_path, name, key, edit)
     _refused(res, "bad.json", f"parameters.{key}", "not a finite number")
