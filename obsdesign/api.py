@@ -284,38 +284,6 @@ def _write_error_report(sp: Spec, out: str | Path, code: int, message: str, forc
     write_atomic(out, rep.to_json(), force)
 
 
-class _TrackedParameters(Parameters):
-    """Parameters that record which keys the checks read (the rest are "not verified")."""
-
-    def __init__(self, values: dict[str, Any]) -> None:
-        super().__init__(values)
-        self.read: set[str] = set()
-
-    def __getitem__(self, k: str) -> Any:
-        self.read.add(k)
-        return super().__getitem__(k)
-
-    def get(self, k: str, default: Any = None) -> Any:
-        self.read.add(k)
-        return super().get(k, default)
-
-    def float(self, k: str) -> Any:
-        self.read.add(k)
-        return super().float(k)
-
-    def is_exact(self, k: str) -> bool:
-        self.read.add(k)
-        return super().is_exact(k)
-
-    def items(self) -> Any:
-        self.read.update(self._v)
-        return super().items()
-
-    def __iter__(self) -> Iterator[str]:
-        self.read.update(self._v)
-        return super().__iter__()
-
-
 #: claims only ``verify`` makes (never in a design report)
 VERIFY_ONLY = ("spec-hash", "parameters-consistent", "report-verdict")
 
@@ -418,8 +386,7 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
                 float_ok=False,
             )
         )
-    tracked = _TrackedParameters(dict(rep.parameters.items()))
-    tracked.read.clear()
+    tracked = rep.parameters.traced()
     notes: list[str] = []
     with captured_warnings(notes):
         try:
@@ -428,7 +395,8 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
             raise _report_named(e, named) from None
     claims += fresh
     claims += compare_claims(old_claims, fresh)
-    rep.unverified = [k for k in rep.parameters if k not in tracked.read]
+    read = set(tracked.read)
+    rep.unverified = [k for k in rep.parameters if k not in read]
     if rep.verdict:
         got = _verdict_of(fresh)
         if rep.verdict != got:
@@ -706,7 +674,7 @@ def simulate(
                 f"{where}: records a design that stopped with an error "
                 f"({rep.error.get('message', '')}): no parameters to simulate"
             )
-        params = rep.parameters.traced()
+        params = rep.parameters.traced(finite=True)
     notes: list[str] = []
     if report is not None and rep.computed_verdict() != "ok":
         # simulate does not verify a report; one whose own claims fail is run, but said so

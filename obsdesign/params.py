@@ -167,9 +167,9 @@ class Parameters(Mapping[str, Any]):
             return "a ragged list"
         return "a number" if shape == () else "×".join(map(str, shape)) + " array"
 
-    def traced(self) -> ReadTrace:
+    def traced(self, finite: bool = False) -> ReadTrace:
         """A copy that records the keys read, in order (:class:`ReadTrace`)."""
-        t = ReadTrace(self._v)
+        t = ReadTrace(self._v, finite)
         t._fj = dict(self._fj)
         return t
 
@@ -351,15 +351,19 @@ def exact_param(params: Parameters, k: str, claims: list[Any], accept_float: boo
 
 
 class ReadTrace(Parameters):
-    """Parameters that record which keys were read, in order (``read``): a report's parameter
-    that a method's simulation cannot use is then named by the last key read before the
-    failure, where numpy's "cannot reshape array of size 6 into shape (2,1)" named none
-    (noticed in session 27, fixed in session 28)."""
+    """Parameters that record which keys were read, in order (``read``; iterating or
+    ``items()`` reads every key). ``verify`` names the parameters no check read ("not
+    verified"); ``simulate --report`` names the parameters read before a wrong-shape failure,
+    where numpy's "cannot reshape array of size 6 into shape (2,1)" named none (session 27's
+    note), and with ``finite`` refuses a float view holding inf or nan: a report's
+    L = [[inf], [1]] with its exact value removed was simulated with exit 0 and nan metrics;
+    no design writes a non-finite value that a simulation reads (session 28)."""
 
-    def __init__(self, values: dict[str, Any] | None = None) -> None:
+    def __init__(self, values: dict[str, Any] | None = None, finite: bool = False) -> None:
         super().__init__(values)
-        #: keys read (``[]``, ``get``, ``float``, ``exact``, ``is_exact``), in order
+        #: keys read, in order
         self.read: list[str] = []
+        self.finite = finite
 
     def __getitem__(self, k: str) -> Any:
         self.read.append(k)
@@ -370,13 +374,11 @@ class ReadTrace(Parameters):
         return super().get(k, default)
 
     def float(self, k: str) -> Any:
-        """The float view, refused (exit 2, naming the key) when a number in it is not
-        finite: a report's L = [[inf], [1]] with its exact value removed was simulated with
-        exit 0 and nan metrics (session 27's note); no design writes a non-finite value that
-        a simulation reads."""
+        """The float view; with ``finite``, refused (exit 2, naming the key) when a number in
+        it is not finite."""
         self.read.append(k)
         f = super().float(k)
-        a = np.asarray(f) if isinstance(f, (np.ndarray, float)) else None
+        a = np.asarray(f) if self.finite and isinstance(f, (np.ndarray, float)) else None
         if a is not None and a.dtype.kind == "f" and not np.isfinite(a).all():
             bad = a.ravel()[~np.isfinite(a.ravel())][0]
             raise InputError(f"report: parameters.{k}: a value is not a finite number ({bad})")
@@ -389,3 +391,11 @@ class ReadTrace(Parameters):
     def exact(self, k: str, claims: list[Any], accept_float: bool = False) -> Any:
         self.read.append(k)
         return super().exact(k, claims, accept_float)
+
+    def items(self) -> Any:
+        self.read.extend(self._v)
+        return super().items()
+
+    def __iter__(self) -> Iterator[str]:
+        self.read.extend(self._v)
+        return super().__iter__()
