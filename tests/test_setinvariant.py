@@ -837,3 +837,41 @@ def test_a_diverging_iteration_is_not_converged_exit_1_not_a_solver_failure() ->
     stage that cannot finish for a run that did not converge is "not converged", exit 1."""
     with pytest.raises(InfeasibleError, match="not converged: the iteration diverges after"):
         api.design(load_spec_text(DIVERGING, "diverging.toml"))
+
+
+def test_a_small_delta_tol_does_not_force_a_linear_law_with_two_outputs() -> None:
+    """docs/methods/set-invariant.md said "use a small delta_tol" when the linear-law claim
+    fails for p = n − 1. With λ = 0.995 this 3-state system stops at ε ≈ λ + 9·10⁻¹⁰
+    (delta_tol = 10⁻⁹) with no admissible linear gain, which exact dual certificates confirm
+    (set-invariant soundness trial, session 28): the claim fails, exit 1, and the docs now say
+    so."""
+    text = """
+[system]
+time = "discrete"
+A = [[0.5, 0.3, 0.1], [-0.2, 0.6, 0.2], [0.1, 0.0, 0.99]]
+C = [[1, 0, 0], [0, 1, 0]]
+B1 = [0.02, 0.01, 0.03]
+[sets.omega]
+type = "polytope"
+G = [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1], [1, 1, 1]]
+g = [1, 1, 1, 1, 1, 1, 1.5]
+[sets.D]
+type = "box"
+dim = 1
+lower = [-1]
+upper = [0.5]
+[method]
+key = "set-invariant"
+omega = "omega"
+disturbance = "D"
+eta_bar = 0
+lambda = 0.995
+algorithm = "symmetric"
+delta_tol = 1e-9
+"""
+    rep = api.design(load_spec_text(text, "two-outputs.toml"))
+    assert rep.exit_code() == 1
+    law = next(c for c in rep.claims if c.id == "linear-law")
+    assert law.status == ClaimStatus.FAILED and "no admissible linear gain" in law.detail
+    eps = float(rep.parameters.float("history_eps")[-1])
+    assert 0.995 < eps <= 0.995 * (1 + 1e-9)
