@@ -790,8 +790,13 @@ def rate_feasibility(
     n = Am.nrows()
     if n == 0:
         return True, "empty matrix"
-    if discrete and r <= 0:
-        return False, "λ ≤ 0"
+    if discrete and r == 0:
+        return False, "λ = 0: −(A − LC)ᵀP(A − LC) ≻ 0 has no solution"
+    if discrete and r < 0:
+        # the LMI holds λ² only: λ < 0 is feasible iff ρ(A − LC) < |λ|. "Infeasible (λ ≤ 0)"
+        # verified a forged bracket end λ = −0.00004 for A − LC = 0, where P = 1 satisfies
+        # the decay LMI strictly (lyapunov/impulsive soundness trial, session 28)
+        r = -r
     key = ("feasible", r, discrete)
     if memo is not None:
         hit = memo.get(key, (Am,))

@@ -1261,3 +1261,41 @@ def test_rate_tol_below_the_float_resolution_names_the_rate_with_its_sign() -> N
     )
     with pytest.raises(SpecError, match="near the rate 10293.1 "):
         api.design(load_spec_text(text, "rt.toml"))
+
+
+def test_a_negative_discrete_rate_is_decided_by_the_lmi_it_states() -> None:
+    """The decay LMI holds λ² only, so λ < 0 is feasible iff ρ(A − LC) < |λ|. "Infeasible
+    (λ ≤ 0)" let verify certify a forged bracket end λ = −0.00004 for A − LC = 0, where P = 1
+    satisfies the LMI strictly (lyapunov/impulsive soundness trial, session 28). λ = 0 stays
+    infeasible (−(A − LC)ᵀP(A − LC) ≻ 0 has no solution)."""
+    from flint import fmpq
+
+    from obsdesign import lyap
+
+    zero = np.array([[fmpq(0)]], dtype=object)
+    half = np.array([[fmpq(1, 2)]], dtype=object)
+    assert lyap.rate_feasibility(zero, fmpq(-1, 25000), True)[0] is True
+    assert lyap.rate_feasibility(zero, fmpq(0), True)[0] is False
+    assert lyap.rate_feasibility(half, fmpq(-2, 5), True)[0] is False
+    assert lyap.rate_feasibility(half, fmpq(-3, 5), True)[0] is True
+    assert lyap.rate_feasibility(half, fmpq(3, 5), True)[0] is True
+
+
+def test_verify_refuses_a_negative_bracket_end_where_the_lmi_holds() -> None:
+    """The forged report of session 28: A − LC = 0, λ_best = 1/20000, bracket end −1/25000
+    "infeasible"; the recomputed bracket claim fails (P = 1 satisfies the LMI there)."""
+    from obsdesign.report.model import Report
+
+    text = '[system]\ntime = "discrete"\nA = [[0.5]]\nC = [[1]]\n[method]\nkey = "lyapunov"\nL = [0.5]\n'
+    rep = api.design(api.load_spec_text(text, "deadbeat.toml"))
+    assert rep.exit_code() == 0
+    d = rep.to_dict()
+    for k, q, f in (("lambda_best", "1/20000", 1 / 20000), ("lambda_bracket", "-1/25000", -4e-5)):
+        d["parameters"][k] = f
+        d["parameters"]["exact"][k] = q
+    forged, problems = Report.from_dict(d)
+    assert not problems
+    ver = api.verify(forged)
+    bracket = [c for c in ver.claims if c.id == "lambda_best-bracket"]
+    assert bracket and bracket[0].status == ClaimStatus.FAILED, bracket
+    assert ver.exit_code() == 1
