@@ -332,3 +332,41 @@ def test_the_violation_warning_says_violated_once() -> None:
     rep = api.design(api.load_spec(spec))
     note = next(n for n in rep.notes if n.startswith("WARNING: Assumption 1"))
     assert note.count("violated") == 1, note
+
+
+@pytest.mark.parametrize("scale", ["1E-6", "1E+9"])
+def test_a_time_rescaled_plant_keeps_its_window(scale: str) -> None:
+    """The QSR scaling θ was searched in e^−12 … e^12 only; its optimum moves like 1/(the
+    plant's scale), so the shipped 3-state plant scaled by 10⁻⁶ or 10⁹ (a time rescaling:
+    the window scales by 10⁶ / 10⁻⁹) ended "Lemma 1 fails" (exit 1), and at 10⁷ its window was
+    2× too narrow (lyapunov/impulsive soundness trial, session 28). The grid now moves while
+    the optimum sits at an end."""
+    s = float(scale)
+
+    def q(x: float) -> str:
+        return repr(x * s)
+
+    text = f"""
+[system]
+time = "continuous"
+A = [[0, {q(0.01)}, 0], [{q(1)}, {q(-3)}, {q(0.5)}], [0, {q(-0.5)}, {q(-3)}]]
+C = [[1, 0, 0]]
+psi = ["0", "0", "0"]
+[nonlinearity.o]
+sector = [{q(-0.2)}, {q(0.2)}]
+[nonlinearity.n]
+sector = [0, {q(0.3)}]
+[method]
+key = "impulsive"
+L = [0.8]
+alpha = 3
+noise_bound = 0.1
+M = [[0, 1, 0], [0, 0, 1]]
+kappa = "widest"
+digits = 14
+"""
+    rep = api.design(api.load_spec_text(text, f"scaled-{scale}.toml"))
+    assert rep.exit_code() == 0, [c.detail for c in rep.failed]
+    t_min, t_max = rep.parameters.float("T_min") * s, rep.parameters.float("T_max") * s
+    # the unit-scale window is [0.41759, 1.34527]; a rescaled one within 0.1 %
+    assert 0.4171 < t_min < 0.4180 and 1.3440 < t_max < 1.3460, (t_min, t_max)

@@ -105,6 +105,36 @@ def best_rate_float(
     return -lam, resid
 
 
+#: the log θ grid of :func:`best_rate`'s first look, and how far it may be moved (θ within
+#: e^±LOG_THETA_MAX: far inside the float range, θ·Q stays finite for any spec's Q)
+LOG_THETA_GRID = np.linspace(-12, 12, 49)
+LOG_THETA_MAX = 600.0
+
+
+def _bracket_log_theta(neg: Any) -> tuple[float, float]:
+    """A bracket [lo, hi] of log θ around the minimum of ``neg`` (−κ*(θ) plus a penalty),
+    for the bounded search of :func:`best_rate`.
+
+    The grid e^−12 … e^12 holds the optimum for plants of unit scale; the optimum moves
+    like 1/(the plant's scale), so a plant scaled by 10⁻⁶ or 10⁹ (a time rescaling, whose
+    window scales by 10⁶ / 10⁻⁹) had its optimum at a grid end: "Lemma 1 fails" (exit 1) on a
+    feasible plant, or a window 2× too narrow (lyapunov/impulsive soundness trial, session
+    28). While the minimum sits at an end, the grid moves that way by its width (−κ*(θ) is
+    convex in θ, so unimodal in log θ), up to |log θ| = :data:`LOG_THETA_MAX`."""
+    grid = LOG_THETA_GRID
+    vals = [neg(g) for g in grid]
+    while True:
+        i = int(np.argmin(vals))
+        width = grid[-1] - grid[0]
+        if i == 0 and grid[0] - width >= -LOG_THETA_MAX:
+            grid = grid - width
+        elif i == len(grid) - 1 and grid[-1] + width <= LOG_THETA_MAX:
+            grid = grid + width
+        else:
+            return grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
+        vals = [neg(g) for g in grid]
+
+
 def best_rate(Ablk: np.ndarray, qsr: QSR, optimize: bool) -> tuple[float, fmpq, float]:
     """(κ*, θ, range residual): the largest ssd rate over the scalings θ·(Q, S, R), θ > 0.
 
@@ -121,10 +151,7 @@ def best_rate(Ablk: np.ndarray, qsr: QSR, optimize: bool) -> tuple[float, fmpq, 
         r, res = best_rate_float(Ablk, t * Qm, t * S, t * R)
         return -r + (1e6 * res if res > 1e-9 else 0.0)
 
-    grid = np.linspace(-12, 12, 49)
-    vals = [neg(g) for g in grid]
-    i = int(np.argmin(vals))
-    lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
+    lo, hi = _bracket_log_theta(neg)
     from scipy.optimize import minimize_scalar  # loaded by the designs that need it
 
     res = minimize_scalar(neg, bounds=(lo, hi), method="bounded", options={"xatol": 1e-9})
