@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -370,3 +371,74 @@ digits = 14
     t_min, t_max = rep.parameters.float("T_min") * s, rep.parameters.float("T_max") * s
     # the unit-scale window is [0.41759, 1.34527]; a rescaled one within 0.1 %
     assert 0.4171 < t_min < 0.4180 and 1.3440 < t_max < 1.3460, (t_min, t_max)
+
+
+def test_a_singular_q_fixes_theta_exactly() -> None:
+    """With Q_n = 0, N(κ) ⪯ 0 needs I + θS_n = 0: S_n = −0.999999 needs θ = 1000000/999999,
+    which the dyadic rounding of the float search missed, and the design ended "could not be
+    certified" (exit 1) although a report with that θ verifies (lyapunov/impulsive soundness
+    trial, session 28). range_theta solves the range condition exactly."""
+    from flint import fmpq
+
+    from obsdesign.methods.impulsive.dissipativity import QSR, range_theta
+
+    def qsr(q: list[list[str]], s: list[list[str]]) -> QSR:
+        def m(rows: list[list[str]]) -> np.ndarray:
+            return np.array(
+                [
+                    [fmpq(*map(int, x.split("/"))) if "/" in x else fmpq(int(x)) for x in r]
+                    for r in rows
+                ],
+                dtype=object,
+            )
+
+        return QSR(m(q), m(s), m([["0"] * len(q)] * len(q)), "test")
+
+    assert range_theta(qsr([["-1", "0"], ["0", "0"]], [["1/2", "0"], ["0", "-1/4"]])) == 4
+    assert range_theta(qsr([["-1", "0"], ["0", "-1"]], [["1", "0"], ["0", "1"]])) is None
+    assert range_theta(qsr([["0"]], [["0"]])) is None  # NᵀS = 0: no θ
+    assert range_theta(qsr([["0"]], [["1"]])) is None  # θ = −1 is not a scaling
+    assert range_theta(qsr([["0", "0"], ["0", "0"]], [["-1", "0"], ["0", "-2"]])) is None
+    text = """
+[system]
+time = "continuous"
+A = [[0.2, 0.1], [0.1, -3]]
+C = [[1, 0]]
+psi = ["0", "0"]
+[nonlinearity.o]
+sector = [-0.1, 0.1]
+[nonlinearity.n]
+Q = [[0]]
+S = [[-0.999999]]
+R = [[0.5]]
+[method]
+key = "impulsive"
+L = [0.8]
+alpha = 3
+noise_bound = 0.1
+M = [[0, 1]]
+"""
+    rep = api.design(api.load_spec_text(text, "qn0.toml"))
+    assert rep.exit_code() == 0
+    assert rep.parameters["theta_n"] == fmpq(1000000, 999999)
+    assert api.verify(rep).exit_code() == 0
+
+
+def test_an_ssd_rate_that_cannot_be_certified_is_inconclusive(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """No exact certificate near the float optimum is no proof of infeasibility: exit 4, not
+    exit 1 (session 28; the exact check is made to fail here)."""
+    from obsdesign.errors import InconclusiveError
+    from obsdesign.methods.impulsive import design as d
+
+    monkeypatch.setattr(d, "check_psd", lambda M: False)
+    with pytest.raises(InconclusiveError, match="no proof of infeasibility"):
+        d.certified_rate(np.array([[fmpq(-1)]], dtype=object), _lipschitz_qsr(), fmpq(1), 1.0)
+
+
+def _lipschitz_qsr() -> Any:
+    """A Lipschitz triple of one state: (Q, S, R) = (−1, 0, 1/4)."""
+    from obsdesign.methods.impulsive.dissipativity import qsr_lipschitz
+
+    return qsr_lipschitz(fmpq(1, 2), 1)

@@ -178,8 +178,14 @@ def certified_rate(Ablk: np.ndarray, qsr: QSR, theta: fmpq, rate_f: float) -> fm
             return r
         r = r - step
         step *= 4
-    raise Infeasible(
-        "the ssd LMI could not be certified near its float optimum (ill-conditioned data)"
+    # no proof of infeasibility (exit 4, not 1): with Q_n = 0 and S_n = −0.999999 the LMI
+    # needs θ = 1000000/999999 exactly, which the dyadic θ cannot be, while a report with that
+    # θ verifies (lyapunov/impulsive soundness trial, session 28)
+    raise InconclusiveError(
+        f"the ssd LMI (eq. (7), Lemma 1 / Lemma 2) could not be certified near its float "
+        f"optimum {rate_f:.6g} at the rounded scaling θ = {float(theta):.6g}: ill-conditioned "
+        "data, or an optimum that needs a θ the rounding cannot reach (a singular Q); no "
+        "proof of infeasibility"
     )
 
 

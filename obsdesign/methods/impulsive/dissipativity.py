@@ -105,6 +105,40 @@ def best_rate_float(
     return -lam, resid
 
 
+def range_theta(qsr: QSR) -> fmpq | None:
+    """The one θ > 0 with (I − QQ⁺)(I + θS) = 0 when Q is singular (exact), else None.
+
+    With Q ⪯ 0 singular, N(κ) ⪯ 0 needs I + θS ∈ range Q (the generalized Schur complement
+    of :func:`best_rate_float`): Nᵀ(I + θS) = 0 for a basis N of ker Q. Unless NᵀS = 0 (then
+    no θ works) that fixes θ = −⟨Nᵀ, NᵀS⟩ / ⟨NᵀS, NᵀS⟩, checked exactly. The float search
+    lands near it, and its dyadic rounding missed it: Q_n = 0 with S_n = −0.999999 needs
+    θ = 1000000/999999, and the design ended "could not be certified" although a report with
+    that θ verifies (lyapunov/impulsive soundness trial, session 28)."""
+    from flint import fmpq_mat
+
+    k = qsr.k
+    if k == 0:
+        return None
+    Qm = fmpq_mat(k, k, [Q(x) for x in np.asarray(qsr.Q, dtype=object).ravel()])
+    X, nullity = Qm.numer_denom()[0].nullspace()  # ker of the integer multiple of Q
+    if nullity == 0:
+        return None
+    N = [[fmpq(X[i, j]) for i in range(k)] for j in range(nullity)]  # rows: a basis of ker Q
+    S = [[Q(x) for x in row] for row in np.asarray(qsr.S, dtype=object)]
+    NS = [[sum((v[i] * S[i][c] for i in range(k)), fmpq(0)) for c in range(k)] for v in N]
+    den = sum((x * x for row in NS for x in row), fmpq(0))
+    if den == 0:
+        return None
+    num = sum(
+        (a * b for va, vb in zip(N, NS, strict=True) for a, b in zip(va, vb, strict=True)), fmpq(0)
+    )
+    theta = -num / den
+    if theta <= 0:
+        return None
+    ok = all(va[c] + theta * vb[c] == 0 for va, vb in zip(N, NS, strict=True) for c in range(k))
+    return theta if ok else None
+
+
 #: the log θ grid of :func:`best_rate`'s first look, and how far it may be moved (θ within
 #: e^±LOG_THETA_MAX: far inside the float range, θ·Q stays finite for any spec's Q)
 LOG_THETA_GRID = np.linspace(-12, 12, 49)
@@ -155,7 +189,7 @@ def best_rate(Ablk: np.ndarray, qsr: QSR, optimize: bool) -> tuple[float, fmpq, 
     from scipy.optimize import minimize_scalar  # loaded by the designs that need it
 
     res = minimize_scalar(neg, bounds=(lo, hi), method="bounded", options={"xatol": 1e-9})
-    theta = dyadic(float(np.exp(res.x)), 24)
+    theta = range_theta(qsr) or dyadic(float(np.exp(res.x)), 24)
     tf = float(to_float(theta))
     r, resid = best_rate_float(Ablk, tf * Qm, tf * S, tf * R)
     return r, theta, resid
