@@ -141,7 +141,7 @@ def _value(v: Any) -> str:
     if arr.ndim == 0:
         item = arr.item()
         if item is v:
-            raise InputError(f"cannot write a {type(v).__name__} into a spec")
+            raise InputError(f"cannot write a value of type {type(v).__name__} into a spec")
         return _value(item)
     if arr.dtype.kind in "fiub":
         if arr.ndim == 1:

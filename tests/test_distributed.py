@@ -547,3 +547,29 @@ def test_a_cluster_whose_start_is_interrupted_is_closed_and_unregistered(
         pass
     assert len(closed) == 1
     assert not [c for c in SpecCluster._instances if isinstance(c, HalfStarted)]
+
+
+def test_an_interrupted_cluster_is_closed_with_a_bounded_wait(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Mutation review 28: obsdesign.distributed.x__abandon__mutmut_1 (``close(timeout=None)``: an interrupted
+    cluster's close could wait without end after Ctrl-C)."""
+    import dask.distributed
+    from distributed.deploy.spec import SpecCluster
+
+    from obsdesign import distributed
+
+    waits: list[object] = []
+
+    class HalfStarted:
+        def __init__(self, **kw: object) -> None:
+            SpecCluster._instances.add(self)
+            raise KeyboardInterrupt
+
+        def close(self, timeout: float | None = None) -> None:
+            waits.append(timeout)
+
+    monkeypatch.setattr(dask.distributed, "LocalCluster", HalfStarted)
+    with pytest.raises(KeyboardInterrupt), distributed.dask_client(workers=1):
+        pass
+    assert len(waits) == 1 and isinstance(waits[0], (int, float)) and 0 < waits[0] <= 60

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import json
 import tomllib
+from decimal import Decimal
+from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
@@ -496,3 +498,109 @@ def test_observer_statespace_checks_the_report(tmp_path: Path) -> None:
     failed = edited("d.json", lambda e: e["claims"][0].__setitem__("status", "failed"))
     with pytest.warns(UserWarning, match="verdict 'failed'"):
         observer_statespace(failed)
+
+
+def test_a_key_that_is_not_bare_is_quoted() -> None:
+    """Mutation review 28: obsdesign.interop.x__key__mutmut_4 (every key bare: 'a b = 1' is not TOML) and _12
+    (``_tstr(None)``: TypeError)."""
+    import tomllib
+
+    from obsdesign.interop import _key, _value
+
+    assert _key("start") == "start"
+    assert _key("a b") == '"a b"'
+    text = "w = " + _value([{"a b": 1, "c.d": 2}])
+    assert tomllib.loads(text) == {"w": [{"a b": 1, "c.d": 2}]}
+
+
+def test_a_zero_dimensional_array_is_its_item_and_an_object_is_refused() -> None:
+    """Mutation review 28: obsdesign.interop.x__value__mutmut_20 (``item = None``), _24 (``_value(None)``): a 0-d
+    array (np.array(1.5)) refused as "None"; _21 (``item is not v``): a 0-d array refused,
+    and an arbitrary object recursed (RecursionError) instead of InputError."""
+    from obsdesign.interop import _value
+
+    assert _value(np.array(1.5)) == "1.5"
+    assert _value(np.array(3)) == "3"
+    with pytest.raises(InputError, match="cannot write a value of type object into a spec"):
+        _value(object())
+
+
+def test_booleans_are_written_as_toml_booleans() -> None:
+    """Mutation review 28: obsdesign.interop.x__num__mutmut_1 .. _6 (pre-existing line of ``_num``: true/false
+    swapped, or written "XXtrueXX" / "TRUE")."""
+    from obsdesign.interop import _value
+
+    assert _value(True) == "true" and _value(False) == "false"
+    assert _value(np.bool_(True)) == "true" and _value(np.bool_(False)) == "false"
+
+
+@pytest.mark.parametrize(
+    "x",
+    [
+        Fraction(3, 10),
+        Fraction(-7, 8),
+        Fraction(1, 2**20),
+        Fraction(1, 5**20),
+        Fraction(1, 10**30),
+        Fraction(1, 5**30),
+        Fraction(-7, 2**70 * 5**3),
+    ],
+    ids=["3/10", "-7/8", "2^-20", "5^-20", "10^-30", "5^-30", "-7/(2^70 5^3)"],
+)
+def test_a_fraction_with_a_finite_decimal_is_written_exactly(x: Fraction) -> None:
+    """Mutation review 28: obsdesign.interop.x__exact__mutmut_11 (``d / 2``: a float, refused 1/10^30), _12
+    (``d // 3``: timeout), _13 (``twos - 1``: too few digits, 2^-20 rounded), _15 (``d / 5
+    == 0``: 3/10 refused), _16 (``d % 6``), _19 (``d, fives = None``), _20 (``d / 5``: 5^-30
+    refused), _21 (``d // 6``: timeout), _22 (``fives - 1``: 5^-20 rounded). The text is the
+    fraction exactly (every Fraction test had a power-of-two denominator)."""
+    from obsdesign.interop import _num
+
+    text = _num(x)
+    assert Fraction(text) == x, text
+
+
+def test_exact_entries_outside_the_float_range_or_not_numbers_are_refused() -> None:
+    """Mutation review 28: obsdesign.interop.x__real__mutmut_48 (``not isfinite(f) and ...``: a Decimal above
+    the float range, or a nonzero one that is 0.0 as a double, passed; the spec loader
+    refuses both), _35 (``isinstance(x, bool) and ...``: a bool beside a Decimal taken as
+    1, text crashed with ValueError), _26 (``dtype == object or any(...)``: an object array
+    of floats skipped the subnormal check)."""
+    from obsdesign.interop import _real
+
+    for big in (Decimal("1e400"), Decimal("-1e-400")):
+        with pytest.raises(InputError, match="outside the float range"):
+            _real(np.array([[big, 1]], dtype=object), "A")
+    for bad in (True, "x"):
+        with pytest.raises(InputError, match="which is not a number"):
+            _real(np.array([[Decimal("0.5"), bad]], dtype=object), "A")
+    with pytest.raises(InputError, match="subnormal|float range"):
+        _real(np.array([[5e-324, 1.0]], dtype=object), "A")
+
+
+def test_import_dt_zero_is_continuous_and_the_smallest_normal_dt_is_accepted(
+    tmp_path: Path,
+) -> None:
+    """Mutation review 28: obsdesign.interop.x_spec_text_from_mat__mutmut_139 (``--dt`` check ``dt > 0``: --dt 0
+    refused) and _174 (``0 <= dt``: dt 0, given or read from the file, refused as
+    subnormal); _175 (``dt <= tiny``: the smallest normal double refused)."""
+    from scipy.io import savemat
+
+    from obsdesign.interop import spec_text_from_mat
+
+    mat = tmp_path / "p.mat"
+    savemat(
+        mat,
+        {
+            "A": np.array([[0.0, 1.0], [-1.0, -1.0]]),
+            "C": np.array([[1.0, 0.0]]),
+            "T0": np.array([[0.0]]),
+        },
+    )
+    names = {"A": "A", "C": "C"}
+    for text in (
+        spec_text_from_mat(mat, names, dt=0.0),
+        spec_text_from_mat(mat, names, dt_name="T0"),
+    ):
+        assert "sample_time" not in text and "discrete = true" not in text, text
+    tiny = float(np.finfo(float).tiny)
+    assert "sample_time" in spec_text_from_mat(mat, names, dt=tiny)

@@ -11,6 +11,7 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from obsdesign.certify.exact import qmat
+from obsdesign.errors import InputError
 from obsdesign.params import Parameters, exact_param
 
 
@@ -281,3 +282,19 @@ def test_traced_parameters_record_reads_in_order() -> None:
     t.get("nope")
     assert t.read == ["P", "L", "x", "nope"]
     assert t.float("P").tolist() == [[2.0]]
+
+
+def test_a_trace_without_finite_returns_non_finite_floats() -> None:
+    """Mutation review 28: obsdesign.params.xǁReadTraceǁfloat__mutmut_6 (``... or True``) and _8 (``finite or
+    isinstance``): only ``traced(finite=True)`` (simulate --report) refuses inf / nan;
+    verify's trace (finite=False) hands the value to the checks, whose failed claim says
+    what is wrong."""
+    from obsdesign.params import Parameters
+
+    p = Parameters({"L": [[math.inf], [1.0]], "x": math.nan})
+    t = p.traced()
+    assert np.isinf(np.asarray(t.float("L"))[0, 0])
+    assert math.isnan(t.float("x"))
+    assert t.read == ["L", "x"]
+    with pytest.raises(InputError, match=r"parameters\.L: a value is not a finite number \(inf\)"):
+        p.traced(finite=True).float("L")

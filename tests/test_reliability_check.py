@@ -295,3 +295,38 @@ def test_check_junit_refusals_do_not_suggest_force(tmp_path: Path) -> None:
         assert "refusing" in res.output and "--force" not in res.output, res.output
     res = runner.invoke(app, ["design", str(SPEC), "-o", "/dev/null"])
     assert res.exit_code == 2 and "(--force writes into it)" in res.output
+
+
+def test_a_folder_that_cannot_be_listed_does_not_end_the_search(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Mutation review 28: obsdesign.api.x__toml_files__mutmut_9 (``continue`` -> ``break`` after a subfolder
+    that cannot be listed: every folder still on the stack was skipped, its specs with no
+    row). Two folders each holding a spec and an unlistable subfolder: whichever is walked
+    first, the other is still searched."""
+    for name in ("a", "b"):
+        (tmp_path / name / "shut").mkdir(parents=True)
+        shutil.copy(SPEC, tmp_path / name / "s.toml")
+    real = os.scandir
+
+    def scandir(p: object = ".") -> object:
+        if Path(str(p)).name == "shut":
+            raise PermissionError(13, "Permission denied")
+        return real(p)
+
+    monkeypatch.setattr(os, "scandir", scandir)
+    assert api.spec_files(tmp_path) == [
+        tmp_path / "a" / "s.toml",
+        tmp_path / "a" / "shut",
+        tmp_path / "b" / "s.toml",
+        tmp_path / "b" / "shut",
+    ]
+
+
+def test_an_entry_whose_kind_cannot_be_read_is_not_searched(tmp_path: Path) -> None:
+    """Mutation review 28: obsdesign.api.x__toml_files__mutmut_16 (an entry whose ``is_dir`` raises taken as a
+    folder): a symbolic link to itself (ELOOP) not named *.toml is neither searched nor a
+    row; the spec beside it is the only row."""
+    shutil.copy(SPEC, tmp_path / "a.toml")
+    (tmp_path / "loop").symlink_to(tmp_path / "loop")
+    assert api.spec_files(tmp_path) == [tmp_path / "a.toml"]

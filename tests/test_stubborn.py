@@ -1422,3 +1422,22 @@ def test_a_given_gain_on_the_stability_boundary_is_infeasible(
     text = f'[system]\ntime = "{time}"\nA = {A}\nC = {C}\n[method]\nkey = "stubborn"\nK = {K}\n'
     with pytest.raises(InfeasibleError, match="A − KC is not (Hurwitz|Schur).*for the given K"):
         api.design(api.load_spec_text(text, "marginal.toml"))
+
+
+def test_a_given_schur_gain_of_a_discrete_plant_is_not_refused() -> None:
+    """Mutation review 28: obsdesign.methods.stubborn.design.x_design_params__mutmut_16 (``_stable_gain(spec,
+    o.K, None)``: a discrete plant's A − KC tested for Hurwitz, not Schur): a given K with
+    A − KC Schur stable (eigenvalues 0.5, 0.5, not Hurwitz) is designed, not refused "at
+    every λ"; every given-K test had a gain on the boundary (refused either way)."""
+    from obsdesign.errors import ObsdesignError
+
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.5, 1], [0, 0.5]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "stubborn"\nK = [0.25, 0]\n'
+    )
+    try:
+        rep = api.design(api.load_spec_text(text, "schur.toml"))
+    except ObsdesignError as e:
+        assert "for the given K" not in str(e), str(e)
+    else:
+        assert rep.exit_code() in (0, 4)

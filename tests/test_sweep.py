@@ -601,3 +601,49 @@ def test_sweep_tables_mark_rounded_values_and_matrices_are_json_lists() -> None:
     )[0]
     assert stub["exit_code"] == 0
     assert json.loads(stub["K"]) == [[-2.5623020538914716], [8.402663141750963]]
+
+
+def test_plot_groups_keeps_groups_apart_and_skips_only_bad_rows() -> None:
+    """Mutation review 28: obsdesign.sweep.x_plot_groups__mutmut_4 (the group key read as ``r.get(None)``: every
+    curve merged into one) and _19 (``continue`` -> ``break``: a row without a numeric x
+    ended the plot, later points lost)."""
+    from obsdesign import sweep as sw
+
+    rows = [
+        {"a": 0.1, "b": 1, "y": 1.0, "exit_code": 0},
+        {"a": "bad", "b": 1, "y": 9.0, "exit_code": 0},
+        {"a": 0.2, "b": 1, "y": 2.0, "exit_code": 0},
+        {"a": 0.1, "b": 2, "y": 3.0, "exit_code": 0},
+    ]
+    assert sw.plot_groups(rows, ["b"], "a", "y") == {
+        (1,): [(0.1, 1.0), (0.2, 2.0)],
+        (2,): [(0.1, 3.0)],
+    }
+
+
+def test_scalar_cells_of_non_finite_text_and_objects() -> None:
+    """Mutation review 28: obsdesign.sweep.x__scalar__mutmut_19 (``isinstance(v0, fmpq) and isfinite(f) or
+    fmpq(...)``: a float inf / nan parameter raised OverflowError / ValueError), _8 (``v =
+    None``: a text parameter became '"abc"'), _15 (``json.dumps(None)``: "null"), _16/_18
+    (no ``default=str``: TypeError on an fmpq inside) and _17 (``json.dumps(default=str)``:
+    TypeError)."""
+    from flint import fmpq
+
+    from obsdesign import sweep as sw
+    from obsdesign.params import Parameters
+
+    p = Parameters({"inf": math.inf, "nan": math.nan, "s": "abc", "d": {"q": fmpq(1, 3)}})
+    got = sw._scalar(p, "inf")
+    assert got == math.inf and type(got) is float
+    assert math.isnan(sw._scalar(p, "nan"))
+    assert sw._scalar(p, "s") == "abc"
+    assert sw._scalar(p, "d") == '{"q": "1/3"}'
+
+
+def test_sweep_cell_of_none_and_of_an_integer() -> None:
+    """Mutation review 28: obsdesign.cli_commands.x__sweep_cell__mutmut_2 (None shown "XXXX") and _21 (every
+    non-float shown "None"): an empty cell stays empty, facets 6 is "6"."""
+    from obsdesign.cli_commands import _sweep_cell
+
+    assert _sweep_cell(None) == ""
+    assert _sweep_cell(6) == "6" and _sweep_cell("ok") == "ok"
