@@ -263,6 +263,19 @@ def test_folders_named_toml_are_searched_not_checked(tmp_path: Path) -> None:
     assert api.spec_files(tmp_path) == [tmp_path / ".h.toml", tmp_path / "v1.toml" / "spec.toml"]
 
 
+def _unlistable(monkeypatch: pytest.MonkeyPatch, name: str) -> None:
+    """Make every folder called ``name`` unlistable (PermissionError from os.scandir): root,
+    which runs CI, reads any folder whatever its mode."""
+    real = os.scandir
+
+    def scandir(p: object = ".") -> object:
+        if Path(str(p)).name == name:
+            raise PermissionError(13, "Permission denied")
+        return real(p)
+
+    monkeypatch.setattr(os, "scandir", scandir)
+
+
 def test_a_folder_that_cannot_be_listed_gets_a_row(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -271,14 +284,7 @@ def test_a_folder_that_cannot_be_listed_gets_a_row(
     (tmp_path / "shut").mkdir()
     shutil.copy(SPEC, tmp_path / "shut" / "s.toml")
     shutil.copy(SPEC, tmp_path / "ok.toml")
-    real = os.scandir
-
-    def scandir(p: object = ".") -> object:
-        if Path(str(p)).name == "shut":
-            raise PermissionError(13, "Permission denied")
-        return real(p)
-
-    monkeypatch.setattr(os, "scandir", scandir)
+    _unlistable(monkeypatch, "shut")
     rows = {Path(r.spec).name: r for r in api.check(tmp_path)}
     assert rows["ok.toml"].code == 0
     assert rows["shut"].code == 2
@@ -307,14 +313,7 @@ def test_a_folder_that_cannot_be_listed_does_not_end_the_search(
     for name in ("a", "b"):
         (tmp_path / name / "shut").mkdir(parents=True)
         shutil.copy(SPEC, tmp_path / name / "s.toml")
-    real = os.scandir
-
-    def scandir(p: object = ".") -> object:
-        if Path(str(p)).name == "shut":
-            raise PermissionError(13, "Permission denied")
-        return real(p)
-
-    monkeypatch.setattr(os, "scandir", scandir)
+    _unlistable(monkeypatch, "shut")
     assert api.spec_files(tmp_path) == [
         tmp_path / "a" / "s.toml",
         tmp_path / "a" / "shut",
