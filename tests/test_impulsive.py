@@ -442,3 +442,27 @@ def _lipschitz_qsr() -> Any:
     from obsdesign.methods.impulsive.dissipativity import qsr_lipschitz
 
     return qsr_lipschitz(fmpq(1, 2), 1)
+
+
+@pytest.mark.parametrize("x_min", [12.0, 11.9, -12.0, 36.0, -36.2, 0.0, 599.0, 1e9, -1e9])
+def test_the_theta_bracket_holds_the_minimum_and_ends(x_min: float) -> None:
+    """Moving the log θ grid by its whole width made consecutive grids share an end: with the
+    minimum near log θ = ±12 (a unit-scale spec with the o-sector [−6.1e-6, 6.1e-6], the
+    shipped plant ×1e6) the grid went back and forth forever (re-check trial, session 28).
+    The bracket holds the minimum of a unimodal function (or the end of the range) after a
+    bounded number of evaluations."""
+    from obsdesign.methods.impulsive.dissipativity import LOG_THETA_MAX, _bracket_log_theta
+
+    calls = []
+
+    def neg(x: float) -> float:
+        calls.append(x)
+        if len(calls) > 49 * 100:  # the old grid went on forever: fail, do not hang
+            raise AssertionError("the grid does not stop")
+        return (x - x_min) ** 2
+
+    lo, hi = _bracket_log_theta(neg)
+    target = min(max(x_min, -LOG_THETA_MAX), LOG_THETA_MAX)
+    assert lo <= target <= hi or abs(target) == LOG_THETA_MAX
+    assert hi - lo <= 1.0 + 1e-9
+    assert len(calls) <= 49 * 60

@@ -153,19 +153,26 @@ def _bracket_log_theta(neg: Any) -> tuple[float, float]:
     like 1/(the plant's scale), so a plant scaled by 10⁻⁶ or 10⁹ (a time rescaling, whose
     window scales by 10⁶ / 10⁻⁹) had its optimum at a grid end: "Lemma 1 fails" (exit 1) on a
     feasible plant, or a window 2× too narrow (lyapunov/impulsive soundness trial, session
-    28). While the minimum sits at an end, the grid moves that way by its width (−κ*(θ) is
-    convex in θ, so unimodal in log θ), up to |log θ| = :data:`LOG_THETA_MAX`."""
+    28). While the minimum sits at an end, the grid moves that way by half its width
+    (−κ*(θ) is convex in θ, so unimodal in log θ), in one direction only and up to
+    |log θ| = :data:`LOG_THETA_MAX`. Moving by the whole width made consecutive grids share
+    an end, and a minimum near log θ = ±12 sent the grid back and forth forever (re-check
+    trial, session 28)."""
     grid = LOG_THETA_GRID
+    half = (grid[-1] - grid[0]) / 2
     vals = [neg(g) for g in grid]
+    direction = 0
     while True:
         i = int(np.argmin(vals))
-        width = grid[-1] - grid[0]
-        if i == 0 and grid[0] - width >= -LOG_THETA_MAX:
-            grid = grid - width
-        elif i == len(grid) - 1 and grid[-1] + width <= LOG_THETA_MAX:
-            grid = grid + width
-        else:
+        step = 0.0
+        if i == 0 and direction <= 0 and grid[0] - half >= -LOG_THETA_MAX:
+            step = -half
+        elif i == len(grid) - 1 and direction >= 0 and grid[-1] + half <= LOG_THETA_MAX:
+            step = half
+        if step == 0.0:
             return grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
+        direction = 1 if step > 0 else -1
+        grid = grid + step
         vals = [neg(g) for g in grid]
 
 
