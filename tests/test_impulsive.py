@@ -335,7 +335,7 @@ def test_the_violation_warning_says_violated_once() -> None:
     assert note.count("violated") == 1, note
 
 
-@pytest.mark.parametrize("scale", ["1E-6", "1E+9"])
+@pytest.mark.parametrize("scale", ["1E-6", "1E+9", "1E-10", "1E-12"])
 def test_a_time_rescaled_plant_keeps_its_window(scale: str) -> None:
     """The QSR scaling θ was searched in e^−12 … e^12 only; its optimum moves like 1/(the
     plant's scale), so the shipped 3-state plant scaled by 10⁻⁶ or 10⁹ (a time rescaling:

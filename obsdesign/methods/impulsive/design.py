@@ -155,6 +155,22 @@ def optimize_M(p: Problem, seed: int = 0, starts: int = 6) -> np.ndarray:
 
 
 # -- exact rounding of the two rates --------------------------------------------------------
+def _data_scale(Ablk: np.ndarray, q: QSR) -> float:
+    """The size of the terms whose largest eigenvalue gives the float rate (:func:`best_rate
+    _float`: Ā + Āᵀ, θR and (I + θS)ᵀ(θQ)⁺(I + θS); 1 when all are 0): the float optimum's
+    error is relative to it, so the first rounding step of :func:`certified_rate` is too. A
+    step of 2⁻³⁰ for every rate below 1 exceeded the rates of a plant scaled by 10⁻¹⁰ (a time
+    rescaling): "Lemma 1 fails" with exit 1 where the rescaled certificate verifies (re-check
+    trial, session 28)."""
+    A = np.asarray(to_float(Ablk), dtype=float)
+    Qm, S, R = q.floats()
+    k = A.shape[0]
+    B = np.eye(k) + S
+    terms = [A + A.T, R, B.T @ np.linalg.pinv(Qm, rcond=1e-12) @ B] if k else []
+    m = max((float(np.abs(t).max(initial=0.0)) for t in terms), default=0.0)
+    return m if m > 0 and math.isfinite(m) else 1.0
+
+
 def certified_rate(Ablk: np.ndarray, qsr: QSR, theta: fmpq, rate_f: float) -> fmpq:
     """A dyadic rate r just below ``rate_f`` with N(r) ⪯ 0 proved exactly (the ssd LMI of
     eq. (7), Lemma 1; Lemma 2 with r = −ϖ_o): κ_n is rounded down, ϖ_o up.
@@ -170,7 +186,7 @@ def certified_rate(Ablk: np.ndarray, qsr: QSR, theta: fmpq, rate_f: float) -> fm
             "Ā + Āᵀ of the spec's A overflows float64; scale the plant's numbers down"
         )
     q = qsr.scaled(theta)
-    step_f = 2.0**-30 * max(1.0, abs(rate_f))
+    step_f = 2.0**-30 * max(abs(rate_f), _data_scale(Ablk, q))
     r = Q(dyadic(rate_f - step_f, 40))
     step = Q(dyadic(step_f, 40))
     for _ in range(60):
