@@ -930,8 +930,8 @@ def spec_files(paths: list[str | Path] | str | Path) -> list[Path]:
 
 def _toml_files(root: Path) -> list[Path]:
     """The ``*.toml`` files under the folder ``root``, sorted: subfolders searched (not
-    hidden ones, not links to folders), and a subfolder that cannot be listed given as itself
-    so that its row says so (:func:`obsdesign.limits.read_input`).
+    hidden ones, not links to folders), and a folder that cannot be listed (``root`` too)
+    given as itself so that its row says so (:func:`obsdesign.limits.read_input`).
 
     An explicit walk with a stack: ``Path.rglob`` recursed once per level, so a folder 1,100
     levels deep stopped ``check`` with exit 3 (RecursionError) and no row at all; and it
@@ -945,8 +945,9 @@ def _toml_files(root: Path) -> list[Path]:
             with os.scandir(d) as it:
                 entries = list(it)
         except OSError:
-            if d != root:
-                found.append(d)
+            # its own row, the folder named on the command line included: `check good
+            # locked` said "1 ok" and `check locked` "no spec files" (re-check trial)
+            found.append(d)
             continue
         for e in entries:
             try:

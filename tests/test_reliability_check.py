@@ -329,3 +329,18 @@ def test_an_entry_whose_kind_cannot_be_read_is_not_searched(tmp_path: Path) -> N
     shutil.copy(SPEC, tmp_path / "a.toml")
     (tmp_path / "loop").symlink_to(tmp_path / "loop")
     assert api.spec_files(tmp_path) == [tmp_path / "a.toml"]
+
+
+def test_a_named_folder_that_cannot_be_listed_gets_a_row(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``check good locked`` said "1 ok" and ``check locked`` "no spec files" for a folder
+    named on the command line that cannot be listed (re-check trial, session 28)."""
+    (tmp_path / "good").mkdir()
+    shutil.copy(SPEC, tmp_path / "good" / "s.toml")
+    (tmp_path / "shut").mkdir()
+    _unlistable(monkeypatch, "shut")
+    rows = {Path(r.spec).name: r for r in api.check([tmp_path / "good", tmp_path / "shut"])}
+    assert rows["s.toml"].code == 0 and rows["shut"].code == 2
+    assert "a folder that cannot be read" in rows["shut"].message
+    assert api.spec_files(tmp_path / "shut") == [tmp_path / "shut"]
