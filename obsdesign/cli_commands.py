@@ -189,27 +189,27 @@ def _print_sweep(rows: list[dict[str, Any]], fmt: Fmt) -> None:
 def _sweep_cell(v: Any) -> str:
     """A sweep table's cell: a float in 6 significant digits, marked "≈" when that text is
     not the value (its decimal is not the float, or the float is not the exact parameter:
-    :class:`obsdesign.sweep.Inexact`); an ISS bound 24842821.6875 showed as a bare
+    :class:`obsdesign.sweep.ExactFloat`); an ISS bound 24842821.6875 showed as a bare
     "2.48428e+07", below the bound (session 28)."""
     from obsdesign.report.shown import APPROX
-    from obsdesign.sweep import Inexact
+    from obsdesign.sweep import ExactFloat
 
     if v is None:
         return ""
     if isinstance(v, float):
         text = format(v, ".6g")
-        same = v.shows(text) if isinstance(v, Inexact) else (float(text) == v or v != v)
+        same = v.shows(text) if isinstance(v, ExactFloat) else (float(text) == v or v != v)
         return text if same else APPROX + text
     return str(v)
 
 
 def _md_value(v: Any) -> Any:
     """A Markdown sweep cell's value: the float's repr, marked "≈" when that decimal is not
-    the exact parameter (:class:`obsdesign.sweep.Inexact`)."""
+    the exact parameter (:class:`obsdesign.sweep.ExactFloat`)."""
     from obsdesign.report.shown import APPROX
-    from obsdesign.sweep import Inexact
+    from obsdesign.sweep import ExactFloat
 
-    if isinstance(v, Inexact):
+    if isinstance(v, ExactFloat):
         text = repr(float(v))
         return text if v.shows(text) else APPROX + text
     return v

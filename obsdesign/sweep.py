@@ -523,23 +523,25 @@ def _run_point(task: PointTask, t0: float) -> dict[str, Any]:
     return row
 
 
-class Inexact(float):
-    """A summary parameter's float whose exact value (``exact``, "p/q") is not this double:
+class ExactFloat(float):
+    """A summary parameter's float beside the exact value it stands for (``exact``, "p/q"):
     tables compare the decimal they show with the exact value and mark it "≈" when it is not
     that value (:func:`obsdesign.cli_commands._sweep_cell`); CSV, JSON and Parquet cells are
     the float. A certified λ = 0.9999999999999999999999 was shown as a bare "1" (sweep,
-    import and check trial, session 28)."""
+    import and check trial, session 28), and an exact μ = 58250127/262144 as its double's
+    shortest text 222.20660018920898 in Markdown, below the bound (re-check trial): every
+    exact parameter carries its value, not only those whose double differs from it."""
 
     __slots__ = ("exact",)
     exact: str
 
-    def __new__(cls, value: float, exact: str) -> Inexact:
+    def __new__(cls, value: float, exact: str) -> ExactFloat:
         self = super().__new__(cls, value)
         self.exact = exact
         return self
 
     def __reduce__(self) -> tuple[Any, ...]:  # pickles (Dask) as itself
-        return (Inexact, (float(self), self.exact))
+        return (ExactFloat, (float(self), self.exact))
 
     def shows(self, text: str) -> bool:
         """Whether the decimal ``text`` is the exact value."""
@@ -550,8 +552,8 @@ class Inexact(float):
 
 def _scalar(params: Any, key: str) -> Any:
     """A summary parameter's cell: an integer stays one (``facets`` 6, not 6.0: outsider
-    trial, session 22), a number is its float (:class:`Inexact` when that double is not
-    the exact value held), a matrix the JSON list of its floats (K, R, W of stubborn were
+    trial, session 22), a number is its float (an :class:`ExactFloat` for an exact
+    parameter), a matrix the JSON list of its floats (K, R, W of stubborn were
     numpy's text of an object array, with literal "\\n": session 28), anything else its
     JSON text."""
     from flint import fmpq
@@ -569,8 +571,8 @@ def _scalar(params: Any, key: str) -> Any:
             return json.dumps(params.float_json(key), allow_nan=False)
         except (TypeError, ValueError):
             return json.dumps(v, default=str)
-    if isinstance(v0, fmpq) and math.isfinite(f) and fmpq(*f.as_integer_ratio()) != v0:
-        return Inexact(f, str(v0))
+    if isinstance(v0, fmpq) and math.isfinite(f):
+        return ExactFloat(f, str(v0))
     return f
 
 

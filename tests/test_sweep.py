@@ -587,14 +587,19 @@ def test_sweep_tables_mark_rounded_values_and_matrices_are_json_lists() -> None:
     lyap = ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml"
     rows = sw.sweep_rows(lyap, ["method.lambda=[0.96, 0.9999999999999999999999]"])
     exact, near = rows
-    assert isinstance(near["lambda"], sw.Inexact) and near["lambda"] == 1.0
+    assert isinstance(near["lambda"], sw.ExactFloat) and near["lambda"] == 1.0
     assert _sweep_cell(near["lambda"]) == "≈1" and _md_value(near["lambda"]) == "≈1.0"
     assert _sweep_cell(exact["lambda"]) == "0.96"  # 24/25 shown as itself
     assert _md_value(exact["lambda"]) == "0.96"
     assert _sweep_cell(exact["mu"]) == "≈2.48428e+07" and exact["mu"] == 24842821.6875
+    # an exact dyadic μ = 58250127/262144: its double's shortest text is not its value (it
+    # showed bare in Markdown: re-check trial, session 28)
+    assert near["mu"].exact == "58250127/262144"
+    assert _md_value(near["mu"]) == "≈222.20660018920898"
+    assert _md_value(exact["mu"]) == "24842821.6875"
     assert _sweep_cell(1.5) == "1.5" and _sweep_cell(float("nan")) == "nan"
     again = pickle.loads(pickle.dumps(near["lambda"]))
-    assert isinstance(again, sw.Inexact) and again.exact == near["lambda"].exact
+    assert isinstance(again, sw.ExactFloat) and again.exact == near["lambda"].exact
     assert json.dumps(near["lambda"]) == "1.0"
     stub = sw.sweep_rows(
         ROOT / "specs" / "astolfi-stubborn-example1.toml", ["method.lambda_fraction=[0.5]"]
