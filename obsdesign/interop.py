@@ -20,6 +20,7 @@
 from __future__ import annotations
 
 import math
+import numbers
 import re
 from collections.abc import Mapping
 from decimal import Decimal, localcontext
@@ -46,6 +47,23 @@ def _control() -> Any:
 
 
 # -- TOML writing ---------------------------------------------------------------------------
+def _rational(x: Any) -> Fraction | int | None:
+    """``x`` as a Fraction (an int when integral) when it is an exact rational of another
+    type — ``flint.fmpq``, ``sympy.Rational`` / ``sympy.Integer`` (any ``numbers.Rational``)
+    — else None. These were rounded to doubles (re-check trial, session 28)."""
+    from flint import fmpq
+
+    if isinstance(x, (bool, np.bool_, int, np.integer, Fraction)):
+        return None
+    if isinstance(x, fmpq):
+        return Fraction(int(x.p), int(x.q))
+    if isinstance(x, numbers.Integral):
+        return int(x)
+    if isinstance(x, numbers.Rational):
+        return Fraction(int(x.numerator), int(x.denominator))
+    return None
+
+
 def _exact(x: Any) -> Decimal | None:
     """The exact decimal a spec writes for an exact input (session 28: these were rounded
     to doubles, so the certificate was about another matrix), else None:
@@ -55,6 +73,9 @@ def _exact(x: Any) -> Decimal | None:
       one without (1/3) is refused, as a spec's numbers are decimals;
     - a long double (``np.longdouble`` wider than a double): its shortest repr at its own
       precision, which reads back as the same long double (as a double's repr does)."""
+    r = _rational(x)
+    if r is not None:
+        x = Fraction(r)
     if isinstance(x, Decimal):
         if not x.is_finite():
             raise InputError(f"cannot write the non-finite number {x} into a spec")
@@ -131,7 +152,7 @@ def _value(v: Any) -> str:
     RecursionError (sweep, import and check trial, session 28)."""
     if isinstance(v, str):
         return _tstr(v)
-    if isinstance(v, (bool, np.bool_, int, float, np.integer, np.floating, Decimal, Fraction)):
+    if isinstance(v, (bool, np.bool_, numbers.Real, Decimal)) or _rational(v) is not None:
         return _num(v)
     if v is None:
         raise InputError("a missing value (None) cannot be written into a spec")
@@ -220,14 +241,17 @@ def _real(M: Any, name: str) -> np.ndarray:
     ):
         return arr
     if (arr.dtype.kind == "f" and arr.dtype.itemsize > 8) or (
-        arr.dtype == object and any(isinstance(x, (Decimal, Fraction)) for x in arr.flat)
+        arr.dtype == object
+        and any(isinstance(x, (Decimal, Fraction)) or _rational(x) is not None for x in arr.flat)
     ):
         # exact inputs kept exact (written by _num through _exact): they were rounded to
         # doubles (sweep, import and check trial, session 28)
         out = np.empty(arr.shape, dtype=object)
         for idx, x in np.ndenumerate(arr):
-            if isinstance(x, bool) or not isinstance(
-                x, (int, float, np.integer, np.floating, Decimal, Fraction)
+            if (
+                isinstance(x, bool)
+                or not isinstance(x, (numbers.Real, Decimal))
+                and _rational(x) is None
             ):
                 raise InputError(f"{name} has the entry {x!r}, which is not a number")
             try:

@@ -604,3 +604,25 @@ def test_import_dt_zero_is_continuous_and_the_smallest_normal_dt_is_accepted(
         assert "sample_time" not in text and "discrete = true" not in text, text
     tiny = float(np.finfo(float).tiny)
     assert "sample_time" in spec_text_from_mat(mat, names, dt=tiny)
+
+
+def test_other_exact_rationals_are_written_exactly() -> None:
+    """sympy.Rational, sympy.Integer, sympy.Matrix and flint.fmpq entries were rounded to
+    doubles, while Fraction(1, 3) was refused (re-check trial, session 28): any exact
+    rational is written exactly, or refused when it has no finite decimal."""
+    import sympy
+    from flint import fmpq
+
+    from obsdesign.interop import _value
+
+    big = 2**60 + 1
+    A = sympy.Matrix([[sympy.Rational(3, 10), sympy.Integer(big)], [fmpq(-1, 8), 0]])
+    t = spec_text_from_statespace((A, np.zeros((2, 0)), [[1.0, 0.0]], np.zeros((1, 0)), True))
+    assert f"A = [[0.3, {big}], [-0.125, 0]]" in t, t
+    with pytest.raises(InputError, match="1/3 has no finite decimal"):
+        spec_text_from_statespace(
+            (sympy.Matrix([[sympy.Rational(1, 3)]]), np.zeros((1, 0)), [[1.0]], [], True)
+        )
+    assert _value(fmpq(3, 8)) == "0.375" and _value(sympy.Rational(-1, 4)) == "-0.25"
+    with pytest.raises(InputError, match="no finite decimal"):
+        _value([fmpq(1, 3)])
