@@ -7,6 +7,7 @@ import json
 import re
 import tomllib
 from collections.abc import Callable
+from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
@@ -1299,3 +1300,26 @@ def test_verify_refuses_a_negative_bracket_end_where_the_lmi_holds() -> None:
     bracket = [c for c in ver.claims if c.id == "lambda_best-bracket"]
     assert bracket and bracket[0].status == ClaimStatus.FAILED, bracket
     assert ver.exit_code() == 1
+
+
+def test_a_bracket_end_on_the_wrong_side_is_named_so() -> None:
+    """A bracket end on the wrong side was refused as "|α_best − α_bracket| = 0.6 is not in
+    (0, rate_tol]" with rate_tol = 3 (re-check trial, session 28): the detail names the
+    side; a bracket wider than rate_tol names the width."""
+    from obsdesign.report.model import Report
+
+    text = '[system]\ntime = "discrete"\nA = [[0.5]]\nC = [[1]]\n[method]\nkey = "lyapunov"\nL = [0.25]\n'
+    rep = api.design(api.load_spec_text(text, "s.toml"))
+    assert rep.exit_code() == 0
+    for end, words in (
+        ("9/10", "lambda_bracket = 0.9 is not below λ_best"),
+        ("1/10", "above rate_tol"),
+    ):
+        d = rep.to_dict()
+        d["parameters"]["lambda_bracket"] = float(Fraction(end))
+        d["parameters"]["exact"]["lambda_bracket"] = end
+        ver = api.verify(Report.from_dict(d)[0])
+        bracket = next(c for c in ver.claims if c.id == "lambda_best-bracket")
+        assert (
+            bracket.status == ClaimStatus.FAILED and words.replace("lambda", "λ") in bracket.detail
+        ), bracket.detail

@@ -245,9 +245,17 @@ def bracket_claim(
     best, other, tol = Q(best), Q(other), Q(o.rate_tol)
     width = best - other if discrete else other - best
     problems = []
-    if not 0 < width <= tol:
+    if width <= 0:
+        # "|α_best − α_bracket| = 0.6 is not in (0, rate_tol]" read as a width problem with
+        # rate_tol = 3 (re-check trial, session 28): the end is on the wrong side
+        side = "below" if discrete else "above"
         problems.append(
-            f"|{sym}_best − {sym}_bracket| = {fmt_exact(abs(best - other))} is not in (0, rate_tol]"
+            f"{sym}_bracket = {fmt_exact(other)} is not {side} {sym}_best = {fmt_exact(best)}"
+        )
+    elif width > tol:
+        problems.append(
+            f"|{sym}_best − {sym}_bracket| = {fmt_exact(width)} is above rate_tol = "
+            f"{fmt_exact(tol)}"
         )
     if o.rate is not None and (best > o.rate if discrete else best < o.rate):
         problems.append(
