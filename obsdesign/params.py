@@ -88,6 +88,33 @@ class Parameters(Mapping[str, Any]):
         f = _floats(v)
         return np.asarray(f, dtype=float) if isinstance(f, list) else f
 
+    def shaped(self, k: str, shape: tuple[int, ...]) -> np.ndarray:
+        """The float view of parameter ``k`` as an array of ``shape`` (one entry may be −1:
+        any number of rows), refused (:class:`InputError`, "report: …", exit 2) when its
+        shape is another: a vector (or a scalar) stands for a shape with one dimension above
+        1. A 2×3 L in a report for a 3×2 gain was reshaped row-major into another matrix and
+        simulated with exit 0 (re-check trial, session 28)."""
+        a = np.asarray(self.float(k), dtype=float)
+        want = tuple(int(d) for d in shape)
+        if -1 in want:
+            cols = want[1]
+            ok = cols > 0 and (
+                (a.ndim == 2 and a.shape[1] == cols) or (a.ndim == 1 and a.size == cols)
+            )
+            target = (-1, cols)
+        else:
+            size = int(np.prod(want, dtype=np.int64)) if want else 1
+            vector = sum(d != 1 for d in want) <= 1
+            ok = a.shape == want or (a.ndim <= 1 and a.size == size and vector)
+            if not ok and vector and a.size == size:  # a column for a row and so on
+                ok = sum(d != 1 for d in a.shape) <= 1
+            target = want
+        if not ok:
+            got = "×".join(map(str, a.shape)) or "a number"
+            exp = "×".join("N" if d == -1 else str(d) for d in want) or "a number"
+            raise InputError(f"report: parameters.{k} has shape {got}, expected {exp}")
+        return a.reshape(target)
+
     def float_json(self, k: str) -> Any:
         """The float form ``to_json`` writes for parameter ``k`` (lists for arrays; a fresh
         copy, the caller may change it)."""

@@ -298,3 +298,30 @@ def test_a_trace_without_finite_returns_non_finite_floats() -> None:
     assert t.read == ["L", "x"]
     with pytest.raises(InputError, match=r"parameters\.L: a value is not a finite number \(inf\)"):
         p.traced(finite=True).float("L")
+
+
+def test_shaped_takes_the_shape_or_a_vector_and_refuses_a_transpose() -> None:
+    """A 2×3 L in a report for a 3×2 gain was reshaped row-major into another matrix and
+    simulated with exit 0 (re-check trial, session 28)."""
+    p = Parameters(
+        {
+            "L": [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]],
+            "c": [[1.0], [2.0], [3.0]],
+            "v": [1.0, 2.0, 3.0],
+            "r": [[1.0, 2.0, 3.0]],
+            "s": 2.5,
+            "G": [[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0]],
+        }
+    )
+    with pytest.raises(InputError, match=r"parameters\.L has shape 2×3, expected 3×2"):
+        p.shaped("L", (3, 2))
+    assert p.shaped("L", (2, 3)).tolist() == [[1, 2, 3], [4, 5, 6]]
+    for k in ("c", "v", "r"):  # a vector stands for any one-dimensional shape
+        assert p.shaped(k, (3, 1)).ravel().tolist() == [1, 2, 3]
+        assert p.shaped(k, (3,)).tolist() == [1, 2, 3]
+    assert p.shaped("s", (1, 1)).tolist() == [[2.5]]
+    assert p.shaped("G", (-1, 2)).shape == (3, 2)
+    with pytest.raises(InputError, match=r"has shape 3×2, expected N×3"):
+        p.shaped("G", (-1, 3))
+    with pytest.raises(InputError, match="expected 2×2"):
+        p.shaped("v", (2, 2))

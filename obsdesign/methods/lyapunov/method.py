@@ -104,9 +104,10 @@ class Lyapunov(Method):
         ie = so.initial_error if so is not None else None
         limit = time_limit if time_limit is not None else (so.time_limit if so else DEFAULT_LIMIT)
         budget = TimeBudget(limit, "raise time_limit, or fewer runs or a shorter horizon")
+        L = params.shaped("L", (spec.system.n, spec.system.p))
         if given is None and ie is None and batch is None and span is None:
-            return simulate_linear_observer(spec, params.float("L"), budget)
-        return simulate_linear_observer_batch(spec, params.float("L"), n, ie, batch, span, budget)
+            return simulate_linear_observer(spec, L, budget)
+        return simulate_linear_observer_batch(spec, L, n, ie, batch, span, budget)
 
     def sim_bytes(self, spec: Spec, runs: int, steps: float, options: dict[str, Any]) -> float:
         """One run keeps its trajectories; several runs keep run 0's trajectories, per-run

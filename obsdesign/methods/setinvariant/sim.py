@@ -36,12 +36,12 @@ def make_law(spec: Spec, params: Parameters, law: str | None) -> Any:
         if "breakpoints" not in params:
             raise InputError(f"the report has no breakpoint table: law '{law}' needs one output")
         z = params.float("breakpoints").reshape(-1)
-        v = params.float("v_breakpoints").reshape(len(z), s.n)
+        v = params.shaped("v_breakpoints", (len(z), s.n))
         return laws.PiecewiseAffineLaw(z, v, lam, law)
     if law == "linear":
         # the designed L, else the spec's [method].L (never the report's copy of it)
         if "L" in params:
-            return laws.LinearLaw(params.float("L").reshape(s.n, s.p))
+            return laws.LinearLaw(params.shaped("L", (s.n, s.p)))
         if spec.options.L is None:
             raise InputError("the report has no linear gain L and the spec gives none")
         return laws.LinearLaw(po.qfloat(spec.options.L).reshape(s.n, s.p))
@@ -55,7 +55,7 @@ def make_law(spec: Spec, params: Parameters, law: str | None) -> Any:
                 f"spec has p = {s.p}: use law=linear"
             )
         d = build(spec).fl
-        return laws.OnlineLPLaw(params.float("G").reshape(-1, s.n), d.A, d.B1, d.C[0], d.Dv, d.eta)
+        return laws.OnlineLPLaw(params.shaped("G", (-1, s.n)), d.A, d.B1, d.C[0], d.Dv, d.eta)
     raise InputError(
         f"unknown law {law!r}: expected interpolated, time-varying, online-lp or linear"
     )
@@ -130,7 +130,7 @@ def simulate(
     name = law or ("interpolated" if "breakpoints" in params else "linear")
     single = s.p == 1 and not isinstance(f, laws.LinearLaw)
     res, e, dd, vv = _run(spec, f, single, budget, f"the {name} law")
-    G = params.float("G").reshape(-1, s.n)
+    G = params.shaped("G", (-1, s.n))
     gauge = (e @ G.T).max(axis=1)
     om = spec.sets[spec.options.omega]
     e0_in = bool(om.contains(e[0], 1e-12))

@@ -311,7 +311,7 @@ def simulate(
     rng = np.random.default_rng(sim.seed)
     F = _rhs(spec)
     ell = float(params.float("ell"))
-    k = np.asarray(params.float("K"), float).reshape(n)
+    k = params.shaped("K", (n,))
     gain = k * ell ** np.arange(1, n + 1)
     _check_step(k, ell, dt)
     lam, eps = float(params.float("lambda")), float(params.float("epsilon"))

@@ -58,10 +58,10 @@ class Gains:
         return cls(
             np.asarray(s.A.f, float),
             np.asarray(s.C.f, float),
-            np.asarray(params.float("K"), float).reshape(n, p),
+            params.shaped("K", (n, p)),
             float(params.float("lambda")),
-            np.asarray(params.float("R"), float).reshape(p, p),
-            np.asarray(params.float("W"), float).reshape(p),
+            params.shaped("R", (p, p)),
+            params.shaped("W", (p,)),
             s.discrete,
         )
 
