@@ -142,3 +142,39 @@ def test_not_above_accepts_the_norm_rounded_up_and_refuses_more() -> None:
     assert not_above(X, 4) and not_above(X, line) and not not_above(X, line + fmpq(1, 2**100))
     assert not_above([[0, 0]], fmpq(1, 10**9)) and not not_above([[0, 0]], fmpq(2, 10**9))
     assert not_above(X, -1)  # below the norm: not above it (norm_bound_holds refuses it)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(
+        st.fractions(min_value=-(10**6), max_value=10**6, max_denominator=10**12),
+        min_size=1,
+        max_size=9,
+    ),
+    st.integers(min_value=-400, max_value=400),
+)
+def test_frobenius_fallback_is_a_tight_proved_bound(entries: list, exp: int) -> None:
+    """norm_upper's fallback (session 28): u ≥ ‖X‖_F ≥ ‖X‖₂ exactly, and u is the first point
+    of its 2^-shift grid above ‖X‖_F (one grid step lower is not a bound), at any scale."""
+    from fractions import Fraction
+
+    from obsdesign.certify.linalg import _frobenius_upper
+
+    xs = [x * Fraction(2) ** exp for x in entries]
+    X = qmat([[fmpq(x.numerator, x.denominator) for x in xs]])
+    f2 = sum((x * x for x in xs), Fraction(0))
+    u = _frobenius_upper(X)
+    U = Fraction(int(u.p), int(u.q))
+    assert U * U >= f2 and norm_bound_holds(X, u)
+    if f2:
+        assert (U - Fraction(1, U.denominator)) ** 2 < f2  # the next grid point down fails
+
+
+def test_frobenius_fallback_just_above_a_square() -> None:
+    """‖[[1 + 2^-100]]‖: scaled by 4^40 the square is just above the perfect square 2^80, so a
+    floor where the ceiling belongs gives u = 1, below the norm."""
+    from obsdesign.certify.linalg import _frobenius_upper
+
+    X = qmat([[1 + fmpq(1, 2**100)]])
+    u = _frobenius_upper(X)
+    assert u > 1 and norm_bound_holds(X, u) and u == 1 + fmpq(1, 2**40)

@@ -85,10 +85,10 @@ def _frobenius_upper(X: Any) -> fmpq:
     """A rational u ≥ ‖X‖_F ≥ ‖X‖₂, proved by u² ≥ Σ x² exactly."""
     f2 = sum((v * v for v in X.flat), fmpq(0))
     num, den = int(f2.p), int(f2.q)
-    # ⌈√(num/den)⌉ at a binary scale fine enough for the entries, checked exactly
+    # the least root/2^shift whose square is ≥ num/den, at a binary scale fine for the entries
     shift = max(0, (den.bit_length() - num.bit_length()) // 2 + 40)
-    root = math.isqrt((num << (2 * shift)) // den) + 1
-    u = fmpq(root, 2**shift)
-    while u * u < f2:  # pragma: no cover - isqrt rounds down by less than 1
-        u += fmpq(1, 2**shift)
-    return u
+    target = -(-(num << (2 * shift)) // den)  # ⌈num·4^shift/den⌉
+    root = math.isqrt(target)
+    if root * root < target:
+        root += 1
+    return fmpq(root, 2**shift)
