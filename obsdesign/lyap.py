@@ -614,16 +614,35 @@ def iss_mu(
         G = Bf.T @ Pf @ Bf + Bf.T @ Pf @ Af @ np.linalg.solve(S, Af.T @ Pf @ Bf)
     else:
         G = Bf.T @ Pf @ np.linalg.solve(S, Pf @ Bf)
-    mu_f = float(np.linalg.eigvalsh((G + G.T) / 2).max())
-    mu = dyadic(mu_f * (1 + 1e-9) + 1e-12, 30)
+    mu_f = float(np.linalg.eigvalsh((G + G.T) / 2).max()) if np.all(np.isfinite(G)) else np.inf
+    if not math.isfinite(mu_f * (1 + 1e-9)):
+        # Bd = 1e150 made μ ≈ 1e311: "cannot round a non-finite number", exit 3 (rendering
+        # soundness trial, session 29); OverflowError is exit 4 (api.captured_warnings)
+        raise OverflowError("the ISS gain μ of eq. (5) is beyond the float range")
+    # the first step and the raise are relative to the data: a fixed +1e-12 / +1e-9 made the
+    # μ of a plant with |B_w|²‖P‖ ≈ 1e-20 about 10¹¹ times too large (still true, not tight)
+    floor = fmpq(1, 2**40) * _mu_scale(Bf, Pf, mu_f)
+    mu = dyadic(max(mu_f, 0.0) * (1 + 1e-9) + float(floor), 30)
     check = check_pd_fast if strict else check_psd
     for _ in range(80):
         if check(iss_matrix(Acl, Bw, P, r, mu, discrete)):
             return mu
-        mu = mu * fmpq(11, 10) + fmpq(1, 10**9)
+        mu = mu * fmpq(11, 10) + floor
     raise InconclusiveError(
         "could not certify the ISS gain μ of eq. (5) (rate too close to its limit?)"
     )
+
+
+def _mu_scale(Bf: np.ndarray, Pf: np.ndarray, mu_f: float) -> fmpq:
+    """The size of the terms of the ISS gain μ (eq. (5)-(6), constrained-redesign paper):
+    max(μ̃, ‖B_w‖²_F·‖P‖_F) as an exact dyadic (1 when both are 0), so that the first rounding
+    step of :func:`iss_mu` and its raises scale with the plant, not with 1.
+
+    :param Bf, Pf: B_w and P in floats; :param mu_f: the float μ."""
+    s = max(abs(mu_f), float(np.sum(Bf * Bf)) * float(np.linalg.norm(Pf)))
+    if not (math.isfinite(s) and s > 0):
+        return fmpq(1)
+    return dyadic(s, 30)
 
 
 # -- exact stability tests (the infeasible end of a rate bracket) ---------------------------

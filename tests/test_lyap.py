@@ -134,6 +134,36 @@ def test_iss_mu_is_certified_and_near_the_infimum(discrete: bool) -> None:
     assert not check_psd(iss_matrix(Acl, Bw, P, rho, mu_star - TINY, discrete))
 
 
+@pytest.mark.parametrize("discrete", [True, False])
+@pytest.mark.parametrize("scale", ["1/10000000000", "10000000000"])
+def test_iss_mu_scales_with_the_plant(discrete: bool, scale: str) -> None:
+    """The scalar case with B_w ×10^±10: μ* ×10^±20, and μ stays within 1 % of it (a fixed
+    first step of +1e-12 made μ ≈ 1e-12 for μ* = 3.6e-19, rendering soundness trial
+    session 29)."""
+    a, p, rho = fmpq(1, 2), fmpq(2), fmpq(1, 2)
+    b = 3 * fmpq(scale)
+    Acl = qmat([[a if discrete else -a]])
+    Bw, P = qmat([[b]]), qmat([[p]])
+    if discrete:
+        mu_star = b * b * p + (a * b * p) ** 2 / (rho * p - a * a * p)
+    else:
+        mu_star = (p * b) ** 2 / ((2 * a - rho) * p)
+    mu = iss_mu(Acl, Bw, P, rho, discrete, strict=True)
+    assert mu_star < mu <= mu_star * fmpq(101, 100)
+    assert check_pd(iss_matrix(Acl, Bw, P, rho, mu, discrete))
+
+
+@pytest.mark.parametrize("discrete", [True, False])
+def test_iss_mu_beyond_the_float_range_is_an_overflow(discrete: bool) -> None:
+    """μ* ≈ 1e311 (B_w = 1e155): OverflowError (exit 4 through api.captured_warnings), not
+    "cannot round a non-finite number" (exit 3; rendering soundness trial, session 29)."""
+    a, p, rho = fmpq(1, 2), fmpq(2), fmpq(1, 2)
+    Acl = qmat([[a if discrete else -a]])
+    Bw, P = qmat([[fmpq(10) ** 155]]), qmat([[p]])
+    with pytest.raises(OverflowError, match="ISS gain"):
+        iss_mu(Acl, Bw, P, rho, discrete, strict=True)
+
+
 def test_best_rate_shipped_section5() -> None:
     """λ_best = 0.9501, the first candidate one rate_tol above the infeasible end (0.95006
     from the bisection before session 11; P_best as the numpy Lyapunov solve of issue 12

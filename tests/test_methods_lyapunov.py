@@ -1323,3 +1323,26 @@ def test_a_bracket_end_on_the_wrong_side_is_named_so() -> None:
         assert (
             bracket.status == ClaimStatus.FAILED and words.replace("lambda", "λ") in bracket.detail
         ), bracket.detail
+
+
+@pytest.mark.parametrize(
+    ("time", "extra", "bd"),
+    [
+        ("discrete", "L = [-1.87, 1.874]\nlambda = 0.955", "1e150"),
+        ("continuous", "L = [2, 2]\nalpha = 0.01", "1e160"),
+    ],
+)
+def test_iss_gain_beyond_the_float_range_is_exit_4(time: str, extra: str, bd: str) -> None:
+    """Bd = 1e150 makes μ ≈ 1e311: exit 4 ("beyond the float range"), as the README says for
+    a float stage the spec's numbers overflow, not exit 3 "internal failure: cannot round a
+    non-finite number" (rendering soundness trial, session 29); Bd = 1e148 certifies."""
+    text = (
+        f'[system]\ntime = "{time}"\nA = [[0, 1], [1, 0]]\nC = [[1, 0]]\nBd = [[{bd}], [{bd}]]\n'
+        f'[method]\nkey = "lyapunov"\n{extra}\niss_gain = true\n'
+    )
+    with pytest.raises(InconclusiveError, match="beyond the float range") as e:
+        api.design(load_spec_text(text, "mu.toml"))
+    assert e.value.exit_code == 4
+    if time == "discrete":
+        ok = api.design(load_spec_text(text.replace(bd, "1e148"), "mu.toml"))
+        assert ok.exit_code() == 0
