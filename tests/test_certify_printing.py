@@ -13,7 +13,7 @@ from flint import fmpq
 from hypothesis import given
 from hypothesis import strategies as st
 
-from obsdesign.certify.printing import fmt_down, fmt_exact, fmt_up
+from obsdesign.certify.printing import fmt_down, fmt_exact, fmt_up, fmt_value_up
 
 F = fmpq
 
@@ -154,3 +154,24 @@ def test_fmt_exact_length_limits():
     q33 = F(12345678901234567890123456789012, 10**21)
     s33 = fmt_exact(q33)
     assert s33 == str(q33) and "/" in s33 and parse(s33) == q33
+
+
+def test_fmt_value_up_never_puts_a_rounded_number_behind_equals() -> None:
+    """Short exact values alone; long ones as "p/q ≤ bound" with the bound ≥ the value
+    (constrained printed "μ = 24485.1886" for 200582665/8192, session 29)."""
+    assert fmt_value_up(fmpq(512451229, 2)) == "256225614.5"
+    mu = fmpq(200582665, 8192)
+    text = fmt_value_up(mu, 10)
+    assert text == "200582665/8192 ≤ 24485.1886"
+    assert Fraction(text.split(" ≤ ")[1]) >= Fraction(200582665, 8192)
+
+
+@given(st.fractions(min_value=-(10**6), max_value=10**6))
+def test_fmt_value_up_is_exact_or_a_safe_bound(x: Fraction) -> None:
+    """Either the exact value, or its p/q followed by an upper bound."""
+    text = fmt_value_up(fmpq(x.numerator, x.denominator))
+    if " ≤ " in text:
+        exact, bound = text.split(" ≤ ")
+        assert Fraction(exact) == x and Fraction(bound) >= x
+    else:
+        assert Fraction(text) == x

@@ -105,3 +105,11 @@ def test_documented_variants(kw: dict, expected: dict[str, float]) -> None:
     for k, v in expected.items():
         got = rep.parameters.float(k)
         assert float(f"{got:.{_sig(v)}g}") == v, (k, got, v)
+
+
+def test_iss_bound_statement_shows_mu_exactly() -> None:
+    """μ = 200582665/8192 is printed with its rounded-up value beside it, not as
+    "μ = 24485.1886" (rendering soundness trial, session 29)."""
+    rep = api.design(SPEC)
+    st = {c.id: c.statement for c in rep.claims}
+    assert "μ = 200582665/8192 ≤ 24485.1886, ρ < 1" in st["iss-bound"]

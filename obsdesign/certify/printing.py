@@ -75,6 +75,18 @@ def fmt_down(x: Any, digits: int = 6) -> str:
     return _fmt(x, digits, False)
 
 
+def fmt_value_up(x: Any, digits: int = 6, longest: int = 16) -> str:
+    """What follows "= " for an upper-bound quantity such as an ISS gain μ: ``x`` exactly when
+    that takes at most ``longest`` characters, else "p/q ≤ d" with d rounded up to ``digits``
+    significant digits — never a rounded number behind "=" (constrained's "μ = 24485.1886"
+    for μ = 200582665/8192, rendering soundness trial, session 29).
+
+    :param x: the exact value; :param digits: significant digits of the bound;
+    :param longest: the longest exact text shown alone."""
+    m = fmt_exact(x)
+    return m if len(m) <= longest else f"{Q(x)} ≤ {fmt_up(x, digits)}"
+
+
 def fmt_exact(x: Any) -> str:
     """``x`` exactly: a finite decimal when it has one with at most 30 digits, else p/q."""
     q = Q(x)

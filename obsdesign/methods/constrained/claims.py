@@ -25,7 +25,7 @@ from obsdesign.certify.claim import Claim, Claims, ClaimStatus
 from obsdesign.certify.exact import Q, qeye, to_float
 from obsdesign.certify.interval import sqrt_upper, upper
 from obsdesign.certify.linalg import ROUNDED_UP_REL
-from obsdesign.certify.printing import fmt_down, fmt_exact, fmt_up
+from obsdesign.certify.printing import fmt_down, fmt_exact, fmt_up, fmt_value_up
 from obsdesign.certify.psd import asymmetric, check_pd, check_psd
 from obsdesign.methods.constrained import bounds as B
 from obsdesign.methods.constrained.cmap import ConstraintMap
@@ -426,7 +426,9 @@ def _linear_claims(c: Claims, spec: Spec, P: Any, rho: fmpq, mu: fmpq, lam: fmpq
     r = check_psd(lyap.iss_matrix(Acl, Bw, P, rho, mu))
     c.exact(
         id="iss-bound",
-        statement=(f"V(e⁺) ≤ ρV(e) + μ|w|² with ρ = {fmt_exact(rho)}, μ = {fmt_up(mu, 10)}, ρ < 1"),
+        statement=(
+            f"V(e⁺) ≤ ρV(e) + μ|w|² with ρ = {fmt_exact(rho)}, μ = {fmt_value_up(mu, 10)}, ρ < 1"
+        ),
         reference=_ref("Assumption 2, eq. (5)-(6)"),
         check="exact LDLᵀ over Q (linear error dynamics)",
         passed=r.ok and rho < 1,

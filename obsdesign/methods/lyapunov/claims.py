@@ -18,7 +18,7 @@ from obsdesign import lyap
 from obsdesign.certify import vchol
 from obsdesign.certify.claim import Claim, Claims
 from obsdesign.certify.exact import Q
-from obsdesign.certify.printing import fmt_exact, fmt_up
+from obsdesign.certify.printing import fmt_exact, fmt_value_up
 from obsdesign.certify.psd import PSDResult, asymmetric, check_pd_fast, check_text
 from obsdesign.methods.lyapunov.design import rate_name
 from obsdesign.methods.lyapunov.options import Options
@@ -360,11 +360,9 @@ def iss_claim(
     else:
         sig, tail = ("d" if Bd.shape[1] else "v"), ""
     what = f"V(e⁺) ≤ λ²V(e) + μ|{sig}|²" if discrete else f"V̇ ≤ −2αV + μ|{sig}|²"
-    m = fmt_exact(mu)
-    shown = m if len(m) <= 16 else f"{Q(mu)} ≤ {fmt_up(mu, 6)}"
     return c.exact(
         id="iss-gain",
-        statement=f"{what}{tail} with μ = {shown}",
+        statement=f"{what}{tail} with μ = {fmt_value_up(mu)}",
         reference=REF,
         check=check_text(r),
         passed=r.ok,
