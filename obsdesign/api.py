@@ -259,19 +259,21 @@ def _error_report_on_failure(sp: Spec, out: str | Path | None, force: bool) -> I
     report of an earlier run."""
     try:
         yield
-    except ObsdesignError as e:
-        if out is not None and e.exit_code != EXIT_BAD_INPUT:
-            _write_error_report(sp, out, e.exit_code, e.message, force)
-        raise
     except Exception as e:
-        if out is not None:
-            msg = f"internal failure: {type(e).__name__}: {e}"
-            _write_error_report(sp, out, EXIT_SOLVER, msg, force)
+        code, msg = design_error(e)
+        if out is not None and code != EXIT_BAD_INPUT:
+            _write_error_report(sp, out, code, msg, force)
         raise
 
 
-def _write_error_report(sp: Spec, out: str | Path, code: int, message: str, force: bool) -> None:
-    rep = Report(
+def error_report(sp: Spec, code: int, message: str) -> Report:
+    """The report of a design of ``sp`` that stopped with an error (``"verdict": "error"``,
+    no parameters, no claims): what ``design -o`` writes and ``design --format json`` prints
+    then, and what ``verify`` reports as that error.
+
+    :param sp: the spec; :param code: the error's exit code (1, 3 or 4); :param message: its
+    one-line message."""
+    return Report(
         method=sp.method,
         spec=sp.text,
         spec_file=sp.file,
@@ -281,7 +283,19 @@ def _write_error_report(sp: Spec, out: str | Path, code: int, message: str, forc
         verdict="error",
         error={"exit_code": code, "message": message},
     )
-    write_atomic(out, rep.to_json(), force)
+
+
+def design_error(e: Exception) -> tuple[int, str]:
+    """(exit code, message) of an exception that stopped a design, as its error report
+    records them: an :class:`ObsdesignError`'s own, any other exception an internal failure
+    (exit 3)."""
+    if isinstance(e, ObsdesignError):
+        return e.exit_code, e.message
+    return EXIT_SOLVER, f"internal failure: {type(e).__name__}: {e}"
+
+
+def _write_error_report(sp: Spec, out: str | Path, code: int, message: str, force: bool) -> None:
+    write_atomic(out, error_report(sp, code, message).to_json(), force)
 
 
 #: claims only ``verify`` makes (never in a design report)

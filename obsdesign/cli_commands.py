@@ -491,7 +491,11 @@ def design(
     if plot is not None and api.method(sp.method).plot_design is None:
         raise InputError(f"--plot: method '{sp.method}' has no design plot")
     with _naming_the_spec(sp.file):
-        rep = api.design(sp, output, progress=progress, force=force)
+        try:
+            rep = api.design(sp, output, progress=progress, force=force)
+        except Exception as e:
+            _design_error_outputs(sp, e, output, fmt)
+            raise
     if not quiet or fmt == Fmt.json:
         _print_report(rep, fmt)
     if plot is not None:
@@ -501,6 +505,24 @@ def design(
     if output is not None and fmt == Fmt.text:
         _say(f"report written to {output}")
     return rep.exit_code()
+
+
+def _design_error_outputs(sp: Any, e: Exception, output: Path | None, fmt: Fmt) -> None:
+    """What a design that stopped with an error (exit 1, 3 or 4) prints besides its error
+    line: ``--format json`` the error report that ``-o`` writes (stdout was empty, so a CI
+    job parsing it got a JSON error instead of ``"verdict": "error"``), text a line saying
+    ``-o`` now holds that report (it was replaced silently; rendering trial, session 29).
+    Bad input (exit 2) writes and prints no report."""
+    from obsdesign import api
+    from obsdesign.errors import EXIT_BAD_INPUT
+
+    code, message = api.design_error(e)
+    if code == EXIT_BAD_INPUT:
+        return
+    if fmt == Fmt.json:
+        print(api.error_report(sp, code, message).to_json())
+    elif output is not None and fmt == Fmt.text:
+        _say(f"error report written to {output}")
 
 
 @contextmanager

@@ -399,3 +399,33 @@ def test_check_and_design_print_control_characters_in_file_names_as_escapes(tmp_
         assert "\x1b" not in res.output and "\\x1b" in res.output
     res = CliRunner().invoke(app, ["design", str(bad), "--width", "200"])
     assert res.exit_code == 0 and "\x1b" not in res.output and "\\x1b" in res.output
+
+
+FAILING_LYAPUNOV = """[system]
+time = "discrete"
+A = [[0.95, 0], [0, 0.1]]
+C = [[0, 1]]
+[method]
+key = "lyapunov"
+L = [0, 0]
+lambda = 0.9
+"""
+
+
+def test_design_error_prints_its_error_report_with_format_json(tmp_path: Path) -> None:
+    """A design that stops with an error (exit 1) prints the error report on stdout with
+    --format json (stdout was empty: rendering trial, session 29), the report -o writes;
+    text with -o says the file now holds it; bad input (exit 2) prints no report."""
+    spec = tmp_path / "fail.toml"
+    spec.write_text(FAILING_LYAPUNOV)
+    out = tmp_path / "r.json"
+    r = runner.invoke(app, ["design", str(spec), "--format", "json", "-o", str(out)])
+    assert r.exit_code == 1 and "no P ≻ 0" in r.stderr
+    printed = json.loads(r.stdout)
+    assert printed["verdict"] == "error" and printed["error"]["exit_code"] == 1
+    assert printed["error"] == json.loads(out.read_text())["error"]
+    r = runner.invoke(app, ["design", str(spec), "-o", str(out)])
+    assert r.exit_code == 1 and f"error report written to {out}" in r.stdout
+    spec.write_text(FAILING_LYAPUNOV.replace("lambda = 0.9", "lambda = -2"))
+    r = runner.invoke(app, ["design", str(spec), "--format", "json"])
+    assert r.exit_code == 2 and r.stdout == ""
