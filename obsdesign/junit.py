@@ -15,6 +15,7 @@ failure | error | system-out`` with the attributes ``name``, ``tests``, ``failur
 
 from __future__ import annotations
 
+import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Any
@@ -23,16 +24,30 @@ from typing import Any
 _ERROR_CODES = (2, 3)
 
 
+#: the characters XML 1.0 forbids (control characters but tab/newline/CR, surrogates,
+#: U+FFFE and U+FFFF)
+_XML_FORBIDDEN = re.compile("[^\t\n\r\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
+
+
 def _clean(text: Any) -> str:
-    """Text without the characters XML 1.0 forbids (control characters but tab/newline/CR)."""
-    return "".join(
-        ch
-        for ch in str(text)
-        if ch in "\t\n\r"
-        or (0x20 <= ord(ch) <= 0xD7FF)
-        or (0xE000 <= ord(ch) <= 0xFFFD)
-        or (0x10000 <= ord(ch) <= 0x10FFFF)
-    )
+    """Text with the characters XML 1.0 forbids written as escapes (``\\x1b``, ``\\udc80``):
+    they were dropped, so a spec file ``f<ESC>[31mred.toml`` was named ``f[31mred.toml``, a
+    different file (rendering trial, session 29)."""
+
+    def esc(m: re.Match[str]) -> str:
+        o = ord(m[0])
+        return f"\\x{o:02x}" if o < 0x100 else f"\\u{o:04x}"
+
+    return _XML_FORBIDDEN.sub(esc, str(text))
+
+
+def _name(text: Any) -> str:
+    """A name (a spec's file, a classname, a claim id) as the text and Markdown tables show it:
+    every control character escaped (:func:`obsdesign.errors.escape_controls`: a newline or a
+    bidirectional override too), then :func:`_clean`."""
+    from obsdesign.errors import escape_controls
+
+    return _clean(escape_controls(str(text)))
 
 
 def _secs(x: float) -> str:
@@ -45,8 +60,8 @@ def junit_tree(rows: list[Any], name: str = "obsdesign check") -> ET.ElementTree
     total = fails = errs = 0
     total_time = 0.0
     for r in rows:
-        suite = ET.SubElement(root, "testsuite", name=_clean(r.spec))
-        cls = _clean(f"obsdesign.{r.method}.{r.spec}")
+        suite = ET.SubElement(root, "testsuite", name=_name(r.spec))
+        cls = _name(f"obsdesign.{r.method}.{r.spec}")
         n = f = e = 0
         case = ET.SubElement(
             suite, "testcase", name="design and verify", classname=cls, time=_secs(r.seconds)
@@ -68,7 +83,7 @@ def junit_tree(rows: list[Any], name: str = "obsdesign check") -> ET.ElementTree
         elif r.summary:
             ET.SubElement(case, "system-out").text = _clean(r.summary)
         for c in r.claims:
-            cc = ET.SubElement(suite, "testcase", name=_clean(c["id"]), classname=cls, time="0")
+            cc = ET.SubElement(suite, "testcase", name=_name(c["id"]), classname=cls, time="0")
             n += 1
             if c["status"] == "failed":
                 el = ET.SubElement(

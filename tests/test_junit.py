@@ -124,8 +124,23 @@ def test_junit_cleans_characters_xml_forbids(tmp_path: Path):
     p = tmp_path / "j.xml"
     p.write_text(junit_xml([row]), encoding="utf-8")
     root = ET.parse(p).getroot()  # parses: no forbidden character left
-    assert root.find("testsuite").get("name") == "ab.toml"
+    # escaped as the text table shows it, not dropped: "ab.toml" is another file (session 29)
+    suite = root.find("testsuite")
+    assert suite.get("name") == "a\\x01b.toml"
+    assert suite.find("testcase").get("classname") == "obsdesign.lyapunov.a\\x01b.toml"
+    failure = suite.find("testcase").find("failure")
+    assert failure.get("message") == "exit 1: bad \\x1b[31m"
+    claim = suite.findall("testcase")[1].find("failure")
+    assert claim.get("message") == "s\\x00" and claim.text == "s\\x00\nd\\x07"
     _validate_xsd(p)
+
+
+def test_junit_names_escape_newlines_and_bidi_controls(tmp_path: Path):
+    """A name is one line, as in the text table: a newline or U+202E in a file name is
+    written as an escape; a message keeps its newlines."""
+    row = CheckRow("a\nb\u202e.toml", "lyapunov", 0, 1, 0, 0, "ok", 0.1, "", [])
+    root = ET.fromstring(junit_xml([row]))
+    assert root.find("testsuite").get("name") == "a\\nb\\u202e.toml"
 
 
 def test_junit_refuses_a_symbolic_link(tmp_path: Path):
