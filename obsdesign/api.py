@@ -606,6 +606,28 @@ def _replace_claims(rep: Report, claims: list[Claim], seconds: float) -> Report:
     return rep
 
 
+def _uncertified_design(sp: Spec, params: Parameters) -> list[str]:
+    """The warning ``simulate`` without a report gives when the parameters it designed do not
+    certify (the claims ``design`` would make, at a fraction of the design's time): a design
+    whose claim failed (``design`` exit 1) was simulated with exit 0 and no word, while
+    ``simulate --report`` of the same design warned (rendering trial, session 29). A design
+    that cannot be certified (an error) is said so too; the simulation still runs.
+
+    :param sp: the spec; :param params: the parameters its method designed."""
+    tail = "the parameters simulated are not certified (obsdesign design says why)"
+    try:
+        with captured_warnings([]):
+            claims = certify(sp, params)
+    except ObsdesignError as e:
+        return [f"{sp.file}: the designed parameters could not be certified ({e.message}): {tail}"]
+    bad = [c for c in claims if c.status == ClaimStatus.FAILED]
+    if not bad:
+        return []
+    verdict = "inconclusive" if all(c.float_ok for c in bad) else "failed"
+    ids = ", ".join(c.id for c in bad[:5]) + (", …" if len(bad) > 5 else "")
+    return [f"{sp.file}: the design's claims give the verdict '{verdict}' ({ids}): {tail}"]
+
+
 def simulate(
     spec: str | Path | Spec,
     report: str | Path | Report | None = None,
@@ -669,9 +691,11 @@ def simulate(
             )
         check_workers(workers, scheduler)
     where = "report"
+    notes: list[str] = []
     if report is None:
         with captured_warnings([]):
             params: Parameters = get_method(sp.method).design(sp).parameters
+        notes += _uncertified_design(sp, params)
     else:
         rep, problems = (
             Report.from_dict(report.to_dict())
@@ -689,7 +713,6 @@ def simulate(
                 f"({rep.error.get('message', '')}): no parameters to simulate"
             )
         params = rep.parameters.traced(finite=True)
-    notes: list[str] = []
     if report is not None and rep.computed_verdict() != "ok":
         # simulate does not verify a report; one whose own claims fail is run, but said so
         # (simulate trial, session 27: a failed report ran with exit 0 and no word)

@@ -418,6 +418,39 @@ def test_simulate_says_when_a_report_does_not_hold(spec: Path, tmp_path: Path) -
     assert "warnings" not in api.simulate(spec, rep).info
 
 
+def test_simulate_without_a_report_says_when_its_design_does_not_certify(tmp_path: Path) -> None:
+    """simulate SPEC of a design whose claim fails (design exit 1: linear-plant, the plant is
+    given by f) warns as simulate --report does (exit 0 and no word: rendering trial, session
+    29); a design that certifies gives no such warning."""
+    from obsdesign import api
+
+    text = """[system]
+time = "discrete"
+states = ["x1", "x2"]
+A = [[0, 1], [1, 0]]
+C = [[1, 0]]
+f = ["x2", "x1 + 0.01*sin(x1)"]
+[method]
+key = "lyapunov"
+L = [-1.87, 1.874]
+lambda = 0.955
+[simulate]
+horizon = 5
+x0 = [-1, -1]
+xhat0 = [1, 1]
+"""
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text)
+    res = api.simulate(bad)
+    assert any(
+        "verdict 'failed' (linear-plant)" in w and "not certified" in w
+        for w in res.info["warnings"]
+    )
+    good = tmp_path / "good.toml"
+    good.write_text(text.replace('f = ["x2", "x1 + 0.01*sin(x1)"]\n', ""))
+    assert "warnings" not in api.simulate(good).info
+
+
 def test_a_plot_of_values_near_the_float_limit_is_exit_4_and_writes_nothing(
     spec: Path, tmp_path: Path
 ) -> None:
