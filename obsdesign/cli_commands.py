@@ -310,6 +310,37 @@ def _print_rows(rows: list[Any], fmt: Fmt) -> None:
 
     from obsdesign.report.render import console, esc
 
+    c = console()
+    cells = [
+        (
+            esc(r.spec),
+            esc(r.method),
+            "ok" if r.code == 0 else f"exit {r.code}",
+            f"{r.certified}/{r.numerical}/{r.failed}",
+            esc(_result_text(r)),
+            f"{r.seconds:.2f}",
+        )
+        for r in rows
+    ]
+    # the columns that never wrap, at their widest, plus 16 for the spec, 20 for the result
+    # and the borders: below that rich ellipsized them ("5/0…" for 5/0/1, the failed claim
+    # hidden) and squeezed spec and result to nothing (--width 40; rendering trial, session
+    # 29), so each row is then a block of lines
+    fixed = sum(
+        max(len(h), *(len(x[i]) for x in cells))
+        for i, h in ((1, "method"), (2, "verdict"), (3, "claims"), (5, "s"))
+    )
+    if cells and c.width < fixed + 16 + 20 + 19:
+        c.print("[bold]obsdesign check[/] (claims: certified/numerical/failed)")
+        for (spec, method, verdict, claims, result, secs), r in zip(cells, rows, strict=True):
+            style = "green" if r.code == 0 else "bold red"
+            c.print(spec, overflow="fold")
+            c.print(
+                f"  {method} · [{style}]{verdict}[/] · claims {claims} · {secs} s",
+                overflow="fold",
+            )
+            c.print(f"  {result}", overflow="fold")
+        return
     t = Table(title="obsdesign check", caption="claims: certified/numerical/failed")
     # method, verdict and the claim counts never wrap; the spec path folds (no spaces in
     # it) and the result wraps at spaces with twice the spec's share of the rest
@@ -319,17 +350,10 @@ def _print_rows(rows: list[Any], fmt: Fmt) -> None:
     t.add_column("claims", no_wrap=True)
     t.add_column("result", overflow="fold", ratio=2)
     t.add_column("s", no_wrap=True)
-    for r in rows:
-        verdict = "[green]ok[/]" if r.code == 0 else f"[bold red]exit {r.code}[/]"
-        t.add_row(
-            esc(r.spec),
-            esc(r.method),
-            verdict,
-            f"{r.certified}/{r.numerical}/{r.failed}",
-            esc(_result_text(r)),
-            f"{r.seconds:.2f}",
-        )
-    console().print(t)
+    for (spec, method, verdict, claims, result, secs), r in zip(cells, rows, strict=True):
+        style = "green" if r.code == 0 else "bold red"
+        t.add_row(spec, method, f"[{style}]{verdict}[/]", claims, result, secs)
+    c.print(t)
 
 
 def _check_verdict(rows: list[Any]) -> str:

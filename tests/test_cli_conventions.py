@@ -259,8 +259,42 @@ def test_check_table_at_80_columns(spec: Path, tmp_path: Path):
     out = _run("check", str(spec), str(si), "--width", "80")[1]
     lines = out.splitlines()
     assert max(len(x) for x in lines) <= 80
-    cells = {c.strip() for line in lines for c in re.split(r"[│┃]", line)}
-    assert {"lyapunov", "set-invariant", "ok"} <= cells  # never broken
+    words = {w.strip() for line in lines for w in re.split(r"[│┃·]", line)}
+    assert {"lyapunov", "set-invariant", "ok"} <= words  # never broken
+    assert "…" not in out
+
+
+@pytest.mark.parametrize("width", [40, 50, 60])
+def test_check_rows_stay_whole_at_narrow_widths(width: int, spec: Path, tmp_path: Path):
+    """At --width 40 rich ellipsized the claim counts ("5/0…" for 5/0/1: the failed claim
+    hidden) and squeezed the spec and result columns to nothing (rendering trial, session
+    29): each row is then a block of lines with every field whole."""
+    bad = tmp_path / "bad.toml"
+    bad.write_text(SPEC.replace("lambda = 0.9", "L = [0, 0]\nlambda = 0.5"))
+    code, out, _ = _run("check", str(spec), str(bad), "--width", str(width))
+    assert code == 1
+    lines = out.splitlines()[:-1]  # the verdict line is one line whatever the width
+    assert max(len(x) for x in lines) <= width
+    assert "…" not in out
+    joined = "".join(x.strip() for x in lines)
+    assert str(bad).replace(" ", "") in joined.replace(" ", "")
+    assert "exit 1" in out and re.search(r"claims \d+/\d+/\d+", out)
+
+
+@pytest.mark.parametrize("width", [40, 50])
+def test_parameter_names_are_never_ellipsized(width: int, spec: Path, tmp_path: Path):
+    """Three equal columns at --width 40 showed lambda_bracket and lambda_bracket_kind both
+    as "lambda_br…" (rendering trial, session 29): names fold, the form goes under them."""
+    report = tmp_path / "r.json"
+    assert _run("design", str(spec), "-q", "-o", str(report))[0] == 0
+    out = _run("verify", str(report), "--width", str(width))[1]
+    assert max(len(x) for x in out.splitlines()) <= width
+    table = out.split("claims")[0]
+    assert "…" not in table
+    names = json.loads(report.read_text())["parameters"].keys() - {"exact"}
+    flat = "".join(c.strip() for line in table.splitlines() for c in re.split(r"[│┃]", line)[1:2])
+    for k in names:
+        assert k in flat, k
 
 
 def test_simulate_from_stdin_json():

@@ -78,6 +78,8 @@ _WIDTH: dict[str, int | None] = {"width": None}
 DEFAULT_WIDTH = 100
 #: below this width the claims table puts check and detail under the statement
 NARROW = 120
+#: below this width the parameters table puts each parameter's form under its name
+NARROW_PARAMS = 72
 
 
 def set_width(n: int | None) -> None:
@@ -133,11 +135,22 @@ def render_text(report: Report, title: str = "") -> None:
 
     out = console()
     t = Table(title=esc(title or f"{report.method} — {report.spec_file}"), show_lines=False)
-    t.add_column("parameter")
-    t.add_column("value", overflow="fold")
-    t.add_column("form")
-    for k, v, form in _param_rows(report):
-        t.add_row(esc(k), esc(v), form)
+    rows = _param_rows(report)
+    if out.width < NARROW_PARAMS:
+        # two columns, the form under the name: three equal columns at --width 40 cut names
+        # ("lambda_br…" for both lambda_bracket and lambda_bracket_kind) and split numbers
+        # ("2.56225e+0" / "8"; rendering trial, session 29); a name folds, never ellipsized
+        name_w = max(4, min(max((len(esc(k)) for k, _, _ in rows), default=4), out.width // 3))
+        t.add_column("parameter / form", overflow="fold", min_width=name_w, max_width=name_w)
+        t.add_column("value", overflow="fold")
+        for k, v, form in rows:
+            t.add_row(f"{esc(k)}\n[dim]{form}[/]", esc(v))
+    else:
+        t.add_column("parameter", overflow="fold")
+        t.add_column("value", overflow="fold")
+        t.add_column("form", no_wrap=True)
+        for k, v, form in rows:
+            t.add_row(esc(k), esc(v), form)
     out.print(t)
     c = Table(title="claims")
     # claim ids never break mid-word: their column is as wide as the longest id (up to 32
