@@ -277,22 +277,29 @@ def _numeric_list(v: Any) -> bool:
 
 
 def same_bits(a: Any, b: Any) -> bool:
-    """Whether two float forms (numbers, nested lists) are equal entry by entry as doubles
-    (``float(x) == float(y)``; booleans, strings and ragged lists are never equal to
-    numbers), vectorized for rectangular arrays of plain numbers."""
+    """Whether two float forms (numbers, nested lists) are the same doubles entry by entry,
+    bit for bit: equal values with the same sign (−0.0 is not the nearest double to an exact
+    0, which is +0.0; ``verify`` took it: rendering trial, session 29); booleans, strings and
+    ragged lists are never equal to numbers; vectorized for rectangular arrays of plain
+    numbers."""
     if isinstance(a, list) and isinstance(b, list):
         fa, fb = _plain_array(a), _plain_array(b)
         if fa is not None and fb is not None:
-            return fa.shape == fb.shape and bool(np.array_equal(fa, fb))
+            return (
+                fa.shape == fb.shape
+                and bool(np.array_equal(fa, fb))
+                and bool(np.array_equal(np.signbit(fa), np.signbit(fb)))
+            )
         return len(a) == len(b) and all(same_bits(x, y) for x, y in zip(a, b, strict=True))
     if isinstance(a, bool) or isinstance(b, bool) or isinstance(a, list) or isinstance(b, list):
         return False
     if not isinstance(a, (int, float)) or not isinstance(b, (int, float)):
         return False
     try:
-        return float(a) == float(b)
+        x, y = float(a), float(b)
     except OverflowError:  # a JSON integer beyond the float range is no double (report fuzz)
         return False
+    return x == y and math.copysign(1.0, x) == math.copysign(1.0, y)
 
 
 def _same(a: Any, b: Any) -> bool:
