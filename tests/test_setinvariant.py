@@ -875,3 +875,16 @@ delta_tol = 1e-9
     assert law.status == ClaimStatus.FAILED and "no admissible linear gain" in law.detail
     eps = float(rep.parameters.float("history_eps")[-1])
     assert 0.995 < eps <= 0.995 * (1 + 1e-9)
+
+
+def test_exact_details_show_short_decimals_alone() -> None:
+    """A detail's exact value with a short finite decimal is shown alone ("0.9", not
+    "9/10 ≈ 0.9"), else p/q beside its float, else the float marked ≈ (session 29)."""
+    from fractions import Fraction
+
+    from obsdesign.methods.setinvariant.claims import ExactBackend
+
+    assert ExactBackend.show(Fraction(9, 10)) == "0.9"
+    assert ExactBackend.show(Fraction(1)) == "1"
+    assert ExactBackend.show(Fraction(1, 3)) == "1/3 ≈ 0.333333333333"
+    assert ExactBackend.show(Fraction(10**30 + 1, 3)).startswith("≈ 3.33333333333e+29")

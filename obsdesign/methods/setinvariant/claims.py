@@ -237,6 +237,12 @@ class ExactBackend:
 
     @staticmethod
     def show(x: Any) -> str:
+        """An exact value for a detail: its finite decimal alone when it has a short one
+        ("0.9", not "9/10 ≈ 0.9"; "= 1 ≈ 1" was noise: rendering trial, session 29), else
+        p/q beside its float, else the float marked "≈"."""
+        d = fmt_exact(x)
+        if "/" not in d and len(d) <= 24:
+            return d
         t = str(x)
         return f"{t} ≈ {float(x):.12g}" if len(t) <= 24 else f"≈ {float(x):.12g}"
 
