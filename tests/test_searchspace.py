@@ -773,9 +773,13 @@ def test_K_one_is_the_rule_when_one_step_exceeds_lemma2s_horizon(tmp_path) -> No
 
 
 def _certified(sp, v: dict) -> dict:
+    return {k: c.status for k, c in _claims(sp, v).items()}
+
+
+def _claims(sp, v: dict) -> dict:
     from obsdesign.params import Parameters
 
-    return {c.id: c.status for c in api.certify(sp, Parameters(v))}
+    return {c.id: c for c in api.certify(sp, Parameters(v))}
 
 
 def test_lemma2_and_K_rule_use_the_safe_side_of_the_logarithm(example) -> None:
@@ -812,22 +816,29 @@ def test_tamper_K_one_is_not_the_rule(example, tmp_path) -> None:
 # ivq, fmpq, ClaimStatus).
 
 
-def test_lemma2_is_strict_at_the_working_precision_of_L_f_dT(example) -> None:
-    """Mutation review 21b (certify): Lemma 2 needs L_f Δτ strictly below the lower bound lo of
-    log(κ/L_h), computed at K_bits(ΔT·L_f) bits. With L_f = 2²⁰ (ΔT·L_f ≈ 6.7·10³: 114 bits;
-    ΔT/L_f ≈ 6·10⁻⁹ would give 141, a tighter lo), Δτ = lo/L_f fails ("≤" passed it, and so
-    did lo at the bits of ΔT/L_f) and Δτ = (lo − 2⁻²⁰⁰)/L_f passes."""
+def test_lemma2_is_decided_beyond_the_working_precision_of_L_f_dT(example) -> None:
+    """Mutation review 21b (certify), restated in session 29: Lemma 2 compares L_f Δτ with
+    log(κ/L_h) starting at K_bits(ΔT·L_f) bits (L_f = 2²⁰: 114 bits). At Δτ = lo/L_f, lo the
+    114-bit lower bound, L_f Δτ = lo < log 1.5 is true: it failed while 114 bits did not
+    decide it, and is certified now that undecided comparisons get more bits. Just above
+    log 1.5 (its 114-bit upper bound, or 2⁻³⁰⁰ above it) Lemma 2 fails, proved (exit 1)."""
+    import mpmath as mp
+
     sp, _ = example
     v = _consistent(sp, L_f=fmpq(2**20))
     L_f, ratio = v["L_f"], v["kappa"] / v["L_h"]
     assert ratio == fmpq(3, 2)
     bits = D.K_bits(v["dT"] * L_f)
-    assert bits == 114 and D.K_bits(v["dT"] / L_f) > bits + 20
-    lo = ivq.log_bounds(ratio, bits)[0]
-    assert lo < ivq.log_bounds(ratio, D.K_bits(v["dT"] / L_f))[0]
-    assert _certified(sp, dict(v, dtau=lo / L_f))["lemma2-consistency"] == ClaimStatus.FAILED
-    w = dict(v, dtau=(lo - fmpq(1, 2**200)) / L_f)
-    assert _certified(sp, w)["lemma2-consistency"] == ClaimStatus.CERTIFIED
+    assert bits == 114
+    lo, hi = ivq.log_bounds(ratio, bits)
+    assert _certified(sp, dict(v, dtau=lo / L_f))["lemma2-consistency"] == ClaimStatus.CERTIFIED
+    with mp.workdps(200):
+        above = Q(mp.nstr(mp.log(mp.mpf(3) / 2) + mp.mpf(2) ** -300, 190))
+    for x in (hi, above):
+        claims = _claims(sp, dict(v, dtau=x / L_f))
+        c = claims["lemma2-consistency"]
+        assert c.status == ClaimStatus.FAILED and not c.float_ok, x
+        assert "by at least" in c.detail and "−" not in c.detail
 
 
 def test_lemma2_fails_at_kappa_equal_L_h_whatever_dtau(example) -> None:
@@ -1044,11 +1055,12 @@ def test_a_function_undefined_on_part_of_its_interval_proves_nothing() -> None:
 
 
 # -- mutation review 27: the K-rule's new condition (K itself satisfies the rule) -------------
-def test_K_rule_needs_K_strictly_below_the_lower_bound(example) -> None:
-    """mutation review 27 (kills claims.x_certify__mutmut_415: `K·ΔT·L_f < lo` → `≤`).
-    ΔT = lo/63, lo the 113-bit lower bound of log 1.5 at the K-rule's precision: 63·ΔT·L_f
-    equals lo exactly, so K = 63 is not proved to satisfy KΔT < log(κ/L_h)/L_f and K-rule
-    fails (while 64·ΔT ≥ hi, the K + 1 side, holds); with `≤` it was certified."""
+def test_K_rule_decides_K_at_the_lower_bound(example) -> None:
+    """mutation review 27, restated in session 29. ΔT = lo/63, lo the 113-bit lower bound of
+    log 1.5 at the K-rule's precision: 63·ΔT·L_f = lo < log 1.5 is true and 64·ΔT ≥ hi, so
+    K = 63 is the largest — it failed while 113 bits did not decide it, and is certified now
+    that an undecided side gets more bits. ΔT = hi/63 puts 63·ΔT above log 1.5: K = 63 breaks
+    the rule, proved (exit 1)."""
     sp, _ = example
     v = _consistent(sp)
     assert v["L_f"] == 1 and v["kappa"] == fmpq(3, 2) and v["K"] == 63
@@ -1056,13 +1068,10 @@ def test_K_rule_needs_K_strictly_below_the_lower_bound(example) -> None:
     lo, hi = ivq.log_bounds(fmpq(3, 2), bits)
     dT = lo / 63
     assert D.K_bits(dT) == bits and 64 * dT >= hi
-    w = dict(v, dT=dT, dtau=63 * dT)
-    assert _certified(sp, w)["K-rule"] == ClaimStatus.FAILED
-    # a hair below lo, K = 63 is proved: the claim turns on the strict inequality alone
-    dT = lo / 63 - fmpq(1, 2**200)
-    assert D.K_bits(dT) == bits
-    w = dict(v, dT=dT, dtau=63 * dT)
-    assert _certified(sp, w)["K-rule"] == ClaimStatus.CERTIFIED
+    assert _certified(sp, dict(v, dT=dT, dtau=63 * dT))["K-rule"] == ClaimStatus.CERTIFIED
+    dT = hi / 63
+    c = _claims(sp, dict(v, dT=dT, dtau=63 * dT))["K-rule"]
+    assert c.status == ClaimStatus.FAILED and not c.float_ok and "K itself breaks" in c.detail
 
 
 def test_K_rule_K_one_with_a_small_L_f_is_not_the_rule(example) -> None:
@@ -1094,3 +1103,120 @@ def test_K_rule_works_at_the_precision_of_dT_times_L_f(example) -> None:
     assert ivq.log_bounds(fmpq(3, 2), D.K_bits(dT / L_f))[1] > hi  # the mutant's bound
     w = dict(v, dT=dT, dtau=K * dT)
     assert _certified(sp, w)["K-rule"] == ClaimStatus.CERTIFIED
+
+
+#: γ⋆ (60 digits) for which 63·ΔT lies 1.7e-59 below ln 1.5 ("dn": the largest K is 63) or
+#: 4.6e-59 above it ("up": 62); ΔT = γ⋆/4 with α = 1/2 and L_f = L_h = f_sup = 1
+_TIE_GAMMA = {
+    "dn": (
+        "0.025743816387819960760508769235831691210920026886507568102476",
+        "0.077231449163459882281526307707495073632760080659522704307428",
+    ),
+    "up": (
+        "0.025743816387819960760508769235831691210920026886507568102480",
+        "0.077231449163459882281526307707495073632760080659522704307440",
+    ),
+}
+
+
+def _tie_spec(side: str, extra: str = "") -> str:
+    g_star, g0 = _TIE_GAMMA[side]
+    return f"""[system]
+time = "continuous"
+states = ["x1"]
+f = ["-x1"]
+h = ["x1"]
+[method]
+key = "search-space"
+alpha = 0.5
+gamma_star = {g_star}
+gamma0 = {g0}
+L_f = 1
+L_h = 1
+f_sup = 1
+kappa = 1.5
+{extra}[method.E]
+lower = [-1]
+upper = [1]
+[method.D]
+lower = [-0.5]
+upper = [0.5]
+"""
+
+
+def _largest_K(side: str) -> int:
+    """The largest K with K·ΔT < ln 1.5, by mpmath at 300 digits (independent)."""
+    from fractions import Fraction
+
+    import mpmath as mp
+
+    with mp.workdps(300):
+        dT = Fraction(_TIE_GAMMA[side][0]) / 4
+        return int(mp.floor(mp.log(mp.mpf(3) / 2) / (mp.mpf(dT.numerator) / dT.denominator)))
+
+
+@pytest.mark.parametrize("side", ["dn", "up"])
+def test_K_rule_decides_a_near_tie(side: str) -> None:
+    """63·ΔT within 1e-58 of ln 1.5: the design picks the largest K (62 where 63 was largest,
+    and "a larger K also keeps Lemma 2's horizon" beside the right K: search-space trial,
+    session 29) and every claim certifies; K = 63 given on the 'dn' side certifies Lemma 2
+    (it failed "by at least −4.36e-35")."""
+    want = _largest_K(side)
+    assert want == (63 if side == "dn" else 62)
+    rep = api.design(api.load_spec_text(_tie_spec(side), "tie.toml"))
+    assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
+    assert rep.parameters["K"] == want
+    if side == "dn":
+        given = api.design(api.load_spec_text(_tie_spec(side, "K = 63\n"), "tie.toml"))
+        assert given.exit_code() == 0, [(c.id, c.detail) for c in given.failed]
+
+
+@pytest.mark.parametrize(
+    ("side", "K", "why"), [("dn", 62, "a larger K also keeps"), ("up", 63, "K itself breaks")]
+)
+def test_K_rule_near_a_tie_refuses_the_wrong_K(side: str, K: int, why: str) -> None:
+    """A report whose K is one off at the near tie fails K-rule with the side proved (exit
+    1); the lemma 2 claim of a K one too large fails with a positive excess."""
+    rep = api.design(api.load_spec_text(_tie_spec(side), "tie.toml"))
+    p = rep.parameters
+    p["K"] = fmpq(K)
+    p["dtau"] = K * p["dT"]
+    claims = {c.id: c for c in api.certify(api.load_spec_text(_tie_spec(side), "tie.toml"), p)}
+    assert claims["K-rule"].status == ClaimStatus.FAILED and why in claims["K-rule"].detail
+    assert not claims["K-rule"].float_ok
+    lemma2 = claims["lemma2-consistency"]
+    if K > _largest_K(side):
+        assert lemma2.status == ClaimStatus.FAILED and not lemma2.float_ok
+        assert "by at least" in lemma2.detail and "−" not in lemma2.detail.split("by at least")[1]
+    else:
+        assert lemma2.status == ClaimStatus.CERTIFIED
+
+
+def test_K_rule_undecided_at_the_cap_is_inconclusive(monkeypatch: pytest.MonkeyPatch) -> None:
+    """With the cap at 150 bits the near tie cannot be decided: the design keeps the K it
+    proved (62 on the 'dn' side) and K-rule is inconclusive (exit 4: no proof either way),
+    not failed; Lemma 2 holds for 62."""
+    from obsdesign.methods.searchspace import claims as SC
+
+    monkeypatch.setattr(D, "MAX_K_BITS", 150)
+    monkeypatch.setattr(SC, "MAX_K_BITS", 150)
+    rep = api.design(api.load_spec_text(_tie_spec("dn"), "tie.toml"))
+    assert rep.parameters["K"] == 62 and rep.exit_code() == 4
+    (bad,) = rep.failed
+    assert bad.id == "K-rule" and bad.float_ok and "not decided at 150 bits" in bad.detail
+
+
+def test_log_compare_decides_by_doubling_and_says_when_it_cannot() -> None:
+    """x against ln r: decided at the precision that separates them, None at the cap; r = 1
+    exactly (ln 1 = 0)."""
+    import mpmath as mp
+
+    with mp.workdps(400):
+        ln15 = mp.log(mp.mpf(3) / 2)
+        near = Q(mp.nstr(ln15 + mp.mpf(10) ** -300, 390))  # 1e-300 above ln 1.5
+    assert ivq.log_compare(near, fmpq(3, 2))[0] == 1
+    d, lo, hi = ivq.log_compare(near, fmpq(3, 2), max_bits=500)
+    assert d is None and lo <= near <= hi
+    assert ivq.log_compare(fmpq(0), fmpq(1))[0] == 0
+    assert ivq.log_compare(fmpq(-1), fmpq(1))[0] == -1
+    assert ivq.log_compare(fmpq(2, 5), fmpq(3, 2))[0] == -1  # ln 1.5 ≈ 0.405

@@ -134,6 +134,35 @@ def log_bounds(x: Any, bits: int = PREC) -> tuple[fmpq, fmpq]:
     return raw_to_q(lo), raw_to_q(hi)
 
 
+def log_compare(
+    x: Any, r: Any, bits: int = PREC, max_bits: int = 65536
+) -> tuple[int | None, fmpq, fmpq]:
+    """x against ln r (x exact, r > 0 exact), decided by enclosures of ln r at ``bits``,
+    doubled up to ``max_bits``: (−1 when x < ln r, +1 when x > ln r, 0 when x = ln r, None
+    when still undecided at ``max_bits``) and the enclosure (lower, upper) that decided (the
+    last one tried when undecided). For rational r ≠ 1, ln r is irrational
+    (Lindemann–Weierstrass), so equality happens only at r = 1, x = 0, decided exactly; any
+    other tie is decided once the enclosure is narrower than |x − ln r|. The K of Theorem 1
+    and Lemma 2 (search-space paper) at a near tie: a fixed 121 bits called a Lemma 2 that
+    holds failed by "at least −4.4e-35" (search-space trial, session 29).
+
+    :param x: the exact number compared; :param r: the argument of ln; :param bits: the
+    first working precision; :param max_bits: the most tried."""
+    q, xq = Q(r), Q(x)
+    if q == 1:
+        return (0 if xq == 0 else (1 if xq > 0 else -1)), fmpq(0), fmpq(0)
+    b = max(PREC, bits)
+    while True:
+        lo, hi = log_bounds(q, b)
+        if xq < lo:
+            return -1, lo, hi
+        if xq > hi:
+            return 1, lo, hi
+        if b >= max_bits:
+            return None, lo, hi
+        b = min(2 * b, max_bits)
+
+
 exp_upper: Callable[[Any], fmpq] = partial(upper, iv.exp)
 exp_lower: Callable[[Any], fmpq] = partial(lower, iv.exp)
 

@@ -21,6 +21,7 @@ from obsdesign.certify.exact import Q
 from obsdesign.certify.printing import fmt_down, fmt_exact, fmt_up
 from obsdesign.methods.searchspace import bounds
 from obsdesign.methods.searchspace.design import (
+    MAX_K_BITS,
     MAX_SCHEDULE,
     SCHEDULE_RTOL,
     K_bits,
@@ -142,24 +143,40 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         float_ok=float(dtau) == float(K) * float(dT),
     )
     ratio = kappa / L_h
+    bits = K_bits(dT * L_f)
+    undecided = (
+        f"not decided at {MAX_K_BITS} bits: the product lies within the enclosure of "
+        "log(κ/L_h) (no proof either way)"
+    )
     if o.K is None:
         if ratio > 1:
-            lo_k, hi = ivq.log_bounds(ratio, K_bits(dT * L_f))
+            # each side decided at more bits where 113 plus those of 1/(ΔT·L_f) do not tell
+            # it from log(κ/L_h) (a near tie: "a larger K also keeps Lemma 2's horizon" for
+            # the largest K; search-space trial, session 29); undecided is exit 4, not 1.
             # K itself must satisfy the rule (or be the floor 1): only K + 1 failing was
             # checked, and K = 64 for the example's 63 read "certified" (search-space trial,
             # session 27; Lemma 2's claim failed beside it)
-            larger_fails = (K + 1) * dT * L_f >= hi or K == 1 and dT * L_f >= hi
-            itself_holds = K == 1 or K * dT * L_f < lo_k
-            ok = bool(k_int and larger_fails and itself_holds)
+            step = dT * L_f
+            itself = True if K == 1 else _below_log(K * step, ratio, bits)
+            larger = _below_log((K + 1) * step, ratio, bits)
+            larger_fails = None if larger is None else not larger
+            if K == 1 and larger_fails is not True:
+                one = _below_log(step, ratio, bits)  # the floor: even K = 1 breaks the rule
+                larger_fails = True if one is False else larger_fails
+            ok = bool(k_int and larger_fails is True and itself is True)
+            open_ = k_int and not ok and False not in (itself, larger_fails)
             if not k_int:
                 why, margin = "K is not an integer ≥ 1", fmpq(-1)
-            elif not itself_holds:  # the detail named the other side (re-check, session 27)
+            elif open_:
+                why, margin = undecided, fmpq(0)
+            elif itself is False:  # the detail named the other side (re-check, session 27)
                 why = "K ΔT L_f is not below log(κ/L_h): K itself breaks the rule (too large)"
-                margin = lo_k - K * dT * L_f
+                margin = ivq.log_bounds(ratio, bits)[0] - K * step
             else:
-                why, margin = "a larger K also keeps Lemma 2's horizon", (K + 1) * dT * L_f - hi
+                why = "a larger K also keeps Lemma 2's horizon"
+                margin = (K + 1) * step - ivq.log_bounds(ratio, bits)[1]
         else:
-            ok = bool(K == 1)
+            ok, open_ = bool(K == 1), False
             why, margin = "κ ≤ L_h: the rule's K is 1", fmpq(0 if ok else -1)
         _verdict(
             c,
@@ -168,28 +185,32 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
             "(at least 1, the paper's max{·, 1})",
             "Theorem 1, hypothesis 1",
             "(K+1)·ΔT·L_f ≥ upper bound of log(κ/L_h), and K = 1 or K·ΔT·L_f < its lower "
-            "bound (outward rounding, 113 bits plus those of 1/(ΔT·L_f))",
+            f"bound (outward rounding, 113 bits plus those of 1/(ΔT·L_f), doubled up to "
+            f"{MAX_K_BITS} where a side is not decided)",
             ok,
             why,
             margin=margin,
+            undecided=open_,
         )
     if ratio > 1:
-        lo = ivq.log_bounds(ratio, K_bits(dT * L_f))[0]
-        ok2 = bool(L_f * dtau < lo)
+        d, lo, hi = ivq.log_compare(L_f * dtau, ratio, bits, MAX_K_BITS)
+        ok2, open2 = d == -1, d is None
         stmt_bound = f" (log(κ/L_h^E)/L_f^E ≥ {fmt_down(lo / L_f, 8)})"
-        excess = fmt_down(L_f * dtau - ivq.log_upper(ratio))
+        excess = undecided if open2 else f"by at least {fmt_down(L_f * dtau - hi)}"
     else:
-        lo, ok2, stmt_bound, excess = fmpq(0), False, "", "κ ≤ L_h"
+        lo, ok2, open2, stmt_bound, excess = fmpq(0), False, False, "", "by κ ≤ L_h"
     _verdict(
         c,
         "lemma2-consistency",
         f"Δτ = {fmt_exact(dtau)} < log(κ/L_h^E)/L_f^E{stmt_bound}",
         "Lemma 2 (consistency) with γ_i/ε_i = κ, Theorem 1",
-        "L_f·Δτ < lower bound of log(κ/L_h) (outward rounding, 113 bits plus those of 1/(ΔT·L_f))",
+        "L_f·Δτ < lower bound of log(κ/L_h) (outward rounding, 113 bits plus those of "
+        f"1/(ΔT·L_f), doubled up to {MAX_K_BITS} where not decided)",
         ok2,
-        f"L_f Δτ exceeds log(κ/L_h) by at least {excess}"
-        + (" (K = 1 already too long: decrease α or γ⋆)" if K == 1 else ""),
+        (undecided if open2 else f"L_f Δτ exceeds log(κ/L_h) {excess}")
+        + (" (K = 1 already too long: decrease α or γ⋆)" if K == 1 and not open2 else ""),
         margin=lo - L_f * dtau,
+        undecided=open2,
     )
     _schedule(c, gam, g_star, L_f, dtau)
     bad_eps = _first_bad_eps(eps, gam, kappa)
@@ -225,10 +246,12 @@ def _verdict(
     ok: bool,
     why: str,
     margin: Any = 0,
+    undecided: bool = False,
 ) -> None:
     """An exact claim on exact data (Lemmas 1-2, Theorem 1 of Hernández & García) whose float
     check is the same verdict: ``why`` is its detail when it fails, ``where`` the place in
-    the paper."""
+    the paper; ``undecided``: not proved either way (a comparison with a logarithm that
+    MAX_K_BITS do not decide), so the claim fails as inconclusive (exit 4), not as false."""
     c.exact(
         id=cid,
         statement=statement,
@@ -237,8 +260,15 @@ def _verdict(
         passed=ok,
         margin=margin,
         detail="" if ok else why,
-        float_ok=ok,
+        float_ok=ok or undecided,
     )
+
+
+def _below_log(x: fmpq, r: fmpq, bits: int) -> bool | None:
+    """Whether x < ln r, decided at ``bits`` doubled up to :data:`MAX_K_BITS`
+    (:func:`obsdesign.certify.interval.log_compare`); None when not decided there."""
+    d = ivq.log_compare(x, r, bits, MAX_K_BITS)[0]
+    return None if d is None else d < 0
 
 
 def _by(what: str, x: fmpq, lo: fmpq, hi: fmpq) -> str:

@@ -157,9 +157,18 @@ def K_rule(kappa: fmpq, L_h: fmpq, L_f: fmpq, dT: fmpq) -> int:
     Δτ = KΔT keeps Lemma 2's consistency horizon; at least 1 (the paper's max{·, 1})."""
     if kappa <= L_h:
         return 1
-    lo, _ = ivq.log_bounds(kappa / L_h, K_bits(L_f * dT))
-    k = int((lo / (L_f * dT)).ceil()) - 1
-    return max(k, 1)
+    r, s = kappa / L_h, L_f * dT
+    lo, _ = ivq.log_bounds(r, K_bits(s))
+    k = max(int((lo / s).ceil()) - 1, 1)  # k·s < lo ≤ ln r: k keeps the rule (or is the floor)
+    # K + 1 may keep it too when ln r lies within the enclosure's width of (k + 1)·s: decide
+    # it at more bits (a near tie gave K = 62 where 63 is the largest: search-space trial,
+    # session 29); undecided at MAX_K_BITS, the smaller K stays (the K-rule claim then says
+    # it is not decided, exit 4)
+    for _ in range(8):  # one step at most unless K_bits is capped (K beyond 10¹⁹⁷⁰⁰)
+        if ivq.log_compare((k + 1) * s, r, K_bits(s), MAX_K_BITS)[0] != -1:
+            break
+        k += 1
+    return k
 
 
 def K_bits(step: fmpq) -> int:
