@@ -1220,3 +1220,19 @@ def test_log_compare_decides_by_doubling_and_says_when_it_cannot() -> None:
     assert ivq.log_compare(fmpq(0), fmpq(1))[0] == 0
     assert ivq.log_compare(fmpq(-1), fmpq(1))[0] == -1
     assert ivq.log_compare(fmpq(2, 5), fmpq(3, 2))[0] == -1  # ln 1.5 ≈ 0.405
+
+
+@pytest.mark.parametrize(("boxes", "ok"), [(20_000, True), (20_001, False), (10**8, False)])
+def test_bound_boxes_is_capped(boxes: int, ok: bool) -> None:
+    """bound_boxes = 10⁸ ran for hours in design, and in verify of a 3-KB report whose
+    embedded spec asked for it (search-space trial, session 29): at most 20,000, exit 2
+    naming the key above (the spec is only loaded here, not designed)."""
+    from obsdesign.methods.searchspace import options as O
+
+    text = SPEC.read_text().replace("[method]\n", f"[method]\nbound_boxes = {boxes}\n", 1)
+    assert O.MAX_BOUND_BOXES == 20_000
+    if ok:
+        assert api.load_spec_text(text, "b.toml").options.bound_boxes == boxes
+    else:
+        with pytest.raises(SpecError, match=r"\[method\.bound_boxes\] expected at most 20,000"):
+            api.load_spec_text(text, "b.toml")

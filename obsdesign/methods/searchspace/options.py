@@ -169,13 +169,31 @@ def parse_options(table: Table, spec: Spec) -> Options:
         L_f=_opt_pos(table, "L_f"),
         L_h=_opt_pos(table, "L_h"),
         f_sup=_opt_pos(table, "f_sup"),
-        bound_boxes=table.int("bound_boxes", default=300, min=1),
+        bound_boxes=_bound_boxes(table),
         bound_rtol=float(table.scalar("bound_rtol", default=fmpq(1, 1000), min=0).f),
         digits=_digits(table),
         t0=table.scalar("t0", default=fmpq(0)).q,
     )
     table.done()
     return opts
+
+
+#: sub-boxes per constant at most (``[method] bound_boxes``): about 1,500 a second, so 10⁸
+#: ran for hours in design and in verify of a 3-KB report (search-space trial, session 29);
+#: this many take about 15 s per constant
+MAX_BOUND_BOXES = 20_000
+
+
+def _bound_boxes(table: Table) -> int:
+    """``[method] bound_boxes``: 1 … :data:`MAX_BOUND_BOXES`."""
+    n = int(table.int("bound_boxes", default=300, min=1))
+    if n > MAX_BOUND_BOXES:
+        raise table.error(
+            "bound_boxes",
+            f"expected at most {MAX_BOUND_BOXES:,} sub-boxes per constant (about 15 s each); "
+            "give L_f, L_h or f_sup in [method] for a bound the branch and bound cannot reach",
+        )
+    return n
 
 
 #: RK4 substeps a sample at most (``[simulate] substeps``): 10⁹ built one Python tuple per
@@ -238,7 +256,7 @@ def options_schema(key: str) -> dict[str, Any]:
             "L_f": pos,
             "L_h": pos,
             "f_sup": pos,
-            "bound_boxes": {"type": "integer", "minimum": 1},
+            "bound_boxes": {"type": "integer", "minimum": 1, "maximum": MAX_BOUND_BOXES},
             "bound_rtol": {"type": "number", "minimum": 0},
             "digits": {"type": "integer", "minimum": 2, "maximum": MAX_DIGITS},
         },
