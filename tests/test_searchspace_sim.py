@@ -401,10 +401,15 @@ def test_substeps_are_bounded_and_a_hopeless_flow_error_is_not_halved_forever(ex
     assert O.MAX_SUBSTEPS == 100_000
     sp, _, _ = example
     plant = S.Plant(sp)
-    P = np.array([[0.0, 1e300]])
+    P = np.array([[0.0, np.inf]])
     with np.errstate(all="ignore"):
         steps, err = S.partition(plant, P, 0.0, 0.1, 4, 1e-12)
     assert len(steps) == 4 and not np.isfinite(err)  # not halved: the estimate is not finite
+    # x = 1e300: the estimate is finite since its norm is scaled (it overflowed to inf before
+    # session 29), so the sample is halved — at most MAX_EXTRA_PIECES times
+    with np.errstate(all="ignore"):
+        steps, err = S.partition(plant, np.array([[0.0, 1e300]]), 0.0, 0.1, 4, 1e-12)
+    assert np.isfinite(err) and len(steps) == 4 + S.MAX_EXTRA_PIECES
     P = np.array([[0.0, 1.5]])
     steps, _ = S.partition(plant, P, 0.0, 0.1, 4, 0.0)  # a tolerance no halving meets
     assert len(steps) == 4 + S.MAX_EXTRA_PIECES
@@ -484,3 +489,39 @@ def test_progress_goes_to_stderr_and_quiet_silences_it(tmp_path):
     json.loads(r.stdout)  # stdout holds the JSON alone
     r = runner.invoke(app, [*args[:4], "-q"])
     assert r.exit_code == 0 and r.stdout == "" and "centres" not in r.stderr
+
+
+def test_distances_do_not_underflow_at_tiny_scales() -> None:
+    """A plant on E = [−1e-198, 1e-198]²: the squares of the distances underflow, so
+    final_error, final_true_cell and the true_cell series read 0 beside a final |e| of
+    2.9e-201 (search-space trial, session 29). They now agree with the scaled norm, and the
+    true cell is within the bound at every sample."""
+    text = """[system]
+time = "continuous"
+states = ["x1", "x2"]
+f = ["-x1", "-x2"]
+h = ["x1", "x2"]
+[method]
+key = "search-space"
+alpha = 0.9
+gamma_star = 1e-199
+gamma0 = 1e-198
+[method.E]
+lower = [-1e-198, -1e-198]
+upper = [1e-198, 1e-198]
+[method.D]
+lower = [-5e-199, -5e-199]
+upper = [5e-199, 5e-199]
+[simulate]
+horizon = 2
+x0 = [3e-199, 3e-199]
+xhat0 = [0, 0]
+"""
+    sim = api.simulate(api.load_spec_text(text, "tiny.toml"))
+    info = sim.info
+    e = sim.xhat[-1] - sim.x[-1]
+    want = math.hypot(*(float(v) for v in e))
+    assert want > 0 and info["final_error"] == pytest.approx(want, rel=1e-12)
+    near = np.asarray(sim.extra["true_cell"])
+    assert np.all(near > 0) and info["final_true_cell"] > 0
+    assert np.all(near <= np.asarray(sim.extra["bound"]))

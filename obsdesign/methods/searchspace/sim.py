@@ -44,7 +44,7 @@ from obsdesign.limits import limits
 from obsdesign.methods.searchspace.options import Options, SimOptions
 from obsdesign.params import Parameters
 from obsdesign.simulate.budget import TimeBudget
-from obsdesign.simulate.result import SimResult
+from obsdesign.simulate.result import SAFE_HI, SAFE_LO, SimResult, norms
 from obsdesign.spec.models import Spec
 
 CHUNK = 1 << 15
@@ -205,7 +205,7 @@ def partition(
         a, w, depth = todo.pop()
         one = rk4(plant, P, a, w, 1)
         two = rk4(plant, P, a, w, 2)
-        err = float(np.max(np.linalg.norm(one - two, axis=1))) * 16 / 15 if len(P) else 0.0
+        err = float(np.max(norms(one - two))) * 16 / 15 if len(P) else 0.0
         if err > tol and depth < MAX_SPLITS and splits < MAX_EXTRA_PIECES and math.isfinite(err):
             splits += 1
             todo += [(a + w / 2, w / 2, depth + 1), (a, w / 2, depth + 1)]
@@ -254,7 +254,7 @@ def flow_error(plant: Plant, X: np.ndarray, t: float, dt: float, nsub: int) -> f
         return 0.0
     a = rk4(plant, X, t, dt, nsub)
     b = rk4(plant, X, t, dt, 2 * nsub)
-    return float(np.max(np.linalg.norm(a - b, axis=1))) * 16 / 15
+    return float(np.max(norms(a - b))) * 16 / 15
 
 
 def cover_box(lo: np.ndarray, hi: np.ndarray, s: float) -> np.ndarray:
@@ -643,13 +643,26 @@ def _record(
     run.xhat.append(c)
     run.live.append(len(C))
     run.err9.append(np.max(np.abs(C - x), axis=0))
-    run.near.append(float(np.sqrt(np.min(np.einsum("ij,ij->i", C - x, C - x)))))
-    spread = float(np.max(np.linalg.norm(C - c, axis=1)))
+    run.near.append(_row_norm(C - x, np.min))
+    spread = _row_norm(C - c, np.max)
     run.bound.append(spread + eps * math.exp(L_f * since))
     run.gamma.append(gamma)
     if k % so.store_every == 0:
         sub = C if len(C) <= 4000 else C[:: len(C) // 4000 + 1]
         run.stored.append((t, sub.copy()))
+
+
+def _row_norm(D: np.ndarray, pick: Any) -> float:
+    """``pick`` (np.min or np.max) of the Euclidean norms of the rows of D, the squares
+    summed directly (fast, at millions of centres) unless the picked square lies outside
+    [SAFE_LO², SAFE_HI²], where they underflow or overflow: then row by row scaled
+    (:func:`obsdesign.simulate.result.norms`). On a plant of size 10⁻²⁰⁰ the true cell's
+    distance read 0 at every sample next to a final |e| of 2.9·10⁻²⁰¹ (search-space trial,
+    session 29)."""
+    sq = float(pick(np.einsum("ij,ij->i", D, D)))
+    if SAFE_LO * SAFE_LO <= sq <= SAFE_HI * SAFE_HI:
+        return math.sqrt(sq)
+    return float(pick(norms(D)))
 
 
 def _diagnose(
@@ -683,7 +696,7 @@ def _diagnose(
             msg.append(outside)
             return " ".join(msg)
         bound = eps * math.exp(L_f * since) + flow_err
-        d = float(np.min(np.linalg.norm(C - x, axis=1))) if len(C) else math.inf
+        d = _row_norm(C - x, np.min) if len(C) else math.inf
         if "refinement" in where and d <= bound:
             msg.append(
                 f"The nearest survivor was within (2)'s bound ({d:.4g} ≤ {bound:.4g}), so a "
@@ -762,7 +775,7 @@ def _result(
     x = np.array(run.x)
     xhat = np.array(run.xhat)
     err9 = np.array(run.err9)
-    final = float(np.linalg.norm(xhat[-1] - x[-1]))
+    final = float(norms(xhat[-1] - x[-1]))
     info = {
         "eps_star": params.float("eps_star"),
         "final_error": final,
