@@ -525,3 +525,24 @@ xhat0 = [0, 0]
     near = np.asarray(sim.extra["true_cell"])
     assert np.all(near > 0) and info["final_true_cell"] > 0
     assert np.all(near <= np.asarray(sim.extra["bound"]))
+
+
+@pytest.mark.parametrize(
+    ("h", "want"),
+    [
+        ('["x1"]', {0: [0]}),
+        ('["x1 + x2", "x1 - x2"]', {}),  # y1 was drawn on the x1 panel as "output y"
+        ('["x2", "x1"]', {1: [0], 0: [1]}),
+        ('["2*x1"]', {}),
+    ],
+)
+def test_outputs_are_drawn_only_on_the_panel_of_the_state_they_are(h: str, want: dict) -> None:
+    """An output goes on a state's panel only when it is that state (search-space trial,
+    session 29: with h = [x1 + x2, x1 − x2] y1 was drawn on x1's panel, y2 nowhere)."""
+    from obsdesign.methods.searchspace.plots import output_panels
+
+    old = 'h = ["x1*step(x1)"]'
+    assert old in TEXT
+    text = TEXT.replace(old, f"h = {h}")
+    sp = api.load_spec_text(text, "p.toml")
+    assert output_panels(sp, ["x1", "x2"]) == want

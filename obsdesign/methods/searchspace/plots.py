@@ -28,6 +28,7 @@ def plot_simulation(spec: Spec, res: SimResult, path: str | Path) -> Path:
     ts = np.concatenate([np.full(len(c), t) for t, c in stored]) if stored else np.zeros(0)
     cs = np.concatenate([c for _, c in stored]) if stored else np.zeros((0, n))
     names = res.states or [f"x{i + 1}" for i in range(n)]
+    panels = output_panels(spec, names)
     for i, ax in enumerate(axes[:n]):
         # rasterized: in a vector format (svg, pdf) each of up to millions of centres was its
         # own path (the template's svg was 87 MB); the lines stay vectors
@@ -36,8 +37,9 @@ def plot_simulation(spec: Spec, res: SimResult, path: str | Path) -> Path:
         )
         ax.plot(res.t, res.x[:, i], "k", lw=1.2, label=f"true {names[i]}")
         ax.plot(res.t, res.xhat[:, i], "tab:red", lw=0.8, label="centroid estimate")
-        if i == 0 and res.y is not None:
-            ax.plot(res.t, res.y[:, 0], "tab:green", lw=0.8, ls="--", label="output y")
+        for j in panels.get(i, []) if res.y is not None else []:
+            label = "output y" if res.y.shape[1] == 1 else f"output y{j + 1}"
+            ax.plot(res.t, res.y[:, j], "tab:green", lw=0.8, ls="--", label=f"{label} = {names[i]}")
         _switches(ax, res)
         ax.set_ylabel(names[i])
         ax.legend(loc="upper right", fontsize=7, markerscale=6)
@@ -63,6 +65,31 @@ def plot_simulation(spec: Spec, res: SimResult, path: str | Path) -> Path:
     from obsdesign.simulate.plot import save_figure
 
     return save_figure(fig, path, dpi=120)
+
+
+def output_panels(spec: Spec, names: list[str]) -> dict[int, list[int]]:
+    """{state i: the outputs j with y_j = x_i}: an output is drawn on a state's panel only
+    when it is that state (h_j the bare name, or row j of C the unit vector e_i). y₁ was drawn
+    on the x₁ panel as "output y" whatever h was (h = [x1 + x2, x1 − x2]: one line, y₂ never
+    shown; search-space trial, session 29).
+
+    :param spec: the spec (its h, else its C); :param names: the state names in order."""
+    import ast
+
+    out: dict[int, list[int]] = {}
+    s = spec.system
+    if s.h:
+        for j, e in enumerate(s.h):
+            body = e.tree.body
+            if isinstance(body, ast.Name) and body.id in names:
+                out.setdefault(names.index(body.id), []).append(j)
+    elif s.C is not None:
+        C = np.asarray(s.C.f if hasattr(s.C, "f") else s.C, dtype=float)
+        for j, row in enumerate(C):
+            nz = np.flatnonzero(row)
+            if len(nz) == 1 and row[nz[0]] == 1.0:
+                out.setdefault(int(nz[0]), []).append(j)
+    return out
 
 
 def _switches(ax: Any, res: SimResult) -> None:
