@@ -120,6 +120,24 @@ def test_lipschitz_valid_and_tight(f, true_L, slack):
     assert b.upper <= true_L * slack
 
 
+@pytest.mark.parametrize(
+    ("f", "true_L", "slack"),
+    [
+        ("x1/1e-200", 1e200, 1.0 + 1e-12),  # b² underflowed to [0, ·]: "no finite bound"
+        ("x1/(x2 + 3)", math.hypot(1 / 2, 1 / 4), 1.5),
+        ("1/(x1 + 3)", 1 / 4, 1.01),
+        ("(x1 + x2)/(x1 - 4)", math.sqrt(34) / 9, 2.0),  # at (1, 1): (−5/9, −1/3)
+    ],
+)
+def test_lipschitz_of_quotients(f, true_L, slack):
+    """The quotient rule as (a' − b'·(a/b))/b encloses the derivative without b² (session
+    29): a tiny constant divisor is bounded; quotients of varying terms stay valid."""
+    ex = [parse_expr(f, ["x1", "x2"])]
+    b = B.lipschitz(ex, ["x1", "x2"], ["x1", "x2"], [-1, -1], [1, 1], 200, 1e-3)
+    assert b.finite and b.upper >= true_L * (1 - 1e-12)
+    assert b.upper <= true_L * slack
+
+
 def test_lipschitz_of_a_jump_is_infinite():
     ex = [parse_expr("step(x1)", ["x1"])]
     b = B.lipschitz(ex, ["x1"], ["x1"], [-1], [1], 50, 1e-3)
