@@ -286,7 +286,7 @@ def error_report(sp: Spec, code: int, message: str) -> Report:
 
 
 def design_error(e: Exception) -> tuple[int, str]:
-    """(exit code, message) of an exception that stopped a design, as its error report
+    """(exit code, message) of the exception ``e`` that stopped a design, as its error report
     records them: an :class:`ObsdesignError`'s own, any other exception an internal failure
     (exit 3)."""
     if isinstance(e, ObsdesignError):
