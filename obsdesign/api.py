@@ -880,7 +880,8 @@ def _simulate_spans(
             k = batches or max(1, sum(c.nthreads().values()))
             parts = run_tasks(fn, spans(k), client=c, chunk=1)
     warns = [w for p in parts for w in p.info.pop("warnings", []) if w]
-    res = merge(parts, sp.system.states)
+    res = merge(parts, sp.system.states)  # adds the warnings counted over every run
+    warns += res.info.pop("warnings", [])
     if warns:
         res.info["warnings"] = list(dict.fromkeys(warns))
     return res

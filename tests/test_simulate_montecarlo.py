@@ -474,3 +474,52 @@ def test_metrics_of_errors_near_the_ends_of_the_float_range(s: str) -> None:
         [mc_q["rmse"]["x1"]["max"], mc_q["rmse"]["x2"]["max"], mc_q["final_error_norm"]["max"]],
     ):
         np.testing.assert_allclose(got, [*rms, fin], rtol=1e-10)
+
+
+@pytest.mark.parametrize("scale", ["1e200", "1e-200"])
+@pytest.mark.parametrize("case", ["uniform noise", "random u, d, noise"])
+def test_rmse_beyond_the_squares_range_is_every_runs_own_for_any_span(case, scale) -> None:
+    """Initial errors of size 10^±200: the running sum of e² overflows (underflows) for every
+    run. At most 64 runs were measured again, per span, so two spans printed other quantiles
+    than one, and the 36 runs left at inf moved the serial quantiles by 30–46 % (Dask trial,
+    session 29). Every such run is now measured again (scaled): each run's RMSE is the one of
+    the same run simulated on its own, and spans give the serial run's numbers bit for bit."""
+    s = float(scale)
+    box = f"lower = [{-2 * s!r}, {-s!r}]\nupper = [{2 * s!r}, {s!r}]"
+    text = CASES[case].replace("lower = [-2, -1]\nupper = [2, 1]", box)
+    assert box in text
+    runs = 70  # > 64: the old cap
+    whole, sp = _run(text, runs)
+    rmse = whole.extra["per_run"]["rmse"]
+    assert np.all(np.isfinite(rmse)) and np.all(rmse > 0)
+    for i, m in enumerate(r.metrics() for r in separate(sp, runs)):
+        np.testing.assert_allclose(rmse[i], [m["rmse"]["x1"], m["rmse"]["x2"]], rtol=1e-12)
+    js = joint_system(sp, L)
+    parts = [mc.run_batch(sp, js, runs, "E0", span=sp_) for sp_ in ((0, 30), (30, 70))]
+    merged = mc.merge(parts, sp.system.states)
+    for k, arr in whole.extra["per_run"].items():
+        np.testing.assert_array_equal(arr, merged.extra["per_run"][k])
+    assert merged.info["quantiles"] == whole.info["quantiles"]
+
+
+def test_run_seed_is_the_spawned_child() -> None:
+    """A batch makes only its own seeds (10⁷ runs spawned all of theirs, 4 GB, before the
+    first time-limit check; Dask trial, session 29): child r alone is spawn's child r."""
+    kids = mc.run_seeds(11, 5)
+    for r in range(5):
+        a, b = np.random.default_rng(kids[r]), np.random.default_rng(mc.run_seed(11, r))
+        assert np.array_equal(a.random(4), b.random(4))
+
+
+def test_nonfinite_runs_are_counted_over_every_span() -> None:
+    """Two spans of 100 runs each said "36 of 100 runs" for 72 of 200 (each span counted its
+    own and the texts merged; Dask trial, session 29): a span leaves the count to merge."""
+    per_run = {
+        "sup_abs_error": np.ones((4, 2)),
+        "rmse": np.array([[1.0, 1.0], [np.inf, 1.0], [1.0, 1.0], [1.0, np.nan]]),
+        "sup_abs_estimate": np.ones((4, 2)),
+        "final_error_norm": np.ones(4),
+    }
+    assert mc.nonfinite_warning(per_run).startswith("the metrics of 2 of 4 runs are not finite")
+    per_run["rmse"][1:] = 1.0
+    assert mc.nonfinite_warning(per_run) == ""

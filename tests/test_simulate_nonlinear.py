@@ -205,3 +205,26 @@ def test_a_signal_the_expressions_do_not_name_is_warned() -> None:
         notes = api.simulate(load_spec_text(text)).info.get("warnings", [])
         said = any(f"[simulate.{sig}] reaches nothing" in w for w in notes)
         assert said is warned, (line, notes)
+
+
+@pytest.mark.parametrize("scale", [1e200, 1e-200])
+def test_rmse_of_errors_beyond_the_squares_range(scale: float) -> None:
+    """Errors of 10^±200 on an expression plant: the plain sum of e² gave RMSE inf (or 0);
+    it is kept scaled by the running max |e| (Dask trial, session 29), and each run's RMSE is
+    the separate run's, computed here with its own scale."""
+    box = f"lower = [{-2 * scale!r}, {-scale!r}]\nupper = [{2 * scale!r}, {scale!r}]"
+    text = scenario(PSI, horizon=200, noise={"kind": "constant", "value": [0.0]}).replace(
+        "lower = [-2, -1]\nupper = [2, 1]", box
+    )
+    assert box in text
+    sp = load_spec_text(text)
+    r = simulate_linear_observer_batch(sp, L, 4, "E0")
+    rmse = r.extra["per_run"]["rmse"]
+    assert np.all(np.isfinite(rmse)) and np.all(rmse > 0)
+    E = r.error  # run 0's error trajectory: its RMSE with its own scale
+    top = np.abs(E).max(axis=0)
+    np.testing.assert_allclose(rmse[0], top * np.sqrt(((E / top) ** 2).mean(axis=0)), rtol=1e-12)
+    for i in range(4):  # max |e| / √(K + 1) ≤ RMSE ≤ max |e|, each run
+        top = r.extra["per_run"]["sup_abs_error"][i]
+        assert np.all(top / np.sqrt(201) <= rmse[i] * (1 + 1e-12))
+        assert np.all(rmse[i] <= top * (1 + 1e-12))

@@ -95,6 +95,14 @@ def run_seeds(seed: int, runs: int) -> list[np.random.SeedSequence]:
     return np.random.SeedSequence(seed).spawn(runs)
 
 
+def run_seed(seed: int, r: int) -> np.random.SeedSequence:
+    """Child r of :func:`run_seeds` alone (the same seed: ``spawn`` gives child r the spawn key
+    (r,)), so a batch or a span makes only its own: 10⁷ runs spawned all their seeds (4 GB)
+    before the first time-limit check, and every Dask worker spawned all N (Dask trial,
+    session 29)."""
+    return np.random.SeedSequence(seed, spawn_key=(r,))
+
+
 def initial_errors(
     eset: ConvexSet | None, rngs: list[np.random.Generator], default: np.ndarray
 ) -> np.ndarray:
@@ -329,10 +337,12 @@ def run_batch(
 
     budget = study_options.get("budget")
 
-    def step(rngs: list[np.random.Generator], e0: np.ndarray, keep: bool) -> Any:
+    def step(
+        rngs: list[np.random.Generator], e0: np.ndarray, keep: bool, scaled: bool = False
+    ) -> Any:
         draws = _Draws(plan.rand, plan.fast, sigs, rngs, grid) if plan.rand else None
         traj0 = np.empty((K + 1, len(plan.idx))) if keep else None
-        m = _run(plan, draws, sim.x0.f, e0, K, n, traj0, budget)
+        m = _run(plan, draws, sim.x0.f, e0, K, n, traj0, budget, scaled)
         if traj0 is None:
             return m, None
         x, e = _trajectory(plan, traj0, n)
@@ -389,8 +399,11 @@ def study(
         raise InputError(f"{spec.file}: initial_error = {initial_error!r} is not in [sets]")
     eset = spec.sets[initial_error] if initial_error is not None else None
     n = s.n
-    children = run_seeds(sim.seed, runs)[first:last]
     total, runs = runs, last - first  # below: runs of the span, indexed from 0
+
+    def children(a: int, b: int) -> list[np.random.SeedSequence]:
+        return [run_seed(sim.seed, first + r) for r in range(a, b)]
+
     cap = int(max(1, min(runs, BATCH_RUNS, BATCH_BYTES // max(per_run_bytes, 1))))
     B = batch or -(-runs // -(-runs // cap))  # equal batches of at most `cap` runs
     out = {k: np.zeros((runs, n)) for k in METRICS[:3]}
@@ -400,7 +413,7 @@ def study(
     for b0 in range(0, runs, B):
         if budget is not None:
             budget.check(f"{b0:,} of {runs:,} Monte Carlo runs done")
-        rngs = [np.random.default_rng(c) for c in children[b0 : b0 + B]]
+        rngs = [np.random.default_rng(c) for c in children(b0, min(b0 + B, runs))]
         try:
             e0 = initial_errors(eset, rngs, sim.xhat0.f - sim.x0.f)
         except InputError as e:  # a thin set a run could not draw from: name file and key
@@ -413,7 +426,7 @@ def study(
         traj = t0 if b0 == 0 else traj
         for k, a in m.items():
             out[k][b0 : b0 + len(rngs)] = a
-    _remeasure(out, children, eset, sim.xhat0.f - sim.x0.f, step, s.states)
+    _remeasure(out, children, eset, sim.xhat0.f - sim.x0.f, step, B, budget)
     y0 = traj[2] if len(traj) > 2 else None
     err = traj[3] if len(traj) > 3 else None
     res = SimResult(grid, traj[0], traj[1], y0, s.states, error=err)
@@ -425,58 +438,66 @@ def study(
     if span is not None:
         res.info["span"] = [first, last]
     res.info["quantiles"] = quantiles(out, s.states)
-    bad = ~np.all(np.isfinite(np.hstack([a.reshape(runs, -1) for a in out.values()])), axis=1)
-    if bad.any():
-        # numpy's "overflow encountered in multiply" was the only word (review)
-        warnings.warn(
-            f"the metrics of {int(bad.sum()):,} of {runs:,} runs are not finite: their errors "
-            "or estimates leave the float range, so their quantiles are inf or nan; smaller "
-            "initial errors or a shorter horizon",
-            stacklevel=2,
-        )
+    text = nonfinite_warning(out)
+    if text and span is None:  # a span's count is of its runs: merge says it for all
+        warnings.warn(text, stacklevel=2)
     return res
 
 
-#: the most runs :func:`_remeasure` steps again one by one
-MAX_REMEASURED = 64
+def nonfinite_warning(per_run: dict[str, np.ndarray]) -> str:
+    """The warning for runs whose metrics are not finite ("" when there are none), counted
+    over every run given: numpy's "overflow encountered in multiply" was the only word
+    (review), and a study in two spans said "36 of 100 runs" for 136 of 200, each span
+    counting its own and the two texts merged (Dask trial, session 29)."""
+    runs = len(per_run["final_error_norm"])
+    flat = np.hstack([a.reshape(runs, -1) for a in per_run.values()])
+    bad = int((~np.all(np.isfinite(flat), axis=1)).sum())
+    if not bad:
+        return ""
+    return (
+        f"the metrics of {bad:,} of {runs:,} runs are not finite: their errors or estimates "
+        "leave the float range, so their quantiles are inf or nan; smaller initial errors or "
+        "a shorter horizon"
+    )
 
 
 def _remeasure(
     out: dict[str, np.ndarray],
-    children: list[np.random.SeedSequence],
+    children: Any,
     eset: Any,
     e_default: np.ndarray,
     step: Any,
-    states: list[str],
+    batch: int,
+    budget: TimeBudget | None = None,
 ) -> None:
     """The RMSE of the runs whose running sum of e² left the float range — overflowed (inf
-    beside a finite sup |e|) or may have underflowed (sup |e| < 10⁻¹⁵⁰) — measured again from
-    the run's own trajectory with :func:`obsdesign.simulate.result.metrics` (scaled): the
-    quantiles printed RMSE inf for errors of 10²⁰⁰ and 0.0 for 10⁻²⁰⁰ while run 0's table said
-    3.6·10²⁰⁰ (simulate trial, session 27). At most :data:`MAX_REMEASURED` runs (each is
-    stepped again alone); the others keep the running sum, said in a warning."""
-    from obsdesign.simulate.result import metrics
+    beside a finite sup |e|) or may have underflowed (sup |e| < 10⁻¹⁵⁰) — stepped again
+    together, ``batch`` at a time, with the sum of squares scaled by each position's running
+    max |e| (``step(..., scaled=True)``): the quantiles printed RMSE inf for errors of 10²⁰⁰
+    and 0.0 for 10⁻²⁰⁰ while run 0's table said 3.6·10²⁰⁰ (simulate trial, session 27). Every
+    such run is measured again: at most 64 were, one by one, counted per span, so a study on
+    two Dask workers printed other quantiles than the serial run, whose 36 runs left at inf
+    moved its finite quantiles by 30–46 % (Dask trial, session 29). A run's numbers do not
+    depend on the runs beside it (see :func:`_run`), so the result is the same for any span.
 
+    :param out: the per-run metrics (``rmse`` is updated); :param children: ``(a, b)`` →
+    the child seeds of the span's runs a..b-1; :param eset, e_default: where the initial
+    errors come from; :param step: the batch stepper of :func:`study`; :param batch: runs
+    stepped together; :param budget: the time budget, looked at per batch."""
     sup, rmse = out["sup_abs_error"], out["rmse"]
     with np.errstate(all="ignore"):
         bad = np.flatnonzero(
             np.any(np.isfinite(sup) & ((~np.isfinite(rmse)) | (sup < 1e-150) & (sup > 0)), axis=1)
         )
-    for r in bad[:MAX_REMEASURED]:
-        rng = np.random.default_rng(children[r])
-        e0 = initial_errors(eset, [rng], e_default)
+    for b0 in range(0, len(bad), batch):
+        if budget is not None:
+            budget.check(f"{b0:,} of {len(bad):,} runs measured again (errors near 1e±154)")
+        rows = bad[b0 : b0 + batch]
+        rngs = [np.random.default_rng(children(int(r), int(r) + 1)[0]) for r in rows]
+        e0 = initial_errors(eset, rngs, e_default)
         with np.errstate(over="ignore", invalid="ignore"):
-            _, t = step([rng], e0, True)
-        e = t[3] if len(t) > 3 and t[3] is not None else t[1] - t[0]
-        m = metrics(e, states)
-        rmse[r] = [m["rmse"][name] for name in states]
-    if len(bad) > MAX_REMEASURED:
-        warnings.warn(
-            f"the RMSE of {len(bad):,} runs left the float range in its running sum of e² "
-            f"(errors near 1e154 or 1e-154); {MAX_REMEASURED} were measured again from their "
-            "trajectories, the others' RMSE is inf or too small",
-            stacklevel=3,
-        )
+            m, _ = step(rngs, e0, False, scaled=True)
+        rmse[rows] = m["rmse"]
 
 
 def _run(
@@ -488,6 +509,7 @@ def _run(
     n: int,
     traj0: np.ndarray | None,
     budget: TimeBudget | None = None,
+    scaled: bool = False,
 ) -> dict[str, np.ndarray]:
     """Step one batch (initial errors ``e0`` (R, n)) over K steps; per-run metrics.
 
@@ -501,7 +523,10 @@ def _run(
     The metrics are running elementwise max / min / sum of squares over the blocks (whole
     contiguous arrays), reduced over the m positions once at the end. ``traj0`` (K + 1, N)
     receives run 0's stepped states ([x; e], or e) when given; ``budget`` (the time budget)
-    is looked at before every chunk of :data:`CHUNK` steps."""
+    is looked at before every chunk of :data:`CHUNK` steps. ``scaled``: the sum of squares
+    of each position is kept over its running max |e| (:func:`_scaled_add`), so the RMSE
+    neither overflows near 10¹⁵⁴ nor underflows near 10⁻¹⁵⁴ (slower: :func:`_remeasure`
+    asks for it for the runs where the plain sum left the float range)."""
     R, N = len(e0), len(plan.idx)
     Rr = max(R, 2)
     shared_x = plan.x_sh is not None
@@ -518,7 +543,8 @@ def _run(
     bm = _BlockMatrices(plan, K, n)
     hi = np.full((2, Rr, BLOCK * n), -np.inf)  # running max of [H; E] per position
     lo = np.full((2, Rr, BLOCK * n), np.inf)
-    sq = np.zeros((Rr, BLOCK * n))  # running sum of E² per position
+    sq = np.zeros((Rr, BLOCK * n))  # running sum of E² per position (scaled: of (E/sc)²)
+    sc = np.zeros((Rr, BLOCK * n)) if scaled else None  # running max |E| per position
     # per block length: [H; E] stacked (each half contiguous, and the whole: one max and one
     # min call per block for both), X and a scratch T
     bufs = {
@@ -562,15 +588,20 @@ def _run(
                 np.add(E, X, out=H)
                 st[:, :n] = X[:, cm - n :]
             st[:, N - n : N] = E[:, cm - n :]
-            np.multiply(E, E, out=T)
+            if sc is not None:
+                _scaled_add(sq[:, :cm], sc[:, :cm], E)
+            else:
+                np.multiply(E, E, out=T)
             if full:
                 np.maximum(hi, HE, out=hi)
                 np.minimum(lo, HE, out=lo)
-                np.add(sq, T, out=sq)
+                if sc is None:
+                    np.add(sq, T, out=sq)
             else:  # a last, shorter block: its cm first positions
                 hi[:, :, :cm] = np.maximum(hi[:, :, :cm], HE)
                 lo[:, :, :cm] = np.minimum(lo[:, :, :cm], HE)
-                sq[:, :cm] += T
+                if sc is None:
+                    sq[:, :cm] += T
             if traj0 is not None:
                 traj0[k0 + 1 : k0 + m + 1, N - n :] = E[0].reshape(m, n)
                 if not shared_x:
@@ -579,12 +610,47 @@ def _run(
     e_end = E[:R, -n:] if K else e
     top = np.maximum(hi[:, :R], -lo[:, :R]).reshape(2, R, BLOCK, n).max(axis=2)
     sup_h, sup_e = top[0], top[1]
+    if sc is None:
+        rmse = np.sqrt((e * e + sq[:R].reshape(R, BLOCK, n).sum(axis=1)) / (K + 1))
+    else:
+        rmse = _scaled_rmse(sq[:R].reshape(R, BLOCK, n), sc[:R].reshape(R, BLOCK, n), e, K + 1)
     return {
         "sup_abs_error": np.maximum(sup_e, np.abs(e)),
-        "rmse": np.sqrt((e * e + sq[:R].reshape(R, BLOCK, n).sum(axis=1)) / (K + 1)),
+        "rmse": rmse,
         "sup_abs_estimate": np.maximum(sup_h, np.abs(xh0)),
         "final_error_norm": norms(e_end),
     }
+
+
+def _scaled_add(sq: np.ndarray, sc: np.ndarray, E: np.ndarray) -> None:
+    """sq ← Σ (e/sc)² with sc ← max(sc, |e|), in place, entry by entry: the running sum of
+    squares kept relative to the running max |e|, rescaled when the max grows, so that it
+    neither overflows nor underflows (:func:`_scaled_rmse` puts the scale back).
+
+    :param sq, sc: the running scaled sums and scales (views, updated); :param E: the new
+    errors, the same shape."""
+    new = np.maximum(sc, np.abs(E))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = np.where(new > 0, sc / new, 0.0)
+        q = np.where(new > 0, E / new, 0.0)
+    sq *= r * r
+    sq += q * q
+    sc[...] = new
+
+
+def _scaled_rmse(sq: np.ndarray, sc: np.ndarray, e0: np.ndarray, count: int) -> np.ndarray:
+    """The RMSE per run and state from :func:`_scaled_add`'s sums over the positions (R, m, n)
+    and the initial error e0 (R, n): S·√((Σ_pos sq·(sc/S)² + (e0/S)²)/count) with S the
+    largest scale, computed without forming any square of a number near 10^±154.
+
+    :param sq, sc: the scaled sums and their scales; :param e0: the initial errors;
+    :param count: the number of errors summed (K + 1)."""
+    S = np.maximum(sc.max(axis=1), np.abs(e0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        Sd = np.where(S > 0, S, 1.0)
+        rel = sc / Sd[:, None, :]
+        tot = (sq * rel * rel).sum(axis=1) + (e0 / Sd) ** 2
+    return np.where(S > 0, S * np.sqrt(tot / count), 0.0)
 
 
 def _matmul_for(rows: int, inner: int, cols: int) -> Any:
@@ -672,6 +738,9 @@ def merge(parts: list[SimResult], states: list[str]) -> SimResult:
     res.extra["initial_errors"] = np.concatenate([p.extra["initial_errors"] for p in parts])
     res.info.pop("span", None)
     res.info["quantiles"] = quantiles(out, states)
+    text = nonfinite_warning(out)
+    if text:  # counted over every run (each span leaves it to merge)
+        res.info["warnings"] = [*res.info.get("warnings", []), text]
     return res
 
 
