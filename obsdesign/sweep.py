@@ -445,6 +445,22 @@ def failure_row(task: PointTask, code: int, message: str, method: str = "") -> d
     }
 
 
+def task_method(task: PointTask) -> str:
+    """The method of a point whose run left no row (a worker lost with it): its spec's
+    ``[method] key`` when that is a known method, else "" (the row of a lost point had an
+    empty method where check's names it; Dask trial, session 29)."""
+    import tomllib
+
+    from obsdesign.methods import method_keys
+
+    try:
+        doc = tomllib.loads(point_text(task.text, task.values, task.file))
+    except Exception:  # noqa: BLE001 - a point that does not read has no method to name
+        return ""
+    key = doc.get("method", {}).get("key") if isinstance(doc.get("method"), dict) else None
+    return key if isinstance(key, str) and key in method_keys() else ""
+
+
 def run_point(task: PointTask) -> dict[str, Any]:
     """Design, serialize, reload and verify one point (and simulate it when asked): its
     row. Never raises (but KeyboardInterrupt): an error is the row's exit code and message;
@@ -453,21 +469,25 @@ def run_point(task: PointTask) -> dict[str, Any]:
     from obsdesign import api
 
     t0 = time.perf_counter()
+    seen = [""]  # the method, once the point's spec is loaded
     try:
         with api._time_budget(task.timeout):
-            return _run_point(task, t0)
+            return _run_point(task, t0, seen)
     except api.SpecTimeout:
+        # the method named, as check's row does (it was empty: Dask trial, session 29)
         row = failure_row(
             task,
             EXIT_SOLVER,
             f"not finished within {task.timeout:g} s (sweep --timeout SECONDS; 0: no limit)",
+            seen[0],
         )
         row["seconds"] = round(time.perf_counter() - t0, 4)
         return row
 
 
-def _run_point(task: PointTask, t0: float) -> dict[str, Any]:
-    """:func:`run_point` without the time budget."""
+def _run_point(task: PointTask, t0: float, seen: list[str]) -> dict[str, Any]:
+    """:func:`run_point` without the time budget; ``seen[0]`` becomes the point's method once
+    its spec is loaded."""
     from obsdesign import api
     from obsdesign.report.model import Report
 
@@ -476,7 +496,7 @@ def _run_point(task: PointTask, t0: float) -> dict[str, Any]:
     try:
         text = point_text(task.text, task.values, name)
         sp = api.load_spec_text(text, name)
-        method = sp.method
+        method = seen[0] = sp.method
         rep = api.design(sp)
         t1 = time.perf_counter()
         ver = api.verify(Report.from_dict(rep.to_dict())[0])
@@ -655,7 +675,7 @@ def sweep_rows(
     _, tasks = plan(spec, grid, simulate, options, timeout)
 
     def lost(task: PointTask, message: str) -> dict[str, Any]:
-        return failure_row(task, EXIT_SOLVER, message)
+        return failure_row(task, EXIT_SOLVER, message, task_method(task))
 
     return run_rows(run_point, tasks, lost, workers, scheduler, client, on_row)
 

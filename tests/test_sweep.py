@@ -414,6 +414,21 @@ def test_a_point_past_the_timeout_gets_its_row_and_the_others_keep_theirs() -> N
     rows = sw.sweep_rows(spec, grid, timeout=1.0)
     assert [r["exit_code"] for r in rows] == [0, 3]
     assert rows[1]["message"].startswith("not finished within 1 s")
+    # named as check's row names it (it was empty: Dask trial, session 29)
+    assert rows[1]["method"] == rows[0]["method"] == "search-space"
+
+
+def test_a_lost_point_names_its_method(tmp_path: Path) -> None:
+    """A point lost with a dying worker had an empty method (Dask trial, session 29): its
+    spec's [method] key when it is a known method, else ""."""
+    text = '[system]\nA = [[0.5]]\nC = [[1]]\n[method]\nkey = "lyapunov"\n'
+    spec = tmp_path / "s.toml"
+    spec.write_text(text)
+    _, tasks = sw.plan(spec, ["system.A=[[[0.1]], [[0.2]]]"])
+    assert [sw.task_method(t) for t in tasks] == ["lyapunov", "lyapunov"]
+    spec.write_text(text.replace("lyapunov", "lyapunovv"))
+    _, tasks = sw.plan(spec, ["system.A=[[[0.1]]]"])
+    assert sw.task_method(tasks[0]) == ""
 
 
 def test_set_key_is_not_fooled_by_a_multiline_string_further_down() -> None:
