@@ -36,7 +36,7 @@ if _os.environ.get(WORKER_ENV) == "1":
     _signal.signal(_signal.SIGINT, _signal.SIG_IGN)
 elif _signal.getsignal(_signal.SIGINT) is _signal.default_int_handler and _os.path.basename(
     _sys.argv[0] if _sys.argv else ""
-) in ("obsdesign", "cli.py"):
+) in ("obsdesign", "cli.py", "-m"):  # "-m": ``python -m obsdesign`` importing this package
     _signal.signal(_signal.SIGINT, _early_interrupt)
 
 __version__ = "0.1.0"

@@ -253,6 +253,30 @@ def test_early_interrupt_handler_installed_by_the_package():
     assert r.stdout.strip() == "False"  # a library import leaves Ctrl-C alone
 
 
+def test_python_dash_m_runs_the_command_line(tmp_path: Path):
+    """``python -m obsdesign`` is the console script (there was no __main__: two trials of
+    session 29 reached for it); its early Ctrl-C handler is installed as for the script."""
+    r = subprocess.run(
+        [sys.executable, "-m", "obsdesign", "--version"], capture_output=True, text=True, timeout=60
+    )
+    assert r.returncode == 0 and r.stdout.strip().startswith("obsdesign ")
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[system\n")
+    r = subprocess.run(
+        [sys.executable, "-m", "obsdesign", "design", str(bad)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert r.returncode == 2 and r.stderr.count("\n") == 1 and "Traceback" not in r.stderr
+    code = (
+        "import sys; sys.argv[0] = '-m'; import obsdesign, signal; "
+        "print(signal.getsignal(signal.SIGINT) is obsdesign._early_interrupt)"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert r.stdout.strip() == "True"
+
+
 def test_check_table_at_80_columns(spec: Path, tmp_path: Path):
     si = tmp_path / "si.toml"
     si.write_text(runner.invoke(app, ["init", "set-invariant"]).stdout)
