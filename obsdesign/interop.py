@@ -412,8 +412,19 @@ def observer_statespace(report: Any, law: str | None = None, verify: bool = Fals
             UserWarning,
             stacklevel=2,
         )
+    if report.method not in LINEAR:
+        raise InputError(_NOT_LINEAR.format(method=report.method, linear=", ".join(LINEAR)))
     sp = load_spec_text(report.spec, report.spec_file or "<report>")
     s, params = sp.system, report.parameters
+    if s.A is None or s.C is None:
+        # AttributeError "'NoneType' object has no attribute 'f'" for the shipped stubborn
+        # high-gain spec (Duffing, f and h only) and every search-space design (outsider
+        # trial, session 29)
+        raise InputError(
+            f"{where}: the plant of method '{report.method}' is given by expressions "
+            "([system] f / h), not by the matrices A and C: its observer is not a linear "
+            "state-space system and is not offered as a python-control system"
+        )
     n, p = s.n, s.p
     A, C = np.asarray(s.A.f, float), np.asarray(s.C.f, float)
     B = np.asarray(s.B.f, float).reshape(n, -1)
@@ -454,11 +465,15 @@ def observer_statespace(report: Any, law: str | None = None, verify: bool = Fals
 
             return linear(make_law(sp, params, "linear").L, -1.0)
         return _setinvariant_nonlinear(ct, sp, params, use, A, B, C, D, dt, inputs, outputs, name)
-    raise InputError(
-        f"method '{report.method}': its observer is not linear (constrained: projection onto "
-        f"X̂; impulsive: sampled and hybrid; search-space: set-valued) and is not offered as "
-        f"a python-control system; observers are offered for {', '.join(LINEAR)}"
-    )
+    raise InputError(_NOT_LINEAR.format(method=report.method, linear=", ".join(LINEAR)))
+
+
+#: why a method's observer is not offered as a python-control system
+_NOT_LINEAR = (
+    "method '{method}': its observer is not linear (constrained: projection onto X̂; "
+    "impulsive: sampled and hybrid; search-space: set-valued) and is not offered as a "
+    "python-control system; observers are offered for {linear}"
+)
 
 
 def _setinvariant_nonlinear(

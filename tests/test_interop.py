@@ -626,3 +626,22 @@ def test_other_exact_rationals_are_written_exactly() -> None:
     assert _value(fmpq(3, 8)) == "0.375" and _value(sympy.Rational(-1, 4)) == "-0.25"
     with pytest.raises(InputError, match="no finite decimal"):
         _value([fmpq(1, 3)])
+
+
+@pytest.mark.parametrize(
+    ("spec", "match"),
+    [
+        ("astolfi-stubborn-duffing.toml", "given by expressions"),
+        ("hernandez-garcia-example.toml", "search-space.*not offered"),
+    ],
+)
+def test_observer_statespace_refuses_a_plant_without_matrices(spec: str, match: str) -> None:
+    """A stubborn high-gain design (plant given by f and h) and a search-space design raised
+    AttributeError "'NoneType' object has no attribute 'f'" (outsider trial, session 29): a
+    one-line InputError says why there is no python-control system."""
+    from obsdesign import api
+    from obsdesign.errors import InputError
+
+    rep = api.design(Path(__file__).resolve().parents[1] / "specs" / spec)
+    with pytest.raises(InputError, match=match):
+        rep.observer_statespace()
