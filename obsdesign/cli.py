@@ -628,7 +628,11 @@ def import_mat(
         typer.Option(
             "--dt",
             metavar="SECONDS",
-            help="Sample time: discrete time (default, or 0: continuous; not with --dt-var).",
+            help=(
+                "Sample time: discrete time with this sample time; 0: continuous time (not "
+                "with --dt-var). Without --dt and --dt-var the spec is continuous time (refused "
+                "when the file holds a scalar named like a sample time, e.g. Ts)."
+            ),
         ),
     ] = None,
     dt_var: Annotated[

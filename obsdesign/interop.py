@@ -516,6 +516,11 @@ def _setinvariant_nonlinear(
 
 
 # -- MATLAB .mat → spec ------------------------------------------------------------------------
+#: variable names (lower case, without "_") that :func:`spec_text_from_mat` reads as a
+#: sample time the user did not choose
+_SAMPLE_TIME_NAMES = frozenset({"ts", "dt", "tsample", "sampletime", "samplingtime"})
+
+
 def spec_text_from_mat(
     path: str | Path,
     names: Mapping[str, str | None],
@@ -525,7 +530,8 @@ def spec_text_from_mat(
 ) -> str:
     """Spec text from the matrices of a MATLAB ``.mat`` file: ``names`` maps ``A``, ``B``,
     ``C``, ``D``, ``Bd`` to variable names in the file (``None``: absent). The sample time is
-    ``dt`` or the scalar variable ``dt_name`` (none: continuous time)."""
+    ``dt`` or the scalar variable ``dt_name`` (0: continuous time; neither: continuous time,
+    refused when the file holds a scalar named like a sample time, e.g. ``Ts``)."""
     from scipy.io import loadmat, whosmat
 
     from obsdesign.limits import limits, read_input
@@ -583,6 +589,21 @@ def spec_text_from_mat(
     B, D, Bd = var("B"), var("D"), var("Bd")
     if Bd is not None and Bd.size == 0:
         Bd = None  # no disturbance input: "Bd = [[], []]" was refused by the loader
+    if dt is None and dt_name is None:
+        # no time given: continuous. A discrete plant exported with its Ts became a
+        # continuous-time spec without a word, every claim certified about another system
+        # (outsider trial, session 29): a scalar named like a sample time asks for a choice
+        ts = [
+            k
+            for k, shape in shapes.items()
+            if k.lower().replace("_", "") in _SAMPLE_TIME_NAMES and int(np.prod(shape)) == 1
+        ]
+        if ts:
+            raise InputError(
+                f"{path}: the file holds '{ts[0]}', which reads as a sample time: give "
+                f"--dt-var {ts[0]} for discrete time, or --dt 0 for continuous time (without "
+                "--dt the spec is continuous time)"
+            )
     given = "--dt"
     if dt is not None and not (math.isfinite(dt) and dt >= 0):
         raise InputError(f"--dt {dt!r}: expected a finite number >= 0 (0: continuous time)")

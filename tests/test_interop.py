@@ -645,3 +645,28 @@ def test_observer_statespace_refuses_a_plant_without_matrices(spec: str, match: 
     rep = api.design(Path(__file__).resolve().parents[1] / "specs" / spec)
     with pytest.raises(InputError, match=match):
         rep.observer_statespace()
+
+
+@pytest.mark.parametrize("name", ["Ts", "dt", "T_s", "SampleTime"])
+def test_import_without_a_time_choice_refuses_a_file_holding_a_sample_time(
+    tmp_path: Path, name: str
+) -> None:
+    """A discrete plant exported with its Ts became a continuous-time spec without a word
+    (outsider trial, session 29): with neither --dt nor --dt-var, a scalar named like a
+    sample time asks for the choice (exit 2); --dt-var or --dt 0 decide; a file without
+    one is continuous time as before."""
+    from scipy.io import savemat
+
+    from obsdesign.errors import InputError
+    from obsdesign.interop import spec_text_from_mat
+
+    mat = tmp_path / "p.mat"
+    plant = {"A": np.array([[0.7, 0.7], [-0.7, 0.7]]), "C": np.array([[1.0, 1.0]])}
+    savemat(mat, {**plant, name: np.array([[0.1]])})
+    names = {"A": "A", "C": "C"}
+    with pytest.raises(InputError, match=f"holds '{name}'.*--dt-var {name}.*--dt 0"):
+        spec_text_from_mat(mat, names)
+    assert 'time = "discrete"' in spec_text_from_mat(mat, names, dt_name=name)
+    assert 'time = "continuous"' in spec_text_from_mat(mat, names, dt=0.0)
+    savemat(mat, plant)
+    assert 'time = "continuous"' in spec_text_from_mat(mat, names)
