@@ -237,6 +237,16 @@ def test_default_width_not_a_terminal(spec: Path, tmp_path: Path, monkeypatch: p
     assert max(len(x) for x in out.splitlines()) == 90
 
 
+def test_columns_below_40_get_40(spec: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch):
+    """COLUMNS=20 wrapped every cell to 6 characters (outsider trial, session 29): the width
+    is at least 40, the least --width takes."""
+    report = tmp_path / "r.json"
+    assert _run("design", str(spec), "-q", "-o", str(report))[0] == 0
+    monkeypatch.setenv("COLUMNS", "20")
+    lines = _run("verify", str(report))[1].splitlines()[:-1]  # the verdict line is one line
+    assert max(len(x) for x in lines) == 40
+
+
 def test_early_interrupt_handler_installed_by_the_package():
     code = (
         "import sys, signal; sys.argv[0] = '/x/bin/obsdesign'; import obsdesign; "

@@ -74,6 +74,8 @@ def _numeric(v: Any) -> bool:
 
 #: ``--width N`` of the command line (None: see :func:`width`)
 _WIDTH: dict[str, int | None] = {"width": None}
+#: the narrowest table width (``--width`` refuses less; COLUMNS or a terminal below it get it)
+MIN_WIDTH = 40
 #: width of tables when stdout is not a terminal and COLUMNS is not set (CI logs, pipes)
 DEFAULT_WIDTH = 100
 #: below this width the claims table puts check and detail under the statement
@@ -90,7 +92,7 @@ def set_width(n: int | None) -> None:
 def width() -> int | None:
     """The table width: ``--width`` if given, else ``COLUMNS`` if set to a positive number,
     else the terminal's width (None: rich asks the terminal) when stdout is a terminal, else
-    :data:`DEFAULT_WIDTH` columns."""
+    :data:`DEFAULT_WIDTH` columns; never below :data:`MIN_WIDTH`."""
     import os
     import sys
 
@@ -98,8 +100,15 @@ def width() -> int | None:
         return _WIDTH["width"]
     env = os.environ.get("COLUMNS", "").strip()
     if env.isdigit() and int(env) > 0:
-        return int(env)
-    return None if sys.stdout.isatty() else DEFAULT_WIDTH
+        # at least MIN_WIDTH, as --width: COLUMNS=20 wrapped every cell to 6 characters
+        # (outsider trial, session 29)
+        return max(MIN_WIDTH, int(env))
+    if not sys.stdout.isatty():
+        return DEFAULT_WIDTH
+    import shutil
+
+    cols = shutil.get_terminal_size((DEFAULT_WIDTH, 24)).columns
+    return None if cols >= MIN_WIDTH else MIN_WIDTH
 
 
 def console() -> Any:
