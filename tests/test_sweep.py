@@ -667,3 +667,31 @@ def test_sweep_cell_of_none_and_of_an_integer() -> None:
 
     assert _sweep_cell(None) == ""
     assert _sweep_cell(6) == "6" and _sweep_cell("ok") == "ok"
+
+
+def test_plot_marks_points_that_are_not_ok_over_the_whole_range(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Failed points at an end of the range were off the axis: the README's sweep drew
+    0.96 … 0.99 of 0.90 … 0.99 and nothing said six points failed (outsider trial, session
+    29). The x range covers every swept value and the failed ones are marked ×."""
+    from obsdesign.simulate import plot as simplot
+
+    figs = []
+    monkeypatch.setattr(simplot, "save_figure", lambda fig, path, dpi: figs.append(fig))
+    axes = sw.parse_grid(["method.lambda=0.90:0.99:10"])
+    rows = [
+        {"method.lambda": 0.9 + i / 100, "exit_code": 0 if i >= 6 else 1, "mu": 10.0 - i}
+        for i in range(10)
+    ]
+    sw.plot_sweep(rows, axes, "mu", tmp_path / "p.png")
+    (ax,) = figs[0].axes
+    lo, hi = ax.get_xlim()
+    assert lo < 0.90 and hi > 0.99
+    marks = [ln for ln in ax.lines if ln.get_label().startswith("not ok")]
+    assert len(marks) == 1 and list(marks[0].get_xdata()) == pytest.approx(
+        [0.9 + i / 100 for i in range(6)]
+    )
+    figs.clear()
+    sw.plot_sweep([dict(r, exit_code=0) for r in rows], axes, "mu", tmp_path / "q.png")
+    assert not [ln for ln in figs[0].axes[0].lines if ln.get_label().startswith("not ok")]
