@@ -672,9 +672,11 @@ def simulate(
 
         m = get_method(sp.method)
         if "span" not in inspect.signature(m.simulate).parameters:
+            # "has no Monte Carlo runs" for impulsive, whose --runs 5 prints quantiles over
+            # 5 runs (outsider trial, session 29): its runs are not split, not absent
             raise InputError(
-                f"method '{sp.method}' has no Monte Carlo runs to distribute: "
-                "run it without --workers/--scheduler"
+                f"method '{sp.method}' does not distribute its simulation runs on Dask: "
+                "run it without --workers/--scheduler (its runs, if any, run in this process)"
             )
         if batches is not None and batches < 1:
             raise InputError(f"batches: expected a positive number, got {batches}")

@@ -1346,3 +1346,18 @@ def test_iss_gain_beyond_the_float_range_is_exit_4(time: str, extra: str, bd: st
     if time == "discrete":
         ok = api.design(load_spec_text(text.replace(bd, "1e148"), "mu.toml"))
         assert ok.exit_code() == 0
+
+
+def test_riccati_Q_zero_with_an_unstable_plant_certifies() -> None:
+    """lyapunov.md said riccati_Q = 0 with an unstable A is still exit 4; A = [[1.5]]
+    certifies (outsider trial, session 29): the Riccati gain with Q = 0 mirrors the pole to
+    1/1.5, and the certified λ lies just above it."""
+    text = (
+        '[system]\ntime = "discrete"\nA = [[1.5]]\nC = [[1]]\n'
+        '[method]\nkey = "lyapunov"\nriccati_Q = [[0]]\n'
+    )
+    rep = api.design(load_spec_text(text, "q0.toml"))
+    assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
+    pole = abs(Q(3) / 2 - Q(np.asarray(rep.parameters["L"], dtype=object).ravel()[0]))
+    best = Q(rep.parameters["lambda_best"])
+    assert abs(pole - Q(2) / 3) < fmpq(1, 10**9) and pole < best < Q(2) / 3 + fmpq(1, 1000)

@@ -101,7 +101,7 @@ def test_method_without_monte_carlo_refuses_workers():
     spec = ROOT / "specs" / "astolfi-stubborn-example1.toml"
     r = CliRunner().invoke(app, ["simulate", str(spec), "--workers", "2"])
     assert r.exit_code == 2, r.output
-    assert "no Monte Carlo runs to distribute" in r.output
+    assert "does not distribute its simulation runs" in r.output
 
 
 def test_the_single_scenario_is_not_distributed() -> None:

@@ -507,6 +507,12 @@ def test_study_option_via_cli_json(tmp_path: Path, how: list[str]) -> None:
     assert r.exit_code == 0, r.output
     out = json.loads(r.output)
     assert "outlier_study" in out and "stubborn" in out["outlier_study"]
+    # the table says what its numbers are (outsider trial, session 29)
+    assert (
+        out["outlier_study"]
+        .lstrip("\n")
+        .startswith("median RMSE of each state's error over 3 runs")
+    )
 
 
 def test_study_table_prints_as_lines_in_text(tmp_path: Path) -> None:

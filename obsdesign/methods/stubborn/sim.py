@@ -330,11 +330,17 @@ def study(
 
 
 def format_table(st: dict[str, Any], states: list[str]) -> str:
-    """The study as a text table like the slides' (medians of the RMSEs)."""
+    """The study as a text table like the slides' (medians of the RMSEs), titled with what
+    its numbers are (neither text nor Markdown said they are median RMSEs: outsider trial,
+    session 29)."""
     amps = [f"{a:g}" for a in st["amplitudes"]]
+    title = (
+        f"median RMSE of each state's error over {st['runs']} runs, per observer and outlier "
+        "amplitude a"
+    )
     head = f"{'observer':20s}" + "".join(f"{'a=' + a:>{12 * len(states)}s}" for a in amps)
     sub = f"{'':20s}" + "".join(f"{s:>12s}" for _ in amps for s in states)
-    rows = [head, sub]
+    rows = [title, head, sub]
     for ob, byamp in st["median_rmse"].items():
         rows.append(f"{ob:20s}" + "".join(f"{byamp[a][s]:12.4g}" for a in amps for s in states))
     return "\n".join(rows)
