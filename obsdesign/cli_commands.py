@@ -311,6 +311,8 @@ def _print_rows(rows: list[Any], fmt: Fmt) -> None:
     from obsdesign.report.render import console, esc
 
     c = console()
+    if not rows:  # (check refuses an empty list of specs before; the widths need a row)
+        return
     cells = [
         (
             esc(r.spec),

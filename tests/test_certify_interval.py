@@ -242,3 +242,48 @@ def test_raw_to_q_refuses_an_exponent_beyond_exact_arithmetic() -> None:
         raw_to_q(mpmath.ldexp(mpmath.mpf(1), -MAX_EXPONENT - 2)._mpf_)
     ok = raw_to_q(mpmath.ldexp(mpmath.mpf(1), MAX_EXPONENT - 1)._mpf_)
     assert ok.p.bit_length() == MAX_EXPONENT
+
+
+# --- Mutation review 29: log_compare
+
+
+def test_log_compare_below_one() -> None:
+    """ln r < 0 for r < 1: x = −1/2 lies above ln(1/2) ≈ −0.693 and −1 below it, decided by
+    the enclosures (mutation review 29: ``q <= 1`` answered the sign of x against 0 for every
+    r ≤ 1 and no test had an r below 1)."""
+    from obsdesign.certify.interval import log_compare
+
+    assert log_compare(fmpq(-1, 2), fmpq(1, 2))[0] == 1
+    assert log_compare(fmpq(-1), fmpq(1, 2))[0] == -1
+    assert log_compare(fmpq(1, 10), fmpq(1, 2))[0] == 1
+    # and r = 1 exactly: x > 0 is above ln 1 = 0
+    assert log_compare(fmpq(1, 10**40), fmpq(1))[0] == 1
+
+
+def test_log_compare_doubles_and_stops_at_max_bits(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The working precision doubles from ``bits`` and never exceeds ``max_bits`` (mutation
+    review 29: one step past the cap, or +1 bit at a time, passed every test). x is 1e-300
+    above ln 1.5 (≈ 2^-997), so 950 bits cannot decide it."""
+    import mpmath as mp
+
+    from obsdesign.certify import interval as ivq
+
+    with mp.workdps(400):
+        s = mp.nstr(mp.log(mp.mpf(3) / 2) + mp.mpf(10) ** -300, 390)
+    from obsdesign.certify.exact import Q
+
+    near = Q(s)
+    seen: list[int] = []
+    real = ivq.log_bounds
+
+    def spy(x, bits=ivq.PREC):
+        seen.append(bits)
+        return real(x, bits)
+
+    monkeypatch.setattr(ivq, "log_bounds", spy)
+    d, lo, hi = ivq.log_compare(near, fmpq(3, 2), ivq.PREC, 950)
+    assert d is None and lo <= near <= hi
+    assert seen == [113, 226, 452, 904, 950]
+    seen.clear()
+    assert ivq.log_compare(near, fmpq(3, 2), 113, 4000)[0] == 1
+    assert seen == [113, 226, 452, 904, 1808]

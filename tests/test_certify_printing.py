@@ -175,3 +175,16 @@ def test_fmt_value_up_is_exact_or_a_safe_bound(x: Fraction) -> None:
         assert Fraction(exact) == x and Fraction(bound) >= x
     else:
         assert Fraction(text) == x
+
+
+# --- Mutation review 29: fmt_value_up
+
+
+def test_fmt_value_up_boundaries_and_default_digits() -> None:
+    """An exact text of exactly ``longest`` (16) characters is shown alone, 17 get the bound;
+    the bound has 6 significant digits by default (mutation review 29: ``<`` for ``<=`` and
+    ``digits = 5`` passed every test)."""
+    assert fmt_value_up(fmpq(123456789012345, 10**8)) == "1234567.89012345"  # 16 characters
+    seventeen = fmpq(1234567890123451, 10**9)  # 1234567.890123451: 17 characters
+    assert fmt_value_up(seventeen) == "1234567890123451/1000000000 ≤ 1234570"
+    assert fmt_value_up(fmpq(200582665, 8192)) == "200582665/8192 ≤ 24485.2"

@@ -385,7 +385,8 @@ def test_a_preformatted_table_and_nested_data_print_by_format() -> None:
     md = _metrics_markdown(m)
     assert "outlier_study_median_rmse" not in md
     block = md.split("```")[1].strip("\n").splitlines()
-    assert block[0].startswith("observer") and block[-1].startswith("stubborn")
+    assert block[0].startswith("median RMSE") and block[1].startswith("observer")
+    assert block[-1].startswith("stubborn")
 
 
 def test_check_and_design_print_control_characters_in_file_names_as_escapes(tmp_path: Path):
@@ -429,3 +430,20 @@ def test_design_error_prints_its_error_report_with_format_json(tmp_path: Path) -
     spec.write_text(FAILING_LYAPUNOV.replace("lambda = 0.9", "lambda = -2"))
     r = runner.invoke(app, ["design", str(spec), "--format", "json"])
     assert r.exit_code == 2 and r.stdout == ""
+
+
+# --- Mutation review 29: _design_error_outputs
+
+
+def test_design_error_says_a_report_was_written_only_when_one_was(tmp_path: Path) -> None:
+    """Text without -o writes no error report and says none ("error report written to
+    None"); Markdown output prints no such text line (mutation review 29: dropping
+    ``output is not None`` or ``fmt == text`` passed every test)."""
+    spec = tmp_path / "fail.toml"
+    spec.write_text(FAILING_LYAPUNOV)
+    r = runner.invoke(app, ["design", str(spec)])
+    assert r.exit_code == 1 and "error report written" not in r.output
+    out = tmp_path / "r.json"
+    r = runner.invoke(app, ["design", str(spec), "--format", "md", "-o", str(out)])
+    assert r.exit_code == 1 and "error report written" not in r.stdout
+    assert json.loads(out.read_text())["verdict"] == "error"

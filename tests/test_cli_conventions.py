@@ -388,3 +388,74 @@ def test_entry_point_passes_exit_codes_and_help_through(
         assert e.value.code == code, argv
     c = capsys.readouterr()
     assert "Usage: obsdesign" in c.out and "Usage: obsdesign" in c.err
+
+
+# --- Mutation review 29: narrow check rows and parameter tables
+
+
+def _check_fixed(spec: Path, bad: Path) -> int:
+    """The width of check's never-wrapping columns (method, verdict, claims, s) at their
+    widest, headers included, as _print_rows computes it (from the JSON rows)."""
+    rows = json.loads(_run("check", str(spec), str(bad), "--format", "json")[1])
+    cols = [
+        ("method", [r["method"] for r in rows]),
+        ("verdict", ["ok" if r["code"] == 0 else f"exit {r['code']}" for r in rows]),
+        ("claims", [f"{r['certified']}/{r['numerical']}/{r['failed']}" for r in rows]),
+        ("s", [f"{r['seconds']:.2f}" for r in rows]),
+    ]
+    return sum(max(len(h), *map(len, v)) for h, v in cols)
+
+
+def test_check_switches_to_blocks_exactly_below_its_threshold(spec: Path, tmp_path: Path):
+    """The table while it fits (the fixed columns + 16 for the spec + 20 for the result + 19
+    for the borders), blocks of lines below; a block holds the result text too (mutation
+    review 29: moving the threshold by the borders, ``<=`` for ``<``, headers or the claims
+    column left out of the sum, or the result line dropped, each passed every test)."""
+    bad = tmp_path / "bad.toml"
+    bad.write_text(SPEC.replace("lambda = 0.9", "L = [0, 0]\nlambda = 0.5"))
+    T = _check_fixed(spec, bad) + 16 + 20 + 19
+    for width, table in ((T, True), (T - 1, False), (T + 19, True), (T - 19, False)):
+        code, out, _ = _run("check", str(spec), str(bad), "--width", str(width))
+        assert code == 1
+        assert ("┃" in out) is table, (width, T, out)
+        # the verdict line is one line whatever the width
+        assert "…" not in out and max(len(x) for x in out.splitlines()[:-1]) <= width
+        if not table:
+            flat = " ".join(out.split())
+            assert "no P ≻ 0 gives decay rate λ = 0.5" in flat, out
+
+
+@pytest.mark.parametrize("width", [40, 50, 71])
+def test_parameter_forms_go_under_names_below_72_columns(width: int, spec: Path, tmp_path: Path):
+    """Below 72 columns the parameters table has two columns, "parameter / form" and value,
+    each name followed by its form (exact, float or not verified); a name folds only when
+    it is longer than a third of the width (mutation review 29: the wide table below 72,
+    the threshold at 41, the form left out, a narrower name column: each passed)."""
+    report = tmp_path / "r.json"
+    assert _run("design", str(spec), "-q", "-o", str(report))[0] == 0
+    out = _run("verify", str(report), "--width", str(width))[1]
+    table = out.split("claims")[0]
+    assert "parameter /" in table and "form" in table
+    cells = [
+        re.split(r"[│┃]", line)[1].strip() for line in table.splitlines() if line.startswith("│")
+    ]
+    d = json.loads(report.read_text())
+    names = [k for k in d["parameters"] if k != "exact"]
+    flat = "".join(cells)
+    for k in names:
+        i = flat.index(k)
+        assert flat[i + len(k) :].startswith(("exact", "float", "not verified")), (k, flat)
+        if len(k) <= width // 3:
+            assert k in cells, (k, cells)  # whole on its line
+    wide = _run("verify", str(report), "--width", "72")[1].split("claims")[0]
+    assert "parameter /" not in wide and "form" in wide
+
+
+def test_print_rows_of_no_rows_prints_nothing(capsys: pytest.CaptureFixture[str]) -> None:
+    """_print_rows([]) raised TypeError (the column widths were taken before any guard;
+    mutation review 29; check refuses an empty list of specs before reaching it)."""
+    from obsdesign.cli import Fmt
+    from obsdesign.cli_commands import _print_rows
+
+    _print_rows([], Fmt.text)
+    assert capsys.readouterr().out == ""

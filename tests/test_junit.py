@@ -19,7 +19,7 @@ from typer.testing import CliRunner
 
 from obsdesign.api import CheckRow
 from obsdesign.cli import app
-from obsdesign.junit import junit_xml
+from obsdesign.junit import _clean, junit_xml
 
 ROOT = Path(__file__).resolve().parents[1]
 XSD = ROOT / "tests" / "data" / "junit.xsd"
@@ -220,3 +220,40 @@ def test_pre_commit_hook_python(tmp_path: Path):
     repo = _scratch_repo(tmp_path)
     ok = _try_repo(repo, "obsdesign-check", ["designs/ok.toml"], tmp_path / "home")
     assert ok.returncode == 0, ok.stdout + ok.stderr
+
+
+# --- Mutation review 29: _clean and _name ---------------------------------------------------
+
+
+def test_clean_keeps_every_character_xml_allows_and_escapes_the_rest() -> None:
+    """XML 1.0's Char production: tab, newline, CR, U+0020-U+D7FF, U+E000-U+FFFD and the
+    astral planes stay as they are; the C0 controls, the surrogates, U+FFFE and U+FFFF are
+    written as escapes (mutation review 29: dropping tab from the allowed set, moving a range
+    end by one, or escaping every astral character passed every test)."""
+    kept = "a\tb\nc\rd \ud7ff\ue000\ufffd\U00010000\U0001f600\U0010ffff"
+    assert _clean(kept) == kept
+    assert _clean("\x00\x08\x1f") == "\\x00\\x08\\x1f"
+    assert _clean("\ud800\udfff\ufffe\uffff") == "\\ud800\\udfff\\ufffe\\uffff"
+    ET.fromstring(f"<a b='{_clean(kept)}'/>".encode())  # a parser takes it
+
+
+def test_junit_classname_escapes_newlines_and_bidi_controls() -> None:
+    """The classname names the spec too: one line, as the text table shows it (mutation
+    review 29: the classname through _clean only, with a raw newline and U+202E, passed)."""
+    row = CheckRow("a\nb\u202e.toml", "lyapunov", 0, 1, 0, 0, "ok", 0.1, "", [])
+    row.claims = [{"id": "c\nd", "status": "certified", "statement": "s", "detail": ""}]
+    root = ET.fromstring(junit_xml([row]))
+    cases = root.find("testsuite").findall("testcase")
+    assert {c.get("classname") for c in cases} == {"obsdesign.lyapunov.a\\nb\\u202e.toml"}
+    assert cases[1].get("name") == "c\\nd"
+
+
+def test_junit_names_escape_what_xml_forbids_beyond_the_controls() -> None:
+    """A lone surrogate (a file name's undecodable byte) and U+FFFE in a spec's name are
+    escaped in every attribute that names it, so the XML parses (mutation review 29)."""
+    row = CheckRow("a\udc80b\ufffe.toml", "lyapunov", 0, 1, 0, 0, "ok", 0.1, "", [])
+    text = junit_xml([row])
+    root = ET.fromstring(text.encode("utf-8", "surrogatepass"))
+    suite = root.find("testsuite")
+    assert suite.get("name") == "a\\udc80b\\ufffe.toml"
+    assert suite.find("testcase").get("classname") == "obsdesign.lyapunov.a\\udc80b\\ufffe.toml"

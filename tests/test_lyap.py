@@ -1013,3 +1013,37 @@ def test_closed_loop_fmat_takes_flint_and_numpy_matrices_mixed() -> None:
     assert lyap.closed_loop_fmat(A, C, L) == lyap.fmat(qmat([[0, 2], ["5/2", 4]]))
     C0 = np.zeros((0, 2), dtype=object)
     assert lyap.closed_loop_fmat(A, C0, C0.T) == A
+
+
+# --- Mutation review 29: iss_mu's raise
+
+
+@pytest.mark.parametrize("strict", [True, False])
+def test_iss_mu_raises_by_ten_percent_steps_when_the_float_value_is_short(
+    strict: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """When the float μ̃ is 20 % short of the smallest certifiable μ (an ill-conditioned S),
+    the raise (μ ← 1.1 μ + floor) reaches it in a few steps and returns the first μ that
+    certifies (mutation review 29: raising by the additive floor alone, 2⁻⁴⁰ of the plant's
+    scale, never got there in 80 steps; no test reached the second candidate). The exact
+    check is replaced by "μ ≥ 1.2 μ̃" to stand for such a plant."""
+    import obsdesign.lyap as L
+
+    a, p, rho, b = fmpq(1, 2), fmpq(2), fmpq(1, 2), fmpq(3)
+    Acl, Bw, P = qmat([[a]]), qmat([[b]]), qmat([[p]])
+    mu_star = b * b * p + (a * b * p) ** 2 / (rho * p - a * a * p)  # the true infimum, 36
+    need = mu_star * fmpq(6, 5)
+    tried: list = []
+
+    def fake_matrix(Acl, Bw, P, r, mu, discrete):
+        if Bw.shape[1] == 0:
+            return iss_matrix(Acl, Bw, P, r, mu, discrete)
+        tried.append(mu)
+        return mu
+
+    monkeypatch.setattr(L, "iss_matrix", fake_matrix)
+    monkeypatch.setattr(L, "check_pd_fast" if strict else "check_psd", lambda mu: mu >= need)
+    mu = L.iss_mu(Acl, Bw, P, rho, True, strict=strict)
+    assert need <= mu <= need * fmpq(11, 10)
+    assert 2 <= len(tried) <= 4 and mu == tried[-1]
+    assert all(y > x * fmpq(109, 100) for x, y in zip(tried, tried[1:], strict=False))

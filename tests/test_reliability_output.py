@@ -619,3 +619,83 @@ def test_simulate_refuses_a_report_parameter_that_is_not_finite(
 
     res = _simulate_edited(tmp_path, name, key, edit)
     _refused(res, "bad.json", f"parameters.{key}", "not a finite number")
+
+
+# --- Mutation review 29: api._uncertified_design
+
+
+def _claim(cid: str, status: str, float_ok: bool):
+    from obsdesign.certify.claim import Claim, ClaimStatus
+
+    return Claim(cid, "s", "r", "c", "0", ClaimStatus(status), "d", float_ok)
+
+
+@pytest.mark.parametrize(
+    ("claims", "want"),
+    [
+        ([("a", "certified", True)], None),
+        ([("a", "failed", True)], "the design's claims give the verdict 'inconclusive' (a)"),
+        ([("a", "failed", True), ("b", "failed", False)], "verdict 'failed' (a, b)"),
+        ([("a", "certified", True), ("b", "failed", False)], "verdict 'failed' (b)"),
+        ([(f"c{i}", "failed", False) for i in range(5)], "(c0, c1, c2, c3, c4)"),
+        ([(f"c{i}", "failed", False) for i in range(6)], "(c0, c1, c2, c3, c4, …)"),
+    ],
+)
+def test_uncertified_design_names_its_verdict_and_claims(monkeypatch, claims, want) -> None:
+    """The warning simulate SPEC gives: nothing when every claim holds; 'inconclusive' only
+    when EVERY failed claim holds in floats, else 'failed'; at most five ids, "…" after
+    (mutation review 29: any() for all(), a verdict always 'failed', one id, "…" at five:
+    each passed every test, which had one failed claim only)."""
+    from obsdesign import api
+
+    sp = api.load_spec_text(api.template("lyapunov"), "s.toml")
+    monkeypatch.setattr(api, "certify", lambda sp, p: [_claim(*c) for c in claims])
+    notes = api._uncertified_design(sp, api.Parameters())
+    if want is None:
+        assert notes == []
+    else:
+        (note,) = notes
+        assert want in note and note.startswith("s.toml: ") and "not certified" in note
+        if "…" not in want:
+            assert "…" not in note
+
+
+@pytest.mark.parametrize("exc", [OverflowError("x"), None])
+def test_uncertified_design_says_when_certify_stops(monkeypatch, exc) -> None:
+    """A certification that stops with an error (here an InconclusiveError, and an
+    OverflowError that captured_warnings makes one) is said so, and the simulation still
+    runs (mutation review 29: returning [] there, or certify outside captured_warnings,
+    passed every test)."""
+    from obsdesign import api
+    from obsdesign.errors import InconclusiveError
+
+    def boom(sp, p):
+        raise exc if exc is not None else InconclusiveError("no proof here")
+
+    sp = api.load_spec_text(api.template("lyapunov"), "s.toml")
+    monkeypatch.setattr(api, "certify", boom)
+    (note,) = api._uncertified_design(sp, api.Parameters())
+    assert note.startswith("s.toml: the designed parameters could not be certified (")
+    assert "not certified" in note
+
+
+def test_bad_input_inside_a_design_leaves_the_output_untouched(
+    spec: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Bad input (exit 2) raised inside the design writes no error report: -o keeps what it
+    held, as api.design documents (mutation review 29: writing the report for every error
+    code passed every test; only exit 1, 3 and 4 were tried)."""
+    from obsdesign import api
+    from obsdesign.errors import InputError
+
+    out = tmp_path / "r.json"
+    assert runner.invoke(app, ["design", str(spec), "-o", str(out)]).exit_code == 0
+    before = out.read_bytes()
+
+    def boom(*a, **k):
+        raise InputError("[method.L] not the shape of C (test)")
+
+    monkeypatch.setattr(api, "certify", boom)
+    res = runner.invoke(app, ["design", str(spec), "-o", str(out), "--format", "json"])
+    assert res.exit_code == 2 and res.stdout == ""
+    assert out.read_bytes() == before

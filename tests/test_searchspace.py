@@ -1236,3 +1236,139 @@ def test_bound_boxes_is_capped(boxes: int, ok: bool) -> None:
     else:
         with pytest.raises(SpecError, match=r"\[method\.bound_boxes\] expected at most 20,000"):
             api.load_spec_text(text, "b.toml")
+
+
+# --- Mutation review 29: K-rule / Lemma 2 near a tie
+# uses _tie_spec, _largest_K, D, api, fmpq, ClaimStatus, TEXT from this module
+
+
+def _capped(monkeypatch: pytest.MonkeyPatch, bits: int = 150) -> None:
+    from obsdesign.methods.searchspace import claims as SC
+
+    monkeypatch.setattr(D, "MAX_K_BITS", bits)
+    monkeypatch.setattr(SC, "MAX_K_BITS", bits)
+
+
+def _tie_claims(side: str, K: int) -> dict:
+    """The claims of the tie spec's design with K replaced (and Δτ = K ΔT)."""
+    sp = api.load_spec_text(_tie_spec(side), "tie.toml")
+    p = api.design(sp).parameters
+    p["K"] = fmpq(K)
+    p["dtau"] = K * p["dT"]
+    return {c.id: c for c in api.certify(sp, p)}
+
+
+def test_lemma2_undecided_at_the_cap_is_inconclusive(monkeypatch: pytest.MonkeyPatch) -> None:
+    """K = 63 given on the 'dn' side: 63·ΔT lies 1e-58 below ln 1.5, so 150 bits cannot
+    decide Lemma 2: it fails as inconclusive (exit 4, float_ok, "not decided"), never
+    certified (mutation review 29: ``d != 1`` certified it, ``open2 = False`` made it exit 1,
+    and no test had Lemma 2 undecided)."""
+    _capped(monkeypatch)
+    rep = api.design(api.load_spec_text(_tie_spec("dn", "K = 63\n"), "tie.toml"))
+    assert rep.parameters["K"] == 63 and rep.exit_code() == 4
+    (bad,) = rep.failed
+    assert bad.id == "lemma2-consistency" and bad.float_ok is True
+    assert "not decided at 150 bits" in bad.detail and "by at least" not in bad.detail
+
+
+def test_K_rule_with_K_itself_undecided_is_not_certified(monkeypatch: pytest.MonkeyPatch) -> None:
+    """K = 63 on the 'up' side is one too large (63·ΔT is 1e-58 ABOVE ln 1.5; _largest_K
+    says 62). At 150 bits "K itself keeps the rule" is undecided while K + 1 = 64 surely
+    breaks it: the K-rule claim must stay unproved (inconclusive), never certified
+    (mutation review 29: ``itself is not False`` certified this false K-rule)."""
+    assert _largest_K("up") == 62
+    _capped(monkeypatch)
+    c = _tie_claims("up", 63)["K-rule"]
+    assert c.status == ClaimStatus.FAILED and c.float_ok is True
+    assert "not decided at 150 bits" in c.detail and c.margin == "0"
+
+
+def test_K_rule_of_a_non_integer_K_is_false_not_inconclusive(example) -> None:
+    """K = 127/2 for the example (63.5·ΔT < ln 1.5 < 64.5·ΔT, so both sides of the rule
+    'hold'): the K-rule claim fails as false (float_ok False, "not an integer"), not as
+    inconclusive (mutation review 29: dropping ``k_int`` from ``open_`` made it exit 4)."""
+    sp, rep = example
+    p = rep.parameters
+    p = Parameters({**{k: p[k] for k in p}, "K": fmpq(127, 2), "dtau": fmpq(127, 2) * p["dT"]})
+    c = {c.id: c for c in api.certify(sp, p)}["K-rule"]
+    assert c.status == ClaimStatus.FAILED and c.float_ok is False
+    assert "not an integer" in c.detail
+
+
+@pytest.mark.parametrize(("side", "K"), [("dn", 62), ("up", 63)])
+def test_K_rule_margin_of_a_wrong_K_is_negative(side: str, K: int) -> None:
+    """The margin a failed K-rule records is the proved distance (negative) on the side that
+    fails: lower bound − K·ΔT·L_f when K is too large, (K+1)·ΔT·L_f − upper bound when a
+    larger K also keeps the rule. At the near tie the enclosure (about 1e-36 wide) is far
+    wider than the 1e-58 gap, so the other end of the enclosure gives a POSITIVE margin for
+    a failed claim (mutation review 29: both swaps passed every test)."""
+    from fractions import Fraction
+
+    c = _tie_claims(side, K)["K-rule"]
+    assert c.status == ClaimStatus.FAILED and not c.float_ok
+    assert Fraction(c.margin) < 0, c.margin
+
+
+def test_K_rule_for_kappa_at_most_L_h_is_false_for_K_above_one(example) -> None:
+    """κ ≤ L_h: the rule's K is 1, so a report with K = 2 fails K-rule as false (float_ok
+    False), not as inconclusive (mutation review 29: ``open_ = True`` in that branch passed)."""
+    sp, rep = example
+    p = dict((k, rep.parameters[k]) for k in rep.parameters)
+    p["kappa"] = fmpq(1)  # = L_h
+    p["K"] = fmpq(2)
+    p["dtau"] = 2 * p["dT"]
+    c = {c.id: c for c in api.certify(sp, Parameters(p))}["K-rule"]
+    assert c.status == ClaimStatus.FAILED and c.float_ok is False
+    assert "κ ≤ L_h" in c.detail
+
+
+def test_lemma2_excess_at_a_near_tie_is_a_true_lower_bound() -> None:
+    """K = 63 on the 'up' side: L_f·Δτ exceeds ln 1.5 by about 1e-58; the detail's "by at
+    least X" must satisfy X ≤ L_f·Δτ − ln 1.5 (mpmath at 300 digits, independent). Measured
+    from the enclosure's lower end it read about 1e-36, a false "at least" (mutation review
+    29: the swap passed, the test only checked the sign)."""
+    from fractions import Fraction
+
+    import mpmath as mp
+
+    lemma2 = _tie_claims("up", 63)["lemma2-consistency"]
+    assert lemma2.status == ClaimStatus.FAILED and not lemma2.float_ok
+    shown = lemma2.detail.split("by at least")[1].split()[0]
+    shown = shown.replace("−", "-").replace("·10^", "e").rstrip(",;)")
+    with mp.workdps(300):
+        dT = Fraction(_TIE_GAMMA["up"][0]) / 4  # ΔT = α γ⋆ / (2 L_h f_sup) = γ⋆/4
+        true = mp.mpf(63 * dT.numerator) / dT.denominator - mp.log(mp.mpf(3) / 2)
+        assert true > 0
+        assert mp.mpf(shown) <= true, (shown, mp.nstr(true, 5))
+
+
+@pytest.mark.parametrize("boxes", [0, -3])
+def test_bound_boxes_is_at_least_one(boxes: int) -> None:
+    """bound_boxes below 1 is bad input naming the key (mutation review 29: ``min=0`` passed
+    every test; only the upper end was tried)."""
+    text = SPEC.read_text().replace("[method]\n", f"[method]\nbound_boxes = {boxes}\n", 1)
+    with pytest.raises(SpecError, match=r"\[method\.bound_boxes\]"):
+        api.load_spec_text(text, "b.toml")
+    assert (
+        api.load_spec_text(text.replace(f"= {boxes}\n", "= 1\n", 1), "b.toml").options.bound_boxes
+        == 1
+    )
+
+
+@pytest.mark.parametrize(("boxes", "ok"), [(20_000, True), (20_001, False)])
+def test_schema_agrees_with_the_bound_boxes_cap(boxes: int, ok: bool) -> None:
+    """The JSON schema (editors, CI) refuses what the loader refuses: bound_boxes above
+    20,000 (mutation review 29: the schema's maximum could be dropped with every test
+    passing)."""
+    import tomllib
+
+    import jsonschema
+
+    data = tomllib.loads(
+        SPEC.read_text().replace("[method]\n", f"[method]\nbound_boxes = {boxes}\n", 1)
+    )
+    if ok:
+        jsonschema.validate(data, api.schema())
+    else:
+        with pytest.raises(jsonschema.ValidationError):
+            jsonschema.validate(data, api.schema())

@@ -546,3 +546,138 @@ def test_outputs_are_drawn_only_on_the_panel_of_the_state_they_are(h: str, want:
     text = TEXT.replace(old, f"h = {h}")
     sp = api.load_spec_text(text, "p.toml")
     assert output_panels(sp, ["x1", "x2"]) == want
+
+
+# --- Mutation review 29: _row_norm at huge scales
+
+
+def test_distances_do_not_overflow_at_huge_scales() -> None:
+    """The mirror of the tiny plant: on E = [−1e198, 1e198]² the squares of the distances
+    overflow (1e396), so the summed squares read inf; the true cell's distance, the bound and
+    the final error must stay finite and agree with the scaled norm (mutation review 29: a
+    ``_row_norm`` that took the summed squares whenever they were not too small passed every
+    test)."""
+    text = """[system]
+time = "continuous"
+states = ["x1", "x2"]
+f = ["-x1", "-x2"]
+h = ["x1", "x2"]
+[method]
+key = "search-space"
+alpha = 0.9
+gamma_star = 1e197
+gamma0 = 1e198
+[method.E]
+lower = [-1e198, -1e198]
+upper = [1e198, 1e198]
+[method.D]
+lower = [-5e197, -5e197]
+upper = [5e197, 5e197]
+[simulate]
+horizon = 2
+x0 = [3e197, 3e197]
+xhat0 = [0, 0]
+"""
+    sim = api.simulate(api.load_spec_text(text, "huge.toml"))
+    info = sim.info
+    e = sim.xhat[-1] - sim.x[-1]
+    want = math.hypot(*(float(v) for v in e))
+    assert math.isfinite(want) and info["final_error"] == pytest.approx(want, rel=1e-12)
+    near = np.asarray(sim.extra["true_cell"])
+    bound = np.asarray(sim.extra["bound"])
+    assert np.all(np.isfinite(near)) and np.all(np.isfinite(bound))
+    assert math.isfinite(info["final_true_cell"])
+    assert np.all(near <= bound)
+
+
+@pytest.mark.parametrize("scale", [1e-200, 1.0, 1e200])
+def test_row_norm_picks_the_norm_at_every_scale(scale: float) -> None:
+    """``_row_norm(D, pick)`` is pick of the Euclidean row norms, the picked one (min or
+    max) whatever the scale: the squares underflow at 1e-200 and overflow at 1e200, where
+    the scaled fallback must still pick with ``pick`` (mutation review 29: the fallback
+    taking np.max for np.min, and the fast path taken above SAFE_HI², passed every test)."""
+    from obsdesign.methods.searchspace.sim import _row_norm
+
+    D = np.array([[3.0, 4.0], [0.3, 0.4], [-6.0, 8.0]]) * scale
+    assert _row_norm(D, np.min) == pytest.approx(0.5 * scale, rel=1e-14)
+    assert _row_norm(D, np.max) == pytest.approx(10.0 * scale, rel=1e-14)
+
+
+def test_centroid_error_is_within_the_bound_at_every_sample(example) -> None:
+    """The "bound" series is the spread of the live centres about their centroid plus the
+    cell radius ε e^{L_f(t − τ)}, so the centroid's error never exceeds it, and at a
+    stored sample with every centre kept it is at least the largest distance of a centre
+    from the centroid (mutation review 29: the spread taken as the SMALLEST distance passed
+    every test)."""
+    from obsdesign.simulate.result import norms
+
+    _, _, res = example
+    bound = np.asarray(res.extra["bound"])
+    err = norms(np.asarray(res.xhat) - np.asarray(res.x))
+    assert np.all(err <= bound * (1 + 1e-12))
+    tt = list(np.asarray(res.t))
+    live = np.asarray(res.extra["live"])
+    checked = 0
+    for t, C in res.extra["stored"]:
+        i = tt.index(t)
+        if len(C) == live[i]:  # every centre stored
+            spread = float(np.max(norms(C - C.mean(axis=0))))
+            assert spread <= bound[i] * (1 + 1e-12)
+            checked += 1
+    assert checked > 0
+
+
+@pytest.mark.parametrize("scale", [1e-250, 1e250])
+def test_flow_error_scales_with_the_state(example, scale: float) -> None:
+    """The example's f is linear in x for a fixed u (f = [u x2, −u x1]), so RK4 and its
+    step-doubling estimate scale exactly with x: at 1e-250 the differences' squares
+    underflow (the estimate read 0: no substep refinement) and at 1e250 they overflow (inf:
+    never refined). flow_error must be ``scale`` times its value at scale 1 (mutation review
+    29: ``np.linalg.norm`` back in flow_error passed every test)."""
+    from obsdesign.methods.searchspace import sim as S
+
+    sp, _, _ = example
+    plant = S.Plant(sp)
+    X = np.array([[0.3, 1.5], [-1.0, 0.7]])
+    one = S.flow_error(plant, X, 1.0, 0.5, 1)  # u = t/3 ≠ 0 on [1, 1.5]
+    assert one > 0
+    with np.errstate(all="ignore"):
+        got = S.flow_error(plant, X * scale, 1.0, 0.5, 1)
+    assert got == pytest.approx(one * scale, rel=1e-6)
+
+
+def test_plot_draws_each_output_on_the_panel_of_its_state(tmp_path, monkeypatch) -> None:
+    """h = [x2, x1]: y1 is drawn on x2's panel and y2 on x1's, each with its OWN samples
+    (mutation review 29: drawing y[:, 0] on every panel, or one output on the wrong panel,
+    passed every test: only output_panels was tested, not the figure)."""
+    import matplotlib.axes
+
+    old = 'h = ["x1*step(x1)"]'
+    text = TEXT.replace("horizon = 12", "horizon = 1").replace(old, 'h = ["x2", "x1"]')
+    sp, rep = _load(text, tmp_path)
+    res = api.simulate(sp, rep, store_every=5)
+    drawn: dict[str, np.ndarray] = {}
+    real = matplotlib.axes.Axes.plot
+
+    def spy(self, *args, **kw):
+        if str(kw.get("label", "")).startswith("output"):
+            drawn[kw["label"]] = np.asarray(args[1], dtype=float)
+        return real(self, *args, **kw)
+
+    monkeypatch.setattr(matplotlib.axes.Axes, "plot", spy)
+    api.plot_simulation(sp, res, tmp_path / "figs.png")
+    assert set(drawn) == {"output y1 = x2", "output y2 = x1"}
+    assert np.array_equal(drawn["output y1 = x2"], res.y[:, 0])
+    assert np.array_equal(drawn["output y2 = x1"], res.y[:, 1])
+    assert not np.array_equal(res.y[:, 0], res.y[:, 1])
+
+
+def test_output_panels_skip_an_output_that_is_a_constant() -> None:
+    """h = [x1, pi] loads (a constant output); pi is a bare name but no state, so it is on
+    no panel, and the plot does not fail on it (mutation review 29: dropping ``in names``
+    passed every test; names.index('pi') then raised ValueError in plot_simulation)."""
+    from obsdesign.methods.searchspace.plots import output_panels
+
+    old = 'h = ["x1*step(x1)"]'
+    sp = api.load_spec_text(TEXT.replace(old, 'h = ["x1", "pi"]'), "p.toml")
+    assert output_panels(sp, ["x1", "x2"]) == {0: [0]}

@@ -69,11 +69,11 @@ def plot_simulation(spec: Spec, res: SimResult, path: str | Path) -> Path:
 
 def output_panels(spec: Spec, names: list[str]) -> dict[int, list[int]]:
     """{state i: the outputs j with y_j = x_i}: an output is drawn on a state's panel only
-    when it is that state (h_j the bare name, or row j of C the unit vector e_i). y₁ was drawn
+    when it is that state (h_j the bare name; search-space plants are given by f and h). y₁ was drawn
     on the x₁ panel as "output y" whatever h was (h = [x1 + x2, x1 − x2]: one line, y₂ never
     shown; search-space trial, session 29).
 
-    :param spec: the spec (its h, else its C); :param names: the state names in order."""
+    :param spec: the spec (its h); :param names: the state names in order."""
     import ast
 
     out: dict[int, list[int]] = {}
@@ -83,12 +83,6 @@ def output_panels(spec: Spec, names: list[str]) -> dict[int, list[int]]:
             body = e.tree.body
             if isinstance(body, ast.Name) and body.id in names:
                 out.setdefault(names.index(body.id), []).append(j)
-    elif s.C is not None:
-        C = np.asarray(s.C.f if hasattr(s.C, "f") else s.C, dtype=float)
-        for j, row in enumerate(C):
-            nz = np.flatnonzero(row)
-            if len(nz) == 1 and row[nz[0]] == 1.0:
-                out.setdefault(int(nz[0]), []).append(j)
     return out
 
 
