@@ -297,6 +297,11 @@ def _result_text(r: Any) -> str:
     return str(r.summary if r.code == 0 else (r.message or r.summary))
 
 
+#: the least widths of check's spec and result columns in its table (below: blocks of lines);
+#: a typical row is then a table at 80 columns
+CHECK_SPEC_MIN, CHECK_RESULT_MIN = 12, 16
+
+
 def _print_rows(rows: list[Any], fmt: Fmt) -> None:
     if fmt == Fmt.md:
         print("| spec | method | exit | certified | numerical | failed | result | seconds |")
@@ -324,7 +329,7 @@ def _print_rows(rows: list[Any], fmt: Fmt) -> None:
         )
         for r in rows
     ]
-    # the columns that never wrap, at their widest, plus 16 for the spec, 20 for the result
+    # the columns that never wrap, at their widest, plus room for the spec and the result
     # and the borders: below that rich ellipsized them ("5/0…" for 5/0/1, the failed claim
     # hidden) and squeezed spec and result to nothing (--width 40; rendering trial, session
     # 29), so each row is then a block of lines
@@ -332,7 +337,7 @@ def _print_rows(rows: list[Any], fmt: Fmt) -> None:
         max(len(h), *(len(x[i]) for x in cells))
         for i, h in ((1, "method"), (2, "verdict"), (3, "claims"), (5, "s"))
     )
-    if cells and c.width < fixed + 16 + 20 + 19:
+    if cells and c.width < fixed + CHECK_SPEC_MIN + CHECK_RESULT_MIN + 19:
         c.print("[bold]obsdesign check[/] (claims: certified/numerical/failed)")
         for (spec, method, verdict, claims, result, secs), r in zip(cells, rows, strict=True):
             style = "green" if r.code == 0 else "bold red"

@@ -407,13 +407,15 @@ def _check_fixed(spec: Path, bad: Path) -> int:
 
 
 def test_check_switches_to_blocks_exactly_below_its_threshold(spec: Path, tmp_path: Path):
-    """The table while it fits (the fixed columns + 16 for the spec + 20 for the result + 19
+    """The table while it fits (the fixed columns + CHECK_SPEC_MIN + CHECK_RESULT_MIN + 19
     for the borders), blocks of lines below; a block holds the result text too (mutation
     review 29: moving the threshold by the borders, ``<=`` for ``<``, headers or the claims
     column left out of the sum, or the result line dropped, each passed every test)."""
     bad = tmp_path / "bad.toml"
     bad.write_text(SPEC.replace("lambda = 0.9", "L = [0, 0]\nlambda = 0.5"))
-    T = _check_fixed(spec, bad) + 16 + 20 + 19
+    from obsdesign.cli_commands import CHECK_RESULT_MIN, CHECK_SPEC_MIN
+
+    T = _check_fixed(spec, bad) + CHECK_SPEC_MIN + CHECK_RESULT_MIN + 19
     for width, table in ((T, True), (T - 1, False), (T + 19, True), (T - 19, False)):
         code, out, _ = _run("check", str(spec), str(bad), "--width", str(width))
         assert code == 1
