@@ -1235,9 +1235,12 @@ def schema() -> dict[str, Any]:
 
     ms = methods()
     sim: dict[str, Any] = {}
+    own: dict[str, list[str]] = {}
     for m in ms:
-        sim.update(m.simulate_schema())
-    return spec_schema([m.options_schema() for m in ms], sim)
+        keys = m.simulate_schema()
+        sim.update(keys)
+        own[m.key] = sorted(keys)
+    return spec_schema([m.options_schema() for m in ms], sim, own)
 
 
 def plot_design(

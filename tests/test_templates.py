@@ -100,3 +100,27 @@ def test_the_schema_refuses_the_unknown_keys_the_tool_refuses(edit, where) -> No
         jsonschema.validate(tomllib.loads(bad), api.schema())
     with pytest.raises(SpecError):
         api.load_spec_text(bad, "typo.toml")
+
+
+@pytest.mark.parametrize(
+    ("spec", "foreign"),
+    [
+        ("constrained-redesign-sec5-lyapunov.toml", "theta_m = 3"),
+        ("schaum-impulsive-example.toml", "max_centres = 10"),
+        ("hernandez-garcia-example.toml", "amplitudes = [1, 10]"),
+    ],
+)
+def test_the_schema_ties_simulate_keys_to_the_method(spec: str, foreign: str) -> None:
+    """[simulate] was one union of every method's keys: a lyapunov spec with theta_m (a
+    constrained key) validated, then design refused it, exit 2 (outsider trial, session 29).
+    The schema refuses another method's key as the tool does, and keeps the spec's own."""
+    from obsdesign.errors import SpecError
+
+    text = (SPECS[0].parent / spec).read_text(encoding="utf-8")
+    assert "\n[simulate]\n" in text
+    jsonschema.validate(tomllib.loads(text), api.schema())
+    bad = text.replace("\n[simulate]\n", f"\n[simulate]\n{foreign}\n", 1)
+    with pytest.raises(jsonschema.ValidationError):
+        jsonschema.validate(tomllib.loads(bad), api.schema())
+    with pytest.raises(SpecError):
+        api.load_spec_text(bad, "foreign.toml")

@@ -126,12 +126,17 @@ def expression_keys(schema: dict[str, Any]) -> list[str]:
 
 
 def spec_schema(
-    method_schemas: list[dict[str, Any]], simulate_keys: dict[str, Any] | None = None
+    method_schemas: list[dict[str, Any]],
+    simulate_keys: dict[str, Any] | None = None,
+    simulate_own: dict[str, list[str]] | None = None,
 ) -> dict[str, Any]:
     """The JSON schema (draft 2020-12) of a spec file.
 
     ``method_schemas`` are the methods' ``[method]`` schemas and ``simulate_keys`` the union of
-    their own ``[simulate]`` keys; the caller (the API) collects them, so this layer imports no
+    their own ``[simulate]`` keys; ``simulate_own`` maps each method key to the names of its
+    own ``[simulate]`` keys, so that a spec of one method with another's key is refused by the
+    schema as by the tool (a lyapunov spec with theta_m validated, then design said exit 2;
+    outsider trial, session 29). The caller (the API) collects them, so this layer imports no
     method."""
 
     sets = {
@@ -165,9 +170,25 @@ def spec_schema(
             },
         ]
     }
+    common = ["horizon", "dt", "x0", "xhat0", "seed", "u", "disturbance", "noise"]
+    per_method = [
+        {
+            "if": {
+                "required": ["method"],
+                "properties": {
+                    "method": {"required": ["key"], "properties": {"key": {"const": k}}}
+                },
+            },
+            "then": {
+                "properties": {"simulate": {"propertyNames": {"enum": [*common, *sorted(own)]}}}
+            },
+        }
+        for k, own in (simulate_own or {}).items()
+    ]
     return {
         "$schema": "https://json-schema.org/draft/2020-12/schema",
         "title": "obsdesign spec",
+        **({"allOf": per_method} if per_method else {}),
         "type": "object",
         "required": ["system", "method"],
         # unknown keys are errors in the tool, so in the schema too: the top level, [system],
