@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pytest
 from flint import fmpq
@@ -118,16 +120,22 @@ def test_error_input_and_iss_matrix_known_answer() -> None:
     assert Mc.tolist() == [[2 * a * p - rho * p, -p * b], [-p * b, mu]]
 
 
-@pytest.mark.parametrize("discrete", [True, False])
-def test_iss_mu_is_certified_and_near_the_infimum(discrete: bool) -> None:
-    """Scalar: μ* = b²p + (abp)²/(ρp − a²p) (discrete), p²b²/((2a − ρ)p) (continuous, ȧ = −a)."""
-    a, b, p, rho = fmpq(1, 2), fmpq(3), fmpq(2), fmpq(1, 2)
+def _scalar_iss(b: fmpq, discrete: bool) -> tuple[Any, Any, Any, fmpq, fmpq]:
+    """(A − LC, B_w, P, ρ, μ*) of the scalar case a = 1/2 (−1/2 continuous), p = 2, ρ = 1/2:
+    μ* = b²p + (abp)²/(ρp − a²p) (discrete), p²b²/((2a − ρ)p) (continuous, ȧ = −a)."""
+    a, p, rho = fmpq(1, 2), fmpq(2), fmpq(1, 2)
     Acl = qmat([[a if discrete else -a]])
-    Bw, P = qmat([[b]]), qmat([[p]])
     if discrete:
         mu_star = b * b * p + (a * b * p) ** 2 / (rho * p - a * a * p)
     else:
         mu_star = (p * b) ** 2 / ((2 * a - rho) * p)
+    return Acl, qmat([[b]]), qmat([[p]]), rho, mu_star
+
+
+@pytest.mark.parametrize("discrete", [True, False])
+def test_iss_mu_is_certified_and_near_the_infimum(discrete: bool) -> None:
+    """Scalar: μ is certified and within 10 % of the infimum μ* (:func:`_scalar_iss`)."""
+    Acl, Bw, P, rho, mu_star = _scalar_iss(fmpq(3), discrete)
     mu = iss_mu(Acl, Bw, P, rho, discrete, strict=True)
     assert mu_star < mu <= mu_star * fmpq(11, 10) + fmpq(1, 10**6)
     assert check_pd(iss_matrix(Acl, Bw, P, rho, mu, discrete))
@@ -140,14 +148,7 @@ def test_iss_mu_scales_with_the_plant(discrete: bool, scale: str) -> None:
     """The scalar case with B_w ×10^±10: μ* ×10^±20, and μ stays within 1 % of it (a fixed
     first step of +1e-12 made μ ≈ 1e-12 for μ* = 3.6e-19, rendering soundness trial
     session 29)."""
-    a, p, rho = fmpq(1, 2), fmpq(2), fmpq(1, 2)
-    b = 3 * fmpq(scale)
-    Acl = qmat([[a if discrete else -a]])
-    Bw, P = qmat([[b]]), qmat([[p]])
-    if discrete:
-        mu_star = b * b * p + (a * b * p) ** 2 / (rho * p - a * a * p)
-    else:
-        mu_star = (p * b) ** 2 / ((2 * a - rho) * p)
+    Acl, Bw, P, rho, mu_star = _scalar_iss(3 * fmpq(scale), discrete)
     mu = iss_mu(Acl, Bw, P, rho, discrete, strict=True)
     assert mu_star < mu <= mu_star * fmpq(101, 100)
     assert check_pd(iss_matrix(Acl, Bw, P, rho, mu, discrete))
@@ -157,9 +158,7 @@ def test_iss_mu_scales_with_the_plant(discrete: bool, scale: str) -> None:
 def test_iss_mu_beyond_the_float_range_is_an_overflow(discrete: bool) -> None:
     """μ* ≈ 1e311 (B_w = 1e155): OverflowError (exit 4 through api.captured_warnings), not
     "cannot round a non-finite number" (exit 3; rendering soundness trial, session 29)."""
-    a, p, rho = fmpq(1, 2), fmpq(2), fmpq(1, 2)
-    Acl = qmat([[a if discrete else -a]])
-    Bw, P = qmat([[fmpq(10) ** 155]]), qmat([[p]])
+    Acl, Bw, P, rho, _ = _scalar_iss(fmpq(10) ** 155, discrete)
     with pytest.raises(OverflowError, match="ISS gain"):
         iss_mu(Acl, Bw, P, rho, discrete, strict=True)
 

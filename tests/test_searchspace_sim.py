@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 import warnings
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -491,12 +492,11 @@ def test_progress_goes_to_stderr_and_quiet_silences_it(tmp_path):
     assert r.exit_code == 0 and r.stdout == "" and "centres" not in r.stderr
 
 
-def test_distances_do_not_underflow_at_tiny_scales() -> None:
-    """A plant on E = [−1e-198, 1e-198]²: the squares of the distances underflow, so
-    final_error, final_true_cell and the true_cell series read 0 beside a final |e| of
-    2.9e-201 (search-space trial, session 29). They now agree with the scaled norm, and the
-    true cell is within the bound at every sample."""
-    text = """[system]
+def _scaled_plant(e: int) -> str:
+    """A 2-state search-space plant ẋ = −x, y = x on E = [−10^e, 10^e]², D half of it,
+    γ⋆ = 10^(e−1), γ₀ = 10^e, x0 = 0.3·10^e (the distances' squares leave the float range
+    for |e| ≳ 154)."""
+    return f"""[system]
 time = "continuous"
 states = ["x1", "x2"]
 f = ["-x1", "-x2"]
@@ -504,27 +504,40 @@ h = ["x1", "x2"]
 [method]
 key = "search-space"
 alpha = 0.9
-gamma_star = 1e-199
-gamma0 = 1e-198
+gamma_star = 1e{e - 1}
+gamma0 = 1e{e}
 [method.E]
-lower = [-1e-198, -1e-198]
-upper = [1e-198, 1e-198]
+lower = [-1e{e}, -1e{e}]
+upper = [1e{e}, 1e{e}]
 [method.D]
-lower = [-5e-199, -5e-199]
-upper = [5e-199, 5e-199]
+lower = [-5e{e - 1}, -5e{e - 1}]
+upper = [5e{e - 1}, 5e{e - 1}]
 [simulate]
 horizon = 2
-x0 = [3e-199, 3e-199]
+x0 = [3e{e - 1}, 3e{e - 1}]
 xhat0 = [0, 0]
 """
-    sim = api.simulate(api.load_spec_text(text, "tiny.toml"))
+
+
+def _scaled_run(e: int) -> tuple[Any, float, np.ndarray, np.ndarray]:
+    """(the simulation of :func:`_scaled_plant`, its final |e| by math.hypot, the true cell's
+    distance series, the bound series)."""
+    sim = api.simulate(api.load_spec_text(_scaled_plant(e), "scaled.toml"))
+    err = sim.xhat[-1] - sim.x[-1]
+    want = math.hypot(*(float(v) for v in err))
+    return sim, want, np.asarray(sim.extra["true_cell"]), np.asarray(sim.extra["bound"])
+
+
+def test_distances_do_not_underflow_at_tiny_scales() -> None:
+    """A plant on E = [−1e-198, 1e-198]²: the squares of the distances underflow, so
+    final_error, final_true_cell and the true_cell series read 0 beside a final |e| of
+    2.9e-201 (search-space trial, session 29). They now agree with the scaled norm, and the
+    true cell is within the bound at every sample."""
+    sim, want, near, bound = _scaled_run(-198)
     info = sim.info
-    e = sim.xhat[-1] - sim.x[-1]
-    want = math.hypot(*(float(v) for v in e))
     assert want > 0 and info["final_error"] == pytest.approx(want, rel=1e-12)
-    near = np.asarray(sim.extra["true_cell"])
     assert np.all(near > 0) and info["final_true_cell"] > 0
-    assert np.all(near <= np.asarray(sim.extra["bound"]))
+    assert np.all(near <= bound)
 
 
 @pytest.mark.parametrize(
@@ -557,34 +570,9 @@ def test_distances_do_not_overflow_at_huge_scales() -> None:
     the final error must stay finite and agree with the scaled norm (mutation review 29: a
     ``_row_norm`` that took the summed squares whenever they were not too small passed every
     test)."""
-    text = """[system]
-time = "continuous"
-states = ["x1", "x2"]
-f = ["-x1", "-x2"]
-h = ["x1", "x2"]
-[method]
-key = "search-space"
-alpha = 0.9
-gamma_star = 1e197
-gamma0 = 1e198
-[method.E]
-lower = [-1e198, -1e198]
-upper = [1e198, 1e198]
-[method.D]
-lower = [-5e197, -5e197]
-upper = [5e197, 5e197]
-[simulate]
-horizon = 2
-x0 = [3e197, 3e197]
-xhat0 = [0, 0]
-"""
-    sim = api.simulate(api.load_spec_text(text, "huge.toml"))
+    sim, want, near, bound = _scaled_run(198)
     info = sim.info
-    e = sim.xhat[-1] - sim.x[-1]
-    want = math.hypot(*(float(v) for v in e))
     assert math.isfinite(want) and info["final_error"] == pytest.approx(want, rel=1e-12)
-    near = np.asarray(sim.extra["true_cell"])
-    bound = np.asarray(sim.extra["bound"])
     assert np.all(np.isfinite(near)) and np.all(np.isfinite(bound))
     assert math.isfinite(info["final_true_cell"])
     assert np.all(near <= bound)
