@@ -1372,3 +1372,62 @@ def test_schema_agrees_with_the_bound_boxes_cap(boxes: int, ok: bool) -> None:
     else:
         with pytest.raises(jsonschema.ValidationError):
             jsonschema.validate(data, api.schema())
+
+
+_LN2_TIE = """[system]
+time = "continuous"
+states = ["x1"]
+f = ["-x1"]
+h = ["x1"]
+[method]
+key = "search-space"
+alpha = 0.5
+gamma_star = 4.40093447974568450423639442195667662270158815466822383568685402852948331409329978162452906e-2
+gamma0 = 4.40093447974568450423639442195667662270158815466822383568685402852948331409329978162452906e-2
+L_f = 1
+L_h = 1
+f_sup = 1
+kappa = 1.999999999999999999999999999999999999999999999999999999999999
+[method.E]
+lower = [-1]
+upper = [1]
+[method.D]
+lower = [-0.5]
+upper = [0.5]
+"""
+
+
+def test_gamma_schedule_decides_e_to_the_L_f_dtau_near_2(monkeypatch: pytest.MonkeyPatch) -> None:
+    """L_f Δτ within 1e-34 below ln 2 (e^(L_f Δτ)/2 = 1 − 1e-50, checked here with mpmath):
+    gamma-schedule failed "e^(L_f Δτ)/2 > 1", exit 1 (re-check trial, session 29). It is
+    decided at more bits and certified; capped at 150 bits it is inconclusive (exit 4)."""
+    import mpmath as mp
+
+    sp = api.load_spec_text(_LN2_TIE, "ln2.toml")
+    rep = api.design(sp)
+    x = rep.parameters["L_f"] * rep.parameters["dtau"]
+    with mp.workdps(200):
+        assert mp.log(2) - mp.mpf(int(x.p)) / int(x.q) > 0  # e^x/2 < 1: the claim is true
+    assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
+    from obsdesign.methods.searchspace import claims as SC
+
+    monkeypatch.setattr(SC, "MAX_K_BITS", 150)
+    monkeypatch.setattr(D, "MAX_K_BITS", 150)
+    c = {c.id: c for c in api.certify(sp, rep.parameters)}["gamma-schedule"]
+    assert c.status == ClaimStatus.FAILED and c.float_ok and "not decided at 150 bits" in c.detail
+
+
+def test_gamma_schedule_fails_when_e_to_the_L_f_dtau_exceeds_2() -> None:
+    """The must-fail side: L_f Δτ = 7/10 and ln 2 + 1e-50 (above ln 2 ≈ 0.6931) fail
+    gamma-schedule, proved (exit 1, not float_ok), "e^(L_f Δτ)/2 > 1"."""
+    import mpmath as mp
+
+    sp = api.load_spec_text(_LN2_TIE, "ln2.toml")
+    p = api.design(sp).parameters
+    with mp.workdps(200):
+        above = Q(mp.nstr(mp.log(2) + mp.mpf(10) ** -50, 150))
+    for x in (fmpq(7, 10), above):
+        p["dtau"] = x / p["L_f"]
+        c = {c.id: c for c in api.certify(sp, p)}["gamma-schedule"]
+        assert c.status == ClaimStatus.FAILED and not c.float_ok, x
+        assert "e^(L_f Δτ)/2 > 1" in c.detail

@@ -322,8 +322,20 @@ def _schedule(c: Claims, gam: list[fmpq], g_star: fmpq, L_f: fmpq, dtau: fmpq) -
                 "shrinks too slowly to reach γ⋆ within them: a smaller K (shorter Δτ), a larger "
                 "γ⋆ or a smaller γ₀)"
             )
+    open_ = False
     if not bad and e_hi > 2:
-        bad = "e^(L_f Δτ)/2 > 1: γ⋆ is not a fixed point of the rule (Δτ too long)"
+        # e^x/2 ≤ 1 iff x ≤ ln 2, decided at more bits where 113 do not (L_f Δτ within 1e-34
+        # of ln 2 failed with "e^(L_f Δτ)/2 > 1" for e^x/2 = 1 − 1e-50: re-check trial,
+        # session 29, the pattern of the K-rule's near tie); undecided is exit 4
+        d = ivq.log_compare(x, fmpq(2), ivq.PREC, MAX_K_BITS)[0]
+        if d is None:
+            bad, open_ = (
+                f"not decided at {MAX_K_BITS} bits whether e^(L_f Δτ)/2 ≤ 1: L_f Δτ lies within "
+                "the enclosure of ln 2 (no proof either way)",
+                True,
+            )
+        elif d > 0:
+            bad = "e^(L_f Δτ)/2 > 1: γ⋆ is not a fixed point of the rule (Δτ too long)"
     _verdict(
         c,
         "gamma-schedule",
@@ -331,9 +343,11 @@ def _schedule(c: Claims, gam: list[fmpq], g_star: fmpq, L_f: fmpq, dtau: fmpq) -
         "(rounded up by at most 1e-12 relative), the last is γ⋆ and stays γ⋆ "
         "(e^(L_f Δτ)/2 ≤ 1)",
         "Theorem 1, hypothesis 2",
-        "every entry against outward-rounded bounds of e^(L_f Δτ) (113 bits)",
+        "every entry against outward-rounded bounds of e^(L_f Δτ) (113 bits; L_f Δτ against "
+        f"ln 2 doubled up to {MAX_K_BITS} bits where they do not decide e^(L_f Δτ)/2 ≤ 1)",
         not bad,
         bad,
+        undecided=open_,
     )
 
 
