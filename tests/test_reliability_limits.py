@@ -488,3 +488,33 @@ def test_the_memory_estimate_counts_disturbance_and_noise_channels() -> None:
         tracemalloc.stop()
     assert peak <= 1.5 * est, (peak, est)
     assert est <= 4 * peak, (peak, est)
+
+
+def test_max_digits_above_pythons_int_string_limit_holds_everywhere(tmp_path: Path) -> None:
+    """--limit max_digits=5000 with a 4502-digit λ: design and verify took it, check refused
+    its in-memory report ("Exceeds the limit (4300 digits)", exit 2), and a design whose
+    exact values pass 4300 digits ended in exit 3 while writing (re-check trial, session
+    29). The report is read up to max_digits and written whatever the length of the tool's
+    own numbers."""
+    import sys
+
+    from obsdesign import api
+
+    lam = "0.96" + "1" * 4500
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0, 1], [1, 0]]\nC = [[1, 0]]\n[method]\n'
+        f'key = "lyapunov"\nL = [-1.87, 1.874]\nlambda = {lam}\n'
+    )
+    spec = tmp_path / "long.toml"
+    spec.write_text(text)
+    before = sys.get_int_max_str_digits()
+    r = runner.invoke(app, ["--limit", "max_digits=5000", "check", str(spec), "-q"])
+    assert r.exit_code == 0, r.output
+    set_limits(max_digits=5000)
+    rep = api.design(spec)
+    big = rep.parameters["lambda"] ** 2  # 9005-digit denominator, beyond max_digits too
+    rep.parameters["lambda_sq"] = big
+    assert big.q.bit_length() > 4300 * 3.3
+    d = rep.to_dict()  # written: the tool's own numbers, any length
+    assert d["parameters"]["exact"]["lambda"].startswith("961")
+    assert sys.get_int_max_str_digits() == before  # the limit is back afterwards

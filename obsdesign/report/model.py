@@ -232,7 +232,10 @@ class Report:
     def to_dict(self) -> dict[str, Any]:
         """The report as JSON data (:meth:`float_view` for its parameters: exit 4 when one
         has no float view)."""
-        params = self.float_view()
+        from obsdesign.limits import own_int_digits
+
+        with own_int_digits():  # exact values the tool made, of any length
+            params = self.float_view()
         d = {
             "schema_version": self.schema_version,
             "tool": self.tool,
@@ -309,6 +312,18 @@ class Report:
 
     @classmethod
     def from_dict(cls, d: Any, file: str = "<report>") -> tuple[Report, list[str]]:
+        """A report from its JSON data (``file`` names it in errors); returns it and the list
+        of float/exact inconsistencies. Integers are read up to ``max_digits`` digits
+        (:func:`obsdesign.limits.int_digits`): check's in-memory round trip refused a
+        4502-digit λ that --limit max_digits=5000 allows and verify read (re-check trial,
+        session 29)."""
+        from obsdesign.limits import int_digits
+
+        with int_digits():
+            return cls._from_dict(d, file)
+
+    @classmethod
+    def _from_dict(cls, d: Any, file: str = "<report>") -> tuple[Report, list[str]]:
         from obsdesign.limits import data_problem
 
         if not isinstance(d, dict):
