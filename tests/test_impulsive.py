@@ -466,3 +466,73 @@ def test_the_theta_bracket_holds_the_minimum_and_ends(x_min: float) -> None:
     assert lo <= target <= hi or abs(target) == LOG_THETA_MAX
     assert hi - lo <= 1.0 + 1e-9
     assert len(calls) <= 49 * 60
+
+
+def _t_min_bound(rep: Any) -> Any:
+    """−ln((α − γ)/α)/κ of eq. (26c) for a design's α, γ, κ, by mpmath at 120 digits
+    (independent of the tool's enclosures)."""
+    import mpmath as mp
+
+    p = rep.parameters
+    alpha, gamma, kappa = (Q(v) for v in (p["alpha"], p["gamma"], p["kappa"]))
+
+    def mpq(q: Any) -> Any:
+        return mp.mpf(int(q.p)) / int(q.q)
+
+    return mp.log(mpq(alpha) / (mpq(alpha) - mpq(gamma))) / mpq(kappa)
+
+
+def test_T_min_a_hair_from_its_bound_is_decided(monkeypatch: pytest.MonkeyPatch) -> None:
+    """T_min 1e-45 above −ln((α − γ)/α)/κ (true) was "failed", exit 1: 113 bits could not
+    decide it (re-check trial, session 29). It is decided at more bits: certified 1e-45
+    above, failed (proved, not float_ok) 1e-45 below, inconclusive when capped at 120 bits."""
+    import functools
+
+    import mpmath as mp
+
+    from obsdesign.certify import interval as ivq
+
+    rep = api.design(EXAMPLE)
+    sp = load_spec(EXAMPLE)
+    with mp.workdps(120):
+        b = _t_min_bound(rep)
+        above, below = (Q(mp.nstr(b + s * mp.mpf(10) ** -45, 100)) for s in (1, -1))
+
+    def claim(t: Any) -> Any:
+        p = rep.parameters
+        p["T_min"] = t
+        return {c.id: c for c in api.certify(sp, p)}["T_min"]
+
+    assert claim(above).ok
+    c = claim(below)
+    assert not c.ok and not c.float_ok and "<" in c.detail
+    monkeypatch.setattr(ivq, "log_compare", functools.partial(ivq.log_compare, max_bits=120))
+    c = claim(above)
+    assert not c.ok and c.float_ok and "not decided" in c.detail
+
+
+def test_T_max_a_hair_from_its_bound_is_decided() -> None:
+    """The T_max side of the same fix: 1e-45 below −ln((1−γ)²)/(ϖ_o + κ + λ*_no + βλ*_on)
+    (mpmath, from the report's exact values) is certified, 1e-45 above fails, proved."""
+    import mpmath as mp
+
+    rep = api.design(EXAMPLE)
+    sp = load_spec(EXAMPLE)
+    p = rep.parameters
+
+    def mpq(key: str) -> Any:
+        q = Q(p[key])
+        return mp.mpf(int(q.p)) / int(q.q)
+
+    with mp.workdps(120):
+        den = mpq("varpi_o") + mpq("kappa") + mpq("lambda_no") + mpq("beta") * mpq("lambda_on")
+        b = -mp.log((1 - mpq("gamma")) ** 2) / den
+        below, above = (Q(mp.nstr(b + s * mp.mpf(10) ** -45, 100)) for s in (-1, 1))
+
+    def claim(t: Any) -> Any:
+        p["T_max"] = t
+        return {c.id: c for c in api.certify(sp, p)}["T_max"]
+
+    assert claim(below).ok
+    c = claim(above)
+    assert not c.ok and not c.float_ok
