@@ -188,3 +188,25 @@ def test_fmt_value_up_boundaries_and_default_digits() -> None:
     seventeen = fmpq(1234567890123451, 10**9)  # 1234567.890123451: 17 characters
     assert fmt_value_up(seventeen) == "1234567890123451/1000000000 ≤ 1234570"
     assert fmt_value_up(fmpq(200582665, 8192)) == "200582665/8192 ≤ 24485.2"
+
+
+@given(st.fractions(min_value=-(10**6), max_value=10**6))
+def test_fmt_value_down_is_exact_or_a_safe_bound(x: Fraction) -> None:
+    """Either the exact value, or its p/q followed by a lower bound (constrained's
+    "γ = 0.000012345678" for γ = 24691357802469/2·10¹⁸: re-check trial, session 29)."""
+    from obsdesign.certify.printing import fmt_value_down
+
+    text = fmt_value_down(fmpq(x.numerator, x.denominator))
+    if " ≥ " in text:
+        exact, bound = text.split(" ≥ ")
+        assert Fraction(exact) == x and Fraction(bound) <= x
+    else:
+        assert Fraction(text) == x
+
+
+def test_fmt_value_down_of_a_long_gamma() -> None:
+    from obsdesign.certify.printing import fmt_value_down
+
+    g = fmpq(24691357802469, 2 * 10**18)
+    assert fmt_value_down(g, 8) == "24691357802469/2000000000000000000 ≥ 0.000012345678"
+    assert fmt_value_down(fmpq(23965, 10**9), 8) == "0.000023965"

@@ -113,3 +113,12 @@ def test_iss_bound_statement_shows_mu_exactly() -> None:
     rep = api.design(SPEC)
     st = {c.id: c.statement for c in rep.claims}
     assert "μ = 200582665/8192 ≤ 24485.1886, ρ < 1" in st["iss-bound"]
+
+
+def test_gamma_bound_statement_shows_a_long_gamma_exactly() -> None:
+    """A given γ = 0.0000123456789012345 was printed "γ = 0.000012345678" (rounded, behind
+    "="; re-check trial, session 29): now exactly, its rounded-down value beside it."""
+    text = SPEC.read_text().replace("[method]\n", "[method]\ngamma = 0.0000123456789012345\n", 1)
+    rep = api.design(api.load_spec_text(text, "g.toml"))
+    st = {c.id: c.statement for c in rep.claims}
+    assert "γ = 24691357802469/2000000000000000000 ≥ 0.000012345678" in st["gamma-bound"]

@@ -87,6 +87,18 @@ def fmt_value_up(x: Any, digits: int = 6, longest: int = 16) -> str:
     return m if len(m) <= longest else f"{Q(x)} ≤ {fmt_up(x, digits)}"
 
 
+def fmt_value_down(x: Any, digits: int = 6, longest: int = 16) -> str:
+    """:func:`fmt_value_up` for a quantity whose statement stays true when it is smaller
+    (constrained's γ in γδ² ≤ λ_min(P)): the exact value when short, else "p/q ≥ d" with d
+    rounded down ("γ = 0.000012345678" for γ = 24691357802469/2·10¹⁸ put a rounded number
+    behind "=": re-check trial, session 29).
+
+    :param x: the exact value; :param digits: significant digits of the bound;
+    :param longest: the longest exact text shown alone."""
+    m = fmt_exact(x)
+    return m if len(m) <= longest else f"{Q(x)} ≥ {fmt_down(x, digits)}"
+
+
 def fmt_exact(x: Any) -> str:
     """``x`` exactly: a finite decimal when it has one with at most 30 digits, else p/q."""
     q = Q(x)

@@ -25,7 +25,13 @@ from obsdesign.certify.claim import Claim, Claims, ClaimStatus
 from obsdesign.certify.exact import Q, qeye, to_float
 from obsdesign.certify.interval import sqrt_upper, upper
 from obsdesign.certify.linalg import ROUNDED_UP_REL
-from obsdesign.certify.printing import fmt_down, fmt_exact, fmt_up, fmt_value_up
+from obsdesign.certify.printing import (
+    fmt_down,
+    fmt_exact,
+    fmt_up,
+    fmt_value_down,
+    fmt_value_up,
+)
 from obsdesign.certify.psd import asymmetric, check_pd, check_psd
 from obsdesign.methods.constrained import bounds as B
 from obsdesign.methods.constrained.cmap import ConstraintMap
@@ -235,7 +241,7 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         ok, det = B.gamma_ok(P, g, dsq)
         c.exact(
             id=cid,
-            statement=f"{label} δ² ≤ λ_min(P) with {label} = {fmt_down(g, 8)}",
+            statement=f"{label} δ² ≤ λ_min(P) with {label} = {fmt_value_down(g, 8)}",
             reference=_ref("Theorem 1, eq. (24)"),
             check=f"exact LDLᵀ of P − {label}δ²I",
             passed=ok,
