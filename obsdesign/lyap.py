@@ -614,7 +614,10 @@ def iss_mu(
         G = Bf.T @ Pf @ Bf + Bf.T @ Pf @ Af @ np.linalg.solve(S, Af.T @ Pf @ Bf)
     else:
         G = Bf.T @ Pf @ np.linalg.solve(S, Pf @ Bf)
-    mu_f = float(np.linalg.eigvalsh((G + G.T) / 2).max()) if np.all(np.isfinite(G)) else np.inf
+    # G/2 + Gᵀ/2, not (G + Gᵀ)/2: the sum overflowed for entries above 9e307, half the float
+    # range, and a μ ≈ 9.96e307 that certifies was refused (re-check trial, session 29)
+    H = G / 2 + G.T / 2
+    mu_f = float(np.linalg.eigvalsh(H).max()) if np.all(np.isfinite(H)) else np.inf
     if not math.isfinite(mu_f * (1 + 1e-9)):
         # Bd = 1e150 made μ ≈ 1e311: "cannot round a non-finite number", exit 3 (rendering
         # soundness trial, session 29); OverflowError is exit 4 (api.captured_warnings)
