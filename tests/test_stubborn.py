@@ -5,6 +5,7 @@ study's qualitative result, bad input."""
 from __future__ import annotations
 
 import json
+import math
 import warnings
 from pathlib import Path
 from typing import Any
@@ -1447,3 +1448,20 @@ def test_a_given_schur_gain_of_a_discrete_plant_is_not_refused() -> None:
         assert "for the given K" not in str(e), str(e)
     else:
         assert rep.exit_code() in (0, 4)
+
+
+@pytest.mark.parametrize("amp", [1e160, 1e-200])
+def test_outlier_study_rmse_of_errors_beyond_the_squares_range(amp: float) -> None:
+    """Outliers of 1e160 made the Luenberger RMSE inf (its error stays below ~1e161) and
+    outliers of 1e-200 made it 0 (re-check trial, session 29): the sum of squares is kept
+    scaled, so the median RMSE is finite and positive, of the amplitude's order."""
+    from obsdesign import api
+
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.5]]\nC = [[1]]\n[method]\nkey = "stubborn"\n'
+        "[simulate]\nhorizon = 40\nx0 = [0]\nxhat0 = [0]\nruns = 3\nnoise_std = 0\n"
+        f"outlier_rate = 0.5\namplitudes = [{amp!r}]\n"
+    )
+    m = api.simulate(api.load_spec_text(text, "s.toml"), study="outliers").metrics()
+    med = m["outlier_study_median_rmse"]["luenberger"][f"{amp:g}"]["x1"]
+    assert math.isfinite(med) and 0 < med and amp * 1e-3 < med < amp * 10

@@ -85,15 +85,21 @@ def run_errors(
     e0: (..., n) initial errors (broadcast); nu(k0, k1) -> (k1 − k0, ..., p) the output noise
     of steps k0..k1−1; levels (..., p): constant saturation levels (inf: Luenberger);
     adaptive (...,) bool: the stubborn observer's adaptive level instead. Continuous time:
-    Heun's method with ν held over each step. Returns the sums of e_i² over the grid points
-    0..steps (for the RMSE, shape (..., n)), the final e and the final σ̄ (trajectories are
+    Heun's method with ν held over each step. Returns the RMSE of each e_i over the grid
+    points 0..steps (shape (..., n); its sum of squares kept scaled, so it neither overflows
+    nor underflows), the final e and the final σ̄ (trajectories are
     not kept: :func:`single_run` steps one at a time to record them). ``dist(k0, k1)`` ->
     (k1 − k0, n): the plant's disturbance term B_d d of steps k0..k1−1 (held over each step),
     the same for every observer (None: no disturbance). ``check(k0, steps)``, the time budget,
     is called before every chunk of steps."""
+    from obsdesign.simulate.montecarlo import _scaled_add
+
     e = np.broadcast_to(e0, adaptive.shape + (g.A.shape[0],)).astype(float).copy()
     sb = np.where(adaptive, sigma0, 0.0)
-    sq = e**2
+    # the sum of e² kept over the running max |e| (montecarlo._scaled_add): outliers of 1e160
+    # made it inf and of 1e-200 made it 0 (re-check trial, session 29)
+    sq, sc = np.zeros_like(e), np.zeros_like(e)
+    _scaled_add(sq, sc, e)
     AT, CT, KT = g.A.T, g.C.T, g.K.T
     ad = adaptive[..., None]
 
@@ -129,8 +135,10 @@ def run_errors(
                 sb = np.where(
                     adaptive, np.maximum(sb + dt / 2 * (ds1 - g.lam * s2 + ry2), 0.0), 0.0
                 )
-            sq += e**2
-    return sq, e, sb
+            _scaled_add(sq, sc, e)
+    with np.errstate(invalid="ignore"):
+        rmse = np.where(sc > 0, sc * np.sqrt(sq / (steps + 1)), np.where(np.isnan(sc), sc, 0.0))
+    return rmse, e, sb
 
 
 #: the time budget is looked at every this many steps of a one-run loop
@@ -299,8 +307,8 @@ def study(
     # warnings and a NaN RMSE (inf − inf) were printed (soundness trial, session 25); such
     # an error left the float range, so its RMSE is inf, said once in words
     with np.errstate(over="ignore", invalid="ignore"):
-        sq, _, _ = run_errors(g, e0, nu, steps, dt, levels, adaptive, s0, check=check)
-        rmse = np.sqrt(sq / (steps + 1))  # (observers, amplitudes, runs, n)
+        rmse, _, _ = run_errors(g, e0, nu, steps, dt, levels, adaptive, s0, check=check)
+        # (observers, amplitudes, runs, n)
     gone = ~np.isfinite(rmse)
     if gone.any():
         rmse = np.where(gone, np.inf, rmse)
