@@ -669,3 +669,24 @@ def test_output_panels_skip_an_output_that_is_a_constant() -> None:
     old = 'h = ["x1*step(x1)"]'
     sp = api.load_spec_text(TEXT.replace(old, 'h = ["x1", "pi"]'), "p.toml")
     assert output_panels(sp, ["x1", "x2"]) == {0: [0]}
+
+
+def test_error_panel_floor_follows_eps_star(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """On a plant of size 1e-198 every error curve sat on a fixed 1e-12 floor and ε⋆ was off
+    the axis (re-check trial, session 29): the floor is ε⋆·1e-6, ε⋆ is in view and the
+    curves keep their values."""
+    from obsdesign.simulate import plot as simplot
+
+    figs = []
+    monkeypatch.setattr(simplot, "save_figure", lambda fig, path, dpi: figs.append(fig))
+    sp = api.load_spec_text(_scaled_plant(-198), "tiny.toml")
+    res = api.simulate(sp)
+    api.plot_simulation(sp, res, tmp_path / "p.png")
+    ax = figs[0].axes[-1]
+    eps = res.info["eps_star"]
+    lo, hi = ax.get_ylim()
+    assert lo <= eps / 100 and hi > eps
+    curve = next(ln for ln in ax.lines if ln.get_label() == "|centroid − x|")
+    assert np.min(curve.get_ydata()) < 1e-199

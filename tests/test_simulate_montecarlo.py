@@ -379,6 +379,10 @@ def test_runs_whose_metrics_overflow_are_said_in_words(tmp_path) -> None:
         w.startswith("warning: UserWarning: the metrics of 3 of 3 runs are not finite")
         for w in notes
     )
+    # in spans (as on Dask): the same words, counted over every run (re-check trial,
+    # session 29: no "warning: UserWarning: " prefix)
+    spans = api.simulate(p, options={"runs": "3"}, batches=2).info["warnings"]
+    assert [w for w in spans if "not finite" in w] == [w for w in notes if "not finite" in w]
     p.write_text(RANDOM.replace("x0 = [1, -1]", "x0 = [1e300, -1e300]"))
     info = api.simulate(p, options={"runs": "3"}).info
     assert "warnings" not in info

@@ -739,8 +739,9 @@ def merge(parts: list[SimResult], states: list[str]) -> SimResult:
     res.info.pop("span", None)
     res.info["quantiles"] = quantiles(out, states)
     text = nonfinite_warning(out)
-    if text:  # counted over every run (each span leaves it to merge)
-        res.info["warnings"] = [*res.info.get("warnings", []), text]
+    if text:  # counted over every run (each span leaves it to merge); worded as the serial
+        # run's warnings.warn is captured (it lacked "warning: UserWarning: ", re-check trial)
+        res.info["warnings"] = [*res.info.get("warnings", []), f"warning: UserWarning: {text}"]
     return res
 
 
