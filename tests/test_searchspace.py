@@ -1120,7 +1120,12 @@ _TIE_GAMMA = {
 
 
 def _tie_spec(side: str, extra: str = "") -> str:
-    g_star, g0 = _TIE_GAMMA[side]
+    return _scalar_spec(*_TIE_GAMMA[side], "1.5", extra)
+
+
+def _scalar_spec(g_star: str, g0: str, kappa: str, extra: str = "") -> str:
+    """ẋ = −x, y = x on E = [−1, 1] with the exact constants L_f = L_h = f_sup = 1 given,
+    α = 1/2: the spec of the near-tie tests (γ⋆, γ₀, κ as TOML literals)."""
     return f"""[system]
 time = "continuous"
 states = ["x1"]
@@ -1134,7 +1139,7 @@ gamma0 = {g0}
 L_f = 1
 L_h = 1
 f_sup = 1
-kappa = 1.5
+kappa = {kappa}
 {extra}[method.E]
 lower = [-1]
 upper = [1]
@@ -1374,27 +1379,11 @@ def test_schema_agrees_with_the_bound_boxes_cap(boxes: int, ok: bool) -> None:
             jsonschema.validate(data, api.schema())
 
 
-_LN2_TIE = """[system]
-time = "continuous"
-states = ["x1"]
-f = ["-x1"]
-h = ["x1"]
-[method]
-key = "search-space"
-alpha = 0.5
-gamma_star = 4.40093447974568450423639442195667662270158815466822383568685402852948331409329978162452906e-2
-gamma0 = 4.40093447974568450423639442195667662270158815466822383568685402852948331409329978162452906e-2
-L_f = 1
-L_h = 1
-f_sup = 1
-kappa = 1.999999999999999999999999999999999999999999999999999999999999
-[method.E]
-lower = [-1]
-upper = [1]
-[method.D]
-lower = [-0.5]
-upper = [0.5]
-"""
+_LN2_TIE = _scalar_spec(
+    "4.40093447974568450423639442195667662270158815466822383568685402852948331409329978162452906e-2",
+    "4.40093447974568450423639442195667662270158815466822383568685402852948331409329978162452906e-2",
+    "1.999999999999999999999999999999999999999999999999999999999999",
+)
 
 
 def test_gamma_schedule_decides_e_to_the_L_f_dtau_near_2(monkeypatch: pytest.MonkeyPatch) -> None:
