@@ -1016,17 +1016,20 @@ RETIMEOUT_S = 0.1
 
 @contextmanager
 def _time_budget(seconds: float | None) -> Any:
-    """Raise :class:`SpecTimeout` in the main thread after ``seconds`` of wall time (SIGALRM;
-    None, 0 or another thread: no budget). A long C call (a solver) is interrupted when it
-    returns to Python. A budget beyond :data:`MAX_BUDGET_S` (``--timeout inf``, 1e300) is no
-    budget: the timer takes no such value (OverflowError from setitimer: exit 3; hostile-input
-    trial, session 24)."""
-    if (
-        not seconds
-        or not seconds <= MAX_BUDGET_S
-        or threading.current_thread() is not threading.main_thread()
-    ):
+    """Raise :class:`SpecTimeout` in this thread after ``seconds`` of wall time (None or 0:
+    no budget). In the main thread by SIGALRM; in another thread (a Dask worker's task:
+    ``check --workers`` ran every spec unbounded, session 30) by an asynchronous exception
+    (:func:`_thread_budget`). Either way a long C call (a solver) is interrupted when it
+    returns to Python, and the stop repeats every :data:`RETIMEOUT_S` until the block is left.
+    A budget beyond :data:`MAX_BUDGET_S` (``--timeout inf``, 1e300) is no budget: the timer
+    takes no such value (OverflowError from setitimer: exit 3; hostile-input trial, session
+    24)."""
+    if not seconds or not seconds <= MAX_BUDGET_S:
         yield
+        return
+    if threading.current_thread() is not threading.main_thread():
+        with _thread_budget(float(seconds)):
+            yield
         return
 
     def on_alarm(signum: int, frame: Any) -> None:
@@ -1043,6 +1046,51 @@ def _time_budget(seconds: float | None) -> Any:
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, old)
+
+
+def _async_raise(tid: int, exc: type[BaseException] | None) -> None:
+    """Schedule ``exc`` in the thread ``tid`` (None: cancel a scheduled one), raised there
+    when it next runs Python code (CPython's ``PyThreadState_SetAsyncExc``)."""
+    import ctypes
+
+    ctypes.pythonapi.PyThreadState_SetAsyncExc(
+        ctypes.c_ulong(tid), ctypes.py_object(exc) if exc is not None else None
+    )
+
+
+@contextmanager
+def _thread_budget(seconds: float) -> Any:
+    """:func:`_time_budget` outside the main thread (no signal reaches it): a timer thread
+    schedules :class:`SpecTimeout` in this thread after ``seconds``, and again every
+    :data:`RETIMEOUT_S` until the block is left. A lock makes leaving the block and the
+    timer's firing exclusive, so no stop is scheduled once the block is left; one scheduled
+    just before is cancelled, or raised in the block's ``finally`` (the caller's ``except
+    SpecTimeout`` takes it, as the deadline had passed)."""
+    tid = threading.get_ident()
+    lock = threading.Lock()
+    armed = [True]
+    timers: list[threading.Timer] = []
+
+    def start(after: float) -> None:
+        t = threading.Timer(after, fire)
+        t.daemon = True
+        timers[:] = [t]
+        t.start()
+
+    def fire() -> None:
+        with lock:
+            if armed[0]:
+                _async_raise(tid, SpecTimeout)
+                start(RETIMEOUT_S)
+
+    start(seconds)
+    try:
+        yield
+    finally:
+        with lock:
+            armed[0] = False
+            timers[0].cancel()
+        _async_raise(tid, None)
 
 
 def check_one(path: Path, timeout: float | None = None) -> CheckRow:
@@ -1122,7 +1170,7 @@ def check(
 ) -> list[CheckRow]:
     """Design and verify every spec under ``paths`` (folders recursively, see
     :func:`spec_files`); ``on_start(path)`` is called before each (in-process runs only).
-    ``timeout``: seconds per spec (in-process runs; see :func:`check_one`).
+    ``timeout``: seconds per spec (see :func:`check_one`; on Dask, in the worker).
     One row per spec, in file order. ``workers`` (a Dask LocalCluster of that many
     processes), ``scheduler`` (an existing Dask scheduler's address; its workers must see
     the same files) or ``client`` (a ``dask.distributed.Client``) run the specs on Dask
@@ -1144,9 +1192,9 @@ def check(
         return rows
     from obsdesign.sweep import run_rows
 
-    items = [_remote_item(f) for f in files]
+    items = [(*_remote_item(f), timeout) for f in files]
 
-    def lost(item: tuple[str, str, str | None], message: str) -> CheckRow:
+    def lost(item: tuple[str, str, str | None, float | None], message: str) -> CheckRow:
         return CheckRow(item[0], "?", EXIT_SOLVER, 0, 0, 0, "", 0.0, one_line(message))
 
     return run_rows(check_remote, items, lost, workers, scheduler, client, on_row)
@@ -1167,14 +1215,15 @@ def _remote_item(f: Path) -> tuple[str, str, str | None]:
     return str(f), os.path.abspath(f), sha
 
 
-def check_remote(item: tuple[str, str, str | None]) -> CheckRow:
-    """:func:`check_one` on a Dask worker for an item of :func:`_remote_item`: the file at the
+def check_remote(item: tuple[str, str, str | None, float | None]) -> CheckRow:
+    """:func:`check_one` on a Dask worker for an item of :func:`_remote_item` and the time
+    budget (seconds or None, as :func:`check_one`'s ``timeout``): the file at the
     absolute path, refused (exit 2) when its bytes are not those read where ``check`` ran
     (workers must see the same files; a stale or different copy was checked silently); the
     row names the path as given."""
     from obsdesign.limits import read_input
 
-    shown, path, sha = item
+    shown, path, sha, timeout = item
     t0 = time.perf_counter()
     if sha is not None:
         try:
@@ -1190,7 +1239,7 @@ def check_remote(item: tuple[str, str, str | None]) -> CheckRow:
                 f"{shown}: the worker's copy ({path}) is not the file check read (sha256 "
                 f"{here[:12]}… vs {sha[:12]}…): the workers must see the same files",
             )
-    row = check_one(Path(path))
+    row = check_one(Path(path), timeout)
     row.spec = shown
     if path != shown:
         row.message = row.message.replace(path, shown)

@@ -372,7 +372,7 @@ def _timeout_opt(unit: str) -> Any:
             metavar="SECONDS",
             min=0,
             help=f"Time budget per {unit} (0 or inf: none); a {unit} past it gets exit 3 and "
-            "the others still run. In-process runs only.",
+            "the others still run (on Dask too: applied in the worker).",
         ),
     ]
 

@@ -150,9 +150,14 @@ def _write_plot(path: Path, draw: Callable[[Path], Any], force: bool) -> None:
 
 
 def _check_distributed(
-    paths: list[Path], workers: int | None, scheduler: str | None, quiet: bool
+    paths: list[Path],
+    workers: int | None,
+    scheduler: str | None,
+    quiet: bool,
+    timeout: float | None = None,
 ) -> list[Any]:
-    """``check`` on Dask, with a progress bar on stderr (unless --quiet)."""
+    """``check`` on Dask, with a progress bar on stderr (unless --quiet); ``timeout``: seconds
+    per spec, applied in the worker."""
     from obsdesign import api
     from obsdesign.distributed import check_workers, progress_bar
 
@@ -160,7 +165,11 @@ def _check_distributed(
     n = len(api.spec_files(list(paths)))
     with progress_bar(n, "check", quiet) as advance:
         return api.check(
-            list(paths), workers=workers, scheduler=scheduler, on_row=lambda r: advance(r.code != 0)
+            list(paths),
+            workers=workers,
+            scheduler=scheduler,
+            on_row=lambda r: advance(r.code != 0),
+            timeout=timeout,
         )
 
 
@@ -638,7 +647,7 @@ def check(
     if workers is None and scheduler is None:
         rows = api.check(list(paths), on_start=each, timeout=timeout or None)
     else:
-        rows = _check_distributed(list(paths), workers, scheduler, quiet)
+        rows = _check_distributed(list(paths), workers, scheduler, quiet, timeout or None)
     if junit is not None:
         from obsdesign.junit import write_junit
 

@@ -400,7 +400,7 @@ class PointTask:
     file: str
     simulate: bool = False
     sim_options: dict[str, str] = field(default_factory=dict)
-    #: seconds this point may run (in the main thread; None: no limit), as ``check --timeout``
+    #: seconds this point may run (None: no limit), as ``check --timeout``; on Dask too
     timeout: float | None = None
 
 
@@ -670,8 +670,8 @@ def sweep_rows(
     timeout: float | None = None,
 ) -> list[dict[str, Any]]:
     """One row per grid point, in grid order (see the module docstring); ``on_row(row)`` is
-    called as each row arrives (completion order); ``timeout``: seconds per point (in-process
-    runs), past which the point's row is exit 3."""
+    called as each row arrives (completion order); ``timeout``: seconds per point (on Dask
+    too: applied in the worker), past which the point's row is exit 3."""
     _, tasks = plan(spec, grid, simulate, options, timeout)
 
     def lost(task: PointTask, message: str) -> dict[str, Any]:

@@ -126,6 +126,48 @@ def test_the_callers_limits_hold_in_the_workers(dask_client):
     assert [r["exit_code"] for r in sw.sweep_rows(SPEC, grid, client=dask_client)] == [0, 0]
 
 
+#: run in each worker by ``client.run(exec, ...)``: api.design of a spec named "slow*.toml"
+#: spins in Python for 20 s (a spec that hangs), of any other the real one
+_SLOW_DESIGN = """
+import time
+import obsdesign.api as _api
+_real = getattr(_api, "_real_design", _api.design)
+_api._real_design = _real
+def _slow(sp, *a, **k):
+    if str(getattr(sp, "file", "")).split("/")[-1].startswith("slow"):
+        t0 = time.perf_counter()
+        while time.perf_counter() - t0 < 20:
+            time.sleep(0.01)
+    return _real(sp, *a, **k)
+_api.design = _slow
+"""
+_REAL_DESIGN = "import obsdesign.api as _api\n_api.design = _api._real_design\n"
+
+
+def test_check_and_sweep_on_dask_stop_a_spec_at_the_timeout(dask_client, tmp_path: Path):
+    """``--timeout`` was not applied with ``--workers`` / ``--scheduler`` (a Dask task runs in
+    a worker thread, which SIGALRM does not reach): one spec that hangs held the run for as
+    long as it hung (session 30). The budget is applied in the worker: an exit-3 row, the
+    others kept."""
+    good, slow = tmp_path / "a.toml", tmp_path / "slow.toml"
+    good.write_text(SPEC.read_text())
+    slow.write_text(SPEC.read_text())
+    dask_client.run(exec, _SLOW_DESIGN, {})
+    try:
+        t0 = time.perf_counter()
+        rows = api.check([good, slow], client=dask_client, timeout=1)
+        took = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        pts = sw.sweep_rows(slow, ["method.lambda=[0.97, 0.98]"], client=dask_client, timeout=1)
+        took_sweep = time.perf_counter() - t0
+    finally:
+        dask_client.run(exec, _REAL_DESIGN, {})
+    assert [r.code for r in rows] == [0, 3] and took < 15, [r.message for r in rows]
+    assert "not finished within 1 s" in rows[1].message and rows[1].method == "lyapunov"
+    assert [r["exit_code"] for r in pts] == [3, 3] and took_sweep < 15
+    assert all("not finished within 1 s" in r["message"] for r in pts)
+
+
 def _check_rows(rows: list) -> list[dict]:
     return [{k: v for k, v in r.__dict__.items() if k != "seconds"} for r in rows]
 
@@ -161,7 +203,7 @@ def test_check_on_dask_reads_relative_paths_here_and_refuses_another_copy(
         dask_client.run(os.chdir, str(ROOT))
     assert serial[0].code == 1 and _check_rows(dist) == _check_rows(serial)
     assert dist[0].spec == "s.toml"
-    item = api._remote_item(Path("s.toml"))
+    item = (*api._remote_item(Path("s.toml")), None)
     (tmp_path / "s.toml").write_text(SPEC.read_text())  # the "worker's" copy differs now
     row = api.check_remote(item)
     assert row.code == 2 and "the workers must see the same files" in row.message

@@ -8,6 +8,7 @@ import os
 import shutil
 import warnings
 from pathlib import Path
+from typing import Any
 
 import pytest
 from typer.testing import CliRunner
@@ -344,3 +345,121 @@ def test_a_named_folder_that_cannot_be_listed_gets_a_row(
     assert rows["s.toml"].code == 0 and rows["shut"].code == 2
     assert "a folder that cannot be read" in rows["shut"].message
     assert api.spec_files(tmp_path / "shut") == [tmp_path / "shut"]
+
+
+def _in_thread(fn: Any) -> Any:
+    """``fn()`` run in a new thread (no signal reaches it, as a Dask worker's task); its
+    result, or the exception it raised, re-raised here."""
+    import threading
+
+    out: list[Any] = []
+
+    def run() -> None:
+        try:
+            out.append(("ok", fn()))
+        except BaseException as e:  # noqa: BLE001 - handed back to the caller
+            out.append(("raised", e))
+
+    t = threading.Thread(target=run)
+    t.start()
+    t.join(60)
+    assert out, "the thread did not finish"
+    kind, v = out[0]
+    if kind == "raised":
+        raise v
+    return v
+
+
+def test_a_time_budget_stops_a_loop_outside_the_main_thread() -> None:
+    """``check --workers`` / ``sweep --workers`` ran every spec unbounded: SIGALRM reaches the
+    main thread only, and a Dask task runs in a worker thread (session 30). There the stop is
+    an exception scheduled in the thread; it repeats if swallowed, and nothing fires once the
+    block is left."""
+    import time
+
+    import pytest
+
+    def spin() -> tuple[int, float]:
+        swallowed = 0
+        t0 = time.perf_counter()
+        try:
+            with api._time_budget(0.2):
+                while time.perf_counter() - t0 < 10:
+                    try:
+                        while time.perf_counter() - t0 < 10:
+                            pass
+                    except api.SpecTimeout:
+                        swallowed += 1  # the first one lost, as in an ignored callback
+                        if swallowed > 1:
+                            raise
+        except api.SpecTimeout:
+            pass
+        took = time.perf_counter() - t0
+        for _ in range(30):  # 0.3 s of Python after the block: no stop arrives
+            time.sleep(0.01)
+        return swallowed, took
+
+    swallowed, took = _in_thread(spin)
+    assert swallowed == 2 and took < 2
+    assert _in_thread(lambda: _spin_within(api._time_budget(5), 0.3)) == "done"
+    with pytest.raises(api.SpecTimeout):
+        _in_thread(lambda: _spin_within(api._time_budget(0.1), 5))
+
+
+def _spin_within(budget: Any, seconds: float) -> str:
+    """Run Python for ``seconds`` inside ``budget``; "done" when it was not stopped."""
+    import time
+
+    t0 = time.perf_counter()
+    with budget:
+        while time.perf_counter() - t0 < seconds:
+            pass
+    time.sleep(0.2)  # after the block: a late stop would be raised here
+    return "done"
+
+
+def test_check_remote_applies_the_time_budget_in_its_thread(tmp_path: Path, monkeypatch):
+    """The item a Dask worker gets carries ``check --timeout``; the worker's thread is
+    stopped at it (exit 3 row naming the method), where it ran to its end (session 30)."""
+    import time
+
+    spec = tmp_path / "b.toml"
+    shutil.copy(SPEC, spec)
+    real = api.design
+
+    def slow(sp, *a, **k):
+        t0 = time.perf_counter()
+        while time.perf_counter() - t0 < 8:
+            time.sleep(0.01)
+        return real(sp, *a, **k)
+
+    monkeypatch.setattr(api, "design", slow)
+    item = (*api._remote_item(spec), 0.5)
+    t0 = time.perf_counter()
+    row = _in_thread(lambda: api.check_remote(item))
+    assert time.perf_counter() - t0 < 5
+    assert row.code == 3 and "not finished within 0.5 s" in row.message
+    assert row.method == "lyapunov"
+
+
+def test_check_workers_passes_the_timeout_on(tmp_path: Path, monkeypatch) -> None:
+    """``check --workers 2 --timeout 7`` hands the budget to the Dask run (it was dropped:
+    the workers ran every spec unbounded; session 30); ``--timeout 0`` is no budget."""
+    import obsdesign.distributed as dist
+
+    spec = tmp_path / "s.toml"
+    shutil.copy(SPEC, spec)
+    seen: list[Any] = []
+    real = api.check
+
+    def record(paths: Any, *a: Any, **k: Any) -> Any:
+        seen.append(k.get("timeout"))
+        k.pop("workers", None)
+        return real(paths, *a, **{**k, "client": None})
+
+    monkeypatch.setattr(dist, "check_workers", lambda *a: None)
+    monkeypatch.setattr(api, "check", record)
+    for t, want in (("7", 7.0), ("0", None)):
+        res = runner.invoke(app, ["check", str(spec), "--workers", "2", "--timeout", t, "-q"])
+        assert res.exit_code == 0, res.output
+        assert seen[-1] == want
