@@ -610,10 +610,11 @@ def iss_mu(
     Af, Bf, Pf = (np.asarray(M, dtype=float) for M in (Acl, Bw, P))
     r = Q(rho)
     S = np.asarray(iss_matrix(Acl, Bw[:, :0], P, r, 0, discrete), dtype=float)
-    if discrete:
-        G = Bf.T @ Pf @ Bf + Bf.T @ Pf @ Af @ np.linalg.solve(S, Af.T @ Pf @ Bf)
-    else:
-        G = Bf.T @ Pf @ np.linalg.solve(S, Pf @ Bf)
+    with np.errstate(over="ignore", invalid="ignore"):  # a non-finite G is OverflowError below
+        if discrete:
+            G = Bf.T @ Pf @ Bf + Bf.T @ Pf @ Af @ np.linalg.solve(S, Af.T @ Pf @ Bf)
+        else:
+            G = Bf.T @ Pf @ np.linalg.solve(S, Pf @ Bf)
     # G/2 + Gᵀ/2, not (G + Gᵀ)/2: the sum overflowed for entries above 9e307, half the float
     # range, and a μ ≈ 9.96e307 that certifies was refused (re-check trial, session 29)
     H = G / 2 + G.T / 2
