@@ -1465,3 +1465,44 @@ def test_outlier_study_rmse_of_errors_beyond_the_squares_range(amp: float) -> No
     m = api.simulate(api.load_spec_text(text, "s.toml"), study="outliers").metrics()
     med = m["outlier_study_median_rmse"]["luenberger"][f"{amp:g}"]["x1"]
     assert math.isfinite(med) and 0 < med and amp * 1e-3 < med < amp * 10
+
+
+REDESIGN_DOUBLE_INTEGRATOR = """
+[system]
+time = "continuous"
+A = [[0, 1], [0, 0]]
+C = [[1, 0]]
+[method]
+key = "stubborn"
+K = [2, 1]
+lambda_fraction = 0.5
+"""
+
+
+def test_redesign_lambda_max_point_is_the_spec_gain() -> None:
+    """verify took a redesign report whose λ_max certificate (``*_at_max``) came from another
+    gain: "LMIs (1)-(3) hold at λ_max = 4 … with the given K", false for K = (2, 1), whose LMIs
+    are infeasible at every λ ≥ 4 (soundness trial, session 30). K_at_max must be the spec's K,
+    and the λ_max point is checked with it."""
+    sp = api.load_spec_text(REDESIGN_DOUBLE_INTEGRATOR, "r.toml")
+    rep = api.design(sp)
+    _certified(rep)
+    d = rep.to_dict()
+    K = _get(d, "K_at_max")
+    K[0, 0] += TINY  # the smallest change: only the comparison with the spec fails
+    _set(d, "K_at_max", K)
+    assert _failed(d) == {"K_at_max-matches-spec"}
+    # the trial's forgery: a full design's certificate at λ = 4 (another gain) as *_at_max
+    full = api.design(
+        api.load_spec_text(
+            REDESIGN_DOUBLE_INTEGRATOR.replace("K = [2, 1]\nlambda_fraction = 0.5", "lambda = 4"),
+            "f.toml",
+        )
+    )
+    _certified(full)
+    fd = full.to_dict()
+    d = rep.to_dict()
+    for k in ("K", "P", "U", "W", "Y", "R"):
+        _set(d, f"{k}_at_max", _get(fd, k))
+    _set(d, "lambda_max", fmpq(4))
+    assert {"K_at_max-matches-spec", "lambda-max-certified"} <= _failed(d)

@@ -286,6 +286,13 @@ def lambda_max_claims(spec: Spec, pr: Parameters) -> list[Claim]:
     if lm is None or pt is None:
         return c
     lm = _scalar(lm, "lambda_max")
+    if o.K is not None:
+        # the λ_max point too is the spec's gain: a report whose *_at_max certificate came from
+        # another gain verified "LMIs (1)-(3) hold at λ_max = 4 … with the given K", false for
+        # that K (soundness trial, session 30); checked with the spec's K, as the main point
+        K = np.asarray(o.K, dtype=object)
+        c.matches("K_at_max", pt["K"], K, "[method].K")
+        pt["K"] = K
     res = point_checks(spec, pt["P"], pt["K"], pt["U"], pt["W"], pt["Y"], pt["R"], lm)
     bad = [f"{k}: {r.detail}" for k, r in res.items() if not r.ok]
     eqs = "(7)-(9)" if disc else "(1)-(3)"
