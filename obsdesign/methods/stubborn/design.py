@@ -22,6 +22,7 @@ import numpy as np
 from flint import fmpq
 
 from obsdesign.certify.exact import Q, dyadic, symmetrize, to_float
+from obsdesign.certify.printing import fmt_exact
 from obsdesign.errors import InconclusiveError, InfeasibleError, SolverError
 from obsdesign.lmi import overflow, solve
 from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
@@ -253,8 +254,11 @@ def search_lambda(pl: Plant, o: Options) -> tuple[float, float, str]:
         lo, hi, st, known = _bisect(feas, lo, hi, st, tol)
         return (lo, *_far_end(feas, lo, hi, st, known, False))
     top = 1 - 1e-6
-    if not feasible(pl, o, top)[0]:
-        return 1.0, top, "infeasible"
+    ok, st = feasible(pl, o, top)
+    if not ok:
+        # the solver's own status (it was "infeasible" whatever the solver said, so an
+        # inaccurate answer near 1 − 10⁻⁶ became exit 1; soundness trial, session 30)
+        return 1.0, top, st
     bot = 1 / LAMBDA_CAP
     ok, st = feasible(pl, o, bot)
     if ok:
@@ -357,7 +361,9 @@ def design_params(
         lam_q = o.lam  # a rate the user asks for is checked directly, before any search
         ok, st = feasible(pl, o, float(lam_q))
         if not ok and st == INFEASIBLE:
-            _infeasible(spec, pl, o, f"at the given λ = {float(lam_q):g}")
+            where = f"at the given λ = {float(lam_q):g}"
+            _unless_feasible_with_less_margin(pl, o, float(lam_q), where)
+            _infeasible(spec, pl, o, where)
         # any other answer (inaccurate, a failure) is no verdict: the certification below
         # decides, and says exit 4 when it finds no point (Example 1 at λ = 7.53, where a
         # certificate exists, was exit 1 "infeasible at the given λ"; soundness trial)
@@ -373,6 +379,7 @@ def design_params(
                     f"(status {st}): not a verdict; a smaller [method] margin (now "
                     f"{float(o.margin):g}) or a rescaled plant may help"
                 )
+            _unless_feasible_with_less_margin(pl, o, bad, "for every λ tried")
             _infeasible(spec, pl, o, "for every λ tried")
         best, cert = _certified_best(spec, pl, o, good)
         vals["lambda_max"] = best
@@ -612,6 +619,29 @@ def _require_detectable(spec: Spec, pl: Plant) -> None:
     if det.verdict is False:
         raise InfeasibleError(
             f"stubborn: (C, A) is not detectable ({det.detail}); LMIs {_refs(pl)} are infeasible"
+        )
+
+
+#: the solver's `infeasible` is a verdict only if it holds with the margin divided by this too
+MARGIN_CONFIRM = 1000
+
+
+def _unless_feasible_with_less_margin(pl: Plant, o: Options, lam: float, where: str) -> None:
+    """Exit 4 when the solver, having answered `infeasible` with the strictness margin δ
+    (``[method] margin``: it solves F ⪯ −δI, not F ≺ 0), finds LMIs (1)-(3) / (7)-(9) feasible
+    at ``lam`` with δ / :data:`MARGIN_CONFIRM`: near the feasibility boundary the δ-tightened
+    problem is infeasible while the strict LMIs are not (A = 2.414213 < 1 + √2, C = 1 in
+    discrete time was exit 1 "infeasible for every λ tried", and certified with margin = 1e-9;
+    soundness trial, session 30). ``lam``: the most lenient λ the answer was at."""
+    less = replace(o, margin=o.margin / MARGIN_CONFIRM)
+    ok, _ = Feasibility(pl, less)(lam)
+    if ok:
+        raise InconclusiveError(
+            f"stubborn: the solver reports LMIs {_refs(pl)} infeasible {where} with the "
+            f"strictness margin {fmt_exact(o.margin)} ([method] margin: it solves F ⪯ −margin·I), "
+            f"but feasible at λ = {lam:g} with margin {fmt_exact(less.margin)}: not a verdict "
+            f"(the LMIs are near their feasibility boundary); set [method] margin = "
+            f"{fmt_exact(less.margin)}"
         )
 
 
