@@ -70,7 +70,12 @@ EXACT = [
     (F(5), "5"),
     (F(-187, 100), "-1.87"),
     (F(1, 2**40), "1/1099511627776"),
-    (F(3, 10**45), "3/" + "1" + "0" * 45),
+    # any exponent (only 10^e with e < 40 was tried: a spec's 1e-300 showed as 1/10³⁰⁰
+    # written out, session 30)
+    (F(3, 10**45), "3e-45"),
+    (F(1, 10**300), "1e-300"),
+    (F(-25, 10**308), "-2.5e-307"),
+    (F(3, 2**45 * 10**45), "3/" + str(2**45 * 10**45)),
     (F(10**20), "1e20"),
     (F(0), "0"),
     (F(1, 2**20), "9.5367431640625e-7"),
@@ -139,16 +144,20 @@ def test_exact_roundtrip(q: fmpq):
 
 def test_fmt_exact_huge_denominators():
     # no float conversion of the denominator anywhere (2^1100 overflows a float)
-    for q in (F(1, 2**1100), F(3, 10**400), F(7, 5**500)):
+    for q in (F(1, 2**1100), F(7, 5**500), F(1, 3 * 10**400)):
         s = fmt_exact(q)
         assert parse(s) == q and "/" in s
+    assert fmt_exact(F(3, 10**400)) == "3e-400"  # a decimal at any exponent
+    assert fmt_exact(F(1, 10**300000)) == "1e-300000"
     assert fmt_exact(F(1, 11)) == "1/11" and fmt_exact(F(1, 22)) == "1/22"
 
 
 def test_fmt_exact_length_limits():
-    """A decimal is used when it needs at most 39 decimals and 32 characters, else p/q."""
+    """A decimal is used when it fits 32 characters, whatever its exponent, else p/q."""
     assert fmt_exact(F(1, 10**39)) == "1e-39"
-    assert fmt_exact(F(1, 10**40)) == "1/1" + "0" * 40
+    assert fmt_exact(F(1, 10**40)) == "1e-40"  # p/q until session 30
+    assert fmt_exact(F(1, 2**30)) == "9.31322574615478515625e-10"  # 26 characters
+    assert fmt_exact(F(1, 2**45)) == "1/" + str(2**45)  # 2.84…e-14 has 38
     s32 = fmt_exact(F(1234567890123456789012345678901, 10**20))
     assert s32 == "12345678901.23456789012345678901" and len(s32) == 32
     q33 = F(12345678901234567890123456789012, 10**21)

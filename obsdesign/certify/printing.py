@@ -38,11 +38,11 @@ def _scaled(q: fmpq, digits: int) -> tuple[int, fmpq]:
 
 
 def _show(m: fmpz | int, e: int) -> str:
-    m = int(m)
+    m = fmpz(m)
     if m == 0:
         return "0"
     sign = "-" if m < 0 else ""
-    digits = str(abs(m))
+    digits = str(abs(m))  # flint's decimal string: no Python int-string limit (4300 digits)
     exp10 = e + len(digits) - 1
     if exp10 > 12 or exp10 < -6:
         body = digits.rstrip("0")
@@ -99,25 +99,28 @@ def fmt_value_down(x: Any, digits: int = 6, longest: int = 16) -> str:
     return m if len(m) <= longest else f"{Q(x)} ≥ {fmt_down(x, digits)}"
 
 
+#: log₂ 5, for the exponent of a power of 5 from its bit length (:func:`fmt_exact`)
+_LOG2_5 = math.log2(5)
+#: beyond this |a − b| a value p/(2^a 5^b) has more than 33 significant decimal digits (its
+#: mantissa p·2^(b−a) or p·5^(a−b) has no trailing zero), too many for :func:`fmt_exact`
+_MAX_SKEW = 110
+
+
 def fmt_exact(x: Any) -> str:
-    """``x`` exactly: a finite decimal when it has one with at most 30 digits, else p/q."""
+    """``x`` exactly: a decimal m·10^e (shown in at most 32 characters, scientific beyond
+    10¹² or below 10⁻⁶) when it has one, else p/q. Any exponent: a spec's ``1e-300`` was
+    shown as 1/1000…0 (301 digits), since only 10^e with e < 40 was tried (session 30)."""
     q = Q(x)
     den = int(q.q)
-    k = 0
-    while den % 10 == 0 or den % 2 == 0 or den % 5 == 0:
-        if den % 10 == 0:
-            den //= 10
-        elif den % 2 == 0:
-            den //= 2
-        else:
-            den //= 5
-        k += 1
-    if den == 1:
-        for e in range(0, 40):
-            m = q * fmpq(10) ** e
-            if m.q == 1:
-                s = _show(m.p, -e)
-                if len(s) <= 32:
-                    return s
-                break
+    twos = (den & -den).bit_length() - 1
+    rest = den >> twos
+    fives: int | None = 0
+    if rest != 1:  # a power of 5? (no loop of divisions: 5^b from the bit length)
+        b = round((rest.bit_length() - 1) / _LOG2_5)
+        fives = next((k for k in (b - 1, b, b + 1) if k > 0 and 5**k == rest), None)
+    if fives is not None and abs(twos - fives) <= _MAX_SKEW:
+        e = max(twos, fives)
+        s = _show(q.p * fmpz(2) ** (e - twos) * fmpz(5) ** (e - fives), -e)
+        if len(s) <= 32:
+            return s
     return str(q)
