@@ -536,3 +536,10 @@ def test_T_max_a_hair_from_its_bound_is_decided() -> None:
     assert claim(below).ok
     c = claim(above)
     assert not c.ok and not c.float_ok
+
+
+def test_an_L_just_outside_its_range_is_named_as_given() -> None:
+    """L = [1.0000001] was refused as "L[0] = 1" (%g), not the value the spec gives
+    (session 30): the message names it as given."""
+    with pytest.raises(SpecError, match=r"L\[0\] = 1\.0000001"):
+        load_spec_text_ex(L="[1.0000001]")

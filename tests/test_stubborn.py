@@ -1542,3 +1542,14 @@ def test_an_infeasible_answer_that_a_smaller_margin_overturns_is_exit_4() -> Non
         api.design(api.load_spec_text(_scalar_discrete("2.41421356"), "s.toml"))
     with pytest.raises(InfeasibleError, match="detectability does not suffice"):
         api.design(api.load_spec_text(_scalar_discrete("2.6"), "s.toml"))
+
+
+def test_the_bound_to_raise_is_named_with_the_spec_value() -> None:
+    """`gain_bound = 1.0000001` was echoed "raise gain_bound (now 1)" (%g; soundness trial,
+    session 30): the hint names the value as given."""
+    text = (
+        '[system]\ntime = "continuous"\nA = [[1]]\nC = [[1]]\n[method]\nkey = "stubborn"\n'
+        "gain_bound = 1.0000001\n"
+    )
+    with pytest.raises(InfeasibleError, match=r"raise gain_bound \(now 1\.0000001\)"):
+        api.design(api.load_spec_text(text, "s.toml"))

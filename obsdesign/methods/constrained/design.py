@@ -204,7 +204,7 @@ def design_params(spec: Spec) -> tuple[dict[str, Any], list[str]]:
             raise SpecError(
                 spec.file,
                 "method.eps_min",
-                f"eps_min = {float(o.eps_min):g} gives {size} refining steps (eq. (22): "
+                f"eps_min = {fmt_exact(o.eps_min)} gives {size} refining steps (eq. (22): "
                 "θ ≥ (v_max − v_min)/(γ ε_min²)), beyond the float range of a report; "
                 "expected a larger eps_min",
             )

@@ -18,6 +18,7 @@ from flint import fmpq
 
 from obsdesign.certify.exact import Q, qvec
 from obsdesign.certify.linalg import qrank
+from obsdesign.certify.printing import fmt_exact
 from obsdesign.certify.psd import check_pd, check_psd
 from obsdesign.errors import SpecError
 from obsdesign.methods.base import table_schema
@@ -221,7 +222,7 @@ def _diag_gain(table: Table, m: int) -> np.ndarray:
             raise table.error(
                 "L",
                 f"expected every eigenvalue of I − L in (0, 1), i.e. 0 < L_ii < 1; "
-                f"L[{i}] = {float(v):g}",
+                f"L[{i}] = {fmt_exact(v)}",
             )
     return np.asarray(d, dtype=object)
 

@@ -39,6 +39,7 @@ from typing import Any
 
 import numpy as np
 
+from obsdesign.certify.printing import fmt_exact
 from obsdesign.errors import InfeasibleError, InputError
 from obsdesign.limits import limits
 from obsdesign.methods.searchspace.options import Options, SimOptions
@@ -590,7 +591,7 @@ def _outside_the_design(
         res.info["past_horizon"] = float(o.horizon)
         warnings.warn(
             f"[simulate] the run covers {span:.6g} s past t0, beyond [method] horizon = "
-            f"{float(o.horizon):g}, over which the design checked the input range",
+            f"{fmt_exact(o.horizon)}, over which the design checked the input range",
             stacklevel=3,
         )
 

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 from flint import fmpq
 
+from obsdesign.certify.printing import fmt_exact
 from obsdesign.errors import InconclusiveError, InfeasibleError, SolverError
 from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
 from obsdesign.params import Parameters
@@ -155,11 +156,11 @@ def _budget(r: al.IterResult, o: Options, run: _Run) -> None:
         )
         run.notes.append(
             f"the general algorithm diverges: after {r.iterations} iterations {where} (last ε = "
-            f"{r.eps:.6g} > λ = {float(o.lam):g}); stopped there, not converged"
+            f"{r.eps:.6g} > λ = {fmt_exact(o.lam)}); stopped there, not converged"
         )
     if r.timed_out:
         last = (
-            f"last ε = {r.eps:.6g} > λ = {float(o.lam):g}"
+            f"last ε = {r.eps:.6g} > λ = {fmt_exact(o.lam)}"
             if np.isfinite(r.eps)
             else "no iteration finished"
         )

@@ -377,7 +377,7 @@ def design_params(
                     f"stubborn: the solver found LMIs {_refs(pl)} feasible at no λ tried "
                     f"(down to {bad:g}), but did not report them infeasible there either "
                     f"(status {st}): not a verdict; a smaller [method] margin (now "
-                    f"{float(o.margin):g}) or a rescaled plant may help"
+                    f"{fmt_exact(o.margin)}) or a rescaled plant may help"
                 )
             _unless_feasible_with_less_margin(pl, o, bad, "for every λ tried")
             _infeasible(spec, pl, o, "for every λ tried")
@@ -414,7 +414,7 @@ def design_params(
         if other is not None and abs(other - best) > o.lambda_tol * abs(best):
             notes.append(
                 f"the λ bracket [{float(best):.6g}, {float(bad):.6g}] is wider than lambda_tol "
-                f"= {float(o.lambda_tol):g}: the solver reports the LMIs infeasible nowhere "
+                f"= {fmt_exact(o.lambda_tol)}: the solver reports the LMIs infeasible nowhere "
                 "nearer (near the boundary its answers are inaccurate), so the far end is the "
                 "nearest λ found where it does"
             )
@@ -708,7 +708,7 @@ def _bounds_too_tight(pl: Plant, o: Options, where: str, verdict: bool | None) -
     well-scaled data of a detectable plant)."""
     # the gain bound applies in full mode only (redesign keeps the given K)
     bounds = ", ".join(
-        f"{k} (now {float(v):g})"
+        f"{k} (now {fmt_exact(v)})"
         for k, v in (("gain_bound", o.gain_bound if o.K is None else None), ("r_bound", o.r_bound))
         if v is not None
     )
