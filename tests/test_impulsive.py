@@ -543,3 +543,65 @@ def test_an_L_just_outside_its_range_is_named_as_given() -> None:
     (session 30): the message names it as given."""
     with pytest.raises(SpecError, match=r"L\[0\] = 1\.0000001"):
         load_spec_text_ex(L="[1.0000001]")
+
+
+#: a 3-state plant with two outputs (soundness trial 30a's w0.toml)
+W0_TWO_OUTPUTS = """
+[system]
+time = "continuous"
+A = [[-3, 0.01, 0], [1, -3, 0.01], [0, -0.01, -3]]
+C = [[1, 0, 0], [0, 1, 0]]
+states = ["x1", "x2", "x3"]
+psi = ["0.2*sin(x1)", "0.3*tanh(x2)", "0.3*tanh(x3)"]
+[nonlinearity.o]
+sector = [-0.3, 0.3]
+[nonlinearity.n]
+sector = [0, 0.3]
+[method]
+key = "impulsive"
+L = [0.8, 0.8]
+alpha = 3
+noise_bound = 0.1
+M = [[0, 0, 1]]
+kappa = "widest"
+"""
+
+
+@pytest.mark.parametrize(("row", "entry"), [(1, "-3e10"), (1, "-3e9"), (0, "-3e10")])
+def test_a_block_with_one_fast_mode_keeps_its_window(row: int, entry: str) -> None:
+    """κ_n's (ϖ_o's) first rounding step was 2⁻³⁰ of the block's data: with one fast mode
+    (Ā + Āᵀ = diag(−6e10, −6), κ_n ≈ 5.4 set by the slow mode) it pushed κ_n to −50.5 and the
+    design said "Lemma 1 fails" (ϖ_o: "empty window"), exit 1, though a report with the true
+    rates verifies (soundness trial, session 30). The window is the one without the fast
+    mode: [0.4176, 1.3452] (unmeasured block), [2.6501, 8.5373] (measured)."""
+    base = (ROOT / "specs" / "impulsive-sector-3state.toml").read_text(encoding="utf-8")
+    if row == 1:
+        text = base.replace("[1, -3, 0.5]", f"[1, {entry}, 0.5]")
+        want = ("0.4176", "1.3452")
+    else:  # two outputs: the fast mode in the measured block
+        text = W0_TWO_OUTPUTS.replace("[[-3, 0.01, 0]", f"[[{entry}, 0.01, 0]")
+        want = ("2.6501", "8.5373")
+    assert entry in text
+    rep = api.design(api.load_spec_text(text, "fast.toml"))
+    assert rep.exit_code() == 0, [c.detail for c in rep.failed]
+    assert (rep.parameters["T_min"], rep.parameters["T_max"]) == (Q(want[0]), Q(want[1]))
+
+
+def test_lemma1_is_not_called_failed_on_a_rounded_kappa_n(monkeypatch) -> None:
+    """κ_n is certified as a lower bound of its float optimum: when only the rounding puts it
+    below λ*_no, "Lemma 1 fails" (exit 1) would be no proof; it is exit 4 (session 30)."""
+    from obsdesign.errors import InconclusiveError
+    from obsdesign.methods.impulsive import design as idesign
+
+    real = idesign.certified_rate
+    calls: list[int] = []
+
+    def low_kappa_n(Ablk, qsr, theta, rate_f):
+        calls.append(1)
+        # the second call is κ_n's: certified far below a float optimum that passes
+        return real(Ablk, qsr, theta, rate_f) if len(calls) == 1 else Q(-100)
+
+    monkeypatch.setattr(idesign, "certified_rate", low_kappa_n)
+    text = (ROOT / "specs" / "impulsive-sector-3state.toml").read_text(encoding="utf-8")
+    with pytest.raises(InconclusiveError, match="no proof either way"):
+        api.design(api.load_spec_text(text, "s.toml"))

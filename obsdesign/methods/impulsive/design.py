@@ -186,7 +186,11 @@ def certified_rate(Ablk: np.ndarray, qsr: QSR, theta: fmpq, rate_f: float) -> fm
             "Ā + Āᵀ of the spec's A overflows float64; scale the plant's numbers down"
         )
     q = qsr.scaled(theta)
-    step_f = 2.0**-30 * max(abs(rate_f), _data_scale(Ablk, q))
+    # 2⁻³⁰ of the rate, but only 2⁻⁴⁴ (~250 ulps) of the data: the float optimum's error is
+    # about ulp·scale, and a step of 2⁻³⁰·scale, far above it, pushed κ_n of a block with a
+    # fast mode (Ā + Āᵀ = diag(−6e10, −6), κ_n ≈ 5.4) to −50.5: "Lemma 1 fails", exit 1, on
+    # a spec whose report with the true rates verifies (soundness trial, session 30)
+    step_f = max(2.0**-30 * abs(rate_f), 2.0**-44 * _data_scale(Ablk, q))
     r = Q(dyadic(rate_f - step_f, 40))
     step = Q(dyadic(step_f, 40))
     for _ in range(60):
@@ -254,6 +258,14 @@ def design_window(p: Problem) -> tuple[dict[str, Any], list[str]]:
     lam_no, lam_on = n_no + data.ell_no, n_on + data.ell_on
     gamma, beta = gamma_of(p.L)
     if not kappa_n > lam_no:
+        if kn_f > float(lam_no):
+            # κ_n is certified as a lower bound only: below λ*_no while the float optimum is
+            # above, the failure is not proved (exit 4, not 1; session 30)
+            raise InconclusiveError(
+                f"Lemma 1: κ_n is certified only down to {float(kappa_n):.6g} ≤ λ*_no = "
+                f"‖Ā_no‖ + ℓ_no = {float(lam_no):.6g}, while its float optimum "
+                f"{kn_f:.17g} lies above: no proof either way (ill-conditioned Ā_n)"
+            )
         raise Infeasible(
             f"Lemma 1 fails: κ_n = {float(kappa_n):.6g} ≤ λ*_no = ‖Ā_no‖ + ℓ_no = "
             f"{float(lam_no):.6g} (short by {float(lam_no - kappa_n):.4g}); try another M"
