@@ -794,3 +794,31 @@ def test_v_min_is_found_at_any_scale() -> None:
     vs = api.design(api.load_spec_text(small, "small.toml")).parameters["v_min"]
     assert v1 > 0 and vs > 0
     assert abs(vs * 10**20 / v1 - 1) < fmpq(1, 10**6), (v1, vs)
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(2, 3), st.integers(0, 2**31 - 1), st.floats(0.05, 1.0), st.floats(0.5, 50.0))
+def test_the_float_estimate_from_below_is_below_the_safe_bounds(n, seed, pad, v):
+    """sup_norm_c_float_lower (which tells an undecided inclusion in C_max from a false one,
+    session 30) is a value of |c| at points of the set: never above the safe upper bounds
+    of sup |c| over X̂_max and over a box, a polytope or an ellipsoid X̂, and close to them
+    where they are exact (the vertices of a box)."""
+    from obsdesign.sets import Ellipsoid, Polytope
+
+    rng = np.random.default_rng(seed)
+    P = _rand_P(rng, n)
+    X = _box(-np.ones(n), np.ones(n))
+    G = qmat(np.vstack([np.eye(n), -np.eye(n), np.ones((1, n))]))
+    g = np.array([Q(1 + pad)] * (2 * n) + [Q(n + pad)], dtype=object)
+    sets = (X, Polytope(G, g), Ellipsoid(_rand_P(rng, n), np.array([Q(pad)] * n, dtype=object)))
+    vq = dyadic(v, 20)
+    for cm in (box_map([-1 - pad] * n, [1 + pad] * n), polytope_map(G, g)):
+        up = float(B.sup_norm_c_over_Xhat_max(cm, P, qinv(P), X, vq))
+        low = B.sup_norm_c_float_lower(cm, X, P, vq)
+        assert 0 <= low <= up * (1 + 1e-9) + 1e-12
+        for S in sets:
+            up = float(B.sup_norm_c_over_set(cm, S))
+            low = B.sup_norm_c_float_lower(cm, S)
+            assert 0 <= low <= up * (1 + 1e-9) + 1e-12
+            if S is X:  # exact at the vertices
+                assert low >= up * (1 - 1e-9)

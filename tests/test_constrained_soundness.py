@@ -781,3 +781,52 @@ def test_Cmin_in_Xhat_undecided_by_its_outer_set_is_inconclusive() -> None:
     disk = '[sets.Xh]\ntype = "ellipsoid"\nE = [[0.3508771929824561, 0], [0, 0.3508771929824561]]\n\n[method]'
     rep = _design(variant(add='Xhat = "Xh"', replace=[("[method]", disk)]), "disk.toml")
     assert {c.id for c in rep.failed} == {"Cmin-in-Xhat"} and rep.exit_code() == 4
+
+
+XHAT_MAX_NOT_TIGHT = """
+[system]
+time = "discrete"
+A = [[0, 1], [1, 0]]
+C = [[1, 0]]
+[sets.X]
+type = "box"
+lower = [-1, -1]
+upper = [1, 1]
+[sets.Xh]
+type = "box"
+lower = [-1.2, -1.2]
+upper = [1.2, 1.2]
+[method]
+key = "constrained"
+L = [-1.87, 1.874]
+lambda = 0.955
+rho = 0.955
+X = "X"
+Xhat = "Xh"
+eps_min = 0.01
+eps_max = EPS
+[method.c]
+type = "box"
+lower = [-1.1, -1.1]
+upper = [1.1, 1.1]
+[method.D]
+lower = [-3]
+upper = [3]
+"""
+
+
+@pytest.mark.parametrize(("eps", "code"), [("140095", 4), ("140080", 1)])
+def test_xhat_max_in_cmax_beyond_a_loose_bound_is_undecided_not_false(eps: str, code: int):
+    """X̂_max ⊆ C_max is checked through a safe upper bound of sup |c| (140097.83 here) that is
+    not tight: the true sup ≈ 140090.75 (soundness trial 30a: 2·10⁶ boundary samples plus a
+    Lipschitz margin ≤ 140092.03). ε_max = 140095 made the claim "failed", exit 1, for a true
+    inclusion; it is undecided (exit 4) unless a point of X̂_max has |c| > ε_max in float
+    (ε_max = 140080: exit 1). verify agrees."""
+    sp = api.load_spec_text(XHAT_MAX_NOT_TIGHT.replace("EPS", eps), "x.toml")
+    rep = api.design(sp)
+    bad = [c for c in rep.claims if c.status == ClaimStatus.FAILED]
+    assert [c.id for c in bad] == ["Xhat_max-in-Cmax"]
+    assert rep.exit_code() == code
+    assert ("undecided" in bad[0].detail) == (code == 4)
+    assert "140090.7467" in bad[0].detail
+    assert api.verify(rep).exit_code() == code

@@ -423,3 +423,67 @@ def theta_of(v_max: Any, v_min: Any, gamma: Any, eps_min: Any) -> int:
     """θ = ceil(max(v_max − v_min, 0)/(γ ε_min²)), eq. (22), in exact arithmetic."""
     num = max(Q(v_max) - Q(v_min), fmpq(0))
     return int((num / (Q(gamma) * Q(eps_min) ** 2)).ceil())
+
+
+#: points per set in :func:`sup_norm_c_float_lower` (vertices, boundary directions)
+LOWER_POINTS = 256
+
+
+def _set_points_f(S: ConvexSet, rng: np.random.Generator) -> np.ndarray:
+    """Float points of the set S (a box's or a polytope's vertices, all or :data:`LOWER_POINTS`
+    of them; an ellipsoid's centre and boundary points): where a convex function's maximum
+    over S is sought from below."""
+    if isinstance(S, Box):
+        lo, hi = np.asarray(S.lower, float), np.asarray(S.upper, float)
+        n = lo.size
+        if 2**n <= LOWER_POINTS:
+            signs = np.array(list(itertools.product((0, 1), repeat=n)), dtype=bool)
+        else:
+            signs = rng.integers(0, 2, size=(LOWER_POINTS, n)).astype(bool)
+        return np.where(signs, hi, lo)
+    if isinstance(S, Polytope):
+        V = np.asarray(S.vertices(), float)
+        return V if len(V) <= LOWER_POINTS else V[rng.choice(len(V), LOWER_POINTS, replace=False)]
+    assert isinstance(S, Ellipsoid)
+    return np.vstack([S.center, S.center + _ellipsoid_boundary_f(np.asarray(S.E, float), 1.0, rng)])
+
+
+def _ellipsoid_boundary_f(P: np.ndarray, v: float, rng: np.random.Generator) -> np.ndarray:
+    """Float points e with eᵀPe = v: P⁻¹g/√(gᵀP⁻¹g)·√v for the coordinate directions ±g and
+    :data:`LOWER_POINTS` random ones (the maximizers of gᵀe over the ellipsoid)."""
+    n = P.shape[0]
+    G = np.vstack([np.eye(n), -np.eye(n), rng.standard_normal((LOWER_POINTS, n))])
+    Pinv = np.linalg.inv(P)
+    D = G @ Pinv  # rows P⁻¹g (P symmetric)
+    w = np.einsum("ij,ij->i", D, G)
+    return D / np.sqrt(w)[:, None] * np.sqrt(v)
+
+
+def sup_norm_c_float_lower(
+    cm: ConstraintMap, S: ConvexSet, P: np.ndarray | None = None, v: Any = 0
+) -> float:
+    """A float estimate from below of sup |c| over S ⊕ {e : eᵀPe ≤ v} (S alone when P is
+    None): |c| at points of S plus boundary points of the ellipsoid (its maximizers of gᵀe
+    for the map's face normals g, the coordinate and random directions). Not a bound: it
+    tells an inclusion that the safe upper bounds of :func:`sup_norm_c_over_Xhat_max` /
+    :func:`sup_norm_c_over_set` fail to prove from one that is false in float64 (exit 4,
+    not 1; soundness trial, session 30: X̂_max ⊆ C_max true, bound 140097.8 > ε_max =
+    140095 > sup ≈ 140090.75)."""
+    rng = np.random.default_rng(0)
+    X = _set_points_f(S, rng)
+    if P is not None and float(v) > 0:
+        Pf = np.asarray(P, dtype=float)
+        E = _ellipsoid_boundary_f(Pf, float(v), rng)
+        if cm.affine:
+            G = np.asarray(cm.G, float)
+            D = G @ np.linalg.inv(Pf)
+            E = np.vstack(
+                [E, D / np.sqrt(np.einsum("ij,ij->i", D, G))[:, None] * np.sqrt(float(v))]
+            )
+        pts = (X[:, None, :] + E[None, :, :]).reshape(-1, X.shape[1])
+    else:
+        pts = X
+    with np.errstate(all="ignore"):
+        vals = np.asarray(cm.norm_c(pts), dtype=float)
+    vals = vals[np.isfinite(vals)]
+    return float(vals.max()) if vals.size else 0.0

@@ -204,7 +204,8 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         reference=_ref("Assumption 3(2), eq. (15)"),
         check="sup |c| over X̂_max bounded by per-face support functions (outward rounding)",
         passed=sup <= eps_max,
-        detail=f"sup |c| over X̂_max ≤ {fmt_up(sup, 10)}",
+        detail=f"sup |c| over X̂_max ≤ {fmt_up(sup, 10)}" + _undecided(sup, eps_max, o, P, v_max),
+        **_float_ok(sup, eps_max, o, P, v_max),
     )
 
     # -- δ (Assumption 3(4)), γ (24) -------------------------------------------------------
@@ -560,7 +561,7 @@ def _inclusions(c: Claims, o: Options, Xhat: ConvexSet, eps_min: fmpq, eps_max: 
             "X̂ ⊂ C_max",
             "sup |c| over X̂ (vertices / support function) ≤ ε_max",
             sup <= eps_max,
-            f"sup |c| over X̂ ≤ {fmt_up(sup, 10)}",
+            f"sup |c| over X̂ ≤ {fmt_up(sup, 10)}" + _undecided(sup, eps_max, o, None, 0, Xhat),
         ),
     )
     for cid, statement, check, passed, detail in chain:
@@ -573,7 +574,41 @@ def _inclusions(c: Claims, o: Options, Xhat: ConvexSet, eps_min: fmpq, eps_max: 
             detail=detail,
             # an outer-set test that fails without refuting the inclusion: exit 4, not 1
             **({"float_ok": not proof} if cid == "Cmin-in-Xhat" and not passed else {}),
+            **(_float_ok(sup, eps_max, o, None, 0, Xhat) if cid == "Xhat-in-Cmax" else {}),
         )
+
+
+def _float_lower(o: Options, P: Any, v: Any, S: ConvexSet | None) -> float:
+    """sup |c| over S ⊕ {eᵀPe ≤ v} (X ⊕ … when S is None) estimated from below in float
+    (:func:`obsdesign.methods.constrained.bounds.sup_norm_c_float_lower`)."""
+    return B.sup_norm_c_float_lower(o.cmap, o.X if S is None else S, P, v)
+
+
+def _float_ok(
+    sup: fmpq, eps_max: fmpq, o: Options, P: Any, v: Any, S: ConvexSet | None = None
+) -> dict[str, bool]:
+    """``float_ok`` of an inclusion in C_max whose safe bound ``sup`` exceeds ε_max: whether
+    the float estimate from below stays within ε_max (the bound is not tight: Assumption
+    3(1)-(2) undecided, exit 4, not 1; soundness trial, session 30). Nothing when it passed."""
+    if sup <= eps_max:
+        return {}
+    return {"float_ok": _float_lower(o, P, v, S) <= float(eps_max)}
+
+
+def _undecided(
+    sup: fmpq, eps_max: fmpq, o: Options, P: Any, v: Any, S: ConvexSet | None = None
+) -> str:
+    """The detail's tail when the bound ``sup`` fails but the float estimate from below does
+    not (:func:`_float_ok`)."""
+    if sup <= eps_max:
+        return ""
+    low = _float_lower(o, P, v, S)
+    if low > float(eps_max):
+        return f"; |c| ≈ {low:.10g} > ε_max at a point of the set (float)"
+    return (
+        f"; the largest |c| found ≈ {low:.10g} (float) is within ε_max: the bound is not tight, "
+        "so the inclusion is undecided (inconclusive, not false)"
+    )
 
 
 def cmin_in_xhat(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet) -> tuple[bool, str]:

@@ -167,7 +167,8 @@ def design_params(spec: Spec) -> tuple[dict[str, Any], list[str]]:
         if eps_max <= o.eps_min:
             eps_max = B.round_sig(o.eps_min * fmpq(1000001, 1000000), 8, up=True)
         notes.append(
-            "ε_max: the smallest (6 digits, rounded up) with X̂ ⊆ C_max and X̂_max ⊆ C_max (Assumption 3(1)-(2))"
+            "ε_max: the smallest (6 digits, rounded up) for which the safe upper bounds of sup |c| "
+            "prove X̂ ⊆ C_max and X̂_max ⊆ C_max (Assumption 3(1)-(2); the true smallest can be lower)"
         )
     else:
         eps_max = o.eps_max
