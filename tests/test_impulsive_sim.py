@@ -464,3 +464,32 @@ def test_noise_max_norm_counts_only_the_samples_a_jump_uses(tmp_path: Path) -> N
         if norms.max() > norms[H > 0].max():
             return  # a padded position held the largest draw, and was not counted
     raise AssertionError("no seed put the largest draw on a padded position")
+
+
+def test_intervals_outside_the_window_warn(tmp_path: Path) -> None:
+    """Sampling intervals of 5 against the window (0.4176, 1.3452) printed
+    "intervals_in_window: False" beside "noise_free_decay: True" with no warning (soundness
+    trial, session 30), where noise beyond the bound warns. The window is open and compared
+    exactly: an interval equal to the double nearest to T_max (0.4176 and 1.3452 are not
+    doubles) is inside or outside as the rationals say."""
+    import warnings
+
+    spec = load_spec_text(_spec3('\nsampling_file = "h.txt"'), str(tmp_path / "s.toml"))
+    rep = api.design(spec)
+    sim = get_method("impulsive").simulate
+    (tmp_path / "h.txt").write_text("\n".join(["0.5", "0.9", "1.2"] * 5), encoding="utf-8")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert sim(spec, rep.parameters).info["intervals_in_window"]
+    (tmp_path / "h.txt").write_text("\n".join(["0.5", "5"] * 3), encoding="utf-8")
+    with pytest.warns(UserWarning, match=r"2 of 4 sampling intervals .* outside the certified"):
+        assert not sim(spec, rep.parameters).info["intervals_in_window"]
+    from flint import fmpq
+
+    from obsdesign.methods.impulsive.sim import _in_window
+
+    lo, hi = fmpq(4176, 10000), fmpq(13452, 10000)
+    flo, fhi = 0.4176, 1.3452
+    below = fmpq(*flo.as_integer_ratio()) < lo  # the double 0.4176 lies below T_min
+    got = _in_window(np.array([flo, fhi, 1.0, np.nextafter(flo, 1), 5.0]), flo, fhi, lo, hi)
+    assert got.tolist() == [not below, fmpq(*fhi.as_integer_ratio()) < hi, True, True, False]

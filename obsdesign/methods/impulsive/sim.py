@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from obsdesign.certify.printing import fmt_exact
 from obsdesign.errors import InputError
 from obsdesign.methods.impulsive.hybrid import (
     HybridBatch,
@@ -200,7 +201,21 @@ def simulate(
     after = horizon / 2
     br = ball_report(noisy, radius, after)
     used = H[H > 0]
-    in_window = bool(np.all((used >= t_lo) & (used <= t_hi)))
+    inside = _in_window(used, t_lo, t_hi, params["T_min"], params["T_max"])
+    in_window = bool(np.all(inside))
+    if not in_window:
+        # the noise beyond noise_bound was warned of, these not: "intervals_in_window: False"
+        # beside "noise_free_decay: True" read as confirming the certificate (soundness
+        # trial, session 30)
+        out = used[~inside]
+        warnings.warn(
+            f"[simulate] {out.size:,} of {used.size:,} sampling intervals (from "
+            f"{float(out.min()):.6g} to {float(out.max()):.6g}) lie outside the certified window "
+            f"T_min = {fmt_exact(params['T_min'])} < t_(k+1) − t_k < T_max = "
+            f"{fmt_exact(params['T_max'])}: the runs are outside the premise of Theorems 1-2, "
+            "and their decay says nothing of the certificate",
+            stacklevel=2,
+        )
     valid0 = noisy.valid[0]
     cl_end = np.array([clean.eps[j, np.nonzero(clean.valid[j])[0][-1]] for j in range(runs)])
     cl_start = clean.eps[:, 0]
@@ -245,6 +260,20 @@ def simulate(
         "noise": W,  # (runs, K, m) w_k at the sample ending interval k
     }
     return res
+
+
+def _in_window(h: np.ndarray, lo: float, hi: float, T_min: Any, T_max: Any) -> np.ndarray:
+    """Whether each interval h lies in the open window T_min < h < T_max (Theorems 1-2),
+    exactly: ``lo``, ``hi`` are the doubles nearest to T_min, T_max, so h > lo (h < hi) already
+    implies h > T_min (h < T_max); only an h equal to one of them is compared as a rational
+    (it was h ≥ lo and h ≤ hi: a closed window, and in floats)."""
+    from flint import fmpq
+
+    ok = (h > lo) & (h < hi)
+    for i in np.nonzero((h == lo) | (h == hi))[0]:
+        q = fmpq(*float(h[i]).as_integer_ratio())
+        ok[i] = bool(T_min < q < T_max)
+    return ok
 
 
 def run_quantiles(b: HybridBatch, states: list[str]) -> dict[str, Any]:
