@@ -955,3 +955,53 @@ def test_rho_and_lambda_are_printed_exactly_in_their_statements():
     lam = st["decay-lmi"].statement.rsplit("with λ = ", 1)[1]
     assert Q(lam) == rep.parameters["lambda"]
     assert api.verify(rep).exit_code() == 0
+
+
+USER_P_REFUTED = """[system]
+time = "discrete"
+A = [[0, 1], [1, 0]]
+C = [[1, 0]]
+[sets.X]
+type = "box"
+lower = [-1, -1]
+upper = [1, 1]
+[method]
+key = "constrained"
+L = [-0.9, 1.2]
+P = [[6.5, 3.5], [3.5, 6.5]]
+rho = 0.8
+mu = 200
+X = "X"
+eps_min = 0.5
+[method.c]
+type = "box"
+lower = [-1, -1]
+upper = [1, 1]
+[method.D]
+lower = [-0.5]
+upper = [0.5]
+[simulate]
+horizon = 20
+x0 = [-1, 1]
+xhat0 = [0.5, -0.5]
+theta_m = [1000]
+"""
+
+
+def test_simulate_names_a_refuted_assumption_2_among_the_premises(tmp_path) -> None:
+    """A user's P, ρ, μ whose inequality (5) the exact LDLᵀ refutes (design: iss-bound
+    failed, exit 1) was simulated with "premises of Theorem 1 (25b): hold" (soundness trial,
+    session 30): Assumption 2 is a premise of Theorem 1, and the line now names it. A P for
+    which (5) holds (ρ = 0.81, μ = 10⁴) gives "hold"."""
+    p = tmp_path / "u.toml"
+    p.write_text(USER_P_REFUTED)
+    assert api.design(api.load_spec(p)).exit_code() == 1
+    info = api.simulate(p).info
+    assert info["premises of Theorem 1 (25b)"].startswith("Assumption 2 fails: V(e⁺) ≤ ρV(e)")
+    p.write_text(
+        USER_P_REFUTED.replace("[[6.5, 3.5], [3.5, 6.5]]", "[[3.2, 2.8], [2.8, 4.9]]")
+        .replace("rho = 0.8\n", "rho = 0.81\n")
+        .replace("mu = 200", "mu = 10000")
+    )
+    assert api.design(api.load_spec(p)).exit_code() == 0
+    assert api.simulate(p).info["premises of Theorem 1 (25b)"] == "hold"

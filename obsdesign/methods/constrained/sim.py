@@ -115,6 +115,32 @@ def _outside_premises(
     return out
 
 
+def _assumption2_refuted(spec: Spec, P: Any, params: Parameters) -> list[str]:
+    """The premise Assumption 2 of Theorem 1 (constrained-redesign paper, eq. (4)-(6): P ≻ 0
+    and V(e⁺) ≤ ρV(e) + μ|w|² for the linear error dynamics) when an exact check refutes it
+    for the parameters simulated: one phrase, else nothing. The premises line said "hold"
+    for a P, ρ, μ whose inequality (5) the design's exact LDLᵀ refutes (soundness trial,
+    session 30). A plant given by expressions is sampled by the design, not decided here."""
+    o: Options = spec.options
+    if o.model is not None and o.model.nonlinear:
+        return []
+    from obsdesign import lyap
+    from obsdesign.certify.psd import check_pd, check_psd
+
+    s = spec.system
+    rho, mu = Q(_exact(params, "rho")), Q(_exact(params, "mu"))
+    if not check_pd(P, o.margin):
+        return ["Assumption 2 fails: P is not positive definite (eq. (4), exact LDLᵀ)"]
+    Acl = lyap.closed_loop(s.A.q, s.C.q, o.L)
+    Bw = lyap.error_input(s.Bd.q, s.Dn.q, o.L)
+    if check_psd(lyap.iss_matrix(Acl, Bw, P, rho, mu)):
+        return []
+    return [
+        "Assumption 2 fails: V(e⁺) ≤ ρV(e) + μ|w|² (eq. (5)) does not hold for the P, ρ, μ "
+        "simulated (exact LDLᵀ)"
+    ]
+
+
 def simulate(
     spec: Spec,
     params: Parameters,
@@ -240,6 +266,7 @@ def simulate(
         if name.startswith("saturated"):
             info[f"{name}: final x̂"] = _fmt(tr.xhat[-1])
     outside = _outside_premises(o, x, u, d, v, sm.xhat0.f, Xhat)
+    outside += _assumption2_refuted(spec, P, params)
     # θ_m < θ matters only where the budget stopped a refining that G would have continued
     # (Lemma 3: the refining ends within θ steps; a budget never reached ran as θ would). A
     # sample that merely spent its whole budget was flagged before, so θ_m = 0 always was,
