@@ -493,3 +493,65 @@ def test_intervals_outside_the_window_warn(tmp_path: Path) -> None:
     below = fmpq(*flo.as_integer_ratio()) < lo  # the double 0.4176 lies below T_min
     got = _in_window(np.array([flo, fhi, 1.0, np.nextafter(flo, 1), 5.0]), flo, fhi, lo, hi)
     assert got.tolist() == [not below, fmpq(*fhi.as_integer_ratio()) < hi, True, True, False]
+
+
+FOUR_STATES = """[system]
+time = "continuous"
+A = [[-0.5, 0, 0.1, 0], [0, -0.3, 0, 0.2], [0.2, 0, -4, 0.5], [0, 0.1, -0.5, -5]]
+C = [[1, 0, 0, 0], [0, 1, 0, 0]]
+states = ["x1", "x2", "x3", "x4"]
+psi = ["0.1*sin(x1)", "0.1*tanh(x2)", "0.2*tanh(x3) + 0.01*sin(x1)", "-0.2*x4/(1+x4^2)"]
+[nonlinearity.o]
+Q = [[-1, 0], [0, -2]]
+S = [[0, 0], [0, 0.1]]
+R = [[0.01, 0], [0, 0.03]]
+cross = 0
+[nonlinearity.n]
+sector = [-0.2, 0.2]
+cross = 0.01
+[nonlinearity.falsify]
+lower = [-3, -3, -3, -3]
+upper = [3, 3, 3, 3]
+[method]
+key = "impulsive"
+L = [[0.6, 0], [0, 0.9]]
+alpha = 1.5
+noise_bound = 0.01
+M = [[0, 0, 1, 0], [0, 0, 0, 1]]
+kappa = "widest"
+digits = 12
+[simulate]
+horizon = 5
+x0 = [1, -1, 2, 0.5]
+xhat0 = [0, 0, 0, 0]
+runs = 2
+[simulate.noise]
+kind = "uniform"
+bound = 0.007
+"""
+
+
+def test_the_plot_draws_every_state_and_a_projected_phase_portrait(tmp_path: Path, monkeypatch):
+    """A 4-state plant's plot drew x1…x3 only, saying nothing of x4, and left the phase
+    portrait (Fig. 3) empty for n ≠ 2 (soundness trial, session 30): up to PLOT_STATES
+    states are drawn (the title says when more exist), and the portrait projects on (x1, x2)."""
+    from obsdesign.methods.impulsive import sim as isim
+    from obsdesign.simulate import plot as splot
+
+    figs = []
+    monkeypatch.setattr(splot, "save_figure", lambda fig, path: figs.append(fig) or Path(path))
+    spec = load_spec_text(FOUR_STATES, str(tmp_path / "s.toml"))
+    rep = api.design(spec)
+    res = get_method("impulsive").simulate(spec, rep.parameters)
+    isim.plot_simulation(spec, res, tmp_path / "p.png")
+    ax = {a.get_title(): a for a in figs[0].axes}
+    assert len(ax["phase portrait (Fig. 3), projection of 4 states"].get_lines()) == 2
+    labels = [t.get_text() for t in ax["no injection (Fig. 4)"].get_legend().get_texts()]
+    assert labels == ["x1", "x2", "x3", "x4"]
+    monkeypatch.setattr(isim, "PLOT_STATES", 3)
+    isim.plot_simulation(spec, res, tmp_path / "p.png")
+    assert "with noise (Fig. 5) — first 3 of 4 states" in [a.get_title() for a in figs[1].axes]
+    import matplotlib.pyplot as plt
+
+    for f in figs:
+        plt.close(f)
