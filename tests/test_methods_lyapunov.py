@@ -1365,3 +1365,18 @@ def test_riccati_Q_zero_with_an_unstable_plant_certifies() -> None:
     pole = abs(Q(3) / 2 - Q(np.asarray(rep.parameters["L"], dtype=object).ravel()[0]))
     best = Q(rep.parameters["lambda_best"])
     assert abs(pole - Q(2) / 3) < fmpq(1, 10**9) and pole < best < Q(2) / 3 + fmpq(1, 1000)
+
+
+def test_riccati_Q_zero_on_a_rotation_names_the_weights_not_the_conditioning() -> None:
+    """Q = 0 on a rotation by 0.6 + 0.8i (|z| = 1) gives the Riccati gain L = 0, as it should
+    (a mode that Q does not weight stays where it is): exit 4 blamed "this badly conditioned
+    plant" (soundness trial, session 30); it now names the singular riccati_Q. Q = I designs."""
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.6, 0.8], [-0.8, 0.6]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\nriccati_Q = [[0, 0], [0, 0]]\n'
+    )
+    with pytest.raises(InconclusiveError, match="singular riccati_Q") as e:
+        api.design(load_spec_text(text, "q0.toml"))
+    assert "badly conditioned" not in e.value.message
+    ok = api.design(load_spec_text(text.replace("[[0, 0], [0, 0]]", "[[1, 0], [0, 1]]"), "q.toml"))
+    assert ok.exit_code() == 0

@@ -19,6 +19,7 @@ from flint import fmpq, fmpq_mat
 from obsdesign import lyap
 from obsdesign.certify.detect import Detectability, detectability, unobservable_restriction
 from obsdesign.certify.printing import fmt_exact
+from obsdesign.certify.psd import check_pd
 from obsdesign.errors import InconclusiveError, InfeasibleError, SolverError, SpecError
 from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
 from obsdesign.methods.lyapunov.options import Options
@@ -87,7 +88,7 @@ def _designed(spec: Spec, o: Options, progress: Progress | None) -> Design:
         try:
             return _design_rounded(spec, Lm, lyap.BITS, solver, how, progress)
         except InfeasibleError as e:
-            first = designed_gain_failed(e, how, Lm, asked)
+            first = designed_gain_failed(e, how, Lm, asked, o)
     # the float Riccati gain is missing or failed the exact tests: the high-precision one
     hp = riccati_retry_hp(spec, o)
     if hp is None:
@@ -96,7 +97,7 @@ def _designed(spec: Spec, o: Options, progress: Progress | None) -> Design:
     try:
         return _design_rounded(spec, Lm, bits, solver, how, progress)
     except InfeasibleError as e2:
-        raise designed_gain_failed(e2, how, Lm, asked) from None
+        raise designed_gain_failed(e2, how, Lm, asked, o) from None
 
 
 def _lmi_fallback(
@@ -146,7 +147,7 @@ def _design_rounded(
 
 
 def designed_gain_failed(
-    e: InfeasibleError, how: str, Lm: fmpq_mat, rate_asked: bool
+    e: InfeasibleError, how: str, Lm: fmpq_mat, rate_asked: bool, o: Options | None = None
 ) -> InconclusiveError:
     """The error for a *designed* L that misses the asked rate or is not Schur / Hurwitz at
     all: inconclusive (exit 4), not infeasible. :func:`design_gain` proved exactly that
@@ -158,14 +159,26 @@ def designed_gain_failed(
     of the constrained-redesign paper (Astolfi et al., NOLCOS 2019).
 
     :param e: the exact verdict about the designed L; :param how: the design path;
-    :param Lm: the gain (exact); :param rate_asked: whether the spec asks a rate."""
+    :param Lm: the gain (exact); :param rate_asked: whether the spec asks a rate;
+    :param o: the options (a singular ``riccati_Q`` is named as the likelier cause)."""
     also = " and its unobservable modes meet the rate" if rate_asked else ""
+    big = f"max |L| ≈ {float(np.abs(lyap.mat_float(Lm)).max()):.3g}"
+    if o is not None and o.riccati_Q is not None and not check_pd(o.riccati_Q):
+        # Q = 0 on a rotation (|z| = 1) gives L = 0, as the Riccati equation should: the
+        # message blamed a "badly conditioned plant" (soundness trial, session 30)
+        why = (
+            f"the Riccati gain for the singular riccati_Q ({big}) leaves the modes of A that Q "
+            "does not weight where they are, and modes on the stability boundary then stay "
+            "there; give a positive definite riccati_Q, L, or another design"
+        )
+    else:
+        why = (
+            f"the float design by {how} is inaccurate on this badly conditioned plant ({big}); "
+            "give L, or try another design or weights"
+        )
     return InconclusiveError(
         f"the designed gain fails: {e.message}; yet some L succeeds ((C, A) is detectable"
-        f"{also}, proved exactly): the float design by {how} is inaccurate on this badly "
-        f"conditioned plant (max |L| ≈ {float(np.abs(lyap.mat_float(Lm)).max()):.3g}); give "
-        "L, or try "
-        "another design or weights"
+        f"{also}, proved exactly): {why}"
     )
 
 
