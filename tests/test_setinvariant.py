@@ -351,8 +351,14 @@ def test_a_defective_unobservable_mode_at_lambda_is_refused_and_named() -> None:
         check_detectable(J, C, nine)
     check_detectable(J, C, nine + fmpq(1, 10**6))  # λ above the block's |μ|: passed on
     B = qmat([[fmpq(3, 10), 0], [0, fmpq(9000001, 10**7)]])
-    with pytest.raises(InfeasibleError, match=r"\|μ\| ≈ 0\.900000099"):
+    with pytest.raises(InfeasibleError, match=r"\|μ\| ≈ 0\.9000001 > λ = 0\.9"):
         check_detectable(B, qmat([[1, 0]]), nine)
+    # as few digits as show it above λ: 19/20 was "0.94999999999999996" (session 30)
+    B = qmat([[fmpq(1, 2), 0], [0, fmpq(19, 20)]])
+    with pytest.raises(InfeasibleError, match=r"μ ≈ 0\.95 has \|μ\| ≈ 0\.95 > λ = 0\.9:"):
+        check_detectable(B, qmat([[1, 0]]), nine)
+    with pytest.raises(InfeasibleError, match=r"μ ≈ -1\.5 \(\|μ\| ≈ 1\.5 > 1\)"):
+        check_detectable(qmat([[fmpq(1, 2), 0], [0, fmpq(-3, 2)]]), qmat([[1, 0]]), nine)
 
 
 def test_necessary_condition_and_not_converged():

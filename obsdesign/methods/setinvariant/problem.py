@@ -174,17 +174,22 @@ def check_detectable(A: Any, C: Any, lam: Any) -> None:
 
 def _refuse(mu: complex, modulus: Any, lam: Any) -> None:
     """The InfeasibleError of an unobservable mode with |μ| certainly above λ (``modulus``
-    an arb ball of |μ|, printed to 17 digits: "|μ| = 0.9 > λ = 0.9" was said of
-    |μ| = 0.9000001)."""
+    an arb ball of |μ|), printed with the fewest significant digits (3 to 17) that show
+    |μ| above the bound: "|μ| = 0.9 > λ = 0.9" was said of |μ| = 0.9000001, and 17 digits
+    always showed μ = 19/20 as 0.94999999999999996 (soundness trial, session 30)."""
+    from fractions import Fraction
+
     m = float(modulus.mid())
-    shown = f"{mu.real:.17g}" if mu.imag == 0 else f"{mu:.17g}"
+    bound = Fraction(1) if modulus > 1 else Fraction(int(lam.p), int(lam.q))
+    d = next((d for d in range(3, 18) if Fraction(f"{m:.{d}g}") > bound), 17)
+    shown = f"{mu.real:.{d}g}" if mu.imag == 0 else f"{mu:.{d}g}"
     if modulus > 1:
         raise InfeasibleError(
-            f"(C, A) is not detectable: the mode μ ≈ {shown} (|μ| ≈ {m:.17g} > 1) "
+            f"(C, A) is not detectable: the mode μ ≈ {shown} (|μ| ≈ {m:.{d}g} > 1) "
             "is unobservable, so no bounded set is D-(C,A)-invariant"
         )
     raise InfeasibleError(
-        f"the unobservable mode μ ≈ {shown} has |μ| ≈ {m:.17g} > λ = {fmt_exact(lam)}: "
+        f"the unobservable mode μ ≈ {shown} has |μ| ≈ {m:.{d}g} > λ = {fmt_exact(lam)}: "
         "no polyhedron is λ-contractive (choose λ >= |μ|)"
     )
 
