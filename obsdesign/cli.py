@@ -647,7 +647,9 @@ def import_mat(
     obsdesign import plant.mat --A A --C C --dt 0.1 > spec.toml.
 
     Floats are written by their shortest repr (the spec reads back as the same doubles).
-    Add the method's options to the printed [method] table (see obsdesign init KEY)."""
+    Add the method's options to the printed [method] table (see obsdesign init KEY). A method
+    whose [method] table has required keys (constrained, set-invariant, ...) is refused,
+    saying which: start from obsdesign init KEY instead."""
 
     _run(lambda cmd: cmd.import_mat(mat, a, c, b, d, bd, dt, dt_var, method))
 

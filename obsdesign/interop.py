@@ -642,6 +642,18 @@ def spec_text_from_mat(
 
     try:  # what import prints, the spec loader accepts (session 28: C = [] exit 0, then 2)
         load_spec_text(text, f"{Path(path).name} (imported)")
-    except (InputError, SpecError) as e:
+    except SpecError as e:
+        if e.key.startswith("method.") and e.expected.startswith("is missing"):
+            # import writes [method] key only: for a method whose [method] table has
+            # required keys it could never print a spec, while --help said to add the
+            # options to the printed table (soundness trial, session 30)
+            raise InputError(
+                f"{path}: --method {method} needs [{e.key}] (and the method's other required "
+                "keys), which import does not write: start from `obsdesign init "
+                f"{method}` and put the matrices in its [system] table, or call "
+                f'obsdesign.spec_from_statespace(sys, method="{method}", ...) with them'
+            ) from None
+        raise InputError(f"{path}: the imported spec would be refused: {e}") from None
+    except InputError as e:
         raise InputError(f"{path}: the imported spec would be refused: {e}") from None
     return text

@@ -670,3 +670,20 @@ def test_import_without_a_time_choice_refuses_a_file_holding_a_sample_time(
     assert 'time = "continuous"' in spec_text_from_mat(mat, names, dt=0.0)
     savemat(mat, plant)
     assert 'time = "continuous"' in spec_text_from_mat(mat, names)
+
+
+@pytest.mark.parametrize(("method", "key"), [("set-invariant", "omega"), ("constrained", "L")])
+def test_mat_import_for_a_method_with_required_keys_says_where_to_start(
+    tmp_path: Path, method: str, key: str
+) -> None:
+    """import writes [method] key only, so for a method whose [method] table has required
+    keys it could never print a spec, while --help said to add the options to the printed
+    table (soundness trial, session 30): exit 2 naming the missing key and `obsdesign init`."""
+    from scipy.io import savemat
+
+    mat = tmp_path / "plant.mat"
+    savemat(mat, {"A": np.array(A_D), "C": np.array([[1.0, 0.0]])})
+    r = CliRunner().invoke(app, ["import", str(mat), "--dt", "0.1", "--method", method])
+    assert r.exit_code == 2 and r.stdout == ""
+    assert f"--method {method} needs [method.{key}]" in r.stderr, r.stderr
+    assert f"obsdesign init {method}" in r.stderr
