@@ -830,3 +830,46 @@ def test_xhat_max_in_cmax_beyond_a_loose_bound_is_undecided_not_false(eps: str, 
     assert ("undecided" in bad[0].detail) == (code == 4)
     assert "140090.7467" in bad[0].detail
     assert api.verify(rep).exit_code() == code
+
+
+ELLIPSOID_XHAT_AT_EPS_MAX = """[system]
+time = "discrete"
+A = [[0.5, 0], [0, 0.5]]
+C = [[1, 0], [0, 1]]
+[sets.X]
+type = "box"
+lower = [-0.5, -0.5]
+upper = [0.5, 0.5]
+[sets.Xh]
+type = "ellipsoid"
+center = [0, 0]
+E = [[E0, 0], [0, E0]]
+[method]
+key = "constrained"
+L = [[0.25, 0], [0, 0.25]]
+lambda = 0.3
+X = "X"
+Xhat = "Xh"
+eps_min = 0.01
+eps_max = 9
+[method.c]
+type = "ellipsoid"
+Q = [[1, 0], [0, 1]]
+r = 1
+[method.D]
+lower = [0, 0]
+upper = [0, 0]
+"""
+
+
+@pytest.mark.parametrize("e0", ["0.25", "0.250000000000000001"])
+def test_xhat_in_cmax_at_a_tie_is_not_refuted_by_rounding(e0: str) -> None:
+    """X̂ = {|x| ≤ 2} in C_max = {(|x|² − 1)² ≤ 9}: sup |c| = 9 = ε_max exactly (and 10⁻¹⁷
+    below it). Float points on X̂'s boundary lie a rounding error outside it, and the float
+    estimate "|c| ≈ 9 > ε_max" made the true inclusion exit 1 (re-check trial, session 30):
+    only an excess beyond 10⁻⁹ relative refutes; this is exit 4 (the bound 9.000000045 is
+    not tight)."""
+    rep = api.design(api.load_spec_text(ELLIPSOID_XHAT_AT_EPS_MAX.replace("E0", e0), "t.toml"))
+    bad = [c for c in rep.claims if c.status == ClaimStatus.FAILED]
+    assert [c.id for c in bad] == ["Xhat-in-Cmax"] and "undecided" in bad[0].detail
+    assert rep.exit_code() == 4 and api.verify(rep).exit_code() == 4
