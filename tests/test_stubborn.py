@@ -1553,3 +1553,24 @@ def test_the_bound_to_raise_is_named_with_the_spec_value() -> None:
     )
     with pytest.raises(InfeasibleError, match=r"raise gain_bound \(now 1\.0000001\)"):
         api.design(api.load_spec_text(text, "s.toml"))
+
+
+@pytest.mark.parametrize(("bound", "code"), [("1.56", 1), ("1.562501", 4), ("1.5625017", 0)])
+def test_a_gain_bound_at_the_limit_is_not_called_infeasible(bound: str, code: int) -> None:
+    """A = C = 1 (continuous): the LMIs are feasible iff gain_bound > 25/16 (exact witness:
+    P = 1, K = k ∈ (25/16, gain_bound]). The solver keeps ‖X‖ 10⁻⁶ inside the bound, so
+    gain_bound = 1.562501 was exit 1 "raise gain_bound" (re-check trial, session 30): the
+    `infeasible` is re-asked with the bound tightened by 10⁻⁹ only, and is exit 4 when that
+    is feasible. 1.56 (below 25/16) stays exit 1."""
+    text = (
+        '[system]\ntime = "continuous"\nA = [[1]]\nC = [[1]]\n[method]\nkey = "stubborn"\n'
+        f"gain_bound = {bound}\n"
+    )
+    sp = api.load_spec_text(text, "g.toml")
+    if code == 0:
+        assert api.design(sp).exit_code() == 0
+        return
+    err = InconclusiveError if code == 4 else InfeasibleError
+    with pytest.raises(err) as e:
+        api.design(sp)
+    assert ("at the feasibility limit" in e.value.message) == (code == 4)

@@ -61,13 +61,25 @@ class Plant:
         )
 
 
-def _problem(pl: Plant, o: Options, lam: Any, criterion: str | None, margin: Any) -> Any:
+#: the solver keeps ‖X‖₂ and R within their bounds times (1 − this): strictly inside, as
+#: the claims check ‖K‖₂ ≤ gain_bound, R ⪯ r_bound·I of the rounded values
+BOUND_INSIDE = 1e-6
+
+
+def _problem(
+    pl: Plant,
+    o: Options,
+    lam: Any,
+    criterion: str | None,
+    margin: Any,
+    inside: float = BOUND_INSIDE,
+) -> Any:
     """cvxpy problem of LMIs (1)-(3) / (7)-(9) at a fixed λ, normalized P ⪰ I, W ⪰ I.
 
     ``criterion`` None: feasibility; ``R``: minimize λ_max(R); ``K``: minimize ‖X‖₂;
     ``l2``: minimize g with the bounded real lemma (g = γ², γ the L2 gain d → e).
-    Full mode adds ‖X‖₂ ≤ gain_bound (then ‖K‖₂ = ‖P⁻¹X‖₂ ≤ gain_bound); r_bound adds
-    R ⪯ r_bound·I."""
+    Full mode adds ‖X‖₂ ≤ gain_bound·(1 − inside) (then ‖K‖₂ = ‖P⁻¹X‖₂ ≤ gain_bound);
+    r_bound adds R ⪯ r_bound·(1 − inside)·I."""
     import cvxpy as cp
 
     A, C = pl.A, pl.C
@@ -107,10 +119,10 @@ def _problem(pl: Plant, o: Options, lam: Any, criterion: str | None, margin: Any
         )
         cons.append(sym(Mi) >> m * np.eye(n + 1))
     if o.K is None and o.gain_bound is not None:
-        gb = float(o.gain_bound) * (1 - 1e-6)  # strictly inside: the claim checks ‖K‖₂ ≤ bound
+        gb = float(o.gain_bound) * (1 - inside)  # strictly inside: the claim checks ‖K‖₂ ≤ bound
         cons.append(cp.bmat([[gb * np.eye(n), X], [X.T, gb * np.eye(p)]]) >> 0)
     if o.r_bound is not None:
-        cons.append(R << float(o.r_bound) * (1 - 1e-6) * np.eye(p))
+        cons.append(R << float(o.r_bound) * (1 - inside) * np.eye(p))
     obj: Any = cp.Minimize(0)
     extra: dict[str, Any] = {}
     if criterion == "R":
@@ -180,14 +192,14 @@ class Feasibility:
     at a λ does not depend on the λs solved before (``verify`` re-solves the bracket's far
     end with a new object and gets the search's answer)."""
 
-    def __init__(self, pl: Plant, o: Options) -> None:
+    def __init__(self, pl: Plant, o: Options, inside: float = BOUND_INSIDE) -> None:
         import cvxpy as cp
 
         self.pl, self.o = pl, o
         self.calls = 0
         self.lam = cp.Parameter(nonneg=True)
         self.margin = cp.Parameter(nonneg=True)
-        self.prob, _ = _problem(pl, o, self.lam, None, self.margin)
+        self.prob, _ = _problem(pl, o, self.lam, None, self.margin, inside)
 
     def __call__(self, lam: float) -> tuple[bool, str]:
         """Whether the solver finds the LMIs feasible at λ (margin :func:`margin_at`), and
@@ -627,21 +639,35 @@ MARGIN_CONFIRM = 1000
 
 
 def _unless_feasible_with_less_margin(pl: Plant, o: Options, lam: float, where: str) -> None:
-    """Exit 4 when the solver, having answered `infeasible` with the strictness margin δ
-    (``[method] margin``: it solves F ⪯ −δI, not F ≺ 0), finds LMIs (1)-(3) / (7)-(9) feasible
-    at ``lam`` with δ / :data:`MARGIN_CONFIRM`: near the feasibility boundary the δ-tightened
-    problem is infeasible while the strict LMIs are not (A = 2.414213 < 1 + √2, C = 1 in
-    discrete time was exit 1 "infeasible for every λ tried", and certified with margin = 1e-9;
-    soundness trial, session 30). ``lam``: the most lenient λ the answer was at."""
+    """Exit 4 when the solver, having answered `infeasible` for the tightened problem, finds
+    LMIs (1)-(3) / (7)-(9) feasible at ``lam`` with less tightening: first the strictness
+    margin δ / :data:`MARGIN_CONFIRM` (``[method] margin``: it solves F ⪯ −δI, not F ≺ 0;
+    A = 2.414213 < 1 + √2, C = 1 in discrete time was exit 1 "infeasible for every λ tried",
+    and certified with margin = 1e-9; soundness trial, session 30), then also the bounds
+    gain_bound / r_bound kept inside by :data:`BOUND_INSIDE` / :data:`MARGIN_CONFIRM` only
+    (A = C = 1 with gain_bound = 1.562501 > 25/16, the exact limit, was exit 1 "raise
+    gain_bound"; re-check trial, session 30). ``lam``: the most lenient λ the answer was at."""
     less = replace(o, margin=o.margin / MARGIN_CONFIRM)
-    ok, _ = Feasibility(pl, less)(lam)
-    if ok:
+    head = f"stubborn: the solver reports LMIs {_refs(pl)} infeasible {where}"
+    if Feasibility(pl, less)(lam)[0]:
         raise InconclusiveError(
-            f"stubborn: the solver reports LMIs {_refs(pl)} infeasible {where} with the "
-            f"strictness margin {fmt_exact(o.margin)} ([method] margin: it solves F ⪯ −margin·I), "
-            f"but feasible at λ = {lam:g} with margin {fmt_exact(less.margin)}: not a verdict "
-            f"(the LMIs are near their feasibility boundary); set [method] margin = "
-            f"{fmt_exact(less.margin)}"
+            f"{head} with the strictness margin {fmt_exact(o.margin)} ([method] margin: it "
+            f"solves F ⪯ −margin·I), but feasible at λ = {lam:g} with margin "
+            f"{fmt_exact(less.margin)}: not a verdict (the LMIs are near their feasibility "
+            f"boundary); set [method] margin = {fmt_exact(less.margin)}"
+        )
+    bounds = [
+        k
+        for k, v in (("gain_bound", o.gain_bound if o.K is None else None), ("r_bound", o.r_bound))
+        if v is not None
+    ]
+    if bounds and Feasibility(pl, less, BOUND_INSIDE / MARGIN_CONFIRM)(lam)[0]:
+        names = " and ".join(bounds)
+        raise InconclusiveError(
+            f"{head}, but feasible at λ = {lam:g} with margin {fmt_exact(less.margin)} and "
+            f"{names} tightened by {BOUND_INSIDE / MARGIN_CONFIRM:g} instead of "
+            f"{BOUND_INSIDE:g} relative: not a verdict ({names} at the feasibility limit); "
+            f"raise {names} by a little more than {BOUND_INSIDE:g} relative"
         )
 
 
