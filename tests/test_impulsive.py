@@ -567,7 +567,9 @@ kappa = "widest"
 """
 
 
-@pytest.mark.parametrize(("row", "entry"), [(1, "-3e10"), (1, "-3e9"), (0, "-3e10")])
+@pytest.mark.parametrize(
+    ("row", "entry"), [(1, "-3e10"), (1, "-3e9"), (0, "-3e10"), (1, "-3.75e13"), (0, "-1e15")]
+)
 def test_a_block_with_one_fast_mode_keeps_its_window(row: int, entry: str) -> None:
     """κ_n's (ϖ_o's) first rounding step was 2⁻³⁰ of the block's data: with one fast mode
     (Ā + Āᵀ = diag(−6e10, −6), κ_n ≈ 5.4 set by the slow mode) it pushed κ_n to −50.5 and the
@@ -605,3 +607,41 @@ def test_lemma1_is_not_called_failed_on_a_rounded_kappa_n(monkeypatch) -> None:
     text = (ROOT / "specs" / "impulsive-sector-3state.toml").read_text(encoding="utf-8")
     with pytest.raises(InconclusiveError, match="no proof either way"):
         api.design(api.load_spec_text(text, "s.toml"))
+
+
+@pytest.mark.parametrize("which", ["kappa_n", "varpi_o"])
+def test_condition_22_and_the_window_are_not_called_failed_on_rounded_rates(monkeypatch, which):
+    """κ_n (ϖ_o) is certified as a bound below (above) its float optimum; (22) "fails for every
+    κ > 0" and "empty window" used the certified values alone and were exit 1 on stiff blocks
+    whose specs are feasible (re-check trial, session 30). A failure the float optima would
+    not meet is exit 4. Here κ_n is certified just above λ*_no (Lemma 1 holds, (22) fails),
+    or ϖ_o far above its optimum (an empty window)."""
+    from obsdesign.errors import InconclusiveError
+    from obsdesign.methods.impulsive import design as idesign
+
+    real = idesign.certified_rate
+    calls: list[int] = []
+
+    def skewed(Ablk, qsr, theta, rate_f):
+        calls.append(1)
+        if which == "kappa_n" and len(calls) == 2:
+            return Q("1.0001")  # λ*_no = 1 for the shipped 3-state plant
+        if which == "varpi_o" and len(calls) == 1:
+            return Q(-1000)  # ϖ_o = 1000
+        return real(Ablk, qsr, theta, rate_f)
+
+    monkeypatch.setattr(idesign, "certified_rate", skewed)
+    text = (ROOT / "specs" / "impulsive-sector-3state.toml").read_text(encoding="utf-8")
+    want = "condition \\(22\\) fails" if which == "kappa_n" else "empty window"
+    with pytest.raises(InconclusiveError, match=f"{want}.*no proof either way"):
+        api.design(api.load_spec_text(text, "s.toml"))
+
+
+def test_a_given_kappa_beyond_kappa_max_is_named_as_given() -> None:
+    """κ = 5.1400001 was refused as "κ = 5.14: it must lie in (0, 5.14)" (re-check trial,
+    session 30): κ as given, and κ_max by a bound above it."""
+    from obsdesign.errors import InfeasibleError
+
+    text = W0_TWO_OUTPUTS.replace('kappa = "widest"', "kappa = 5.1400001")
+    with pytest.raises(InfeasibleError, match=r"κ = 5\.1400001: it must lie in \(0, κ_max\)"):
+        api.design(api.load_spec_text(text, "k.toml"))

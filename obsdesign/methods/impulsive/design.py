@@ -186,11 +186,11 @@ def certified_rate(Ablk: np.ndarray, qsr: QSR, theta: fmpq, rate_f: float) -> fm
             "Ā + Āᵀ of the spec's A overflows float64; scale the plant's numbers down"
         )
     q = qsr.scaled(theta)
-    # 2⁻³⁰ of the rate, but only 2⁻⁴⁴ (~250 ulps) of the data: the float optimum's error is
+    # 2⁻³⁰ of the rate, but only 2⁻⁵⁰ (4 ulps) of the data: the float optimum's error is
     # about ulp·scale, and a step of 2⁻³⁰·scale, far above it, pushed κ_n of a block with a
     # fast mode (Ā + Āᵀ = diag(−6e10, −6), κ_n ≈ 5.4) to −50.5: "Lemma 1 fails", exit 1, on
     # a spec whose report with the true rates verifies (soundness trial, session 30)
-    step_f = max(2.0**-30 * abs(rate_f), 2.0**-44 * _data_scale(Ablk, q))
+    step_f = max(2.0**-30 * abs(rate_f), 2.0**-50 * _data_scale(Ablk, q))
     r = Q(dyadic(rate_f - step_f, 40))
     step = Q(dyadic(step_f, 40))
     for _ in range(60):
@@ -219,6 +219,87 @@ def coordinates_for(p: Problem) -> Coordinates:
             return default_coordinates(p.A, p.C)
         return transform(p.A, p.C, rational_M(optimize_M(p)), "optimized")
     return transform(p.A, p.C, p.M, "given")
+
+
+def _window(
+    p: Problem,
+    kappa_n: fmpq,
+    varpi: fmpq,
+    lam_no: fmpq,
+    lam_on: fmpq,
+    gamma: fmpq,
+    beta: fmpq,
+    lam_Mo: float,
+    notes: list[str],
+) -> tuple[fmpq, fmpq, fmpq, fmpq, fmpq]:
+    """Lemma 1 (κ_n > λ*_no), condition (22) (κ_max > 0, κ chosen or given in (0, κ_max)) and
+    the window (26b)-(26c) rounded to ``p.digits`` decimals, from κ_n and ϖ_o: (κ_max, κ,
+    ϖ_o used, T_min, T_max). Raises :class:`Infeasible` with the failing inequality.
+
+    :param p: the problem; :param kappa_n, varpi: the rates of Lemmas 1-2; :param lam_no,
+    lam_on: λ*_no, λ*_on; :param gamma, beta: of L; :param lam_Mo: λ_max(M_o) (float, for the
+    note); :param notes: the design's notes (Assumption 2's note is added)."""
+    if not kappa_n > lam_no:
+        raise Infeasible(
+            f"Lemma 1 fails: κ_n = {float(kappa_n):.6g} ≤ λ*_no = ‖Ā_no‖ + ℓ_no = "
+            f"{float(lam_no):.6g} (short by {float(lam_no - kappa_n):.4g}); try another M"
+        )
+    kmax = kappa_max(kappa_n, lam_no, lam_on, beta)
+    if kmax <= 0:
+        raise Infeasible(
+            f"condition (22) fails for every κ > 0: κ_n = {float(kappa_n):.6g} ≤ λ*_no + β λ*_on = "
+            f"{float(lam_no):.6g} + {float(beta):.6g}·{float(lam_on):.6g} = "
+            f"{float(coupling(lam_no, lam_on, beta)):.6g} (short by {float(-kmax):.4g})"
+        )
+    vp = max(float(varpi), 0.0)
+    if p.given_kappa is None:
+        kf = _kappa_float(p, vp, float(coupling(lam_no, lam_on, beta)), float(gamma), float(kmax))
+        kappa = Q(dyadic(kf, 30))
+        while kappa >= kmax:
+            kappa = kappa * fmpq(1023, 1024)
+    else:
+        kappa = p.given_kappa
+        if not (0 < kappa < kmax):
+            raise Infeasible(
+                f"condition (22) fails for the given κ = {fmt_exact(kappa)}: it must lie in "
+                f"(0, κ_max) with κ_max {_below(kmax)}"
+            )
+    if varpi <= 0:
+        # N(−ϖ) ⪯ N(−ϖ_o) for ϖ ≥ ϖ_o, so ϖ_o = 0 is still certified and keeps (26b) finite
+        notes.append(
+            f"Assumption 2 (ϖ_o > 0) does not hold: λ_max(M_o) = {lam_Mo:.6g}; ϖ_o = 0 is used "
+            "in (26b) (sound: the ssd LMI of Lemma 2 holds for every ϖ_o ≥ λ_max(M_o))"
+        )
+        varpi = fmpq(0)
+    T_max = T_max_lower(gamma, varpi, kappa, lam_no, lam_on, beta)
+    T_min = T_min_upper(p.alpha, gamma, kappa)
+    T_max_r, T_min_r = safe_window(T_max, T_min, p.digits)
+    if not T_min_r < T_max_r and T_min < T_max:
+        raise Infeasible(
+            f"the window T_min = {float_or_inf(T_min):.6g} < T_max = "
+            f"{float_or_inf(T_max):.6g} (κ = "
+            f"{float(kappa):.6g}) is not empty, but it holds no pair of {p.digits}-decimal "
+            f"bounds (T_max rounded down to {fmt_exact(T_max_r)}, T_min up to "
+            f"{fmt_exact(T_min_r)}); raise [method] digits (at most 30) or widen the window "
+            "(γ = min L_ii raises the numerator of (26b))"
+        )
+    if not T_min_r < T_max_r:
+        raise Infeasible(
+            f"empty window: T_min = {float_or_inf(T_min):.6g} ≥ T_max = "
+            f"{float_or_inf(T_max):.6g} "
+            f"(κ = {float(kappa):.6g}); a larger α lowers T_min (26c); another L changes "
+            "both ends (γ = min L_ii raises T_min and the numerator of (26b), β = 1/(1 − γ)² "
+            "its denominator), another κ or M may help"
+        )
+    return kmax, kappa, varpi, T_min_r, T_max_r
+
+
+def _below(x: fmpq) -> str:
+    """ "= x" when x is short, else "≤ (x rounded up)" (a bound the reader may use)."""
+    from obsdesign.certify.printing import fmt_value_up
+
+    text = fmt_value_up(x, 10)
+    return f"≤ {text.split(' ≤ ')[-1]}" if " ≤ " in text else f"= {text}"
 
 
 def design_window(p: Problem) -> tuple[dict[str, Any], list[str]]:
@@ -257,66 +338,24 @@ def design_window(p: Problem) -> tuple[dict[str, Any], list[str]]:
     n_no, n_on = norm_upper(co.Ano), norm_upper(co.Aon)
     lam_no, lam_on = n_no + data.ell_no, n_on + data.ell_on
     gamma, beta = gamma_of(p.L)
-    if not kappa_n > lam_no:
-        if kn_f > float(lam_no):
-            # κ_n is certified as a lower bound only: below λ*_no while the float optimum is
-            # above, the failure is not proved (exit 4, not 1; session 30)
-            raise InconclusiveError(
-                f"Lemma 1: κ_n is certified only down to {float(kappa_n):.6g} ≤ λ*_no = "
-                f"‖Ā_no‖ + ℓ_no = {float(lam_no):.6g}, while its float optimum "
-                f"{kn_f:.17g} lies above: no proof either way (ill-conditioned Ā_n)"
-            )
-        raise Infeasible(
-            f"Lemma 1 fails: κ_n = {float(kappa_n):.6g} ≤ λ*_no = ‖Ā_no‖ + ℓ_no = "
-            f"{float(lam_no):.6g} (short by {float(lam_no - kappa_n):.4g}); try another M"
+    try:
+        kmax, kappa, varpi, T_min_r, T_max_r = _window(
+            p, kappa_n, varpi, lam_no, lam_on, gamma, beta, lam_Mo, notes
         )
-    kmax = kappa_max(kappa_n, lam_no, lam_on, beta)
-    if kmax <= 0:
-        raise Infeasible(
-            f"condition (22) fails for every κ > 0: κ_n = {float(kappa_n):.6g} ≤ λ*_no + β λ*_on = "
-            f"{float(lam_no):.6g} + {float(beta):.6g}·{float(lam_on):.6g} = "
-            f"{float(coupling(lam_no, lam_on, beta)):.6g} (short by {float(-kmax):.4g})"
-        )
-    vp = max(float(varpi), 0.0)
-    if p.given_kappa is None:
-        kf = _kappa_float(p, vp, float(coupling(lam_no, lam_on, beta)), float(gamma), float(kmax))
-        kappa = Q(dyadic(kf, 30))
-        while kappa >= kmax:
-            kappa = kappa * fmpq(1023, 1024)
-    else:
-        kappa = p.given_kappa
-        if not (0 < kappa < kmax):
-            raise Infeasible(
-                f"condition (22) fails for the given κ = {float(kappa):.6g}: it must lie in "
-                f"(0, {float(kmax):.6g})"
-            )
-    if varpi <= 0:
-        # N(−ϖ) ⪯ N(−ϖ_o) for ϖ ≥ ϖ_o, so ϖ_o = 0 is still certified and keeps (26b) finite
-        notes.append(
-            f"Assumption 2 (ϖ_o > 0) does not hold: λ_max(M_o) = {lam_Mo:.6g}; ϖ_o = 0 is used "
-            "in (26b) (sound: the ssd LMI of Lemma 2 holds for every ϖ_o ≥ λ_max(M_o))"
-        )
-        varpi = fmpq(0)
-    T_max = T_max_lower(gamma, varpi, kappa, lam_no, lam_on, beta)
-    T_min = T_min_upper(p.alpha, gamma, kappa)
-    T_max_r, T_min_r = safe_window(T_max, T_min, p.digits)
-    if not T_min_r < T_max_r and T_min < T_max:
-        raise Infeasible(
-            f"the window T_min = {float_or_inf(T_min):.6g} < T_max = "
-            f"{float_or_inf(T_max):.6g} (κ = "
-            f"{float(kappa):.6g}) is not empty, but it holds no pair of {p.digits}-decimal "
-            f"bounds (T_max rounded down to {fmt_exact(T_max_r)}, T_min up to "
-            f"{fmt_exact(T_min_r)}); raise [method] digits (at most 30) or widen the window "
-            "(γ = min L_ii raises the numerator of (26b))"
-        )
-    if not T_min_r < T_max_r:
-        raise Infeasible(
-            f"empty window: T_min = {float_or_inf(T_min):.6g} ≥ T_max = "
-            f"{float_or_inf(T_max):.6g} "
-            f"(κ = {float(kappa):.6g}); a larger α lowers T_min (26c); another L changes "
-            "both ends (γ = min L_ii raises T_min and the numerator of (26b), β = 1/(1 − γ)² "
-            "its denominator), another κ or M may help"
-        )
+    except Infeasible as e:
+        # κ_n (ϖ_o) is certified as a bound below (above) its float optimum: a failure that
+        # the optima would not meet is no proof (stiff blocks: exit 1 through (22) or the
+        # window where the spec is feasible; soundness and re-check trials, session 30)
+        try:
+            _window(p, Q(kn_f), Q(-ko), lam_no, lam_on, gamma, beta, lam_Mo, [])
+        except Infeasible:
+            raise e from None
+        raise InconclusiveError(
+            f"{e}; but not with the float optima κ_n ≈ {kn_f:.17g}, ϖ_o ≈ {-ko:.17g} in "
+            f"place of the certified κ_n = {float(kappa_n):.17g}, ϖ_o = {float(varpi):.17g} "
+            "(rounded until exactly proved, by steps relative to the blocks' data): no proof "
+            "either way (ill-conditioned Ā_n / Ā_o: entries of very different sizes)"
+        ) from None
     params: dict[str, Any] = {
         "T": co.T,
         "M_source": co.source,
