@@ -359,6 +359,17 @@ def test_a_defective_unobservable_mode_at_lambda_is_refused_and_named() -> None:
         check_detectable(B, qmat([[1, 0]]), nine)
     with pytest.raises(InfeasibleError, match=r"μ ≈ -1\.5 \(\|μ\| ≈ 1\.5 > 1\)"):
         check_detectable(qmat([[fmpq(1, 2), 0], [0, fmpq(-3, 2)]]), qmat([[1, 0]]), nine)
+    # beyond a double: 1 + 10⁻¹⁷ was "|μ| ≈ 1 > 1" (re-check trial, session 30)
+    tiny = fmpq(1) + fmpq(1, 10**17)
+    with pytest.raises(InfeasibleError, match=r"\|μ\| ≈ 1\.00000000000000001 > 1\)"):
+        check_detectable(qmat([[fmpq(1, 2), 0], [0, tiny]]), qmat([[1, 0]]), nine)
+    # a complex pair (0.6 ± 0.8i)·(1 + 10⁻⁷), |μ| > 1, shown with its imaginary part
+    k = fmpq(1) + fmpq(1, 10**7)
+    r = qmat([[fmpq(1, 2), 0, 0], [0, k * 6 / 10, -k * 8 / 10], [0, k * 8 / 10, k * 6 / 10]])
+    with pytest.raises(
+        InfeasibleError, match=r"μ ≈ 0\.6[0-9]*[+-]0\.8[0-9]*j \(\|μ\| ≈ 1\.0000001 > 1"
+    ):
+        check_detectable(r, qmat([[1, 0, 0]]), nine)
 
 
 def test_necessary_condition_and_not_converged():

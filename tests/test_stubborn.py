@@ -1574,3 +1574,11 @@ def test_a_gain_bound_at_the_limit_is_not_called_infeasible(bound: str, code: in
     with pytest.raises(err) as e:
         api.design(sp)
     assert ("at the feasibility limit" in e.value.message) == (code == 4)
+
+
+def test_the_given_lambda_is_named_as_given() -> None:
+    """λ = 2.99999999 was refused "infeasible at the given λ = 3" (%g; re-check trial,
+    session 30)."""
+    text = REDESIGN_DOUBLE_INTEGRATOR.replace("lambda_fraction = 0.5", "lambda = 2.99999999")
+    with pytest.raises(InfeasibleError, match=r"at the given λ = 2\.99999999:"):
+        api.design(api.load_spec_text(text, "l.toml"))

@@ -161,7 +161,7 @@ def check_detectable(A: Any, C: Any, lam: Any) -> None:
             over = [(r, abs(r)) for r, _ in minp.complex_roots() if abs(r) > lam_b]
             if over:
                 r, a = max(over, key=lambda t: float(t[1].mid()))
-                _refuse(complex(float(r.real.mid()), float(r.imag.mid())), a, lq)
+                _refuse(r, a, lq)
     for sign in (1, -1):
         mu = sign * lq
         if minp(mu) == 0 and minp.derivative()(mu) == 0:
@@ -172,26 +172,39 @@ def check_detectable(A: Any, C: Any, lam: Any) -> None:
             )
 
 
-def _refuse(mu: complex, modulus: Any, lam: Any) -> None:
-    """The InfeasibleError of an unobservable mode with |μ| certainly above λ (``modulus``
-    an arb ball of |μ|), printed with the fewest significant digits (3 to 17) that show
-    |μ| above the bound: "|μ| = 0.9 > λ = 0.9" was said of |μ| = 0.9000001, and 17 digits
-    always showed μ = 19/20 as 0.94999999999999996 (soundness trial, session 30)."""
+def _refuse(mu: Any, modulus: Any, lam: Any) -> None:
+    """The InfeasibleError of an unobservable mode ``mu`` (an acb ball) with |μ| certainly
+    above λ (``modulus``, an arb ball of |μ|), printed from the balls' midpoints with the
+    fewest significant digits (3 to 40) that show |μ| above the bound: "|μ| = 0.9 > λ = 0.9"
+    was said of |μ| = 0.9000001, 17 digits of a double showed μ = 19/20 as
+    0.94999999999999996 (soundness trial, session 30), and a double could not show
+    1 + 10⁻¹⁷ above 1 at all ("|μ| ≈ 1 > 1"; re-check trial, session 30)."""
     from fractions import Fraction
 
-    m = float(modulus.mid())
     bound = Fraction(1) if modulus > 1 else Fraction(int(lam.p), int(lam.q))
-    d = next((d for d in range(3, 18) if Fraction(f"{m:.{d}g}") > bound), 17)
-    shown = f"{mu.real:.{d}g}" if mu.imag == 0 else f"{mu:.{d}g}"
+    d = next((d for d in range(3, 41) if Fraction(_digits(modulus, d)) > bound), 40)
+    re, im = _digits(mu.real, d), _digits(mu.imag, d)
+    shown = re if float(mu.imag.mid()) == 0 else f"{re}{'' if im.startswith('-') else '+'}{im}j"
+    m = _digits(modulus, d)
     if modulus > 1:
         raise InfeasibleError(
-            f"(C, A) is not detectable: the mode μ ≈ {shown} (|μ| ≈ {m:.{d}g} > 1) "
+            f"(C, A) is not detectable: the mode μ ≈ {shown} (|μ| ≈ {m} > 1) "
             "is unobservable, so no bounded set is D-(C,A)-invariant"
         )
     raise InfeasibleError(
-        f"the unobservable mode μ ≈ {shown} has |μ| ≈ {m:.{d}g} > λ = {fmt_exact(lam)}: "
+        f"the unobservable mode μ ≈ {shown} has |μ| ≈ {m} > λ = {fmt_exact(lam)}: "
         "no polyhedron is λ-contractive (choose λ >= |μ|)"
     )
+
+
+def _digits(x: Any, d: int) -> str:
+    """The midpoint of the arb ball ``x`` in ``d`` significant decimal digits, without
+    trailing zeros."""
+    s = x.mid().str(d, radius=False)
+    mant, e, exp = s.partition("e")
+    if "." in mant:
+        mant = mant.rstrip("0").rstrip(".")
+    return mant + e + exp
 
 
 def necessary_condition(

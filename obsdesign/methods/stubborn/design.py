@@ -373,7 +373,7 @@ def design_params(
         lam_q = o.lam  # a rate the user asks for is checked directly, before any search
         ok, st = feasible(pl, o, float(lam_q))
         if not ok and st == INFEASIBLE:
-            where = f"at the given λ = {float(lam_q):g}"
+            where = f"at the given λ = {fmt_exact(lam_q)}"
             _unless_feasible_with_less_margin(pl, o, float(lam_q), where)
             _infeasible(spec, pl, o, where)
         # any other answer (inaccurate, a failure) is no verdict: the certification below
@@ -451,7 +451,7 @@ def design_params(
             )
     if cand is None:
         raise InconclusiveError(
-            f"stubborn: no candidate certified at λ = {float(lam_q):g} ({solver})"
+            f"stubborn: no candidate certified at λ = {fmt_exact(lam_q)} ({solver})"
         )
     cand.update(vals)
     cand["criterion"] = o.criterion
