@@ -24,9 +24,10 @@ _state = {"quiet": False}
 
 
 def setup(quiet: bool = False, width: int | None = None) -> None:
-    """Apply -q/--quiet and --width for this command."""
+    """Apply -q/--quiet and --width for this command (no --width: none, not the last
+    command's; an in-process caller's earlier ``--width 40`` wrapped every later table)."""
     _state["quiet"] = quiet
-    if width is not None:
+    if width is not None or "obsdesign.report.render" in sys.modules:  # else it is fresh
         from obsdesign.report.render import set_width
 
         set_width(width)

@@ -461,3 +461,15 @@ def test_print_rows_of_no_rows_prints_nothing(capsys: pytest.CaptureFixture[str]
 
     _print_rows([], Fmt.text)
     assert capsys.readouterr().out == ""
+
+
+def test_width_does_not_outlive_its_command(spec: Path, tmp_path: Path):
+    """--width was kept for every later command of the same process (CliRunner, an API
+    caller of the CLI): one `verify --width 40` wrapped the tables of all the commands after
+    it, and a test of the default table broke depending on the tests before it (session 30)."""
+    report = tmp_path / "r.json"
+    assert _run("design", str(spec), "-q", "-o", str(report))[0] == 0
+    narrow = _run("verify", str(report), "--width", "40")[1]
+    assert max(len(x) for x in narrow.splitlines()) <= 40
+    out = _run("verify", str(report))[1]
+    assert max(len(x) for x in out.splitlines()) == 100
