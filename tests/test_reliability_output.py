@@ -699,3 +699,54 @@ def test_bad_input_inside_a_design_leaves_the_output_untouched(
     res = runner.invoke(app, ["design", str(spec), "-o", str(out), "--format", "json"])
     assert res.exit_code == 2 and res.stdout == ""
     assert out.read_bytes() == before
+
+
+def test_parquet_into_a_fifo_keeps_the_fifo_and_arrives_whole(spec: Path, tmp_path: Path):
+    """``sweep -o X.parquet --force`` into a FIFO: pyarrow's writer removes its target path on
+    any error (a FIFO cannot seek), and deleted the FIFO — through a link, a device node
+    such as /dev/full (output trial, session 30). The writer now works on a temp file whose
+    bytes are copied in: the reader gets the whole Parquet file, and the FIFO stays."""
+    import threading
+
+    pytest.importorskip("pyarrow")
+    fifo = tmp_path / "o.parquet"
+    os.mkfifo(fifo)
+    got: list[bytes] = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_bytes()), daemon=True)
+    reader.start()
+    args = ["sweep", str(spec), "--set", "method.lambda=[0.96, 0.97]", "-q", "-o", str(fifo)]
+    res = runner.invoke(app, [*args, "--force"])
+    reader.join(timeout=30)
+    assert res.exit_code == 0, res.output
+    assert stat.S_ISFIFO(os.lstat(fifo).st_mode)
+    assert got and got[0].startswith(b"PAR1") and got[0].endswith(b"PAR1")
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".json"])
+def test_a_name_of_nearly_255_bytes_is_written_or_refused_before_the_work(
+    spec: Path, tmp_path: Path, suffix: str
+) -> None:
+    """A 241–255-byte output name passed the check before the work (a short probe name) and
+    failed after it: the temp file ".NAME.XXXXXXXX.csv" passed 255 bytes (output trial,
+    session 30). The temp name is cut to fit: the file is written under its full name."""
+    name = "b" * (255 - len(suffix)) + suffix
+    out = tmp_path / name
+    if suffix == ".csv":
+        args = ["sweep", str(spec), "--set", "method.lambda=[0.96, 0.97]", "-q", "-o", str(out)]
+    else:
+        args = ["design", str(spec), "-q", "-o", str(out)]
+    res = runner.invoke(app, args)
+    assert res.exit_code == 0, res.output
+    assert out.is_file() and out.stat().st_size > 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["s.toml", name])
+
+
+def test_force_through_a_dangling_link_creates_no_folders(spec: Path, tmp_path: Path) -> None:
+    """``-o link --force``, the link pointing into a missing folder tree, created every
+    missing folder (the plain path is refused: output trial, session 30); it is refused
+    before the work, and nothing is created."""
+    link = tmp_path / "link.json"
+    link.symlink_to(tmp_path / "no" / "such" / "x.json")
+    res = runner.invoke(app, ["design", str(spec), "-q", "-o", str(link), "--force"])
+    _refused(res, "does not exist")
+    assert not (tmp_path / "no").exists()

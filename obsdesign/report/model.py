@@ -517,8 +517,14 @@ def _check_output(path: str | Path, force: bool, inputs: tuple[Path, ...]) -> No
         )
     try:
         st = os.stat(p)
-    except OSError as e:  # a dangling link with --force: written as a new file
+    except OSError as e:  # a dangling link with --force: written as a new file at its target
         if force and stat.S_ISLNK(lst.st_mode):
+            target = Path(os.path.realpath(p))
+            if not target.parent.is_dir():
+                raise InputError(
+                    f"{p}: cannot write (the link's target folder {target.parent} does not exist)"
+                ) from None
+            _probe_dir(target)
             return
         raise InputError(f"{p}: cannot write ({e.strerror})") from None
     if stat.S_ISDIR(st.st_mode):
@@ -536,22 +542,41 @@ def _check_output(path: str | Path, force: bool, inputs: tuple[Path, ...]) -> No
     if stat.S_ISREG(st.st_mode) and protected and not force:
         raise InputError(f"{p}: is write-protected; refusing to replace it (--force)")
     if stat.S_ISREG(st.st_mode):
-        _probe_dir(p)
+        # through a link (--force) the file written is the target's (a link in a writable
+        # folder to /proc/version ran every point, then failed: output trial, session 30)
+        _probe_dir(Path(os.path.realpath(p)) if stat.S_ISLNK(lst.st_mode) else p)
 
 
 def _probe_dir(p: Path) -> None:
     """Refuse (one line) an output whose directory cannot take the new file: the result is
     written to a temporary file there and renamed (:func:`write_via`), so that is tried now,
-    with an empty probe file removed at once (``sweep -o /sys/s.csv`` and ``check --junit
-    /sys/j.xml`` ran every point, then lost the rows: CLI fuzzer)."""
+    with an empty probe file of the same name pattern removed at once (``sweep -o
+    /sys/s.csv`` and ``check --junit /sys/j.xml`` ran every point, then lost the rows: CLI
+    fuzzer; a 241–255-byte name passed a short probe name and failed after the work: output
+    trial, session 30)."""
     parent = p.parent if str(p.parent) else Path(".")
     try:
-        fd, name = tempfile.mkstemp(prefix=".obsdesign-probe-", dir=parent)
+        fd, name = _temp_file(p)
     except OSError as e:
         raise InputError(f"{p}: cannot write in {parent} ({e.strerror})") from None
     os.close(fd)
     with contextlib.suppress(OSError):
         os.unlink(name)
+
+
+#: the longest file name (bytes) of the usual file systems (NAME_MAX)
+NAME_MAX = 255
+
+
+def _temp_file(p: Path) -> tuple[int, str]:
+    """``tempfile.mkstemp`` beside ``p``: ".NAME.XXXXXXXX" plus p's suffix, NAME cut so the
+    whole stays within :data:`NAME_MAX` bytes (a 241–255-byte output name made the temp name
+    too long: "File name too long" after the whole sweep; output trial, session 30)."""
+    parent = p.parent if str(p.parent) else Path(".")
+    suffix = p.suffix or ".tmp"
+    room = NAME_MAX - 2 - 8 - len(os.fsencode(suffix))  # ".", ".", 8 random characters
+    name = os.fsdecode(os.fsencode(p.name)[: max(room, 1)])
+    return tempfile.mkstemp(dir=parent, prefix=f".{name}.", suffix=suffix)
 
 
 def _umask_mode() -> int:
@@ -572,15 +597,15 @@ def write_via(path: str | Path, writer: Callable[[Path], Any], force: bool = Fal
         if force and p.is_symlink():
             p = Path(os.path.realpath(p))
         if force and p.exists() and not p.is_file() and not p.is_dir():
-            interrupt.check()
-            writer(p)  # a FIFO or a device: write into it, never replace it
+            _write_into(p, writer)  # a FIFO or a device: write into it, never replace it
             return p
-        p.parent.mkdir(parents=True, exist_ok=True)
+        # no mkdir: a link's missing target folder was created, folders and all, where the
+        # plain path is refused (output trial, session 30)
         try:
             mode = stat.S_IMODE(os.stat(p).st_mode)
         except FileNotFoundError:
             mode = _umask_mode()
-        fd, tmp = tempfile.mkstemp(dir=p.parent, prefix=f".{p.name}.", suffix=p.suffix or ".tmp")
+        fd, tmp = _temp_file(p)
         os.close(fd)
         try:
             writer(Path(tmp))
@@ -596,6 +621,26 @@ def write_via(path: str | Path, writer: Callable[[Path], Any], force: bool = Fal
     except OSError as e:
         raise InputError(f"{path}: cannot write ({e.strerror or e})") from None
     return p
+
+
+def _write_into(p: Path, writer: Callable[[Path], Any]) -> None:
+    """Write into the FIFO or device ``p`` (``--force``): ``writer`` makes a temp file in the
+    system's temp folder (with p's suffix, which picks the format), whose bytes are then
+    copied into ``p``. The writer never sees ``p``: pyarrow's Parquet writer removes its
+    target path on any error, and deleted a FIFO or a device node (``-o x.parquet --force``
+    on a link to /dev/full; output trial, session 30); a format that seeks works too."""
+    import shutil
+
+    fd, tmp = tempfile.mkstemp(prefix=".obsdesign-", suffix=p.suffix or ".tmp")
+    os.close(fd)
+    try:
+        writer(Path(tmp))
+        interrupt.check()
+        with open(tmp, "rb") as src, open(p, "wb") as dst:
+            shutil.copyfileobj(src, dst)
+    finally:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
 
 
 def write_atomic(path: str | Path, text: str, force: bool = False) -> Path:
