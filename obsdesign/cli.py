@@ -167,6 +167,7 @@ def _run(fn: Callable[[Any], int], quiet: bool = False, width: int | None = None
         from obsdesign import cli_commands
 
         cli_commands.setup(quiet, width)
+        sys.stdout = _Stdout(sys.stdout)  # an OS error on stdout is exit 2 (undone below)
 
         # the API turns warnings into report notes; any other stray warning (numpy, scipy)
         # is not printed unless --debug
@@ -197,11 +198,53 @@ def _run(fn: Callable[[Any], int], quiet: bool = False, width: int | None = None
             raise
         _err(f"internal failure: {type(e).__name__}: {e} (run with --debug for the traceback)")
         raise typer.Exit(EXIT_SOLVER) from None
+    finally:
+        if isinstance(sys.stdout, _Stdout):
+            sys.stdout = sys.stdout.wrapped
     try:
         sys.stdout.flush()
     except BrokenPipeError:
         _quiet_broken_pipe()
+    except OSError as e:
+        _err(_stdout_error(e).message)
+        raise typer.Exit(_stdout_error(e).exit_code) from None
     raise typer.Exit(code)
+
+
+def _stdout_error(e: OSError) -> Any:
+    """The bad-input error of an OS error (no space, I/O error) writing stdout."""
+    from obsdesign.errors import InputError
+
+    return InputError(f"stdout: cannot write ({e.strerror or e})")
+
+
+class _Stdout:
+    """sys.stdout during a command: an OS error writing it (``obsdesign schema > /dev/full``:
+    no space left) is exit 2 "stdout: cannot write (REASON)", as for any output file; it
+    was exit 3 "internal failure" (output trial, session 30). A broken pipe stays
+    BrokenPipeError (exit 141). Everything else is the wrapped stream's."""
+
+    def __init__(self, wrapped: Any) -> None:
+        self.wrapped = wrapped
+
+    def write(self, text: str) -> int:
+        try:
+            return int(self.wrapped.write(text))
+        except BrokenPipeError:
+            raise
+        except OSError as e:
+            raise _stdout_error(e) from None
+
+    def flush(self) -> None:
+        try:
+            self.wrapped.flush()
+        except BrokenPipeError:
+            raise
+        except OSError as e:
+            raise _stdout_error(e) from None
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.wrapped, name)
 
 
 def _settle(owned: bool) -> None:

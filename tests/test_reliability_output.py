@@ -750,3 +750,21 @@ def test_force_through_a_dangling_link_creates_no_folders(spec: Path, tmp_path: 
     res = runner.invoke(app, ["design", str(spec), "-q", "-o", str(link), "--force"])
     _refused(res, "does not exist")
     assert not (tmp_path / "no").exists()
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full")
+@pytest.mark.parametrize("args", [["schema"], ["init", "lyapunov"], ["methods"]])
+def test_a_full_disk_on_stdout_is_exit_2(args: list[str]) -> None:
+    """``obsdesign schema > /dev/full`` (no space left) was exit 3 "internal failure:
+    OSError" (output trial, session 30): an OS error writing stdout is bad output, exit 2
+    with one line, as for any output file; a closed pipe stays exit 141."""
+    with open("/dev/full", "w") as full:
+        p = subprocess.run(
+            [sys.executable, "-m", "obsdesign", *args],
+            stdout=full,
+            stderr=subprocess.PIPE,
+            text=True,
+            timeout=120,
+        )
+    assert p.returncode == 2, p.stderr
+    assert p.stderr.strip() == "obsdesign: error: stdout: cannot write (No space left on device)"
