@@ -768,3 +768,25 @@ def test_a_full_disk_on_stdout_is_exit_2(args: list[str]) -> None:
         )
     assert p.returncode == 2, p.stderr
     assert p.stderr.strip() == "obsdesign: error: stdout: cannot write (No space left on device)"
+
+
+def test_an_eps_plot_prints_nothing_on_stderr(spec: Path, tmp_path: Path) -> None:
+    """``simulate --plot o.eps -q`` printed matplotlib's "The PostScript backend does not
+    support transparency" on stderr (its logger, not a warning; output trial, session 30)."""
+    p = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "obsdesign",
+            "simulate",
+            str(spec),
+            "-q",
+            "--plot",
+            str(tmp_path / "o.eps"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert p.returncode == 0 and p.stderr == "", p.stderr
+    assert (tmp_path / "o.eps").read_bytes().startswith(b"%!PS")

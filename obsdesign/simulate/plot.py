@@ -47,14 +47,22 @@ def save_figure(fig: object, path: str | Path, dpi: int = 110) -> Path:
     rename, so ``--plot FIFO --force`` replaced the FIFO (or, through a link, a device node)
     with a regular file (simulate trial, session 27)."""
     import io
+    import logging
 
     import matplotlib.pyplot as plt
 
     p = Path(path)
     buf = io.BytesIO()
+    # matplotlib's logger, not warnings: "The PostScript backend does not support
+    # transparency" reached stderr through -q (output trial, session 30); the PS/EPS
+    # backends draw translucent bands opaque, which docs/reliability.md says
+    log = logging.getLogger("matplotlib")
+    level = log.level
+    log.setLevel(logging.ERROR)
     try:
         fig.savefig(buf, dpi=dpi, format=p.suffix.lstrip(".").lower() or "png")  # type: ignore[attr-defined]
     finally:
+        log.setLevel(level)
         plt.close(fig)  # type: ignore[arg-type]
     with open(p, "wb") as f:
         f.write(buf.getvalue())
