@@ -721,10 +721,13 @@ def sweep(
             on_row=lambda r: advance(r["exit_code"] != 0),
             timeout=timeout,
         )
+    if plot is not None:
+        # before -o: a --y that no row has was refused after the table was written (output
+        # trial, session 30)
+        sw.check_plot_column(rows, axes, y or "", x, cols)
     if output is not None:
         sw.write_table(output, rows, force)
     if plot is not None:
-        sw.check_plot_column(rows, axes, y or "", x, cols)
         _write_plot(plot, lambda tmp: sw.plot_sweep(rows, axes, y or "", tmp, x), force)
     if fmt == Fmt.json:
         print(_dumps(rows, indent=2, ensure_ascii=False, default=_jsonable))

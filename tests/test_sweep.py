@@ -695,3 +695,20 @@ def test_plot_marks_points_that_are_not_ok_over_the_whole_range(
     figs.clear()
     sw.plot_sweep([dict(r, exit_code=0) for r in rows], axes, "mu", tmp_path / "q.png")
     assert not [ln for ln in figs[0].axes[0].lines if ln.get_label().startswith("not ok")]
+
+
+def test_a_y_column_no_row_has_is_refused_before_the_table_is_written(tmp_path: Path) -> None:
+    """``sweep --simulate -o T --plot P --y bogus``: the columns of a simulated sweep are
+    known after the run only, and the table was written before --y was found wrong (exit 2
+    with -o replaced; output trial, session 30). --y is checked before -o is written."""
+    out, png = tmp_path / "t.csv", tmp_path / "p.png"
+    out.write_text("old\n")
+    r = CliRunner().invoke(
+        app,
+        [
+            "sweep", str(SPEC), "--simulate", "--set", "method.lambda=[0.96, 0.97]",
+            "-o", str(out), "--plot", str(png), "--y", "bogus", "-q",
+        ],
+    )  # fmt: skip
+    assert r.exit_code == 2 and "--y bogus" in r.output, r.output
+    assert out.read_text() == "old\n" and not png.exists()
