@@ -219,3 +219,32 @@ def test_fmt_value_down_of_a_long_gamma() -> None:
     g = fmpq(24691357802469, 2 * 10**18)
     assert fmt_value_down(g, 8) == "24691357802469/2000000000000000000 ≥ 0.000012345678"
     assert fmt_value_down(fmpq(23965, 10**9), 8) == "0.000023965"
+
+
+# -- mutation review 30 (docs/mutation.md)
+
+
+# --- Mutation review 30: printing.fmt_exact / _show (ready to append to
+# tests/test_certify_printing.py)
+
+
+def test_fmt_exact_decimal_up_to_the_longest_skew_that_fits() -> None:
+    """Mutation review 30 (printing._MAX_SKEW = 110 → 80): 1/5⁸⁹ = 2⁸⁹·10⁻⁸⁹ has a 27-digit
+    mantissa and fits 32 characters exactly; 1/5⁹⁰ does not. The skew cap must not cut the
+    decimals that fit."""
+    s = fmt_exact(F(1, 5**89))
+    assert s == "6.18970019642690137449562112e-63" and len(s) == 32 and parse(s) == F(1, 5**89)
+    assert fmt_exact(F(1, 5**90)) == "1/" + str(5**90)
+    assert fmt_exact(F(1, 2**38)) == "3.63797880709171295166015625e-12"  # 32 characters
+
+
+def test_fmt_exact_of_an_integer_beyond_pythons_int_string_limit() -> None:
+    """Mutation review 30 (printing._show: ``m = fmpz(m)`` → ``int(m)``): Python refuses to
+    write an int of more than 4300 digits (ValueError); fmt_exact of a 4772-digit integer is
+    its exact digits (p/q with q = 1), not a crash."""
+    from flint import fmpz
+
+    big = fmpz(3) ** 10000
+    s = fmt_exact(F(big))
+    assert s == str(big) and len(s) == 4772
+    assert fmt_exact(F(big, 2**40)) == str(big) + "/" + str(2**40)

@@ -822,3 +822,74 @@ def test_the_float_estimate_from_below_is_below_the_safe_bounds(n, seed, pad, v)
             assert 0 <= low <= up * (1 + 1e-9) + 1e-12
             if S is X:  # exact at the vertices
                 assert low >= up * (1 - 1e-9)
+
+
+# -- mutation review 30 (docs/mutation.md)
+
+
+# --- Mutation review 30: bounds._set_points_f, _ellipsoid_boundary_f,
+# sup_norm_c_float_lower (ready to append to tests/test_constrained_bounds.py)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_the_float_estimate_from_below_is_tight_where_the_bound_is_exact(seed: int) -> None:
+    """Mutation review 30 (_set_points_f: a polytope's vertices cut to one, an ellipsoid's
+    boundary points dropped or shrunk; sup_norm_c_float_lower: the map's face normals
+    dropped): the estimate from below reaches the safe bound at a polytope's vertices (exact
+    there) and comes within 30 % / 20 % of the per-face bounds of |c|₂ over an ellipsoid and
+    over X ⊕ {eᵀPe ≤ v} (loose there)."""
+    from obsdesign.sets import Ellipsoid, Polytope
+
+    rng = np.random.default_rng(seed)
+    n = 3
+    G = qmat(np.vstack([np.eye(n), -np.eye(n), np.ones((1, n))]))
+    g = np.array([Q(1)] * (2 * n) + [Q(2)], dtype=object)  # a cut cube: 10 vertices
+    poly = Polytope(G, g)
+    ell = Ellipsoid(_rand_P(rng, n), np.array([Q("0.1")] * n, dtype=object))
+    cm = box_map([Q("-0.5")] * n, [Q("0.5")] * n)
+    up = float(B.sup_norm_c_over_set(cm, poly))
+    assert B.sup_norm_c_float_lower(cm, poly) >= up * (1 - 1e-9)
+    lop_g = np.array([Q(1)] * n + [Q("0.2")] * n + [Q(2)], dtype=object)
+    for k in range(n):  # lopsided, turned: the farthest vertex is not always the first listed
+        turned = Polytope(np.asarray(G, dtype=object)[:, np.roll(np.arange(n), k)], lop_g)
+        up = float(B.sup_norm_c_over_set(cm, turned))
+        assert B.sup_norm_c_float_lower(cm, turned) >= up * (1 - 1e-9)
+    up = float(B.sup_norm_c_over_set(cm, ell))  # per-face bound: not exact for |c|₂
+    assert B.sup_norm_c_float_lower(cm, ell) >= 0.7 * up
+    P = _rand_P(rng, n)
+    X = _box(-np.ones(n), np.ones(n))
+    pm = polytope_map(G, np.array([Q(3)] * (2 * n) + [Q(4)], dtype=object))
+    vq = dyadic(2.0, 20)
+    up = float(B.sup_norm_c_over_Xhat_max(pm, P, qinv(P), X, vq))
+    assert B.sup_norm_c_float_lower(pm, X, P, vq) >= 0.8 * up
+
+
+def test_set_points_of_a_box_are_its_vertices_all_or_sampled() -> None:
+    """Mutation review 30 (_set_points_f: ``2**n <= LOWER_POINTS`` → ``<``; the sampled
+    corners all the lower one): a box of 8 dimensions gives its 256 vertices; of 10, 256
+    sampled vertices, not all the same."""
+    rng = np.random.default_rng(0)
+    pts = B._set_points_f(_box(-np.ones(8), np.ones(8)), rng)
+    assert pts.shape == (256, 8) and len({tuple(p) for p in pts}) == 256
+    pts = B._set_points_f(_box(-np.ones(10), np.ones(10)), rng)
+    assert pts.shape == (256, 10) and len({tuple(p) for p in pts}) > 200
+    assert set(np.unique(pts)) == {-1.0, 1.0}
+
+
+def test_the_float_estimate_skips_values_that_are_not_finite() -> None:
+    """Mutation review 30 (sup_norm_c_float_lower: the isfinite filter dropped; 0 for no
+    finite value made inf): a |c| that overflows at some points is no evidence (the largest
+    finite one counts), and none finite is 0 — undecided, never a refutation."""
+
+    class Stub:
+        affine = False
+
+        def __init__(self, vals):
+            self.vals = vals
+
+        def norm_c(self, pts):
+            return np.resize(np.asarray(self.vals, float), len(pts))
+
+    X = _box(-np.ones(2), np.ones(2))
+    assert B.sup_norm_c_float_lower(Stub([1.0, np.nan, 2.0, np.inf]), X) == 2.0
+    assert B.sup_norm_c_float_lower(Stub([np.nan, np.inf, -np.inf, np.nan]), X) == 0.0

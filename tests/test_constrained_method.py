@@ -1005,3 +1005,42 @@ def test_simulate_names_a_refuted_assumption_2_among_the_premises(tmp_path) -> N
     )
     assert api.design(api.load_spec(p)).exit_code() == 0
     assert api.simulate(p).info["premises of Theorem 1 (25b)"] == "hold"
+
+
+# -- mutation review 30 (docs/mutation.md)
+
+
+# --- Mutation review 30: constrained sim._assumption2_refuted (ready to append to
+# tests/test_constrained_method.py)
+
+
+def test_simulate_names_assumption_2_refuted_just_below_the_needed_mu(tmp_path) -> None:
+    """Mutation review 30 (sim._assumption2_refuted: μ (or ρ) changed in the exact check,
+    e.g. 2μ): with P = [[3.2, 2.8], [2.8, 4.9]], ρ = 0.81 the inequality (5) needs
+    μ ≳ 3.93; μ = 3 is refuted by the design (exit 1) and named by simulate, μ = 4 holds."""
+    p = tmp_path / "u.toml"
+    base = USER_P_REFUTED.replace("[[6.5, 3.5], [3.5, 6.5]]", "[[3.2, 2.8], [2.8, 4.9]]").replace(
+        "rho = 0.8\n", "rho = 0.81\n"
+    )
+    p.write_text(base.replace("mu = 200", "mu = 3"))
+    assert api.design(api.load_spec(p)).exit_code() == 1
+    got = api.simulate(p).info["premises of Theorem 1 (25b)"]
+    assert got.startswith("Assumption 2 fails: V(e⁺) ≤ ρV(e) + μ|w|² (eq. (5))"), got
+    p.write_text(base.replace("mu = 200", "mu = 4"))
+    assert api.design(api.load_spec(p)).exit_code() == 0
+    assert api.simulate(p).info["premises of Theorem 1 (25b)"] == "hold"
+
+
+def test_simulate_names_a_P_below_the_margin_as_assumption_2_failing(tmp_path) -> None:
+    """Mutation review 30 (sim._assumption2_refuted: the P test dropped, or made without
+    [method] margin): a P positive definite but not above margin·I (the design's P-positive
+    claim fails, exit 1) is named by simulate as failing eq. (4), as the design says."""
+    p = tmp_path / "u.toml"
+    text = USER_P_REFUTED.replace("[[6.5, 3.5], [3.5, 6.5]]", "[[3.2, 2.8], [2.8, 4.9]]")
+    text = text.replace("rho = 0.8\n", "rho = 0.81\n").replace("mu = 200", "mu = 10000")
+    assert "[method]\n" in text
+    p.write_text(text.replace("[method]\n", "[method]\nmargin = 1000\n", 1))
+    rep = api.design(api.load_spec(p))
+    assert rep.exit_code() == 1 and "P-positive-definite" in {c.id for c in rep.failed}
+    got = api.simulate(p).info["premises of Theorem 1 (25b)"]
+    assert got.startswith("Assumption 2 fails: P is not positive definite"), got

@@ -873,3 +873,34 @@ def test_xhat_in_cmax_at_a_tie_is_not_refuted_by_rounding(e0: str) -> None:
     bad = [c for c in rep.claims if c.status == ClaimStatus.FAILED]
     assert [c.id for c in bad] == ["Xhat-in-Cmax"] and "undecided" in bad[0].detail
     assert rep.exit_code() == 4 and api.verify(rep).exit_code() == 4
+
+
+# -- mutation review 30 (docs/mutation.md)
+
+
+# --- Mutation review 30: constrained claims' X̂-in-C_max site of _float_ok / _undecided /
+# _float_lower (ready to append to tests/test_constrained_soundness.py)
+
+
+@pytest.mark.parametrize(("eps", "undecided"), [("0.0142", True), ("0.01", False)])
+def test_xhat_in_cmax_undecided_or_refuted_at_the_points_of_xhat(monkeypatch, eps, undecided):
+    """Mutation review 30 (claims._inclusions: the float estimate of X̂ ⊂ C_max taken over X
+    instead of X̂, the float_ok of that claim dropped or put on another id, the detail's tail
+    computed over X): with a loose safe bound (patched to 0.02) of sup |c| over X̂ (true sup
+    √2·0.01 ≈ 0.0141421 at X̂'s corners; 0 over X), ε_max = 0.0142 is undecided (float_ok
+    True, exit 4) and ε_max = 0.01 is refuted by a corner of X̂ (float_ok False, exit 1)."""
+    from obsdesign.methods.constrained import bounds as B
+    from obsdesign.methods.constrained import claims as cc
+
+    sp = api.load_spec_text(XHAT_MAX_NOT_TIGHT.replace("EPS", "140095"), "x.toml")
+    o = sp.options
+    Xh = cc.xhat_set(o)
+    assert float(B.sup_norm_c_over_set(o.cmap, Xh)) == pytest.approx(0.0141421356, rel=1e-8)
+    monkeypatch.setattr(B, "sup_norm_c_over_set", lambda cm, S: Q("0.02"))
+    c = Claims()
+    cc._inclusions(c, o, Xh, Q("0.001"), Q(eps))
+    claim = {x.id: x for x in c}["Xhat-in-Cmax"]
+    assert claim.status == ClaimStatus.FAILED
+    assert claim.float_ok is undecided
+    assert ("undecided" in claim.detail) is undecided
+    assert "0.01414213562" in claim.detail

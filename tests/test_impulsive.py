@@ -645,3 +645,69 @@ def test_a_given_kappa_beyond_kappa_max_is_named_as_given() -> None:
     text = W0_TWO_OUTPUTS.replace('kappa = "widest"', "kappa = 5.1400001")
     with pytest.raises(InfeasibleError, match=r"κ = 5\.1400001: it must lie in \(0, κ_max\)"):
         api.design(api.load_spec_text(text, "k.toml"))
+
+
+# -- mutation review 30 (docs/mutation.md)
+
+
+# --- Mutation review 30: impulsive certified_rate (step_f) and design_window's Lemma 1
+# guard (ready to append to tests/test_impulsive.py)
+
+
+@pytest.mark.parametrize("entry", ["-3", "-3e10"])
+def test_certified_rates_stay_within_a_few_steps_of_the_float_optimum(monkeypatch, entry) -> None:
+    """Mutation review 30 (certified_rate: the first step 2⁻³⁰ of the rate or 2⁻⁴⁴ of the
+    data made 2⁻²⁰ / 2⁻³⁶, or 2⁻³⁰ of the data): every certified rate lies within two first
+    steps, max(2⁻²⁹|rate|, 2⁻⁴³·scale), below its float optimum — on the plain block (the
+    rate's step) and on one with a fast mode (the data's step)."""
+    from obsdesign.methods.impulsive import design as idesign
+
+    real = idesign.certified_rate
+    seen: list[tuple[float, Any, float]] = []
+
+    def rec(Ablk, qsr, theta, rate_f):
+        r = real(Ablk, qsr, theta, rate_f)
+        seen.append((rate_f, r, idesign._data_scale(Ablk, qsr.scaled(theta))))
+        return r
+
+    monkeypatch.setattr(idesign, "certified_rate", rec)
+    base = (ROOT / "specs" / "impulsive-sector-3state.toml").read_text(encoding="utf-8")
+    rep = api.design(
+        api.load_spec_text(base.replace("[1, -3, 0.5]", f"[1, {entry}, 0.5]"), "s.toml")
+    )
+    assert rep.exit_code() == 0 and len(seen) == 2
+    for rate_f, r, scale in seen:
+        assert Q(r) < Q(rate_f)
+        assert rate_f - float(r) <= max(2.0**-29 * abs(rate_f), 2.0**-43 * scale), (rate_f, r)
+
+
+@pytest.mark.parametrize(("kappa_n_float", "code"), [(None, 4), (1.001, 1)])
+def test_lemma1_near_miss_of_the_float_optimum(monkeypatch, kappa_n_float, code) -> None:
+    """Mutation review 30, restated for the window chain of session 30: with the certified
+    κ_n at λ*_no = 1 (Lemma 1 fails), the design is exit 4 "no proof either way" when the
+    float optima pass Lemma 1, (22) and the window (the real float κ_n ≈ 5.4), and exit 1
+    when they do not either (a float κ_n of 1.001 passes Lemma 1 but not (22))."""
+    from obsdesign.errors import InconclusiveError, InfeasibleError
+    from obsdesign.methods.impulsive import design as idesign
+
+    real_best, real_cert = idesign.best_rate, idesign.certified_rate
+    n = {"best": 0, "cert": 0}
+
+    def best(A, qsr, opt):
+        n["best"] += 1
+        k, th, resid = real_best(A, qsr, opt)
+        # the second call is κ_n's
+        return (kappa_n_float if n["best"] == 2 and kappa_n_float else k), th, resid
+
+    def cert(Ablk, qsr, theta, rate_f):
+        n["cert"] += 1
+        return real_cert(Ablk, qsr, theta, rate_f) if n["cert"] == 1 else Q(1)
+
+    monkeypatch.setattr(idesign, "best_rate", best)
+    monkeypatch.setattr(idesign, "certified_rate", cert)
+    text = (ROOT / "specs" / "impulsive-sector-3state.toml").read_text(encoding="utf-8")
+    err = InconclusiveError if code == 4 else InfeasibleError
+    with pytest.raises(err, match="Lemma 1 fails") as e:
+        api.design(api.load_spec_text(text, "s.toml"))
+    assert ("no proof either way" in e.value.message) == (code == 4)
+    assert n == {"best": 2, "cert": 2}

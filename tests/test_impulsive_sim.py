@@ -555,3 +555,95 @@ def test_the_plot_draws_every_state_and_a_projected_phase_portrait(tmp_path: Pat
 
     for f in figs:
         plt.close(f)
+
+
+# -- mutation review 30 (docs/mutation.md)
+
+
+# --- Mutation review 30: impulsive sim _in_window, the window warning, plot_simulation
+# (ready to append to tests/test_impulsive_sim.py)
+
+
+def test_in_window_is_open_and_exact_at_both_ends() -> None:
+    """Mutation review 30 (sim._in_window: ``T_min < q < T_max`` → ``≤`` at either end, or
+    always True; T_min and T_max swapped at the call): a dyadic window end equal to an interval
+    is outside (the window of Theorems 1-2 is open), and a double next to a non-dyadic end is
+    inside or outside as the rationals say."""
+    from flint import fmpq
+
+    from obsdesign.methods.impulsive.sim import _in_window
+
+    got = _in_window(np.array([0.5, 1.0, 2.0]), 0.5, 2.0, fmpq(1, 2), fmpq(2))
+    assert got.tolist() == [False, True, False]
+    lo, hi = fmpq(1, 3), fmpq(2, 3)
+    flo, fhi = float(1 / 3), float(2 / 3)
+    assert fmpq(*flo.as_integer_ratio()) < lo and fmpq(*fhi.as_integer_ratio()) < hi
+    got = _in_window(np.array([flo, fhi, 0.5]), flo, fhi, lo, hi)
+    assert got.tolist() == [False, True, True]
+
+
+def test_the_window_warning_names_the_outside_intervals_and_the_exact_window(
+    tmp_path: Path,
+) -> None:
+    """Mutation review 30 (sim.simulate's warning: the range of *all* intervals instead of
+    the outside ones; T_min printed %g; T_min and T_max swapped in the call of _in_window):
+    intervals 0.5 and 5 warn "from 5 to 5" and name the window's ends exactly (10 digits);
+    an interval equal to the double nearest to a window end that lies inside the window (as
+    the rationals say) draws no warning."""
+    import warnings
+
+    from flint import fmpq
+
+    from obsdesign.certify.printing import fmt_exact
+
+    def dyadic(f: float) -> fmpq:
+        return fmpq(*f.as_integer_ratio())
+
+    for digits in (10, 11, 12, 9, 13, 8):  # a window with an end whose double lies inside
+        text = _spec3('\nsampling_file = "h.txt"').replace(
+            'key = "impulsive"', f'key = "impulsive"\ndigits = {digits}'
+        )
+        spec = load_spec_text(text, str(tmp_path / "s.toml"))
+        rep = api.design(spec)
+        t_min, t_max = rep.parameters["T_min"], rep.parameters["T_max"]
+        inside = [f for f in (float(t_min), float(t_max)) if Q(t_min) < dyadic(f) < Q(t_max)]
+        if inside:
+            break
+    assert inside
+    shown = fmt_exact(t_min), fmt_exact(t_max)
+    assert len(shown[0].replace("0.", "")) > 6  # more digits than %g shows
+    (tmp_path / "h.txt").write_text("\n".join(["0.5", "5"] * 3), encoding="utf-8")
+    with pytest.warns(UserWarning) as w:
+        get_method("impulsive").simulate(spec, rep.parameters)
+    msg = [str(x.message) for x in w if "certified window" in str(x.message)]
+    assert len(msg) == 1 and "2 of 4 sampling intervals (from 5 to 5)" in msg[0]
+    assert f"T_min = {shown[0]} < t_(k+1) − t_k < T_max = {shown[1]}" in msg[0]
+    (tmp_path / "h.txt").write_text("\n".join([repr(inside[0]), "1.0"] * 8), encoding="utf-8")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert get_method("impulsive").simulate(spec, rep.parameters).info["intervals_in_window"]
+
+
+def test_the_two_state_plot_has_the_field_and_named_axes(tmp_path: Path, monkeypatch) -> None:
+    """Mutation review 30 (plot_simulation: the field of a 2-state plant dropped, the axis
+    names swapped; PLOT_STATES): the phase portrait of n = 2 has the vector field (a
+    streamplot) and x1 on the horizontal axis, x2 on the vertical; up to 6 states are drawn."""
+    import matplotlib.pyplot as plt
+
+    from obsdesign.methods.impulsive import sim as isim
+    from obsdesign.simulate import plot as splot
+
+    assert isim.PLOT_STATES == 6
+    figs: list = []
+    monkeypatch.setattr(splot, "save_figure", lambda fig, path: figs.append(fig) or Path(path))
+    text = (ROOT / "specs" / "schaum-impulsive-example.toml").read_text(encoding="utf-8")
+    spec = load_spec_text(text.replace("horizon = 60", "horizon = 10"), str(tmp_path / "s.toml"))
+    rep = api.design(spec)
+    res = get_method("impulsive").simulate(spec, rep.parameters, runs=2)
+    isim.plot_simulation(spec, res, tmp_path / "p.png")
+    ax = {a.get_title(): a for a in figs[0].axes}["phase portrait (Fig. 3)"]
+    assert ax.collections  # the streamplot's field
+    names = spec.system.states
+    assert (ax.get_xlabel(), ax.get_ylabel()) == (names[0], names[1])
+    for f in figs:
+        plt.close(f)

@@ -1380,3 +1380,46 @@ def test_riccati_Q_zero_on_a_rotation_names_the_weights_not_the_conditioning() -
     assert "badly conditioned" not in e.value.message
     ok = api.design(load_spec_text(text.replace("[[0, 0], [0, 0]]", "[[1, 0], [0, 1]]"), "q.toml"))
     assert ok.exit_code() == 0
+
+
+# -- mutation review 30 (docs/mutation.md)
+
+
+# --- Mutation review 30: lyapunov.designed_gain_failed, the riccati_Q branch (ready to
+# append to tests/test_methods_lyapunov.py)
+
+
+def test_a_failed_gain_under_a_positive_definite_riccati_Q_blames_the_float_design(
+    monkeypatch,
+) -> None:
+    """Mutation review 30 (designed_gain_failed: ``not check_pd(riccati_Q)`` dropped, so any
+    given riccati_Q was blamed; the high-precision retry's failure without the options): a
+    positive definite riccati_Q is not named; a singular one is, on the retry's failure too."""
+    from obsdesign.errors import InfeasibleError
+    from obsdesign.methods.lyapunov import design as ld
+
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.6, 0.8], [-0.8, 0.6]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\nriccati_Q = [[1, 0], [0, 1]]\n'
+    )
+    sp = load_spec_text(text, "q.toml")
+    Lm = lyap.dyadic_fmat(np.zeros((2, 1)), lyap.BITS)[0]
+    err = ld.designed_gain_failed(
+        InfeasibleError("A − LC is not Schur"), "Riccati", Lm, False, sp.options
+    )
+    assert "badly conditioned" in err.message and "riccati_Q" not in err.message
+    # the high-precision retry fails as well: its error names the singular riccati_Q too
+    q0 = load_spec_text(text.replace("[[1, 0], [0, 1]]", "[[0, 0], [0, 0]]"), "q0.toml")
+    real_hp = ld.riccati_retry_hp
+
+    def hp(spec, o):
+        got = real_hp(spec, o)
+        if got is None:  # no retry here: give it the zero gain, which fails again
+            Lz = lyap.dyadic_fmat(np.zeros((2, 1)), lyap.BITS)[0]
+            first = ld.design_gain(spec, o, None)
+            return Lz, lyap.BITS, first[1], "Riccati (high precision)"
+        return got
+
+    monkeypatch.setattr(ld, "riccati_retry_hp", hp)
+    with pytest.raises(InconclusiveError, match="singular riccati_Q"):
+        api.design(q0)

@@ -451,3 +451,54 @@ def test_check_workers_passes_the_timeout_on(tmp_path: Path, monkeypatch) -> Non
         res = runner.invoke(app, ["check", str(spec), "--workers", "2", "--timeout", t, "-q"])
         assert res.exit_code == 0, res.output
         assert seen[-1] == want
+
+
+# -- mutation review 30 (docs/mutation.md)
+
+
+# --- Mutation review 30: api._thread_budget (ready to append to tests/test_reliability_check.py)
+
+
+class _FakeTimer:
+    """threading.Timer that never runs by itself: the test fires it by hand."""
+
+    made: list[_FakeTimer] = []
+
+    def __init__(self, after: float, fn: Any) -> None:
+        self.after, self.fn, self.cancelled, self.daemon = after, fn, False, False
+        _FakeTimer.made.append(self)
+
+    def start(self) -> None:
+        pass
+
+    def cancel(self) -> None:
+        self.cancelled = True
+
+
+def test_thread_budget_schedules_no_stop_once_the_block_is_left(monkeypatch) -> None:
+    """Mutation review 30 (api._thread_budget: ``armed = [True]`` kept after the block, the
+    ``if armed[0]`` test dropped, ``timers[0].cancel()`` dropped, the final
+    ``_async_raise(tid, None)`` dropped, ``timers.append``): a timer that fires after the block
+    was left (it lost the race for the lock) schedules nothing and starts no retimer; every
+    timer is cancelled, and a stop scheduled before leaving is cancelled on the way out."""
+    import threading
+
+    _FakeTimer.made = []
+    calls: list[tuple[int, Any]] = []
+    monkeypatch.setattr(api.threading, "Timer", _FakeTimer)
+    monkeypatch.setattr(api, "_async_raise", lambda tid, exc: calls.append((tid, exc)))
+    tid = threading.get_ident()
+    with api._thread_budget(5.0):
+        assert [t.after for t in _FakeTimer.made] == [5.0]
+        _FakeTimer.made[0].fn()  # the deadline passes inside the block: a stop, then a retimer
+        assert calls == [(tid, api.SpecTimeout)]
+        assert [t.after for t in _FakeTimer.made] == [5.0, api.RETIMEOUT_S]
+    assert _FakeTimer.made[-1].cancelled  # the retimer pending at the exit
+    assert calls[-1] == (tid, None)  # a stop scheduled but not yet raised is cancelled
+    n_calls, n_timers = len(calls), len(_FakeTimer.made)
+    for t in list(_FakeTimer.made):
+        t.fn()  # a timer that fires late (it was waiting for the lock while the block left)
+    assert len(calls) == n_calls and len(_FakeTimer.made) == n_timers
+    with api._thread_budget(3.0):
+        pass
+    assert _FakeTimer.made[-1].after == 3.0 and _FakeTimer.made[-1].cancelled

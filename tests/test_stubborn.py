@@ -1582,3 +1582,87 @@ def test_the_given_lambda_is_named_as_given() -> None:
     text = REDESIGN_DOUBLE_INTEGRATOR.replace("lambda_fraction = 0.5", "lambda = 2.99999999")
     with pytest.raises(InfeasibleError, match=r"at the given λ = 2\.99999999:"):
         api.design(api.load_spec_text(text, "l.toml"))
+
+
+# -- mutation review 30 (docs/mutation.md)
+
+
+# --- Mutation review 30: stubborn _unless_feasible_with_less_margin and its call sites
+# (ready to append to tests/test_stubborn.py)
+
+
+def _margin_sensitive_solver(monkeypatch, feasible_at: Any) -> list[tuple[float, float]]:
+    """Feasibility answering `infeasible` at the spec's [method] margin everywhere and, with
+    that margin divided by 1000, `optimal` where ``feasible_at(λ, calls)``: the list of calls
+    (λ, [method] margin) is returned."""
+    from obsdesign.methods.stubborn import design as sd
+
+    calls: list[tuple[float, float]] = []
+
+    def fake(self: Any, lam: float) -> tuple[bool, str]:
+        m = float(self.o.margin)
+        ok = m < 1e-7 and feasible_at(float(lam), calls)
+        calls.append((float(lam), m))
+        return (True, "optimal") if ok else (False, sd.INFEASIBLE)
+
+    monkeypatch.setattr(sd.Feasibility, "__call__", fake)
+    return calls
+
+
+def test_the_smaller_margin_is_asked_at_the_given_lambda(monkeypatch) -> None:
+    """Mutation review 30 (stubborn.design_params: the re-ask of a given λ's `infeasible`
+    dropped, or asked at another λ): with λ given, an `infeasible` that the margin / 1000
+    overturns at that λ is exit 4 naming the margin and the λ, not exit 1."""
+    calls = _margin_sensitive_solver(monkeypatch, lambda lam, calls: lam == 0.75)
+    sp = api.load_spec_text(_scalar_discrete("0.5", "lambda = 0.75\n"), "s.toml")
+    with pytest.raises(InconclusiveError, match=r"feasible at λ = 0\.75 with margin 1e-9"):
+        api.design(sp)
+    assert [lam for lam, m in calls if m < 1e-7] == [0.75]
+
+
+@pytest.mark.parametrize("time", ["discrete", "continuous"])
+def test_the_smaller_margin_is_asked_at_the_most_lenient_lambda_tried(monkeypatch, time) -> None:
+    """Mutation review 30 (stubborn.design_params: the re-ask after "infeasible for every λ
+    tried" made at the search's good end, 1 or 0, a λ never tried, or at half the λ): it is
+    asked at the most lenient λ the search tried (discrete 1 − 10⁻⁶, continuous the smallest),
+    and there an answer `optimal` makes it exit 4."""
+
+    def lenient(lam: float, calls: list[tuple[float, float]]) -> bool:
+        tried = [x for x, m in calls if m >= 1e-7]
+        return lam == (max(tried) if time == "discrete" else min(tried))
+
+    calls = _margin_sensitive_solver(monkeypatch, lenient)
+    text = (
+        _scalar_discrete("0.5")
+        if time == "discrete"
+        else '[system]\ntime = "continuous"\nA = [[0, 1], [0, 0]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "stubborn"\n'
+    )
+    with pytest.raises(
+        InconclusiveError, match=r"infeasible for every λ tried .*set \[method\] margin"
+    ):
+        api.design(api.load_spec_text(text, "s.toml"))
+    tried = [x for x, m in calls if m >= 1e-7]
+    small = [x for x, m in calls if m < 1e-7]
+    assert small == [1 - 1e-6 if time == "discrete" else min(tried)]
+    assert (max(tried) == 1 - 1e-6) if time == "discrete" else (min(tried) < 1e-20)
+
+
+def test_a_redesign_without_r_bound_is_not_told_to_raise_gain_bound() -> None:
+    """Mutation review 30 (stubborn._bounds_too_tight: ``o.gain_bound if o.K is None else
+    None`` → ``o.gain_bound``): a redesign without r_bound carries the default gain_bound 100,
+    a key the redesign refuses (exit 2); the hint must not ask to raise it."""
+    text = """[system]
+time = "continuous"
+A = [[-99.91073, 2.76064, 0.23936], [1.36144, -98.99884, 1.99884], [0.1685, 0.03, -101.03]]
+C = [[-1, -2, 2], [2, -2, 2]]
+[method]
+key = "stubborn"
+K = [[0.05003, 0.06965], [-0.4542, -0.04638], [-0.3995, -0.1155]]
+lambda = 1e3
+"""
+    with pytest.raises(InfeasibleError) as e:
+        api.design(api.load_spec_text(text, "k.toml"))
+    msg = e.value.message
+    assert "with the given K" in msg and "try a smaller λ" in msg and "omit K" in msg
+    assert "gain_bound" not in msg
