@@ -762,14 +762,8 @@ def test_l2_step_failing_falls_back_on_a_certified_bound() -> None:
     assert "l2-gain" in _failed(d)
 
 
-def test_infeasible_with_a_given_K_points_at_lambda_too() -> None:
-    """Continuous, A ≈ −100·I, a given K and λ = 1000 (hard-case fuzzer): the message blamed
-    the given K alone, but on ker C the (1,1) block of (1) does not depend on K; it now also
-    says to try a smaller λ, raise r_bound, or omit K."""
-    from obsdesign import api
-    from obsdesign.errors import InfeasibleError
-
-    text = """[system]
+#: a redesign whose λ = 1000 is beyond A's own decay on ker C (hard-case fuzzer)
+HARD_REDESIGN = """[system]
 time = "continuous"
 A = [[-99.91073, 2.76064, 0.23936], [1.36144, -98.99884, 1.99884], [0.1685, 0.03, -101.03]]
 C = [[-1, -2, 2], [2, -2, 2]]
@@ -777,8 +771,17 @@ C = [[-1, -2, 2], [2, -2, 2]]
 key = "stubborn"
 K = [[0.05003, 0.06965], [-0.4542, -0.04638], [-0.3995, -0.1155]]
 lambda = 1e3
-r_bound = 1
 """
+
+
+def test_infeasible_with_a_given_K_points_at_lambda_too() -> None:
+    """Continuous, A ≈ −100·I, a given K and λ = 1000 (hard-case fuzzer): the message blamed
+    the given K alone, but on ker C the (1,1) block of (1) does not depend on K; it now also
+    says to try a smaller λ, raise r_bound, or omit K."""
+    from obsdesign import api
+    from obsdesign.errors import InfeasibleError
+
+    text = HARD_REDESIGN + "r_bound = 1\n"
     with pytest.raises(InfeasibleError) as e:
         api.design(api.load_spec_text(text, "k.toml"))
     msg = e.value.message
@@ -1652,15 +1655,7 @@ def test_a_redesign_without_r_bound_is_not_told_to_raise_gain_bound() -> None:
     """Mutation review 30 (stubborn._bounds_too_tight: ``o.gain_bound if o.K is None else
     None`` → ``o.gain_bound``): a redesign without r_bound carries the default gain_bound 100,
     a key the redesign refuses (exit 2); the hint must not ask to raise it."""
-    text = """[system]
-time = "continuous"
-A = [[-99.91073, 2.76064, 0.23936], [1.36144, -98.99884, 1.99884], [0.1685, 0.03, -101.03]]
-C = [[-1, -2, 2], [2, -2, 2]]
-[method]
-key = "stubborn"
-K = [[0.05003, 0.06965], [-0.4542, -0.04638], [-0.3995, -0.1155]]
-lambda = 1e3
-"""
+    text = HARD_REDESIGN
     with pytest.raises(InfeasibleError) as e:
         api.design(api.load_spec_text(text, "k.toml"))
     msg = e.value.message
