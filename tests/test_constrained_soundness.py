@@ -872,6 +872,8 @@ def test_xhat_in_cmax_at_a_tie_is_not_refuted_by_rounding(e0: str) -> None:
     rep = api.design(api.load_spec_text(ELLIPSOID_XHAT_AT_EPS_MAX.replace("E0", e0), "t.toml"))
     bad = [c for c in rep.claims if c.status == ClaimStatus.FAILED]
     assert [c.id for c in bad] == ["Xhat-in-Cmax"] and "undecided" in bad[0].detail
+    # "(inconclusive, not false)" was said of a false inclusion too (re-check trial, session 30)
+    assert "neither proved nor refuted" in bad[0].detail and "not false" not in bad[0].detail
     assert rep.exit_code() == 4 and api.verify(rep).exit_code() == 4
 
 

@@ -536,7 +536,7 @@ def _inclusions(c: Claims, o: Options, Xhat: ConvexSet, eps_min: fmpq, eps_max: 
     if not proof:
         det += (
             " — not a proof that C_min ⊄ X̂: the outer set is larger than C_min (or the bound "
-            "is not tight), so the inclusion is undecided (inconclusive, not false)"
+            "is not tight), so the inclusion is undecided (inconclusive: neither proved nor refuted)"
         )
     sup = B.sup_norm_c_over_set(cm, Xhat)
     chain = (
@@ -620,7 +620,7 @@ def _undecided(
         return f"; |c| ≈ {low:.10g} > ε_max at a point of the set (float)"
     return (
         f"; the largest |c| found ≈ {low:.10g} (float) does not exceed ε_max beyond rounding: "
-        "the bound is not tight, so the inclusion is undecided (inconclusive, not false)"
+        "the bound is not tight, so the inclusion is undecided (inconclusive: neither proved nor refuted)"
     )
 
 
