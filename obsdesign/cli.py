@@ -292,6 +292,14 @@ def _quiet_broken_pipe() -> None:
     raise typer.Exit(141) from None
 
 
+def _quiet_broken_pipe_exit() -> None:
+    """:func:`_quiet_broken_pipe` outside typer (``main``): exit 141 by ``sys.exit``."""
+    try:
+        _quiet_broken_pipe()
+    except typer.Exit as e:
+        sys.exit(e.exit_code)
+
+
 def _version(value: bool) -> None:
     if value:
         from obsdesign import __version__
@@ -725,11 +733,23 @@ def main() -> None:
     argument, a bad option value) become one line, like every other bad input: "obsdesign:
     error: <what> (see 'obsdesign CMD --help')", exit 2, instead of click's four-line
     usage block."""
+    if sys.stdout is None:
+        # stdout closed (`>&-`): what goes there is dropped, files are written and the exit
+        # code is the command's (every print raised AttributeError: exit 3, or a traceback
+        # and exit 1; re-check trial, session 30)
+        sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - for the whole process
     try:
         rv = app(standalone_mode=False, prog_name="obsdesign")
     except KeyboardInterrupt:  # pragma: no cover - Ctrl-C outside a command body
         _err("interrupted")
         sys.exit(130)
+    except BrokenPipeError:  # --help | head -1: as a command's output
+        _quiet_broken_pipe_exit()
+    except OSError as e:
+        # click's own output (--help, --version, usage) to a full stdout: a traceback and
+        # exit 1 (re-check trial, session 30); a command's OS errors are handled in _run
+        _err(_stdout_error(e).message)
+        sys.exit(2)
     except Exception as e:
         kind = _click_kind(e)
         if kind is None:

@@ -790,3 +790,79 @@ def test_an_eps_plot_prints_nothing_on_stderr(spec: Path, tmp_path: Path) -> Non
     )
     assert p.returncode == 0 and p.stderr == "", p.stderr
     assert (tmp_path / "o.eps").read_bytes().startswith(b"%!PS")
+
+
+def test_temp_names_keep_whole_characters_and_the_given_suffix(tmp_path: Path) -> None:
+    """The temp name was cut in bytes through a UTF-8 character (a 255-byte 'é…x.parquet'
+    ended exit 3 from pyarrow after the sweep), kept a suffix over 244 bytes (a legal name
+    refused "File name too long"), and, through a link to a suffix-less FIFO, took the
+    target's suffix (a plot "Format 'tmp' is not supported", exit 3; re-check trial, session
+    30). The temp name is whole UTF-8 within 255 bytes with the suffix of the name given."""
+    from obsdesign.report.model import NAME_MAX, _temp_file
+
+    for name in ("é" * 123 + "x.parquet", "é" * 119 + "xy.parquet", "r." + "x" * 253):
+        p = tmp_path / name
+        assert len(os.fsencode(p.name)) <= NAME_MAX
+        fd, tmp = _temp_file(p)
+        os.close(fd)
+        t = os.fsencode(Path(tmp).name)
+        assert len(t) <= NAME_MAX and t.decode("utf-8")  # whole characters
+        assert Path(tmp).suffix == (p.suffix if len(p.suffix) <= 32 else ".tmp")
+        os.unlink(tmp)
+    fd, tmp = _temp_file(tmp_path / "fifo", ".svg")
+    os.close(fd)
+    assert tmp.endswith(".svg")
+    os.unlink(tmp)
+
+
+def test_plot_through_a_link_to_a_suffixless_fifo(spec: Path, tmp_path: Path) -> None:
+    """``--plot p.svg --force`` where p.svg links to a FIFO named without a suffix: the
+    format is the name given's (svg), as before session 30's temp copy."""
+    import threading
+
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    link = tmp_path / "p.svg"
+    link.symlink_to(fifo)
+    got: list[bytes] = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_bytes()), daemon=True)
+    reader.start()
+    res = runner.invoke(app, ["simulate", str(spec), "-q", "--plot", str(link), "--force"])
+    reader.join(timeout=30)
+    assert res.exit_code == 0, res.output
+    assert got and b"<svg" in got[0][:500]
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full")
+@pytest.mark.parametrize("args", [["--help"], ["--version"], ["design", "--help"]])
+def test_help_and_version_to_a_full_stdout_are_exit_2(args: list[str]) -> None:
+    """click's own output to a full stdout was a traceback and exit 1 (re-check trial,
+    session 30)."""
+    with open("/dev/full", "w") as full:
+        p = subprocess.run(
+            [sys.executable, "-m", "obsdesign", *args],
+            stdout=full,
+            stderr=subprocess.PIPE,
+            text=True,
+            timeout=120,
+        )
+    assert p.returncode == 2, p.stderr
+    assert p.stderr.strip() == "obsdesign: error: stdout: cannot write (No space left on device)"
+
+
+def test_a_closed_stdout_drops_the_output_and_keeps_the_exit_code(spec: Path, tmp_path: Path):
+    """With stdout closed (``>&-``) every print raised AttributeError: exit 3, or a traceback
+    and exit 1 after the report was written (re-check trial, session 30). What goes to stdout
+    is dropped; files are written and the exit code is the command's."""
+    out = tmp_path / "r.json"
+    for args, code in ((["schema"], 0), (["design", str(spec), "-q", "-o", str(out)], 0)):
+        p = subprocess.run(
+            [sys.executable, "-m", "obsdesign", *args],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            text=True,
+            timeout=120,
+            preexec_fn=lambda: os.close(1),
+        )
+        assert p.returncode == code and p.stderr == "", (args, p.stderr)
+    assert json.loads(out.read_text())["verdict"] == "ok"

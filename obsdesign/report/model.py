@@ -568,14 +568,21 @@ def _probe_dir(p: Path) -> None:
 NAME_MAX = 255
 
 
-def _temp_file(p: Path) -> tuple[int, str]:
-    """``tempfile.mkstemp`` beside ``p``: ".NAME.XXXXXXXX" plus p's suffix, NAME cut so the
-    whole stays within :data:`NAME_MAX` bytes (a 241–255-byte output name made the temp name
-    too long: "File name too long" after the whole sweep; output trial, session 30)."""
+def _temp_file(p: Path, suffix: str | None = None) -> tuple[int, str]:
+    """``tempfile.mkstemp`` beside ``p``: ".NAME.XXXXXXXX" plus the suffix (``p``'s, or the
+    one given: the name the user wrote, whose suffix picks a writer's format), within
+    :data:`NAME_MAX` bytes: NAME is cut, and kept to whole UTF-8 characters (bytes that are
+    not UTF-8 dropped), so writers that need a UTF-8 path (pyarrow) take it; a suffix longer
+    than 32 bytes, which names no format, is ".tmp". A 241–255-byte output name made the temp
+    name too long, "File name too long" after the whole sweep (output trial, session 30); a
+    cut through a character, exit 3 from pyarrow (re-check trial, session 30)."""
     parent = p.parent if str(p.parent) else Path(".")
-    suffix = p.suffix or ".tmp"
-    room = NAME_MAX - 2 - 8 - len(os.fsencode(suffix))  # ".", ".", 8 random characters
-    name = os.fsdecode(os.fsencode(p.name)[: max(room, 1)])
+    suffix = p.suffix if suffix is None else suffix
+    if not suffix or len(os.fsencode(suffix)) > 32:
+        suffix = ".tmp"
+    suffix = os.fsencode(suffix).decode("utf-8", "ignore") or ".tmp"
+    room = NAME_MAX - 2 - 8 - len(suffix.encode("utf-8"))  # ".", ".", 8 random characters
+    name = os.fsencode(p.name)[: max(room, 1)].decode("utf-8", "ignore")
     return tempfile.mkstemp(dir=parent, prefix=f".{name}.", suffix=suffix)
 
 
@@ -593,11 +600,12 @@ def write_via(path: str | Path, writer: Callable[[Path], Any], force: bool = Fal
     through (its target replaced) and a non-regular file (FIFO, device) is written into
     directly. Every OS error is an :class:`InputError` naming the path and the reason."""
     p = Path(path)
+    given = p.suffix  # the name written picks the format, not a link's target (session 30)
     try:
         if force and p.is_symlink():
             p = Path(os.path.realpath(p))
         if force and p.exists() and not p.is_file() and not p.is_dir():
-            _write_into(p, writer)  # a FIFO or a device: write into it, never replace it
+            _write_into(p, writer, given)  # a FIFO or a device: write into it, never replace
             return p
         # no mkdir: a link's missing target folder was created, folders and all, where the
         # plain path is refused (output trial, session 30)
@@ -605,7 +613,7 @@ def write_via(path: str | Path, writer: Callable[[Path], Any], force: bool = Fal
             mode = stat.S_IMODE(os.stat(p).st_mode)
         except FileNotFoundError:
             mode = _umask_mode()
-        fd, tmp = _temp_file(p)
+        fd, tmp = _temp_file(p, given)
         os.close(fd)
         try:
             writer(Path(tmp))
@@ -623,15 +631,16 @@ def write_via(path: str | Path, writer: Callable[[Path], Any], force: bool = Fal
     return p
 
 
-def _write_into(p: Path, writer: Callable[[Path], Any]) -> None:
+def _write_into(p: Path, writer: Callable[[Path], Any], suffix: str) -> None:
     """Write into the FIFO or device ``p`` (``--force``): ``writer`` makes a temp file in the
-    system's temp folder (with p's suffix, which picks the format), whose bytes are then
+    system's temp folder (with the ``suffix`` of the name given, which picks the format: a
+    link's suffix-less target gave "Format 'tmp' is not supported"), whose bytes are then
     copied into ``p``. The writer never sees ``p``: pyarrow's Parquet writer removes its
     target path on any error, and deleted a FIFO or a device node (``-o x.parquet --force``
     on a link to /dev/full; output trial, session 30); a format that seeks works too."""
     import shutil
 
-    fd, tmp = tempfile.mkstemp(prefix=".obsdesign-", suffix=p.suffix or ".tmp")
+    fd, tmp = _temp_file(Path(tempfile.gettempdir()) / "obsdesign", suffix)
     os.close(fd)
     try:
         writer(Path(tmp))
