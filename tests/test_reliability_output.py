@@ -758,16 +758,7 @@ def test_a_full_disk_on_stdout_is_exit_2(args: list[str]) -> None:
     """``obsdesign schema > /dev/full`` (no space left) was exit 3 "internal failure:
     OSError" (output trial, session 30): an OS error writing stdout is bad output, exit 2
     with one line, as for any output file; a closed pipe stays exit 141."""
-    with open("/dev/full", "w") as full:
-        p = subprocess.run(
-            [sys.executable, "-m", "obsdesign", *args],
-            stdout=full,
-            stderr=subprocess.PIPE,
-            text=True,
-            timeout=120,
-        )
-    assert p.returncode == 2, p.stderr
-    assert p.stderr.strip() == "obsdesign: error: stdout: cannot write (No space left on device)"
+    _assert_full_stdout_is_exit_2(args)
 
 
 def test_an_eps_plot_prints_nothing_on_stderr(spec: Path, tmp_path: Path) -> None:
@@ -838,16 +829,7 @@ def test_plot_through_a_link_to_a_suffixless_fifo(spec: Path, tmp_path: Path) ->
 def test_help_and_version_to_a_full_stdout_are_exit_2(args: list[str]) -> None:
     """click's own output to a full stdout was a traceback and exit 1 (re-check trial,
     session 30)."""
-    with open("/dev/full", "w") as full:
-        p = subprocess.run(
-            [sys.executable, "-m", "obsdesign", *args],
-            stdout=full,
-            stderr=subprocess.PIPE,
-            text=True,
-            timeout=120,
-        )
-    assert p.returncode == 2, p.stderr
-    assert p.stderr.strip() == "obsdesign: error: stdout: cannot write (No space left on device)"
+    _assert_full_stdout_is_exit_2(args)
 
 
 def test_a_closed_stdout_drops_the_output_and_keeps_the_exit_code(spec: Path, tmp_path: Path):
@@ -866,3 +848,18 @@ def test_a_closed_stdout_drops_the_output_and_keeps_the_exit_code(spec: Path, tm
         )
         assert p.returncode == code and p.stderr == "", (args, p.stderr)
     assert json.loads(out.read_text())["verdict"] == "ok"
+
+
+def _assert_full_stdout_is_exit_2(args: list[str]) -> None:
+    """``obsdesign ARGS > /dev/full`` ends with exit 2 and the one line "stdout: cannot
+    write (No space left on device)"."""
+    with open("/dev/full", "w") as full:
+        p = subprocess.run(
+            [sys.executable, "-m", "obsdesign", *args],
+            stdout=full,
+            stderr=subprocess.PIPE,
+            text=True,
+            timeout=120,
+        )
+    assert p.returncode == 2, p.stderr
+    assert p.stderr.strip() == "obsdesign: error: stdout: cannot write (No space left on device)"
