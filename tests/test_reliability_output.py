@@ -83,7 +83,6 @@ def test_plot_force_writes_into_a_fifo_and_keeps_it(
     leaves a FIFO: the plot writer made its own temp file and renamed it over the FIFO, or
     through a link over a device node (simulate trial, session 27). The link case is a FIFO
     too: a device node here would be the machine's own."""
-    import threading
 
     fifo = tmp_path / "f.png"
     os.mkfifo(fifo)
@@ -91,14 +90,12 @@ def test_plot_force_writes_into_a_fifo_and_keeps_it(
     if through_link:
         target = tmp_path / "link.png"
         target.symlink_to(fifo)
-    got: list[bytes] = []
-    reader = threading.Thread(target=lambda: got.append(fifo.read_bytes()), daemon=True)
-    reader.start()
-    res = runner.invoke(app, ["simulate", str(spec), "-q", "--plot", str(target), "--force"])
-    reader.join(timeout=20)
+    res, got = _invoke_reading(
+        fifo, ["simulate", str(spec), "-q", "--plot", str(target), "--force"]
+    )
     assert res.exit_code == 0, res.output
     assert stat.S_ISFIFO(os.lstat(fifo).st_mode)
-    assert got and got[0].startswith(b"\x89PNG")
+    assert got.startswith(b"\x89PNG")
 
 
 def test_output_dev_null_is_not_replaced(spec: Path):
@@ -706,20 +703,15 @@ def test_parquet_into_a_fifo_keeps_the_fifo_and_arrives_whole(spec: Path, tmp_pa
     any error (a FIFO cannot seek), and deleted the FIFO — through a link, a device node
     such as /dev/full (output trial, session 30). The writer now works on a temp file whose
     bytes are copied in: the reader gets the whole Parquet file, and the FIFO stays."""
-    import threading
 
     pytest.importorskip("pyarrow")
     fifo = tmp_path / "o.parquet"
     os.mkfifo(fifo)
-    got: list[bytes] = []
-    reader = threading.Thread(target=lambda: got.append(fifo.read_bytes()), daemon=True)
-    reader.start()
     args = ["sweep", str(spec), "--set", "method.lambda=[0.96, 0.97]", "-q", "-o", str(fifo)]
-    res = runner.invoke(app, [*args, "--force"])
-    reader.join(timeout=30)
+    res, got = _invoke_reading(fifo, [*args, "--force"])
     assert res.exit_code == 0, res.output
     assert stat.S_ISFIFO(os.lstat(fifo).st_mode)
-    assert got and got[0].startswith(b"PAR1") and got[0].endswith(b"PAR1")
+    assert got.startswith(b"PAR1") and got.endswith(b"PAR1")
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".json"])
@@ -809,19 +801,14 @@ def test_temp_names_keep_whole_characters_and_the_given_suffix(tmp_path: Path) -
 def test_plot_through_a_link_to_a_suffixless_fifo(spec: Path, tmp_path: Path) -> None:
     """``--plot p.svg --force`` where p.svg links to a FIFO named without a suffix: the
     format is the name given's (svg), as before session 30's temp copy."""
-    import threading
 
     fifo = tmp_path / "fifo"
     os.mkfifo(fifo)
     link = tmp_path / "p.svg"
     link.symlink_to(fifo)
-    got: list[bytes] = []
-    reader = threading.Thread(target=lambda: got.append(fifo.read_bytes()), daemon=True)
-    reader.start()
-    res = runner.invoke(app, ["simulate", str(spec), "-q", "--plot", str(link), "--force"])
-    reader.join(timeout=30)
+    res, got = _invoke_reading(fifo, ["simulate", str(spec), "-q", "--plot", str(link), "--force"])
     assert res.exit_code == 0, res.output
-    assert got and b"<svg" in got[0][:500]
+    assert b"<svg" in got[:500]
 
 
 @pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full")
@@ -863,3 +850,16 @@ def _assert_full_stdout_is_exit_2(args: list[str]) -> None:
         )
     assert p.returncode == 2, p.stderr
     assert p.stderr.strip() == "obsdesign: error: stdout: cannot write (No space left on device)"
+
+
+def _invoke_reading(fifo: Path, args: list[str]) -> tuple[Any, bytes]:
+    """Run ``obsdesign ARGS`` (CliRunner) while a thread reads the FIFO to its end: the
+    result and the bytes read (b"" when nothing arrived within 30 s)."""
+    import threading
+
+    got: list[bytes] = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_bytes()), daemon=True)
+    reader.start()
+    res = runner.invoke(app, args)
+    reader.join(timeout=30)
+    return res, (got[0] if got else b"")
