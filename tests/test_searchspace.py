@@ -1420,3 +1420,49 @@ def test_gamma_schedule_fails_when_e_to_the_L_f_dtau_exceeds_2() -> None:
         c = {c.id: c for c in api.certify(sp, p)}["gamma-schedule"]
         assert c.status == ClaimStatus.FAILED and not c.float_ok, x
         assert "e^(L_f Δτ)/2 > 1" in c.detail
+
+
+_LINEAR = """
+[system]
+time = "continuous"
+states = ["x1"]
+f = ["{f}"]
+h = ["2*x1"]
+[method]
+key = "search-space"
+alpha = 0.000000001
+gamma_star = 0.1
+gamma0 = 0.5
+{given}
+E = {{lower = [-1], upper = [1]}}
+D = {{lower = [-0.5], upper = [0.5]}}
+"""
+
+
+@pytest.mark.parametrize(
+    ("f", "k", "value", "want"),
+    [
+        ("0", "L_h", "1.999999", ClaimStatus.FAILED),  # 5·10⁻⁷ below: inside float tolerance
+        ("0", "L_h", "1.99999999999", ClaimStatus.FAILED),  # 5·10⁻¹² below
+        ("0", "L_h", "2", ClaimStatus.CERTIFIED),
+        ("1", "f_sup", "0.9999999", ClaimStatus.FAILED),
+        ("1", "f_sup", "1", ClaimStatus.CERTIFIED),
+        ("0.5*x1", "L_f", "0.49999999", ClaimStatus.FAILED),
+        ("0.5*x1", "L_f", "0.5", ClaimStatus.CERTIFIED),
+    ],
+)
+def test_a_given_constant_below_a_proved_quotient_fails(
+    f: str, k: str, value: str, want: ClaimStatus
+) -> None:
+    """Session 31 (search-space trial): a given L_h = 1.999999 for h = 2·x1 (constant exactly
+    2) was 5·10⁻⁷ below the sampled 2, inside the 10⁻⁶ float tolerance of the safety net, so
+    L_h-bound stayed "numerical" beside claims built on it, exit 0, and `simulate` lost the
+    state. The best sample is now proved at its exact points: a given value below it fails,
+    with the points in the detail; the true constant itself is certified."""
+    text = _LINEAR.format(f=f, given=f"{k} = {value}")
+    assert _constant_status(text, k, Q(value)) == want
+    if want == ClaimStatus.FAILED:
+        rep = api.design(api.load_spec_text(text, "g.toml"))
+        claim = next(c for c in rep.claims if c.id == f"{k}-bound")
+        assert claim.status == ClaimStatus.FAILED and rep.exit_code() == 1
+        assert "(exact interval evaluation)" in claim.detail

@@ -108,3 +108,71 @@ def test_sampled_norms_of_tiny_rows_do_not_underflow() -> None:
     n = B._norms(np.array([[3e-200, 4e-200], [0.0, 3e-170], [0.5, 0.0]]))
     assert math.isclose(n[0], 5e-200, rel_tol=1e-15)
     assert n[1] == 3e-170 and n[2] == 0.5
+
+
+def _ex(*src: str, names: tuple[str, ...] = ("x1",)) -> list:
+    from obsdesign.spec.expr import parse_expr
+
+    return [parse_expr(s, list(names)) for s in src]
+
+
+def test_proved_lower_sq_is_the_exact_quotient_of_rational_expressions() -> None:
+    """Session 31: the witness of a sampled estimate proved exactly. h = 2·x1 between 1/2
+    and 1/4 gives the quotient² 4 exactly; f = x1 − 3 at x1 = 1 gives |f|² = 4; two outputs
+    add their squares (‖(2Δ, Δ)‖²/Δ² = 5)."""
+    E = ([Fraction(-1)], [Fraction(1)])
+    w = (np.array([0.5]), np.array([0.25]))
+    assert B.proved_lower_sq(_ex("2*x1"), ["x1"], ["x1"], *E, w) == 4
+    assert B.proved_lower_sq(_ex("x1 - 3"), ["x1"], [], *E, (np.array([1.0]),)) == 4
+    assert B.proved_lower_sq(_ex("2*x1", "x1"), ["x1"], ["x1"], *E, w) == 5
+
+
+def test_proved_lower_sq_of_a_smooth_function_is_a_lower_bound() -> None:
+    """sin(x1) between 0 and 10⁻³: the proved square lies below (sin(10⁻³)/10⁻³)² and within
+    10⁻⁹ relative of it (the float enclosure of sin is a few ulps wide)."""
+    w = (np.array([1e-3]), np.array([0.0]))
+    got = B.proved_lower_sq(_ex("sin(x1)"), ["x1"], ["x1"], [Fraction(-1)], [Fraction(1)], w)
+    assert got is not None
+    from flint import arb, ctx, fmpq
+
+    prec, ctx.prec = ctx.prec, 200
+    try:
+        x = arb(1e-3)  # the double's exact value
+        true = (x.sin() / x) ** 2  # a ball of about 10⁻⁵⁸ radius around the true square
+        q = arb(fmpq(got.numerator, got.denominator))
+        assert q < true and q > true * (1 - arb(10) ** -9)
+    finally:
+        ctx.prec = prec
+
+
+def test_proved_lower_sq_refuses_what_proves_nothing() -> None:
+    """No bound (None) from a witness that proves nothing about the constant on the box: a
+    point outside the exact box (E = [0, 1/10], and the float 0.1 is above 1/10), points
+    that differ in a variable the quotient holds fixed (u), equal points, no witness, or an
+    expression undefined at the point (log(0))."""
+    E = ([Fraction(0)], [Fraction(1, 10)])
+    assert (
+        B.proved_lower_sq(_ex("x1"), ["x1"], ["x1"], *E, (np.array([0.1]), np.array([0.0]))) is None
+    )
+    assert B.proved_lower_sq(_ex("x1"), ["x1"], [], *E, (np.array([0.1]),)) is None
+    assert B.proved_lower_sq(_ex("x1"), ["x1"], [], *E, (np.array([0.05]),)) is not None
+    box2 = ([Fraction(-1)] * 2, [Fraction(1)] * 2)
+    ex = _ex("x1 + u1", names=("x1", "u1"))
+    w = (np.array([0.5, 0.5]), np.array([0.25, 0.0]))
+    assert B.proved_lower_sq(ex, ["x1", "u1"], ["x1"], *box2, w) is None
+    assert B.proved_lower_sq(ex, ["x1", "u1"], ["x1", "u1"], *box2, w) is not None
+    same = (np.array([0.5]), np.array([0.5]))
+    assert B.proved_lower_sq(_ex("x1"), ["x1"], ["x1"], [Fraction(-1)], [Fraction(1)], same) is None
+    assert B.proved_lower_sq(_ex("x1"), ["x1"], ["x1"], [Fraction(-1)], [Fraction(1)], None) is None
+    assert B.proved_lower_sq(_ex("log(x1)"), ["x1"], [], *E, (np.array([0.0]),)) is None
+
+
+def test_bounds_keep_their_best_sample_as_witness() -> None:
+    """The witness is the sample of the lower estimate: its quotient is that estimate."""
+    b = B.lipschitz(_ex("x1^2"), ["x1"], ["x1"], [Fraction(-1)], [Fraction(2)], 64, 1e-6)
+    assert b.witness is not None and len(b.witness) == 2
+    a, c = (float(w[0]) for w in b.witness)
+    assert math.isclose(abs(a * a - c * c) / abs(a - c), b.lower_est, rel_tol=1e-9)
+    assert b.lower_est > 3.9  # |2 x1| up to 4 on [−1, 2]
+    s = B.sup_norm(_ex("x1 - 3"), ["x1"], [Fraction(-1)], [Fraction(2)], 64, 1e-6)
+    assert s.witness is not None and s.lower_est == abs(float(s.witness[0][0]) - 3) == 4

@@ -45,11 +45,16 @@ from obsdesign.spec.expr import Expr
 
 @dataclass
 class Bound:
-    """A certified upper bound (float, rigorous) and a sampled lower estimate of a constant."""
+    """A certified upper bound (float, rigorous) and a sampled lower estimate of a constant;
+    ``witness``: the sample point(s) of that estimate (two points of a difference quotient, or
+    one point of a sup norm), inside the exact box; ``lower_sq``: an exact lower bound of the
+    square of the constant proved there (:func:`proved_lower_sq`), None when not computed."""
 
     upper: float
     lower_est: float
     boxes: int
+    witness: tuple[np.ndarray, ...] | None = None
+    lower_sq: Fraction | None = None
 
     @property
     def finite(self) -> bool:
@@ -180,20 +185,25 @@ def _split(box: Box, widths0: Sequence[float]) -> tuple[Box, Box] | None:
     return a, b
 
 
+#: a sampled lower estimate and the point(s) where it was taken (None: no finite sample)
+Sample = tuple[float, tuple[np.ndarray, ...] | None]
+
+
 def branch_and_bound(
     box: Box,
     upper_of: Callable[[Box], float],
-    lower_of: Callable[[Box], float],
+    lower_of: Callable[[Box], Sample],
     budget: int,
     rtol: float,
 ) -> Bound:
     """Largest of ``upper_of`` over a subdivision of ``box``: split the sub-box with the
     largest bound (along its relatively widest side) until that bound is within ``rtol`` of
-    the best sampled value ``lower_of`` or ``budget`` sub-boxes were evaluated."""
+    the best sampled value ``lower_of`` or ``budget`` sub-boxes were evaluated. The bound
+    keeps the best sample's point(s) as its witness."""
     widths0 = [iv.hi - iv.lo for iv in box]
     upper_of = _safe(upper_of)
     ub0 = upper_of(box)
-    lb = lower_of(box)
+    lb, wit = lower_of(box)
     heap: list[tuple[float, int, Box]] = [(-ub0, 0, box)]
     count = 1
     while count < budget:
@@ -208,8 +218,10 @@ def branch_and_bound(
         for child in parts:
             count += 1
             heapq.heappush(heap, (-upper_of(child), count, child))
-            lb = max(lb, lower_of(child))
-    return Bound(-heap[0][0], lb, count)
+            v, w = lower_of(child)
+            if v > lb:
+                lb, wit = v, w
+    return Bound(-heap[0][0], lb, count, wit)
 
 
 def _safe(upper_of: Callable[[Box], float]) -> Callable[[Box], float]:
@@ -271,11 +283,19 @@ def sup_norm(
         vs = _enclose(exprs, names, b, ())
         return hypot_hi([d.v.mag for d in vs])
 
-    def lower_of(b: Box) -> float:
-        v = _norms(_eval(exprs, names, _samples(b)))
-        v = v[np.isfinite(v)]
-        return float(v.max()) if v.size else 0.0
+    def lower_of(b: Box) -> Sample:
+        # the samples are kept in the exact box (its float box is rounded outward), so that
+        # the witness is a point of E × U
+        Z = np.clip(_samples(b), inner_lo, inner_hi)
+        v = _norms(_eval(exprs, names, Z))
+        ok = np.flatnonzero(np.isfinite(v))
+        if not ok.size:
+            return 0.0, None
+        i = int(ok[np.argmax(v[ok])])
+        return float(v[i]), (Z[i],)
 
+    inner_lo = np.array([I.of_q(x).hi for x in lo])
+    inner_hi = np.array([I.of_q(x).lo for x in hi])
     return branch_and_bound(_box(lo, hi), upper_of, lower_of, budget, rtol)
 
 
@@ -296,7 +316,7 @@ def lipschitz(
         vs = _enclose(exprs, names, b, diff)
         return norm_upper_iv([list(d.g) for d in vs])
 
-    def lower_of(b: Box) -> float:
+    def lower_of(b: Box) -> Sample:
         """Largest difference quotient |F(m + δv) − F(m − δv)|/(2δ) at the sample points m,
         v the top right singular vector of a finite-difference Jacobian (a true lower
         estimate of the Lipschitz constant, up to float rounding)."""
@@ -309,7 +329,7 @@ def lipschitz(
         V = _eval(exprs, names, P)  # (2·nd, S, p)
         J = (V[: len(idx)] - V[len(idx) :]).transpose(1, 2, 0) / (2 * scale)  # (S, p, nd)
         if not np.all(np.isfinite(J)):
-            return 0.0
+            return 0.0, None
         _, _, vt = np.linalg.svd(J)
         v = np.zeros_like(M)
         v[:, idx] = vt[:, 0, :]
@@ -323,13 +343,79 @@ def lipschitz(
         dist = np.linalg.norm(Pp - Pm, axis=-1)
         with np.errstate(all="ignore"):
             q = _norms(d) / dist
-        q = q[np.isfinite(q) & (dist > 0)]
-        return float(q.max()) if q.size else 0.0
+        ok = np.flatnonzero(np.isfinite(q) & (dist > 0))
+        if not ok.size:
+            return 0.0, None
+        i = int(ok[np.argmax(q[ok])])
+        return float(q[i]), (Pp[i], Pm[i])
 
     # floats inside the exact box [lo, hi] (its own float box is rounded outward)
     inner_lo = np.array([I.of_q(x).hi for x in lo])
     inner_hi = np.array([I.of_q(x).lo for x in hi])
     return branch_and_bound(_box(lo, hi), upper_of, lower_of, budget, rtol)
+
+
+def proved_lower_sq(
+    exprs: Sequence[Expr],
+    names: Sequence[str],
+    diff: Sequence[str],
+    lo: Sequence[Any],
+    hi: Sequence[Any],
+    witness: tuple[np.ndarray, ...] | None,
+) -> Fraction | None:
+    """An exact lower bound of the square of the constant a :class:`Bound` estimates, proved at
+    its witness: ‖F(a) − F(b)‖²/‖a − b‖² for two points a ≠ b of the box [lo, hi] that differ
+    only in the variables ``diff`` (so it bounds the squared Lipschitz constant in ``diff``
+    from below, uniformly in the others: L_f^E, L_h^E of Lemmas 1-2, Hernández & García), or
+    ‖F(z)‖² for one point z of the box (‖f_u‖_E of Lemma 1). Each F_i is enclosed with exact
+    rational end points (:func:`~obsdesign.methods.searchspace.qintervals.evaluate_q` at the
+    points' exact binary values) and only the part of the enclosure away from 0 counts, so a
+    given constant below this bound is refuted, not just doubted. None when a point is not
+    in the box exactly, the points differ elsewhere or coincide, or an evaluation fails.
+
+    :param exprs: F's components; :param names: the variables, in the points' order;
+    :param diff: the variables of the difference quotient; :param lo, hi: the exact box;
+    :param witness: one or two float points."""
+    if witness is None or len(witness) not in (1, 2):
+        return None
+    LO, HI = [_frac(q) for q in lo], [_frac(q) for q in hi]
+    pts = []
+    for w in witness:
+        if len(w) != len(names) or not np.all(np.isfinite(w)):
+            return None
+        q = [Fraction(float(x)) for x in w]
+        if not all(a <= x <= b for a, x, b in zip(LO, q, HI, strict=True)):
+            return None
+        pts.append(q)
+    if len(pts) == 2:
+        same = [i for i, n in enumerate(names) if n not in diff]
+        if any(pts[0][i] != pts[1][i] for i in same):
+            return None
+        dist_sq = sum(((x - y) ** 2 for x, y in zip(pts[0], pts[1], strict=True)), Fraction(0))
+        if dist_sq == 0:
+            return None
+    else:
+        dist_sq = Fraction(1)
+    total = Fraction(0)
+    for ex in exprs:
+        params = _exact_params(ex)
+        src = ex.source.strip().replace("^", "**")
+        try:
+            vals = [
+                evaluate_q(
+                    ex.tree,
+                    {n: QI.point(x) for n, x in zip(names, q, strict=True)},
+                    params,
+                    src,
+                )
+                for q in pts
+            ]
+        except (ArithmeticError, ValueError, KeyError):
+            return None
+        d = vals[0] - vals[1] if len(vals) == 2 else vals[0]
+        mig = Fraction(0) if d.lo <= 0 <= d.hi else min(abs(d.lo), abs(d.hi))
+        total += mig * mig
+    return total / dist_sq
 
 
 def range_inside(

@@ -10,6 +10,7 @@ are checked entry by entry, all of them.
 
 from __future__ import annotations
 
+from fractions import Fraction
 from typing import Any
 
 import numpy as np
@@ -417,6 +418,27 @@ def _box(lo: Any, hi: Any) -> str:
     return " × ".join(f"[{fmt_exact(a)}, {fmt_exact(b)}]" for a, b in zip(lo, hi, strict=True))
 
 
+def _proved_above(k: str, b: bounds.Bound) -> str:
+    """What refutes a constant: the witness of :attr:`bounds.Bound.lower_sq` and the proved
+    lower bound (rounded down)."""
+    assert b.witness is not None and b.lower_sq is not None
+    low = fmt_down(_sqrt_down(b.lower_sq), 8)
+    pts = [("(" + ", ".join(repr(float(x)) for x in w) + ")") for w in b.witness]
+    if k == "f_sup":
+        return f"|f| ≥ {low} at {pts[0]} (exact interval evaluation)"
+    return (
+        f"the difference quotient ≥ {low} between {pts[0]} and {pts[1]} (exact interval evaluation)"
+    )
+
+
+def _sqrt_down(x: Fraction) -> fmpq:
+    """A rational ≤ √x (x ≥ 0), within 10⁻¹² relative: for printing a proved lower bound."""
+    import math
+
+    p, d = x.numerator, x.denominator  # √(p/d) = √(p d)/d, and √(p d) ≥ 1 when p ≥ 1
+    return fmpq(math.isqrt(p * d * 10**24), d * 10**12)
+
+
 def _d_in_e(c: Claims, o: Options) -> None:
     ok = all(
         e_lo <= d_lo and d_hi <= e_hi
@@ -443,7 +465,14 @@ def _constant(c: Claims, spec: Spec, k: str, val: fmpq) -> None:
     # the enclosure says: were the enclosure and the run-time evaluator of the spec's
     # expressions ever to disagree (sat with a negative radius did, review 19), the claim
     # fails instead of certifying a false bound
-    refuted = b.lower_est > float(val) * (1 + 1e-6) + 1e-300
+    # a sampled value proved above the value exactly (at the sample's exact points, by
+    # exact-end-point interval evaluation) refutes it: a given L_h = 1.999999 for h = 2·x1 was
+    # 5·10⁻⁷ below the sampled 2, inside the float tolerance below, and stayed "numerical"
+    # beside certified claims built on it, exit 0 (search-space trial, session 31)
+    proved_above = b.lower_sq is not None and fmpq(
+        b.lower_sq.numerator, b.lower_sq.denominator
+    ) > Q(val) * Q(val)
+    refuted = proved_above or b.lower_est > float(val) * (1 + 1e-6) + 1e-300
     proved = b.finite and Q(b.upper) <= val and not refuted
     est = f"sampled lower estimate {b.lower_est:.6g}" + (
         f", interval bound {fmt_up(b.upper, 8)}" if b.finite else ", no finite interval bound"
@@ -468,7 +497,13 @@ def _constant(c: Claims, spec: Spec, k: str, val: fmpq) -> None:
             if proved
             else (
                 f"{est}: the value is below "
-                + ("a sampled difference quotient" if refuted else "the interval bound")
+                + (
+                    _proved_above(k, b)
+                    if proved_above
+                    else "a sampled difference quotient"
+                    if refuted
+                    else "the interval bound"
+                )
             ),
             float_ok=b.finite and float(val) >= b.upper and not refuted,
         )

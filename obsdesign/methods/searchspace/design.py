@@ -69,10 +69,18 @@ def _compute(kind: str, spec: Spec, budget: int, rtol: float) -> bounds.Bound:
     lo = [*o.E.lower_q, *(o.U.lower_q if o.U is not None else [])]
     hi = [*o.E.upper_q, *(o.U.upper_q if o.U is not None else [])]
     if kind == "L_f":
-        return bounds.lipschitz(s.f, names, s.states, lo, hi, budget, rtol)
-    if kind == "f_sup":
-        return bounds.sup_norm(s.f, names, lo, hi, budget, rtol)
-    return bounds.lipschitz(s.h, s.states, s.states, o.E.lower_q, o.E.upper_q, budget, rtol)
+        exprs, diff = s.f, s.states
+        b = bounds.lipschitz(exprs, names, diff, lo, hi, budget, rtol)
+    elif kind == "f_sup":
+        exprs, diff = s.f, []
+        b = bounds.sup_norm(exprs, names, lo, hi, budget, rtol)
+    else:
+        exprs, names, diff = s.h, s.states, s.states
+        lo, hi = o.E.lower_q, o.E.upper_q
+        b = bounds.lipschitz(exprs, names, diff, lo, hi, budget, rtol)
+    # the best sample proved exactly: a given constant below it is refuted (claims._constant)
+    b.lower_sq = bounds.proved_lower_sq(exprs, names, diff, lo, hi, b.witness)
+    return b
 
 
 def interval_bound(kind: str, spec: Spec) -> bounds.Bound:
