@@ -1417,6 +1417,21 @@ def test_solver_infeasible_on_badly_scaled_data_is_no_verdict(
         assert rep.exit_code() == 0
 
 
+def test_solver_infeasible_with_a_badly_scaled_given_gain_is_no_verdict() -> None:
+    """The redesign of the double integrator with the slow K = (10⁻⁵, 10⁻¹⁰) was exit 1
+    ("infeasible for every λ tried"), yet K = (a, a²) is the unit gain (1, 1) in the
+    coordinates diag(1, 1/a)·e and time a·t, and the unit design's certificate rescaled
+    certifies it (search-space/stubborn trial, session 31): the spread rule looked at A and C
+    only. The given K counts now: exit 4, naming it; K = (1, 1) still designs."""
+    text = (
+        '[system]\ntime = "continuous"\nA = [[0, 1], [0, 0]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "stubborn"\nK = {K}\n'
+    )
+    with pytest.raises(InconclusiveError, match="entries of A, C and the given K span a factor"):
+        api.design(api.load_spec_text(text.format(K="[[0.00001], [0.0000000001]]"), "s.toml"))
+    assert api.design(api.load_spec_text(text.format(K="[[1], [1]]"), "s.toml")).exit_code() == 0
+
+
 @pytest.mark.parametrize(
     ("A", "C", "K", "time"),
     [

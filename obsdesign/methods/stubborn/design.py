@@ -688,15 +688,18 @@ def _infeasible(spec: Spec, pl: Plant, o: Options, where: str) -> None:
         )
     if o.K is not None and not _stable_gain(spec, o.K, pl.discrete):
         _unstable_gain(pl, where)
-    spread = _data_spread(pl)
+    spread = _data_spread(pl, o.K)
     if spread > SPREAD_MAX:
         # Clarabel answered "infeasible" on feasible LMIs of plants such as A = [[1e-8, 1],
         # [0, 1e-8]], C = [[1e8, 0]] (K = 0 and an exact P certify them) and A = [[0, 1],
-        # [0, 0]], C = [[1e6, 0]] (edge-shape trial, session 26): on data this badly scaled
-        # the status is no proof
+        # [0, 0]], C = [[1e6, 0]] (edge-shape trial, session 26), and of the redesign of
+        # A = [[0, 1], [0, 0]], C = [[1, 0]] with the slow K = (1e-5, 1e-10), feasible by a
+        # rescaled certificate (search-space/stubborn trial, session 31): on data this badly
+        # scaled the status is no proof
+        what = "A, C and the given K" if o.K is not None else "A and C"
         raise InconclusiveError(
             f"stubborn: the solver reports LMIs {_refs(pl)} infeasible {where}, but (C, A) is "
-            f"detectable and the nonzero entries of A and C span a factor {spread:.3g} (above "
+            f"detectable and the nonzero entries of {what} span a factor {spread:.3g} (above "
             f"{SPREAD_MAX:g}): on data this badly scaled that status is no proof of "
             "infeasibility (rescale the states or the outputs)"
         )
@@ -709,9 +712,13 @@ def _infeasible(spec: Spec, pl: Plant, o: Options, where: str) -> None:
 SPREAD_MAX = 1e5
 
 
-def _data_spread(pl: Plant) -> float:
-    """max / min of the nonzero |entries| of A and C (1 when there are none)."""
-    v = np.abs(np.concatenate([np.asarray(pl.A, float).ravel(), np.asarray(pl.C, float).ravel()]))
+def _data_spread(pl: Plant, K: np.ndarray | None = None) -> float:
+    """max / min of the nonzero |entries| of A, C and the given gain K (1 when there are
+    none)."""
+    parts = [np.asarray(pl.A, float).ravel(), np.asarray(pl.C, float).ravel()]
+    if K is not None:
+        parts.append(np.asarray(K, float).ravel())
+    v = np.abs(np.concatenate(parts))
     v = v[(v > 0) & np.isfinite(v)]
     return float(v.max() / v.min()) if v.size else 1.0
 
