@@ -1562,6 +1562,23 @@ def test_an_infeasible_answer_that_a_smaller_margin_overturns_is_exit_4() -> Non
         api.design(api.load_spec_text(_scalar_discrete("2.6"), "s.toml"))
 
 
+def test_a_stable_mode_near_the_unit_circle_makes_discrete_infeasible_no_verdict() -> None:
+    """A = diag(0.9999999, 1.5), C = (0, 1): the unseen mode needs λ > 0.9999998, beyond the
+    search's most lenient 1 − 10⁻⁶, and the design said "infeasible … at any λ < 1" (exit 1),
+    though an exact witness exists at λ = 0.9999999 (search-space/stubborn trial, session
+    31). A stable mode within 10⁻⁵ of the unit circle makes it exit 4, naming |μ|²; with the
+    mode at 0.99 it designs, and A = 2.6 keeps its exit 1, now saying "λ ≤ 1 − 10⁻⁶"."""
+    text = (
+        '[system]\ntime = "discrete"\nA = [[{a}, 0], [0, 1.5]]\nC = [[0, 1]]\n'
+        '[method]\nkey = "stubborn"\n'
+    )
+    with pytest.raises(InconclusiveError, match=r"\|μ\|² ≈ 0\.9999998 \(float\), within 1e-05"):
+        api.design(api.load_spec_text(text.format(a="0.9999999"), "s.toml"))
+    assert api.design(api.load_spec_text(text.format(a="0.99"), "s.toml")).exit_code() == 0
+    with pytest.raises(InfeasibleError, match=r"at any λ ≤ 1 − 10⁻⁶ \(the search's most"):
+        api.design(api.load_spec_text(_scalar_discrete("2.6"), "s.toml"))
+
+
 def test_the_bound_to_raise_is_named_with_the_spec_value() -> None:
     """`gain_bound = 1.0000001` was echoed "raise gain_bound (now 1)" (%g; soundness trial,
     session 30): the hint names the value as given."""

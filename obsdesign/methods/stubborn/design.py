@@ -763,7 +763,9 @@ def _bounds_too_tight(pl: Plant, o: Options, where: str, verdict: bool | None) -
         if verdict is True and pl.discrete:
             free = replace(o, gain_bound=None, r_bound=None)
             if not feasible(pl, free, 1 - 1e-6)[0]:
-                without = f" even without {bounds} and at any λ < 1" if bounds else " at any λ < 1"
+                _slow_mode(pl, where)
+                at = "at any λ ≤ 1 − 10⁻⁶ (the search's most lenient λ)"
+                without = f" even without {bounds} and {at}" if bounds else f" {at}"
                 why = (
                     f"(C, A) is detectable, but the LMIs are infeasible{without}: in discrete "
                     "time detectability does not suffice (the sector conditions of the "
@@ -772,6 +774,31 @@ def _bounds_too_tight(pl: Plant, o: Options, where: str, verdict: bool | None) -
                     "continuous-time model may help"
                 )
     raise InfeasibleError(f"stubborn: LMIs {_refs(pl)} infeasible {where}: {why}")
+
+
+#: a stable mode of A with |μ|² above 1 − NEAR_ONE makes a discrete `infeasible` at the
+#: search's λ = 1 − 10⁻⁶ no verdict (:func:`_slow_mode`)
+NEAR_ONE = 1e-5
+
+
+def _slow_mode(pl: Plant, where: str) -> None:
+    """Exit 4 when the discrete LMIs (7)-(9), infeasible at the search's most lenient
+    λ = 1 − 10⁻⁶, may be feasible closer to 1: a mode of A the output does not see bounds λ
+    from below by |μ|² (its block of (7) is negative definite only for λ > |μ|²), so a stable
+    mode with |μ|² within :data:`NEAR_ONE` of 1 may need a λ the search never tries (A =
+    diag(0.9999999, 1.5), C = (0, 1) was exit 1 "infeasible at any λ < 1", feasible at
+    λ = 0.9999999 by an exact witness; search-space/stubborn trial, session 31)."""
+    mags = np.abs(np.linalg.eigvals(np.asarray(pl.A, float))) ** 2
+    slow = mags[(mags < 1) & (mags > 1 - NEAR_ONE)]
+    if slow.size:
+        mu2 = float(slow.max())
+        raise InconclusiveError(
+            f"stubborn: the solver reports LMIs {_refs(pl)} infeasible {where}, the most "
+            f"lenient λ of the search being 1 − 10⁻⁶; but A has a stable mode with |μ|² ≈ "
+            f"{mu2:.10g} (float), within {NEAR_ONE:g} of 1: a mode the output does not see "
+            "needs λ > |μ|², so a λ closer to 1 may be feasible: not a verdict (give "
+            "[method] lambda between |μ|² and 1)"
+        )
 
 
 def _linear_decay_note(pl: Plant, K: Any) -> str:
