@@ -1693,3 +1693,22 @@ def test_a_redesign_without_r_bound_is_not_told_to_raise_gain_bound() -> None:
     msg = e.value.message
     assert "with the given K" in msg and "try a smaller λ" in msg and "omit K" in msg
     assert "gain_bound" not in msg
+
+
+def test_the_bracket_names_the_margin_its_far_end_is_infeasible_with() -> None:
+    """With margin = 1 the bracket said "the largest λ with LMIs (1)-(3) feasible lies between
+    4.814 and 4.818", but 6.756 certifies (the default margin's design): its far end is where
+    F ⪯ −δI is infeasible, not (1)-(3) (search-space/stubborn trial, session 31). The
+    statement names δ; the default margin's bracket lies above the margin-1 one."""
+    text = (
+        '[system]\ntime = "continuous"\nA = [[0, 1], [-1, 0]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "stubborn"\n'
+    )
+    big = api.design(api.load_spec_text(text + "margin = 1\n", "m.toml"))
+    small = api.design(api.load_spec_text(text, "d.toml"))
+    b_big, b_small = (
+        next(c for c in r.claims if c.id == "lambda-max-bracket") for r in (big, small)
+    )
+    assert "with the strictness margin δ = 1 (F ⪯ −δI" in b_big.statement
+    assert "with the strictness margin δ = 0.000001 (F ⪯ −δI" in b_small.statement
+    assert small.parameters["lambda_max"] > big.parameters["lambda_bracket"][-1]

@@ -322,8 +322,12 @@ def lambda_max_claims(spec: Spec, pr: Parameters) -> list[Claim]:
     width = abs(hi - lo) / abs(lo) if lo != 0 else None
     c.numerical(
         id="lambda-max-bracket",
-        statement=f"the {word} λ with LMIs {eqs} feasible lies between λ_max = {fmt_exact(lo)} "
-        f"and {fmt_exact(hi)}"
+        # the far end is where the solver's problem, F ⪯ −δI, is infeasible: with margin = 1
+        # the statement "the largest λ with (1)-(3) feasible lies below 4.818" was false (6.756
+        # certifies with the default margin; search-space/stubborn trial, session 31)
+        statement=f"the {word} λ with LMIs {eqs} feasible with the strictness margin δ = "
+        f"{fmt_exact(o.margin)} (F ⪯ −δI, [method] margin) lies between λ_max = "
+        f"{fmt_exact(lo)} and {fmt_exact(hi)}"
         + (f" (relative width {float_or_inf(width):.3g})" if width is not None else "")
         + f": the solver finds them infeasible at {fmt_exact(hi)}",
         reference=f"{PAPER}, optimized parameter selection (first maximize λ)",
