@@ -690,3 +690,37 @@ def test_error_panel_floor_follows_eps_star(
     assert lo <= eps / 100 and hi > eps
     curve = next(ln for ln in ax.lines if ln.get_label() == "|centroid − x|")
     assert np.min(curve.get_ydata()) < 1e-199
+
+
+_X0_SPEC = """
+[system]
+time = "continuous"
+states = ["x1", "x2"]
+f = ["x2", "-x1 + u1"]
+h = ["x1"]
+u = ["sin(t)"]
+[method]
+key = "search-space"
+alpha = 0.5
+gamma_star = 0.2
+gamma0 = 1
+E = {{lower = [-2, -2], upper = [2, 2]}}
+D = {{lower = [-1, -1], upper = [1, 1]}}
+U = {{lower = [-1], upper = [1]}}
+[simulate]
+horizon = 0.5
+x0 = [{x0}, 0.2]
+xhat0 = [0, 0]
+"""
+
+
+@pytest.mark.parametrize(("x0", "warned"), [("1.5", True), ("1.0000001", True), ("1", False)])
+def test_x0_outside_D_is_warned(x0: str, warned: bool) -> None:
+    """x0 = (1.5, 0.2) with D = [−1, 1]² ran silently with its metrics (search-space trial,
+    session 31): the guarantee assumes x0 ∈ D. A warning names x0 and D, decided exactly (x0
+    on D's edge is in D)."""
+    res = api.simulate(api.load_spec_text(_X0_SPEC.format(x0=x0), "x0.toml"))
+    said = [w for w in res.info.get("warnings", []) if "is not in D" in w]
+    assert bool(said) == warned
+    if warned:
+        assert f"[simulate] x0 = ({x0}, 0.2) is not in D = [-1, 1] × [-1, 1]" in said[0]

@@ -393,6 +393,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
             stacklevel=2,
         )
     x0 = np.asarray(spec.simulate.x0.f, dtype=float).reshape(1, n)
+    _warn_x0_outside_D(spec, o)
     E_lo, E_hi = o.E.lower, o.E.upper
     nsub = so.substeps or 1
     bar = _progress(progress, N)
@@ -507,6 +508,24 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
 #: generic ``[simulate]`` keys this method does not use: the observer of Definition 6 reads
 #: the plant's output at the sampling instants ΔT (no noise, no disturbance, no other step)
 UNUSED_KEYS = ("noise", "disturbance", "seed", "dt")
+
+
+def _warn_x0_outside_D(spec: Spec, o: Options) -> None:
+    """Warn when [simulate] x0 is not in D (compared exactly): D is the initial search space,
+    and the guarantee that the true state's cell is never discarded (Theorem 1, Hernández &
+    García) assumes x0 ∈ D; a run from outside it ran silently, with its metrics, until the
+    centres were all discarded (search-space trial, session 31)."""
+    assert spec.simulate is not None
+    x0 = np.asarray(spec.simulate.x0.q, dtype=object).reshape(-1)
+    if all(a <= v <= b for v, a, b in zip(x0, o.D.lower_q, o.D.upper_q, strict=True)):
+        return
+    shown = ", ".join(fmt_exact(v) for v in x0)
+    warnings.warn(
+        f"[simulate] x0 = ({shown}) is not in D = {o.D.describe()}, the initial search space: "
+        "the observer's guarantee (the cell of the true state is never discarded) assumes "
+        "x0 ∈ D, so this run shows nothing about it",
+        stacklevel=3,
+    )
 
 
 def _warn_unused(spec: Spec) -> None:
