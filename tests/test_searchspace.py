@@ -1466,3 +1466,32 @@ def test_a_given_constant_below_a_proved_quotient_fails(
         claim = next(c for c in rep.claims if c.id == f"{k}-bound")
         assert claim.status == ClaimStatus.FAILED and rep.exit_code() == 1
         assert "(exact interval evaluation)" in claim.detail
+
+
+def test_a_schedule_entry_within_the_113_bit_enclosure_is_decided_at_more_bits() -> None:
+    """γ₁ rounded up from γ₀ e^(L_f Δτ)/2 by less than 10⁻⁴⁰ (a true entry: the rule allows
+    10⁻¹² relative) lies inside the 113-bit enclosure of the target, and verify refused it
+    "is not …" with the entry inside the printed interval (search-space trial, session 31).
+    The enclosure is refined (doubled up to MAX_K_BITS): the entry certifies, and an entry
+    10⁻⁴⁰ below the target still fails."""
+    from obsdesign.certify import interval as I
+    from obsdesign.certify.claim import Claims
+    from obsdesign.certify.interval import iv
+    from obsdesign.methods.searchspace import claims as C
+
+    L_f, dtau, g_star = fmpq(1), fmpq(1, 10), fmpq(1, 100)
+    lo, hi = I.bounds(iv.exp, L_f * dtau, bits=1024)
+    scale = 10**40
+    up = fmpq(-((-hi.p * scale // 2) // hi.q), scale)  # ⌈e^x/2 · 10⁴⁰⌉ / 10⁴⁰ (γ₀ = 1)
+    down = fmpq((lo.p * scale // 2) // lo.q - 1, scale)  # below e^x/2 by at least 10⁻⁴⁰
+    e_hi = D.exp_upper(L_f * dtau)
+    assert lo / 2 < up < e_hi / 2  # inside the 113-bit enclosure: undecided at 113 bits
+
+    def status(g1: fmpq) -> ClaimStatus:
+        c = Claims()
+        C._schedule(c, [fmpq(1), *D.schedule(g1, g_star, L_f, dtau)], g_star, L_f, dtau)
+        (claim,) = c
+        return claim.status
+
+    assert status(up) == ClaimStatus.CERTIFIED
+    assert status(down) == ClaimStatus.FAILED

@@ -37,10 +37,11 @@ class _prec:
         iv.prec = self.saved
 
 
-def q_to_iv(x: Any) -> Any:
-    """Exact rational → the tightest interval that contains it."""
+def q_to_iv(x: Any, bits: int = PREC) -> Any:
+    """Exact rational → the tightest interval (of ``bits``-bit end points) that contains
+    it."""
     q = Q(x)
-    with _prec():
+    with _prec(bits):
         return iv.mpf(int(q.p)) / iv.mpf(int(q.q))
 
 
@@ -71,13 +72,15 @@ def raw_to_q(x: tuple) -> fmpq:
     return -v if sign else v
 
 
-def bounds(f: Callable[..., Any], *args: Any) -> tuple[fmpq, fmpq]:
-    """Rational (lower, upper) enclosing f(*args), f built from mpmath ``iv`` operations.
+def bounds(f: Callable[..., Any], *args: Any, bits: int = PREC) -> tuple[fmpq, fmpq]:
+    """Rational (lower, upper) enclosing f(*args), f built from mpmath ``iv`` operations at
+    ``bits`` bits (default :data:`PREC`).
 
     ``args`` are exact rationals (or anything :func:`Q` takes); ``f`` receives intervals.
     """
-    with _prec():
-        r = iv.mpf(f(*[q_to_iv(a) for a in args]))  # a constant result becomes an interval
+    with _prec(bits):
+        # a constant result becomes an interval
+        r = iv.mpf(f(*[q_to_iv(a, bits) for a in args]))
         lo, hi = r._mpi_
     return raw_to_q(lo), raw_to_q(hi)
 
