@@ -1695,11 +1695,13 @@ def test_a_redesign_without_r_bound_is_not_told_to_raise_gain_bound() -> None:
     assert "gain_bound" not in msg
 
 
-def test_the_bracket_names_the_margin_its_far_end_is_infeasible_with() -> None:
+def test_the_bracket_names_the_solver_problem_its_far_end_is_infeasible_for() -> None:
     """With margin = 1 the bracket said "the largest λ with LMIs (1)-(3) feasible lies between
     4.814 and 4.818", but 6.756 certifies (the default margin's design): its far end is where
-    F ⪯ −δI is infeasible, not (1)-(3) (search-space/stubborn trial, session 31). The
-    statement names δ; the default margin's bracket lies above the margin-1 one."""
+    the solver's problem is infeasible, not (1)-(3) (search-space/stubborn trial, session 31).
+    Naming δ alone was still false: (1)-(3) are homogeneous, so a scaled solution meets any
+    δ, and the normalization P ⪰ I, W ⪰ I with the gain bound limit it (re-check trial). The
+    statement names the whole problem; the default margin's bracket lies above margin 1's."""
     text = (
         '[system]\ntime = "continuous"\nA = [[0, 1], [-1, 0]]\nC = [[1, 0]]\n'
         '[method]\nkey = "stubborn"\n'
@@ -1709,6 +1711,10 @@ def test_the_bracket_names_the_margin_its_far_end_is_infeasible_with() -> None:
     b_big, b_small = (
         next(c for c in r.claims if c.id == "lambda-max-bracket") for r in (big, small)
     )
-    assert "with the strictness margin δ = 1 (F ⪯ −δI" in b_big.statement
-    assert "with the strictness margin δ = 0.000001 (F ⪯ −δI" in b_small.statement
+    assert "solver's problem is feasible (LMIs (1)-(3) with margin δ = 1 (each ⪯ −δI" in (
+        b_big.statement
+    )
+    assert "margin δ = 0.000001 (each ⪯ −δI; [method] margin), P ⪰ I, W ⪰ I, ‖X‖₂ ≤ " in (
+        b_small.statement
+    )
     assert small.parameters["lambda_max"] > big.parameters["lambda_bracket"][-1]

@@ -322,14 +322,15 @@ def lambda_max_claims(spec: Spec, pr: Parameters) -> list[Claim]:
     width = abs(hi - lo) / abs(lo) if lo != 0 else None
     c.numerical(
         id="lambda-max-bracket",
-        # the far end is where the solver's problem, F ⪯ −δI, is infeasible: with margin = 1
-        # the statement "the largest λ with (1)-(3) feasible lies below 4.818" was false (6.756
-        # certifies with the default margin; search-space/stubborn trial, session 31)
-        statement=f"the {word} λ with LMIs {eqs} feasible with the strictness margin δ = "
-        f"{fmt_exact(o.margin)} (F ⪯ −δI, [method] margin) lies between λ_max = "
-        f"{fmt_exact(lo)} and {fmt_exact(hi)}"
+        # the far end is where the solver's problem is infeasible, not LMIs (1)-(3): with
+        # margin = 1 "the largest λ with (1)-(3) feasible lies below 4.818" was false (6.756
+        # certifies with the default margin; search-space/stubborn trial, session 31), and
+        # naming δ alone was not enough: (1)-(3) are homogeneous, so a scaled solution meets
+        # any δ, and the normalization and the bounds are what limit it (re-check trial)
+        statement=f"the {word} λ at which the solver's problem is feasible ({_problem_text(o, eqs)}) "
+        f"lies between λ_max = {fmt_exact(lo)} and {fmt_exact(hi)}"
         + (f" (relative width {float_or_inf(width):.3g})" if width is not None else "")
-        + f": the solver finds them infeasible at {fmt_exact(hi)}",
+        + f": the solver finds it infeasible at {fmt_exact(hi)}",
         reference=f"{PAPER}, optimized parameter selection (first maximize λ)",
         check="exact side; feasibility SDP re-solved at the far end (Clarabel, cold start): "
         f"status '{INFEASIBLE}' required",
@@ -346,6 +347,23 @@ def lambda_max_claims(spec: Spec, pr: Parameters) -> list[Claim]:
         ),
     )
     return c
+
+
+def _problem_text(o: Options, eqs: str) -> str:
+    """The solver's feasibility problem in words (design.Feasibility): LMIs ``eqs`` tightened
+    by the margin δ, the normalization P ⪰ I, W ⪰ I and the spec's bounds, each kept 10⁻⁶
+    inside."""
+    parts = [
+        f"LMIs {eqs} with margin δ = {fmt_exact(o.margin)} (each ⪯ −δI; [method] margin)",
+        "P ⪰ I, W ⪰ I",
+    ]
+    if o.K is None and o.gain_bound is not None:
+        parts.append(f"‖X‖₂ ≤ gain_bound = {fmt_exact(o.gain_bound)}")
+    if o.r_bound is not None:
+        parts.append(f"R ⪯ r_bound = {fmt_exact(o.r_bound)}")
+    if o.K is not None:
+        parts.append("the given K")
+    return ", ".join(parts)
 
 
 def _lambda_choice(c: Claims, o: Options, pr: Parameters, lam: fmpq, disc: bool) -> None:
