@@ -1495,3 +1495,23 @@ def test_a_schedule_entry_within_the_113_bit_enclosure_is_decided_at_more_bits()
 
     assert status(up) == ClaimStatus.CERTIFIED
     assert status(down) == ClaimStatus.FAILED
+
+
+def test_a_schedule_with_a_ratio_within_1e_14_of_one_still_reaches_gamma_star() -> None:
+    """e^(L_f Δτ)/2 = 1 − 1.1·10⁻¹⁶ (Δτ = 0.6931471805599452, just below ln 2, L_f = 1): the
+    14-digit rounding gave γ_i back, the schedule stalled at γ₀ for 100,000 entries and the
+    design said "shrinks too slowly" (exit 1), where the rule reaches γ⋆ in about 9,000
+    steps (re-check trial, session 31). More digits where 14 make no progress: it reaches γ⋆,
+    strictly decreasing, and the claim certifies it."""
+    from obsdesign.certify.claim import Claims
+    from obsdesign.methods.searchspace import claims as C
+
+    L_f, dtau = fmpq(1), Q("0.6931471805599452")
+    g0, g_star = Q("0.1000000000001"), fmpq(1, 10)
+    gam = D.schedule(g0, g_star, L_f, dtau)
+    assert gam[-1] == g_star and len(gam) < D.MAX_SCHEDULE
+    assert all(a > b for a, b in zip(gam, gam[1:], strict=False))
+    c = Claims()
+    C._schedule(c, gam, g_star, L_f, dtau)
+    (claim,) = c
+    assert claim.status == ClaimStatus.CERTIFIED, claim.detail

@@ -32,8 +32,10 @@ from obsdesign.methods.searchspace.options import Options
 from obsdesign.params import Parameters
 from obsdesign.spec.models import Spec
 
-#: the γ schedule is rounded up to this many significant digits (a coarser grid still covers)
+#: the γ schedule is rounded up to this many significant digits (a coarser grid still covers),
+#: more (doubled up to SCHEDULE_MAX_DIGITS) where that rounding would not decrease an entry
 SCHEDULE_DIGITS = 14
+SCHEDULE_MAX_DIGITS = 112
 #: an entry may exceed max(γ_i e^{L_f Δτ}/2, γ⋆) by at most this relative amount
 SCHEDULE_RTOL = fmpq(1, 10**12)
 MAX_SCHEDULE = 100_000
@@ -207,11 +209,24 @@ def schedule(gamma0: fmpq, gamma_star: fmpq, L_f: fmpq, dtau: fmpq) -> list[fmpq
         return out
     r = exp_upper(L_f * dtau) / 2
     g = gamma0
+    digits = SCHEDULE_DIGITS
     while g != gamma_star and len(out) < MAX_SCHEDULE:
         if r >= 1:
             break
         nxt = g * r
-        g = gamma_star if nxt <= gamma_star else round_up_q(nxt, SCHEDULE_DIGITS)
+        if nxt <= gamma_star:
+            g = gamma_star
+        else:
+            cand = round_up_q(nxt, digits)
+            # with e^{L_f Δτ}/2 within 10⁻¹⁴ of 1 the rounding gave γ_i back and the
+            # schedule stalled at γ₀ for 100,000 entries, exit 1 "shrinks too slowly", where
+            # the rule reaches γ⋆ in 20,000 (re-check trial, session 31): more digits then
+            while cand >= g and digits < SCHEDULE_MAX_DIGITS:
+                digits = min(2 * digits, SCHEDULE_MAX_DIGITS)
+                cand = round_up_q(nxt, digits)
+            if cand >= g:  # no progress even at the most digits: the cap's message says why
+                break
+            g = cand
         out.append(g)
     return out
 
