@@ -1487,14 +1487,19 @@ def test_a_schedule_entry_within_the_113_bit_enclosure_is_decided_at_more_bits()
     e_hi = D.exp_upper(L_f * dtau)
     assert lo / 2 < up < e_hi / 2  # inside the 113-bit enclosure: undecided at 113 bits
 
-    def status(g1: fmpq) -> ClaimStatus:
+    def claim_of(g1: fmpq):  # noqa: ANN202
         c = Claims()
         C._schedule(c, [fmpq(1), *D.schedule(g1, g_star, L_f, dtau)], g_star, L_f, dtau)
         (claim,) = c
-        return claim.status
+        return claim
 
-    assert status(up) == ClaimStatus.CERTIFIED
-    assert status(down) == ClaimStatus.FAILED
+    assert claim_of(up).status == ClaimStatus.CERTIFIED
+    bad = claim_of(down)
+    assert bad.status == ClaimStatus.FAILED
+    # by how much, from the enclosure that decided (the 113-bit interval printed alone
+    # looked as if it held the entry; re-check trial, session 31)
+    m = re.search(r"below the rule's value by at least (\S+)$", bad.detail)
+    assert m is not None and Q(m[1]) > 0 and Q(m[1]) <= lo / 2 - down
 
 
 def test_a_schedule_with_a_ratio_within_1e_14_of_one_still_reaches_gamma_star() -> None:
@@ -1515,3 +1520,15 @@ def test_a_schedule_with_a_ratio_within_1e_14_of_one_still_reaches_gamma_star() 
     C._schedule(c, gam, g_star, L_f, dtau)
     (claim,) = c
     assert claim.status == ClaimStatus.CERTIFIED, claim.detail
+
+
+def test_a_refuted_constant_prints_a_bound_above_it() -> None:
+    """h = sin(x1), given L_h = 0.999999999: refuted, and the detail's proved bound was
+    printed "≥ 0.99999999" (8 digits, below the value it refutes; re-check trial, session 31).
+    It takes as many digits as show it above the value."""
+    text = _LINEAR.format(f="0", given="L_h = 0.999999999").replace('"2*x1"', '"sin(x1)"')
+    rep = api.design(api.load_spec_text(text, "s.toml"))
+    claim = next(c for c in rep.claims if c.id == "L_h-bound")
+    assert claim.status == ClaimStatus.FAILED
+    m = re.search(r"the difference quotient ≥ (\S+) between", claim.detail)
+    assert m is not None and Q(m[1]) > Q("0.999999999")

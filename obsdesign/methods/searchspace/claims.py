@@ -309,13 +309,21 @@ def _schedule(c: Claims, gam: list[fmpq], g_star: fmpq, L_f: fmpq, dtau: fmpq) -
     open_ = False
     for i in range(len(gam) - 1 if not bad else 0):
         g, nxt = gam[i], gam[i + 1]
-        ok = _follows(g, nxt, g_star, x, e_lo, e_hi)
+        ok, lo_e, hi_e = _follows(g, nxt, g_star, x, e_lo, e_hi)
         if ok is not True:
-            low = max(g * e_hi / 2, g_star)
-            high = max(g * e_lo / 2 * (1 + SCHEDULE_RTOL), g_star)
+            # the enclosure that decided, and by how much (an entry 5·10⁻¹⁶ below the rule
+            # printed beside "[0.5, 0.500000000000501]" and looked inside; re-check trial,
+            # session 31)
+            t_lo = max(g * lo_e / 2, g_star)
+            u_hi = max(g * hi_e / 2 * (1 + SCHEDULE_RTOL), g_star)
+            off = (
+                f"below the rule's value by at least {fmt_down(t_lo - nxt, 3)}"
+                if nxt < t_lo
+                else f"above the rounding allowed by at least {fmt_down(nxt - u_hi, 3)}"
+            )
             bad = (
                 f"γ_{i + 1} = {fmt_exact(nxt)} is not max(γ_{i} e^(L_f Δτ)/2, γ⋆) ∈ "
-                f"[{fmt_down(low, 15)}, {fmt_up(high, 15)}]"
+                f"[{fmt_down(t_lo, 15)}, {fmt_up(u_hi, 15)}]: {off}"
                 if ok is False
                 else f"not decided at {MAX_K_BITS} bits whether γ_{i + 1} = {fmt_exact(nxt)} "
                 f"follows the rule: it lies within the enclosure of max(γ_{i} e^(L_f Δτ)/2, γ⋆) "
@@ -359,14 +367,17 @@ def _schedule(c: Claims, gam: list[fmpq], g_star: fmpq, L_f: fmpq, dtau: fmpq) -
     )
 
 
-def _follows(g: fmpq, nxt: fmpq, g_star: fmpq, x: fmpq, e_lo: fmpq, e_hi: fmpq) -> bool | None:
+def _follows(
+    g: fmpq, nxt: fmpq, g_star: fmpq, x: fmpq, e_lo: fmpq, e_hi: fmpq
+) -> tuple[bool | None, fmpq, fmpq]:
     """Whether max(g e^x/2, γ⋆) ≤ nxt ≤ max(g e^x/2 (1 + SCHEDULE_RTOL), γ⋆) (one step of the
     γ schedule, Theorem 1 hypothesis 2, search-space paper), decided by enclosures
     [e_lo, e_hi] of e^x (113 bits), doubled up to MAX_K_BITS bits where they do not decide;
     None when still undecided. Both sides increase with e^x. An entry rounded up from the
     exact value by less than the 113-bit enclosure's width (10⁻⁴⁰ above it) was refused
     "is not …" with the entry inside the printed interval (search-space trial, session 31);
-    e^x is irrational for rational x ≠ 0, so only the precision limits the decision."""
+    e^x is irrational for rational x ≠ 0, so only the precision limits the decision.
+    Returns the verdict and the enclosure of e^x that gave it."""
     bits = ivq.PREC
     while True:
         sure_low = nxt >= max(g * e_hi / 2, g_star)
@@ -374,11 +385,11 @@ def _follows(g: fmpq, nxt: fmpq, g_star: fmpq, x: fmpq, e_lo: fmpq, e_hi: fmpq) 
         sure_high = nxt <= max(g * e_lo / 2 * (1 + SCHEDULE_RTOL), g_star)
         not_high = nxt > max(g * e_hi / 2 * (1 + SCHEDULE_RTOL), g_star)
         if not_low or not_high:
-            return False
+            return False, e_lo, e_hi
         if sure_low and sure_high:
-            return True
+            return True, e_lo, e_hi
         if bits >= MAX_K_BITS:
-            return None
+            return None, e_lo, e_hi
         bits *= 2
         e_lo, e_hi = ivq.bounds(iv.exp, x, bits=bits)
 
@@ -449,11 +460,16 @@ def _box(lo: Any, hi: Any) -> str:
     return " × ".join(f"[{fmt_exact(a)}, {fmt_exact(b)}]" for a, b in zip(lo, hi, strict=True))
 
 
-def _proved_above(k: str, b: bounds.Bound) -> str:
-    """What refutes a constant: the witness of :attr:`bounds.Bound.lower_sq` and the proved
-    lower bound (rounded down)."""
+def _proved_above(k: str, b: bounds.Bound, val: fmpq) -> str:
+    """What refutes the constant ``val``: the witness of :attr:`bounds.Bound.lower_sq` and
+    the proved lower bound, rounded down to as many digits as show it above ``val`` (8 gave
+    "≥ 0.99999999" against a refuted 0.999999999; re-check trial, session 31)."""
     assert b.witness is not None and b.lower_sq is not None
-    low = fmt_down(_sqrt_down(b.lower_sq), 8)
+    root = _sqrt_down(b.lower_sq)
+    digits = 8
+    while Q(fmt_down(root, digits)) <= val and digits < 40:
+        digits += 4
+    low = fmt_down(root, digits)
     pts = [("(" + ", ".join(repr(float(x)) for x in w) + ")") for w in b.witness]
     if k == "f_sup":
         return f"|f| ≥ {low} at {pts[0]} (exact interval evaluation)"
@@ -529,7 +545,7 @@ def _constant(c: Claims, spec: Spec, k: str, val: fmpq) -> None:
             else (
                 f"{est}: the value is below "
                 + (
-                    _proved_above(k, b)
+                    _proved_above(k, b, val)
                     if proved_above
                     else "a sampled difference quotient"
                     if refuted
