@@ -1449,6 +1449,10 @@ D = {{lower = [-0.5], upper = [0.5]}}
         ("1", "f_sup", "1", ClaimStatus.CERTIFIED),
         ("0.5*x1", "L_f", "0.49999999", ClaimStatus.FAILED),
         ("0.5*x1", "L_f", "0.5", ClaimStatus.CERTIFIED),
+        # the secant shrunk towards the derivative: 10⁻⁹ below the constant 3 of x1² on
+        # [0, 3/2] was numerical with the 2·10⁻⁶ secant alone (re-check trial, session 31)
+        ("x1^2@", "L_h", "2.999999997", ClaimStatus.FAILED),
+        ("x1^2@", "L_h", "3", ClaimStatus.CERTIFIED),
     ],
 )
 def test_a_given_constant_below_a_proved_quotient_fails(
@@ -1460,6 +1464,10 @@ def test_a_given_constant_below_a_proved_quotient_fails(
     state. The best sample is now proved at its exact points: a given value below it fails,
     with the points in the detail; the true constant itself is certified."""
     text = _LINEAR.format(f=f, given=f"{k} = {value}")
+    if f == "x1^2@":  # h = x1² on E = [0, 3/2]
+        text = _LINEAR.format(f="0", given=f"{k} = {value}").replace('"2*x1"', '"x1^2"')
+        text = text.replace("lower = [-1], upper = [1]", "lower = [0], upper = [1.5]")
+        text = text.replace("lower = [-0.5], upper = [0.5]", "lower = [0], upper = [0.5]")
     assert _constant_status(text, k, Q(value)) == want
     if want == ClaimStatus.FAILED:
         rep = api.design(api.load_spec_text(text, "g.toml"))

@@ -55,6 +55,9 @@ class Bound:
     boxes: int
     witness: tuple[np.ndarray, ...] | None = None
     lower_sq: Fraction | None = None
+    #: the exact point(s) at which ``lower_sq`` was proved (the witness, or a pair shrunk
+    #: from it)
+    proof_points: tuple[tuple[Fraction, ...], ...] | None = None
 
     @property
     def finite(self) -> bool:
@@ -355,6 +358,13 @@ def lipschitz(
     return branch_and_bound(_box(lo, hi), upper_of, lower_of, budget, rtol)
 
 
+#: :func:`proved_lower_sq` also tries the witness pair shrunk by 10⁻¹ … 10⁻ᴷ (K below)
+#: towards either point and its midpoint: a secant 2·10⁻⁶ long refuted only values about
+#: 10⁻⁶ below the constant (x1² on [0, 1.5] with a given L_h = 2.999999997 stayed numerical;
+#: re-check trial, session 31)
+SHRINK_STEPS = 12
+
+
 def proved_lower_sq(
     exprs: Sequence[Expr],
     names: Sequence[str],
@@ -362,16 +372,19 @@ def proved_lower_sq(
     lo: Sequence[Any],
     hi: Sequence[Any],
     witness: tuple[np.ndarray, ...] | None,
-) -> Fraction | None:
+) -> tuple[Fraction, tuple[tuple[Fraction, ...], ...]] | None:
     """An exact lower bound of the square of the constant a :class:`Bound` estimates, proved at
     its witness: ‖F(a) − F(b)‖²/‖a − b‖² for two points a ≠ b of the box [lo, hi] that differ
     only in the variables ``diff`` (so it bounds the squared Lipschitz constant in ``diff``
-    from below, uniformly in the others: L_f^E, L_h^E of Lemmas 1-2, Hernández & García), or
-    ‖F(z)‖² for one point z of the box (‖f_u‖_E of Lemma 1). Each F_i is enclosed with exact
-    rational end points (:func:`~obsdesign.methods.searchspace.qintervals.evaluate_q` at the
-    points' exact binary values) and only the part of the enclosure away from 0 counts, so a
-    given constant below this bound is refuted, not just doubted. None when a point is not
-    in the box exactly, the points differ elsewhere or coincide, or an evaluation fails.
+    from below, uniformly in the others: L_f^E, L_h^E of Lemmas 1-2, Hernández & García), the
+    largest over the pair and its shrunk copies on the segment [a, b] (:data:`SHRINK_STEPS`:
+    a shorter secant comes closer to the derivative), or ‖F(z)‖² for one point z of the box
+    (‖f_u‖_E of Lemma 1). Each F_i is enclosed with exact rational end points
+    (:func:`~obsdesign.methods.searchspace.qintervals.evaluate_q` at the points' exact
+    values) and only the part of the enclosure away from 0 counts, so a given constant below
+    this bound is refuted, not just doubted. Returns it with the exact point(s) that prove
+    it; None when a point is not in the box exactly, the points differ elsewhere or
+    coincide, or no evaluation succeeds.
 
     :param exprs: F's components; :param names: the variables, in the points' order;
     :param diff: the variables of the difference quotient; :param lo, hi: the exact box;
@@ -387,35 +400,52 @@ def proved_lower_sq(
         if not all(a <= x <= b for a, x, b in zip(LO, q, HI, strict=True)):
             return None
         pts.append(q)
-    if len(pts) == 2:
-        same = [i for i, n in enumerate(names) if n not in diff]
-        if any(pts[0][i] != pts[1][i] for i in same):
-            return None
-        dist_sq = sum(((x - y) ** 2 for x, y in zip(pts[0], pts[1], strict=True)), Fraction(0))
-        if dist_sq == 0:
-            return None
-    else:
-        dist_sq = Fraction(1)
-    total = Fraction(0)
-    for ex in exprs:
-        params = _exact_params(ex)
-        src = ex.source.strip().replace("^", "**")
+    params = [_exact_params(ex) for ex in exprs]
+    srcs = [ex.source.strip().replace("^", "**") for ex in exprs]
+
+    def values(z: list[Fraction]) -> list[QI]:
+        env = {n: QI.point(x) for n, x in zip(names, z, strict=True)}
+        return [
+            evaluate_q(ex.tree, env, pa, sr) for ex, pa, sr in zip(exprs, params, srcs, strict=True)
+        ]
+
+    def mig_sq(d: QI) -> Fraction:
+        m = Fraction(0) if d.lo <= 0 <= d.hi else min(abs(d.lo), abs(d.hi))
+        return m * m
+
+    if len(pts) == 1:
         try:
-            vals = [
-                evaluate_q(
-                    ex.tree,
-                    {n: QI.point(x) for n, x in zip(names, q, strict=True)},
-                    params,
-                    src,
-                )
-                for q in pts
-            ]
+            return sum((mig_sq(v) for v in values(pts[0])), Fraction(0)), (tuple(pts[0]),)
         except (ArithmeticError, ValueError, KeyError):
             return None
-        d = vals[0] - vals[1] if len(vals) == 2 else vals[0]
-        mig = Fraction(0) if d.lo <= 0 <= d.hi else min(abs(d.lo), abs(d.hi))
-        total += mig * mig
-    return total / dist_sq
+    a, b = pts
+    same = [i for i, n in enumerate(names) if n not in diff]
+    if any(a[i] != b[i] for i in same) or a == b:
+        return None
+    mid = [(x + y) / 2 for x, y in zip(a, b, strict=True)]
+    pairs = [(a, b)]
+    for k in range(1, SHRINK_STEPS + 1):
+        t = Fraction(1, 10**k)
+        for c in (a, b, mid):  # the segment's points stay in the (convex) box
+            pairs.append(
+                (
+                    [x + (y - x) * t for x, y in zip(c, a, strict=True)] if c is not a else a,
+                    [x + (y - x) * t for x, y in zip(c, b, strict=True)] if c is not b else b,
+                )
+            )
+    best: tuple[Fraction, tuple[tuple[Fraction, ...], ...]] | None = None
+    for p, q in pairs:
+        dist_sq = sum(((x - y) ** 2 for x, y in zip(p, q, strict=True)), Fraction(0))
+        if dist_sq == 0:
+            continue
+        try:
+            vp, vq = values(p), values(q)
+        except (ArithmeticError, ValueError, KeyError):
+            continue
+        r = sum((mig_sq(x - y) for x, y in zip(vp, vq, strict=True)), Fraction(0)) / dist_sq
+        if best is None or r > best[0]:
+            best = r, (tuple(p), tuple(q))
+    return best
 
 
 def range_inside(

@@ -464,18 +464,24 @@ def _proved_above(k: str, b: bounds.Bound, val: fmpq) -> str:
     """What refutes the constant ``val``: the witness of :attr:`bounds.Bound.lower_sq` and
     the proved lower bound, rounded down to as many digits as show it above ``val`` (8 gave
     "≥ 0.99999999" against a refuted 0.999999999; re-check trial, session 31)."""
-    assert b.witness is not None and b.lower_sq is not None
+    assert b.proof_points is not None and b.lower_sq is not None
     root = _sqrt_down(b.lower_sq)
     digits = 8
     while Q(fmt_down(root, digits)) <= val and digits < 40:
         digits += 4
     low = fmt_down(root, digits)
-    pts = [("(" + ", ".join(repr(float(x)) for x in w) + ")") for w in b.witness]
+    pts = ["(" + ", ".join(_coord(x) for x in w) + ")" for w in b.proof_points]
     if k == "f_sup":
         return f"|f| ≥ {low} at {pts[0]} (exact interval evaluation)"
     return (
         f"the difference quotient ≥ {low} between {pts[0]} and {pts[1]} (exact interval evaluation)"
     )
+
+
+def _coord(x: Fraction) -> str:
+    """A proof point's coordinate: the float itself when it is one, else ≈ the nearest."""
+    f = float(x)
+    return repr(f) if Fraction(f) == x else f"≈{f!r}"
 
 
 def _sqrt_down(x: Fraction) -> fmpq:

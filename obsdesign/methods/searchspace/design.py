@@ -81,7 +81,9 @@ def _compute(kind: str, spec: Spec, budget: int, rtol: float) -> bounds.Bound:
         lo, hi = o.E.lower_q, o.E.upper_q
         b = bounds.lipschitz(exprs, names, diff, lo, hi, budget, rtol)
     # the best sample proved exactly: a given constant below it is refuted (claims._constant)
-    b.lower_sq = bounds.proved_lower_sq(exprs, names, diff, lo, hi, b.witness)
+    proved = bounds.proved_lower_sq(exprs, names, diff, lo, hi, b.witness)
+    if proved is not None:
+        b.lower_sq, b.proof_points = proved
     return b
 
 
