@@ -905,3 +905,25 @@ def test_exact_details_show_short_decimals_alone() -> None:
     assert ExactBackend.show(Fraction(1)) == "1"
     assert ExactBackend.show(Fraction(1, 3)) == "1/3 ≈ 0.333333333333"
     assert ExactBackend.show(Fraction(10**30 + 1, 3)).startswith("≈ 3.33333333333e+29")
+
+
+def test_the_gain_set_dimension_is_exact_and_rounded_vertices_are_marked() -> None:
+    """Four vertices of a gain polygon 10⁻²⁴ wide were reported "dimension 1" (a float rank
+    with an absolute tolerance of 10⁻¹²) beside the note that the set has an interior, and
+    printed as two equal pairs without "≈" (set-invariant trial, session 31). The dimension
+    is the exact rank; a rounded entry is marked."""
+    from flint import fmpq
+
+    from obsdesign.methods.setinvariant.design import _vec_text
+    from obsdesign.methods.setinvariant.linear import _affine_dim
+
+    t = fmpq(1, 10**24)
+    sq = [
+        np.array([fmpq(a), fmpq(b) * t], dtype=object) for a, b in [(0, 0), (1, 0), (1, 1), (0, 1)]
+    ]
+    assert _affine_dim(sq) == 2
+    assert _affine_dim(sq[:2]) == 1 and _affine_dim(sq[:1]) == 0
+    line = [np.array([fmpq(k), fmpq(k)], dtype=object) for k in range(3)]
+    assert _affine_dim(line) == 1
+    assert _vec_text(np.array([fmpq(2, 5), fmpq(-7, 5)], dtype=object)) == "[0.4, -1.4]"
+    assert _vec_text(np.array([fmpq(2, 5) + t, fmpq(1)], dtype=object)) == "≈[0.4, 1]"

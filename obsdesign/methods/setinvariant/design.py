@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 from flint import fmpq
 
+from obsdesign.certify.exact import Q
 from obsdesign.certify.printing import fmt_exact
 from obsdesign.errors import InconclusiveError, InfeasibleError, SolverError
 from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
@@ -272,10 +273,13 @@ def _unscale(run: _Run, s: list[fmpq]) -> None:
 
 def _vec_text(M: np.ndarray) -> str:
     """An exact matrix as a flat list of 4 significant digits for a note (a fixed number of
-    decimals showed a gain of 10⁻³⁰¹ as 0.0)."""
-    return (
-        "[" + ", ".join(f"{x:.4g}" for x in np.asarray(po.qfloat(M), dtype=float).reshape(-1)) + "]"
-    )
+    decimals showed a gain of 10⁻³⁰¹ as 0.0), marked "≈" when an entry is not its exact
+    value (four vertices of a polygon 10⁻²⁴ wide printed as two equal pairs, unmarked;
+    set-invariant trial, session 31)."""
+    exact = np.asarray(M, dtype=object).reshape(-1)
+    shown = [f"{x:.4g}" for x in np.asarray(po.qfloat(M), dtype=float).reshape(-1)]
+    rounded = any("inf" in t or Q(t) != Q(q) for t, q in zip(shown, exact, strict=True))
+    return ("≈" if rounded else "") + "[" + ", ".join(shown) + "]"
 
 
 def polytope_params(
