@@ -160,10 +160,13 @@ def _run(fn: Callable[[Any], int], quiet: bool = False, width: int | None = None
     try:
         if owned:
             signal.signal(signal.SIGINT, interrupt.handler)
+            interrupt.install_quiet_unraisable()  # the console script's own process
         # SIGTERM whoever owns SIGINT: a script's background job starts with SIGINT ignored,
         # and `timeout` there still left a half-written temp file (re-check trial, session 27)
         if _main_thread() and signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
             signal.signal(signal.SIGTERM, interrupt.handler)
+            if os.path.basename(sys.argv[0] if sys.argv else "") in _SCRIPTS:
+                interrupt.install_quiet_unraisable()  # a background console script's process
         from obsdesign import cli_commands
 
         cli_commands.setup(quiet, width)
@@ -209,6 +212,11 @@ def _run(fn: Callable[[Any], int], quiet: bool = False, width: int | None = None
         _err(_stdout_error(e).message)
         raise typer.Exit(_stdout_error(e).exit_code) from None
     raise typer.Exit(code)
+
+
+#: the program names of the console script's own process (``obsdesign``, ``python -m
+#: obsdesign``, ``python obsdesign/cli.py``), where process-wide hooks may be installed
+_SCRIPTS = ("obsdesign", "__main__.py", "cli.py")
 
 
 def _stdout_error(e: OSError) -> Any:
