@@ -1540,3 +1540,20 @@ def test_a_refuted_constant_prints_a_bound_above_it() -> None:
     assert claim.status == ClaimStatus.FAILED
     m = re.search(r"the difference quotient ≥ (\S+) between", claim.detail)
     assert m is not None and Q(m[1]) > Q("0.999999999")
+
+
+def test_a_refuted_irrational_constant_prints_enough_digits() -> None:
+    """h = (x1 + x2, x1 − x2) has every quotient √2; a given L_h 1.7·10⁻²¹ below it is
+    refuted, and the printed bound came from a square root good to 10⁻¹² only, below the
+    value (re-check trial, session 31). The root is taken to the digits printed."""
+    text = (
+        '[system]\ntime = "continuous"\nstates = ["x1", "x2"]\nf = ["-x1", "-x2"]\n'
+        'h = ["x1 + x2", "x1 - x2"]\n[method]\nkey = "search-space"\nalpha = 0.5\n'
+        "gamma_star = 0.1\ngamma0 = 1\nL_h = 1.4142135623730950488\n"
+        "E = {lower = [-1, -1], upper = [1, 1]}\nD = {lower = [-0.5, -0.5], upper = [0.5, 0.5]}\n"
+    )
+    rep = api.design(api.load_spec_text(text, "s.toml"))
+    claim = next(c for c in rep.claims if c.id == "L_h-bound")
+    assert claim.status == ClaimStatus.FAILED
+    m = re.search(r"the difference quotient ≥ (\S+) between", claim.detail)
+    assert m is not None and Q(m[1]) > Q("1.4142135623730950488")

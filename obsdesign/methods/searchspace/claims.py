@@ -465,11 +465,11 @@ def _proved_above(k: str, b: bounds.Bound, val: fmpq) -> str:
     the proved lower bound, rounded down to as many digits as show it above ``val`` (8 gave
     "≥ 0.99999999" against a refuted 0.999999999; re-check trial, session 31)."""
     assert b.proof_points is not None and b.lower_sq is not None
-    root = _sqrt_down(b.lower_sq)
     digits = 8
-    while Q(fmt_down(root, digits)) <= val and digits < 40:
+    low = fmt_down(_sqrt_down(b.lower_sq, digits + 4), digits)
+    while Q(low) <= val and digits < 60:  # √2 refuted 1.7·10⁻²¹ below needs 22 digits
         digits += 4
-    low = fmt_down(root, digits)
+        low = fmt_down(_sqrt_down(b.lower_sq, digits + 4), digits)
     pts = ["(" + ", ".join(_coord(x) for x in w) + ")" for w in b.proof_points]
     if k == "f_sup":
         return f"|f| ≥ {low} at {pts[0]} (exact interval evaluation)"
@@ -484,12 +484,13 @@ def _coord(x: Fraction) -> str:
     return repr(f) if Fraction(f) == x else f"≈{f!r}"
 
 
-def _sqrt_down(x: Fraction) -> fmpq:
-    """A rational ≤ √x (x ≥ 0), within 10⁻¹² relative: for printing a proved lower bound."""
+def _sqrt_down(x: Fraction, digits: int = 12) -> fmpq:
+    """A rational ≤ √x (x ≥ 0), within 10⁻ᵈⁱᵍⁱᵗˢ relative: for printing a proved lower
+    bound."""
     import math
 
     p, d = x.numerator, x.denominator  # √(p/d) = √(p d)/d, and √(p d) ≥ 1 when p ≥ 1
-    return fmpq(math.isqrt(p * d * 10**24), d * 10**12)
+    return fmpq(math.isqrt(p * d * 10 ** (2 * digits)), d * 10**digits)
 
 
 def _d_in_e(c: Claims, o: Options) -> None:

@@ -327,7 +327,7 @@ def lambda_max_claims(spec: Spec, pr: Parameters) -> list[Claim]:
         # certifies with the default margin; search-space/stubborn trial, session 31), and
         # naming δ alone was not enough: (1)-(3) are homogeneous, so a scaled solution meets
         # any δ, and the normalization and the bounds are what limit it (re-check trial)
-        statement=f"the {word} λ at which the solver's problem is feasible ({_problem_text(o, eqs)}) "
+        statement=f"the {word} λ at which the solver's problem is feasible ({_problem_text(o, eqs, disc)}) "
         f"lies between λ_max = {fmt_exact(lo)} and {fmt_exact(hi)}"
         + (f" (relative width {float_or_inf(width):.3g})" if width is not None else "")
         + f": the solver finds it infeasible at {fmt_exact(hi)}",
@@ -349,18 +349,16 @@ def lambda_max_claims(spec: Spec, pr: Parameters) -> list[Claim]:
     return c
 
 
-def _problem_text(o: Options, eqs: str) -> str:
-    """The solver's feasibility problem in words (design.Feasibility): LMIs ``eqs`` tightened
-    by the margin δ, the normalization P ⪰ I, W ⪰ I and the spec's bounds, each kept 10⁻⁶
-    inside."""
-    parts = [
-        f"LMIs {eqs} with margin δ = {fmt_exact(o.margin)} (each ⪯ −δI; [method] margin)",
-        "P ⪰ I, W ⪰ I",
-    ]
+def _problem_text(o: Options, eqs: str, disc: bool) -> str:
+    """The solver's feasibility problem in words (design.Feasibility, design.margin_at): LMIs
+    ``eqs`` tightened by the margin δ (``[method] margin``, times min(1, λ) in continuous
+    time), the normalization P ⪰ I, W ⪰ I and the spec's bounds, each kept 10⁻⁶ inside."""
+    delta = fmt_exact(o.margin) + ("" if disc else "·min(1, λ)")
+    parts = [f"LMIs {eqs} with margin δ = {delta} (each ⪯ −δI; [method] margin)", "P ⪰ I, W ⪰ I"]
     if o.K is None and o.gain_bound is not None:
-        parts.append(f"‖X‖₂ ≤ gain_bound = {fmt_exact(o.gain_bound)}")
+        parts.append(f"‖X‖₂ ≤ gain_bound·(1 − 10⁻⁶), gain_bound = {fmt_exact(o.gain_bound)}")
     if o.r_bound is not None:
-        parts.append(f"R ⪯ r_bound = {fmt_exact(o.r_bound)}")
+        parts.append(f"R ⪯ r_bound·(1 − 10⁻⁶), r_bound = {fmt_exact(o.r_bound)}")
     if o.K is not None:
         parts.append("the given K")
     return ", ".join(parts)
