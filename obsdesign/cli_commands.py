@@ -800,6 +800,10 @@ def simulate(
             raise InputError(f"--study {study} and --option study={opts['study']}: give it once")
         opts["study"] = study
     if quiet and "progress" in opts:  # -q: no progress, whatever --option asked
+        from obsdesign.methods import get_method
+
+        # the user's value checked first: -q hid a bad one (exit 0; docs trial, session 31)
+        get_method(sp.method).parse_sim_options({"progress": opts["progress"]})
         opts["progress"] = "false"
     with _naming_the_spec(sp.file):
         res = api.simulate(sp, report, options=opts, workers=workers, scheduler=scheduler)

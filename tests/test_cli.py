@@ -447,3 +447,13 @@ def test_design_error_says_a_report_was_written_only_when_one_was(tmp_path: Path
     r = runner.invoke(app, ["design", str(spec), "--format", "md", "-o", str(out)])
     assert r.exit_code == 1 and "error report written" not in r.stdout
     assert json.loads(out.read_text())["verdict"] == "error"
+
+
+def test_simulate_quiet_still_checks_the_progress_value() -> None:
+    """``-q --option progress=maybe`` ran the simulation with exit 0: -q replaced the user's
+    value with "false" before it was checked (docs trial, session 31). It is exit 2 naming
+    the option, as without -q; a good value still runs quietly."""
+    spec = SPEC.parent / "hernandez-garcia-example.toml"
+    for extra in ([], ["-q"]):
+        r = CliRunner().invoke(app, ["simulate", str(spec), "--option", "progress=maybe", *extra])
+        assert r.exit_code == 2 and "--option progress" in r.stderr, (extra, r.stderr)
