@@ -654,7 +654,26 @@ def plan(
         PointTask(i, p, text, file, simulate, dict(options or {}), timeout or None)
         for i, p in enumerate(points)
     ]
+    if options:
+        check_options(tasks, simulate, options)
     return axes, tasks
+
+
+def check_options(tasks: Sequence[PointTask], simulate: bool, options: dict[str, str]) -> None:
+    """The ``--option`` pairs, checked once before any work: without ``simulate`` they were
+    ignored unread, and with it a bad one was found point by point after each design and
+    verify (docs trial, session 31). They are the same for every point, so they are checked
+    against the method of each point (of the first alone when ``method.key`` is not swept);
+    a point whose method does not read gets its own row later."""
+    if not simulate:
+        keys = ", ".join(sorted(options))
+        raise InputError(f"--option {keys}: simulation options need --simulate")
+    from obsdesign.methods import get_method
+
+    swept = any(k in ("method", "method.key") for k in tasks[0].values)
+    methods = {task_method(t) for t in (tasks if swept else tasks[:1])} - {""}
+    for key in sorted(methods):
+        get_method(key).parse_sim_options(options)
 
 
 def sweep_rows(

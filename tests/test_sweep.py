@@ -174,6 +174,18 @@ def test_simulate_without_a_simulate_table_is_bad_input_before_any_work(tmp_path
         sw.plan(p, ["method.lambda=0.97"], simulate=True)
 
 
+def test_options_are_checked_against_each_swept_method(tmp_path: Path):
+    """With ``method.key`` swept, every point's method reads the options: ``runs`` is a
+    lyapunov option, so a grid that also has a method without it is refused at once."""
+    p = tmp_path / "s.toml"
+    p.write_text(SPEC.read_text(encoding="utf-8"), encoding="utf-8")
+    sw.plan(p, ["method.lambda=0.97"], simulate=True, options={"runs": "2"})
+    tasks = sw.plan(p, ["method.key=['lyapunov', 'set-invariant']"], simulate=True)[1]
+    with pytest.raises(InputError, match="--option runs: not an option of method 'set-inv"):
+        sw.check_options(tasks, True, {"runs": "2"})
+    sw.check_options(tasks, True, {"time_limit": "60"})  # an option of both
+
+
 def test_api_sweep_returns_a_dataframe():
     pd = pytest.importorskip("pandas")
     from obsdesign import api
@@ -246,6 +258,11 @@ def test_cli_sweep_parquet(tmp_path: Path):
         (["--workers", "2", "--scheduler", "tcp://h:1"], "exclude each other"),
         (["--scheduler", "localhost"], "tcp://HOST"),
         (["--set", "method.lambda=1"], "given twice"),
+        # --option was ignored unread without --simulate, and with it a bad one was found
+        # point by point after design and verify (docs trial, session 31)
+        (["--option", "bogus=1"], "need --simulate"),
+        (["--simulate", "--option", "bogus=1"], "--option bogus: not an option"),
+        (["--simulate", "--option", "runs=0"], "--option runs"),
     ],
 )
 def test_cli_sweep_refuses_before_any_work(tmp_path: Path, extra: list[str], msg: str):
