@@ -100,3 +100,19 @@ def test_an_empty_matrix_says_to_leave_the_key_out(empty: list) -> None:
     with pytest.raises(SpecError) as e:  # a malformed, non-empty matrix: no such hint
         Table({"B": [[1], "x"]}, "t.toml", checked=True).matrix("B", rows=2)
     assert "leave" not in str(e.value)
+
+
+def test_missing_key_held_by_a_misspelt_sibling_table_names_the_typo() -> None:
+    """``[simulte]`` beside a ``[simulate.noise]`` subtable: the key is reported missing in
+    [simulate] and the message names the misspelt table that holds it (docs trial, session
+    31); with no close sibling holding it there is no hint."""
+    root = Table({"simulte": {"horizon": 5}, "simulate": {"noise": {}}}, "s.toml")
+    sim = root.table("simulate")
+    assert sim is not None
+    with pytest.raises(SpecError, match=r"is in \[simulte\]: is 'simulte' a misspelling"):
+        sim.int("horizon")
+    far = Table({"other": {"horizon": 5}, "simulate": {"noise": {}}}, "s.toml").table("simulate")
+    assert far is not None
+    with pytest.raises(SpecError) as e:
+        far.int("horizon")
+    assert "misspelling" not in str(e.value)

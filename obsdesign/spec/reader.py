@@ -48,16 +48,23 @@ class Table:
     """A TOML table with its file name and key path; getters validate and convert."""
 
     def __init__(
-        self, data: dict[str, Any], file: str, path: str = "", checked: bool = False
+        self,
+        data: dict[str, Any],
+        file: str,
+        path: str = "",
+        checked: bool = False,
+        parent: Table | None = None,
     ) -> None:
         """:param data: the table's parsed TOML; :param file: for messages; :param path: the
         key path; :param checked: every number in ``data`` has passed
         :func:`obsdesign.limits.data_problem` (the loader's walk): the getters then skip the
-        per-number size check before the exact conversion (it would repeat the walk's)."""
+        per-number size check before the exact conversion (it would repeat the walk's);
+        :param parent: the table this one was read from (for the hint of a missing key)."""
         self.data = data
         self.file = file
         self.path = path
         self.checked = checked
+        self.parent = parent
         self._used: set[str] = set()
 
     # -- plumbing ---------------------------------------------------------------------------
@@ -82,8 +89,29 @@ class Table:
 
             close = difflib.get_close_matches(k, sorted(set(self.data) - self._used), n=1)
             hint = f" (is '{close[0]}' a misspelling of it?)" if close else ""
+            if not close:
+                hint = self._in_misspelt_sibling(k)
             raise self.error(k, f"is missing{hint}")
         return default
+
+    def _in_misspelt_sibling(self, k: str) -> str:
+        """The hint for a key missing here that a sibling table with a close name holds:
+        ``[simulte]`` beside a ``[simulate.noise]`` subtable was reported as
+        "[simulate.horizon] is missing" without naming the typo (docs trial, session 31)."""
+        import difflib
+
+        if self.parent is None or not self.path:
+            return ""
+        name = self.path.rsplit(".", 1)[-1]
+        holders = [
+            s for s, v in self.parent.data.items() if s != name and isinstance(v, dict) and k in v
+        ]
+        close = difflib.get_close_matches(name, sorted(holders), n=1)
+        if not close:
+            return ""
+        return (
+            f" (it is in [{self.parent.key(close[0])}]: is '{close[0]}' a misspelling of '{name}'?)"
+        )
 
     def done(self, allowed_extra: tuple[str, ...] = ()) -> None:
         """Reject keys nobody read: a typo must not be silently ignored."""
@@ -103,7 +131,7 @@ class Table:
             return None
         if not isinstance(v, dict):
             raise self.error(k, "expected a table")
-        return Table(v, self.file, self.key(k), self.checked)
+        return Table(v, self.file, self.key(k), self.checked, self)
 
     def tables(self, k: str) -> dict[str, Table]:
         t = self.table(k)
@@ -114,7 +142,7 @@ class Table:
             if not isinstance(v, dict):
                 raise t.error(name, "expected a table")
             t.mark(name)
-            out[name] = Table(v, self.file, t.key(name), self.checked)
+            out[name] = Table(v, self.file, t.key(name), self.checked, t)
         return out
 
     # -- scalars ----------------------------------------------------------------------------
