@@ -430,7 +430,7 @@ def test_check_switches_to_blocks_exactly_below_its_threshold(spec: Path, tmp_pa
 @pytest.mark.parametrize("width", [40, 50, 71])
 def test_parameter_forms_go_under_names_below_72_columns(width: int, spec: Path, tmp_path: Path):
     """Below 72 columns the parameters table has two columns, "parameter / form" and value,
-    each name followed by its form (exact, float or not verified); a name folds only when
+    each name followed by its form (exact, float, text or not verified); a name folds only when
     it is longer than a third of the width (mutation review 29: the wide table below 72,
     the threshold at 41, the form left out, a narrower name column: each passed)."""
     report = tmp_path / "r.json"
@@ -446,7 +446,7 @@ def test_parameter_forms_go_under_names_below_72_columns(width: int, spec: Path,
     flat = "".join(cells)
     for k in names:
         i = flat.index(k)
-        assert flat[i + len(k) :].startswith(("exact", "float", "not verified")), (k, flat)
+        assert flat[i + len(k) :].startswith(("exact", "float", "text", "not verified")), (k, flat)
         if len(k) <= width // 3:
             assert k in cells, (k, cells)  # whole on its line
     wide = _run("verify", str(report), "--width", "72")[1].split("claims")[0]

@@ -109,6 +109,10 @@ def test_parameter_tables_mark_rounded_values(monkeypatch: pytest.MonkeyPatch) -
     assert "| alpha | `≈ 2.16667` | exact |" in md
     assert "≈ 2.16667" in _rendered(monkeypatch, rep)
     assert rows["alpha_bracket"].startswith("≈ ")
+    # a text parameter's form is "text", not "float" (docs trial, session 31)
+    forms = {k: f for k, _, f in render._param_rows(rep)}
+    assert forms["alpha_bracket_kind"] == "text" and forms["spectral_abscissa"] == "float"
+    assert "| alpha_bracket_kind | `infeasible` | text |" in md
 
 
 @pytest.mark.parametrize("width", [40, 47, 59])

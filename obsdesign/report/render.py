@@ -40,7 +40,9 @@ def _param_rows(report: Report) -> list[tuple[str, str, str]]:
         # a rounded number is marked "≈" (a certified α = 2.16666655 showed as "2.16667",
         # a proven-infeasible rate: rendering trial, session 27)
         text = cell(raw, report.parameters.float(k)) if _numeric(raw) else fmt_value(raw)
-        form = "exact" if report.parameters.is_exact(k) else "float"
+        # a text or true/false parameter is neither exact nor float (a bracket's kind showed
+        # "float": docs trial, session 31)
+        form = "exact" if report.parameters.is_exact(k) else "float" if _numeric(raw) else "text"
         if k in report.unverified:
             form = "not verified"
         rows.append((k, text, form))
