@@ -957,15 +957,20 @@ def spec_files(paths: list[str | Path] | str | Path) -> list[Path]:
         else:
             out.append(p)
     # one row per file: "check d d/ d/a.toml" checked and counted d's specs twice (outsider
-    # trial, session 26); the first path given names it
-    seen: set[str] = set()
-    unique = []
+    # trial, session 26); the first path given names it, but a path that is not a symbolic
+    # link names it over one that is (the row of a folder with alias.toml -> real/b.toml was
+    # "alias.toml", and real/b.toml was in no row: docs trial, session 31)
+    first: dict[str, int] = {}
+    unique: list[Path | None] = []
     for f in out:
         key = os.path.realpath(f)
-        if key not in seen:
-            seen.add(key)
+        i = first.get(key)
+        if i is None or (os.path.islink(unique[i] or f) and not os.path.islink(f)):
+            if i is not None:
+                unique[i] = None  # the file's own place in the order
+            first[key] = len(unique)
             unique.append(f)
-    return unique
+    return [f for f in unique if f is not None]
 
 
 def _toml_files(root: Path) -> list[Path]:

@@ -184,6 +184,17 @@ def test_a_spec_named_twice_gets_one_row(tmp_path: Path) -> None:
     assert got == [d / "a.toml", d / "b.toml"]
 
 
+def test_a_link_and_its_target_are_one_row_named_after_the_target(tmp_path: Path) -> None:
+    """A folder with alias.toml -> real/b.toml had one row, "alias.toml", and real/b.toml
+    in none (docs trial, session 31): the file itself names the row, in the link's place."""
+    (tmp_path / "real").mkdir()
+    (tmp_path / "real" / "b.toml").write_text("x = 1\n")
+    (tmp_path / "alias.toml").symlink_to(tmp_path / "real" / "b.toml")
+    (tmp_path / "c.toml").write_text("x = 1\n")
+    assert api.spec_files(tmp_path) == [tmp_path / "c.toml", tmp_path / "real" / "b.toml"]
+    assert api.spec_files([tmp_path / "alias.toml"]) == [tmp_path / "alias.toml"]
+
+
 def test_a_time_budget_whose_first_alarm_is_swallowed_fires_again() -> None:
     """An exception raised while Python runs a __del__ or a weakref callback is printed and
     dropped: a sweep point past its 1 s budget then ran to its end (exit 1 instead of 3; a CI
