@@ -511,8 +511,9 @@ def test_junit_over_a_spec_inside_a_checked_folder(spec: Path):
 def test_an_existing_toml_file_is_never_an_output(spec: Path, tmp_path: Path):
     """No output is TOML, so an existing .toml is somebody's spec: refused for -o, --csv and
     check --junit (a .toml in a hidden folder, which check skips, was replaced by the JUnit XML:
-    session 26), byte-for-byte intact; design -o --force still replaces it, and a new .toml
-    name is written."""
+    session 26), byte-for-byte intact; design -o --force still replaces it. A new .toml name
+    is refused too, without --force: the report written there made the next run refuse it and
+    every later check read it as a bad spec (docs trial, session 31)."""
     hidden = tmp_path / ".old"
     hidden.mkdir()
     other = hidden / "other.toml"
@@ -528,7 +529,14 @@ def test_an_existing_toml_file_is_never_an_output(spec: Path, tmp_path: Path):
     res = runner.invoke(app, ["design", str(spec), "-q", "-o", str(other), "--force"])
     assert res.exit_code == 0 and json.loads(other.read_text())["verdict"] == "ok"
     new = tmp_path / "new.toml"
-    assert runner.invoke(app, ["design", str(spec), "-q", "-o", str(new)]).exit_code == 0
+    for args in (
+        ["check", str(spec), "--junit", str(new)],
+        ["design", str(spec), "-o", str(new)],
+        ["simulate", str(spec), "--csv", str(new)],
+    ):
+        _refused(runner.invoke(app, args), str(new), "a .toml name is read as a spec")
+        assert not new.exists()
+    assert runner.invoke(app, ["design", str(spec), "-q", "-o", str(new), "--force"]).exit_code == 0
 
 
 def test_an_output_folder_that_takes_no_file_is_refused_before_the_work(
@@ -593,7 +601,7 @@ def test_the_api_never_writes_a_report_over_a_loaded_specs_file(tmp_path: Path) 
     with pytest.raises(InputError, match="is the input file itself") as e:
         api.design(api.load_spec(spec), out=spec)
     assert e.value.exit_code == 2 and spec.read_bytes() == src.read_bytes()
-    out = tmp_path / "virtual.toml"
+    out = tmp_path / "virtual.json"  # (a new .toml name is refused: session 31)
     api.design(api.load_spec_text(src.read_text(encoding="utf-8"), str(out)), out=out)
     assert out.read_text(encoding="utf-8").lstrip().startswith("{")
 

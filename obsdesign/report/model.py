@@ -467,8 +467,8 @@ def check_output(
 ) -> None:
     """Refuse (:class:`InputError`, one line) an output path that would destroy something:
     one of ``inputs`` (the spec itself), a symbolic link, an existing file that is not a
-    regular file (device, FIFO, socket), a write-protected file, or an existing ``.toml``
-    file (no output is TOML), unless ``force``; a
+    regular file (device, FIFO, socket), a write-protected file, or a ``.toml`` name, new
+    or existing (no output is TOML), unless ``force``; a
     directory, a path given for two outputs, or a directory that cannot take a new file
     always. Nothing is written here (an empty probe file is created and removed). ``-``
     (stdin for a spec) is refused as an output: it wrote a file named ``-`` (a path with a
@@ -497,6 +497,13 @@ def _check_output(path: str | Path, force: bool, inputs: tuple[Path, ...]) -> No
     try:
         lst = os.lstat(p)
     except FileNotFoundError:
+        if p.suffix.lower() == ".toml" and not force:
+            # a report written as NEW.toml made the next run refuse it and every later
+            # `check` of the folder read it as a bad spec (docs trial, session 31)
+            raise InputError(
+                f"{p}: a .toml name is read as a spec (check reads every *.toml) and no output "
+                "is TOML; choose another name (--force)"
+            ) from None
         parent = p.parent
         if parent.exists() and not parent.is_dir():
             raise InputError(f"{p}: cannot write ({parent} is not a directory)") from None
