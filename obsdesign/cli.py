@@ -318,6 +318,7 @@ def _version(value: bool) -> None:
 
 @app.callback()
 def _main(
+    ctx: typer.Context,
     version: Annotated[
         bool,
         typer.Option(
@@ -338,8 +339,12 @@ def _main(
     _state["debug"] = debug
     if limit:
         from obsdesign.errors import ObsdesignError
-        from obsdesign.limits import parse_limit, set_limits
+        from obsdesign.limits import parse_limit, restore, saved, set_limits
 
+        # for this command only: in one process (CliRunner, an embedding program) the next
+        # command ran under them (a test's max_file_bytes failed 46 later tests; session 32)
+        before = saved()
+        ctx.call_on_close(lambda: restore(before))
         try:
             set_limits(**dict(parse_limit(x) for x in limit))
         except ObsdesignError as e:

@@ -96,6 +96,20 @@ def set_limits(**values: int) -> Limits:
     return old
 
 
+def saved() -> tuple[Limits, frozenset[str]]:
+    """The limits in force and the names overridden, for :func:`restore`."""
+    return _current, frozenset(_overridden)
+
+
+def restore(state: tuple[Limits, frozenset[str]]) -> None:
+    """Back to a :func:`saved` state: the CLI's ``--limit`` holds for one command (in one
+    process, ``CliRunner`` invocations kept the previous command's limits)."""
+    global _current
+    _current = state[0]
+    _overridden.clear()
+    _overridden.update(state[1])
+
+
 def _check_ceiling(k: str, v: int) -> None:
     """An :class:`InputError` when ``v`` is above the limit's :data:`CEILINGS` entry."""
     cap = CEILINGS.get(k)

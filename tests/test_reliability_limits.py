@@ -520,3 +520,17 @@ def test_max_digits_above_pythons_int_string_limit_holds_everywhere(tmp_path: Pa
     d = rep.to_dict()  # written: the tool's own numbers, any length
     assert d["parameters"]["exact"]["lambda"].startswith("961")
     assert sys.get_int_max_str_digits() == before  # the limit is back afterwards
+
+
+def test_a_cli_limit_holds_for_that_command_only() -> None:
+    """``--limit`` changed the process's limits for good: in one process (CliRunner, an
+    embedding program) every later command ran under them, and a test's
+    max_file_bytes=5561 failed 46 later tests (session 32). They are restored when the
+    command ends, also when it fails."""
+    from obsdesign.limits import Limits, limits
+
+    spec = Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+    res = runner.invoke(app, ["--limit", "max_digits=5000", "design", str(spec), "-q"])
+    assert res.exit_code == 0 and limits() == Limits()
+    res = runner.invoke(app, ["--limit", "max_file_bytes=10", "design", str(spec), "-q"])
+    assert res.exit_code == 2 and limits() == Limits()
