@@ -545,7 +545,34 @@ def design(
             _say(f"plot written to {plot}")
     if output is not None and fmt == Fmt.text:
         _say(f"report written to {output}")
+    if output is not None:
+        _warn_above_read_limit(output)
     return rep.exit_code()
+
+
+def _warn_above_read_limit(output: Path) -> None:
+    """A warning on stderr (also with -q) when the written report is larger than
+    ``max_file_bytes``: a search-space design with a 70,000-entry schedule exited 0 with an
+    18.9 MB report that its own ``verify`` then refused as bad input, exit 2 (re-check trial,
+    session 31). The report is right; reading it takes a raised limit, which the warning
+    names."""
+    from obsdesign.errors import one_line
+    from obsdesign.limits import limits
+
+    try:
+        size = os.path.getsize(output)
+    except OSError:  # written through a link to a device, or gone since: nothing to say
+        return
+    lim = limits().max_file_bytes
+    if size > lim:
+        sys.stderr.write(
+            one_line(
+                f"obsdesign: warning: {output} is {size:,} bytes, above the {lim:,} that "
+                f"verify reads by default: verify it with 'obsdesign --limit "
+                f"max_file_bytes={size} verify {output}'"
+            )
+            + "\n"
+        )
 
 
 def _design_error_outputs(sp: Any, e: Exception, output: Path | None, fmt: Fmt) -> None:

@@ -457,3 +457,26 @@ def test_simulate_quiet_still_checks_the_progress_value() -> None:
     for extra in ([], ["-q"]):
         r = CliRunner().invoke(app, ["simulate", str(spec), "--option", "progress=maybe", *extra])
         assert r.exit_code == 2 and "--option progress" in r.stderr, (extra, r.stderr)
+
+
+def test_design_warns_when_its_report_is_above_the_read_limit(tmp_path: Path) -> None:
+    """A design that exited 0 wrote a report its own verify refused as bad input (exit 2,
+    above max_file_bytes; re-check trial, session 31): design now warns on stderr, also with
+    -q, naming the limit that reads it; under the limit there is no warning."""
+    spec = tmp_path / "s.toml"
+    spec.write_text(
+        '[system]\ntime = "discrete"\nA = [[0.5, 1], [0, 0.8]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\nL = [0.6, 0.1]\n'
+    )
+    out = tmp_path / "r.json"
+    r = CliRunner().invoke(
+        app, ["--limit", "max_file_bytes=3000", "design", str(spec), "-q", "-o", str(out)]
+    )
+    size = out.stat().st_size
+    assert r.exit_code == 0 and size > 3000
+    assert "above the 3,000 that verify reads" in r.stderr
+    assert f"--limit max_file_bytes={size} verify" in r.stderr
+    v = CliRunner().invoke(app, ["--limit", f"max_file_bytes={size}", "verify", str(out), "-q"])
+    assert v.exit_code == 0, v.output
+    r = CliRunner().invoke(app, ["design", str(spec), "-q", "-o", str(out), "--force"])
+    assert r.exit_code == 0 and "warning" not in r.stderr
