@@ -531,6 +531,9 @@ def test_a_schedule_cut_by_the_cap_says_so(monkeypatch: pytest.MonkeyPatch) -> N
     bad = {c.id: c.detail for c in rep.failed}
     assert list(bad) == ["gamma-schedule"]
     assert "at most 5 entries" in bad["gamma-schedule"] and "a smaller K" in bad["gamma-schedule"]
+    # the note said "γ reaches γ⋆ after 4 switches" beside it (re-check trial, session 31)
+    assert any("does not reach γ⋆ within the 5 listed entries" in n for n in rep.notes)
+    assert not any("reaches γ⋆ after" in n for n in rep.notes)
 
 
 #: the example with γ⋆ = 1e-300
@@ -1557,3 +1560,48 @@ def test_a_refuted_irrational_constant_prints_enough_digits() -> None:
     assert claim.status == ClaimStatus.FAILED
     m = re.search(r"the difference quotient ≥ (\S+) between", claim.detail)
     assert m is not None and Q(m[1]) > Q("1.4142135623730950488")
+
+
+#: e^(L_f Δτ)/2 = 1 − 5·10⁻¹³¹: the exact rule reaches γ⋆ in 2,000 steps
+RATIO_NEAR_ONE = (
+    '[system]\ntime = "continuous"\nstates = ["x1"]\nf = ["-x1"]\nh = ["x1"]\n'
+    '[method]\nkey = "search-space"\nalpha = 1e-133\ngamma_star = 0.1\n'
+    f"gamma0 = 0.1{'0' * 126}1\nkappa = 1.{'9' * 130}\n"
+    "E = {lower = [-1], upper = [1]}\nD = {lower = [-0.5], upper = [0.5]}\n"
+)
+
+
+def test_a_ratio_within_1e_130_of_one_is_bounded_below_one_at_more_bits() -> None:
+    """The 113-bit upper bound of e^(L_f Δτ)/2 = 1 − 5·10⁻¹³¹ is above 1: the design listed
+    γ₀ alone and ended exit 1 with no reason, and its note said "γ reaches γ⋆ after 0
+    switches" (re-check trial, session 31). The bound is taken at more bits: the schedule
+    reaches γ⋆ in 2,000 steps, certified, and verify agrees."""
+    rep = api.design(api.load_spec_text(RATIO_NEAR_ONE, "near.toml"))
+    assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
+    gam = list(rep.parameters.get("gamma_schedule"))
+    assert len(gam) == 2001 and gam[-1] == fmpq(1, 10)
+    assert any("γ reaches γ⋆ after 2000 switches" in n for n in rep.notes)
+    assert api.verify(rep).exit_code() == 0
+    # ln 2 cut after 70 digits: e^x/2 ≈ 1 − 3·10⁻⁷¹, above 1 at 113 bits, below at more
+    x = Q("0.6931471805599453094172321214581765680755001343602552541206800094933936")
+    r = D.schedule_ratio(x)
+    assert D.exp_upper(x) / 2 >= 1 and r is not None and r < 1 and 1 - r < Q("1e-70")
+
+
+def test_a_schedule_the_design_stopped_says_why() -> None:
+    """A schedule that ends before γ⋆ without reaching the cap said only "ends at γ₀, not at
+    γ⋆" (re-check trial, session 31): the claim now names the reason, the ratio too close to
+    1 when e^(L_f Δτ)/2 < 1, else that γ⋆ is not a fixed point."""
+    from obsdesign.certify.claim import Claims
+    from obsdesign.methods.searchspace import claims as C
+
+    g0, g_star = Q("0.2"), fmpq(1, 10)
+    for dtau, why in (
+        (Q("0.5"), "the design stopped after 1 entries"),
+        (Q("0.7"), "not shown below 1"),
+    ):
+        c = Claims()
+        C._schedule(c, [g0], g_star, fmpq(1), dtau)
+        (claim,) = c
+        assert claim.status == ClaimStatus.FAILED and why in claim.detail, claim.detail
+    assert D.schedule_ratio(Q("0.7")) is None and D.schedule_ratio(Q("0.5")) < 1

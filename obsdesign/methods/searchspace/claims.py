@@ -25,6 +25,7 @@ from obsdesign.methods.searchspace import bounds
 from obsdesign.methods.searchspace.design import (
     MAX_K_BITS,
     MAX_SCHEDULE,
+    SCHEDULE_MAX_DIGITS,
     SCHEDULE_RTOL,
     K_bits,
     exp_lower,
@@ -339,6 +340,15 @@ def _schedule(c: Claims, gam: list[fmpq], g_star: fmpq, L_f: fmpq, dtau: fmpq) -
                 "shrinks too slowly to reach γ⋆ within them: a smaller K (shorter Δτ), a larger "
                 "γ⋆ or a smaller γ₀)"
             )
+        elif ivq.log_compare(x, fmpq(2), ivq.PREC, MAX_K_BITS)[0] == -1:
+            # the design stopped before the cap: it said nothing (re-check trial, session 31)
+            bad += (
+                f" (the design stopped after {len(gam):,} entries: e^(L_f Δτ)/2 is too close "
+                f"to 1 for entries of up to {SCHEDULE_MAX_DIGITS:,} significant digits to "
+                "decrease: a smaller K (shorter Δτ) or a larger κ)"
+            )
+        else:
+            bad += " (e^(L_f Δτ)/2 is not shown below 1: γ⋆ is not a fixed point of the rule)"
     if not bad and e_hi > 2:
         # e^x/2 ≤ 1 iff x ≤ ln 2, decided at more bits where 113 do not (L_f Δτ within 1e-34
         # of ln 2 failed with "e^(L_f Δτ)/2 > 1" for e^x/2 = 1 − 1e-50: re-check trial,

@@ -35,7 +35,9 @@ from obsdesign.spec.models import Spec
 #: the γ schedule is rounded up to this many significant digits (a coarser grid still covers),
 #: more (doubled up to SCHEDULE_MAX_DIGITS) where that rounding would not decrease an entry
 SCHEDULE_DIGITS = 14
-SCHEDULE_MAX_DIGITS = 112
+SCHEDULE_MAX_DIGITS = 1024
+#: bits of the upper bound of e^{L_f Δτ}/2 (doubled from 113) where 113 do not show it below 1
+SCHEDULE_MAX_BITS = 4096
 #: an entry may exceed max(γ_i e^{L_f Δτ}/2, γ⋆) by at most this relative amount
 SCHEDULE_RTOL = fmpq(1, 10**12)
 MAX_SCHEDULE = 100_000
@@ -202,18 +204,20 @@ MAX_K_BITS = 65536
 def schedule(gamma0: fmpq, gamma_star: fmpq, L_f: fmpq, dtau: fmpq) -> list[fmpq]:
     """γ_{i+1} = max(γ_i e^{L_f Δτ}/2, γ⋆) (Theorem 1, hypothesis 2), each entry rounded up
     to SCHEDULE_DIGITS significant digits, listed until it reaches γ⋆ (constant after).
-    Stops early (without reaching γ⋆) when e^{L_f Δτ}/2 ≥ 1 or after MAX_SCHEDULE entries.
+    Stops early (without reaching γ⋆) when e^{L_f Δτ}/2 < 1 is not shown
+    (:func:`schedule_ratio`), when SCHEDULE_MAX_DIGITS digits make no progress, or after
+    MAX_SCHEDULE entries.
     For L_f Δτ ≥ 1 that is known without e^{L_f Δτ} (e^x ≥ 1 + x ≥ 2), which is never
     formed there: a huge K (10¹⁵) made its 113-bit enclosure an integer of 10¹⁵ bits and
     python-flint died with SIGFPE in design and in verify (review 19)."""
     out = [gamma0]
     if L_f * dtau >= 1:
         return out
-    r = exp_upper(L_f * dtau) / 2
+    r = schedule_ratio(L_f * dtau)
     g = gamma0
     digits = SCHEDULE_DIGITS
     while g != gamma_star and len(out) < MAX_SCHEDULE:
-        if r >= 1:
+        if r is None:
             break
         nxt = g * r
         if nxt <= gamma_star:
@@ -226,11 +230,31 @@ def schedule(gamma0: fmpq, gamma_star: fmpq, L_f: fmpq, dtau: fmpq) -> list[fmpq
             while cand >= g and digits < SCHEDULE_MAX_DIGITS:
                 digits = min(2 * digits, SCHEDULE_MAX_DIGITS)
                 cand = round_up_q(nxt, digits)
-            if cand >= g:  # no progress even at the most digits: the cap's message says why
+            if cand >= g:  # no progress even at the most digits: the claim says why
                 break
             g = cand
         out.append(g)
     return out
+
+
+def schedule_ratio(x: fmpq) -> fmpq | None:
+    """A rational r with e^x/2 ≤ r < 1, the factor of the γ rule of Theorem 1 (hypothesis 2)
+    for x = L_f Δτ, or None when e^x/2 < 1 is not shown. The bound is taken at 113 bits, then
+    doubled up to SCHEDULE_MAX_BITS: with e^x/2 = 1 − 5·10⁻¹³¹ the 113-bit bound was above 1,
+    and the design listed γ₀ alone and ended exit 1 with no reason, where the rule reaches γ⋆
+    in 2,000 steps (re-check trial, session 31)."""
+    r = exp_upper(x) / 2
+    if r < 1:
+        return r
+    if ivq.log_compare(x, fmpq(2), ivq.PREC, SCHEDULE_MAX_BITS)[0] != -1:
+        return None  # e^x/2 ≥ 1, or undecided: no decreasing schedule
+    bits = ivq.PREC
+    while bits < SCHEDULE_MAX_BITS:
+        bits = min(2 * bits, SCHEDULE_MAX_BITS)
+        r = ivq.bounds(iv.exp, x, bits=bits)[1] / 2
+        if r < 1:
+            return r
+    return None
 
 
 def rules(
@@ -319,11 +343,16 @@ def design_params(spec: Spec) -> tuple[dict[str, Any], list[str]]:
                     else ""
                 )
             )
-    n_sw = len(vals["gamma_schedule"]) - 1
-    notes.append(
-        f"schedule: γ reaches γ⋆ after {n_sw} switches (t = {float(n_sw * vals['dtau']):.4g}); "
-        f"{o.K and 'K given' or 'K from Lemma 2'}"
+    gam = vals["gamma_schedule"]
+    n_sw = len(gam) - 1
+    # "reaches γ⋆ after 99999 switches" was printed beside a failed schedule claim (re-check
+    # trial, session 31)
+    reach = (
+        f"γ reaches γ⋆ after {n_sw} switches (t = {float(n_sw * vals['dtau']):.4g})"
+        if gam[-1] == vals["gamma_star"]
+        else f"γ does not reach γ⋆ within the {len(gam):,} listed entries (see gamma-schedule)"
     )
+    notes.append(f"schedule: {reach}; {o.K and 'K given' or 'K from Lemma 2'}")
     if math.isclose(float(vals["kappa"]), float(c.L_h) * 1.5) and o.kappa is None:
         notes.append("κ = 3/2·L_h (default; [method].kappa sets it)")
     return vals, notes
