@@ -1605,3 +1605,16 @@ def test_a_schedule_the_design_stopped_says_why() -> None:
         (claim,) = c
         assert claim.status == ClaimStatus.FAILED and why in claim.detail, claim.detail
     assert D.schedule_ratio(Q("0.7")) is None and D.schedule_ratio(Q("0.5")) < 1
+
+
+def test_long_entries_only_where_the_schedule_is_short() -> None:
+    """Entries of up to 1,024 digits where few reach γ⋆ (γ₀ within 10⁻¹²⁸ of γ⋆, factor
+    1 − 5·10⁻¹³¹), but 112 where the schedule would be long (γ₀ = 2γ⋆ with the factor
+    1 − 10⁻²⁰⁰ needs ~10²⁰⁰ entries): 100,000 entries of 1,000 digits make a report of
+    hundreds of MB. There the schedule stops at once and the claim says why."""
+    near = 1 - Q("5e-131")
+    assert D._most_digits(Q("0.1") + Q("1e-128"), fmpq(1, 10), near) == D.SCHEDULE_MAX_DIGITS
+    far = 1 - Q("1e-200")
+    assert D._most_digits(Q("0.2"), fmpq(1, 10), far) == D.SCHEDULE_LONG_DIGITS
+    assert D._most_digits(Q("0.2"), fmpq(1, 10), None) == D.SCHEDULE_DIGITS
+    assert D._most_digits(Q("0.2"), fmpq(1, 10), 1 - Q("1e-400")) == D.SCHEDULE_LONG_DIGITS

@@ -344,8 +344,9 @@ def _schedule(c: Claims, gam: list[fmpq], g_star: fmpq, L_f: fmpq, dtau: fmpq) -
             # the design stopped before the cap: it said nothing (re-check trial, session 31)
             bad += (
                 f" (the design stopped after {len(gam):,} entries: e^(L_f Δτ)/2 is too close "
-                f"to 1 for entries of up to {SCHEDULE_MAX_DIGITS:,} significant digits to "
-                "decrease: a smaller K (shorter Δτ) or a larger κ)"
+                f"to 1 for entries of at most {SCHEDULE_MAX_DIGITS:,} significant digits (112 "
+                "where the schedule would be long) to decrease: a smaller K (shorter Δτ) or a "
+                "larger κ)"
             )
         else:
             bad += " (e^(L_f Δτ)/2 is not shown below 1: γ⋆ is not a fixed point of the rule)"

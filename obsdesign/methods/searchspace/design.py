@@ -36,6 +36,10 @@ from obsdesign.spec.models import Spec
 #: more (doubled up to SCHEDULE_MAX_DIGITS) where that rounding would not decrease an entry
 SCHEDULE_DIGITS = 14
 SCHEDULE_MAX_DIGITS = 1024
+#: ... but at most 112 when the schedule's entries would hold more than SCHEDULE_MAX_CHARS
+#: digits in all (estimated): a report of 100,000 entries of 1,000 digits is hundreds of MB
+SCHEDULE_LONG_DIGITS = 112
+SCHEDULE_MAX_CHARS = 4_000_000
 #: bits of the upper bound of e^{L_f Δτ}/2 (doubled from 113) where 113 do not show it below 1
 SCHEDULE_MAX_BITS = 4096
 #: an entry may exceed max(γ_i e^{L_f Δτ}/2, γ⋆) by at most this relative amount
@@ -216,6 +220,7 @@ def schedule(gamma0: fmpq, gamma_star: fmpq, L_f: fmpq, dtau: fmpq) -> list[fmpq
     r = schedule_ratio(L_f * dtau)
     g = gamma0
     digits = SCHEDULE_DIGITS
+    most = _most_digits(gamma0, gamma_star, r)
     while g != gamma_star and len(out) < MAX_SCHEDULE:
         if r is None:
             break
@@ -227,14 +232,30 @@ def schedule(gamma0: fmpq, gamma_star: fmpq, L_f: fmpq, dtau: fmpq) -> list[fmpq
             # with e^{L_f Δτ}/2 within 10⁻¹⁴ of 1 the rounding gave γ_i back and the
             # schedule stalled at γ₀ for 100,000 entries, exit 1 "shrinks too slowly", where
             # the rule reaches γ⋆ in 20,000 (re-check trial, session 31): more digits then
-            while cand >= g and digits < SCHEDULE_MAX_DIGITS:
-                digits = min(2 * digits, SCHEDULE_MAX_DIGITS)
+            while cand >= g and digits < most:
+                digits = min(2 * digits, most)
                 cand = round_up_q(nxt, digits)
             if cand >= g:  # no progress even at the most digits: the claim says why
                 break
             g = cand
         out.append(g)
     return out
+
+
+def _most_digits(gamma0: fmpq, gamma_star: fmpq, r: fmpq | None) -> int:
+    """The most significant digits :func:`schedule` gives an entry: SCHEDULE_MAX_DIGITS when
+    the entries that reach γ⋆ (about ln(γ₀/γ⋆)/(1 − r) of them, each of about −log₁₀(1 − r)
+    digits) hold at most SCHEDULE_MAX_CHARS digits in all, else SCHEDULE_LONG_DIGITS (the
+    schedule then stalls or meets the cap, and gamma-schedule says so)."""
+    if r is None or gamma0 <= gamma_star:
+        return SCHEDULE_DIGITS
+    gap = float(1 - r)
+    try:
+        steps = math.log1p(float(gamma0 / gamma_star - 1)) / gap
+    except (OverflowError, ZeroDivisionError):
+        return SCHEDULE_LONG_DIGITS
+    need = -math.log10(gap) + 3
+    return SCHEDULE_MAX_DIGITS if steps * need <= SCHEDULE_MAX_CHARS else SCHEDULE_LONG_DIGITS
 
 
 def schedule_ratio(x: fmpq) -> fmpq | None:
