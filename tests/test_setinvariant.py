@@ -927,3 +927,30 @@ def test_the_gain_set_dimension_is_exact_and_rounded_vertices_are_marked() -> No
     assert _affine_dim(line) == 1
     assert _vec_text(np.array([fmpq(2, 5), fmpq(-7, 5)], dtype=object)) == "[0.4, -1.4]"
     assert _vec_text(np.array([fmpq(2, 5) + t, fmpq(1)], dtype=object)) == "≈[0.4, 1]"
+
+
+def test_notes_print_lambda_as_given_and_epsilon_on_its_side() -> None:
+    """Example 7.2 with λ = 0.9999999: the note printed "max ε(z) = 1.06169 > λ = 1" (λ
+    rounded by {:g}, unmarked; re-check trial, session 31). λ is printed as given and the
+    float ε with "≈" and digits on its side of λ."""
+    path = Path(__file__).resolve().parents[1] / "specs" / "dorea-pimenta-7-2.toml"
+    text = path.read_text(encoding="utf-8").replace("lambda = 1\n", "lambda = 0.9999999\n")
+    assert "lambda = 0.9999999" in text
+    rep = api.design(load_spec_text(text, "lam.toml"))
+    notes = " ".join(rep.notes)
+    assert "max ε(z) ≈ 1.0616869 > λ = 0.9999999" in notes, notes
+    assert "λ = 1 " not in notes and "λ = 1)" not in notes
+
+
+def test_eps_vs_lam_shows_the_side_exactly() -> None:
+    """The printed ε lies on the side of the exact λ that the float ε lies on, with the
+    fewest digits from 6; within 4 ulps and not above, "= λ in floats"."""
+    from obsdesign.methods.setinvariant.design import eps_vs_lam
+
+    lam = Q("0.9999999")
+    assert eps_vs_lam("ε", 0.99999990004, lam) == "ε ≈ 0.99999990004 > λ = 0.9999999"
+    assert eps_vs_lam("ε", 0.9999999500001, lam) == "ε ≈ 0.99999995 > λ = 0.9999999"
+    assert eps_vs_lam("ε", 0.9000000000000002, Q("0.9")) == "ε = λ = 0.9 in floats"
+    assert eps_vs_lam("ε", 0.5, Q("0.9")) == "ε ≈ 0.5 ≤ λ = 0.9"
+    assert eps_vs_lam("ε", 0.9, Q("0.9")) == "ε = λ = 0.9 in floats"
+    assert eps_vs_lam("ε", 0.95, Q("0.9")) == "ε ≈ 0.95 > λ = 0.9"

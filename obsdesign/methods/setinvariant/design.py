@@ -11,6 +11,7 @@ stages run in float64 (:mod:`.numerical`) and every claim is numerical.
 from __future__ import annotations
 
 import dataclasses
+import re
 import time
 from dataclasses import dataclass, field
 from typing import Any
@@ -103,6 +104,25 @@ def final_stage(
     return Stage(Gq, vrep, res)
 
 
+def eps_vs_lam(what: str, eps: float, lam: fmpq) -> str:
+    """``"{what} ≈ ε > λ = …"`` for a float ε (a contractivity of eq. (22), set-invariant
+    paper) against the spec's exact λ: λ as given (``{lam:g}`` printed λ = 0.9999999 as
+    "λ = 1": re-check trial, session 31); ε with the fewest digits (from 6, and more than
+    λ's own) whose decimal lies on ε's side of λ, and "≤" when it is not above; within 4
+    ulps of λ, ``"{what} = λ = … in floats"`` (10⁻⁶² above printed "0.9 > λ = 0.9": review
+    19)."""
+    lam_text = fmt_exact(lam)
+    if not np.isfinite(eps):
+        return f"{what} = {eps:g}, λ = {lam_text}"
+    if abs(eps - float(lam)) <= 4 * np.spacing(float(lam)):
+        return f"{what} = λ = {lam_text} in floats"
+    above = Q(eps) > lam
+    # more than λ's own digits: "ε ≈ 1 > λ = 0.9999999" is true but shows nothing
+    first = max(6, len(re.sub(r"\D", "", lam_text).lstrip("0")) + 1)
+    text = next((t for d in range(first, 18) if (Q(t := f"{eps:.{d}g}") > lam) == above), repr(eps))
+    return f"{what} ≈ {text} {'>' if above else '≤'} λ = {lam_text}"
+
+
 def _final_of(
     r: al.IterResult, data: Data, single: bool, lam: float, dl: float, o: Options
 ) -> Stage:
@@ -118,9 +138,9 @@ def _final_of(
             raise
         how = "diverges" if r.diverged else "did not converge"
         raise InfeasibleError(
-            f"not converged: the iteration {how} after {r.iterations} iterations (last ε = "
-            f"{r.eps:.6g} > λ = {lam:g}), and the exact check of its last polyhedron did not "
-            f"finish ({e.message}), so it is not reported"
+            f"not converged: the iteration {how} after {r.iterations} iterations "
+            f"({eps_vs_lam('last ε', r.eps, o.lam)}), and the exact check of its last "
+            f"polyhedron did not finish ({e.message}), so it is not reported"
         ) from None
 
 
@@ -156,15 +176,11 @@ def _budget(r: al.IterResult, o: Options, run: _Run) -> None:
             r.why or f"a new vertex lies more than {al.GROWTH_MAX:g} times Ω's size from the origin"
         )
         run.notes.append(
-            f"the general algorithm diverges: after {r.iterations} iterations {where} (last ε = "
-            f"{r.eps:.6g} > λ = {fmt_exact(o.lam)}); stopped there, not converged"
+            f"the general algorithm diverges: after {r.iterations} iterations {where} "
+            f"({eps_vs_lam('last ε', r.eps, o.lam)}); stopped there, not converged"
         )
     if r.timed_out:
-        last = (
-            f"last ε = {r.eps:.6g} > λ = {fmt_exact(o.lam)}"
-            if np.isfinite(r.eps)
-            else "no iteration finished"
-        )
+        last = eps_vs_lam("last ε", r.eps, o.lam) if np.isfinite(r.eps) else "no iteration finished"
         raise SolverError(
             f"not converged within {o.time_limit:g} s ([method] time_limit) / {r.iterations} "
             f"iterations: {last} with {len(r.G)} facets (raise time_limit, or a larger λ or Δδ)"
@@ -204,11 +220,11 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
                 symmetric_contractivity=sym_eps,
             )
             # floats may not resolve the excess (A₁₁ = 0.7 + 1e-61 printed "0.9 > λ = 0.9")
-            excess = (
-                f"max ε(z) = {sym_eps:.6g} > λ = {lam:g}"
-                if f"{sym_eps:.6g}" != f"{lam:.6g}" and sym_eps > lam
-                else f"max ε(z) = λ = {lam:g} in floats, exceeded in exact arithmetic"
-            )
+            excess = eps_vs_lam("max ε(z)", sym_eps, o.lam)
+            if " > λ" not in excess:
+                excess += (", " if excess.endswith("floats") else " in floats, ") + (
+                    "exceeded in exact arithmetic"
+                )
             msg = (
                 f"the symmetric C_K^∞ meets condition (14) after {r.iterations} iterations but "
                 f"not Theorem 3.1: {excess}"
