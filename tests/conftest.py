@@ -32,6 +32,7 @@ def pytest_sessionstart(session: pytest.Session) -> None:
         mod = sys.modules.get("obsdesign.methods.searchspace.design")
         if mod is not None:
             mod._CACHE.clear()
+            mod._PROOFS.clear()  # the exact refutations, kept per process likewise
         # the exact vertices of Ω (``po.exact_h_to_v``), kept per process by an lru_cache:
         # a mutant of polytope_ops would else be handed the clean run's vertices
         prob = sys.modules.get("obsdesign.methods.setinvariant.problem")

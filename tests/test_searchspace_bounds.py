@@ -8,6 +8,7 @@ import math
 from fractions import Fraction
 
 import numpy as np
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -191,3 +192,48 @@ def test_proved_lower_sq_shrinks_the_pair_towards_the_derivative() -> None:
     (a,), (b,) = pts
     assert (a + b) ** 2 == sq  # the quotient of x² between a and b is a + b
     assert 0 < abs(a - b) < Fraction(1, 10**15) and max(a, b) == Fraction(3, 2)
+
+
+def test_proved_lower_sq_stops_at_the_first_pair_above_the_target() -> None:
+    """With a target the proof stops at the first pair whose square exceeds it (the witness
+    pair itself here: (1.5 + 1.4999975)² > 8.9), where without one the shrunk pairs go on to
+    the best; a target no pair exceeds gives that best."""
+    w = (np.array([1.5]), np.array([1.4999975]))
+    args = (_ex("x1^2"), ["x1"], ["x1"], [Fraction(0)], [Fraction(3, 2)], w)
+    first = B.proved_lower_sq(*args, target=Fraction(89, 10))
+    best = B.proved_lower_sq(*args)
+    assert first is not None and best is not None
+    assert Fraction(89, 10) < first[0] == (Fraction(3, 2) + Fraction(1.4999975)) ** 2 < best[0]
+    assert B.proved_lower_sq(*args, target=Fraction(9)) == best
+
+
+def test_the_exact_proof_runs_only_for_a_value_the_enclosure_does_not_prove(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Every constant was proved at its witness at design time, 37 exact evaluations each,
+    and specs with many long polynomials took 2.8× as long (re-check trial, session 31).
+    Computed constants (rounded-up bounds) need no proof; a given value below the enclosure
+    does, and is refuted by it."""
+    from obsdesign import api
+    from obsdesign.methods.searchspace import design as D
+
+    calls: list[str] = []
+    real = B.proved_lower_sq
+
+    def counting(*a: object, **k: object) -> object:
+        calls.append("x")
+        return real(*a, **k)
+
+    monkeypatch.setattr(B, "proved_lower_sq", counting)
+    text = (
+        '[system]\ntime = "continuous"\nstates = ["x1"]\nf = ["-x1"]\nh = ["2*x1"]\n'
+        '[method]\nkey = "search-space"\nalpha = 0.5\ngamma_star = 0.1\ngamma0 = 1\n'
+        "E = {lower = [-1], upper = [1]}\nD = {lower = [-0.5], upper = [0.5]}\n"
+    )
+    D._PROOFS.clear()
+    assert api.design(api.load_spec_text(text, "s.toml")).exit_code() == 0
+    assert calls == []
+    given = text.replace("gamma0 = 1\n", "gamma0 = 1\nL_h = 1.999999\n")
+    rep = api.design(api.load_spec_text(given, "g.toml"))
+    claim = next(c for c in rep.claims if c.id == "L_h-bound")
+    assert calls and claim.status.value == "failed" and "difference quotient ≥" in claim.detail

@@ -47,17 +47,13 @@ from obsdesign.spec.expr import Expr
 class Bound:
     """A certified upper bound (float, rigorous) and a sampled lower estimate of a constant;
     ``witness``: the sample point(s) of that estimate (two points of a difference quotient, or
-    one point of a sup norm), inside the exact box; ``lower_sq``: an exact lower bound of the
-    square of the constant proved there (:func:`proved_lower_sq`), None when not computed."""
+    one point of a sup norm), inside the exact box (:func:`proved_lower_sq` proves a lower
+    bound there)."""
 
     upper: float
     lower_est: float
     boxes: int
     witness: tuple[np.ndarray, ...] | None = None
-    lower_sq: Fraction | None = None
-    #: the exact point(s) at which ``lower_sq`` was proved (the witness, or a pair shrunk
-    #: from it)
-    proof_points: tuple[tuple[Fraction, ...], ...] | None = None
 
     @property
     def finite(self) -> bool:
@@ -372,6 +368,7 @@ def proved_lower_sq(
     lo: Sequence[Any],
     hi: Sequence[Any],
     witness: tuple[np.ndarray, ...] | None,
+    target: Fraction | None = None,
 ) -> tuple[Fraction, tuple[tuple[Fraction, ...], ...]] | None:
     """An exact lower bound of the square of the constant a :class:`Bound` estimates, proved at
     its witness: ‖F(a) − F(b)‖²/‖a − b‖² for two points a ≠ b of the box [lo, hi] that differ
@@ -388,7 +385,9 @@ def proved_lower_sq(
 
     :param exprs: F's components; :param names: the variables, in the points' order;
     :param diff: the variables of the difference quotient; :param lo, hi: the exact box;
-    :param witness: one or two float points."""
+    :param witness: one or two float points; :param target: stop at the first pair whose
+        square exceeds it (all that a refutation of a value whose square is ``target``
+        needs)."""
     if witness is None or len(witness) not in (1, 2):
         return None
     LO, HI = [_frac(q) for q in lo], [_frac(q) for q in hi]
@@ -445,6 +444,8 @@ def proved_lower_sq(
         r = sum((mig_sq(x - y) for x, y in zip(vp, vq, strict=True)), Fraction(0)) / dist_sq
         if best is None or r > best[0]:
             best = r, (tuple(p), tuple(q))
+            if target is not None and r > target:
+                break
     return best
 
 

@@ -31,6 +31,7 @@ from obsdesign.methods.searchspace.design import (
     exp_lower,
     exp_upper,
     interval_bound,
+    proved_lower,
 )
 from obsdesign.methods.searchspace.options import Options
 from obsdesign.params import Parameters
@@ -471,17 +472,18 @@ def _box(lo: Any, hi: Any) -> str:
     return " × ".join(f"[{fmt_exact(a)}, {fmt_exact(b)}]" for a, b in zip(lo, hi, strict=True))
 
 
-def _proved_above(k: str, b: bounds.Bound, val: fmpq) -> str:
-    """What refutes the constant ``val``: the witness of :attr:`bounds.Bound.lower_sq` and
-    the proved lower bound, rounded down to as many digits as show it above ``val`` (8 gave
-    "≥ 0.99999999" against a refuted 0.999999999; re-check trial, session 31)."""
-    assert b.proof_points is not None and b.lower_sq is not None
+def _proved_above(k: str, proof: tuple[Any, Any], val: fmpq) -> str:
+    """What refutes the constant ``val``: the proved square and its exact points
+    (:func:`~obsdesign.methods.searchspace.design.proved_lower`), the root rounded down to
+    as many digits as show it above ``val`` (8 gave "≥ 0.99999999" against a refuted
+    0.999999999; re-check trial, session 31)."""
+    lower_sq, points = proof
     digits = 8
-    low = fmt_down(_sqrt_down(b.lower_sq, digits + 4), digits)
+    low = fmt_down(_sqrt_down(lower_sq, digits + 4), digits)
     while Q(low) <= val and digits < 60:  # √2 refuted 1.7·10⁻²¹ below needs 22 digits
         digits += 4
-        low = fmt_down(_sqrt_down(b.lower_sq, digits + 4), digits)
-    pts = ["(" + ", ".join(_coord(x) for x in w) + ")" for w in b.proof_points]
+        low = fmt_down(_sqrt_down(lower_sq, digits + 4), digits)
+    pts = ["(" + ", ".join(_coord(x) for x in w) + ")" for w in points]
     if k == "f_sup":
         return f"|f| ≥ {low} at {pts[0]} (exact interval evaluation)"
     return (
@@ -534,9 +536,12 @@ def _constant(c: Claims, spec: Spec, k: str, val: fmpq) -> None:
     # exact-end-point interval evaluation) refutes it: a given L_h = 1.999999 for h = 2·x1 was
     # 5·10⁻⁷ below the sampled 2, inside the float tolerance below, and stayed "numerical"
     # beside certified claims built on it, exit 0 (search-space trial, session 31)
-    proved_above = b.lower_sq is not None and fmpq(
-        b.lower_sq.numerator, b.lower_sq.denominator
-    ) > Q(val) * Q(val)
+    # proved only for a value the enclosure does not prove (F7 of the re-check trial,
+    # session 31: at design time for every constant it cost 37 exact evaluations each)
+    proof = None if b.finite and Q(b.upper) <= val else proved_lower(k, spec, val)
+    proved_above = proof is not None and fmpq(proof[0].numerator, proof[0].denominator) > Q(
+        val
+    ) * Q(val)
     refuted = proved_above or b.lower_est > float(val) * (1 + 1e-6) + 1e-300
     proved = b.finite and Q(b.upper) <= val and not refuted
     est = f"sampled lower estimate {b.lower_est:.6g}" + (
@@ -563,8 +568,8 @@ def _constant(c: Claims, spec: Spec, k: str, val: fmpq) -> None:
             else (
                 f"{est}: the value is below "
                 + (
-                    _proved_above(k, b, val)
-                    if proved_above
+                    _proved_above(k, proof, val)
+                    if proof is not None and proved_above
                     else "a sampled difference quotient"
                     if refuted
                     else "the interval bound"
