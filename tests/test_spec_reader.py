@@ -116,3 +116,15 @@ def test_missing_key_held_by_a_misspelt_sibling_table_names_the_typo() -> None:
     with pytest.raises(SpecError) as e:
         far.int("horizon")
     assert "misspelling" not in str(e.value)
+
+
+def test_an_unknown_key_beside_the_key_it_misspells_gets_the_hint() -> None:
+    """``--set method.lambdaa=…`` in a sweep adds lambdaa beside the spec's lambda: the row
+    said "is not a known key here" without the hint design gives when lambda is absent
+    (docs trial, session 31)."""
+    t = Table({"lambda": 1, "lambdaa": 2}, "s.toml", "method")
+    t.int("lambda")
+    with pytest.raises(
+        SpecError, match=r"\[method.lambdaa\] is not a known key here \(did you mean 'lambda'\?\)"
+    ):
+        t.done()
