@@ -1618,3 +1618,20 @@ def test_long_entries_only_where_the_schedule_is_short() -> None:
     assert D._most_digits(Q("0.2"), fmpq(1, 10), far) == D.SCHEDULE_LONG_DIGITS
     assert D._most_digits(Q("0.2"), fmpq(1, 10), None) == D.SCHEDULE_DIGITS
     assert D._most_digits(Q("0.2"), fmpq(1, 10), 1 - Q("1e-400")) == D.SCHEDULE_LONG_DIGITS
+
+
+def test_a_schedule_far_beyond_the_cap_is_refused_before_listing() -> None:
+    """κ = 2(1 − 10⁻¹²) makes e^(L_f Δτ)/2 ≈ 1 − 10⁻¹²: from γ₀ = 2γ⋆ the rule needs ~7·10¹¹
+    entries. Listed up to the 100,000-entry cap such schedules were failed reports of up to
+    70 MB after 20 s (session 32); the design now stops at once, exit 1, saying how many
+    entries the rule needs. _steps_estimate is within a factor 2 above the true count."""
+    text = RATIO_NEAR_ONE.replace(f"gamma0 = 0.1{'0' * 126}1", "gamma0 = 0.2").replace(
+        f"kappa = 1.{'9' * 130}", "kappa = 1.999999999998"
+    )
+    assert "gamma0 = 0.2" in text and "kappa = 1.999999999998" in text
+    with pytest.raises(InfeasibleError, match=r"needs about 6\.9e\+11 entries .* 100,000"):
+        api.design(api.load_spec_text(text, "far.toml"))
+    r = fmpq(9, 10)
+    est = D._steps_estimate(fmpq(2), fmpq(1), r)
+    k = next(k for k in range(100) if r**k <= fmpq(1, 2))  # the rule's exact count
+    assert k - 1 <= est <= 2 * k

@@ -234,7 +234,8 @@ def schedule(gamma0: fmpq, gamma_star: fmpq, L_f: fmpq, dtau: fmpq) -> list[fmpq
     to SCHEDULE_DIGITS significant digits, listed until it reaches γ⋆ (constant after).
     Stops early (without reaching γ⋆) when e^{L_f Δτ}/2 < 1 is not shown
     (:func:`schedule_ratio`), when SCHEDULE_MAX_DIGITS digits make no progress, or after
-    MAX_SCHEDULE entries.
+    MAX_SCHEDULE entries; an :class:`InfeasibleError` when the rule needs more than
+    10·MAX_SCHEDULE entries (:func:`_steps_estimate`), before listing any.
     For L_f Δτ ≥ 1 that is known without e^{L_f Δτ} (e^x ≥ 1 + x ≥ 2), which is never
     formed there: a huge K (10¹⁵) made its 113-bit enclosure an integer of 10¹⁵ bits and
     python-flint died with SIGFPE in design and in verify (review 19)."""
@@ -245,6 +246,18 @@ def schedule(gamma0: fmpq, gamma_star: fmpq, L_f: fmpq, dtau: fmpq) -> list[fmpq
     g = gamma0
     digits = SCHEDULE_DIGITS
     most = _most_digits(gamma0, gamma_star, r)
+    if r is not None and gamma0 > gamma_star:
+        est = _steps_estimate(gamma0, gamma_star, r)
+        if est > 10 * MAX_SCHEDULE:
+            # listed up to the cap, such a schedule was a failed report of up to 70 MB after
+            # 20 s (1 − e^(L_f Δτ)/2 = 10⁻⁸⁰; session 32): the rule needs at least est/2
+            raise InfeasibleError(
+                f"the γ schedule of Theorem 1 (hypothesis 2) needs about {est:.2g} entries to "
+                f"go from γ₀ = {fmt_exact(gamma0)} to γ⋆ = {fmt_exact(gamma_star)} "
+                f"(e^(L_f Δτ)/2 ≈ 1 − {float(1 - r):.3g} per switch), beyond the "
+                f"{MAX_SCHEDULE:,} entries the design lists: a smaller K (shorter Δτ), a "
+                "larger γ⋆ or a smaller γ₀"
+            )
     while g != gamma_star and len(out) < MAX_SCHEDULE:
         if r is None:
             break
@@ -273,13 +286,22 @@ def _most_digits(gamma0: fmpq, gamma_star: fmpq, r: fmpq | None) -> int:
     schedule then stalls or meets the cap, and gamma-schedule says so)."""
     if r is None or gamma0 <= gamma_star:
         return SCHEDULE_DIGITS
-    gap = float(1 - r)
-    try:
-        steps = math.log1p(float(gamma0 / gamma_star - 1)) / gap
-    except (OverflowError, ZeroDivisionError):
+    steps = _steps_estimate(gamma0, gamma_star, r)
+    if not math.isfinite(steps):
         return SCHEDULE_LONG_DIGITS
-    need = -math.log10(gap) + 3
+    need = -math.log10(float(1 - r)) + 3
     return SCHEDULE_MAX_DIGITS if steps * need <= SCHEDULE_MAX_CHARS else SCHEDULE_LONG_DIGITS
+
+
+def _steps_estimate(gamma0: fmpq, gamma_star: fmpq, r: fmpq) -> float:
+    """ln(γ₀/γ⋆)/(1 − r) in floats (inf when a float cannot hold it), for γ₀ > γ⋆ and
+    1/2 ≤ r < 1: between k − 1 and 2k for the k entries the rule γ_{i+1} = γ_i r needs to
+    reach γ⋆ (k = ⌈ln(γ₀/γ⋆)/(−ln r)⌉, and −ln r ≥ 1 − r ≥ −r ln r) — Theorem 1,
+    hypothesis 2."""
+    try:
+        return math.log1p(float(gamma0 / gamma_star - 1)) / float(1 - r)
+    except (OverflowError, ZeroDivisionError):
+        return math.inf
 
 
 def schedule_ratio(x: fmpq) -> fmpq | None:
