@@ -755,3 +755,52 @@ def test_window_details_print_true_inequalities_rounded_the_safe_way() -> None:
     assert wd("T_min", t, third, True, up=True) == f"T_min = {fmt_exact(t)} ≥ 1/3 (exact)"
     t = third - eps
     assert wd("T_max", t, third, True, up=False) == f"T_max = {fmt_exact(t)} ≤ 1/3 (exact)"
+
+
+#: 3 states, 2 outputs, QSR given; the true κ_max of (22) is 5.6 − (√0.2 + 0.01) −
+#: 4(√0.05 + 0.05) = 4.04835921350013…
+KAPPA_NEAR_MAX = """[system]
+time = "continuous"
+A = [[-1, 0.5, 0.2], [0.3, -2, 0.1], [0.4, 0.2, -3]]
+C = [[1, 0, 0], [0, 1, 0]]
+states = ["x1", "x2", "x3"]
+psi = ["0.1*sin(x1)", "0.1*sin(x2)", "0.2*tanh(x3)"]
+[nonlinearity.o]
+Q = [[-1, 0.1], [0.1, -2]]
+S = [[0.05, 0], [0, 0.05]]
+R = [[0.01, 0], [0, 0.01]]
+cross = 0.05
+[nonlinearity.n]
+sector = [0, 0.2]
+cross = 0.01
+[method]
+key = "impulsive"
+L = [[0.5, 0], [0, 0.9]]
+alpha = 2
+noise_bound = 0.05
+M = [[0, 0, 1]]
+kappa = KAPPA
+digits = 30
+"""
+
+
+@pytest.mark.parametrize(
+    ("kappa", "code"), [("4.048359213", 4), ("4.0483592135002", 1), ("4.04835", 0)]
+)
+def test_a_given_kappa_between_the_certified_and_the_true_kappa_max_is_inconclusive(
+    kappa: str, code: int
+) -> None:
+    """κ = 4.048359213 lies 5·10⁻¹⁰ below the true κ_max of (22) but above the certified one
+    (‖Ā_no‖, ‖Ā_on‖ rounded up by 2⁻³⁰ relative, ×β = 4): it was exit 1 "condition (22)
+    fails" (soundness trial, session 32). The retry with float values now also takes the
+    float norms: exit 4, no proof either way. A κ above the true κ_max is still exit 1, and
+    one well inside certifies."""
+    from obsdesign.errors import ObsdesignError
+
+    spec = load_spec_text(KAPPA_NEAR_MAX.replace("KAPPA", kappa), "k.toml")
+    try:
+        got = api.design(spec).exit_code()
+    except ObsdesignError as e:
+        got = e.exit_code
+        assert "certified κ_max ≤ 4.048359208" in e.message
+    assert got == code

@@ -262,7 +262,8 @@ def _window(
         if not (0 < kappa < kmax):
             raise Infeasible(
                 f"condition (22) fails for the given κ = {fmt_exact(kappa)}: it must lie in "
-                f"(0, κ_max) with κ_max {_below(kmax)}"
+                f"(0, κ_max) with the certified κ_max {_below(kmax)} (from κ_n rounded down "
+                "and ‖Ā_no‖, ‖Ā_on‖ rounded up until exactly proved)"
             )
     if varpi <= 0:
         # N(−ϖ) ⪯ N(−ϖ_o) for ϖ ≥ ϖ_o, so ϖ_o = 0 is still certified and keeps (26b) finite
@@ -292,6 +293,13 @@ def _window(
             "its denominator), another κ or M may help"
         )
     return kmax, kappa, varpi, T_min_r, T_max_r
+
+
+def _float_norm(X: Any) -> fmpq:
+    """‖X‖₂ in floats, as an exact rational (0 for an empty block): the value, not a bound,
+    for the retry of :func:`design_window` (λ*_no, λ*_on of Lemma 1 and (22))."""
+    F = np.asarray(to_float(X), dtype=float)
+    return Q(float(np.linalg.norm(F, 2))) if F.size else fmpq(0)
 
 
 def _below(x: fmpq) -> str:
@@ -346,15 +354,24 @@ def design_window(p: Problem) -> tuple[dict[str, Any], list[str]]:
         # κ_n (ϖ_o) is certified as a bound below (above) its float optimum: a failure that
         # the optima would not meet is no proof (stiff blocks: exit 1 through (22) or the
         # window where the spec is feasible; soundness and re-check trials, session 30)
+        # likewise ‖Ā_no‖, ‖Ā_on‖, rounded up by 2⁻³⁰ relative and more: a given κ between
+        # the certified κ_max and the true one (4.048359213 against 4.0483592135) was exit 1
+        # "condition (22) fails" (soundness trial, session 32)
+        fn_no, fn_on = _float_norm(co.Ano), _float_norm(co.Aon)
         try:
-            _window(p, Q(kn_f), Q(-ko), lam_no, lam_on, gamma, beta, lam_Mo, [])
+            _window(
+                p, Q(kn_f), Q(-ko), fn_no + data.ell_no, fn_on + data.ell_on, gamma, beta,
+                lam_Mo, [],
+            )  # fmt: skip
         except Infeasible:
             raise e from None
         raise InconclusiveError(
-            f"{e}; but not with the float optima κ_n ≈ {kn_f:.17g}, ϖ_o ≈ {-ko:.17g} in "
-            f"place of the certified κ_n = {float(kappa_n):.17g}, ϖ_o = {float(varpi):.17g} "
-            "(rounded until exactly proved, by steps relative to the blocks' data): no proof "
-            "either way (ill-conditioned Ā_n / Ā_o: entries of very different sizes)"
+            f"{e}; but not with the float values κ_n ≈ {kn_f:.17g}, ϖ_o ≈ {-ko:.17g}, "
+            f"‖Ā_no‖ ≈ {float(fn_no):.17g}, ‖Ā_on‖ ≈ {float(fn_on):.17g} in place of the "
+            f"certified κ_n = {float(kappa_n):.17g}, ϖ_o = {float(varpi):.17g}, ‖Ā_no‖ ≤ "
+            f"{float(n_no):.17g}, ‖Ā_on‖ ≤ {float(n_on):.17g} (rounded until exactly proved): "
+            "no proof either way (a given κ this close to κ_max, or ill-conditioned Ā_n / "
+            "Ā_o: entries of very different sizes)"
         ) from None
     params: dict[str, Any] = {
         "T": co.T,
