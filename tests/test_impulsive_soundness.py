@@ -804,3 +804,46 @@ def test_a_given_kappa_between_the_certified_and_the_true_kappa_max_is_inconclus
         got = e.exit_code
         assert "certified κ_max ≤ 4.048359208" in e.message
     assert got == code
+
+
+@pytest.mark.parametrize(("kappa", "code"), [("1.9499999963", 4), ("1.9500000139", 1)])
+def test_a_given_kappa_near_kappa_max_with_lipschitz_x_data(kappa: str, code: int) -> None:
+    """With `lipschitz_x`, the template's plant with ℓ = 0.1 has κ_max = 1.95 (certified
+    1.94999999436): a κ 4·10⁻⁹ below it is exit 4 (no proof either way), one 10⁻⁸ above it
+    exit 1."""
+    import re
+
+    from obsdesign.errors import ObsdesignError
+
+    t = api.template("impulsive").replace("[nonlinearity]\n", "[nonlinearity]\nlipschitz_x = 0.1\n")
+    t = re.sub(r"\[nonlinearity\.o\].*?(?=\[method\])", "", t, flags=re.S)
+    t = t.replace('kappa = "max"', f"kappa = {kappa}")
+    try:
+        got = api.design(load_spec_text(t, "lx.toml")).exit_code()
+    except ObsdesignError as e:
+        got = e.exit_code
+    assert got == code
+
+
+def test_the_float_retry_derives_lipschitz_x_block_data_from_float_norms(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The block data of `lipschitz_x` come from norm bounds rounded up; the retry that
+    tells exit 4 from exit 1 derives them again from the float norms. With the bounds
+    inflated by 10⁻³ (a stand-in for the rounding), κ = 1.9499999 below the true κ_max = 1.95
+    of the template's plant is exit 4, where the rounded data alone said exit 1."""
+    import re
+
+    from obsdesign.errors import ObsdesignError
+    from obsdesign.methods.impulsive import design as D
+
+    real = D.norm_bounds
+    monkeypatch.setattr(
+        D, "norm_bounds", lambda co: {k: v * fmpq(1001, 1000) for k, v in real(co).items()}
+    )
+    t = api.template("impulsive").replace("[nonlinearity]\n", "[nonlinearity]\nlipschitz_x = 0.1\n")
+    t = re.sub(r"\[nonlinearity\.o\].*?(?=\[method\])", "", t, flags=re.S)
+    t = t.replace('kappa = "max"', "kappa = 1.9499999")
+    with pytest.raises(ObsdesignError) as e:
+        api.design(load_spec_text(t, "lx.toml"))
+    assert e.value.exit_code == 4, e.value.message

@@ -32,7 +32,15 @@ from .coordinates import (
     rational_M,
     transform,
 )
-from .core import BlockData, Infeasible, LipschitzX, Problem, blocks_from_norms, norm_bounds
+from .core import (
+    BlockData,
+    Infeasible,
+    LipschitzX,
+    Problem,
+    blocks_from_norms,
+    norm_bounds,
+    norm_matrices,
+)
 from .dissipativity import QSR, best_rate, ssd_matrix
 from .window import (
     T_max_lower,
@@ -358,15 +366,21 @@ def design_window(p: Problem) -> tuple[dict[str, Any], list[str]]:
         # the certified κ_max and the true one (4.048359213 against 4.0483592135) was exit 1
         # "condition (22) fails" (soundness trial, session 32)
         fn_no, fn_on = _float_norm(co.Ano), _float_norm(co.Aon)
+        fdata, fk_n, fk_o = data, kn_f, ko
+        if isinstance(p.data, LipschitzX):  # the block data too, from the float norms
+            fnorms = {k: _float_norm(X) for k, X in norm_matrices(co).items()}
+            fdata = blocks_from_norms(p.data.ell, fnorms, p.m, p.A.shape[0])
+            fk_o = best_rate(Af["Ao"], fdata.qsr_o, p.optimize_scaling)[0]
+            fk_n = best_rate(Af["An"], fdata.qsr_n, p.optimize_scaling)[0]
         try:
             _window(
-                p, Q(kn_f), Q(-ko), fn_no + data.ell_no, fn_on + data.ell_on, gamma, beta,
+                p, Q(fk_n), Q(-fk_o), fn_no + fdata.ell_no, fn_on + fdata.ell_on, gamma, beta,
                 lam_Mo, [],
             )  # fmt: skip
-        except Infeasible:
+        except (Infeasible, ValueError, OverflowError):  # (a non-finite float rate)
             raise e from None
         raise InconclusiveError(
-            f"{e}; but not with the float values κ_n ≈ {kn_f:.17g}, ϖ_o ≈ {-ko:.17g}, "
+            f"{e}; but not with the float values κ_n ≈ {fk_n:.17g}, ϖ_o ≈ {-fk_o:.17g}, "
             f"‖Ā_no‖ ≈ {float(fn_no):.17g}, ‖Ā_on‖ ≈ {float(fn_on):.17g} in place of the "
             f"certified κ_n = {float(kappa_n):.17g}, ϖ_o = {float(varpi):.17g}, ‖Ā_no‖ ≤ "
             f"{float(n_no):.17g}, ‖Ā_on‖ ≤ {float(n_on):.17g} (rounded until exactly proved): "
