@@ -906,3 +906,77 @@ def test_xhat_in_cmax_undecided_or_refuted_at_the_points_of_xhat(monkeypatch, ep
     assert claim.float_ok is undecided
     assert ("undecided" in claim.detail) is undecided
     assert "0.01414213562" in claim.detail
+
+
+#: a box map r = ±1.2 (Euclidean |c|, ε_min = 0.05) against an ellipsoid X̂ off the origin
+CMIN_OUTSIDE_XHAT = """[system]
+time = "discrete"
+A = [[0.5, 1], [-0.3, 0.9]]
+C = [[1, 0]]
+[sets.X]
+type = "box"
+lower = [-1, -1]
+upper = [1, 1]
+[sets.XH]
+type = "ellipsoid"
+E = [[0.3, 0.05], [0.05, 0.25]]
+center = [0.1, -0.05]
+[method]
+key = "constrained"
+L = [0.6, 0.2]
+lambda = 0.8
+X = "X"
+Xhat = "XH"
+eps_min = 0.05
+[method.c]
+type = "box"
+lower = [-1.2, -1.2]
+upper = [1.2, 1.2]
+[method.D]
+lower = [-0.1]
+upper = [0.1]
+"""
+
+
+def test_a_point_of_cmin_outside_xhat_refutes_the_inclusion() -> None:
+    """C_min ⊂ X̂ false by 30 % was "inconclusive", exit 4: only the outer box's corners,
+    which lie outside C_min, were tried (soundness trial, session 32). A point of C_min
+    itself, found by exact bisection from the centre towards a failing corner, refutes it:
+    exit 1, the detail names the point. Checked here with Fractions."""
+    from fractions import Fraction as F
+
+    rep = api.design(api.load_spec_text(CMIN_OUTSIDE_XHAT, "c.toml"))
+    claim = next(c for c in rep.claims if c.id == "Cmin-in-Xhat")
+    assert claim.status == ClaimStatus.FAILED and rep.exit_code() == 1
+    m = re.search(r"x = \(([^,]+), ([^)]+)\) lies in C_min", claim.detail)
+    assert m is not None
+    x = [F(m[1]), F(m[2])]
+    s = [max(F(-12, 10) - xi, 0) + max(xi - F(12, 10), 0) for xi in x]
+    assert sum(si**4 for si in s) <= F(1, 400)  # |c(x)|² ≤ ε_min²
+    y = [x[0] - F(1, 10), x[1] + F(1, 20)]
+    assert F(3, 10) * y[0] ** 2 + F(1, 10) * y[0] * y[1] + F(1, 4) * y[1] ** 2 > 1  # ∉ X̂
+
+
+def test_no_witness_where_cmin_lies_in_xhat_but_its_outer_box_does_not() -> None:
+    """The disk of radius 1.98 holds C_min (its farthest points, on the diagonals, are at
+    1.963) but not the outer box's corners (2.013): the outer-set test fails, and the
+    witness search must find nothing (a false refutation would be exit 1 for a true
+    inclusion); a disk of radius 1.95 is refuted."""
+    from obsdesign.methods.constrained import claims as CL
+    from obsdesign.methods.constrained.cmap import box_map
+    from obsdesign.sets import Ellipsoid
+
+    cm = box_map(np.array([-1.2, -1.2]), np.array([1.2, 1.2]))
+    eps = Q("0.05")
+
+    def disk(r: str) -> Ellipsoid:
+        e = 1 / Q(r) ** 2
+        return Ellipsoid(
+            np.array([[e, fmpq(0)], [fmpq(0), e]], dtype=object),
+            np.array([fmpq(0)] * 2, dtype=object),
+        )
+
+    assert not CL.cmin_in_xhat(cm, eps, disk("1.98"))[0]
+    assert CL.cmin_witness(cm, eps, disk("1.98")) is None
+    w = CL.cmin_witness(cm, eps, disk("1.95"))
+    assert w is not None and cm.norm_c_sq_q(w) <= eps**2 and w[0] ** 2 + w[1] ** 2 > Q("1.95") ** 2

@@ -534,6 +534,14 @@ def _inclusions(c: Claims, o: Options, Xhat: ConvexSet, eps_min: fmpq, eps_max: 
     if not proof and worst <= 0 and hasattr(o.X, "vertices_q"):
         proof = any(not contains_q(Xhat, v) for v in o.X.vertices_q())
     if not proof:
+        w = cmin_witness(cm, eps_min, Xhat)
+        if w is not None:
+            proof = True
+            det += (
+                f"; x = ({', '.join(fmt_exact(x) for x in w)}) lies in C_min (|c(x)|² = "
+                f"{fmt_up(cm.norm_c_sq_q(w), 6)} ≤ ε_min²) and outside X̂"
+            )
+    if not proof:
         det += (
             " — not a proof that C_min ⊄ X̂: the outer set is larger than C_min (or the bound "
             "is not tight), so the inclusion is undecided (inconclusive: neither proved nor refuted)"
@@ -738,6 +746,56 @@ def box_l4_faces(
         f"support of C_min = R ⊕ {{‖d‖₄ ≤ √ε_min}} below all {G.shape[0]} faces of X̂ "
         "(Hölder, rigorous balls)"
     )
+
+
+#: bisection steps of :func:`cmin_witness` towards C_min's boundary, and the most vertices of
+#: the outer set it tries
+WITNESS_STEPS = 40
+WITNESS_VERTICES = 256
+
+
+def cmin_witness(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet) -> np.ndarray | None:
+    """A rational point of C_min = {|c| ≤ ε_min} outside X̂, refuting C_min ⊂ X̂ of
+    Assumption 3(1) (constrained-redesign paper), or None. For an affine map: from the
+    centre p of the outer set's vertices (when p ∈ C_min) towards each vertex outside X̂,
+    the last point of the segment in C_min by exact bisection (|c|² ≤ ε_min² exactly, at
+    dyadic steps). The outer-set test alone left an inclusion false by 30 % "inconclusive",
+    exit 4 (a box map's rounded corners against an ellipsoid X̂; soundness trial, session
+    32)."""
+    if not cm.affine:
+        return None
+    t = sqrt_upper(Q(eps_min))
+    V, bounded = vertices_exact(cm.G_q, np.array([h + t for h in cm.h_q], dtype=object))
+    if not bounded or not 0 < len(V) <= WITNESS_VERTICES:
+        return None
+    e2 = Q(eps_min) ** 2
+    p = np.array([sum((v[i] for v in V), fmpq(0)) / len(V) for i in range(len(V[0]))])
+    if cm.norm_c_sq_q(p) > e2:
+        return None
+    for v in V:
+        if contains_q(Xhat, v):
+            continue
+        lo, hi = fmpq(0), fmpq(1)
+        for _ in range(WITNESS_STEPS):
+            mid = (lo + hi) / 2
+            if cm.norm_c_sq_q(p + (v - p) * mid) <= e2:
+                lo = mid
+            else:
+                hi = mid
+        x = p + (v - p) * lo
+        if not contains_q(Xhat, x):
+            return _short_witness(x, cm, e2, Xhat)
+    return None
+
+
+def _short_witness(x: np.ndarray, cm: ConstraintMap, e2: fmpq, Xhat: ConvexSet) -> np.ndarray:
+    """The witness of :func:`cmin_witness` with short decimal coordinates (3 to 17 digits)
+    when those still lie in C_min and outside X̂, else itself."""
+    for d in range(3, 18):
+        xr = np.array([Q(f"{float(xi):.{d}g}") for xi in x], dtype=object)
+        if cm.norm_c_sq_q(xr) <= e2 and not contains_q(Xhat, xr):
+            return xr
+    return x
 
 
 def failure_refutes(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet) -> bool:
