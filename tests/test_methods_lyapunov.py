@@ -108,7 +108,7 @@ def test_shipped_spec_key_results_exact() -> None:
     assert rep.solver["status"] == "closed_form"
     assert rep.solver["name"] == "Lyapunov equation: numpy, one n²×n² linear system"
     assert api.method("lyapunov").summary(rep.parameters) == (
-        "lambda = 0.955, best = 0.9501, mu ≈ 2.562e+08"
+        "lambda = 0.955, best = 0.9501, mu ≤ 2.563e+08"
     )
 
 

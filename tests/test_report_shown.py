@@ -4,6 +4,8 @@ the decimal shown is not the value held (rendering trial, session 27: a certifie
 
 from __future__ import annotations
 
+from fractions import Fraction
+
 import numpy as np
 from flint import fmpq
 from hypothesis import given
@@ -73,3 +75,33 @@ def test_a_float_vector_held_as_a_list_is_shown() -> None:
     assert cell(p["w"], p.float("w")) == "≈ [0.1, 2]"
     assert cell(p["n"], p.float("n")) == "[1, 2]"
     assert item("v", p["v"], p.float("v"), ".4g") == "v = [1.5, 2.5]"
+
+
+@given(
+    st.fractions(min_value=Fraction(-(10**12)), max_value=Fraction(10**12), max_denominator=10**15),
+    st.sampled_from([".4g", ".6g", ".9g"]),
+    st.sampled_from(["up", "down"]),
+)
+def test_a_summary_item_with_a_side_is_rounded_to_that_side(
+    x: Fraction, fmt: str, side: str
+) -> None:
+    """A value shown with "≤" is at most the number printed, with "≥" at least it: T_max =
+    2.4755274e-7 was printed "T_max ≈ 2.476e-07", above the bound (soundness trial, session
+    32). A value the text shows exactly keeps "="."""
+    q = Q(x)
+    text = item("v", q, float(q), fmt, side)
+    label, rel, num = text.split(" ", 2)
+    assert label == "v"
+    if rel == "=":
+        assert Q(num) == q
+    else:
+        assert rel == ("≤" if side == "up" else "≥")
+        assert (q <= Q(num)) if side == "up" else (q >= Q(num))
+
+
+def test_the_impulsive_window_is_shown_on_its_safe_sides() -> None:
+    """T_min rounded up, T_max down, each marked: the trial's window 7.106147e-8 … 2.4755274e-7
+    (a field without a side keeps "≈")."""
+    p = Parameters({"T_min": Q("7.106147e-8"), "T_max": Q("2.4755274e-7"), "kappa": Q("1.2345678")})
+    s = get_method("impulsive").summary(p)
+    assert s == "T_min ≤ 7.107e-08, T_max ≥ 2.475e-07, κ ≈ 1.235"

@@ -113,6 +113,11 @@ class SummaryField:
     label: str
     param: str = ""
     fmt: str | None = None
+    #: "up" when the statements stay true with a larger value in its place (an upper bound
+    #: such as v_max, T_min), "down" when with a smaller one (T_max, γ): a rounded value is
+    #: then shown rounded that way, "label ≤ text" / "label ≥ text", never on its unsafe
+    #: side ("T_max ≈ 2.476e-07" for T_max = 2.4755274e-7; soundness trial, session 32)
+    side: str = ""
 
     def __post_init__(self) -> None:
         if not self.param:
@@ -281,7 +286,7 @@ class Method:
             try:
                 if isinstance(raw, (bool, str, bytes)):
                     raise TypeError("not a number")
-                out.append(item(f.label, raw, params.float(f.param), fmt))
+                out.append(item(f.label, raw, params.float(f.param), fmt, f.side))
             except (TypeError, ValueError):
                 out.append(f"{f.label} = {raw}")
         return ", ".join(out)

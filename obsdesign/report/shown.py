@@ -12,6 +12,7 @@ the number's role is not known, so the mark says that the shown decimal is round
 from __future__ import annotations
 
 import math
+import re
 from typing import Any
 
 import numpy as np
@@ -65,7 +66,31 @@ def cell(raw: Any, floats: Any, fmt: str = ".6g") -> str:
     return text if same else f"{APPROX} {text}"
 
 
-def item(label: str, raw: Any, floats: Any, fmt: str) -> str:
-    """A summary item: ``label = text`` when the text is the value, else ``label ≈ text``."""
+def item(label: str, raw: Any, floats: Any, fmt: str, side: str = "") -> str:
+    """A summary item: ``label = text`` when the text is the value, else ``label ≈ text``;
+    with ``side`` "up" ("down") an exact scalar rounded for the text is rounded up (down)
+    to ``fmt``'s digits and shown ``label ≤ text`` (``label ≥ text``)."""
     text, same = shown(raw, floats, fmt)
+    if not same and side in ("up", "down") and np.ndim(floats) == 0:
+        directed = _directed(raw, fmt, side == "up")
+        if directed is not None:
+            return f"{label} {'≤' if side == 'up' else '≥'} {directed}"
     return f"{label} {'=' if same else APPROX} {text}"
+
+
+def _directed(raw: Any, fmt: str, up: bool) -> str | None:
+    """``raw`` (exact) rounded up or down to the significant digits of ``fmt`` (".4g": 4;
+    other formats: 6), printed in ``fmt``; None for a value that is not exact and finite."""
+    from obsdesign.certify.printing import fmt_down, fmt_up
+
+    if isinstance(raw, (float, bool)) or raw is None:
+        return None
+    try:
+        q = Q(raw)
+    except (TypeError, ValueError):
+        return None
+    m = re.fullmatch(r"\.(\d+)g", fmt)
+    digits = int(m[1]) if m else 6
+    d = Q(fmt_up(q, digits) if up else fmt_down(q, digits))
+    text = format(float(d), fmt)
+    return text if Q(text) == d else str(d)

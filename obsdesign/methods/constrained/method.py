@@ -29,12 +29,12 @@ class Constrained(Method):
     plant_expressions = frozenset({"f", "h", "psi"})  # psi: refused with its own message
     required_params = _claims.REQUIRED
     summary_fields = (
-        SummaryField("γ", "gamma"),
-        SummaryField("γ_max", "gamma_max"),
-        SummaryField("δ", "delta"),
-        SummaryField("v_max"),
-        SummaryField("v_min"),
-        SummaryField("θ", "theta"),
+        SummaryField("γ", "gamma", side="down"),
+        SummaryField("γ_max", "gamma_max", side="down"),
+        SummaryField("δ", "delta", side="up"),
+        SummaryField("v_max", side="up"),
+        SummaryField("v_min", side="down"),
+        SummaryField("θ", "theta", side="up"),
     )
     summary_format = ".4g"
     sim_options = (

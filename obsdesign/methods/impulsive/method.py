@@ -33,12 +33,12 @@ class Impulsive(Method):
     plant_expressions = frozenset({"psi", "f", "h", "u"})  # f, h, u refused with its own message
     required_params = _claims.PARAM_KEYS
     summary_fields = (
-        SummaryField("T_min"),
-        SummaryField("T_max"),
+        SummaryField("T_min", side="up"),
+        SummaryField("T_max", side="down"),
         SummaryField("κ", "kappa"),
-        SummaryField("κ_n", "kappa_n"),
-        SummaryField("ϖ_o", "varpi_o"),
-        SummaryField("r_B", "ball_radius"),
+        SummaryField("κ_n", "kappa_n", side="down"),
+        SummaryField("ϖ_o", "varpi_o", side="up"),
+        SummaryField("r_B", "ball_radius", side="up"),
     )
     summary_format = ".4g"
     sim_options = (

@@ -44,11 +44,11 @@ class Lyapunov(Method):
     # (the observer can still be simulated on it)
     plant_expressions = frozenset({"f", "psi", "h"})
     summary_fields = (
-        SummaryField("lambda", "lambda"),
-        SummaryField("alpha", "alpha"),
-        SummaryField("best", "lambda_best"),
-        SummaryField("best", "alpha_best"),
-        SummaryField("mu", "mu", ".4g"),
+        SummaryField("lambda", "lambda", side="up"),
+        SummaryField("alpha", "alpha", side="down"),
+        SummaryField("best", "lambda_best", side="up"),
+        SummaryField("best", "alpha_best", side="down"),
+        SummaryField("mu", "mu", ".4g", side="up"),
     )
 
     sim_options = (

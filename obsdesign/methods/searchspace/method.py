@@ -39,9 +39,9 @@ class SearchSpace(Method):
         "eps_schedule",
     )
     summary_fields = (
-        SummaryField("L_f"),
-        SummaryField("L_h"),
-        SummaryField("‖f_u‖", "f_sup"),
+        SummaryField("L_f", side="up"),
+        SummaryField("L_h", side="up"),
+        SummaryField("‖f_u‖", "f_sup", side="up"),
         SummaryField("κ", "kappa"),
         SummaryField("ΔT", "dT", ".4g"),
         SummaryField("K", fmt=".0f"),

@@ -37,8 +37,8 @@ class SetInvariant(Method):
     summary_fields = (
         SummaryField("facets", "facets", "d"),
         SummaryField("iterations", "iterations", "d"),
-        SummaryField("certified factor", "contractivity", ".9g"),
-        SummaryField("L factor", "L_factor", ".9g"),
+        SummaryField("certified factor", "contractivity", ".9g", side="up"),
+        SummaryField("L factor", "L_factor", ".9g", side="up"),
     )
     sim_options = (
         SimOption(
