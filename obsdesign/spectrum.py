@@ -9,7 +9,8 @@ spectrum's size. Otherwise — a strongly non-normal or nearly defective matrix,
 error dynamics A − LC of a Kalman-type gain on a plant with ρ(A) ≈ 10³ (a float spectral
 radius of 15 for an exactly Schur matrix whose radius is 0.88) — the eigenvalues are computed
 from the exact entries by python-flint's ``acb_mat.eig`` (approximate QR, no error bounds) at
-:data:`PRECISIONS` bits, up to :data:`HP_MAX_N` states, until two precisions agree.
+:data:`PRECISIONS` bits, up to :data:`HP_MAX_N` states, until two precisions agree, else as
+the roots of the exact characteristic polynomial.
 
 The spectral radius (discrete time) and spectral abscissa (continuous time) bound the decay
 rates of V = eᵀPe for the error dynamics e⁺ = (A − LC)e of Section 5 of the
@@ -86,18 +87,23 @@ def spectrum(Am: fmpq_mat, Af: np.ndarray) -> Spectrum:
             return Spectrum(w, FLOAT_SOURCE, V if Vi is not None else None, Vi)
     hp = eig_hp(Am) if 0 < n <= HP_MAX_N else None
     if hp is not None:
-        return Spectrum(hp[0], f"python-flint eigenvalues at {hp[1]} bits")
+        return Spectrum(hp[0], hp[1])
     if w is None:
         w = np.linalg.eigvals(np.nan_to_num(Af))
     return Spectrum(w, FLOAT_SOURCE)
 
 
-def eig_hp(Am: fmpq_mat) -> tuple[np.ndarray, int] | None:
+def eig_hp(Am: fmpq_mat) -> tuple[np.ndarray, str] | None:
     """The eigenvalues of the exact matrix ``Am`` from python-flint's ``acb_mat.eig``
     (approximate, midpoints only) at the precisions of :data:`PRECISIONS` until two in a row
-    agree on the spectral radius and abscissa (:data:`AGREE_TOL`); the last computed when none
-    do. Returns (eigenvalues as complex floats, the precision in bits), or None when no
-    precision gives finite eigenvalues.
+    agree on the spectral radius and abscissa (:data:`AGREE_TOL`). When none do, the roots of
+    the exact characteristic polynomial (:func:`charpoly_roots`): on a 4×4 Jordan block
+    beside a complex pair ``eig`` was right at 128 bits and returned other values at 320 and
+    1024 bits (0.508 ± 0.976i for a spectrum −0.1 ± 3i, −0.5), and the last of them was
+    taken: the guide said "spectral abscissa ≈ 3.02" for a Hurwitz A − LC and skipped the
+    high-precision Lyapunov solve that certifies its rate (exit 4; soundness trial, session
+    32). Returns (eigenvalues as complex floats, where they come from, for messages), or None
+    when nothing gives finite eigenvalues.
 
     :param Am: the exact matrix (n ≥ 1)."""
     last: tuple[np.ndarray, int] | None = None
@@ -111,9 +117,29 @@ def eig_hp(Am: fmpq_mat) -> tuple[np.ndarray, int] | None:
         if not np.all(np.isfinite(w)):
             continue
         if last is not None and _agree(last[0], w):
-            return w, prec
+            return w, f"python-flint eigenvalues at {prec} bits"
         last = (w, prec)
-    return last
+    roots = charpoly_roots(Am)
+    if roots is not None:
+        return roots, CHARPOLY_SOURCE
+    return None if last is None else (last[0], f"python-flint eigenvalues at {last[1]} bits")
+
+
+#: the source of :func:`charpoly_roots`, for messages
+CHARPOLY_SOURCE = "roots of the exact characteristic polynomial"
+
+
+def charpoly_roots(Am: fmpq_mat) -> np.ndarray | None:
+    """The eigenvalues of the exact matrix ``Am`` as the roots of its exact characteristic
+    polynomial (python-flint's ``charpoly`` and ``complex_roots``: isolated with
+    multiplicities, so a defective eigenvalue is found as well as a simple one), as complex
+    floats (the balls' midpoints); None when they are not finite or flint fails."""
+    try:
+        roots = Am.charpoly().complex_roots()
+        w = np.array([complex(r.mid()) for r, m in roots for _ in range(m)], dtype=complex)
+    except (ValueError, ZeroDivisionError, OverflowError):
+        return None
+    return w if w.size == Am.nrows() and np.all(np.isfinite(w)) else None
 
 
 def _agree(a: np.ndarray, b: np.ndarray) -> bool:

@@ -1423,3 +1423,48 @@ def test_a_failed_gain_under_a_positive_definite_riccati_Q_blames_the_float_desi
     monkeypatch.setattr(ld, "riccati_retry_hp", hp)
     with pytest.raises(InconclusiveError, match="singular riccati_Q"):
         api.design(q0)
+
+
+#: continuous A − LC with spectrum −0.1 ± 3i and a 4×4 Jordan block at −0.5, in disguise
+JORDAN_CONTINUOUS = """title = "t"
+[system]
+time = "continuous"
+A = [[-1810.9, -3828.41, -3948.77, 13456.98, 8509.23, 372.17], [114.6, 244.09, 249.23, -838.02, -528.77, -20.83], [1006.4, 2122.76, 2194.42, -7503.08, -4747.08, -203.72], [611.6, 1292.82, 1331.14, -4549.46, -2878.86, -114.94], [-838.4, -1773.44, -1824.68, 6232.92, 3943.82, 158.08], [108.6, 229.18, 237.26, -808.04, -510.74, -23.96]]
+C = [[0, -0.1, 0.3, -0.2, 0.3, -0.3]]
+
+[method]
+key = "lyapunov"
+L = [[0.1], [0.1], [0.4], [-0.2], [0.4], [0.2]]
+alpha = 0.05
+"""
+#: discrete A − LC with spectrum 0.48 ± 0.64i (ρ = 0.8) and a 4×4 Jordan block at 0.5
+JORDAN_DISCRETE = """title = "t"
+[system]
+time = "discrete"
+A = [[101.2, 1999.86, -2289.4, -1394, 2404.2, -1141.86], [1291.67, 19.16, -17.43, -12910, -4945.82, 286.32], [-2726.04, -402.98, 455.76, 27318, 9929.44, -389.98], [1063.45, 303.88, -345.35, -10686, -3669.5, 67.02], [-2690.47, -264.5, 296.03, 26935, 9986.52, -463.48], [774.5, 88.1, -99, -7756, -2858, 126.4]]
+C = [[0.3, 0, 0.3, 0, 0.2, 0.2]]
+
+[method]
+key = "lyapunov"
+L = [[0], [-0.1], [0.2], [-0.5], [0.1], [0]]
+lambda = 0.9
+"""
+
+
+@pytest.mark.parametrize(
+    ("text", "rate", "bound"),
+    [(JORDAN_CONTINUOUS, "alpha", -0.1), (JORDAN_DISCRETE, "lambda", 0.8)],
+)
+def test_a_jordan_block_does_not_mislead_the_spectral_guide(
+    text: str, rate: str, bound: float
+) -> None:
+    """python-flint's eig gave values far from the spectrum at 320 and 1024 bits and the last
+    was taken: the guide put α = 0.05 (λ = 0.9) on the infeasible side, skipped the
+    high-precision Lyapunov solve, and the design ended exit 4, with "largest real part ≈
+    0.114" (spectral radius ≈ 1.04) in its message (soundness trial, session 32). The exact
+    characteristic polynomial decides now: certified, the guide at the true spectrum."""
+    rep = api.design(api.load_spec_text(text, "j.toml"))
+    assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
+    key = "spectral_abscissa" if rate == "alpha" else "spectral_radius"
+    assert rep.parameters.float(key) == pytest.approx(bound, abs=1e-6)
+    assert api.verify(rep).exit_code() == 0

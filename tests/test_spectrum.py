@@ -57,15 +57,51 @@ def test_above_the_size_limit_the_float_eigenvalues_stay(monkeypatch: pytest.Mon
     assert abs(g.bound(True) - 0.9) > 1e-6  # the poor float answer, as documented
 
 
-def test_precisions_must_agree_else_the_last_one_is_returned(
+def test_precisions_must_agree_else_the_characteristic_polynomial_decides(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
+    """Two precisions in a row must agree; when none do, the roots of the exact
+    characteristic polynomial are taken (the last precision's were, and acb_mat.eig returned
+    values far from the spectrum at 320 and 1024 bits on a Jordan block: session 32)."""
     Am = _jordan_in_disguise(fmpq(1, 2), 2, 10)
-    w, prec = eig_hp(Am)  # type: ignore[misc]
-    assert prec == spectrum.PRECISIONS[1] and np.allclose(w, 0.5, atol=1e-15)
+    w, src = eig_hp(Am)  # type: ignore[misc]
+    assert src == f"python-flint eigenvalues at {spectrum.PRECISIONS[1]} bits"
+    assert np.allclose(w, 0.5, atol=1e-15)
     monkeypatch.setattr(spectrum, "AGREE_TOL", -1.0)  # never agree
-    w, prec = eig_hp(Am)  # type: ignore[misc]
-    assert prec == spectrum.PRECISIONS[-1] and np.allclose(w, 0.5, atol=1e-15)
+    w, src = eig_hp(Am)  # type: ignore[misc]
+    assert src == spectrum.CHARPOLY_SOURCE and np.allclose(w, 0.5, atol=1e-15)
+
+
+def _jordan_beside_a_pair() -> fmpq_mat:
+    """T J T⁻¹ with J = diag(−0.1 ± 3i as a real 2×2 block, a 4×4 Jordan block at −0.5) and
+    T an integer unimodular matrix of 30 seeded elementary steps: the trial's A − LC, on
+    which acb_mat.eig at 320 and 1024 bits is far off."""
+    n = 6
+    J = [[fmpq(0)] * n for _ in range(n)]
+    J[0][0], J[0][1], J[1][0], J[1][1] = fmpq(-1, 10), fmpq(3), fmpq(-3), fmpq(-1, 10)
+    for i in range(2, 6):
+        J[i][i] = fmpq(-1, 2)
+        if i < 5:
+            J[i][i + 1] = fmpq(1)
+    T = fmpq_mat(n, n, [1 if i == j else 0 for i in range(n) for j in range(n)])
+    rng = np.random.default_rng(0)
+    for _ in range(30):
+        i, j = rng.choice(n, 2, replace=False)
+        E = fmpq_mat(n, n, [1 if a == b else 0 for a in range(n) for b in range(n)])
+        E[int(i), int(j)] = int(rng.integers(-3, 4))
+        T = T * E
+    return T * fmpq_mat(J) * T.inv()
+
+
+def test_a_jordan_block_beside_a_pair_gets_its_true_spectrum() -> None:
+    """The guide of the trial's A − LC (exact spectrum −0.1 ± 3i, −0.5 four times) is within
+    10⁻³ of it, whatever source decided (it said abscissa +3.02 before)."""
+    Am = _jordan_beside_a_pair()
+    g = spectrum.spectrum(Am, lyap.mat_float(Am))
+    assert g.bound(False) == pytest.approx(-0.1, abs=1e-3)
+    assert g.bound(True) == pytest.approx(abs(complex(-0.1, 3)), abs=1e-3)
+    w = spectrum.charpoly_roots(Am)
+    assert w is not None and sorted(np.round(w.real, 9)) == [-0.5] * 4 + [-0.1] * 2
 
 
 def test_empty_spectrum_bounds() -> None:
