@@ -841,6 +841,10 @@ def test_place_poles_the_rate_excludes_are_refused(time, rate, slow, fast) -> No
     with pytest.raises(SpecError, match=r"\[method\.poles\] pole .* cannot meet") as ei:
         load_spec_text(_designed(A, C_UO, time, extra + slow + "\n"))
     assert ei.value.exit_code == 2
+    # the way out is a slower rate: a larger λ, a smaller α (it said "a smaller lambda" in
+    # discrete time; soundness trial, session 32)
+    way = "larger lambda" if time == "discrete" else "smaller alpha"
+    assert str(ei.value).endswith(f"give faster poles or a {way}")
     rep = api.design(load_spec_text(_designed(A, C_UO, time, extra + fast + "\n")))
     assert rep.exit_code() == 0
 

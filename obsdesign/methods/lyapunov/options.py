@@ -60,7 +60,10 @@ def _poles_meet_the_rate(table: Any, poles: Any, rate: Any, discrete: bool) -> N
         raise table.error(
             "poles",
             f"pole {float(slow[0]):g} cannot meet {key} = {float(rate):g} (A − LC has it as an "
-            f"eigenvalue; {need} are needed): give faster poles or a smaller {key}",
+            f"eigenvalue; {need} are needed): give faster poles or a "
+            # a slower discrete rate is a larger λ (it said "a smaller lambda" in both times;
+            # soundness trial, session 32)
+            f"{'larger' if discrete else 'smaller'} {key}",
         )
 
 
