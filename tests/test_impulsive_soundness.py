@@ -849,3 +849,39 @@ def test_the_float_retry_derives_lipschitz_x_block_data_from_float_norms(
     with pytest.raises(ObsdesignError) as e:
         api.design(load_spec_text(t, "lx.toml"))
     assert e.value.exit_code == 4, e.value.message
+
+
+OPTIMIZE_M = """[system]
+time = "continuous"
+A = [[-2, 1, 0, 0], [0, -3, 1, 0], [0, 0, -4, 1], [1, 0, 0, -5]]
+C = [[1, 1, 0, 0], [0, 0, 1, 0]]
+states = ["x1", "x2", "x3", "x4"]
+psi = ["0.05*sin(x1)", "0", "0.05*sin(x4)", "0"]
+[nonlinearity]
+lipschitz_x = 0.05
+[method]
+kappa = KAPPA
+key = "impulsive"
+L = [0.7, 0.6]
+alpha = 5
+noise_bound = 0.01
+M = "optimize"
+digits = 12
+"""
+
+
+@pytest.mark.parametrize(("kappa", "code"), [("0.7785", 0), ("0.5", 0), ("100", 1)])
+def test_m_optimize_with_a_given_kappa_keeps_to_ms_that_admit_it(kappa: str, code: int) -> None:
+    """M = "optimize" scored an M by the window's formulas even where (22) does not admit the
+    given κ: for κ = 0.7785 it chose an M with κ_max ≈ 8·10⁻⁷, exit 1, where the M it picks
+    for κ = "max" certifies that κ (re-check trial, session 32). Such an M now scores by how
+    far (22) is from admitting κ, with the margin "max" keeps: κ = 0.7785 and 0.5 certify; κ
+    = 100, above every κ_max, is exit 1 naming the given κ."""
+    from obsdesign.errors import ObsdesignError
+
+    try:
+        got = api.design(load_spec_text(OPTIMIZE_M.replace("KAPPA", kappa), "m.toml")).exit_code()
+    except ObsdesignError as e:
+        got = e.exit_code
+        assert "for the given κ = 100" in e.message
+    assert got == code

@@ -119,6 +119,12 @@ def float_window(p: Problem, Mf: np.ndarray) -> float:
     g, beta = (float(v) for v in gamma_of(p.L))
     coup = n2(Ano) + nM * ell * nPo + beta * (n2(Aon) + nC * ell * nPn)
     kmax = kap_n - coup
+    if p.kappa not in ("max", "widest") and float(p.kappa) >= kmax * (1 - 1e-6):
+        # a given κ that (22) does not admit at this M (with the margin "max" keeps): scored
+        # by how far, so that the search moves towards an M that admits it (the window's
+        # formulas still gave it a width, and the search chose an M with κ_max ≈ 8·10⁻⁷ for
+        # κ = 0.7785, exit 1, where another M certifies it; re-check trial, session 32)
+        return kmax * (1 - 1e-6) - float(p.kappa) - 10.0
     if kmax <= 0:
         return kmax - 10.0
     kap = _kappa_float(p, max(varpi, 0.0), coup, g, kmax)
