@@ -1635,3 +1635,16 @@ def test_a_schedule_far_beyond_the_cap_is_refused_before_listing() -> None:
     est = D._steps_estimate(fmpq(2), fmpq(1), r)
     k = next(k for k in range(100) if r**k <= fmpq(1, 2))  # the rule's exact count
     assert k - 1 <= est <= 2 * k
+
+
+def test_the_entries_estimate_takes_ratios_beyond_the_float_range() -> None:
+    """γ₀/γ⋆ = 10⁴⁰⁰ at r = 3/4 needs ln(10⁴⁰⁰)/ln(4/3) ≈ 3,200 entries: the float ratio made
+    the estimate inf and the design refused it, "needs about inf entries", exit 1 (a
+    regression of the refusal beyond 10× the cap; re-check trial, session 32). Ratios and
+    gaps below the float range are estimated from their exact quotient."""
+    est = D._steps_estimate(fmpq(10**400), fmpq(1), fmpq(3, 4))
+    assert 3000 < est < 2 * 3300
+    tiny = fmpq(1, 10**400)
+    assert D._steps_estimate(1 + tiny, fmpq(1), 1 - tiny * 1000) == pytest.approx(0.001)
+    gam = D.schedule(fmpq(10**400), fmpq(1), fmpq(1), Q("0.4"))
+    assert gam[-1] == 1 and len(gam) < 10_000

@@ -298,8 +298,22 @@ def _steps_estimate(gamma0: fmpq, gamma_star: fmpq, r: fmpq) -> float:
     1/2 ≤ r < 1: between k − 1 and 2k for the k entries the rule γ_{i+1} = γ_i r needs to
     reach γ⋆ (k = ⌈ln(γ₀/γ⋆)/(−ln r)⌉, and −ln r ≥ 1 − r ≥ −r ln r) — Theorem 1,
     hypothesis 2."""
+    ratio = gamma0 / gamma_star
+    if ratio < 2 and 1 - r < fmpq(1, 10**300):  # both below the float range: their quotient
+        try:
+            return float((ratio - 1) / (1 - r))
+        except OverflowError:
+            return math.inf
+    # ln of a ratio beyond the float range from its integers (γ₀/γ⋆ = 10⁴⁰⁰ needs 2,800
+    # entries at r = 3/4, and the float ratio made it "about inf entries", exit 1; re-check
+    # trial, session 32)
+    ln = (
+        math.log1p(float(ratio - 1))
+        if ratio < 2
+        else math.log(int(ratio.p)) - math.log(int(ratio.q))
+    )
     try:
-        return math.log1p(float(gamma0 / gamma_star - 1)) / float(1 - r)
+        return ln / float(1 - r)
     except (OverflowError, ZeroDivisionError):
         return math.inf
 
