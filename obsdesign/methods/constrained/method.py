@@ -28,13 +28,16 @@ class Constrained(Method):
     needs_linear = False
     plant_expressions = frozenset({"f", "h", "psi"})  # psi: refused with its own message
     required_params = _claims.REQUIRED
+    # γ, γ_max and θ are the design's choices, used together ((22)-(24)): rounded each to
+    # a side of its own, "γ ≥ 2.396e-05 … θ ≤ 1.11e+15" broke θ-covers (re-check trial,
+    # session 32); the bounds δ, v_max, v_min are shown on their safe sides
     summary_fields = (
-        SummaryField("γ", "gamma", side="down"),
-        SummaryField("γ_max", "gamma_max", side="down"),
+        SummaryField("γ", "gamma"),
+        SummaryField("γ_max", "gamma_max"),
         SummaryField("δ", "delta", side="up"),
         SummaryField("v_max", side="up"),
         SummaryField("v_min", side="down"),
-        SummaryField("θ", "theta", side="up"),
+        SummaryField("θ", "theta"),
     )
     summary_format = ".4g"
     sim_options = (
