@@ -567,8 +567,8 @@ def _warn_above_read_limit(output: Path) -> None:
     if size > lim:
         sys.stderr.write(
             one_line(
-                f"obsdesign: warning: {output} is {size:,} bytes, above the {lim:,} that "
-                f"verify reads by default: verify it with 'obsdesign --limit "
+                f"obsdesign: warning: {output} is {size:,} bytes, above max_file_bytes = "
+                f"{lim:,}, the most verify reads: verify it with 'obsdesign --limit "
                 f"max_file_bytes={size} verify {output}'"
             )
             + "\n"
@@ -830,7 +830,8 @@ def simulate(
         from obsdesign.methods import get_method
 
         # the user's value checked first: -q hid a bad one (exit 0; docs trial, session 31)
-        get_method(sp.method).parse_sim_options({"progress": opts["progress"]})
+        with _naming_the_spec(sp.file):
+            get_method(sp.method).parse_sim_options({"progress": opts["progress"]})
         opts["progress"] = "false"
     with _naming_the_spec(sp.file):
         res = api.simulate(sp, report, options=opts, workers=workers, scheduler=scheduler)

@@ -457,6 +457,7 @@ def test_simulate_quiet_still_checks_the_progress_value() -> None:
     for extra in ([], ["-q"]):
         r = CliRunner().invoke(app, ["simulate", str(spec), "--option", "progress=maybe", *extra])
         assert r.exit_code == 2 and "--option progress" in r.stderr, (extra, r.stderr)
+        assert spec.name in r.stderr  # the spec named with -q too (re-check trial, session 32)
 
 
 def test_design_warns_when_its_report_is_above_the_read_limit(tmp_path: Path) -> None:
@@ -474,7 +475,7 @@ def test_design_warns_when_its_report_is_above_the_read_limit(tmp_path: Path) ->
     )
     size = out.stat().st_size
     assert r.exit_code == 0 and size > 3000
-    assert "above the 3,000 that verify reads" in r.stderr
+    assert "above max_file_bytes = 3,000, the most verify reads" in r.stderr
     assert f"--limit max_file_bytes={size} verify" in r.stderr
     v = CliRunner().invoke(app, ["--limit", f"max_file_bytes={size}", "verify", str(out), "-q"])
     assert v.exit_code == 0, v.output

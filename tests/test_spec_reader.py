@@ -128,3 +128,14 @@ def test_an_unknown_key_beside_the_key_it_misspells_gets_the_hint() -> None:
         SpecError, match=r"\[method.lambdaa\] is not a known key here \(did you mean 'lambda'\?\)"
     ):
         t.done()
+
+
+def test_an_unknown_key_that_differs_in_case_gets_the_hint() -> None:
+    """``[method.d]`` for ``[method.D]``: difflib finds no close match between one-letter
+    names (re-check trial, session 32); a case-only difference is named first."""
+    t = Table({"d": {}}, "s.toml", "method")
+    t.table("D")
+    with pytest.raises(
+        SpecError, match=r"\[method.d\] is not a known key here \(did you mean 'D'\?\)"
+    ):
+        t.done()

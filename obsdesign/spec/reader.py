@@ -122,7 +122,11 @@ class Table:
             # a key the table also holds is a hint too: sweep's --set method.lambdaa=… beside
             # the spec's lambda had no "did you mean" (docs trial, session 31)
             known = sorted(self._used | set(allowed_extra))
-            close = difflib.get_close_matches(unknown[0], known, n=1, cutoff=0.6)
+            # a key that differs only in case first ([method.d] for [method.D] had no hint:
+            # re-check trial, session 32)
+            close = [k for k in known if k.lower() == unknown[0].lower()] or (
+                difflib.get_close_matches(unknown[0], known, n=1, cutoff=0.6)
+            )
             hint = f" (did you mean '{close[0]}'?)" if close else ""
             raise self.error(unknown[0], f"is not a known key here{hint}")
 
