@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 from mpmath import iv
 
 from obsdesign.certify import interval
+from obsdesign.certify import interval as I
 from obsdesign.certify.interval import (
     PREC,
     bounds,
@@ -287,3 +288,25 @@ def test_log_compare_doubles_and_stops_at_max_bits(monkeypatch: pytest.MonkeyPat
     seen.clear()
     assert ivq.log_compare(near, fmpq(3, 2), 113, 4000)[0] == 1
     assert seen == [113, 226, 452, 904, 1808]
+
+
+# -- mutation review 32 (session 31's checks) ----------------------------------------
+def _width(x) -> fmpq:  # noqa: ANN001
+    lo, hi = x._mpi_
+    return raw_to_q(hi) - raw_to_q(lo)
+
+
+def test_q_to_iv_has_end_points_of_the_bits_asked() -> None:
+    third = F(1, 3)
+    assert 0 < _width(q_to_iv(third)) <= fmpq(1, 2 ** (PREC - 1))  # default PREC bits
+    assert _width(q_to_iv(third)) > fmpq(1, 2 ** (PREC + 2))
+    assert 0 < _width(q_to_iv(third, 1024)) <= fmpq(1, 2**1020)
+
+
+def test_bounds_at_more_bits_is_narrower_than_at_prec() -> None:
+    """The identity and exp of 1/3 (not a binary fraction) at 1024 bits: ≈ 2^-1024 wide."""
+    for f in (lambda x: x, iv.exp):
+        lo, hi = I.bounds(f, fmpq(1, 3), bits=1024)
+        assert lo <= hi and hi - lo < fmpq(1, 2**1000)
+        lo, hi = I.bounds(f, fmpq(1, 3))
+        assert hi - lo > fmpq(1, 2**120)

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import sys
+from types import SimpleNamespace
+
 import pytest
 import typer
 
@@ -147,3 +150,20 @@ def test_an_unraisable_keyboard_interrupt_of_a_recorded_ctrl_c_is_not_printed(ca
         sys.unraisablehook = old
     assert seen == [KeyboardInterrupt, ValueError]
     assert capsys.readouterr().err == ""
+
+
+# -- mutation review 32 (session 31's checks) ----------------------------------------
+def test_install_quiet_unraisable_installs_once_and_passes_others(monkeypatch) -> None:  # noqa: ANN001
+    seen: list = []
+    monkeypatch.setattr(sys, "unraisablehook", lambda a: seen.append(a))
+    monkeypatch.setattr(interrupt, "_requested", False)
+    interrupt.install_quiet_unraisable()
+    h = sys.unraisablehook
+    assert getattr(h, "_obsdesign_quiet", False) is True
+    interrupt.install_quiet_unraisable()
+    assert sys.unraisablehook is h  # not wrapped twice
+    h(SimpleNamespace(exc_value=ValueError("x")))
+    assert len(seen) == 1
+    monkeypatch.setattr(interrupt, "_requested", True)
+    h(SimpleNamespace(exc_value=KeyboardInterrupt()))
+    assert len(seen) == 1

@@ -7,6 +7,7 @@ import copy
 import dataclasses
 import json
 import re
+from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
@@ -15,11 +16,14 @@ from flint import fmpq
 from typer.testing import CliRunner
 
 from obsdesign import api
+from obsdesign.certify import interval as I
 from obsdesign.certify import interval as ivq
-from obsdesign.certify.claim import ClaimStatus
+from obsdesign.certify.claim import Claims, ClaimStatus
 from obsdesign.certify.exact import Q
+from obsdesign.certify.interval import iv
 from obsdesign.cli import app
 from obsdesign.errors import InfeasibleError, SpecError
+from obsdesign.methods.searchspace import claims as C
 from obsdesign.methods.searchspace import design as D
 from obsdesign.params import Parameters
 
@@ -1648,3 +1652,101 @@ def test_the_entries_estimate_takes_ratios_beyond_the_float_range() -> None:
     assert D._steps_estimate(1 + tiny, fmpq(1), 1 - tiny * 1000) == pytest.approx(0.001)
     gam = D.schedule(fmpq(10**400), fmpq(1), fmpq(1), Q("0.4"))
     assert gam[-1] == 1 and len(gam) < 10_000
+
+
+# -- mutation review 32 (session 31's checks) ----------------------------------------
+def _ceil(x: fmpq, scale: int) -> fmpq:
+    return fmpq(-((-x.p * scale) // x.q), scale)
+
+
+def _floor(x: fmpq, scale: int) -> fmpq:
+    return fmpq((x.p * scale) // x.q, scale)
+
+
+def test_follows_decides_the_upper_side_inside_the_113_bit_enclosure() -> None:
+    """Kills C23 (sure_high with e_hi: accepts an entry above the allowed maximum that lies
+    within the 113-bit enclosure) and C25 (not_high with e_lo: refuses an entry below it that
+    lies within the enclosure). γ = 1, x = 1/10: the allowed maximum is
+    e^x/2·(1 + SCHEDULE_RTOL); entries 10⁻⁴⁰ above / below it are undecided at 113 bits."""
+    g, g_star, x = fmpq(1), fmpq(1, 100), fmpq(1, 10)
+    e_lo, e_hi = I.bounds(iv.exp, x, bits=I.PREC)
+    lo, hi = I.bounds(iv.exp, x, bits=1024)
+    r = 1 + D.SCHEDULE_RTOL
+    scale = 10**40
+    above = _ceil(hi / 2 * r, scale) + fmpq(1, scale)
+    below = _floor(lo / 2 * r, scale) - fmpq(1, scale)
+    assert e_lo / 2 * r < below < above < e_hi / 2 * r  # both inside the 113-bit enclosure
+    assert C._follows(g, above, g_star, x, e_lo, e_hi)[0] is False
+    assert C._follows(g, below, g_star, x, e_lo, e_hi)[0] is True
+
+
+def test_sqrt_down_is_a_lower_bound_within_the_digits() -> None:
+    """Kills C15 (isqrt + 1: above √x) and C18 (√p/√d taken separately: not √(p/d))."""
+    for x in (Fraction(4), Fraction(2), Fraction(2, 3), Fraction(1, 10**30), Fraction(10**30, 7)):
+        for d in (4, 12, 30):
+            s = C._sqrt_down(x, d)
+            sq = Fraction(int(s.p), int(s.q)) ** 2
+            assert sq <= x, (x, d)
+            assert sq > x * (1 - Fraction(3, 10**d)), (x, d)
+    assert C._sqrt_down(Fraction(4), 12) == 2 and C._sqrt_down(Fraction(9, 4), 12) == fmpq(3, 2)
+
+
+def test_coord_marks_only_a_non_float_coordinate() -> None:
+    """Kills C13 (the ≈ mark inverted) and C14 (never marked)."""
+    assert C._coord(Fraction(1, 2)) == "0.5"
+    assert C._coord(Fraction(1, 3)) == "≈" + repr(1 / 3)
+
+
+def test_proved_above_names_both_points_of_the_pair() -> None:
+    """Kills C12 (the first point printed twice): a quotient proved between 1/2 and 1/3."""
+    proof = (Fraction(4), ((Fraction(1, 2),), (Fraction(1, 3),)))
+    text = C._proved_above("L_h", proof, Q("1.999999"))
+    assert "between (0.5) and (≈" + repr(1 / 3) + ")" in text
+    assert text.startswith("the difference quotient ≥ 2 ")
+
+
+def test_follows_undecided_at_the_bit_cap_is_none(monkeypatch) -> None:  # noqa: ANN001
+    """Kills C30/C31 (an undecided step reported as refuted / as following the rule): with
+    the cap at 113 bits an entry 10⁻⁴⁰ from e^x/2 is neither proved nor refuted."""
+    monkeypatch.setattr(C, "MAX_K_BITS", I.PREC)
+    g, g_star, x = fmpq(1), fmpq(1, 100), fmpq(1, 10)
+    e_lo, e_hi = I.bounds(iv.exp, x, bits=I.PREC)
+    lo, hi = I.bounds(iv.exp, x, bits=1024)
+    up = _ceil(hi / 2, 10**40)
+    assert e_lo / 2 < up < e_hi / 2
+    assert C._follows(g, up, g_star, x, e_lo, e_hi)[0] is None
+
+
+def test_schedule_claim_undecided_at_the_cap_is_inconclusive(monkeypatch) -> None:  # noqa: ANN001
+    """Kills C34 (an undecided step reported as false, exit 1, not inconclusive, exit 4) and
+    C30/C31 through the claim: with the cap at 113 bits, γ₁ 10⁻⁴⁰ above γ₀ e^x/2 fails as
+    not decided, its float check passing (inconclusive)."""
+    from obsdesign.certify.claim import Claims, ClaimStatus
+
+    monkeypatch.setattr(C, "MAX_K_BITS", I.PREC)
+    L_f, dtau, g_star = fmpq(1), fmpq(1, 10), fmpq(1, 100)
+    lo, hi = I.bounds(iv.exp, L_f * dtau, bits=1024)
+    up = _ceil(hi / 2, 10**40)
+    c = Claims()
+    C._schedule(c, [fmpq(1), *D.schedule(up, g_star, L_f, dtau)], g_star, L_f, dtau)
+    (claim,) = c
+    assert claim.status == ClaimStatus.FAILED
+    assert "not decided" in claim.detail
+    assert claim.float_ok is True
+
+
+# -- mutation review 32 (session 31's checks) ----------------------------------------
+def test_a_schedule_with_a_ratio_within_1e_32_of_one_doubles_past_28_digits() -> None:
+    ln2_lo, _ = I.bounds(iv.log, 2, bits=1024)
+    L_f, dtau = fmpq(1), ln2_lo - fmpq(1, 10**32)  # e^(L_f Δτ)/2 ≈ 1 − 10⁻³²
+    r = D.exp_upper(L_f * dtau) / 2
+    assert 1 - fmpq(1, 10**31) < r < 1
+    g_star = fmpq(1, 10)
+    g0 = g_star + fmpq(1, 10**30)
+    gam = D.schedule(g0, g_star, L_f, dtau)
+    assert gam[-1] == g_star and len(gam) < D.MAX_SCHEDULE
+    assert all(a > b for a, b in zip(gam, gam[1:], strict=False))
+    c = Claims()
+    C._schedule(c, gam, g_star, L_f, dtau)
+    (claim,) = c
+    assert claim.status == ClaimStatus.CERTIFIED, claim.detail

@@ -237,3 +237,112 @@ def test_the_exact_proof_runs_only_for_a_value_the_enclosure_does_not_prove(
     rep = api.design(api.load_spec_text(given, "g.toml"))
     claim = next(c for c in rep.claims if c.id == "L_h-bound")
     assert calls and claim.status.value == "failed" and "difference quotient ≥" in claim.detail
+
+
+# -- mutation review 32 (session 31's checks) ----------------------------------------
+def _ex_p(*src: str, names: tuple[str, ...] = ("x1",), params: dict | None = None) -> list:
+    from obsdesign.spec.expr import parse_expr
+
+    return [parse_expr(s, list(names), params) for s in src]
+
+
+E = ([Fraction(-1)], [Fraction(1)])
+
+
+def test_proved_lower_sq_malformed_witness_is_none_not_an_error() -> None:
+    """Kills B1 (3 points accepted: unpacking error), B3 (a point of the wrong length:
+    zip(strict) error), B4 (a nan/inf point: Fraction(nan) error)."""
+    p = np.array([0.5])
+    assert B.proved_lower_sq(_ex_p("x1"), ["x1"], ["x1"], *E, (p, p / 2, p / 4)) is None
+    assert B.proved_lower_sq(_ex_p("x1"), ["x1"], [], *E, (np.array([0.5, 0.5]),)) is None
+    assert B.proved_lower_sq(_ex_p("x1"), ["x1"], [], *E, (np.array([np.nan]),)) is None
+    assert B.proved_lower_sq(_ex_p("x1"), ["x1"], [], *E, (np.array([np.inf]),)) is None
+
+
+def test_proved_lower_sq_refuses_a_point_below_the_exact_box() -> None:
+    """Kills B6 (lower end of the box not checked). The float −0.1 lies below −1/10."""
+    box = ([Fraction(-1, 10)], [Fraction(1)])
+    assert B.proved_lower_sq(_ex_p("x1 - 3"), ["x1"], [], *box, (np.array([-0.1]),)) is None
+    assert B.proved_lower_sq(_ex_p("x1 - 3"), ["x1"], [], *box, (np.array([0.5]),)) is not None
+
+
+def test_proved_lower_sq_needs_every_held_variable_equal() -> None:
+    """Kills B15 (any → all): the pair differs in u1 (held fixed) but not in u2."""
+    names = ["x1", "u1", "u2"]
+    box = ([Fraction(-1)] * 3, [Fraction(1)] * 3)
+    ex = _ex_p("x1 + u1 + u2", names=tuple(names))
+    w = (np.array([0.5, 0.5, 0.0]), np.array([0.25, 0.0, 0.0]))
+    assert B.proved_lower_sq(ex, names, ["x1"], *box, w) is None
+
+
+def test_proved_lower_sq_shrinks_towards_the_midpoint() -> None:
+    """Kills B18 (mid = (a+b)/3) and B22 (no shrinking towards the midpoint): sin(x1 − 1)
+    between 0 and 2 has its largest slope (cos 0 = 1) at the midpoint 1; the secant gives
+    sin(1)² ≈ 0.708 and the ends cos(1)² ≈ 0.29."""
+    w = (np.array([0.0]), np.array([2.0]))
+    got = B.proved_lower_sq(_ex_p("sin(x1 - 1)"), ["x1"], ["x1"], [Fraction(0)], [Fraction(2)], w)
+    assert got is not None
+    sq, ((a,), (b,)) = got
+    assert 1 - Fraction(1, 10**9) < sq < 1
+    assert a + b == 2  # a pair shrunk around the midpoint
+
+
+def test_proved_lower_sq_keeps_the_whole_pair_when_it_is_best() -> None:
+    """Kills B28 (the witness pair itself not tried): x1 − sin(12 x1)/12 has slope
+    1 − cos(12 x1), 0 at 0, π/6 and π/3 (the pair's ends and midpoint) and average 1 over
+    [0, π/3]: only the whole pair proves ≈ 1 (every shrunk copy < 0.06)."""
+    w = (np.array([0.0]), np.array([1.0471975511965976]))
+    got = B.proved_lower_sq(
+        _ex_p("x1 - sin(12*x1)/12"), ["x1"], ["x1"], [Fraction(0)], [Fraction(2)], w
+    )
+    assert got is not None
+    sq, pts = got
+    assert sq > Fraction(99, 100)
+    assert pts == ((Fraction(0),), (Fraction(1.0471975511965976),))
+
+
+def test_proved_lower_sq_shrinks_by_exactly_ten_to_the_minus_shrink_steps() -> None:
+    """Kills B20 (the last shrink step 10⁻ᴷ dropped): for x1² the shortest secant at 3/2 is
+    the best, so the proof's pair is the witness pair shrunk by exactly 10⁻¹²."""
+    w = (np.array([1.5]), np.array([1.4999975]))
+    got = B.proved_lower_sq(_ex_p("x1^2"), ["x1"], ["x1"], [Fraction(0)], [Fraction(3, 2)], w)
+    assert got is not None
+    (a,), (b,) = got[1]
+    assert abs(a - b) == (Fraction(1.5) - Fraction(1.4999975)) / 10**B.SHRINK_STEPS
+
+
+def test_proved_lower_sq_skips_a_shrunk_pair_it_cannot_evaluate() -> None:
+    """Kills B26 (an evaluation error on a shrunk pair returns None): 1/(x1 − 1) is defined
+    at the witness 0 and 10 but not at the shrunk point 1 = 0 + (10 − 0)/10."""
+    w = (np.array([0.0]), np.array([10.0]))
+    got = B.proved_lower_sq(_ex_p("1/(x1 - 1)"), ["x1"], ["x1"], [Fraction(0)], [Fraction(10)], w)
+    assert got is not None and got[0] >= Fraction(100, 81)
+
+
+def test_proved_lower_sq_uses_the_exact_parameter_values() -> None:
+    """Kills B41 (a parameter p/q taken as q/p): k·x1 with k = 2 has quotient² 4."""
+    w = (np.array([0.5]), np.array([0.25]))
+    got = B.proved_lower_sq(_ex_p("k*x1", params={"k": 2}), ["x1"], ["x1"], *E, w)
+    assert got is not None and got[0] == 4
+
+
+def test_sup_norm_witness_is_in_the_exact_box() -> None:
+    """Kills B35 (samples not clipped into the exact box) and B37 (clipped to the outward
+    float box): E = [−1/10, 1/10] has float ends outside it; |x1 − 3| peaks at −1/10, and the
+    witness must be a point of E so that it proves something."""
+    lo, hi = [Fraction(-1, 10)], [Fraction(1, 10)]
+    s = B.sup_norm(_ex_p("x1 - 3"), ["x1"], lo, hi, 64, 1e-6)
+    assert s.witness is not None and lo[0] <= Fraction(float(s.witness[0][0])) <= hi[0]
+    assert B.proved_lower_sq(_ex_p("x1 - 3"), ["x1"], [], lo, hi, s.witness) is not None
+
+
+def test_witness_follows_the_best_sample_of_the_subdivision() -> None:
+    """Kills B33 (the witness not updated when a sub-box samples more): a narrow peak at
+    0.3371 is found only after splitting; the witness is the point of lower_est."""
+    s = B.sup_norm(
+        _ex_p("1/(1 + 100*(x1 - 0.3371)^2)"), ["x1"], [Fraction(0)], [Fraction(1)], 64, 1e-6
+    )
+    assert s.witness is not None
+    z = float(s.witness[0][0])
+    assert s.lower_est > 0.99
+    assert math.isclose(s.lower_est, 1 / (1 + 100 * (z - 0.3371) ** 2), rel_tol=1e-12)

@@ -24,6 +24,7 @@ from obsdesign.errors import (
     SpecError,
 )
 from obsdesign.methods.setinvariant import laws
+from obsdesign.methods.setinvariant.linear import _affine_dim
 from obsdesign.methods.setinvariant.spectext import spec_text as matrix_spec_text
 
 
@@ -954,3 +955,11 @@ def test_eps_vs_lam_shows_the_side_exactly() -> None:
     assert eps_vs_lam("ε", 0.5, Q("0.9")) == "ε ≈ 0.5 ≤ λ = 0.9"
     assert eps_vs_lam("ε", 0.9, Q("0.9")) == "ε = λ = 0.9 in floats"
     assert eps_vs_lam("ε", 0.95, Q("0.9")) == "ε ≈ 0.95 > λ = 0.9"
+
+
+# -- mutation review 32 (session 31's checks) ----------------------------------------
+def test_affine_dim_of_collinear_points_off_the_origin() -> None:
+    pts = [np.array([fmpq(a), fmpq(b)], dtype=object) for a, b in [(1, 0), (0, 1), (2, -1)]]
+    assert _affine_dim(pts) == 1
+    tri = [np.array([fmpq(a), fmpq(b)], dtype=object) for a, b in [(1, 1), (2, 1), (1, 2)]]
+    assert _affine_dim(tri) == 2

@@ -1721,3 +1721,34 @@ def test_the_bracket_names_the_solver_problem_its_far_end_is_infeasible_for() ->
     )
     assert "‖X‖₂ ≤ gain_bound·(1 − 10⁻⁶), gain_bound = 100" in b_small.statement
     assert small.parameters["lambda_max"] > big.parameters["lambda_bracket"][-1]
+
+
+# -- mutation review 32 (session 31's checks) ----------------------------------------
+@pytest.mark.parametrize("m", ["1", "0.5"])
+def test_discrete_infeasible_with_a_mode_not_near_one_inside_is_a_verdict(m: str) -> None:
+    text = (
+        f'[system]\ntime = "discrete"\nA = [[{m}, 0], [0, 2.6]]\nC = [[1, 1]]\n'
+        '[method]\nkey = "stubborn"\ngain_bound = 1000000\n'
+    )
+    with pytest.raises(InfeasibleError, match="does not suffice"):
+        api.design(api.load_spec_text(text, "s.toml"))
+
+
+def test_problem_text_names_r_bound_and_a_given_K() -> None:
+    """Kills S15 (the r_bound part dropped) and S16 ("the given K" dropped): the bracket's
+    statement names every constraint of the solver's problem."""
+    from types import SimpleNamespace
+
+    import numpy as np
+    from flint import fmpq
+
+    from obsdesign.methods.stubborn.claims import _problem_text
+
+    o = SimpleNamespace(margin=fmpq(1, 10**6), K=None, gain_bound=fmpq(100), r_bound=fmpq(5))
+    t = _problem_text(o, "(1)-(3)", False)
+    assert "R ⪯ r_bound·(1 − 10⁻⁶), r_bound = 5" in t and "gain_bound = 100" in t
+    o = SimpleNamespace(
+        margin=fmpq(1, 10**6), K=np.array([[1.0]]), gain_bound=fmpq(100), r_bound=None
+    )
+    t = _problem_text(o, "(7)-(9)", True)
+    assert t.endswith("the given K") and "gain_bound" not in t and "r_bound" not in t
