@@ -1523,11 +1523,12 @@ def test_a_schedule_with_a_ratio_within_1e_14_of_one_still_reaches_gamma_star() 
     design said "shrinks too slowly" (exit 1), where the rule reaches γ⋆ in about 9,000
     steps (re-check trial, session 31). More digits where 14 make no progress: it reaches γ⋆,
     strictly decreasing, and the claim certifies it."""
-    from obsdesign.certify.claim import Claims
-    from obsdesign.methods.searchspace import claims as C
+    _reaches_and_certifies(Q("0.1000000000001"), fmpq(1, 10), fmpq(1), Q("0.6931471805599452"))
 
-    L_f, dtau = fmpq(1), Q("0.6931471805599452")
-    g0, g_star = Q("0.1000000000001"), fmpq(1, 10)
+
+def _reaches_and_certifies(g0: fmpq, g_star: fmpq, L_f: fmpq, dtau: fmpq) -> None:
+    """The design's schedule from γ₀ reaches γ⋆ within the cap, strictly decreasing, and the
+    gamma-schedule claim certifies it."""
     gam = D.schedule(g0, g_star, L_f, dtau)
     assert gam[-1] == g_star and len(gam) < D.MAX_SCHEDULE
     assert all(a > b for a, b in zip(gam, gam[1:], strict=False))
@@ -1741,12 +1742,4 @@ def test_a_schedule_with_a_ratio_within_1e_32_of_one_doubles_past_28_digits() ->
     L_f, dtau = fmpq(1), ln2_lo - fmpq(1, 10**32)  # e^(L_f Δτ)/2 ≈ 1 − 10⁻³²
     r = D.exp_upper(L_f * dtau) / 2
     assert 1 - fmpq(1, 10**31) < r < 1
-    g_star = fmpq(1, 10)
-    g0 = g_star + fmpq(1, 10**30)
-    gam = D.schedule(g0, g_star, L_f, dtau)
-    assert gam[-1] == g_star and len(gam) < D.MAX_SCHEDULE
-    assert all(a > b for a, b in zip(gam, gam[1:], strict=False))
-    c = Claims()
-    C._schedule(c, gam, g_star, L_f, dtau)
-    (claim,) = c
-    assert claim.status == ClaimStatus.CERTIFIED, claim.detail
+    _reaches_and_certifies(fmpq(1, 10) + fmpq(1, 10**30), fmpq(1, 10), L_f, dtau)
