@@ -8,9 +8,9 @@ u·‖A‖_F·κ_F(V) (V the eigenvectors, κ_F(V) = ‖V‖_F‖V⁻¹‖_F; Ba
 spectrum's size. Otherwise — a strongly non-normal or nearly defective matrix, such as the
 error dynamics A − LC of a Kalman-type gain on a plant with ρ(A) ≈ 10³ (a float spectral
 radius of 15 for an exactly Schur matrix whose radius is 0.88) — the eigenvalues are computed
-from the exact entries by python-flint's ``acb_mat.eig`` (approximate QR, no error bounds) at
-:data:`PRECISIONS` bits, up to :data:`HP_MAX_N` states, until two precisions agree, else as
-the roots of the exact characteristic polynomial.
+from the exact entries, up to :data:`HP_MAX_N` states, as the roots of the exact
+characteristic polynomial (python-flint), else by ``acb_mat.eig`` at :data:`PRECISIONS` bits
+until two precisions agree.
 
 The spectral radius (discrete time) and spectral abscissa (continuous time) bound the decay
 rates of V = eᵀPe for the error dynamics e⁺ = (A − LC)e of Section 5 of the
@@ -94,18 +94,25 @@ def spectrum(Am: fmpq_mat, Af: np.ndarray) -> Spectrum:
 
 
 def eig_hp(Am: fmpq_mat) -> tuple[np.ndarray, str] | None:
-    """The eigenvalues of the exact matrix ``Am`` from python-flint's ``acb_mat.eig``
-    (approximate, midpoints only) at the precisions of :data:`PRECISIONS` until two in a row
-    agree on the spectral radius and abscissa (:data:`AGREE_TOL`). When none do, the roots of
-    the exact characteristic polynomial (:func:`charpoly_roots`): on a 4×4 Jordan block
-    beside a complex pair ``eig`` was right at 128 bits and returned other values at 320 and
-    1024 bits (0.508 ± 0.976i for a spectrum −0.1 ± 3i, −0.5), and the last of them was
-    taken: the guide said "spectral abscissa ≈ 3.02" for a Hurwitz A − LC and skipped the
-    high-precision Lyapunov solve that certifies its rate (exit 4; soundness trial, session
-    32). Returns (eigenvalues as complex floats, where they come from, for messages), or None
+    """The eigenvalues of the exact matrix ``Am``: the roots of its exact characteristic
+    polynomial (:func:`charpoly_roots`), else python-flint's ``acb_mat.eig`` (approximate,
+    midpoints only) at the precisions of :data:`PRECISIONS` until two in a row agree on the
+    spectral radius and abscissa (:data:`AGREE_TOL`), the last computed when none do.
+
+    ``acb_mat.eig`` came first until session 32, and it is not reliable beside a Jordan
+    block: on a 4×4 block next to a complex pair it was right at 128 bits and far off at 320
+    and 1024 (the guide said "spectral abscissa ≈ 3.02" for a Hurwitz A − LC, skipped the
+    high-precision Lyapunov solve and certifiable rates ended exit 4), and with a 5×5 block
+    320 and 1024 bits agreed on radius and abscissa while both misplaced the pair (radius
+    0.1875 for 0.938; soundness and re-check trials, session 32). The characteristic
+    polynomial's roots are isolated with their multiplicities, 4-54 ms at n = 24.
+    Returns (eigenvalues as complex floats, where they come from, for messages), or None
     when nothing gives finite eigenvalues.
 
     :param Am: the exact matrix (n ≥ 1)."""
+    roots = charpoly_roots(Am)
+    if roots is not None:
+        return roots, CHARPOLY_SOURCE
     last: tuple[np.ndarray, int] | None = None
     for prec in PRECISIONS:
         with ctx.workprec(prec):
@@ -119,9 +126,6 @@ def eig_hp(Am: fmpq_mat) -> tuple[np.ndarray, str] | None:
         if last is not None and _agree(last[0], w):
             return w, f"python-flint eigenvalues at {prec} bits"
         last = (w, prec)
-    roots = charpoly_roots(Am)
-    if roots is not None:
-        return roots, CHARPOLY_SOURCE
     return None if last is None else (last[0], f"python-flint eigenvalues at {last[1]} bits")
 
 

@@ -10,6 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from obsdesign import lyap, spectrum
+from obsdesign.certify.exact import Q
 from obsdesign.spectrum import FLOAT_SOURCE, Spectrum, eig_hp
 
 
@@ -39,12 +40,13 @@ def test_a_well_conditioned_matrix_keeps_its_float_eigenvalues() -> None:
 
 def test_a_defective_non_normal_matrix_takes_high_precision_eigenvalues() -> None:
     """A triple eigenvalue 0.9 in disguise: numpy's radius is off (here by more than 10⁻⁶);
-    the guide's is 0.9 to 10⁻¹², from python-flint, with no float eigenvectors."""
+    the guide's is 0.9 to 10⁻¹², from the exact characteristic polynomial (python-flint),
+    with no float eigenvectors."""
     Am = _jordan_in_disguise(fmpq(9, 10), 3, 1000)
     Af = lyap.mat_float(Am)
     assert abs(float(np.max(np.abs(np.linalg.eigvals(Af)))) - 0.9) > 1e-6
     g = spectrum.spectrum(Am, Af)
-    assert g.source.startswith("python-flint eigenvalues at") and g.V is None
+    assert g.source == spectrum.CHARPOLY_SOURCE and g.V is None
     assert g.bound(True) == pytest.approx(0.9, abs=1e-12)
     assert g.bound(False) == pytest.approx(0.9, abs=1e-12)
 
@@ -57,19 +59,21 @@ def test_above_the_size_limit_the_float_eigenvalues_stay(monkeypatch: pytest.Mon
     assert abs(g.bound(True) - 0.9) > 1e-6  # the poor float answer, as documented
 
 
-def test_precisions_must_agree_else_the_characteristic_polynomial_decides(
+def test_the_characteristic_polynomial_first_else_agreeing_precisions(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    """Two precisions in a row must agree; when none do, the roots of the exact
-    characteristic polynomial are taken (the last precision's were, and acb_mat.eig returned
-    values far from the spectrum at 320 and 1024 bits on a Jordan block: session 32)."""
+    """The exact characteristic polynomial's roots decide; without them (monkeypatched away)
+    two precisions of acb_mat.eig in a row must agree, else the last is taken."""
     Am = _jordan_in_disguise(fmpq(1, 2), 2, 10)
+    w, src = eig_hp(Am)  # type: ignore[misc]
+    assert src == spectrum.CHARPOLY_SOURCE and np.allclose(w, 0.5, atol=1e-15)
+    monkeypatch.setattr(spectrum, "charpoly_roots", lambda Am: None)
     w, src = eig_hp(Am)  # type: ignore[misc]
     assert src == f"python-flint eigenvalues at {spectrum.PRECISIONS[1]} bits"
     assert np.allclose(w, 0.5, atol=1e-15)
     monkeypatch.setattr(spectrum, "AGREE_TOL", -1.0)  # never agree
     w, src = eig_hp(Am)  # type: ignore[misc]
-    assert src == spectrum.CHARPOLY_SOURCE and np.allclose(w, 0.5, atol=1e-15)
+    assert src == f"python-flint eigenvalues at {spectrum.PRECISIONS[-1]} bits"
 
 
 def _jordan_beside_a_pair() -> fmpq_mat:
@@ -132,3 +136,25 @@ def test_the_guide_agrees_with_high_precision_eigenvalues(rows: list[list[int]],
     tol = 1e-7 * size  # a defective eigenvalue at 128 bits agrees to ~u^(1/n) of 2^-128
     assert abs(g.bound(True) - float(np.max(np.abs(w)))) <= tol
     assert abs(g.bound(False) - float(np.max(w.real))) <= tol
+
+
+#: the trial's (5/16)·T J T⁻¹, J = (−0.1 ± 3i, a 5×5 Jordan block at 0.6), T unimodular
+MISPLACED_PAIR = [
+    [53.84375, -31.09375, 13.46875, -6.40625, -17.25, 246.3125, 254.21875],
+    [-105.9375, -469.09375, -26.25, -93.8125, -190.125, 1008.71875, -471.5625],
+    [-45.875, 127.5, -11.5, 26.25, 56.5, -498.0625, -216.25],
+    [-7.8125, 1037.03125, -3.125, 207.375, 439.0625, -2943.59375, -97.5],
+    [130, 373.4375, 32.5, 74.6875, 148, -667.1875, 589.6875],
+    [-18.75, -37.5, -4.6875, -7.5, -14.375, 50.5, -86.25],
+    [5, 29.6875, 1.25, 5.9375, 12.1875, -68.75, 21.75],
+]
+
+
+def test_agreeing_precisions_that_misplace_a_pair_do_not_decide() -> None:
+    """On this matrix acb_mat.eig at 320 and 1024 bits agreed on radius and abscissa (both
+    set by the Jordan block at 0.1875) while misplacing the pair, and the guide said radius
+    0.1875 for 0.938 (re-check trial, session 32). The exact characteristic polynomial gives
+    0.938 = (5/16)·|−0.1 ± 3i|."""
+    Am = fmpq_mat([[Q(str(x)) for x in row] for row in MISPLACED_PAIR])
+    g = spectrum.spectrum(Am, lyap.mat_float(Am))
+    assert g.bound(True) == pytest.approx(abs(complex(-0.1, 3)) * 5 / 16, abs=1e-6)
