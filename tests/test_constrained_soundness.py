@@ -980,3 +980,62 @@ def test_no_witness_where_cmin_lies_in_xhat_but_its_outer_box_does_not() -> None
     assert CL.cmin_witness(cm, eps, disk("1.98")) is None
     w = CL.cmin_witness(cm, eps, disk("1.95"))
     assert w is not None and cm.norm_c_sq_q(w) <= eps**2 and w[0] ** 2 + w[1] ** 2 > Q("1.95") ** 2
+
+
+ELLIPSOID_MAP = """[system]
+time = "discrete"
+A = [[0.5, 0.1], [0, 0.5]]
+C = [[1, 0]]
+[sets.X]
+type = "box"
+lower = [-0.5, -0.5]
+upper = [0.5, 0.5]
+[sets.XH]
+XHAT
+[method]
+key = "constrained"
+L = [0.5, 0]
+lambda = 0.6
+X = "X"
+Xhat = "XH"
+eps_min = 0.04
+[method.c]
+type = "ellipsoid"
+Q = [[1, 0], [0, 1]]
+r = 1
+[method.D]
+lower = [-0.01]
+upper = [0.01]
+"""
+
+
+@pytest.mark.parametrize(
+    ("xhat", "code"),
+    [
+        ('type = "box"\nlower = [-1, -1]\nupper = [1, 1]', 1),
+        ('type = "ellipsoid"\nE = [[0.9, 0.1], [0.1, 0.7]]\ncenter = [0.05, 0]', 1),
+        ('type = "box"\nlower = [-1.1, -1.1]\nupper = [1.1, 1.1]', 0),
+    ],
+)
+def test_an_ellipsoid_map_refutes_cmin_in_xhat_by_a_point_of_cmin(xhat: str, code: int) -> None:
+    """The ellipsoid map c = max(xᵀx − 1, 0)² with ε_min = 0.04 has C_min = {xᵀx ≤ 1.2}: the
+    box [−1, 1]² misses 9.5 % of it and the off-centre ellipsoid 23 %, and both were exit 4
+    (the witness search covered affine maps only; re-check trial, session 32). A point of
+    C_min outside X̂ now refutes them, checked here exactly; the box [−1.1, 1.1]² holds C_min
+    (√1.2 ≈ 1.0954) and certifies."""
+    from fractions import Fraction as F
+
+    rep = api.design(api.load_spec_text(ELLIPSOID_MAP.replace("XHAT", xhat), "e.toml"))
+    claim = next(c for c in rep.claims if c.id == "Cmin-in-Xhat")
+    assert rep.exit_code() == code, claim.detail
+    if code == 1:
+        m = re.search(r"x = \(([^,]+), ([^)]+)\) lies in C_min", claim.detail)
+        assert m is not None
+        x = [F(m[1]), F(m[2])]
+        assert x[0] ** 2 + x[1] ** 2 <= F(6, 5)  # in C_min
+        if "box" in xhat:
+            assert max(abs(v) for v in x) > 1  # outside [−1, 1]²
+        else:
+            y = [x[0] - F(1, 20), x[1]]
+            q = F(9, 10) * y[0] ** 2 + F(1, 5) * y[0] * y[1] + F(7, 10) * y[1] ** 2
+            assert q > 1

@@ -13,6 +13,7 @@ exact or rounded in the direction that keeps the statement true
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 from typing import Any
 
@@ -22,7 +23,7 @@ from mpmath import iv
 
 from obsdesign import lyap
 from obsdesign.certify.claim import Claim, Claims, ClaimStatus
-from obsdesign.certify.exact import Q, qeye, to_float
+from obsdesign.certify.exact import Q, dyadic, qeye, to_float
 from obsdesign.certify.interval import sqrt_upper, upper
 from obsdesign.certify.linalg import ROUNDED_UP_REL
 from obsdesign.certify.printing import (
@@ -763,7 +764,7 @@ def cmin_witness(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet) -> np.ndarray
     exit 4 (a box map's rounded corners against an ellipsoid X̂; soundness trial, session
     32)."""
     if not cm.affine:
-        return None
+        return _ellipsoid_map_witness(cm, eps_min, Xhat)
     t = sqrt_upper(Q(eps_min))
     V, bounded = vertices_exact(cm.G_q, np.array([h + t for h in cm.h_q], dtype=object))
     if not bounded or not 0 < len(V) <= WITNESS_VERTICES:
@@ -785,6 +786,46 @@ def cmin_witness(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet) -> np.ndarray
         x = p + (v - p) * lo
         if not contains_q(Xhat, x):
             return _short_witness(x, cm, e2, Xhat)
+    return None
+
+
+def _ellipsoid_map_witness(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet) -> np.ndarray | None:
+    """:func:`cmin_witness` for the ellipsoid map (18), whose C_min is the ellipsoid
+    {xᵀQx ≤ r(1 + √ε_min)} around 0: along rational directions d (±e_i, ±Q⁻¹h for each face h
+    of a box / polytope X̂, ± the float axes of an ellipsoid X̂ and its centre), the last
+    point s·d in C_min by exact bisection, kept when it lies outside X̂ (an inclusion false by
+    23 % was exit 4; re-check trial, session 32)."""
+    n = cm.dim
+    dirs = [np.array([fmpq(int(i == j)) for j in range(n)], dtype=object) for i in range(n)]
+    if isinstance(Xhat, (Box, Polytope)):
+        G, _ = Xhat.h_form_q()
+        Qinv = B.qinv(cm.Q_q)
+        dirs += [Qinv @ G[j] for j in range(G.shape[0])]
+    elif isinstance(Xhat, Ellipsoid):
+        _, vecs = np.linalg.eigh(np.asarray(Xhat.E, dtype=float))
+        dirs += [np.array([Q(float(v)) for v in vecs[:, k]], dtype=object) for k in range(n)]
+        if any(x != 0 for x in Xhat.center_q):
+            dirs.append(np.array(Xhat.center_q, dtype=object))
+    e2 = Q(eps_min) ** 2
+    R = Q(cm.r_q) * (1 + 2 * sqrt_upper(Q(eps_min)))  # outside C_min at s = 1 below
+    for d0 in dirs:
+        for d in (d0, -d0):
+            quad = B.quad(cm.Q_q, d)
+            if quad <= 0:
+                continue
+            hi = Q(dyadic(math.sqrt(float(R / quad)) * 1.01 + 1e-300, 30))
+            lo = fmpq(0)
+            if cm.norm_c_sq_q(d * hi) <= e2:
+                continue
+            for _ in range(WITNESS_STEPS):
+                mid = (lo + hi) / 2
+                if cm.norm_c_sq_q(d * mid) <= e2:
+                    lo = mid
+                else:
+                    hi = mid
+            x = d * lo
+            if not contains_q(Xhat, x):
+                return _short_witness(x, cm, e2, Xhat)
     return None
 
 
