@@ -870,7 +870,12 @@ digits = 12
 """
 
 
-@pytest.mark.parametrize(("kappa", "code"), [("0.7785", 0), ("0.5", 0), ("100", 1)])
+@pytest.mark.parametrize(
+    ("kappa", "code"),
+    # 0.389275 and 0.77855 stopped at Ms whose certified κ_max was ~10⁻⁵ below κ with a
+    # 10⁻⁶ margin (second re-check trial, session 32)
+    [("0.7785", 0), ("0.5", 0), ("0.389275", 0), ("0.77855", 0), ("100", 1)],
+)
 def test_m_optimize_with_a_given_kappa_keeps_to_ms_that_admit_it(kappa: str, code: int) -> None:
     """M = "optimize" scored an M by the window's formulas even where (22) does not admit the
     given κ: for κ = 0.7785 it chose an M with κ_max ≈ 8·10⁻⁷, exit 1, where the M it picks

@@ -95,6 +95,13 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
 
 
 # -- float evaluation (used by the M search) -------------------------------------------------
+#: relative margin below the float κ_max at which :func:`float_window` takes a given κ as
+#: admitted: the certified κ_max lies up to ~10⁻⁵ below the float one (κ_n rounded down, the
+#: norms up), and a margin of 10⁻⁶ let the search stop at Ms that then failed (22) for κ =
+#: 0.389275 … 0.77855, each certified at another M (second re-check trial, session 32)
+GIVEN_KAPPA_MARGIN = 1e-3
+
+
 def float_window(p: Problem, Mf: np.ndarray) -> float:
     """Window width T_max − T_min of (26b)-(26c) in floats for a float M (``lipschitz_x``
     data); a negative score measures how far (22) is from holding. Used only to choose M.
@@ -119,12 +126,13 @@ def float_window(p: Problem, Mf: np.ndarray) -> float:
     g, beta = (float(v) for v in gamma_of(p.L))
     coup = n2(Ano) + nM * ell * nPo + beta * (n2(Aon) + nC * ell * nPn)
     kmax = kap_n - coup
-    if p.kappa not in ("max", "widest") and float(p.kappa) >= kmax * (1 - 1e-6):
-        # a given κ that (22) does not admit at this M (with the margin "max" keeps): scored
-        # by how far, so that the search moves towards an M that admits it (the window's
-        # formulas still gave it a width, and the search chose an M with κ_max ≈ 8·10⁻⁷ for
-        # κ = 0.7785, exit 1, where another M certifies it; re-check trial, session 32)
-        return kmax * (1 - 1e-6) - float(p.kappa) - 10.0
+    if p.kappa not in ("max", "widest") and float(p.kappa) >= kmax * (1 - GIVEN_KAPPA_MARGIN):
+        # a given κ that (22) does not admit at this M (with a margin for the exact rounding):
+        # scored by how far, so that the search moves towards an M that admits it (the
+        # window's formulas still gave it a width, and the search chose an M with κ_max ≈
+        # 8·10⁻⁷ for κ = 0.7785, exit 1, where another M certifies it; re-check trial,
+        # session 32)
+        return kmax * (1 - GIVEN_KAPPA_MARGIN) - float(p.kappa) - 10.0
     if kmax <= 0:
         return kmax - 10.0
     kap = _kappa_float(p, max(varpi, 0.0), coup, g, kmax)
