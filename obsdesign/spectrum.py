@@ -19,6 +19,7 @@ constrained-redesign paper (Astolfi et al., NOLCOS 2019), eq. (4)-(6).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -129,6 +130,22 @@ def eig_hp(Am: fmpq_mat) -> tuple[np.ndarray, str] | None:
     return None if last is None else (last[0], f"python-flint eigenvalues at {last[1]} bits")
 
 
+#: :func:`charpoly_roots` is skipped when n times the bits of the entries' common denominator
+#: exceeds this: a 24×24 matrix whose 7×7 block had distinct 30-bit denominators took 58-77 s
+#: (second re-check trial, session 32); a spec's A − LC has decimal and dyadic entries, whose
+#: common denominator 2^a·10^b stays a few hundred bits
+CHARPOLY_MAX_BITS = 20_000
+
+
+def _denominator_bits(Am: fmpq_mat) -> int:
+    """Bits of the least common denominator of the entries of ``Am``."""
+    d = 1
+    for i in range(Am.nrows()):
+        for j in range(Am.ncols()):
+            d = math.lcm(d, int(Am[i, j].q))
+    return d.bit_length()
+
+
 #: the source of :func:`charpoly_roots`, for messages
 CHARPOLY_SOURCE = "roots of the exact characteristic polynomial"
 
@@ -138,6 +155,8 @@ def charpoly_roots(Am: fmpq_mat) -> np.ndarray | None:
     polynomial (python-flint's ``charpoly`` and ``complex_roots``: isolated with
     multiplicities, so a defective eigenvalue is found as well as a simple one), as complex
     floats (the balls' midpoints); None when they are not finite or flint fails."""
+    if Am.nrows() * _denominator_bits(Am) > CHARPOLY_MAX_BITS:
+        return None
     try:
         roots = Am.charpoly().complex_roots()
         w = np.array([complex(r.mid()) for r, m in roots for _ in range(m)], dtype=complex)

@@ -158,3 +158,23 @@ def test_agreeing_precisions_that_misplace_a_pair_do_not_decide() -> None:
     Am = fmpq_mat([[Q(str(x)) for x in row] for row in MISPLACED_PAIR])
     g = spectrum.spectrum(Am, lyap.mat_float(Am))
     assert g.bound(True) == pytest.approx(abs(complex(-0.1, 3)) * 5 / 16, abs=1e-6)
+
+
+def test_the_characteristic_polynomial_is_skipped_for_huge_common_denominators() -> None:
+    """Distinct 40-bit denominators in a 24×24 matrix made the exact characteristic
+    polynomial's roots take a minute (second re-check trial, session 32): above
+    CHARPOLY_MAX_BITS (n × the common denominator's bits) they are skipped and acb_mat.eig
+    decides; a decimal matrix's small common denominator keeps them."""
+    n = 24
+    rng = np.random.default_rng(3)
+    odd = [
+        fmpq(int(rng.integers(-(2**40), 2**40)), int(rng.integers(2**40, 2**41)))
+        for _ in range(n * n)
+    ]
+    Am = fmpq_mat(n, n, odd)
+    assert n * spectrum._denominator_bits(Am) > spectrum.CHARPOLY_MAX_BITS
+    assert spectrum.charpoly_roots(Am) is None
+    got = eig_hp(Am)
+    assert got is not None and got[1].startswith("python-flint eigenvalues at")
+    dec = fmpq_mat(n, n, [fmpq(int(rng.integers(-999, 1000)), 1000) for _ in range(n * n)])
+    assert spectrum.charpoly_roots(dec) is not None
