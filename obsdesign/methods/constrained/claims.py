@@ -776,14 +776,7 @@ def cmin_witness(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet) -> np.ndarray
     for v in V:
         if contains_q(Xhat, v):
             continue
-        lo, hi = fmpq(0), fmpq(1)
-        for _ in range(WITNESS_STEPS):
-            mid = (lo + hi) / 2
-            if cm.norm_c_sq_q(p + (v - p) * mid) <= e2:
-                lo = mid
-            else:
-                hi = mid
-        x = p + (v - p) * lo
+        x = _last_in_cmin(cm, e2, p, v - p, fmpq(1))
         if not contains_q(Xhat, x):
             return _short_witness(x, cm, e2, Xhat)
     return None
@@ -814,19 +807,28 @@ def _ellipsoid_map_witness(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet) -> 
             if quad <= 0:
                 continue
             hi = Q(dyadic(math.sqrt(float(R / quad)) * 1.01 + 1e-300, 30))
-            lo = fmpq(0)
             if cm.norm_c_sq_q(d * hi) <= e2:
                 continue
-            for _ in range(WITNESS_STEPS):
-                mid = (lo + hi) / 2
-                if cm.norm_c_sq_q(d * mid) <= e2:
-                    lo = mid
-                else:
-                    hi = mid
-            x = d * lo
+            x = _last_in_cmin(cm, e2, d * 0, d, hi)
             if not contains_q(Xhat, x):
                 return _short_witness(x, cm, e2, Xhat)
     return None
+
+
+def _last_in_cmin(
+    cm: ConstraintMap, e2: fmpq, p: np.ndarray, d: np.ndarray, hi: fmpq
+) -> np.ndarray:
+    """p + s·d for the largest s ∈ [0, hi] found by :data:`WITNESS_STEPS` exact bisection
+    steps with |c(p + s·d)|² ≤ ε_min² = ``e2`` (p in C_min, p + hi·d outside it): a point of
+    C_min near its boundary (Assumption 3(1), constrained-redesign paper)."""
+    lo = fmpq(0)
+    for _ in range(WITNESS_STEPS):
+        mid = (lo + hi) / 2
+        if cm.norm_c_sq_q(p + d * mid) <= e2:
+            lo = mid
+        else:
+            hi = mid
+    return p + d * lo
 
 
 def _short_witness(x: np.ndarray, cm: ConstraintMap, e2: fmpq, Xhat: ConvexSet) -> np.ndarray:
