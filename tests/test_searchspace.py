@@ -6,6 +6,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import json
+import math
 import re
 from fractions import Fraction
 from pathlib import Path
@@ -1640,6 +1641,25 @@ def test_a_schedule_far_beyond_the_cap_is_refused_before_listing() -> None:
     est = D._steps_estimate(fmpq(2), fmpq(1), r)
     k = next(k for k in range(100) if r**k <= fmpq(1, 2))  # the rule's exact count
     assert k - 1 <= est <= 2 * k
+
+
+def test_a_schedule_whose_entries_need_more_digits_than_allowed_is_refused() -> None:
+    """γ₀ = γ⋆ + 2·10⁻¹²⁷ with e^(L_f Δτ)/2 = 1 − 5·10⁻¹³¹: the rule reaches γ⋆ in ~40,000
+    entries of ~134 digits, above the digits a design lists, so entries are cut to 112 digits,
+    at which γ r rounds up to γ. The design listed γ₀ alone and the claim blamed "1,024
+    significant digits" (re-check trial, session 32, F5); it is now refused before listing,
+    exit 1, with the count and the digits the rule needs. _places works below the float
+    range (a float of 1 − r was 0 there and math.log10 raised)."""
+    text = RATIO_NEAR_ONE.replace(f"gamma0 = 0.1{'0' * 126}1", f"gamma0 = 0.1{'0' * 125}2")
+    assert f"gamma0 = 0.1{'0' * 125}2" in text
+    with pytest.raises(
+        InfeasibleError, match=r"needs about 4e\+04 entries of about 133 significant digits"
+    ):
+        api.design(api.load_spec_text(text, "long.toml"))
+    assert D._places(fmpq(3, 4)) == pytest.approx(math.log10(4))
+    tiny = fmpq(1, 10**400)
+    assert D._places(1 - tiny) == pytest.approx(400)
+    assert D._most_digits(fmpq(1, 10) + tiny, fmpq(1, 10), 1 - tiny) == D.SCHEDULE_MAX_DIGITS
 
 
 def test_the_entries_estimate_takes_ratios_beyond_the_float_range() -> None:

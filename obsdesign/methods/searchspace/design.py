@@ -235,7 +235,8 @@ def schedule(gamma0: fmpq, gamma_star: fmpq, L_f: fmpq, dtau: fmpq) -> list[fmpq
     Stops early (without reaching γ⋆) when e^{L_f Δτ}/2 < 1 is not shown
     (:func:`schedule_ratio`), when SCHEDULE_MAX_DIGITS digits make no progress, or after
     MAX_SCHEDULE entries; an :class:`InfeasibleError` when the rule needs more than
-    10·MAX_SCHEDULE entries (:func:`_steps_estimate`), before listing any.
+    10·MAX_SCHEDULE entries (:func:`_steps_estimate`), or entries of more digits than
+    SCHEDULE_LONG_DIGITS where :func:`_most_digits` allows no more, before listing any.
     For L_f Δτ ≥ 1 that is known without e^{L_f Δτ} (e^x ≥ 1 + x ≥ 2), which is never
     formed there: a huge K (10¹⁵) made its 113-bit enclosure an integer of 10¹⁵ bits and
     python-flint died with SIGFPE in design and in verify (review 19)."""
@@ -257,6 +258,19 @@ def schedule(gamma0: fmpq, gamma_star: fmpq, L_f: fmpq, dtau: fmpq) -> list[fmpq
                 f"(e^(L_f Δτ)/2 ≈ 1 − {float(1 - r):.3g} per switch), beyond the "
                 f"{MAX_SCHEDULE:,} entries the design lists: a smaller K (shorter Δτ), a "
                 "larger γ⋆ or a smaller γ₀"
+            )
+        places = _places(r)
+        if most == SCHEDULE_LONG_DIGITS and places > SCHEDULE_LONG_DIGITS - 1:
+            # entries of SCHEDULE_LONG_DIGITS digits cannot decrease (an entry γ r rounded up
+            # at d digits is below γ only when 1 − r > 10^(1−d)): listed, γ₀ stalled alone and
+            # the claim blamed 1,024 digits (re-check trial, session 32: 40,000 entries of
+            # 134 digits)
+            raise InfeasibleError(
+                f"the γ schedule of Theorem 1 (hypothesis 2) needs about {est:.2g} entries of "
+                f"about {places + 3:.0f} significant digits each to go from γ₀ = "
+                f"{fmt_exact(gamma0)} to γ⋆ = {fmt_exact(gamma_star)} (e^(L_f Δτ)/2 ≈ 1 − "
+                f"{float(1 - r):.3g} per switch), beyond the {SCHEDULE_MAX_CHARS:,} digits the "
+                "design lists: a smaller K (shorter Δτ), a larger γ⋆ or a smaller γ₀"
             )
     while g != gamma_star and len(out) < MAX_SCHEDULE:
         if r is None:
@@ -289,8 +303,16 @@ def _most_digits(gamma0: fmpq, gamma_star: fmpq, r: fmpq | None) -> int:
     steps = _steps_estimate(gamma0, gamma_star, r)
     if not math.isfinite(steps):
         return SCHEDULE_LONG_DIGITS
-    need = -math.log10(float(1 - r)) + 3
+    need = _places(r) + 3
     return SCHEDULE_MAX_DIGITS if steps * need <= SCHEDULE_MAX_CHARS else SCHEDULE_LONG_DIGITS
+
+
+def _places(r: fmpq) -> float:
+    """−log₁₀(1 − r) for 1/2 ≤ r < 1, from the integers of 1 − r (a float of 1 − r is 0
+    below 10⁻³⁰⁸, where e^(L_f Δτ)/2 is still bounded below 1): about the significant digits
+    at which γ r, rounded up, is still below γ (Theorem 1, hypothesis 2)."""
+    d = 1 - r
+    return math.log10(int(d.q)) - math.log10(int(d.p))
 
 
 def _steps_estimate(gamma0: fmpq, gamma_star: fmpq, r: fmpq) -> float:
