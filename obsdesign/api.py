@@ -889,6 +889,18 @@ def _simulate_spans(
     return res
 
 
+def sim_steps(sp: Spec) -> float:
+    """The steps of one run of the bound spec ``sp``'s ``[simulate]`` table, as a float
+    (inf when it cannot hold them): the horizon in discrete time (or without ``dt``),
+    horizon / dt in continuous time."""
+    sim = sp.simulate
+    assert sim is not None
+    horizon = float(sim.horizon.f)
+    if sp.system.discrete or sim.dt is None:
+        return horizon
+    return horizon / max(float(sim.dt.f), 1e-300)
+
+
 def check_sim_memory(sp: Spec, kwargs: dict[str, Any]) -> None:
     """Refuse a simulation of the bound spec ``sp`` with the typed ``kwargs`` of ``simulate``
     that would not fit: the method's estimate (:meth:`Method.sim_bytes`; by default every
@@ -901,11 +913,7 @@ def check_sim_memory(sp: Spec, kwargs: dict[str, Any]) -> None:
     runs = kwargs.get("runs")
     if runs is None:
         runs = getattr(sim.options, "runs", None) or getattr(sp.options, "runs", None) or 1
-    horizon = float(sim.horizon.f)
-    if sp.system.discrete or sim.dt is None:
-        steps = horizon
-    else:
-        steps = horizon / max(float(sim.dt.f), 1e-300)
+    steps = sim_steps(sp)
     method = get_method(sp.method)
     need = method.sim_bytes(sp, int(runs), steps, kwargs)
     cap = limits().max_sim_bytes

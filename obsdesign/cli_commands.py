@@ -806,6 +806,22 @@ def simulate(
     if csv is not None:
         check_output(csv, force, _inputs(spec, report))
     sp = _load_spec(spec)
+    if (
+        plot is not None
+        and sp.simulate is not None
+        and api.method(sp.method).sim_grid_from_dt
+        and api.sim_steps(sp) > MAX_PLOT_POINTS
+    ):
+        from obsdesign.errors import InputError
+
+        # refused after the whole run (10⁷ steps, 40 s) until session 33; the check after
+        # the run stays for grids the horizon does not count (a run's exact length)
+        raise InputError(
+            f"{spec}: [simulate] horizon{'' if sp.system.discrete else ' / dt'} gives a "
+            f"run of about {api.sim_steps(sp):,.0f} steps, above the {MAX_PLOT_POINTS:,} grid "
+            f"points --plot {plot} takes (a shorter horizon or a larger dt; --csv writes any "
+            "length)"
+        )
     opts = _kv(option or [])
     if runs is not None or study is not None:
         from obsdesign.methods import get_method

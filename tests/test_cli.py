@@ -259,13 +259,48 @@ def test_simulate_plot_of_a_huge_run_is_refused_before_output(tmp_path: Path, mo
         "[simulate]\nhorizon = 60\nx0 = [1, 0]\nxhat0 = [0, 0]\n"
     )
     png, out = tmp_path / "p.png", tmp_path / "t.csv"
+    # 50 steps are 51 grid points: known only after the run
+    spec.write_text(spec.read_text().replace("horizon = 60", "horizon = 50"))
     r = CliRunner().invoke(app, ["simulate", str(spec), "--plot", str(png), "--csv", str(out)])
     assert r.exit_code == 2, r.output
-    assert "the run has 61 grid points, above the 50 a plot takes" in r.output
+    assert "the run has 51 grid points, above the 50 a plot takes" in r.output
     assert "final |e|" not in r.output and not png.exists() and not out.exists()
-    spec.write_text(spec.read_text().replace("horizon = 60", "horizon = 40"))
+    spec.write_text(spec.read_text().replace("horizon = 50", "horizon = 40"))
     r = CliRunner().invoke(app, ["simulate", str(spec), "--plot", str(png)])
     assert r.exit_code == 0 and png.exists()
+
+
+def test_simulate_plot_of_a_run_longer_than_the_plot_takes_is_refused_before_running(
+    tmp_path: Path, monkeypatch
+) -> None:
+    """A run whose horizon / dt is above MAX_PLOT_POINTS was simulated whole (10⁷ steps, about
+    40 s) before ``--plot`` refused it (session 32's notes): it is refused from the spec, before
+    the simulation starts, naming the steps; continuous time counts horizon / dt."""
+    from obsdesign import api, cli_commands
+
+    monkeypatch.setattr(cli_commands, "MAX_PLOT_POINTS", 50)
+
+    def no_run(*a: object, **k: object) -> None:
+        raise AssertionError("simulated")
+
+    monkeypatch.setattr(api, "simulate", no_run)
+    spec = tmp_path / "s.toml"
+    spec.write_text(
+        '[system]\ntime = "continuous"\nA = [[-1, 1], [0, -2]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\nL = [1, 0]\n'
+        "[simulate]\nhorizon = 6\ndt = 0.1\nx0 = [1, 0]\nxhat0 = [0, 0]\n"
+    )
+    png = tmp_path / "p.png"
+    r = CliRunner().invoke(app, ["simulate", str(spec), "--plot", str(png)])
+    assert r.exit_code == 2, r.output
+    assert "[simulate] horizon / dt gives a run of about 60 steps, above the 50" in r.output
+    assert "simulated" not in r.output and not png.exists()
+    # impulsive runs follow the sampling instants: horizon / dt = 1,000 steps, 369 points
+    monkeypatch.undo()
+    monkeypatch.setattr(cli_commands, "MAX_PLOT_POINTS", 500)
+    shipped = Path(__file__).parent.parent / "specs" / "impulsive-sector-3state.toml"
+    r = CliRunner().invoke(app, ["simulate", str(shipped), "--plot", str(png), "-q"])
+    assert r.exit_code == 0 and png.exists(), r.output
 
 
 def test_dash_is_not_an_output_and_runs_is_given_once(tmp_path: Path, monkeypatch) -> None:

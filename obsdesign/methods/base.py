@@ -205,6 +205,10 @@ class Method:
     summary_format: ClassVar[str] = ".6g"
     #: ``simulate --option`` keys
     sim_options: ClassVar[tuple[SimOption, ...]] = ()
+    #: a run's grid is ``[simulate]`` horizon / dt steps (discrete time: horizon), so its
+    #: length is known from the spec before the run (``simulate --plot`` refuses a long one
+    #: then); False where the grid follows the method's own sampling instead
+    sim_grid_from_dt: ClassVar[bool] = True
     #: plot hooks: ``plot_design(spec, params, path)``, ``plot_simulation(spec, result, path)``
     plot_design: Callable[..., Any] | None = None
     plot_simulation: Callable[..., Any] | None = None

@@ -30,6 +30,7 @@ class Impulsive(Method):
     Options = Options
     SimOptions = SimOptions
     extra_tables = ("nonlinearity",)
+    sim_grid_from_dt = False  # the grid follows the sampling instants
     plant_expressions = frozenset({"psi", "f", "h", "u"})  # f, h, u refused with its own message
     required_params = _claims.PARAM_KEYS
     summary_fields = (

@@ -24,6 +24,7 @@ class SearchSpace(Method):
     Options = _opts.Options
     SimOptions = _opts.SimOptions
     needs_linear = False
+    sim_grid_from_dt = False  # the grid follows the sampling instants
     plant_expressions = frozenset({"f", "h", "u"})
     required_params = (
         "L_f",
