@@ -1643,6 +1643,25 @@ def test_a_schedule_far_beyond_the_cap_is_refused_before_listing() -> None:
     assert k - 1 <= est <= 2 * k
 
 
+def test_a_given_constant_of_an_expression_beyond_the_float_range_is_refuted() -> None:
+    """h = (x1 + 2^1100) − 2^1100 is exactly x1: with a given L_h = 0.5 the float samples
+    were all inf − inf, the claim stayed numerical and the design certified 13 claims on it,
+    exit 0 (soundness trial, session 33). The exact quotient across E refutes it, and the
+    design without L_h still certifies L_h = 1."""
+    text = (
+        '[system]\ntime = "continuous"\nstates = ["x1"]\nf = ["-x1"]\n'
+        'h = ["(x1 + 2^1100) - 2^1100"]\n[method]\nkey = "search-space"\nalpha = 0.9\n'
+        "gamma_star = 0.05\ngamma0 = 1\nL_h = 0.5\n"
+        "E = {lower = [-1], upper = [1]}\nD = {lower = [0], upper = [0.5]}\n"
+    )
+    rep = api.design(api.load_spec_text(text, "big.toml"))
+    claim = next(c for c in rep.claims if c.id == "L_h-bound")
+    assert claim.status == ClaimStatus.FAILED and rep.exit_code() == 1
+    assert "the difference quotient ≥ 1 between (-1.0) and (1.0)" in claim.detail, claim.detail
+    rep = api.design(api.load_spec_text(text.replace("L_h = 0.5\n", ""), "big2.toml"))
+    assert rep.exit_code() == 0 and rep.parameters["L_h"] == 1
+
+
 def test_a_schedule_whose_entries_need_more_digits_than_allowed_is_refused() -> None:
     """γ₀ = γ⋆ + 2·10⁻¹²⁷ with e^(L_f Δτ)/2 = 1 − 5·10⁻¹³¹: the rule reaches γ⋆ in ~40,000
     entries of ~134 digits, above the digits a design lists, so entries are cut to 112 digits,

@@ -179,6 +179,28 @@ def test_bounds_keep_their_best_sample_as_witness() -> None:
     assert s.witness is not None and s.lower_est == abs(float(s.witness[0][0]) - 3) == 4
 
 
+def test_expressions_beyond_the_float_range_still_get_a_witness() -> None:
+    """h = (x1 + 2^1100) − 2^1100 is exactly x1, but every float sample is inf − inf: the
+    bound had no witness, and a given L_h = 0.5 stayed numerical, exit 0 (soundness trial,
+    session 33). The witness is then the pair across the box in the variables of the
+    quotient (the others at the midpoint), or the midpoint for a sup, and the exact
+    evaluation proves the quotient 1 (and |h| = 2 at x1 = 2 for the sup)."""
+    lo, hi = [Fraction(-1), Fraction(0)], [Fraction(1), Fraction(2)]
+    ex = _ex("(x1 + 2^1100) - 2^1100 + 0*x2", names=("x1", "x2"))
+    b = B.lipschitz(ex, ["x1", "x2"], ["x1"], lo, hi, 16, 1e-6)
+    assert b.lower_est == 0 and b.witness is not None
+    (a1, a2), (c1, c2) = (tuple(float(v) for v in w) for w in b.witness)
+    assert (a1, c1) == (-1.0, 1.0) and a2 == c2 == 1.0
+    proof = B.proved_lower_sq(ex, ["x1", "x2"], ["x1"], lo, hi, b.witness)
+    assert proof is not None and proof[0] == 1
+    s = B.sup_norm(_ex("x1*10^400/10^400 + 2"), ["x1"], [Fraction(-1)], [Fraction(1)], 16, 1e-6)
+    assert s.lower_est == 0 and s.witness is not None and float(s.witness[0][0]) == 0.0
+    proof = B.proved_lower_sq(
+        _ex("x1*10^400/10^400 + 2"), ["x1"], [], [Fraction(-1)], [Fraction(1)], s.witness
+    )
+    assert proof is not None and proof[0] == 4
+
+
 def test_proved_lower_sq_shrinks_the_pair_towards_the_derivative() -> None:
     """x1² on [0, 3/2], witness pair (1.5, 1.4999975): the secant gives 2.9999975, which
     refutes only values 10⁻⁶ below the constant 3 (a given 2.999999997 stayed numerical;

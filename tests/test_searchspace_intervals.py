@@ -1038,6 +1038,21 @@ def test_a_near_integer_exponent_literal_is_not_an_integer_power() -> None:
     assert IV.int_literal(ast.parse("x**3.0", mode="eval").body.right, "x**3.0") == 3
 
 
+def test_a_signed_integer_exponent_is_an_integer_power() -> None:
+    """``x1^(-2)`` went through exp(−2·log x1), refused for every base that may be ≤ 0 (an
+    infinite bound); a signed integer literal now takes the integer power's rule (session
+    33): on [−2, −1] the enclosure is [1/4, 1], and 2.5 with a sign is not an integer."""
+
+    def lit(text: str) -> int | None:
+        return IV.int_literal(ast.parse(text, mode="eval").body.right, text)
+
+    assert (lit("x**(-2)"), lit("x**(+3)"), lit("x**-(-4)"), lit("x**(-2.5)")) == (-2, 3, 4, None)
+    text = "x1**(-2)"
+    x = IV.Dual(IV.I(-2.0, -1.0), (IV.I(1.0, 1.0),))
+    r = IV.evaluate(ast.parse(text, mode="eval"), {"x1": x}, {}, 1, text)
+    assert r.v.lo <= 0.25 and 1.0 <= r.v.hi < 1.0 + 1e-12 and r.v.lo > 0.25 - 1e-12
+
+
 # -- mutation review 27: log / sqrt refusals and the X*X → X² branch -------------------------
 def test_log_of_the_point_zero_is_refused() -> None:
     """mutation review 27 (kills intervals.x_log__mutmut_1: `x.hi <= 0` → `x.hi < 0`). log

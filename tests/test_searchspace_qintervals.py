@@ -342,8 +342,14 @@ def test_exact_enclosures_limits_and_refusals() -> None:
     taken exactly; no source text means literals known as their doubles; an unknown
     operator, a divisor or modulus across 0 are refused."""
     third = Fraction(1, 3)
-    q = _enclose("t**65", third, third)
-    assert q.lo < third**65 < q.hi
+    # exact up to MAX_BITS bits whatever the exponent (65 went through floats until session
+    # 33, and 2^1100 overflowed them), signed exponents too; 3^4097 is beyond MAX_BITS
+    assert _enclose("t**65", third, third) == QI(third**65, third**65)
+    assert _enclose("(t + 2**1100) - 2**1100", third, third) == QI(third, third)
+    assert _enclose("t*2**(-1100)", third, third) == QI(third / 2**1100, third / 2**1100)
+    assert _enclose("t**(-3)", third, third) == QI(Fraction(27), Fraction(27))
+    q = _enclose("t**4097", third, third)
+    assert q.lo < third**4097 < q.hi
     big = Fraction(1, 2**63 + 1)  # 64 bits: 64·64 = MAX_BITS, kept exact
     assert _enclose("t**64", big, big) == QI(big**64, big**64)
     big = Fraction(1, 2**64 + 1)  # 65 bits: the float enclosure

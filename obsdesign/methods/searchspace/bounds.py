@@ -288,8 +288,8 @@ def sup_norm(
         Z = np.clip(_samples(b), inner_lo, inner_hi)
         v = _norms(_eval(exprs, names, Z))
         ok = np.flatnonzero(np.isfinite(v))
-        if not ok.size:
-            return 0.0, None
+        if not ok.size:  # no float value: the midpoint still serves the exact proof
+            return 0.0, (Z[0],)
         i = int(ok[np.argmax(v[ok])])
         return float(v[i]), (Z[i],)
 
@@ -328,7 +328,7 @@ def lipschitz(
         V = _eval(exprs, names, P)  # (2·nd, S, p)
         J = (V[: len(idx)] - V[len(idx) :]).transpose(1, 2, 0) / (2 * scale)  # (S, p, nd)
         if not np.all(np.isfinite(J)):
-            return 0.0, None
+            return 0.0, _across(b)
         _, _, vt = np.linalg.svd(J)
         v = np.zeros_like(M)
         v[:, idx] = vt[:, 0, :]
@@ -344,9 +344,22 @@ def lipschitz(
             q = _norms(d) / dist
         ok = np.flatnonzero(np.isfinite(q) & (dist > 0))
         if not ok.size:
-            return 0.0, None
+            return 0.0, _across(b)
         i = int(ok[np.argmax(q[ok])])
         return float(q[i]), (Pp[i], Pm[i])
+
+    def _across(b: Box) -> tuple[np.ndarray, np.ndarray] | None:
+        """Two points of the box (and of E) across it in the variables ``diff``, the others
+        at the midpoint: the exact proof's pair where floats give no quotient. An expression
+        that overflows floats (h = (x1 + 2^1100) − 2^1100, exactly x1) had every sample
+        inf − inf, no witness, and a given L_h = 0.5 stayed numerical, exit 0 (soundness
+        trial, session 33); its exact rational value refutes it."""
+        p = np.clip(_mid(b), inner_lo, inner_hi)
+        q = p.copy()
+        for j in idx:
+            p[j] = max(b[j].lo, inner_lo[j])
+            q[j] = min(b[j].hi, inner_hi[j])
+        return (p, q) if np.any(p != q) else None
 
     # floats inside the exact box [lo, hi] (its own float box is rounded outward)
     inner_lo = np.array([I.of_q(x).hi for x in lo])

@@ -520,7 +520,12 @@ def int_literal(node: ast.AST, src: str | None) -> int | None:
     """The integer value of a literal whose exact decimal (its source text) is an integer,
     else None. The double alone is not enough: ``t^2.0000000000000001`` parses to the
     exponent 2.0, and was enclosed as t², so u(10) ≤ 100 was certified although
-    u(10) > 100 (search-space trial, session 24)."""
+    u(10) > 100 (search-space trial, session 24). A signed literal (``t^(-2)``) counts: the
+    power then has its exact rule, not exp(k·log t), which refused every base that may be
+    ≤ 0, and 2^(-1100) is exact (soundness trial, session 33)."""
+    if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)):
+        k = int_literal(node.operand, src)
+        return None if k is None else (-k if isinstance(node.op, ast.USub) else k)
     if not isinstance(node, ast.Constant) or isinstance(node.value, bool):
         return None
     if isinstance(node.value, int):

@@ -184,8 +184,10 @@ def _qmod(a: QI, b: QI) -> QI:
 
 
 #: integer powers beyond this exponent go through the float enclosure (the exact end points
-#: of x^k grow like k digits)
-MAX_EXACT_POWER = 64
+#: of x^k grow like k digits; those of more than MAX_BITS bits do too, whatever k): 64 made
+#: 2^1100 and 10^400 float overflows, and h = (x1 + 2^1100) − 2^1100 (exactly x1) could not
+#: refute a given L_h = 0.5 (soundness trial, session 33)
+MAX_EXACT_POWER = 4096
 #: an end point whose numerator or denominator passes this many bits is widened to the
 #: enclosing float interval (rigorous), so nested powers such as ((t^64)^64)^64 cannot
 #: build numbers of millions of digits
