@@ -724,3 +724,53 @@ def test_x0_outside_D_is_warned(x0: str, warned: bool) -> None:
     assert bool(said) == warned
     if warned:
         assert f"[simulate] x0 = ({x0}, 0.2) is not in D = [-1, 1] × [-1, 1]" in said[0]
+
+
+FAR = """
+[system]
+time = "continuous"
+states = ["x1", "x2"]
+f = ["x2", "-(x1 - 1000000000)"]
+h = ["x1"]
+[method]
+key = "search-space"
+alpha = 0.9
+gamma_star = GSTAR
+gamma0 = 0.001
+E = {lower = [999999999.99, -0.01], upper = [1000000000.01, 0.01]}
+D = {lower = [999999999.995, -0.005], upper = [1000000000.005, 0.005]}
+[simulate]
+horizon = 4
+x0 = [1000000000.001, 0.0005]
+xhat0 = [0, 0]
+max_centres = 300000
+"""
+
+
+def test_cells_finer_than_the_float_spacing_of_E_are_refused_as_inconclusive() -> None:
+    """Around x1 = 10⁹ the float spacing is 1.19·10⁻⁷: cells of half-side 4.7·10⁻⁹ cannot be
+    represented, the run lost consistency (exit 1) and the message blamed the certified L_h
+    (soundness trial, session 33). The run is refused before it starts, exit 4, naming the
+    spacing (cells of about 40 spacings, γ⋆ = 10⁻⁵ with a wider E, run and keep the true
+    state: 9 s for half the horizon, so checked by hand, not here)."""
+    from obsdesign.errors import InconclusiveError
+    from obsdesign.methods.searchspace import sim as S
+
+    narrow = (
+        FAR.replace("GSTAR", "0.00000001")
+        .replace("gamma0 = 0.001", "gamma0 = 0.0000001")
+        .replace("999999999.99, -0.01", "999999999.9999975, -0.0000025")
+        .replace("1000000000.01, 0.01", "1000000000.0000025, 0.0000025")
+        .replace("999999999.995, -0.005", "999999999.999998, -0.000002")
+        .replace("1000000000.005, 0.005", "1000000000.000002, 0.000002")
+        .replace("1000000000.001, 0.0005", "1000000000.000001, 0.0000005")
+    )
+    assert narrow.count("999999999.99999") == 2 and "0.0000005]" in narrow
+    sp = api.load_spec_text(narrow, "far.toml")
+    with pytest.raises(InconclusiveError, match=r"below 16 float spacings \(1\.19e-07\) of E"):
+        api.simulate(sp)
+    o = sp.options
+    ulp = float(np.spacing(1000000000.0000025))
+    S._check_float_spacing(o, S.MIN_CELL_ULPS * ulp)  # at the threshold: runs
+    with pytest.raises(InconclusiveError):
+        S._check_float_spacing(o, S.MIN_CELL_ULPS * ulp * (1 - 1e-9))

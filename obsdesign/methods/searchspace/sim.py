@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 
 from obsdesign.certify.printing import fmt_exact
-from obsdesign.errors import InfeasibleError, InputError
+from obsdesign.errors import InconclusiveError, InfeasibleError, InputError
 from obsdesign.limits import limits
 from obsdesign.methods.searchspace.options import Options, SimOptions
 from obsdesign.params import Parameters
@@ -392,6 +392,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
             f"sampling period ΔT = {dT:.6g}: the observer takes no sample",
             stacklevel=2,
         )
+    _check_float_spacing(o, eps[min(len(eps) - 1, N // max(K, 1))] / math.sqrt(n))
     x0 = np.asarray(spec.simulate.x0.f, dtype=float).reshape(1, n)
     _warn_x0_outside_D(spec, o)
     E_lo, E_hi = o.E.lower, o.E.upper
@@ -736,6 +737,29 @@ def _diagnose(
                 "horizon Δτ < log(κ/L_h)/L_f does not hold."
             )
     return " ".join(msg)
+
+
+#: the smallest cell half-side, in float spacings of E's coordinates, that a run takes
+MIN_CELL_ULPS = 16
+
+
+def _check_float_spacing(o: Options, s: float) -> None:
+    """Refuse (exit 4) a run whose smallest cell half-side ``s`` = ε_i/√n (the finest level
+    the horizon reaches) is below MIN_CELL_ULPS float spacings of a coordinate of E: the grid
+    2sℤⁿ of Definition 7 cannot be represented there, centres round by more than a cell, and
+    the run lost consistency with a message blaming the certified L_h (E = 10⁹ ± 2.5·10⁻⁶,
+    ε⋆ = 6.7·10⁻⁹ against a spacing of 1.2·10⁻⁷; soundness trial, session 33)."""
+    big = np.maximum(np.abs(np.asarray(o.E.lower, float)), np.abs(np.asarray(o.E.upper, float)))
+    ulp = np.spacing(big)
+    j = int(np.argmax(ulp))
+    if s < MIN_CELL_ULPS * ulp[j]:
+        raise InconclusiveError(
+            f"the cells of the finest level the horizon reaches have half-side ε/√n = {s:.3g}, "
+            f"below {MIN_CELL_ULPS} float spacings ({ulp[j]:.3g}) of E's coordinate {j + 1} "
+            f"(up to {big[j]:.6g} in magnitude): float64 centres cannot represent the grid "
+            "(translate the state so that E lies near the origin, or a larger γ⋆ / shorter "
+            "horizon)"
+        )
 
 
 def _centre_outside_E(C: np.ndarray | None, x: np.ndarray, o: Options) -> str | None:
