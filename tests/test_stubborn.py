@@ -1363,27 +1363,66 @@ def test_a_slow_plant_is_no_infeasibility_verdict() -> None:
     _certified_or_inconclusive(text)
 
 
+def test_a_single_run_with_outliers_of_1e160_stays_finite() -> None:
+    """Every sample an outlier of amplitude 10¹⁶⁰: σ̄ ≈ a²‖R‖ overflowed, and the single run
+    printed nan for every metric and "leaves the float range" while the Luenberger run gave
+    |e| ≈ 6·10¹⁵⁹ (soundness trial, session 33). With the level carried as √σ̄ the run is
+    finite: σ finite, |e| about the Luenberger observer's size."""
+    text = (
+        '[system]\ntime = "discrete"\nA = [[1.2, 1, 0, 0], [0, 0.9, 0.3, 0], [0, 0, 1.05, 1], '
+        '[0.1, 0, 0, 0.5]]\nC = [[1, 0, 0, 0], [0, 0, 1, 0]]\n[method]\nkey = "stubborn"\n'
+        'criterion = "K"\ngain_bound = 10\n[simulate]\nhorizon = 20\nx0 = [1, -1, 2, 0.5]\n'
+        'xhat0 = [-3, 4, 0, 0]\n[simulate.noise]\nkind = "outliers"\namplitude = 1e160\n'
+        "rate = 1\nbound = 0\n"
+    )
+    sp = api.load_spec_text(text, "single.toml")
+    rep = api.design(sp)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        res = api.simulate(sp, rep)
+    lu = api.simulate(sp, rep, options={"observer": "luenberger"})
+    err, err_lu = np.abs(res.error).max(), np.abs(lu.error).max()
+    assert np.all(np.isfinite(res.error)) and np.all(np.isfinite(res.extra["sigma"]))
+    assert 1e158 < err < 1e162 and 1e158 < err_lu < 1e162
+    assert np.isinf(res.extra["sigma_bar"]).any()  # σ̄ itself is beyond the float range
+
+
 def test_outliers_near_the_float_range_give_inf_not_nan() -> None:
-    """Outliers of amplitude 10³⁰⁰ at every sample: the squares overflow, and the study
+    """Outliers of amplitude 10³⁰⁰ at every sample: the squares overflowed, and the study
     printed numpy's RuntimeWarnings and a NaN RMSE (inf − inf) for the stubborn observer
-    (soundness trial, session 25). The error left the float range: inf, said once."""
+    (soundness trial, session 25). Since the level is carried as √σ̄ (session 33) such runs
+    are finite and scale with the amplitude (the error dynamics are positively homogeneous:
+    e, ν → c·e, c·ν with σ̄ → c²σ̄), where σ̄ ≈ a²‖R‖ made the stubborn RMSE inf from
+    a ≈ 10¹⁵⁴ on. An error that does leave the float range (a = 1.7·10³⁰⁸) is inf, said
+    once, never NaN."""
     from obsdesign.methods.stubborn.sim import study
 
-    text = (
-        '[system]\ntime = "continuous"\nA = [[0, 1], [0, 0]]\nC = [[1, 0]]\n'
-        '[method]\nkey = "stubborn"\n[simulate]\nhorizon = 1\ndt = 0.001\nx0 = [1, 0]\n'
-        "xhat0 = [0, 0]\nsigma0 = 0\nnoise_std = 0\noutlier_rate = 1\namplitudes = [1e300]\n"
-        "runs = 2\n"
-    )
-    sp = api.load_spec_text(text, "amp.toml")
-    rep = api.design(sp)
-    with warnings.catch_warnings(record=True) as got:
-        warnings.simplefilter("always")
-        st = study(sp, rep.parameters)
-    assert not [w for w in got if issubclass(w.category, RuntimeWarning)], got
+    def run(amp: str) -> tuple[dict, list]:
+        text = (
+            '[system]\ntime = "continuous"\nA = [[0, 1], [0, 0]]\nC = [[1, 0]]\n'
+            '[method]\nkey = "stubborn"\n[simulate]\nhorizon = 1\ndt = 0.001\nx0 = [1, 0]\n'
+            f"xhat0 = [0, 0]\nsigma0 = 0\nnoise_std = 0\noutlier_rate = 1\namplitudes = [{amp}]\n"
+            "runs = 2\n"
+        )
+        sp = api.load_spec_text(text, "amp.toml")
+        rep = api.design(sp)
+        with warnings.catch_warnings(record=True) as got:
+            warnings.simplefilter("always")
+            st = study(sp, rep.parameters)
+        assert not [w for w in got if issubclass(w.category, RuntimeWarning)], got
+        return st["median_rmse"], got
+
+    big, got = run("1e300")
+    small, _ = run("1e150")
+    assert not got
+    for ob in ("luenberger", "stubborn"):
+        for x in ("x1", "x2"):
+            assert big[ob]["1e+300"][x] == pytest.approx(small[ob]["1e+150"][x] * 1e150, rel=1e-9)
+    huge, got = run("1.7e308")
     assert any("left the float range" in str(w.message) for w in got)
-    vals = [v for ob in st["median_rmse"].values() for a in ob.values() for v in a.values()]
+    vals = [v for ob in huge.values() for a in ob.values() for v in a.values()]
     assert not any(np.isnan(v) for v in vals) and np.inf in vals
+    assert huge["stubborn"]["1.7e+308"]["x1"] == np.inf
 
 
 @pytest.mark.parametrize(

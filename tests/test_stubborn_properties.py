@@ -54,7 +54,7 @@ def _noise_free_errors(g: sim.Gains, e0: np.ndarray, steps: int, dt: float) -> n
         dt,
         np.full(1, np.inf),
         np.array(True),
-        sim.default_sigma0(g, e0),
+        sim.root0_of(g, e0, None),
     )
     return e
 

@@ -21,6 +21,7 @@ dt (the measurement is sampled every dt).
 
 from __future__ import annotations
 
+import math
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -74,7 +75,7 @@ def run_errors(
     dt: float,
     levels: np.ndarray,
     adaptive: np.ndarray,
-    sigma0: float,
+    root0: Any,
     dist: Any = None,
     check: Callable[[int, int], None] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -85,17 +86,22 @@ def run_errors(
     e0: (..., n) initial errors (broadcast); nu(k0, k1) -> (k1 − k0, ..., p) the output noise
     of steps k0..k1−1; levels (..., p): constant saturation levels (inf: Luenberger);
     adaptive (...,) bool: the stubborn observer's adaptive level instead. Continuous time:
-    Heun's method with ν held over each step. Returns the RMSE of each e_i over the grid
-    points 0..steps (shape (..., n); its sum of squares kept scaled, so it neither overflows
-    nor underflows), the final e and the final σ̄ (trajectories are
-    not kept: :func:`single_run` steps one at a time to record them). ``dist(k0, k1)`` ->
+    Heun's method with ν held over each step. ``root0`` is √σ̄(0): the level is carried as
+    ρ = √σ̄ and each step's σ̄ in units of M² (M the larger of ρ and max|e_y|), so that
+    outliers of 10¹⁶⁰ do not overflow the sum of squares (σ̄ ≈ a²‖R‖ was inf for a ≥ 10¹⁵⁴
+    and the study printed an RMSE of inf where the error was 7·10¹⁵⁹; soundness trial,
+    session 33). Returns the RMSE of each e_i over the grid points 0..steps (shape (..., n);
+    its sum of squares kept scaled, so it neither overflows nor underflows), the final e and
+    the final ρ = √σ̄ (trajectories are not kept: :func:`single_run` steps one at a time to
+    record them). ``dist(k0, k1)`` ->
     (k1 − k0, n): the plant's disturbance term B_d d of steps k0..k1−1 (held over each step),
     the same for every observer (None: no disturbance). ``check(k0, steps)``, the time budget,
     is called before every chunk of steps."""
     from obsdesign.simulate.montecarlo import _scaled_add
 
     e = np.broadcast_to(e0, adaptive.shape + (g.A.shape[0],)).astype(float).copy()
-    sb = np.where(adaptive, sigma0, 0.0)
+    rho = np.where(adaptive, root0, 0.0)
+    rw = np.sqrt(g.w)
     # the sum of e² kept over the running max |e| (montecarlo._scaled_add): outliers of 1e160
     # made it inf and of 1e-200 made it 0 (re-check trial, session 29)
     sq, sc = np.zeros_like(e), np.zeros_like(e)
@@ -103,11 +109,14 @@ def run_errors(
     AT, CT, KT = g.A.T, g.C.T, g.K.T
     ad = adaptive[..., None]
 
-    def inject(e: np.ndarray, sb: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def inject(e: np.ndarray, rho: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         ey = e @ CT + v
-        sig = np.sqrt(np.maximum(sb, 0.0)[..., None] / g.w)
-        lev = np.where(ad, sig, levels)
+        lev = np.where(ad, rho[..., None] / rw, levels)  # σ_i = √(σ̄/w_i) = ρ/√w_i
         return np.clip(ey, -lev, lev) @ KT, ey
+
+    def quad(ey: np.ndarray, M: np.ndarray) -> np.ndarray:
+        u = ey / M[..., None]
+        return np.einsum("...i,ij,...j->...", u, g.R, u)  # e_yᵀRe_y / M²
 
     chunk = 2000
     for k0 in range(0, steps, chunk):
@@ -119,26 +128,27 @@ def run_errors(
         for k in range(k1 - k0):
             v = V[k]
             d = 0.0 if Dd is None else Dd[k]
-            q, ey = inject(e, sb, v)
-            ry = np.einsum("...i,ij,...j->...", ey, g.R, ey)
+            q, ey = inject(e, rho, v)
+            M = np.maximum(rho, np.max(np.abs(ey), axis=-1, initial=0.0))
+            M = np.where(M > 0, M, 1.0)
+            S = (rho / M) ** 2  # σ̄ / M²
             if g.discrete:
                 e = e @ AT - q + d
-                sb = np.where(adaptive, g.lam * sb + ry, 0.0)
+                S1 = np.maximum(g.lam * S + quad(ey, M), 0.0)
+                rho = np.where(adaptive, M * np.sqrt(S1), 0.0)
             else:
                 de1 = e @ AT - q + d
-                ds1 = -g.lam * sb + ry
+                ds1 = -g.lam * S + quad(ey, M)
                 e2 = e + dt * de1
-                s2 = np.maximum(sb + dt * ds1, 0.0)
-                q2, ey2 = inject(e2, s2, v)
-                ry2 = np.einsum("...i,ij,...j->...", ey2, g.R, ey2)
+                S2 = np.maximum(S + dt * ds1, 0.0)
+                q2, ey2 = inject(e2, M * np.sqrt(S2), v)
                 e = e + dt / 2 * (de1 + e2 @ AT - q2 + d)
-                sb = np.where(
-                    adaptive, np.maximum(sb + dt / 2 * (ds1 - g.lam * s2 + ry2), 0.0), 0.0
-                )
+                S1 = np.maximum(S + dt / 2 * (ds1 - g.lam * S2 + quad(ey2, M)), 0.0)
+                rho = np.where(adaptive, M * np.sqrt(S1), 0.0)
             _scaled_add(sq, sc, e)
     with np.errstate(invalid="ignore"):
         rmse = np.where(sc > 0, sc * np.sqrt(sq / (steps + 1)), np.where(np.isnan(sc), sc, 0.0))
-    return rmse, e, sb
+    return rmse, e, rho
 
 
 #: the time budget is looked at every this many steps of a one-run loop
@@ -192,8 +202,16 @@ def _grid(spec: Spec) -> tuple[int, float]:
 
 def default_sigma0(g: Gains, e0: np.ndarray) -> float:
     """σ̄(0) = max_i w_i (C e(0))_i²: every σ_i(0) ≥ |(C e(0))_i| (unsaturated start)."""
+    return root0_of(g, e0, None) ** 2
+
+
+def root0_of(g: Gains, e0: np.ndarray, sigma0: float | None) -> float:
+    """√σ̄(0): of the ``sigma0`` given, else max_i √w_i |(C e(0))_i| (:func:`default_sigma0`,
+    without forming the squares, which overflow for e(0) near 10¹⁶⁰)."""
+    if sigma0 is not None:
+        return math.sqrt(max(float(sigma0), 0.0))
     ey = g.C @ e0
-    return float(np.max(g.w * ey**2)) if ey.size else 0.0
+    return float(np.max(np.sqrt(g.w) * np.abs(ey))) if ey.size else 0.0
 
 
 def noise_fn(
@@ -253,16 +271,15 @@ def sigma_levels(
     nom = SimOptions(so.noise_std, 0.0, (0.0,), 1, so.sigma0)
     nu = noise_fn(rng, (), p, nom, np.zeros(()))
     V = nu(0, steps)
-    s0 = so.sigma0 if so.sigma0 is not None else default_sigma0(g, e0)
     sig = np.empty((steps, p))
-    e, sb = e0.astype(float), s0
+    e, rho = e0.astype(float), root0_of(g, e0, so.sigma0)
     for k in range(steps):  # one run: plain loop, keeps σ(t)
         if budget is not None and k % CHECK_EVERY == 0:
             budget.check(f"the nominal run of the outlier study at step {k:,} of {steps:,}")
-        _, e, sb = run_errors(
-            g, e, lambda a, b, V=V, k=k: V[k : k + 1], 1, dt, np.zeros(p), np.array(True), sb
+        _, e, rho = run_errors(
+            g, e, lambda a, b, V=V, k=k: V[k : k + 1], 1, dt, np.zeros(p), np.array(True), rho
         )
-        sig[k] = np.sqrt(max(float(sb), 0.0) / g.w)
+        sig[k] = float(rho) / np.sqrt(g.w)
     return sig, sig.mean(axis=0), sig.max(axis=0)
 
 
@@ -290,7 +307,7 @@ def study(
     levels[3] = np.inf
     adaptive = np.zeros((no, na, runs), bool)
     adaptive[3] = True
-    s0 = so.sigma0 if so.sigma0 is not None else default_sigma0(g, e0)
+    r0 = root0_of(g, e0, so.sigma0)
     # run r draws from child r of SeedSequence(seed + 1): the same numbers for any number of
     # runs (one generator for all runs made run r's numbers depend on how many there were)
     rngs = [np.random.default_rng(c) for c in np.random.SeedSequence(sim.seed + 1).spawn(runs)]
@@ -307,7 +324,7 @@ def study(
     # warnings and a NaN RMSE (inf − inf) were printed (soundness trial, session 25); such
     # an error left the float range, so its RMSE is inf, said once in words
     with np.errstate(over="ignore", invalid="ignore"):
-        rmse, _, _ = run_errors(g, e0, nu, steps, dt, levels, adaptive, s0, check=check)
+        rmse, _, _ = run_errors(g, e0, nu, steps, dt, levels, adaptive, r0, check=check)
         # (observers, amplitudes, runs, n)
     gone = ~np.isfinite(rmse)
     if gone.any():
@@ -379,17 +396,16 @@ def single_run(
         V = noise_fn(rng, (), p, so, np.asarray(10.0))(0, steps + 1)
     x, Dd = _plant(spec, steps, dt, rng, budget)
     e0 = x[0] - np.asarray(sim.xhat0.f, float)
-    s0 = so.sigma0 if so.sigma0 is not None else default_sigma0(g, e0)
     E = np.empty((steps + 1, n))
-    S = np.empty(steps + 1)
-    E[0], S[0] = e0, s0
+    S = np.empty(steps + 1)  # ρ = √σ̄
+    E[0], S[0] = e0, root0_of(g, e0, so.sigma0)
     adaptive = np.array(observer == "stubborn")
     lev = np.full(p, np.inf)
-    e, sb = e0, s0
+    e, rho = e0, S[0]
     for k in range(steps):
         if budget is not None and k % CHECK_EVERY == 0:
             budget.check(f"the {observer} observer at step {k:,} of {steps:,}")
-        _, e, sb = run_errors(
+        _, e, rho = run_errors(
             g,
             e,
             lambda a, b, k=k: V[k : k + 1],
@@ -397,13 +413,15 @@ def single_run(
             dt,
             lev,
             adaptive,
-            sb,
+            rho,
             lambda a, b, k=k: Dd[k : k + 1],
         )
-        E[k + 1], S[k + 1] = e, sb
+        E[k + 1], S[k + 1] = e, rho
     xhat = x - E
     y = x @ np.asarray(s.C.f, float).T + V
-    sig = np.sqrt(np.maximum(S, 0)[:, None] / g.w)
+    sig = S[:, None] / np.sqrt(g.w)
+    with np.errstate(over="ignore"):
+        S = S * S  # σ̄ itself (inf where it leaves the float range; σ stays finite)
     return SimResult(
         t,
         x,
