@@ -473,3 +473,25 @@ def test_width_does_not_outlive_its_command(spec: Path, tmp_path: Path):
     assert max(len(x) for x in narrow.splitlines()) <= 40
     out = _run("verify", str(report))[1]
     assert max(len(x) for x in out.splitlines()) == 100
+
+
+def test_messages_name_the_papers_as_the_docs_do(tmp_path: Path) -> None:
+    """ "paper 000" / "paper 004" are the team's folder numbers, defined nowhere a user reads:
+    the wrong-time refusals of constrained and search-space, and every search-space claim's
+    reference, printed them (docs trial, session 33). They name the authors, as the docs do."""
+    for key, time, who in (
+        ("constrained", "continuous", "Astolfi et al."),
+        ("search-space", "discrete", "Hernández & García"),
+    ):
+        spec = tmp_path / f"{key}.toml"
+        spec.write_text(
+            f'[system]\ntime = "{time}"\nA = [[0.5]]\nC = [[1]]\n[method]\nkey = "{key}"\n'
+        )
+        r = CliRunner().invoke(app, ["design", str(spec)])
+        assert r.exit_code == 2 and who in r.output and "paper 0" not in r.output, r.output
+    root = Path(__file__).parent.parent
+    r = CliRunner().invoke(
+        app, ["design", str(root / "specs" / "hernandez-garcia-example.toml"), "--format", "json"]
+    )
+    refs = {c["reference"] for c in json.loads(r.output)["claims"]}
+    assert r.exit_code == 0 and refs and not [x for x in refs if "paper 0" in x], refs

@@ -94,7 +94,7 @@ def parse_options(table: Table, spec: Spec) -> Options:
     if not s.discrete:
         raise table.error(
             "key",
-            'the constrained redesign (paper 000) is for discrete time: set [system] time = "discrete"',
+            'the constrained redesign (Astolfi et al.) is for discrete time: set [system] time = "discrete"',
         )
     n = s.n
     from obsdesign.methods.constrained.nonlinear import parse_model

@@ -37,7 +37,7 @@ from obsdesign.methods.searchspace.options import Options
 from obsdesign.params import Parameters
 from obsdesign.spec.models import Spec
 
-PAPER = "Hernández & García (paper 004)"
+PAPER = "Hernández & García"
 SCALARS = ("L_f", "L_h", "f_sup", "kappa", "gamma_star", "eps_star", "dT", "K", "dtau")
 LISTS = ("gamma_schedule", "eps_schedule")
 _SYM = {"L_f": "L_f^E", "L_h": "L_h^E", "f_sup": "‖f_u‖_E"}

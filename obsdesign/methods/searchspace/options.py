@@ -103,7 +103,7 @@ def parse_options(table: Table, spec: Spec) -> Options:
     if s.discrete:
         raise table.error(
             "key",
-            'the search-space observer (paper 004) is for continuous time: set [system] time = "continuous"',
+            'the search-space observer (Hernández & García) is for continuous time: set [system] time = "continuous"',
         )
     if s.f is None or s.h is None:
         raise table.error("key", "the search-space method needs the plant as [system] f and h")
