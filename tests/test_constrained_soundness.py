@@ -1039,3 +1039,124 @@ def test_an_ellipsoid_map_refutes_cmin_in_xhat_by_a_point_of_cmin(xhat: str, cod
             y = [x[0] - F(1, 20), x[1]]
             q = F(9, 10) * y[0] ** 2 + F(1, 5) * y[0] * y[1] + F(7, 10) * y[1] ** 2
             assert q > 1
+
+
+# -- mutation review 33 (session 32's checks) ----------------------------------------
+def _q(rows):
+    return np.array([[Q(x) for x in r] for r in rows], dtype=object)
+
+
+def test_no_witness_when_cmin_is_empty() -> None:
+    """x ≤ −0.095 and x ≥ 0.095 (|y| ≤ 1), ε_min = 0.01: every point has
+    Σ φ_i⁺⁴ ≥ 2·0.095⁴ > ε_min², so C_min is empty (and lies in any X̂), while the outer
+    polytope {φ_i ≤ √ε_min = 0.1} is the strip |x| ≤ 0.005: its vertices' centre (0, 0) is
+    not in C_min, and no witness may be returned (kills C03: without the centre check the
+    bisection never leaves p and p itself, outside C_min, was returned)."""
+    G = _q([["1", "0"], ["-1", "0"], ["0", "1"], ["0", "-1"]])
+    h = np.array([Q("-0.095"), Q("-0.095"), Q(1), Q(1)], dtype=object)
+    cm = polytope_map(G, h)
+    eps = Q("0.01")
+    far = Box(np.array([Q(5), Q(5)], dtype=object), np.array([Q(6), Q(6)], dtype=object))
+    w = CL.cmin_witness(cm, eps, far)
+    assert w is None or cm.norm_c_sq_q(w) <= eps**2
+
+
+def test_last_in_cmin_returns_a_point_of_cmin_next_to_the_boundary() -> None:
+    """_last_in_cmin from the centre of the box map [−1.2, 1.2]² (ε_min = 0.05) towards
+    (3, 3): the point returned lies in C_min exactly (kills L03, which returned the last
+    point *outside* C_min; cmin_witness hid it because _short_witness re-checks the rounded
+    points) and a step 2⁻³⁰ further out does not."""
+    cm = box_map(np.array([-1.2, -1.2]), np.array([1.2, 1.2]))
+    e2 = Q("0.05") ** 2
+    p = np.array([fmpq(0), fmpq(0)], dtype=object)
+    d = np.array([Q(3), Q(3)], dtype=object)
+    x = CL._last_in_cmin(cm, e2, p, d, fmpq(1))
+    assert cm.norm_c_sq_q(x) <= e2
+    s = x[0] / 3
+    assert cm.norm_c_sq_q(d * (s + fmpq(1, 2**30))) > e2
+
+
+def test_short_witness_keeps_the_exact_point_when_no_rounding_works() -> None:
+    """A witness x of C_min outside X̂ whose every 3..17-digit rounding leaves C_min or enters
+    X̂ comes back unchanged; and one that rounds well comes back short, in C_min and
+    outside X̂ (kills S01-S03, S06 at unit level)."""
+    cm = box_map(np.array([-1, -1]), np.array([1, 1]))
+    e2 = Q("0.01") ** 2  # C_min: |x_i| ≤ 1 + 0.1 per coordinate, rounded corners
+    # X̂ = the disk of radius 1.0502: (1.0504, 0) lies in C_min, outside X̂, and its 3-digit
+    # rounding (1.05, 0) lies inside X̂ (S02 returned it)
+    e = 1 / Q("1.0502") ** 2
+    disk = Ellipsoid(_q([[e, 0], [0, e]]), np.array([fmpq(0)] * 2, dtype=object))
+    x = np.array([Q("1.05040000000000000000001"), fmpq(0)], dtype=object)
+    assert cm.norm_c_sq_q(x) <= e2
+    xr = CL._short_witness(x, cm, e2, disk)
+    assert cm.norm_c_sq_q(xr) <= e2 and not CL.contains_q(disk, xr)
+    assert list(xr) == [Q("1.0504"), fmpq(0)]  # the shortest such rounding (5 digits)
+    # a point just inside X̂ (no witness): whatever comes back must not be claimed short
+    y = np.array([Q("1.0499999999999999999999"), fmpq(0)], dtype=object)
+    assert CL.contains_q(disk, y)
+    yr = CL._short_witness(y, cm, e2, disk)
+    assert all(a == b for a, b in zip(yr, y, strict=True))
+
+
+def test_ellipsoid_map_witness_on_the_negative_side_only() -> None:
+    """Ellipsoid map c = max(xᵀx − 1, 0)², ε_min = 0.04: C_min = {xᵀx ≤ 1.2} (radius
+    1.0954). X̂ = the disk of radius 1.12 centred at (0.2, 0) holds C_min's points along +e1,
+    ±e2 and its centre's direction, but not (−1.0954, 0): only a negative direction refutes
+    (kills E04, which tried d0 alone)."""
+    from obsdesign.methods.constrained.cmap import ellipsoid_map
+
+    cm = ellipsoid_map(_q([[1, 0], [0, 1]]), Q(1))
+    eps = Q("0.04")
+    e = 1 / Q("1.12") ** 2
+    xh = Ellipsoid(_q([[e, 0], [0, e]]), np.array([Q("0.2"), fmpq(0)], dtype=object))
+    w = CL.cmin_witness(cm, eps, xh)
+    assert w is not None
+    assert cm.norm_c_sq_q(w) <= eps**2 and not CL.contains_q(xh, w)
+    assert w[0] < 0
+
+
+def test_ellipsoid_map_witness_along_a_box_face_normal() -> None:
+    """Q = [[2, 1.8], [1.8, 2]], r = 1, ε_min = 0.04: C_min = {xᵀQx ≤ 1.2} reaches
+    |x1| = √(1.2·(Q⁻¹)₁₁) ≈ 1.777 along Q⁻¹e1, but only 0.775 along ±e_i. The box
+    [−1.5, 1.5]² misses it only near Q⁻¹(±e_i): the face directions of a Box X̂ refute it
+    (kills E06 (Box dropped from the face directions) and E11)."""
+    from obsdesign.methods.constrained.cmap import ellipsoid_map
+
+    cm = ellipsoid_map(_q([["2", "1.8"], ["1.8", "2"]]), Q(1))
+    eps = Q("0.04")
+    xh = Box(np.array([Q("-1.5")] * 2, dtype=object), np.array([Q("1.5")] * 2, dtype=object))
+    w = CL.cmin_witness(cm, eps, xh)
+    assert w is not None
+    assert cm.norm_c_sq_q(w) <= eps**2 and max(abs(x) for x in w) > Q("1.5")
+
+
+def _disk_map():
+    from obsdesign.methods.constrained.cmap import ellipsoid_map
+
+    return ellipsoid_map(_q([[1, 0], [0, 1]]), Q(1)), Q("0.04")  # C_min: xᵀx ≤ 1.2
+
+
+def test_ellipsoid_map_witness_away_from_an_off_centre_xhat() -> None:
+    """X̂ = the disk of radius 1.34 centred at (0.2, 0.2): C_min's points along ±e_i lie in
+    it (at most 1.3104 from the centre), but −1.0954·(1, 1)/√2 is 1.378 away: only the
+    direction −centre refutes (kills E07)."""
+    cm, eps = _disk_map()
+    e = 1 / Q("1.34") ** 2
+    xh = Ellipsoid(_q([[e, 0], [0, e]]), np.array([Q("0.2"), Q("0.2")], dtype=object))
+    w = CL.cmin_witness(cm, eps, xh)
+    assert w is not None
+    assert cm.norm_c_sq_q(w) <= eps**2 and not CL.contains_q(xh, w)
+
+
+def test_ellipsoid_map_witness_along_the_axes_of_a_rotated_xhat() -> None:
+    """X̂ = the ellipse with semi-axes 2 along (1, 1) and 1.05 along (1, −1), centred at 0:
+    C_min (radius 1.0954) leaves it only near ±(1, −1)/√2, which neither ±e_i nor a centre
+    direction reaches: the float axes of X̂ do (kills E09)."""
+    cm, eps = _disk_map()
+    p, q = fmpq(1, 4), 1 / Q("1.05") ** 2
+    half = fmpq(1, 2)
+    E = np.array([[half * (p + q), half * (p - q)], [half * (p - q), half * (p + q)]], dtype=object)
+    xh = Ellipsoid(E, np.array([fmpq(0), fmpq(0)], dtype=object))
+    w = CL.cmin_witness(cm, eps, xh)
+    assert w is not None
+    assert cm.norm_c_sq_q(w) <= eps**2 and not CL.contains_q(xh, w)

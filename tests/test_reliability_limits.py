@@ -15,6 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from typer.testing import CliRunner
 
+from obsdesign import limits as L
 from obsdesign.cli import app
 from obsdesign.limits import reset_limits, set_limits
 
@@ -534,3 +535,36 @@ def test_a_cli_limit_holds_for_that_command_only() -> None:
     assert res.exit_code == 0 and limits() == Limits()
     res = runner.invoke(app, ["--limit", "max_file_bytes=10", "design", str(spec), "-q"])
     assert res.exit_code == 2 and limits() == Limits()
+
+
+# -- mutation review 33 (session 32's checks) ----------------------------------------
+def test_restore_forgets_names_overridden_since_saved() -> None:
+    """--limit max_states=… for one command must not leave max_states "overridden" for the
+    next: max_states_for would keep returning the global value in place of the method's
+    own (kills K01, restore without clearing the names)."""
+    L.reset_limits()
+    try:
+        own = L.max_states_for("lyapunov")
+        before = L.saved()
+        L.set_limits(max_states=7)
+        assert L.max_states_for("lyapunov") == 7
+        L.restore(before)
+        assert L.saved() == before
+        assert L.max_states_for("lyapunov") == own
+    finally:
+        L.reset_limits()
+
+
+def test_saved_is_a_snapshot_not_the_live_set() -> None:
+    """An override made before saved() survives a restore after another override (kills K03,
+    saved() returning the live set, which restore then cleared)."""
+    L.reset_limits()
+    try:
+        L.set_limits(max_states=9)
+        before = L.saved()
+        L.set_limits(max_digits=5000)
+        L.restore(before)
+        assert "max_states" in L.saved()[1] and "max_digits" not in L.saved()[1]
+        assert L.max_states_for("lyapunov") == 9
+    finally:
+        L.reset_limits()

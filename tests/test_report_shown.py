@@ -7,6 +7,7 @@ from __future__ import annotations
 from fractions import Fraction
 
 import numpy as np
+import pytest
 from flint import fmpq
 from hypothesis import given
 from hypothesis import strategies as st
@@ -14,6 +15,7 @@ from hypothesis import strategies as st
 from obsdesign.certify.exact import Q
 from obsdesign.methods import get_method
 from obsdesign.params import Parameters
+from obsdesign.report import shown as shown_mod
 from obsdesign.report.shown import cell, item, shown
 
 
@@ -105,3 +107,52 @@ def test_the_impulsive_window_is_shown_on_its_safe_sides() -> None:
     p = Parameters({"T_min": Q("7.106147e-8"), "T_max": Q("2.4755274e-7"), "kappa": Q("1.2345678")})
     s = get_method("impulsive").summary(p)
     assert s == "T_min ≤ 7.107e-08, T_max ≥ 2.475e-07, κ ≈ 1.235"
+
+
+# -- mutation review 33 (session 32's checks) ----------------------------------------
+def test_a_directed_bound_below_the_float_range_is_not_printed_as_zero() -> None:
+    """v = 10⁻⁴⁰⁰ exactly, side "up": its 4-digit upper bound 1e-400 has no float (0.0);
+    "v ≤ 0" would be false (kills H05, which returned the float text unchecked)."""
+    got = shown_mod.item("v", fmpq(1, 10**400), 0.0, ".4g", "up")
+    assert got != "v ≤ 0"
+    assert not got.endswith("≤ 0")
+
+
+def test_a_float_value_gets_no_directed_bound() -> None:
+    """A float (not exact) value is marked ≈, never "≤"/"≥", which claim a bound of an exact
+    value (kills H06, which let floats through _directed)."""
+    assert shown_mod._directed(0.123456789, ".4g", False) is None
+    got = shown_mod.item("T_max", 0.123456789, 0.123456789, ".4g", "down")
+    assert "≥" not in got and "≤" not in got
+
+
+# -- mutation review 33 (session 32's checks) ----------------------------------------
+# side "up": the statements stay true with a larger value (an upper bound: T_min, v_max,
+# λ of a decay bound, Lipschitz constants); "down": with a smaller one (T_max, α, κ_n)
+SAFE = {
+    "impulsive": {
+        "T_min": "up",
+        "T_max": "down",
+        "kappa_n": "down",
+        "varpi_o": "up",
+        "ball_radius": "up",
+    },
+    "lyapunov": {
+        "lambda": "up",
+        "alpha": "down",
+        "lambda_best": "up",
+        "alpha_best": "down",
+        "mu": "up",
+    },
+    "constrained": {"delta": "up", "v_max": "up", "v_min": "down"},
+    "search-space": {"L_f": "up", "L_h": "up", "f_sup": "up"},
+}
+
+
+@pytest.mark.parametrize("key", sorted(SAFE))
+def test_summary_fields_round_towards_their_safe_side(key: str) -> None:
+    """Kills H11 (impulsive T_max "up"), H13 (lyapunov alpha "up"), H14, H15, H16: the
+    summary would print "T_max ≤ …" rounded up, a window end the observer may not use."""
+    sides = {f.param: f.side for f in get_method(key).summary_fields}
+    for param, side in SAFE[key].items():
+        assert sides[param] == side, (key, param)

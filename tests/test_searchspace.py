@@ -1782,3 +1782,138 @@ def test_a_schedule_with_a_ratio_within_1e_32_of_one_doubles_past_28_digits() ->
     r = D.exp_upper(L_f * dtau) / 2
     assert 1 - fmpq(1, 10**31) < r < 1
     _reaches_and_certifies(fmpq(1, 10) + fmpq(1, 10**30), fmpq(1, 10), L_f, dtau)
+
+
+# -- mutation review 33 (session 32's checks) ----------------------------------------
+def test_a_schedule_just_beyond_ten_times_the_cap_is_refused() -> None:
+    """L_f Δτ = 0.69314688 makes e^(L_f Δτ)/2 ≈ 1 − 3.0·10⁻⁷: from γ₀ = 2γ⋆ the rule needs
+    ~2.3·10⁶ entries (between 10× and 100× MAX_SCHEDULE). The design refuses it before
+    listing (kills M09, which raised the threshold to 100× and listed 100,000 entries)."""
+    with pytest.raises(InfeasibleError, match=r"needs about 2\.3e\+06 entries"):
+        D.schedule(fmpq(2), fmpq(1), Q("0.69314688"), fmpq(1))
+
+
+def test_the_digit_budget_counts_the_margin_of_three_digits() -> None:
+    """r = 1 − 10⁻⁴ from γ₀/γ⋆ = 10³⁵: ~8.06·10⁵ entries of about 4 + 3 digits = 5.6·10⁶ >
+    SCHEDULE_MAX_CHARS, so 112 digits at most (kills M04, need = places without the +3:
+    3.2·10⁶ ≤ 4·10⁶ gave 1,024)."""
+    r = 1 - fmpq(1, 10**4)
+    assert D._most_digits(fmpq(10**35), fmpq(1), r) == D.SCHEDULE_LONG_DIGITS
+    assert D._most_digits(fmpq(10**20), fmpq(1), r) == D.SCHEDULE_MAX_DIGITS
+
+
+def test_steps_estimate_is_ln_ratio_over_the_gap() -> None:
+    """ln(γ₀/γ⋆)/(1 − r) as documented: γ₀/γ⋆ = 1.9 at r = 0.9 is ln 1.9/0.1 (kills T01,
+    which took (ratio − 1)/(1 − r) for every ratio below 2), and a non-integer ratio beyond
+    the float range (10⁴⁰⁰ + 1)/10²⁰⁰ is ln(p) − ln(q) (kills T03, + in place of −)."""
+    import math
+
+    assert D._steps_estimate(Q("1.9"), fmpq(1), Q("0.9")) == pytest.approx(math.log(1.9) / 0.1)
+    est = D._steps_estimate(fmpq(10**400 + 1, 10**200), fmpq(1), fmpq(3, 4))
+    assert est == pytest.approx(200 * math.log(10) / 0.25, rel=1e-9)
+
+
+def test_steps_estimate_overflowing_quotient_is_inf() -> None:
+    """γ₀/γ⋆ = 1.5 with 1 − r = 10⁻⁴⁰⁰: (ratio − 1)/(1 − r) = 5·10³⁹⁹ has no float: inf, and
+    the design refuses the schedule (kills T07, which returned 0.0 there: no refusal, and
+    1,024-digit entries allowed)."""
+    import math
+
+    r = 1 - fmpq(1, 10**400)
+    assert D._steps_estimate(Q("1.5"), fmpq(1), r) == math.inf
+    assert D._most_digits(Q("1.5"), fmpq(1), r) == D.SCHEDULE_LONG_DIGITS
+
+
+_SIN = """
+[system]
+time = "continuous"
+states = ["x1"]
+f = ["F"]
+h = ["H"]
+[method]
+key = "search-space"
+alpha = 0.000000001
+gamma_star = 0.1
+gamma0 = 0.5
+E = {lower = [-1], upper = [1]}
+D = {lower = [-0.5], upper = [0.5]}
+"""
+
+
+def _spec(h: str, f: str = "0"):  # noqa: ANN202
+    from obsdesign import api
+    from obsdesign.api import bind
+
+    return bind(api.load_spec_text(_SIN.replace("H", h).replace("F", f), "s.toml"))
+
+
+def test_proofs_are_cached_per_spec_text() -> None:
+    """proved_lower for h = 2·x1 (L_h = 2) and then for h = sin(x1) (L_h = 1) at the same
+    value 1.5: the second proof is sin's own, never above its true constant (kills Q02: a
+    cache key without the spec text handed sin the proof of 2·x1, a false refutation)."""
+    D._PROOFS.clear()
+    a = D.proved_lower("L_h", _spec("2*x1"), Q("1.5"))
+    assert a is not None and a[0] > Fraction("1.5") ** 2
+    b = D.proved_lower("L_h", _spec("sin(x1)"), Q("1.5"))
+    assert b is None or b[0] <= 1
+
+
+def test_proofs_are_cached_per_value() -> None:
+    """A proof computed for a small value (stopping at its first pair above it) is not
+    reused for a larger one: h = x1² on E = [0, 3/2] (L_h = 3): after a proof for 2 (the
+    first secant, ≈ 3 − 2·10⁻⁶, suffices), L_h = 2.999999997 needs the pair shrunk towards
+    the derivative (kills Q01, a cache key without the value)."""
+    D._PROOFS.clear()
+    from obsdesign import api
+    from obsdesign.api import bind
+
+    text = (
+        _SIN.replace("H", "x1^2")
+        .replace("F", "0")
+        .replace("lower = [-1], upper = [1]", "lower = [0], upper = [1.5]")
+        .replace("lower = [-0.5], upper = [0.5]", "lower = [0], upper = [0.5]")
+    )
+    sp = bind(api.load_spec_text(text, "s.toml"))
+    assert D.proved_lower("L_h", sp, Q("2")) is not None
+    b = D.proved_lower("L_h", sp, Q("2.999999997"))
+    assert b is not None and b[0] > Fraction("2.999999997") ** 2
+    D._PROOFS.clear()
+
+
+def test_proofs_are_cached_per_constant() -> None:
+    """f = 3·x1 (L_f = 3), h = sin(x1) (L_h = 1): the proof for L_f at 1.5 is not L_h's
+    (kills Q06, a cache key without the constant's kind: L_h = 1.5 refuted by f's quotient)."""
+    D._PROOFS.clear()
+    sp = _spec("sin(x1)", "3*x1")
+    a = D.proved_lower("L_f", sp, Q("1.5"))
+    assert a is not None and a[0] > Fraction("1.5") ** 2
+    b = D.proved_lower("L_h", sp, Q("1.5"))
+    assert b is None or b[0] <= 1
+    D._PROOFS.clear()
+
+
+def test_the_printed_refuting_bound_is_below_the_proved_square_root() -> None:
+    """h = sin(x1), given L_h = 0.9: refuted; the detail's "difference quotient ≥ b" must be
+    true, b² ≤ the proved square (kills Q12: the first b rounded up, above the proof)."""
+    import re
+
+    from obsdesign import api
+    from obsdesign.certify.claim import ClaimStatus
+
+    D._PROOFS.clear()
+    text = (
+        _SIN.replace("H", "sin(x1)")
+        .replace("F", "0")
+        .replace("gamma0 = 0.5\n", "gamma0 = 0.5\nL_h = 0.9\n")
+    )
+    rep = api.design(api.load_spec_text(text, "s.toml"))
+    claim = next(c for c in rep.claims if c.id == "L_h-bound")
+    assert claim.status == ClaimStatus.FAILED
+    m = re.search(r"the difference quotient ≥ (\S+) between", claim.detail)
+    assert m is not None
+    from obsdesign.api import bind
+
+    proof = D.proved_lower("L_h", bind(api.load_spec_text(text, "s.toml")), Q("0.9"))
+    assert proof is not None
+    b = Q(m[1])
+    assert Q("0.9") < b and b * b <= fmpq(proof[0].numerator, proof[0].denominator)

@@ -139,3 +139,25 @@ def test_an_unknown_key_that_differs_in_case_gets_the_hint() -> None:
         SpecError, match=r"\[method.d\] is not a known key here \(did you mean 'D'\?\)"
     ):
         t.done()
+
+
+# -- mutation review 33 (session 32's checks) ----------------------------------------
+def test_misspelt_sibling_among_named_subtables_is_named_by_its_full_path() -> None:
+    """[sets.box] lacks "horizon", which its misspelt sibling [sets.bxo] holds: the hint names
+    [sets.bxo] (kills D06, tables() giving no parent, so no hint, and D09, the sibling's
+    name without its path: "[bxo]")."""
+    root = Table({"sets": {"box": {"type": "box"}, "bxo": {"horizon": 5}}}, "s.toml")
+    box = root.tables("sets")["box"]
+    with pytest.raises(SpecError, match=r"is in \[sets\.bxo\]: is 'bxo' a misspelling of 'box'"):
+        box.int("horizon")
+
+
+def test_a_string_sibling_is_not_a_table_that_holds_the_key() -> None:
+    """A sibling *string* containing the key's name is no table holding it (kills D04:
+    `k in v` on a string matched a substring and named it)."""
+    root = Table({"simulte": "horizon = 5", "simulate": {"noise": {}}}, "s.toml")
+    sim = root.table("simulate")
+    assert sim is not None
+    with pytest.raises(SpecError) as e:
+        sim.int("horizon")
+    assert "simulte" not in str(e.value)

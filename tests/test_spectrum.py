@@ -178,3 +178,13 @@ def test_the_characteristic_polynomial_is_skipped_for_huge_common_denominators()
     assert got is not None and got[1].startswith("python-flint eigenvalues at")
     dec = fmpq_mat(n, n, [fmpq(int(rng.integers(-999, 1000)), 1000) for _ in range(n * n)])
     assert spectrum.charpoly_roots(dec) is not None
+
+
+# -- mutation review 33 (session 32's checks) ----------------------------------------
+def test_charpoly_roots_beyond_the_float_range_are_none() -> None:
+    """An eigenvalue 10⁴⁰⁰ has no float: charpoly_roots gives None (kills P08, which
+    returned [inf] and let eig_hp report a non-finite spectrum as exact roots)."""
+    Am = fmpq_mat([[fmpq(10**400)]])
+    assert spectrum.charpoly_roots(Am) is None
+    got = spectrum.eig_hp(Am)
+    assert got is None or got[1] != spectrum.CHARPOLY_SOURCE
