@@ -890,3 +890,20 @@ def test_m_optimize_with_a_given_kappa_keeps_to_ms_that_admit_it(kappa: str, cod
         got = e.exit_code
         assert "for the given κ = 100" in e.message
     assert got == code
+
+
+def test_the_float_norm_of_the_retry_is_the_spectral_norm() -> None:
+    """_float_norm gives ‖X‖₂ of a block (the value λ*_no, λ*_on of Lemma 1 use), not the
+    Frobenius norm: every test plant had single-row or single-column off-diagonal blocks,
+    where the two agree, so the Frobenius mutant survived (mutation review 33, I08). On
+    [[3, 0], [0, 4]] they differ (4 against 5); an empty block is 0."""
+    from flint import fmpq
+
+    from obsdesign.methods.impulsive.design import _float_norm
+
+    def q(rows: list[list[int]]) -> np.ndarray:
+        return np.array([[fmpq(x) for x in r] for r in rows], dtype=object).reshape(-1, 2)
+
+    assert _float_norm(q([[3, 0], [0, 4]])) == 4
+    assert _float_norm(q([[1, 1], [1, 1]])) == 2
+    assert _float_norm(q([])) == 0
