@@ -1662,6 +1662,21 @@ def test_a_given_constant_of_an_expression_beyond_the_float_range_is_refuted() -
     assert rep.exit_code() == 0 and rep.parameters["L_h"] == 1
 
 
+def test_a_tiny_signed_power_in_h_is_certified() -> None:
+    """h = x1 + (x1 + 3)^(−700) was certified until signed literals took the integer-power
+    rule, then exit 1 "no finite interval bound" (re-check trial, session 33): certified
+    again, L_h = 1 (rounded up)."""
+    text = (
+        '[system]\ntime = "continuous"\nstates = ["x1", "x2"]\nf = ["x2", "-x1"]\n'
+        'h = ["x1 + (x1+3)^(-700)"]\n[method]\nkey = "search-space"\nalpha = 0.9\n'
+        "gamma_star = 0.05\ngamma0 = 1\n"
+        "E = {lower = [-1, -1], upper = [1, 1]}\nD = {lower = [-0.5, -0.5], upper = [0.5, 0.5]}\n"
+    )
+    rep = api.design(api.load_spec_text(text, "neg.toml"))
+    assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
+    assert rep.parameters["L_h"] == 1
+
+
 def test_a_schedule_whose_entries_need_more_digits_than_allowed_is_refused() -> None:
     """γ₀ = γ⋆ + 2·10⁻¹²⁷ with e^(L_f Δτ)/2 = 1 − 5·10⁻¹³¹: the rule reaches γ⋆ in ~40,000
     entries of ~134 digits, above the digits a design lists, so entries are cut to 112 digits,

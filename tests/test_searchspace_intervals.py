@@ -1053,6 +1053,30 @@ def test_a_signed_integer_exponent_is_an_integer_power() -> None:
     assert r.v.lo <= 0.25 and 1.0 <= r.v.hi < 1.0 + 1e-12 and r.v.lo > 0.25 - 1e-12
 
 
+def test_a_signed_power_beyond_the_float_range_stays_finite() -> None:
+    """1/a^|k| with a^|k| beyond the float range (2^(−1100), (x1 + 3)^(−700)) was everything
+    by interval division once signed literals took the integer-power rule, and specs
+    certified before ended exit 1 "no finite interval bound" (re-check trial, session 33):
+    a positive base then takes exp(k·log a), tiny and finite, with a finite derivative; a
+    base that may be ≤ 0 still has no finite enclosure."""
+
+    def enc(text: str, lo: float, hi: float) -> IV.Dual:
+        x = IV.Dual(IV.I(lo, hi), (IV.I(1.0, 1.0),))
+        return IV.evaluate(ast.parse(text, mode="eval"), {"x1": x}, {}, 1, text)
+
+    r = enc("2**(-1100)*x1", 0.0, 1.0)
+    assert r.v.finite and 0.0 <= r.v.lo and r.v.hi < 1e-300 and r.g[0].finite
+    r = enc("(x1 + 3)**(-700)", 0.0, 1.0)
+    assert r.v.finite and r.v.lo >= 0.0 and r.v.hi < 1e-300 and r.g[0].finite
+    assert r.g[0].lo <= 0.0
+    try:
+        r = enc("x1**(-2)", -1.0, 1.0)
+    except ArithmeticError:
+        pass
+    else:
+        assert not r.v.finite
+
+
 # -- mutation review 27: log / sqrt refusals and the X*X → X² branch -------------------------
 def test_log_of_the_point_zero_is_refused() -> None:
     """mutation review 27 (kills intervals.x_log__mutmut_1: `x.hi <= 0` → `x.hi < 0`). log
