@@ -1677,6 +1677,64 @@ def test_a_tiny_signed_power_in_h_is_certified() -> None:
     assert rep.parameters["L_h"] == 1
 
 
+OVERFLOW_BASE = (
+    '[system]\ntime = "continuous"\nstates = ["x1", "x2"]\nF\nH\nU_SIG\n[method]\n'
+    'key = "search-space"\nalpha = 0.9\ngamma_star = 0.05\ngamma0 = 1\nGIVEN\n'
+    "E = {lower = [-1, -1], upper = [1, 1]}\nD = {lower = [0, -0.5], upper = [0, 0.5]}\nU_SET\n"
+)
+
+
+def _overflow_spec(f: str, h: str, given: str, inputs: bool = False) -> str:
+    return (
+        OVERFLOW_BASE.replace("F", f"f = [{f}]")
+        .replace("H", f"h = [{h}]")
+        .replace("GIVEN", given)
+        .replace("U_SIG", 'u = ["0.5+0.5*sin(t)"]' if inputs else "")
+        .replace("U_SET", "U = {lower = [0], upper = [1]}\nhorizon = 2" if inputs else "")
+    )
+
+
+@pytest.mark.parametrize(
+    "f, h, given, true, inputs, claim",
+    [
+        # f exactly (x2, −x1), |f| = √2 at a corner, 0 at the midpoint the fallback took
+        (
+            '"(x2 + 2^1100) - 2^1100", "-x1"',
+            '"x1"',
+            "f_sup = 0.5",
+            "f_sup = 1.4142135623730951",
+            False,
+            "f_sup",
+        ),
+        # h exactly x1 + x1² (L_h = 3), floats finite only for |x1| < 0.134
+        ('"x2", "-x1"', '"x1 + (x1*10^300)*(x1*10^10)/10^310"', "L_h = 2", "L_h = 3", False, "L_h"),
+        # f exactly u1·(x2, −x1): L_f = 1 at u1 = 1, 1/2 at the input's midpoint
+        (
+            '"u1*((x2 + 2^1100) - 2^1100)", "-u1*((x1 + 2^1100) - 2^1100)"',
+            '"x1"',
+            "L_f = 0.7\nf_sup = 1.5",
+            "L_f = 1\nf_sup = 1.5",
+            True,
+            "L_f",
+        ),
+    ],
+)
+def test_given_constants_where_floats_overflow_on_part_of_the_box_are_refuted(
+    f: str, h: str, given: str, true: str, inputs: bool, claim: str
+) -> None:
+    """The fallback of session 33 proved only the sampled witness, or the box's midpoint
+    where every sample overflowed: a given f_sup, an L_h reached where floats overflow, and
+    an L_f reached at an input's extreme stayed numerical beside 12-13 certified claims, exit
+    0 (re-check trial, session 33). Where floats overflowed the box's corners are proved too:
+    refuted, exit 1; the true constants are not."""
+    rep = api.design(api.load_spec_text(_overflow_spec(f, h, given, inputs), "o.toml"))
+    c = next(c for c in rep.claims if c.id == f"{claim}-bound")
+    assert c.status == ClaimStatus.FAILED and rep.exit_code() == 1, c.detail
+    assert "exact interval evaluation" in c.detail
+    rep = api.design(api.load_spec_text(_overflow_spec(f, h, true, inputs), "t.toml"))
+    assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
+
+
 def test_a_schedule_whose_entries_need_more_digits_than_allowed_is_refused() -> None:
     """γ₀ = γ⋆ + 2·10⁻¹²⁷ with e^(L_f Δτ)/2 = 1 − 5·10⁻¹³¹: the rule reaches γ⋆ in ~40,000
     entries of ~134 digits, above the digits a design lists, so entries are cut to 112 digits,

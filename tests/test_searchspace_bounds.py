@@ -368,3 +368,25 @@ def test_witness_follows_the_best_sample_of_the_subdivision() -> None:
     z = float(s.witness[0][0])
     assert s.lower_est > 0.99
     assert math.isclose(s.lower_est, 1 / (1 + 100 * (z - 0.3371) ** 2), rel_tol=1e-12)
+
+
+def test_corner_witnesses_cover_the_box_corners_and_the_held_corners() -> None:
+    """Where floats overflowed, the refutation also proves points at the box's corners
+    (re-check trial, session 33): for a sup every corner; for a Lipschitz constant in (x1, x2)
+    with an input u held, the pair across the box and each coordinate's own pair, at both of
+    u's ends, every point inside the exact box."""
+    lo, hi = [Fraction(-1), Fraction(0), Fraction(2)], [Fraction(1), Fraction(3), Fraction(5)]
+    sup = B.corner_witnesses(["x1", "x2", "u"], [], lo, hi)
+    assert len(sup) == 8 and all(len(w) == 1 for w in sup)
+    assert {tuple(w[0]) for w in sup} == {
+        (a, b, c) for a in (-1.0, 1.0) for b in (0.0, 3.0) for c in (2.0, 5.0)
+    }
+    lip = B.corner_witnesses(["x1", "x2", "u"], ["x1", "x2"], lo, hi)
+    assert len(lip) == 2 * (1 + 2 * 2)
+    for p, q in lip:
+        assert p[2] == q[2] and p[2] in (2.0, 5.0)  # the held input at one of its ends
+        assert np.all(p >= [-1, 0, 2]) and np.all(q <= [1, 3, 5])
+    assert any(tuple(p[:2]) == (-1.0, 0.0) and tuple(q[:2]) == (1.0, 3.0) for p, q in lip)
+    assert any(tuple(p[:2]) == (-1.0, 3.0) and tuple(q[:2]) == (1.0, 3.0) for p, q in lip)
+    # one variable: the pair across it, no duplicate per-coordinate pairs
+    assert len(B.corner_witnesses(["x1"], ["x1"], lo[:1], hi[:1])) == 1

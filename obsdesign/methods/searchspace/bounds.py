@@ -54,6 +54,10 @@ class Bound:
     lower_est: float
     boxes: int
     witness: tuple[np.ndarray, ...] | None = None
+    #: some float sample was not finite (an expression that overflows floats on part of the
+    #: box): the witness may miss where the constant is reached, so a refutation also tries
+    #: :func:`corner_witnesses`
+    overflow: bool = False
 
     @property
     def finite(self) -> bool:
@@ -220,7 +224,7 @@ def branch_and_bound(
             v, w = lower_of(child)
             if v > lb:
                 lb, wit = v, w
-    return Bound(-heap[0][0], lb, count, wit)
+    return Bound(-heap[0][0], lb, count, wit, getattr(lower_of, "overflow", False))
 
 
 def _safe(upper_of: Callable[[Box], float]) -> Callable[[Box], float]:
@@ -288,6 +292,8 @@ def sup_norm(
         Z = np.clip(_samples(b), inner_lo, inner_hi)
         v = _norms(_eval(exprs, names, Z))
         ok = np.flatnonzero(np.isfinite(v))
+        if ok.size < len(v):
+            lower_of.overflow = True  # type: ignore[attr-defined]
         if not ok.size:  # no float value: the midpoint still serves the exact proof
             return 0.0, (Z[0],)
         i = int(ok[np.argmax(v[ok])])
@@ -328,6 +334,7 @@ def lipschitz(
         V = _eval(exprs, names, P)  # (2·nd, S, p)
         J = (V[: len(idx)] - V[len(idx) :]).transpose(1, 2, 0) / (2 * scale)  # (S, p, nd)
         if not np.all(np.isfinite(J)):
+            lower_of.overflow = True  # type: ignore[attr-defined]
             return 0.0, _across(b)
         _, _, vt = np.linalg.svd(J)
         v = np.zeros_like(M)
@@ -343,6 +350,8 @@ def lipschitz(
         with np.errstate(all="ignore"):
             q = _norms(d) / dist
         ok = np.flatnonzero(np.isfinite(q) & (dist > 0))
+        if not np.all(np.isfinite(q)):
+            lower_of.overflow = True  # type: ignore[attr-defined]
         if not ok.size:
             return 0.0, _across(b)
         i = int(ok[np.argmax(q[ok])])
@@ -365,6 +374,56 @@ def lipschitz(
     inner_lo = np.array([I.of_q(x).hi for x in lo])
     inner_hi = np.array([I.of_q(x).lo for x in hi])
     return branch_and_bound(_box(lo, hi), upper_of, lower_of, budget, rtol)
+
+
+#: at most this many held-variable corners (2^4) in :func:`corner_witnesses`
+MAX_CORNER_VARS = 4
+
+
+def corner_witnesses(
+    names: Sequence[str], diff: Sequence[str], lo: Sequence[Any], hi: Sequence[Any]
+) -> list[tuple[np.ndarray, ...]]:
+    """Candidate witnesses for :func:`proved_lower_sq` where float samples overflowed
+    (:attr:`Bound.overflow`), at the exact box [lo, hi]'s corners (floats inside it): for a
+    sup (``diff`` empty) every corner of the first MAX_CORNER_VARS + 1 variables, the others
+    at their midpoints; for a Lipschitz constant the pair across the box in ``diff`` and, for
+    each variable of ``diff``, the pair across it alone (at the upper and the lower corner of
+    the other differenced variables), each with the held variables at every corner of the
+    first MAX_CORNER_VARS of them. A given f_sup, or an L_f reached at an input's extreme, or
+    a constant reached where floats overflow stayed numerical, exit 0, when only the sampled
+    witness was proved (re-check trial, session 33)."""
+    import itertools
+
+    a = np.array([I.of_q(x).hi for x in lo])
+    b = np.array([I.of_q(x).lo for x in hi])
+    mid = np.clip((a + b) / 2, a, b)
+    idx = [list(names).index(d) for d in diff]
+    held = [i for i in range(len(names)) if i not in idx]
+    out: list[tuple[np.ndarray, ...]] = []
+    if not idx:
+        free = held[: MAX_CORNER_VARS + 1]
+        for c in itertools.product((0, 1), repeat=len(free)):
+            z = mid.copy()
+            for i, k in zip(free, c, strict=True):
+                z[i] = b[i] if k else a[i]
+            out.append((z,))
+        return out
+    free = held[:MAX_CORNER_VARS]
+    for c in itertools.product((0, 1), repeat=len(free)):
+        base = mid.copy()
+        for i, k in zip(free, c, strict=True):
+            base[i] = b[i] if k else a[i]
+        p, q = base.copy(), base.copy()
+        p[idx], q[idx] = a[idx], b[idx]
+        out.append((p, q))
+        if len(idx) > 1:
+            for j in idx:
+                for side in (a, b):
+                    p, q = base.copy(), base.copy()
+                    p[idx], q[idx] = side[idx], side[idx]
+                    p[j], q[j] = a[j], b[j]
+                    out.append((p, q))
+    return [w for w in out if not all(np.array_equal(w[0], x) for x in w[1:]) or len(w) == 1]
 
 
 #: :func:`proved_lower_sq` also tries the witness pair shrunk by 10⁻¹ … 10⁻ᴷ (K below)

@@ -113,7 +113,18 @@ def proved_lower(kind: str, spec: Spec, val: fmpq) -> tuple[Any, Any] | None:
         exprs, names, diff, lo, hi = _problem(kind, spec)
         b = interval_bound(kind, spec)
         target = Fraction(int(val.p) ** 2, int(val.q) ** 2)
-        _PROOFS[key] = bounds.proved_lower_sq(exprs, names, diff, lo, hi, b.witness, target)
+        best = bounds.proved_lower_sq(exprs, names, diff, lo, hi, b.witness, target)
+        if b.overflow and (best is None or best[0] <= target):
+            # floats overflowed on part of the box: the sampled witness may be far from where
+            # the constant is reached; the box's corners are tried too (re-check trial,
+            # session 33)
+            for w in bounds.corner_witnesses(names, diff, lo, hi):
+                got = bounds.proved_lower_sq(exprs, names, diff, lo, hi, w, target)
+                if got is not None and (best is None or got[0] > best[0]):
+                    best = got
+                    if best[0] > target:
+                        break
+        _PROOFS[key] = best
     return _PROOFS[key]
 
 
