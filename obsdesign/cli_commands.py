@@ -810,7 +810,7 @@ def simulate(
         plot is not None
         and sp.simulate is not None
         and api.method(sp.method).sim_grid_from_dt
-        and api.sim_steps(sp) > MAX_PLOT_POINTS
+        and api.sim_steps(sp) + 1 > MAX_PLOT_POINTS  # N steps are N + 1 grid points
     ):
         from obsdesign.errors import InputError
 
@@ -818,8 +818,8 @@ def simulate(
         # the run stays for grids the horizon does not count (a run's exact length)
         raise InputError(
             f"{spec}: [simulate] horizon{'' if sp.system.discrete else ' / dt'} gives a "
-            f"run of about {api.sim_steps(sp):,.0f} steps, above the {MAX_PLOT_POINTS:,} grid "
-            f"points --plot {plot} takes (a shorter horizon or a larger dt; --csv writes any "
+            f"run of about {api.sim_steps(sp):,.0f} steps ({api.sim_steps(sp) + 1:,.0f} grid "
+            f"points), above the {MAX_PLOT_POINTS:,} --plot {plot} takes (a shorter horizon or a larger dt; --csv writes any "
             "length)"
         )
     opts = _kv(option or [])

@@ -259,11 +259,12 @@ def test_simulate_plot_of_a_huge_run_is_refused_before_output(tmp_path: Path, mo
         "[simulate]\nhorizon = 60\nx0 = [1, 0]\nxhat0 = [0, 0]\n"
     )
     png, out = tmp_path / "p.png", tmp_path / "t.csv"
-    # 50 steps are 51 grid points: known only after the run
+    # 50 steps are 51 grid points: refused before the run (it ran, then was refused, until
+    # the off-by-one of the check before the run was found: re-check trial, session 33)
     spec.write_text(spec.read_text().replace("horizon = 60", "horizon = 50"))
     r = CliRunner().invoke(app, ["simulate", str(spec), "--plot", str(png), "--csv", str(out)])
     assert r.exit_code == 2, r.output
-    assert "the run has 51 grid points, above the 50 a plot takes" in r.output
+    assert "about 50 steps (51 grid points), above the 50 --plot" in r.output
     assert "final |e|" not in r.output and not png.exists() and not out.exists()
     spec.write_text(spec.read_text().replace("horizon = 50", "horizon = 40"))
     r = CliRunner().invoke(app, ["simulate", str(spec), "--plot", str(png)])
@@ -293,7 +294,7 @@ def test_simulate_plot_of_a_run_longer_than_the_plot_takes_is_refused_before_run
     png = tmp_path / "p.png"
     r = CliRunner().invoke(app, ["simulate", str(spec), "--plot", str(png)])
     assert r.exit_code == 2, r.output
-    assert "[simulate] horizon / dt gives a run of about 60 steps, above the 50" in r.output
+    assert "[simulate] horizon / dt gives a run of about 60 steps (61 grid points)" in r.output
     assert "simulated" not in r.output and not png.exists()
     # impulsive runs follow the sampling instants: horizon / dt = 1,000 steps, 369 points
     monkeypatch.undo()
@@ -301,6 +302,12 @@ def test_simulate_plot_of_a_run_longer_than_the_plot_takes_is_refused_before_run
     shipped = Path(__file__).parent.parent / "specs" / "impulsive-sector-3state.toml"
     r = CliRunner().invoke(app, ["simulate", str(shipped), "--plot", str(png), "-q"])
     assert r.exit_code == 0 and png.exists(), r.output
+    # ... and a longer one is refused after the run, when its grid is known
+    png.unlink()
+    monkeypatch.setattr(cli_commands, "MAX_PLOT_POINTS", 300)
+    r = CliRunner().invoke(app, ["simulate", str(shipped), "--plot", str(png), "-q"])
+    assert r.exit_code == 2 and not png.exists(), r.output
+    assert "the run has 369 grid points, above the 300 a plot takes" in r.output
 
 
 def test_dash_is_not_an_output_and_runs_is_given_once(tmp_path: Path, monkeypatch) -> None:
