@@ -525,19 +525,20 @@ def test_digits_beyond_30_is_bad_input(tmp_path: Path) -> None:
 
 
 def test_a_schedule_cut_by_the_cap_says_so(monkeypatch: pytest.MonkeyPatch) -> None:
-    """A schedule that needs more entries than the design lists (MAX_SCHEDULE, here 5 for the
-    example's 12) fails gamma-schedule with the cap and the way out named (it read only "ends
-    at …, not at γ⋆", though every listed entry keeps the rule: review 19, κ near 2L_h)."""
+    """A schedule that needs more entries than the design lists (MAX_SCHEDULE, here 7 for the
+    example's 12; at 5 it is refused before listing, the rule needing at least est/2 > 5)
+    fails gamma-schedule with the cap and the way out named (it read only "ends at …, not at
+    γ⋆", though every listed entry keeps the rule: review 19, κ near 2L_h)."""
     from obsdesign.methods.searchspace import claims as C
 
-    monkeypatch.setattr(D, "MAX_SCHEDULE", 5)
-    monkeypatch.setattr(C, "MAX_SCHEDULE", 5)
+    monkeypatch.setattr(D, "MAX_SCHEDULE", 7)
+    monkeypatch.setattr(C, "MAX_SCHEDULE", 7)
     rep = api.design(api.load_spec(SPEC))
     bad = {c.id: c.detail for c in rep.failed}
     assert list(bad) == ["gamma-schedule"]
-    assert "at most 5 entries" in bad["gamma-schedule"] and "a smaller K" in bad["gamma-schedule"]
+    assert "at most 7 entries" in bad["gamma-schedule"] and "a smaller K" in bad["gamma-schedule"]
     # the note said "γ reaches γ⋆ after 4 switches" beside it (re-check trial, session 31)
-    assert any("does not reach γ⋆ within the 5 listed entries" in n for n in rep.notes)
+    assert any("does not reach γ⋆ within the 7 listed entries" in n for n in rep.notes)
     assert not any("reaches γ⋆ after" in n for n in rep.notes)
 
 
@@ -1752,6 +1753,34 @@ def test_a_schedule_whose_entries_need_more_digits_than_allowed_is_refused() -> 
     tiny = fmpq(1, 10**400)
     assert D._places(1 - tiny) == pytest.approx(400)
     assert D._most_digits(fmpq(1, 10) + tiny, fmpq(1, 10), 1 - tiny) == D.SCHEDULE_MAX_DIGITS
+
+
+def test_a_schedule_between_twice_and_ten_times_the_cap_is_refused_before_listing() -> None:
+    """The rule needs at least est/2 entries: est ≈ 5·10⁵ (γ₀ = 2γ⋆, 1 − e^(L_f Δτ)/2 ≈
+    1.4·10⁻⁶) cannot reach γ⋆ within the 100,000 listed; at 10× the cap such schedules were
+    listed to it, 25 s and a 50 MB failed report (re-check trial, session 33). Beyond the float
+    range the count reads "more than 10³⁰⁸" (it read "about inf"), and 1 − r below it "10^-N"."""
+    import mpmath
+
+    with pytest.raises(InfeasibleError, match=r"needs about 5e\+05 entries"):
+        D.schedule(fmpq(2, 10), fmpq(1, 10), fmpq(1), Q("0.6931458"))
+    with mpmath.workdps(340):
+        x = Q(mpmath.nstr(mpmath.log(2), 330, strip_zeros=False)[:322])
+    with pytest.raises(InfeasibleError, match="needs more than 10³⁰⁸ entries"):
+        D.schedule(fmpq(2, 10), fmpq(1, 10), fmpq(1), x)
+    assert D._gap(1 - fmpq(1, 10**400)) == "10^-400"
+
+
+def test_a_K_beyond_the_float_range_is_named() -> None:
+    """alpha = 3·10⁻³⁰⁸ makes ΔT ≈ 10⁻³⁰⁹ and K ≈ 10³⁰⁸: the report's float view overflowed
+    in a claim, exit 4 "a number is beyond the float range (integer division result too large
+    for a float)", naming none (re-check trial, session 33). It is refused naming K."""
+    from obsdesign.errors import InconclusiveError
+
+    text = RATIO_NEAR_ONE.replace("alpha = 1e-133", "alpha = 3e-308")
+    assert "alpha = 3e-308" in text
+    with pytest.raises(InconclusiveError, match=r"K ≈ 10\^308 samples per Δτ .* a larger alpha"):
+        api.design(api.load_spec_text(text, "k.toml"))
 
 
 def test_the_entries_estimate_takes_ratios_beyond_the_float_range() -> None:

@@ -26,7 +26,7 @@ from mpmath import iv
 from obsdesign.certify import interval as ivq
 from obsdesign.certify.exact import Q
 from obsdesign.certify.printing import fmt_exact, fmt_up
-from obsdesign.errors import InfeasibleError
+from obsdesign.errors import InconclusiveError, InfeasibleError
 from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
 from obsdesign.methods.searchspace import bounds
 from obsdesign.methods.searchspace.options import Options
@@ -260,13 +260,15 @@ def schedule(gamma0: fmpq, gamma_star: fmpq, L_f: fmpq, dtau: fmpq) -> list[fmpq
     most = _most_digits(gamma0, gamma_star, r)
     if r is not None and gamma0 > gamma_star:
         est = _steps_estimate(gamma0, gamma_star, r)
-        if est > 10 * MAX_SCHEDULE:
+        if est > 2 * MAX_SCHEDULE * (1 + 1e-9):
             # listed up to the cap, such a schedule was a failed report of up to 70 MB after
             # 20 s (1 − e^(L_f Δτ)/2 = 10⁻⁸⁰; session 32): the rule needs at least est/2
+            # entries, so above twice the cap it cannot reach γ⋆ within it (10× the cap
+            # listed 7.6·10⁵-entry schedules to the cap, 25 s and 50 MB; re-check, session 33)
             raise InfeasibleError(
-                f"the γ schedule of Theorem 1 (hypothesis 2) needs about {est:.2g} entries to "
+                f"the γ schedule of Theorem 1 (hypothesis 2) needs {_about(est)} entries to "
                 f"go from γ₀ = {fmt_exact(gamma0)} to γ⋆ = {fmt_exact(gamma_star)} "
-                f"(e^(L_f Δτ)/2 ≈ 1 − {float(1 - r):.3g} per switch), beyond the "
+                f"(e^(L_f Δτ)/2 ≈ 1 − {_gap(r)} per switch), beyond the "
                 f"{MAX_SCHEDULE:,} entries the design lists: a smaller K (shorter Δτ), a "
                 "larger γ⋆ or a smaller γ₀"
             )
@@ -277,10 +279,10 @@ def schedule(gamma0: fmpq, gamma_star: fmpq, L_f: fmpq, dtau: fmpq) -> list[fmpq
             # the claim blamed 1,024 digits (re-check trial, session 32: 40,000 entries of
             # 134 digits)
             raise InfeasibleError(
-                f"the γ schedule of Theorem 1 (hypothesis 2) needs about {est:.2g} entries of "
+                f"the γ schedule of Theorem 1 (hypothesis 2) needs {_about(est)} entries of "
                 f"about {places + 3:.0f} significant digits each to go from γ₀ = "
                 f"{fmt_exact(gamma0)} to γ⋆ = {fmt_exact(gamma_star)} (e^(L_f Δτ)/2 ≈ 1 − "
-                f"{float(1 - r):.3g} per switch), beyond the {SCHEDULE_MAX_CHARS:,} digits the "
+                f"{_gap(r)} per switch), beyond the {SCHEDULE_MAX_CHARS:,} digits the "
                 "design lists: a smaller K (shorter Δτ), a larger γ⋆ or a smaller γ₀"
             )
     while g != gamma_star and len(out) < MAX_SCHEDULE:
@@ -316,6 +318,18 @@ def _most_digits(gamma0: fmpq, gamma_star: fmpq, r: fmpq | None) -> int:
         return SCHEDULE_LONG_DIGITS
     need = _places(r) + 3
     return SCHEDULE_MAX_DIGITS if steps * need <= SCHEDULE_MAX_CHARS else SCHEDULE_LONG_DIGITS
+
+
+def _about(est: float) -> str:
+    """An entry count for a message ("about 4e+04"; "more than 10³⁰⁸" beyond floats, where
+    it read "about inf": re-check trial, session 33)."""
+    return f"about {est:.2g}" if math.isfinite(est) else "more than 10³⁰⁸"
+
+
+def _gap(r: fmpq) -> str:
+    """1 − r for a message, also below the float range (10^-N there)."""
+    g = float(1 - r)
+    return f"{g:.3g}" if g > 0 else f"10^-{_places(r):.0f}"
 
 
 def _places(r: fmpq) -> float:
@@ -380,6 +394,15 @@ def rules(
     gamma_star = o.gamma_star if o.gamma_star is not None else kappa * o.eps_star
     dT = dT_rule(o.alpha, gamma_star, L_h, F)
     K = K if K is not None else (o.K if o.K is not None else K_rule(kappa, L_h, L_f, dT))
+    if K.bit_length() > 1023:
+        # the report's float view overflowed in a claim: "a number is beyond the float range
+        # (integer division result too large for a float)", naming none (alpha = 3e-308;
+        # re-check trial, session 33)
+        raise InconclusiveError(
+            f"K ≈ 10^{len(str(K)) - 1} samples per Δτ "
+            f"(Lemma 2's rule, with ΔT = {fmt_exact(dT)}) is beyond the float range of the "
+            "report's float view: a larger alpha (a longer ΔT)"
+        )
     dtau = K * dT
     gam = schedule(o.gamma0, gamma_star, L_f, dtau)
     return params_from(L_f, L_h, F, kappa, gamma_star, dT, K, dtau, gam)
