@@ -901,6 +901,19 @@ def sim_steps(sp: Spec) -> float:
     return horizon / max(float(sim.dt.f), 1e-300)
 
 
+def sim_grid_steps(sp: Spec) -> int:
+    """The exact steps of one run's grid of the bound spec ``sp``: horizon / dt rounded to
+    the nearest integer in continuous time (:func:`obsdesign.simulate.grid.steps_of`, as
+    ``time_grid`` builds it), the horizon in discrete time (or without ``dt``)."""
+    from obsdesign.simulate.grid import steps_of
+
+    sim = sp.simulate
+    assert sim is not None
+    if sp.system.discrete or sim.dt is None:
+        return max(int(sim.horizon.q), 0)
+    return steps_of(sim.horizon.q, sim.dt.q)
+
+
 def check_sim_memory(sp: Spec, kwargs: dict[str, Any]) -> None:
     """Refuse a simulation of the bound spec ``sp`` with the typed ``kwargs`` of ``simulate``
     that would not fit: the method's estimate (:meth:`Method.sim_bytes`; by default every

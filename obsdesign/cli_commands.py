@@ -806,21 +806,21 @@ def simulate(
     if csv is not None:
         check_output(csv, force, _inputs(spec, report))
     sp = _load_spec(spec)
-    if (
-        plot is not None
-        and sp.simulate is not None
-        and api.method(sp.method).sim_grid_from_dt
-        and api.sim_steps(sp) + 1 > MAX_PLOT_POINTS  # N steps are N + 1 grid points
-    ):
+    steps = (
+        api.sim_grid_steps(sp)
+        if plot is not None and sp.simulate is not None and api.method(sp.method).sim_grid_from_dt
+        else None
+    )
+    if steps is not None and steps + 1 > MAX_PLOT_POINTS:  # N steps are N + 1 grid points
         from obsdesign.errors import InputError
 
         # refused after the whole run (10⁷ steps, 40 s) until session 33; the check after
-        # the run stays for grids the horizon does not count (a run's exact length)
+        # the run stays for grids the horizon does not count (a run's exact length); exact
+        # (the float quotient 299.9997 / 0.0003 = 999999.0000000001 refused a run that fits)
         raise InputError(
-            f"{spec}: [simulate] horizon{'' if sp.system.discrete else ' / dt'} gives a "
-            f"run of about {api.sim_steps(sp):,.0f} steps ({api.sim_steps(sp) + 1:,.0f} grid "
-            f"points), above the {MAX_PLOT_POINTS:,} --plot {plot} takes (a shorter horizon or a larger dt; --csv writes any "
-            "length)"
+            f"{spec}: [simulate] horizon{'' if sp.system.discrete else ' / dt'} gives a run of "
+            f"{steps:,} steps ({steps + 1:,} grid points), above the {MAX_PLOT_POINTS:,} "
+            f"--plot {plot} takes (a shorter horizon or a larger dt; --csv writes any length)"
         )
     opts = _kv(option or [])
     if runs is not None or study is not None:

@@ -264,7 +264,7 @@ def test_simulate_plot_of_a_huge_run_is_refused_before_output(tmp_path: Path, mo
     spec.write_text(spec.read_text().replace("horizon = 60", "horizon = 50"))
     r = CliRunner().invoke(app, ["simulate", str(spec), "--plot", str(png), "--csv", str(out)])
     assert r.exit_code == 2, r.output
-    assert "about 50 steps (51 grid points), above the 50 --plot" in r.output
+    assert "a run of 50 steps (51 grid points), above the 50 --plot" in r.output
     assert "final |e|" not in r.output and not png.exists() and not out.exists()
     spec.write_text(spec.read_text().replace("horizon = 50", "horizon = 40"))
     r = CliRunner().invoke(app, ["simulate", str(spec), "--plot", str(png)])
@@ -294,8 +294,16 @@ def test_simulate_plot_of_a_run_longer_than_the_plot_takes_is_refused_before_run
     png = tmp_path / "p.png"
     r = CliRunner().invoke(app, ["simulate", str(spec), "--plot", str(png)])
     assert r.exit_code == 2, r.output
-    assert "[simulate] horizon / dt gives a run of about 60 steps (61 grid points)" in r.output
+    assert "[simulate] horizon / dt gives a run of 60 steps (61 grid points)" in r.output
     assert "simulated" not in r.output and not png.exists()
+    # exact: 29.9997 / 0.0003 is 99,999 steps, 99999.00000000001 in floats
+    monkeypatch.setattr(cli_commands, "MAX_PLOT_POINTS", 100_000)
+    spec.write_text(
+        spec.read_text().replace("horizon = 6\ndt = 0.1", "horizon = 29.9997\ndt = 0.0003")
+    )
+    assert "horizon = 29.9997" in spec.read_text() and 29.9997 / 0.0003 > 99999
+    r = CliRunner().invoke(app, ["simulate", str(spec), "--plot", str(png)])
+    assert "simulated" in r.output and "grid points" not in r.output, r.output
     # impulsive runs follow the sampling instants: horizon / dt = 1,000 steps, 369 points
     monkeypatch.undo()
     monkeypatch.setattr(cli_commands, "MAX_PLOT_POINTS", 500)
