@@ -1781,6 +1781,8 @@ def test_a_K_beyond_the_float_range_is_named() -> None:
     assert "alpha = 3e-308" in text
     with pytest.raises(InconclusiveError, match=r"K ≈ 10\^308 samples per Δτ .* a larger alpha"):
         api.design(api.load_spec_text(text, "k.toml"))
+    # a K of 1,024 bits below 1.8·10³⁰⁸ has a double: designed (a bit count refused it)
+    assert D._fits_float(2**1023 + 2**1000) and not D._fits_float(2**1024)
 
 
 def test_the_entries_estimate_takes_ratios_beyond_the_float_range() -> None:

@@ -320,6 +320,16 @@ def _most_digits(gamma0: fmpq, gamma_star: fmpq, r: fmpq | None) -> int:
     return SCHEDULE_MAX_DIGITS if steps * need <= SCHEDULE_MAX_CHARS else SCHEDULE_LONG_DIGITS
 
 
+def _fits_float(K: int) -> bool:
+    """Whether the integer K has a finite double (K of 1,024 bits up to 1.8·10³⁰⁸ does: a bit
+    count refused them; re-check trial, session 33)."""
+    try:
+        float(K)
+    except OverflowError:
+        return False
+    return True
+
+
 def _about(est: float) -> str:
     """An entry count for a message ("about 4e+04"; "more than 10³⁰⁸" beyond floats, where
     it read "about inf": re-check trial, session 33)."""
@@ -394,7 +404,7 @@ def rules(
     gamma_star = o.gamma_star if o.gamma_star is not None else kappa * o.eps_star
     dT = dT_rule(o.alpha, gamma_star, L_h, F)
     K = K if K is not None else (o.K if o.K is not None else K_rule(kappa, L_h, L_f, dT))
-    if K.bit_length() > 1023:
+    if not _fits_float(K):
         # the report's float view overflowed in a claim: "a number is beyond the float range
         # (integer division result too large for a float)", naming none (alpha = 3e-308;
         # re-check trial, session 33)
