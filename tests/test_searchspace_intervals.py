@@ -1075,6 +1075,19 @@ def test_a_signed_power_beyond_the_float_range_stays_finite() -> None:
         pass
     else:
         assert not r.v.finite
+    # a negative base too, (−1)^k·exp(k·log|a|) ((x1 − 3)^(−700) was everything, and its
+    # specs exit 1: re-check trial, session 33); each enclosure holds the exact values
+    import mpmath
+
+    for text, k in (("(x1 - 3)**(-700)", -700), ("(x1 - 3)**(-701)", -701)):
+        r = enc(text, -1.0, 1.0)
+        assert r.v.finite and r.g[0].finite
+        with mpmath.workdps(50):
+            for x in (-1, -0.5, 0, 0.25, 1):
+                v = mpmath.power(mpmath.mpf(x) - 3, k)
+                dv = k * mpmath.power(mpmath.mpf(x) - 3, k - 1)
+                assert r.v.lo <= v <= r.v.hi and r.g[0].lo <= dv <= r.g[0].hi
+        assert (r.v.hi <= 0.0) if k % 2 else (r.v.lo >= 0.0)
 
 
 # -- mutation review 27: log / sqrt refusals and the X*X → X² branch -------------------------

@@ -585,12 +585,22 @@ def evaluate(
             k = int_literal(right, src)
             if k is not None:
                 r = d_pow_int(a, k)
-                if k >= 0 or a.v.lo <= 0.0 or (r.v.finite and all(x.finite for x in r.g)):
+                if (
+                    k >= 0
+                    or (a.v.lo <= 0.0 <= a.v.hi)
+                    or (r.v.finite and all(x.finite for x in r.g))
+                ):
                     return r
                 # 1/a^|k| with a^|k| beyond the float range (2^(−1100), (x1 + 3)^(−700)) is
-                # everything by interval division; exp(k·log a) keeps it tiny and finite (the
-                # signed-literal rule of session 33 made such certified specs exit 1 "no finite
-                # interval bound": re-check trial, session 33)
+                # everything by interval division; exp(k·log |a|) keeps it tiny and finite,
+                # with the sign (−1)^k for a negative base (the signed-literal rule of session
+                # 33 made such certified specs exit 1 "no finite interval bound", and
+                # (x1 − 3)^(−700) was so before: re-check trials, session 33)
+                b = evaluate(right, env, params, nd, src)
+                if a.v.lo > 0.0:
+                    return d_fn(d_mul(b, d_fn(a, "log")), "exp")
+                m = d_fn(d_mul(b, d_fn(d_neg(a), "log")), "exp")
+                return d_neg(m) if k % 2 else m
             b = evaluate(right, env, params, nd, src)
             if a.v.lo <= 0.0:
                 raise ArithmeticError("non-integer power of a base that may be ≤ 0")
