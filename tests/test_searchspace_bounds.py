@@ -373,8 +373,8 @@ def test_witness_follows_the_best_sample_of_the_subdivision() -> None:
 def test_corner_witnesses_cover_the_box_corners_and_the_held_corners() -> None:
     """Where floats overflowed, the refutation also proves points at the box's corners
     (re-check trial, session 33): for a sup every corner; for a Lipschitz constant in (x1, x2)
-    with an input u held, the pair across the box and each coordinate's own pair, at both of
-    u's ends, every point inside the exact box."""
+    with an input u held, the pair across the box at both of u's ends and each coordinate's
+    own pair at u's midpoint, every point inside the exact box."""
     lo, hi = [Fraction(-1), Fraction(0), Fraction(2)], [Fraction(1), Fraction(3), Fraction(5)]
     sup = B.corner_witnesses(["x1", "x2", "u"], [], lo, hi)
     assert len(sup) == 8 and all(len(w) == 1 for w in sup)
@@ -382,11 +382,26 @@ def test_corner_witnesses_cover_the_box_corners_and_the_held_corners() -> None:
         (a, b, c) for a in (-1.0, 1.0) for b in (0.0, 3.0) for c in (2.0, 5.0)
     }
     lip = B.corner_witnesses(["x1", "x2", "u"], ["x1", "x2"], lo, hi)
-    assert len(lip) == 2 * (1 + 2 * 2)
+    assert len(lip) == 2 + 2 * 2  # across at u's two ends; each coordinate at u's midpoint
+    assert sorted(float(p[2]) for p, _ in lip) == [2.0, 3.5, 3.5, 3.5, 3.5, 5.0]
     for p, q in lip:
-        assert p[2] == q[2] and p[2] in (2.0, 5.0)  # the held input at one of its ends
+        assert p[2] == q[2]  # the held input equal in both points
         assert np.all(p >= [-1, 0, 2]) and np.all(q <= [1, 3, 5])
     assert any(tuple(p[:2]) == (-1.0, 0.0) and tuple(q[:2]) == (1.0, 3.0) for p, q in lip)
     assert any(tuple(p[:2]) == (-1.0, 3.0) and tuple(q[:2]) == (1.0, 3.0) for p, q in lip)
     # one variable: the pair across it, no duplicate per-coordinate pairs
     assert len(B.corner_witnesses(["x1"], ["x1"], lo[:1], hi[:1])) == 1
+
+
+def test_a_zero_width_side_without_a_double_is_its_exact_value() -> None:
+    """E = [−1, 1] × {1/10}: the floats beside 1/10 lie outside the exact box, so every
+    witness was refused and a false L_h = 2 (h = x1 + x1², L_h = 3) or f_sup = 0.5 stayed
+    numerical, exit 0 (re-check trial, session 33). A float within an ulp of a zero-width
+    side stands for its exact value; elsewhere the box still refuses a point outside it."""
+    lo, hi = [Fraction(-1), Fraction(1, 10)], [Fraction(1), Fraction(1, 10)]
+    ex = _ex("x1 + x1**2 + 0*x2", names=("x1", "x2"))
+    pair = (np.array([0.9, 0.1]), np.array([1.0, 0.1]))
+    proof = B.proved_lower_sq(ex, ["x1", "x2"], ["x1"], lo, hi, pair)
+    assert proof is not None and proof[0] > 4 and proof[1][0][1] == Fraction(1, 10)
+    far = (np.array([0.9, 0.1000001]), np.array([1.0, 0.1000001]))
+    assert B.proved_lower_sq(ex, ["x1", "x2"], ["x1"], lo, hi, far) is None
