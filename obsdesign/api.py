@@ -920,14 +920,20 @@ def check_sim_memory(sp: Spec, kwargs: dict[str, Any]) -> None:
     run's trajectories) made before anything is allocated, against ``max_sim_bytes``
     (:mod:`obsdesign.limits`). ``runs`` is the
     ``--option runs`` value, else the spec's, else 1; steps are the horizon (discrete time)
-    or horizon / dt (continuous time)."""
+    or horizon / dt (continuous time). Methods whose grid follows their own sampling
+    instants (:attr:`Method.sim_grid_from_dt` False) count it themselves."""
     sim = sp.simulate
     assert sim is not None
     runs = kwargs.get("runs")
     if runs is None:
         runs = getattr(sim.options, "runs", None) or getattr(sp.options, "runs", None) or 1
-    steps = sim_steps(sp)
     method = get_method(sp.method)
+    if not method.sim_grid_from_dt:
+        # the grid follows the method's sampling instants, which it counts itself before it
+        # allocates (impulsive: 8 points per sampling interval; search-space: one record per
+        # ΔT): horizon / dt refused an impulsive run with an unused dt = 1e-8 as 1.2e4 GiB
+        return
+    steps = sim_steps(sp)
     need = method.sim_bytes(sp, int(runs), steps, kwargs)
     cap = limits().max_sim_bytes
     if need > cap:

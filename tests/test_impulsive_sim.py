@@ -150,7 +150,10 @@ def test_simulation_memory_is_checked_before_allocating(tmp_path: Path) -> None:
     )
     assert res.exit_code == 2 and "GiB" in res.output
     assert time.perf_counter() - t0 < 5
-    assert res.output.startswith(f"obsdesign: error: {spec}: simulating 100000 run(s)")
+    # the method's own count (runs × samples × 8 points), the API's horizon / dt count
+    # being skipped for a grid that follows the sampling intervals (session 33)
+    assert res.output.startswith(f"obsdesign: error: {spec}: the simulation would need")
+    assert "100000 run" in res.output or "100,000 run" in res.output, res.output
 
 
 def test_an_astronomic_horizon_is_refused_in_a_few_digits() -> None:
@@ -647,3 +650,19 @@ def test_the_two_state_plot_has_the_field_and_named_axes(tmp_path: Path, monkeyp
     assert (ax.get_xlabel(), ax.get_ylabel()) == (names[0], names[1])
     for f in figs:
         plt.close(f)
+
+
+def test_an_unused_dt_does_not_count_the_run(tmp_path: Path) -> None:
+    """The grid of an impulsive run follows its sampling intervals (8 points each), which the
+    method counts before it allocates; the API's check counted horizon / dt, and a spec with
+    dt = 1e-8 was refused as 1.2·10⁴ GiB (session 33). It runs; the method's own count still
+    refuses a horizon that would not fit."""
+    text = _spec3().replace("horizon = 8", "horizon = 8\ndt = 0.00000001")
+    assert "dt = 0.00000001" in text
+    spec = load_spec_text(text, str(tmp_path / "s.toml"))
+    rep = api.design(spec)
+    res = api.simulate(spec, rep)
+    assert res.x.shape[1] == 3 and len(res.t) < 10_000
+    huge = load_spec_text(text.replace("horizon = 8\n", "horizon = 1e12\n"), "h.toml")
+    with pytest.raises(InputError, match="GiB"):
+        get_method("impulsive").simulate(huge, rep.parameters)
