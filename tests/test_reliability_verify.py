@@ -296,3 +296,24 @@ def test_a_huge_edited_statement_or_id_is_quoted_clipped() -> None:
     adds = [c for c in ver.claims if c.id.startswith("report-adds:")]
     assert ver.exit_code() == 1 and adds
     assert len(adds[0].id) < 2100 and len(adds[0].detail) < 5000
+
+
+def test_a_report_read_from_json_and_edited_in_memory_is_verified_as_edited(good):
+    """verify(Report) took the parameters as read (for the bit-for-bit float check) even when
+    the object was edited after reading: μ = 1 or λ_best = 0.9 set on a loaded report made
+    certified claims false and verify said ok (API trial, session 33). An edited report is
+    verified as edited; an unedited one still as read (a float one ulp off still fails)."""
+    from flint import fmpq
+
+    rep, _ = Report.from_dict(copy.deepcopy(good))
+    assert api.verify(rep).exit_code() == 0
+    rep.parameters["mu"] = fmpq(1)
+    got = api.verify(rep)
+    assert got.exit_code() == 1 and "iss-gain" in _failed(got), _failed(got)
+    rep, _ = Report.from_dict(copy.deepcopy(good))
+    rep.parameters["lambda_best"] = fmpq(9, 10)
+    assert "decay-lmi_best" in _failed(api.verify(rep))
+    d = copy.deepcopy(good)
+    d["parameters"]["P"][0][0] = math.nextafter(d["parameters"]["P"][0][0], math.inf)
+    rep, _ = Report.from_dict(d)
+    assert _failed(api.verify(rep)) == {"parameters-consistent"}
