@@ -161,7 +161,9 @@ def _value(v: Any) -> str:
     arr = np.asarray(v)
     if arr.ndim == 0:
         item = arr.item()
-        if item is v:
+        # a complex number's item is a new complex, never `v` itself: RecursionError (API
+        # trial, session 33); the same type again means nothing was unwrapped
+        if item is v or type(item) is type(v) or isinstance(item, complex):
             raise InputError(f"cannot write a value of type {type(v).__name__} into a spec")
         return _value(item)
     if arr.dtype.kind in "fiub":

@@ -687,3 +687,15 @@ def test_mat_import_for_a_method_with_required_keys_says_where_to_start(
     assert r.exit_code == 2 and r.stdout == ""
     assert f"--method {method} needs [method.{key}]" in r.stderr, r.stderr
     assert f"obsdesign init {method}" in r.stderr
+
+
+def test_a_complex_value_is_refused_not_a_recursion() -> None:
+    """A complex λ or an entry of L (also numpy's complex128) went through np.asarray as a
+    0-d array whose item is a new complex, again and again: RecursionError (API trial,
+    session 33). It is bad input naming the type."""
+    from obsdesign.interop import _value
+
+    for v in (0.955 + 0j, np.complex128(0.955), [complex(-1.87), 1.874]):
+        with pytest.raises(InputError, match="cannot write a value of type complex"):
+            _value(v)
+    assert _value([0.5, 1]) == "[0.5, 1]"
