@@ -234,14 +234,17 @@ def grid_points(axes: Sequence[Axis]) -> list[dict[str, str]]:
 
 def parse_grid(grid: Sequence[str] | dict[str, Any]) -> list[Axis]:
     """Axes from ``--set`` texts, or from a dict ``{key: "a:b:n" | [values] | value}``
-    (values may be Python numbers: written with ``repr``, i.e. the shortest decimal)."""
+    (values may be Python numbers: written with ``repr``, i.e. the shortest decimal; a
+    numpy array is the list of its values along its first axis, as a list would be)."""
     if isinstance(grid, dict):
         texts = []
         for k, v in grid.items():
+            if _is_ndarray(v) and getattr(v, "ndim", 0) > 0:
+                v = list(v)  # the points; as one string it was one bad point (API trial 33)
             if isinstance(v, (list, tuple)):
-                v = "[" + ", ".join(_py_literal(x) for x in v) + "]"
+                v = "[" + ", ".join(_py_literal(x, k) for x in v) + "]"
             elif not isinstance(v, str):
-                v = _py_literal(v)
+                v = _py_literal(v, k)
             texts.append(f"{k}={v}")
         grid = texts
     if not grid:
@@ -249,24 +252,28 @@ def parse_grid(grid: Sequence[str] | dict[str, Any]) -> list[Axis]:
     return [parse_axis(t) for t in grid]
 
 
-def _py_literal(x: Any) -> str:
-    if isinstance(x, bool):
-        return "true" if x else "false"
-    if isinstance(x, (int, float, Decimal, Fraction)):
-        if isinstance(x, float) and not math.isfinite(x):
-            raise InputError(f"sweep: {x!r} is not a finite number")
-        if isinstance(x, int):
-            from obsdesign.limits import int_problem
+def _is_ndarray(v: Any) -> bool:
+    """Whether ``v`` is a numpy array, without importing numpy for a grid that has none."""
+    return type(v).__module__ == "numpy" and type(v).__name__ == "ndarray"
 
-            why = int_problem(x)  # str() of a 5000-digit int is a ValueError (outsider trial)
-            if why is not None:
-                raise InputError(f"sweep: an integer value {why}")
-        if isinstance(x, Fraction):
-            x = Decimal(x.numerator) / Decimal(x.denominator)
-        return repr(x) if isinstance(x, float) else str(x)
-    if isinstance(x, (list, tuple)):
-        return "[" + ", ".join(_py_literal(y) for y in x) + "]"
-    return json.dumps(str(x))
+
+def _py_literal(x: Any, key: str = "") -> str:
+    """One value of a dict grid as TOML, written as :func:`obsdesign.interop` writes a spec
+    value: numpy scalars and arrays as numbers (they became strings, ``'0.96'`` for a
+    float32: API trial, session 33), exact rationals exactly or refused (a Fraction(29, 30)
+    was rounded to 28 digits silently)."""
+    if isinstance(x, int) and not isinstance(x, bool):
+        from obsdesign.limits import int_problem
+
+        why = int_problem(x)  # str() of a 5000-digit int is a ValueError (outsider trial)
+        if why is not None:
+            raise InputError(f"sweep: {key}: an integer value {why}")
+    from obsdesign.interop import _value
+
+    try:
+        return _value(x)
+    except InputError as e:
+        raise InputError(f"sweep: {key}: {e}") from None
 
 
 # -- editing the spec text --------------------------------------------------------------------

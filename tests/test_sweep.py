@@ -90,6 +90,39 @@ def test_grid_is_the_product_last_axis_fastest_and_limited():
     ]
 
 
+def test_a_dict_grid_takes_numpy_values_and_exact_rationals_as_numbers() -> None:
+    """A numpy array was written as one string point ('[0.96 0.97]'), numpy scalars other
+    than float64 as strings, and Fraction(29, 30) was rounded to 28 digits silently (API
+    trial, session 33). An array is its list of points; every value is written as
+    :mod:`obsdesign.interop` writes a spec's; a rational without a finite decimal is refused
+    naming the key."""
+    from decimal import Decimal
+    from fractions import Fraction
+
+    import numpy as np
+
+    axes = sw.parse_grid(
+        {
+            "a.x": np.linspace(0.96, 0.97, 2),
+            "a.y": [np.float32(0.5), np.int64(3), np.float16(0.25)],
+            "a.z": [np.array([-1.87, 1.874])],
+            "a.w": np.array([[1, 2], [3, 4]]),
+            "a.q": [Fraction(1, 4), Decimal("0.125"), True],
+        }
+    )
+    assert [a.values for a in axes] == [
+        ("0.96", "0.97"),
+        ("0.5", "3", "0.25"),
+        ("[-1.87, 1.874]",),
+        ("[1, 2]", "[3, 4]"),
+        ("0.25", "0.125", "true"),
+    ]
+    with pytest.raises(InputError, match=r"sweep: a\.q: the exact number 29/30 has no finite"):
+        sw.parse_grid({"a.q": [Fraction(29, 30)]})
+    with pytest.raises(InputError, match=r"sweep: a\.q: cannot write the non-finite number"):
+        sw.parse_grid({"a.q": [np.float32("nan")]})
+
+
 # -- editing the spec text -----------------------------------------------------------------
 def _changed(old: str, new: str) -> dict:
     a, b = tomllib.loads(old), tomllib.loads(new)
