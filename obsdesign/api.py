@@ -121,6 +121,7 @@ def load_spec(path: str | Path) -> Spec:
     """Read the spec file at ``path`` and bind its method (see :func:`bind`). Warnings raised while
     reading (numpy, scipy) are kept in ``spec.warnings`` rather than printed."""
     notes: list[str] = []
+    _path_arg(path, "spec")
     with captured_warnings(notes):
         sp = bind(read_spec(path))
     _keep_warnings(sp, notes)
@@ -130,6 +131,14 @@ def load_spec(path: str | Path) -> Spec:
 def load_spec_text(text: str, file: str = "<spec>") -> Spec:
     """Parse spec ``text`` and bind its method (see :func:`bind`); ``file`` names it in
     error messages."""
+    if not isinstance(text, str):
+        # bytes, None or a Spec reached the reader's str methods: a bare TypeError or
+        # AttributeError (API trial, session 33)
+        hint = " (decode it: text.decode('utf-8'))" if isinstance(text, (bytes, bytearray)) else ""
+        raise InputError(
+            f"{file}: expected the spec's text as a str, got a value of type "
+            f"{type(text).__name__}{hint}"
+        )
     notes: list[str] = []
     with captured_warnings(notes):
         sp = bind(read_spec_text(text, file))
@@ -146,7 +155,21 @@ def _keep_warnings(sp: Spec, notes: list[str]) -> None:
 
 
 def _spec(spec: str | Path | Spec) -> Spec:
-    return bind(spec) if isinstance(spec, Spec) else load_spec(spec)
+    if isinstance(spec, Spec):
+        return bind(spec)
+    return load_spec(_path_arg(spec, "spec", "a Spec"))
+
+
+def _path_arg(value: Any, name: str, other: str = "") -> Any:
+    """``value`` when it is a path (str or os.PathLike), else an :class:`InputError` naming
+    the argument and the type given (``design(123)``, ``verify({})`` were bare TypeErrors
+    from deep in the reader; API trial, session 33)."""
+    import os
+
+    if isinstance(value, (str, os.PathLike)):
+        return value
+    also = f" or {other}" if other else ""
+    raise InputError(f"{name}: expected a path{also}, got a value of type {type(value).__name__}")
 
 
 def _did_you_mean(word: str, known: list[str]) -> str:
@@ -200,7 +223,7 @@ def design(
     ``"verdict": "error"`` and the error, which ``verify`` reports as such. Bad input (exit 2)
     writes nothing and leaves ``out`` untouched."""
     if out is not None:
-        check_output(out, force, inputs=_spec_inputs(spec))
+        check_output(_path_arg(out, "out"), force, inputs=_spec_inputs(spec))
     t0 = time.perf_counter()
     sp = _spec(spec)
     t1 = time.perf_counter()
@@ -333,11 +356,11 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
         rep, problems = Report.from_dict(d)
         rep.extra_keys = list(report.extra_keys)
     else:
-        rep, problems = Report.load(report)
+        rep, problems = Report.load(_path_arg(report, "report", "a Report"))
     if spec is not None:
         from obsdesign.limits import read_input
 
-        p = Path(spec)
+        p = Path(_path_arg(spec, "spec"))
         raw = read_input(p, "spec")
         try:
             text = raw.decode("utf-8")
@@ -658,6 +681,45 @@ def _uncertified_design(sp: Spec, params: Parameters) -> list[str]:
     return [f"{sp.file}: the design's claims give the verdict '{verdict}' ({ids}): {tail}"]
 
 
+def _check_sim_keywords(method: Any, kwargs: dict[str, Any]) -> None:
+    """Keyword values of :func:`simulate` the method does not take: an :class:`InputError`
+    naming the key and the known ones (``simulate(spec, bogus=3)`` was a bare TypeError from
+    deep in the method; API trial, session 33). Known: the method's declared
+    ``sim_options`` and the named parameters of the function that runs its simulation."""
+    import inspect
+
+    known = {o.name for o in method.sim_options}
+    fn = method.simulate
+    for _ in range(2):
+        ps = inspect.signature(fn).parameters.values()
+        known |= {p.name for p in ps if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)}
+        if not any(p.kind == p.VAR_KEYWORD for p in ps):
+            break
+        sim = _sim_part(method)  # the base class's simulate passes **options to it
+        if sim is None:
+            break
+        fn = sim.simulate
+    known -= {"self", "spec", "params"}
+    for k in kwargs:
+        if k not in known:
+            names = ", ".join(sorted(known)) or "none"
+            hint = _did_you_mean(k, sorted(known))
+            raise InputError(
+                f"simulate: {k}: not an option of method '{method.key}'{hint} (known: {names})"
+            )
+
+
+def _sim_part(method: Any) -> Any:
+    """The method's ``sim`` module, or None when it has none (a module it imports that is
+    missing is raised, as :meth:`Method.simulate` raises it)."""
+    try:
+        return method.part("sim")
+    except ModuleNotFoundError as e:
+        if e.name != f"{type(method).__module__.rsplit('.', 1)[0]}.sim":
+            raise
+        return None
+
+
 def simulate(
     spec: str | Path | Spec,
     report: str | Path | Report | None = None,
@@ -686,6 +748,7 @@ def simulate(
     values passed as they are.
     """
     sp = _spec(spec)
+    _check_sim_keywords(get_method(sp.method), kwargs)
     kwargs = {**get_method(sp.method).parse_sim_options(options or {}), **kwargs}
     r = kwargs.get("runs")
     if r is not None and (isinstance(r, bool) or not isinstance(r, numbers.Integral) or r < 1):
@@ -732,7 +795,7 @@ def simulate(
         rep, problems = (
             Report.from_dict(report.to_dict())
             if isinstance(report, Report)
-            else Report.load(report)
+            else Report.load(_path_arg(report, "report", "a Report"))
         )
         if rep.spec_sha256 != sp.sha256:
             raise InputError(f"{sp.file}: the report was made from another spec (sha256 differs)")

@@ -317,3 +317,41 @@ def test_a_report_read_from_json_and_edited_in_memory_is_verified_as_edited(good
     d["parameters"]["P"][0][0] = math.nextafter(d["parameters"]["P"][0][0], math.inf)
     rep, _ = Report.from_dict(d)
     assert _failed(api.verify(rep)) == {"parameters-consistent"}
+
+
+def test_api_arguments_of_the_wrong_type_are_input_errors(tmp_path: Path) -> None:
+    """``load_spec_text(bytes | None)``, ``design(123)``, ``verify({})`` and
+    ``simulate(spec, bogus=3)`` raised bare TypeError / AttributeError from deep in the
+    reader or the method (API trial, session 33): each is an :class:`InputError` naming
+    the argument, and a misspelt simulate keyword gets a hint and the known ones."""
+    from obsdesign.errors import InputError
+
+    text = SPEC.read_text("utf-8")
+    with pytest.raises(
+        InputError,
+        match=r"<spec>: expected the spec's text as a str, got a va"
+        r"lue of type bytes \(decode it",
+    ):
+        api.load_spec_text(text.encode())
+    with pytest.raises(InputError, match="of type NoneType"):
+        api.load_spec_text(None)  # type: ignore[arg-type]
+    assert api.load_spec_text(text).method == "lyapunov"
+    with pytest.raises(InputError, match="spec: expected a path or a Spec, got .* int"):
+        api.design(123)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="out: expected a path, got .* float"):
+        api.design(SPEC, out=1.5)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="report: expected a path or a Report, got .* dict"):
+        api.verify({})  # type: ignore[arg-type]
+    out = tmp_path / "r.json"
+    api.design(SPEC, out=out)
+    with pytest.raises(InputError, match="spec: expected a path, got .* int"):
+        api.verify(out, spec=7)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="report: expected a path or a Report, got .* int"):
+        api.simulate(SPEC, report=5)  # type: ignore[arg-type]
+    with pytest.raises(
+        InputError,
+        match=r"simulate: run: not an option of method 'lyapunov' \(did you mean 'runs'\?\) "
+        r"\(known: batch, runs, span, time_limit\)",
+    ):
+        api.simulate(SPEC, run=3)
+    assert api.simulate(SPEC, runs=2).metrics  # the known keywords still pass
