@@ -1394,7 +1394,7 @@ def best_rate(
     edge = fmpq(1) if discrete else fmpq(0)  # r must stay below it
     if lo >= edge:
         what = "Schur" if discrete else "Hurwitz"
-        lim = f"spectral radius ≈ {bound:.6g}" if discrete else f"largest real part ≈ {bound:.6g}"
+        lim = guide.figure(discrete)
         raise InfeasibleError(f"A − LC is not {what}: {lim} ({stability_test(discrete)})")
     known_r = None if known is None else Q(known[0]) * sign
     hi, P = edge - grid, None

@@ -59,6 +59,15 @@ class Spectrum:
             return 0.0 if discrete else -np.inf
         return float(np.max(np.abs(self.w))) if discrete else float(np.max(self.w.real))
 
+    def figure(self, discrete: bool) -> str:
+        """The spectral radius / largest real part as a message's "≈" figure, naming where it
+        comes from unless it is accurate float eigenvalues ("spectral radius ≈ 6064.19" was
+        printed for an exact radius of 0.9 at n = 40, unlabelled; lyapunov trial, session
+        34)."""
+        b = self.bound(discrete)
+        what = f"spectral radius ≈ {b:.6g}" if discrete else f"largest real part ≈ {b:.6g}"
+        return what if self.source == FLOAT_SOURCE else f"{what} from {self.source}"
+
 
 def spectrum(Am: fmpq_mat, Af: np.ndarray) -> Spectrum:
     """The eigenvalues of the exact matrix ``Am`` (e.g. A − LC of eq. (3), constrained-redesign
@@ -85,13 +94,20 @@ def spectrum(Am: fmpq_mat, Af: np.ndarray) -> Spectrum:
     if w is not None and np.all(np.isfinite(w)):
         size = max(1.0, float(np.max(np.abs(w)))) if n else 1.0
         if err <= FLOAT_TOL * size or n > HP_MAX_N:
-            return Spectrum(w, FLOAT_SOURCE, V if Vi is not None else None, Vi)
+            src = FLOAT_SOURCE if err <= FLOAT_TOL * size else inaccurate_source(err)
+            return Spectrum(w, src, V if Vi is not None else None, Vi)
     hp = eig_hp(Am) if 0 < n <= HP_MAX_N else None
     if hp is not None:
         return Spectrum(hp[0], hp[1])
     if w is None:
         w = np.linalg.eigvals(np.nan_to_num(Af))
-    return Spectrum(w, FLOAT_SOURCE)
+    return Spectrum(w, inaccurate_source(err))
+
+
+def inaccurate_source(err: float) -> str:
+    """The source of float eigenvalues whose error bound ``err`` (absolute) is not met."""
+    bound = f"≈ {err:.2g}" if math.isfinite(err) else "not finite"
+    return f"{FLOAT_SOURCE}, not reliable here: their Bauer–Fike error bound is {bound}"
 
 
 def eig_hp(Am: fmpq_mat) -> tuple[np.ndarray, str] | None:

@@ -104,3 +104,24 @@ def slow_clock(monkeypatch: pytest.MonkeyPatch):
         monkeypatch.setattr(budget, "time", Clock)
 
     return start
+
+
+@pytest.fixture
+def jordan_in_disguise():
+    """``make(z, n, scale)``: S J S⁻¹ exactly (``fmpq_mat``), J the n×n Jordan block of z,
+    S = I + scale·(subdiagonal ones): a defective, strongly non-normal matrix whose float
+    eigenvalues are off by ~(u‖·‖)^(1/n)."""
+    from flint import fmpq, fmpq_mat
+
+    def make(z: fmpq, n: int, scale: int) -> fmpq_mat:
+        J = fmpq_mat(
+            n, n, [z if i == j else (1 if j == i + 1 else 0) for i in range(n) for j in range(n)]
+        )
+        S = fmpq_mat(
+            n,
+            n,
+            [1 if i == j else (scale if i == j + 1 else 0) for i in range(n) for j in range(n)],
+        )
+        return S * J * S.inv()
+
+    return make

@@ -796,7 +796,7 @@ def test_rho_below_the_best_rate_squared_names_the_key() -> None:
     )
     with pytest.raises(SpecError, match=r"\[method\.rho\] expected rho >= λ_best² = 0\.04") as e:
         api.design(load_spec_text(text.format(rho="0.03"), "rho.toml"))
-    assert e.value.exit_code == 2 and "spectral radius 0.2" in e.value.message
+    assert e.value.exit_code == 2 and "spectral radius ≈ 0.2" in e.value.message
     rep = api.design(load_spec_text(text.format(rho="0.05"), "rho.toml"))
     assert rep.exit_code() == 0
 
@@ -938,6 +938,13 @@ def test_a_schur_gain_with_a_float_radius_above_one_is_decided_exactly() -> None
     assert api.verify(rep).exit_code() == 0
     with pytest.raises(InfeasibleError, match=r"not Schur \(an eigenvalue of modulus ≥ 1, exact"):
         api.design(load_spec_text(_jordan_spec("[[0, 1], [-1, 0]]", 2), "rot.toml"))
+    # the message's "≈" figure is the spectral guide's, naming its source: float eigenvalues
+    # printed 1.00017 here for an exact 1.00001 (lyapunov trial, session 34)
+    A = "[[1.00001, 1, 0, 0], [0, 1.00001, 1, 0], [-1, 1, 0.00001, 1], [-1, 2, -2, 2.00001]]"
+    with pytest.raises(
+        InfeasibleError, match=r"spectral radius ≈ 1\.00001 from roots of the exact"
+    ):
+        api.design(load_spec_text(_jordan_spec(A, 4), "jordan.toml"))
 
 
 def test_rho_and_lambda_are_printed_exactly_in_their_statements():

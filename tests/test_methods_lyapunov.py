@@ -1472,3 +1472,26 @@ def test_a_jordan_block_does_not_mislead_the_spectral_guide(
     key = "spectral_abscissa" if rate == "alpha" else "spectral_radius"
     assert rep.parameters.float(key) == pytest.approx(bound, abs=1e-6)
     assert api.verify(rep).exit_code() == 0
+
+
+def test_bracket_detail_gives_the_spectral_guide_not_raw_float_eigenvalues(
+    jordan_in_disguise,
+) -> None:
+    """The bracket claim's "optimal rate ρ(A − LC) ≈ …" came from raw float eigenvalues: 1.4693
+    beside a certified λ = 0.98311 for an exact ρ = 0.8525 (lyapunov trial, session 34). It
+    is the spectral guide's value, naming its source where floats are poor."""
+    from obsdesign.methods.lyapunov.claims import _float_bound
+
+    Am = jordan_in_disguise(fmpq(1, 2), 3, 1000)  # exactly ρ = 1/2, not so in floats
+    Af = lyap.mat_float(Am)
+    assert abs(float(np.max(np.abs(np.linalg.eigvals(Af)))) - 0.5) > 1e-5
+    got = _float_bound(Am, Af, True)
+    assert (
+        got == "the optimal rate ρ(A − LC) ≈ 0.5 from roots of the exact characteristic polynomial"
+    )
+    assert _float_bound(Am, None, False) == (
+        "the optimal rate −max Re eig(A − LC) ≈ -0.5 from roots of the exact characteristic "
+        "polynomial"
+    )
+    diag = lyap.fmat(np.diag([0.5, 0.25]))
+    assert _float_bound(diag, None, True) == "the optimal rate ρ(A − LC) ≈ 0.5 in floats"

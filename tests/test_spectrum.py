@@ -18,18 +18,6 @@ def _exact(M: list[list[int | fmpq]]) -> fmpq_mat:
     return fmpq_mat([[fmpq(x) for x in row] for row in M])
 
 
-def _jordan_in_disguise(z: fmpq, n: int, scale: int) -> fmpq_mat:
-    """S J S⁻¹ exactly, J the n×n Jordan block of z, S = I + scale·(subdiagonal ones): a
-    defective, strongly non-normal matrix whose float eigenvalues are off by ~(u‖·‖)^(1/n)."""
-    J = fmpq_mat(
-        n, n, [z if i == j else (1 if j == i + 1 else 0) for i in range(n) for j in range(n)]
-    )
-    S = fmpq_mat(
-        n, n, [1 if i == j else (scale if i == j + 1 else 0) for i in range(n) for j in range(n)]
-    )
-    return S * J * S.inv()
-
-
 def test_a_well_conditioned_matrix_keeps_its_float_eigenvalues() -> None:
     Am = _exact([[fmpq(1, 2), 1], [0, fmpq(-1, 3)]])
     g = spectrum.spectrum(Am, lyap.mat_float(Am))
@@ -38,11 +26,11 @@ def test_a_well_conditioned_matrix_keeps_its_float_eigenvalues() -> None:
     assert g.bound(False) == pytest.approx(0.5, abs=1e-15)
 
 
-def test_a_defective_non_normal_matrix_takes_high_precision_eigenvalues() -> None:
+def test_a_defective_non_normal_matrix_takes_high_precision_eigenvalues(jordan_in_disguise) -> None:
     """A triple eigenvalue 0.9 in disguise: numpy's radius is off (here by more than 10⁻⁶);
     the guide's is 0.9 to 10⁻¹², from the exact characteristic polynomial (python-flint),
     with no float eigenvectors."""
-    Am = _jordan_in_disguise(fmpq(9, 10), 3, 1000)
+    Am = jordan_in_disguise(fmpq(9, 10), 3, 1000)
     Af = lyap.mat_float(Am)
     assert abs(float(np.max(np.abs(np.linalg.eigvals(Af)))) - 0.9) > 1e-6
     g = spectrum.spectrum(Am, Af)
@@ -51,20 +39,23 @@ def test_a_defective_non_normal_matrix_takes_high_precision_eigenvalues() -> Non
     assert g.bound(False) == pytest.approx(0.9, abs=1e-12)
 
 
-def test_above_the_size_limit_the_float_eigenvalues_stay(monkeypatch: pytest.MonkeyPatch) -> None:
-    Am = _jordan_in_disguise(fmpq(9, 10), 3, 1000)
+def test_above_the_size_limit_the_float_eigenvalues_stay(
+    monkeypatch: pytest.MonkeyPatch, jordan_in_disguise
+) -> None:
+    Am = jordan_in_disguise(fmpq(9, 10), 3, 1000)
     monkeypatch.setattr(spectrum, "HP_MAX_N", 2)
     g = spectrum.spectrum(Am, lyap.mat_float(Am))
-    assert g.source == FLOAT_SOURCE
+    # labelled: "spectral radius ≈ 6064.19" was printed for an exact 0.9 (session 34)
+    assert g.source.startswith(FLOAT_SOURCE + ", not reliable here: their Bauer–Fike error")
     assert abs(g.bound(True) - 0.9) > 1e-6  # the poor float answer, as documented
 
 
 def test_the_characteristic_polynomial_first_else_agreeing_precisions(
-    monkeypatch: pytest.MonkeyPatch,
+    monkeypatch: pytest.MonkeyPatch, jordan_in_disguise
 ) -> None:
     """The exact characteristic polynomial's roots decide; without them (monkeypatched away)
     two precisions of acb_mat.eig in a row must agree, else the last is taken."""
-    Am = _jordan_in_disguise(fmpq(1, 2), 2, 10)
+    Am = jordan_in_disguise(fmpq(1, 2), 2, 10)
     w, src = eig_hp(Am)  # type: ignore[misc]
     assert src == spectrum.CHARPOLY_SOURCE and np.allclose(w, 0.5, atol=1e-15)
     monkeypatch.setattr(spectrum, "charpoly_roots", lambda Am: None)
@@ -188,3 +179,27 @@ def test_charpoly_roots_beyond_the_float_range_are_none() -> None:
     assert spectrum.charpoly_roots(Am) is None
     got = spectrum.eig_hp(Am)
     assert got is None or got[1] != spectrum.CHARPOLY_SOURCE
+
+
+def test_figure_names_its_source_unless_accurate_floats(
+    monkeypatch: pytest.MonkeyPatch, jordan_in_disguise
+) -> None:
+    """The "≈" figure of messages names where it comes from: nothing for accurate float
+    eigenvalues, the exact characteristic polynomial where floats are poor (n ≤ 24), and
+    "not reliable here" with the Bauer–Fike bound above 24 states ("spectral radius ≈
+    6064.19" was printed unlabelled for an exact radius of 0.9; lyapunov trial, session 34)."""
+    diag = lyap.fmat(np.diag([0.5, -0.25]))
+    g = spectrum.spectrum(diag, lyap.mat_float(diag))
+    assert g.figure(True) == "spectral radius ≈ 0.5"
+    assert g.figure(False) == "largest real part ≈ 0.5"
+    Am = jordan_in_disguise(fmpq(1, 2), 3, 1000)
+    g = spectrum.spectrum(Am, lyap.mat_float(Am))
+    assert (
+        g.figure(True) == "spectral radius ≈ 0.5 from roots of the exact characteristic polynomial"
+    )
+    monkeypatch.setattr(spectrum, "HP_MAX_N", 2)
+    g = spectrum.spectrum(Am, lyap.mat_float(Am))
+    assert g.figure(True).startswith("spectral radius ≈ 0.5")
+    assert " from float eigenvalues, not reliable here: their Bauer–Fike error bound is ≈ " in (
+        g.figure(True)
+    )

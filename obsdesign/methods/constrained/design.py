@@ -42,6 +42,15 @@ class LyapData:
     other_kind: str = ""
 
 
+def _radius_figure(A: Any, C: Any, L: Any) -> str:
+    """ "spectral radius ≈ …" of A − LC for a message, from the spectral guide (naming its
+    source when it is not accurate float eigenvalues; :func:`obsdesign.spectrum.spectrum`)."""
+    from obsdesign.spectrum import spectrum
+
+    Am = lyap.fmat(lyap.closed_loop(A, C, L))
+    return spectrum(Am, lyap.mat_float(Am)).figure(True)
+
+
 def lyapunov_data(spec: Spec) -> LyapData:
     """Assumption 2 and Section 5 of the constrained-redesign paper (Astolfi et al., NOLCOS
     2019): V(e) = eᵀPe (eq. (4)) with P solving (A−LC)ᵀP(A−LC) − λ²P = −I, certified exactly
@@ -65,8 +74,8 @@ def lyapunov_data(spec: Spec) -> LyapData:
         schur, how = lyap.rate_feasibility(lyap.closed_loop(A, C, o.L), 1, True)
         if not schur:
             raise InfeasibleError(
-                f"A − LC is not Schur (an eigenvalue of modulus ≥ 1, {how}; spectral radius "
-                f"≈ {rad:.6g}): no Lyapunov function (Assumption 2)"
+                f"A − LC is not Schur (an eigenvalue of modulus ≥ 1, {how}; "
+                f"{_radius_figure(A, C, o.L)}): no Lyapunov function (Assumption 2)"
             )
     bracket: tuple[fmpq | None, str] = (None, "")
     if o.lam is None:
@@ -84,9 +93,9 @@ def lyapunov_data(spec: Spec) -> LyapData:
                 spec.file,
                 "method.rho",
                 f"expected rho >= λ_best² = {float(lam * lam):.6g} (λ omitted: the best "
-                f"certified rate λ_best = {float(lam):.6g}, A − LC has spectral radius "
-                f"{rad:.6g}; β(v, d) = ρv + μ|d|² needs ρ ≥ λ²): give a larger rho, or "
-                "lambda with rho >= lambda²",
+                f"certified rate λ_best = {float(lam):.6g}, A − LC has "
+                f"{_radius_figure(A, C, o.L)}; β(v, d) = ρv + μ|d|² needs ρ ≥ λ²): give a "
+                "larger rho, or lambda with rho >= lambda²",
             )
     else:
         lam = o.lam
@@ -98,7 +107,7 @@ def lyapunov_data(spec: Spec) -> LyapData:
                 raise InfeasibleError(
                     f"{lyap.infeasible_head(o.margin)} decay rate λ = {fmt_exact(lam)}: A − LC "
                     "has an eigenvalue "
-                    f"of modulus ≥ λ ({how}; spectral radius ≈ {rad:.6g})"
+                    f"of modulus ≥ λ ({how}; {_radius_figure(A, C, o.L)})"
                     + lyap.nonstrict_note(o.margin, True)
                 )
             raise InconclusiveError(

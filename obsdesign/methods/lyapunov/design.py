@@ -25,7 +25,7 @@ from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
 from obsdesign.methods.lyapunov.options import Options
 from obsdesign.params import Parameters
 from obsdesign.spec.models import Spec
-from obsdesign.spectrum import FLOAT_SOURCE, spectrum
+from obsdesign.spectrum import spectrum
 
 
 def rate_name(discrete: bool) -> str:
@@ -214,12 +214,9 @@ def _design_for(
     sym = "λ" if s.discrete else "α"
     if s.discrete:
         params["spectral_radius"] = bound  # ρ(A − LC), informational
-        lim = f"spectral radius ≈ {bound:.6g}"
     else:
         params["spectral_abscissa"] = bound  # max Re λ_i(A − LC), informational
-        lim = f"largest real part ≈ {bound:.6g}"
-    if guide.source != FLOAT_SOURCE:
-        lim += f" from {guide.source}"
+    lim = guide.figure(s.discrete)
     known = None
     if o.rate is not None:
         # the asked rate first, directly: no search can make it fail
