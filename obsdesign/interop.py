@@ -227,15 +227,39 @@ def _matrices(sys: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
     return A, B, C, D, dt
 
 
+def _big_int(x: Any) -> bool:
+    """An integer (not a bool) that a double does not hold exactly: beyond 2⁵³."""
+    return isinstance(x, (int, np.integer)) and not isinstance(x, bool) and abs(int(x)) > 2**53
+
+
 def _real(M: Any, name: str) -> np.ndarray:
     """A real matrix: integer entries stay integers (exact: an int64 above 2⁵³ was rounded by
     a conversion to float, soundness trial, session 23), anything else as floats; complex
-    entries are refused (they were cast to their real part)."""
-    arr = np.asarray(M)
+    entries are refused (they were cast to their real part), and so are ragged rows, text,
+    None and other non-numbers (a bare ValueError, TypeError or OverflowError, or "nan" for
+    None; lyapunov trial, session 34)."""
+    try:
+        arr = np.asarray(M)
+    except (ValueError, TypeError):
+        raise InputError(
+            f"{name} is not a matrix of numbers: its rows are not all of one length"
+        ) from None
+    if arr.dtype.kind == "f" and isinstance(M, (list, tuple)):
+        # a list mixing floats with an integer beyond 2⁵³ became floats: the integer rounded
+        probe = np.array(M, dtype=object)
+        if probe.shape == arr.shape and any(_big_int(x) for x in probe.flat):
+            arr = probe
     if arr.dtype.kind == "c" or (
-        arr.dtype == object and any(isinstance(x, complex) for x in arr.flat)
+        arr.dtype == object and any(isinstance(x, (complex, np.complexfloating)) for x in arr.flat)
     ):
         raise InputError(f"{name} has complex entries: a spec's matrices are real")
+    if arr.dtype.kind not in "biuf" and arr.dtype != object:
+        first = str(arr.reshape(-1)[0]) if arr.size else ""
+        raise InputError(f"{name} has the entry {first!r}, which is not a number")
+    if arr.dtype == object:
+        for idx, x in np.ndenumerate(arr):
+            if not isinstance(x, (numbers.Real, Decimal)) and _rational(x) is None:
+                raise InputError(f"{name}{list(idx)} = {x!r}, which is not a number")
     if arr.dtype.kind in "iu":
         return arr
     if arr.dtype == object and all(
@@ -244,8 +268,13 @@ def _real(M: Any, name: str) -> np.ndarray:
         return arr
     if (arr.dtype.kind == "f" and arr.dtype.itemsize > 8) or (
         arr.dtype == object
-        and any(isinstance(x, (Decimal, Fraction)) or _rational(x) is not None for x in arr.flat)
+        and any(
+            isinstance(x, (Decimal, Fraction)) or _rational(x) is not None or _big_int(x)
+            for x in arr.flat
+        )
     ):
+        # an integer beyond 2⁵³ beside floats is kept exact too: it was rounded to a double,
+        # or overflowed (10⁴⁰⁰: a bare OverflowError; lyapunov trial, session 34)
         # exact inputs kept exact (written by _num through _exact): they were rounded to
         # doubles (sweep, import and check trial, session 28)
         out = np.empty(arr.shape, dtype=object)
@@ -261,7 +290,10 @@ def _real(M: Any, name: str) -> np.ndarray:
             except InputError as e:
                 raise InputError(f"{name}{list(idx)}: {e}") from None
             out[idx] = x if q is None else q
-            f = float(out[idx])
+            try:
+                f = float(out[idx])
+            except OverflowError:
+                f = math.inf
             if not math.isfinite(f) or (f == 0) != (out[idx] == 0):
                 raise InputError(
                     f"{name}{list(idx)} = {x}: outside the float range, which a spec refuses: "
@@ -368,6 +400,14 @@ def _names(prefix: str, k: int) -> list[str]:
     return [f"{prefix}[{i}]" for i in range(k)]
 
 
+def _named(shaped: Any, key: str, shape: tuple[int, int], where: str) -> np.ndarray:
+    """``shaped(key, shape)`` (:meth:`Parameters.shaped`) with its refusal naming the report."""
+    try:
+        return shaped(key, shape)  # type: ignore[no-any-return]
+    except InputError as e:
+        raise InputError(f"{where}: {e.message.removeprefix('report: ')}") from None
+
+
 def observer_statespace(report: Any, law: str | None = None, verify: bool = False) -> Any:
     """The designed observer of ``report`` (a :class:`obsdesign.report.model.Report` or a path
     to one) as a python-control system with inputs ``u[0..m-1]``, ``y[0..p-1]`` and outputs
@@ -456,10 +496,12 @@ def observer_statespace(report: Any, law: str | None = None, verify: bool = Fals
             name=name,
         )
 
+    # shaped: a 4×5 L of a 5×4 gain was reshaped row-major into another gain and returned
+    # without a word, while simulate --report refuses it (lyapunov trial, session 34)
     if report.method == "lyapunov":
-        return linear(params.float("L"), +1.0)
+        return linear(_named(params.shaped, "L", (n, p), where), +1.0)
     if report.method == "stubborn":
-        return linear(params.float("K"), +1.0)
+        return linear(_named(params.shaped, "K", (n, p), where), +1.0)
     if report.method == "set-invariant":
         use = law or ("linear" if "L" in params or sp.options.L is not None else "interpolated")
         if use == "linear":

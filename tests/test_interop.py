@@ -699,3 +699,56 @@ def test_a_complex_value_is_refused_not_a_recursion() -> None:
         with pytest.raises(InputError, match="cannot write a value of type complex"):
             _value(v)
     assert _value([0.5, 1]) == "[0.5, 1]"
+
+
+def test_observer_statespace_refuses_a_gain_of_another_shape(tmp_path: Path) -> None:
+    """A report whose L is transposed (2×3 for a 3×2 gain, float and exact alike) was
+    reshaped row-major into another gain and returned without a word, while
+    ``simulate --report`` refuses it (lyapunov trial, session 34)."""
+    from obsdesign.interop import observer_statespace
+
+    spec = tmp_path / "s.toml"
+    spec.write_text(
+        '[system]\ntime = "discrete"\nA = [[0.5, 0.1, 0], [0, 0.6, 0.2], [0.1, 0, 0.7]]\n'
+        'C = [[1, 0, 0], [0, 1, 0]]\n[method]\nkey = "lyapunov"\n'
+        "L = [[0.1, 0.2], [0.3, 0.4], [0.5, 0.6]]\n"
+    )
+    rep = tmp_path / "r.json"
+    assert CliRunner().invoke(app, ["design", str(spec), "-q", "-o", str(rep)]).exit_code == 0
+    obs = observer_statespace(rep)
+    np.testing.assert_array_equal(obs.B[:, -2:], [[0.1, 0.2], [0.3, 0.4], [0.5, 0.6]])
+    d = json.loads(rep.read_text())
+    for part in (d["parameters"], d["parameters"]["exact"]):
+        part["L"] = [list(col) for col in zip(*part["L"], strict=True)]
+    bad = tmp_path / "t.json"
+    bad.write_text(json.dumps(d))
+    with pytest.raises(InputError, match=r"t\.json: parameters\.L has shape 2×3, expected 3×2"):
+        observer_statespace(bad)
+
+
+@pytest.mark.parametrize(
+    ("A", "message"),
+    [
+        ([[0, 1], [1]], r"^A is not a matrix of numbers: its rows are not all of one length$"),
+        ([[{}, 1], [1, 0]], r"^A\[0, 0\] = \{\}, which is not a number$"),
+        ([[None, 1], [1, 0]], r"^A\[0, 0\] = None, which is not a number$"),
+        ([["abc", 1], [1, 0]], r"^A has the entry 'abc', which is not a number$"),
+        ([["0.1", "1"], ["1", "0"]], r"^A has the entry '0\.1', which is not a number$"),
+        ([[10**400, 1.5], [1, 0]], r"^A\[0, 0\] = 1000.*: outside the float range"),
+        (np.array([[10**400, 1.5], [1, 0]], dtype=object), r"^A\[0, 0\] = 1000.*: outside the"),
+    ],
+)
+def test_statespace_matrices_that_are_not_numbers_are_input_errors(A, message) -> None:
+    """Ragged rows, a dict, a word and a huge integer beside floats raised bare ValueError /
+    TypeError / OverflowError, None read as "nan" and numeric text was taken as numbers
+    (lyapunov trial, session 34): each is an InputError naming the matrix and the entry."""
+    with pytest.raises(InputError, match=message):
+        spec_text_from_statespace((A, [[0], [1]], [[1, 0]], [[0]], 1))
+
+
+def test_a_large_integer_beside_floats_is_written_exactly() -> None:
+    """np.asarray of [[2⁶⁰ + 1, 0.5], …] is a float array: the integer was rounded to 2⁶⁰."""
+    text = spec_text_from_statespace(
+        ([[2**60 + 1, 0.5], [0, 0.25]], [[0], [1]], [[1, 0]], [[0]], 1)
+    )
+    assert tomllib.loads(text)["system"]["A"][0] == [2**60 + 1, 0.5]
