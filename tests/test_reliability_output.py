@@ -871,3 +871,24 @@ def _invoke_reading(fifo: Path, args: list[str]) -> tuple[Any, bytes]:
     res = runner.invoke(app, args)
     reader.join(timeout=30)
     return res, (got[0] if got else b"")
+
+
+@pytest.mark.parametrize("command", ["design", "verify"])
+def test_a_closed_pipe_under_the_text_tables_is_exit_141(
+    spec: Path, tmp_path: Path, command: str
+) -> None:
+    """``verify r.json | head -1`` of a good report exited 1 (the code of a failed claim)
+    with nothing on stderr: rich's console handles a broken pipe itself with SystemExit(1)
+    (soundness trial, session 34). The reader here has gone before anything is written."""
+    rep = tmp_path / "r.json"
+    assert runner.invoke(app, ["design", str(spec), "-q", "-o", str(rep)]).exit_code == 0
+    arg = str(spec) if command == "design" else str(rep)
+    p = subprocess.Popen(
+        [sys.executable, "-m", "obsdesign", command, arg],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    assert p.stdout is not None and p.stderr is not None
+    p.stdout.close()
+    err = p.stderr.read()
+    assert p.wait(timeout=120) == 141 and err == b"", err

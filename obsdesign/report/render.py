@@ -120,8 +120,16 @@ def console() -> Any:
     cold ``obsdesign design``."""
     from rich.console import Console
 
-    out = Console(width=width())
-    return out if out.color_system is not None else Console(width=width(), highlight=False)
+    class _Console(Console):
+        def on_broken_pipe(self) -> None:
+            """The reader of stdout went away: raise it to the CLI, which exits 141. rich's own
+            handler exits 1, the code of a failed claim (``verify r.json | head -1`` of a
+            good report exited 1; soundness trial, session 34)."""
+            self.quiet = True
+            raise BrokenPipeError
+
+    out = _Console(width=width())
+    return out if out.color_system is not None else _Console(width=width(), highlight=False)
 
 
 def verdict_line(report: Report, verb: str = "verified") -> str:
