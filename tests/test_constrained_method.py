@@ -1051,3 +1051,70 @@ def test_simulate_names_a_P_below_the_margin_as_assumption_2_failing(tmp_path) -
     assert rep.exit_code() == 1 and "P-positive-definite" in {c.id for c in rep.failed}
     got = api.simulate(p).info["premises of Theorem 1 (25b)"]
     assert got.startswith("Assumption 2 fails: P is not positive definite"), got
+
+
+TINY = """[system]
+time = "discrete"
+A = [[0.5]]
+C = [[1]]
+[sets.X]
+type = "box"
+lower = [-1e-12]
+upper = [1e-12]
+[sets.Xh]
+type = "box"
+lower = [-1.5e-12]
+upper = [1.5e-12]
+[method]
+key = "constrained"
+L = [0.9]
+lambda = 0.5
+X = "X"
+Xhat = "Xh"
+eps_min = 1e-26
+[method.c]
+type = "box"
+lower = [-1.1e-12]
+upper = [1.1e-12]
+[method.D]
+lower = [-1e-12]
+upper = [1e-12]
+[simulate]
+horizon = 300
+x0 = [1e-12]
+xhat0 = [-1.5e-12]
+theta_m = [0, 3]
+[simulate.noise]
+kind = "uniform"
+bound = 1e-12
+"""
+
+
+def test_simulate_flags_hold_at_any_scale(tmp_path: Path) -> None:
+    """At scale 10⁻¹² the simulate flags used absolute tolerances (10⁻⁹ for X, X̂; 10⁻¹² for
+    D): "x̂_k in X̂ for all k ≥ 1: True" with x̂_1 = 1.75·10⁻¹² outside X̂ = ±1.5·10⁻¹², and
+    "premises … hold" with x̂_0, x_0 outside or noise 100× outside D (soundness trial,
+    session 34). The tolerance is now 10⁻⁹ of each set's own size."""
+    p = tmp_path / "tiny.toml"
+
+    def info(text: str) -> dict:
+        p.write_text(text)
+        return api.simulate(p).info
+
+    got = info(TINY)
+    assert got["modified θ_m=0: x̂_k in X̂ for all k ≥ 1"] is False
+    assert got["modified θ_m=3: x̂_k in X̂ for all k ≥ 1"] is False
+    got = info(TINY.replace("x0 = [1e-12]\nxhat0 = [-1.5e-12]", "x0 = [3e-12]\nxhat0 = [5e-12]"))
+    premises = got["premises of Theorem 1 (25b)"]
+    assert "the estimate starts outside X̂" in premises and "the plant leaves X at k = 0" in premises
+    small_D = TINY.replace(
+        "lower = [-1e-12]\nupper = [1e-12]\n[simulate]",
+        "lower = [-1e-14]\nupper = [1e-14]\n[simulate]",
+    )
+    assert small_D != TINY
+    premises = info(small_D)["premises of Theorem 1 (25b)"]
+    assert premises.startswith("w_k = (d_k, v_k) leaves D at k = ") and "e-1" in premises
+    # x̂_0 on X̂'s boundary, x, w inside: no premise of the run itself is flagged (only the
+    # step budgets, which these θ_m are below)
+    premises = info(TINY)["premises of Theorem 1 (25b)"]
+    assert "X̂" not in premises and "leaves" not in premises and "all spent" in premises

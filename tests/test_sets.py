@@ -120,3 +120,25 @@ def test_ellipsoid_membership_and_bounding_box():
     assert E.contains([1.5, 0]) and not E.contains([0.4, 0])
     lo, hi = E.bounding_box()
     assert np.allclose(lo, [0.5, -1]) and np.allclose(hi, [1.5, 1])
+
+
+@settings(max_examples=40, deadline=None)
+@given(k=st.integers(-12, 12), out=st.sampled_from([0.0, 1e-12, 1e-6, 0.1]))
+def test_contains_rel_does_not_depend_on_the_scale(k: int, out: float) -> None:
+    """contains_rel(x) is the same for a set and x scaled by 10^k, and a polytope's answer
+    does not depend on how its rows are scaled: an absolute 1e-9 counted a point 16 % outside
+    a box 3·10⁻¹² wide as inside (constrained simulate, soundness trial, session 34). Points
+    ``out`` × width outside: inside for out ≤ 10⁻¹² (below the 10⁻⁹ slack), outside above."""
+    c = fmpq(10) ** k
+    box = Box(qvec([-c, -c]), qvec([c, 2 * c]))
+    tri = Polytope(qmat([[c**-1 * 1000, c**-1 * 1000], [-1, 0], [0, -1]]), qvec([1000, 0, 0]))
+    ell = Ellipsoid(qmat([[4 / c**2, 0], [0, 1 / c**2]]), qvec([c, 0]))
+    cf = 10.0**k
+    cases = [
+        (box, np.array([cf * (1 + 2 * out), 0.0])),  # width 2c
+        (tri, np.array([cf * (1 + out), 0.0])),  # width c
+        (ell, np.array([cf * (1.5 + out / 2), 0.0])),  # x semi-axis c/2, so out of the form ≈ 2·out
+    ]
+    for S, x in cases:
+        inside = bool(np.asarray(S.contains_rel(x[None, :])).reshape(-1)[0])
+        assert inside is (out <= 1e-12), (type(S).__name__, k, out)

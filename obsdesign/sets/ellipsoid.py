@@ -28,6 +28,11 @@ class Ellipsoid(ConvexSet):
         d = np.asarray(x, dtype=float) - self.center
         return np.einsum("...i,ij,...j->...", d, self.E, d) <= 1 + tol
 
+    def contains_rel(self, x: np.ndarray, rel: float = 1e-9) -> np.ndarray | bool:
+        """(x − c)ᵀE(x − c) ≤ 1 + ``rel``: the quadratic form is already relative to the
+        set's size (:meth:`ConvexSet.contains_rel`)."""
+        return self.contains(x, tol=rel)
+
     def bounding_box(self) -> tuple[np.ndarray, np.ndarray]:
         half = np.sqrt(np.diag(np.linalg.inv(self.E)))
         return self.center - half, self.center + half

@@ -115,6 +115,14 @@ class Polytope(ConvexSet):
         x = np.asarray(x, dtype=float)
         return np.all(x @ self.G.T <= self.g + tol, axis=-1)
 
+    def contains_rel(self, x: np.ndarray, rel: float = 1e-9) -> np.ndarray | bool:
+        """Gx ≤ g + s‖G_i‖₁ row by row, s the slack in state units of
+        :meth:`ConvexSet.contains_rel` (a scalar slack on g depends on how the rows are
+        scaled)."""
+        x = np.asarray(x, dtype=float)
+        slack = self._slack(rel) * np.abs(self.G).sum(axis=1)
+        return np.all(x @ self.G.T <= self.g + slack, axis=-1)
+
     def vertices_q(self) -> np.ndarray:
         """Exact vertices (cdd.gmp)."""
         G, g = self.h_form_q()

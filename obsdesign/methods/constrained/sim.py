@@ -85,7 +85,7 @@ def _outside_premises(
     "False" with no word of why; x̂_0 = (10⁶, −10⁶) printed "hold")."""
     out: list[str] = []
     if xhat0 is not None and Xhat is not None:
-        inside = np.asarray(Xhat.contains(np.asarray(xhat0, float)[None, :], tol=1e-9))
+        inside = np.asarray(Xhat.contains_rel(np.asarray(xhat0, float)[None, :]))
         if not bool(inside.reshape(-1)[0]):
             out.append("the estimate starts outside X̂ (x̂_0 ∉ X̂; Corollary 1 needs x̂_0 ∈ X̂)")
     K = len(x)
@@ -97,14 +97,16 @@ def _outside_premises(
     w = w[:used]
     lo, hi = np.asarray(o.D_lower, float), np.asarray(o.D_upper, float)
     if w.shape[1] == lo.size and lo.size:
-        bad = np.any((w < lo - 1e-12) | (w > hi + 1e-12), axis=1)
+        # D's own scale: 1e-12 let noise 100× outside a D of ±10⁻¹⁴ "hold" (session 34)
+        tol = 1e-9 * float(np.max(hi - lo)) + 4 * float(np.spacing(np.max(np.abs([lo, hi]))))
+        bad = np.any((w < lo - tol) | (w > hi + tol), axis=1)
         if bad.any():
             k = _first(bad)
             out.append(
                 f"w_k = (d_k, v_k) leaves D at k = {k} ({int(bad.sum())} of {used} samples; "
-                f"w_{k} = {np.round(w[k], 6).tolist()})"
+                f"w_{k} = [{', '.join(f'{c:.6g}' for c in w[k])}])"
             )
-    bad = ~np.asarray(o.X.contains(x, tol=1e-9), dtype=bool).reshape(-1)
+    bad = ~np.asarray(o.X.contains_rel(x), dtype=bool).reshape(-1)
     if bad.any():
         out.append(f"the plant leaves X at k = {_first(bad)} (Assumption 1)")
     if o.model is not None and o.U_lower.size:
@@ -259,7 +261,7 @@ def simulate(
                 f"{int(tr.steps.sum())}, {int(tr.steps.max(initial=0))}"
             )
             info[f"{name}: x̂_k in X̂ for all k ≥ 1"] = bool(
-                np.all(Xhat.contains(tr.xhat[1:], tol=1e-9))
+                np.all(Xhat.contains_rel(tr.xhat[1:]))
             )
             worst = tr.v_increase if tr.v_increase > -np.inf else 0.0
             info[f"{name}: max V increase over a refining step"] = f"{worst:.3g}"
