@@ -483,7 +483,10 @@ def _print_metrics(m: dict[str, Any]) -> None:
 
     from obsdesign.report.render import console, esc
 
-    t = Table(title="simulation metrics")
+    who = m.get("observer")
+    # which observer the numbers are of, where a method simulates several (constrained,
+    # stubborn): the title said "simulation metrics" only (soundness trial, session 34)
+    t = Table(title="simulation metrics" + (f" ({esc(str(who))})" if who else ""))
     t.add_column("state")
     t.add_column("sup |e_i|")
     t.add_column("RMSE")

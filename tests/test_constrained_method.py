@@ -1118,3 +1118,13 @@ def test_simulate_flags_hold_at_any_scale(tmp_path: Path) -> None:
     # step budgets, which these θ_m are below)
     premises = info(TINY)["premises of Theorem 1 (25b)"]
     assert "X̂" not in premises and "leaves" not in premises and "all spent" in premises
+
+
+def test_simulate_names_the_observer_its_metrics_and_csv_are_of() -> None:
+    """The metrics table and --csv are of the first modified observer (θ_m = 10, with the
+    uncertified γ = 17 on Section 5) and said only "simulation metrics" (soundness trial,
+    session 34): the info and the table's title name it."""
+    spec = Path(__file__).resolve().parents[1] / "specs" / SEC5
+    assert api.simulate(spec).info["observer"] == "modified θ_m=10"
+    r = CliRunner().invoke(app, ["simulate", str(spec)])
+    assert r.exit_code == 0 and "simulation metrics (modified θ_m=10)" in r.stdout, r.stdout

@@ -288,6 +288,9 @@ def simulate(
             stacklevel=2,
         )
     main = next((n for n in traces if n.startswith("modified")), "unmodified")
+    # the metrics and --csv are of this observer: the table said "simulation metrics" only,
+    # for the first θ_m's (γ = 17 uncertified on Section 5; soundness trial, session 34)
+    info = {"observer": main, **info}
     res = SimResult(k.astype(float), x, traces[main].xhat, y, s.states)
     res.extra = {
         "estimates": {n: tr.xhat for n, tr in traces.items() if n != main},
