@@ -260,9 +260,7 @@ def simulate(
             info[f"{name}: steps (total, max per sample)"] = (
                 f"{int(tr.steps.sum())}, {int(tr.steps.max(initial=0))}"
             )
-            info[f"{name}: x̂_k in X̂ for all k ≥ 1"] = bool(
-                np.all(Xhat.contains_rel(tr.xhat[1:]))
-            )
+            info[f"{name}: x̂_k in X̂ for all k ≥ 1"] = bool(np.all(Xhat.contains_rel(tr.xhat[1:])))
             worst = tr.v_increase if tr.v_increase > -np.inf else 0.0
             info[f"{name}: max V increase over a refining step"] = f"{worst:.3g}"
         if name.startswith("saturated"):
