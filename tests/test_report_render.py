@@ -104,10 +104,12 @@ def test_parameter_tables_mark_rounded_values(monkeypatch: pytest.MonkeyPatch) -
     rep = api.design(spec)
     assert rep.exit_code() == 0 and str(rep.parameters["alpha"]) == "43333331/20000000"
     rows = {k: v for k, v, _ in render._param_rows(rep)}
-    assert rows["alpha"] == "≈ 2.16667" and rows["L"] == "≈ [1.33333; 0.777778]"
+    # α is a lower bound (its summary field's side is "down"): rounded down, marked ≥
+    # (session 34; "≈ 2.16667" before, above the certified rate)
+    assert rows["alpha"] == "≥ 2.16666" and rows["L"] == "≈ [1.33333; 0.777778]"
     md = render.render_markdown(rep)
-    assert "| alpha | `≈ 2.16667` | exact |" in md
-    assert "≈ 2.16667" in _rendered(monkeypatch, rep)
+    assert "| alpha | `≥ 2.16666` | exact |" in md
+    assert "≥ 2.16666" in _rendered(monkeypatch, rep)
     assert rows["alpha_bracket"].startswith("≈ ")
     # a text parameter's form is "text", not "float" (docs trial, session 31)
     forms = {k: f for k, _, f in render._param_rows(rep)}

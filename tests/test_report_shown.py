@@ -156,3 +156,41 @@ def test_summary_fields_round_towards_their_safe_side(key: str) -> None:
     sides = {f.param: f.side for f in get_method(key).summary_fields}
     for param, side in SAFE[key].items():
         assert sides[param] == side, (key, param)
+
+
+def test_a_one_sided_bound_is_rounded_to_its_safe_side_in_a_table_cell() -> None:
+    """The parameter table rounded to nearest: "T_max ≈ 0.608687" for a certified T_max =
+    0.6086869942…, above the limit of (26b) 0.6086869942923880… (soundness trial, session
+    34). With the summary field's side, a cell is rounded that way and marked ≥ / ≤."""
+    from obsdesign.report.shown import cell
+
+    t_max = Q("0.60868699429238801")
+    assert cell(t_max, float(t_max)) == "≈ 0.608687"
+    assert cell(t_max, float(t_max), side="down") == "≥ 0.608686"
+    assert cell(t_max, float(t_max), side="up") == "≤ 0.608687"
+    assert cell(Q("0.5396"), 0.5396, side="down") == "0.5396"  # shown exactly: no mark
+    vec = np.array([t_max, t_max], dtype=object)
+    assert cell(vec, [float(t_max)] * 2, side="down") == "≈ [0.608687, 0.608687]"
+
+
+def test_the_parameter_table_takes_the_sides_of_the_methods_summary_fields() -> None:
+    """render's rows use the side of each parameter's summary field (impulsive: T_max down,
+    T_min up); a parameter without one keeps "≈"."""
+    from obsdesign.report.model import Report
+    from obsdesign.report.render import _param_rows
+
+    p = Parameters(
+        {
+            "T_max": Q("0.60868699429238801"),
+            "T_min": Q("0.10917512345678"),
+            "kappa": Q("2.16666655"),
+        }
+    )
+    rep = Report(
+        method="impulsive", spec="", spec_file="s.toml", spec_sha256="", claims=[], parameters=p
+    )
+    rows = {k: v for k, v, _ in _param_rows(rep)}
+    assert rows["T_max"] == "≥ 0.608686" and rows["T_min"] == "≤ 0.109176"
+    assert rows["kappa"] == "≈ 2.16667"
+    rep.method = "no-such-method"
+    assert {k: v for k, v, _ in _param_rows(rep)}["T_max"] == "≈ 0.608687"

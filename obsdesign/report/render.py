@@ -33,13 +33,33 @@ def fmt_value(v: Any, digits: int = 6) -> str:
     return s if len(s) < 200 else s[:197] + "..."
 
 
+def _sides(method: str) -> dict[str, str]:
+    """Parameter → the side its rounding keeps statements true on ("up" / "down"), from the
+    method's summary fields (:class:`obsdesign.methods.base.SummaryField`); none for an
+    unknown method."""
+    try:
+        from obsdesign.methods import get_method
+
+        fields = get_method(method).summary_fields
+    except Exception:  # noqa: BLE001 - an unknown or hostile method name: no sides
+        return {}
+    return {f.param: f.side for f in fields if f.side}
+
+
 def _param_rows(report: Report) -> list[tuple[str, str, str]]:
     rows = []
+    sides = _sides(report.method)
     for k in report.parameters:
         raw = report.parameters[k]
         # a rounded number is marked "≈" (a certified α = 2.16666655 showed as "2.16667",
-        # a proven-infeasible rate: rendering trial, session 27)
-        text = cell(raw, report.parameters.float(k)) if _numeric(raw) else fmt_value(raw)
+        # a proven-infeasible rate: rendering trial, session 27); a one-sided bound is
+        # rounded to its safe side, "≥ 0.608686" for T_max = 0.6086869942…, not "≈ 0.608687"
+        # above the limit of (26b) (soundness trial, session 34)
+        text = (
+            cell(raw, report.parameters.float(k), side=sides.get(k, ""))
+            if _numeric(raw)
+            else fmt_value(raw)
+        )
         # a text or true/false parameter is neither exact nor float (a bracket's kind showed
         # "float": docs trial, session 31)
         form = "exact" if report.parameters.is_exact(k) else "float" if _numeric(raw) else "text"

@@ -60,10 +60,24 @@ def shown(raw: Any, floats: Any, fmt: str = ".6g") -> tuple[str, bool]:
     return "[" + "; ".join(texts) + "]", same
 
 
-def cell(raw: Any, floats: Any, fmt: str = ".6g") -> str:
-    """A table cell: :func:`shown`'s text, prefixed "≈ " when rounded."""
+def cell(raw: Any, floats: Any, fmt: str = ".6g", side: str = "") -> str:
+    """A table cell: :func:`shown`'s text, prefixed "≈ " when rounded; with ``side`` "up"
+    ("down") an exact scalar is rounded up (down) and prefixed "≤ " ("≥ "), as
+    :func:`item` does."""
     text, same = shown(raw, floats, fmt)
+    bound = None if same else _one_sided(raw, floats, fmt, side)
+    if bound is not None:
+        return bound
     return text if same else f"{APPROX} {text}"
+
+
+def _one_sided(raw: Any, floats: Any, fmt: str, side: str) -> str | None:
+    """ "≤ text" (side "up") or "≥ text" (side "down") for an exact scalar rounded that way
+    to ``fmt``'s digits; None for another side, a vector, or a value that is not exact."""
+    if side not in ("up", "down") or np.ndim(floats) != 0:
+        return None
+    directed = _directed(raw, fmt, side == "up")
+    return None if directed is None else f"{'≤' if side == 'up' else '≥'} {directed}"
 
 
 def item(label: str, raw: Any, floats: Any, fmt: str, side: str = "") -> str:
@@ -71,10 +85,9 @@ def item(label: str, raw: Any, floats: Any, fmt: str, side: str = "") -> str:
     with ``side`` "up" ("down") an exact scalar rounded for the text is rounded up (down)
     to ``fmt``'s digits and shown ``label ≤ text`` (``label ≥ text``)."""
     text, same = shown(raw, floats, fmt)
-    if not same and side in ("up", "down") and np.ndim(floats) == 0:
-        directed = _directed(raw, fmt, side == "up")
-        if directed is not None:
-            return f"{label} {'≤' if side == 'up' else '≥'} {directed}"
+    bound = None if same else _one_sided(raw, floats, fmt, side)
+    if bound is not None:
+        return f"{label} {bound}"
     return f"{label} {'=' if same else APPROX} {text}"
 
 
