@@ -312,6 +312,46 @@ def test_reserved_parameter_names_are_refused(name: str, what: str) -> None:
     assert {"delta", "pi", "e"} <= set(load_spec_text(ok, "names.toml").system.parameters)
 
 
+@pytest.mark.parametrize(
+    ("states", "shown"),
+    [
+        ('["ｘ", "x"]', "'ｘ' is read as 'x'"),  # fullwidth x beside x: one name in f
+        ('["ｘ", "y"]', "'ｘ' is read as 'x'"),
+        ('["ｔ", "y"]', "'ｔ' is read as 't'"),  # fullwidth t: the time in f
+        ('["ℓ", "y"]', "'ℓ' is read as 'l'"),
+        ('["x²", "y"]', None),  # not an identifier
+    ],
+)
+def test_state_names_are_read_as_expressions_read_them(states: str, shown: str | None) -> None:
+    """Python reads identifiers in NFKC form: with states ["ｘ", "x"] (distinct strings),
+    f = ["u1", "ｘ*ｘ"] was read as x*x, and a search-space report certified L_f ≤ 0.2 and
+    sup |f| ≤ 0.01 where the spec's f has 9.9 and 25 (false certificate; CLI hostile-input
+    trial, session 34). A name whose NFKC form differs is refused, naming both forms."""
+    text = (
+        f'[system]\ntime = "discrete"\nstates = {states}\nA = [[0.5, 0], [0, 0.5]]\n'
+        'C = [[1, 0]]\n[method]\nkey = "lyapunov"\n'
+    )
+    with pytest.raises(SpecError, match=r"\[system\.states\] ") as e:
+        load_spec_text(text, "names.toml")
+    assert e.value.exit_code == 2
+    if shown is not None:
+        assert f"the state name {shown} in expressions (Python reads identifiers in NFKC" in (
+            e.value.message
+        )
+    ok = text.replace(f"states = {states}", 'states = ["θ", "x_ω"]')  # NFKC-normal already
+    assert load_spec_text(ok, "names.toml").system.states == ["θ", "x_ω"]
+
+
+def test_parameter_names_are_read_as_expressions_read_them() -> None:
+    """[system.parameters] "ｄelta2" = 1.5 is delta2 in an expression: refused naming both
+    forms."""
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "specs" / "astolfi-stubborn-duffing.toml").read_text()
+    bad = text.replace("delta = 0.3", 'delta = 0.3\n"ｄelta2" = 1.5')  # a quoted key
+    with pytest.raises(SpecError, match=r"the parameter name 'ｄelta2' is read as 'delta2'"):
+        load_spec_text(bad, "names.toml")
+
+
 def test_a_byte_order_mark_is_named(tmp_path: Path) -> None:
     """A spec saved as "UTF-8 with BOM" got "is not valid TOML (Invalid statement (at line 1,
     column 1))" (outsider trial, session 22): the BOM is named, exit 2."""

@@ -195,6 +195,9 @@ def _state_names(t: Table, sys: System) -> None:
     share one name; ``v1`` is a free state name when the plant has no noise input)."""
     signals = {*sys.inputs, *sys.disturbances, *sys.noises}
     for s in sys.states:
+        unread = _not_normal(s)
+        if unread is not None:
+            raise t.error("states", f"the state name {unread}")
         what = _reserved_name(s) or ("an input, disturbance or noise" if s in signals else None)
         if what is not None:
             raise t.error(
@@ -203,6 +206,23 @@ def _state_names(t: Table, sys: System) -> None:
                 "t, the function names, Python's keywords, and this plant's inputs "
                 "u1…, disturbances d1…, noises v1…)",
             )
+
+
+def _not_normal(name: str) -> str | None:
+    """Why an expression cannot name ``name`` as it is written (None when it can): Python
+    reads identifiers in NFKC form, so in an expression the fullwidth ``ｘ`` is ``x``, ``ℓ``
+    is ``l`` and ``ｔ`` is the time ``t``. States ``["ｘ", "x"]`` passed as distinct while
+    ``f = ["u1", "ｘ*ｘ"]`` was read as ``x*x``, and a search-space report certified L_f and
+    sup |f| for that other plant (false certificate; CLI hostile-input trial, session 34)."""
+    import unicodedata
+
+    normal = unicodedata.normalize("NFKC", name)
+    if normal == name:
+        return None
+    return (
+        f"{name!r} is read as {normal!r} in expressions (Python reads identifiers in NFKC "
+        f"form): write it as {normal!r}"
+    )
 
 
 def _reserved_name(name: str) -> str | None:
@@ -306,6 +326,9 @@ def _system(t: Table) -> System:
         for k in list(pt.data):
             if not k.isidentifier():
                 raise pt.error(k, "expected an identifier as parameter name")
+            unread = _not_normal(k)
+            if unread is not None:
+                raise pt.error(k, f"the parameter name {unread}")
             why = _reserved_name(k)
             if why is not None:
                 raise pt.error(
