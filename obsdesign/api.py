@@ -7,6 +7,7 @@ import math
 import numbers
 import os
 import signal
+import sys
 import threading
 import time
 import warnings
@@ -1158,7 +1159,8 @@ def _time_budget(seconds: float | None) -> Any:
         return
 
     def on_alarm(signum: int, frame: Any) -> None:
-        raise SpecTimeout
+        if not _importing():  # else the repeat RETIMEOUT_S later stops it
+            raise SpecTimeout
 
     old = signal.signal(signal.SIGALRM, on_alarm)
     # the alarm repeats every RETIMEOUT_S after the deadline until the block is left: an
@@ -1171,6 +1173,17 @@ def _time_budget(seconds: float | None) -> Any:
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, old)
+
+
+def _importing() -> bool:
+    """Whether a module is being imported (its code running): a time budget waits for the
+    import to end. A stop raised inside ``import cvxpy`` left parts of it in
+    ``sys.modules``, and every later spec of the same ``check`` that needed it failed with
+    "module 'cvxpy' has no attribute 'promote'" (CLI hostile-input trial, session 34)."""
+    for m in list(sys.modules.values()):
+        if getattr(getattr(m, "__spec__", None), "_initializing", False):
+            return True
+    return False
 
 
 def _async_raise(tid: int, exc: type[BaseException] | None) -> None:
@@ -1205,7 +1218,8 @@ def _thread_budget(seconds: float) -> Any:
     def fire() -> None:
         with lock:
             if armed[0]:
-                _async_raise(tid, SpecTimeout)
+                if not _importing():
+                    _async_raise(tid, SpecTimeout)
                 start(RETIMEOUT_S)
 
     start(seconds)

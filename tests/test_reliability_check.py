@@ -513,3 +513,45 @@ def test_thread_budget_schedules_no_stop_once_the_block_is_left(monkeypatch) -> 
     with api._thread_budget(3.0):
         pass
     assert _FakeTimer.made[-1].after == 3.0 and _FakeTimer.made[-1].cancelled
+
+
+@pytest.mark.parametrize("thread", [False, True])
+def test_a_time_budget_waits_for_an_import_to_finish(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, thread: bool
+) -> None:
+    """A budget that fired inside ``import cvxpy`` left half of cvxpy in sys.modules, and every
+    later spec of that ``check`` failed "module 'cvxpy' has no attribute 'promote'" (CLI
+    hostile-input trial, session 34). The stop waits until no module is being imported: the
+    slow import completes, the stop comes right after it."""
+    import sys
+    import threading
+    import time
+
+    (tmp_path / "slow_mod_34.py").write_text(
+        "import time\nt0 = time.perf_counter()\n"
+        "while time.perf_counter() - t0 < 0.6:\n    pass\ndone = True\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, "slow_mod_34", raising=False)
+    out: dict[str, Any] = {}
+
+    def run() -> None:
+        try:
+            with api._time_budget(0.1):
+                import slow_mod_34  # noqa: F401
+
+                out["imported"] = time.perf_counter()
+                while True:
+                    time.sleep(0.01)
+        except api.SpecTimeout:
+            out["stopped"] = time.perf_counter()
+
+    if thread:
+        th = threading.Thread(target=run)
+        th.start()
+        th.join(10)
+    else:
+        run()
+    assert sys.modules["slow_mod_34"].done is True
+    assert "imported" in out and out["stopped"] - out["imported"] < 0.5
+    sys.modules.pop("slow_mod_34", None)
