@@ -255,6 +255,42 @@ class _Stdout:
         return getattr(self.wrapped, name)
 
 
+class _Stderr:
+    """sys.stderr for the whole process: a stream that cannot take the error line (closed,
+    ``2>/dev/full``, a pipe whose reader has gone) drops it, and the exit code stays the
+    command's. Every such write raised inside the error handler, and bad input, an ok design
+    and Ctrl-C all ended exit 1 (CLI hostile-input trial, session 34)."""
+
+    def __init__(self, wrapped: Any) -> None:
+        self.wrapped = wrapped
+        self.dead = False
+
+    def write(self, text: str) -> int:
+        if not self.dead:
+            try:
+                self.wrapped.write(text)
+                self.wrapped.flush()  # an error line must not wait in a buffer
+            except (OSError, ValueError):
+                self.dead = True
+        return len(text)
+
+    def flush(self) -> None:
+        if not self.dead:
+            try:
+                self.wrapped.flush()
+            except (OSError, ValueError):
+                self.dead = True
+
+    def isatty(self) -> bool:
+        try:
+            return not self.dead and bool(self.wrapped.isatty())
+        except (OSError, ValueError):
+            return False
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.wrapped, name)
+
+
 def _settle(owned: bool) -> None:
     """The command body has ended: a Ctrl-C from now on is ignored (the work is done and its
     files are written; Python's shutdown would otherwise die of the signal, exit -2), and a
@@ -751,6 +787,9 @@ def main() -> None:
         # code is the command's (every print raised AttributeError: exit 3, or a traceback
         # and exit 1; re-check trial, session 30)
         sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - for the whole process
+    # stderr closed (`2>&-`), full or a dead pipe: the error line is dropped, the exit code
+    # is the command's (exit 1 for everything before session 34)
+    sys.stderr = _Stderr(sys.stderr if sys.stderr is not None else open(os.devnull, "w"))  # noqa: SIM115
     try:
         rv = app(standalone_mode=False, prog_name="obsdesign")
     except KeyboardInterrupt:  # pragma: no cover - Ctrl-C outside a command body

@@ -892,3 +892,27 @@ def test_a_closed_pipe_under_the_text_tables_is_exit_141(
     p.stdout.close()
     err = p.stderr.read()
     assert p.wait(timeout=120) == 141 and err == b"", err
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full")
+@pytest.mark.parametrize("redirect", ["2>/dev/full", "2>&-"])
+def test_a_stderr_that_cannot_take_the_error_line_keeps_the_exit_code(
+    spec: Path, tmp_path: Path, redirect: str
+) -> None:
+    """With stderr closed or full every command exited 1 (the error line's write raised
+    inside the error handler): bad input 2 → 1, an ok design 0 → 1 (CLI hostile-input
+    trial, session 34). The line is dropped; the code is the command's."""
+    exe = Path(sys.executable).parent / "obsdesign"
+    bad = tmp_path / "bad.toml"
+    bad.write_text(spec.read_text().replace("[system]", "[system]\nbogus_key = 1", 1))
+    out = tmp_path / "r.json"
+    for args, code in (([str(bad)], 2), ([str(spec), "-q", "-o", str(out)], 0)):
+        r = subprocess.run(
+            f"'{exe}' design {' '.join(args)} {redirect}",
+            shell=True,
+            executable="/bin/bash",
+            capture_output=True,
+            timeout=120,
+        )
+        assert r.returncode == code, (args, r.returncode)
+    assert json.loads(out.read_text())["verdict"] == "ok"
