@@ -891,6 +891,8 @@ def plot_sweep(
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from obsdesign.simulate.plot import plain
+
     keys = [a.key for a in axes]
     x = x or keys[0]
     others = [k for k in keys if k != x]
@@ -899,7 +901,7 @@ def plot_sweep(
     try:
         for g, pts in groups.items():
             pts.sort()
-            label = ", ".join(f"{k} = {v}" for k, v in zip(others, g, strict=True)) or None
+            label = plain(", ".join(f"{k} = {v}" for k, v in zip(others, g, strict=True))) or None
             ax.plot([p[0] for p in pts], [p[1] for p in pts], marker="o", label=label)
         # the points that are not ok, marked × on the x axis over the whole swept range: a
         # gap at an end of the range was simply off the axis (the README's sweep showed

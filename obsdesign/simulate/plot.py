@@ -7,6 +7,14 @@ from pathlib import Path
 from obsdesign.simulate.result import SimResult
 
 
+def plain(text: str) -> str:
+    """``text`` as matplotlib draws it literally: a ``$`` starts math text there, so a spec
+    titled "costs $5 to $10" was drawn "costs 5to10" in math italics and a title with a bad
+    ``$\\frac{`` ended a finished simulation with exit 3 (CLI hostile-input trial, session
+    34). User text (titles, file names, swept values) goes through this."""
+    return str(text).replace("$", r"\$")
+
+
 def plot_result(res: SimResult, path: str | Path, title: str = "") -> Path:
     """Write a PNG/SVG (by suffix) with x vs x̂ per state and the errors (:func:`save_figure`:
     not atomic by itself)."""
@@ -34,7 +42,7 @@ def plot_result(res: SimResult, path: str | Path, title: str = "") -> Path:
     ax.legend(loc="upper right", fontsize=8)
     ax.grid(alpha=0.3)
     if title:
-        fig.suptitle(title)
+        fig.suptitle(plain(title))
     fig.tight_layout()
     return save_figure(fig, path)
 

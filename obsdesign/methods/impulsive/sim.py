@@ -307,7 +307,7 @@ def plot_simulation(spec: Spec, res: SimResult, path: str | Path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from obsdesign.simulate.plot import save_figure
+    from obsdesign.simulate.plot import plain, save_figure
 
     ex = res.extra
     fig, axes = plt.subplots(2, 3, figsize=(15, 8))
@@ -371,6 +371,6 @@ def plot_simulation(spec: Spec, res: SimResult, path: str | Path) -> Path:
     ax.axvline(w[0], color="r")
     ax.axvline(w[1], color="r")
     ax.set_title("sampling intervals vs [T_min, T_max]")
-    fig.suptitle(spec.title or "impulsive observer")
+    fig.suptitle(plain(spec.title or "impulsive observer"))
     fig.tight_layout()
     return save_figure(fig, path)

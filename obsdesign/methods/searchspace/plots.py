@@ -23,6 +23,8 @@ def plot_simulation(spec: Spec, res: SimResult, path: str | Path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from obsdesign.simulate.plot import plain
+
     n = res.x.shape[1]
     fig, axes = plt.subplots(n + 1, 1, figsize=(8, 2.6 * (n + 1)), sharex=True)
     stored = res.extra.get("stored", [])
@@ -65,7 +67,7 @@ def plot_simulation(spec: Spec, res: SimResult, path: str | Path) -> Path:
     ax.set_xlabel("t")
     ax.set_ylabel("estimation error")
     ax.legend(loc="upper right", fontsize=7)
-    fig.suptitle(spec.title or spec.file, fontsize=9)
+    fig.suptitle(plain(spec.title or spec.file), fontsize=9)
     fig.tight_layout()
     from obsdesign.simulate.plot import save_figure
 

@@ -65,7 +65,7 @@ def draw_sets(
 
 def plot_simulation(spec: Spec, res: Any, path: str | Path) -> Path:
     """Polyhedra and the error trajectory e(k) = x − x̂ (projections for n >= 3)."""
-    from obsdesign.simulate.plot import save_figure
+    from obsdesign.simulate.plot import plain, save_figure
 
     n = spec.system.n
     e = res.extra["e_paper"]
@@ -86,7 +86,7 @@ def plot_simulation(spec: Spec, res: Any, path: str | Path) -> Path:
         ax.set_ylabel("e1")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8, loc="best")
-        fig.suptitle(f"{spec.title or spec.file}: max gauge {res.info['max_gauge']:.4f}")
+        fig.suptitle(plain(f"{spec.title or spec.file}: max gauge {res.info['max_gauge']:.4f}"))
         fig.tight_layout()
         return save_figure(fig, path)
     pairs = _axes(n)
@@ -95,7 +95,7 @@ def plot_simulation(spec: Spec, res: Any, path: str | Path) -> Path:
     for ax, (i, j) in zip(axes, pairs, strict=False):
         ax.plot(e[:, i], e[:, j], "r.-", lw=0.8, ms=4, label="error e(k)")
         ax.legend(fontsize=8, loc="best")
-    fig.suptitle(f"{spec.title or spec.file}: max gauge {res.info['max_gauge']:.4f}")
+    fig.suptitle(plain(f"{spec.title or spec.file}: max gauge {res.info['max_gauge']:.4f}"))
     fig.tight_layout()
     return save_figure(fig, path)
 
@@ -103,7 +103,7 @@ def plot_simulation(spec: Spec, res: Any, path: str | Path) -> Path:
 def plot_design(spec: Spec, params: Parameters, path: str | Path) -> Path:
     """ε(z) against z (LP (9), Fig. 2 of the paper) for the designed polyhedron, and for the
     symmetric C_K^∞ when the design fell back from it; plus the polyhedra."""
-    from obsdesign.simulate.plot import save_figure
+    from obsdesign.simulate.plot import plain, save_figure
 
     s = spec.system
     d = build(spec).fl
@@ -135,6 +135,6 @@ def plot_design(spec: Spec, params: Parameters, path: str | Path) -> Path:
     draw_sets(axes[1:], pairs, spec, G, extra)
     for a in axes[1:]:
         a.legend(fontsize=8)
-    fig.suptitle(spec.title or spec.file)
+    fig.suptitle(plain(spec.title or spec.file))
     fig.tight_layout()
     return save_figure(fig, path)

@@ -20,6 +20,8 @@ def plot_simulation(spec: Spec, res: SimResult, path: str | Path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from obsdesign.simulate.plot import plain
+
     fig: Any
     if "error_norm" in res.extra:
         err = res.extra["error_norm"]
@@ -29,7 +31,7 @@ def plot_simulation(spec: Spec, res: SimResult, path: str | Path) -> Path:
         ax.set_xlabel("t")
         ax.set_ylabel("|x̂(t) − x(t)|")
         ax.legend()
-        ax.set_title(spec.title or "stubborn high-gain observer")
+        ax.set_title(plain(spec.title or "stubborn high-gain observer"))
     else:
         fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
         e = res.e
@@ -44,7 +46,7 @@ def plot_simulation(spec: Spec, res: SimResult, path: str | Path) -> Path:
             a2.set_ylabel("saturation level σ_i")
             a2.legend()
         a2.set_xlabel("t")
-        a1.set_title(spec.title or "stubborn observer")
+        a1.set_title(plain(spec.title or "stubborn observer"))
     fig.tight_layout()
     from obsdesign.simulate.plot import save_figure
 
