@@ -28,7 +28,7 @@ from obsdesign.errors import (
     SpecError,
     one_line,
 )
-from obsdesign.limits import limits, max_states_for
+from obsdesign.limits import ensure_recursion_limit, limits, max_states_for
 from obsdesign.methods import get_method, method_keys
 from obsdesign.methods.base import Method, Progress
 from obsdesign.params import Parameters, same_bits
@@ -223,6 +223,7 @@ def design(
     writes a report with
     ``"verdict": "error"`` and the error, which ``verify`` reports as such. Bad input (exit 2)
     writes nothing and leaves ``out`` untouched."""
+    ensure_recursion_limit()
     if out is not None:
         check_output(_path_arg(out, "out"), force, inputs=_spec_inputs(spec))
     t0 = time.perf_counter()
@@ -349,6 +350,7 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
     - **notes** of the report are not verified: they are kept, each prefixed with
       "not verified (from the report):". Unknown top-level keys are ignored with a note.
     """
+    ensure_recursion_limit()
     t0 = time.perf_counter()
     if isinstance(report, Report):
         d = report.to_dict()
@@ -748,6 +750,7 @@ def simulate(
     ``sim_options`` (unknown key or bad value: :class:`InputError`); ``kwargs`` are typed
     values passed as they are.
     """
+    ensure_recursion_limit()
     sp = _spec(spec)
     _check_sim_keywords(get_method(sp.method), kwargs)
     kwargs = {**get_method(sp.method).parse_sim_options(options or {}), **kwargs}

@@ -77,6 +77,20 @@ CEILINGS: dict[str, int] = {
 METHOD_MAX_STATES: dict[str, int] = {"set-invariant": 12, "stubborn": 24}
 
 
+#: Python's recursion limit while obsdesign works: an expression at the depth limit (200,
+#: or 400 raised) is walked recursively by the evaluators, several frames a level — a
+#: 190-deep ``x1*sin(sin(…))`` in a search-space f was exit 3 "RecursionError" under the
+#: default 1000 (CLI hostile-input trial, session 34); 198 levels need ~2,500
+RECURSION_LIMIT = 6000
+
+
+def ensure_recursion_limit() -> None:
+    """Raise Python's recursion limit to :data:`RECURSION_LIMIT` (never lower it: a caller's
+    higher limit is kept, and threads need no restore)."""
+    if sys.getrecursionlimit() < RECURSION_LIMIT:
+        sys.setrecursionlimit(RECURSION_LIMIT)
+
+
 def limits() -> Limits:
     """The limits in force."""
     return _current

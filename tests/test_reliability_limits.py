@@ -568,3 +568,31 @@ def test_saved_is_a_snapshot_not_the_live_set() -> None:
         assert L.max_states_for("lyapunov") == 9
     finally:
         L.reset_limits()
+
+
+def test_an_expression_at_the_depth_limit_is_evaluated(tmp_path: Path) -> None:
+    """A search-space f of 198 levels (within max_expr_depth = 200) was exit 3 "internal
+    failure: RecursionError" naming neither file nor key: its evaluators recurse several
+    frames a level, past Python's default limit of 1000 (CLI hostile-input trial, session
+    34). The API raises the limit to RECURSION_LIMIT (never lowers it)."""
+    import sys
+
+    from obsdesign import api
+    from obsdesign.limits import RECURSION_LIMIT
+
+    old = sys.getrecursionlimit()
+    sys.setrecursionlimit(1000)
+    try:
+        root = Path(__file__).resolve().parents[1]
+        text = (root / "specs" / "hernandez-garcia-example.toml").read_text()
+        deep = "sin(" * 194 + "x1" + ")" * 194
+        spec = tmp_path / "deep.toml"
+        spec.write_text(text.replace('"-u1*x1"]', f'"-u1*x1 + 0*(x1*{deep})"]', 1))
+        rep = api.design(spec)
+        assert rep.exit_code() == 0
+        assert sys.getrecursionlimit() == RECURSION_LIMIT
+        sys.setrecursionlimit(RECURSION_LIMIT + 1)
+        api.design(spec)
+        assert sys.getrecursionlimit() == RECURSION_LIMIT + 1  # a higher limit is kept
+    finally:
+        sys.setrecursionlimit(old)
