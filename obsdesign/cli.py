@@ -163,10 +163,17 @@ def _run(fn: Callable[[Any], int], quiet: bool = False, width: int | None = None
             interrupt.install_quiet_unraisable()  # the console script's own process
         # SIGTERM whoever owns SIGINT: a script's background job starts with SIGINT ignored,
         # and `timeout` there still left a half-written temp file (re-check trial, session 27)
-        if _main_thread() and signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
-            signal.signal(signal.SIGTERM, interrupt.handler)
-            if os.path.basename(sys.argv[0] if sys.argv else "") in _SCRIPTS:
-                interrupt.install_quiet_unraisable()  # a background console script's process
+        # SIGHUP (a closed terminal, a dropped ssh) and SIGQUIT (Ctrl-\\) likewise: they left
+        # the hidden temp file of an output being written (CLI hostile-input trial, session 34)
+        caught = [
+            sig
+            for sig in _STOP_SIGNALS
+            if _main_thread() and signal.getsignal(sig) is signal.SIG_DFL
+        ]
+        for sig in caught:
+            signal.signal(sig, interrupt.handler)
+        if caught and os.path.basename(sys.argv[0] if sys.argv else "") in _SCRIPTS:
+            interrupt.install_quiet_unraisable()  # a background console script's process
         from obsdesign import cli_commands
 
         cli_commands.setup(quiet, width)
@@ -299,12 +306,27 @@ def _settle(owned: bool) -> None:
 
     if owned:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
-    if _main_thread() and signal.getsignal(signal.SIGTERM) is interrupt.handler:
-        # the work is done and written: back to the default (an in-process caller keeps its
-        # own SIGTERM behaviour after the command)
-        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    for sig in _STOP_SIGNALS:
+        if _main_thread() and signal.getsignal(sig) is interrupt.handler:
+            # the work is done and written: back to the default (an in-process caller keeps
+            # its own SIGTERM behaviour after the command)
+            signal.signal(sig, signal.SIG_DFL)
     if interrupt.requested():
         _interrupted()
+
+
+#: signals that stop a command as Ctrl-C does (cleanup runs, exit 128 + the signal), where
+#: their action is still the default
+_STOP_SIGNALS = tuple(
+    getattr(signal, n) for n in ("SIGTERM", "SIGHUP", "SIGQUIT") if hasattr(signal, n)
+)
+#: the one line printed for each
+_SIGNAL_WORDS = {
+    int(signal.SIGINT): "interrupted",
+    int(signal.SIGTERM): "terminated",
+    **({int(signal.SIGHUP): "hung up"} if hasattr(signal, "SIGHUP") else {}),
+    **({int(signal.SIGQUIT): "quit"} if hasattr(signal, "SIGQUIT") else {}),
+}
 
 
 def _main_thread() -> bool:
@@ -318,10 +340,10 @@ def _interrupted() -> None:
     ``except typer.Exit`` branch of :func:`_run` settles again and must not say it twice)."""
     from obsdesign import interrupt
 
-    term = interrupt.signal_number() == signal.SIGTERM
+    num = interrupt.signal_number() or int(signal.SIGINT)
     interrupt.reset()
-    _err("terminated" if term else "interrupted")
-    raise typer.Exit(143 if term else 130) from None
+    _err(_SIGNAL_WORDS.get(num, "interrupted"))
+    raise typer.Exit(128 + num) from None
 
 
 def _quiet_broken_pipe() -> None:

@@ -17,12 +17,12 @@ from collections.abc import Callable
 from typing import Any
 
 _requested = False
-#: the signal recorded (SIGINT 2 or SIGTERM 15), 0 when none
+#: the signal recorded (SIGINT 2, SIGTERM 15, SIGHUP 1 or SIGQUIT 3), 0 when none
 _signum = 0
 
 
 def handler(signum: int, frame: object) -> None:
-    """SIGINT and SIGTERM handler of a command body: record the interrupt, then raise
+    """SIGINT / SIGTERM / SIGHUP / SIGQUIT handler of a command body: record the interrupt, then raise
     KeyboardInterrupt as Python does for SIGINT, so the same cleanup runs (temp files
     removed). SIGTERM (what ``timeout`` sends) killed the process at once and left a hidden
     half-written ``.NAME.XXXX.csv`` beside the output (simulate trial, session 27)."""

@@ -284,17 +284,26 @@ def test_ctrl_c_is_one_line_no_traceback(delay: float):
 
 
 @pytest.mark.parametrize(
-    ("delay", "background"), [(0.5, False), (1.5, False), (3.0, False), (1.5, True)]
+    ("delay", "background", "sig"),
+    [
+        (0.5, False, "SIGTERM"),
+        (1.5, False, "SIGTERM"),
+        (3.0, False, "SIGTERM"),
+        (1.5, True, "SIGTERM"),
+        (1.5, False, "SIGHUP"),
+        (1.5, False, "SIGQUIT"),
+    ],
 )
 def test_sigterm_cleans_up_like_ctrl_c(
-    spec: Path, tmp_path: Path, delay: float, background: bool
+    spec: Path, tmp_path: Path, delay: float, background: bool, sig: str
 ) -> None:
     """SIGTERM (what ``timeout`` sends) during ``simulate --csv`` killed the process at once
     and left a hidden half-written ``.out.csv.XXXX.csv`` beside the output (simulate trial,
     session 27). It is handled as Ctrl-C is now: cleanup runs, one line "terminated", exit
     143 (128 + 15); the file is there whole or not at all. ``background``: started with
     SIGINT ignored, as a script's background job is (the handler was installed only with
-    SIGINT's: re-check trial, session 27)."""
+    SIGINT's: re-check trial, session 27). SIGHUP (a closed terminal) and SIGQUIT (Ctrl-\\)
+    left the temp file (CLI hostile-input trial, session 34): "hung up" 129, "quit" 131."""
     import signal
     import time
 
@@ -313,12 +322,14 @@ def test_sigterm_cleans_up_like_ctrl_c(
         preexec_fn=as_a_background_job if background else None,  # noqa: PLW1509
     )
     time.sleep(delay)
-    p.send_signal(signal.SIGTERM)
+    num = int(getattr(signal, sig))
+    p.send_signal(num)
     _, err = p.communicate(timeout=120)
     assert "Traceback" not in err
-    assert p.returncode in (0, 143), err
-    if p.returncode == 143:
-        assert err.strip().splitlines()[-1].endswith("terminated")
+    assert p.returncode in (0, 128 + num), err
+    if p.returncode == 128 + num:
+        word = {"SIGTERM": "terminated", "SIGHUP": "hung up", "SIGQUIT": "quit"}[sig]
+        assert err.strip().splitlines()[-1].endswith(word)
         assert not out.exists()
     else:
         assert out.read_text().count("\n") == 400001 + 1  # the header and every step
