@@ -124,13 +124,14 @@ def restore(state: tuple[Limits, frozenset[str]]) -> None:
     _overridden.update(state[1])
 
 
-def _check_ceiling(k: str, v: int) -> None:
-    """An :class:`InputError` when ``v`` is above the limit's :data:`CEILINGS` entry."""
+def _check_ceiling(k: str, v: int, shown: str | None = None) -> None:
+    """An :class:`InputError` when ``v`` is above the limit's :data:`CEILINGS` entry
+    (``shown``: the value as the user wrote it, else ``v``)."""
     cap = CEILINGS.get(k)
     if cap is not None and v > cap:
         raise InputError(
             f"--limit {k}: at most {cap} (above it one value can take minutes or exhaust "
-            f"Python's recursion), got {v}"
+            f"Python's recursion), got {shown if shown is not None else v}"
         )
 
 
@@ -157,11 +158,16 @@ def parse_limit(text: str) -> tuple[str, int]:
     k, v = (s.strip() for s in text.split("=", 1))
     mult = {"k": 1024, "m": 1024**2, "g": 1024**3}.get(v[-1:].lower(), 1)
     num = v[:-1] if mult != 1 else v
-    if not num.isdigit() or len(num) > 18 or int(num) <= 0:
+    if not num.isascii() or not num.isdigit() or not num.strip("0"):
         raise InputError(f"--limit {k}: expected a positive integer, got {v!r}")
     if k not in {f.name for f in fields(Limits)}:
         known = ", ".join(sorted(f.name for f in fields(Limits)))
         raise InputError(f"--limit {k}: unknown limit (known: {known})")
+    if len(num.lstrip("0")) > 18:
+        # a positive integer, too large: it said "expected a positive integer" (CLI
+        # hostile-input trial, session 34); a limit with a ceiling names it
+        _check_ceiling(k, 10**18, v if len(v) <= 40 else f"a {len(num)}-digit number")
+        raise InputError(f"--limit {k}: at most 18 digits, got {len(num.lstrip('0'))}")
     _check_ceiling(k, int(num) * mult)
     return k, int(num) * mult
 

@@ -171,9 +171,14 @@ def test_limits_stop_at_their_ceiling(key: str) -> None:
     cap = CEILINGS[key]
     assert parse_limit(f"{key}={cap}") == (key, cap)
     set_limits(**{key: cap})
-    for bad in (f"{key}={cap + 1}", f"{key}={cap * 1000}"):
+    # 26 digits said "expected a positive integer" (CLI hostile-input trial, session 34)
+    for bad in (f"{key}={cap + 1}", f"{key}={cap * 1000}", f"{key}={'9' * 26}"):
         with pytest.raises(InputError, match=f"--limit {key}: at most {cap}"):
             parse_limit(bad)
+    with pytest.raises(InputError, match="--limit max_states: at most 18 digits, got 26"):
+        parse_limit(f"max_states={'9' * 26}")
+    with pytest.raises(InputError, match="expected a positive integer"):
+        parse_limit("max_states=000")
     with pytest.raises(InputError, match=f"at most {cap}"):
         set_limits(**{key: cap + 1})
     res = runner.invoke(app, ["--limit", f"{key}={cap + 1}", "methods"])
