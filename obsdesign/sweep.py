@@ -119,6 +119,13 @@ def _range_values(key: str, a_text: str, b_text: str, n: int, log: bool) -> list
         if exp and abs(int(exp.group(1))) > 300:
             raise InputError(f"--set {key}: the exponent of {t!r} is out of range (±300)")
     a, b = Decimal(a_text), Decimal(b_text)
+    if n == 1 and a != b:
+        # the one value was a, and b was dropped without a word (CLI hostile-input trial,
+        # session 34): the docs say both ends are included
+        raise InputError(
+            f"--set {key}: {a_text}:{b_text}:1 has one value but two different ends: give "
+            f"at least 2 values, or the one value ({a_text})"
+        )
     as_int = all("." not in t and "e" not in t.lower() for t in (a_text, b_text))
     prec = max(DIGITS, len(a.as_tuple().digits), len(b.as_tuple().digits))
     out: list[Decimal] = []

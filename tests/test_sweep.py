@@ -36,7 +36,7 @@ def test_integer_ends_give_integers_and_thirds_are_rounded_to_15_digits():
     assert sw.parse_axis("simulate.horizon=100:300:3").values == ("100", "200", "300")
     assert sw.parse_axis("k=0:1:4").values == ("0", "0.333333333333333", "0.666666666666667", "1")
     assert sw.parse_axis("k=0.0:1:3").values == ("0.0", "0.5", "1.0")
-    assert sw.parse_axis("k=2.5:7:1").values == ("2.5",)
+    assert sw.parse_axis("k=2.5:2.50:1").values == ("2.5",)  # one value: the ends agree
 
 
 def test_log_range_hits_the_decades_exactly():
@@ -61,6 +61,9 @@ def test_lists_and_single_values():
         ("method.lambda", "KEY=VALUES"),
         ("method..lambda=1", "not a dotted spec key"),
         ("x=1:2:0", "at least 1"),
+        # b was dropped without a word (CLI hostile-input trial, session 34)
+        ("x=2.5:7:1", "2.5:7:1 has one value but two different ends"),
+        ("x=1:10:1:log", "one value but two different ends"),
         ("x=1:2:1000001", "above the limit"),
         ("x=0:1:3:log", "positive ends"),
         ("x=[1, 2", "end with ']'"),
