@@ -233,7 +233,12 @@ def _kv(items: list[str]) -> dict[str, str]:
         if "=" not in it:
             raise InputError(f"--option expects KEY=VALUE, got {it!r}")
         k, v = it.split("=", 1)
-        out[k.strip()] = v.strip()
+        k = k.strip()
+        if k in out and out[k] != v.strip():
+            # the last one was used without a word, while --runs 2 --option runs=3 and a
+            # repeated sweep --set key are refused (CLI hostile-input trial, session 34)
+            raise InputError(f"--option {k} is given twice ({out[k]}, {v.strip()}): give it once")
+        out[k] = v.strip()
     return out
 
 

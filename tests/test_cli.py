@@ -333,6 +333,12 @@ def test_dash_is_not_an_output_and_runs_is_given_once(tmp_path: Path, monkeypatc
     assert r.exit_code == 2 and "give the run count once" in r.output
     r = CliRunner().invoke(app, ["simulate", str(SPEC), "--runs", "3", "--option", "runs=3", "-q"])
     assert r.exit_code == 0
+    # a repeated --option key kept the last value without a word (session 34)
+    twice = ["--option", "runs=2", "--option", "runs=3"]
+    r = CliRunner().invoke(app, ["simulate", str(SPEC), *twice])
+    assert r.exit_code == 2 and "--option runs is given twice (2, 3): give it once" in r.output
+    r = CliRunner().invoke(app, ["simulate", str(SPEC), "-q", "--option", "runs=2", *twice[:2]])
+    assert r.exit_code == 0  # the same value twice is one value
 
 
 def _continuous(tmp_path: Path, grid: str) -> Path:
