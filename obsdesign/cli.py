@@ -827,7 +827,15 @@ def main() -> None:
     except Exception as e:
         kind = _click_kind(e)
         if kind is None:
-            raise
+            # --debug re-raises for the traceback; the exit code stays the error's (every
+            # failure was exit 1, "infeasible", under --debug; CLI hostile-input trial,
+            # session 34)
+            import traceback
+
+            from obsdesign.errors import ObsdesignError
+
+            traceback.print_exc()
+            sys.exit(e.exit_code if isinstance(e, ObsdesignError) else 3)
         if kind == "NoArgsIsHelpError":  # bare `obsdesign`: the help, as click shows it
             e.show()  # type: ignore[attr-defined]
         elif kind == "UsageError":

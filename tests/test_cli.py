@@ -537,3 +537,17 @@ def test_design_warns_when_its_report_is_above_the_read_limit(tmp_path: Path) ->
     assert v.exit_code == 0, v.output
     r = CliRunner().invoke(app, ["design", str(spec), "-q", "-o", str(out), "--force"])
     assert r.exit_code == 0 and "warning" not in r.stderr
+
+
+def test_debug_shows_the_traceback_and_keeps_the_exit_code(tmp_path: Path) -> None:
+    """``--debug`` turned every failure into exit 1 (the traceback's), "infeasible" for a CI
+    job (CLI hostile-input trial, session 34): the traceback, then the error's own code."""
+    bad = tmp_path / "bad.toml"
+    bad.write_text(SPEC.read_text().replace("[system]", "[system]\nbogus = 1", 1))
+    r = subprocess.run(
+        [sys.executable, "-m", "obsdesign", "--debug", "design", str(bad)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert r.returncode == 2 and "Traceback" in r.stderr and "SpecError" in r.stderr
