@@ -812,6 +812,14 @@ def main() -> None:
     # stderr closed (`2>&-`), full or a dead pipe: the error line is dropped, the exit code
     # is the command's (exit 1 for everything before session 34)
     sys.stderr = _Stderr(sys.stderr if sys.stderr is not None else open(os.devnull, "w"))  # noqa: SIM115
+    if "" in sys.argv[1:]:
+        # an empty argument is a path '' that pathlib reads as '.': `check "$SPECS"` with
+        # SPECS unset checked every spec under the working folder, `-o ''` said ".: is a
+        # directory" (CLI hostile-input trial, session 34). No option takes '' either.
+        at = sys.argv[1:].index("")
+        after = f" after {sys.argv[at]!r}" if at else ""
+        _err(f"an empty argument{after} (an unset shell variable?): give a path or a value")
+        sys.exit(2)
     try:
         rv = app(standalone_mode=False, prog_name="obsdesign")
     except KeyboardInterrupt:  # pragma: no cover - Ctrl-C outside a command body

@@ -551,3 +551,20 @@ def test_debug_shows_the_traceback_and_keeps_the_exit_code(tmp_path: Path) -> No
         timeout=120,
     )
     assert r.returncode == 2 and "Traceback" in r.stderr and "SpecError" in r.stderr
+
+
+def test_an_empty_argument_is_refused_not_read_as_the_working_folder(tmp_path: Path) -> None:
+    """pathlib reads '' as '.': ``check "$SPECS"`` with SPECS unset checked every spec under
+    the working folder (CLI hostile-input trial, session 34). An empty argument is exit 2."""
+    (tmp_path / "s.toml").write_text(SPEC.read_text())
+    for args, after in ((["check", ""], "check"), (["design", str(SPEC), "-o", ""], "-o")):
+        r = subprocess.run(
+            [sys.executable, "-m", "obsdesign", *args],
+            capture_output=True,
+            text=True,
+            timeout=120,
+            cwd=tmp_path,
+        )
+        assert r.returncode == 2 and r.stdout == ""
+        assert f"an empty argument after '{after}' (an unset shell variable?)" in r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
