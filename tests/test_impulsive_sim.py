@@ -154,6 +154,12 @@ def test_simulation_memory_is_checked_before_allocating(tmp_path: Path) -> None:
     # being skipped for a grid that follows the sampling intervals (session 33)
     assert res.output.startswith(f"obsdesign: error: {spec}: the simulation would need")
     assert "100000 run" in res.output or "100,000 run" in res.output, res.output
+    # the count comes from T_min, and the message says so (a valid α = 1e30 design was
+    # refused for 2.6·10¹¹ GiB without a word of why; soundness trial, session 34)
+    assert (
+        "⌈horizon / T_min⌉ + 1 intervals of each run are drawn first, T_min = " in (res.output)
+        and "a smaller [method.alpha] or a sampling file avoids it" in res.output
+    )
 
 
 def test_an_astronomic_horizon_is_refused_in_a_few_digits() -> None:

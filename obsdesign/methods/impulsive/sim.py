@@ -57,7 +57,9 @@ def read_intervals(path: Path) -> np.ndarray:
     return vals
 
 
-def check_memory(runs: int, samples: float, n: int, dense: int = 8, file: str = "") -> None:
+def check_memory(
+    runs: int, samples: float, n: int, dense: int = 8, file: str = "", why: str = ""
+) -> None:
     """Refuse (:class:`InputError`) a simulation whose arrays would exceed the
     ``max_sim_bytes`` limit: two batches of ``runs`` trajectories with ``samples`` intervals
     of ``dense`` points, each point holding t, x, ẑ (n each) and flags, as float64. Counted
@@ -65,7 +67,8 @@ def check_memory(runs: int, samples: float, n: int, dense: int = 8, file: str = 
     GiB, with no file named; independent simulate review).
 
     :param runs: runs; :param samples: sampling intervals per run; :param n: states;
-    :param dense: points per interval; :param file: the spec file, for the message."""
+    :param dense: points per interval; :param file: the spec file, for the message;
+    :param why: where the sample count comes from, for the message."""
     from obsdesign.limits import limits
 
     r, k = float(runs), float(samples)
@@ -75,7 +78,7 @@ def check_memory(runs: int, samples: float, n: int, dense: int = 8, file: str = 
         where = f"{file}: " if file else ""
         raise InputError(
             f"{where}the simulation would need about {need / 2**30:.3g} GiB "
-            f"({runs:,} runs × {k:.3g} samples × {n} states); the limit is "
+            f"({runs:,} runs × {k:.3g} samples × {n} states{why}); the limit is "
             f"{cap / 2**30:.3g} GiB (fewer runs, a shorter horizon, or "
             "obsdesign --limit max_sim_bytes=...)"
         )
@@ -137,7 +140,13 @@ def simulate(
     else:
         if not 0 < t_lo <= t_hi:
             raise InputError(f"report: expected 0 < T_min ≤ T_max, got {t_lo:g}, {t_hi:g}")
-        check_memory(runs, np.ceil(horizon / t_lo) + 1, n, file=spec.file)
+        # the count comes from T_min: a valid design with α = 1e30 (T_min ≈ 3·10⁻¹⁶) was
+        # refused for 2.6·10¹¹ GiB without a word of why (soundness trial, session 34)
+        why = (
+            f"; ⌈horizon / T_min⌉ + 1 intervals of each run are drawn first, T_min = "
+            f"{t_lo:.3g} (26c): a smaller [method.alpha] or a sampling file avoids it"
+        )
+        check_memory(runs, np.ceil(horizon / t_lo) + 1, n, file=spec.file, why=why)
     # run r draws from its own generator, child r of SeedSequence(seed): first its sampling
     # intervals, then its noise, each of a length that does not depend on the other runs, so
     # run r's numbers do not depend on the number of runs (docs/spec.md). One generator for
