@@ -752,3 +752,24 @@ def test_a_large_integer_beside_floats_is_written_exactly() -> None:
         ([[2**60 + 1, 0.5], [0, 0.25]], [[0], [1]], [[1, 0]], [[0]], 1)
     )
     assert tomllib.loads(text)["system"]["A"][0] == [2**60 + 1, 0.5]
+
+
+# -- mutation review 34 (session 33's checks) ----------------------------------------
+def test_a_numpy_complex_is_named_by_its_own_type() -> None:
+    """O01 (no isinstance(item, complex)): np.complex128's item is a Python complex, which
+    the mutant still refuses one recursion later as "complex": only the type named differs."""
+    from obsdesign.interop import _value
+
+    with pytest.raises(InputError, match="of type complex128 "):
+        _value(np.complex128(0.5))
+
+
+def test_bytes_are_refused_not_a_recursion() -> None:
+    """Kills O02 (no `type(item) is type(v)`): np.asarray(b"ab").item() is a new bytes object
+    each time, never `v` itself: without the same-type test _value recursed until
+    RecursionError. Bad input naming the type."""
+    from obsdesign.interop import _value
+
+    for v in (b"ab", np.bytes_(b"ab")):
+        with pytest.raises(InputError, match="of type bytes"):
+            _value(v)

@@ -355,3 +355,41 @@ def test_api_arguments_of_the_wrong_type_are_input_errors(tmp_path: Path) -> Non
     ):
         api.simulate(SPEC, run=3)
     assert api.simulate(SPEC, runs=2).metrics  # the known keywords still pass
+
+
+# -- mutation review 34 (session 33's checks) ----------------------------------------
+LYAP = (
+    '[system]\ntime = "continuous"\nA = [[-1, 1], [0, -2]]\nC = [[1, 0]]\n'
+    '[method]\nkey = "lyapunov"\nL = [1, 0]\n'
+    "[simulate]\nhorizon = H\ndt = DT\nx0 = [1, 0]\nxhat0 = [0, 0]\n"
+)
+
+
+def test_sim_grid_steps_rounds_the_exact_quotient() -> None:
+    """Kills A03 (int of the float quotient): 0.3 / 0.1 is 2.9999999999999996 in floats, but
+    the grid time_grid builds has 3 steps (the exact quotient rounded to the nearest)."""
+    sp = api.load_spec_text(LYAP.replace("H", "0.3").replace("DT", "0.1"), "s.toml")
+    assert 0.3 / 0.1 < 3
+    assert api.sim_grid_steps(sp) == 3
+    sp = api.load_spec_text(LYAP.replace("H", "1").replace("DT", "0.4"), "s.toml")
+    assert api.sim_grid_steps(sp) == 3  # 2.5 rounds half up (steps_of)
+
+
+def test_a_report_whose_parameters_lost_a_key_is_verified_as_edited() -> None:
+    """Kills A11 (no key-set comparison in _unchanged_since_read: the loop over the keys as
+    read looked up the missing one in the edited parameters, a KeyError out of verify). A
+    report read from JSON whose parameters are replaced without μ is verified as edited:
+    exit 1 with "mu missing"."""
+    import copy
+    import json
+
+    from obsdesign.params import Parameters
+    from obsdesign.report.model import Report
+
+    spec = SPEC
+    good = json.loads(api.design(spec).to_json())
+    rep, _ = Report.from_dict(copy.deepcopy(good))
+    rep.parameters = Parameters({k: v for k, v in rep.parameters.items() if k != "mu"})
+    got = api.verify(rep)
+    assert got.exit_code() == 1
+    assert "mu-present" in {c.id for c in got.failed}

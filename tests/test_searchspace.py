@@ -2021,3 +2021,100 @@ def test_the_printed_refuting_bound_is_below_the_proved_square_root() -> None:
     assert proof is not None
     b = Q(m[1])
     assert Q("0.9") < b and b * b <= fmpq(proof[0].numerator, proof[0].denominator)
+
+
+# -- mutation review 34 (session 33's checks) ----------------------------------------
+def test_a_schedule_between_twice_and_three_times_the_cap_is_refused() -> None:
+    """Kills D02 (refusal at 3× the cap): L_f Δτ = 0.6931444 makes 1 − e^(L_f Δτ)/2 ≈ 2.8·10⁻⁶;
+    from γ₀ = 2γ⋆ the estimate is ≈ 2.5·10⁵ (between 2× and 3× MAX_SCHEDULE): refused."""
+    with pytest.raises(InfeasibleError, match=r"needs about 2\.\de\+05 entries"):
+        D.schedule(fmpq(2, 10), fmpq(1, 10), fmpq(1), Q("0.6931444"))
+
+
+@pytest.mark.parametrize("factor", [1, 1 + 1e-10])
+def test_an_estimate_of_exactly_twice_the_cap_is_not_refused(monkeypatch, factor) -> None:  # noqa: ANN001
+    """Kills D04 (tolerance 1 − 10⁻⁹) and D05 (est ≥ 2·MAX_SCHEDULE): the rule needs at least
+    est/2 entries, so at est = 2·MAX_SCHEDULE (within the 10⁻⁹ float tolerance) the schedule
+    may still fit and is listed, not refused."""
+    monkeypatch.setattr(D, "_steps_estimate", lambda *a: 2 * D.MAX_SCHEDULE * factor)
+    gam = D.schedule(fmpq(2), fmpq(1), fmpq(1), Q("0.1"))
+    assert gam[-1] == 1
+
+
+def test_the_digit_refusal_is_at_one_digit_below_the_long_entries(monkeypatch) -> None:  # noqa: ANN001
+    """Kills D08 (places > 113), D09 (places > 109) and D10 (places ≥ 112): entries of
+    SCHEDULE_LONG_DIGITS = 112 digits decrease only when 1 − r > 10^(1−112). With
+    1 − r = 5·10⁻¹¹² (places ≈ 111.3) the rule cannot progress: refused before listing; with
+    1 − r = 10⁻¹¹⁰ (places = 110) it can: ~4·10⁴ entries are listed and reach γ⋆."""
+    g_star = fmpq(1, 10)
+    monkeypatch.setattr(D, "schedule_ratio", lambda x: 1 - fmpq(5, 10**112))
+    g0 = g_star * (1 + fmpq(4, 10**107))
+    assert D._most_digits(g0, g_star, 1 - fmpq(5, 10**112)) == D.SCHEDULE_LONG_DIGITS
+    with pytest.raises(InfeasibleError, match="significant digits each"):
+        D.schedule(g0, g_star, fmpq(1), fmpq(1, 10))
+    monkeypatch.setattr(D, "schedule_ratio", lambda x: 1 - fmpq(1, 10**110))
+    g0 = g_star * (1 + fmpq(4, 10**106))
+    assert D._most_digits(g0, g_star, 1 - fmpq(1, 10**110)) == D.SCHEDULE_LONG_DIGITS
+    gam = D.schedule(g0, g_star, fmpq(1), fmpq(1, 10))
+    assert gam[-1] == g_star and len(gam) > 30_000
+
+
+def test_the_digit_budget_margin_is_exactly_three_digits() -> None:
+    """Kills D13 (need = places + 2): r = 1 − 10⁻⁴ from γ₀/γ⋆ = 10²⁷ needs ~6.2·10⁵ entries;
+    at 4 + 3 digits that is 4.35·10⁶ > SCHEDULE_MAX_CHARS (112 digits at most), at 4 + 2 it
+    would be 3.7·10⁶ (1,024)."""
+    r = 1 - fmpq(1, 10**4)
+    assert D._most_digits(fmpq(10**27), fmpq(1), r) == D.SCHEDULE_LONG_DIGITS
+
+
+def test_gap_prints_the_float_gap_when_it_has_one() -> None:
+    """Kills D21 (_gap always "10^-N"): 1 − r with a double is printed as it (.3g)."""
+    assert D._gap(fmpq(3, 4)) == "0.25"
+    assert D._gap(1 - fmpq(1, 10**400)) == "10^-400"
+
+
+OVERFLOW_F = (
+    '[system]\ntime = "continuous"\nstates = ["x1", "x2"]\n'
+    'f = ["(x2 + 2^1100) - 2^1100", "-x1"]\nh = ["x1"]\n[method]\n'
+    'key = "search-space"\nalpha = 0.9\ngamma_star = 0.05\ngamma0 = 1\nGIVEN\n'
+    "E = {lower = [-1, -1], upper = [1, 2]}\nD = {lower = [0, -0.5], upper = [0, 0.5]}\n"
+)
+
+
+def test_the_corners_go_on_past_an_improvement_below_the_target() -> None:
+    """Kills D31 (the corner loop stops at the first corner that improves on the proof):
+    |f|² = x1² + x2² overflows floats everywhere (midpoint witness: 1/4); the first corner
+    (−1, −1) proves 2, below 2.1² = 4.41, and only the second, (−1, 2), proves 5: a given
+    f_sup = 2.1 is refuted (exit 1), the true √5 is not."""
+    from obsdesign import api
+    from obsdesign.certify.claim import ClaimStatus
+
+    D._PROOFS.clear()
+    rep = api.design(api.load_spec_text(OVERFLOW_F.replace("GIVEN", "f_sup = 2.1"), "o.toml"))
+    c = next(c for c in rep.claims if c.id == "f_sup-bound")
+    assert c.status == ClaimStatus.FAILED and rep.exit_code() == 1, c.detail
+    assert "at (-1.0, 2.0)" in c.detail
+    rep = api.design(
+        api.load_spec_text(OVERFLOW_F.replace("GIVEN", "f_sup = 2.2360679775"), "t.toml")
+    )
+    assert rep.exit_code() == 0
+
+
+def test_corners_are_tried_only_where_floats_overflowed(monkeypatch) -> None:  # noqa: ANN001
+    """Kills D29 (corners tried whenever the sampled witness does not refute): h = 2·x1 has
+    finite float samples, so a value above L_h = 2 is proved at the sampled witness only."""
+    from obsdesign import api
+    from obsdesign.methods.searchspace import bounds as B
+
+    calls: list[object] = []
+    real = B.corner_witnesses
+    monkeypatch.setattr(B, "corner_witnesses", lambda *a: calls.append(a) or real(*a))
+    text = (
+        '[system]\ntime = "continuous"\nstates = ["x1"]\nf = ["-x1"]\nh = ["2*x1"]\n'
+        '[method]\nkey = "search-space"\nalpha = 0.5\ngamma_star = 0.1\ngamma0 = 1\n'
+        "E = {lower = [-1], upper = [1]}\nD = {lower = [-0.5], upper = [0.5]}\n"
+    )
+    D._PROOFS.clear()
+    got = D.proved_lower("L_h", api.load_spec_text(text, "s.toml"), fmpq(3))
+    assert got is not None and got[0] <= 9
+    assert calls == []

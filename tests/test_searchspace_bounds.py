@@ -4,6 +4,7 @@ squares taken after scaling, so constants near the ends of the float range are b
 
 from __future__ import annotations
 
+import itertools
 import math
 from fractions import Fraction
 
@@ -405,3 +406,15 @@ def test_a_zero_width_side_without_a_double_is_its_exact_value() -> None:
     assert proof is not None and proof[0] > 4 and proof[1][0][1] == Fraction(1, 10)
     far = (np.array([0.9, 0.1000001]), np.array([1.0, 0.1000001]))
     assert B.proved_lower_sq(ex, ["x1", "x2"], ["x1"], lo, hi, far) is None
+
+
+# -- mutation review 34 (session 33's checks) ----------------------------------------
+def test_sup_corners_span_max_corner_vars_plus_one_variables() -> None:
+    """Kills B13 (free = held[:MAX_CORNER_VARS]): for a sup the corners of the first
+    MAX_CORNER_VARS + 1 = 5 variables are tried (32 points); the 6th sits at its midpoint."""
+    names = [f"x{i}" for i in range(1, 7)]
+    lo, hi = [Fraction(-1)] * 6, [Fraction(1)] * 6
+    sup = B.corner_witnesses(names, [], lo, hi)
+    assert len(sup) == 2 ** (B.MAX_CORNER_VARS + 1) == 32
+    got = {tuple(float(v) for v in w[0]) for w in sup}
+    assert got == {(*c, 0.0) for c in itertools.product((-1.0, 1.0), repeat=5)}

@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 import warnings
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -15,7 +16,8 @@ from typer.testing import CliRunner
 
 from obsdesign import api
 from obsdesign.cli import app
-from obsdesign.errors import InputError
+from obsdesign.errors import InconclusiveError, InputError
+from obsdesign.methods.searchspace import sim as S
 from obsdesign.methods.searchspace.sim import ConsistencyLost, MemoryCap, cover_box, recover
 from obsdesign.simulate.budget import TimeBudget, TimeExceeded
 
@@ -774,3 +776,49 @@ def test_cells_finer_than_the_float_spacing_of_E_are_refused_as_inconclusive() -
     S._check_float_spacing(o, S.MIN_CELL_ULPS * ulp)  # at the threshold: runs
     with pytest.raises(InconclusiveError):
         S._check_float_spacing(o, S.MIN_CELL_ULPS * ulp * (1 - 1e-9))
+
+
+# -- mutation review 34 (session 33's checks) ----------------------------------------
+def _E(lower: list[float], upper: list[float]) -> SimpleNamespace:
+    return SimpleNamespace(E=SimpleNamespace(lower=lower, upper=upper))
+
+
+def test_the_float_spacing_is_that_of_the_larger_end_of_E() -> None:
+    """Kills S06 (|lower| only) and S07 (|upper| only): E = [0, 10⁹] and [−10⁹, 0] both
+    have spacing 1.19·10⁻⁷ at their far end: a half-side of 10⁻⁹ is refused for both."""
+    for o in (_E([0.0], [1e9]), _E([-1e9], [0.0])):
+        with pytest.raises(InconclusiveError, match="below 16 float spacings"):
+            S._check_float_spacing(o, 1e-9)  # type: ignore[arg-type]
+    S._check_float_spacing(_E([0.0], [1.0]), 1e-9)  # type: ignore[arg-type]
+
+
+class _Seen(Exception):
+    pass
+
+
+@pytest.mark.parametrize("horizon", ["12", "1.3"])
+def test_the_spacing_check_takes_the_finest_level_the_horizon_reaches(
+    monkeypatch: pytest.MonkeyPatch, horizon: str
+) -> None:
+    """Kills S09 (ε₀, the coarsest level), S10 (the last level whatever the horizon) and S11
+    (ε_i without /√n): the half-side checked is ε_i/√n for i = min(len − 1, N // K), N the
+    samples of the horizon (the shipped example: i = 11 for horizon 12, i = 3 for 1.3)."""
+    text = SPEC.read_text(encoding="utf-8").replace("horizon = 12", f"horizon = {horizon}")
+    sp = api.load_spec_text(text, "h.toml")
+    rep = api.design(sp)
+    p = rep.parameters
+    eps = [float(e) for e in p["eps_schedule"]]
+    K = int(round(float(p["K"])))
+    N = S._samples(sp, float(p["dT"]))
+    i = min(len(eps) - 1, N // K)
+    assert (horizon == "12") == (i == len(eps) - 1) and i > 0
+    seen: list[float] = []
+
+    def spy(o, s):  # noqa: ANN001, ANN202
+        seen.append(s)
+        raise _Seen
+
+    monkeypatch.setattr(S, "_check_float_spacing", spy)
+    with pytest.raises(_Seen):
+        api.simulate(sp)
+    assert seen == [pytest.approx(eps[i] / math.sqrt(sp.system.n), rel=1e-12)]

@@ -203,3 +203,19 @@ def test_figure_names_its_source_unless_accurate_floats(
     assert " from float eigenvalues, not reliable here: their Bauer–Fike error bound is ≈ " in (
         g.figure(True)
     )
+
+
+# -- mutation review 34 (session 33's checks) ----------------------------------------
+def test_agree_compares_the_abscissa_too() -> None:
+    """Kills P05 (_agree on the spectral radius alone): {1, −0.5} and {−1, 0.5} have the same
+    radius 1 but abscissas 1 and 0.5: two precisions giving them do not agree (the stability
+    verdict is read from the abscissa)."""
+    a = np.array([1.0 + 0j, -0.5 + 0j])
+    b = np.array([-1.0 + 0j, 0.5 + 0j])
+    assert not spectrum._agree(a, b)
+    assert spectrum._agree(a, a.copy())
+
+
+def test_agree_compares_the_radius_too() -> None:
+    """Kills P06 (_agree on the abscissa alone): {0.5, −1} and {0.5, −2}."""
+    assert not spectrum._agree(np.array([0.5 + 0j, -1 + 0j]), np.array([0.5 + 0j, -2 + 0j]))

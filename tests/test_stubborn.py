@@ -20,6 +20,7 @@ from obsdesign.certify.claim import ClaimStatus
 from obsdesign.certify.exact import Q, qparse, qstr, to_float
 from obsdesign.cli import app
 from obsdesign.errors import InconclusiveError, InfeasibleError, SpecError
+from obsdesign.methods.stubborn import sim
 from obsdesign.methods.stubborn.sim import study
 from obsdesign.report import Report
 
@@ -1791,3 +1792,82 @@ def test_problem_text_names_r_bound_and_a_given_K() -> None:
     )
     t = _problem_text(o, "(7)-(9)", True)
     assert t.endswith("the given K") and "gain_bound" not in t and "r_bound" not in t
+
+
+# -- mutation review 34 (session 33's checks) ----------------------------------------
+def _g(w: list[float], discrete: bool = False) -> sim.Gains:
+    p = len(w)
+    return sim.Gains(
+        -np.eye(2), np.eye(p, 2), 0.5 * np.eye(2, p), 1.0, np.eye(p), np.asarray(w, float), discrete
+    )
+
+
+def test_root0_weighs_the_output_error_by_the_square_root_of_w() -> None:
+    """Kills T02 (w·|e_y| in place of √w·|e_y|) and T03 (no |·|): √σ̄(0) = max_i √w_i |(Ce₀)_i|,
+    so σ̄(0) = max_i w_i (Ce₀)_i² (default_sigma0): with w = (4, 1), e₀ = (−1, −3) it is 3
+    (σ̄ = 9), where w·|e_y| gives 4."""
+    g = _g([4.0, 1.0])
+    e0 = np.array([-1.0, -3.0])
+    assert sim.root0_of(g, e0, None) == 3.0
+    assert sim.default_sigma0(g, e0) == 9.0
+    assert sim.root0_of(g, np.array([-2.0, 0.5]), None) == 4.0  # √4·|−2|
+    assert sim.root0_of(g, e0, 2.25) == 1.5
+    assert sim.root0_of(g, e0, -1.0) == 0.0
+
+
+def test_the_adaptive_level_is_rho_over_root_w() -> None:
+    """Kills T05 (ρ·√w_i in place of ρ/√w_i): σ_i = √(σ̄/w_i); one discrete step from
+    e = (0, 0) with ν = (10, 10), ρ = 2, w = (4, 1): the injected output error is clipped
+    at σ = (1, 2), so e₁ = −K·clip = −0.5·(1, 2)."""
+    g = _g([4.0, 1.0], discrete=True)
+    g.A[:] = 0.0
+    _, e, _ = sim.run_errors(
+        g,
+        np.zeros(2),
+        lambda a, b: np.full((b - a, 2), 10.0),
+        1,
+        1.0,
+        np.full(2, np.inf),
+        np.array(True),
+        2.0,
+    )
+    assert e == pytest.approx([-0.5, -1.0])
+
+
+def test_one_heun_step_uses_the_predicted_level_at_the_second_stage() -> None:
+    """Kills T09 (the second stage clipped at ρ(0), not at the predicted √σ̄): scalar plant
+    ė = −K sat(e + ν), K = 1, λ = 1, R = w = 1, e(0) = 0, ν = 10, ρ(0) = 1, dt = 0.1. By hand
+    (σ̄ in units of M² = 100): stage 1 clips 10 at 1, de = −1, dσ̄/M² = −0.01 + 1 = 0.99;
+    e₂ = −0.1, σ̄₂/M² = 0.109, so stage 2 clips 9.9 at 10·√0.109; then
+    e = −0.05·(1 + 10√0.109) and ρ = 10·√(0.01 + 0.05·(0.99 − 0.109 + 0.99²))."""
+    g = sim.Gains(np.zeros((1, 1)), np.eye(1), np.eye(1), 1.0, np.eye(1), np.ones(1), False)
+    _, e, rho = sim.run_errors(
+        g,
+        np.zeros(1),
+        lambda a, b: np.full((b - a, 1), 10.0),
+        1,
+        0.1,
+        np.full(1, np.inf),
+        np.array(True),
+        1.0,
+    )
+    assert float(e[0]) == pytest.approx(-0.05 * (1 + 10 * math.sqrt(0.109)), rel=1e-12)
+    assert float(rho) == pytest.approx(
+        10 * math.sqrt(0.01 + 0.05 * (0.99 - 0.109 + 0.99**2)), rel=1e-12
+    )
+
+
+def test_the_single_runs_sigma_is_root_of_sigma_bar_over_w() -> None:
+    """Kills T11 (σ = √(ρ/w) from ρ = √σ̄, a unit slip): the run's σ_i(t)² w_i = σ̄(t)
+    (σ_i = √(σ̄/w_i), the slides' definition) at every step, on a shipped example."""
+
+    from obsdesign import api
+
+    spec = SPECS / "astolfi-stubborn-example1.toml"
+    sp = api.load_spec(spec)
+    rep = api.design(sp)
+    res = api.simulate(sp, rep)
+    w = np.asarray(rep.parameters.float("W"), float).ravel()
+    sig, sb = res.extra["sigma"], res.extra["sigma_bar"]
+    assert sig.shape[1] == w.size and np.all(sb > 0)
+    assert sig**2 * w == pytest.approx(np.broadcast_to(sb[:, None], sig.shape), rel=1e-9)

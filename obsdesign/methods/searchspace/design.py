@@ -246,7 +246,7 @@ def schedule(gamma0: fmpq, gamma_star: fmpq, L_f: fmpq, dtau: fmpq) -> list[fmpq
     Stops early (without reaching γ⋆) when e^{L_f Δτ}/2 < 1 is not shown
     (:func:`schedule_ratio`), when SCHEDULE_MAX_DIGITS digits make no progress, or after
     MAX_SCHEDULE entries; an :class:`InfeasibleError` when the rule needs more than
-    10·MAX_SCHEDULE entries (:func:`_steps_estimate`), or entries of more digits than
+    2·MAX_SCHEDULE entries (:func:`_steps_estimate`), or entries of more digits than
     SCHEDULE_LONG_DIGITS where :func:`_most_digits` allows no more, before listing any.
     For L_f Δτ ≥ 1 that is known without e^{L_f Δτ} (e^x ≥ 1 + x ≥ 2), which is never
     formed there: a huge K (10¹⁵) made its 113-bit enclosure an integer of 10¹⁵ bits and
