@@ -2118,3 +2118,65 @@ def test_corners_are_tried_only_where_floats_overflowed(monkeypatch) -> None:  #
     got = D.proved_lower("L_h", api.load_spec_text(text, "s.toml"), fmpq(3))
     assert got is not None and got[0] <= 9
     assert calls == []
+
+
+UNDEFINED = """[system]
+time = "continuous"
+states = ["x1", "x2"]
+f = ["x2 + F1", "-x1 + u1"]
+h = ["x1"]
+u = ["U1"]
+[system.parameters]
+k = 0
+[method]
+key = "search-space"
+alpha = 0.9
+gamma_star = 0.05
+gamma0 = 1
+[method.E]
+lower = [-2, -2]
+upper = [2, 2]
+[method.D]
+lower = [-1, -1]
+upper = [1, 1]
+[method.U]
+lower = [-1]
+upper = [1]
+[simulate]
+horizon = 2
+x0 = [0.5, 0.5]
+xhat0 = [0, 0]
+"""
+
+
+@pytest.mark.parametrize(
+    ("f1", "u1", "undefined"),
+    [
+        ("0", "sin(1/t)", "u"),  # undefined at t = 0
+        ("0", "sat(1/(t - 1), 1)", "u"),
+        ("0", "0.5 + k*tan(t)", "u"),  # a pole at π/2 inside [0, 2]: k = 0 hid it
+        ("k*(1/x1)", "0.5", "f"),  # undefined at x1 = 0 in E
+        ("k*tan(x1)", "0.5", "f"),
+        ("(1/x1)^0", "0.5", "f"),
+        ("0*log(x1 + 2)", "0.5", "f"),  # log 0 at x1 = −2, E's edge
+    ],
+)
+def test_an_expression_undefined_somewhere_on_its_set_certifies_nothing(
+    f1: str, u1: str, undefined: str
+) -> None:
+    """Interval division by an interval holding 0, tan at a pole and log at 0 gave "any
+    real", which sin, sat, step or an exact factor 0 then bounded: u = sin(1/t) was certified
+    in [−1, 1] for t ∈ [0, 2], and L_f, sup |f| of k·(1/x1) with k = 0 on an E holding 0,
+    verified ok (false certificates; expression soundness trial, session 34). Undefined
+    somewhere is now refused, as sqrt and log below 0 were."""
+    text = UNDEFINED.replace("F1", f1).replace("U1", u1)
+    sp = api.load_spec_text(text, "undefined.toml")
+    try:
+        rep = api.design(sp)
+    except (InfeasibleError, SpecError) as e:
+        assert "not defined" in e.message or "no finite" in e.message, e.message
+        return
+    assert rep.exit_code() != 0
+    ids = {"u": ("input-range",), "f": ("L_f-bound", "f_sup-bound")}[undefined]
+    bad = [c.id for c in rep.claims if c.status == ClaimStatus.CERTIFIED and c.id in ids]
+    assert not bad, bad

@@ -184,8 +184,13 @@ class I:  # noqa: E742 - I for "interval"
         return I(min(los), max(his))
 
     def __truediv__(self, o: I) -> I:
+        """self / o; refused (ArithmeticError) when o holds 0: the quotient is undefined
+        there (or o is not separated from 0 on this box). It was "any real", which sin,
+        sat, step or an exact factor 0 then bounded: u = sin(1/t) was certified in [−1, 1]
+        over t ∈ [0, 2], and L_f of k·(1/x1) with k = 0 over an E holding 0 (expression
+        soundness trial, session 34)."""
         if o.contains0():
-            return I.entire()
+            raise ArithmeticError("division by an interval holding 0 (undefined there)")
         if not (self.finite and o.finite):
             return I.entire()
         qs = [(a / b, a, b) for a in (self.lo, self.hi) for b in (o.lo, o.hi)]
@@ -290,15 +295,15 @@ def exp(x: I) -> I:
 
 
 def log(x: I) -> I:
-    """log over x; refused (ArithmeticError) when x reaches below 0, where log is undefined
-    (the enclosure of the defined part alone proved claims about an undefined function: see
-    :func:`sqrt`); x reaching 0 gives an enclosure unbounded below."""
+    """log over x; refused (ArithmeticError) when x reaches 0 or below, where log is
+    undefined (the enclosure of the defined part alone proved claims about an undefined
+    function: see :func:`sqrt`)."""
     if x.hi <= 0.0:
         raise ArithmeticError("log of a non-positive interval")
-    if x.lo < 0.0:
-        raise ArithmeticError("log of an interval reaching below 0 (undefined there)")
     if x.lo <= 0.0:
-        return I(-INF, _iv_call(iv.log, I(x.hi, x.hi)).hi)
+        # log 0 is undefined too: an enclosure unbounded below was bounded by sat or an
+        # exact factor 0, as 1/x was (session 34)
+        raise ArithmeticError("log of an interval reaching 0 (undefined there)")
     return _iv_call(iv.log, x)
 
 
@@ -311,7 +316,12 @@ def cos(x: I) -> I:
 
 
 def tan(x: I) -> I:
-    return _iv_call(iv.tan, x)
+    """tan over x; refused (ArithmeticError) when x may hold a pole, where tan is undefined
+    (its enclosure was "any real", which 0·tan(x1) turned into 0; session 34)."""
+    r = _iv_call(iv.tan, x)
+    if not r.finite:  # a pole inside, or an unbounded x (which holds poles)
+        raise ArithmeticError("tan over an interval that may hold a pole (undefined there)")
+    return r
 
 
 def sqrt(x: I) -> I:
