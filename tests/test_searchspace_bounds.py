@@ -418,3 +418,18 @@ def test_sup_corners_span_max_corner_vars_plus_one_variables() -> None:
     assert len(sup) == 2 ** (B.MAX_CORNER_VARS + 1) == 32
     got = {tuple(float(v) for v in w[0]) for w in sup}
     assert got == {(*c, 0.0) for c in itertools.product((-1.0, 1.0), repeat=5)}
+
+
+def test_the_sampled_quotient_is_not_float_noise_over_an_ulp() -> None:
+    """Branch and bound narrowed a corner box to a few ulps and the sampled pair, clipped
+    into it, was 5.6·10⁻¹⁷ apart: its float quotient 1.0 (exactly 0.7 at that pair) failed
+    a true L_f = 0.8724 — exit 1 in design and verify (expression soundness trial, session
+    34). f = (x1·x2 + x1/10, x1/3) on [0, 0.7] × [0, 0.3] has L_f = ‖J(0.7, 0.3)‖₂ =
+    0.825339…; the sampled estimate stays below it and the enclosure above."""
+    ex = _ex("x1*x2 + 0.1*x1", "x1/3", names=("x1", "x2"))
+    lo, hi = [Fraction(0), Fraction(0)], [Fraction(7, 10), Fraction(3, 10)]
+    b = B.lipschitz(ex, ["x1", "x2"], ["x1", "x2"], lo, hi, 300, 1e-6)
+    # ‖[[0.4, 0.7], [1/3, 0]]‖₂ = 0.82533934…, between these two
+    assert b.lower_est <= 0.8253394 and b.upper >= 0.8253393
+    p, q = b.witness
+    assert np.linalg.norm(np.asarray(p) - np.asarray(q)) > 1e-9

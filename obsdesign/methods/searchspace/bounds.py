@@ -339,17 +339,22 @@ def lipschitz(
         _, _, vt = np.linalg.svd(J)
         v = np.zeros_like(M)
         v[:, idx] = vt[:, 0, :]
-        # the quotient's two points are kept in the box and in E: from a corner, m ± δv
-        # left E and crossed a jump just outside it (floor(x2) at x2 = 0 with E's x2 ∈
-        # [0, 1/2] gave 2.5·10⁵ and failed a true L_f = 1; search-space trial, session 24)
-        a = np.maximum([iv.lo for iv in b], inner_lo)
-        c = np.minimum([iv.hi for iv in b], inner_hi)
-        Pp, Pm = np.clip(M + scale * v, a, c), np.clip(M - scale * v, a, c)
+        # the quotient's two points are kept in E: from a corner, m ± δv left E and crossed
+        # a jump just outside it (floor(x2) at x2 = 0 with E's x2 ∈ [0, 1/2] gave 2.5·10⁵
+        # and failed a true L_f = 1; search-space trial, session 24). Not in the sub-box:
+        # branch and bound narrows a box to a few ulps, and a pair clipped into it divided
+        # float rounding by 10⁻¹⁷ — a "sampled quotient" of 1 failed a true L_f = 0.8725
+        # (exactly 0.7 at that pair; expression soundness trial, session 34). A pair much
+        # closer than δ (clipped at E's edge) is skipped for the same reason.
+        Pp, Pm = (
+            np.clip(M + scale * v, inner_lo, inner_hi),
+            np.clip(M - scale * v, inner_lo, inner_hi),
+        )
         d = _eval(exprs, names, Pp) - _eval(exprs, names, Pm)
         dist = np.linalg.norm(Pp - Pm, axis=-1)
         with np.errstate(all="ignore"):
             q = _norms(d) / dist
-        ok = np.flatnonzero(np.isfinite(q) & (dist > 0))
+        ok = np.flatnonzero(np.isfinite(q) & (dist > 1e-3 * scale))
         if not np.all(np.isfinite(q)):
             lower_of.overflow = True  # type: ignore[attr-defined]
         if not ok.size:
