@@ -822,3 +822,24 @@ def test_the_spacing_check_takes_the_finest_level_the_horizon_reaches(
     with pytest.raises(_Seen):
         api.simulate(sp)
     assert seen == [pytest.approx(eps[i] / math.sqrt(sp.system.n), rel=1e-12)]
+
+
+def test_a_state_that_floats_cannot_evaluate_is_inconclusive_not_left_e(tmp_path: Path) -> None:
+    """f = x2 + 0·2^1100·x1 is exactly a rotation (certified correctly), but floats evaluate
+    0·inf = nan: the run ended exit 1 "the true state left E", blaming the constants
+    (expression soundness trial, session 34). It is exit 4 naming the non-finite state."""
+    from obsdesign.errors import InconclusiveError
+
+    text = (
+        '[system]\ntime = "continuous"\nstates = ["x1", "x2"]\n'
+        'f = ["x2 + 0*2^1100*x1", "-x1"]\nh = ["x1 + 0"]\n[method]\nkey = "search-space"\n'
+        "alpha = 0.9\ngamma_star = 0.05\ngamma0 = 1\n"
+        "[method.E]\nlower = [-2, -2]\nupper = [2, 2]\n[method.D]\nlower = [-1, -1]\n"
+        "upper = [1, 1]\n[simulate]\nhorizon = 1\nx0 = [0.5, 0.5]\nxhat0 = [0, 0]\n"
+    )
+    p = tmp_path / "nan.toml"
+    p.write_text(text)
+    assert api.design(p).exit_code() == 0  # the certificate is right
+    with pytest.raises(InconclusiveError, match="not finite in floats at t = ") as e:
+        api.simulate(p)
+    assert "left E" not in e.value.message

@@ -402,6 +402,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
     t = t0
     x = x0.copy()
     y = plant.out(x)[0]
+    _check_finite(x[0], y, t0)
     i = 0
     s = eps[0] / math.sqrt(n)
     cover = cover_box(o.D.lower, o.D.upper, s)
@@ -446,6 +447,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
         )
         flow_err = max(flow_err, fe)
         t = t_next
+        _check_finite(x[0], y, t)
         if left_E is None and not (np.all(x[0] >= E_lo) and np.all(x[0] <= E_hi)):
             left_E = t
         if not keep.any():
@@ -741,6 +743,18 @@ def _diagnose(
 
 #: the smallest cell half-side, in float spacings of E's coordinates, that a run takes
 MIN_CELL_ULPS = 16
+
+
+def _check_finite(x: np.ndarray, y: Any, t: float) -> None:
+    """Refuse (exit 4) a run whose true state or output is not finite in floats: f = x2 +
+    0·2^1100·x1 (exactly a rotation) evaluated 0·inf = nan, and the run ended exit 1 "the true
+    state left E", blaming the certified constants (expression soundness trial, session 34)."""
+    if not (np.all(np.isfinite(x)) and np.all(np.isfinite(np.asarray(y, dtype=float)))):
+        raise InconclusiveError(
+            f"the true state or output is not finite in floats at t = {t:.6g} (x = "
+            f"{np.asarray(x).tolist()}): f, h or u overflows or is undefined there in float "
+            "arithmetic (e.g. 0·2^1100 = 0·inf), so floats cannot simulate this plant"
+        )
 
 
 def _check_float_spacing(o: Options, s: float) -> None:
