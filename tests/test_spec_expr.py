@@ -117,6 +117,9 @@ def test_sympy_form_takes_decimal_literals_exactly(text: str, num: int, den: int
         ("2*1E+1001", "decimal exponent 1001"),
         ("1e400*t", "beyond the float range"),
         ("t + .5e99999", "decimal exponent 99999"),
+        # 1024 bits, rounding past the largest double: an OverflowError, exit 4 (session 34)
+        (f"{2**1024 - 1}*t", "integer constant beyond the float range"),
+        (f"{2**1024}*t", "integer constant beyond the float range"),
     ],
 )
 def test_literal_beyond_the_exponent_limit_is_refused(text: str, msg: str) -> None:

@@ -349,9 +349,13 @@ def _compile(node: ast.AST, known: set[str], file: str, key: str) -> Fn:
     if isinstance(node, ast.Constant):
         if isinstance(node.value, bool) or not isinstance(node.value, (int, float)):
             raise bad(f"the constant {node.value!r} is")
-        if isinstance(node.value, int) and node.value.bit_length() > 1024:
-            raise SpecError(file, key, "has an integer constant beyond the float range")
-        c = float(node.value)
+        try:
+            # an int of 1024 bits near 2^1024 rounds past the largest double: OverflowError,
+            # exit 4 naming no file or key, where 2^1024 itself was this exit 2 (expression
+            # soundness trial, session 34)
+            c = float(node.value)
+        except OverflowError:
+            raise SpecError(file, key, "has an integer constant beyond the float range") from None
         if not math.isfinite(c):
             raise SpecError(file, key, "has a constant beyond the float range")
         return lambda env: c
