@@ -1161,8 +1161,10 @@ def _time_budget(seconds: float | None) -> Any:
             yield
         return
 
+    already = _initializing()  # the caller's own imports (a check run at module level)
+
     def on_alarm(signum: int, frame: Any) -> None:
-        if not _importing():  # else the repeat RETIMEOUT_S later stops it
+        if not _importing(already):  # else the repeat RETIMEOUT_S later stops it
             raise SpecTimeout
 
     old = signal.signal(signal.SIGALRM, on_alarm)
@@ -1178,15 +1180,23 @@ def _time_budget(seconds: float | None) -> Any:
         signal.signal(signal.SIGALRM, old)
 
 
-def _importing() -> bool:
-    """Whether a module is being imported (its code running): a time budget waits for the
-    import to end. A stop raised inside ``import cvxpy`` left parts of it in
-    ``sys.modules``, and every later spec of the same ``check`` that needed it failed with
-    "module 'cvxpy' has no attribute 'promote'" (CLI hostile-input trial, session 34)."""
-    for m in list(sys.modules.values()):
-        if getattr(getattr(m, "__spec__", None), "_initializing", False):
-            return True
-    return False
+def _initializing() -> set[str]:
+    """The modules whose code is running (being imported) now."""
+    return {
+        name
+        for name, m in list(sys.modules.items())
+        if getattr(getattr(m, "__spec__", None), "_initializing", False)
+    }
+
+
+def _importing(already: set[str]) -> bool:
+    """Whether a module other than those of ``already`` (being imported when the budget
+    started: the caller's own, a ``check`` run at a module's top level, which otherwise never
+    stopped — re-check trial, session 34) is being imported: a time budget waits for that
+    import to end. A stop raised inside ``import cvxpy`` left parts of it in ``sys.modules``,
+    and every later spec of the same ``check`` that needed it failed with "module 'cvxpy' has
+    no attribute 'promote'" (CLI hostile-input trial, session 34)."""
+    return bool(_initializing() - already)
 
 
 def _async_raise(tid: int, exc: type[BaseException] | None) -> None:
@@ -1208,6 +1218,7 @@ def _thread_budget(seconds: float) -> Any:
     just before is cancelled, or raised in the block's ``finally`` (the caller's ``except
     SpecTimeout`` takes it, as the deadline had passed)."""
     tid = threading.get_ident()
+    already = _initializing()
     lock = threading.Lock()
     armed = [True]
     timers: list[threading.Timer] = []
@@ -1221,7 +1232,7 @@ def _thread_budget(seconds: float) -> Any:
     def fire() -> None:
         with lock:
             if armed[0]:
-                if not _importing():
+                if not _importing(already):
                     _async_raise(tid, SpecTimeout)
                 start(RETIMEOUT_S)
 

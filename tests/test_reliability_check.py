@@ -555,3 +555,25 @@ def test_a_time_budget_waits_for_an_import_to_finish(
     assert sys.modules["slow_mod_34"].done is True
     assert "imported" in out and out["stopped"] - out["imported"] < 0.5
     sys.modules.pop("slow_mod_34", None)
+
+
+def test_a_time_budget_started_inside_an_import_still_stops(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The wait for a running import counted the caller's own: a ``check(timeout=2)`` at the
+    top level of an imported module never stopped (re-check trial, session 34). Only imports
+    begun after the budget started make it wait."""
+    import sys
+
+    (tmp_path / "outer_mod_34.py").write_text(
+        "import time\nfrom obsdesign import api\nt0 = time.perf_counter()\nstopped = None\n"
+        "try:\n    with api._time_budget(0.2):\n"
+        "        while time.perf_counter() - t0 < 5:\n            pass\n"
+        "except api.SpecTimeout:\n    stopped = time.perf_counter() - t0\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, "outer_mod_34", raising=False)
+    import outer_mod_34  # type: ignore[import-not-found]
+
+    assert outer_mod_34.stopped is not None and outer_mod_34.stopped < 2
+    sys.modules.pop("outer_mod_34", None)
