@@ -142,3 +142,15 @@ def test_contains_rel_does_not_depend_on_the_scale(k: int, out: float) -> None:
     for S, x in cases:
         inside = bool(np.asarray(S.contains_rel(x[None, :])).reshape(-1)[0])
         assert inside is (out <= 1e-12), (type(S).__name__, k, out)
+
+
+def test_contains_rel_reads_a_thin_direction_at_its_own_scale() -> None:
+    """The slack was taken from the widest side: a set 10¹² times thinner in one direction let
+    a point 8× outside it count as inside (constrained simulate; re-check trial, session 34)."""
+    t = fmpq(1, 10**12)
+    box = Box(qvec([-1, -t]), qvec([1, t]))
+    poly = Polytope(qmat([[0, 10**12], [0, -1], [1, 1], [-1, 0]]), qvec([1, t, 2, 1]))
+    for S in (box, poly):
+        assert bool(np.asarray(S.contains_rel(np.array([[0.0, 8e-12]]))).reshape(-1)[0]) is False
+        assert bool(np.asarray(S.contains_rel(np.array([[0.0, 1e-12]]))).reshape(-1)[0]) is True
+        assert bool(np.asarray(S.contains_rel(np.array([[0.5, -1e-12]]))).reshape(-1)[0]) is True

@@ -116,11 +116,14 @@ class Polytope(ConvexSet):
         return np.all(x @ self.G.T <= self.g + tol, axis=-1)
 
     def contains_rel(self, x: np.ndarray, rel: float = 1e-9) -> np.ndarray | bool:
-        """Gx ≤ g + s‖G_i‖₁ row by row, s the slack in state units of
-        :meth:`ConvexSet.contains_rel` (a scalar slack on g depends on how the rows are
-        scaled)."""
+        """G_i x ≤ g_i + rel·(the polytope's width along row i, max − min of G_i v over its
+        vertices) + four float spacings, row by row: independent of how the rows are scaled
+        and of a thin direction (the widest side's slack let a polytope 10¹² times thinner
+        across one face pass points 8× outside; re-check trial, session 34)."""
         x = np.asarray(x, dtype=float)
-        slack = self._slack(rel) * np.abs(self.G).sum(axis=1)
+        proj = self.vertices() @ self.G.T
+        mag = np.maximum(np.abs(proj).max(axis=0), np.abs(self.g))
+        slack = rel * (proj.max(axis=0) - proj.min(axis=0)) + 4 * np.spacing(mag)
         return np.all(x @ self.G.T <= self.g + slack, axis=-1)
 
     def vertices_q(self) -> np.ndarray:

@@ -98,7 +98,8 @@ def _outside_premises(
     lo, hi = np.asarray(o.D_lower, float), np.asarray(o.D_upper, float)
     if w.shape[1] == lo.size and lo.size:
         # D's own scale: 1e-12 let noise 100× outside a D of ±10⁻¹⁴ "hold" (session 34)
-        tol = 1e-9 * float(np.max(hi - lo)) + 4 * float(np.spacing(np.max(np.abs([lo, hi]))))
+        # per coordinate: the widest side's let a thin coordinate pass (re-check, session 34)
+        tol = 1e-9 * (hi - lo) + 4 * np.spacing(np.maximum(np.abs(lo), np.abs(hi)))
         bad = np.any((w < lo - tol) | (w > hi + tol), axis=1)
         if bad.any():
             k = _first(bad)
