@@ -19,7 +19,11 @@ def _early_interrupt(signum: int, frame: object) -> None:  # pragma: no cover - 
     """Ctrl-C while the command line starts (imports of typer, rich, numpy): one line,
     exit 130, no traceback. :func:`obsdesign.cli._run` restores Python's handler when a
     command body starts, so that cleanup code (temporary files) runs on Ctrl-C."""
-    _sys.stderr.write("obsdesign: interrupted\n")
+    try:  # stderr closed or full: the line is dropped, the code stays 130 (session 34)
+        _sys.stderr.write("obsdesign: interrupted\n")
+        _sys.stderr.flush()
+    except (OSError, ValueError, AttributeError):
+        pass
     _os._exit(130)
 
 

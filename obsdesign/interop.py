@@ -81,6 +81,12 @@ def _exact(x: Any) -> Decimal | None:
             raise InputError(f"cannot write the non-finite number {x} into a spec")
         return x
     if isinstance(x, Fraction):
+        from obsdesign.limits import int_problem
+
+        for part in (x.numerator, x.denominator):
+            why = int_problem(part)  # str() of a 5000-digit int is a ValueError (session 34)
+            if why is not None:
+                raise InputError(f"the exact number's numerator or denominator {why}")
         d, twos, fives = x.denominator, 0, 0
         while d % 2 == 0:
             d, twos = d // 2, twos + 1

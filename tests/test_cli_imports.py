@@ -205,3 +205,24 @@ def test_typer_internals_changed_falls_back_to_typer(monkeypatch: pytest.MonkeyP
     assert r.exit_code == 0 and "[method]" in r.output
     r = CliRunner().invoke(app, ["design", str(SPEC), "--width", "10"])
     assert r.exit_code == 2 and "--width" in r.output
+
+
+def test_the_start_up_ctrl_c_exits_130_with_stderr_closed(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Ctrl-C during start-up with stderr closed or full exited 1: the early handler's error
+    line raised before its exit (re-check trial, session 34). The line is dropped."""
+    import io
+    import sys
+
+    import obsdesign
+
+    def fake_exit(code: int) -> None:
+        raise SystemExit(code)
+
+    monkeypatch.setattr(obsdesign._os, "_exit", fake_exit)
+    closed = io.StringIO()
+    closed.close()
+    for stream in (closed, None):
+        monkeypatch.setattr(sys, "stderr", stream)
+        with pytest.raises(SystemExit) as e:
+            obsdesign._early_interrupt(2, None)
+        assert e.value.code == 130

@@ -773,3 +773,18 @@ def test_bytes_are_refused_not_a_recursion() -> None:
     for v in (b"ab", np.bytes_(b"ab")):
         with pytest.raises(InputError, match="of type bytes"):
             _value(v)
+
+
+def test_a_fraction_beyond_the_digit_limit_is_an_input_error() -> None:
+    """A Fraction whose numerator has more than 4300 digits raised a bare ValueError (Python's
+    int-to-text limit) from spec_from_statespace and a sweep dict grid (re-check trial,
+    session 34): the digit limit names it first."""
+    from obsdesign import sweep as sw
+
+    big = Fraction(10**5000 + 1, 10**5000)
+    with pytest.raises(InputError, match=r"A\[0, 0\]: the exact number's numerator or denom"):
+        spec_text_from_statespace(([[big]], [[0]], [[1]], [[0]], 1))
+    with pytest.raises(InputError, match="sweep: method.lambda: the exact number's numerator"):
+        sw.parse_grid({"method.lambda": [big]})
+    with pytest.raises(InputError, match="about 5000 digits"):
+        spec_text_from_statespace(([[Fraction(1, 3 * 10**5000)]], [[0]], [[1]], [[0]], 1))
