@@ -219,9 +219,15 @@ def _not_normal(name: str) -> str | None:
     normal = unicodedata.normalize("NFKC", name)
     if normal == name:
         return None
+
+    def shown(s: str) -> str:
+        # code points where the two forms look alike (a decomposed é read as 'é' is 'é';
+        # re-check trial, session 34)
+        return repr(s) if s.isascii() else f"{s!r} ({' '.join(f'U+{ord(c):04X}' for c in s)})"
+
     return (
-        f"{name!r} is read as {normal!r} in expressions (Python reads identifiers in NFKC "
-        f"form): write it as {normal!r}"
+        f"{shown(name)} is read as {shown(normal)} in expressions (Python reads identifiers in "
+        f"NFKC form): write it as {normal!r}"
     )
 
 
