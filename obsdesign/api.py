@@ -1331,6 +1331,10 @@ def check(
     ``on_row(row)`` is called as each row arrives."""
     if isinstance(paths, (str, Path)):
         paths = [paths]
+    if any(isinstance(p, str) and p == "" for p in paths):
+        # pathlib reads '' as '.': the working folder was checked, as the CLI did until it
+        # refused '' (re-check trial, session 34)
+        raise InputError("check: an empty path (an unset variable?): give a file or folder")
     files = spec_files(paths)
     if not files:
         raise InputError(f"no spec files (*.toml) in {', '.join(map(str, paths))}")

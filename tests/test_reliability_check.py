@@ -577,3 +577,13 @@ def test_a_time_budget_started_inside_an_import_still_stops(
 
     assert outer_mod_34.stopped is not None and outer_mod_34.stopped < 2
     sys.modules.pop("outer_mod_34", None)
+
+
+def test_the_api_check_refuses_an_empty_path() -> None:
+    """``check([''])`` checked the working folder (pathlib reads '' as '.'), which the CLI
+    refuses (re-check trial, session 34)."""
+    from obsdesign.errors import InputError
+
+    for paths in ("", [""], ["specs", ""]):
+        with pytest.raises(InputError, match="check: an empty path"):
+            api.check(paths)
