@@ -134,6 +134,10 @@ def test_literal_beyond_the_exponent_limit_is_refused(text: str, msg: str) -> No
 def test_literal_at_the_exponent_limit_is_kept() -> None:
     ex = parse_expr("1e-1000*t + 1e300 + x1e5", ["t", "x1e5"])
     assert float(ex(t=1.0, x1e5=0.0)) == 1e300
+    # a name ending in digits and e after a non-ASCII letter is a name, not the constant
+    # 1e9999 (re-check trial, session 34)
+    ex = parse_expr("2*θ1e9999", ["θ1e9999"])
+    assert float(ex(θ1e9999=1.5)) == 3.0
 
 
 @settings(max_examples=60, deadline=None)

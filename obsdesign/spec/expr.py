@@ -234,7 +234,7 @@ def _too_deep(depth: int) -> str:
 #: spec's numbers are: the exact value of a literal (the interval enclosures and the sympy
 #: form take decimal literals exactly) is otherwise a power of ten with that many digits
 #: (u = "1e-99999999*sin(t)" hung the input-range check)
-_EXPONENT = re.compile(r"(?<![A-Za-z_\d.])(?:\d+\.?\d*|\.\d+)[eE]([+-]?\d+)")
+_EXPONENT = re.compile(r"(?<![\w.])(?:\d+\.?\d*|\.\d+)[eE]([+-]?\d+)")
 
 _TOKEN = re.compile(
     r"\s*(?:(\d+\.?\d*(?:[eE][+-]?\d+)?|\.\d+(?:[eE][+-]?\d+)?)|([A-Za-z_]\w*)|(\*\*|[-+*/%^(),]))"
