@@ -250,11 +250,24 @@ def _real(M: Any, name: str) -> np.ndarray:
         raise InputError(
             f"{name} is not a matrix of numbers: its rows are not all of one length"
         ) from None
-    if arr.dtype.kind == "f" and isinstance(M, (list, tuple)):
-        # a list mixing floats with an integer beyond 2⁵³ became floats: the integer rounded
+    probe = arr
+    if arr.dtype.kind in "iuf" and isinstance(M, (list, tuple)):
         probe = np.array(M, dtype=object)
-        if probe.shape == arr.shape and any(_big_int(x) for x in probe.flat):
-            arr = probe
+        if probe.shape != arr.shape:
+            probe = arr
+    # a boolean is not a number, as in a spec ("a boolean"): numpy made True 1 in a plain
+    # list, and 1.0 beside a float, but refused it beside a Fraction (re-check 34 §9)
+    if arr.dtype.kind == "b" or (
+        probe.dtype == object and any(isinstance(x, (bool, np.bool_)) for x in probe.flat)
+    ):
+        where = next(
+            (list(i) for i, x in np.ndenumerate(probe) if isinstance(x, (bool, np.bool_))),
+            [0] * arr.ndim,
+        )
+        raise InputError(f"{name}{where} is a boolean, not a number")
+    if arr.dtype.kind == "f" and probe.dtype == object and any(_big_int(x) for x in probe.flat):
+        # a list mixing floats with an integer beyond 2⁵³ became floats: the integer rounded
+        arr = probe
     if arr.dtype.kind == "c" or (
         arr.dtype == object and any(isinstance(x, (complex, np.complexfloating)) for x in arr.flat)
     ):

@@ -570,9 +570,10 @@ def test_exact_entries_outside_the_float_range_or_not_numbers_are_refused() -> N
     for big in (Decimal("1e400"), Decimal("-1e-400")):
         with pytest.raises(InputError, match="outside the float range"):
             _real(np.array([[big, 1]], dtype=object), "A")
-    for bad in (True, "x"):
-        with pytest.raises(InputError, match="which is not a number"):
-            _real(np.array([[Decimal("0.5"), bad]], dtype=object), "A")
+    with pytest.raises(InputError, match="which is not a number"):
+        _real(np.array([[Decimal("0.5"), "x"]], dtype=object), "A")
+    with pytest.raises(InputError, match=r"A\[0, 1\] is a boolean, not a number"):
+        _real(np.array([[Decimal("0.5"), True]], dtype=object), "A")
     with pytest.raises(InputError, match="subnormal|float range"):
         _real(np.array([[5e-324, 1.0]], dtype=object), "A")
 
@@ -788,3 +789,25 @@ def test_a_fraction_beyond_the_digit_limit_is_an_input_error() -> None:
         sw.parse_grid({"method.lambda": [big]})
     with pytest.raises(InputError, match="about 5000 digits"):
         spec_text_from_statespace(([[Fraction(1, 3 * 10**5000)]], [[0]], [[1]], [[0]], 1))
+
+
+@pytest.mark.parametrize(
+    "M",
+    [
+        [[1, True]],
+        [[0.5, True]],
+        [[0.5, np.bool_(True)]],
+        [[Fraction(1, 2), True]],
+        np.array([[1.0, 0.0], [0.0, 1.0]]) > 0.5,
+        np.array([[1, False]], dtype=object),
+    ],
+    ids=["int-list", "float-list", "numpy-bool-in-list", "fraction-list", "bool-array", "object"],
+)
+def test_a_boolean_entry_is_refused_wherever_it_sits(M: object) -> None:
+    """Re-check 34 §9: booleans were taken as 1 / 0 in a plain list or beside a float and
+    refused beside a Fraction; a spec refuses a boolean where a number belongs, and so does
+    every matrix the interop layer reads."""
+    from obsdesign.interop import _real
+
+    with pytest.raises(InputError, match=r"A\[0, \d\] is a boolean, not a number"):
+        _real(M, "A")
