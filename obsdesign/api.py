@@ -868,7 +868,7 @@ def _unfit_report(e: Exception, where: str, method: str, params: Parameters) -> 
         )
         what = f"has parameters of the wrong shape or kind ({type(e).__name__}: {e}{seen})"
     return InputError(
-        f"{where}: {what} for a {method} simulation of this spec (obsdesign verify says which "
+        f"{where}: {what} for the {method} simulation of this spec (obsdesign verify says which "
         "claim the report breaks)"
     )
 

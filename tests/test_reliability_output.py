@@ -407,7 +407,8 @@ def test_simulate_names_the_report_parameter_of_the_wrong_shape(
     if "has shape" in err:  # a gain the simulation reads with its shape (Parameters.shaped)
         _refused(res, "bad.json", f"parameters.{key} has shape 5×3, expected")
     else:
-        _refused(res, "bad.json", "wrong shape or kind", f"{key} (5×3 array)")
+        # "for the impulsive simulation", not "for a impulsive simulation" (session 35)
+        _refused(res, "bad.json", "wrong shape or kind", f"{key} (5×3 array)", "for the ")
 
 
 def test_simulate_says_when_a_report_does_not_hold(spec: Path, tmp_path: Path) -> None:
