@@ -14,7 +14,10 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import logging
 
 _requested = False
 #: the signal recorded (SIGINT 2, SIGTERM 15, SIGHUP 1 or SIGQUIT 3), 0 when none
@@ -74,8 +77,28 @@ def quiet_unraisable(hook: Callable[[Any], object]) -> Callable[[Any], None]:
 
 
 def install_quiet_unraisable() -> None:
-    """Install :func:`quiet_unraisable` over the current ``sys.unraisablehook`` (once)."""
+    """Install :func:`quiet_unraisable` over the current ``sys.unraisablehook`` (once), and
+    :func:`quiet_after_interrupt` on the loggers of :data:`QUIET_LOGGERS` (once each)."""
     if not getattr(sys.unraisablehook, "_obsdesign_quiet", False):
         q = quiet_unraisable(sys.unraisablehook)
         q._obsdesign_quiet = True  # type: ignore[attr-defined]
         sys.unraisablehook = q
+    import logging  # here: `obsdesign --help` does not import it
+
+    for name in QUIET_LOGGERS:
+        log = logging.getLogger(name)
+        if quiet_after_interrupt not in log.filters:
+            log.addFilter(quiet_after_interrupt)
+
+
+#: loggers that report an interrupt as something else: cvxpy catches what a signal raises
+#: inside a solver's import (an extension module's init turns the KeyboardInterrupt into a
+#: SystemError) and logs "Encountered unexpected exception importing solver HIGHS" over
+#: several lines before the command's one-line "interrupted" (re-check trial, session 34)
+QUIET_LOGGERS = ("__cvxpy__",)
+
+
+def quiet_after_interrupt(record: logging.LogRecord) -> bool:
+    """A logging filter: drop every record once an interrupt is recorded (:func:`handler`);
+    the command is ending with 128 + the signal and says so itself."""
+    return not _requested

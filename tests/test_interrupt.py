@@ -191,3 +191,26 @@ def test_an_interrupted_command_ends_by_os_exit(monkeypatch: pytest.MonkeyPatch,
     with pytest.raises(SystemExit) as e:
         cli.main()
     assert e.value.code == 2
+
+
+def test_cvxpy_logs_nothing_once_an_interrupt_is_recorded(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Re-check 34 §3: a signal inside cvxpy's solver import made cvxpy log "Encountered
+    unexpected exception importing solver HIGHS" over several lines before the one-line
+    "interrupted"; before any interrupt its warnings still pass."""
+    import logging
+
+    log = logging.getLogger("__cvxpy__")
+    monkeypatch.setattr(log, "filters", [])
+    monkeypatch.setattr(log, "handlers", [logging.StreamHandler(sys.stderr)])
+    monkeypatch.setattr(log, "propagate", False)
+    monkeypatch.setattr(sys, "unraisablehook", sys.unraisablehook)
+    monkeypatch.setattr(interrupt, "_requested", False)
+    interrupt.install_quiet_unraisable()
+    interrupt.install_quiet_unraisable()
+    assert log.filters == [interrupt.quiet_after_interrupt]  # once
+    log.warning("before")
+    monkeypatch.setattr(interrupt, "_requested", True)
+    log.warning("Encountered unexpected exception importing solver HIGHS:\nSystemError()")
+    assert capsys.readouterr().err == "before\n"
