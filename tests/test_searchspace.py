@@ -2120,6 +2120,40 @@ def test_corners_are_tried_only_where_floats_overflowed(monkeypatch) -> None:  #
     assert calls == []
 
 
+@pytest.mark.parametrize(
+    ("f1", "u1", "L_f"),
+    [
+        ("x2*step(cosh(1e39))", "0.5", 2),  # step read as 0: L_f = 1 certified
+        ("x2*sign(sinh(1e39))", "0.5", 2),
+        ("0", "0.5*sign(-sinh(1e39)) - 0.75", None),  # u = −1.25 ∉ U, sign read as 0
+        ("0", "max(0.5, cosh(1e39))", None),  # max(0.5, NaN) kept 0.5
+        ("0", "sat(-cosh(1e39)) + 0.5*step(cosh(1e39)) - 0.75", None),  # u = −1.25
+    ],
+)
+def test_a_function_beyond_the_float_range_proves_nothing_from_nan(
+    f1: str, u1: str, L_f: int | None
+) -> None:
+    """sinh / cosh of an argument beyond 2¹²⁸ came back NaN from the interval kernel
+    (python-flint's ball overflows), and max(a, NaN) kept a while step / sign read every
+    comparison with NaN as false: L_f = 1 was certified for f1 = x2 + x2·step(cosh(1e39))
+    (true 2), and u = max(0.5, cosh(1e39)) in U = [−1, 1] (false certificates, search-space
+    trial, session 35). A NaN end point now proves nothing, and arb's NaN ball is (−∞, ∞)."""
+    text = UNDEFINED.replace("F1", f1).replace("U1", u1)
+    sp = api.load_spec_text(text, "nan.toml")
+    try:
+        rep = api.design(sp)
+    except (InfeasibleError, SpecError) as e:
+        assert "no finite" in e.message or "not defined" in e.message, e.message
+        return
+    certified = {c.id for c in rep.claims if c.status == ClaimStatus.CERTIFIED}
+    if L_f is None:
+        assert "input-range" not in certified
+        assert rep.exit_code() != 0
+    else:
+        assert "L_f-bound" in certified  # true and provable once step reads 1
+        assert rep.parameters.float("L_f") >= L_f
+
+
 UNDEFINED = """[system]
 time = "continuous"
 states = ["x1", "x2"]

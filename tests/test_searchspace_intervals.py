@@ -1126,3 +1126,21 @@ def test_a_product_of_two_different_literals_is_not_a_square() -> None:
     with pytest.raises(ArithmeticError):
         _enc(f"sqrt({text})", {"x": (-1.0, 1.0)})
     assert _enc("(x + 0.1)*(x + 0.1)", {"x": (-1.0, 1.0)}).v.lo == 0.0  # one factor: X²
+
+
+def test_a_nan_end_point_is_refused_and_overflowing_sinh_cosh_are_unbounded() -> None:
+    """Session 35: python-flint's ball of cosh(1e39) is NaN; the kernel took it as an end
+    point, which max dropped and step / sign read as 0 (false L_f, u-range certificates).
+    An interval with a NaN end point is refused (proves nothing); arb's NaN is (−∞, ∞)."""
+    for lo, hi in ((math.nan, 1.0), (0.0, math.nan), (math.nan, math.nan)):
+        with pytest.raises(ArithmeticError, match="NaN"):
+            I(lo, hi)
+    big = I(1e39, 1e39)
+    for fn in ("sinh", "cosh"):
+        d = IV.d_fn(Dual(big, (ONE,)), fn)
+        assert d.v.hi == math.inf and d.v.lo <= 1.7e308  # an enclosure, not NaN
+        assert d_step(d).v.hi == 1.0  # not [0, 0]
+        assert d_max(Dual(I(0.5, 0.5), (ZERO,)), d).v.hi == math.inf
+    assert IV.cosh(I(-1e39, -1e39)).hi == math.inf
+    s = IV._monotone("sinh", I(-1e39, -1e39))
+    assert s.lo == -math.inf  # sinh(−1e39) is hugely negative: never a finite lower end

@@ -129,6 +129,14 @@ class I:  # noqa: E742 - I for "interval"
     lo: float
     hi: float
 
+    def __post_init__(self) -> None:
+        """A NaN end point proves nothing: refused (ArithmeticError, as an undefined part).
+        sinh / cosh beyond 2¹²⁸ came back NaN, then ``max(a, nan)`` kept ``a`` and step /
+        sign read every comparison with NaN as false, so f = x2·step(cosh(1e39)) had a
+        certified L_f of 1 (search-space trial, session 35)."""
+        if self.lo != self.lo or self.hi != self.hi:
+            raise ArithmeticError("an interval end point is NaN (not a number)")
+
     @staticmethod
     def point(x: float) -> I:
         return I(x, x)
@@ -280,7 +288,9 @@ def _arb_point(fn: str, x: float) -> tuple[float, float]:
     if not math.isfinite(x):
         return (-INF, INF)
     b = getattr(arb(x), fn)()
-    return _down(float(b.lower())), _up(float(b.upper()))
+    lo, hi = float(b.lower()), float(b.upper())
+    # arb's ball is NaN where its exponent outgrows it (cosh of 1e39): no bound at all
+    return (-INF if lo != lo else _down(lo)), (INF if hi != hi else _up(hi))
 
 
 def _monotone(fn: str, x: I) -> I:
