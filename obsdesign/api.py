@@ -1162,29 +1162,62 @@ def _time_budget(seconds: float | None) -> Any:
         return
 
     already = _initializing()  # the caller's own imports (a check run at module level)
+    leaving = [False]
+    _install_quiet_timeout()
 
     def on_alarm(signum: int, frame: Any) -> None:
-        if not _importing(already):  # else the repeat RETIMEOUT_S later stops it
+        # not once the block is being left, nor inside an import (the repeat RETIMEOUT_S
+        # later stops it)
+        if not leaving[0] and not _importing(already):
             raise SpecTimeout
 
-    old = signal.signal(signal.SIGALRM, on_alarm)
-    # the alarm repeats every RETIMEOUT_S after the deadline until the block is left: an
-    # exception raised while Python runs a __del__ or a weakref callback is printed and
-    # dropped ("Exception ignored in ..."), and a sweep point past its 1 s budget then ran
-    # to its end (exit 1 instead of 3; a CI run, session 26)
-    signal.setitimer(signal.ITIMER_REAL, float(seconds), RETIMEOUT_S)
+    old = signal.getsignal(signal.SIGALRM)
+    # the timer starts inside the try, and the finally disarms it first: an alarm that landed
+    # between starting the timer and the try (--timeout 1e-7), or in the finally before the
+    # timer was cleared, left it repeating with this handler installed — "Alarm clock", exit
+    # 142, after check had written its rows, and SpecTimeout tracebacks in an API caller's
+    # own code later (batch trial, session 35)
     try:
+        signal.signal(signal.SIGALRM, on_alarm)
+        # the alarm repeats every RETIMEOUT_S after the deadline until the block is left: an
+        # exception raised while Python runs a __del__ or a weakref callback is printed and
+        # dropped ("Exception ignored in ..."), and a sweep point past its 1 s budget then
+        # ran to its end (exit 1 instead of 3; a CI run, session 26)
+        signal.setitimer(signal.ITIMER_REAL, float(seconds), RETIMEOUT_S)
         yield
     finally:
+        leaving[0] = True
         signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, old)
+        signal.signal(signal.SIGALRM, old if old is not None else signal.SIG_DFL)
+
+
+def _install_quiet_timeout() -> None:
+    """Drop a :class:`SpecTimeout` that Python cannot propagate (raised inside a ``__del__``
+    or a weakref callback: "Exception ignored in …" with a traceback, on a Dask worker's
+    stderr in the batch trial, session 35); the budget's repeat stops the work again. Once
+    per process, over whatever ``sys.unraisablehook`` is then."""
+    hook = sys.unraisablehook
+    if getattr(hook, "_obsdesign_quiet_timeout", False):
+        return
+
+    def quiet(args: Any) -> None:
+        if not isinstance(args.exc_value, SpecTimeout):
+            hook(args)
+
+    quiet._obsdesign_quiet_timeout = True  # type: ignore[attr-defined]
+    sys.unraisablehook = quiet
 
 
 def _initializing() -> set[str]:
     """The modules whose code is running (being imported) now."""
+    # a copy taken by C code alone: list(sys.modules.items()) makes a tuple per module, whose
+    # allocation can run a collection, a finalizer and a thread switch; an import in the
+    # worker then changed the dict under the walk, and the RuntimeError killed the budget's
+    # timer thread, so the spec ran unbounded (check --workers, batch trial, session 35)
+    modules = sys.modules.copy()
     return {
         name
-        for name, m in list(sys.modules.items())
+        for name, m in modules.items()
         if getattr(getattr(m, "__spec__", None), "_initializing", False)
     }
 
@@ -1219,6 +1252,7 @@ def _thread_budget(seconds: float) -> Any:
     SpecTimeout`` takes it, as the deadline had passed)."""
     tid = threading.get_ident()
     already = _initializing()
+    _install_quiet_timeout()
     lock = threading.Lock()
     armed = [True]
     timers: list[threading.Timer] = []
@@ -1232,7 +1266,11 @@ def _thread_budget(seconds: float) -> Any:
     def fire() -> None:
         with lock:
             if armed[0]:
-                if not _importing(already):
+                try:
+                    busy = _importing(already)
+                except Exception:  # noqa: BLE001 - never lose the timer: try again shortly
+                    busy = True
+                if not busy:
                     _async_raise(tid, SpecTimeout)
                 start(RETIMEOUT_S)
 

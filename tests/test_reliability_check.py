@@ -587,3 +587,110 @@ def test_the_api_check_refuses_an_empty_path() -> None:
     for paths in ("", [""], ["specs", ""]):
         with pytest.raises(InputError, match="check: an empty path"):
             api.check(paths)
+
+
+def _real_itimer_and_alarm_restored(before: Any) -> None:
+    import signal
+
+    assert signal.getsignal(signal.SIGALRM) is before
+    assert signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0)
+
+
+def test_a_stop_that_lands_as_the_timer_starts_leaves_no_timer(monkeypatch) -> None:
+    """``check --timeout 1e-7``: the first alarm landed between starting the timer and the
+    ``try``, so the ``finally`` never ran — the timer kept repeating with the budget's handler,
+    and the process died "Alarm clock" (exit 142) after check had written its rows (batch
+    trial, session 35). Here the alarm's handler runs right after the timer is armed."""
+    import signal
+
+    before = signal.getsignal(signal.SIGALRM)
+    real = signal.setitimer
+
+    def arm_then_fire(which: int, seconds: float, interval: float = 0.0) -> Any:
+        out = real(which, seconds, interval)
+        if seconds > 0:
+            signal.getsignal(signal.SIGALRM)(signal.SIGALRM, None)
+        return out
+
+    monkeypatch.setattr(signal, "setitimer", arm_then_fire)
+    with pytest.raises(api.SpecTimeout):
+        with api._time_budget(30):
+            pass
+    monkeypatch.setattr(signal, "setitimer", real)
+    _real_itimer_and_alarm_restored(before)
+
+
+def test_a_stop_that_lands_as_the_block_is_left_is_ignored(monkeypatch) -> None:
+    """The other end of the same race: an alarm landing in the ``finally`` before the timer
+    was cleared raised there and skipped the cleanup (batch trial, session 35). A stop that
+    comes once the block is being left is ignored: the block's work is done."""
+    import signal
+
+    before = signal.getsignal(signal.SIGALRM)
+    real = signal.setitimer
+
+    def fire_then_disarm(which: int, seconds: float, interval: float = 0.0) -> Any:
+        if seconds == 0:
+            signal.getsignal(signal.SIGALRM)(signal.SIGALRM, None)
+        return real(which, seconds, interval)
+
+    monkeypatch.setattr(signal, "setitimer", fire_then_disarm)
+    with api._time_budget(30):
+        done = True
+    monkeypatch.setattr(signal, "setitimer", real)
+    assert done
+    _real_itimer_and_alarm_restored(before)
+
+
+def test_many_tiny_budgets_leave_no_timer_behind() -> None:
+    """The race itself, not simulated: budgets of 10⁻⁷ s fire at every point of the way in
+    and out; none may leave the timer or its handler behind (batch trial, session 35)."""
+    import signal
+
+    before = signal.getsignal(signal.SIGALRM)
+    for _ in range(300):
+        try:
+            with api._time_budget(1e-7):
+                sum(range(50))
+        except api.SpecTimeout:
+            pass
+    _real_itimer_and_alarm_restored(before)
+
+
+def test_the_thread_budget_timer_survives_a_failed_import_probe(monkeypatch) -> None:
+    """A Dask worker's budget timer died of "dictionary changed size during iteration" while
+    it looked for running imports, and the spec then ran unbounded (batch trial, session 35):
+    a failed probe schedules no stop now, and the timer tries again."""
+    _FakeTimer.made = []
+    calls: list[Any] = []
+    monkeypatch.setattr(api.threading, "Timer", _FakeTimer)
+    monkeypatch.setattr(api, "_async_raise", lambda tid, exc: calls.append(exc))
+
+    def broken(already: Any) -> bool:
+        raise RuntimeError("dictionary changed size during iteration")
+
+    with api._thread_budget(5.0):
+        monkeypatch.setattr(api, "_importing", broken)
+        _FakeTimer.made[0].fn()  # does not raise
+        assert calls == [] and [t.after for t in _FakeTimer.made] == [5.0, api.RETIMEOUT_S]
+        monkeypatch.setattr(api, "_importing", lambda already: False)
+        _FakeTimer.made[-1].fn()  # the retry stops the work
+        assert calls == [api.SpecTimeout]
+
+
+def test_a_stop_python_cannot_propagate_is_not_printed(monkeypatch) -> None:
+    """A SpecTimeout raised inside a ``__del__`` printed "Exception ignored in …" with a
+    traceback on a Dask worker's stderr (batch trial, session 35); the budget's repeat stops
+    the work again, so the hook drops it and passes anything else on."""
+    import sys
+    from types import SimpleNamespace
+
+    seen: list[Any] = []
+    monkeypatch.setattr(sys, "unraisablehook", lambda a: seen.append(a.exc_value))
+    api._install_quiet_timeout()
+    api._install_quiet_timeout()
+    sys.unraisablehook(SimpleNamespace(exc_value=api.SpecTimeout()))
+    err = ValueError("x")
+    sys.unraisablehook(SimpleNamespace(exc_value=err))
+    assert seen == [err]
+    assert sys.unraisablehook._obsdesign_quiet_timeout is True
