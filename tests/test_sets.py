@@ -154,3 +154,89 @@ def test_contains_rel_reads_a_thin_direction_at_its_own_scale() -> None:
         assert bool(np.asarray(S.contains_rel(np.array([[0.0, 8e-12]]))).reshape(-1)[0]) is False
         assert bool(np.asarray(S.contains_rel(np.array([[0.0, 1e-12]]))).reshape(-1)[0]) is True
         assert bool(np.asarray(S.contains_rel(np.array([[0.5, -1e-12]]))).reshape(-1)[0]) is True
+
+
+def _form(E: np.ndarray, c: np.ndarray, x: np.ndarray) -> object:
+    from fractions import Fraction
+
+    d = [Fraction(float(v)) - Fraction(int(ci.p), int(ci.q)) for v, ci in zip(x, c, strict=True)]
+    return sum(
+        d[i] * Fraction(int(E[i, j].p), int(E[i, j].q)) * d[j]
+        for i in range(len(d))
+        for j in range(len(d))
+    )
+
+
+def test_ellipsoid_contains_rel_reads_an_ill_conditioned_form_exactly() -> None:
+    """E with eigenvalues 10⁸ and 1.5·10⁻⁸: the float form of x̂₀ = (0.5, −0.5) about
+    c = (−8191.5, 8191.5) is 1.0 while the exact one is 1.986, and simulate said "premises
+    hold" (batch trial, session 35)."""
+    from fractions import Fraction
+
+    E = qmat(
+        [
+            [fmpq(500000000000000037, 10**10), fmpq(499999999999999889, 10**10)],
+            [fmpq(499999999999999889, 10**10), fmpq(500000000000000037, 10**10)],
+        ]
+    )
+    c = qvec([fmpq(-16383, 2), fmpq(16383, 2)])
+    ell = Ellipsoid(E, c)
+    x = np.array([0.5, -0.5])
+    assert _form(E, c, x) == Fraction(19398656, 9765625)
+    assert ell.contains_rel(x) is False
+    assert ell.contains_rel(np.array([[0.5, -0.5], [-8191.5, 8191.5]])).tolist() == [False, True]
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    big=st.integers(0, 9),
+    small=st.integers(0, 9),
+    angle=st.integers(1, 89),
+    u=st.floats(-1.5, 1.5),
+    v=st.floats(-1.5, 1.5),
+    shift=st.integers(0, 6),
+)
+def test_ellipsoid_contains_rel_agrees_with_the_exact_form(
+    big: int, small: int, angle: int, u: float, v: float, shift: int
+) -> None:
+    """Random rotated ellipsoids with eigenvalues 10^big and 10^−small, centred 10^shift away
+    from 0, and points at u, v semi-axes along the axes: contains_rel equals the exact
+    (x − c)ᵀE(x − c) ≤ 1 + 10⁻⁹ of the float point, whatever the conditioning."""
+    import math
+    from fractions import Fraction
+
+    t = math.radians(angle)
+    R = np.array([[math.cos(t), -math.sin(t)], [math.sin(t), math.cos(t)]])
+    lam = np.array([10.0**big, 10.0**-small])
+    Ef = R @ np.diag(lam) @ R.T
+    Ef = (Ef + Ef.T) / 2
+    E = qmat([[Fraction(float(Ef[i, j])) for j in range(2)] for i in range(2)])
+    if not (E[0, 0] > 0 and E[0, 0] * E[1, 1] - E[0, 1] ** 2 > 0):
+        return  # rounding made it indefinite: not an ellipsoid
+    c = qvec([10**shift, -(10**shift)])
+    cf = np.array([10.0**shift, -(10.0**shift)])
+    x = cf + R @ (np.array([u, v]) / np.sqrt(lam))
+    if not np.isfinite(x).all():
+        return
+    ell = Ellipsoid(E, c)
+    want = _form(E, c, x) <= 1 + Fraction(1e-9)
+    assert ell.contains_rel(x) is want
+
+
+def test_a_thin_sheared_polytope_has_vertices_where_float_cdd_fails() -> None:
+    """Float cdd finds a "numerical inconsistency" in {|x1 + 10⁻⁹x2| ≤ 10⁻⁹, |x2| ≤ 10⁶}:
+    simulate's membership flag was exit 3 for this valid X̂ (batch trial, session 35). The
+    exact vertices, in floats, stand in; membership reads the thin direction."""
+    from obsdesign.sets.polytope import vertices_float
+
+    e = fmpq(1, 10**9)
+    G = qmat([[1, e], [-1, -e], [0, 1], [0, -1]])
+    g = qvec([e, e, 10**6, 10**6])
+    P = Polytope(G, g)
+    with pytest.raises(RuntimeError):
+        vertices_float(P.G, P.g)
+    V = P.vertices()
+    assert V.shape == (4, 2)
+    want = [(-1e-3 - 1e-9, 1e6), (-1e-3 + 1e-9, 1e6), (1e-3 - 1e-9, -1e6), (1e-3 + 1e-9, -1e6)]
+    assert np.allclose(sorted(map(tuple, V)), want, rtol=1e-12, atol=0)
+    assert P.contains_rel(np.array([[1.2e-9, 0.0], [0.5e-9, 0.0]])).tolist() == [False, True]

@@ -132,8 +132,15 @@ class Polytope(ConvexSet):
         return vertices_exact(G, g)[0]
 
     def vertices(self) -> np.ndarray:
-        """Float vertices (float cdd)."""
-        return vertices_float(self.G, self.g)[0]
+        """Float vertices (float cdd); the exact ones in floats where float cdd finds a
+        "numerical inconsistency" (a thin, sheared polytope: simulate's membership flag was
+        exit 3 for a valid X̂ before session 35)."""
+        try:
+            return vertices_float(self.G, self.g)[0]
+        except RuntimeError:
+            if not po.HAVE_GMP:
+                raise
+            return np.asarray(to_float(self.vertices_q()), dtype=float).reshape(-1, self.dim)
 
     def bounding_box(self) -> tuple[np.ndarray, np.ndarray]:
         v = self.vertices()

@@ -118,17 +118,53 @@ def lambda_min_lower(P: np.ndarray) -> fmpq:
 
 
 def gen_eig_upper(A: np.ndarray, B: np.ndarray) -> fmpq:
-    """A rational κ with A ⪯ κ B (B ≻ 0), proved by κB − A ⪰ 0 exactly: κ ≥ λ_max(B⁻¹A)."""
+    """A rational κ with A ⪯ κ B (B ≻ 0), proved by κB − A ⪰ 0 exactly: κ ≥ λ_max(B⁻¹A).
+
+    The guide is scipy's generalized ``eigh`` in floats; where B's float form is not positive
+    definite (an ellipsoid X̂ with eigenvalues 10⁸ and 10⁻⁸: exit 3 "LinAlgError" before
+    session 35), the eigenvalues of the exact B⁻¹A in floats, and last ‖A‖_∞·‖B⁻¹‖_∞ ≥
+    λ_max(A)·λ_max(B⁻¹) (for A ⪰ 0). Each candidate is proved exactly; none proved is
+    :class:`~obsdesign.errors.InconclusiveError` (exit 4)."""
     import scipy.linalg as sl
 
-    Af, Bf = np.asarray(A, dtype=float), np.asarray(B, dtype=float)
-    k = float(sl.eigh(Af, Bf, eigvals_only=True).max())
-    k = max(k, 0.0)
-    for f in (1e-9, 1e-6, 1e-3, 1e-1, 1.0):
-        kap = dyadic(k * (1 + f) + 1e-300, 30)
-        if check_psd(symmetrize(B * kap - A)):
-            return kap
-    raise ArithmeticError("could not bound the generalized eigenvalue")
+    from obsdesign.errors import InconclusiveError
+
+    def guides() -> Any:
+        Af, Bf = np.asarray(A, dtype=float), np.asarray(B, dtype=float)
+        try:
+            with np.errstate(all="ignore"):
+                yield float(sl.eigh(Af, Bf, eigvals_only=True).max())
+        except (np.linalg.LinAlgError, ValueError):
+            pass
+        try:
+            Binv = qinv(B)
+        except (ZeroDivisionError, ValueError, np.linalg.LinAlgError):
+            return
+        M = np.asarray(Binv @ A, dtype=object)
+        try:
+            with np.errstate(all="ignore"):
+                yield float(np.max(np.linalg.eigvals(np.asarray(M, dtype=float)).real))
+        except (np.linalg.LinAlgError, ValueError, OverflowError):
+            pass
+        na = max(sum((abs(Q(v)) for v in row), fmpq(0)) for row in A)
+        nb = max(sum((abs(Q(v)) for v in row), fmpq(0)) for row in Binv)
+        yield na * nb
+
+    for k in guides():
+        if isinstance(k, fmpq):
+            cands = [k]
+        elif not np.isfinite(k):
+            continue
+        else:
+            k = max(k, 0.0)
+            cands = [dyadic(k * (1 + f) + 1e-300, 30) for f in (1e-9, 1e-6, 1e-3, 1e-1, 1.0)]
+        for kap in cands:
+            if check_psd(symmetrize(B * kap - A)):
+                return kap
+    raise InconclusiveError(
+        "could not bound the generalized eigenvalue λ_max(E⁻¹P) of X̂'s shape E (κ with "
+        "P ⪯ κE): E is too ill-conditioned for the float guide; rescale the ellipsoid"
+    )
 
 
 # -- sets -----------------------------------------------------------------------------------
