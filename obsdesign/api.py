@@ -1450,8 +1450,8 @@ def sweep(
     """Design and verify ``spec`` at every point of ``grid`` (``["method.lambda=0.9:0.99:10"]``
     or ``{"method.lambda": [0.9, 0.95]}``): a pandas DataFrame with one row per point (a list
     of dicts without pandas). ``client`` (a ``dask.distributed.Client``) runs the points on
-    Dask; ``kwargs``: ``simulate``, ``options``, ``workers``, ``scheduler`` (see
-    :func:`obsdesign.sweep.sweep`)."""
+    Dask; ``kwargs``: ``simulate``, ``options``, ``workers``, ``scheduler``, ``timeout``
+    (seconds per point; see :func:`obsdesign.sweep.sweep`)."""
     from obsdesign.sweep import sweep as _sweep
 
     return _sweep(spec, grid, client, **kwargs)

@@ -768,11 +768,14 @@ def sweep(
     options: dict[str, str] | None = None,
     workers: int | None = None,
     scheduler: str | None = None,
+    timeout: float | None = None,
 ) -> Any:
     """Sweep ``spec`` (a path or a Spec) over ``grid`` (``["method.lambda=0.9:0.99:10"]`` or
     ``{"method.lambda": [0.9, 0.95]}``): a pandas DataFrame with one row per point (a list of
     dicts without pandas). ``client`` (a ``dask.distributed.Client``), ``workers`` (a
-    LocalCluster) or ``scheduler`` run the points on Dask; the rows are the same."""
+    LocalCluster) or ``scheduler`` run the points on Dask; the rows are the same.
+    ``timeout``: seconds per point (None or 0: no limit), past which the point's row is exit
+    3, as ``sweep --timeout`` (the API had no budget: a TypeError; batch trial, session 35)."""
     rows = sweep_rows(
         spec,
         grid,
@@ -781,6 +784,7 @@ def sweep(
         client=client,
         workers=workers,
         scheduler=scheduler,
+        timeout=timeout,
     )
     return to_frame(rows)
 
