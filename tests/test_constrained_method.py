@@ -1128,3 +1128,31 @@ def test_simulate_names_the_observer_its_metrics_and_csv_are_of() -> None:
     assert api.simulate(spec).info["observer"] == "modified θ_m=10"
     r = CliRunner().invoke(app, ["simulate", str(spec)])
     assert r.exit_code == 0 and "simulation metrics (modified θ_m=10)" in r.stdout, r.stdout
+
+
+def test_the_noise_premise_reads_each_coordinate_of_d_at_its_own_scale() -> None:
+    """D = [−1, 1] × [−10⁻¹², 10⁻¹²]: noise 8·10⁻¹² is 8× outside the thin coordinate, and the
+    widest side's tolerance (2·10⁻⁹) passed it as "premises hold" (mutation review 35, T7). A
+    zero-width coordinate at 10⁸ still takes a sample one float spacing off as on it (the
+    spacing allowance, T12)."""
+    import types
+
+    from obsdesign.certify.exact import qvec
+    from obsdesign.methods.constrained.sim import _outside_premises
+    from obsdesign.sets import Box
+
+    K = 3
+    o = types.SimpleNamespace(
+        D_lower=np.array([-1.0, -1e-12]),
+        D_upper=np.array([1.0, 1e-12]),
+        X=Box(qvec([-10]), qvec([10])),
+        model=None,
+        U_lower=np.array([]),
+    )
+    x, u, d = np.zeros((K, 1)), np.zeros((K, 0)), np.zeros((K, 1))
+    out = _outside_premises(o, x, u, d, np.full((K, 1), 8e-12))
+    assert out and out[0].startswith("w_k = (d_k, v_k) leaves D at k = 0")
+    assert _outside_premises(o, x, u, d, np.full((K, 1), 0.5e-12)) == []
+    o.D_lower, o.D_upper = np.array([-1.0, 1e8]), np.array([1.0, 1e8])
+    near = np.full((K, 1), np.nextafter(1e8, np.inf))
+    assert _outside_premises(o, x, u, d, near) == []

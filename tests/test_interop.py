@@ -811,3 +811,37 @@ def test_a_boolean_entry_is_refused_wherever_it_sits(M: object) -> None:
 
     with pytest.raises(InputError, match=r"A\[0, \d\] is a boolean, not a number"):
         _real(M, "A")
+
+
+def test_observer_statespace_refuses_a_stubborn_gain_of_another_shape(tmp_path: Path) -> None:
+    """The stubborn twin of the lyapunov test above: a transposed K (2×3 for a 3×2 gain) was
+    accepted as another gain when its shape check was weakened (mutation review 35, N12)."""
+    from obsdesign.interop import observer_statespace
+
+    spec = tmp_path / "s.toml"
+    spec.write_text(
+        '[system]\ntime = "continuous"\nA = [[0, 1, 0], [-1, 0, 0], [0, 0, -1]]\n'
+        'C = [[1, 0, 0], [0, 0, 1]]\n[method]\nkey = "stubborn"\n'
+    )
+    rep = tmp_path / "r.json"
+    assert CliRunner().invoke(app, ["design", str(spec), "-q", "-o", str(rep)]).exit_code == 0
+    d = json.loads(rep.read_text())
+    K = np.array(d["parameters"]["K"], dtype=float)
+    assert K.shape == (3, 2)
+    np.testing.assert_array_equal(observer_statespace(rep).B[:, -2:], K)
+    for part in (d["parameters"], d["parameters"]["exact"]):
+        part["K"] = [list(col) for col in zip(*part["K"], strict=True)]
+    bad = tmp_path / "t.json"
+    bad.write_text(json.dumps(d))
+    with pytest.raises(InputError, match=r"t\.json: parameters\.K has shape 2×3, expected 3×2"):
+        observer_statespace(bad)
+
+
+def test_an_integer_just_above_2_53_beside_a_float_stays_exact() -> None:
+    """2⁵³ + 1 has no double; beside a float it was rounded to 2⁵³ (the ``_big_int`` bound at
+    2⁵⁴ passed every test: mutation review 35, N8). 2⁵³ itself is a double and may go float."""
+    from obsdesign.interop import _real
+
+    out = _real([[0.5, 2**53 + 1]], "A")
+    assert out.dtype == object and int(out[0, 1]) == 2**53 + 1
+    assert float(_real([[0.5, 2**53]], "A")[0, 1]) == 2.0**53

@@ -2191,6 +2191,8 @@ xhat0 = [0, 0]
         ("0", "0.5 + k*tan(t)", "u"),  # a pole at π/2 inside [0, 2]: k = 0 hid it
         ("0", "(1/0)^0", "u"),  # sympy's zoo^0 = 1 decided the constant (re-check 34)
         ("0", "(0^-1)^0", "u"),
+        ("0", "(0/0)^0", "u"),  # sympy's nan^0 = 1 too (mutation review 35, E1)
+        ("0", "(k/k)^0", "u"),
         ("k*(1/x1)", "0.5", "f"),  # undefined at x1 = 0 in E
         ("k*tan(x1)", "0.5", "f"),
         ("(1/x1)^0", "0.5", "f"),

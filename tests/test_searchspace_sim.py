@@ -843,3 +843,35 @@ def test_a_state_that_floats_cannot_evaluate_is_inconclusive_not_left_e(tmp_path
     with pytest.raises(InconclusiveError, match="not finite in floats at t = ") as e:
         api.simulate(p)
     assert "left E" not in e.value.message
+
+
+@pytest.mark.parametrize(
+    ("f2", "h", "at_t0"),
+    [
+        ("-x1", "x1 + 0*2^1100*x2", True),  # the output alone is nan, from t₀ on
+        ("-x2 + 0*2^1100*x2", "x1", False),  # the state alone turns nan after a step
+    ],
+    ids=["output-at-t0", "state-later"],
+)
+def test_an_output_or_state_floats_cannot_evaluate_is_inconclusive(
+    tmp_path: Path, f2: str, h: str, at_t0: bool
+) -> None:
+    """Each half of the finiteness check, at t₀ and in the loop: without the check at t₀, or
+    with the state alone checked, a nan output gave exit 1 "every centre was discarded by the
+    output filter at t₀", blaming the certificate; with the output alone checked, a nan state
+    crashed with "cannot convert float NaN to integer" (mutation review 35, S1, S3, S4)."""
+    from obsdesign.errors import InconclusiveError
+
+    f1 = "x2" if at_t0 else "-x1"
+    text = (
+        '[system]\ntime = "continuous"\nstates = ["x1", "x2"]\n'
+        f'f = ["{f1}", "{f2}"]\nh = ["{h}"]\n[method]\nkey = "search-space"\n'
+        "alpha = 0.9\ngamma_star = 0.05\ngamma0 = 1\n"
+        "[method.E]\nlower = [-2, -2]\nupper = [2, 2]\n[method.D]\nlower = [-1, -1]\n"
+        "upper = [1, 1]\n[simulate]\nhorizon = 1\nx0 = [0.5, 0.5]\nxhat0 = [0, 0]\n"
+    )
+    p = tmp_path / "nan.toml"
+    p.write_text(text)
+    with pytest.raises(InconclusiveError, match="not finite in floats at t = ") as e:
+        api.simulate(p)
+    assert ("at t = 0 " in e.value.message) is at_t0, e.value.message

@@ -240,3 +240,30 @@ def test_a_thin_sheared_polytope_has_vertices_where_float_cdd_fails() -> None:
     want = [(-1e-3 - 1e-9, 1e6), (-1e-3 + 1e-9, 1e6), (1e-3 - 1e-9, -1e6), (1e-3 + 1e-9, -1e6)]
     assert np.allclose(sorted(map(tuple, V)), want, rtol=1e-12, atol=0)
     assert P.contains_rel(np.array([[1.2e-9, 0.0], [0.5e-9, 0.0]])).tolist() == [False, True]
+
+
+def test_contains_rel_pins_its_tolerance_of_1e_9_of_the_size() -> None:
+    """The documented 10⁻⁹ of each set's own size: 10× (box) or 1000× (ellipsoid) more passed
+    every test (mutation review 35, T3, T6). Just inside the tolerance, inside; 5× beyond it,
+    outside; and a point one float spacing past a bound far from 0 counts as on it (T2: the
+    spacing allowance)."""
+    box = Box(qvec([0]), qvec([1]))
+    assert box.contains_rel(np.array([[1 + 0.5e-9]])).tolist() == [True]
+    assert box.contains_rel(np.array([[1 + 5e-9]])).tolist() == [False]
+    disk = Ellipsoid(qmat([[1, 0], [0, 1]]), qvec([0, 0]))
+    assert disk.contains_rel(np.array([1 + 0.25e-9, 0.0])) is True  # form 1 + 5·10⁻¹⁰
+    assert disk.contains_rel(np.array([1 + 1e-8, 0.0])) is False  # form 1 + 2·10⁻⁸
+    far = Box(qvec([10**8]), qvec([10**8 + fmpq(1, 10**6)]))
+    hi = float(far.upper[0])
+    assert far.contains_rel(np.array([[np.nextafter(hi, np.inf)]])).tolist() == [True]
+
+
+def test_a_polytope_reads_each_face_at_its_own_magnitude() -> None:
+    """The float-spacing allowance is per face: the box [10⁶, 10⁶ + 1] × [0, 10⁻¹²] written as
+    a polytope took the largest face's magnitude (10⁶, spacing 1.2·10⁻¹⁰) for the thin face
+    too and passed a point 10× outside it (mutation review 35, T5)."""
+    P = Polytope(
+        qmat([[1, 0], [-1, 0], [0, 1], [0, -1]]), qvec([10**6 + 1, -(10**6), fmpq(1, 10**12), 0])
+    )
+    xs = np.array([[1e6 + 0.5, y] for y in (0.5e-12, 2e-12, 1e-11, 1e-10)])
+    assert P.contains_rel(xs).tolist() == [True, False, False, False]
