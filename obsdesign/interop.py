@@ -238,6 +238,14 @@ def _big_int(x: Any) -> bool:
     return isinstance(x, (int, np.integer)) and not isinstance(x, bool) and abs(int(x)) > 2**53
 
 
+def _is_bool(x: Any) -> bool:
+    """A boolean: Python's, numpy's, or a 0-d numpy array of one (``np.array(True)`` in a
+    list was read as 1; mutation review 35)."""
+    return isinstance(x, (bool, np.bool_)) or (
+        isinstance(x, np.ndarray) and x.ndim == 0 and x.dtype.kind == "b"
+    )
+
+
 def _real(M: Any, name: str) -> np.ndarray:
     """A real matrix: integer entries stay integers (exact: an int64 above 2⁵³ was rounded by
     a conversion to float, soundness trial, session 23), anything else as floats; complex
@@ -257,13 +265,8 @@ def _real(M: Any, name: str) -> np.ndarray:
             probe = arr
     # a boolean is not a number, as in a spec ("a boolean"): numpy made True 1 in a plain
     # list, and 1.0 beside a float, but refused it beside a Fraction (re-check 34 §9)
-    if arr.dtype.kind == "b" or (
-        probe.dtype == object and any(isinstance(x, (bool, np.bool_)) for x in probe.flat)
-    ):
-        where = next(
-            (list(i) for i, x in np.ndenumerate(probe) if isinstance(x, (bool, np.bool_))),
-            [0] * arr.ndim,
-        )
+    if arr.dtype.kind == "b" or (probe.dtype == object and any(map(_is_bool, probe.flat))):
+        where = next((list(i) for i, x in np.ndenumerate(probe) if _is_bool(x)), [0] * arr.ndim)
         raise InputError(f"{name}{where} is a boolean, not a number")
     if arr.dtype.kind == "f" and probe.dtype == object and any(_big_int(x) for x in probe.flat):
         # a list mixing floats with an integer beyond 2⁵³ became floats: the integer rounded

@@ -800,8 +800,17 @@ def test_a_fraction_beyond_the_digit_limit_is_an_input_error() -> None:
         [[Fraction(1, 2), True]],
         np.array([[1.0, 0.0], [0.0, 1.0]]) > 0.5,
         np.array([[1, False]], dtype=object),
+        [[0.5, np.array(True)]],
     ],
-    ids=["int-list", "float-list", "numpy-bool-in-list", "fraction-list", "bool-array", "object"],
+    ids=[
+        "int-list",
+        "float-list",
+        "numpy-bool-in-list",
+        "fraction-list",
+        "bool-array",
+        "object",
+        "0-d-array",
+    ],
 )
 def test_a_boolean_entry_is_refused_wherever_it_sits(M: object) -> None:
     """Re-check 34 §9: booleans were taken as 1 / 0 in a plain list or beside a float and

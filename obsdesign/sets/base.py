@@ -31,10 +31,14 @@ class ConvexSet(ABC):
         """Float (lower, upper) of the smallest enclosing box."""
 
     def contains_rel(self, x: np.ndarray, rel: float = 1e-9) -> np.ndarray | bool:
-        """Float membership up to ``rel`` of the set's size: a point at most ``rel`` × the
+        """Float membership up to ``rel`` of the set's size. This default takes ``rel`` × the
         widest side of the bounding box (plus four float spacings of its largest coordinate)
-        outside, in state units. An absolute tolerance of 1e-9 let a point 16 % outside a
-        set 3·10⁻¹² wide count as inside (soundness trial, session 34)."""
+        in state units; every set of this package overrides it to read each direction at its
+        own scale (a box per side, a polytope per face, an ellipsoid on its form, decided
+        exactly near the threshold), as the widest side let a point 8× outside a thin
+        direction count as inside (re-check trial, session 34). A new set type should too.
+        An absolute tolerance of 1e-9 let a point 16 % outside a set 3·10⁻¹² wide count as
+        inside (soundness trial, session 34)."""
         return self.contains(x, tol=self._slack(rel))
 
     def _slack(self, rel: float) -> float:
