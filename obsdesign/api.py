@@ -26,6 +26,7 @@ from obsdesign.errors import (
     InputError,
     ObsdesignError,
     SpecError,
+    ascii_name,
     one_line,
 )
 from obsdesign.limits import ensure_recursion_limit, limits, max_states_for
@@ -327,6 +328,20 @@ def _write_error_report(sp: Spec, out: str | Path, code: int, message: str, forc
 VERIFY_ONLY = ("spec-hash", "parameters-consistent", "report-verdict")
 
 
+def _hash_mismatch(where: str, sha: str, stored: str) -> str:
+    """The spec-hash claim's detail: both hashes' first 12 digits, and why they differ where
+    those look the same — the stored hash in upper case, or differing further on, showed two
+    identical-looking prefixes (verify trial, session 35)."""
+    if stored.lower() == sha:
+        return (
+            f"{where} has sha256 {sha[:12]}…; the report's spec_sha256 is the same digits in "
+            "upper case (the report writes lower-case hex: edited by hand?)"
+        )
+    if stored[:12] == sha[:12]:
+        return f"{where} has sha256 {sha}, the report was made from {stored}"
+    return f"{where} has sha256 {sha[:12]}…, the report was made from {stored[:12]}…"
+
+
 def verify(report: str | Path | Report, spec: str | Path | None = None) -> Report:
     """Re-check a report from the spec and the parameters alone, and compare it with what
     the report claims.
@@ -385,7 +400,7 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
                 "sha256",
                 0,
                 False,
-                f"{where} has sha256 {sha[:12]}…, the report was made from {rep.spec_sha256[:12]}…",
+                _hash_mismatch(where, sha, rep.spec_sha256),
                 float_ok=False,
             )
         ]
@@ -457,7 +472,8 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
         notes.append(f"ignored report keys (not part of a report): {', '.join(unknown)}")
     if rep.unverified:
         notes.append(
-            "not verified (no check reads them; informational only): " + ", ".join(rep.unverified)
+            "not verified (no check reads them; informational only): "
+            + ", ".join(map(ascii_name, rep.unverified))
         )
     if spec is None:
         moved = _named_file_differs(rep.spec_file, sha)

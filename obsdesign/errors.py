@@ -36,8 +36,21 @@ def escape_controls(text: str) -> str:
 #: the characters of Unicode categories Cc, Zl and Zp, and the bidirectional controls of Cf
 #: (LRM, RLM, the embeddings, overrides and isolates: U+202E in a file name reordered the rest
 #: of check's row and of the Markdown report in bidi-aware viewers, "Trojan Source" style;
-#: rendering trial, session 27): what :func:`escape_controls` escapes
-_CONTROLS = re.compile("[\x00-\x1f\x7f-\x9f\u2028\u2029\u200e\u200f\u202a-\u202e\u2066-\u2069]")
+#: rendering trial, session 27), and the invisible format characters of Cf that no text needs
+#: (zero-width space, word joiner, invisible operators, BOM: a parameter "mu\u200b" showed as a
+#: second "mu" row; verify trial, session 35): what :func:`escape_controls` escapes. The soft
+#: hyphen and the zero-width (non-)joiner, which Persian, Indic and emoji text use, stay.
+_CONTROLS = re.compile(
+    "[\x00-\x1f\x7f-\x9f\u061c\u180e\u200b\u200e\u200f\u2028\u2029\u202a-\u202e"
+    "\u2060-\u2064\u2066-\u206f\ufeff\ufff9-\ufffb]"
+)
+
+
+def ascii_name(text: str) -> str:
+    """``text`` with every character outside ASCII written as an escape (``\\u0420``): for
+    names a report adds that no check reads, where a Cyrillic "Р" showed as the method's "P"
+    (verify trial, session 35). The method's own names are ASCII."""
+    return escape_controls(text).encode("ascii", "backslashreplace").decode("ascii")
 
 
 def one_line(message: str) -> str:

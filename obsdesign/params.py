@@ -230,8 +230,9 @@ class Parameters(Mapping[str, Any]):
                     try:
                         q, fl = qparse_floats(ek)
                     except (ValueError, TypeError, ZeroDivisionError) as e:
+                        why = str(e).removeprefix("not an exact value: ")
                         raise InputError(
-                            f"{file}: parameters.exact.{k}: not an exact value ({e})"
+                            f"{file}: parameters.exact.{k}: not an exact value ({why})"
                         ) from e
                     except OverflowError:
                         # no report carries one (its float view would be infinite: the design

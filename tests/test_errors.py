@@ -65,11 +65,16 @@ def test_a_5000_digit_schema_version_is_one_short_line(tmp_path: Path) -> None:
     assert r.exit_code == 2, r.stderr
     assert r.stderr.count("\n") == 1 and len(r.stderr) < 300
     assert 'schema_version must be a string like "1.1", got a number' in r.stderr
-    bad.write_text(json.dumps(d).replace('"SV"', '"' + "9" * 5000 + '"'))
+    bad.write_text(json.dumps(d).replace('"SV"', '"' + "9" * 5000 + '.1"'))
     r = runner.invoke(app, ["--limit", "max_digits=10000", "verify", str(bad)])
     assert r.exit_code == 2, r.stderr
     assert r.stderr.count("\n") == 1 and len(r.stderr) < 300
-    assert "schema_version 99999999999999999999…(5000 digits) is not supported" in r.stderr
+    assert "schema_version 99999999999999999999…(5000 digits)" in r.stderr
+    assert "is not supported" in r.stderr
+    bad.write_text(json.dumps(d).replace('"SV"', '"' + "9" * 5000 + '"'))  # no MINOR
+    r = runner.invoke(app, ["--limit", "max_digits=10000", "verify", str(bad)])
+    assert r.exit_code == 2 and r.stderr.count("\n") == 1 and len(r.stderr) < 300
+    assert "must be MAJOR.MINOR" in r.stderr
 
 
 def test_one_line_shortens_a_huge_message_and_success_lines_are_one_line(tmp_path) -> None:
@@ -102,3 +107,31 @@ def test_bidirectional_controls_are_escaped() -> None:
     for ch in "\u200e\u200f\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069":
         assert escape_controls(f"a{ch}b") == f"a\\u{ord(ch):04x}b"
     assert escape_controls("soft\u00adhy\u200dphen") == "soft\u00adhy\u200dphen"
+
+
+def test_invisible_format_characters_and_look_alike_names_are_shown_escaped(
+    tmp_path: Path,
+) -> None:
+    """A parameter "mu\\u200b" a report adds showed as a second "mu" row and a Cyrillic "Р" as
+    the method's "P" (verify trial, session 35): zero-width and other invisible format
+    characters are escaped wherever user text is, and a name no check reads is shown in
+    ASCII escapes."""
+    from obsdesign.errors import ascii_name, escape_controls
+
+    for ch in ("\u200b", "\u2060", "\ufeff", "\u2062", "\u180e"):
+        assert escape_controls(f"mu{ch}") == f"mu\\u{ord(ch):04x}", ch
+    # the soft hyphen and the joiners stay in text (session 27), but not in a name no check
+    # reads
+    assert ascii_name("mu\u200d") == "mu\\u200d"
+    assert escape_controls("θ, ß, 中") == "θ, ß, 中"  # visible text as it is
+    assert ascii_name("\u0420") == "\\u0420" and ascii_name("theta_1") == "theta_1"
+    d = api.design(api.load_spec(ROOT / "tests" / "specs" / "lyapunov-minimal.toml")).to_dict()
+    d["parameters"]["\u0420"] = 1.5
+    d["parameters"]["exact"]["\u0420"] = "3/2"
+    d["parameters"]["mu\u200b"] = 1
+    p = tmp_path / "r.json"
+    p.write_text(json.dumps(d))
+    r = runner.invoke(app, ["verify", str(p), "--width", "200"])
+    assert r.exit_code == 0, r.output
+    assert "\\u0420" in r.stdout and "mu\\u200b" in r.stdout
+    assert "\u0420" not in r.stdout + r.stderr and "\u200b" not in r.stdout + r.stderr

@@ -13,6 +13,7 @@ import pytest
 from typer.testing import CliRunner
 
 from obsdesign import api
+from obsdesign.certify.claim import ClaimStatus
 from obsdesign.cli import app
 from obsdesign.report.model import Report
 
@@ -393,3 +394,94 @@ def test_a_report_whose_parameters_lost_a_key_is_verified_as_edited() -> None:
     got = api.verify(rep)
     assert got.exit_code() == 1
     assert "mu-present" in {c.id for c in got.failed}
+
+
+def _lyap_report() -> dict:
+    from obsdesign import api
+
+    src = Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+    return api.design(src).to_dict()
+
+
+@pytest.mark.parametrize(
+    ("edit", "words"),
+    [
+        (
+            lambda c: c.__setitem__("extra", "x"),
+            "claims[1] (ID): key 'extra': expected an object, got a string",
+        ),
+        (lambda c: c.pop("status"), "claims[1] (ID): key 'status' is missing"),
+        (lambda c: c.__setitem__("status", "proved"), "key 'status': expected one of certified"),
+        (lambda c: c.__setitem__("status", 1), "key 'status': expected one of"),
+        (
+            lambda c: c.__setitem__("float_ok", "yes"),
+            "key 'float_ok': expected true, false or null",
+        ),
+        (lambda c: c.pop("id"), "claims[1]: key 'id' is missing"),
+    ],
+    ids=["extra-string", "no-status", "unknown-status", "numeric-status", "float-ok", "no-id"],
+)
+def test_a_malformed_claim_is_named_with_its_key(tmp_path: Path, edit: Any, words: str) -> None:
+    """ "malformed claims ('status')" and "malformed claims (dictionary update sequence element
+    #0 has length 1; 2 is required)" named neither the claim nor the key (verify trial,
+    session 35)."""
+    from obsdesign.cli import app
+
+    d = _lyap_report()
+    cid = d["claims"][1]["id"]
+    edit(d["claims"][1])
+    p = tmp_path / "r.json"
+    p.write_text(json.dumps(d))
+    res = CliRunner().invoke(app, ["verify", str(p)])
+    assert res.exit_code == 2, res.output
+    assert words.replace("ID", cid) in res.output, res.output
+
+
+@pytest.mark.parametrize(
+    "version", ["1.x", "1", "1.-1", "1.1.1", "1.1\n", " 1.1", "01.1", "1.01", "١.١"]
+)
+def test_schema_version_is_major_dot_minor(tmp_path: Path, version: str) -> None:
+    """Only the part before the first dot was compared: "1.x", "1", "1.1.1" and "1.1\\n"
+    verified while "01.1" was refused (verify trial, session 35). MAJOR.MINOR in ASCII digits,
+    no leading zeros, or exit 2; 1.0 and 1.1 still read."""
+    from obsdesign.cli import app
+
+    d = _lyap_report()
+    d["schema_version"] = version
+    p = tmp_path / "r.json"
+    p.write_text(json.dumps(d))
+    res = CliRunner().invoke(app, ["verify", str(p)])
+    assert res.exit_code == 2 and "schema_version must be MAJOR.MINOR" in res.output, res.output
+    d["schema_version"] = "1.1"
+    p.write_text(json.dumps(d))
+    assert CliRunner().invoke(app, ["verify", str(p)]).exit_code == 0
+
+
+def test_an_upper_case_spec_hash_says_so_and_a_bool_exact_value_reads_once(tmp_path: Path) -> None:
+    """An upper-case spec_sha256 failed spec-hash with two identical-looking 12-digit
+    prefixes; a boolean exact value said "not an exact value (not an exact value: True)"
+    (verify trial, session 35)."""
+    from obsdesign import api
+    from obsdesign.cli import app
+
+    d = _lyap_report()
+    d["spec_sha256"] = d["spec_sha256"].upper()
+    ver = api.verify(Report.from_dict(d)[0])
+    (c,) = [c for c in ver.claims if c.id == "spec-hash"]
+    assert c.status == ClaimStatus.FAILED and "upper case" in c.detail
+    d = _lyap_report()
+    d["spec_sha256"] = (
+        d["spec_sha256"][:12]
+        + ("0" if d["spec_sha256"][12] != "0" else "1")
+        + d["spec_sha256"][13:]
+    )
+    ver = api.verify(Report.from_dict(d)[0])
+    (c,) = [c for c in ver.claims if c.id == "spec-hash"]
+    assert c.status == ClaimStatus.FAILED and d["spec_sha256"] in c.detail  # whole, not a prefix
+    d = _lyap_report()
+    key = next(iter(d["parameters"]["exact"]))
+    d["parameters"]["exact"][key] = True
+    p = tmp_path / "r.json"
+    p.write_text(json.dumps(d))
+    res = CliRunner().invoke(app, ["verify", str(p)])
+    assert res.exit_code == 2 and f"parameters.exact.{key}: not an exact value (True)" in res.output

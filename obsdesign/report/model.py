@@ -345,6 +345,13 @@ class Report:
                 f'{file}: schema_version must be a string like "{SCHEMA_VERSION}", got '
                 f"{_json_kind(d['schema_version'])}"
             )
+        if not re.fullmatch(r"(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)", d["schema_version"]):
+            # only the part before the first dot was read: "1.x", "1", "1.1.1" and "1.1\n"
+            # verified (verify trial, session 35)
+            raise InputError(
+                f'{file}: schema_version must be MAJOR.MINOR like "{SCHEMA_VERSION}", got '
+                f"{d['schema_version']!r}"
+            )
         if d["schema_version"].split(".")[0] != SCHEMA_VERSION.split(".")[0]:
             raise InputError(
                 f"{file}: schema_version {d['schema_version']} is not supported (expected {SCHEMA_VERSION})"
@@ -381,10 +388,7 @@ class Report:
             # a "claims" object gave "malformed claims (string indices must be integers…)"
             # (hostile-input trial, session 24)
             raise InputError(f"{file}: key 'claims': expected a list of claim objects")
-        try:
-            claims = [Claim.from_dict(c) for c in d["claims"]]
-        except (KeyError, TypeError, ValueError) as e:
-            raise InputError(f"{file}: malformed claims ({e})") from None
+        claims = [_claim_from(c, i, file) for i, c in enumerate(d["claims"])]
         return (
             cls(
                 method=str(d["method"]),
@@ -416,7 +420,39 @@ def _json_kind(v: Any) -> str:
         return "a boolean"
     if isinstance(v, (int, float)):
         return "a number"
+    if isinstance(v, str):
+        return "a string"
     return "an array" if isinstance(v, list) else "an object"
+
+
+#: the keys every claim object has (:meth:`Claim.to_dict`)
+CLAIM_KEYS = ("id", "statement", "reference", "check", "margin", "status")
+
+
+def _claim_from(c: dict[str, Any], i: int, file: str) -> Claim:
+    """Claim ``i`` of a report, refused naming it and its key: "malformed claims ('status')"
+    and "dictionary update sequence element #0 has length 1" named neither (verify trial,
+    session 35)."""
+    name = f"claims[{i}]" + (f" ({c['id']})" if isinstance(c.get("id"), str) else "")
+    for k in CLAIM_KEYS:
+        if k not in c:
+            raise InputError(f"{file}: {name}: key '{k}' is missing")
+    statuses = [s.value for s in ClaimStatus]
+    if c["status"] not in statuses:
+        raise InputError(
+            f"{file}: {name}: key 'status': expected one of {', '.join(statuses)}, got "
+            f"{_json_kind(c['status']) if not isinstance(c['status'], str) else repr(c['status'])}"
+        )
+    if not isinstance(c.get("extra", {}), dict):
+        raise InputError(
+            f"{file}: {name}: key 'extra': expected an object, got {_json_kind(c['extra'])}"
+        )
+    if c.get("float_ok") is not None and not isinstance(c["float_ok"], bool):
+        raise InputError(
+            f"{file}: {name}: key 'float_ok': expected true, false or null, got "
+            f"{_json_kind(c['float_ok'])}"
+        )
+    return Claim.from_dict(c)
 
 
 def _version(v: Any) -> tuple[int, ...]:

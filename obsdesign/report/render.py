@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 
 from obsdesign.certify.claim import ClaimStatus
+from obsdesign.errors import ascii_name
 from obsdesign.report.model import Report
 from obsdesign.report.shown import cell
 
@@ -63,9 +64,11 @@ def _param_rows(report: Report) -> list[tuple[str, str, str]]:
         # a text or true/false parameter is neither exact nor float (a bracket's kind showed
         # "float": docs trial, session 31)
         form = "exact" if report.parameters.is_exact(k) else "float" if _numeric(raw) else "text"
+        name = k
         if k in report.unverified:
             form = "not verified"
-        rows.append((k, text, form))
+            name = ascii_name(k)  # a Cyrillic "Р" showed as the method's "P" (session 35)
+        rows.append((name, text, form))
     return rows
 
 
