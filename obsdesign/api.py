@@ -1440,7 +1440,7 @@ def check_remote(item: tuple[str, str, str | None, float | None]) -> CheckRow:
         try:
             here = hashlib.sha256(read_input(path, "spec")).hexdigest()
         except ObsdesignError as e:
-            return _error_row(Path(shown), "?", e.exit_code, t0, e.message.replace(path, shown))
+            return _error_row(Path(shown), "?", e.exit_code, t0, _as_shown(e.message, path, shown))
         if here != sha:
             return _error_row(
                 Path(shown),
@@ -1452,9 +1452,21 @@ def check_remote(item: tuple[str, str, str | None, float | None]) -> CheckRow:
             )
     row = check_one(Path(path), timeout)
     row.spec = shown
-    if path != shown:
-        row.message = row.message.replace(path, shown)
+    row.message = _as_shown(row.message, path, shown)
     return row
+
+
+def _as_shown(message: str, path: str, shown: str) -> str:
+    """A worker's message with its absolute ``path`` written as the path ``check`` was given
+    (``shown``), raw or escaped as messages print it: a name holding a newline kept the
+    worker's absolute path, so ``--workers`` rows differed from the serial run's (batch
+    trial, session 35)."""
+    from obsdesign.errors import escape_controls
+
+    if path == shown:
+        return message
+    message = message.replace(path, shown)
+    return message.replace(escape_controls(path), escape_controls(shown))
 
 
 def sweep(

@@ -694,3 +694,19 @@ def test_a_stop_python_cannot_propagate_is_not_printed(monkeypatch) -> None:
     sys.unraisablehook(SimpleNamespace(exc_value=err))
     assert seen == [err]
     assert sys.unraisablehook._obsdesign_quiet_timeout is True
+
+
+def test_a_worker_row_names_a_file_with_a_newline_as_the_serial_row_does(
+    tmp_path: Path, monkeypatch
+) -> None:
+    """The worker's message holds the file name escaped ("nl\\\\nname.toml"), so replacing the
+    raw absolute path missed it and ``check --workers`` rows kept the worker's absolute path
+    where the serial row has the name as given (batch trial, session 35)."""
+    monkeypatch.chdir(tmp_path)
+    name = Path("nl\nname.toml")
+    name.write_text('title = "x"\n')
+    serial = api.check_one(name)
+    remote = api.check_remote((*api._remote_item(name), None))
+    assert remote.code == serial.code == 2
+    assert remote.message == serial.message, (remote.message, serial.message)
+    assert str(tmp_path) not in remote.message
