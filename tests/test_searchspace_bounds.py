@@ -433,3 +433,35 @@ def test_the_sampled_quotient_is_not_float_noise_over_an_ulp() -> None:
     assert b.lower_est <= 0.8253394 and b.upper >= 0.8253393
     p, q = b.witness
     assert np.linalg.norm(np.asarray(p) - np.asarray(q)) > 1e-9
+
+
+# -- Lipschitz-pair review 35 (619f3a7's two halves, each alone) --------------------------
+def test_a_sampled_pair_squeezed_by_a_zero_width_side_of_e_is_not_a_quotient() -> None:
+    """E = [0, 1] × {1}: a zero-width side in a differenced variable. h = x1 + 10⁴·x2 is
+    x1 + 10⁴ on E, so L_h^E = 1 exactly; the finite-difference direction is almost all x2
+    (v ≈ (10⁻⁴, 1)), and clipped into E the pair is 2·10⁻¹⁰ apart, where the rounding of
+    h ≈ 10⁴ (ulp 1.8·10⁻¹²) made a "quotient" of 1.00044 (exact quotient at those points: 1):
+    with the pair kept at any distance > 0 (or > 10⁻⁹·δ) a true given L_h = 1 failed,
+    exit 1. A pair closer than 10⁻³·δ is skipped."""
+    ex = _ex("x1 + 1e4*x2", names=("x1", "x2"))
+    lo, hi = [Fraction(0), Fraction(1)], [Fraction(1), Fraction(1)]
+    b = B.lipschitz(ex, ["x1", "x2"], ["x1", "x2"], lo, hi, 300, 1e-3)
+    assert b.lower_est <= 1 + 1e-6  # the refutation tolerance of claims._constant
+    assert b.upper >= 1
+    if b.lower_est > 0:
+        p, q = b.witness
+        assert np.linalg.norm(np.asarray(p) - np.asarray(q)) > 1e-9
+
+
+def test_a_pair_clipped_into_a_narrow_corner_box_is_not_a_quotient() -> None:
+    """h = x1² + 3000.7 on [0, 7/10]: L_h = 1.4 exactly (at x1 = 0.7). With rtol 10⁻⁹ the
+    branch and bound narrows the corner box to 10⁻⁸ … 10⁻⁷; a pair clipped into it (4.2·10⁻⁸
+    apart) divided the rounding of h ≈ 3000 (ulp 4.5·10⁻¹³) by that: 1.4000048 (exact
+    quotient at the pair 1.39999987), which failed a true given L_h = 1.4, exit 1. Kept δ
+    apart in E, the pair's rounding is 3·10⁻⁷ of the quotient at most."""
+    ex = _ex("x1^2 + 3000.7")
+    b = B.lipschitz(ex, ["x1"], ["x1"], [Fraction(0)], [Fraction(7, 10)], 300, 1e-9)
+    assert b.upper >= 1.4
+    assert b.lower_est <= 1.4 * (1 + 1e-6)  # the refutation tolerance of claims._constant
+    p, q = b.witness
+    assert np.linalg.norm(np.asarray(p) - np.asarray(q)) > 1e-6
