@@ -267,3 +267,105 @@ def test_a_polytope_reads_each_face_at_its_own_magnitude() -> None:
     )
     xs = np.array([[1e6 + 0.5, y] for y in (0.5e-12, 2e-12, 1e-11, 1e-10)])
     assert P.contains_rel(xs).tolist() == [True, False, False, False]
+
+
+def _strip(C: int, w: fmpq) -> tuple[Polytope, list]:
+    """{|0.1x1 + 0.3x2| ≤ w, C − 10⁶ ≤ x1 ≤ C + 10⁶} and its exact data (re-check trial,
+    session 35)."""
+    G = qmat([[fmpq(1, 10), fmpq(3, 10)], [fmpq(-1, 10), fmpq(-3, 10)], [1, 0], [-1, 0]])
+    g = qvec([w, w, C + 10**6, -(C - 10**6)])
+    return Polytope(G, g), [G, g]
+
+
+def test_polytope_vertices_are_exact_where_float_cdd_gives_none_or_too_few() -> None:
+    """Float cdd returned no vertex for a strip at x₁ ≈ 3·10¹⁵ (simulate exit 3 "zero-size
+    array") and 2 of the 4 vertices of [−2, 2]² written with rows scaled 10⁻⁸ (Monte Carlo
+    drew every initial error from the segment x₁ = 0), without an error (re-check trial,
+    session 35). The vertices are the exact ones now."""
+    from obsdesign.sets.polytope import vertices_float
+
+    P, _ = _strip(3 * 10**15, fmpq(1, 100))
+    assert len(vertices_float(P.G, P.g)[0]) == 0
+    assert P.vertices().shape == (4, 2)
+    s = fmpq(1, 10**8)
+    box = Polytope(qmat([[s, 0], [-s, 0], [0, 1], [0, -1]]), qvec([2 * s, 2 * s, 2, 2]))
+    assert len(vertices_float(box.G, box.g)[0]) == 2
+    lo, hi = box.bounding_box()
+    assert lo.tolist() == [-2.0, -2.0] and hi.tolist() == [2.0, 2.0]
+    pts = box.sample(np.random.default_rng(0), 200)
+    assert pts[:, 0].min() < -1 and pts[:, 0].max() > 1
+
+
+def test_float_only_mode_refuses_float_vertices_it_cannot_confirm(monkeypatch) -> None:
+    """Without cdd.gmp, float cdd's vertices are used only when each row's support over them
+    is its LP maximum: the scaled box's 2 of 4 vertices are refused, the unit-row box is
+    accepted."""
+    from obsdesign.sets import polytope as pmod
+    from obsdesign.sets import polytope_ops as po
+
+    monkeypatch.setattr(po, "HAVE_GMP", False)
+    s = 1e-8
+    G = np.array([[s, 0], [-s, 0], [0, 1], [0, -1]])
+    g = np.array([2 * s, 2 * s, 2, 2])
+    half = np.array([[0.0, 2.0], [0.0, -2.0]])
+    assert pmod._float_vertices_ok(G, g, half) is False
+    full = np.array([[2.0, 2.0], [2.0, -2.0], [-2.0, 2.0], [-2.0, -2.0]])
+    assert pmod._float_vertices_ok(G, g, full) is True
+    assert pmod._float_vertices_ok(G, g, np.vstack([full, [[2.1, 0.0]]])) is False  # outside
+    assert pmod._float_vertices_ok(G, g, np.zeros((0, 2))) is False
+    box = Polytope(qmat([[1, 0], [-1, 0], [0, 1], [0, -1]]), qvec([2, 2, 2, 2]))
+    assert sorted(map(tuple, box.vertices())) == sorted(map(tuple, full))
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    e=st.integers(12, 15),
+    k=st.integers(2, 5),
+    off=st.integers(-(10**6), 10**6),
+    t=st.floats(-3, 3),
+)
+def test_polytope_contains_rel_agrees_with_the_exact_rows(e: int, k: int, off: int, t: float):
+    """Points across a strip of half-width 10^−k at x₁ ≈ 3·10^e: contains_rel equals the exact
+    G x ≤ g + slack of the float point. The float G·x alone read points 1.45 strip widths
+    outside as inside (re-check trial, session 35)."""
+    from fractions import Fraction
+
+    C = 3 * 10**e
+    w = fmpq(1, 10**k)
+    P, (G, g) = _strip(C, w)
+    x1 = float(C + off)
+    x = np.array([x1, (t * float(w) - 0.1 * x1) / 0.3])
+    proj = P.vertices() @ P.G.T
+    mag = np.maximum(np.abs(proj).max(axis=0), np.abs(P.g))
+    slack = 1e-9 * (proj.max(axis=0) - proj.min(axis=0)) + 4 * np.spacing(mag)
+
+    def q(a: fmpq) -> Fraction:
+        return Fraction(int(a.p), int(a.q))
+
+    want = all(
+        sum((q(G[i, j]) * Fraction(float(x[j])) for j in range(2)), Fraction(0)) - q(g[i])
+        <= Fraction(float(slack[i]))
+        for i in range(4)
+    )
+    assert P.contains_rel(x) is want
+    assert P.contains_rel(x[None, :]).tolist() == [want]
+
+
+def test_polytope_contains_rel_reads_a_far_sheared_strip_exactly() -> None:
+    """x₁ = 3·10¹³ on a strip of half-width 10⁻⁴: a point 1.45 widths outside is outside, one
+    0.5 widths inside is inside (both were misread in floats); non-finite points are outside."""
+    P, _ = _strip(3 * 10**13, fmpq(1, 10**4))
+    x1 = 3e13
+
+    def at(r: float) -> np.ndarray:  # 0.1 x1 + 0.3 x2 ≈ r·10⁻⁴, rounded x2
+        return np.array([x1, (r * 1e-4 - 0.1 * x1) / 0.3])
+
+    from fractions import Fraction
+
+    def row(x: np.ndarray) -> Fraction:
+        return Fraction(1, 10) * Fraction(x[0]) + Fraction(3, 10) * Fraction(x[1])
+
+    out, inside = at(3.9), at(0.0)
+    assert row(out) > Fraction(1, 10**4) * 2 and abs(row(inside)) < Fraction(1, 10**4) / 2
+    assert P.contains_rel(np.vstack([out, inside])).tolist() == [False, True]
+    assert P.contains_rel(np.array([[np.nan, 0.0], [np.inf, 0.0]])).tolist() == [False, False]
