@@ -164,6 +164,13 @@ def _value(v: Any) -> str:
         raise InputError("a missing value (None) cannot be written into a spec")
     if isinstance(v, Mapping):
         return "{" + ", ".join(f"{_key(k)} = {_value(x)}" for k, x in v.items()) + "}"
+    if isinstance(v, (list, tuple)) or (
+        isinstance(v, np.ndarray) and v.dtype == object and v.ndim > 0
+    ):
+        # item by item: np.asarray made True 1.0 beside a float, and `L=[[True], [0.5]]`
+        # was written as L = [[1], [0.5]] and certified; a boolean stays `true`, which the
+        # spec refuses where a number belongs (re-check trial, session 35)
+        return "[" + ", ".join(_value(x) for x in v) + "]"
     arr = np.asarray(v)
     if arr.ndim == 0:
         item = arr.item()
@@ -372,7 +379,8 @@ def spec_text_from_statespace(
     decimals (0.1 is 1/10, not the double's binary value), which a certificate with a margin
     near 10⁻¹⁶ relative can tell apart (docs/quickstart.md). Integer entries are written
     exactly; B and Bd must have n rows and D p×m (a vector is one column, D's one row or
-    column), else InputError."""
+    column), else InputError. A boolean is written as ``true`` / ``false`` wherever it sits
+    (never as 1 / 0 beside a float), so the spec refuses it where a number belongs."""
     A, B, C, D, dt = _matrices(sys)
     if dt is None or (dt is not True and float(dt) == 0):
         time, sample_time = "continuous", None

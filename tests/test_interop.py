@@ -19,7 +19,7 @@ from typer.testing import CliRunner
 import obsdesign
 from obsdesign import api
 from obsdesign.cli import app
-from obsdesign.errors import InputError
+from obsdesign.errors import InputError, SpecError
 from obsdesign.interop import (
     observer_statespace,
     spec_from_statespace,
@@ -820,6 +820,31 @@ def test_a_boolean_entry_is_refused_wherever_it_sits(M: object) -> None:
 
     with pytest.raises(InputError, match=r"A\[0, \d\] is a boolean, not a number"):
         _real(M, "A")
+
+
+@pytest.mark.parametrize(
+    "L",
+    [
+        [[True], [0.5]],
+        [[np.True_], [0.5]],
+        [[np.array(True)], [0.5]],
+        np.array([[True], [0.5]], dtype=object),
+        ([1.0], [False]),
+    ],
+    ids=["bool", "numpy-bool", "0-d-array", "object-array", "tuple"],
+)
+def test_a_boolean_in_a_method_option_is_not_written_as_a_number(L: object) -> None:
+    """Re-check 35 §2: the boolean refusal covered A, B, C, D only; ``L=[[True], [0.5]]`` was
+    written as L = [[1], [0.5]] and certified. It is written as ``true`` now, and the spec
+    refuses it where a number belongs; a gain of plain numbers still loads."""
+    from obsdesign.interop import spec_from_statespace, spec_text_from_statespace
+
+    sys = ([[0.5, 0], [0, 0.2]], [[0], [0]], [[1, 0]], [[0]], 1)
+    text = spec_text_from_statespace(sys, "lyapunov", L=L)
+    assert "true" in text or "false" in text
+    with pytest.raises(SpecError, match=r"\[method.L\] expected a number, got a boolean"):
+        spec_from_statespace(sys, "lyapunov", L=L)
+    assert spec_from_statespace(sys, "lyapunov", L=[[1], [0.5]]) is not None
 
 
 def test_observer_statespace_refuses_a_stubborn_gain_of_another_shape(tmp_path: Path) -> None:
