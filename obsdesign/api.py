@@ -1159,6 +1159,28 @@ MAX_BUDGET_S = 1e9
 RETIMEOUT_S = 0.1
 
 
+def budget_seconds(timeout: Any, name: str = "timeout") -> float | None:
+    """A time budget the API was given (``check(timeout=)``, ``sweep(timeout=)``), read as
+    the CLI's ``--timeout``: None, 0 and anything beyond :data:`MAX_BUDGET_S` (inf) are no
+    budget (None); a non-negative real number is seconds. A boolean, a string, NaN or a
+    negative number is an :class:`InputError` (−1 reached setitimer's raw "Invalid argument",
+    NaN and −10⁻⁹ ran without a limit, "1" was a TypeError and True one second; re-check
+    trial, session 35)."""
+    import numbers
+
+    if timeout is None:
+        return None
+    if isinstance(timeout, bool) or not isinstance(timeout, numbers.Real):
+        raise InputError(
+            f"{name} must be a number of seconds (0 or None: no limit), got "
+            f"{type(timeout).__name__} {timeout!r}"
+        )
+    t = float(timeout)
+    if not t >= 0:
+        raise InputError(f"{name} must be ≥ 0 seconds (0 or None: no limit), got {timeout!r}")
+    return t if 0 < t <= MAX_BUDGET_S else None
+
+
 @contextmanager
 def _time_budget(seconds: float | None) -> Any:
     """Raise :class:`SpecTimeout` in this thread after ``seconds`` of wall time (None or 0:
@@ -1305,7 +1327,9 @@ def check_one(path: Path, timeout: float | None = None) -> CheckRow:
     kind (bad input, solver failure, an internal error) becomes that row's exit code and
     message, so one spec never loses the others' rows (KeyboardInterrupt still stops).
     ``timeout``: seconds for the whole spec (in the main thread; None: no limit), past which
-    the row is exit 3 "not finished" (one spec that hung cost every row: CLI fuzzer)."""
+    the row is exit 3 "not finished" (one spec that hung cost every row: CLI fuzzer); read
+    by :func:`budget_seconds` (a bad one is an :class:`InputError`, not a row)."""
+    timeout = budget_seconds(timeout)
     t0 = time.perf_counter()
     seen = ["?"]  # the method, once the spec is loaded
     try:
@@ -1383,6 +1407,7 @@ def check(
     the same files) or ``client`` (a ``dask.distributed.Client``) run the specs on Dask
     (:mod:`obsdesign.distributed`): the rows are the serial run's (but ``seconds``).
     ``on_row(row)`` is called as each row arrives."""
+    timeout = budget_seconds(timeout)
     if isinstance(paths, (str, Path)):
         paths = [paths]
     if any(isinstance(p, str) and p == "" for p in paths):

@@ -653,6 +653,9 @@ def plan(
     """The axes and one task per grid point; bad input that concerns every point (a bad
     ``--set``, a key that cannot be written, a spec without ``[simulate]`` for
     ``simulate=True``) is an :class:`InputError` here, before any work."""
+    from obsdesign.api import budget_seconds
+
+    timeout = budget_seconds(timeout)
     axes = parse_grid(grid)
     text, file = _spec_source(spec)
     points = grid_points(axes)
@@ -665,7 +668,7 @@ def plan(
         if "simulate" not in doc and not any(k.startswith("simulate.") for k in points[0]):
             raise InputError(f"{file}: [simulate] is missing: nothing to simulate (--simulate)")
     tasks = [
-        PointTask(i, p, text, file, simulate, dict(options or {}), timeout or None)
+        PointTask(i, p, text, file, simulate, dict(options or {}), timeout)
         for i, p in enumerate(points)
     ]
     if options:

@@ -15,6 +15,7 @@ from typer.testing import CliRunner
 
 from obsdesign import api
 from obsdesign.cli import app
+from obsdesign.errors import InputError
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml"
@@ -170,6 +171,28 @@ def test_check_timeout_beyond_the_timer_range_is_no_limit(tmp_path: Path) -> Non
         assert res.exit_code == 0, (t, res.output)
     with api._time_budget(1e300):
         pass
+
+
+@pytest.mark.parametrize("bad", [-1, -1e-9, float("nan"), "1", True, [1]])
+def test_the_api_reads_its_timeout_as_the_cli_does(tmp_path: Path, bad: object) -> None:
+    """``api.check`` / ``api.sweep`` / ``check_one`` took ``timeout=`` unread: −1 reached
+    setitimer's raw "Invalid argument", NaN and −10⁻⁹ ran without a limit, "1" was a
+    TypeError and True one second (re-check trial, session 35). Each is an InputError naming
+    the timeout; 0, None, inf and 1e300 are no limit, as ``--timeout``."""
+    spec = tmp_path / "s.toml"
+    shutil.copy(ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml", spec)
+    with pytest.raises(InputError, match=r"^timeout must be"):
+        api.check([spec], timeout=bad)
+    with pytest.raises(InputError, match=r"^timeout must be"):
+        api.check_one(spec, timeout=bad)
+    with pytest.raises(InputError, match=r"^timeout must be"):
+        api.sweep(spec, ["method.lambda=0.9:0.95:2"], timeout=bad)
+
+
+def test_budget_seconds_keeps_a_real_budget_and_drops_no_budget() -> None:
+    assert [api.budget_seconds(t) for t in (None, 0, 0.0, float("inf"), 1e300)] == [None] * 5
+    assert api.budget_seconds(2.5) == 2.5 and api.budget_seconds(1) == 1.0
+    assert api.budget_seconds(api.MAX_BUDGET_S) == api.MAX_BUDGET_S
 
 
 def test_a_spec_named_twice_gets_one_row(tmp_path: Path) -> None:
