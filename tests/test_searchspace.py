@@ -472,7 +472,9 @@ def test_an_input_undefined_on_the_horizon_is_hinted(u: str, at: str) -> None:
     assert "not finite" not in next(c for c in rep.claims if c.id == "input-range").detail
 
 
-@pytest.mark.parametrize(("est", "status"), [(1.0, "certified"), (1.0 + 2e-6, "failed")])
+@pytest.mark.parametrize(
+    ("est", "status"), [(1.0, "certified"), (1.0 + 2e-6, "failed"), (1.0000000000000002, "failed")]
+)
 def test_a_sampled_value_above_the_bound_fails_the_claim(
     example, monkeypatch: pytest.MonkeyPatch, est: float, status: str
 ) -> None:
@@ -571,11 +573,13 @@ def test_K_bits_grow_with_K_and_are_capped() -> None:
     assert D.K_bits(fmpq(0)) == 113
 
 
-def test_the_safety_net_refutes_only_beyond_float_error(example, monkeypatch) -> None:
-    """Mutation review 20: _constant refutes a value only when a sample exceeds it by more
-    than float error. A sample exactly at val·(1 + 10⁻⁶) + 10⁻³⁰⁰ does not refute a proved
-    L_h (≥ would), and a constant h (interval bound 0, sample 0) has the bound 0 proved (the
-    10⁻³⁰⁰ is what keeps 0 > −10⁻³⁰⁰ from refuting it)."""
+def test_the_safety_net_refutes_exactly_above_the_value(example, monkeypatch) -> None:
+    """Mutation review 20, restated in session 36: the sampled estimate is a proved lower bound
+    (bounds.proved_quotient), so _constant refutes a value exactly when the estimate is above
+    it. An estimate equal to the value does not refute a proved L_h (≥ would); one float
+    spacing above it does; a constant h (interval bound 0, sample 0) has the bound 0 proved."""
+    import math
+
     from obsdesign.api import bind
     from obsdesign.certify.claim import Claims
     from obsdesign.methods.searchspace import claims as C
@@ -583,15 +587,18 @@ def test_the_safety_net_refutes_only_beyond_float_error(example, monkeypatch) ->
 
     sp, rep = example
     bsp = bind(sp)
-    val = rep.parameters["L_h"]
-    at = float(val) * (1 + 1e-6) + 1e-300
-    cases = [(Bound(float(val) / 2, at, 1), val), (Bound(0.0, 0.0, 1), fmpq(0))]
-    for bound, v in cases:
+    val = fmpq(1)
+    cases = [
+        (Bound(0.5, 1.0, 1), val, ClaimStatus.CERTIFIED),
+        (Bound(0.5, math.nextafter(1.0, 2.0), 1), val, ClaimStatus.FAILED),
+        (Bound(0.0, 0.0, 1), fmpq(0), ClaimStatus.CERTIFIED),
+    ]
+    for bound, v, want in cases:
         monkeypatch.setattr(C, "interval_bound", lambda k, spec, b=bound: b)
         c = Claims()
         C._constant(c, bsp, "L_h", v)
         (claim,) = c
-        assert claim.id == "L_h-bound" and claim.status == ClaimStatus.CERTIFIED, claim.detail
+        assert claim.id == "L_h-bound" and claim.status == want, claim.detail
 
 
 def test_an_unproved_constant_fails_unless_the_user_gave_it(example, monkeypatch) -> None:

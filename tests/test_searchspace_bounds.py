@@ -446,7 +446,7 @@ def test_a_sampled_pair_squeezed_by_a_zero_width_side_of_e_is_not_a_quotient() -
     ex = _ex("x1 + 1e4*x2", names=("x1", "x2"))
     lo, hi = [Fraction(0), Fraction(1)], [Fraction(1), Fraction(1)]
     b = B.lipschitz(ex, ["x1", "x2"], ["x1", "x2"], lo, hi, 300, 1e-3)
-    assert b.lower_est <= 1 + 1e-6  # the refutation tolerance of claims._constant
+    assert b.lower_est <= 1  # a proved lower bound since session 36
     assert b.upper >= 1
     if b.lower_est > 0:
         p, q = b.witness
@@ -462,6 +462,68 @@ def test_a_pair_clipped_into_a_narrow_corner_box_is_not_a_quotient() -> None:
     ex = _ex("x1^2 + 3000.7")
     b = B.lipschitz(ex, ["x1"], ["x1"], [Fraction(0)], [Fraction(7, 10)], 300, 1e-9)
     assert b.upper >= 1.4
-    assert b.lower_est <= 1.4 * (1 + 1e-6)  # the refutation tolerance of claims._constant
+    assert Fraction(b.lower_est) <= Fraction(7, 5)  # a proved lower bound since session 36
     p, q = b.witness
     assert np.linalg.norm(np.asarray(p) - np.asarray(q)) > 1e-6
+
+
+# -- the sampled estimate is a proved lower bound (Lipschitz-pair review 35, §5) -----------
+@pytest.mark.parametrize("c", ["300", "500", "700"])
+def test_a_pair_above_the_skip_distance_is_not_float_noise(c: str) -> None:
+    """E = [0, 1] × {1}, h = x1 + c·x2 (L_h^E = 1 exactly): the pair, 5.7 … 8·10⁻⁹ apart,
+    passes the 10⁻³·δ skip, and the float quotient was 1.0000035 … 1.000013 — a true given
+    L_h = 1 failed, exit 1. The quotient is bounded below from the enclosures at the pair."""
+    ex = _ex(f"x1 + {c}*x2", names=("x1", "x2"))
+    lo, hi = [Fraction(0), Fraction(1)], [Fraction(1), Fraction(1)]
+    b = B.lipschitz(ex, ["x1", "x2"], ["x1", "x2"], lo, hi, 300, 1e-3)
+    assert 0.99 < b.lower_est <= 1
+
+
+@pytest.mark.parametrize("offset", ["1e6", "1e7", "1e8"])
+def test_a_large_offset_is_not_a_steeper_slope(offset: str) -> None:
+    """h = x1 + 10⁶ on [0, 1]: L_h = 1 exactly, and the interval bound is 1; the float
+    quotient over 4·10⁻⁶ of values near 10⁶ was 1.0000076 (10⁷: 1.00024), and the design's
+    own L_h = 1 failed its claim, design and verify exit 1 (Lipschitz-pair review, session 35)."""
+    ex = _ex(f"x1 + {offset}")
+    b = B.lipschitz(ex, ["x1"], ["x1"], [Fraction(0)], [Fraction(1)], 300, 1e-3)
+    assert b.upper == 1.0
+    assert 0.9 < b.lower_est <= 1
+
+
+def test_a_sup_norm_sample_is_not_cancellation_noise() -> None:
+    """f = (x1 + 10¹⁷ + 8.1) − 10¹⁷ − x1 − 8 is 1/10 everywhere; floats evaluate it as about
+    8 (10¹⁷ + 8.1 rounds to 10¹⁷ + 16), which as a sampled |f| refuted a true bound. The
+    estimate is the enclosure's lower end at the sample: at most 1/10."""
+    ex = _ex("(x1 + 1e17 + 8.1) - 1e17 - x1 - 8")
+    s = B.sup_norm(ex, ["x1"], [Fraction(0)], [Fraction(1)], 50, 1e-3)
+    assert Fraction(s.lower_est) <= Fraction(1, 10)
+    assert s.upper >= 0.1
+
+
+def test_proved_quotient_and_norm_bound_the_exact_values() -> None:
+    """At float points, the proved quotient and norm are ≤ the exact ones and within a few
+    float spacings of them for a well-conditioned expression; an expression that cannot be
+    enclosed (log at 0) gives 0, and so do equal points."""
+    ex = _ex("x1^2 + 3000.7")
+    p, q = np.array([0.7]), np.array([0.6999])
+    exact = (Fraction(0.7) ** 2 - Fraction(0.6999) ** 2) / (Fraction(0.7) - Fraction(0.6999))
+    got = B.proved_quotient(ex, ["x1"], p, q)
+    assert Fraction(got) <= exact and got > float(exact) * (1 - 1e-8)  # ulp(3000)/10⁻⁴
+    assert B.proved_quotient(ex, ["x1"], p, p) == 0.0
+    assert B.proved_quotient(_ex("log(x1)"), ["x1"], np.array([0.0]), np.array([1.0])) == 0.0
+    n = B.proved_norm_at(_ex("x1 - 3"), ["x1"], np.array([0.5]))
+    assert n == 2.5
+    assert B.proved_norm_at(_ex("x1 - 3"), ["x1"], np.array([3.0])) == 0.0
+
+
+@pytest.mark.parametrize(
+    "xs",
+    [[3.0, 4.0], [1e-300, 1e-300], [1e300, 1e300, 1e300], [0.1, 0.2, 0.3], [5e-324], [0.0]],
+)
+def test_hypot_lo_is_at_most_the_exact_norm(xs: list[float]) -> None:
+    """hypot_lo ≤ √Σx² (checked exactly on the squares) and hypot_hi ≥ it, without overflow
+    or underflow of the squares."""
+    lo, hi = B.hypot_lo(xs), B.hypot_hi(xs)
+    sq = sum(Fraction(x) ** 2 for x in xs)
+    assert Fraction(lo) ** 2 <= sq <= Fraction(hi) ** 2
+    assert lo == 0 or hi / lo < 1 + 1e-15

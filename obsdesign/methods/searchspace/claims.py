@@ -10,6 +10,7 @@ are checked entry by entry, all of them.
 
 from __future__ import annotations
 
+import math
 from fractions import Fraction
 from typing import Any
 
@@ -542,7 +543,14 @@ def _constant(c: Claims, spec: Spec, k: str, val: fmpq) -> None:
     proved_above = proof is not None and fmpq(proof[0].numerator, proof[0].denominator) > Q(
         val
     ) * Q(val)
-    refuted = proved_above or b.lower_est > float(val) * (1 + 1e-6) + 1e-300
+    # the sampled estimate is itself a proved lower bound (the enclosures of F at the
+    # sample's float points, bounds.proved_quotient / proved_norm_at): above the value, it
+    # refutes it exactly. The float quotient it replaced, compared with a 10⁻⁶ relative
+    # tolerance, refuted true constants (h = x1 + 10⁶: 1.0000076 over a 4·10⁻⁶ pair failed
+    # the design's own L_h = 1; Lipschitz-pair review, session 35)
+    refuted = (
+        proved_above or b.lower_est > 0 and (not math.isfinite(b.lower_est) or Q(b.lower_est) > val)
+    )
     proved = b.finite and Q(b.upper) <= val and not refuted
     est = f"sampled lower estimate {b.lower_est:.6g}" + (
         f", interval bound {fmt_up(b.upper, 8)}" if b.finite else ", no finite interval bound"
