@@ -556,6 +556,42 @@ def test_falsification_passes_on_the_3state_spec() -> None:
     assert c.status.value == "numerical" and "no violation" in c.detail
 
 
+@pytest.mark.parametrize(("scale", "sector", "code"), [("1e200", "0.2", 0), ("1e200", "0.19", 1)])
+def test_falsification_reads_a_huge_box_without_overflow(scale: str, sector: str, code: int):
+    """The 3-state spec with x1 ∈ ±10²⁰⁰: ε ≈ 2·10¹⁹⁷ squared to inf, inf − inf gave NaN and a
+    true Assumption 1 (ψ_1 = 0.2 sin x1 in the sector ±0.2) was "violated", exit 1 — and a
+    false numerical "violated" claim verified with on_violation = "warn" (non-finite
+    expressions trial, session 35). (15) is read on φ, ε scaled row-wise; ψ_1 = 0.2·x1 with
+    a sector ±0.19 is still found violated there, with a finite worst value."""
+    txt = (
+        SPEC3.read_text(encoding="utf-8")
+        .replace("lower = [-4, -4, -4]", f"lower = [-{scale}, -4, -4]")
+        .replace("upper = [4, 4, 4]", f"upper = [{scale}, 4, 4]")
+        .replace("samples = 20000", "samples = 2000")
+    )
+    assert scale in txt
+    if sector != "0.2":  # ψ_1 = 0.2·x1 violates the sector ±0.19 at every scale
+        txt = txt.replace("[-0.2, 0.2]", f"[-{sector}, {sector}]").replace("0.2*sin(x1)", "0.2*x1")
+        assert f"-{sector}" in txt and "0.2*x1" in txt
+    rep = api.design(api.load_spec_text(txt, "bigbox.toml"))
+    c = next(c for c in rep.claims if c.id == "assumption1-falsification")
+    assert rep.exit_code() == code, c.detail
+    assert "nan" not in c.detail
+    if code:
+        assert "(15) own part, i = o" in c.detail
+
+
+def test_row_norms_do_not_overflow() -> None:
+    from obsdesign.methods.impulsive.falsify import _rows, _scaled
+
+    a = np.array([[3e200, 4e200], [0.0, 0.0], [np.inf, 1.0], [3e-200, 4e-200]])
+    got = _rows(a)
+    assert got[0] == pytest.approx(5e200) and got[1] == 0 and got[2] == np.inf
+    assert got[3] == pytest.approx(5e-200)
+    ph, e, sc = _scaled(a[:, :1], a[:, 1:])
+    assert sc.tolist() == [4e200, 1.0, 1.0, 4e-200] and ph[0, 0] == 0.75 and e[0, 0] == 1.0
+
+
 # -- shipped numbers (issue 8: no printed number changes) ----------------------------------
 def test_shipped_numbers() -> None:
     p = designed("example")[1].parameters

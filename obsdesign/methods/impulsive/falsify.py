@@ -128,7 +128,26 @@ def _rounding(scale: np.ndarray, denom: np.ndarray, n: int) -> np.ndarray:
 
 
 def _rows(a: np.ndarray) -> np.ndarray:
-    return np.linalg.norm(a, axis=1)
+    """Euclidean norms of the rows, scaled by each row's largest entry first: squared as
+    they were, entries beyond ~10¹⁵⁴ overflowed to inf (and the rounding allowance with
+    them; non-finite expressions trial, session 35)."""
+    m = np.max(np.abs(a), axis=1, initial=0.0) if a.size else np.zeros(a.shape[0])
+    safe = np.where((m > 0) & np.isfinite(m), m, 1.0)
+    with np.errstate(all="ignore"):
+        out = np.linalg.norm(a / safe[:, None], axis=1) * safe
+    return np.where(np.isfinite(m), out, np.inf)
+
+
+def _scaled(phi: np.ndarray, e: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """φ and ε divided row-wise by their largest entry (1 where that is 0 or not finite),
+    and that scale: ω/(‖φ‖² + ‖ε‖²) of (15) is homogeneous of degree 0, and read unscaled
+    ε ≈ 2·10¹⁹⁷ squared to inf, inf − inf made NaN and a true Assumption 1 was "violated",
+    exit 1 (non-finite expressions trial, session 35)."""
+    sc = np.maximum(
+        np.max(np.abs(phi), axis=1, initial=0.0), np.max(np.abs(e), axis=1, initial=0.0)
+    )
+    sc = np.where((sc > 0) & np.isfinite(sc), sc, 1.0)
+    return phi / sc[:, None], e / sc[:, None], sc
 
 
 def _finite(psi_x: np.ndarray, psi_xh: np.ndarray, x: np.ndarray, xh: np.ndarray) -> Violation:
@@ -190,10 +209,11 @@ def falsify_blocks(
     def own(phi: np.ndarray, e: np.ndarray, qsr: tuple[np.ndarray, ...], s_mix: np.ndarray) -> Any:
         """ω/(‖φ‖² + ‖ε‖²) of (15) and its rounding allowance: the error of φ (a difference
         of ψ̄ values) through the quadratic form, relative to √(‖φ‖² + ‖ε‖²)."""
-        norm2 = np.maximum(np.sum(phi**2, 1) + np.sum(e**2, 1), 1e-300)
+        ph, es, sc = _scaled(phi, e)
+        norm2 = np.maximum(np.sum(ph**2, 1) + np.sum(es**2, 1), 1e-300)
         qn = max(float(np.linalg.norm(np.block([[qsr[0], qsr[1]], [qsr[1].T, qsr[2]]]), 2)), 1.0)
-        return _qsr_value(phi, e, *qsr) / norm2, 2 * qn * _rounding(
-            s_z + s_mix, np.sqrt(norm2), dim
+        return _qsr_value(ph, es, *qsr) / norm2, 2 * qn * _rounding(
+            s_z + s_mix, np.sqrt(norm2) * sc, dim
         )
 
     # own parts
@@ -205,9 +225,9 @@ def falsify_blocks(
         w, r = own(phi_n, en, qsr_n, size(p_mn, mix_n, ell))
         items.append(_worst("(15) own part, i = n", -w[ok_n], x[ok_n], xh[ok_n], tol + r[ok_n]))
         # cross parts
-        c_o = np.linalg.norm(p_zh[:, :m] - p_mo[:, :m], axis=1)
-        c_n = np.linalg.norm(p_zh[:, m:] - p_mn[:, m:], axis=1)
-        ne_n, ne_o = np.linalg.norm(en, axis=1), np.linalg.norm(eo, axis=1)
+        c_o = _rows(p_zh[:, :m] - p_mo[:, :m])
+        c_n = _rows(p_zh[:, m:] - p_mn[:, m:])
+        ne_n, ne_o = _rows(en), _rows(eo)
         s_zh = size(p_zh, zh, ell)
         sel = ok_o & (ne_n > 1e-12)
         ratio = c_o[sel] / ne_n[sel]
@@ -234,9 +254,9 @@ def falsify_lipschitz_x(
         rng = np.random.default_rng(seed)
         x, xh = sample_pairs(rng, lo, hi, samples)
         px, pxh = psi(x), psi(xh)
-        d = np.linalg.norm(xh - x, axis=1)
+        d = _rows(xh - x)
         sel = d > 1e-12
-        ratio = np.linalg.norm(pxh - px, axis=1)[sel] / d[sel]
+        ratio = _rows(pxh - px)[sel] / d[sel]
         scale = _rows(px) + _rows(pxh) + (1.0 + ell) * (_rows(x) + _rows(xh))
         r = _rounding(scale[sel], d[sel], x.shape[1])
         items = [
