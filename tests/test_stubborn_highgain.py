@@ -285,6 +285,40 @@ def test_high_gain_f_form_is_checked_too() -> None:
     api.load_spec(DUFFING)
 
 
+@pytest.mark.parametrize("psi0", ["max(x1, 1/0)", "sat(x1, 0/0)"])
+def test_an_undefined_psi_is_bad_input_in_the_triangular_check(psi0: str) -> None:
+    """sympy refuses Max(x1, zoo) ("not comparable"): the high-gain triangular-form check was
+    exit 3 "internal failure" (non-finite expressions trial, session 35); it is bad input
+    naming the expression now."""
+    spec = _HG.format(A=_CHAIN, psi=f'["{psi0}", "0", "0"]', L=1)
+    with pytest.raises(SpecError) as ei:
+        api.load_spec_text(spec, "hg.toml")
+    assert ei.value.exit_code == 2 and ei.value.key == "system.psi[0]"
+    assert "triangular-form check" in ei.value.message
+
+
+def test_the_triangular_check_expands_only_what_is_small() -> None:
+    """(x1 + 1)^300000 was expanded at load (6 GB, then MemoryError, exit 3: same trial). A ψ_i
+    free of later states is never expanded; one with a later state is expanded only when
+    small, so (x1 + x2)^2 − x2² − 2x1x2 still cancels to x1², and (x1 + x2)^100 − x2^100 is
+    refused without expanding, saying why."""
+    from obsdesign.methods.stubborn import options as O
+
+    big = _HG.format(A=_CHAIN, psi='["(x1+1)^300000", "0", "0"]', L=1)
+    assert api.load_spec_text(big, "hg.toml") is not None
+    ok = _HG.format(A=_CHAIN, psi='["(x1+x2)^2 - x2^2 - 2*x1*x2", "0", "0"]', L=1)
+    assert api.load_spec_text(ok, "hg.toml") is not None
+    bad = _HG.format(A=_CHAIN, psi='["(x1+x2)^100 - x2^100", "0", "0"]', L=1)
+    with pytest.raises(SpecError) as ei:
+        api.load_spec_text(bad, "hg.toml")
+    assert "too large to expand" in ei.value.message and ei.value.key == "system.psi"
+    import sympy
+
+    x = sympy.Symbol("x")
+    assert O._expandable((x + 1) ** O.EXPAND_MAX_POWER)
+    assert not O._expandable((x + 1) ** (O.EXPAND_MAX_POWER + 1))
+
+
 def test_high_gain_warns_when_L_misses_the_linear_part_of_A() -> None:
     """A = A₀ + 5·e₂e₁ᵀ with L = 0.1 (the ψ's constant, not φ's): the design says that L does
     not cover A's terms below the chain, and its statements name A₀, not the spec's A."""

@@ -118,17 +118,52 @@ def _check_triangular(spec: Spec) -> None:
                     )
     exprs, key = (s.f, "system.f") if s.f is not None else (s.psi, "system.psi")
     for i, e in enumerate((exprs or [])[: n - 1]):
-        phi = e.sympy() - (sympy.Symbol(s.states[i + 1]) if s.f is not None else 0)
-        later = {str(v) for v in sympy.expand(phi).free_symbols} & set(s.states[i + 1 :])
+        later_states = set(s.states[i + 1 :])
+        try:
+            phi = e.sympy() - (sympy.Symbol(s.states[i + 1]) if s.f is not None else 0)
+            later = {str(v) for v in phi.free_symbols} & later_states
+            # expanded only where a later state is left, and only when small: expanding
+            # (x1 + 1)^300000 took 6 GB at load (non-finite expressions trial, session 35)
+            small = _expandable(phi)
+            if later and small:
+                later = {str(v) for v in sympy.expand(phi).free_symbols} & later_states
+        except (ArithmeticError, TypeError, ValueError, RecursionError) as err:
+            # max(x1, 1/0), sat(x1, 0/0): sympy's "not comparable" was exit 3 (same trial)
+            raise SpecError(
+                spec.file,
+                f"{key}[{i}]",
+                f"cannot be read for the high-gain triangular-form check: {err}",
+            ) from None
         if later:
             what = f"{key}[{i}]" + (f" − {s.states[i + 1]}" if s.f is not None else "")
             raise SpecError(
                 spec.file,
                 key,
-                f"{what} depends on {', '.join(sorted(later))}: mode = 'high-gain' needs the "
+                f"{what} depends on {', '.join(sorted(later))}"
+                + ("" if small else " (too large to expand and cancel)")
+                + ": mode = 'high-gain' needs the "
                 f"triangular form ẋ_i = x_{{i+1}} + φ_i(x_1..x_i) (φ_{i + 1} of "
                 f"{', '.join(s.states[: i + 1])} only)",
             )
+
+
+#: the triangular-form check expands φ_i only with at most this many operations and integer
+#: powers of at most this degree (:func:`_expandable`)
+EXPAND_MAX_OPS = 2000
+EXPAND_MAX_POWER = 64
+
+
+def _expandable(phi: Any) -> bool:
+    """Whether sympy may expand φ_i to cancel a dependence: at most :data:`EXPAND_MAX_OPS`
+    operations and no integer power above :data:`EXPAND_MAX_POWER` (expansion grows with
+    the power's binomial coefficients)."""
+    import sympy
+
+    if sympy.count_ops(phi) > EXPAND_MAX_OPS:
+        return False
+    return all(
+        not (p.exp.is_Integer and abs(int(p.exp)) > EXPAND_MAX_POWER) for p in phi.atoms(sympy.Pow)
+    )
 
 
 def parse_options(table: Table, spec: Spec) -> Options:
