@@ -936,6 +936,21 @@ def _left_float_range(res: SimResult) -> str | None:
             "finite; take smaller initial states"
         )
     at = float(res.t[first]) if first < len(res.t) else float(first)
+    before = max(
+        (float(np.max(np.abs(a[first - 1]))) for a in (res.x, res.xhat) if a.ndim == 2),
+        default=0.0,
+    )
+    if before < 1e100:
+        # u = 1e308*10*t, 1/t, log(x1) at x̂ = 0: the first non-finite sample followed values
+        # far inside the float range, and "the plant or the observer diverges" was false
+        # (non-finite expressions trial, session 35)
+        return (
+            f"the trajectory is not finite from t = {at:g} on (sample {first} of "
+            f"{len(res.t)}), one step after values of at most {before:.3g}: an input u(t) or the "
+            "field of the plant or the observer is not finite there (an expression undefined or "
+            "beyond the float range, such as 1/t at t = 0 or log of a value ≤ 0), so the "
+            "metrics are not finite"
+        )
     return (
         f"the trajectory leaves the float range at t = {at:g} (sample {first} of {len(res.t)}): "
         "the plant or the observer diverges over this horizon, so the metrics are not finite; "

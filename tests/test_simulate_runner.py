@@ -114,6 +114,23 @@ def test_a_diverging_trajectory_gets_a_plain_warning():
     assert not any("float range" in w for w in res.info.get("warnings", []))
 
 
+def test_an_input_that_is_not_finite_is_not_called_a_divergence() -> None:
+    """u = 1e308·10·t is inf from the first step: the warning blamed a divergence of the plant
+    or the observer (non-finite expressions trial, session 35). One step after values far
+    inside the float range, it names a non-finite input or field instead."""
+    from obsdesign import api
+
+    text = (
+        '[system]\ntime = "continuous"\nA = [[0, 1], [-1, 0]]\nB = [[0], [1]]\n'
+        'C = [[1, 1]]\nu = ["1e308*10*t"]\n[method]\nkey = "stubborn"\n'
+        "[simulate]\nhorizon = 0.05\ndt = 0.001\nx0 = [1, 0]\nxhat0 = [0.9, 0]\n"
+    )
+    res = api.simulate(load_spec_text(text, "u.toml"))
+    first = next(w for w in res.info["warnings"] if "finite" in w)
+    assert "an input u(t) or the field" in first and "diverges" not in first
+    assert "one step after values of at most 1:" in first
+
+
 def test_obsdesign_simulate_stays_callable_after_the_subpackage_loads() -> None:
     """README's ``obsdesign.simulate(spec)``: the first call imports ``obsdesign.simulate.*``,
     which rebinds the package attribute to the subpackage; the subpackage is callable, so a
