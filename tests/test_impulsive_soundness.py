@@ -581,6 +581,32 @@ def test_falsification_reads_a_huge_box_without_overflow(scale: str, sector: str
         assert "(15) own part, i = o" in c.detail
 
 
+@pytest.mark.parametrize(
+    ("sector", "error", "text"),
+    [
+        ("1e160", "InfeasibleError", "κ_n = -2e+160 ≤ λ*_no"),
+        ("1e200", "InfeasibleError", "κ_n = -2e+200 ≤ λ*_no"),
+        ("1e300", "InconclusiveError", "the float search of κ_n gave"),
+    ],
+)
+def test_a_huge_sector_is_reported_for_what_it_is(sector: str, error: str, text: str) -> None:
+    """Sector [0, s] of block n: κ_n = max_θ −λ_max(Ā_n + Ā_nᵀ + (1 + θs)²/θ) = 6 − 4s. With
+    s = 10¹⁶⁰ the whole first θ grid overflowed, its NaN was taken as the minimum and the
+    design said "I + S_n ∉ range Q_n" (false: Q_n = −I); with 10²⁰⁰ it printed κ_n =
+    −5.8·10³⁰⁷ (non-finite expressions trial, session 35). Now the search steps past the
+    overflow: κ_n = −2s exactly as printed; where no θ within e^±600 avoids it (10³⁰⁰), the
+    design is inconclusive, exit 4, saying so."""
+    from obsdesign.errors import InconclusiveError, InfeasibleError
+
+    txt = SPEC3.read_text(encoding="utf-8").replace("sector = [0, 0.3]", f"sector = [0, {sector}]")
+    assert sector in txt
+    sp = api.load_spec_text(txt, "huge.toml")
+    errors = {"InfeasibleError": InfeasibleError, "InconclusiveError": InconclusiveError}
+    with pytest.raises(errors[error]) as ei:
+        api.design(sp)
+    assert text in str(ei.value) and "range Q_n" not in str(ei.value)
+
+
 def test_row_norms_do_not_overflow() -> None:
     from obsdesign.methods.impulsive.falsify import _rows, _scaled
 

@@ -360,9 +360,16 @@ def design_window(p: Problem) -> tuple[dict[str, Any], list[str]]:
     varpi = -certified_rate(co.Ao, data.qsr_o, th_o, ko)
     # Lemma 1: κ_n = largest ssd rate of Σ(Ā_n, I, I)
     kn_f, th_n, resid = best_rate(Af["An"], data.qsr_n, p.optimize_scaling)
-    if not np.isfinite(kn_f) or resid > 1e-7:
+    if resid > 1e-7:
         raise Infeasible(
             "Lemma 1: no κ_n makes Σ(Ā_n, I, I) (−R_n, −S_nᵀ, −Q_n)-ssd (I + S_n ∉ range Q_n)"
+        )
+    if not np.isfinite(kn_f) or not np.isfinite(resid):
+        # not the range condition: the float search overflowed (it was reported as "I + S_n
+        # ∉ range Q_n" for a sector [0, 10¹⁶⁰]; non-finite expressions trial, session 35)
+        raise InconclusiveError(
+            f"Lemma 1: the float search of κ_n gave {kn_f} (the QSR data of block n, "
+            "scaled, overflow float64); scale the sector / QSR numbers down"
         )
     kappa_n = certified_rate(co.An, data.qsr_n, th_n, kn_f)
     n_no, n_on = norm_upper(co.Ano), norm_upper(co.Aon)

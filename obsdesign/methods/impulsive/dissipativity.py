@@ -20,6 +20,7 @@ scale invariant; the tool picks θ (rounded to a dyadic rational) to minimize ϖ
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -189,8 +190,14 @@ def best_rate(Ablk: np.ndarray, qsr: QSR, optimize: bool) -> tuple[float, fmpq, 
 
     def neg(lt: float) -> float:
         t = float(np.exp(lt))
-        r, res = best_rate_float(Ablk, t * Qm, t * S, t * R)
-        return -r + (1e6 * res if res > 1e-9 else 0.0)
+        with np.errstate(all="ignore"):
+            r, res = best_rate_float(Ablk, t * Qm, t * S, t * R)
+        v = -r + (1e6 * res if res > 1e-9 else 0.0)
+        # an overflowed θ (NaN or inf) is the worst value, not the first argmin: a sector
+        # [0, 10¹⁶⁰] overflowed (θS)² on the whole first grid, and its NaN was taken as the
+        # minimum ("I + S_n ∉ range Q_n", a false reason; non-finite expressions trial,
+        # session 35)
+        return v if math.isfinite(v) else math.inf
 
     lo, hi = _bracket_log_theta(neg)
     from scipy.optimize import minimize_scalar  # loaded by the designs that need it
