@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import ast
 import math
+import sys
 from fractions import Fraction
 from itertools import combinations, product
 from typing import Any
@@ -31,6 +32,7 @@ from obsdesign.methods.searchspace.intervals import (
     d_abs,
     d_frac,
     d_max,
+    d_min,
     d_step,
     evaluate,
     mul_hi,
@@ -1136,11 +1138,16 @@ def test_a_nan_end_point_is_refused_and_overflowing_sinh_cosh_are_unbounded() ->
         with pytest.raises(ArithmeticError, match="NaN"):
             I(lo, hi)
     big = I(1e39, 1e39)
+    top = sys.float_info.max
     for fn in ("sinh", "cosh"):
         d = IV.d_fn(Dual(big, (ONE,)), fn)
-        assert d.v.hi == math.inf and d.v.lo <= 1.7e308  # an enclosure, not NaN
-        assert d_step(d).v.hi == 1.0  # not [0, 0]
+        # beyond the largest float, not NaN (session 35), and not (−∞, ∞) either: |sinh x|
+        # and cosh x pass it from |x| ≈ 711 (re-check trial, session 35: cosh ≥ 1 was lost)
+        assert d.v.hi == math.inf and d.v.lo == top
+        assert d_step(d).v.lo == d_step(d).v.hi == 1.0  # not [0, 0]
         assert d_max(Dual(I(0.5, 0.5), (ZERO,)), d).v.hi == math.inf
-    assert IV.cosh(I(-1e39, -1e39)).hi == math.inf
+        assert d_min(Dual(I(1.0, 1.0), (ZERO,)), d).v == I(1.0, 1.0)
+    assert IV.cosh(I(-1e39, -1e39)) == I(top, math.inf)
     s = IV._monotone("sinh", I(-1e39, -1e39))
-    assert s.lo == -math.inf  # sinh(−1e39) is hugely negative: never a finite lower end
+    assert s == I(-math.inf, -top)  # sinh(−1e39) is hugely negative: never a finite lower end
+    assert IV._arb_point("sinh", 710.0)[1] < top  # finite where floats hold it

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import ast
 import math
+import sys
 from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any
@@ -289,7 +290,13 @@ def _arb_point(fn: str, x: float) -> tuple[float, float]:
         return (-INF, INF)
     b = getattr(arb(x), fn)()
     lo, hi = float(b.lower()), float(b.upper())
-    # arb's ball is NaN where its exponent outgrows it (cosh of 1e39): no bound at all
+    if (lo != lo or hi != hi) and fn in ("sinh", "cosh") and abs(x) > 1000.0:
+        # arb's ball is NaN where its exponent outgrows it (cosh of 1e39), but |sinh x| and
+        # cosh x exceed the largest float from |x| ≈ 711 on: (−∞, ∞) lost cosh ≥ 1, and
+        # min(1, cosh(1e39)) was unbounded (re-check trial, session 35)
+        big = sys.float_info.max
+        return (big, INF) if (fn == "cosh" or x > 0) else (-INF, -big)
+    # otherwise NaN is no bound at all
     return (-INF if lo != lo else _down(lo)), (INF if hi != hi else _up(hi))
 
 
