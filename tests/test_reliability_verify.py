@@ -49,6 +49,20 @@ def test_added_claim_fails(good):
     assert rep.exit_code() == 1
 
 
+@pytest.mark.parametrize("mark", ["\U000e0020", "\u034f", "\ufe0f", "\u3164", "\U0001d173"])
+def test_an_added_claim_id_is_shown_in_ascii(good, mark: str) -> None:
+    """A tag character, U+034F, U+FE0F or U+3164 appended to a claim id printed
+    "report-adds:<id>" beside "report-omits:<id>", the two looking identical (re-check
+    trial, session 35): the added id is shown in ASCII escapes."""
+    d = copy.deepcopy(good)
+    cid = d["claims"][0]["id"]
+    d["claims"][0]["id"] = cid + mark
+    failed = _failed(_verify(d))
+    esc = mark.encode("ascii", "backslashreplace").decode("ascii")
+    assert failed == {f"report-adds:{cid}{esc}", f"report-omits:{cid}"}
+    assert all(x.isascii() for x in failed)
+
+
 def test_duplicated_claim_fails(good):
     d = copy.deepcopy(good)
     d["claims"].append(copy.deepcopy(d["claims"][0]))
