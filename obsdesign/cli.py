@@ -498,7 +498,9 @@ def _timeout_opt(unit: str) -> Any:
             metavar="SECONDS",
             min=0,
             help=f"Time budget per {unit} (0 or inf: none); a {unit} past it gets exit 3 and "
-            "the others still run (on Dask too: applied in the worker).",
+            "the others still run (on Dask too: applied in the worker). It stops a "
+            f"{unit} only between imports: a budget below ~0.1 s can be overrun by the first "
+            f"{unit}'s imports.",
         ),
     ]
 
