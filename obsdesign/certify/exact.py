@@ -112,6 +112,17 @@ def _qfloat(x: Any) -> float:
     return float(x)
 
 
+def frac(x: Any) -> Fraction:
+    """An exact number (fmpq, Fraction, int, a float or numpy scalar as it is) as a Fraction."""
+    if isinstance(x, fmpq):
+        return Fraction(int(x.p), int(x.q))
+    if isinstance(x, (float, np.floating)):
+        return Fraction(float(x))
+    if isinstance(x, np.integer):  # Fraction(np.int64) keeps a numpy numerator, which fmpq
+        return Fraction(int(x))  # refuses (canonical with an integer array; mutation review)
+    return Fraction(x)
+
+
 def dyadic(a: Any, bits: int = 24) -> QMatrix | fmpq:
     """Round each float to ``bits`` significant bits (a dyadic rational) and return it exactly.
 

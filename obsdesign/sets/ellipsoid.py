@@ -7,6 +7,7 @@ from fractions import Fraction
 
 import numpy as np
 
+from obsdesign.certify.exact import frac
 from obsdesign.sets.base import ConvexSet, float_view
 
 
@@ -57,16 +58,12 @@ class Ellipsoid(ConvexSet):
 
     def _form_q(self, x: np.ndarray) -> Fraction:
         """(x − c)ᵀE(x − c) exactly, for the float point x as it is."""
-        d = [
-            Fraction(float(v)) - Fraction(int(c.p), int(c.q))
-            for v, c in zip(x, self.center_q, strict=True)
-        ]
+        d = [frac(float(v)) - frac(c) for v, c in zip(x, self.center_q, strict=True)]
         E = self.E_q
         return sum(
-            (d[i] * Fraction(int(E[i, j].p), int(E[i, j].q)) * d[j])
-            for i in range(len(d))
-            for j in range(len(d))
-        ) or Fraction(0)
+            (d[i] * frac(E[i, j]) * d[j] for i in range(len(d)) for j in range(len(d))),
+            start=Fraction(0),
+        )
 
     def bounding_box(self) -> tuple[np.ndarray, np.ndarray]:
         half = np.sqrt(np.diag(np.linalg.inv(self.E)))

@@ -15,13 +15,9 @@ from fractions import Fraction
 import numpy as np
 from flint import fmpq
 
-from obsdesign.certify.exact import Q, to_float
+from obsdesign.certify.exact import Q, frac, to_float
 from obsdesign.sets import polytope_ops as po
 from obsdesign.sets.base import ConvexSet, float_view
-
-
-def _frac(q: fmpq) -> Fraction:
-    return Fraction(int(q.p), int(q.q))
 
 
 def vertices_exact(G_q: np.ndarray, g_q: np.ndarray) -> tuple[np.ndarray, bool]:
@@ -34,7 +30,7 @@ def vertices_exact(G_q: np.ndarray, g_q: np.ndarray) -> tuple[np.ndarray, bool]:
     import cdd
     import cdd.gmp
 
-    rows = [[_frac(g_q[i])] + [-_frac(v) for v in G_q[i]] for i in range(G_q.shape[0])]
+    rows = [[frac(g_q[i])] + [-frac(v) for v in G_q[i]] for i in range(G_q.shape[0])]
     mat = cdd.gmp.matrix_from_array(rows, rep_type=cdd.RepType.INEQUALITY)
     gen = cdd.gmp.copy_generators(cdd.gmp.polyhedron_from_matrix(mat))
     verts, bounded = [], not gen.lin_set
@@ -189,10 +185,8 @@ class Polytope(ConvexSet):
     def _row_q(self, i: int, x: np.ndarray) -> Fraction:
         """G_i x − g_i exactly, for the float point x as it is."""
         row = self.G_q[i]
-        total = sum(
-            (_frac(row[j]) * Fraction(float(v)) for j, v in enumerate(x)), start=Fraction(0)
-        )
-        return total - _frac(self.g_q[i])
+        total = sum((frac(row[j]) * Fraction(float(v)) for j, v in enumerate(x)), start=Fraction(0))
+        return total - frac(self.g_q[i])
 
     def vertices_q(self) -> np.ndarray:
         """Exact vertices (cdd.gmp), enumerated once per polytope."""

@@ -32,6 +32,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from flint import fmpq
 
+from obsdesign.certify.exact import frac
+
 if TYPE_CHECKING:
     from scipy.spatial import ConvexHull
 
@@ -301,14 +303,7 @@ def check_polytope(G: np.ndarray) -> None:
 # =============================================================================== exact mode
 
 
-def _fr(x: Any) -> Fraction:
-    if isinstance(x, fmpq):
-        return Fraction(int(x.p), int(x.q))
-    if isinstance(x, (float, np.floating)):
-        return Fraction(float(x))
-    if isinstance(x, np.integer):  # Fraction(np.int64) keeps a numpy numerator, which fmpq
-        return Fraction(int(x))  # refuses (canonical with an integer array; mutation review)
-    return Fraction(x)
+_fr = frac
 
 
 def _q(x: Fraction) -> fmpq:
