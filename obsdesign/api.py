@@ -1185,7 +1185,9 @@ def budget_seconds(timeout: Any, name: str = "timeout") -> float | None:
     budget (None); a non-negative real number is seconds. A boolean, a string, NaN or a
     negative number is an :class:`InputError` (−1 reached setitimer's raw "Invalid argument",
     NaN and −10⁻⁹ ran without a limit, "1" was a TypeError and True one second; re-check
-    trial, session 35)."""
+    trial, session 35).
+
+    :param timeout: the budget given; :param name: how the error message names it."""
     import numbers
 
     if timeout is None:
