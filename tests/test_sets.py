@@ -369,3 +369,17 @@ def test_polytope_contains_rel_reads_a_far_sheared_strip_exactly() -> None:
     assert row(out) > Fraction(1, 10**4) * 2 and abs(row(inside)) < Fraction(1, 10**4) / 2
     assert P.contains_rel(np.vstack([out, inside])).tolist() == [False, True]
     assert P.contains_rel(np.array([[np.nan, 0.0], [np.inf, 0.0]])).tolist() == [False, False]
+
+
+def test_a_polytope_with_vertices_beyond_the_float_range_keeps_its_row_widths() -> None:
+    """Rows x1 + x2 and x1 + (1 + 2⁻⁴⁰)x2, each within ±10³⁰⁰: vertices near 10³¹², beyond
+    the float range. The exact vertices went through a float conversion that raised
+    OverflowError; as ±inf their projections made every row's width inf − inf = NaN, and a
+    point at x1 + x2 = 3·10³⁰⁰ read as inside. The widths come from the exact vertices there."""
+    e, b = fmpq(1, 2**40), fmpq(10**300)
+    P = Polytope(qmat([[1, 1], [-1, -1], [1, 1 + e], [-1, -1 - e]]), qvec([b, b, b, b]))
+    assert not np.all(np.isfinite(P.vertices()))
+    lo, hi = P._row_extent()
+    assert lo.tolist() == [-1e300] * 4 and hi.tolist() == [1e300] * 4
+    pts = np.array([[0.0, 0.5], [3e300, 0.0], [-3e300, 0.0]])
+    assert P.contains_rel(pts).tolist() == [True, False, False]

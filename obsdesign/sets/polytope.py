@@ -15,7 +15,7 @@ from fractions import Fraction
 import numpy as np
 from flint import fmpq
 
-from obsdesign.certify.exact import Q, frac, to_float
+from obsdesign.certify.exact import Q, float_or_inf, frac, to_float
 from obsdesign.sets import polytope_ops as po
 from obsdesign.sets.base import ConvexSet, float_view
 
@@ -167,20 +167,43 @@ class Polytope(ConvexSet):
         one = X.ndim == 1
         X2 = X.reshape(-1, self.dim)
         G, g = self.G, self.g
-        proj = self.vertices() @ G.T
-        mag = np.maximum(np.abs(proj).max(axis=0), np.abs(g))
-        slack = rel * (proj.max(axis=0) - proj.min(axis=0)) + 4 * np.spacing(mag)
+        lo, hi = self._row_extent()
+        mag = np.maximum(np.maximum(np.abs(lo), np.abs(hi)), np.abs(g))
         with np.errstate(all="ignore"):
+            slack = rel * (hi - lo) + 4 * np.spacing(mag)
             r = X2 @ G.T - g
             s = np.abs(X2) @ np.abs(G).T + np.abs(g)
             err = 4 * (self.dim + 8) * np.finfo(float).eps * s
         ok = r <= slack
         finite = np.isfinite(X2).all(axis=-1)
-        unsure = finite[:, None] & ~(np.abs(r - slack) > err)
+        unsure = finite[:, None] & ~(np.abs(r - slack) > err) & np.isfinite(slack)[None, :]
         for k, i in zip(*np.nonzero(unsure), strict=True):
             ok[k, i] = self._row_q(int(i), X2[k]) <= Fraction(float(slack[i]))
         out = np.all(ok, axis=-1) & finite
         return bool(out[0]) if one else out.reshape(X.shape[:-1])
+
+    def _row_extent(self) -> tuple[np.ndarray, np.ndarray]:
+        """min and max of G_i v over the vertices, per row, in floats (once per polytope):
+        from the float vertices, or exactly where a vertex is beyond the float range (nearly
+        parallel rows), whose inf − inf made a row's width NaN."""
+        ext = self.__dict__.get("_row_extent_f")
+        if ext is None:
+            V = self.vertices()
+            if np.all(np.isfinite(V)):
+                proj = V @ self.G.T
+                ext = (proj.min(axis=0), proj.max(axis=0))
+            else:
+                P = [
+                    [sum((a * b for a, b in zip(row, v, strict=True)), fmpq(0)) for row in self.G_q]
+                    for v in self.vertices_q()
+                ]
+                cols = list(zip(*P, strict=True))
+                ext = (
+                    np.array([float_or_inf(min(c)) for c in cols]),
+                    np.array([float_or_inf(max(c)) for c in cols]),
+                )
+            self.__dict__["_row_extent_f"] = ext
+        return ext
 
     def _row_q(self, i: int, x: np.ndarray) -> Fraction:
         """G_i x − g_i exactly, for the float point x as it is."""
@@ -208,7 +231,10 @@ class Polytope(ConvexSet):
         V = self.__dict__.get("_vertices_f")
         if V is None:
             if po.HAVE_GMP:
-                V = np.asarray(to_float(self.vertices_q()), dtype=float).reshape(-1, self.dim)
+                # a vertex beyond the float range (nearly parallel rows) is ±inf, not an
+                # OverflowError
+                Vq = self.vertices_q()
+                V = np.array([float_or_inf(v) for v in Vq.flat], dtype=float).reshape(-1, self.dim)
             else:
                 V = _checked_float_vertices(self.G, self.g)
             V.setflags(write=False)
