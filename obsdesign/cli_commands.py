@@ -904,9 +904,12 @@ def _flags_known(method: Any, runs: int | None, study: str | None) -> None:
     for flag, name, val in (("--runs", "runs", runs), ("--study", "study", study)):
         if val is not None and name not in known:
             have = [k for k in method_keys() if name in {o.name for o in get_method(k).sim_options}]
+            # "simulate makes one run" was false for impulsive, which has runs but no study
+            # (simulate review, session 36)
+            what = "one run" if "runs" not in known else "its runs, without a study"
             raise InputError(
                 f"{flag} {val}: method '{method.key}' has no {name} option (simulate makes "
-                f"one run; {flag} is for {', '.join(have)})"
+                f"{what}; {flag} is for {', '.join(have)})"
             )
 
 

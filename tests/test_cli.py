@@ -392,6 +392,17 @@ def test_a_flag_the_method_lacks_is_named_as_typed(flag: str, value: str, have: 
     assert r.exit_code == 2, r.output
     assert f"{flag} {value}: method 'constrained' has no" in r.output
     assert f"{flag} is for {have})" in r.output and "--option" not in r.output
+    assert "simulate makes one run" in " ".join(r.output.split())
+
+
+def test_study_on_a_method_with_runs_does_not_say_one_run() -> None:
+    """``--study outliers`` on an impulsive spec said "simulate makes one run"; impulsive
+    makes ``runs`` runs (20 by default) and has no study (simulate review, session 36)."""
+    spec = SPEC.parent / "impulsive-sector-3state.toml"
+    r = CliRunner().invoke(app, ["simulate", str(spec), "--study", "outliers"])
+    out = " ".join(r.output.split())
+    assert r.exit_code == 2, r.output
+    assert "simulate makes its runs, without a study; --study is for stubborn" in out
 
 
 def test_check_refuses_stdin_plainly() -> None:

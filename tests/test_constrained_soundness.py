@@ -1160,3 +1160,22 @@ def test_ellipsoid_map_witness_along_the_axes_of_a_rotated_xhat() -> None:
     w = CL.cmin_witness(cm, eps, xh)
     assert w is not None
     assert cm.norm_c_sq_q(w) <= eps**2 and not CL.contains_q(xh, w)
+
+
+def test_theta_covers_prints_a_bound_below_a_large_theta() -> None:
+    """θ = 44524601863 against the exact (v_max − v_min)/(γ ε_min²) = 44524601862.96: the
+    detail rounded up to 10 digits printed "≤ 44524601870", above θ, so a true claim looked
+    self-contradictory (simulate review, session 36). Enough digits show it below θ."""
+    from obsdesign.methods.constrained.claims import _theta_covers
+
+    c = Claims()
+    theta = fmpq(44524601863)
+    need_top = fmpq(4452460186296, 100)  # v_min = 0, γ = ε_min = 1: need = 44524601862.96
+    _theta_covers(c, "theta", theta, "v_max", need_top, fmpq(0), fmpq(1), fmpq(1), "eq. (22)")
+    (claim,) = c
+    assert claim.status == ClaimStatus.CERTIFIED
+    shown = Q(claim.detail.split("≤ ")[-1])
+    assert need_top <= shown <= theta
+    c = Claims()
+    _theta_covers(c, "theta", theta - 1, "v_max", need_top, fmpq(0), fmpq(1), fmpq(1), "(22)")
+    assert next(iter(c)).status == ClaimStatus.FAILED

@@ -399,7 +399,9 @@ def _theta_covers(
         reference=_ref(where),
         check=f"exact rational comparison; {sym} an integer",
         passed=theta >= need and _is_int(theta),
-        detail=f"{ratio} ≤ {fmt_up(need, 10)}",
+        # enough digits that a bound below the integer θ prints below it: 10 showed
+        # "θ = 44524601863 ≥ …" beside "… ≤ 44524601870" (simulate review, session 36)
+        detail=f"{ratio} ≤ {fmt_up(need, max(10, len(str(abs(int(theta)))) + 3))}",
     )
 
 
