@@ -37,6 +37,17 @@ def test_simulate_enters_ball(tmp_path: Path) -> None:
     assert png.exists() and png.stat().st_size > 10_000
 
 
+def test_a_zero_initial_error_that_stays_zero_is_noise_free_decay(tmp_path: Path) -> None:
+    """x̂_0 = x_0: the noise-free error is 0 throughout, and "noise_free_decay: False" (a strict
+    < against its start) read as a failed guarantee beside a certified window (simulate
+    review, session 36)."""
+    text = _spec3().replace("xhat0 = [0, 0, 0]", "xhat0 = [1, -1, 2]")
+    assert "xhat0 = [1, -1, 2]" in text
+    spec = load_spec_text(text, str(tmp_path / "s.toml"))
+    info = get_method("impulsive").simulate(spec, api.design(spec).parameters).info
+    assert info["noise_free_final_eps_max"] == 0.0 and info["noise_free_decay"] is True
+
+
 def test_sampling_file(tmp_path: Path) -> None:
     (tmp_path / "h.txt").write_text("\n".join(["0.5", "0.9", "1.2"] * 5), encoding="utf-8")
     spec = load_spec_text(_spec3('\nsampling_file = "h.txt"'), str(tmp_path / "s.toml"))

@@ -246,7 +246,13 @@ def simulate(
         "diverged_runs": int(noisy.diverged.sum()),
         "plant_escaped_runs": int(noisy.escaped.sum()),
         "noise_free_final_eps_max": float(cl_end.max()),
-        "noise_free_decay": bool(np.all(cl_end < cl_start) and not clean.diverged.any()),
+        # a run that starts at ε = 0 decays when it stays there: the strict < alone printed
+        # "noise_free_decay: False" beside "noise_free_final_eps_max: 0.0" for x̂_0 = x_0
+        # (simulate review, session 36)
+        "noise_free_decay": bool(
+            np.all((cl_end < cl_start) | ((cl_start == 0) & (cl_end == 0)))
+            and not clean.diverged.any()
+        ),
         "open_loop_final_eps": float(open_.eps[0, np.nonzero(open_.valid[0])[0][-1]]),
     }
     info["quantiles"] = run_quantiles(noisy, list(spec.system.states))
