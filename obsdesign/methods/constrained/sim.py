@@ -263,7 +263,7 @@ def simulate(
             )
             info[f"{name}: x̂_k in X̂ for all k ≥ 1"] = bool(np.all(Xhat.contains_rel(tr.xhat[1:])))
             worst = tr.v_increase if tr.v_increase > -np.inf else 0.0
-            info[f"{name}: max V increase over a refining step"] = f"{worst:.3g}"
+            info[f"{name}: max relative V increase over a refining step"] = f"{worst:.3g}"
         if name.startswith("saturated"):
             info[f"{name}: final x̂"] = _fmt(tr.xhat[-1])
     outside = _outside_premises(o, x, u, d, v, sm.xhat0.f, Xhat)
