@@ -86,6 +86,8 @@ class SimOptions:
     hf_start: float = 0.0
     hf_stop: float = 0.0
     hf_amplitude: float = 0.0
+    #: high-gain scenario: Heun substeps per dt (ν held over the step)
+    substeps: int = 1
     #: seconds the simulation may run (exit 3 past it)
     time_limit: float = DEFAULT_LIMIT
 
@@ -291,8 +293,18 @@ def parse_simulate(table: Table, spec: Spec) -> SimOptions:
             raise table.error(
                 "hf_stop", f"expected hf_stop >= hf_start = {o.hf_start:g} (the noise window)"
             )
+    if table.has("substeps"):
+        o.substeps = table.int("substeps", min=1)
+        if o.substeps > MAX_SUBSTEPS:
+            raise table.error(
+                "substeps", f"expected an integer <= {MAX_SUBSTEPS:,}, got {o.substeps}"
+            )
     o.time_limit = parse_time_limit(table)
     return o
+
+
+#: the largest ``[simulate] substeps`` of the high-gain scenario
+MAX_SUBSTEPS = 10_000
 
 
 def options_schema(key: str) -> dict[str, Any]:
@@ -337,5 +349,6 @@ def simulate_schema() -> dict[str, Any]:
         "hf_start": {**num, "minimum": 0},
         "hf_stop": {**num, "minimum": 0},
         "hf_amplitude": {**num, "minimum": 0},
+        "substeps": {"type": "integer", "minimum": 1, "maximum": MAX_SUBSTEPS},
         "time_limit": TIME_LIMIT_SCHEMA,
     }
