@@ -269,15 +269,22 @@ def branch_and_bound(
     lower_of: Callable[[Box], Sample],
     budget: int,
     rtol: float,
+    prove: Callable[[tuple[np.ndarray, ...]], float] | None = None,
 ) -> Bound:
     """Largest of ``upper_of`` over a subdivision of ``box``: split the sub-box with the
     largest bound (along its relatively widest side) until that bound is within ``rtol`` of
     the best sampled value ``lower_of`` or ``budget`` sub-boxes were evaluated. The bound
-    keeps the best sample's point(s) as its witness."""
+    keeps the best sample's point(s) as its witness. ``prove`` (witness → a proved lower
+    bound of the constant there) replaces a float sample by its proved value; it runs only
+    for a sample whose float value beats the best float value so far (every child was
+    proved before: 30 % of a search-space design's time)."""
     widths0 = [iv.hi - iv.lo for iv in box]
     upper_of = _safe(upper_of)
     ub0 = upper_of(box)
     lb, wit = lower_of(box)
+    best_float = lb  # the float value of the best sample (proved ones are compared to lb)
+    if prove is not None:
+        lb = prove(wit) if wit is not None and lb > 0 else 0.0
     heap: list[tuple[float, int, Box]] = [(-ub0, 0, box)]
     count = 1
     while count < budget:
@@ -293,6 +300,11 @@ def branch_and_bound(
             count += 1
             heapq.heappush(heap, (-upper_of(child), count, child))
             v, w = lower_of(child)
+            if prove is not None:
+                if not v > best_float:
+                    continue
+                best_float = v
+                v = prove(w) if w is not None else 0.0
             if v > lb:
                 lb, wit = v, w
     return Bound(-heap[0][0], lb, count, wit, getattr(lower_of, "overflow", False))
@@ -368,11 +380,18 @@ def sup_norm(
         if not ok.size:  # no float value: the midpoint still serves the exact proof
             return 0.0, (Z[0],)
         i = int(ok[np.argmax(v[ok])])
-        return proved_norm_at(exprs, names, Z[i]), (Z[i],)
+        return float(v[i]), (Z[i],)
 
     inner_lo = np.array([I.of_q(x).hi for x in lo])
     inner_hi = np.array([I.of_q(x).lo for x in hi])
-    return branch_and_bound(_box(lo, hi), upper_of, lower_of, budget, rtol)
+    return branch_and_bound(
+        _box(lo, hi),
+        upper_of,
+        lower_of,
+        budget,
+        rtol,
+        prove=lambda w: proved_norm_at(exprs, names, w[0]),
+    )
 
 
 def lipschitz(
@@ -394,9 +413,10 @@ def lipschitz(
 
     def lower_of(b: Box) -> Sample:
         """Largest difference quotient |F(m + δv) − F(m − δv)|/(2δ) at the sample points m,
-        v the top right singular vector of a finite-difference Jacobian; the best pair's
-        quotient is then bounded below rigorously (:func:`proved_quotient`), so the estimate
-        is a true lower bound of the Lipschitz constant, float rounding included."""
+        v the top right singular vector of a finite-difference Jacobian, in floats;
+        :func:`branch_and_bound` bounds the best pair's quotient below rigorously
+        (:func:`proved_quotient`), so the estimate is a true lower bound of the Lipschitz
+        constant, float rounding included."""
         M = _samples(b)
         scale = 1e-6 * (1.0 + float(np.max(np.abs(M))))
         steps = np.zeros((len(idx), M.shape[1]))
@@ -432,7 +452,7 @@ def lipschitz(
         if not ok.size:
             return 0.0, _across(b)
         i = int(ok[np.argmax(q[ok])])
-        return proved_quotient(exprs, names, Pp[i], Pm[i]), (Pp[i], Pm[i])
+        return float(q[i]), (Pp[i], Pm[i])
 
     def _across(b: Box) -> tuple[np.ndarray, np.ndarray] | None:
         """Two points of the box (and of E) across it in the variables ``diff``, the others
@@ -450,7 +470,11 @@ def lipschitz(
     # floats inside the exact box [lo, hi] (its own float box is rounded outward)
     inner_lo = np.array([I.of_q(x).hi for x in lo])
     inner_hi = np.array([I.of_q(x).lo for x in hi])
-    return branch_and_bound(_box(lo, hi), upper_of, lower_of, budget, rtol)
+
+    def prove(w: tuple[np.ndarray, ...]) -> float:
+        return proved_quotient(exprs, names, w[0], w[1]) if len(w) == 2 else 0.0
+
+    return branch_and_bound(_box(lo, hi), upper_of, lower_of, budget, rtol, prove=prove)
 
 
 #: at most this many held-variable corners (2^4) in :func:`corner_witnesses`
