@@ -112,7 +112,8 @@ def test_stubborn_high_gain_rejects_the_impulsive_outlier(rep: Report) -> None:
     sp = api.load_spec_text(DUFFING.read_text().replace("horizon = 10", "horizon = 6"), "d.toml")
     from obsdesign.methods.stubborn.highgain import simulate
 
-    res = simulate(sp, rep.parameters)
+    with pytest.warns(UserWarning, match="grows from .* at t = 2 "):  # the level's jump
+        res = simulate(sp, rep.parameters)
     sup = res.info["sup_error_after_impulse"]
     assert sup["stubborn"] * 3 <= sup["standard"]
     err = res.extra["error_norm"]
@@ -176,7 +177,8 @@ def test_state_bound_holds_phi_not_the_integrator_chain() -> None:
     free = api.load_spec_text(text.replace("state_bound = [2, 2]\n", ""), "chain.toml")
     assert free.options.state_bound is None and boxed.options.state_bound is not None
     rep = api.design(boxed)
-    a, b = simulate(boxed, rep.parameters), simulate(free, rep.parameters)
+    with pytest.warns(UserWarning, match="grows from"):  # x̂0 far off: the level jumps
+        a, b = simulate(boxed, rep.parameters), simulate(free, rep.parameters)
     assert np.abs(a.x).max() > 2 and np.array_equal(a.xhat, b.xhat)  # x̂₂ → 3, outside the box
     # Duffing itself, x̂0 = (0, 5) outside the box |x̂_i| ≤ 2: one Heun step of the standard
     # observer computed here, with φ₂ = −δx₂ − αx₁ − βx₁³ + γcos(ωt) at clip(x̂) and the
@@ -186,7 +188,8 @@ def test_state_bound_holds_phi_not_the_integrator_chain() -> None:
         "d.toml",
     )
     prm = api.design(sp).parameters
-    res = simulate(sp, prm)
+    with pytest.warns(UserWarning, match="grows from"):  # the impulse at t = 2
+        res = simulate(sp, prm)
     dt, ell = float(sp.simulate.dt.f), float(prm.float("ell"))
     gain = np.array([2 * ell, 1 * ell**2])  # K = (2, 1)
 
