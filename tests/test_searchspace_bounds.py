@@ -527,3 +527,43 @@ def test_hypot_lo_is_at_most_the_exact_norm(xs: list[float]) -> None:
     sq = sum(Fraction(x) ** 2 for x in xs)
     assert Fraction(lo) ** 2 <= sq <= Fraction(hi) ** 2
     assert lo == 0 or hi / lo < 1 + 1e-15
+
+
+ZW = """[system]
+time = "continuous"
+states = ["x1", "x2"]
+f = ["x2", "2e17*(0.1000000000000000055511151231257827021181583404541015625 - u1)*x1"]
+h = ["x1"]
+u = ["0.1"]
+[method]
+key = "search-space"
+alpha = 0.9
+gamma_star = 0.05
+gamma0 = 1
+L_f = LF
+[method.E]
+lower = [-1, -1]
+upper = [1, 1]
+[method.D]
+lower = [0, -0.5]
+upper = [0, 0.5]
+[method.U]
+lower = [0.1]
+upper = [0.1]
+"""
+
+
+@pytest.mark.parametrize(
+    ("lf", "status"), [("2", "numerical"), ("1.12", "numerical"), ("1.1", "failed")]
+)
+def test_a_quotient_on_a_zero_width_side_without_a_double_is_proved_at_its_value(
+    lf: str, status: str
+) -> None:
+    """U = {1/10}, which has no double: the samples' u1 is the float next to 1/10, and f2 =
+    2·10¹⁷(0.1 as a double − u1)·x1 has slope 1.11 at u1 = 1/10 but 2.78 at the float below
+    it; the quotient proved at that float point failed a true given L_f = 2, exit 1 (re-check
+    trial, session 36). The side's exact value is enclosed instead; a false L_f = 1.1 is still
+    refuted (exactly, at the value), and the true 1.12 stays numerical."""
+    rep = api.design(api.load_spec_text(ZW.replace("LF", lf), "zw.toml"))
+    c = next(c for c in rep.claims if c.id == "L_f-bound")
+    assert c.status.value == status, c.detail
