@@ -567,3 +567,14 @@ def test_a_quotient_on_a_zero_width_side_without_a_double_is_proved_at_its_value
     rep = api.design(api.load_spec_text(ZW.replace("LF", lf), "zw.toml"))
     c = next(c for c in rep.claims if c.id == "L_f-bound")
     assert c.status.value == status, c.detail
+
+
+def test_a_side_narrower_than_an_ulp_is_enclosed_whole() -> None:
+    """[1/10, 1/10 + 10⁻³⁰] holds no float either (re-check trial, session 36): it is enclosed
+    by its tight interval, as a zero-width side without a double is; a side holding a float
+    is not."""
+    lo = [Fraction(1, 10), Fraction(0), Fraction(1)]
+    hi = [Fraction(1, 10) + Fraction(1, 10**30), Fraction(1), Fraction(1)]
+    fx = B.fixed_sides(lo, hi)
+    assert list(fx) == [0]
+    assert fx[0].lo < Fraction(1, 10) and Fraction(1, 10) + Fraction(1, 10**30) < fx[0].hi

@@ -193,14 +193,14 @@ Fixed = dict[int, I]
 
 
 def fixed_sides(lo: Sequence[Any], hi: Sequence[Any]) -> Fixed:
-    """The zero-width sides of the box [lo, hi] whose exact value has no double: no float
-    lies in them, so a sample's coordinate there is a float next to the value, and the value
+    """The sides of the box [lo, hi] that hold no float (a zero-width side whose exact value
+    has no double, or one narrower than an ulp between two doubles): no float lies in them, so a sample's coordinate there is a float next to the value, and the value
     is enclosed by its tight interval instead (:func:`_values_at`)."""
     out: Fixed = {}
     for j, (a, b) in enumerate(zip(lo, hi, strict=True)):
-        iv_a = I.of_q(a)
-        if a == b and iv_a.lo != iv_a.hi:
-            out[j] = iv_a
+        iv_a, iv_b = I.of_q(a), I.of_q(b)
+        if iv_a.hi > iv_b.lo:  # no float inside: a single value with no double, or narrower
+            out[j] = I(iv_a.lo, iv_b.hi)  # than one ulp (re-check trial, session 36)
     return out
 
 
