@@ -383,3 +383,12 @@ def test_a_polytope_with_vertices_beyond_the_float_range_keeps_its_row_widths() 
     assert lo.tolist() == [-1e300] * 4 and hi.tolist() == [1e300] * 4
     pts = np.array([[0.0, 0.5], [3e300, 0.0], [-3e300, 0.0]])
     assert P.contains_rel(pts).tolist() == [True, False, False]
+
+
+def test_a_polytope_face_width_beyond_the_float_range_is_not_an_infinite_slack() -> None:
+    """|x1| ≤ 10³⁰⁸: the width 2·10³⁰⁸ overflowed, the slack was inf and (1.7·10³⁰⁸, 0) read
+    as inside (re-check trial, session 36)."""
+    b = fmpq(10**308)
+    P = Polytope(qmat([[1, 0], [-1, 0], [0, 1], [0, -1]]), qvec([b, b, 1, 1]))
+    pts = np.array([[1.7e308, 0.0], [1.0000001e308, 0.0], [1e308, 0.0], [0.0, 0.5]])
+    assert P.contains_rel(pts).tolist() == [False, False, True, True]

@@ -170,7 +170,9 @@ class Polytope(ConvexSet):
         lo, hi = self._row_extent()
         mag = np.maximum(np.maximum(np.abs(lo), np.abs(hi)), np.abs(g))
         with np.errstate(all="ignore"):
-            slack = rel * (hi - lo) + 4 * np.spacing(mag)
+            # rel·hi − rel·lo: hi − lo overflowed for |x1| ≤ 1e308, and an inf slack let
+            # (1.7e308, 0) pass (re-check trial, session 36)
+            slack = (rel * hi - rel * lo) + 4 * np.spacing(mag)
             r = X2 @ G.T - g
             s = np.abs(X2) @ np.abs(G).T + np.abs(g)
             err = 4 * (self.dim + 8) * np.finfo(float).eps * s
