@@ -1175,6 +1175,8 @@ class SpecTimeout(BaseException):
 
 #: a time budget above this many seconds (about 31 years) is no budget
 MAX_BUDGET_S = 1e9
+#: the smallest time budget the timer is given (a positive budget that rounds below it)
+MIN_BUDGET_S = 1e-6
 #: seconds between repeats of a time budget's alarm once it has fired (:func:`_time_budget`)
 RETIMEOUT_S = 0.1
 
@@ -1197,9 +1199,14 @@ def budget_seconds(timeout: Any, name: str = "timeout") -> float | None:
             f"{name} must be a number of seconds (0 or None: no limit), got "
             f"{type(timeout).__name__} {timeout!r}"
         )
-    t = float(timeout)
+    try:
+        t = float(timeout)
+    except OverflowError:  # 10**400: beyond any budget (re-check trial, session 36)
+        t = math.inf if timeout > 0 else -math.inf
     if not t >= 0:
         raise InputError(f"{name} must be ≥ 0 seconds (0 or None: no limit), got {timeout!r}")
+    if t == 0 and timeout > 0:  # Fraction(1, 10**400) rounds to 0.0, which is no limit
+        t = MIN_BUDGET_S
     return t if 0 < t <= MAX_BUDGET_S else None
 
 

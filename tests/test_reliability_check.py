@@ -193,6 +193,14 @@ def test_budget_seconds_keeps_a_real_budget_and_drops_no_budget() -> None:
     assert [api.budget_seconds(t) for t in (None, 0, 0.0, float("inf"), 1e300)] == [None] * 5
     assert api.budget_seconds(2.5) == 2.5 and api.budget_seconds(1) == 1.0
     assert api.budget_seconds(api.MAX_BUDGET_S) == api.MAX_BUDGET_S
+    # re-check trial, session 36: 10**400 raised OverflowError; a positive Fraction that
+    # rounds to 0.0 became no limit
+    from fractions import Fraction
+
+    assert api.budget_seconds(10**400) is None
+    assert api.budget_seconds(Fraction(1, 10**400)) == api.MIN_BUDGET_S
+    with pytest.raises(InputError):
+        api.budget_seconds(-(10**400))
 
 
 def test_a_spec_named_twice_gets_one_row(tmp_path: Path) -> None:
