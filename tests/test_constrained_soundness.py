@@ -1179,3 +1179,20 @@ def test_theta_covers_prints_a_bound_below_a_large_theta() -> None:
     c = Claims()
     _theta_covers(c, "theta", theta - 1, "v_max", need_top, fmpq(0), fmpq(1), fmpq(1), "(22)")
     assert next(iter(c)).status == ClaimStatus.FAILED
+
+
+def test_theta_covers_prints_a_bound_strictly_below_theta() -> None:
+    """Mutation review 36, _theta_covers' digits: θ = 44524601863 against the exact bound
+    44524601862.96 prints the bound below θ (13 significant digits), not rounded up to θ
+    itself (11 or 12 digits print 44524601863, and "θ ≥ … ≤ θ" hides the margin)."""
+    from obsdesign.certify.claim import Claims
+    from obsdesign.certify.exact import Q
+    from obsdesign.methods.constrained.claims import _theta_covers
+
+    c = Claims()
+    theta = fmpq(44524601863)
+    need_top = fmpq(4452460186296, 100)
+    _theta_covers(c, "theta", theta, "v_max", need_top, fmpq(0), fmpq(1), fmpq(1), "eq. (22)")
+    (claim,) = c
+    shown = Q(claim.detail.split("≤ ")[-1])
+    assert need_top <= shown < theta, claim.detail

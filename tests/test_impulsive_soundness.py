@@ -12,6 +12,7 @@ Meurer, Moreno, MTNS 2020) with M = [−3, 1]: Ā = [[0, 0], [0, −1]], so with
 from __future__ import annotations
 
 import json
+import math
 import re
 from collections.abc import Callable
 from pathlib import Path
@@ -969,3 +970,73 @@ def test_the_float_norm_of_the_retry_is_the_spectral_norm() -> None:
     assert _float_norm(q([[3, 0], [0, 4]])) == 4
     assert _float_norm(q([[1, 1], [1, 1]])) == 2
     assert _float_norm(q([])) == 0
+
+
+def test_rows_of_a_non_finite_row_are_infinite() -> None:
+    """Mutation review 36, falsify._rows: a row with a NaN (or ±inf) entry has the norm +inf,
+    never NaN — a NaN row norm compares false everywhere and would drop that sample from
+    the ratio and rounding checks instead of flagging it."""
+    from obsdesign.methods.impulsive.falsify import _rows
+
+    out = _rows(np.array([[np.nan, 1.0], [np.inf, 0.0], [3e200, 4e200], [0.0, 0.0]]))
+    assert out[0] == math.inf and out[1] == math.inf
+    assert out[2] == pytest.approx(5e200) and out[3] == 0.0
+
+
+@pytest.mark.parametrize("ell", [0.5, 0.49])
+def test_lipschitz_x_falsification_reads_a_huge_box(ell: float) -> None:
+    """Mutation review 36, falsify_lipschitz_x on _rows: ψ(x) = x/2 on the box ±10²⁰⁰ is
+    exactly ½-Lipschitz. Norms squared unscaled overflow there (‖x̂ − x‖ = inf, the ratio
+    inf/inf = NaN for every independent pair): every wide pair must still be tested, with no
+    violation of ℓ = ½ and a finite worst value, and ℓ = 0.49 is found violated."""
+    from obsdesign.methods.impulsive.falsify import falsify_lipschitz_x
+
+    lo, hi = np.full(2, -1e200), np.full(2, 1e200)
+    f = falsify_lipschitz_x(lambda X: 0.5 * X, ell, lo, hi, 200, 0)
+    (v,) = [v for v in f.items if v.name == "Lipschitz bound of ψ in x"]
+    assert v.tested == 200 and math.isfinite(v.worst)
+    assert (v.count > 0) == (ell < 0.5), f.summary()
+
+
+def test_best_rate_takes_an_infinite_rate_as_the_worst_theta(monkeypatch) -> None:
+    """Mutation review 36, best_rate's neg: a θ where the float rate search overflowed to
+    κ = +inf (−κ = −inf) is the worst value, like NaN — not the best one, which would return
+    the overflowing θ. Faked here: κ(θ) = −(log θ)² (optimum θ = 1), +inf beyond θ = e³."""
+    from obsdesign.certify.exact import to_float
+    from obsdesign.methods.impulsive import dissipativity as dv
+
+    def fake(A, Qm, S, R):
+        t = float(Qm[0, 0])
+        return (math.inf, 0.0) if t > math.exp(3) else (-(math.log(t) ** 2), 0.0)
+
+    monkeypatch.setattr(dv, "best_rate_float", fake)
+    monkeypatch.setattr(dv, "range_theta", lambda qsr: None)
+    one = np.array([[fmpq(1)]], dtype=object)
+    qsr = dv.QSR(one, np.array([[fmpq(0)]], dtype=object), -one, "test")
+    r, theta, _ = dv.best_rate(np.eye(1), qsr, True)
+    assert abs(math.log(float(to_float(theta)))) < 0.1 and r > -0.01
+
+
+def test_a_non_finite_lemma1_residual_is_inconclusive(monkeypatch) -> None:
+    """Mutation review 36, design_window's second Lemma 1 branch: a NaN range residual (the
+    float search overflowed) with a finite κ_n is not a design — it is "the float search of
+    κ_n gave …" (InconclusiveError), never passed on to certified_rate as if the range
+    condition held (NaN > 10⁻⁷ is false, so the first branch lets it through)."""
+    from pathlib import Path
+
+    from obsdesign import api
+    from obsdesign.errors import InconclusiveError
+    from obsdesign.methods.impulsive import design as dmod
+
+    real = dmod.best_rate
+    calls = []
+
+    def fake(A, qsr, opt):
+        calls.append(1)
+        r, th, res = real(A, qsr, opt)
+        return (r, th, math.nan) if len(calls) == 2 else (r, th, res)
+
+    monkeypatch.setattr(dmod, "best_rate", fake)
+    spec = Path(__file__).resolve().parents[1] / "specs" / "impulsive-sector-3state.toml"
+    with pytest.raises(InconclusiveError, match="float search of κ_n"):
+        api.design(api.load_spec(spec))

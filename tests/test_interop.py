@@ -879,3 +879,14 @@ def test_an_integer_just_above_2_53_beside_a_float_stays_exact() -> None:
     out = _real([[0.5, 2**53 + 1]], "A")
     assert out.dtype == object and int(out[0, 1]) == 2**53 + 1
     assert float(_real([[0.5, 2**53]], "A")[0, 1]) == 2.0**53
+
+
+def test_an_object_array_is_written_item_by_item() -> None:
+    """Mutation review 36, interop._value: a numpy object array (as pandas hands over a mixed
+    column) is written item by item like a list, so a boolean in it stays `true`; a 0-d object
+    array is its one item, not iterated (a TypeError; the branch's `v.ndim > 0`)."""
+    from obsdesign import interop
+
+    assert interop._value(np.array([True, 0.5], dtype=object)) == "[true, 0.5]"
+    assert interop._value(np.array([[True], [0.5]], dtype=object)) == "[[true], [0.5]]"
+    assert interop._value(np.array(0.5, dtype=object)) == "0.5"

@@ -741,3 +741,14 @@ def test_a_worker_row_names_a_file_with_a_newline_as_the_serial_row_does(
     assert remote.code == serial.code == 2
     assert remote.message == serial.message, (remote.message, serial.message)
     assert str(tmp_path) not in remote.message
+
+
+@pytest.mark.parametrize("bad", [-1, "1", True, float("nan")])
+def test_check_refuses_a_bad_timeout_before_any_row(bad) -> None:
+    """Mutation review 36: check() reads timeout= by budget_seconds itself, so a bad budget is
+    an InputError even when no spec would reach check_one (an empty list of paths)."""
+    from obsdesign import api
+    from obsdesign.errors import InputError
+
+    with pytest.raises(InputError, match="timeout"):
+        api.check([], timeout=bad)

@@ -2225,3 +2225,27 @@ def test_an_expression_undefined_somewhere_on_its_set_certifies_nothing(
     ids = {"u": ("input-range",), "f": ("L_f-bound", "f_sup-bound")}[undefined]
     bad = [c.id for c in rep.claims if c.status == ClaimStatus.CERTIFIED and c.id in ids]
     assert not bad, bad
+
+
+def test_an_estimate_beyond_the_float_range_refutes_the_value(monkeypatch) -> None:
+    """Mutation review 36: _constant's `not math.isfinite(b.lower_est)` branch. An infinite
+    sampled lower estimate (a norm beyond the largest float) is above every value: the claim
+    fails, even with an interval bound below the value — Q(inf) would raise, and skipping
+    the non-finite estimate would certify. (hypot_lo / proved_quotient cap at the largest
+    float today, so this pins the guard for any other producer of lower_est.)"""
+    from pathlib import Path
+
+    from obsdesign import api
+    from obsdesign.api import bind
+    from obsdesign.certify.claim import Claims, ClaimStatus
+    from obsdesign.methods.searchspace import claims as C
+    from obsdesign.methods.searchspace.bounds import Bound
+
+    sp = api.load_spec(
+        Path(__file__).resolve().parents[1] / "specs" / "hernandez-garcia-example.toml"
+    )
+    monkeypatch.setattr(C, "interval_bound", lambda k, spec: Bound(0.5, math.inf, 1))
+    c = Claims()
+    C._constant(c, bind(sp), "L_h", fmpq(1))
+    (claim,) = c
+    assert claim.id == "L_h-bound" and claim.status == ClaimStatus.FAILED, claim.detail

@@ -578,3 +578,74 @@ def test_a_side_narrower_than_an_ulp_is_enclosed_whole() -> None:
     fx = B.fixed_sides(lo, hi)
     assert list(fx) == [0]
     assert fx[0].lo < Fraction(1, 10) and Fraction(1, 10) + Fraction(1, 10**30) < fx[0].hi
+
+
+def _ex(*src: str, names: tuple[str, ...] = ("x1",)) -> list:
+    from obsdesign.spec.expr import parse_expr
+
+    return [parse_expr(s, list(names)) for s in src]
+
+
+@pytest.mark.parametrize(
+    "xs",
+    [
+        [0.38655710476146987, 2.9000000000000004, 0.4],  # Σ rounded up would pass the root
+        [1e-323, 1e-323],  # 2√2 least subnormals: rounding the result to nearest gives 3
+    ],
+)
+def test_hypot_lo_rounds_every_step_down(xs: list[float]) -> None:
+    """Mutation review 36: hypot_lo ≤ √Σx² exactly needs the sum of squares rounded down
+    (add_hi/mul_hi gave 2.952867486908543 > √Σx² for the first list) and the subnormal
+    result stepped down where ldexp rounded it up (2√2·2⁻¹⁰⁷⁴ rounds to 3·2⁻¹⁰⁷⁴)."""
+    lo = B.hypot_lo(xs)
+    assert Fraction(lo) ** 2 <= sum(Fraction(x) ** 2 for x in xs)
+    assert lo > 0
+
+
+def test_hypot_lo_beyond_the_float_range_is_the_largest_float() -> None:
+    """Mutation review 36: a norm beyond the largest float is bounded below by the largest
+    float, never by +∞ (∞ is no lower bound of a real number: proved_norm_at's estimate
+    would be "above" every value)."""
+    assert B.hypot_lo([1.7e308, 1.7e308]) == 1.7976931348623157e308
+
+
+def test_proved_norm_at_a_point_without_an_enclosure_is_zero() -> None:
+    """Mutation review 36: where F cannot be enclosed at the sample (log at 0), the proved
+    sup-norm estimate is 0 (no claim), as proved_quotient's is."""
+    assert B.proved_norm_at(_ex("log(x1)"), ["x1"], np.array([0.0])) == 0.0
+
+
+def test_proved_norm_at_is_the_near_end_of_the_enclosure() -> None:
+    """Mutation review 36: the proved |F(z)| is the end of F's enclosure nearest 0, rounded
+    down. (x1 + 10¹⁷ + 0.1) − 10¹⁷ + 100 is exactly 100.6 at x1 = 0.5, enclosed as about
+    [84, 116]: the far end would refute a true sup-norm bound; and 0.1·x1 is exactly 1/20 at 0.5,
+    whose enclosure's upper end 0.05 is above 1/20 (hypot_hi of the near end reaches it)."""
+    r = B.proved_norm_at(_ex("(x1 + 1e17 + 0.1) - 1e17 + 100"), ["x1"], np.array([0.5]))
+    assert 0 < Fraction(r) <= Fraction(1006, 10)
+    r = B.proved_norm_at(_ex("0.1*x1"), ["x1"], np.array([0.5]))
+    assert 0.0499 < r and Fraction(r) <= Fraction(1, 20)
+
+
+def test_proved_quotient_of_a_gap_enclosing_zero_is_zero() -> None:
+    """Mutation review 36: h = (x1 + 10¹⁷ + 0.1) − 10¹⁷ − x1 is the constant 1/10 (L = 0),
+    but its enclosure at a float point is about [0, 16]; the difference of two such
+    enclosures contains 0, and only then is the gap 0 — its nearer end (16) over |p − q|
+    would be a "proved" quotient of 64 for a constant."""
+    ex = _ex("(x1 + 1e17 + 0.1) - 1e17 - x1")
+    assert B.proved_quotient(ex, ["x1"], np.array([0.5]), np.array([0.25])) == 0.0
+
+
+def test_proved_quotient_rounds_its_numerator_and_quotient_down_and_its_distance_up() -> None:
+    """Mutation review 36: |F(p) − F(q)| bounded below (hypot_lo), |p − q| above (hypot_hi),
+    and the quotient rounded down (_div_lo). For h = x1 at p = (1/2, 0), q = (0, y) the
+    gap 1/2 is exact, so hypot_lo of the distance (y = 0.463…) or a nearest-rounded
+    quotient (y = 0.795…) is above the exact quotient; 5.3·x1 over p = 0, q = 1 needs the
+    gap rounded down (hypot_hi gave 5.300000000000001 > 53/10); x1 over 0.5, 0.25 is exactly
+    1, and rounding it up gives 1 + 2⁻⁵²."""
+    ex = _ex("x1", names=("x1", "x2"))
+    for y in (0.46300735781502145, 0.7951042385853743):
+        r = B.proved_quotient(ex, ["x1", "x2"], np.array([0.5, 0.0]), np.array([0.0, y]))
+        assert r > 0 and Fraction(r) ** 2 * (Fraction(1, 4) + Fraction(y) ** 2) <= Fraction(1, 4)
+    r = B.proved_quotient(_ex("5.3*x1"), ["x1"], np.array([0.0]), np.array([1.0]))
+    assert 5.29 < r and Fraction(r) <= Fraction(53, 10)
+    assert B.proved_quotient(_ex("x1"), ["x1"], np.array([0.5]), np.array([0.25])) == 1.0

@@ -392,3 +392,113 @@ def test_a_polytope_face_width_beyond_the_float_range_is_not_an_infinite_slack()
     P = Polytope(qmat([[1, 0], [-1, 0], [0, 1], [0, -1]]), qvec([b, b, 1, 1]))
     pts = np.array([[1.7e308, 0.0], [1.0000001e308, 0.0], [1e308, 0.0], [0.0, 0.5]])
     assert P.contains_rel(pts).tolist() == [False, False, True, True]
+
+
+def _fo_box(s: float = 1e-8) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """[−2, 2]² with its x₁ rows scaled by s, and its four vertices."""
+    G = np.array([[s, 0], [-s, 0], [0, 1], [0, -1]])
+    g = np.array([2 * s, 2 * s, 2, 2])
+    full = np.array([[2.0, 2.0], [2.0, -2.0], [-2.0, 2.0], [-2.0, -2.0]])
+    return G, g, full
+
+
+def test_float_vertices_ok_tolerance_and_refusals() -> None:
+    """Mutation review 36, _float_vertices_ok: a NaN vertex (every comparison with it false)
+    is refused by the finiteness check, not accepted; a vertex outside by 10⁻⁵ relative is
+    refused (the tolerance is 10⁻⁹ of the row's scale, not 10⁻³); the scale includes |g|
+    (a vertex 3·10⁻⁹ outside [−2, 2]², within 10⁻⁹·(2 + 2), is accepted)."""
+    from obsdesign.sets import polytope as pmod
+
+    G, g, full = _fo_box()
+    assert pmod._float_vertices_ok(G, g, np.vstack([full, [[np.nan, np.nan]]])) is False
+    assert pmod._float_vertices_ok(G, g, np.vstack([full, [[2.00001, 0.0]]])) is False
+    Gu, gu, _ = _fo_box(1.0)
+    near = full.copy()
+    near[0, 0] = 2 + 3e-9
+    assert pmod._float_vertices_ok(Gu, gu, near) is True
+
+
+def test_checked_float_vertices_refuses_what_it_cannot_confirm(monkeypatch) -> None:
+    """Mutation review 36, _checked_float_vertices: float cdd's vertices that fail the check
+    (2 of the box's 4) and float cdd's own RuntimeError are a PolytopeError (float-only mode
+    names cdd.gmp), never used or passed on raw; rows are scaled to unit length before float
+    cdd, so the 10⁻⁸-scaled box (2 of 4 vertices unscaled) is enumerated in full, and a zero
+    row (0·x ≤ 1) does not turn the scaling into NaN."""
+    from obsdesign.sets import polytope as pmod
+    from obsdesign.sets import polytope_ops as po
+
+    G, g, full = _fo_box()
+    V = pmod._checked_float_vertices(G, g)
+    assert sorted(map(tuple, np.round(V, 9))) == sorted(map(tuple, full))
+    Gz, gz = np.vstack([G, [[0.0, 0.0]]]), np.append(g, 1.0)
+    V = pmod._checked_float_vertices(Gz, gz)
+    assert sorted(map(tuple, np.round(V, 9))) == sorted(map(tuple, full))
+    monkeypatch.setattr(pmod, "vertices_float", lambda G, g: (full[[0, 2]], True))
+    with pytest.raises(po.PolytopeError, match="unreliable"):
+        pmod._checked_float_vertices(G, g)
+
+    def boom(G, g):
+        raise RuntimeError("numerical inconsistency")
+
+    monkeypatch.setattr(pmod, "vertices_float", boom)
+    with pytest.raises(po.PolytopeError, match="cdd.gmp"):
+        pmod._checked_float_vertices(G, g)
+
+
+def test_polytope_contains_rel_on_the_threshold_and_with_an_inexact_g() -> None:
+    """Mutation review 36, contains_rel / _row_q: a point exactly at G_i x − g_i = slack is
+    inside (≤, not <; the slack includes 4 float spacings: x = 1 + 2⁻⁵⁰ for x ≤ 1 at rel = 0),
+    and the exact row uses the spec's g (1/10), not its float: for 1/10 ≥ x ≥ −1 the slack is
+    4 spacings of 1 (2⁻⁵⁰), and x = 0.1 + 2⁻⁵⁰ is exactly that above float(0.1) but
+    2⁻⁵⁰ + 5.6·10⁻¹⁸ above 1/10, so outside."""
+    from fractions import Fraction
+
+    from obsdesign.certify.exact import qmat, qvec
+    from obsdesign.sets import Polytope
+
+    P = Polytope(qmat([[1], [-1]]), qvec([1, 1]))
+    assert P.contains_rel(np.array([1 + 2.0**-50]), rel=0.0)
+    assert not P.contains_rel(np.array([1 + 2.0**-49]), rel=0.0)
+    P = Polytope(qmat([[1], [-1]]), qvec([fmpq(1, 10), 1]))
+    x = 0.1 + 2.0**-50
+    assert Fraction(x) - Fraction(0.1) == Fraction(2.0**-50)
+    assert not P.contains_rel(np.array([x]), rel=0.0)
+
+
+def test_polytope_caches_its_vertices_read_only() -> None:
+    """Mutation review 36: vertices(), vertices_q() and the row extents are computed once per
+    polytope (the same objects again), and the cached float vertices are read-only, so a
+    caller that edits them in place cannot change the polytope's later answers."""
+    from obsdesign.certify.exact import qmat, qvec
+    from obsdesign.sets import Polytope
+
+    P = Polytope(qmat([[1, 0], [-1, 0], [0, 1], [0, -1]]), qvec([2, 2, 2, 2]))
+    V = P.vertices()
+    assert V is P.vertices() and P.vertices_q() is P.vertices_q()
+    assert P._row_extent() is P._row_extent()
+    with pytest.raises(ValueError):
+        V[0, 0] = 100.0
+
+
+def test_ellipsoid_form_uses_the_exact_center() -> None:
+    """Mutation review 36, Ellipsoid._form_q: (x − c)ᵀE(x − c) with the spec's c (1/10), not
+    its float: at x = 0.1 the form is (0.1 − 1/10)² > 0, not 0."""
+    from fractions import Fraction
+
+    from obsdesign.certify.exact import qmat, qvec
+    from obsdesign.sets import Ellipsoid
+
+    El = Ellipsoid(qmat([[1]]), qvec([fmpq(1, 10)]))
+    assert El._form_q(np.array([0.1])) == (Fraction(0.1) - Fraction(1, 10)) ** 2
+
+
+def test_frac_of_a_numpy_integer_has_a_python_numerator() -> None:
+    """Mutation review 36, certify.exact.frac: Fraction(np.int64) keeps a numpy numerator,
+    which fmpq refuses; frac gives Python ints."""
+    from flint import fmpq as _fmpq
+
+    from obsdesign.certify.exact import frac
+
+    f = frac(np.int64(3))
+    assert f == 3 and type(f.numerator) is int
+    assert _fmpq(f.numerator, f.denominator) == 3

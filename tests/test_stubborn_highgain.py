@@ -388,3 +388,82 @@ def test_ell_star_is_2L_norm_P_rounded_up_not_any_larger_bound(rep: Report) -> N
         ver = api.verify(r)
         failed = {c.id for c in ver.claims if c.status == ClaimStatus.FAILED}
         assert ("ell-star-bound" in failed) == fails, (value, failed)
+
+
+_HG = """[system]
+time = "continuous"
+states = ["x1", "x2", "x3"]
+A = [[0, 1, 0], [0, 0, 1], [0, 0, 0]]
+psi = {psi}
+C = [[1, 0, 0]]
+[method]
+key = "stubborn"
+mode = "high-gain"
+K = [3, 3, 1]
+lipschitz = 1
+"""
+
+
+def test_the_triangular_check_expands_up_to_its_limits() -> None:
+    """Mutation review 36, options._expandable: ψ_1 that cancels x2 only when expanded is
+    accepted below both limits — power 10 (≤ 64), 28 operations (≤ 2000) — and a symbolic
+    exponent (x1^x1) is no integer power to refuse (not an error); ψ_1 = x2·Σ sin(k·x1) of
+    2096 operations (> 2000) is refused without expanding, saying so."""
+    from obsdesign import api
+    from obsdesign.errors import SpecError
+
+    def load(p: str):
+        return api.load_spec_text(_HG.format(psi=f'["{p}", "0", "0"]'), "hg.toml")
+
+    assert load("(x1+x2)^10 - (x1^2 + 2*x1*x2 + x2^2)^5") is not None
+    ops = " + ".join(f"x1^{k}" for k in range(1, 12))
+    assert load(f"(x1+x2)^2 - x2^2 - 2*x1*x2 + {ops}") is not None
+    assert load("x1^x1") is not None
+    terms = [f"sin({k}*x1)" for k in range(1, 700)]
+    big = " + ".join("(" + " + ".join(terms[i : i + 20]) + ")" for i in range(0, len(terms), 20))
+    with pytest.raises(SpecError, match="too large to expand"):
+        load(f"x2*({big})")
+
+
+def test_level_jump_warning_counts_the_jumps_that_matter() -> None:
+    """Mutation review 36, highgain._check_level_jumps, on a made-up level √σ̄ with top 1:
+    1e-9 → 4·10⁻³ (to 0.4 % of the top: ignored), 4·10⁻³ → 0.05 (12.5×, to 5 %) and
+    0.05 → 1 (20×) are the jumps that count — more than LEVEL_JUMP = 10×, to at least 10⁻² of
+    the run's largest level: one warning, "2 step(s) in all", first at t = 0.2; none at
+    substeps = 16."""
+    import warnings
+
+    from obsdesign.methods.stubborn.highgain import _check_level_jumps
+
+    lev = np.array([1e-9, 4e-3, 4e-3, 0.05, 0.05, 1.0])
+    t = np.arange(len(lev)) * 0.1
+    with warnings.catch_warnings(record=True) as got:
+        warnings.simplefilter("always")
+        _check_level_jumps(t, lev**2, 1)
+    msgs = [str(w.message) for w in got if "grows from" in str(w.message)]
+    assert len(msgs) == 1 and "2 step(s) in all" in msgs[0] and "t = 0.2 " in msgs[0], msgs
+    with warnings.catch_warnings(record=True) as got:
+        warnings.simplefilter("always")
+        _check_level_jumps(t, lev**2, 16)
+    assert not [w for w in got if "grows from" in str(w.message)]
+    with warnings.catch_warnings(record=True) as got:  # a NaN level later (a run that
+        warnings.simplefilter("always")  # diverged) does not hide the jumps before it
+        _check_level_jumps(np.append(t, 0.6), np.append(lev**2, np.nan), 1)
+    assert [w for w in got if "2 step(s) in all" in str(w.message)]
+
+
+def test_substeps_accepts_its_documented_maximum() -> None:
+    """Mutation review 36: [simulate] substeps ≤ 10 000 (MAX_SUBSTEPS) — the maximum itself is
+    accepted (10 001 is refused by test_substeps_is_a_bounded_positive_integer)."""
+    from pathlib import Path
+
+    from obsdesign import api
+    from obsdesign.methods.stubborn.options import MAX_SUBSTEPS
+
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "specs" / "astolfi-stubborn-duffing.toml").read_text(encoding="utf-8")
+    assert "dt = 0.001" in text
+    spec = api.load_spec_text(
+        text.replace("dt = 0.001", f"dt = 0.001\nsubsteps = {MAX_SUBSTEPS}"), "d.toml"
+    )
+    assert spec is not None
