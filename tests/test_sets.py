@@ -502,3 +502,33 @@ def test_frac_of_a_numpy_integer_has_a_python_numerator() -> None:
     f = frac(np.int64(3))
     assert f == 3 and type(f.numerator) is int
     assert _fmpq(f.numerator, f.denominator) == 3
+
+
+def _far_strip() -> Polytope:
+    """{|e1/10 + 3e2/10| ≤ 10⁻⁴, 3·10¹³ − 1 ≤ e1 ≤ 3·10¹³ + 1}: a thin sheared strip far out."""
+    return Polytope(
+        qmat([[fmpq(1, 10), fmpq(3, 10)], [fmpq(-1, 10), fmpq(-3, 10)], [1, 0], [-1, 0]]),
+        qvec([fmpq(1, 10**4), fmpq(1, 10**4), 30000000000001, -29999999999999]),
+    )
+
+
+def _exactly_inside(P: Polytope, pts: np.ndarray) -> bool:
+    from fractions import Fraction
+
+    from obsdesign.certify.exact import frac
+
+    return all(
+        sum(frac(a) * Fraction(float(v)) for a, v in zip(row, x, strict=True)) <= frac(b)
+        for x in pts
+        for row, b in zip(P.G_q, P.g_q, strict=True)
+    )
+
+
+def test_sampling_a_far_thin_strip_keeps_only_points_inside() -> None:
+    """Re-check trial 36: rejection sampling tested membership with the float ``contains``
+    (absolute 10⁻¹²), so every point it kept from this strip was outside, up to 5.9 strip
+    widths; it now keeps a drawn point only when ``contains_rel`` at SAMPLE_REL (decided
+    exactly near a face) puts it in the set: here every kept point is inside exactly."""
+    P = _far_strip()
+    pts = P.sample(np.random.default_rng(0), 20)
+    assert pts.shape == (20, 2) and _exactly_inside(P, pts)

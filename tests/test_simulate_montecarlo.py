@@ -527,3 +527,28 @@ def test_nonfinite_runs_are_counted_over_every_span() -> None:
     assert mc.nonfinite_warning(per_run).startswith("the metrics of 2 of 4 runs are not finite")
     per_run["rmse"][1:] = 1.0
     assert mc.nonfinite_warning(per_run) == ""
+
+
+def test_initial_errors_from_a_far_thin_strip_are_inside_it() -> None:
+    """Re-check trial 36: all 20 Monte Carlo initial errors drawn from a thin sheared strip
+    at e1 ≈ 3·10¹³ were outside it (the float ``contains`` with an absolute 10⁻¹²); the
+    batch draw now tests membership as ``ConvexSet.sample`` does (``contains_rel`` at
+    SAMPLE_REL), and gives the same points as the set's own sampler."""
+    from fractions import Fraction
+
+    from flint import fmpq
+
+    from obsdesign.certify.exact import frac, qmat, qvec
+    from obsdesign.sets import Polytope
+
+    E0 = Polytope(
+        qmat([[fmpq(1, 10), fmpq(3, 10)], [fmpq(-1, 10), fmpq(-3, 10)], [1, 0], [-1, 0]]),
+        qvec([fmpq(1, 10**4), fmpq(1, 10**4), 30000000000001, -29999999999999]),
+    )
+    gens = [np.random.default_rng(s) for s in range(20)]
+    got = mc.initial_errors(E0, gens, np.zeros(2))
+    for x in got:
+        for row, b in zip(E0.G_q, E0.g_q, strict=True):
+            assert sum(frac(a) * Fraction(float(v)) for a, v in zip(row, x, strict=True)) <= frac(b)
+    want = np.stack([E0.sample(np.random.default_rng(s), 1)[0] for s in range(20)])
+    np.testing.assert_array_equal(got, want)

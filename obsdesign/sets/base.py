@@ -11,6 +11,11 @@ from obsdesign.certify.exact import to_float
 
 #: rounds of :meth:`ConvexSet.sample`'s rejection sampler before it gives up
 MAX_SAMPLE_ROUNDS = 20_000
+#: ``rel`` of the membership test of :meth:`ConvexSet.sample`: a drawn point is kept when it is
+#: in the set up to four float spacings (``contains_rel``, decided exactly near a face), not
+#: within the absolute 10⁻¹² of ``contains``, which kept points 5.9 strip widths outside a thin
+#: sheared strip at |x| ≈ 3·10¹³ (re-check trial, session 36)
+SAMPLE_REL = 0.0
 
 
 class ConvexSet(ABC):
@@ -53,7 +58,8 @@ class ConvexSet(ABC):
         """k points of the set (rejection sampling from the bounding box), in at most
         :data:`MAX_SAMPLE_ROUNDS` rounds: a set of (almost) no volume, a segment in the plane,
         accepted nothing and the loop ran forever (independent simulate review). Raises
-        :class:`~obsdesign.errors.InputError` then."""
+        :class:`~obsdesign.errors.InputError` then. Membership is ``contains_rel`` at
+        :data:`SAMPLE_REL` (the point as drawn is in the set, up to float spacing)."""
         lo, hi = self.bounding_box()
         out: list[np.ndarray] = []
         got = 0
@@ -61,7 +67,7 @@ class ConvexSet(ABC):
             if got >= k:
                 break
             pts = rng.uniform(lo, hi, size=(max(4 * k, 64), self.dim))
-            out.append(pts[np.asarray(self.contains(pts))])
+            out.append(pts[np.asarray(self.contains_rel(pts, rel=SAMPLE_REL), dtype=bool)])
             got += len(out[-1])
         if got < k:
             from obsdesign.errors import InputError
