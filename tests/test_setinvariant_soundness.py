@@ -1038,3 +1038,33 @@ def test_the_translated_necessary_condition_at_its_exact_boundary(lam: fmpq, hol
     assert b.necessary(G) == (False, q(19, 10))
     ok, eps = b.necessary_shifted(G)
     assert eps == q(19, 20) and ok is holds
+
+
+def test_admissibility_reads_noise_and_disturbance_at_their_own_scale() -> None:
+    """Session 37 (after re-check trial 36): the scenario's admissibility took |η| ≤ η̄ + 10⁻¹²
+    and the float ``D.contains`` with an absolute 10⁻¹², so η = 5·10⁻¹³ was admissible for
+    η̄ = 10⁻¹⁵ and a disturbance four strip widths outside a thin sheared D at d₁ ≈ 3·10¹³ was
+    in D — leaving Ω under either was exit 1, a "violation" by an inadmissible scenario.
+    η̄ itself, and a point of D, stay admissible."""
+    from types import SimpleNamespace
+
+    from obsdesign.certify.exact import qmat, qvec
+    from obsdesign.methods.setinvariant.sim import _admissible
+    from obsdesign.sets import Polytope
+
+    D = Polytope(
+        qmat([[fmpq(1, 10), fmpq(3, 10)], [fmpq(-1, 10), fmpq(-3, 10)], [1, 0], [-1, 0]]),
+        qvec([fmpq(1, 10**4), fmpq(1, 10**4), 30000000000001, -29999999999999]),
+    )
+    inside = np.array([[3e13, -1e13]])
+    out = np.array([[30000000000000.746, -10000000000000.25]])  # (e1 + 3e2)/10 = −3.9·10⁻⁴
+    assert D.contains(out, 1e-12).all()  # the float test read it inside
+    for eta, v in [(1e-15, 1e-15), (0.0, 0.0), (0.25, 0.25)]:
+        spec = SimpleNamespace(options=SimpleNamespace(eta_bar=fmpq(0), D=None))
+        spec.options.eta_bar = Q(str(eta)) if eta else fmpq(0)
+        assert _admissible(spec, np.zeros((0, 0)), np.array([[v]]))
+    spec = SimpleNamespace(options=SimpleNamespace(eta_bar=Q("1e-15"), D=None))
+    assert not _admissible(spec, np.zeros((0, 0)), np.array([[5e-13]]))
+    spec = SimpleNamespace(options=SimpleNamespace(eta_bar=fmpq(0), D=D))
+    assert _admissible(spec, inside, np.zeros((1, 1)))
+    assert not _admissible(spec, out, np.zeros((1, 1)))
