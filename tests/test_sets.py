@@ -532,3 +532,18 @@ def test_sampling_a_far_thin_strip_keeps_only_points_inside() -> None:
     P = _far_strip()
     pts = P.sample(np.random.default_rng(0), 20)
     assert pts.shape == (20, 2) and _exactly_inside(P, pts)
+
+
+def test_contains_rel_where_row_products_overflow() -> None:
+    """Mutation review 36 (R9): the strip |2x1 − 2x2| ≤ 1 in the box ±1.7·10³⁰⁸. Its row
+    extents over the float vertices overflowed (2·1.7e308 − 2·1.7e308 = NaN), so the slack was
+    NaN and every point was refused, (1.5e308, 1.5e308) — inside, 2x1 − 2x2 = 0 — included; the
+    extent is now exact there and the rows are decided exactly. Points a few float spacings
+    off the diagonal (2^973 ≥ 1 and more) stay outside."""
+    b = int(1.7e308)
+    P = Polytope(qmat([[1, 0], [-1, 0], [0, 1], [0, -1], [2, -2], [-2, 2]]), qvec([b] * 4 + [1, 1]))
+    pts = np.array(
+        [[1.5e308, 1.5e308], [1.5e308, 1.5e308 - 2.0**972], [1.5e308, 1.4e308], [-1e308, 1e308]]
+    )
+    assert P.contains_rel(pts).tolist() == [True, False, False, False]
+    assert bool(P.contains_rel(np.array([-1.5e308, -1.5e308])))

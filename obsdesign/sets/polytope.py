@@ -178,31 +178,58 @@ class Polytope(ConvexSet):
             err = 4 * (self.dim + 8) * np.finfo(float).eps * s
         ok = r <= slack
         finite = np.isfinite(X2).all(axis=-1)
-        unsure = finite[:, None] & ~(np.abs(r - slack) > err) & np.isfinite(slack)[None, :]
+        # a row whose slack is beyond the float range (its width, or g, overflowed) is decided
+        # exactly for every finite point, against its exact slack: an inf slack let any point
+        # pass, and a NaN one refused (1.5e308, 1.5e308) in a strip |2x1 − 2x2| ≤ 1 of the box
+        # ±1.7e308 (mutation review 36)
+        wide = ~np.isfinite(slack)
+        unsure = finite[:, None] & (~(np.abs(r - slack) > err) | wide[None, :])
         for k, i in zip(*np.nonzero(unsure), strict=True):
-            ok[k, i] = self._row_q(int(i), X2[k]) <= Fraction(float(slack[i]))
+            thr = self._slack_q(int(i), rel) if wide[i] else Fraction(float(slack[i]))
+            ok[k, i] = self._row_q(int(i), X2[k]) <= thr
         out = np.all(ok, axis=-1) & finite
         return bool(out[0]) if one else out.reshape(X.shape[:-1])
 
+    def _slack_q(self, i: int, rel: float) -> Fraction:
+        """Row i's slack of :meth:`contains_rel` exactly, for a row whose float slack is not
+        finite: ``rel`` × its exact width + four spacings of the largest float."""
+        lo, hi = self._row_extent_q()
+        big = 4 * Fraction(float(np.spacing(np.finfo(float).max)))
+        return Fraction(rel) * (frac(hi[i]) - frac(lo[i])) + big
+
+    def _row_extent_q(self) -> tuple[list[fmpq], list[fmpq]]:
+        """Exact min and max of G_i v over the exact vertices, per row (once per polytope)."""
+        ext = self.__dict__.get("_row_extent_q_")
+        if ext is None:
+            P = [
+                [sum((a * b for a, b in zip(row, v, strict=True)), fmpq(0)) for row in self.G_q]
+                for v in self.vertices_q()
+            ]
+            cols = list(zip(*P, strict=True))
+            ext = ([min(c) for c in cols], [max(c) for c in cols])
+            self.__dict__["_row_extent_q_"] = ext
+        return ext
+
     def _row_extent(self) -> tuple[np.ndarray, np.ndarray]:
         """min and max of G_i v over the vertices, per row, in floats (once per polytope):
-        from the float vertices, or exactly where a vertex is beyond the float range (nearly
-        parallel rows), whose inf − inf made a row's width NaN."""
+        from the float vertices, or exactly (then rounded) where a vertex is beyond the float
+        range (nearly parallel rows), whose inf − inf made a row's width NaN, or where a
+        product G_i v overflowed (a row [2, −2] over vertices near 1.7e308; mutation review
+        36)."""
         ext = self.__dict__.get("_row_extent_f")
         if ext is None:
             V = self.vertices()
+            proj = None
             if np.all(np.isfinite(V)):
-                proj = V @ self.G.T
+                with np.errstate(all="ignore"):
+                    proj = V @ self.G.T
+            if proj is not None and np.all(np.isfinite(proj)):
                 ext = (proj.min(axis=0), proj.max(axis=0))
             else:
-                P = [
-                    [sum((a * b for a, b in zip(row, v, strict=True)), fmpq(0)) for row in self.G_q]
-                    for v in self.vertices_q()
-                ]
-                cols = list(zip(*P, strict=True))
+                lo, hi = self._row_extent_q()
                 ext = (
-                    np.array([float_or_inf(min(c)) for c in cols]),
-                    np.array([float_or_inf(max(c)) for c in cols]),
+                    np.array([float_or_inf(v) for v in lo]),
+                    np.array([float_or_inf(v) for v in hi]),
                 )
             self.__dict__["_row_extent_f"] = ext
         return ext
