@@ -1040,3 +1040,26 @@ def test_a_non_finite_lemma1_residual_is_inconclusive(monkeypatch) -> None:
     spec = Path(__file__).resolve().parents[1] / "specs" / "impulsive-sector-3state.toml"
     with pytest.raises(InconclusiveError, match="float search of κ_n"):
         api.design(api.load_spec(spec))
+
+
+@pytest.mark.parametrize(("scale", "slack"), [(1e200, 1.0), (1e200, 0.99), (1.0, 0.99)])
+def test_block_cross_bounds_read_a_huge_box(scale: float, slack: float) -> None:
+    """Mutation review 36 (X1–X3): the cross parts of the split (15) on ψ(x) = (3x₂, 5x₁),
+    T = I, m = 1: c_o = ψ_o(ẑ) − ψ_o(ẑ_o, z_n) = 3ε_n and c_n = 5ε_o exactly, so ℓ_on = 3,
+    ℓ_no = 5 hold with the ratios 3 and 5, and 0.99 of them is violated. On the box ±10²⁰⁰
+    the norms ‖c_o‖, ‖c_n‖, ‖ε‖ squared unscaled overflow (inf/inf = NaN for every pair):
+    every pair must still be read, with the measured ratios 3 and 5."""
+    from obsdesign.methods.impulsive.falsify import falsify_blocks
+
+    def psi(X: np.ndarray) -> np.ndarray:
+        return np.stack([3 * X[:, 1], 5 * X[:, 0]], axis=1)
+
+    one, zero = np.ones((1, 1)), np.zeros((1, 1))
+    qsr = (one, zero, zero)  # ω = |ε|² ≥ 0: the own parts hold
+    lo, hi = np.full(2, -scale), np.full(2, scale)
+    f = falsify_blocks(psi, np.eye(2), 1, qsr, qsr, 3 * slack, 5 * slack, lo, hi, 300, 0)
+    cross = [v for v in f.items if v.name.startswith("cross bound")]
+    assert len(cross) == 2 and all(v.tested > 250 for v in cross), f.summary()
+    lit = f.literal_cross
+    assert lit["o"] == pytest.approx(3, rel=1e-6) and lit["n"] == pytest.approx(5, rel=1e-6)
+    assert all((v.count > 0) == (slack < 1) for v in cross), f.summary()
