@@ -467,3 +467,42 @@ def test_substeps_accepts_its_documented_maximum() -> None:
         text.replace("dt = 0.001", f"dt = 0.001\nsubsteps = {MAX_SUBSTEPS}"), "d.toml"
     )
     assert spec is not None
+
+
+def test_substeps_are_the_steps_of_a_finer_grid() -> None:
+    """Mutation review 36 (HG2–HG4): without noise, dt = 0.004 with substeps = 4 is the run
+    of dt = 0.001 with substeps = 1 at the shared grid points — each substep at its own time
+    t_i + j·h (the forcing cos(ωt)), the input u(t) = sin 7t read at both ends of the substep,
+    and the measurement of the substep's own plant state. Reading t_i, u(t_i) or y(t_i) for
+    every substep of a step moves the trajectories by ~10⁻⁵; u(t_i) at both stages leaves
+    Heun first order in time."""
+    import re
+    import warnings
+
+    text = DUFFING.read_text(encoding="utf-8").replace(
+        'gamma*cos(omega*t)"]', 'gamma*cos(omega*t) + u1"]\nu = ["sin(7*t)"]'
+    )
+    text = re.sub(r"(impulse|hf)_\w+ = .*\n", "", text).replace("horizon = 10", "horizon = 1")
+    assert "u1" in text and "impulse" not in text and "hf_" not in text
+
+    def run(dt: str, m: int) -> Any:
+        sp = api.load_spec_text(text.replace("dt = 0.001", f"dt = {dt}\nsubsteps = {m}"), "s.toml")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return api.simulate(sp, api.design(sp))
+
+    coarse, fine = run("0.004", 4), run("0.001", 1)
+    assert coarse.t.shape == (251,) and fine.t.shape == (1001,)
+    np.testing.assert_allclose(coarse.x, fine.x[::4], rtol=0, atol=1e-12)
+    for key in ("xhat_standard", "xhat_stubborn"):
+        np.testing.assert_allclose(coarse.extra[key], fine.extra[key][::4], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(coarse.extra["sigma"], fine.extra["sigma"][::4], rtol=0, atol=1e-12)
+    # and the plant is Heun's second order in time: u at the substep's end in its second
+    # stage (u(t_i) there is first order, ~10⁻⁴ off at t = 1)
+    from scipy.integrate import solve_ivp
+
+    def f(t: float, x: np.ndarray) -> list[float]:
+        return [x[1], -0.3 * x[1] + x[0] - x[0] ** 3 + 0.5 * np.cos(1.2 * t) + np.sin(7 * t)]
+
+    ref = solve_ivp(f, (0, 1), [1.0, 0.0], t_eval=fine.t, rtol=1e-12, atol=1e-12).y.T
+    np.testing.assert_allclose(fine.x, ref, rtol=0, atol=1e-6)

@@ -332,7 +332,8 @@ def simulate(
     """Plant, standard and stubborn high-gain observers (Heun, step dt); ν: the spec's
     impulsive outlier and high-frequency noise window. Reports |x̂ − x| of both (high-gain
     observer of the stubborn-observer slides, Astolfi, Alessandri, Zaccarian, WUDS 2017).
-    ``budget`` (the time budget) is looked at every 1024 steps."""
+    ``budget`` (the time budget) is looked at every 1024 substeps (every ⌊1024 / substeps⌋
+    steps, at least every step)."""
     s = spec.system
     sim = spec.simulate
     so: SimOptions = sim.options or SimOptions()
