@@ -580,12 +580,6 @@ def test_a_side_narrower_than_an_ulp_is_enclosed_whole() -> None:
     assert fx[0].lo < Fraction(1, 10) and Fraction(1, 10) + Fraction(1, 10**30) < fx[0].hi
 
 
-def _ex(*src: str, names: tuple[str, ...] = ("x1",)) -> list:
-    from obsdesign.spec.expr import parse_expr
-
-    return [parse_expr(s, list(names)) for s in src]
-
-
 @pytest.mark.parametrize(
     "xs",
     [
