@@ -390,20 +390,6 @@ def test_ell_star_is_2L_norm_P_rounded_up_not_any_larger_bound(rep: Report) -> N
         assert ("ell-star-bound" in failed) == fails, (value, failed)
 
 
-_HG_CHAIN3 = """[system]
-time = "continuous"
-states = ["x1", "x2", "x3"]
-A = [[0, 1, 0], [0, 0, 1], [0, 0, 0]]
-psi = {psi}
-C = [[1, 0, 0]]
-[method]
-key = "stubborn"
-mode = "high-gain"
-K = [3, 3, 1]
-lipschitz = 1
-"""
-
-
 def test_the_triangular_check_expands_up_to_its_limits() -> None:
     """Mutation review 36, options._expandable: ψ_1 that cancels x2 only when expanded is
     accepted below both limits — power 10 (≤ 64), 28 operations (≤ 2000) — and a symbolic
@@ -413,7 +399,7 @@ def test_the_triangular_check_expands_up_to_its_limits() -> None:
     from obsdesign.errors import SpecError
 
     def load(p: str):
-        return api.load_spec_text(_HG_CHAIN3.format(psi=f'["{p}", "0", "0"]'), "hg.toml")
+        return api.load_spec_text(_HG.format(A=_CHAIN, psi=f'["{p}", "0", "0"]', L=1), "hg.toml")
 
     assert load("(x1+x2)^10 - (x1^2 + 2*x1*x2 + x2^2)^5") is not None
     ops = " + ".join(f"x1^{k}" for k in range(1, 12))
