@@ -547,3 +547,14 @@ def test_contains_rel_where_row_products_overflow() -> None:
     )
     assert P.contains_rel(pts).tolist() == [True, False, False, False]
     assert bool(P.contains_rel(np.array([-1.5e308, -1.5e308])))
+
+
+def test_contains_rel_reads_a_face_whose_width_overflows_exactly() -> None:
+    """Mutation review 36 follow-up: 2x1 ≤ 1 over x1 ≥ −1.7·10³⁰⁸ has the width 3.4·10³⁰⁸,
+    beyond the float range, so its float slack (10⁻⁹ of the width) is inf and every point
+    passed it; it is now decided exactly against the exact slack 10⁻⁹·(1 + 3.4·10³⁰⁸) + 4·2⁹⁷¹
+    ≈ 3.4·10²⁹⁹ (an exact slack of np.spacing(largest float) = inf raised OverflowError)."""
+    b = int(1.7e308)
+    P = Polytope(qmat([[2, 0], [-1, 0], [0, 1], [0, -1]]), qvec([1, b, 1, 1]))
+    pts = np.array([[1.8e299, 0], [1.6e299, 0], [-1.7e308, 0.5], [-1.7e308, 1.5], [-1.8e308, 0]])
+    assert P.contains_rel(pts).tolist() == [False, True, True, False, False]

@@ -192,10 +192,10 @@ class Polytope(ConvexSet):
 
     def _slack_q(self, i: int, rel: float) -> Fraction:
         """Row i's slack of :meth:`contains_rel` exactly, for a row whose float slack is not
-        finite: ``rel`` × its exact width + four spacings of the largest float."""
+        finite: ``rel`` × its exact width + four spacings of the largest finite float (2⁹⁷¹
+        each; ``np.spacing`` of it is inf)."""
         lo, hi = self._row_extent_q()
-        big = 4 * Fraction(float(np.spacing(np.finfo(float).max)))
-        return Fraction(rel) * (frac(hi[i]) - frac(lo[i])) + big
+        return Fraction(rel) * (frac(hi[i]) - frac(lo[i])) + 4 * 2**971
 
     def _row_extent_q(self) -> tuple[list[fmpq], list[fmpq]]:
         """Exact min and max of G_i v over the exact vertices, per row (once per polytope)."""
