@@ -558,3 +558,19 @@ def test_contains_rel_reads_a_face_whose_width_overflows_exactly() -> None:
     P = Polytope(qmat([[2, 0], [-1, 0], [0, 1], [0, -1]]), qvec([1, b, 1, 1]))
     pts = np.array([[1.8e299, 0], [1.6e299, 0], [-1.7e308, 0.5], [-1.7e308, 1.5], [-1.8e308, 0]])
     assert P.contains_rel(pts).tolist() == [False, True, True, False, False]
+
+
+def test_box_contains_rel_on_sides_near_the_float_range() -> None:
+    """Session 37: a side ±1.7·10³⁰⁸ has the width 3.4·10³⁰⁸, so rel·(hi − lo) was inf and
+    x₁ = 1.75·10³⁰⁸ and 1.79·10³⁰⁸ counted inside; the slack is now rel·hi − rel·lo (and
+    four spacings, capped at the largest float's), so they are outside, 1.7·10³⁰⁸ + 10²⁹⁹
+    (within 10⁻⁹ of the width) inside. A side up to the largest float and an infinite
+    coordinate (outside) raise no overflow warning."""
+    b = int(1.7e308)
+    B = Box(qvec([-b, -1]), qvec([b, 1]))
+    pts = np.array([[1.75e308, 0], [1.7e308, 0], [1.79e308, 0], [1.7e308 + 1e299, 0]])
+    assert B.contains_rel(pts).tolist() == [False, True, False, True]
+    top = np.finfo(float).max
+    B = Box(qvec([0, -1]), qvec([int(top), 1]))
+    pts = np.array([[1.7e308, 1.5], [1.7e308, 1], [top, 0], [np.inf, 0]])
+    assert B.contains_rel(pts).tolist() == [False, True, True, False]

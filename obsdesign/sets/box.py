@@ -40,11 +40,17 @@ class Box(ConvexSet):
     def contains_rel(self, x: np.ndarray, rel: float = 1e-9) -> np.ndarray | bool:
         """Membership up to ``rel`` of each side's own width (plus four float spacings of its
         bounds): the widest side's let a box 10¹² times thinner in one coordinate count a
-        point 8× outside as inside (re-check trial, session 34)."""
+        point 8× outside as inside (re-check trial, session 34). ``rel·hi − rel·lo`` and
+        spacings capped at the largest float's (2⁹⁷¹): ``rel·(hi − lo)`` overflowed for a side
+        ±1.7·10³⁰⁸, and its inf slack let x₁ = 1.79·10³⁰⁸ in (session 37). A non-finite
+        coordinate is outside, as in the other sets."""
         x = np.asarray(x, dtype=float)
         lo, hi = np.asarray(self.lower, float), np.asarray(self.upper, float)
-        slack = rel * (hi - lo) + 4 * np.spacing(np.maximum(np.abs(lo), np.abs(hi)))
-        return ((x >= lo - slack) & (x <= hi + slack)).all(axis=-1)
+        with np.errstate(over="ignore"):  # spacing of the largest float is inf; hi + slack
+            ulp = np.minimum(np.spacing(np.maximum(np.abs(lo), np.abs(hi))), 2.0**971)
+            slack = (rel * hi - rel * lo) + 4 * ulp
+            inside = (x >= lo - slack) & (x <= hi + slack)
+        return (inside & np.isfinite(x)).all(axis=-1)
 
     def bounding_box(self) -> tuple[np.ndarray, np.ndarray]:
         return self.lower, self.upper
