@@ -420,12 +420,11 @@ def simulate(
         xi, xhi = x[i], xh[i]
         us = u_step(i)
         for j in range(m):  # Heun substeps of h = dt/m, ν held over the step dt
-            ti = t[i] + offs[j]
-            u, u2 = us[j], us[j + 1]
-            f1, a, sa = stage(xi, xhi, sg, xi[0] + nu[i], u, ti)
+            ti, t2 = t[i] + offs[j], t[i] + offs[j + 1]  # u is read at these same times
+            f1, a, sa = stage(xi, xhi, sg, xi[0] + nu[i], us[j], ti)
             x2 = xi + h * f1
             xb, sb_ = xhi + h * a, max(sg + h * sa, 0.0)
-            f2, b, sbb = stage(x2, xb, sb_, x2[0] + nu[i], u2, ti + h)
+            f2, b, sbb = stage(x2, xb, sb_, x2[0] + nu[i], us[j + 1], t2)
             xi = xi + h / 2 * (f1 + f2)
             xhi = xhi + h / 2 * (a + b)
             sg = max(sg + h / 2 * (sa + sbb), 0.0)
