@@ -1045,7 +1045,8 @@ def test_admissibility_reads_noise_and_disturbance_at_their_own_scale() -> None:
     and the float ``D.contains`` with an absolute 10⁻¹², so η = 5·10⁻¹³ was admissible for
     η̄ = 10⁻¹⁵ and a disturbance four strip widths outside a thin sheared D at d₁ ≈ 3·10¹³ was
     in D — leaving Ω under either was exit 1, a "violation" by an inadmissible scenario.
-    η̄ itself, and a point of D, stay admissible."""
+    η̄ itself (the float of 10⁻¹⁵, above the exact bound by a rounding), and a point of D,
+    stay admissible; 10⁻¹⁵ + 5 spacings is not."""
     from types import SimpleNamespace
 
     from obsdesign.certify.exact import qmat, qvec
@@ -1065,6 +1066,25 @@ def test_admissibility_reads_noise_and_disturbance_at_their_own_scale() -> None:
         assert _admissible(spec, np.zeros((0, 0)), np.array([[v]]))
     spec = SimpleNamespace(options=SimpleNamespace(eta_bar=Q("1e-15"), D=None))
     assert not _admissible(spec, np.zeros((0, 0)), np.array([[5e-13]]))
+    over = 1e-15 + 5 * np.spacing(1e-15)
+    assert not _admissible(spec, np.zeros((0, 0)), np.array([[over]]))
     spec = SimpleNamespace(options=SimpleNamespace(eta_bar=fmpq(0), D=D))
     assert _admissible(spec, inside, np.zeros((1, 1)))
     assert not _admissible(spec, out, np.zeros((1, 1)))
+
+
+@pytest.mark.parametrize("law", ["linear", "interpolated"])
+def test_an_initial_error_just_outside_omega_is_no_violation(law: str) -> None:
+    """Re-check trial 37: e(0) = (1 + 1.9·10⁻⁹, −1 − 1.9·10⁻⁹) is outside Ω (the vertex
+    (1, −1) it shares with the polyhedron), yet "e(0) ∈ Ω" read it inside with 10⁻⁹ of the
+    face's width (2·10⁻⁹) while the gauge allowed only 10⁻⁹: exit 1, "left the polyhedron",
+    for a run the guarantee does not cover. e(0) ∈ Ω is now read to four float spacings."""
+    text = SPEC71.read_text(encoding="utf-8").replace(
+        "x0 = [0, 0]", "x0 = [1.0000000019, -1.0000000019]"
+    )
+    text = re.sub(r"\[simulate\.disturbance\]\nkind = .*\nvalues = .*\n", "", text)
+    assert "1.0000000019" in text and "simulate.disturbance" not in text
+    sp = api.load_spec_text(text, "e0.toml")
+    res = api.simulate(sp, api.design(sp), law=law)
+    assert res.info["e0_in_omega"] is False and res.info["max_gauge"] > 1 + 1e-9
+    assert res.info.get("exit_code", 0) == 0
