@@ -254,3 +254,23 @@ def test_qstr_floats_declines_mixed_arrays_and_qparse_floats_scalars() -> None:
     assert qparse_floats("-3/4") == (fmpq(-3, 4), -0.75)
     with pytest.raises(ZeroDivisionError):
         qparse_floats(["1/0"])
+
+
+@pytest.mark.parametrize(
+    ("x", "lo", "hi"),
+    [
+        ("1/10", 0.09999999999999999, 0.1),
+        ("-1/10", -0.1, -0.09999999999999999),
+        ("3", 3.0, 3.0),
+        ("30000000000000001/1000", 30000000000000.0, 30000000000000.004),
+        (f"{10**400}", 1.7976931348623157e308, float("inf")),
+        (f"-{10**400}", float("-inf"), -1.7976931348623157e308),
+    ],
+)
+def test_float_floor_and_ceil_bracket_the_exact_number(x: str, lo: float, hi: float) -> None:
+    """float_floor / float_ceil: the largest float ≤ x and the smallest ≥ x (the exact box
+    test of Box.contains_exact); beyond the float range ±inf on the far side, the largest
+    float on the near one."""
+    from obsdesign.certify.exact import float_ceil, float_floor
+
+    assert float_floor(Q(x)) == lo and float_ceil(Q(x)) == hi

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import re
+import sys
 from decimal import Decimal
 from fractions import Fraction
 from typing import Any
@@ -103,6 +104,22 @@ def float_or_inf(x: Any) -> float:
         return _qfloat(Q(x))
     except OverflowError:
         return math.inf if Q(x) > 0 else -math.inf
+
+
+def float_floor(x: Any) -> float:
+    """The largest float ≤ the exact number x (−inf below the float range): a float y
+    satisfies y ≤ x exactly iff y ≤ float_floor(x)."""
+    q = Q(x)
+    f = float_or_inf(q)
+    if math.isinf(f):
+        return f if f < 0 else sys.float_info.max
+    return f if frac(f) <= frac(q) else math.nextafter(f, -math.inf)
+
+
+def float_ceil(x: Any) -> float:
+    """The smallest float ≥ the exact number x (+inf above the float range): a float y
+    satisfies y ≥ x exactly iff y ≥ float_ceil(x)."""
+    return -float_floor(-Q(x))
 
 
 def _qfloat(x: Any) -> float:
