@@ -574,3 +574,140 @@ def test_box_contains_rel_on_sides_near_the_float_range() -> None:
     B = Box(qvec([0, -1]), qvec([int(top), 1]))
     pts = np.array([[1.7e308, 1.5], [1.7e308, 1], [top, 0], [np.inf, 0]])
     assert B.contains_rel(pts).tolist() == [False, True, True, False]
+
+
+def test_sampling_a_box_side_without_a_float_is_refused() -> None:
+    """Re-check trial 37: e1 ∈ [3·10¹³ + 0.001, 3·10¹³ + 0.002] holds no float, yet every
+    sampled point was 3·10¹³ + 0.0039 (outside: the float test, and four spacings of the bound,
+    took it in). Sampling decides membership exactly: no point, the documented "no volume"
+    error; the float bounds nearest the side are outside."""
+    from obsdesign.errors import InputError
+
+    B = Box(qvec([fmpq(30000000000000001, 1000), 0]), qvec([fmpq(30000000000000002, 1000), 1]))
+    near = np.array([[30000000000000.0, 0.5], [30000000000000.004, 0.5]])
+    assert B.contains_exact(near).tolist() == [False, False]
+    with pytest.raises(InputError, match="no volume"):
+        B.sample(np.random.default_rng(0), 1)
+
+
+def test_sampling_a_far_strip_with_a_large_offset_keeps_points_inside(monkeypatch) -> None:
+    """Re-check trial 37: 3·10¹³ ≤ e1 + e2 ≤ 3·10¹³ + 10⁻⁴ (0 ≤ e2 ≤ 1): four float spacings of
+    the face's offset 3·10¹³ are 150 strip widths, and 199 of 200 sampled points were outside.
+    Sampling keeps a point only when it is in the set exactly — and reads G x − g about the
+    middle of the bounding box, so only points within rounding of a face (here few) go to
+    exact arithmetic: it took 58 s for 200 points with G x − g read directly."""
+    from obsdesign.sets import polytope as pmod
+
+    P = Polytope(
+        qmat([[1, 1], [-1, -1], [0, 1], [0, -1]]),
+        qvec([30000000000000 + fmpq(1, 10**4), -30000000000000, 1, 0]),
+    )
+    calls = []
+    real = pmod.Polytope._row_q
+
+    def counted(self, i, x):
+        calls.append(i)
+        return real(self, i, x)
+
+    monkeypatch.setattr(pmod.Polytope, "_row_q", counted)
+    pts = P.sample(np.random.default_rng(0), 50)
+    monkeypatch.undo()
+    assert pts.shape == (50, 2) and _exactly_inside(P, pts)
+    assert len(calls) < 2000, len(calls)
+
+
+def test_ellipsoid_far_from_the_origin_is_decided_in_floats(monkeypatch) -> None:
+    """Re-check trial 37: the rounding bound of the form grew with |x|², so for an ellipsoid of
+    radius 10⁻³ centred at 10⁴ every point went to exact arithmetic (20,000 Monte Carlo initial
+    errors in 55 s instead of 0.1 s). The bound now scales with |x − c| and the centre's own
+    rounding: of 2,000 points of the bounding box, only those within ~10⁻⁸ of the boundary
+    (none here) are decided exactly, and the answers agree with the exact form."""
+    E = Ellipsoid(qmat([[10**6, 0], [0, 10**6]]), qvec([10**4, 10**4]))
+    rng = np.random.default_rng(1)
+    pts = 1e4 + rng.uniform(-1e-3, 1e-3, size=(2000, 2))
+    calls = []
+    real = Ellipsoid._form_q
+
+    def counted(self, x):
+        calls.append(1)
+        return real(self, x)
+
+    monkeypatch.setattr(Ellipsoid, "_form_q", counted)
+    got = E.contains_exact(pts)
+    monkeypatch.undo()
+    assert len(calls) < 20, len(calls)
+    want = [real(E, x) <= 1 for x in pts]
+    assert got.tolist() == want and 0 < sum(want) < 2000
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    k=st.integers(0, 14),
+    rows=st.lists(
+        st.tuples(st.integers(-9, 9), st.integers(-9, 9)).filter(lambda r: r != (0, 0)),
+        min_size=3,
+        max_size=5,
+    ),
+    seed=st.integers(0, 2**16),
+)
+def test_contains_exact_agrees_with_exact_arithmetic(k: int, rows: list, seed: int) -> None:
+    """contains_exact of a polytope (random integer rows, the box |x_i| ≤ 1 added, moved to
+    10^k), of the ellipsoid and of the box through the same point, against Fractions at
+    points near the faces, also far from the origin."""
+    from fractions import Fraction
+
+    from obsdesign.certify.exact import frac
+
+    shift = 10**k
+    G = [[fmpq(a, 7), fmpq(b, 3)] for a, b in rows] + [[1, 0], [-1, 0], [0, 1], [0, -1]]
+    g = [fmpq(abs(a) + abs(b), 3) + fmpq(a, 7) * shift + fmpq(b, 3) * shift for a, b in rows]
+    g += [shift + 1, 1 - shift, shift + 1, 1 - shift]
+    P = Polytope(qmat(G), qvec(g))
+    rng = np.random.default_rng(seed)
+    pts = shift + rng.uniform(-1.2, 1.2, size=(40, 2))
+    V = P.vertices()
+    # points on the faces (between vertices, rounded) and a few float spacings either side
+    w = rng.uniform(0, 1, size=(len(V), 1))
+    on = w * V + (1 - w) * np.roll(V, 1, axis=0)
+    near = [on + j * np.spacing(on) for j in (-2, -1, 0, 1, 2)]
+    pts = np.vstack([pts, V, V + np.spacing(V), *near])
+
+    def inside(x) -> bool:
+        return all(
+            sum(frac(a) * Fraction(float(v)) for a, v in zip(row, x, strict=True)) <= frac(b)
+            for row, b in zip(P.G_q, P.g_q, strict=True)
+        )
+
+    assert P.contains_exact(pts).tolist() == [inside(x) for x in pts]
+    El = Ellipsoid(qmat([[3, 1], [1, 2]]), qvec([shift + fmpq(1, 3), shift]))
+    th = rng.uniform(0, 2 * np.pi, size=40)
+    u = np.stack([np.cos(th), np.sin(th)], axis=1)
+    r = 1 / np.sqrt(np.einsum("ki,ij,kj->k", u, El.E, u))
+    rim = El.center + u * r[:, None]  # on the boundary, rounded, and spacings either side
+    rim = np.vstack([rim + j * np.spacing(rim) * u for j in (-3, -1, 0, 1, 3)])
+    pts_e = np.vstack([pts, rim])
+    assert El.contains_exact(pts_e).tolist() == [El._form_q(x) <= 1 for x in pts_e]
+    B = Box(qvec([shift - fmpq(1, 3), shift - 1]), qvec([shift + fmpq(1, 7), shift + 1]))
+    want = [
+        all(
+            frac(lo) <= Fraction(float(v)) <= frac(hi)
+            for lo, v, hi in zip(B.lower_q, x, B.upper_q, strict=True)
+        )
+        for x in pts
+    ]
+    assert B.contains_exact(pts).tolist() == want
+
+
+def test_contains_exact_decides_where_the_float_sign_is_wrong() -> None:
+    """Points on the face 6x1 + (32/3)x2 ≤ 15/11, rounded: the float G x − g (about the middle
+    of the bounding box) is −5.0·10⁻¹⁸ at the first, whose exact value is +8.4·10⁻¹⁹ (outside),
+    and +2.1·10⁻¹⁸ at the second, exactly −4.4·10⁻¹⁷ (inside): where the rounding bound
+    reaches 0 the row is decided exactly, and a bound too small would answer the float's sign."""
+    P = Polytope(qmat([[6, fmpq(32, 3)], [-1, 0], [0, -1], [1, 1]]), qvec([fmpq(15, 11), 0, 0, 10]))
+    pts = np.array(
+        [
+            [float.fromhex("0x1.897bbe9562bbbp-4"), float.fromhex("0x1.2e4d4d8627021p-4")],
+            [float.fromhex("0x1.a5cf0251a498bp-8"), float.fromhex("0x1.fccea1a54fc24p-4")],
+        ]
+    )
+    assert P.contains_exact(pts).tolist() == [False, True]

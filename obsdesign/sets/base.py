@@ -11,11 +11,6 @@ from obsdesign.certify.exact import to_float
 
 #: rounds of :meth:`ConvexSet.sample`'s rejection sampler before it gives up
 MAX_SAMPLE_ROUNDS = 20_000
-#: ``rel`` of the membership test of :meth:`ConvexSet.sample`: a drawn point is kept when it is
-#: in the set up to four float spacings (``contains_rel``, decided exactly near a face), not
-#: within the absolute 10⁻¹² of ``contains``, which kept points 5.9 strip widths outside a thin
-#: sheared strip at |x| ≈ 3·10¹³ (re-check trial, session 36)
-SAMPLE_REL = 0.0
 
 
 class ConvexSet(ABC):
@@ -46,6 +41,12 @@ class ConvexSet(ABC):
         inside (soundness trial, session 34)."""
         return self.contains(x, tol=self._slack(rel))
 
+    def contains_exact(self, x: np.ndarray) -> np.ndarray | bool:
+        """Membership of the float point x as it is in the exact set, no tolerance (the test
+        of :meth:`sample`). This default is ``contains_rel`` at ``rel = 0`` (four float
+        spacings); every set of this package overrides it with an exact decision."""
+        return self.contains_rel(x, rel=0.0)
+
     def _slack(self, rel: float) -> float:
         """``rel`` × the widest side of the bounding box + 4 float spacings of its magnitude."""
         lo, hi = (np.asarray(b, dtype=float) for b in self.bounding_box())
@@ -58,8 +59,11 @@ class ConvexSet(ABC):
         """k points of the set (rejection sampling from the bounding box), in at most
         :data:`MAX_SAMPLE_ROUNDS` rounds: a set of (almost) no volume, a segment in the plane,
         accepted nothing and the loop ran forever (independent simulate review). Raises
-        :class:`~obsdesign.errors.InputError` then. Membership is ``contains_rel`` at
-        :data:`SAMPLE_REL` (the point as drawn is in the set, up to float spacing)."""
+        :class:`~obsdesign.errors.InputError` then. A drawn point is kept when it is in the
+        set exactly (:meth:`contains_exact`): the float ``contains`` (absolute 10⁻¹²) kept
+        points 5.9 strip widths outside a thin sheared strip at |x| ≈ 3·10¹³ (re-check trial,
+        session 36), and four float spacings of a face's offset still 140 widths (re-check
+        trial, session 37)."""
         lo, hi = self.bounding_box()
         out: list[np.ndarray] = []
         got = 0
@@ -67,7 +71,7 @@ class ConvexSet(ABC):
             if got >= k:
                 break
             pts = rng.uniform(lo, hi, size=(max(4 * k, 64), self.dim))
-            out.append(pts[np.asarray(self.contains_rel(pts, rel=SAMPLE_REL), dtype=bool)])
+            out.append(pts[np.asarray(self.contains_exact(pts), dtype=bool)])
             got += len(out[-1])
         if got < k:
             from obsdesign.errors import InputError

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from obsdesign.certify.exact import qzeros
+from obsdesign.certify.exact import float_ceil, float_floor, qzeros
 from obsdesign.sets.base import ConvexSet, float_view
 
 
@@ -51,6 +51,25 @@ class Box(ConvexSet):
             slack = (rel * hi - rel * lo) + 4 * ulp
             inside = (x >= lo - slack) & (x <= hi + slack)
         return (inside & np.isfinite(x)).all(axis=-1)
+
+    def contains_exact(self, x: np.ndarray) -> np.ndarray | bool:
+        """lower ≤ x ≤ upper exactly for the float point x: x ≥ the smallest float ≥ each
+        exact lower bound and ≤ the largest float ≤ each upper bound (a side with no float in
+        it, [3·10¹³ + 0.001, 3·10¹³ + 0.002], holds no point)."""
+        lo, hi = self._float_inner()
+        x = np.asarray(x, dtype=float)
+        return ((x >= lo) & (x <= hi)).all(axis=-1)
+
+    def _float_inner(self) -> tuple[np.ndarray, np.ndarray]:
+        """(smallest float ≥ lower_q, largest float ≤ upper_q), per side, once per box."""
+        inner = self.__dict__.get("_inner")
+        if inner is None:
+            inner = (
+                np.array([float_ceil(v) for v in self.lower_q], dtype=float),
+                np.array([float_floor(v) for v in self.upper_q], dtype=float),
+            )
+            self.__dict__["_inner"] = inner
+        return inner
 
     def bounding_box(self) -> tuple[np.ndarray, np.ndarray]:
         return self.lower, self.upper

@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from obsdesign.errors import InputError
-from obsdesign.sets.base import SAMPLE_REL, ConvexSet
+from obsdesign.sets.base import ConvexSet
 from obsdesign.simulate.budget import TimeBudget
 from obsdesign.simulate.result import SimResult, norms
 from obsdesign.spec.models import Spec
@@ -112,8 +112,8 @@ def initial_errors(
     :data:`SAMPLE_BLOCK` uniform points of the bounding box (``lo + (hi − lo)·U``, the formula
     of ``Generator.uniform``, so the same numbers), one membership test for all runs, and the
     set's own ``sample`` only for a run none of whose points is inside (the generator then
-    continues exactly where ``sample`` would). Membership is ``contains_rel`` at
-    :data:`~obsdesign.sets.base.SAMPLE_REL`, the test of ``sample``. Returns (runs, n)."""
+    continues exactly where ``sample`` would). Membership is ``contains_exact``, the test of
+    ``sample``. Returns (runs, n)."""
     R = len(rngs)
     if eset is None:
         return np.tile(default, (R, 1))
@@ -126,7 +126,7 @@ def initial_errors(
     for r, g in enumerate(rngs):
         g.random(out=raw[r])
     pts = lo + rg * raw.reshape(R, SAMPLE_BLOCK, n)
-    inside = np.asarray(eset.contains_rel(pts.reshape(-1, n), rel=SAMPLE_REL), dtype=bool)
+    inside = np.asarray(eset.contains_exact(pts.reshape(-1, n)), dtype=bool)
     inside = inside.reshape(R, SAMPLE_BLOCK)
     first = inside.argmax(axis=1)
     out = pts[np.arange(R), first]
