@@ -552,3 +552,37 @@ def test_initial_errors_from_a_far_thin_strip_are_inside_it() -> None:
             assert sum(frac(a) * Fraction(float(v)) for a, v in zip(row, x, strict=True)) <= frac(b)
     want = np.stack([E0.sample(np.random.default_rng(s), 1)[0] for s in range(20)])
     np.testing.assert_array_equal(got, want)
+
+
+def test_drawing_initial_errors_respects_the_time_limit() -> None:
+    """Re-check trial 37: an ellipsoid 10⁻⁵ wide at 3·10¹³ (thinner than the float spacing
+    there, 0.004) has every drawn point decided in rational arithmetic: the spec loader's
+    check and the runs' draws took ~55 s each before the "no volume" error, past any
+    time_limit. The loader now gives up after LOAD_SAMPLE_SECONDS (leaving the set to the
+    runs) and the draws look at the time budget: exit 3 naming the sampling."""
+    from obsdesign import api
+    from obsdesign.simulate.budget import TimeExceeded
+
+    text = """[system]
+time = "discrete"
+A = [[0.5, 1], [0, 0.8]]
+C = [[1, 0]]
+[method]
+key = "lyapunov"
+L = [0.6, 0.1]
+[sets.E0]
+type = "ellipsoid"
+E = [[10000000000, 0], [0, 1]]
+center = [30000000000000.001953125, 0]
+[simulate]
+horizon = 5
+x0 = [0, 0]
+xhat0 = [0, 0]
+seed = 1
+runs = 3
+time_limit = 0.5
+initial_error = "E0"
+"""
+    sp = load_spec_text(text, "far.toml")
+    with pytest.raises(TimeExceeded, match="sampling the ellipsoid"):
+        api.simulate(sp, api.design(sp))

@@ -40,7 +40,7 @@ import numpy as np
 
 from obsdesign.errors import InputError
 from obsdesign.sets.base import ConvexSet
-from obsdesign.simulate.budget import TimeBudget
+from obsdesign.simulate.budget import TimeBudget, TimeExceeded
 from obsdesign.simulate.result import SimResult, norms
 from obsdesign.spec.models import Spec
 from obsdesign.spec.reader import Table
@@ -57,6 +57,8 @@ BLOCK = 16
 CHUNK = 1024
 #: rows × columns × inner size of a product that OpenBLAS runs on one thread
 MNK_ONE_THREAD = 1 << 18
+#: seconds the spec loader spends trying to draw one point of ``initial_error``'s set
+LOAD_SAMPLE_SECONDS = 2.0
 #: points of the first rejection-sampling block of ``ConvexSet.sample(rng, 1)``
 SAMPLE_BLOCK = 64
 #: quantiles reported for every per-run metric
@@ -78,10 +80,17 @@ def parse_initial_error(table: Table, spec: Spec) -> str | None:
         raise table.error(
             "initial_error", f"expected a set of dimension {spec.system.n} (states), got {dim}"
         )
-    try:  # a set the runs cannot draw from (no volume) is bad input here, not a hang later
-        spec.sets[name].sample(np.random.default_rng(0), 1)
+    # a set the runs cannot draw from (no volume) is bad input here, not a hang later; a set
+    # whose points all need rational arithmetic can take a minute to say so, and is left to
+    # the runs after LOAD_SAMPLE_SECONDS (they draw under the simulation's time_limit)
+    try:
+        spec.sets[name].sample(
+            np.random.default_rng(0), 1, TimeBudget(LOAD_SAMPLE_SECONDS, "not reported")
+        )
     except InputError as e:
         raise table.error("initial_error", f"set {name!r}: {e}") from None
+    except TimeExceeded:
+        pass
     return name
 
 
@@ -104,7 +113,10 @@ def run_seed(seed: int, r: int) -> np.random.SeedSequence:
 
 
 def initial_errors(
-    eset: ConvexSet | None, rngs: list[np.random.Generator], default: np.ndarray
+    eset: ConvexSet | None,
+    rngs: list[np.random.Generator],
+    default: np.ndarray,
+    budget: TimeBudget | None = None,
 ) -> np.ndarray:
     """One initial error per run, ``eset.sample(rngs[r], 1)[0]`` (``default`` for every run when
     ``eset`` is None), drawn for all runs at once when the set keeps the rejection sampler of
@@ -113,12 +125,12 @@ def initial_errors(
     of ``Generator.uniform``, so the same numbers), one membership test for all runs, and the
     set's own ``sample`` only for a run none of whose points is inside (the generator then
     continues exactly where ``sample`` would). Membership is ``contains_exact``, the test of
-    ``sample``. Returns (runs, n)."""
+    ``sample``; ``budget`` (the time budget) is passed on to it. Returns (runs, n)."""
     R = len(rngs)
     if eset is None:
         return np.tile(default, (R, 1))
     if type(eset).sample is not ConvexSet.sample:
-        return np.stack([eset.sample(g, 1)[0] for g in rngs]).reshape(R, -1)
+        return np.stack([eset.sample(g, 1, budget)[0] for g in rngs]).reshape(R, -1)
     n = eset.dim
     lo, hi = eset.bounding_box()
     lo, rg = np.asarray(lo, dtype=float), np.subtract(hi, lo, dtype=float)
@@ -131,7 +143,7 @@ def initial_errors(
     first = inside.argmax(axis=1)
     out = pts[np.arange(R), first]
     for r in np.flatnonzero(~inside.any(axis=1)):
-        out[r] = eset.sample(rngs[r], 1)[0]
+        out[r] = eset.sample(rngs[r], 1, budget)[0]
     return out
 
 
@@ -417,7 +429,7 @@ def study(
             budget.check(f"{b0:,} of {runs:,} Monte Carlo runs done")
         rngs = [np.random.default_rng(c) for c in children(b0, min(b0 + B, runs))]
         try:
-            e0 = initial_errors(eset, rngs, sim.xhat0.f - sim.x0.f)
+            e0 = initial_errors(eset, rngs, sim.xhat0.f - sim.x0.f, budget)
         except InputError as e:  # a thin set a run could not draw from: name file and key
             raise InputError(
                 f"{spec.file}: [simulate.initial_error] set {initial_error!r}: {e}"
@@ -496,7 +508,7 @@ def _remeasure(
             budget.check(f"{b0:,} of {len(bad):,} runs measured again (errors near 1e±154)")
         rows = bad[b0 : b0 + batch]
         rngs = [np.random.default_rng(children(int(r), int(r) + 1)[0]) for r in rows]
-        e0 = initial_errors(eset, rngs, e_default)
+        e0 = initial_errors(eset, rngs, e_default, budget)
         with np.errstate(over="ignore", invalid="ignore"):
             m, _ = step(rngs, e0, False, scaled=True)
         rmse[rows] = m["rmse"]
