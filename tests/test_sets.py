@@ -576,18 +576,26 @@ def test_box_contains_rel_on_sides_near_the_float_range() -> None:
     assert B.contains_rel(pts).tolist() == [False, True, True, False]
 
 
-def test_sampling_a_box_side_without_a_float_is_refused() -> None:
-    """Re-check trial 37: e1 ∈ [3·10¹³ + 0.001, 3·10¹³ + 0.002] holds no float, yet every
-    sampled point was 3·10¹³ + 0.0039 (outside: the float test, and four spacings of the bound,
-    took it in). Sampling decides membership exactly: no point, the documented "no volume"
-    error; the float bounds nearest the side are outside."""
-    from obsdesign.errors import InputError
-
-    B = Box(qvec([fmpq(30000000000000001, 1000), 0]), qvec([fmpq(30000000000000002, 1000), 1]))
-    near = np.array([[30000000000000.0, 0.5], [30000000000000.004, 0.5]])
-    assert B.contains_exact(near).tolist() == [False, False]
-    with pytest.raises(InputError, match="no volume"):
-        B.sample(np.random.default_rng(0), 1)
+def test_box_sampling_is_exact_where_a_side_holds_floats() -> None:
+    """Re-check trial 37 and the choice for a side without a float: e1 ∈ [0.1, 0.3] is read
+    exactly (the float 0.1 is above 1/10 and inside, the float below it outside), while a side
+    that holds no float — the degenerate 1/10, or [3·10¹³ + 0.001, 3·10¹³ + 0.002] — is the
+    floats nearest its ends, so a fixed coordinate 0.1 can be sampled (it was "no volume" with
+    the exact test alone, and worked before it)."""
+    B = Box(qvec([fmpq(1, 10), fmpq(1, 10)]), qvec([fmpq(3, 10), fmpq(1, 10)]))
+    below = np.nextafter(0.1, 0.0)
+    assert B.contains_exact(np.array([[0.1, 0.1], [below, 0.1], [0.2, below]])).tolist() == [
+        True,
+        False,
+        False,
+    ]
+    pts = B.sample(np.random.default_rng(0), 20)
+    assert np.all(pts[:, 1] == 0.1) and np.all((pts[:, 0] >= 0.1) & (pts[:, 0] <= 0.3))
+    far = Box(qvec([fmpq(30000000000000001, 1000), 0]), qvec([fmpq(30000000000000002, 1000), 1]))
+    near = np.array(
+        [[30000000000000.0, 0.5], [30000000000000.004, 0.5], [3.0000000000000008e13, 0]]
+    )
+    assert far.contains_exact(near).tolist() == [True, True, False]
 
 
 def test_sampling_a_far_strip_with_a_large_offset_keeps_points_inside(monkeypatch) -> None:

@@ -54,20 +54,25 @@ class Box(ConvexSet):
 
     def contains_exact(self, x: np.ndarray) -> np.ndarray | bool:
         """lower ≤ x ≤ upper exactly for the float point x: x ≥ the smallest float ≥ each
-        exact lower bound and ≤ the largest float ≤ each upper bound (a side with no float in
-        it, [3·10¹³ + 0.001, 3·10¹³ + 0.002], holds no point)."""
+        exact lower bound and ≤ the largest float ≤ each upper bound. A side that holds no
+        float at all — a degenerate side 1/10, or [3·10¹³ + 0.001, 3·10¹³ + 0.002] — is read
+        as the floats nearest its ends (the float 0.1; 3·10¹³ and 3·10¹³ + 0.0039), the
+        point a spec's decimal stands for: else a fixed coordinate 0.1 could not be sampled."""
         lo, hi = self._float_inner()
         x = np.asarray(x, dtype=float)
         return ((x >= lo) & (x <= hi)).all(axis=-1)
 
     def _float_inner(self) -> tuple[np.ndarray, np.ndarray]:
-        """(smallest float ≥ lower_q, largest float ≤ upper_q), per side, once per box."""
+        """(smallest float ≥ lower_q, largest float ≤ upper_q) per side, or the nearest
+        floats of both ends where the side holds no float; once per box."""
         inner = self.__dict__.get("_inner")
         if inner is None:
-            inner = (
-                np.array([float_ceil(v) for v in self.lower_q], dtype=float),
-                np.array([float_floor(v) for v in self.upper_q], dtype=float),
-            )
+            lo = np.array([float_ceil(v) for v in self.lower_q], dtype=float)
+            hi = np.array([float_floor(v) for v in self.upper_q], dtype=float)
+            empty = lo > hi
+            lo[empty] = np.asarray(self.lower, dtype=float)[empty]
+            hi[empty] = np.asarray(self.upper, dtype=float)[empty]
+            inner = (lo, hi)
             self.__dict__["_inner"] = inner
         return inner
 
