@@ -719,3 +719,15 @@ def test_contains_exact_decides_where_the_float_sign_is_wrong() -> None:
         ]
     )
     assert P.contains_exact(pts).tolist() == [False, True]
+
+
+def test_sampling_a_set_wider_than_the_float_range_is_refused_by_name() -> None:
+    """Session 37: a box ±1.7·10³⁰⁸ as the initial-error set made numpy's uniform overflow —
+    exit 4, "a number is beyond the float range", naming nothing; it is an InputError saying
+    which coordinate of which set cannot be sampled (the loader names file and key)."""
+    from obsdesign.errors import InputError
+
+    b = int(1.7e308)
+    B = Box(qvec([-b, -1]), qvec([b, 1]))
+    with pytest.raises(InputError, match="wider than the float range \\(coordinate 1 "):
+        B.sample(np.random.default_rng(0), 1)

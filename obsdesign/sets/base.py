@@ -67,7 +67,18 @@ class ConvexSet(ABC):
         trial, session 37). ``budget`` (a simulation's time budget, or None) is looked at every
         16 rounds: a set far thinner than the float spacing at its position has every drawn
         point decided in rational arithmetic, up to a minute before the "no volume" error."""
+        from obsdesign.errors import InputError
+
         lo, hi = self.bounding_box()
+        with np.errstate(over="ignore"):
+            wide = ~np.isfinite(np.subtract(hi, lo, dtype=float))
+        if np.any(wide):  # numpy's uniform overflowed: exit 4 "beyond the float range"
+            i = int(np.argmax(wide))
+            raise InputError(
+                f"the bounding box of the {self.kind or 'set'} is wider than the float range "
+                f"(coordinate {i + 1} from {float(lo[i]):.4g} to {float(hi[i]):.4g}): it "
+                "cannot be sampled"
+            )
         out: list[np.ndarray] = []
         got = 0
         for i in range(MAX_SAMPLE_ROUNDS):
@@ -79,8 +90,6 @@ class ConvexSet(ABC):
             out.append(pts[np.asarray(self.contains_exact(pts), dtype=bool)])
             got += len(out[-1])
         if got < k:
-            from obsdesign.errors import InputError
-
             draws = MAX_SAMPLE_ROUNDS * max(4 * k, 64)
             raise InputError(
                 f"rejection sampling kept {got:,} of {draws:,} points drawn in the bounding box "
