@@ -1156,3 +1156,18 @@ def test_the_noise_premise_reads_each_coordinate_of_d_at_its_own_scale() -> None
     o.D_lower, o.D_upper = np.array([-1.0, 1e8]), np.array([1.0, 1e8])
     near = np.full((K, 1), np.nextafter(1e8, np.inf))
     assert _outside_premises(o, x, u, d, near) == []
+
+
+def test_rho_below_lambda_squared_says_it_is_the_designs_rule() -> None:
+    """Independent fuzz 37: ρ < λ² said "β(v, d) = ρv + μ|d|² needs ρ ≥ λ²", which is not true
+    (for the design's P, (5) holds a little below λ²): it is the design's rule, and the message
+    says so and how to get a smaller ρ (a smaller lambda)."""
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.5]]\nC = [[1]]\n[sets.X]\ntype = "box"\n'
+        'lower = [-1]\nupper = [1]\n[method]\nkey = "constrained"\nL = [0.3]\nlambda = 0.9\n'
+        'rho = 0.5\nX = "X"\neps_min = 0.01\n[method.c]\ntype = "box"\nlower = [-1.1]\n'
+        "upper = [1.1]\n[method.D]\nlower = [-0.1]\nupper = [0.1]\n"
+    )
+    with pytest.raises(SpecError, match=r"\[method\.rho\] expected rho >= lambda² = 0\.81") as e:
+        load_spec_text(text, "rho.toml")
+    assert "needs" not in e.value.message and "give lambda <= √rho" in e.value.message

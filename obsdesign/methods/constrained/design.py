@@ -94,8 +94,9 @@ def lyapunov_data(spec: Spec) -> LyapData:
                 "method.rho",
                 f"expected rho >= λ_best² = {float(lam * lam):.6g} (λ omitted: the best "
                 f"certified rate λ_best = {float(lam):.6g}, A − LC has "
-                f"{_radius_figure(A, C, o.L)}; β(v, d) = ρv + μ|d|² needs ρ ≥ λ²): give a "
-                "larger rho, or lambda with rho >= lambda²",
+                f"{_radius_figure(A, C, o.L)}; the design builds P for that rate and "
+                "certifies β(v, d) = ρv + μ|d|² for ρ ≥ λ²): give a larger rho, or lambda "
+                "with rho >= lambda²",
             )
     else:
         lam = o.lam

@@ -145,7 +145,9 @@ def parse_options(table: Table, spec: Spec) -> Options:
         if rho is not None and lam is not None and rho < lam * lam:
             raise table.error(
                 "rho",
-                f"expected rho >= lambda² = {float(lam * lam):g} (β(v, d) = ρv + μ|d|² needs ρ ≥ λ²)",
+                f"expected rho >= lambda² = {float(lam * lam):g} (the design builds P for the "
+                "rate λ and certifies β(v, d) = ρv + μ|d|² for ρ ≥ λ²; for a smaller rho give "
+                "lambda <= √rho)",
             )
     X_name, X = _set_ref(table, "X", spec, ("box", "polytope"))
     Xhat_name, Xhat = (None, None)
