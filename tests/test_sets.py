@@ -731,3 +731,29 @@ def test_sampling_a_set_wider_than_the_float_range_is_refused_by_name() -> None:
     B = Box(qvec([-b, -1]), qvec([b, 1]))
     with pytest.raises(InputError, match="wider than the float range \\(coordinate 1 "):
         B.sample(np.random.default_rng(0), 1)
+
+
+def test_a_subnormal_coefficient_is_rounded_absolutely() -> None:
+    """Re-check trial 37b: a = 500001/(5·10³²³) ≈ 10⁻³¹⁸ in x2 ≤ a·x1 is a subnormal whose float is
+    1.7·10⁻⁶ off relatively — at x1 = 5·10²⁹⁹ that is ~10⁻²⁴, which a bound relative to |G|
+    does not cover, and a point between the exact and the float face read inside. The bound
+    adds the smallest subnormal per unit of |x − c| (and (Σ|d|)² for an ellipsoid's E)."""
+    from fractions import Fraction
+
+    from obsdesign.certify.exact import frac
+
+    a = fmpq(500001, 5 * 10**323)
+    P = Polytope(
+        qmat([[-a, 1], [1, 0], [-1, 0], [0, -1]]), qvec([0, 10**300, 10**300, fmpq(1, 10**18)])
+    )
+    x1 = 5e299
+    exact, rounded = frac(a) * Fraction(x1), Fraction(float(a)) * Fraction(x1)
+    assert rounded > exact
+    pt = np.array([x1, float((exact + rounded) / 2)])
+    assert Fraction(pt[1]) > exact  # outside the exact face
+    assert not P.contains_exact(pt) and not P.contains_rel(pt, rel=0.0)
+    E = Ellipsoid(qmat([[1, 0], [0, a]]), qvec([0, 0]))
+    y = float(1 / np.sqrt(float(a)))  # on the float boundary along x2
+    ys = [y * (1 + k * 1e-7) for k in (-3, -1, 1, 3)]
+    want = [E._form_q(np.array([0.0, v])) <= 1 for v in ys]
+    assert E.contains_exact(np.array([[0.0, v] for v in ys])).tolist() == want

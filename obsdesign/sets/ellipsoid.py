@@ -39,7 +39,8 @@ class Ellipsoid(ConvexSet):
 
         The bound, with d = fl(x − c) and η = ε(|d| + |c|) + the smallest subnormal (the
         rounding of the difference and of the centre): 2(n² + 8)·ε·|d|ᵀ|E||d| (the sums of the
-        n² products, E rounded) + 4·ηᵀ|E|(|d| + η) (the error of d through the form). It was
+        n² products, E rounded) + 4·ηᵀ|E|(|d| + η) (the error of d through the form) + twice the
+        smallest subnormal × (Σ|d|)² (subnormal entries of E, rounded absolutely). It was
         4(n + 8)·ε·aᵀ|E|a with a = |x| + |c|, which for an ellipsoid of radius 10⁻³ centred at
         10⁴ exceeded the threshold everywhere: every point went to exact arithmetic, and
         20,000 Monte Carlo initial errors took 55 s instead of 0.1 s (re-check trial, session
@@ -55,6 +56,8 @@ class Ellipsoid(ConvexSet):
             eta = eps * (ad + np.abs(self.center)) + 5e-324
             err = 2 * (n * n + 8) * eps * np.einsum("...i,ij,...j->...", ad, aE, ad)
             err = err + 4 * np.einsum("...i,ij,...j->...", eta, aE, ad + eta)
+            # a subnormal E_ij is rounded absolutely (up to half the smallest subnormal)
+            err = err + 2 * 5e-324 * np.sum(ad, axis=-1) ** 2
         thr = 1 + rel
         out = q <= thr
         finite = np.isfinite(X2).all(axis=-1)

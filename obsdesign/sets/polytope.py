@@ -183,7 +183,8 @@ class Polytope(ConvexSet):
     ) -> np.ndarray | bool:
         """G_i x − g_i ≤ slack_i for every row, for the float point x as it is: in floats
         where the rounding of G_i x − g_i (bounded by 4(n + 8)·(ε·(Σ_j |G_ij x_j| + |g_i|) +
-        the smallest subnormal)) cannot reach the threshold, else exactly with the spec's G and g; a row whose slack is
+        the smallest subnormal) + twice the smallest subnormal per unit of Σ_j |x_j − c_j|, for
+        subnormal entries of G) cannot reach the threshold, else exactly with the spec's G and g; a row whose slack is
         not finite against ``exact_slack(i)``."""
         X = np.asarray(x, dtype=float)
         one = X.ndim == 1
@@ -199,8 +200,11 @@ class Polytope(ConvexSet):
             d = X2 - c
             r = d @ G.T + b
             s = np.abs(d) @ np.abs(G).T + np.abs(b)
-            # + the smallest subnormal per term: a product that underflows is off absolutely
+            # + the smallest subnormal per term (a product that underflows is off absolutely)
+            # and per unit of |x − c| (a subnormal G_ij is rounded absolutely: a = 10⁻³¹⁸ at
+            # x1 = 5·10²⁹⁹ was 10⁻²⁴ off; re-check trial, session 37)
             err = 4 * (self.dim + 8) * (np.finfo(float).eps * s + 5e-324)
+            err = err + 2 * 5e-324 * np.sum(np.abs(d), axis=-1)[:, None]
         ok = r <= slack
         finite = np.isfinite(X2).all(axis=-1)
         # a row whose slack is beyond the float range (its width, or g, overflowed) is decided
