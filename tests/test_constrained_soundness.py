@@ -1196,3 +1196,56 @@ def test_theta_covers_prints_a_bound_strictly_below_theta() -> None:
     (claim,) = c
     shown = Q(claim.detail.split("≤ ")[-1])
     assert need_top <= shown < theta, claim.detail
+
+
+_CMIN_MISS = """[system]
+time = "discrete"
+A = [[0.62662114, -0.31808279], [-0.0086982016, -0.25985715]]
+C = [[0.47162381, -0.28777435], [0.16276174, 0.32379847]]
+Bd = [[-0.2003], [-0.07478]]
+[sets.X]
+type = "box"
+lower = [212.62599, -240.39595]
+upper = [369.29515, 70.813944]
+[sets.Xh]
+type = "box"
+lower = [-1440.85876021, -763.10600421]
+upper = [985.474705836, 673.156614686]
+[method]
+key = "constrained"
+L = [[1.53482, 0.38171594], [0.41981388, -1.2699079]]
+X = "X"
+eps_min = 2.906e+04
+lambda = 0.285756
+Xhat = "Xh"
+[method.c]
+type = "polytope"
+G = [[0.967868, -0.320384], [-0.342427, 0.945578], [-0.152309, -0.560248], [0.483934, -0.160192]]
+h = [593.090139, 150.638911, 192.638163, 296.54507]
+[method.D]
+lower = [-70.683291, -77.01158, -73.620829]
+upper = [70.683291, 77.01158, 73.620829]
+"""
+
+
+def test_a_false_cmin_inclusion_is_refuted_by_a_faces_support() -> None:
+    """Independent fuzz 37b: X̂ about 0.1 % too small for C_min (a polytope map, Euclidean
+    norm) was exit 4 "undecided": the segments from the centre towards the outer set's
+    vertices missed every point of C_min outside X̂. Maximizing each face of X̂ over C_min
+    (convex, in floats, then pulled back into C_min exactly) finds one: exit 1 with a witness,
+    checked here with Fractions on the spec's data."""
+    from fractions import Fraction as F
+
+    rep = api.design(api.load_spec_text(_CMIN_MISS, "miss.toml"))
+    (c,) = [c for c in rep.claims if c.id == "Cmin-in-Xhat"]
+    assert rep.exit_code() == 1 and c.status == ClaimStatus.FAILED, c.detail
+    m = re.search(r"x = \(([^)]*)\) lies in C_min", c.detail)
+    assert m, c.detail
+    x = [F(v.strip()) for v in m.group(1).split(",")]
+    G = [["0.967868", "-0.320384"], ["-0.342427", "0.945578"], ["-0.152309", "-0.560248"]]
+    G += [["0.483934", "-0.160192"]]
+    h = ["593.090139", "150.638911", "192.638163", "296.54507"]
+    phi = [F(a) * x[0] + F(b) * x[1] - F(k) for (a, b), k in zip(G, h, strict=True)]
+    assert sum(max(p, 0) ** 4 for p in phi) <= F("2.906e4") ** 2
+    lo, hi = (F("-1440.85876021"), F("-763.10600421")), (F("985.474705836"), F("673.156614686"))
+    assert any(v < a or v > b for v, a, b in zip(x, lo, hi, strict=True))
