@@ -1046,7 +1046,7 @@ def test_admissibility_reads_noise_and_disturbance_at_their_own_scale() -> None:
     η̄ = 10⁻¹⁵ and a disturbance four strip widths outside a thin sheared D at d₁ ≈ 3·10¹³ was
     in D — leaving Ω under either was exit 1, a "violation" by an inadmissible scenario.
     η̄ itself (the float of 10⁻¹⁵, above the exact bound by a rounding), and a point of D,
-    stay admissible; 10⁻¹⁵ + 5 spacings is not."""
+    stay admissible; the next float above 10⁻¹⁵ is not."""
     from types import SimpleNamespace
 
     from obsdesign.certify.exact import qmat, qvec
@@ -1058,18 +1058,23 @@ def test_admissibility_reads_noise_and_disturbance_at_their_own_scale() -> None:
         qvec([fmpq(1, 10**4), fmpq(1, 10**4), 30000000000001, -29999999999999]),
     )
     inside = np.array([[3e13, -1e13]])
-    out = np.array([[30000000000000.746, -10000000000000.25]])  # (e1 + 3e2)/10 = −3.9·10⁻⁴
-    assert D.contains(out, 1e-12).all()  # the float test read it inside
+    # (e1 + 3e2)/10 = −3.9·10⁻⁴: 4 strip widths out, but within the point's own rounding
+    # (|G|·ulp(x)/2 ≈ 4.9·10⁻⁴ at 3·10¹³): the nearest float of an admissible value, so
+    # admissible by the documented choice (session 37b); the float test read it inside too
+    near = np.array([[30000000000000.746, -10000000000000.25]])
+    assert D.contains(near, 1e-12).all()
+    out = np.array([[3e13, -1e13 + 0.0078125]])  # (e1 + 3e2)/10 = 2.3·10⁻³: beyond rounding
     for eta, v in [(1e-15, 1e-15), (0.0, 0.0), (0.25, 0.25)]:
         spec = SimpleNamespace(options=SimpleNamespace(eta_bar=fmpq(0), D=None))
         spec.options.eta_bar = Q(str(eta)) if eta else fmpq(0)
         assert _admissible(spec, np.zeros((0, 0)), np.array([[v]]))
     spec = SimpleNamespace(options=SimpleNamespace(eta_bar=Q("1e-15"), D=None))
     assert not _admissible(spec, np.zeros((0, 0)), np.array([[5e-13]]))
-    over = 1e-15 + 5 * np.spacing(1e-15)
+    over = 1e-15 + np.spacing(1e-15)
     assert not _admissible(spec, np.zeros((0, 0)), np.array([[over]]))
     spec = SimpleNamespace(options=SimpleNamespace(eta_bar=fmpq(0), D=D))
     assert _admissible(spec, inside, np.zeros((1, 1)))
+    assert _admissible(spec, near, np.zeros((1, 1)))
     assert not _admissible(spec, out, np.zeros((1, 1)))
 
 
@@ -1088,3 +1093,49 @@ def test_an_initial_error_just_outside_omega_is_no_violation(law: str) -> None:
     res = api.simulate(sp, api.design(sp), law=law)
     assert res.info["e0_in_omega"] is False and res.info["max_gauge"] > 1 + 1e-9
     assert res.info.get("exit_code", 0) == 0
+
+
+_FAR_FACES = """[system]
+time = "discrete"
+A = [[0.5, 0], [0, 0.5]]
+{B1}C = [[1, 0]]
+[sets.omega]
+type = "polytope"
+G = [[1, 0], [-1, 0], [0, 1], [0, -1]]
+g = [{top}, {bottom}, 1, 1]
+{D}[method]
+key = "set-invariant"
+omega = "omega"
+{dist}eta_bar = 0
+lambda = 0.9
+algorithm = "none"
+L = [0, 0]
+[simulate]
+horizon = 3
+x0 = [{x0}, 0]
+xhat0 = [0, 0]
+{seq}"""
+
+
+@pytest.mark.parametrize("case", ["e0", "d"])
+def test_admissibility_reads_a_face_at_its_own_offset(case: str) -> None:
+    """Re-check trial 37b: "four float spacings of a face's magnitude" — the largest |G_i v| over
+    the set, here 10⁸ and 10⁷ — let e(0)₁ = 5.9·10⁻⁸ into e₁ ≤ 10⁻⁸ of Ω = [−10⁸, 10⁻⁸] × [−1, 1]
+    and d₀ = 1.7·10⁻⁸ into D = [−10⁷, 10⁻⁸]: exit 1, "left the polyhedron", for runs the
+    guarantee does not cover. e(0) ∈ Ω and d_k ∈ D now ask that the float be within its own
+    rounding of each face (``contains_rounded``): not admissible, exit 0."""
+    if case == "e0":
+        kw = {"B1": "", "top": "1e-8", "bottom": "1e8", "D": "", "dist": "", "x0": "5.9e-8"}
+        kw["seq"] = ""
+    else:
+        kw = {"B1": "B1 = [1, 0]\n", "top": "2.5e-8", "bottom": "2.5e7", "x0": "2.4e-8"}
+        kw["D"] = '[sets.D]\ntype = "box"\ndim = 1\nlower = [-1e7]\nupper = [1e-8]\n'
+        kw["dist"] = 'disturbance = "D"\n'
+        kw["seq"] = '[simulate.disturbance]\nkind = "sequence"\nvalues = [1.7e-8, 0, 0]\n'
+    sp = api.load_spec_text(_FAR_FACES.format(**kw), "far.toml")
+    rep = api.design(sp)
+    assert rep.exit_code() == 0
+    res = api.simulate(sp, rep)
+    assert res.info["max_gauge"] > 1.1
+    key = "e0_in_omega" if case == "e0" else "admissible_scenario"
+    assert res.info[key] is False and res.info.get("exit_code", 0) == 0

@@ -62,6 +62,13 @@ class Box(ConvexSet):
         x = np.asarray(x, dtype=float)
         return ((x >= lo) & (x <= hi)).all(axis=-1)
 
+    def contains_rounded(self, x: np.ndarray) -> np.ndarray | bool:
+        """Whether the float point x is the nearest float of a point of the box: between the
+        floats nearest its bounds (the float views), with no tolerance (as
+        :meth:`Polytope.contains_rounded`)."""
+        x = np.asarray(x, dtype=float)
+        return ((x >= self.lower) & (x <= self.upper)).all(axis=-1)
+
     def _float_inner(self) -> tuple[np.ndarray, np.ndarray]:
         """(smallest float ≥ lower_q, largest float ≤ upper_q) per side, or the nearest
         floats of both ends where the side holds no float; once per box."""

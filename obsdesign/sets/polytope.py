@@ -170,22 +170,51 @@ class Polytope(ConvexSet):
             # rel·hi − rel·lo: hi − lo overflowed for |x1| ≤ 1e308, and an inf slack let
             # (1.7e308, 0) pass (re-check trial, session 36)
             slack = (rel * hi - rel * lo) + 4 * np.spacing(mag)
-        return self._decide(x, slack, lambda i: self._slack_q(i, rel))
+        return self._decide(x, slack, lambda k, i: self._slack_q(i, rel))
 
     def contains_exact(self, x: np.ndarray) -> np.ndarray | bool:
         """G x ≤ g exactly for the float point x as it is (no tolerance; the test of
         :meth:`~obsdesign.sets.base.ConvexSet.sample`): in floats where the rounding of
         G_i x − g_i cannot reach 0, else exactly."""
-        return self._decide(x, np.zeros(len(self.g)), lambda i: Fraction(0))
+        return self._decide(x, np.zeros(len(self.g)), lambda k, i: Fraction(0))
+
+    def contains_rounded(self, x: np.ndarray) -> np.ndarray | bool:
+        """Whether the float point x is within its own rounding of the polytope, face by face:
+        G_i x − g_i ≤ Σ_j |G_ij|·spacing(x_j)/2 exactly, i.e. x could be the nearest float of a
+        point on the inner side of each face — a decimal written at a bound (d = 0.1 for
+        d ≤ 1/10, the float above) is in, a point 5.9 times a face's offset out is not, however
+        far the polytope's other faces are (four spacings of the face's magnitude let
+        e₁ = 5.9·10⁻⁸ into e₁ ≤ 10⁻⁸ of a set reaching −10⁸; re-check trial 37b). The test of a
+        simulated scenario's admissibility (set-invariant)."""
+        X = np.asarray(x, dtype=float)
+        X2 = X.reshape(-1, self.dim)
+        with np.errstate(all="ignore"):
+            half = np.minimum(np.spacing(np.abs(X2)), 2.0**971) / 2
+            slack = half @ np.abs(self.G).T  # (points, rows)
+
+        def exact(k: int, i: int) -> Fraction:
+            return (
+                sum(
+                    (
+                        abs(frac(self.G_q[i][j]))
+                        * Fraction(float(min(np.spacing(abs(v)), 2.0**971)))
+                        for j, v in enumerate(X2[k])
+                    ),
+                    start=Fraction(0),
+                )
+                / 2
+            )
+
+        return self._decide(x, slack, exact)
 
     def _decide(
-        self, x: np.ndarray, slack: np.ndarray, exact_slack: Callable[[int], Fraction]
+        self, x: np.ndarray, slack: np.ndarray, exact_slack: Callable[[int, int], Fraction]
     ) -> np.ndarray | bool:
         """G_i x − g_i ≤ slack_i for every row, for the float point x as it is: in floats
         where the rounding of G_i x − g_i (bounded by 4(n + 8)·(ε·(Σ_j |G_ij x_j| + |g_i|) +
         the smallest subnormal) + twice the smallest subnormal per unit of Σ_j |x_j − c_j|, for
         subnormal entries of G) cannot reach the threshold, else exactly with the spec's G and g; a row whose slack is
-        not finite against ``exact_slack(i)``."""
+        not finite against ``exact_slack(k, i)`` (``slack`` per row, or per point and row)."""
         X = np.asarray(x, dtype=float)
         one = X.ndim == 1
         X2 = X.reshape(-1, self.dim)
@@ -211,10 +240,11 @@ class Polytope(ConvexSet):
         # exactly for every finite point, against its exact slack: an inf slack let any point
         # pass, and a NaN one refused (1.5e308, 1.5e308) in a strip |2x1 − 2x2| ≤ 1 of the box
         # ±1.7e308 (mutation review 36)
-        wide = ~np.isfinite(slack)
-        unsure = finite[:, None] & (~(np.abs(r - slack) > err) | wide[None, :])
+        S = np.broadcast_to(slack, r.shape)  # per row, or per point and row
+        wide = ~np.isfinite(S)
+        unsure = finite[:, None] & (~(np.abs(r - S) > err) | wide)
         for k, i in zip(*np.nonzero(unsure), strict=True):
-            thr = exact_slack(int(i)) if wide[i] else Fraction(float(slack[i]))
+            thr = exact_slack(int(k), int(i)) if wide[k, i] else Fraction(float(S[k, i]))
             ok[k, i] = self._row_q(int(i), X2[k]) <= thr
         out = np.all(ok, axis=-1) & finite
         return bool(out[0]) if one else out.reshape(X.shape[:-1])
