@@ -757,3 +757,20 @@ def test_a_subnormal_coefficient_is_rounded_absolutely() -> None:
     ys = [y * (1 + k * 1e-7) for k in (-3, -1, 1, 3)]
     want = [E._form_q(np.array([0.0, v])) <= 1 for v in ys]
     assert E.contains_exact(np.array([[0.0, v] for v in ys])).tolist() == want
+
+
+def test_contains_rounded_takes_a_decimal_written_at_a_face() -> None:
+    """contains_rounded (set-invariant admissibility): x within its own rounding of each face.
+    d = 0.1 (the float above 1/10) is in {x ≤ 1/10} — it is the nearest float of 1/10 — the
+    next float above is not; x1 + x2 ≤ 3/10 holds (0.1, 0.2) (exactly 1.7·10⁻¹⁷ above, within
+    rounding); a face scaled by 10³⁰⁰ reads 1 + 2⁻⁵² outside x1 ≤ 1 (it is the rounding of no
+    point ≤ 1), with no overflow."""
+    P = Polytope(qmat([[1], [-1]]), qvec([fmpq(1, 10), 1]))
+    assert P.contains_rounded(np.array([[0.1], [np.nextafter(0.1, 1.0)]])).tolist() == [True, False]
+    S = Polytope(qmat([[1, 1], [-1, 0], [0, -1]]), qvec([fmpq(3, 10), 0, 0]))
+    assert bool(S.contains_rounded(np.array([0.1, 0.2])))
+    assert not bool(S.contains_rounded(np.array([0.1, 0.2 + 1e-15])))
+    big = int(1e300)
+    H = Polytope(qmat([[big, 0], [-1, 0], [0, 1], [0, -1]]), qvec([big, 0, 1, 1]))
+    pts = np.array([[1.0, 0.0], [1.0 + 2**-52, 0.0], [1e10, 0]])
+    assert H.contains_rounded(pts).tolist() == [True, False, False]
