@@ -307,14 +307,18 @@ def test_a_batch_checks_its_budget_between_chunks(monkeypatch) -> None:
 
     def check(where: str) -> None:
         looks.append(where)
-        if len(looks) == 4:
+        if len(looks) == 5:
             budget.deadline = -1.0
         real(where)
 
     budget.check = check
     with pytest.raises(SolverError, match=r"a batch of 2 runs at step 320 of 600"):
         mc.run_batch(sp, joint_system(sp, L), 2, "E0", budget=budget)
-    assert looks[:2] == ["0 of 2 Monte Carlo runs done", "a batch of 2 runs at step 0 of 600"]
+    assert looks[:3] == [
+        "0 of 2 Monte Carlo runs done",
+        "drawing initial errors (0 of 128 points tested)",  # session 37: the draw looks too
+        "a batch of 2 runs at step 0 of 600",
+    ]
 
 
 def test_an_initial_error_set_without_volume_is_bad_input() -> None:
