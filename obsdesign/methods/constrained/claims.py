@@ -35,6 +35,7 @@ from obsdesign.certify.printing import (
 )
 from obsdesign.certify.psd import asymmetric, check_pd, check_psd
 from obsdesign.methods.constrained import bounds as B
+from obsdesign.methods.constrained import dual as D
 from obsdesign.methods.constrained.cmap import ConstraintMap
 from obsdesign.methods.constrained.design import v_max_breve, xhat_set
 from obsdesign.methods.constrained.lyap import w_sq_max
@@ -563,7 +564,8 @@ def _inclusions(c: Claims, o: Options, Xhat: ConvexSet, eps_min: fmpq, eps_max: 
             "Cmin-in-Xhat",
             "C_min ⊂ X̂",
             "exact: the outer set {φ_i ≤ t}, t ≥ √ε_min, lies in X̂ (box map with the "
-            "Euclidean norm: C_min's own support per face of X̂, Hölder)",
+            "Euclidean norm: C_min's own support per face of X̂, Hölder; else, for an affine "
+            "map, a dual certificate per face of a box / polytope X̂)",
             ok,
             det,
         ),
@@ -640,6 +642,9 @@ def cmin_in_xhat(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet) -> tuple[bool
     through the outer set of C_min: {φ_i ≤ t} with a rational t ≥ √ε_min (each |c_i| ≤ |c|),
     i.e. the box [r̲ − t, r̄ + t] for the box map (19), a polytope for a polytope map, the
     ellipsoid {xᵀQx ≤ r(1 + t)} for the ellipsoid map (18). Every face / vertex is checked.
+    When that fails for an affine map (other than the Euclidean box map, decided exactly by
+    :func:`box_l4_faces`) and a box / polytope X̂, each face of X̂ by a dual certificate
+    (:mod:`obsdesign.methods.constrained.dual`): the outer set's corners are not in C_min.
 
     :param cm: the map c; :param eps_min: ε_min; :param Xhat: the set X̂.
     Returns (holds, detail)."""
@@ -655,16 +660,25 @@ def cmin_in_xhat(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet) -> tuple[bool
             for j in range(G.shape[0])
         ]
         worst = max(faces)
-        if worst <= 0 or cm.norm == "max":
-            return worst <= 0, f"max over the outer box of C_min of (H x − k) ≤ {fmt_up(worst, 10)}"
+        if worst <= 0:
+            return True, f"max over the outer box of C_min of (H x − k) ≤ {fmt_up(worst, 10)}"
+        if cm.norm == "max":
+            return _by_duality(
+                cm,
+                eps_min,
+                Xhat,
+                f"max over the outer box of C_min of (H x − k) ≤ {fmt_up(worst, 10)}",
+            )
         verdict, how = box_l4_faces(cm, eps_min, G, g)
         return verdict is True, how
     if cm.affine:
         V, bounded = vertices_exact(cm.G_q, np.array([h + t for h in cm.h_q], dtype=object))
         if not bounded or len(V) == 0:
-            return False, "the outer set of C_min is unbounded"
+            return _by_duality(cm, eps_min, Xhat, "the outer set of C_min is unbounded")
         bad = [v for v in V if not contains_q(Xhat, v)]
-        return not bad, f"{len(V)} vertices checked" + (f"; {len(bad)} outside X̂" if bad else "")
+        if not bad:
+            return True, f"{len(V)} vertices checked"
+        return _by_duality(cm, eps_min, Xhat, f"{len(V)} vertices checked; {len(bad)} outside X̂")
     R = Q(cm.r_q) * (1 + t)  # ellipsoid map: the outer set {xᵀQx ≤ r(1 + t)}
     if isinstance(Xhat, Ellipsoid):
         if all(x == 0 for x in Xhat.center_q):
@@ -683,6 +697,22 @@ def cmin_in_xhat(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet) -> tuple[bool
     return True, f"support function of the outer ellipsoid below all {G.shape[0]} faces of X̂"
 
 
+def _by_duality(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet, outer: str) -> tuple[bool, str]:
+    """C_min ⊂ X̂ for an affine map and a box / polytope X̂ once the outer-set test failed
+    (``outer``, its detail): one dual certificate per face of X̂
+    (:mod:`obsdesign.methods.constrained.dual`)."""
+    if not isinstance(Xhat, (Box, Polytope)):
+        return False, outer
+    H, k = Xhat.h_form_q()
+    ok, open_faces = D.faces_by_duality(cm.G_q, cm.h_q, cm.norm, eps_min, H, k)
+    if ok:
+        return True, (
+            f"{outer}, but every one of the {H.shape[0]} faces of X̂ is proved by a dual "
+            "certificate (y ≥ 0, Gᵀy = a, b − yᵀh ≥ √ε_min‖y‖_{q*}, exact)"
+        )
+    return False, f"{outer}; no dual certificate for faces {open_faces} of X̂"
+
+
 def box_l4_faces(
     cm: ConstraintMap, eps_min: Any, G: np.ndarray, g: np.ndarray
 ) -> tuple[bool | None, str]:
@@ -698,8 +728,6 @@ def box_l4_faces(
 
     :param cm: the box map; :param eps_min: ε_min; :param G, g: X̂'s faces (exact).
     Returns (verdict, detail)."""
-    from flint import arb, ctx
-
     n = cm.dim
     lo = [-cm.h_q[2 * i] for i in range(n)]
     hi = [cm.h_q[2 * i + 1] for i in range(n)]
@@ -712,34 +740,11 @@ def box_l4_faces(
         open_faces.append((j, a))
     undecided = []
     for j, a in open_faces:
-        verdict = None
-        mags = {abs(G[j, i]) for i in range(n) if G[j, i] != 0}
-        if len(mags) <= 1:
-            # m equal nonzero |h_i| = w (an axis face: m = 1): (Σ|h_i|^{4/3})³ = m³w⁴, rational
-            m = sum(1 for i in range(n) if G[j, i] != 0)
-            w = next(iter(mags), fmpq(0))
-            if e * e * m**3 * w**4 <= a**4:
-                continue
-            return False, (
-                f"face {j} of X̂: the support of C_min (R ⊕ the 4-norm ball of radius "
-                "√ε_min) is above it (exact)"
-            )
-        for prec in (64, 256, 1024):
-            with ctx.workprec(prec):
-                s43 = sum(
-                    (arb(abs(G[j, i])) ** arb(fmpq(4, 3)) for i in range(n) if G[j, i] != 0), arb(0)
-                )
-                lhs, rhs = arb(e * e) * s43**3, arb(a**4)
-                if lhs < rhs:
-                    verdict = True
-                elif lhs > rhs:
-                    verdict = False
-            if verdict is not None:
-                break
+        verdict = D.holder_below(e, [abs(G[j, i]) for i in range(n)], a)
         if verdict is False:
             return False, (
                 f"face {j} of X̂: the support of C_min (R ⊕ the 4-norm ball of radius √ε_min) "
-                "is above it (rigorous balls)"
+                "is above it (exact / rigorous balls)"
             )
         if verdict is None:
             undecided.append(j)
