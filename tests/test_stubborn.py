@@ -1871,3 +1871,76 @@ def test_the_single_runs_sigma_is_root_of_sigma_bar_over_w() -> None:
     sig, sb = res.extra["sigma"], res.extra["sigma_bar"]
     assert sig.shape[1] == w.size and np.all(sb > 0)
     assert sig**2 * w == pytest.approx(np.broadcast_to(sb[:, None], sig.shape), rel=1e-9)
+
+
+#: the slides' printed design results (WUDS 2017 slides, Examples 1 and 3): K, R, W
+SLIDES_KRW = {
+    EX1: ((-11.9944, 20.4153), 3.3256e3, 528.2705),
+    EX3: ((-6.7510, 11.7510), 3.0895e3, 512.6717),
+}
+#: ours (default criterion R, fraction 1/2, gain bound 100; docs/methods/stubborn.md)
+OURS_KRW = {EX1: ((-2.56, 8.40), 32.0, 24.9), EX3: ((-1.31, 4.98), 29.2, 15.9)}
+
+
+@pytest.mark.parametrize("spec", [EX1, EX3])
+def test_slides_K_R_W_are_not_reproduced(spec: Path, ex1: Report) -> None:
+    """Not reproduced, and why (docs/methods/stubborn.md, "Reproduced numbers"): the slides
+    print K, R, W without the bound, the fraction or the normalization used. We get the docs'
+    values (to the 3 digits printed there: Clarabel's last digits may move), far from the
+    slides'; only K, λ and R/W define the observer, and R/W is 1.28 / 1.84 for us against the
+    slides' 6.30 / 6.03."""
+    rep = ex1 if spec == EX1 else api.design(spec)
+    p = rep.parameters
+    K, R, W = p.float("K").ravel(), float(p.float("R").item()), float(p.float("W").item())
+    (k1, k2), r, w = OURS_KRW[spec]
+    assert K == pytest.approx([k1, k2], rel=5e-3, abs=5e-3)
+    assert (R, W) == pytest.approx((r, w), rel=5e-3)
+    (s1, s2), sr, sw = SLIDES_KRW[spec]
+    assert abs(K[0] - s1) > 4 and abs(K[1] - s2) > 6 and sr / R > 90 and sw / W > 20
+    assert round(sr / sw, 2) == (6.30 if spec == EX1 else 6.03)
+    assert round(R / W, 2) == (1.28 if spec == EX1 else 1.84)
+
+
+#: the slides' Luenberger row of Example 1 at outlier amplitudes 0.1 and 1000 (x1, x2)
+SLIDES_LUENBERGER_EX1 = {"0.1": (0.11, 0.12), "1000": (18.01, 29.97)}
+
+
+def test_slides_rmse_tables_are_not_reproduced_and_examples_1_2_agree(ex1: Report) -> None:
+    """The slides' RMSE tables are not reproduced (docs/methods/stubborn.md): their noise
+    level, outlier rate, horizon, x̂(0) and "(max. abs. 10)" are not stated. With our gain
+    and outlier model the Luenberger RMSE is ≈ 0.03 at amplitude 0.1 (slides 0.11 / 0.12) and
+    ≈ 2 / 5 at 1000 (slides 18.01 / 29.97). With the slides' own K and an outlier rate of 0.05
+    (our guess, fitted to that row, not the slides' statement) the 1000 column comes within
+    10 % of the printed one, while the 0.1 column stays ≈ 0.03: the base level is not
+    explained. Example 2 differs from Example 1 only in u, which the error does not see, so
+    its table is Example 1's (to rounding), where the slides' two tables differ slightly."""
+    from obsdesign.methods.stubborn import sim
+
+    def study(spec: Path, edit: tuple = (), params: Any = None) -> dict:
+        text = spec.read_text().replace("dt = 0.001", "dt = 0.002")
+        for old, new in edit:
+            assert old in text
+            text = text.replace(old, new)
+        sp = api.load_spec_text(text, str(spec))
+        return sim.study(sp, params or api.design(sp).parameters, runs=16)["median_rmse"]
+
+    ex1_dt = study(EX1, params=ex1.parameters)
+    ex2_dt = study(SPECS / "astolfi-stubborn-example2.toml", params=ex1.parameters)
+    for obs, row in ex1_dt.items():
+        for a, by_state in row.items():
+            for s, v in by_state.items():
+                assert ex2_dt[obs][a][s] == pytest.approx(v, rel=1e-9), (obs, a, s)
+    lu = ex1_dt["luenberger"]
+    for s, slides in zip(("x1", "x2"), SLIDES_LUENBERGER_EX1["0.1"], strict=True):
+        assert 0.02 < lu["0.1"][s] < 0.04 < slides
+    for s, slides in zip(("x1", "x2"), SLIDES_LUENBERGER_EX1["1000"], strict=True):
+        assert lu["1000"][s] < slides / 3
+    gain = (
+        'lambda_fraction = 0.5\ngain_bound = 100\ncriterion = "R"',
+        "K = [-11.9944, 20.4153]\nlambda = 5",
+    )
+    fitted = study(EX1, (gain, ("outlier_rate = 0.01", "outlier_rate = 0.05")))["luenberger"]
+    for s, slides in zip(("x1", "x2"), SLIDES_LUENBERGER_EX1["1000"], strict=True):
+        assert fitted["1000"][s] == pytest.approx(slides, rel=0.1)
+    for s, slides in zip(("x1", "x2"), SLIDES_LUENBERGER_EX1["0.1"], strict=True):
+        assert fitted["0.1"][s] < slides / 3
