@@ -139,7 +139,8 @@ def test_simulate_metrics_and_plot(tmp_path: Path):
     # Table 1 of the constrained-redesign paper, unmodified observer: 22.582 / 21.611
     assert round(m["sup_abs_estimate"]["x1"], 3) == 22.582
     # we get 21.610486 (21.610 at the printed precision): 1.4e-5 below the rounding boundary
-    # of the paper's 21.611; every other digit of the row matches (see README, "Reproduction")
+    # of the paper's 21.611; every other digit of the row matches (docs/methods/lyapunov.md,
+    # "Reproduced numbers"; docs/methods/constrained.md, Table 1)
     assert m["sup_abs_estimate"]["x2"] == pytest.approx(21.610486, abs=1e-6)
     assert abs(m["sup_abs_estimate"]["x2"] - 21.611) < 5e-4 + 2e-5
     assert png.exists() and png.stat().st_size > 1000
