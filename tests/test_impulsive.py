@@ -70,12 +70,12 @@ def test_example_numbers_and_verify(tmp_path: Path) -> None:
 
 
 def test_example_with_paper_kappa() -> None:
-    """κ = 0.4923 is what T_min = 0.63 needs (−ln(2.2/3)/0.63); T_max then is 0.7223, not 1.09
+    """κ = 0.4923 is what T_min = 0.63 needs (−ln(2.2/3)/0.63); T_max then is 0.7222, not 1.09
     (the paper's pair needs ϖ_o + λ*_no + βλ*_on ≈ 2.46, we get 3.96)."""
     rep = api.design(load_spec_text_ex(kappa="0.4923"))
     p = rep.parameters
     assert p["T_min"] == Q("0.6301")  # rounded up from 0.630007
-    assert p["T_max"] == Q("0.7222")  # rounded down from 0.72229
+    assert p["T_max"] == Q("0.7222")  # rounded down from 0.72225
 
 
 def load_spec_text_ex(**kw: str):  # noqa: ANN201
