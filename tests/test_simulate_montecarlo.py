@@ -162,6 +162,9 @@ def test_initial_errors_come_from_the_set_and_differ():
         {"type": "ellipsoid", "E": [[2, 0.5], [0.5, 1]], "center": [0.5, 0]},
         # a thin strip (2 % of its bounding box): many runs find no point in the first block
         {"type": "polytope", "G": [[1, -1], [-1, 1], [1, 1], [-1, -1]], "g": [0.02] * 2 + [2] * 2},
+        # one draw in 10⁴ inside: runs need more than 16 rounds, whose size then doubles (the
+        # continuation after the first block counts it: start_round = 1; session 38)
+        {"type": "polytope", "G": [[1, -1], [-1, 1], [1, 1], [-1, -1]], "g": [1e-4] * 2 + [2] * 2},
     ],
 )
 def test_initial_errors_at_once_are_the_sets_own_samples(table):

@@ -10,8 +10,20 @@ import numpy as np
 
 from obsdesign.certify.exact import to_float
 
-#: rounds of :meth:`ConvexSet.sample`'s rejection sampler before it gives up
+#: rounds of max(4k, 64) points that :meth:`ConvexSet.sample`'s rejection sampler draws (as
+#: fewer, larger rounds after the first ones) before it gives up
 MAX_SAMPLE_ROUNDS = 20_000
+#: rounds of :meth:`ConvexSet.sample` at each round size before the size doubles
+SAMPLE_ESCALATE = 16
+#: the largest round of :meth:`ConvexSet.sample`, in multiples of the first
+SAMPLE_MAX_FACTOR = 1024
+#: points of one round tested at once, with a look at the time budget between
+MEMBERSHIP_CHUNK = 2048
+
+
+def _round_size(i: int, base: int) -> int:
+    """Points drawn in round i of :meth:`ConvexSet.sample` (``base`` = max(4k, 64))."""
+    return base * min(1 << (i // SAMPLE_ESCALATE), SAMPLE_MAX_FACTOR)
 
 
 class ConvexSet(ABC):
@@ -56,17 +68,29 @@ class ConvexSet(ABC):
         mag = float(np.max(np.maximum(np.abs(lo), np.abs(hi))))
         return rel * float(np.max(hi - lo)) + 4 * float(np.spacing(mag))
 
-    def sample(self, rng: np.random.Generator, k: int, budget: Any = None) -> np.ndarray:
-        """k points of the set (rejection sampling from the bounding box), in at most
-        :data:`MAX_SAMPLE_ROUNDS` rounds: a set of (almost) no volume, a segment in the plane,
-        accepted nothing and the loop ran forever (independent simulate review). Raises
-        :class:`~obsdesign.errors.InputError` then. A drawn point is kept when it is in the
-        set exactly (:meth:`contains_exact`): the float ``contains`` (absolute 10⁻¹²) kept
-        points 5.9 strip widths outside a thin sheared strip at |x| ≈ 3·10¹³ (re-check trial,
-        session 36), and four float spacings of a face's offset still 140 widths (re-check
-        trial, session 37). ``budget`` (a simulation's time budget, or None) is looked at every
-        16 rounds: a set far thinner than the float spacing at its position has every drawn
-        point decided in rational arithmetic, up to a minute before the "no volume" error."""
+    def sample(
+        self, rng: np.random.Generator, k: int, budget: Any = None, start_round: int = 0
+    ) -> np.ndarray:
+        """k points of the set (rejection sampling from the bounding box), from at most
+        :data:`MAX_SAMPLE_ROUNDS` × max(4k, 64) drawn points: a set of (almost) no volume, a
+        segment in the plane, accepted nothing and the loop ran forever (independent simulate
+        review). Raises :class:`~obsdesign.errors.InputError` then. A drawn point is kept when
+        it is in the set exactly (:meth:`contains_exact`): the float ``contains`` (absolute
+        10⁻¹²) kept points 5.9 strip widths outside a thin sheared strip at |x| ≈ 3·10¹³
+        (re-check trial, session 36), and four float spacings of a face's offset still 140
+        widths (re-check trial, session 37).
+
+        Rounds draw max(4k, 64) points each for the first :data:`SAMPLE_ESCALATE` rounds, then
+        twice as many every :data:`SAMPLE_ESCALATE` rounds (at most :data:`SAMPLE_MAX_FACTOR`
+        times): deciding "no volume" took 20,000 calls of ``contains_exact`` on 64 points,
+        2.4 s, beyond the spec loader's 2 s for that check, so a thin set passed the loader on
+        a busy machine and failed it on an idle one. A set that keeps a point within the first
+        rounds draws the same numbers as before. ``budget`` (a simulation's time budget, or
+        None) is looked at every 16 rounds and between chunks of :data:`MEMBERSHIP_CHUNK`
+        points of a larger round: a set far thinner than the float spacing at its position has
+        every drawn point decided in rational arithmetic. ``start_round``: rounds already drawn
+        from ``rng`` by the caller (the Monte Carlo draw's first block), so that the
+        continuation draws what an uninterrupted call would."""
         from obsdesign.errors import InputError
 
         lo, hi = self.bounding_box()
@@ -79,20 +103,31 @@ class ConvexSet(ABC):
                 f"(coordinate {i + 1} from {float(lo[i]):.4g} to {float(hi[i]):.4g}): it "
                 "cannot be sampled"
             )
+        base = max(4 * k, 64)
+        total = MAX_SAMPLE_ROUNDS * base
+        drawn = sum(_round_size(r, base) for r in range(start_round))
         out: list[np.ndarray] = []
-        got = 0
-        for i in range(MAX_SAMPLE_ROUNDS):
-            if got >= k:
-                break
+        got, i = 0, start_round
+        while got < k and drawn < total:
+            size = min(_round_size(i, base), total - drawn)
             if budget is not None and i % 16 == 0:
                 budget.check(f"sampling the {self.kind or 'set'} ({got:,} of {k:,} points kept)")
-            pts = rng.uniform(lo, hi, size=(max(4 * k, 64), self.dim))
-            out.append(pts[np.asarray(self.contains_exact(pts), dtype=bool)])
+            pts = rng.uniform(lo, hi, size=(size, self.dim))
+            keep = np.empty(size, dtype=bool)
+            for a in range(0, size, MEMBERSHIP_CHUNK):
+                if budget is not None and a:
+                    budget.check(
+                        f"sampling the {self.kind or 'set'} ({got:,} of {k:,} points kept)"
+                    )
+                b = min(a + MEMBERSHIP_CHUNK, size)
+                keep[a:b] = np.asarray(self.contains_exact(pts[a:b]), dtype=bool).reshape(b - a)
+            out.append(pts[keep])
             got += len(out[-1])
+            drawn += size
+            i += 1
         if got < k:
-            draws = MAX_SAMPLE_ROUNDS * max(4 * k, 64)
             raise InputError(
-                f"rejection sampling kept {got:,} of {draws:,} points drawn in the bounding box "
+                f"rejection sampling kept {got:,} of {total:,} points drawn in the bounding box "
                 f"of the {self.kind or 'set'} (wanted {k:,}): it has (almost) no volume"
             )
         return np.concatenate(out)[:k]

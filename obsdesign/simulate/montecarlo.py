@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from obsdesign.errors import InputError
-from obsdesign.sets.base import ConvexSet
+from obsdesign.sets.base import MEMBERSHIP_CHUNK, ConvexSet
 from obsdesign.simulate.budget import TimeBudget, TimeExceeded
 from obsdesign.simulate.result import SimResult, norms
 from obsdesign.spec.models import Spec
@@ -59,8 +59,6 @@ CHUNK = 1024
 MNK_ONE_THREAD = 1 << 18
 #: seconds the spec loader spends trying to draw one point of ``initial_error``'s set
 LOAD_SAMPLE_SECONDS = 2.0
-#: points tested at once when drawing initial errors, with a look at the time budget between
-MEMBERSHIP_CHUNK = 2048
 #: points of the first rejection-sampling block of ``ConvexSet.sample(rng, 1)``
 SAMPLE_BLOCK = 64
 #: quantiles reported for every per-run metric
@@ -151,7 +149,7 @@ def initial_errors(
     first = inside.argmax(axis=1)
     out = pts[np.arange(R), first]
     for r in np.flatnonzero(~inside.any(axis=1)):
-        out[r] = eset.sample(rngs[r], 1, budget)[0]
+        out[r] = eset.sample(rngs[r], 1, budget, start_round=1)[0]
     return out
 
 
