@@ -711,3 +711,32 @@ def test_lemma1_near_miss_of_the_float_optimum(monkeypatch, kappa_n_float, code)
         api.design(api.load_spec_text(text, "s.toml"))
     assert ("no proof either way" in e.value.message) == (code == 4)
     assert n == {"best": 2, "cert": 2}
+
+
+def test_ssd_statements_name_the_scaling_they_hold_for() -> None:
+    """The 3-state spec: [nonlinearity.o] sector ±0.2 is (Q, S, R) = (−1, 0, 1/25) with Ā_o = 0,
+    so the declared triple needs ϖ_o ≥ λ_max(M_o) = 26/25 (eq. (16)); the design scales it by
+    θ_o = 5 and certifies ϖ_o = 0.4 for 5·(Q, S, R). The statement said "(−R_o, −S_oᵀ, −Q_o)-ssd
+    (−ϖ_o) with ϖ_o ≤ 0.400001", false for the declared triple (independent fuzz, session 38);
+    it prints θ_o now. Checked here with Fractions from the statement's own numbers: 2 × 2
+    N(−ϖ_o) = [[−ϖ_o + θR, 1 + θS], [1 + θS, θQ]] ⪯ 0 for the printed θ_o, not for θ_o = 1."""
+    import re
+    from fractions import Fraction as F
+
+    rep = api.design(ROOT / "specs" / "impulsive-sector-3state.toml")
+    (st,) = [c.statement for c in rep.claims if c.id == "varpi_o"]
+    m = re.search(
+        r"θ_o·\(−R_o, −S_oᵀ, −Q_o\)-ssd\(−ϖ_o\) with θ_o = ([0-9./]+) and 0 ≤ ϖ_o ≤ ([0-9.e+-]+)",
+        st,
+    )
+    assert m, st
+    theta, varpi = F(m.group(1)), F(m.group(2))
+
+    def nsd(th: F) -> bool:
+        # N(κ) = [[Ā + Āᵀ + κ + θR, 1 + θS], [1 + θS, θQ]] with Ā_o = 0, κ = −ϖ_o (1 × 1 blocks)
+        a, b, d = -varpi + th * F(1, 25), F(1), th * -1
+        return a <= 0 and d <= 0 and a * d - b * b >= 0
+
+    assert theta == 5 and nsd(theta) and not nsd(F(1))
+    (st,) = [c.statement for c in rep.claims if c.id == "kappa_n"]
+    assert re.search(r"θ_n·\(−R_n, −S_nᵀ, −Q_n\)-ssd\(κ_n\) with θ_n = [0-9./]+ and κ_n ≥ ", st), st

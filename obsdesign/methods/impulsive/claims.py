@@ -204,8 +204,8 @@ def certify_window(p: Problem, P: dict[str, Any], c: Claims | None = None) -> Cl
     c.exact(
         id="varpi_o",
         statement=(
-            f"Σ(Ā_o, I, I) is (−R_o, −S_oᵀ, −Q_o)-ssd(−ϖ_o) with 0 ≤ ϖ_o ≤ {fmt_up(varpi)}, "
-            "so ϖ_o ≥ λ_max(M_o)"
+            f"Σ(Ā_o, I, I) is θ_o·(−R_o, −S_oᵀ, −Q_o)-ssd(−ϖ_o) with θ_o = {fmt_exact(th_o)} "
+            f"and 0 ≤ ϖ_o ≤ {fmt_up(varpi)}, so ϖ_o ≥ λ_max(M_o) of the triple scaled by θ_o"
         ),
         reference=_ref("Lemma 2, eq. (16)"),
         check="exact LDLᵀ of −N(−ϖ_o) (QSR scaled by θ_o > 0)",
@@ -215,7 +215,10 @@ def certify_window(p: Problem, P: dict[str, Any], c: Claims | None = None) -> Cl
     ok, det = _ssd(co.An, data.qsr_n, th_n, kappa_n, "θ_n")
     c.exact(
         id="kappa_n",
-        statement=(f"Σ(Ā_n, I, I) is (−R_n, −S_nᵀ, −Q_n)-ssd(κ_n) with κ_n ≥ {fmt_down(kappa_n)}"),
+        statement=(
+            f"Σ(Ā_n, I, I) is θ_n·(−R_n, −S_nᵀ, −Q_n)-ssd(κ_n) with θ_n = {fmt_exact(th_n)} "
+            f"and κ_n ≥ {fmt_down(kappa_n)}"
+        ),
         reference=_ref("Lemma 1, eq. (7)"),
         check="exact LDLᵀ of −N(κ_n) (QSR scaled by θ_n > 0)",
         passed=ok,
