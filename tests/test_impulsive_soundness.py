@@ -677,8 +677,9 @@ def test_window_bounds_stay_sound_and_positive_for_a_tiny_gamma(gamma_exp: int) 
 
 def test_a_window_too_narrow_for_its_digits_says_so() -> None:
     """L = 1e-300: the window (3.4·10⁻³⁰¹, 8.4·10⁻³⁰¹) is not empty but holds no pair of
-    4-decimal bounds: exit 1 saying so and naming digits (it said "empty window: T_min ≥ T_max"
-    with a negative T_max)."""
+    30-decimal bounds (digits not given: as many as the window needs, at most 30): exit 1
+    saying so (it said "empty window: T_min ≥ T_max" with a negative T_max); with digits = 4
+    given, it names digits."""
     from obsdesign.errors import InfeasibleError
 
     text = SPEC3.read_text(encoding="utf-8").replace("L = [0.8]", "L = [1e-300]")
@@ -686,8 +687,63 @@ def test_a_window_too_narrow_for_its_digits_says_so() -> None:
     with pytest.raises(InfeasibleError) as ei:
         api.design(load_spec_text(text, "tiny.toml"))
     msg = ei.value.message
+    assert "is not empty, but it holds no pair of 30-decimal bounds" in msg
+    assert "raise [method] digits" not in msg and "T_max = -" not in msg
+    text = text.replace('key = "impulsive"', 'key = "impulsive"\ndigits = 4')
+    with pytest.raises(InfeasibleError) as ei:
+        api.design(load_spec_text(text, "tiny4.toml"))
+    msg = ei.value.message
     assert "is not empty, but it holds no pair of 4-decimal bounds" in msg
-    assert "raise [method] digits" in msg and "T_max = -" not in msg
+    assert "raise [method] digits (at most 30)" in msg
+
+
+FAST = """
+[system]
+time = "continuous"
+A = [[2000, 1000], [5000, -20000]]
+C = [[1, 0]]
+psi = ["0", "0"]
+[nonlinearity.o]
+lipschitz = 0
+[nonlinearity.n]
+lipschitz = 0
+[method]
+key = "impulsive"
+L = [0.8]
+alpha = 3
+noise_bound = 0
+M = [[0, 1]]
+"""
+
+
+def test_a_fast_plant_gets_the_decimals_its_window_needs() -> None:
+    """A plant 10⁴ times faster than a slow one: window [3.1016·10⁻⁵, 7.3156·10⁻⁵] (mpmath
+    below). With 4 decimals it held no pair of bounds and was exit 1 "infeasible" although the
+    design is feasible (independent fuzz, session 38). Not given, digits is 4 significant
+    digits of T_max below 1: T_min = 0.00003102, T_max = 0.00007315, certified, with a note;
+    digits = 4 given is still exit 1 naming digits."""
+    from obsdesign.errors import InfeasibleError
+
+    rep = api.design(load_spec_text(FAST, "fast.toml"))
+    assert rep.exit_code() == 0
+    assert rep.parameters["T_min"] == Q("0.00003102") and rep.parameters["T_max"] == Q("0.00007315")
+    assert any("have 8 decimals" in n for n in rep.notes)
+    # the bounds of (26c) and (26b) in mpmath: κ and the λ*'s from the report, exact enough
+    mpmath.mp.dps = 30
+    kq = Q(rep.parameters["kappa"])
+    kappa = mpmath.mpf(int(kq.p)) / int(kq.q)
+    assert float(-mpmath.log(1 - mpmath.mpf("0.8") / 3) / kappa) == pytest.approx(
+        3.1016e-5, rel=1e-4
+    )
+    with pytest.raises(
+        InfeasibleError, match="no pair of 4-decimal bounds.*raise \\[method\\] digits"
+    ):
+        api.design(
+            load_spec_text(FAST.replace("M = [[0, 1]]", "M = [[0, 1]]\ndigits = 4"), "f4.toml")
+        )
+    for slow in ("schaum-impulsive-example.toml", "impulsive-sector-3state.toml"):
+        p = api.design(ROOT / "specs" / slow).parameters  # T_max > 0.1: 4 decimals as before
+        assert all(len(str(Q(p[k]) * 10**4).split("/")) == 1 for k in ("T_min", "T_max"))
 
 
 @pytest.mark.parametrize("alpha", ["3.3", "2.7"])

@@ -30,6 +30,11 @@ class Infeasible(Exception):
     """A condition of the paper fails; the message names it and by how much."""
 
 
+#: decimals of T_min / T_max when ``digits`` is not given, and the most ``digits`` allows
+DEFAULT_DIGITS = 4
+MAX_DIGITS = 30
+
+
 @dataclass
 class BlockData:
     """Declared data of Assumption 1 in z-coordinates (split reading, see dissipativity.py)."""
@@ -63,7 +68,9 @@ class Problem:
     data: BlockData | LipschitzX
     kappa: Any = "max"
     optimize_scaling: bool = True
-    digits: int = 4
+    #: decimals of T_min / T_max; None (not given): DEFAULT_DIGITS, or more when a narrow
+    #: window holds no pair of such bounds (up to MAX_DIGITS)
+    digits: int | None = None
 
     @property
     def m(self) -> int:

@@ -26,11 +26,10 @@ from obsdesign.simulate.budget import DEFAULT_LIMIT, TIME_LIMIT_SCHEMA, parse_ti
 from obsdesign.spec.models import Spec
 from obsdesign.spec.reader import Table
 
-from .core import BlockData, LipschitzX, Problem
+from .core import MAX_DIGITS, BlockData, LipschitzX, Problem
 from .dissipativity import QSR, qsr_lipschitz, qsr_sector
 
-#: most decimals of T_min / T_max (``digits``) and most sampled pairs of the falsification
-MAX_DIGITS = 30
+#: most sampled pairs of the falsification
 MAX_SAMPLES = 1_000_000
 
 
@@ -117,8 +116,8 @@ def parse_options(table: Table, spec: Spec) -> Options:
     elif table.has("kappa"):
         kappa = table.scalar("kappa", min=0, strict_min=True).q
     scaling = table.str("qsr_scaling", default="optimize", choices=("optimize", "as-given"))
-    digits = table.int("digits", default=4, min=1)
-    if digits > MAX_DIGITS:
+    digits = table.int("digits", default=None, min=1)
+    if digits is not None and digits > MAX_DIGITS:
         raise table.error("digits", f"expected at most {MAX_DIGITS} decimals, got {digits}")
     table.done()
     nl = spec.tables.get("nonlinearity")
