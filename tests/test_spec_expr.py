@@ -264,3 +264,56 @@ def test_a_huge_exact_power_of_a_rational_is_taken_in_floats() -> None:
     )  # e^(100 - 5e-5)
     small = parse_expr("(1 + 1/10^6)^100", []).sympy()
     assert isinstance(small, sp.Rational) and small == sp.Rational(1000001, 1000000) ** 100
+
+
+def test_source_segment_is_the_text_of_the_node_and_cached() -> None:
+    """``source_segment`` gives ``ast.get_source_segment``'s text, None without a source or a
+    position, and splits the source once per literal position, not once per call."""
+    import ast
+
+    from obsdesign.spec import expr
+
+    src = "0.1*x1 + 3.25e-2*sin(x2)\n"
+    tree = ast.parse(src, mode="eval")
+    lits = [n for n in ast.walk(tree) if isinstance(n, ast.Constant)]
+    assert [expr.source_segment(src, n) for n in lits] == ["0.1", "3.25e-2"]
+    assert expr.source_segment(None, lits[0]) is None
+    assert expr.source_segment(src, ast.Constant(value=1)) is None
+    expr._segment.cache_clear()
+    for _ in range(100):
+        for n in lits:
+            expr.source_segment(src, n)
+    assert expr._segment.cache_info().misses == 2
+
+
+def test_a_long_search_space_expression_splits_its_source_once_per_literal(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Hostile-input review, session 38: the interval enclosures asked
+    ``ast.get_source_segment`` (which splits the whole source) for every literal in every
+    sub-box: a sum of 190 sin terms took 63 s to design, a product of 700 more than 10 min
+    (8 s and 12 s now). Counted here on 30 terms: at most one call per literal position."""
+    import ast
+    from pathlib import Path
+
+    from obsdesign import api
+    from obsdesign.spec import expr
+
+    spec = Path(__file__).resolve().parents[1] / "specs" / "hernandez-garcia-pendulum.toml"
+    terms = "+".join(f"0.01*sin(x1*{i}.5)" for i in range(30))
+    text = spec.read_text(encoding="utf-8")
+    old = 'f = ["x2", "-sin(x1) - 0.2*x2 + u1"]'
+    assert old in text
+    text = text.replace(old, f'f = ["x2", "-sin(x1) - 0.2*x2 + u1 + {terms}"]')
+    calls = []
+    real = ast.get_source_segment
+
+    def counted(src: str, node: ast.AST, **kw: object) -> str | None:
+        calls.append(1)
+        return real(src, node, **kw)
+
+    monkeypatch.setattr(ast, "get_source_segment", counted)
+    expr._segment.cache_clear()
+    api.design(api.load_spec_text(text, "long.toml"))
+    literals = 2 * 30 + 1 + 5  # 0.01 and i.5 per term, 0.2, and the spec's other literals
+    assert 0 < len(calls) <= 4 * literals

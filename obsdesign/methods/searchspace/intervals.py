@@ -42,6 +42,7 @@ from mpmath import iv
 from mpmath.libmp import from_float, mpf_cmp, to_float
 
 from obsdesign.methods.searchspace import switches
+from obsdesign.spec.expr import source_segment
 
 INF = math.inf
 _SPLIT = 134217729.0  # 2^27 + 1 (Veltkamp)
@@ -557,7 +558,7 @@ def int_literal(node: ast.AST, src: str | None) -> int | None:
         return None
     if isinstance(node.value, int):
         return node.value
-    seg = ast.get_source_segment(src, node) if src is not None else None
+    seg = source_segment(src, node)
     if seg is None:
         return None
     try:
@@ -584,7 +585,7 @@ def evaluate(
         node = node.body
     if isinstance(node, ast.Constant):
         c = float(node.value)
-        seg = ast.get_source_segment(src, node) if src is not None else None
+        seg = source_segment(src, node)
         try:
             return _const(I.of_q(Fraction(seg)), nd) if seg is not None else _lit(c, nd)
         except (ValueError, ZeroDivisionError):

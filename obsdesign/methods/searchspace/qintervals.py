@@ -46,6 +46,7 @@ from obsdesign.methods.searchspace.intervals import (
     evaluate,
     int_literal,
 )
+from obsdesign.spec.expr import source_segment
 
 _SMOOTH = ("exp", "log", "sqrt", "sin", "cos", "tan", "atan", "tanh", "sinh", "cosh")
 #: the exact range of a smooth function, where it has a rational one
@@ -223,7 +224,7 @@ def evaluate_q(node: ast.AST, env: dict[str, QI], params: dict[str, QI], src: st
     if isinstance(node, ast.Expression):
         node = node.body
     if isinstance(node, ast.Constant):
-        seg = ast.get_source_segment(src, node) if src is not None else None
+        seg = source_segment(src, node)
         try:
             return QI.point(Fraction(seg)) if seg is not None else _float_q(node, env, params, src)
         except (ValueError, ZeroDivisionError):

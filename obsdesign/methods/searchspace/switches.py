@@ -32,6 +32,8 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any
 
+from obsdesign.spec.expr import source_segment
+
 #: the switches: step(b) = heaviside(b) = [b > 0], sign(b)
 _SWITCHES = ("step", "heaviside", "sign")
 
@@ -116,7 +118,7 @@ def exact_key(node: Any, src: str | None) -> str:
     (search-space trial, session 24). A literal without a position in ``src`` (the ``1`` of
     a ``1/c`` factor) shows its Python value."""
     if isinstance(node, ast.Constant):
-        seg = ast.get_source_segment(src, node) if src is not None else None
+        seg = source_segment(src, node)
         if seg is not None:
             try:
                 return f"Q({Fraction(seg.replace('_', ''))})"
