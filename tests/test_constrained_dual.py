@@ -176,3 +176,58 @@ def test_design_certifies_a_polytope_map_inclusion_its_outer_set_refused() -> No
         (claim,) = [x for x in rep.claims if x.id == "Cmin-in-Xhat"]
         assert (claim.status == ClaimStatus.CERTIFIED) is holds, claim.detail
         assert rep.exit_code() == (0 if holds else 1), [(x.id, x.detail) for x in rep.failed]
+
+
+@pytest.mark.parametrize("scale", [1, 10**8, fmpq(1, 10**8)])
+@pytest.mark.parametrize("norm", ["euclidean", "max"])
+def test_rows_and_faces_of_any_scale(scale: object, norm: str) -> None:
+    """C_0 = [−2, 2] written as x ≤ 2, −s·x ≤ 2s, and the face written as s·x ≤ s·b: the float
+    dual of the unscaled data had no solution for s = 10⁸ (Clarabel: "infeasible"), and a face
+    with a 1000 % margin stayed exit 4, as did 10⁻¹⁰x₁ + 10⁻¹⁰x₂ ≤ 2.38·10⁻¹⁰ (re-check trial,
+    session 38). Rows and face are normalized for the solve: proved; 10⁻³ below the support
+    (2 + √ε_min in both norms, one face violated at a time) still refused."""
+    s = Q(scale)
+    G = np.array([[Q(1)], [-s]], dtype=object)
+    h = np.array([Q(2), 2 * s], dtype=object)
+    face = np.array([[s]], dtype=object)
+    for b, holds in (
+        (Q(22), True),
+        (fmpq(21, 10) + fmpq(1, 10**6), True),
+        (fmpq(21, 10) - fmpq(1, 10**3), False),
+    ):
+        ok, _ = D.faces_by_duality(G, h, norm, fmpq(1, 100), face, np.array([s * b], dtype=object))
+        assert ok is holds, (b, scale, norm)
+
+
+def test_face_holds_refuses_wrong_sizes_and_a_huge_eps() -> None:
+    """A face with an extra component, or y of the wrong length, is no certificate; an ε_min
+    beyond the float range is refused (it raised OverflowError) — re-check trial, session 38."""
+    a = qv(np.array([1, 1]))
+    y = qv(np.array([1, 1, 0, 0]))
+    e = fmpq(1, 100)
+    assert D.face_holds(AXES, ONES, "max", e, qv(np.array([1, 1, 5])), Q(100), y) is False
+    assert D.face_holds(AXES, ONES, "max", e, a, Q(100), y[:3]) is False
+    assert D.face_holds(AXES, ONES, "max", e, a, Q(100), y) is True
+    big = fmpq(10) ** 400
+    ok, faces = D.faces_by_duality(
+        AXES, ONES, "max", big, qv(np.array([a])), np.array([big], dtype=object)
+    )
+    assert not ok and faces == [0]
+
+
+def test_a_refutation_by_a_vertex_of_X_names_it() -> None:
+    """Polytope map |x_i| ≤ 1.1, X = [−1, 1]², X̂ = the box 1.2 cut by x1 + x2 ≤ 1.9: refuted
+    (exit 1) because X's vertex (1, 1) is outside X̂, but the detail said only "no dual
+    certificate for faces [4]", which reads as inconclusive (re-check trial, session 38)."""
+    c = 'type = "polytope"\nG = [[1, 0], [0, 1], [-1, 0], [0, -1]]\nh = [1.1, 1.1, 1.1, 1.1]'
+    xh = (
+        '[sets.Xh]\ntype = "polytope"\nG = [[1, 0], [-1, 0], [0, 1], [0, -1], [1, 1]]\n'
+        "g = [1.2, 1.2, 1.2, 1.2, 1.9]\n\n[method]"
+    )
+    text = variant(add='Xhat = "Xh"', c=c, replace=[("[method]", xh)])
+    rep = api.design(api.load_spec_text(text, "xv.toml"))
+    (claim,) = [x for x in rep.claims if x.id == "Cmin-in-Xhat"]
+    assert (
+        rep.exit_code() == 1
+        and "X's vertex (1, 1) lies in C_0 ⊂ C_min and outside X̂" in claim.detail
+    )

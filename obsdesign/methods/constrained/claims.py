@@ -536,7 +536,11 @@ def _inclusions(c: Claims, o: Options, Xhat: ConvexSet, eps_min: fmpq, eps_max: 
     # C_0 ⊂ C_min once X-in-C0 holds) lies outside X̂
     proof = ok or failure_refutes(cm, eps_min, Xhat)
     if not proof and worst <= 0 and hasattr(o.X, "vertices_q"):
-        proof = any(not contains_q(Xhat, v) for v in o.X.vertices_q())
+        out = next((v for v in o.X.vertices_q() if not contains_q(Xhat, v)), None)
+        if out is not None:
+            # name the refuting point: the detail read as inconclusive (re-check trial, 38)
+            proof = True
+            det += f"; X's vertex ({', '.join(fmt_exact(x) for x in out)}) lies in C_0 ⊂ C_min and outside X̂"
     if not proof:
         w = cmin_witness(cm, eps_min, Xhat)
         if w is not None:

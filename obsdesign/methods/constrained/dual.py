@@ -65,7 +65,7 @@ def face_holds(
     :param G, h: the map's φ = G x − h (exact); :param norm: "euclidean" or "max";
     :param eps: ε_min; :param a, b: the face (exact); :param y: the multipliers (exact)."""
     m, n = G.shape
-    if any(v < 0 for v in y):
+    if len(a) != n or len(y) != m or any(v < 0 for v in y):
         return False
     for j in range(n):
         if sum((G[i, j] * y[i] for i in range(m) if y[i] != 0), fmpq(0)) != a[j]:
@@ -135,22 +135,36 @@ def float_multipliers(
     Gf: np.ndarray, hf: np.ndarray, norm: str, eps: float, af: np.ndarray
 ) -> np.ndarray | None:
     """The float y minimizing yᵀh + √ε‖y‖_{q*} subject to Gᵀy = a, y ≥ 0 (the dual of
-    max_{C_min} a·x; cvxpy, Clarabel), or None when the solver gives none.
+    max_{C_min} a·x; cvxpy, Clarabel), or None when the solver gives none. Solved for
+    z = ‖a‖⁻¹ D y (D the rows' norms): Ĝᵀz = â with unit rows Ĝ = D⁻¹G and â = a/‖a‖, and
+    ‖D⁻¹z‖_{q*} in the objective. Unscaled, a face written as 10⁻¹⁰x₁ + 10⁻¹⁰x₂ ≤ 2.38·10⁻¹⁰ or
+    one row scaled by 10⁸ gave no y (Clarabel said "infeasible"), and true inclusions with
+    margins of 0.5 % to 1000 % stayed exit 4 (re-check trial, session 38).
 
     :param Gf, hf: the map (floats); :param norm: "euclidean" or "max"; :param eps: ε_min;
     :param af: the face's normal (floats)."""
+    import warnings
+
     import cvxpy as cp
 
-    y = cp.Variable(Gf.shape[0], nonneg=True)
-    size = cp.norm1(y) if norm == "max" else cp.pnorm(y, 4 / 3)
-    prob = cp.Problem(cp.Minimize(hf @ y + math.sqrt(eps) * size), [Gf.T @ y == af])
+    d = np.linalg.norm(Gf, axis=1)
+    na = float(np.linalg.norm(af))
+    if not (na > 0 and np.all(d > 0) and np.all(np.isfinite(d)) and math.isfinite(na)):
+        return None
+    z = cp.Variable(Gf.shape[0], nonneg=True)
+    w = cp.multiply(1 / d, z)
+    size = cp.norm1(w) if norm == "max" else cp.pnorm(w, 4 / 3)
+    obj = (hf / d) @ z + math.sqrt(eps) * size
+    prob = cp.Problem(cp.Minimize(obj), [(Gf / d[:, None]).T @ z == af / na])
     try:
-        prob.solve(solver=cp.CLARABEL)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # "Solution may be inaccurate": checked exactly
+            prob.solve(solver=cp.CLARABEL)
     except (cp.error.SolverError, ValueError, ArithmeticError):
         return None
-    if y.value is None or not np.all(np.isfinite(y.value)):
+    if z.value is None or not np.all(np.isfinite(z.value)):
         return None
-    return np.maximum(np.asarray(y.value, dtype=float), 0.0)
+    return np.maximum(np.asarray(z.value, dtype=float), 0.0) * na / d
 
 
 def faces_by_duality(
@@ -162,6 +176,8 @@ def faces_by_duality(
     :param G, h: the map (exact); :param norm: "euclidean" or "max"; :param eps: ε_min;
     :param H, k: X̂'s faces (exact)."""
     e = Q(eps)
+    if not e <= fmpq(10) ** 300:  # beyond the float solver (a spec's ε_min is a float)
+        return False, list(range(H.shape[0]))
     Gf = np.asarray(to_float(G), dtype=float)
     hf = np.asarray(to_float(h), dtype=float).reshape(-1)
     Hf = np.asarray(to_float(H), dtype=float)
