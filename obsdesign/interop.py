@@ -595,6 +595,14 @@ def _setinvariant_nonlinear(
 _SAMPLE_TIME_NAMES = frozenset({"ts", "dt", "tsample", "sampletime", "samplingtime"})
 
 
+#: MATLAB classes whose memory the declared shape bounds (others, a cell or a struct, hold
+#: arrays of any size behind a 1×1 shape)
+MAT_BOUNDED_CLASSES = frozenset(
+    ("double", "single", "logical", "char", "sparse")
+    + tuple(f"{s}int{b}" for s in ("", "u") for b in (8, 16, 32, 64))
+)
+
+
 def spec_text_from_mat(
     path: str | Path,
     names: Mapping[str, str | None],
@@ -618,10 +626,18 @@ def spec_text_from_mat(
     try:
         # the declared shapes first, and only the named variables loaded: a 7.5 MB file of
         # compressed zeros inflated to 11 GB before any check (hostile-input trial, session 24)
-        shapes = {name: shape for name, shape, _ in whosmat(str(path))}
+        info = whosmat(str(path))
+        shapes = {name: shape for name, shape, _ in info}
+        kinds = {name: kind for name, _, kind in info}
         for key, v in (*names.items(), ("the sample time", dt_name)):
             if v is None or v not in shapes:
                 continue
+            if kinds[v] not in MAT_BOUNDED_CLASSES:
+                # a 1×1 cell or struct passed the shape check and loadmat inflated what it
+                # holds: 1.1 MB to 1.4 GB (hostile-input trial, session 38)
+                raise InputError(
+                    f"{path}: variable '{v}' ({key}) is a MATLAB {kinds[v]}, not a numeric matrix"
+                )
             size = int(np.prod(shapes[v], dtype=object))
             if size > limits().max_values or max(shapes[v], default=0) > limits().max_states:
                 raise InputError(

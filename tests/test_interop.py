@@ -890,3 +890,28 @@ def test_an_object_array_is_written_item_by_item() -> None:
     assert interop._value(np.array([True, 0.5], dtype=object)) == "[true, 0.5]"
     assert interop._value(np.array([[True], [0.5]], dtype=object)) == "[[true], [0.5]]"
     assert interop._value(np.array(0.5, dtype=object)) == "0.5"
+
+
+@pytest.mark.parametrize("kind", ["cell", "struct"])
+def test_mat_import_refuses_a_cell_or_struct_before_loading_it(
+    tmp_path: Path, kind: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A 1×1 cell or struct passed the declared-shape check and ``loadmat`` inflated what it
+    holds (1.1 MB to 1.4 GB; hostile-input trial, session 38): refused from ``whosmat``'s class,
+    exit 2 naming file, variable and class, and ``loadmat`` is never called."""
+    import scipy.io
+    from scipy.io import savemat
+
+    inner = np.array(A_D)
+    wrapped = np.array([[inner]], dtype=object) if kind == "cell" else {"m": inner}
+    mat = tmp_path / "plant.mat"
+    savemat(mat, {"Ad": wrapped, "Cm": np.array([[1.0, 0.0]])})
+
+    def never(*a: object, **k: object) -> None:
+        raise AssertionError("loadmat called")
+
+    monkeypatch.setattr(scipy.io, "loadmat", never)
+    r = CliRunner().invoke(app, ["import", str(mat), "--A", "Ad", "--C", "Cm"])
+    assert r.exit_code == 2, r.stderr
+    assert f"variable 'Ad' (A) is a MATLAB {kind}, not a numeric matrix" in r.stderr
+    assert str(mat) in r.stderr and len(r.stderr.splitlines()) == 1
