@@ -805,6 +805,46 @@ def _click_kind(e: BaseException) -> str | None:
     return None
 
 
+def _empty_arg(a: str) -> bool:
+    """An empty argument: '' or an option's ``--name=`` form with nothing after '='."""
+    return a == "" or (a.startswith("--") and a.endswith("=") and a.count("=") == 1)
+
+
+def _json_escape(err: UnicodeError) -> tuple[str, int]:
+    """Codec error handler: each character the stream cannot encode as a JSON string escape,
+    ``\\uXXXX`` (a surrogate pair beyond the BMP), so JSON output stays valid JSON and text
+    stays readable."""
+    if not isinstance(err, UnicodeEncodeError):  # pragma: no cover - encoding only
+        raise err
+    out = []
+    for ch in err.object[err.start : err.end]:
+        c = ord(ch)
+        if c > 0xFFFF:
+            c -= 0x10000
+            out.append(f"\\u{0xD800 + (c >> 10):04x}\\u{0xDC00 + (c & 0x3FF):04x}")
+        else:
+            out.append(f"\\u{c:04x}")
+    return "".join(out), err.end
+
+
+def _encodable(stream: Any) -> None:
+    """Let ``stream`` write any text: on a stream whose encoding is not UTF-8
+    (``PYTHONIOENCODING=ascii``, a latin-1 console) a character it cannot encode is written as
+    a JSON string escape (:func:`_json_escape`, ``\\u2014``) instead of raising
+    UnicodeEncodeError — which made a valid ``verify``, ``check``, ``methods`` or ``schema``
+    exit 3 "internal failure", and ``design -o`` exit 3 after writing a report whose verdict
+    is ok (hostile-input trial, session 38)."""
+    import codecs
+
+    enc = (getattr(stream, "encoding", None) or "").lower().replace("-", "").replace("_", "")
+    if enc not in ("utf8", "utf8sig") and hasattr(stream, "reconfigure"):
+        codecs.register_error("obsdesign-json-escape", _json_escape)
+        try:
+            stream.reconfigure(errors="obsdesign-json-escape")
+        except (ValueError, OSError):  # pragma: no cover - a stream that refuses
+            pass
+
+
 def main() -> None:
     """Console-script entry point. Click's own usage errors (an unknown option, a missing
     argument, a bad option value) become one line, like every other bad input: "obsdesign:
@@ -815,15 +855,22 @@ def main() -> None:
         # code is the command's (every print raised AttributeError: exit 3, or a traceback
         # and exit 1; re-check trial, session 30)
         sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - for the whole process
+    _encodable(sys.stdout)
+    _encodable(sys.stderr)
     # stderr closed (`2>&-`), full or a dead pipe: the error line is dropped, the exit code
     # is the command's (exit 1 for everything before session 34)
     sys.stderr = _Stderr(sys.stderr if sys.stderr is not None else open(os.devnull, "w"))  # noqa: SIM115
-    if "" in sys.argv[1:]:
+    empty = next((i for i, a in enumerate(sys.argv[1:], 1) if _empty_arg(a)), None)
+    if empty is not None:
         # an empty argument is a path '' that pathlib reads as '.': `check "$SPECS"` with
         # SPECS unset checked every spec under the working folder, `-o ''` said ".: is a
-        # directory" (CLI hostile-input trial, session 34). No option takes '' either.
-        at = sys.argv[1:].index("")
-        after = f" after {sys.argv[at]!r}" if at else ""
+        # directory" (CLI hostile-input trial, session 34). No option takes '' either, nor
+        # the `--output=` form (it read '.' too; hostile-input trial, session 38).
+        arg = sys.argv[empty]
+        if arg:
+            after = f" after {arg[:-1]!r}"
+        else:
+            after = f" after {sys.argv[empty - 1]!r}" if empty > 1 else ""
         _err(f"an empty argument{after} (an unset shell variable?): give a path or a value")
         sys.exit(2)
     try:

@@ -569,7 +569,13 @@ def test_an_empty_argument_is_refused_not_read_as_the_working_folder(tmp_path: P
     """pathlib reads '' as '.': ``check "$SPECS"`` with SPECS unset checked every spec under
     the working folder (CLI hostile-input trial, session 34). An empty argument is exit 2."""
     (tmp_path / "s.toml").write_text(SPEC.read_text())
-    for args, after in ((["check", ""], "check"), (["design", str(SPEC), "-o", ""], "-o")):
+    for args, after in (
+        (["check", ""], "check"),
+        (["design", str(SPEC), "-o", ""], "-o"),
+        # the --name= form read '.' too ("is a directory"; hostile-input trial, session 38)
+        (["design", str(SPEC), "--output="], "--output"),
+        (["simulate", str(SPEC), "--csv="], "--csv"),
+    ):
         r = subprocess.run(
             [sys.executable, "-m", "obsdesign", *args],
             capture_output=True,
@@ -580,3 +586,37 @@ def test_an_empty_argument_is_refused_not_read_as_the_working_folder(tmp_path: P
         assert r.returncode == 2 and r.stdout == ""
         assert f"an empty argument after '{after}' (an unset shell variable?)" in r.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
+
+
+@pytest.mark.parametrize("encoding", ["ascii", "latin-1"])
+def test_a_stdout_that_is_not_utf8_gets_escapes_not_exit_3(tmp_path: Path, encoding: str) -> None:
+    """PYTHONIOENCODING=ascii or latin-1: verify, check, methods and schema of valid input
+    exit 3 "internal failure: UnicodeEncodeError", and design -o exit 3 after writing a report
+    whose verdict is ok (hostile-input trial, session 38). Characters the stream cannot encode
+    are written as JSON string escapes: text stays readable, JSON stays valid JSON."""
+    import json as _json
+
+    env = dict(os.environ, PYTHONIOENCODING=encoding)
+    rep = tmp_path / "r.json"
+
+    def run(*args: str) -> subprocess.CompletedProcess:
+        return subprocess.run(
+            [sys.executable, "-m", "obsdesign", *args],
+            capture_output=True,
+            timeout=300,
+            env=env,
+            cwd=tmp_path,
+        )
+
+    r = run("design", str(SPEC), "-o", str(rep))
+    assert r.returncode == 0, r.stderr
+    for args in (["verify", str(rep)], ["methods"], ["schema"], ["check", str(SPEC)]):
+        r = run(*args)
+        assert r.returncode == 0 and b"internal failure" not in r.stderr, (args, r.stderr)
+        r.stdout.decode(encoding)
+    r = run("verify", str(rep), "--format", "json")
+    assert r.returncode == 0
+    d = _json.loads(r.stdout.decode(encoding))
+    assert any("≻" in c["statement"] for c in d["claims"])
+    if encoding == "ascii":
+        assert b"\\u227b" in r.stdout  # ≻ as a JSON escape
