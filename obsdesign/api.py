@@ -169,6 +169,8 @@ def _path_arg(value: Any, name: str, other: str = "") -> Any:
     import os
 
     if isinstance(value, (str, os.PathLike)):
+        if "\0" in os.fspath(value):  # open() said "embedded null byte" (ValueError)
+            raise InputError(f"{name}: a path with a NUL character: {os.fspath(value)!r}")
         return value
     also = f" or {other}" if other else ""
     raise InputError(f"{name}: expected a path{also}, got a value of type {type(value).__name__}")
@@ -724,6 +726,7 @@ def _check_sim_keywords(method: Any, kwargs: dict[str, Any]) -> None:
             break
         fn = sim.simulate
     known -= {"self", "spec", "params"}
+    declared = {o.name: o for o in method.sim_options}
     for k in kwargs:
         if k not in known:
             names = ", ".join(sorted(known)) or "none"
@@ -731,6 +734,8 @@ def _check_sim_keywords(method: Any, kwargs: dict[str, Any]) -> None:
             raise InputError(
                 f"simulate: {k}: not an option of method '{method.key}'{hint} (known: {names})"
             )
+        if k in declared and k != "runs" and kwargs[k] is not None:
+            kwargs[k] = declared[k].check_value(kwargs[k])
 
 
 def _sim_part(method: Any) -> Any:
@@ -1437,8 +1442,14 @@ def check(
     (:mod:`obsdesign.distributed`): the rows are the serial run's (but ``seconds``).
     ``on_row(row)`` is called as each row arrives."""
     timeout = budget_seconds(timeout)
-    if isinstance(paths, (str, Path)):
+    if isinstance(paths, (str, os.PathLike)):
         paths = [paths]
+    if not isinstance(paths, (list, tuple)):
+        # check(None) / check(123): a bare TypeError (hostile-input trial, session 38)
+        raise InputError(
+            f"check: expected a path or a list of paths, got a value of type {type(paths).__name__}"
+        )
+    paths = [_path_arg(p, "check") for p in paths]
     if any(isinstance(p, str) and p == "" for p in paths):
         # pathlib reads '' as '.': the working folder was checked, as the CLI did until it
         # refused '' (re-check trial, session 34)

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import functools
 import logging
+import numbers
 import os
 import sys
 import time
@@ -76,6 +77,15 @@ def check_workers(workers: int | None, scheduler: str | None) -> None:
     work starts."""
     if workers is not None and scheduler is not None:
         raise InputError("--workers and --scheduler exclude each other (a scheduler has its own)")
+    if workers is not None and (
+        isinstance(workers, bool) or not isinstance(workers, numbers.Integral)
+    ):
+        # workers='2' from the API: a bare TypeError (hostile-input trial, session 38)
+        raise InputError(f"--workers: expected a whole number of processes, got {workers!r}")
+    if scheduler is not None and not isinstance(scheduler, str):
+        raise InputError(
+            f"--scheduler: expected an address such as tcp://HOST:8786, got {scheduler!r}"
+        )
     if workers is not None and workers < 1:
         raise InputError(f"--workers: expected a positive number of processes, got {workers}")
     if workers is not None and workers > MAX_LOCAL_WORKERS:

@@ -33,7 +33,7 @@ import sys
 import time
 import tomllib
 import types
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from decimal import Decimal, localcontext
 from fractions import Fraction
@@ -656,6 +656,15 @@ def plan(
     from obsdesign.api import budget_seconds
 
     timeout = budget_seconds(timeout)
+    if options is not None and not (
+        isinstance(options, Mapping)
+        and all(isinstance(k, str) and isinstance(v, str) for k, v in options.items())
+    ):
+        # options=[1]: a bare TypeError from dict() (hostile-input trial, session 38)
+        raise InputError(
+            f"options: expected a mapping of option names to value texts "
+            f"({{'time_limit': '10'}}), got {options!r}"
+        )
     axes = parse_grid(grid)
     text, file = _spec_source(spec)
     points = grid_points(axes)

@@ -372,6 +372,53 @@ def test_api_arguments_of_the_wrong_type_are_input_errors(tmp_path: Path) -> Non
     assert api.simulate(SPEC, runs=2).metrics  # the known keywords still pass
 
 
+@pytest.mark.parametrize(
+    ("call", "match"),
+    [
+        (lambda: api.design(str(SPEC) + "\0"), "spec: a path with a NUL character"),
+        (
+            lambda: api.simulate(SPEC, time_limit="x"),
+            "simulate: time_limit: expected a finite number, got 'x'",
+        ),
+        (
+            lambda: api.simulate(SPEC, time_limit=-1),
+            "simulate: time_limit: expected a value >= 0.001, got -1",
+        ),
+        (
+            lambda: api.simulate(SPEC, time_limit=float("nan")),
+            "time_limit: expected a finite number, got nan",
+        ),
+        (lambda: api.check(None), "check: expected a path or a list of paths, got .* NoneType"),
+        (lambda: api.check(123), "check: expected a path or a list of paths, got .* int"),
+        (lambda: api.check([SPEC, 5]), "check: expected a path, got .* int"),
+        (
+            lambda: api.sweep(SPEC, {"method.lambda": [0.96]}, workers="2"),
+            "--workers: expected a whole number of processes, got '2'",
+        ),
+        (
+            lambda: api.sweep(SPEC, {"method.lambda": [0.96]}, simulate=True, options=[1]),
+            "options: expected a mapping",
+        ),
+    ],
+)
+def test_the_api_refuses_bad_arguments_with_input_errors(call: Any, match: str) -> None:
+    """Hostile-input trial, session 38: each was a bare ValueError / TypeError, a TimeExceeded
+    (the exit-3 class) for time_limit=-1 where the CLI says exit 2, or ran without a limit
+    (time_limit=nan). docs/reliability.md promises InputError."""
+    from obsdesign.errors import InputError
+
+    with pytest.raises(InputError, match=match):
+        call()
+
+
+def test_the_api_still_takes_numpy_numbers_for_simulate_options() -> None:
+    """The typed check of simulate keywords takes what numpy gives (np.float64, np.int64)."""
+    import numpy as np
+
+    r = api.simulate(SPEC, time_limit=np.float64(60), runs=np.int64(2))
+    assert r.metrics
+
+
 # -- mutation review 34 (session 33's checks) ----------------------------------------
 LYAP = (
     '[system]\ntime = "continuous"\nA = [[-1, 1], [0, -2]]\nC = [[1, 0]]\n'

@@ -168,6 +168,34 @@ class SimOption:
             raise InputError(f"{what}: expected a value <= {self.max:g}, got {text}")
         return v
 
+    def check_value(self, v: Any) -> Any:
+        """A typed value given to :func:`obsdesign.api.simulate` as a keyword, checked as
+        :meth:`parse` checks a text: ``time_limit='x'`` was a bare ValueError, ``-1`` ran out
+        of time at once (exit 3 where the CLI says exit 2) and NaN ran without a limit
+        (hostile-input trial, session 38). Returns the value (a path as a Path)."""
+        import numbers
+        import os
+
+        what = f"simulate: {self.name}"
+        ok = {
+            "int": isinstance(v, numbers.Integral) and not isinstance(v, bool),
+            "float": isinstance(v, numbers.Real)
+            and not isinstance(v, bool)
+            and math.isfinite(float(v)),
+            "bool": isinstance(v, bool),
+            "str": isinstance(v, str),
+            "path": isinstance(v, (str, os.PathLike)) and "\0" not in os.fspath(v),
+        }[self.kind]
+        if not ok:
+            raise InputError(f"{what}: expected {_KIND[self.kind]}, got {v!r}")
+        if self.choices is not None and v not in self.choices:
+            raise InputError(f"{what}: expected one of {', '.join(self.choices)}, got {v!r}")
+        if self.min is not None and v < self.min:
+            raise InputError(f"{what}: expected a value >= {self.min:g}, got {v!r}")
+        if self.max is not None and v > self.max:
+            raise InputError(f"{what}: expected a value <= {self.max:g}, got {v!r}")
+        return Path(v) if self.kind == "path" else v
+
 
 _KIND = {
     "int": "an integer",
