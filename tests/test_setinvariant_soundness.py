@@ -220,6 +220,15 @@ def test_theorem31(base71: dict[str, Any], tmp_path: Path) -> None:
     f = exact(d, "contractivity")
     assert fmpq(9, 10) < f < fmpq(9, 10) * (1 + 10 * TINY)
     assert_only(d, {"theorem-3.1"}, tmp_path)
+    # the detail says by how much the factor is above λ: "= ≈ 0.9 (λ = 0.9)" alone read as a
+    # pass (independent fuzz, session 38)
+    rep, _ = Report.from_dict(d)
+    spec = api.load_spec_text(rep.spec, rep.spec_file)
+    (c,) = [c for c in api.certify(spec, rep.parameters) if c.id == "theorem-3.1"]
+    m = re.search(r"\(λ = 9/10\), above λ by ([^;]+);", c.detail)
+    assert m, c.detail
+    excess = m.group(1).split(" ≈ ")[0].lstrip("≈ ")
+    assert float(excess) == pytest.approx(float(f - fmpq(9, 10)), rel=1e-6)
 
 
 def test_theorem31_missing_breakpoint(base71: dict[str, Any], tmp_path: Path) -> None:

@@ -500,11 +500,14 @@ def _single_output(
         emit("theorem-3.1", False, "; ".join(res.notes), float_ok=False)
         return
     ok, fok = b.leq(res.factor, b.lam)
+    # a failure says by how much: "= ≈ 1 (λ = 1)" hid a factor 1 + 2.3·10⁻¹² (fuzz, session 38)
+    above = "" if ok else f", above λ by {b.show(res.factor - b.lam)}"
     emit(
         "theorem-3.1",
         ok,
         f"max over the {len(res.zs)} points of Z_d of max_i(φ_i(z) + G_i v + δ_i) = "
-        f"{b.show(res.factor)} (λ = {spec.options.lam}); worst z ≈ {float(res.zs[res.worst]):.6g}",
+        f"{b.show(res.factor)} (λ = {spec.options.lam}){above}; worst z ≈ "
+        f"{float(res.zs[res.worst]):.6g}",
         b.margin(spec.options.lam, res.factor),
         fok,
     )
