@@ -41,6 +41,9 @@ def test_a_huge_disturbance_gain_is_inconclusive_not_a_solver_failure() -> None:
     with pytest.raises(InconclusiveError, match=r"LP \(9\) is out of a float LP's range") as e:
         api.design(spec)
     assert e.value.exit_code == 4
+    # the hint names A and the growth of the iterates too: a spec without B1 whose scale came
+    # from A (entries 5e11) was pointed at "B1, the sets" (independent fuzz, session 38)
+    assert "(A, C, B1, the sets) or the growth of the iterates under A" in e.value.message
 
 
 def test_failing_highs_stops_at_the_deadline(monkeypatch: pytest.MonkeyPatch) -> None:

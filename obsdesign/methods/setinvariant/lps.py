@@ -136,8 +136,8 @@ def check_lp_range(A: np.ndarray, b: np.ndarray, what: str) -> None:
         raise InconclusiveError(
             f"{what} is out of a float LP's range (largest |coefficient| {a:.3g}, largest "
             f"|right-hand side| {r:.3g}; HiGHS takes values above {HIGHS_MATRIX_MAX:g} and "
-            f"{HIGHS_INFINITY:g} as infinite): the spec's numbers (B1, the sets) are too large "
-            "for the float design"
+            f"{HIGHS_INFINITY:g} as infinite): the spec's numbers (A, C, B1, the sets) or the "
+            "growth of the iterates under A are too large for the float design"
         )
 
 
