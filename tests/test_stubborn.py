@@ -1944,3 +1944,22 @@ def test_slides_rmse_tables_are_not_reproduced_and_examples_1_2_agree(ex1: Repor
         assert fitted["1000"][s] == pytest.approx(slides, rel=0.1)
     for s, slides in zip(("x1", "x2"), SLIDES_LUENBERGER_EX1["0.1"], strict=True):
         assert fitted["0.1"][s] < slides / 3
+
+
+@pytest.mark.parametrize("bound", ["1e-12", "1e-300"])
+def test_a_tiny_gain_bound_shrinks_the_gain_into_it(bound: str) -> None:
+    """A stable plant with gain_bound = 10⁻¹² (or 10⁻³⁰⁰): the solver keeps ‖X‖₂ within the
+    bound only to its own accuracy, every rounded point failed the gain bound, and the design
+    was exit 4 although K = 0 certifies (independent fuzz, session 38). The gain is shrunk into
+    the bound (or set to 0) and the exact checks decide: exit 0, ‖K‖_F ≤ bound by Fractions."""
+    from fractions import Fraction as F
+
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.8, 0.5], [-0.5, 0.8]]\nC = [[1, 0.5]]\n'
+        f'[method]\nkey = "stubborn"\ngain_bound = {bound}\n'
+    )
+    rep = api.design(api.load_spec_text(text, "gb.toml"))
+    assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
+    K = [F(int(k.p), int(k.q)) for k in np.asarray(rep.parameters["K"], dtype=object).ravel()]
+    assert sum(k * k for k in K) <= F(bound) ** 2
+    assert {c.id: c.status for c in rep.claims}["gain-bound"] == ClaimStatus.CERTIFIED
