@@ -805,6 +805,26 @@ def _click_kind(e: BaseException) -> str | None:
     return None
 
 
+#: the options that name an output file
+OUTPUT_OPTIONS = ("-o", "--output", "--plot", "--plot-epsilon", "--junit", "--csv")
+
+
+def _output_named_as_folder(args: list[str]) -> str | None:
+    """The value of an output option (:data:`OUTPUT_OPTIONS`, ``--opt VALUE`` or
+    ``--opt=VALUE``) that ends with a slash, if any."""
+    for i, a in enumerate(args):
+        name, eq, val = a.partition("=")
+        if eq and name in OUTPUT_OPTIONS:
+            v = val
+        elif a in OUTPUT_OPTIONS and i + 1 < len(args):
+            v = args[i + 1]
+        else:
+            continue
+        if v.endswith(("/", os.sep)) and v.strip("/" + os.sep):
+            return v
+    return None
+
+
 def _empty_arg(a: str) -> bool:
     """An empty argument: '' or an option's ``--name=`` form with nothing after '='."""
     return a == "" or (a.startswith("--") and a.endswith("=") and a.count("=") == 1)
@@ -860,6 +880,12 @@ def main() -> None:
     # stderr closed (`2>&-`), full or a dead pipe: the error line is dropped, the exit code
     # is the command's (exit 1 for everything before session 34)
     sys.stderr = _Stderr(sys.stderr if sys.stderr is not None else open(os.devnull, "w"))  # noqa: SIM115
+    folder = _output_named_as_folder(sys.argv[1:])
+    if folder is not None:
+        # pathlib drops a trailing slash: -o out.json/ wrote the file out.json (hostile-input
+        # trial, session 38)
+        _err(f"{folder}: names a folder (trailing '/'); outputs are files")
+        sys.exit(2)
     empty = next((i for i, a in enumerate(sys.argv[1:], 1) if _empty_arg(a)), None)
     if empty is not None:
         # an empty argument is a path '' that pathlib reads as '.': `check "$SPECS"` with

@@ -620,3 +620,22 @@ def test_a_stdout_that_is_not_utf8_gets_escapes_not_exit_3(tmp_path: Path, encod
     assert any("≻" in c["statement"] for c in d["claims"])
     if encoding == "ascii":
         assert b"\\u227b" in r.stdout  # ≻ as a JSON escape
+
+
+def test_an_output_named_with_a_trailing_slash_is_refused(tmp_path: Path) -> None:
+    """pathlib drops a trailing slash: ``-o out.json/`` wrote the file out.json (hostile-input
+    trial, session 38). A name ending in '/' names a folder: exit 2, nothing written."""
+    for args in (
+        ["design", str(SPEC), "-o", "out.json/"],
+        ["design", str(SPEC), "--output=out.json/"],
+        ["simulate", str(SPEC), "--csv", "c.csv/"],
+    ):
+        r = subprocess.run(
+            [sys.executable, "-m", "obsdesign", *args],
+            capture_output=True,
+            text=True,
+            timeout=120,
+            cwd=tmp_path,
+        )
+        assert r.returncode == 2 and "names a folder (trailing '/'); outputs are files" in r.stderr
+    assert list(tmp_path.iterdir()) == []
