@@ -825,6 +825,37 @@ def _output_named_as_folder(args: list[str]) -> str | None:
     return None
 
 
+def _matplotlib_config_dir() -> None:
+    """A private, persistent ``MPLCONFIGDIR`` when matplotlib's own (``$XDG_CONFIG_HOME`` or
+    ``~/.config``) cannot be written: matplotlib then printed two warning lines on stderr and
+    rebuilt its font cache in a fresh temporary folder at every plot, about 5 s
+    (hostile-input trial, session 38, with a read-only HOME). Set before any matplotlib import;
+    a user's own MPLCONFIGDIR is kept, and a folder not ours (a symbolic link, another owner,
+    open to others) is not used."""
+    import stat
+    import tempfile
+
+    if os.environ.get("MPLCONFIGDIR"):
+        return
+    base = os.environ.get("XDG_CONFIG_HOME") or os.path.join(os.path.expanduser("~"), ".config")
+    probe = os.path.join(base, "matplotlib")
+    while probe and not os.path.exists(probe):
+        parent = os.path.dirname(probe)
+        if parent == probe:
+            break
+        probe = parent
+    if os.path.isdir(probe) and os.access(probe, os.W_OK | os.X_OK):
+        return
+    own = os.path.join(tempfile.gettempdir(), f"obsdesign-matplotlib-{os.getuid()}")
+    try:
+        os.makedirs(own, mode=0o700, exist_ok=True)
+        st = os.lstat(own)
+    except OSError:
+        return
+    if stat.S_ISDIR(st.st_mode) and st.st_uid == os.getuid() and not st.st_mode & 0o077:
+        os.environ["MPLCONFIGDIR"] = own
+
+
 def _empty_arg(a: str) -> bool:
     """An empty argument: '' or an option's ``--name=`` form with nothing after '='."""
     return a == "" or (a.startswith("--") and a.endswith("=") and a.count("=") == 1)
@@ -877,6 +908,7 @@ def main() -> None:
         sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - for the whole process
     _encodable(sys.stdout)
     _encodable(sys.stderr)
+    _matplotlib_config_dir()
     # stderr closed (`2>&-`), full or a dead pipe: the error line is dropped, the exit code
     # is the command's (exit 1 for everything before session 34)
     sys.stderr = _Stderr(sys.stderr if sys.stderr is not None else open(os.devnull, "w"))  # noqa: SIM115

@@ -639,3 +639,22 @@ def test_an_output_named_with_a_trailing_slash_is_refused(tmp_path: Path) -> Non
         )
         assert r.returncode == 2 and "names a folder (trailing '/'); outputs are files" in r.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_plot_with_an_unwritable_home_prints_no_matplotlib_warning(tmp_path: Path) -> None:
+    """HOME=/proc/1 (no ~/.config can be made there, even as root): matplotlib printed two
+    warning lines on stderr and rebuilt its font cache in a fresh temporary folder at every
+    plot (hostile-input trial, session 38). The CLI gives it a private MPLCONFIGDIR."""
+    env = {k: v for k, v in os.environ.items() if k not in ("MPLCONFIGDIR", "XDG_CONFIG_HOME")}
+    env["HOME"] = "/proc/1"
+    png = tmp_path / "p.png"
+    r = subprocess.run(
+        [sys.executable, "-m", "obsdesign", "simulate", str(SPEC), "--plot", str(png), "-q"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=env,
+    )
+    assert r.returncode == 0, r.stderr
+    assert "Matplotlib" not in r.stderr and "mkdir" not in r.stderr, r.stderr
+    assert png.stat().st_size > 0
