@@ -752,7 +752,7 @@ def import_mat(
         typer.Option("--Bd", metavar="NAME", help="Variable holding the disturbance input Bd."),
     ] = None,
     dt: Annotated[
-        float | None,
+        str | None,
         typer.Option(
             "--dt",
             metavar="SECONDS",

@@ -936,7 +936,7 @@ def import_mat(
     b: str | None,
     d: str | None,
     bd: str | None,
-    dt: float | None,
+    dt: str | None,
     dt_var: str | None,
     method: str,
 ) -> int:
@@ -946,8 +946,32 @@ def import_mat(
 
     api.method(method)  # an unknown key: "did you mean"
     names = {"A": a, "C": c, "B": b, "D": d, "Bd": bd}
-    sys.stdout.write(spec_text_from_mat(mat, names, method, dt=dt, dt_name=dt_var))
+    seconds = None if dt is None else _dt_seconds(dt)
+    sys.stdout.write(spec_text_from_mat(mat, names, method, dt=seconds, dt_name=dt_var))
     return 0
+
+
+def _dt_seconds(text: str) -> float:
+    """``import --dt``: the text read exactly first, so that a positive sample time below the
+    float range is refused rather than read as 0, continuous time (``--dt 1e-400`` wrote
+    ``time = "continuous"``; hostile-input trial, session 38)."""
+    from decimal import Decimal, InvalidOperation
+
+    from obsdesign.errors import InputError
+
+    try:
+        q = Decimal(text.strip().replace("_", ""))
+        f = float(q)
+    except (InvalidOperation, ValueError):
+        raise InputError(
+            f"--dt {text!r}: expected a number of seconds (0: continuous time)"
+        ) from None
+    if q.is_finite() and q > 0 and f == 0:
+        raise InputError(
+            f"--dt is {text}, a nonzero number below the float range (it would read as 0, "
+            "continuous time)"
+        )
+    return f
 
 
 def methods(fmt: Fmt) -> int:

@@ -408,6 +408,9 @@ def test_lists_of_tables_and_missing_values() -> None:
         ({"ts": 5e-324}, ["--dt-var", "ts"], "'ts' (the sample time) is 5e-324, a nonzero", True),
         ({}, ["--dt", "1e-320"], "--dt is 1e-320, a nonzero number below", False),
         ({}, ["--dt", "inf"], "--dt inf: expected a finite number", False),
+        # below the float range: read as 0.0, continuous time, silently (session 38)
+        ({}, ["--dt", "1e-400"], "--dt is 1e-400, a nonzero number below the float range", False),
+        ({}, ["--dt", "abc"], "--dt 'abc': expected a number of seconds", False),
     ],
 )
 def test_mat_import_refuses_what_the_loader_would_refuse(
