@@ -57,7 +57,7 @@ TIMING_COLUMNS = ("design_s", "verify_s", "simulate_s", "seconds")
 
 _KEY_RE = re.compile(r"^[A-Za-z0-9_-]+(\.[A-Za-z0-9_-]+)*$")
 _NUM = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
-_RANGE_RE = re.compile(rf"^({_NUM}):({_NUM}):(\d+)(?::(lin|log))?$")
+_RANGE_RE = re.compile(rf"^({_NUM}):({_NUM}):([-+]?\d+)(?::(lin|log))?$")
 
 
 # -- axes and grid --------------------------------------------------------------------------
@@ -86,7 +86,7 @@ def parse_axis(text: str) -> Axis:
     if not spec:
         raise InputError(f"--set {key}: no value")
     m = _RANGE_RE.match(spec)
-    if m and len(m.group(3).lstrip("0")) > 12:
+    if m and len(m.group(3).lstrip("+-").lstrip("0")) > 12:
         # int() of a 5000-digit count raised past Python's int-string limit: exit 3
         # (hostile-input trial, session 24)
         raise InputError(

@@ -771,3 +771,14 @@ def test_a_y_column_no_row_has_is_refused_before_the_table_is_written(tmp_path: 
     )  # fmt: skip
     assert r.exit_code == 2 and "--y bogus" in r.output, r.output
     assert out.read_text() == "old\n" and not png.exists()
+
+
+@pytest.mark.parametrize("count", ["-1", "+0", "-00000000000000000000005"])
+def test_a_range_with_a_negative_or_zero_count_says_so(count: str) -> None:
+    """`a:b:-1` said "'0.96:0.97:-1' is not a TOML value" (hostile-input trial, session 38):
+    the count is read with its sign and the message names it; `:lin` is the default spacing."""
+    from obsdesign.errors import InputError
+
+    with pytest.raises(InputError, match="the number of values must be at least 1, got "):
+        sw.parse_grid([f"method.lambda=0.96:0.97:{count}"])
+    assert sw.parse_grid(["a.x=1:2:3:lin"])[0].values == sw.parse_grid(["a.x=1:2:3"])[0].values
