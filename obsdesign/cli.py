@@ -805,6 +805,9 @@ def _click_kind(e: BaseException) -> str | None:
     return None
 
 
+#: the options of ``obsdesign`` itself (before the command)
+GLOBAL_OPTIONS = ("--limit", "--debug", "--version")
+
 #: the options that name an output file
 OUTPUT_OPTIONS = ("-o", "--output", "--plot", "--plot-epsilon", "--junit", "--csv")
 
@@ -960,6 +963,14 @@ def main() -> None:
         elif kind == "UsageError":
             ctx = getattr(e, "ctx", None)
             where = ctx.command_path if ctx is not None else "obsdesign"
+            opt = getattr(e, "option_name", None)
+            if opt in GLOBAL_OPTIONS and where != "obsdesign":
+                # `design s.toml --limit …` suggested "--plot" (hostile-input trial, 38)
+                _err(
+                    f"{opt} is an option of obsdesign itself: give it before the command "
+                    f"(obsdesign {opt} … {where.split(' ', 1)[-1]} …)"
+                )
+                sys.exit(2)
             _err(f"{e.format_message()} (see '{where} --help')")  # type: ignore[attr-defined]
         elif kind == "ClickException":  # e.g. a click.File that cannot be opened
             _err(e.format_message())  # type: ignore[attr-defined]

@@ -658,3 +658,19 @@ def test_a_plot_with_an_unwritable_home_prints_no_matplotlib_warning(tmp_path: P
     assert r.returncode == 0, r.stderr
     assert "Matplotlib" not in r.stderr and "mkdir" not in r.stderr, r.stderr
     assert png.stat().st_size > 0
+
+
+def test_a_global_option_after_the_command_says_where_it_goes() -> None:
+    """`design s.toml --limit max_states=1` said "No such option: --limit (Possible options:
+    --plot)" (hostile-input trial, session 38): it names the right place now."""
+    r = subprocess.run(
+        [sys.executable, "-m", "obsdesign", "design", str(SPEC), "--limit", "max_states=1"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert r.returncode == 2 and r.stdout == ""
+    assert r.stderr.strip() == (
+        "obsdesign: error: --limit is an option of obsdesign itself: give it before the "
+        "command (obsdesign --limit … design …)"
+    )
