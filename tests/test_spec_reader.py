@@ -141,6 +141,23 @@ def test_an_unknown_key_that_differs_in_case_gets_the_hint() -> None:
         t.done()
 
 
+def test_an_unknown_key_with_a_lookalike_character_names_it() -> None:
+    """A Cyrillic 'а' in "lambdа" printed exactly like "lambda" (hostile-input trial, session
+    38): the message names each non-ASCII character by code point and name."""
+    t = Table({"lambd\u0430": 2}, "s.toml", "method")
+    t.int("lambda", default=1)
+    with pytest.raises(SpecError) as e:
+        t.done()
+    assert "(did you mean 'lambda'?); it holds non-ASCII characters: U+0430 CYRILLIC SMALL " in str(
+        e.value
+    )
+    t = Table({"lambdaa": 2}, "s.toml", "method")
+    t.int("lambda", default=1)
+    with pytest.raises(SpecError) as e:
+        t.done()
+    assert "non-ASCII" not in str(e.value)
+
+
 # -- mutation review 33 (session 32's checks) ----------------------------------------
 def test_misspelt_sibling_among_named_subtables_is_named_by_its_full_path() -> None:
     """[sets.box] lacks "horizon", which its misspelt sibling [sets.bxo] holds: the hint names

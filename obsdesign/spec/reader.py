@@ -128,6 +128,10 @@ class Table:
                 difflib.get_close_matches(unknown[0], known, n=1, cutoff=0.6)
             )
             hint = f" (did you mean '{close[0]}'?)" if close else ""
+            odd = _non_ascii(unknown[0])
+            if odd:
+                # "lambdа" with a Cyrillic а printed like "lambda" (hostile-input trial, 38)
+                hint += f"; it holds non-ASCII characters: {odd}"
             raise self.error(unknown[0], f"is not a known key here{hint}")
 
     # -- tables -----------------------------------------------------------------------------
@@ -382,3 +386,12 @@ def _dim(d: int | None) -> str:
 
 def _shape(r: int | None, c: int | None) -> str:
     return "" if r is None and c is None else f" of shape {_dim(r)}×{_dim(c)}"
+
+
+def _non_ascii(key: str) -> str:
+    """The non-ASCII characters of ``key`` by code point and name (a Cyrillic 'а' in a key
+    looks like the Latin 'a' in a message), or ''."""
+    import unicodedata
+
+    seen = dict.fromkeys(ch for ch in key if ord(ch) > 127)
+    return ", ".join(f"U+{ord(ch):04X} {unicodedata.name(ch, 'unnamed')}" for ch in list(seen)[:5])
