@@ -812,6 +812,23 @@ GLOBAL_OPTIONS = ("--limit", "--debug", "--version")
 OUTPUT_OPTIONS = ("-o", "--output", "--plot", "--plot-epsilon", "--junit", "--csv")
 
 
+def _output_given_twice(args: list[str]) -> str | None:
+    """The first output option (:data:`OUTPUT_OPTIONS`; -o and --output are one) given a
+    second time, if any."""
+    seen: set[str] = set()
+    for a in args:
+        if a == "--":
+            break
+        name = a.partition("=")[0] if a.startswith("--") else a
+        if name not in OUTPUT_OPTIONS:
+            continue
+        key = "--output" if name == "-o" else name
+        if key in seen:
+            return "-o/--output" if key == "--output" else key
+        seen.add(key)
+    return None
+
+
 def _output_named_as_folder(args: list[str]) -> str | None:
     """The value of an output option (:data:`OUTPUT_OPTIONS`, ``--opt VALUE`` or
     ``--opt=VALUE``) that ends with a slash, if any."""
@@ -915,6 +932,12 @@ def main() -> None:
     # stderr closed (`2>&-`), full or a dead pipe: the error line is dropped, the exit code
     # is the command's (exit 1 for everything before session 34)
     sys.stderr = _Stderr(sys.stderr if sys.stderr is not None else open(os.devnull, "w"))  # noqa: SIM115
+    twice = _output_given_twice(sys.argv[1:])
+    if twice is not None:
+        # click keeps the last: -o a.json -o b.json wrote b.json alone, silently
+        # (hostile-input trial, session 38)
+        _err(f"{twice} is given twice; give each output once")
+        sys.exit(2)
     folder = _output_named_as_folder(sys.argv[1:])
     if folder is not None:
         # pathlib drops a trailing slash: -o out.json/ wrote the file out.json (hostile-input

@@ -674,3 +674,21 @@ def test_a_global_option_after_the_command_says_where_it_goes() -> None:
         "obsdesign: error: --limit is an option of obsdesign itself: give it before the "
         "command (obsdesign --limit … design …)"
     )
+
+
+def test_an_output_option_given_twice_is_refused(tmp_path: Path) -> None:
+    """click keeps the last of a repeated option: ``-o a.json -o b.json`` wrote b.json alone,
+    silently (hostile-input trial, session 38). Exit 2, nothing written."""
+    for args, name in (
+        (["design", str(SPEC), "-o", "a.json", "--output", "b.json"], "-o/--output"),
+        (["simulate", str(SPEC), "--csv=a.csv", "--csv", "b.csv"], "--csv"),
+    ):
+        r = subprocess.run(
+            [sys.executable, "-m", "obsdesign", *args],
+            capture_output=True,
+            text=True,
+            timeout=120,
+            cwd=tmp_path,
+        )
+        assert r.returncode == 2 and f"{name} is given twice; give each output once" in r.stderr
+    assert list(tmp_path.iterdir()) == []
