@@ -773,14 +773,45 @@ def test_Cmin_in_Xhat_euclidean_box_map_is_decided_exactly(
     assert {c.id for c in rep.failed} == failed and rep.exit_code() == code
 
 
-def test_Cmin_in_Xhat_undecided_by_its_outer_set_is_inconclusive() -> None:
-    """X̂ the disk |x|² ≤ 2.85 contains C_min (max |x|² over it 2(1.1 + (5·10⁻⁵)^¼)² ≈
-    2.804), but the outer box's corners (|x|² = 2.88) are outside and a Euclidean C_min has
-    no corners there: the claim is not proved, and that is exit 4 (inconclusive), not exit 1
-    (it was exit 1: constrained soundness trial, session 25)."""
-    disk = '[sets.Xh]\ntype = "ellipsoid"\nE = [[0.3508771929824561, 0], [0, 0.3508771929824561]]\n\n[method]'
+@pytest.mark.parametrize(
+    ("e", "holds"),
+    [("0.3508771929824561", True), ("0.3566", True), ("0.35663", False), ("0.36", False)],
+)
+def test_Cmin_in_Xhat_of_a_disk_is_decided_beyond_the_outer_corners(e: str, holds: bool) -> None:
+    """X̂ the disk |x|² ≤ 1/e. C_min = R ⊕ {‖d‖₄ ≤ 0.1} reaches |x|² = (1.1√2 + 0.1·2^{1/4})²
+    = 2.80413655833536535 (mpmath), the outer box's corners 2.88. Until session 38 a true
+    inclusion (1/e = 2.85) was exit 4 (inconclusive; it was exit 1 before session 25): now the
+    E-norm bound (√m + √μ·n^{1/4}·√ε_min)², exact for a disk, proves 1/e = 2.85 and 2.80426,
+    and 2.80403 / 2.778 are refused (exit 1, a point of C_min outside X̂)."""
+    disk = f'[sets.Xh]\ntype = "ellipsoid"\nE = [[{e}, 0], [0, {e}]]\n\n[method]'
     rep = _design(variant(add='Xhat = "Xh"', replace=[("[method]", disk)]), "disk.toml")
-    assert {c.id for c in rep.failed} == {"Cmin-in-Xhat"} and rep.exit_code() == 4
+    failed = {c.id for c in rep.failed}
+    if holds:
+        assert not failed and rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
+    else:
+        assert failed == {"Cmin-in-Xhat"} and rep.exit_code() == 1
+
+
+def test_box_l4_in_ellipsoid_is_never_proved_below_the_true_maximum() -> None:
+    """An off-centre, tilted ellipsoid: the bound is an upper bound of the E-form over C_min,
+    so scaling E until the form at a point of C_min (a vertex of R plus the 4-norm ball's
+    point along E's leading axis, checked with Fractions) exceeds 1 must fail; with room to
+    spare it holds."""
+    from fractions import Fraction as F
+
+    cm = _box_cm()  # R = [−1, 1]², ε_min = 1/100: the 4-norm ball of radius 1/10
+    c = np.array([Q("0.2"), Q("-0.1")], dtype=object)
+    E0 = np.array([[Q(2), Q("0.5")], [Q("0.5"), Q(1)]], dtype=object)
+    # a point of C_min: the vertex (1, −1) plus d with ‖d‖₄ ≤ 1/10
+    x = [F(108, 100), F(-108, 100)]
+    assert sum((x[i] - (F(1) if i == 0 else F(-1))) ** 4 for i in range(2)) <= F(1, 10**4)
+    d = [x[0] - F("0.2"), x[1] + F("0.1")]
+    form = F(2) * d[0] ** 2 + 2 * F("0.5") * d[0] * d[1] + d[1] ** 2
+    too_small = fmpq(form.numerator, form.denominator) * fmpq(999, 1000)  # form/scale > 1
+    ok, _ = CL.box_l4_in_ellipsoid(cm, EPS, Ellipsoid(E0 * (1 / too_small), c), "outer")
+    assert not ok
+    ok, detail = CL.box_l4_in_ellipsoid(cm, EPS, Ellipsoid(E0 * fmpq(1, 20), c), "outer")
+    assert ok, detail
 
 
 XHAT_MAX_NOT_TIGHT = """
@@ -961,7 +992,7 @@ def test_no_witness_where_cmin_lies_in_xhat_but_its_outer_box_does_not() -> None
     """The disk of radius 1.98 holds C_min (its farthest points, on the diagonals, are at
     1.963) but not the outer box's corners (2.013): the outer-set test fails, and the
     witness search must find nothing (a false refutation would be exit 1 for a true
-    inclusion); a disk of radius 1.95 is refuted."""
+    inclusion); a disk of radius 1.95 is refuted. (The inclusion itself is proved now.)"""
     from obsdesign.methods.constrained import claims as CL
     from obsdesign.methods.constrained.cmap import box_map
     from obsdesign.sets import Ellipsoid
@@ -976,7 +1007,9 @@ def test_no_witness_where_cmin_lies_in_xhat_but_its_outer_box_does_not() -> None
             np.array([fmpq(0)] * 2, dtype=object),
         )
 
-    assert not CL.cmin_in_xhat(cm, eps, disk("1.98"))[0]
+    # proved since session 38 (the E-norm bound beyond the outer corners); before, it failed
+    assert CL.cmin_in_xhat(cm, eps, disk("1.98"))[0]
+    assert not CL.cmin_in_xhat(cm, eps, disk("1.95"))[0]
     assert CL.cmin_witness(cm, eps, disk("1.98")) is None
     w = CL.cmin_witness(cm, eps, disk("1.95"))
     assert w is not None and cm.norm_c_sq_q(w) <= eps**2 and w[0] ** 2 + w[1] ** 2 > Q("1.95") ** 2
