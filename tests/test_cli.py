@@ -565,6 +565,20 @@ def test_debug_shows_the_traceback_and_keeps_the_exit_code(tmp_path: Path) -> No
     assert r.returncode == 2 and "Traceback" in r.stderr and "SpecError" in r.stderr
 
 
+def _cli(
+    *args: str, cwd: Path | None = None, env: dict | None = None
+) -> subprocess.CompletedProcess:
+    """``python -m obsdesign ARGS`` in a fresh process (text output, 300 s at most)."""
+    return subprocess.run(
+        [sys.executable, "-m", "obsdesign", *args],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=cwd,
+        env=env,
+    )
+
+
 def test_an_empty_argument_is_refused_not_read_as_the_working_folder(tmp_path: Path) -> None:
     """pathlib reads '' as '.': ``check "$SPECS"`` with SPECS unset checked every spec under
     the working folder (CLI hostile-input trial, session 34). An empty argument is exit 2."""
@@ -576,13 +590,7 @@ def test_an_empty_argument_is_refused_not_read_as_the_working_folder(tmp_path: P
         (["design", str(SPEC), "--output="], "--output"),
         (["simulate", str(SPEC), "--csv="], "--csv"),
     ):
-        r = subprocess.run(
-            [sys.executable, "-m", "obsdesign", *args],
-            capture_output=True,
-            text=True,
-            timeout=120,
-            cwd=tmp_path,
-        )
+        r = _cli(*args, cwd=tmp_path)
         assert r.returncode == 2 and r.stdout == ""
         assert f"an empty argument after '{after}' (an unset shell variable?)" in r.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
@@ -630,13 +638,7 @@ def test_an_output_named_with_a_trailing_slash_is_refused(tmp_path: Path) -> Non
         ["design", str(SPEC), "--output=out.json/"],
         ["simulate", str(SPEC), "--csv", "c.csv/"],
     ):
-        r = subprocess.run(
-            [sys.executable, "-m", "obsdesign", *args],
-            capture_output=True,
-            text=True,
-            timeout=120,
-            cwd=tmp_path,
-        )
+        r = _cli(*args, cwd=tmp_path)
         assert r.returncode == 2 and "names a folder (trailing '/'); outputs are files" in r.stderr
     assert list(tmp_path.iterdir()) == []
 
@@ -648,13 +650,7 @@ def test_a_plot_with_an_unwritable_home_prints_no_matplotlib_warning(tmp_path: P
     env = {k: v for k, v in os.environ.items() if k not in ("MPLCONFIGDIR", "XDG_CONFIG_HOME")}
     env["HOME"] = "/proc/1"
     png = tmp_path / "p.png"
-    r = subprocess.run(
-        [sys.executable, "-m", "obsdesign", "simulate", str(SPEC), "--plot", str(png), "-q"],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        env=env,
-    )
+    r = _cli("simulate", str(SPEC), "--plot", str(png), "-q", env=env)
     assert r.returncode == 0, r.stderr
     assert "Matplotlib" not in r.stderr and "mkdir" not in r.stderr, r.stderr
     assert png.stat().st_size > 0
@@ -663,12 +659,7 @@ def test_a_plot_with_an_unwritable_home_prints_no_matplotlib_warning(tmp_path: P
 def test_a_global_option_after_the_command_says_where_it_goes() -> None:
     """`design s.toml --limit max_states=1` said "No such option: --limit (Possible options:
     --plot)" (hostile-input trial, session 38): it names the right place now."""
-    r = subprocess.run(
-        [sys.executable, "-m", "obsdesign", "design", str(SPEC), "--limit", "max_states=1"],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    r = _cli("design", str(SPEC), "--limit", "max_states=1")
     assert r.returncode == 2 and r.stdout == ""
     assert r.stderr.strip() == (
         "obsdesign: error: --limit is an option of obsdesign itself: give it before the "
@@ -683,12 +674,6 @@ def test_an_output_option_given_twice_is_refused(tmp_path: Path) -> None:
         (["design", str(SPEC), "-o", "a.json", "--output", "b.json"], "-o/--output"),
         (["simulate", str(SPEC), "--csv=a.csv", "--csv", "b.csv"], "--csv"),
     ):
-        r = subprocess.run(
-            [sys.executable, "-m", "obsdesign", *args],
-            capture_output=True,
-            text=True,
-            timeout=120,
-            cwd=tmp_path,
-        )
+        r = _cli(*args, cwd=tmp_path)
         assert r.returncode == 2 and f"{name} is given twice; give each output once" in r.stderr
     assert list(tmp_path.iterdir()) == []

@@ -160,13 +160,18 @@ class SimOption:
                 v = text
         except ValueError:
             raise InputError(f"{what}: expected {_KIND[self.kind]}, got {text!r}") from None
-        if self.choices is not None and v not in self.choices:
-            raise InputError(f"{what}: expected one of {', '.join(self.choices)}, got {text!r}")
-        if self.min is not None and v < self.min:
-            raise InputError(f"{what}: expected a value >= {self.min:g}, got {text}")
-        if self.max is not None and v > self.max:
-            raise InputError(f"{what}: expected a value <= {self.max:g}, got {text}")
+        self._in_range(what, v, repr(text), text)
         return v
+
+    def _in_range(self, what: str, v: Any, shown: str, number: str) -> None:
+        """``choices`` / ``min`` / ``max`` of a parsed or given value (``shown`` / ``number``:
+        how the message quotes it)."""
+        if self.choices is not None and v not in self.choices:
+            raise InputError(f"{what}: expected one of {', '.join(self.choices)}, got {shown}")
+        if self.min is not None and v < self.min:
+            raise InputError(f"{what}: expected a value >= {self.min:g}, got {number}")
+        if self.max is not None and v > self.max:
+            raise InputError(f"{what}: expected a value <= {self.max:g}, got {number}")
 
     def check_value(self, v: Any) -> Any:
         """A typed value given to :func:`obsdesign.api.simulate` as a keyword, checked as
@@ -188,12 +193,7 @@ class SimOption:
         }[self.kind]
         if not ok:
             raise InputError(f"{what}: expected {_KIND[self.kind]}, got {v!r}")
-        if self.choices is not None and v not in self.choices:
-            raise InputError(f"{what}: expected one of {', '.join(self.choices)}, got {v!r}")
-        if self.min is not None and v < self.min:
-            raise InputError(f"{what}: expected a value >= {self.min:g}, got {v!r}")
-        if self.max is not None and v > self.max:
-            raise InputError(f"{what}: expected a value <= {self.max:g}, got {v!r}")
+        self._in_range(what, v, repr(v), repr(v))
         return Path(v) if self.kind == "path" else v
 
 
