@@ -310,3 +310,39 @@ def test_bounds_at_more_bits_is_narrower_than_at_prec() -> None:
         assert lo <= hi and hi - lo < fmpq(1, 2**1000)
         lo, hi = I.bounds(f, fmpq(1, 3))
         assert hi - lo > fmpq(1, 2**120)
+
+
+@pytest.mark.parametrize("bits", [60, 113, 247])
+def test_rexp_and_rlog_enclose_where_mpmath_intervals_miss(bits: int) -> None:
+    """mpmath's iv.exp / iv.log round a slightly low approximation, so their "upper" end can
+    lie below the true value: iv.exp at 60 bits gave [1 + 2⁻⁴⁰] for e^(2⁻⁴⁰) (true
+    1 + 2⁻⁴⁰ + 2⁻⁸¹ + …), iv.log missed ln(1 + 2⁻¹³²) at 247 bits (search-space soundness
+    trial, session 38: four false certificates). rexp / rlog (python-flint arb) enclose every
+    x = ±2⁻ᵏ, 1 + 2⁻ᵏ, checked against mpmath at 600 bits (errors ~2⁻⁶⁰⁰, far below the
+    ends' distance to the truth)."""
+    import mpmath
+    from mpmath import iv
+    from mpmath.libmp import from_man_exp
+
+    from obsdesign.certify import interval as ivq
+
+    with mpmath.workprec(600):
+        for k in range(1, bits + 20, 3):
+            for raw, f, ref in (
+                (from_man_exp(1, -k), ivq.rexp, mpmath.exp),
+                (from_man_exp(-1, -k), ivq.rexp, mpmath.exp),
+                (from_man_exp((1 << k) + 1, -k), ivq.rlog, mpmath.log),
+            ):
+                with ivq._prec(bits):
+                    lo, hi = f(iv.make_mpf((raw, raw)))._mpi_
+                truth = ref(mpmath.mpf(raw))
+                assert mpmath.mpf(lo) <= truth <= mpmath.mpf(hi), (k, f.__name__)
+    with ivq._prec(60):
+        lo, hi = ivq.rexp(iv.make_mpf((from_man_exp(1, -40),) * 2))._mpi_
+    assert hi != from_man_exp((1 << 40) + 1, -40)  # not the end iv.exp gave
+    with pytest.raises(ArithmeticError):
+        ivq.rlog(iv.mpf([0, 1]))
+    # ln 2 = 0.69314718055994530941…
+    assert ivq.log_lower(2) < fmpq(6931471805599453095, 10**19)
+    assert ivq.log_upper(2) > fmpq(6931471805599453094, 10**19)
+    assert ivq.exp_upper(fmpq(1, 2**40)) > 1 + fmpq(1, 2**40) + fmpq(1, 2**81)

@@ -2249,3 +2249,43 @@ def test_an_estimate_beyond_the_float_range_refutes_the_value(monkeypatch) -> No
     C._constant(c, bind(sp), "L_h", fmpq(1))
     (claim,) = c
     assert claim.id == "L_h-bound" and claim.status == ClaimStatus.FAILED, claim.detail
+
+
+_CANCEL = """
+[system]
+time = "continuous"
+states = ["x1", "x2"]
+f = ["x2", "-x1 - 1e25*(exp(p) - 1 - p)*x2"]
+h = ["x1"]
+[system.parameters]
+p = 9.094947017729282379150390625e-13
+[method]
+key = "search-space"
+alpha = 0.9
+gamma_star = 0.05
+gamma0 = 0.5
+[method.E]
+lower = [-2, -2]
+upper = [2, 2]
+[method.D]
+lower = [-1, -1]
+upper = [1, 1]
+"""
+
+
+def test_an_exp_cancellation_gets_a_true_lipschitz_bound() -> None:
+    """f₂ = −x1 − c·x2 with c = 10²⁵(e^p − 1 − p), p = 2⁻⁴⁰: c ≈ 4.136, but mpmath's interval
+    exp gave e^p = 1 + 2⁻⁴⁰ exactly, so c was enclosed as 0 and L_f = 1, ‖f_u‖ = 2.83 were
+    certified (search-space soundness trial, session 38). With Fractions: e^p − 1 − p ≥ p²/2,
+    so the difference quotient between (0, 0) and (0, 1) is ≥ √(1 + c²) ≥ 4.255 and
+    |f(2, 2)| ≥ 10.46: the certified L_f and f_sup are at least that (loose, but true)."""
+    from fractions import Fraction as F
+
+    rep = api.design(api.load_spec_text(_CANCEL, "cancel.toml"))
+    p = F(1, 2**40)
+    c = 10**25 * p**2 / 2
+    L = Q(rep.parameters["L_f"])
+    Lf = F(int(L.p), int(L.q))
+    S = Q(rep.parameters["f_sup"])
+    assert Lf**2 >= 1 + c**2
+    assert F(int(S.p), int(S.q)) ** 2 >= 4 + (2 + 2 * c) ** 2

@@ -616,8 +616,8 @@ def test_function_enclosures_at_the_domain_edges() -> None:
     assert IV.sqrt(I(0.0, 4.0)) == I(0.0, 2.0) and IV.sqrt(I(0.0, 0.0)) == ZERO
     assert IV.sqrt(I(4.0, inf)) == I(2.0, inf) and IV.sqrt(I(9.0, 16.0)) == I(3.0, 4.0)
     assert IV.sin(I(0.0, inf)) == I(-1.0, 1.0) == IV.cos(I(-inf, 0.0))
-    for f in (IV.exp, IV.cosh):
-        assert f(I(0.0, inf)) == I.entire()
+    assert IV.cosh(I(0.0, inf)) == I.entire()
+    assert IV.exp(I(0.0, inf)) == I(0.0, inf)  # e^x > 0 kept (session 38)
     for x in (I(0.0, inf), I(1.0, 2.0)):  # poles inside: undefined (session 34)
         with pytest.raises(ArithmeticError, match="may hold a pole"):
             IV.tan(x)
@@ -1151,3 +1151,42 @@ def test_a_nan_end_point_is_refused_and_overflowing_sinh_cosh_are_unbounded() ->
     s = IV._monotone("sinh", I(-1e39, -1e39))
     assert s == I(-math.inf, -top)  # sinh(−1e39) is hugely negative: never a finite lower end
     assert IV._arb_point("sinh", 710.0)[1] < top  # finite where floats hold it
+
+
+@pytest.mark.parametrize("name", ["exp", "log", "sin", "cos", "tan"])
+def test_transcendental_enclosures_hold_where_mpmath_intervals_miss(name: str) -> None:
+    """mpmath's interval exp / log (and the same code path for sin, cos, tan) at 60 bits
+    missed the true value at x = ±2⁻ᵏ: e^(2⁻⁴⁰) came out [1 + 2⁻⁴⁰], exact as a float, so
+    1e12·(exp(x1) − x1) had L_h 1.3·10⁻¹³ too small and 1e25·(exp(p) − 1 − p) was 0 — L_f
+    false by 4× (search-space soundness trial, session 38). Every enclosure must hold the
+    value mpmath gives at 400 bits, at points and on short intervals, also near the maxima
+    and poles, where the sin / cos / tan ranges are decided with arb balls."""
+    f = getattr(IV, name)
+    pts = [2.0**-k for k in range(1, 80)] + [-(2.0**-k) for k in range(1, 80)]
+    pts += [1 + 2.0**-k for k in range(1, 53)] + [math.pi / 2, 1e6, 12345.678, 1e15 + 0.5]
+    ref = {"exp": mpmath.exp, "log": mpmath.log, "sin": mpmath.sin, "cos": mpmath.cos}
+    ref["tan"] = mpmath.tan
+    with mpmath.workprec(400):
+        for x in pts:
+            if name == "log" and x <= 0:
+                continue
+            for box in (I(x, x), I(x, math.nextafter(x, math.inf))):
+                try:
+                    r = f(box)
+                except ArithmeticError:  # tan near a pole, refused
+                    assert name == "tan"
+                    continue
+                for v in (box.lo, box.hi):
+                    t = ref[name](mpmath.mpf(v))
+                    assert mpmath.mpf(r.lo) <= t <= mpmath.mpf(r.hi), (name, x, r)
+        # a maximum or minimum strictly inside is ±1 exactly
+        top = 4 * 10**6 * math.pi + math.pi / 2  # a maximum of sin near 1.3e7
+        r = IV.sin(I(top - 1e-6, top + 1e-6))
+        assert r.hi == 1.0 and r.lo > 0.99
+        assert IV.cos(I(-1e-300, 1e-300)).hi == 1.0
+
+
+def test_exact_points_stay_exact() -> None:
+    """sin 0 = 0, cos 0 = 1, e⁰ = 1, ln 1 = 0 as points (the arb ends are floats: no step)."""
+    assert IV.sin(I(0.0, 0.0)) == ZERO and IV.cos(I(0.0, 0.0)) == ONE
+    assert IV.exp(ZERO) == ONE and IV.log(ONE) == ZERO and IV.tan(ZERO) == ZERO

@@ -1,8 +1,13 @@
 """Outward-rounded bounds for quantities that are not rational (sqrt, log, exp, ...).
 
-mpmath's interval type ``iv.mpf`` rounds every operation outward, so the true value of an
-expression lies in the returned interval. We convert interval ends to exact rationals, so a
-bound reported as "T_max ≥ 1.0899" is a proof. Directions are explicit in every name:
+mpmath's interval type ``iv.mpf`` rounds the arithmetic operations and √ outward (exact
+directed rounding), so the true value of an expression built from them lies in the returned
+interval. Its transcendental functions do NOT: ``iv.exp`` at 60 bits gave [1 + 2⁻⁴⁰] for
+e^(2⁻⁴⁰), whose true value is 1 + 2⁻⁴⁰ + 2⁻⁸¹ + …, and ``iv.log`` misses likewise at many
+precisions (search-space soundness trial, session 38: four false certificates). ``rexp`` and
+``rlog`` below take exp and log from python-flint's ``arb`` balls (rigorous) and return
+mpmath intervals; every enclosure here uses them. We convert interval ends to exact rationals,
+so a bound reported as "T_max ≥ 1.0899" is a proof. Directions are explicit in every name:
 ``*_upper`` returns a rational ≥ the true value, ``*_lower`` one ≤ it.
 """
 
@@ -14,7 +19,7 @@ from typing import Any
 
 from flint import fmpq
 from mpmath import iv
-from mpmath.libmp import finf, fnan, fninf
+from mpmath.libmp import finf, fnan, fninf, from_man_exp, mpf_pos
 
 from obsdesign.certify.exact import Q
 from obsdesign.errors import InconclusiveError
@@ -72,6 +77,53 @@ def raw_to_q(x: tuple) -> fmpq:
     return -v if sign else v
 
 
+def _raw_arb(x: tuple) -> Any:
+    """The finite raw mpmath float x as an exact python-flint ``arb`` (radius 0)."""
+    from flint import arb, arf, fmpz
+
+    if x in (finf, fninf, fnan):
+        raise ArithmeticError("interval evaluation did not give a finite enclosure")
+    sign, man, exp, _ = x
+    a = arb(arf((fmpz(-man if sign else man), fmpz(exp))))
+    return a
+
+
+def _arb_raw(a: Any, rnd: str) -> tuple:
+    """The exact ``arb`` point a (a ball's end) as a raw mpmath float rounded to ``iv.prec``
+    bits in direction ``rnd`` ('f' down, 'c' up)."""
+    if not a.is_finite():
+        raise ArithmeticError("interval evaluation did not give a finite enclosure")
+    man, exp = a.man_exp()
+    return mpf_pos(from_man_exp(int(man), int(exp)), iv.prec, rnd)
+
+
+def _monotone_arb(name: str, x: Any) -> Any:
+    """The mpmath interval enclosing f(x) for an increasing function f (``arb`` method
+    ``name``), x an mpmath interval or number: [f(lo)↓, f(hi)↑] from rigorous balls at
+    ``iv.prec`` + 32 bits, ends rounded outward to ``iv.prec``."""
+    from flint import ctx
+
+    lo, hi = iv.mpf(x)._mpi_
+    with ctx.workprec(iv.prec + 32):
+        a = getattr(_raw_arb(lo), name)()
+        b = getattr(_raw_arb(hi), name)()
+        return iv.make_mpf((_arb_raw(a.lower(), "f"), _arb_raw(b.upper(), "c")))
+
+
+def rexp(x: Any) -> Any:
+    """e^x of an mpmath interval, rigorously (``arb``; ``iv.exp`` is not: module docstring)."""
+    return _monotone_arb("exp", x)
+
+
+def rlog(x: Any) -> Any:
+    """ln x of an mpmath interval x > 0, rigorously (``arb``; ``iv.log`` is not: module
+    docstring). ArithmeticError when x reaches 0 or below."""
+    lo, _ = iv.mpf(x)._mpi_
+    if lo in (finf, fninf, fnan) or lo[0] or lo[1] == 0:
+        raise ArithmeticError("log of an interval reaching 0 or below")
+    return _monotone_arb("log", x)
+
+
 def bounds(f: Callable[..., Any], *args: Any, bits: int = PREC) -> tuple[fmpq, fmpq]:
     """Rational (lower, upper) enclosing f(*args), f built from mpmath ``iv`` operations at
     ``bits`` bits (default :data:`PREC`).
@@ -122,8 +174,8 @@ def sqrt_lower(x: Any) -> fmpq:
     return r if r is not None else lower(iv.sqrt, x)
 
 
-log_upper: Callable[[Any], fmpq] = partial(upper, iv.log)
-log_lower: Callable[[Any], fmpq] = partial(lower, iv.log)
+log_upper: Callable[[Any], fmpq] = partial(upper, rlog)
+log_lower: Callable[[Any], fmpq] = partial(lower, rlog)
 
 
 def log_bounds(x: Any, bits: int = PREC) -> tuple[fmpq, fmpq]:
@@ -132,7 +184,7 @@ def log_bounds(x: Any, bits: int = PREC) -> tuple[fmpq, fmpq]:
     paper, compares K·ΔT·L_f with ln(κ/L_h) when K ≈ 10³⁰⁰)."""
     q = Q(x)
     with _prec(max(PREC, bits)):
-        r = iv.log(iv.mpf(int(q.p)) / iv.mpf(int(q.q)))
+        r = rlog(iv.mpf(int(q.p)) / iv.mpf(int(q.q)))
         lo, hi = r._mpi_
     return raw_to_q(lo), raw_to_q(hi)
 
@@ -166,8 +218,8 @@ def log_compare(
         b = min(2 * b, max_bits)
 
 
-exp_upper: Callable[[Any], fmpq] = partial(upper, iv.exp)
-exp_lower: Callable[[Any], fmpq] = partial(lower, iv.exp)
+exp_upper: Callable[[Any], fmpq] = partial(upper, rexp)
+exp_lower: Callable[[Any], fmpq] = partial(lower, rexp)
 
 
 def round_up(x: Any, digits: int) -> fmpq:

@@ -11,10 +11,9 @@ from typing import Any
 
 import numpy as np
 from flint import fmpq
-from mpmath import iv
 
 from obsdesign.certify.exact import Q
-from obsdesign.certify.interval import bounds, round_down, round_up, sqrt_upper
+from obsdesign.certify.interval import bounds, rlog, round_down, round_up, sqrt_upper
 
 
 def gamma_of(L_diag: Any) -> tuple[fmpq, fmpq]:
@@ -72,7 +71,7 @@ def T_max_lower(gamma: Any, varpi_o: Any, kappa: Any, lam_no: Any, lam_on: Any, 
     if den <= 0:
         raise ValueError("the denominator of (26b) is not positive")
     g = Q(gamma)
-    lo, _ = bounds(lambda om, d: -iv.log(om * om) / d, fmpq(1) - g, den)
+    lo, _ = bounds(lambda om, d: -rlog(om * om) / d, fmpq(1) - g, den)
     return max(lo, 2 * g / den) if 0 <= g < 1 else lo
 
 
@@ -85,7 +84,7 @@ def T_min_upper(alpha: Any, gamma: Any, kappa: Any) -> fmpq:
     a, g, k = Q(alpha), Q(gamma), Q(kappa)
     if not (a > g and k > 0):
         raise ValueError("(26c) needs α > γ and κ > 0")
-    _, hi = bounds(lambda r, kk: -iv.log(r) / kk, (a - g) / a, k)
+    _, hi = bounds(lambda r, kk: -rlog(r) / kk, (a - g) / a, k)
     x = g / a
     return min(hi, x / ((1 - x) * k)) if x >= 0 else hi
 

@@ -20,7 +20,6 @@ from flint import fmpq
 from obsdesign.certify import interval as ivq
 from obsdesign.certify.claim import Claim, Claims
 from obsdesign.certify.exact import Q
-from obsdesign.certify.interval import iv
 from obsdesign.certify.printing import fmt_down, fmt_exact, fmt_up
 from obsdesign.methods.searchspace import bounds
 from obsdesign.methods.searchspace.design import (
@@ -404,7 +403,7 @@ def _follows(
         if bits >= MAX_K_BITS:
             return None, e_lo, e_hi
         bits *= 2
-        e_lo, e_hi = ivq.bounds(iv.exp, x, bits=bits)
+        e_lo, e_hi = ivq.bounds(ivq.rexp, x, bits=bits)
 
 
 def _input_range(c: Claims, spec: Spec) -> None:

@@ -21,7 +21,6 @@ from typing import Any
 
 import numpy as np
 from flint import fmpq
-from mpmath import iv
 
 from obsdesign.certify import interval as ivq
 from obsdesign.certify.exact import Q
@@ -190,14 +189,14 @@ def exp_upper(x: fmpq) -> fmpq:
     """A rational ≥ e^x (113-bit outward rounding), for γ_i e^{L_f Δτ}/2 of Theorem 1.
 
     ``x``: an exact rational."""
-    return ivq.upper(iv.exp, x)
+    return ivq.upper(ivq.rexp, x)
 
 
 def exp_lower(x: fmpq) -> fmpq:
     """A rational ≤ e^x (113-bit outward rounding), for γ_i e^{L_f Δτ}/2 of Theorem 1.
 
     ``x``: an exact rational."""
-    return ivq.lower(iv.exp, x)
+    return ivq.lower(ivq.rexp, x)
 
 
 def dT_rule(alpha: fmpq, gamma_star: fmpq, L_h: fmpq, f_sup: fmpq) -> fmpq:
@@ -389,7 +388,7 @@ def schedule_ratio(x: fmpq) -> fmpq | None:
     bits = ivq.PREC
     while bits < SCHEDULE_MAX_BITS:
         bits = min(2 * bits, SCHEDULE_MAX_BITS)
-        r = ivq.bounds(iv.exp, x, bits=bits)[1] / 2
+        r = ivq.bounds(ivq.rexp, x, bits=bits)[1] / 2
         if r < 1:
             return r
     return None

@@ -38,9 +38,6 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any
 
-from mpmath import iv
-from mpmath.libmp import from_float, mpf_cmp, to_float
-
 from obsdesign.methods.searchspace import switches
 from obsdesign.spec.expr import source_segment
 
@@ -252,37 +249,6 @@ def _div_hi(q: float, a: float, b: float) -> float:
 
 
 # -- transcendental functions -----------------------------------------------------------
-def _iv_call(fn: Any, x: I) -> I:
-    """Apply an mpmath interval function with outward conversion of the end points."""
-    if not x.finite:
-        return I.entire()
-    saved = iv.prec
-    iv.prec = 60
-    try:
-        r = fn(iv.mpf([x.lo, x.hi]))
-        lo, hi = r._mpi_
-    finally:
-        iv.prec = saved
-    # mpmath's enclosure is rigorous; its end points are converted outward
-    return I(_mpf_down(lo), _mpf_up(hi))
-
-
-def _mpf_down(v: Any) -> float:
-    """The largest float ≤ the raw mpmath number v. ``to_float(v, rnd="f")`` alone is not
-    one: in the subnormal range it ignores the direction (exp(−740)'s lower end came out
-    above the true value), so the result is compared exactly and stepped down."""
-    f = to_float(v, rnd="f")
-    return f if math.isnan(f) or mpf_cmp(from_float(f), v) <= 0 else _down(f)
-
-
-def _mpf_up(v: Any) -> float:
-    """The smallest float ≥ the raw mpmath number v (see :func:`_mpf_down`): below the
-    subnormal range ``to_float(v, rnd="c")`` gave 0.0, so exp of [−1000, −800] was [0, 0] and
-    f = exp(x)·10⁴⁰⁰ had a certified bound 0 (search-space trial, session 24)."""
-    f = to_float(v, rnd="c")
-    return f if math.isnan(f) or mpf_cmp(from_float(f), v) >= 0 else _up(f)
-
-
 def _arb_point(fn: str, x: float) -> tuple[float, float]:
     """Rigorous float bounds of fn(x) at one point, from a python-flint arb ball."""
     from flint import arb
@@ -297,8 +263,19 @@ def _arb_point(fn: str, x: float) -> tuple[float, float]:
         # min(1, cosh(1e39)) was unbounded (re-check trial, session 35)
         big = sys.float_info.max
         return (big, INF) if (fn == "cosh" or x > 0) else (-INF, -big)
-    # otherwise NaN is no bound at all
-    return (-INF if lo != lo else _down(lo)), (INF if hi != hi else _up(hi))
+    # otherwise NaN is no bound at all; an end that is a float is kept (sin 0 = 0, e⁰ = 1:
+    # a step outward made exact values intervals), else one float step outward
+    return (
+        -INF if lo != lo else (lo if _is(b.lower(), lo) else _down(lo)),
+        INF if hi != hi else (hi if _is(b.upper(), hi) else _up(hi)),
+    )
+
+
+def _is(a: Any, f: float) -> bool:
+    """Whether the exact arb point a equals the float f."""
+    from flint import arb
+
+    return math.isfinite(f) and bool(a == arb(f))
 
 
 def _monotone(fn: str, x: I) -> I:
@@ -308,8 +285,45 @@ def _monotone(fn: str, x: I) -> I:
     return I(_arb_point(fn, x.lo)[0], _arb_point(fn, x.hi)[1])
 
 
+def _may_hold(x: I, c: float, period: int) -> bool:
+    """Whether [x.lo, x.hi] may hold a point (c + period·k)·π, k an integer, decided with
+    rigorous balls (python-flint ``arb``) at enough bits for the magnitude of x (True when
+    unsure): the critical points of sin / cos and the poles of tan."""
+    from flint import arb, ctx
+
+    if x.hi - x.lo >= 2 * period * 3.1416:  # a whole period (rounding: a bit more than 2π)
+        return True
+    _, e = math.frexp(max(abs(x.lo), abs(x.hi), 1.0))
+    with ctx.workprec(64 + e):
+        t_lo = (arb(x.lo) / arb.pi() - c) / period
+        t_hi = (arb(x.hi) / arb.pi() - c) / period
+        first = t_lo.lower().ceil().unique_fmpz()
+        last = t_hi.upper().floor().unique_fmpz()
+    return first is None or last is None or first <= last
+
+
+def _periodic(fn: str, x: I) -> I:
+    """sin or cos over x, rigorously: the ends from ``arb`` balls, and ±1 where x may hold a
+    maximum / minimum (:func:`_may_hold`). mpmath's interval sin / cos are not rigorous (its
+    exp and log missed the true value at many precisions: session 38)."""
+    if not x.finite:
+        return I(-1.0, 1.0)
+    a, b = _arb_point(fn, x.lo), _arb_point(fn, x.hi)
+    lo, hi = min(a[0], b[0]), max(a[1], b[1])
+    top = 0.5 if fn == "sin" else 0.0  # the maxima at (top + 2k)π, the minima at (top + 1 + 2k)π
+    if _may_hold(x, top, 2):
+        hi = 1.0
+    if _may_hold(x, top + 1, 2):
+        lo = -1.0
+    return I(max(lo, -1.0), min(hi, 1.0))
+
+
 def exp(x: I) -> I:
-    return _iv_call(iv.exp, x)
+    """e^x over x, from ``arb`` balls (mpmath's ``iv.exp`` at 60 bits gave [1 + 2⁻⁴⁰] for
+    e^(2⁻⁴⁰) = 1 + 2⁻⁴⁰ + 2⁻⁸¹ + …: an L_f false by 4× after a cancellation; search-space
+    soundness trial, session 38)."""
+    r = _monotone("exp", x)
+    return I(max(r.lo, 0.0), r.hi)
 
 
 def log(x: I) -> I:
@@ -322,22 +336,25 @@ def log(x: I) -> I:
         # log 0 is undefined too: an enclosure unbounded below was bounded by sat or an
         # exact factor 0, as 1/x was (session 34)
         raise ArithmeticError("log of an interval reaching 0 (undefined there)")
-    return _iv_call(iv.log, x)
+    return _monotone("log", x)
 
 
 def sin(x: I) -> I:
-    return _iv_call(iv.sin, x) if x.finite else I(-1.0, 1.0)
+    return _periodic("sin", x)
 
 
 def cos(x: I) -> I:
-    return _iv_call(iv.cos, x) if x.finite else I(-1.0, 1.0)
+    return _periodic("cos", x)
 
 
 def tan(x: I) -> I:
     """tan over x; refused (ArithmeticError) when x may hold a pole, where tan is undefined
-    (its enclosure was "any real", which 0·tan(x1) turned into 0; session 34)."""
-    r = _iv_call(iv.tan, x)
-    if not r.finite:  # a pole inside, or an unbounded x (which holds poles)
+    (its enclosure was "any real", which 0·tan(x1) turned into 0; session 34). Increasing
+    between poles: the ends from ``arb`` balls."""
+    if not x.finite or _may_hold(x, 0.5, 1):  # an unbounded x holds poles
+        raise ArithmeticError("tan over an interval that may hold a pole (undefined there)")
+    r = I(_arb_point("tan", x.lo)[0], _arb_point("tan", x.hi)[1])
+    if not r.finite:
         raise ArithmeticError("tan over an interval that may hold a pole (undefined there)")
     return r
 
