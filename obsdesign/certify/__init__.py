@@ -1,7 +1,8 @@
 """Exact certificate kernel: rationals, exact PSD tests, outward-rounded bounds, claims.
 
 Everything a report calls *certified* is decided here, in exact rational arithmetic
-(python-flint ``fmpq``) or in interval arithmetic with outward rounding (mpmath ``iv``).
+(python-flint ``fmpq``) or in interval arithmetic with outward rounding (mpmath ``iv`` for
+arithmetic and √, python-flint ``arb`` for exp and log).
 """
 
 from obsdesign.certify.claim import Claim, ClaimStatus

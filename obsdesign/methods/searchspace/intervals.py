@@ -11,9 +11,10 @@ contains the exact result of the operation on every pair of points of its operan
   the rounding error, so an exact result stays exact (1·u is [u, u], not one ulp wider) and an
   inexact one moves one ulp outward; ``÷`` and ``sqrt`` check exactness with rationals and
   otherwise widen by one ulp (both are correctly rounded in IEEE 754);
-- ``exp log sin cos tan`` come from mpmath's interval context and ``atan tanh sinh cosh``
-  from python-flint ``arb`` balls at the end points (monotone functions), converted to
-  floats with directed rounding.
+- ``exp log atan tanh sinh cosh`` come from python-flint ``arb`` balls at the end points
+  (monotone functions), ``sin cos tan`` from ``arb`` balls at the end points and an ``arb``
+  test for a maximum, minimum or pole inside; converted to floats with directed rounding
+  (mpmath's interval exp / log / sin / cos / tan are not rigorous: session 38).
 
 :func:`evaluate` walks the checked expression tree (:class:`obsdesign.spec.expr.Expr`) and
 returns a :class:`Dual`: an interval enclosure of the value and of every partial derivative
