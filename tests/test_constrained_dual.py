@@ -231,3 +231,19 @@ def test_a_refutation_by_a_vertex_of_X_names_it() -> None:
         rep.exit_code() == 1
         and "X's vertex (1, 1) lies in C_0 ⊂ C_min and outside X̂" in claim.detail
     )
+
+
+@pytest.mark.parametrize("s", [1, fmpq(1, 10**5), fmpq(1, 10**6), fmpq(1, 10**7), 10**6])
+def test_one_cmin_written_at_any_scale_is_proved_alike(s: object) -> None:
+    """G, h times s and ε_min times s² describe one C_min (c scales with s²). With the weights
+    √ε/d outside the norm, s = 10⁻⁶ made Clarabel fail and a face 97 % above the support
+    (x2 ≤ 100, C_min's largest x2 ≈ 3) had no certificate (re-check trial, session 38): every
+    scale proves it now, and a face below the support stays refused."""
+    s = Q(s)
+    G = qv(np.array([[2, 5], [3, -4], [-3, 3]])) * s
+    h = qv(np.array([4, 3, 4])) * s
+    eps = fmpq(1, 10) * s * s
+    face = qv(np.array([[0, 1]]))
+    for norm in ("euclidean", "max"):
+        assert D.faces_by_duality(G, h, norm, eps, face, np.array([Q(100)], dtype=object))[0]
+        assert not D.faces_by_duality(G, h, norm, eps, face, np.array([Q(1)], dtype=object))[0]

@@ -152,9 +152,11 @@ def float_multipliers(
     if not (na > 0 and np.all(d > 0) and np.all(np.isfinite(d)) and math.isfinite(na)):
         return None
     z = cp.Variable(Gf.shape[0], nonneg=True)
-    w = cp.multiply(1 / d, z)
+    # the weights √ε/d inside the norm, one O(1) vector: √ε·‖z/d‖ with rows of size 1e-6
+    # (1/d ~ 1e6, √ε ~ 3e-7) made Clarabel fail (re-check trial, session 38)
+    w = cp.multiply(math.sqrt(eps) / d, z)
     size = cp.norm1(w) if norm == "max" else cp.pnorm(w, 4 / 3)
-    obj = (hf / d) @ z + math.sqrt(eps) * size
+    obj = (hf / d) @ z + size
     prob = cp.Problem(cp.Minimize(obj), [(Gf / d[:, None]).T @ z == af / na])
     try:
         with warnings.catch_warnings():
