@@ -918,3 +918,27 @@ def test_mat_import_refuses_a_cell_or_struct_before_loading_it(
     assert r.exit_code == 2, r.stderr
     assert f"variable 'Ad' (A) is a MATLAB {kind}, not a numeric matrix" in r.stderr
     assert str(mat) in r.stderr and len(r.stderr.splitlines()) == 1
+
+
+def test_mat_import_refuses_a_variable_name_given_twice(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A MAT-5 file can hold one name twice; the shape check saw the last copy (1×1) while
+    loadmat inflated every one: 498 KB to 1.7 GB (re-check trial, session 38). Refused from
+    whosmat before loading, exit 2 naming the variable."""
+    import scipy.io
+    from scipy.io import savemat
+
+    big, small = tmp_path / "big.mat", tmp_path / "small.mat"
+    savemat(big, {"Ad": np.zeros((30, 30)), "Cm": np.array([[1.0] * 30])})
+    savemat(small, {"Ad": np.array(A_D), "Cm": np.array([[1.0, 0.0]])})
+    mat = tmp_path / "dup.mat"
+    mat.write_bytes(big.read_bytes() + small.read_bytes()[128:])  # the second without header
+    assert [n for n, _, _ in scipy.io.whosmat(str(mat))].count("Ad") == 2
+
+    def never(*a: object, **k: object) -> None:
+        raise AssertionError("loadmat called")
+
+    monkeypatch.setattr(scipy.io, "loadmat", never)
+    r = CliRunner().invoke(app, ["import", str(mat), "--A", "Ad", "--C", "Cm"])
+    assert r.exit_code == 2 and "variable 'Ad' appears more than once in the file" in r.stderr
