@@ -820,3 +820,28 @@ def test_sampling_draws_the_same_numbers_whatever_the_round_sizes() -> None:
         <= fmpq(1, 10**5)
         for a, b in pts
     )
+
+
+def test_escalated_rounds_stay_within_a_bounded_size(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The doubling rounds of ``sample`` reached 1024 × max(4k, 64) points: 82 million points
+    for k = 20,000 (1.3 GB at n = 2; re-check trial, session 38). A round is at most
+    max(4k, 64, SAMPLE_MAX_ROUND) points; the first rounds are unchanged."""
+    from obsdesign.sets import base
+
+    assert base._round_size(0, 64) == 64 and base._round_size(160, 64) == 64 * 1024
+    assert base._round_size(10**6, 80_000) == 80_000  # k = 20,000: never above its base
+    assert all(base._round_size(i, 4000) <= base.SAMPLE_MAX_ROUND for i in range(400))
+    P = Polytope(qmat([[1, -1], [-1, 1], [1, 0], [-1, 0]]), qvec(["1e-12", "1e-12", 1, 1]))
+    sizes: list[int] = []
+
+    class Counted:  # numpy's Generator cannot be patched: a stand-in that counts the draws
+        g = np.random.default_rng(0)
+
+        def uniform(self, lo: object, hi: object, size: tuple) -> np.ndarray:
+            sizes.append(size[0])
+            return self.g.uniform(lo, hi, size=size)
+
+    monkeypatch.setattr(base, "MAX_SAMPLE_ROUNDS", 64)
+    with pytest.raises(Exception, match="no volume"):
+        P.sample(Counted(), 2000)  # type: ignore[arg-type]
+    assert max(sizes) <= max(8000, base.SAMPLE_MAX_ROUND) and sum(sizes) == 64 * 8000

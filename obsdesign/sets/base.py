@@ -21,9 +21,17 @@ SAMPLE_MAX_FACTOR = 1024
 MEMBERSHIP_CHUNK = 2048
 
 
+#: the most points one round of :meth:`ConvexSet.sample` draws once it escalates (a round of
+#: max(4k, 64) points is never cut): 1024 × 4k points for k = 20,000 were 82 million points,
+#: about 1.3 GB at n = 2 (re-check trial, session 38)
+SAMPLE_MAX_ROUND = 1 << 16
+
+
 def _round_size(i: int, base: int) -> int:
     """Points drawn in round i of :meth:`ConvexSet.sample` (``base`` = max(4k, 64))."""
-    return base * min(1 << (i // SAMPLE_ESCALATE), SAMPLE_MAX_FACTOR)
+    return min(
+        base * min(1 << (i // SAMPLE_ESCALATE), SAMPLE_MAX_FACTOR), max(base, SAMPLE_MAX_ROUND)
+    )
 
 
 class ConvexSet(ABC):
