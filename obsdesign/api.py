@@ -11,7 +11,7 @@ import sys
 import threading
 import time
 import warnings
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -779,6 +779,14 @@ def simulate(
     ensure_recursion_limit()
     sp = _spec(spec)
     _check_sim_keywords(get_method(sp.method), kwargs)
+    if options is not None and not (
+        isinstance(options, Mapping)
+        and all(isinstance(k, str) and isinstance(v, str) for k, v in options.items())
+    ):
+        # options=[1]: a bare AttributeError (re-check trial, session 38)
+        raise InputError(
+            f"options: expected a mapping of option names to value texts, got {options!r}"
+        )
     kwargs = {**get_method(sp.method).parse_sim_options(options or {}), **kwargs}
     r = kwargs.get("runs")
     if r is not None and (isinstance(r, bool) or not isinstance(r, numbers.Integral) or r < 1):
@@ -1444,6 +1452,8 @@ def check(
     timeout = budget_seconds(timeout)
     if isinstance(paths, (str, os.PathLike)):
         paths = [paths]
+    if isinstance(paths, (set, frozenset)) or type(paths).__name__ == "ndarray":
+        paths = sorted(map(str, paths)) if isinstance(paths, (set, frozenset)) else list(paths)
     if not isinstance(paths, (list, tuple)):
         # check(None) / check(123): a bare TypeError (hostile-input trial, session 38)
         raise InputError(

@@ -412,11 +412,28 @@ def test_the_api_refuses_bad_arguments_with_input_errors(call: Any, match: str) 
 
 
 def test_the_api_still_takes_numpy_numbers_for_simulate_options() -> None:
-    """The typed check of simulate keywords takes what numpy gives (np.float64, np.int64)."""
+    """The typed check of simulate keywords takes what worked before it (re-check trial,
+    session 38): numpy numbers and booleans, Decimal, a text parsed as --option parses it,
+    any value of a str option (theta_m=10), and check() of a numpy array or a set of paths;
+    simulate(options=[1]) is an InputError (it was an AttributeError)."""
+    from decimal import Decimal
+
     import numpy as np
+
+    from obsdesign.errors import InputError
 
     r = api.simulate(SPEC, time_limit=np.float64(60), runs=np.int64(2))
     assert r.metrics
+    assert api.simulate(SPEC, time_limit="60").metrics
+    sec5 = SPEC.parent / "constrained-redesign-sec5.toml"
+    assert api.simulate(sec5, theta_m=10, gamma=Decimal("17"), time_limit=Decimal(60)).metrics
+    hg = SPEC.parent / "hernandez-garcia-example.toml"
+    assert api.simulate(hg, progress=np.bool_(False)).metrics
+    assert len(api.check(np.array([str(SPEC)]))) == 1 == len(api.check({str(SPEC)}))
+    with pytest.raises(InputError, match="options: expected a mapping"):
+        api.simulate(sec5, options=[1])
+    with pytest.raises(InputError, match="simulate: time_limit: expected a finite number"):
+        api.simulate(SPEC, time_limit="soon")
 
 
 # -- mutation review 34 (session 33's checks) ----------------------------------------

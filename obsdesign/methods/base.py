@@ -177,24 +177,42 @@ class SimOption:
         """A typed value given to :func:`obsdesign.api.simulate` as a keyword, checked as
         :meth:`parse` checks a text: ``time_limit='x'`` was a bare ValueError, ``-1`` ran out
         of time at once (exit 3 where the CLI says exit 2) and NaN ran without a limit
-        (hostile-input trial, session 38). Returns the value (a path as a Path)."""
+        (hostile-input trial, session 38). A text is parsed as ``--option`` parses it; numbers
+        may be any real type (numpy, Decimal, Fraction), booleans numpy's too; a ``str``
+        option takes any value, as before (``theta_m=10``; re-check trial, session 38).
+        Returns the value (a number as int / float, a path as a Path)."""
+        import decimal
         import numbers
         import os
 
+        import numpy as np
+
         what = f"simulate: {self.name}"
-        ok = {
-            "int": isinstance(v, numbers.Integral) and not isinstance(v, bool),
-            "float": isinstance(v, numbers.Real)
-            and not isinstance(v, bool)
-            and math.isfinite(float(v)),
-            "bool": isinstance(v, bool),
-            "str": isinstance(v, str),
-            "path": isinstance(v, (str, os.PathLike)) and "\0" not in os.fspath(v),
-        }[self.kind]
-        if not ok:
+        if isinstance(v, str) and self.kind not in ("str", "path"):
+            try:
+                return self.parse(v)
+            except InputError as e:
+                raise InputError(str(e).replace(f"--option {self.name}", what, 1)) from None
+        real = isinstance(v, (numbers.Real, decimal.Decimal)) and not isinstance(
+            v, (bool, np.bool_)
+        )
+        if self.kind == "int" and isinstance(v, numbers.Integral) and real:
+            out: Any = int(v)
+        elif self.kind == "float" and real and math.isfinite(float(v)):
+            out = float(v)
+        elif self.kind == "bool" and isinstance(v, (bool, np.bool_)):
+            out = bool(v)
+        elif self.kind == "str":
+            out = v
+        elif self.kind == "path" and isinstance(v, (str, os.PathLike)) and "\0" not in os.fspath(v):
+            out = Path(v)
+        else:
             raise InputError(f"{what}: expected {_KIND[self.kind]}, got {v!r}")
-        self._in_range(what, v, repr(v), repr(v))
-        return Path(v) if self.kind == "path" else v
+        if self.kind in ("int", "float"):
+            self._in_range(what, out, repr(v), repr(v))
+        elif self.choices is not None and out not in self.choices:
+            raise InputError(f"{what}: expected one of {', '.join(self.choices)}, got {v!r}")
+        return out
 
 
 _KIND = {

@@ -292,7 +292,7 @@ def _may_hold(x: I, c: float, period: int) -> bool:
     unsure): the critical points of sin / cos and the poles of tan."""
     from flint import arb, ctx
 
-    if x.hi - x.lo >= 2 * period * 3.1416:  # a whole period (rounding: a bit more than 2π)
+    if x.hi - x.lo >= period * 3.1416:  # a whole period, period·π (3.1416 > π: a bit more)
         return True
     _, e = math.frexp(max(abs(x.lo), abs(x.hi), 1.0))
     with ctx.workprec(64 + e):
