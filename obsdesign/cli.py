@@ -938,6 +938,12 @@ def main() -> None:
         # (hostile-input trial, session 38)
         _err(f"{twice} is given twice; give each output once")
         sys.exit(2)
+    glued = next((a for a in sys.argv[1:] if a.startswith("-o=")), None)
+    if glued is not None:
+        # click reads -o=out.json as -o with the value "=out.json": a file named "=out.json"
+        # ("=" for -o=; re-check trial, session 38)
+        _err(f"{glued}: write -o FILE or --output=FILE (-o= names a file starting with '=')")
+        sys.exit(2)
     folder = _output_named_as_folder(sys.argv[1:])
     if folder is not None:
         # pathlib drops a trailing slash: -o out.json/ wrote the file out.json (hostile-input
