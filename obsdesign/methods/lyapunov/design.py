@@ -116,11 +116,13 @@ def _lmi_fallback(
     import dataclasses
 
     ric = dataclasses.replace(o, design="riccati", riccati_Q=None, riccati_R=None)
+    why = lmi_error.message.split(_LMI_HINT)[0]
     try:
         d = _designed(spec, ric, progress)
-    except (InconclusiveError, InfeasibleError):
-        raise lmi_error from None
-    why = lmi_error.message.split(_LMI_HINT)[0]
+    except (InconclusiveError, InfeasibleError) as e:
+        # the LMI error's own hint ("omit design") cannot help once Riccati failed too
+        # (lyapunov fuzz, session 38)
+        raise type(lmi_error)(f"{why}; the Riccati design failed too: {e.message}") from None
     d.notes.insert(0, f"the LMI gain design gave no certified gain ({why}): L is the Riccati gain")
     if isinstance(d.solver, SolverResult):
         d.solver.extra.update(gain_design="lmi", lmi_fallback="riccati")
@@ -761,8 +763,8 @@ def lmi_gain(
         slack = float(o.rate) * (SLACK_DISCRETE if s.discrete else SLACK_CONTINUOUS)
         if not feasible(slack) and not feasible(float(o.rate)):
             raise InconclusiveError(
-                f"the LMI solver found no gain at rate {fmt_exact(o.rate)}, although (C, A) "
-                f"allows it ({reason})" + _LMI_HINT
+                f"the LMI solver found no gain at rate {fmt_exact(o.rate)}, although no "
+                f"unobservable mode of (C, A) rules it out (checked exactly; {reason})" + _LMI_HINT
             )
     elif s.discrete:
         lo = float(np.abs(ueig).max()) if len(ueig) else 0.0
