@@ -1190,3 +1190,15 @@ def test_exact_points_stay_exact() -> None:
     """sin 0 = 0, cos 0 = 1, e⁰ = 1, ln 1 = 0 as points (the arb ends are floats: no step)."""
     assert IV.sin(I(0.0, 0.0)) == ZERO and IV.cos(I(0.0, 0.0)) == ONE
     assert IV.exp(ZERO) == ONE and IV.log(ONE) == ZERO and IV.tan(ZERO) == ZERO
+
+
+def test_an_arb_end_is_kept_only_when_it_is_that_float() -> None:
+    """``_is`` (an end kept without a step outward) holds only for an exact ball equal to the
+    float: not for a ball around it (1/3), nor for an exact value the float only rounds
+    (2⁻¹⁰⁷⁵ rounds to 0), nor for an infinite float."""
+    from flint import arb
+
+    assert IV._is(arb(0.5), 0.5) and IV._is(arb(0), 0.0)
+    assert not IV._is(arb(1) / 3, 1 / 3)
+    assert not IV._is(arb(2) ** -1075, 0.0)
+    assert not IV._is(arb(2) ** 1100, math.inf)
