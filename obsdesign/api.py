@@ -11,7 +11,7 @@ import sys
 import threading
 import time
 import warnings
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -1450,16 +1450,21 @@ def check(
     (:mod:`obsdesign.distributed`): the rows are the serial run's (but ``seconds``).
     ``on_row(row)`` is called as each row arrives."""
     timeout = budget_seconds(timeout)
+    if type(paths).__name__ == "ndarray" and getattr(paths, "ndim", 1) == 0:
+        paths = paths.item()  # type: ignore[union-attr]  # one path in a 0-d array
     if isinstance(paths, (str, os.PathLike)):
         paths = [paths]
-    if isinstance(paths, (set, frozenset)) or type(paths).__name__ == "ndarray":
-        paths = sorted(map(str, paths)) if isinstance(paths, (set, frozenset)) else list(paths)
-    if not isinstance(paths, (list, tuple)):
-        # check(None) / check(123): a bare TypeError (hostile-input trial, session 38)
+    if isinstance(paths, (set, frozenset)):
+        paths = sorted(map(str, paths))
+    if isinstance(paths, (bytes, Mapping)) or not isinstance(paths, Iterable):
+        # check(None) / check(123): a bare TypeError (hostile-input trial, session 38); any
+        # other iterable of paths (a tuple, an array, dict keys) is a list of paths
         raise InputError(
             f"check: expected a path or a list of paths, got a value of type {type(paths).__name__}"
         )
     paths = [_path_arg(p, "check") for p in paths]
+    if not paths:
+        raise InputError("check: no paths given")
     if any(isinstance(p, str) and p == "" for p in paths):
         # pathlib reads '' as '.': the working folder was checked, as the CLI did until it
         # refused '' (re-check trial, session 34)

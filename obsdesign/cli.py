@@ -812,36 +812,50 @@ GLOBAL_OPTIONS = ("--limit", "--debug", "--version")
 OUTPUT_OPTIONS = ("-o", "--output", "--plot", "--plot-epsilon", "--junit", "--csv")
 
 
-def _output_given_twice(args: list[str]) -> str | None:
-    """The first output option (:data:`OUTPUT_OPTIONS`; -o and --output are one) given a
-    second time, if any."""
-    seen: set[str] = set()
-    for a in args:
+#: the output options that are names of one option (-o / --output, --plot / --plot-epsilon)
+_SAME_OUTPUT = {"-o": "--output", "--plot-epsilon": "--plot"}
+
+
+def _output_uses(args: list[str]) -> list[tuple[str, str, str]]:
+    """(option as written, its canonical name, its value) for each use of an output option
+    (:data:`OUTPUT_OPTIONS`) before ``--``: ``--opt VALUE`` (the value is skipped, so a value
+    that reads like an option is not one), ``--opt=VALUE`` and the glued ``-oVALUE``."""
+    uses = []
+    i = 0
+    while i < len(args):
+        a = args[i]
         if a == "--":
             break
-        name = a.partition("=")[0] if a.startswith("--") else a
-        if name not in OUTPUT_OPTIONS:
-            continue
-        key = "--output" if name == "-o" else name
-        if key in seen:
-            return "-o/--output" if key == "--output" else key
-        seen.add(key)
-    return None
-
-
-def _output_named_as_folder(args: list[str]) -> str | None:
-    """The value of an output option (:data:`OUTPUT_OPTIONS`, ``--opt VALUE`` or
-    ``--opt=VALUE``) that ends with a slash, if any."""
-    for i, a in enumerate(args):
         name, eq, val = a.partition("=")
-        if eq and name in OUTPUT_OPTIONS:
-            v = val
-        elif a in OUTPUT_OPTIONS and i + 1 < len(args):
-            v = args[i + 1]
-        else:
+        if a in OUTPUT_OPTIONS and i + 1 < len(args):
+            uses.append((a, _SAME_OUTPUT.get(a, a), args[i + 1]))
+            i += 2
             continue
-        if v.endswith(("/", os.sep)) and v.strip("/" + os.sep):
-            return v
+        if a.startswith("--") and eq and name in OUTPUT_OPTIONS:
+            uses.append((name, _SAME_OUTPUT.get(name, name), val))
+        elif a.startswith("-o") and not a.startswith("--") and len(a) > 2:
+            uses.append(("-o", "--output", a[2:]))
+        i += 1
+    return uses
+
+
+def _output_problem(args: list[str]) -> str | None:
+    """The one-line error for an output option used badly, or None: given twice (click kept
+    the last: ``-o a.json -o b.json`` wrote b.json alone), a name that ends in a slash or in
+    "/." (pathlib dropped it and wrote out.json), or ``-o=FILE`` (click read a file named
+    "=FILE") — hostile-input trial and re-checks, session 38."""
+    seen: set[str] = set()
+    for written, key, value in _output_uses(args):
+        if written == "-o" and value.startswith("="):
+            return f"-o{value}: write -o FILE or --output=FILE (-o= names a file starting with '=')"
+        if key in seen:
+            shown = {"--output": "-o/--output", "--plot": "--plot/--plot-epsilon"}.get(key, key)
+            return f"{shown} is given twice; give each output once"
+        seen.add(key)
+        bare = value.rstrip("/" + os.sep)
+        folder = value.endswith(("/", os.sep)) or value.endswith(("/.", os.sep + "."))
+        if folder and bare.strip("." + "/" + os.sep):
+            return f"{value}: names a folder (trailing '/'); outputs are files"
     return None
 
 
@@ -932,23 +946,9 @@ def main() -> None:
     # stderr closed (`2>&-`), full or a dead pipe: the error line is dropped, the exit code
     # is the command's (exit 1 for everything before session 34)
     sys.stderr = _Stderr(sys.stderr if sys.stderr is not None else open(os.devnull, "w"))  # noqa: SIM115
-    twice = _output_given_twice(sys.argv[1:])
-    if twice is not None:
-        # click keeps the last: -o a.json -o b.json wrote b.json alone, silently
-        # (hostile-input trial, session 38)
-        _err(f"{twice} is given twice; give each output once")
-        sys.exit(2)
-    glued = next((a for a in sys.argv[1:] if a.startswith("-o=")), None)
-    if glued is not None:
-        # click reads -o=out.json as -o with the value "=out.json": a file named "=out.json"
-        # ("=" for -o=; re-check trial, session 38)
-        _err(f"{glued}: write -o FILE or --output=FILE (-o= names a file starting with '=')")
-        sys.exit(2)
-    folder = _output_named_as_folder(sys.argv[1:])
-    if folder is not None:
-        # pathlib drops a trailing slash: -o out.json/ wrote the file out.json (hostile-input
-        # trial, session 38)
-        _err(f"{folder}: names a folder (trailing '/'); outputs are files")
+    bad_output = _output_problem(sys.argv[1:])
+    if bad_output is not None:
+        _err(bad_output)
         sys.exit(2)
     empty = next((i for i, a in enumerate(sys.argv[1:], 1) if _empty_arg(a)), None)
     if empty is not None:

@@ -630,8 +630,9 @@ def spec_text_from_mat(
         shapes = {name: shape for name, shape, _ in info}
         kinds = {name: kind for name, _, kind in info}
         names_seen = [name for name, _, _ in info]
-        twice = next((v for v in wanted if names_seen.count(v) > 1), None)
+        twice = next((v for v in names_seen if names_seen.count(v) > 1), None)
         if twice is not None:
+            # any name: a file that holds Ts twice was read by its last copy (re-check, 38)
             # the dicts keep the last copy (1×1) while loadmat inflates every one: 498 KB to
             # 1.7 GB before "shapes do not fit" (re-check trial, session 38)
             raise InputError(f"{path}: variable '{twice}' appears more than once in the file")

@@ -643,6 +643,17 @@ def test_an_output_named_with_a_trailing_slash_is_refused(tmp_path: Path) -> Non
     for arg in ("-o=", "-o=out.json"):  # click read "=out.json" as the file name
         r = _cli("design", str(SPEC), arg, cwd=tmp_path)
         assert r.returncode == 2 and "write -o FILE or --output=FILE" in r.stderr
+    # the glued -oVALUE and a name ending in "/." too (re-check trial, session 38)
+    for args in (["-oout.json/"], ["-o", "out.json/."], ["--output=out.json/."]):
+        r = _cli("design", str(SPEC), *args, cwd=tmp_path)
+        assert r.returncode == 2 and "names a folder" in r.stderr
+    # after "--" nothing is an option: a folder named with a slash is a path to check
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "s.toml").write_text(SPEC.read_text())
+    r = _cli("check", "-q", "--", "sub/", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    (tmp_path / "sub" / "s.toml").unlink()
+    (tmp_path / "sub").rmdir()
     assert list(tmp_path.iterdir()) == []
 
 
@@ -676,6 +687,11 @@ def test_an_output_option_given_twice_is_refused(tmp_path: Path) -> None:
     for args, name in (
         (["design", str(SPEC), "-o", "a.json", "--output", "b.json"], "-o/--output"),
         (["simulate", str(SPEC), "--csv=a.csv", "--csv", "b.csv"], "--csv"),
+        (["design", str(SPEC), "-oa.json", "-o", "b.json"], "-o/--output"),
+        (
+            ["design", str(SPEC), "--plot", "a.png", "--plot-epsilon", "b.png"],
+            "--plot/--plot-epsilon",
+        ),
     ):
         r = _cli(*args, cwd=tmp_path)
         assert r.returncode == 2 and f"{name} is given twice; give each output once" in r.stderr

@@ -942,3 +942,10 @@ def test_mat_import_refuses_a_variable_name_given_twice(
     monkeypatch.setattr(scipy.io, "loadmat", never)
     r = CliRunner().invoke(app, ["import", str(mat), "--A", "Ad", "--C", "Cm"])
     assert r.exit_code == 2 and "variable 'Ad' appears more than once in the file" in r.stderr
+    # any name, not only the requested ones: Ts twice was read by its last copy (re-check)
+    ts = tmp_path / "ts.mat"
+    savemat(big, {"Ad": np.array(A_D), "Cm": np.array([[1.0, 0.0]]), "Ts": np.eye(2)})
+    savemat(small, {"Ts": np.array([[0.1]])})
+    ts.write_bytes(big.read_bytes() + small.read_bytes()[128:])
+    r = CliRunner().invoke(app, ["import", str(ts), "--A", "Ad", "--C", "Cm"])
+    assert r.exit_code == 2 and "variable 'Ts' appears more than once in the file" in r.stderr

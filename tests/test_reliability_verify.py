@@ -434,6 +434,18 @@ def test_the_api_still_takes_numpy_numbers_for_simulate_options() -> None:
         api.simulate(sec5, options=[1])
     with pytest.raises(InputError, match="simulate: time_limit: expected a finite number"):
         api.simulate(SPEC, time_limit="soon")
+    # second re-check: beyond the float range or a signalling NaN were bare errors; whole
+    # numbers written as floats, 0 / 1 for true / false, a 0-d array and dict keys are taken
+    from fractions import Fraction
+
+    for bad in (10**400, -(10**400), Fraction(10**400), Decimal("sNaN")):
+        with pytest.raises(InputError, match="simulate: gamma: expected a finite number"):
+            api.simulate(sec5, gamma=bad)
+    assert api.simulate(hg, max_centres=100000.0, progress=0).metrics
+    assert api.simulate(sec5, gamma=np.array(17.0), theta_m="10").metrics
+    assert len(api.check({str(SPEC): 1}.keys())) == 1 == len(api.check(np.array(str(SPEC))))
+    with pytest.raises(InputError, match="check: no paths given"):
+        api.check(set())
 
 
 # -- mutation review 34 (session 33's checks) ----------------------------------------

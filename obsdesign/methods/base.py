@@ -178,8 +178,10 @@ class SimOption:
         :meth:`parse` checks a text: ``time_limit='x'`` was a bare ValueError, ``-1`` ran out
         of time at once (exit 3 where the CLI says exit 2) and NaN ran without a limit
         (hostile-input trial, session 38). A text is parsed as ``--option`` parses it; numbers
-        may be any real type (numpy, Decimal, Fraction), booleans numpy's too; a ``str``
-        option takes any value, as before (``theta_m=10``; re-check trial, session 38).
+        may be any real type (numpy, Decimal, Fraction, a 0-d array; an integer option takes
+        3.0, a true/false one 0 and 1), and one beyond the float range or a NaN is an
+        InputError; a ``str`` option takes any value, as before (``theta_m=10``; re-check
+        trials, session 38).
         Returns the value (a number as int / float, a path as a Path)."""
         import decimal
         import numbers
@@ -193,15 +195,21 @@ class SimOption:
                 return self.parse(v)
             except InputError as e:
                 raise InputError(str(e).replace(f"--option {self.name}", what, 1)) from None
-        real = isinstance(v, (numbers.Real, decimal.Decimal)) and not isinstance(
-            v, (bool, np.bool_)
-        )
-        if self.kind == "int" and isinstance(v, numbers.Integral) and real:
-            out: Any = int(v)
-        elif self.kind == "float" and real and math.isfinite(float(v)):
-            out = float(v)
-        elif self.kind == "bool" and isinstance(v, (bool, np.bool_)):
-            out = bool(v)
+        if isinstance(v, np.ndarray) and v.ndim == 0:
+            v = v.item()
+        number = isinstance(v, (numbers.Real, decimal.Decimal, bool, np.bool_))
+        try:
+            # 10**400 overflows and Decimal('sNaN') refuses float(): bare errors before
+            f = float(v) if number else math.nan
+        except (OverflowError, ValueError):
+            f = math.nan
+        whole = isinstance(v, numbers.Integral) and not isinstance(v, (bool, np.bool_))
+        if self.kind == "int" and (whole or (number and math.isfinite(f) and f == int(f))):
+            out: Any = int(v) if whole else int(f)
+        elif self.kind == "float" and number and math.isfinite(f):
+            out = f
+        elif self.kind == "bool" and number and f in (0.0, 1.0):
+            out = bool(f)
         elif self.kind == "str":
             out = v
         elif self.kind == "path" and isinstance(v, (str, os.PathLike)) and "\0" not in os.fspath(v):
