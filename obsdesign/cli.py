@@ -897,7 +897,7 @@ def _empty_arg(a: str) -> bool:
 
 def _json_escape(err: UnicodeError) -> tuple[str, int]:
     """Codec error handler: each character the stream cannot encode as a JSON string escape,
-    ``\\uXXXX`` (a surrogate pair beyond the BMP), so JSON output stays valid JSON and text
+    ``\\u`` and four hex digits (a surrogate pair beyond the BMP), so JSON output stays valid JSON and text
     stays readable."""
     if not isinstance(err, UnicodeEncodeError):  # pragma: no cover - encoding only
         raise err
