@@ -276,7 +276,10 @@ def _design_for(
     if o.iss_gain:
         Bw = lyap.error_input(s.Bd.q, s.Dn.q, L)
         rho = lyap.decay_factor(rate, s.discrete)
-        params["mu"] = lyap.iss_mu(lyap.as_array(Acl), Bw, P, rho, s.discrete, strict=True)
+        # 10⁻⁶ above the float μ: the verified float check decides it (lyap.iss_mu)
+        params["mu"] = lyap.iss_mu(
+            lyap.as_array(Acl), Bw, P, rho, s.discrete, strict=True, rel=ISS_MU_REL
+        )
     why = (
         "no P ≻ 0 gives strict decay there (proved exactly, see the bracket claim)"
         if br.kind == lyap.INFEASIBLE
@@ -663,6 +666,9 @@ RICCATI_START = "Riccati gain (LMI bisection start)"
 
 #: the way out of a failed LMI gain search (the SDP solver's conditioning, not the plant:
 #: the default Riccati design certified 9 specs where design = "lmi" was exit 4 — review)
+#: relative step of the ISS gain μ above its float value (:func:`obsdesign.lyap.iss_mu`)
+ISS_MU_REL = 1e-6
+
 _LMI_HINT = '; the default design = "riccati" (or "place") needs no SDP solver: omit design'
 
 
