@@ -665,12 +665,13 @@ def test_sweep_tables_mark_rounded_values_and_matrices_are_json_lists() -> None:
     assert _sweep_cell(near["lambda"]) == "≈1" and _md_value(near["lambda"]) == "≈1.0"
     assert _sweep_cell(exact["lambda"]) == "0.96"  # 24/25 shown as itself
     assert _md_value(exact["lambda"]) == "0.96"
-    assert _sweep_cell(exact["mu"]) == "≈2.48428e+07" and exact["mu"] == 24842821.6875
-    # an exact dyadic μ = 58250127/262144: its double's shortest text is not its value (it
+    # (μ values since session 38: 10⁻⁶ above the float μ, lyapunov.design.ISS_MU_REL)
+    assert _sweep_cell(exact["mu"]) == "≈2.48428e+07" and exact["mu"] == 24842846.5
+    # an exact dyadic μ = 233000741/1048576: its double's shortest text is not its value (it
     # showed bare in Markdown: re-check trial, session 28)
-    assert near["mu"].exact == "58250127/262144"
-    assert _md_value(near["mu"]) == "≈222.20660018920898"
-    assert _md_value(exact["mu"]) == "24842821.6875"
+    assert near["mu"].exact == "233000741/1048576"
+    assert _md_value(near["mu"]) == "≈222.2068223953247"
+    assert _md_value(exact["mu"]) == "24842846.5"
     assert _sweep_cell(1.5) == "1.5" and _sweep_cell(float("nan")) == "nan"
     again = pickle.loads(pickle.dumps(near["lambda"]))
     assert isinstance(again, sw.ExactFloat) and again.exact == near["lambda"].exact
