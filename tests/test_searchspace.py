@@ -2289,3 +2289,48 @@ def test_an_exp_cancellation_gets_a_true_lipschitz_bound() -> None:
     S = Q(rep.parameters["f_sup"])
     assert Lf**2 >= 1 + c**2
     assert F(int(S.p), int(S.q)) ** 2 >= 4 + (2 + 2 * c) ** 2
+
+
+_SCHEDULE_EXP = """
+[system]
+time = "continuous"
+states = ["x1", "x2"]
+f = ["x2", "-x1"]
+h = ["x1"]
+[method]
+key = "search-space"
+alpha = 0.00000000000000000021684043449710088680149056017398834228515625
+gamma_star = 1.000000000000000000108420217248550443400745280086994171142578125
+gamma0 = 2
+K = 1
+f_sup = 1.000000000000000000108420217248550443400745280086994171142578125
+[method.E]
+lower = [-0.5, -0.5]
+upper = [0.5, 0.5]
+[method.D]
+lower = [-0.25, -0.25]
+upper = [0.25, 0.25]
+"""
+
+
+def test_a_schedule_entry_at_a_wrong_upper_bound_of_exp_fails(tmp_path: Path) -> None:
+    """L_f·Δτ = 2⁻⁶³ and γ⋆ = 1 + 2⁻⁶³, the end mpmath's interval exp gave as an upper bound
+    of e^(2⁻⁶³) at 113 bits (it is below: e^x > 1 + x). γ₁ = max(γ₀e^x/2, γ⋆) = e^x with
+    γ₀ = 2, so a schedule entry γ₁ = γ⋆ is below the rule, and the gamma-schedule claim passed
+    with mpmath's bound (search-space soundness trial, session 38); with arb's it fails. The
+    designed schedule holds the rule, checked with Fractions (e^x ≥ 1 + x + x²/2)."""
+    from fractions import Fraction as F
+
+    sp = api.load_spec_text(_SCHEDULE_EXP, "sched.toml")
+    rep = api.design(sp)
+    p = rep.parameters
+    x = F(int(Q(p["L_f"] * p["dtau"]).p), int(Q(p["L_f"] * p["dtau"]).q))
+    assert x == F(1, 2**63)
+    g = [F(int(Q(a).p), int(Q(a).q)) for a in p["gamma_schedule"]]
+    assert rep.exit_code() == 0 and g[1] >= g[0] * (1 + x + x * x / 2) / 2
+    v = {k: p[k] for k in p.keys()}
+    sched = list(p["gamma_schedule"])
+    sched[1] = p["gamma_star"]  # 1 + 2⁻⁶³ < e^(2⁻⁶³)
+    v["gamma_schedule"] = sched
+    v["eps_schedule"] = [a / p["kappa"] for a in sched]
+    assert _failed(_report_with(rep, v, tmp_path)) == {"gamma-schedule"}
