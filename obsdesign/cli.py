@@ -316,21 +316,32 @@ def _settle(owned: bool) -> None:
 
 
 #: signals that stop a command as Ctrl-C does (cleanup runs, exit 128 + the signal), where
-#: their action is still the default
-_STOP_SIGNALS = tuple(
-    getattr(signal, n) for n in ("SIGTERM", "SIGHUP", "SIGQUIT") if hasattr(signal, n)
-)
+#: their action is still the default, with the one line printed for each. Every catchable
+#: signal whose default action ends the process: SIGUSR1 / SIGUSR2 / SIGALRM (a stray `kill
+#: -USR1`, an alarm set by a wrapper) left the hidden temp file of an output being written
+#: (CLI hostile-input trial, session 38); SIGXCPU is a CPU-time limit (``ulimit -t``) reached.
+#: SIGPIPE is ignored by Python (a closed stdout is exit 141, see _quiet_broken_pipe).
+_STOP_WORDS = {
+    "SIGTERM": "terminated",
+    "SIGHUP": "hung up",
+    "SIGQUIT": "quit",
+    "SIGUSR1": "user signal 1",
+    "SIGUSR2": "user signal 2",
+    "SIGALRM": "alarm clock",
+    "SIGVTALRM": "virtual timer expired",
+    "SIGPROF": "profiling timer expired",
+    "SIGXCPU": "CPU time limit exceeded",
+}
+_STOP_SIGNALS = tuple(getattr(signal, n) for n in _STOP_WORDS if hasattr(signal, n))
 #: the one line printed for each
 _SIGNAL_WORDS = {
     int(signal.SIGINT): "interrupted",
-    int(signal.SIGTERM): "terminated",
-    **({int(signal.SIGHUP): "hung up"} if hasattr(signal, "SIGHUP") else {}),
-    **({int(signal.SIGQUIT): "quit"} if hasattr(signal, "SIGQUIT") else {}),
+    **{int(getattr(signal, n)): w for n, w in _STOP_WORDS.items() if hasattr(signal, n)},
 }
 
 
-#: the exit codes of a command stopped by a signal (128 + SIGINT, SIGTERM, SIGHUP, SIGQUIT)
-_INTERRUPT_CODES = frozenset({130, 143, 129, 131})
+#: the exit codes of a command stopped by a signal (128 + SIGINT and each of _STOP_SIGNALS)
+_INTERRUPT_CODES = frozenset(128 + num for num in _SIGNAL_WORDS)
 
 
 def _main_thread() -> bool:

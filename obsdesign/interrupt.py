@@ -20,14 +20,15 @@ if TYPE_CHECKING:
     import logging
 
 _requested = False
-#: the signal recorded (SIGINT 2, SIGTERM 15, SIGHUP 1 or SIGQUIT 3), 0 when none
+#: the signal recorded (SIGINT 2, or one of cli._STOP_SIGNALS: SIGTERM 15, SIGHUP 1, ...),
+#: 0 when none
 _signum = 0
 
 
 def handler(signum: int, frame: object) -> None:
-    """SIGINT / SIGTERM / SIGHUP / SIGQUIT handler of a command body: record the interrupt, then raise
-    KeyboardInterrupt as Python does for SIGINT, so the same cleanup runs (temp files
-    removed). SIGTERM (what ``timeout`` sends) killed the process at once and left a hidden
+    """SIGINT / SIGTERM / SIGHUP / ... (cli._STOP_SIGNALS) handler of a command body: record
+    the interrupt, then raise KeyboardInterrupt as Python does for SIGINT, so the same
+    cleanup runs (temp files removed). SIGTERM (what ``timeout`` sends) killed the process at once and left a hidden
     half-written ``.NAME.XXXX.csv`` beside the output (simulate trial, session 27)."""
     global _requested, _signum
     _requested = True

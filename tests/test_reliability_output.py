@@ -292,6 +292,8 @@ def test_ctrl_c_is_one_line_no_traceback(delay: float):
         (1.5, True, "SIGTERM"),
         (1.5, False, "SIGHUP"),
         (1.5, False, "SIGQUIT"),
+        (1.5, False, "SIGUSR1"),
+        (1.5, True, "SIGALRM"),
     ],
 )
 def test_sigterm_cleans_up_like_ctrl_c(
@@ -303,7 +305,8 @@ def test_sigterm_cleans_up_like_ctrl_c(
     143 (128 + 15); the file is there whole or not at all. ``background``: started with
     SIGINT ignored, as a script's background job is (the handler was installed only with
     SIGINT's: re-check trial, session 27). SIGHUP (a closed terminal) and SIGQUIT (Ctrl-\\)
-    left the temp file (CLI hostile-input trial, session 34): "hung up" 129, "quit" 131."""
+    left the temp file (CLI hostile-input trial, session 34): "hung up" 129, "quit" 131; so did
+    SIGUSR1 / SIGALRM (session 38): "user signal 1" 138, "alarm clock" 142."""
     import signal
     import time
 
@@ -328,7 +331,13 @@ def test_sigterm_cleans_up_like_ctrl_c(
     assert "Traceback" not in err
     assert p.returncode in (0, 128 + num), err
     if p.returncode == 128 + num:
-        word = {"SIGTERM": "terminated", "SIGHUP": "hung up", "SIGQUIT": "quit"}[sig]
+        word = {
+            "SIGTERM": "terminated",
+            "SIGHUP": "hung up",
+            "SIGQUIT": "quit",
+            "SIGUSR1": "user signal 1",
+            "SIGALRM": "alarm clock",
+        }[sig]
         assert err.strip().splitlines()[-1].endswith(word)
         assert not out.exists()
     else:
