@@ -25,6 +25,7 @@ from obsdesign.errors import (
     InconclusiveError,
     InputError,
     ObsdesignError,
+    SolverError,
     SpecError,
     ascii_name,
     one_line,
@@ -213,10 +214,17 @@ def design(
     out: str | Path | None = None,
     progress: Progress | None = None,
     force: bool = False,
+    timeout: float | None = None,
 ) -> Report:
     """Design the observer of ``spec`` (a path or a Spec) and certify every claim; write the
     JSON report to ``out`` (atomically) when given; ``progress(message)`` is called as the
     design advances. Raises :class:`ObsdesignError` subclasses.
+
+    ``timeout``: seconds for the design and its certification together, read as
+    :func:`budget_seconds` does (None, 0 or inf: no limit); past it the design stops with a
+    :class:`SolverError` (exit 3, "not finished within …"), whose error report ``out`` gets.
+    A search-space spec with a long expression in u ran for minutes with no way to bound it
+    but ``check --timeout`` (search-space trial, session 38).
 
     ``out`` is checked before anything runs (:func:`obsdesign.report.model.check_output`:
     never the spec itself, a symbolic link, a non-regular or a write-protected file unless
@@ -229,15 +237,25 @@ def design(
     ensure_recursion_limit()
     if out is not None:
         check_output(_path_arg(out, "out"), force, inputs=_spec_inputs(spec))
+    budget = budget_seconds(timeout)
     t0 = time.perf_counter()
     sp = _spec(spec)
     t1 = time.perf_counter()
     m = get_method(sp.method)
     notes: list[str] = []
-    with _error_report_on_failure(sp, out, force), captured_warnings(notes):
+    deadline = None if budget is None else time.monotonic() + budget
+    with (
+        _error_report_on_failure(sp, out, force),
+        captured_warnings(notes),
+        _design_budget(budget, deadline),
+    ):
         d = m.design(sp, progress)
     t2 = time.perf_counter()
-    with _error_report_on_failure(sp, out, force), captured_warnings(notes):
+    with (
+        _error_report_on_failure(sp, out, force),
+        captured_warnings(notes),
+        _design_budget(budget, deadline),
+    ):
         claims = certify(sp, d.parameters)
     t3 = time.perf_counter()
     notes = [*getattr(sp, "warnings", []), *notes]
@@ -267,6 +285,27 @@ def design(
         # table, 0 with -q; unusual-spec trial, session 24)
         report.check_float_view()
     return report
+
+
+@contextmanager
+def _design_budget(budget: float | None, deadline: float | None) -> Iterator[None]:
+    """The part of :func:`design`'s ``timeout`` left at this stage (``deadline`` on
+    ``time.monotonic``): the stage runs under it (:func:`_time_budget`), and one past it,
+    or a budget already spent, is a :class:`SolverError` (exit 3).
+
+    :param budget: the whole budget in seconds (None: no limit), for the message."""
+    if budget is None or deadline is None:
+        yield
+        return
+    message = f"not finished within {budget:g} s (design --timeout SECONDS; 0: no limit)"
+    left = deadline - time.monotonic()
+    if left <= 0:
+        raise SolverError(message)
+    try:
+        with _time_budget(max(left, MIN_BUDGET_S)):
+            yield
+    except SpecTimeout:
+        raise SolverError(message) from None
 
 
 def _spec_inputs(spec: str | Path | Spec) -> tuple[Path, ...]:

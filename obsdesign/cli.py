@@ -454,6 +454,16 @@ def design(
     ] = False,
     quiet: QuietOpt = False,
     width: WidthOpt = None,
+    timeout: Annotated[
+        float,
+        typer.Option(
+            "--timeout",
+            metavar="SECONDS",
+            min=0,
+            help="Time budget of the design and its certification (0 or inf: none, the "
+            "default); past it the design stops with exit 3 and -o gets its error report.",
+        ),
+    ] = 0.0,
 ) -> None:
     """Design the observer of SPEC, certify every claim, and print (or write) the report.
 
@@ -461,7 +471,7 @@ def design(
     inconclusive, or error when the design stopped with an error), so it is never stale;
     bad input (exit 2) writes nothing."""
 
-    _run(lambda cmd: cmd.design(spec, output, fmt, plot, force, quiet), quiet, width)
+    _run(lambda cmd: cmd.design(spec, output, fmt, plot, force, quiet, timeout), quiet, width)
 
 
 @app.command()

@@ -523,7 +523,13 @@ def _print_metrics(m: dict[str, Any]) -> None:
 
 
 def design(
-    spec: Path, output: Path | None, fmt: Fmt, plot: Path | None, force: bool, quiet: bool
+    spec: Path,
+    output: Path | None,
+    fmt: Fmt,
+    plot: Path | None,
+    force: bool,
+    quiet: bool,
+    timeout: float = 0.0,
 ) -> int:
     """The body of ``obsdesign design`` (see :func:`obsdesign.cli.design`)."""
     _precheck(spec)  # before the heavy imports: an oversized spec is refused at once
@@ -541,7 +547,7 @@ def design(
         raise InputError(f"--plot: method '{sp.method}' has no design plot")
     with _naming_the_spec(sp.file):
         try:
-            rep = api.design(sp, output, progress=progress, force=force)
+            rep = api.design(sp, output, progress=progress, force=force, timeout=timeout)
         except Exception as e:
             _design_error_outputs(sp, e, output, fmt)
             raise

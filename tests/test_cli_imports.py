@@ -153,6 +153,9 @@ VALUES = [
     ("a=1", "b=2"),
     ("x.toml", "specs"),
     (),
+    0.0,  # a float option's default (design --timeout): coerced too, without pydantic
+    2.5,
+    float("inf"),
 ]
 
 
@@ -226,3 +229,18 @@ def test_the_start_up_ctrl_c_exits_130_with_stderr_closed(monkeypatch: pytest.Mo
         with pytest.raises(SystemExit) as e:
             obsdesign._early_interrupt(2, None)
         assert e.value.code == 130
+
+
+def test_fast_float_takes_only_an_admissible_float() -> None:
+    """A float below the option's min, NaN or a typed-in str goes to typer's own path."""
+    from typer._click import Context
+
+    from obsdesign import cli_coerce
+
+    (p, cmd), *_ = [
+        (p, c) for p, c in _typer_params() if c.name == "design" and p.name == "timeout"
+    ]
+    ctx = Context(cmd)
+    for v in (-1.0, float("nan"), "2.5", 1):
+        assert cli_coerce.fast_value(p.type_descriptor, v, p, ctx) is cli_coerce.SLOW, v
+    assert cli_coerce.fast_value(p.type_descriptor, 0.0, p, ctx) == 0.0

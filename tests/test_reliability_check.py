@@ -752,3 +752,82 @@ def test_check_refuses_a_bad_timeout_before_any_row(bad) -> None:
 
     with pytest.raises(InputError, match="timeout"):
         api.check([], timeout=bad)
+
+
+def _hang_forever(*a: Any, **k: Any) -> Any:
+    """A stage that never ends and swallows every Exception (as a method might)."""
+    import time
+
+    while True:
+        try:
+            time.sleep(0.05)
+        except Exception:  # noqa: BLE001, S110
+            pass
+
+
+@pytest.mark.parametrize("stage", ["design", "certify"])
+def test_design_timeout_stops_a_stage_with_exit_3_and_an_error_report(
+    tmp_path: Path, monkeypatch, stage: str
+):
+    """``design --timeout`` bounds the design and its certification together: a search-space
+    spec with a long expression in u ran for minutes and only ``check --timeout`` could stop
+    it (search-space trial, session 38). Past the budget: exit 3, one line, and -o holds the
+    error report (never a stale one)."""
+    import time
+
+    from obsdesign.methods import get_method
+
+    out = tmp_path / "r.json"
+    out.write_text('{"stale": true}')
+    if stage == "design":
+        monkeypatch.setattr(type(get_method("lyapunov")), "design", _hang_forever)
+    else:
+        monkeypatch.setattr(api, "certify", _hang_forever)
+    t0 = time.perf_counter()
+    res = runner.invoke(app, ["design", str(SPEC), "-o", str(out), "--timeout", "0.5"])
+    assert time.perf_counter() - t0 < 30
+    assert res.exit_code == 3, res.output
+    assert "not finished within 0.5 s (design --timeout" in res.output
+    assert "Traceback" not in res.output
+    rep = json.loads(out.read_text())
+    assert rep["verdict"] == "error" and rep["error"]["exit_code"] == 3
+    with pytest.raises(api.SolverError, match="not finished within 0.5 s"):
+        api.design(SPEC, timeout=0.5)
+
+
+def test_design_timeout_is_one_budget_for_both_stages(monkeypatch):
+    """The certify stage gets what the design stage left, not a fresh budget."""
+    import time
+
+    from obsdesign.methods import get_method
+
+    cls = type(get_method("lyapunov"))
+    real = cls.design
+
+    def slow(self: Any, *a: Any, **k: Any) -> Any:
+        time.sleep(0.6)
+        return real(self, *a, **k)
+
+    def sleepy_certify(*a: Any, **k: Any) -> Any:
+        time.sleep(0.6)
+        return []
+
+    monkeypatch.setattr(cls, "design", slow)
+    monkeypatch.setattr(api, "certify", sleepy_certify)
+    with pytest.raises(api.SolverError, match="not finished within 1 s"):
+        api.design(SPEC, timeout=1)
+    assert api.design(SPEC, timeout=5).claims == []  # both stages fit in 5 s
+
+
+def test_design_timeout_generous_or_none_changes_nothing(tmp_path: Path):
+    ref = api.design(SPEC)
+    for t in (None, 0, 600, float("inf")):
+        rep = api.design(SPEC, timeout=t)
+        assert rep.verdict == ref.verdict == "ok"
+        assert [c.status for c in rep.claims] == [c.status for c in ref.claims]
+    assert runner.invoke(app, ["design", str(SPEC), "--timeout", "600", "-q"]).exit_code == 0
+    res = runner.invoke(app, ["design", str(SPEC), "--timeout", "-1"])
+    assert res.exit_code == 2 and "Traceback" not in res.output
+    for bad in (-1, float("nan"), "1", True):
+        with pytest.raises(InputError, match="timeout"):
+            api.design(SPEC, timeout=bad)
