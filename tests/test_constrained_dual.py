@@ -247,3 +247,29 @@ def test_one_cmin_written_at_any_scale_is_proved_alike(s: object) -> None:
     for norm in ("euclidean", "max"):
         assert D.faces_by_duality(G, h, norm, eps, face, np.array([Q(100)], dtype=object))[0]
         assert not D.faces_by_duality(G, h, norm, eps, face, np.array([Q(1)], dtype=object))[0]
+
+
+@pytest.mark.parametrize("norm", ["euclidean", "max"])
+@pytest.mark.parametrize("h0", [1, 0])
+def test_a_zero_row_of_the_map_gets_the_multiplier_zero(norm: str, h0: int) -> None:
+    """A row 0·x ≤ h₀ (h₀ ≥ 0: φ_i = −h₀ ≤ 0 is never positive) leaves C_min as it is; its
+    norm 0 made the unit-row scaling give up and every face undecided, exit 4 for a true
+    inclusion with a 10⁻³ margin (constrained fuzz, session 39). Its multiplier is 0: the
+    same faces are proved with and without it, and none below the support."""
+    G = qv(np.array([[1, 0], [0, 1], [-1, 0], [0, -1]]))
+    h = np.array([fmpq(11, 10)] * 4, dtype=object)
+    Gz = np.vstack([G, qv(np.array([[0, 0]]))])
+    hz = np.append(h, Q(h0))
+    # support along (1, 1) with ε = 1/100: 2.2 + 2^{3/4}/10 ≈ 2.3681793 (Euclidean),
+    # 2.2 + 2/10 (max)
+    face = qv(np.array([[1, 1]]))
+    s = Q(Decimal("2.36818" if norm == "euclidean" else "2.4"))
+    above = np.array([s + fmpq(1, 10**3)], dtype=object)
+    below = np.array([s - fmpq(1, 10**3)], dtype=object)
+    assert D.faces_by_duality(G, h, norm, fmpq(1, 100), face, above)[0]
+    assert D.faces_by_duality(Gz, hz, norm, fmpq(1, 100), face, above)[0]
+    assert not D.faces_by_duality(Gz, hz, norm, fmpq(1, 100), face, below)[0]
+    yf = D.float_multipliers(
+        np.asarray(Gz, dtype=float), np.asarray(hz, dtype=float), norm, 0.01, np.ones(2)
+    )
+    assert yf is not None and yf[-1] == 0.0

@@ -139,7 +139,8 @@ def float_multipliers(
     z = ‖a‖⁻¹ D y (D the rows' norms): Ĝᵀz = â with unit rows Ĝ = D⁻¹G and â = a/‖a‖, and
     ‖D⁻¹z‖_{q*} in the objective. Unscaled, a face written as 10⁻¹⁰x₁ + 10⁻¹⁰x₂ ≤ 2.38·10⁻¹⁰ or
     one row scaled by 10⁸ gave no y (Clarabel said "infeasible"), and true inclusions with
-    margins of 0.5 % to 1000 % stayed exit 4 (re-check trial, session 38).
+    margins of 0.5 % to 1000 % stayed exit 4 (re-check trial, session 38). A zero row of G
+    gets the multiplier 0.
 
     :param Gf, hf: the map (floats); :param norm: "euclidean" or "max"; :param eps: ε_min;
     :param af: the face's normal (floats)."""
@@ -147,10 +148,22 @@ def float_multipliers(
 
     import cvxpy as cp
 
-    d = np.linalg.norm(Gf, axis=1)
+    d_all = np.linalg.norm(Gf, axis=1)
     na = float(np.linalg.norm(af))
-    if not (na > 0 and np.all(d > 0) and np.all(np.isfinite(d)) and math.isfinite(na)):
+    keep = d_all > 0
+    if not (na > 0 and keep.any() and np.all(np.isfinite(d_all)) and math.isfinite(na)):
         return None
+    if not keep.all():
+        # a zero row of G (φ_i = −h_i, a constant) adds nothing to Gᵀy: its multiplier is 0
+        # (the exact check decides with it); it made the unit-row scaling divide by 0 and
+        # every face undecided, exit 4 for a true inclusion (constrained fuzz, session 39)
+        y = float_multipliers(Gf[keep], hf[keep], norm, eps, af)
+        if y is None:
+            return None
+        out = np.zeros(Gf.shape[0])
+        out[keep] = y
+        return out
+    d = d_all
     z = cp.Variable(Gf.shape[0], nonneg=True)
     # the weights √ε/d inside the norm, one O(1) vector: √ε·‖z/d‖ with rows of size 1e-6
     # (1/d ~ 1e6, √ε ~ 3e-7) made Clarabel fail (re-check trial, session 38)
