@@ -243,6 +243,43 @@ def test_runs_of_an_unstable_plant_keep_their_errors() -> None:
         assert res.x[-1, 0] == 3.0**60
 
 
+@pytest.mark.parametrize("disturbance", [None, {"kind": "uniform", "bound": 0.1}])
+def test_runs_keep_a_finite_error_after_the_plant_overflows(disturbance) -> None:
+    """x⁺ = 3x (+ d), L = 2.5 (e⁺ = 0.5e − d), 700 steps: x leaves the float range at step
+    647 while the error stays finite. The error read x's columns with coefficient 0, and
+    0·inf = nan made every run's sup |e|, RMSE and final |e| nan, and the 16-step block
+    product spread it back to the block's start (simulate trial, session 39; the single run
+    was right). Shared x (no random signal in the plant) and per-run x alike: each run's
+    error metrics are those of its own run stepped with x and e apart."""
+    text = (
+        '[system]\ntime = "discrete"\nA = [[3]]\nC = [[1]]\nBd = [[1]]\n[sets.E0]\n'
+        'type = "box"\nlower = [-1]\nupper = [1]\n[method]\nkey = "lyapunov"\nL = [2.5]\n'
+        "[simulate]\nhorizon = 700\nx0 = [1]\nxhat0 = [2]\nseed = 5\n"
+    )
+    if disturbance is not None:
+        text += toml("simulate.disturbance", **disturbance)
+    sp = load_spec_text(text)
+    Lg = np.array([[2.5]])
+    js = joint_system(sp, Lg)
+    with np.errstate(all="ignore"), pytest.warns(UserWarning, match="not finite"):
+        res = mc.run_batch(sp, js, 5, "E0")  # sup |x̂| = inf in every run
+    per = res.extra["per_run"]
+    sim = sp.simulate
+    for r, child in enumerate(mc.run_seeds(sim.seed, 5)):
+        g = np.random.default_rng(child)
+        e0 = sp.sets["E0"].sample(g, 1)[0]
+        u, d, v = (sig.evaluate(js.grid, g) for sig in (sim.u, sim.disturbance, sim.noise))
+        e = np.empty(701)
+        e[0] = e0[0]
+        for k in range(700):  # e = x̂ − x: e⁺ = 0.5e − d (+ L·v, v = 0)
+            e[k + 1] = 0.5 * e[k] - d[k, 0]
+        assert per["sup_abs_error"][r, 0] == pytest.approx(np.max(np.abs(e)), rel=1e-12)
+        assert per["rmse"][r, 0] == pytest.approx(np.sqrt(np.mean(e * e)), rel=1e-12)
+        assert per["final_error_norm"][r] == pytest.approx(abs(e[-1]), rel=1e-9, abs=1e-300)
+        assert per["sup_abs_estimate"][r, 0] == np.inf
+    assert np.all(np.isfinite(res.e))  # run 0's error trajectory
+
+
 def test_runs_1_is_run_0_of_any_run_count(tmp_path) -> None:
     """``--runs 1`` took the single scenario (default_rng(seed)), so its numbers differed from
     run 0 of ``--runs 2`` (child 0 of SeedSequence(seed)), against the documented "run r's

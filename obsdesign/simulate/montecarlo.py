@@ -270,6 +270,12 @@ def _plan(js: Any, sigs: tuple[Any, ...], grid: np.ndarray, x0: np.ndarray, seed
         x_sh = _step_blocks(M[:n, :n], E[:n], x0, S[:-1])
         G_sh = np.concatenate([M[n:, :n], E[n:]], axis=1)
         W_sh = np.concatenate([x_sh[:-1], S[:-1]], axis=1)
+        # only the inputs the error reads: in error coordinates e⁺ does not read x (a zero
+        # block), and a plant state that overflowed (an unstable plant over a long horizon)
+        # made every run's error nan through 0·inf — sup |e| = nan for a converging error
+        # that the single run gives finite (simulate trial, session 39)
+        reads = np.any(G_sh != 0, axis=0)
+        G_sh, W_sh = G_sh[:, reads], W_sh[:, reads]
     G_rand = []
     for i in rand:
         Gi = E[idx][:, cols[i] : cols[i + 1]]
@@ -576,6 +582,11 @@ def _run(
     E = np.empty((Rr, 0))
     mm = _matmul_for(Rr, max(N + 1, BLOCK * max(dims, default=1)), BLOCK * n)
     PH, PE, PX = bm.PH, bm.PE, bm.PX
+    # the error from [e; 1] alone when it does not read x (as for a shared x, see _plan): the
+    # plant's columns of st may overflow while the error stays finite (0·inf = nan)
+    st_e, PE_e = st, PE
+    if not shared_x and not np.any(PE[:n]):
+        st_e, PE_e = st[:, n:], PE[n:]
     for c0 in range(0, K, CHUNK):
         if budget is not None:
             budget.check(f"a batch of {R:,} runs at step {c0:,} of {K:,}")
@@ -588,7 +599,7 @@ def _run(
             H, E = HE[0], HE[1]
             bm.at(k0 // BLOCK)
             full = m == BLOCK
-            mm(st, PE if full else PE[:, :cm], out=E)  # the stepped error
+            mm(st_e, PE_e if full else PE_e[:, :cm], out=E)  # the stepped error
             if shared_x:
                 mm(st, PH if full else PH[:, :cm], out=H)  # e + x(k) (x in the block term)
             else:
