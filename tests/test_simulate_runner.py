@@ -109,6 +109,13 @@ def test_a_diverging_trajectory_gets_a_plain_warning():
     res = api.simulate(load_spec_text(text, "diverge.toml"))
     first = res.info["warnings"][0]
     assert "leaves the float range at t = 119 (sample 119 of 201)" in first  # 400^119 > 1e308
+    # e⁺ = (400 − 400)e stays finite: only sup |x̂| is not (it said "the metrics are not
+    # finite" beside a finite sup |e|, RMSE, final |e|: simulate trial, session 39)
+    assert "while the error stays finite, so only sup |x̂| is not finite" in first
+    assert np.isfinite(res.metrics()["sup_abs_error"]["x1"])
+    both = res.__class__(res.t, res.x, res.x * 2, res.y, res.states)  # e = x: not finite
+    said = api._left_float_range(both)
+    assert said is not None and "the plant or the observer diverges over this horizon, so " in said
     stable = text.replace("A = [[400.0]]", "A = [[0.5]]").replace("L = [[400.0]]", "L = [[0.5]]")
     res = api.simulate(load_spec_text(stable, "stable.toml"))
     assert not any("float range" in w for w in res.info.get("warnings", []))
