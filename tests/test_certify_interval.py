@@ -346,3 +346,11 @@ def test_rexp_and_rlog_enclose_where_mpmath_intervals_miss(bits: int) -> None:
     assert ivq.log_lower(2) < fmpq(6931471805599453095, 10**19)
     assert ivq.log_upper(2) > fmpq(6931471805599453094, 10**19)
     assert ivq.exp_upper(fmpq(1, 2**40)) > 1 + fmpq(1, 2**40) + fmpq(1, 2**81)
+
+
+def test_rexp_lower_end_is_below_one_for_a_tiny_negative_argument() -> None:
+    """e^(−2⁻²⁰⁰) < 1: the lower end of the ball, not its midpoint (which rounds to 1 at
+    113 bits); a mutation reading the midpoint survived every test (mutation review,
+    session 39). Likewise e^(2⁻²⁰⁰) > 1 at the upper end."""
+    assert exp_lower(-fmpq(1, 2**200)) < 1
+    assert exp_upper(fmpq(1, 2**200)) > 1

@@ -814,6 +814,96 @@ def test_box_l4_in_ellipsoid_is_never_proved_below_the_true_maximum() -> None:
     assert ok, detail
 
 
+def test_box_l4_in_ellipsoid_reads_every_vertex_of_R() -> None:
+    """X̂ = {(x − c)ᵀ(I/3)(x − c) ≤ 1}, c = (−0.2, −0.2): the vertex (1, 1) of R = [−1, 1]²,
+    the last one the loop visits, has the largest form 2.88/3 = 0.96, and C_min's point
+    (1, 1) + (1, 1)·(10⁻⁴/2)^{1/4} has the form 1.0993 > 1 (Fractions below). A loop that
+    skipped that vertex proved the false inclusion (≈ 0.963 < 1; mutation review, session
+    39); the whole design of the same spec is exit 1."""
+    from fractions import Fraction as F
+
+    from obsdesign.sets import Ellipsoid
+
+    E = np.array([[fmpq(1, 3), Q(0)], [Q(0), fmpq(1, 3)]], dtype=object)
+    c = np.array([Q("-0.2"), Q("-0.2")], dtype=object)
+    ok, _ = CL.box_l4_in_ellipsoid(_box_cm(), EPS, Ellipsoid(E, c), "outer")
+    assert not ok
+    t = F(84, 1000)  # 2t⁴ ≤ 10⁻⁴: (1 + t, 1 + t) is in C_min
+    assert 2 * t**4 <= F(1, 10**4)
+    assert 2 * (1 + t + F(2, 10)) ** 2 / 3 > 1  # and outside X̂
+    disk = (
+        '[sets.Xh]\ntype = "ellipsoid"\nE = [[0.3333333333333333, 0], [0, 0.3333333333333333]]'
+        "\ncenter = [-0.2, -0.2]\n\n[method]"
+    )
+    rep = _design(variant(add='Xhat = "Xh"', replace=[("[method]", disk)]), "disk.toml")
+    assert {c.id for c in rep.failed} == {"Cmin-in-Xhat"} and rep.exit_code() == 1
+
+
+def _support_1_2(digits: int) -> fmpq:
+    """C_min's support along (1, 2) for R = [−1.1, 1.1]², √ε_min = 1/10 (Section 5's box
+    map): 3.3 + (1 + 2^{4/3})^{3/4}/10, truncated to ``digits`` decimals (mpmath)."""
+    import mpmath
+
+    with mpmath.workdps(digits + 30):
+        v = (
+            mpmath.mpf("3.3")
+            + (1 + mpmath.mpf(2) ** (mpmath.mpf(4) / 3)) ** (mpmath.mpf(3) / 4) / 10
+        )
+        return fmpq(int(mpmath.floor(v * 10**digits)), 10**digits)
+
+
+def test_a_tie_undecided_at_1024_bits_is_never_proved() -> None:
+    """A face x1 + 2x2 ≤ k with k C_min's support truncated to 420 decimals (5·10⁻⁴²¹ below
+    it): the Hölder comparison cannot decide at 1024 bits (≈ 308 digits), so the face is
+    undecided (exit 4), never proved. A tie counted as proved survived every test, by the
+    box map's faces and by the dual certificates alike (mutation review, session 39); 10⁻²⁰⁰
+    either side is decided."""
+    k = _support_1_2(420)
+    lo = np.array([Q("-1.1")] * 2, dtype=object)
+    hi = np.array([Q("1.1")] * 2, dtype=object)
+    box = box_map(lo, hi, "euclidean")
+    face = np.vectorize(Q, otypes=[object])(np.array([[1, 2]]))
+    eps = fmpq(1, 100)
+    verdict, detail = CL.box_l4_faces(box, eps, face, np.array([k], dtype=object))
+    assert verdict is None, detail
+    assert CL.box_l4_faces(box, eps, face, np.array([k + fmpq(1, 10**200)], dtype=object))[0]
+    assert (
+        CL.box_l4_faces(box, eps, face, np.array([k - fmpq(1, 10**200)], dtype=object))[0] is False
+    )
+    from obsdesign.methods.constrained import dual as D
+
+    assert D.holder_below(eps, [Q(1), Q(2)], k - fmpq(33, 10)) is None
+    G = np.vectorize(Q, otypes=[object])(np.array([[1, 0], [0, 1], [-1, 0], [0, -1]]))
+    h = np.array([Q("1.1")] * 4, dtype=object)
+    ok, open_faces = D.faces_by_duality(G, h, "euclidean", eps, face, np.array([k], dtype=object))
+    assert not ok and open_faces == [0]
+    big = np.array([k + fmpq(1, 10**200)], dtype=object)
+    assert D.faces_by_duality(G, h, "euclidean", eps, face, big)[0]
+    rep = _design(
+        variant(
+            add='Xhat = "Xh"',
+            replace=[
+                (
+                    "[method]",
+                    '[sets.Xh]\ntype = "polytope"\nG = [[1, 0], [-1, 0], [0, 1], [0, -1], '
+                    f"[1, 2]]\ng = [1.2, 1.2, 1.2, 1.2, {_decimal_text(k)}]"
+                    "\n\n[method]",
+                )
+            ],
+        ),
+        "tie.toml",
+    )
+    assert rep.exit_code() == 4, [(c.id, c.detail) for c in rep.failed]
+
+
+def _decimal_text(q: fmpq) -> str:
+    """The decimal text of a rational with a power-of-ten denominator."""
+    digits = len(str(q.q)) - 1
+    assert q.q == 10**digits
+    sgn, p = ("-" if q.p < 0 else ""), abs(int(q.p))
+    return f"{sgn}{p // 10**digits}.{p % 10**digits:0{digits}d}"
+
+
 XHAT_MAX_NOT_TIGHT = """
 [system]
 time = "discrete"
