@@ -273,3 +273,40 @@ def test_a_zero_row_of_the_map_gets_the_multiplier_zero(norm: str, h0: int) -> N
         np.asarray(Gz, dtype=float), np.asarray(hz, dtype=float), norm, 0.01, np.ones(2)
     )
     assert yf is not None and yf[-1] == 0.0
+
+
+def test_holder_is_exact_for_weights_a_rational_cube_apart() -> None:
+    """Weights w_i = w_1·k_i³ (1.728, 3.375, 8 = 1.2³, 1.5³, 2³): (Σ w_i^{4/3})³ = w_1⁴(Σ k_i⁴)³
+    is rational, so a face exactly touching C_min is decided (it was "undecided at 1024
+    bits", exit 4; mutation review, session 39) — the tie holds, 10⁻⁶⁰ less does not; a
+    ratio that is no cube (1, 2) still goes to the balls."""
+    w = [Q(Decimal("1.728")), Q(Decimal("3.375")), Q(8)]
+    eps = Q(Decimal("0.000481"))
+    # √ε·‖w‖_{4/3} = √ε·(1.2⁴ + 1.5⁴ + 2⁴)^{3/4} = √0.000481·(23.1361)^{3/4}
+    # = 0.0219317…·10.5453… : the exact a with a⁴ = ε²·(Σ k_i⁴·1.2⁴)³ is 0.01·4.81² = 0.231361
+    tie = Q(Decimal("0.231361"))
+    assert eps**2 * (Q(Decimal("23.1361"))) ** 3 == tie**4
+    assert D.holder_below(eps, w, tie) is True
+    assert D.holder_below(eps, w, tie - fmpq(1, 10**60)) is False
+    assert D.holder_below(eps, [Q(0), *w, Q(0)], tie) is True  # zeros are skipped
+    assert D.holder_below(eps, [Q(0), Q(0)], Q(0)) is True
+    # scaled by a non-cube: still a cube apart from each other
+    assert D.holder_below(eps * 4, [x * 2 for x in w], tie * 4) is True  # ×256 both sides
+    assert D._cube_roots([Q(2)]) is None and D._cube_roots([fmpq(27, 8)]) == [fmpq(3, 2)]
+
+
+def test_a_face_touching_cmin_with_cube_weights_is_certified() -> None:
+    """The 3-state box map R = [−1, 1]³, ε_min = 0.000481 and the X̂ face
+    (1.728, 3.375, 8)·x ≤ 13.334361, exactly C_min's support (13.103 + 0.231361): certified
+    (exit 4 before); 10⁻³⁰ lower: refused."""
+    from obsdesign.methods.constrained.cmap import box_map
+
+    lo = np.array([Q(-1)] * 3, dtype=object)
+    hi = np.array([Q(1)] * 3, dtype=object)
+    cm = box_map(lo, hi, "euclidean")
+    face = np.array([[Q(Decimal("1.728")), Q(Decimal("3.375")), Q(8)]], dtype=object)
+    k = Q(Decimal("13.334361"))
+    eps = Q(Decimal("0.000481"))
+    assert CL.box_l4_faces(cm, eps, face, np.array([k], dtype=object))[0] is True
+    low = np.array([k - fmpq(1, 10**30)], dtype=object)
+    assert CL.box_l4_faces(cm, eps, face, low)[0] is False
