@@ -78,6 +78,10 @@ def test_face_holds_refuses_every_tampered_certificate() -> None:
     assert D.face_holds(AXES, ONES, "max", e, a, Q(100), neg) is False
     off = np.array([1 + TINY, Q(1), Q(0), Q(0)], dtype=object)
     assert D.face_holds(AXES, ONES, "max", e, a, Q(100), off) is False
+    # every coordinate of Gᵀy = a is compared, the last one too (a check that skipped it
+    # survived every test: mutation review, session 39)
+    last = np.array([Q(1), 1 + TINY, Q(0), Q(0)], dtype=object)
+    assert D.face_holds(AXES, ONES, "max", e, a, Q(100), last) is False
     # Euclidean: b − 2 ≥ √ε·‖y‖_{4/3} = 2^{3/4}/10 = 0.16817928305074290860…
     assert D.face_holds(AXES, ONES, "euclidean", e, a, Q(Decimal("2.1681792830507429087")), y)
     assert not D.face_holds(AXES, ONES, "euclidean", e, a, Q(Decimal("2.1681792830507429086")), y)

@@ -839,6 +839,22 @@ def test_box_l4_in_ellipsoid_reads_every_vertex_of_R() -> None:
     assert {c.id for c in rep.failed} == {"Cmin-in-Xhat"} and rep.exit_code() == 1
 
 
+def test_box_l4_in_ellipsoid_needs_an_exact_bound_of_the_largest_eigenvalue(monkeypatch) -> None:
+    """μ ≥ λ_max(E) is checked exactly (μI − E ⪰ 0): a float eigenvalue too small by half
+    (a solver's wrong answer) would make the E-norm bound too small, and the inclusion is
+    then not proved (no test had made that check fail: mutation review, session 39)."""
+    from obsdesign.sets import Ellipsoid
+
+    E = np.array([[fmpq(1, 20), Q(0)], [Q(0), fmpq(1, 20)]], dtype=object)
+    c = np.array([Q(0), Q(0)], dtype=object)
+    ok, detail = CL.box_l4_in_ellipsoid(_box_cm(), EPS, Ellipsoid(E, c), "outer")
+    assert ok, detail
+    real = np.linalg.eigvalsh
+    monkeypatch.setattr(np.linalg, "eigvalsh", lambda M: real(M) / 2)
+    ok, detail = CL.box_l4_in_ellipsoid(_box_cm(), EPS, Ellipsoid(E, c), "outer")
+    assert not ok and "λ_max(E_X̂) not bounded" in detail
+
+
 def _support_1_2(digits: int) -> fmpq:
     """C_min's support along (1, 2) for R = [−1.1, 1.1]², √ε_min = 1/10 (Section 5's box
     map): 3.3 + (1 + 2^{4/3})^{3/4}/10, truncated to ``digits`` decimals (mpmath)."""
