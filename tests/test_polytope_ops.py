@@ -255,6 +255,20 @@ def test_cdd_hull_in_a_child_gives_the_same_hull():
     assert [tuple(r) for r in G2] == [tuple(r) for r in G] and idx2 == idx and edges2 == edges
 
 
+def test_the_hull_child_does_not_import_from_the_working_folder(tmp_path, monkeypatch):
+    """A ``cdd.py`` in the folder where obsdesign runs (a CI checkout) replaced the real
+    module in the child (started as ``python -c``, which puts the working folder first on
+    its import path), whose hull is trusted (batch trial, session 39): the child runs with
+    ``-P``, and imports obsdesign from where this process has it."""
+    (tmp_path / "cdd.py").write_text('raise ImportError("local cdd.py")\n')
+    (tmp_path / "numpy.py").write_text('raise ImportError("local numpy.py")\n')
+    monkeypatch.chdir(tmp_path)
+    P = _hard_clouds(1, 3)[0]
+    G, idx, edges = po._cdd_hull(P)
+    G2, idx2, edges2 = po._cdd_hull_bounded(P, time.perf_counter() + 60)
+    assert [tuple(r) for r in G2] == [tuple(r) for r in G] and idx2 == idx and edges2 == edges
+
+
 def test_time_budget_stops_a_long_exact_hull(monkeypatch):
     """Issue 12 item 2: a budget of 1 s on an exact hull that cdd.gmp needs a minute for
     (150 points on the 4-sphere, the incidence proof switched off) is refused within the
@@ -291,7 +305,7 @@ def test_child_dies_with_its_parent():
             except OSError:
                 continue
             if (
-                b"from obsdesign.sets.polytope_ops import _child; _child()" in cmd
+                any(b"from obsdesign.sets.polytope_ops import _child; _child()" in c for c in cmd)
                 and str(pid).encode() in cmd
             ):
                 out.append(int(d))

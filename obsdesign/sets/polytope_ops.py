@@ -692,9 +692,16 @@ def _cdd_hull_bounded(
     left = deadline - time.perf_counter()
     if left <= 0:
         raise HullTimeout(0.0)
-    code = "from obsdesign.sets.polytope_ops import _child; _child()"
+    # -P: the working folder is not put on the child's import path (a cdd.py or numpy.py
+    # where `obsdesign check` runs replaced the real module in the child, whose hull is
+    # trusted; batch trial, session 39); obsdesign itself from where this process has it
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    code = (
+        f"import sys; sys.path.insert(0, {root!r}); "
+        "from obsdesign.sets.polytope_ops import _child; _child()"
+    )
     proc = subprocess.Popen(
-        [sys.executable, "-c", code, str(os.getpid())],
+        [sys.executable, "-P", "-c", code, str(os.getpid())],
         stdin=subprocess.PIPE,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
