@@ -724,26 +724,38 @@ def _replace_claims(rep: Report, claims: list[Claim], seconds: float) -> Report:
     return rep
 
 
-def _uncertified_design(sp: Spec, params: Parameters) -> list[str]:
-    """The warning ``simulate`` without a report gives when the parameters it designed do not
-    certify (the claims ``design`` would make, at a fraction of the design's time): a design
-    whose claim failed (``design`` exit 1) was simulated with exit 0 and no word, while
-    ``simulate --report`` of the same design warned (rendering trial, session 29). A design
-    that cannot be certified (an error) is said so too; the simulation still runs.
+def _uncertified_design(sp: Spec, params: Parameters, where: str | None = None) -> list[str]:
+    """The warning ``simulate`` gives when the parameters it runs do not certify (the claims
+    ``design`` would make, at a fraction of the design's time): a design whose claim failed
+    (``design`` exit 1) was simulated with exit 0 and no word, while ``simulate --report`` of
+    the same design warned (rendering trial, session 29). A design that cannot be certified
+    (an error) is said so too; the simulation still runs. ``where``: the report the
+    parameters come from — its claims are recomputed, not read: a report edited consistently
+    (float and exact alike, claims left "certified") ran L = [1, 5] against a spec that fixes
+    L, an impulsive window [4, 5] and a destabilizing K with exit 0 and no word (verify
+    tamper trial, session 39).
 
-    :param sp: the spec; :param params: the parameters its method designed."""
-    tail = "the parameters simulated are not certified (obsdesign design says why)"
+    :param sp: the spec; :param params: the parameters simulated; :param where: the report's
+    name, None for parameters the method designed."""
+    if where is None:
+        tail = "the parameters simulated are not certified (obsdesign design says why)"
+        whose, source = "the design's claims", "the designed parameters"
+    else:
+        tail = f"the parameters simulated are not certified (obsdesign verify {where} says why)"
+        whose = "its parameters' claims, recomputed from the spec,"
+        source = "its parameters"
+    name = sp.file if where is None else where
     try:
         with captured_warnings([]):
             claims = certify(sp, params)
     except ObsdesignError as e:
-        return [f"{sp.file}: the designed parameters could not be certified ({e.message}): {tail}"]
+        return [f"{name}: {source} could not be certified ({e.message}): {tail}"]
     bad = [c for c in claims if c.status == ClaimStatus.FAILED]
     if not bad:
         return []
     verdict = "inconclusive" if all(c.float_ok for c in bad) else "failed"
     ids = ", ".join(c.id for c in bad[:5]) + (", …" if len(bad) > 5 else "")
-    return [f"{sp.file}: the design's claims give the verdict '{verdict}' ({ids}): {tail}"]
+    return [f"{name}: {whose} give the verdict '{verdict}' ({ids}): {tail}"]
 
 
 def _check_sim_keywords(method: Any, kwargs: dict[str, Any]) -> None:
@@ -886,12 +898,14 @@ def simulate(
             )
         params = rep.parameters.traced(finite=True)
     if report is not None and rep.computed_verdict() != "ok":
-        # simulate does not verify a report; one whose own claims fail is run, but said so
-        # (simulate trial, session 27: a failed report ran with exit 0 and no word)
+        # a report whose own claims fail is run, but said so (simulate trial, session 27: a
+        # failed report ran with exit 0 and no word)
         notes.append(
             f"{where}: its claims give the verdict '{rep.computed_verdict()}', not 'ok': the "
             "parameters simulated are not certified (obsdesign verify says which claim fails)"
         )
+    elif report is not None:
+        notes += _uncertified_design(sp, params, where)
     try:
         if distributed:
             try:

@@ -647,6 +647,54 @@ def test_simulate_refuses_a_report_parameter_that_is_not_finite(
     _refused(res, "bad.json", f"parameters.{key}", "not a finite number")
 
 
+def _edit_consistently(d: dict, key: str, value: Any) -> None:
+    """Set parameter ``key`` of report dict ``d`` to ``value`` in floats and exactly alike
+    (the nearest doubles of the exact values), claims left as they were."""
+    from fractions import Fraction
+
+    def exact(v: Any) -> Any:
+        return [exact(x) for x in v] if isinstance(v, list) else str(Fraction(v))
+
+    d["parameters"][key] = value
+    d["parameters"]["exact"][key] = exact(value)
+
+
+@pytest.mark.parametrize(
+    ("name", "key", "value", "failed"),
+    [
+        ("constrained-redesign-sec5-lyapunov", "L", [[1.0], [5.0]], "L-matches-spec"),
+        ("schaum-impulsive-example", "T_min", 4.0, "T_max"),
+        ("astolfi-stubborn-example1", "K", None, "lmi-global"),
+    ],
+)
+def test_simulate_a_report_edited_consistently_warns(
+    tmp_path: Path, name: str, key: str, value: Any, failed: str
+) -> None:
+    """A report whose parameters were edited consistently (float and exact), its claims left
+    "certified": simulate recomputes the claims from the spec and warns that the parameters
+    are not certified, naming the failed claims. It ran L = [1, 5] against a spec that fixes
+    L (final |e| = 4·10⁹⁰), an impulsive window [4, 5] with "intervals_in_window: True" and a
+    destabilizing K, each with exit 0 and no word (verify tamper trial, session 39)."""
+    src = SPEC.parent / f"{name}.toml"
+    rep = tmp_path / "r.json"
+    assert runner.invoke(app, ["design", str(src), "-q", "-o", str(rep)]).exit_code == 0
+    ok = runner.invoke(app, ["simulate", str(src), "--report", str(rep)])
+    assert ok.exit_code == 0 and "not certified" not in ok.output
+    d = json.loads(rep.read_text())
+    if key == "T_min":
+        _edit_consistently(d, "T_max", 5.0)
+    elif key == "K":
+        value = [[-100.0 for _ in row] for row in d["parameters"]["K"]]  # its shape
+    _edit_consistently(d, key, value)
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(d))
+    res = runner.invoke(app, ["simulate", str(src), "--report", str(bad)])
+    assert res.exit_code == 0, res.output
+    text = " ".join(res.output.split())
+    assert f"{bad}: its parameters' claims, recomputed from the spec, give the verdict" in text
+    assert failed in text and "not certified (obsdesign verify" in text
+
+
 # --- Mutation review 29: api._uncertified_design
 
 
