@@ -1314,6 +1314,11 @@ def _time_budget(seconds: float | None) -> Any:
             raise SpecTimeout
 
     old = signal.getsignal(signal.SIGALRM)
+    # a caller's own timer (an API caller's alarm / setitimer watchdog) is put back after the
+    # block with what was left of it (at least MIN_BUDGET_S: one that ran out meanwhile fires
+    # at once); it was disarmed for good (batch trial, session 39)
+    caller_left, caller_every = signal.getitimer(signal.ITIMER_REAL)
+    t_start = time.monotonic()
     # the timer starts inside the try, and the finally disarms it first: an alarm that landed
     # between starting the timer and the try (--timeout 1e-7), or in the finally before the
     # timer was cleared, left it repeating with this handler installed — "Alarm clock", exit
@@ -1331,6 +1336,9 @@ def _time_budget(seconds: float | None) -> Any:
         leaving[0] = True
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, old if old is not None else signal.SIG_DFL)
+        if caller_left > 0:
+            left = max(caller_left - (time.monotonic() - t_start), MIN_BUDGET_S)
+            signal.setitimer(signal.ITIMER_REAL, left, caller_every)
 
 
 def _install_quiet_timeout() -> None:

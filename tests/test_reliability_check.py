@@ -831,3 +831,39 @@ def test_design_timeout_generous_or_none_changes_nothing(tmp_path: Path):
     for bad in (-1, float("nan"), "1", True):
         with pytest.raises(InputError, match="timeout"):
             api.design(SPEC, timeout=bad)
+
+
+def test_a_budget_puts_back_the_callers_own_timer(tmp_path: Path):
+    """An API caller's own watchdog (setitimer / alarm) survives check(timeout=) and
+    design(timeout=): the budget disarmed it for good, so the caller's hang protection was
+    silently lost (batch trial, session 39). It is re-armed with what was left of it."""
+    import signal
+    import time
+
+    fired = []
+    old = signal.signal(signal.SIGALRM, lambda *a: fired.append(1))
+    try:
+        signal.setitimer(signal.ITIMER_REAL, 30.0)
+        api.check([SPEC], timeout=600)
+        left, _ = signal.getitimer(signal.ITIMER_REAL)
+        assert 0 < left <= 30.0
+        api.design(SPEC, timeout=600)
+        left2, _ = signal.getitimer(signal.ITIMER_REAL)
+        assert 0 < left2 <= left
+        signal.setitimer(signal.ITIMER_REAL, 0.2)  # runs out during the budget's block
+        real = api.design
+
+        def slow(*a, **k):
+            time.sleep(0.4)
+            return real(*a, **k)
+
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setattr(api, "design", slow)
+            api.check([SPEC], timeout=600)
+        t0 = time.monotonic()
+        while not fired and time.monotonic() - t0 < 5:
+            time.sleep(0.01)
+        assert fired  # fired right after the block
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
