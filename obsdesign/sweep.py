@@ -98,6 +98,12 @@ def parse_axis(text: str) -> Axis:
             key,
             tuple(_range_values(key, m.group(1), m.group(2), int(m.group(3)), m.group(4) == "log")),
         )
+    if ":" in spec and not spec.startswith(("[", "{", '"', "'")):
+        # 0.5:0.7:2.0 and 1_0:2_0:2 were "is not a TOML value" (batch trial, session 39)
+        raise InputError(
+            f"--set {key}: {spec!r} is not a range START:STOP:N[:lin|log] (START and STOP "
+            "decimal numbers such as 0.9 or 1e-3, N a whole number of values)"
+        )
     if spec.startswith("["):
         items = _split_list(key, spec)
         if not items:
@@ -346,6 +352,19 @@ def _check_edit(old: str, new: str, parts: list[str], literal: str, file: str) -
         ) from None
 
 
+def _immutable_hint(before: dict, parts: list[str]) -> str:
+    """Why TOML cannot add ``parts`` to the spec ``before``: a part that is an array (an
+    array's entry is no key: ``system.A.0`` said "an inline table holds it"; batch trial,
+    session 39), else an inline table."""
+    d: object = before
+    for i, p in enumerate(parts[:-1]):
+        d = d.get(p) if isinstance(d, dict) else None
+        if isinstance(d, list):
+            whole = ".".join(parts[: i + 1])
+            return f"; {whole} is an array: --set replaces it whole, e.g. --set {whole}=[...]"
+    return "; an inline table holds it: write it as a [table]"
+
+
 def _check_edit_parsed(old: str, new: str, parts: list[str], literal: str, file: str) -> None:
     key = ".".join(parts)
     try:
@@ -363,7 +382,7 @@ def _check_edit_parsed(old: str, new: str, parts: list[str], literal: str, file:
             ) from None
         raise InputError(
             f"{file}: cannot set {key} = {literal} ({e}"
-            + ("; an inline table holds it: write it as a [table]" if "immutable" in str(e) else "")
+            + (_immutable_hint(before, parts) if "immutable" in str(e) else "")
             + ")"
         ) from None
     d = before

@@ -71,6 +71,11 @@ def test_lists_and_single_values():
         ("x=[1,,2]", "empty item"),
         ("x=1e400:1:2", "exponent"),
         ("x=a b", "not a TOML value"),
+        # a range's N that is not whole, or TOML's own integer forms, said "is not a TOML
+        # value" (batch trial, session 39)
+        ("x=0.5:0.7:2.0", "is not a range START:STOP:N"),
+        ("x=1_0:2_0:2", "is not a range START:STOP:N"),
+        ("x=0x10:0x20:2", "N a whole number of values"),
     ],
 )
 def test_bad_axes_are_bad_input(text: str, where: str):
@@ -156,6 +161,10 @@ def test_set_key_refuses_what_it_cannot_write_exactly():
         sw.set_key(text, "simulate.noise.bound", "0.5")
     with pytest.raises(InputError, match="cannot set method.key.x"):
         sw.set_key("[method]\nkey = 1\n", "method.key.x", "2")
+    # an array's entry is no key: it said "an inline table holds it" (batch trial, session 39)
+    with pytest.raises(InputError, match=r"system\.A is an array: --set replaces it whole") as e:
+        sw.set_key("[system]\nA = [[1, 2], [3, 4]]\n", "system.A.0", "1")
+    assert "inline table" not in str(e.value)
 
 
 def test_point_text_of_the_shipped_spec_changes_exactly_the_swept_keys():
