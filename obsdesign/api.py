@@ -750,6 +750,10 @@ def _uncertified_design(sp: Spec, params: Parameters, where: str | None = None) 
             claims = certify(sp, params)
     except ObsdesignError as e:
         return [f"{name}: {source} could not be certified ({e.message}): {tail}"]
+    except (KeyError, ValueError, IndexError, TypeError, ArithmeticError) as e:
+        if where is None:  # the design's own parameters: a defect
+            raise
+        return [f"{name}: {source} could not be certified ({type(e).__name__}: {e}): {tail}"]
     bad = [c for c in claims if c.status == ClaimStatus.FAILED]
     if not bad:
         return []
@@ -904,8 +908,6 @@ def simulate(
             f"{where}: its claims give the verdict '{rep.computed_verdict()}', not 'ok': the "
             "parameters simulated are not certified (obsdesign verify says which claim fails)"
         )
-    elif report is not None:
-        notes += _uncertified_design(sp, params, where)
     try:
         if distributed:
             try:
@@ -925,6 +927,10 @@ def simulate(
         if report is None:  # the design's own parameters: a defect, exit 3
             raise
         raise _unfit_report(e, where, sp.method, params) from None
+    if report is not None and rep.computed_verdict() == "ok":
+        # after the simulation, whose own checks of the parameters (shape, finiteness) name
+        # the parameter at fault; the claims' reads do not enter its trace
+        notes += _uncertified_design(sp, rep.parameters, where)
     left = _left_float_range(res)
     if left is not None:
         notes.insert(0, left)
