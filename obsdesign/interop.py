@@ -509,10 +509,11 @@ def observer_statespace(report: Any, law: str | None = None, verify: bool = Fals
     inputs, outputs = _names("u", m) + _names("y", p), _names("xhat", n)
     name = f"obsdesign-{report.method}"
 
-    def linear(G: np.ndarray, sign: float) -> Any:
+    def linear(G: np.ndarray, sign: float, rate: Any = None) -> Any:
         # x̂' = A x̂ + B u + sign·G (y − C x̂ − D u)
         G = np.asarray(G, float).reshape(n, p)
         Ao = A - sign * G @ C
+        _check_float_realization(Ao, s.discrete, rate, where)
         Bo = np.hstack([B - sign * G @ D, sign * G])
         return ct.ss(
             Ao,
@@ -529,8 +530,19 @@ def observer_statespace(report: Any, law: str | None = None, verify: bool = Fals
     # shaped: a 4×5 L of a 5×4 gain was reshaped row-major into another gain and returned
     # without a word, while simulate --report refuses it (lyapunov trial, session 34)
     if report.method == "lyapunov":
-        return linear(_named(params.shaped, "L", (n, p), where), +1.0)
+        key = "lambda" if s.discrete else "alpha"
+        rate = params.exact(key, [], accept_float=True) if key in params else None
+        return linear(_named(params.shaped, "L", (n, p), where), +1.0, rate)
     if report.method == "stubborn":
+        if getattr(sp.options, "mode", None) == "high-gain" or not s.linear:
+            # A + psi in mode high-gain passed the f / h test above and returned the linear
+            # observer with the K of the nominal design: the certified observer injects
+            # k_i·ℓ^i and runs ψ(x̂) (interop trial, session 39)
+            raise InputError(
+                f"{where}: the stubborn observer of this spec (mode high-gain, or a plant "
+                "with psi) runs the nonlinearity and the high-gain injection: it is not a "
+                "linear state-space system and is not offered as a python-control system"
+            )
         return linear(_named(params.shaped, "K", (n, p), where), +1.0)
     if report.method == "set-invariant":
         use = law or ("linear" if "L" in params or sp.options.L is not None else "interpolated")
@@ -540,6 +552,41 @@ def observer_statespace(report: Any, law: str | None = None, verify: bool = Fals
             return linear(make_law(sp, params, "linear").L, -1.0)
         return _setinvariant_nonlinear(ct, sp, params, use, A, B, C, D, dt, inputs, outputs, name)
     raise InputError(_NOT_LINEAR.format(method=report.method, linear=", ".join(LINEAR)))
+
+
+def _check_float_realization(Ao: np.ndarray, discrete: bool, rate: Any, where: str) -> None:
+    """The exported observer matrix (A − LC formed in doubles, the realization the user
+    takes away) checked exactly: every eigenvalue within the certified ``rate`` (lyapunov's
+    λ or α; None: stability, |z| < 1 or Re z < 0), by :func:`obsdesign.lyap.rate_feasibility`
+    on the doubles' exact values. The certificate is about the exact gain: on an
+    ill-conditioned plant (ρ(A − LC) = 0.647 certified) the doubles gave ρ = 3.5, an
+    unstable observer handed over with no word (interop trial, session 39). Unstable: an
+    :class:`InconclusiveError`; stable but slower than ``rate``: a ``UserWarning``."""
+    import warnings
+
+    from obsdesign.certify.exact import Q
+    from obsdesign.errors import InconclusiveError
+    from obsdesign.lyap import rate_feasibility
+
+    Aq = np.vectorize(Q, otypes=[object])(Ao)
+    if rate is not None and rate_feasibility(Aq, rate, discrete)[0]:
+        return
+    if rate_feasibility(Aq, Q(1) if discrete else Q(0), discrete)[0]:
+        if rate is not None:
+            warnings.warn(
+                f"{where}: the observer matrix in doubles (A − LC rounded) is stable but does "
+                f"not keep the certified rate {float(Q(rate)):.6g}: the certificate is about "
+                "the exact gain (report parameters.exact)",
+                UserWarning,
+                stacklevel=3,
+            )
+        return
+    raise InconclusiveError(
+        f"{where}: the observer matrix in doubles (A − LC rounded) is not "
+        f"{'Schur' if discrete else 'Hurwitz'}: the certificate holds for the exact gain "
+        "(report parameters.exact), and this ill-conditioned observer has no float64 "
+        "realization that keeps it; no observer is offered"
+    )
 
 
 #: why a method's observer is not offered as a python-control system

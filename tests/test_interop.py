@@ -949,3 +949,49 @@ def test_mat_import_refuses_a_variable_name_given_twice(
     ts.write_bytes(big.read_bytes() + small.read_bytes()[128:])
     r = CliRunner().invoke(app, ["import", str(ts), "--A", "Ad", "--C", "Cm"])
     assert r.exit_code == 2 and "variable 'Ts' appears more than once in the file" in r.stderr
+
+
+def test_an_observer_with_no_float_realization_is_not_offered() -> None:
+    """The 5-state plant with ρ(A − LC) certified at 0.647 for the exact 64-bit gain: A − LC
+    formed in doubles has ρ ≈ 3.5 (even the exact A − LC rounded once has 3.6), and
+    observer_statespace handed over that unstable system with no word, verify=True included
+    (interop trial, session 39). Refused now; the 8-state ill-conditioned plant's doubles
+    stay stable but slower than the certified λ: a warning."""
+    from obsdesign.errors import InconclusiveError
+
+    data = Path(__file__).parent / "data"
+    rep = api.design(api.load_spec(data / "lyapunov-rho-6000-5state.toml"))
+    assert rep.exit_code() == 0
+    with pytest.raises(InconclusiveError, match="not Schur"):
+        rep.observer_statespace()
+    rep8 = api.design(api.load_spec(data / "lyapunov-ill-conditioned-8state.toml"))
+    assert rep8.exit_code() == 0
+    with pytest.warns(UserWarning, match="does not keep the certified rate"):
+        ss = rep8.observer_statespace()
+    assert max(abs(np.linalg.eigvals(ss.A))) < 1
+
+
+def test_the_float_realization_of_a_shipped_observer_keeps_its_rate() -> None:
+    """The shipped lyapunov spec: no warning, the doubles keep the certified λ."""
+    import warnings
+
+    rep = api.design(api.load_spec(ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ss = rep.observer_statespace()
+    assert max(abs(np.linalg.eigvals(ss.A))) < float(rep.parameters["lambda"])
+
+
+def test_a_stubborn_high_gain_plant_given_by_A_and_psi_is_not_offered() -> None:
+    """mode = "high-gain" with the plant written as A + psi passed the f / h test and
+    returned a linear observer with the nominal K, while the certified observer injects
+    k_i·ℓ^i and runs ψ(x̂) (interop trial, session 39)."""
+    text = (
+        '[system]\ntime = "continuous"\nstates = ["x1", "x2"]\nA = [[0, 1], [0, 0]]\n'
+        'psi = ["0", "-0.3*x2 + x1 - x1**3 + 0.5*cos(1.2*t)"]\nC = [[1, 0]]\n'
+        '[method]\nkey = "stubborn"\nmode = "high-gain"\nK = [2, 1]\nlipschitz = 16\n'
+        "lambda = 1\nepsilon = 1\nstate_bound = [2, 2]\n"
+    )
+    rep = api.design(api.load_spec_text(text, "hg.toml"))
+    with pytest.raises(InputError, match="not a linear state-space system"):
+        rep.observer_statespace()
