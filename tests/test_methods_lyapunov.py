@@ -1500,3 +1500,17 @@ def test_bracket_detail_gives_the_spectral_guide_not_raw_float_eigenvalues(
     )
     diag = lyap.fmat(np.diag([0.5, 0.25]))
     assert _float_bound(diag, None, True) == "the optimal rate ρ(A − LC) ≈ 0.5 in floats"
+
+
+def test_simulate_warns_when_the_gain_in_doubles_loses_the_certificate() -> None:
+    """The 5-state plant certified at ρ(A − LC) = 0.647 for the exact gain: A − LC in doubles
+    is unstable, and simulate ran it to |e| ≈ 10⁴⁰ with exit 0 and no word (interop trial,
+    session 39). The shipped spec's doubles keep the rate: no such warning."""
+    data = Path(__file__).parent / "data" / "lyapunov-rho-6000-5state.toml"
+    text = data.read_text() + "\n[simulate]\nhorizon = 60\nx0 = [1, 0, 0, 0, 0]\n"
+    text += "xhat0 = [0, 0, 0, 0, 0]\n"
+    res = api.simulate(api.load_spec_text(text, "rho.toml"))
+    said = " ".join(res.info.get("warnings", []))
+    assert "A − LC in doubles is not stable" in said
+    ok = api.simulate(ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml")
+    assert not any("in doubles" in w for w in ok.info.get("warnings", []))
