@@ -1312,19 +1312,49 @@ def _time_budget(seconds: float | None) -> Any:
     already = _initializing()  # the caller's own imports (a check run at module level)
     leaving = [False]
     _install_quiet_timeout()
-
-    def on_alarm(signum: int, frame: Any) -> None:
-        # not once the block is being left, nor inside an import (the repeat RETIMEOUT_S
-        # later stops it)
-        if not leaving[0] and not _importing(already):
-            raise SpecTimeout
-
     old = signal.getsignal(signal.SIGALRM)
-    # a caller's own timer (an API caller's alarm / setitimer watchdog) is put back after the
-    # block with what was left of it (at least MIN_BUDGET_S: one that ran out meanwhile fires
-    # at once); it was disarmed for good (batch trial, session 39)
+    # a caller's own timer (an API caller's alarm / setitimer watchdog) keeps its time: the
+    # timer is armed for whichever comes first, the budget's deadline or the caller's, and
+    # the caller's alarm goes to the caller's handler; after the block it is re-armed with
+    # what is left of it. It was disarmed for good, then delayed to the block's end (batch
+    # trial and re-check trial, session 39)
     caller_left, caller_every = signal.getitimer(signal.ITIMER_REAL)
     t_start = time.monotonic()
+    deadline = t_start + float(seconds)
+    caller: list[float | None] = [t_start + caller_left if caller_left > 0 else None]
+
+    def arm(now: float) -> None:
+        if caller[0] is not None and caller[0] < deadline:
+            signal.setitimer(signal.ITIMER_REAL, max(caller[0] - now, MIN_BUDGET_S))
+        else:
+            # the alarm repeats every RETIMEOUT_S after the deadline until the block is
+            # left: an exception raised while Python runs a __del__ or a weakref callback is
+            # printed and dropped ("Exception ignored in ..."), and a sweep point past its
+            # 1 s budget then ran to its end (exit 1 instead of 3; a CI run, session 26)
+            signal.setitimer(signal.ITIMER_REAL, max(deadline - now, MIN_BUDGET_S), RETIMEOUT_S)
+
+    def on_alarm(signum: int, frame: Any) -> None:
+        if leaving[0]:
+            # the block's work is done (a stop landing in the finally skipped the cleanup:
+            # batch trial, session 35); the caller's timer is re-armed there
+            return
+        now = time.monotonic()
+        if caller[0] is not None and now >= caller[0] - ALARM_SLACK_S:
+            caller[0] = caller[0] + caller_every if caller_every > 0 else None
+            arm(now)
+            _pass_alarm(old, signum, frame)
+            return
+        if now < deadline - ALARM_SLACK_S:
+            # before either deadline: a SIGALRM from outside (kill -ALRM, a wrapper's
+            # alarm) goes to the handler there was (the CLI's: "alarm clock", exit 142); the
+            # budget took it for its own, "not finished within 600 s" after 0.06 s, or
+            # dropped it inside an import (re-check trial, session 39)
+            _pass_alarm(old, signum, frame)
+            return
+        # not inside an import (the repeat RETIMEOUT_S later stops it)
+        if not _importing(already):
+            raise SpecTimeout
+
     # the timer starts inside the try, and the finally disarms it first: an alarm that landed
     # between starting the timer and the try (--timeout 1e-7), or in the finally before the
     # timer was cleared, left it repeating with this handler installed — "Alarm clock", exit
@@ -1332,19 +1362,31 @@ def _time_budget(seconds: float | None) -> Any:
     # own code later (batch trial, session 35)
     try:
         signal.signal(signal.SIGALRM, on_alarm)
-        # the alarm repeats every RETIMEOUT_S after the deadline until the block is left: an
-        # exception raised while Python runs a __del__ or a weakref callback is printed and
-        # dropped ("Exception ignored in ..."), and a sweep point past its 1 s budget then
-        # ran to its end (exit 1 instead of 3; a CI run, session 26)
-        signal.setitimer(signal.ITIMER_REAL, float(seconds), RETIMEOUT_S)
+        arm(time.monotonic())
         yield
     finally:
         leaving[0] = True
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, old if old is not None else signal.SIG_DFL)
-        if caller_left > 0:
-            left = max(caller_left - (time.monotonic() - t_start), MIN_BUDGET_S)
+        if caller[0] is not None:
+            left = max(caller[0] - time.monotonic(), MIN_BUDGET_S)
             signal.setitimer(signal.ITIMER_REAL, left, caller_every)
+
+
+#: an alarm this close before a deadline is that deadline's (timer and clock granularity)
+ALARM_SLACK_S = 1e-3
+
+
+def _pass_alarm(old: Any, signum: int, frame: Any) -> None:
+    """Hand a SIGALRM that is not the time budget's to the handler installed before the
+    budget: call it, or take the default action (end the process, as without the budget),
+    or nothing when it was ignored."""
+    if callable(old):
+        old(signum, frame)
+    elif old == signal.SIG_DFL:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, signal.SIG_DFL)
+        os.kill(os.getpid(), signal.SIGALRM)
 
 
 def _install_quiet_timeout() -> None:

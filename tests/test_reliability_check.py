@@ -631,7 +631,8 @@ def test_a_stop_that_lands_as_the_timer_starts_leaves_no_timer(monkeypatch) -> N
     """``check --timeout 1e-7``: the first alarm landed between starting the timer and the
     ``try``, so the ``finally`` never ran — the timer kept repeating with the budget's handler,
     and the process died "Alarm clock" (exit 142) after check had written its rows (batch
-    trial, session 35). Here the alarm's handler runs right after the timer is armed."""
+    trial, session 35). Here the alarm's handler runs right after the timer is armed, past
+    the deadline of a 10⁻⁷ s budget (an alarm before the deadline is not the budget's)."""
     import signal
 
     before = signal.getsignal(signal.SIGALRM)
@@ -645,7 +646,7 @@ def test_a_stop_that_lands_as_the_timer_starts_leaves_no_timer(monkeypatch) -> N
 
     monkeypatch.setattr(signal, "setitimer", arm_then_fire)
     with pytest.raises(api.SpecTimeout):
-        with api._time_budget(30):
+        with api._time_budget(1e-7):
             pass
     monkeypatch.setattr(signal, "setitimer", real)
     _real_itimer_and_alarm_restored(before)
@@ -866,4 +867,72 @@ def test_a_budget_puts_back_the_callers_own_timer(tmp_path: Path):
         assert fired  # fired right after the block
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+
+
+def test_the_callers_timer_fires_on_time_during_a_budget(monkeypatch):
+    """A caller's 0.3 s watchdog during design(timeout=100) of a design that takes 2 s fired
+    only when the design returned (re-check trial, session 39): the timer is armed for the
+    earlier of the two deadlines, and the caller's alarm goes to the caller's handler."""
+    import signal
+    import time
+
+    from obsdesign.methods import get_method
+
+    cls = type(get_method("lyapunov"))
+    real = cls.design
+
+    def slow(self: Any, *a: Any, **k: Any) -> Any:
+        for _ in range(40):
+            time.sleep(0.05)
+        return real(self, *a, **k)
+
+    class Watchdog(Exception):
+        pass
+
+    def bark(*a: Any) -> None:
+        raise Watchdog
+
+    monkeypatch.setattr(cls, "design", slow)
+    old = signal.signal(signal.SIGALRM, bark)
+    try:
+        t0 = time.monotonic()
+        signal.setitimer(signal.ITIMER_REAL, 0.3)
+        with pytest.raises(Watchdog):
+            api.design(SPEC, timeout=100)
+        assert time.monotonic() - t0 < 1.5
+        assert signal.getitimer(signal.ITIMER_REAL)[0] == 0  # the budget's timer is gone
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+
+
+def test_a_sigalrm_from_outside_is_not_the_budgets(monkeypatch):
+    """kill -ALRM during check's 600 s budget was read as the budget's own alarm: the spec
+    was "not finished within 600 s" after 0.06 s (re-check trial, session 39). An alarm
+    before the deadline goes to the handler installed before the budget (the CLI's stops
+    the command, "alarm clock", exit 142)."""
+    import os
+    import signal
+    import threading
+    import time
+
+    from obsdesign.methods import get_method
+
+    cls = type(get_method("lyapunov"))
+    real = cls.design
+
+    def slow(self: Any, *a: Any, **k: Any) -> Any:
+        for _ in range(20):
+            time.sleep(0.05)
+        return real(self, *a, **k)
+
+    got = []
+    monkeypatch.setattr(cls, "design", slow)
+    old = signal.signal(signal.SIGALRM, lambda *a: got.append(1))
+    try:
+        threading.Timer(0.2, lambda: os.kill(os.getpid(), signal.SIGALRM)).start()
+        rep = api.design(SPEC, timeout=600)  # no SolverError "not finished within 600 s"
+        assert rep.verdict == "ok" and got == [1]
+    finally:
         signal.signal(signal.SIGALRM, old)
