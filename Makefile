@@ -53,7 +53,7 @@ lint: install
 # Prints the score (equivalent mutants listed in docs/mutation.md excluded) and every mutant
 # not killed (`mutmut show NAME` shows one).
 MUTATION_SCOPE ?= kernel
-MUTATION_CLAIMS := obsdesign/methods/*/claims.py obsdesign/methods/lyapunov.py obsdesign/methods/lyapunov/* obsdesign/methods/impulsive/core.py obsdesign/methods/setinvariant/certificate.py
+MUTATION_CLAIMS := obsdesign/methods/*/claims.py obsdesign/lyap.py obsdesign/methods/lyapunov/* obsdesign/methods/impulsive/core.py obsdesign/methods/setinvariant/certificate.py
 MUTATION_TESTS ?= tests/
 MUTATION_JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 
