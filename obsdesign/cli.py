@@ -125,8 +125,9 @@ QuietOpt = Annotated[
     typer.Option(
         "-q",
         "--quiet",
-        help="Print only the one-line verdict (verify, check) or nothing (design, simulate); "
-        "no progress. Errors still go to stderr; --format json still prints the JSON.",
+        help="Print only the one-line verdict (verify, check, sweep) or nothing (design, "
+        "simulate); no progress. Errors still go to stderr; --format json still prints the "
+        "JSON.",
     ),
 ]
 WidthOpt = Annotated[
@@ -441,7 +442,8 @@ def design(
             "--plot",
             "--plot-epsilon",
             metavar="FILE",
-            help="Write the method's design plot (PNG/SVG), e.g. ε(z).",
+            help="Write the method's design plot, e.g. ε(z) (.png .svg .pdf .eps .jpg … by "
+            "the suffix).",
         ),
     ] = None,
     force: Annotated[
@@ -601,7 +603,11 @@ def sweep(
     ] = None,
     plot: Annotated[
         Path | None,
-        typer.Option("--plot", metavar="FILE", help="Plot --y against a swept key (PNG/SVG)."),
+        typer.Option(
+            "--plot",
+            metavar="FILE",
+            help="Plot --y against a swept key (.png .svg .pdf … by the suffix).",
+        ),
     ] = None,
     y: Annotated[
         str | None, typer.Option("--y", metavar="COLUMN", help="The plotted column.")
@@ -660,7 +666,10 @@ def simulate(
         typer.Option("--report", metavar="REPORT", help="Use this report's parameters."),
     ] = None,
     plot: Annotated[
-        Path | None, typer.Option("--plot", metavar="FILE", help="Write a plot (PNG/SVG).")
+        Path | None,
+        typer.Option(
+            "--plot", metavar="FILE", help="Write a plot (.png .svg .pdf … by the suffix)."
+        ),
     ] = None,
     csv: Annotated[
         Path | None,
