@@ -1963,3 +1963,16 @@ def test_a_tiny_gain_bound_shrinks_the_gain_into_it(bound: str) -> None:
     K = [F(int(k.p), int(k.q)) for k in np.asarray(rep.parameters["K"], dtype=object).ravel()]
     assert sum(k * k for k in K) <= F(bound) ** 2
     assert {c.id: c.status for c in rep.claims}["gain-bound"] == ClaimStatus.CERTIFIED
+
+
+def test_the_simulated_output_has_the_D_u_term() -> None:
+    """[system] D is accepted: the printed and CSV y left out D u (y = C x), while the
+    observer and observer_statespace take D u off (interop trial, session 39)."""
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.9, 0.2], [-0.1, 1.05]]\nC = [[1, 0]]\n'
+        'B = [[1], [0.5]]\nD = [[0.2]]\nsample_time = 0.1\n[method]\nkey = "stubborn"\n'
+        "[simulate]\nhorizon = 30\nx0 = [1, -1]\nxhat0 = [0, 0]\n"
+        '[simulate.u]\nkind = "constant"\nvalue = [0.3]\n[simulate.noise]\nkind = "zero"\n'
+    )
+    res = api.simulate(api.load_spec_text(text, "d.toml"))
+    np.testing.assert_allclose(res.y[:, 0], res.x[:, 0] + 0.2 * 0.3, rtol=0, atol=1e-15)

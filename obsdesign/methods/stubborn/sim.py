@@ -394,7 +394,7 @@ def single_run(
         V = v @ np.asarray(s.Dn.f, float).T
     else:
         V = noise_fn(rng, (), p, so, np.asarray(10.0))(0, steps + 1)
-    x, Dd = _plant(spec, steps, dt, rng, budget)
+    x, Dd, U = _plant(spec, steps, dt, rng, budget)
     e0 = x[0] - np.asarray(sim.xhat0.f, float)
     E = np.empty((steps + 1, n))
     S = np.empty(steps + 1)  # ρ = √σ̄
@@ -418,7 +418,12 @@ def single_run(
         )
         E[k + 1], S[k + 1] = e, rho
     xhat = x - E
+    # y = C x + D u + v: the plant's output (the D u term was left out of the printed and
+    # CSV y, while the observer — and observer_statespace — take it off; interop trial,
+    # session 39); the error recursion has no D u (it cancels in y − ŷ)
     y = x @ np.asarray(s.C.f, float).T + V
+    if s.m:
+        y = y + U @ np.asarray(s.D.f, float).reshape(s.p, s.m).T
     sig = S[:, None] / np.sqrt(g.w)
     with np.errstate(over="ignore"):
         S = S * S  # σ̄ itself (inf where it leaves the float range; σ stays finite)
@@ -442,12 +447,13 @@ def _plant(
     dt: float,
     rng: np.random.Generator,
     budget: TimeBudget | None = None,
-) -> tuple[np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Plant trajectory x (steps+1, n): ẋ = A x + B u(t) + Bd d (RK4; u from [system] u
     evaluated at each stage's time, or the [simulate.u] sample u_k and the
     [simulate.disturbance] sample d_k held over [t_k, t_{k+1})); x⁺ = ... in discrete
     time. Also returns the disturbance term Bd d_k (steps+1, n), which the observer does not
-    know: it enters the error dynamics."""
+    know: it enters the error dynamics, and the input u at each grid point (steps+1, m), for
+    the output's D u."""
     s = spec.system
     sim = spec.simulate
     A, B, Bd = (np.asarray(M.f, float) for M in (s.A, s.B, s.Bd))
@@ -486,7 +492,10 @@ def _plant(
         k3 = f(tk + dt / 2, xk + dt / 2 * k2)
         k4 = f(tk + dt, xk + dt * k3)
         x[k + 1] = xk + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-    return x, np.asarray(D, dtype=float).reshape(steps + 1, -1) @ Bd.T
+    U = np.zeros((steps + 1, s.m))
+    if s.m:
+        U[:] = np.array([u(grid[k], k) for k in range(steps + 1)], dtype=float).reshape(U.shape)
+    return x, np.asarray(D, dtype=float).reshape(steps + 1, -1) @ Bd.T, U
 
 
 def simulate(
