@@ -711,7 +711,19 @@ def spec_text_from_mat(
         if v not in data:
             known = ", ".join(sorted(k for k in shapes if not k.startswith("__")))
             raise InputError(f"{path}: no variable '{v}' for {key} (variables: {known})")
-        arr = np.asarray(data[v])
+        raw = data[v]
+        if hasattr(raw, "toarray"):
+            # a MATLAB sparse matrix (loadmat gives a scipy.sparse one; np.asarray made a
+            # 0-d object array, refused as "not a real numeric matrix" although the docs
+            # accept sparse: interop trial, session 39); its size is bounded above
+            raw = raw.toarray()
+        arr = np.asarray(raw)
+        if arr.dtype.kind == "c":
+            if np.any(arr.imag != 0):
+                raise InputError(
+                    f"{path}: variable '{v}' ({key}) is complex, with a nonzero imaginary part"
+                )
+            arr = arr.real.copy()
         if arr.dtype.kind not in "fiu":
             raise InputError(f"{path}: variable '{v}' ({key}) is not a real numeric matrix")
         if arr.ndim > 2:

@@ -995,3 +995,30 @@ def test_a_stubborn_high_gain_plant_given_by_A_and_psi_is_not_offered() -> None:
     rep = api.design(api.load_spec_text(text, "hg.toml"))
     with pytest.raises(InputError, match="not a linear state-space system"):
         rep.observer_statespace()
+
+
+def test_mat_import_takes_a_sparse_matrix_and_a_complex_one_with_zero_imaginary_part(
+    tmp_path: Path,
+) -> None:
+    """The docs accept sparse matrices, but loadmat's scipy.sparse value became a 0-d object
+    array, refused as "not a real numeric matrix"; a complex matrix with zero imaginary part
+    had the same message (interop trial, session 39). Both give the dense real matrix; a
+    nonzero imaginary part is named."""
+    import scipy.sparse
+    from scipy.io import savemat
+
+    A = np.array(A_D)
+    for name, value in (
+        ("sparse", scipy.sparse.csc_matrix(A)),
+        ("complex", A.astype(complex)),
+    ):
+        mat = tmp_path / f"{name}.mat"
+        savemat(mat, {"Ad": value, "Cm": np.array([[1.0, 0.0]])})
+        r = CliRunner().invoke(app, ["import", str(mat), "--A", "Ad", "--C", "Cm", "--dt", "1"])
+        assert r.exit_code == 0, r.stderr
+        got = tomllib.loads(r.stdout)["system"]["A"]
+        np.testing.assert_array_equal(np.array(got, float), A)
+    mat = tmp_path / "imag.mat"
+    savemat(mat, {"Ad": A + 1j, "Cm": np.array([[1.0, 0.0]])})
+    r = CliRunner().invoke(app, ["import", str(mat), "--A", "Ad", "--C", "Cm", "--dt", "1"])
+    assert r.exit_code == 2 and "complex, with a nonzero imaginary part" in r.stderr
