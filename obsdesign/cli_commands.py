@@ -977,6 +977,8 @@ def _dt_seconds(text: str) -> float:
             f"--dt is {text}, a nonzero number below the float range (it would read as 0, "
             "continuous time)"
         )
+    if f == -1 and q != -1:  # only -1 itself is MATLAB's "no sample time"
+        raise InputError(f"--dt {text!r}: expected a finite number >= 0, or exactly -1")
     return f
 
 

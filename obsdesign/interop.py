@@ -760,8 +760,12 @@ def spec_text_from_mat(
                 "--dt the spec is continuous time)"
             )
     given = "--dt"
-    if dt is not None and not (math.isfinite(dt) and dt >= 0):
-        raise InputError(f"--dt {dt!r}: expected a finite number >= 0 (0: continuous time)")
+    unspecified = dt == -1  # MATLAB's Ts = -1: discrete time, the sample time not given
+    if dt is not None and not unspecified and not (math.isfinite(dt) and dt >= 0):
+        raise InputError(
+            f"--dt {dt!r}: expected a finite number >= 0 (0: continuous time), or -1 (discrete "
+            "time with no sample time, as MATLAB's Ts = -1)"
+        )
     if dt_name is not None:
         given = f"{path}: variable '{dt_name}' (the sample time)"
         t = data.get(dt_name)
@@ -773,10 +777,13 @@ def spec_text_from_mat(
                 f"{path}: variable '{dt_name}' (the sample time) is not a real numeric scalar"
             )
         dt = float(t.reshape(-1)[0])
-        if not (np.isfinite(dt) and dt >= 0):
+        # MATLAB writes Ts = -1 for a discrete-time system whose sample time is not given
+        # (it was refused as "expected a finite number >= 0"; interop trial, session 39)
+        unspecified = dt == -1
+        if not unspecified and not (np.isfinite(dt) and dt >= 0):
             raise InputError(
                 f"{path}: variable '{dt_name}' (the sample time) is {dt:g}; expected a finite "
-                "number >= 0 (0: continuous time)"
+                "number >= 0 (0: continuous time), or -1 (discrete time with no sample time)"
             )
     if dt is not None and 0 < dt < np.finfo(float).tiny:
         # written as sample_time = 5e-324, then refused by the spec loader (session 28)
@@ -789,7 +796,10 @@ def spec_text_from_mat(
     Dm = D if D is not None else np.zeros((C.shape[0], 0))
     try:
         text = spec_text_from_statespace(
-            (A, Bm, C, Dm, dt if dt else 0), method, Bd=Bd, title=f"imported from {Path(path).name}"
+            (A, Bm, C, Dm, True if unspecified else (dt if dt else 0)),
+            method,
+            Bd=Bd,
+            title=f"imported from {Path(path).name}",
         )
     except InputError as e:  # e.g. shapes that do not fit: name the file
         raise InputError(f"{path}: {e}") from None

@@ -174,7 +174,8 @@ def test_mat_import_round_trip(tmp_path: Path):
         ({"Ts": "x"}, ["--dt-var", "Ts"], "'Ts' (the sample time) is not a real numeric scalar"),
         ({"Ts": np.array([[1.0, 2.0]])}, ["--dt-var", "Ts"], "not a real numeric scalar"),
         ({"Ts": np.nan}, ["--dt-var", "Ts"], "'Ts' (the sample time) is nan; expected a finite"),
-        ({"Ts": -1.0}, ["--dt-var", "Ts"], "(the sample time) is -1; expected a finite number"),
+        # -1 is MATLAB's "no sample time" (session 39): -2 is refused
+        ({"Ts": -2.0}, ["--dt-var", "Ts"], "(the sample time) is -2; expected a finite number"),
         ({"Ad": np.array([[np.inf, 0], [0, 1]])}, [], "'Ad' (A) has a non-finite entry"),
         ({"Ad": np.zeros((2, 2, 2))}, [], "'Ad' (A) has 3 dimensions, not 2"),
         ({"Ad": np.zeros((2, 3))}, [], "plant.mat: state-space shapes do not fit"),
@@ -1022,3 +1023,25 @@ def test_mat_import_takes_a_sparse_matrix_and_a_complex_one_with_zero_imaginary_
     savemat(mat, {"Ad": A + 1j, "Cm": np.array([[1.0, 0.0]])})
     r = CliRunner().invoke(app, ["import", str(mat), "--A", "Ad", "--C", "Cm", "--dt", "1"])
     assert r.exit_code == 2 and "complex, with a nonzero imaginary part" in r.stderr
+
+
+@pytest.mark.parametrize("how", ["var", "option"])
+def test_mat_import_reads_matlabs_ts_minus_one_as_discrete_time_without_a_sample_time(
+    tmp_path: Path, how: str
+) -> None:
+    """MATLAB writes Ts = -1 for a discrete-time system whose sample time is not given: it was
+    refused, "expected a finite number >= 0" (interop trial, session 39). It is discrete time
+    with no sample_time; -1.00000000000000001 (a float -1 that is not -1) is refused."""
+    from scipy.io import savemat
+
+    mat = tmp_path / "plant.mat"
+    savemat(mat, {"Ad": np.array(A_D), "Cm": np.array([[1.0, 0.0]]), "Ts": -1.0})
+    args = ["--dt-var", "Ts"] if how == "var" else ["--dt", "-1"]
+    r = CliRunner().invoke(app, ["import", str(mat), "--A", "Ad", "--C", "Cm", *args])
+    assert r.exit_code == 0, r.stderr
+    system = tomllib.loads(r.stdout)["system"]
+    assert system["time"] == "discrete" and "sample_time" not in system
+    if how == "option":
+        bad = ["--dt", "-1.00000000000000001"]
+        r = CliRunner().invoke(app, ["import", str(mat), "--A", "Ad", "--C", "Cm", *bad])
+        assert r.exit_code == 2 and "exactly -1" in r.stderr
