@@ -1514,3 +1514,16 @@ def test_simulate_warns_when_the_gain_in_doubles_loses_the_certificate() -> None
     assert "A − LC in doubles is not stable" in said
     ok = api.simulate(ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml")
     assert not any("in doubles" in w for w in ok.info.get("warnings", []))
+
+
+def test_design_notes_when_the_gain_in_doubles_loses_the_certificate() -> None:
+    """design and verify said nothing while the report's float L made A − LC unstable on an
+    ill-conditioned plant (lyapunov trial, session 39): the design notes it (decided exactly
+    on the doubles); a well-conditioned design (the shipped spec)
+    has no such note."""
+    data = Path(__file__).parent / "data" / "lyapunov-rho-6000-5state.toml"
+    rep = api.design(api.load_spec(data))
+    assert rep.exit_code() == 0
+    assert any("A − LC with L in doubles is not stable" in n for n in rep.notes)
+    ok = api.design(ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml")
+    assert not any("in doubles" in n for n in ok.notes)

@@ -293,8 +293,48 @@ def _design_for(
         + (f"infimum ≈ {bound:.6g}" if s.discrete else f"supremum ≈ {-bound:.6g}")
         + f" ({guide.source})"
     )
+    note = _float_gain_note(s, Af, L, rate, bound, guide.source)
+    if note is not None:
+        notes.append(note)
     lyap.attach_memo(spec, memo)
     return Design(params, solver, notes)
+
+
+def _float_gain_note(
+    s: Any, Af: np.ndarray, L: np.ndarray, rate: Any, bound: float, source: str
+) -> str | None:
+    """A note when L in doubles does not keep the certified rate (what ``simulate`` steps and
+    ``observer_statespace`` exports; both check it exactly): the certificate is about the
+    exact L, and on ill-conditioned plants the doubles lose it (certified ρ = 0.17, ρ = 1.06
+    for the float gain; lyapunov trial, session 39). Decided exactly by
+    :func:`obsdesign.lyap.float_realization`, skipped when the eigenvalues are accurate float
+    ones and the rate's margin is far above what rounding L, A and C can move them
+    (Bauer–Fike with the guide's error bound; a guide, the exact checks are downstream).
+
+    :param s: the plant; :param Af: A − LC (float); :param L: the gain (exact); :param rate:
+    the certified rate; :param bound: the spectral radius / abscissa (guide); :param source:
+    where the guide's eigenvalues come from."""
+    from obsdesign.certify.exact import to_float
+    from obsdesign.spectrum import FLOAT_SOURCE, FLOAT_TOL
+
+    Lf = np.asarray(to_float(np.asarray(L, dtype=object)), dtype=float)  # the report's doubles
+    Af_plant, Cf = np.asarray(s.A.f, float), np.asarray(s.C.f, float)
+    margin = float(rate) - bound if s.discrete else -bound - float(rate)
+    scale = 1.0 + (np.linalg.norm(Af_plant) + np.linalg.norm(Lf) * np.linalg.norm(Cf)) / max(
+        float(np.linalg.norm(Af)), np.finfo(float).tiny
+    )
+    if source == FLOAT_SOURCE and margin > 10 * FLOAT_TOL * max(1.0, abs(bound)) * scale:
+        return None
+    verdict = lyap.float_realization(Af_plant - Lf @ Cf, s.discrete, rate)
+    if verdict == "ok":
+        return None
+    what = "is not stable" if verdict == "unstable" else "is stable but slower than the rate"
+    return (
+        f"warning: A − LC with L in doubles {what}: the certificate is about the exact L "
+        "(parameters.exact.L), and this plant is too badly conditioned for a float64 gain to "
+        "keep it; simulate and observer_statespace() use the doubles (simulate warns, "
+        "observer_statespace refuses an unstable one)"
+    )
 
 
 #: default Riccati weights (the Kalman-filter reading: process noise covariance Q, output
