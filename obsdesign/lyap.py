@@ -1171,6 +1171,39 @@ def _certified_P_hp(
         P = as_array(Pm)
         if _passes(Am, P, Pm, r, discrete, margin, memo, Af):
             return P
+    return _certified_P_exact(Am, r, discrete, margin, memo, Af)
+
+
+def _certified_P_exact(
+    Am: fmpq_mat, r: fmpq, discrete: bool, margin: Any, memo: ExactMemo | None, Af: np.ndarray
+) -> np.ndarray | None:
+    """The last fallback of :func:`certified_P` (n ≤ ``lyap_hp.EXACT_MAX_N``): the exact
+    rational Lyapunov P (decay matrix exactly I, :func:`obsdesign.lyap_hp.lyapunov_P_exact`),
+    rounded to 512, 1024, 2048 relative bits, scaled for the margin and checked by the same
+    exact tests; a candidate whose exact strings would exceed the report's ``max_digits``
+    (verify could not read it back) is not taken. Eq. (4)-(6), constrained-redesign paper."""
+    from obsdesign import lyap_hp
+    from obsdesign.limits import limits
+
+    if Am.nrows() > lyap_hp.EXACT_MAX_N:
+        return None
+    Pe = lyap_hp.lyapunov_P_exact(Am, r, discrete)
+    if Pe is None:
+        return None
+    most = limits().max_digits
+    for bits in lyap_hp.EXACT_BITS:
+        Pm = lyap_hp.round_relative(Pe, bits)
+        Pm = Pm * margin_scale(mat_float(Pm), margin, Pm)
+        n = Pm.nrows()
+        if any(
+            len(str(abs(Pm[i, j].p))) > most or len(str(Pm[i, j].q)) > most
+            for i in range(n)
+            for j in range(n)
+        ):
+            break
+        P = as_array(Pm)
+        if _passes(Am, P, Pm, r, discrete, margin, memo, Af):
+            return P
     return None
 
 

@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 
 from obsdesign import api, lyap, lyap_hp
 from obsdesign.certify.exact import Q, qmat
+from obsdesign.certify.psd import check_pd
 from obsdesign.spectrum import Spectrum
 
 #: the soundness audit's spec (session 11): a Riccati gain makes A − LC entries of ~1e5
@@ -197,3 +198,68 @@ def test_hp_P_with_integer_entries_is_exact(acl: list, rate: object, discrete: b
     P = lyap_hp.lyapunov_P_hp(Am, rate, discrete, 128)
     assert P == fmpq_mat(want)
     assert lyap.decay_fmat(Am, P, Q(rate), discrete) == fmpq_mat([[1, 0], [0, 1]])
+
+
+#: the lyapunov trial's 6-state plant (session 39): ‖A − LC‖ ≈ 9·10¹¹ around a spectral
+#: radius of 0.0028 (entries 10⁻⁸ … 10⁸); 128 and 320 bits gave no P at λ = 0.01 (exit 4)
+SCALES = Path(__file__).parent / "data" / "lyapunov-scales-6state.toml"
+
+
+def test_the_exact_solve_certifies_where_320_bits_do_not(monkeypatch) -> None:
+    """λ = 0.01 for the 6-state plant: the exact rational P (decay matrix exactly I) rounded
+    to 512 relative bits passes the exact checks; without the exact fallback (EXACT_MAX_N =
+    0) nothing does, as before; below the spectral radius (λ = 0.0027) nothing does either
+    (the exact P is then not ≻ 0)."""
+    sp = api.load_spec(SCALES)
+    s = sp.system
+    L = lyap.fmat(sp.options.L)
+    Acl = lyap.closed_loop_fmat(s.A.q, s.C.q, L)
+    Lq = lyap.as_array(L)
+    d = fmpq(1, 10**9)
+    P = lyap.certified_P(s.A.q, s.C.q, Lq, True, fmpq(1, 100), d, Acl=Acl)
+    assert P is not None
+    Pm = lyap.fmat(P)
+    r = fmpq(1, 100)
+    eye = fmpq_mat(6, 6, [int(i == j) for i in range(6) for j in range(6)])
+    assert check_pd(lyap.as_array(Pm - d * eye)).ok  # P − δI ≻ 0 and the decay LMI, exactly
+    assert check_pd(lyap.as_array(r * r * Pm - Acl.transpose() * Pm * Acl - d * eye)).ok
+    assert lyap.certified_P(s.A.q, s.C.q, Lq, True, fmpq(27, 10000), d, Acl=Acl) is None
+    monkeypatch.setattr(lyap_hp, "EXACT_MAX_N", 0)
+    assert lyap.certified_P(s.A.q, s.C.q, Lq, True, fmpq(1, 100), d, Acl=Acl) is None
+
+
+def test_exact_P_has_the_decay_matrix_I_and_rounding_stays_close() -> None:
+    Acl = lyap.fmat(qmat([[fmpq(1, 2), 1000], [0, fmpq(-1, 3)]]))
+    r = fmpq(3, 5)
+    P = lyap_hp.lyapunov_P_exact(Acl, r, True)
+    assert P is not None and P == P.transpose()
+    assert r * r * P - Acl.transpose() * P * Acl == fmpq_mat(2, 2, [1, 0, 0, 1])
+    R = lyap_hp.round_relative(P, 64)
+    top = max(abs(P[i, j]) for i in (0, 1) for j in (0, 1))
+    assert all(abs(R[i, j] - P[i, j]) <= top / 2**62 for i in (0, 1) for j in (0, 1))
+    assert (
+        lyap_hp.lyapunov_P_exact(
+            lyap.fmat(qmat([[fmpq(1, 2), 0], [0, fmpq(1, 2)]])), fmpq(1, 2), True
+        )
+        is None
+    )
+
+
+def test_an_exact_P_beyond_the_reports_digits_is_not_taken(monkeypatch) -> None:
+    """A candidate whose exact strings exceed max_digits would make a report verify cannot
+    read back: with max_digits = 60 the 6-state plant's fallback gives nothing."""
+    from obsdesign.limits import limits, reset_limits, set_limits
+
+    sp = api.load_spec(SCALES)
+    s = sp.system
+    L = lyap.fmat(sp.options.L)
+    Acl = lyap.closed_loop_fmat(s.A.q, s.C.q, L)
+    old = set_limits(max_digits=60)
+    try:
+        assert limits().max_digits == 60
+        got = lyap._certified_P_exact(
+            Acl, fmpq(1, 100), True, fmpq(1, 10**9), None, lyap.mat_float(Acl)
+        )
+        assert got is None
+    finally:
+        reset_limits(old)
