@@ -196,9 +196,12 @@ def captured_warnings(notes: list[str]) -> Iterator[None]:
         try:
             yield
         except OverflowError as e:
+            # math's OverflowError carries (errno, text): it printed as a raw tuple,
+            # "((34, 'Numerical result out of range'))" (lyapunov trial, session 39)
+            why = e.args[1] if len(e.args) == 2 and isinstance(e.args[0], int) else str(e)
             raise InconclusiveError(
-                f"a number is beyond the float range ({e}): the spec's numbers are too "
-                "large for this computation"
+                f"a number is beyond the float range ({why}): the spec's numbers are too "
+                "large (or too small: their inverses) for this computation"
             ) from e
         finally:
             seen: set[str] = set()

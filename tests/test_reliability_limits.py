@@ -385,6 +385,18 @@ def test_an_overflow_inside_a_computation_is_inconclusive_not_internal() -> None
     with pytest.raises(ZeroDivisionError):
         with api.captured_warnings([]):
             1 / 0  # noqa: B018
+    # math's (errno, text) pair printed as a raw tuple (lyapunov trial, session 39)
+    import math
+
+    with pytest.raises(InconclusiveError) as e:
+        with api.captured_warnings([]):
+            math.exp(1000)
+    with pytest.raises(InconclusiveError) as e2:
+        with api.captured_warnings([]):
+            1e300**2
+    for err in (e, e2):
+        assert "((" not in err.value.message and "(34," not in err.value.message
+        assert "beyond the float range (" in err.value.message
 
 
 @given(
