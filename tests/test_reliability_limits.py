@@ -393,7 +393,7 @@ def test_an_overflow_inside_a_computation_is_inconclusive_not_internal() -> None
             math.exp(1000)
     with pytest.raises(InconclusiveError) as e2:
         with api.captured_warnings([]):
-            1e300**2
+            1e300**2  # noqa: B018
     for err in (e, e2):
         assert "((" not in err.value.message and "(34," not in err.value.message
         assert "beyond the float range (" in err.value.message
