@@ -100,6 +100,11 @@ def test_an_empty_matrix_says_to_leave_the_key_out(empty: list) -> None:
     with pytest.raises(SpecError) as e:  # a malformed, non-empty matrix: no such hint
         Table({"B": [[1], "x"]}, "t.toml", checked=True).matrix("B", rows=2)
     assert "leave" not in str(e.value)
+    # Dn left out is the identity, not "no noise" (lyapunov trial, session 39)
+    with pytest.raises(SpecError) as e:
+        Table({"Dn": empty}, "t.toml", checked=True).matrix("Dn", rows=2)
+    assert "leaves B, D or Bd out" not in str(e.value)
+    assert "left out, Dn is the identity" in str(e.value) and "as zeros" in str(e.value)
 
 
 def test_missing_key_held_by_a_misspelt_sibling_table_names_the_typo() -> None:

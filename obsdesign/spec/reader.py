@@ -263,6 +263,13 @@ class Table:
                 if empty
                 else ""
             )
+            if empty and k == "Dn":
+                # leaving Dn out is the identity, one noise per output, not "no noise"
+                # (lyapunov trial, session 39)
+                hint = (
+                    "; [] and [[], ...] are not matrices (left out, Dn is the identity: one "
+                    "noise per output; an output without noise writes its row of Dn as zeros)"
+                )
             raise self.error(
                 k, f"expected a matrix (a list of rows of numbers){_shape(rows, cols)}{hint}"
             )
