@@ -1527,3 +1527,18 @@ def test_design_notes_when_the_gain_in_doubles_loses_the_certificate() -> None:
     assert any("A − LC with L in doubles is not stable" in n for n in rep.notes)
     ok = api.design(ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml")
     assert not any("in doubles" in n for n in ok.notes)
+
+
+def test_the_float_gain_note_is_not_skipped_by_a_small_continuous_abscissa() -> None:
+    """Continuous, α = 0.0009, eigenvalues −0.001 and −10⁷ of the exact A − LC: the doubles
+    give +2.8·10⁻⁴, unstable, and the design said nothing — its skip measured the rate's
+    margin against the abscissa (10⁻³) instead of the eigenvalues' size (10⁷) that the
+    guide's error bound is relative to (re-check trial, session 39)."""
+    text = (
+        '[system]\ntime = "continuous"\nA = [[690287.999, -13420000000], '
+        '[5000000000.997, -10000000]]\nC = [[8000, 0]]\n[method]\nkey = "lyapunov"\n'
+        "L = [86.286, 625000.000124625]\nalpha = 0.0009\n"
+    )
+    rep = api.design(api.load_spec_text(text, "fg1.toml"))
+    assert rep.exit_code() == 0
+    assert any("A − LC with L in doubles is not stable" in n for n in rep.notes)

@@ -293,7 +293,7 @@ def _design_for(
         + (f"infimum ≈ {bound:.6g}" if s.discrete else f"supremum ≈ {-bound:.6g}")
         + f" ({guide.source})"
     )
-    note = _float_gain_note(s, Af, L, rate, bound, guide.source)
+    note = _float_gain_note(s, Af, L, rate, bound, guide)
     if note is not None:
         notes.append(note)
     lyap.attach_memo(spec, memo)
@@ -301,7 +301,7 @@ def _design_for(
 
 
 def _float_gain_note(
-    s: Any, Af: np.ndarray, L: np.ndarray, rate: Any, bound: float, source: str
+    s: Any, Af: np.ndarray, L: np.ndarray, rate: Any, bound: float, guide: Any
 ) -> str | None:
     """A note when L in doubles does not keep the certified rate (what ``simulate`` steps and
     ``observer_statespace`` exports; both check it exactly): the certificate is about the
@@ -312,8 +312,11 @@ def _float_gain_note(
     (Bauer–Fike with the guide's error bound; a guide, the exact checks are downstream).
 
     :param s: the plant; :param Af: A − LC (float); :param L: the gain (exact); :param rate:
-    the certified rate; :param bound: the spectral radius / abscissa (guide); :param source:
-    where the guide's eigenvalues come from."""
+    the certified rate; :param bound: the spectral radius / abscissa (guide); :param guide:
+    the :class:`~obsdesign.spectrum.Spectrum` of A − LC (its error bound is relative to
+    max(1, the largest |eigenvalue|), not to the abscissa: a continuous abscissa of 10⁻³
+    beside an eigenvalue of −10⁷ skipped a check the doubles fail; re-check trial, session
+    39)."""
     from obsdesign.certify.exact import to_float
     from obsdesign.spectrum import FLOAT_SOURCE, FLOAT_TOL
 
@@ -323,7 +326,8 @@ def _float_gain_note(
     scale = 1.0 + (np.linalg.norm(Af_plant) + np.linalg.norm(Lf) * np.linalg.norm(Cf)) / max(
         float(np.linalg.norm(Af)), np.finfo(float).tiny
     )
-    if source == FLOAT_SOURCE and margin > 10 * FLOAT_TOL * max(1.0, abs(bound)) * scale:
+    size = max(1.0, float(np.max(np.abs(guide.w)))) if guide.w.size else 1.0
+    if guide.source == FLOAT_SOURCE and margin > 10 * FLOAT_TOL * size * scale:
         return None
     verdict = lyap.float_realization(Af_plant - Lf @ Cf, s.discrete, rate)
     if verdict == "ok":
