@@ -1174,6 +1174,10 @@ def _certified_P_hp(
     return _certified_P_exact(Am, r, discrete, margin, memo, Af)
 
 
+#: the largest binary exponent of an entry of the exact fallback's P (a float view's margin)
+FLOAT_VIEW_BITS = 1020
+
+
 def _certified_P_exact(
     Am: fmpq_mat, r: fmpq, discrete: bool, margin: Any, memo: ExactMemo | None, Af: np.ndarray
 ) -> np.ndarray | None:
@@ -1195,6 +1199,16 @@ def _certified_P_exact(
         Pm = lyap_hp.round_relative(Pe, bits)
         Pm = Pm * margin_scale(mat_float(Pm), margin, Pm)
         n = Pm.nrows()
+        # a P beyond the float range has no float view (the report is then exit 4, "an
+        # exact value lies beyond the float range"): scaled down by a power of two to about
+        # 2^1020, the exact checks deciding whether the margin still holds (re-check trial,
+        # session 39: a 4×4 Jordan block at λ = ρ + 10⁻⁴⁰)
+        top = max(
+            (Pm[i, j].p.bit_length() - Pm[i, j].q.bit_length() for i in range(n) for j in range(n)),
+            default=0,
+        )
+        if top > FLOAT_VIEW_BITS:
+            Pm = Pm * fmpq(1, 2 ** (top - FLOAT_VIEW_BITS))
         if any(
             len(str(abs(Pm[i, j].p))) > most or len(str(Pm[i, j].q)) > most
             for i in range(n)

@@ -263,3 +263,21 @@ def test_an_exact_P_beyond_the_reports_digits_is_not_taken(monkeypatch) -> None:
         assert got is None
     finally:
         reset_limits(old)
+
+
+def test_an_exact_P_beyond_the_float_range_is_scaled_into_it() -> None:
+    """A 4×4 Jordan block (0.5, superdiagonal 10⁶) at λ = ½ + 10⁻⁴⁰, margin 10⁻²⁰: the exact
+    fallback's P had entries beyond the float range, and the design stopped with exit 4 "an
+    exact value lies beyond the float range" (re-check trial, session 39). Scaled down to
+    about 2^1020 it still passes the exact checks; the report verifies."""
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.5, 1000000, 0, 0], [0, 0.5, 1000000, 0], '
+        "[0, 0, 0.5, 1000000], [0, 0, 0, 0.5]]\nC = [[1, 0, 0, 0]]\n[method]\n"
+        'key = "lyapunov"\nL = [0, 0, 0, 0]\n'
+        "lambda = 0.50000000000000000000000000000000000000001\nmargin = 1e-20\n"
+    )
+    rep = api.design(api.load_spec_text(text, "jd4.toml"))
+    assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
+    P = np.asarray(rep.parameters.float("P"), dtype=float)
+    assert np.all(np.isfinite(P)) and np.max(np.abs(P)) > 1e300
+    assert api.verify(rep).exit_code() == 0
