@@ -771,7 +771,11 @@ def spec_text_from_mat(
         t = data.get(dt_name)
         if t is None:
             raise InputError(f"{path}: no variable '{dt_name}' for the sample time")
+        if hasattr(t, "toarray"):  # sparse, as the matrices (re-check trial, session 39)
+            t = t.toarray()
         t = np.asarray(t)
+        if t.dtype.kind == "c" and t.size == 1 and not np.any(t.imag != 0):
+            t = t.real.copy()
         if t.dtype.kind not in "fiu" or t.size != 1:
             raise InputError(
                 f"{path}: variable '{dt_name}' (the sample time) is not a real numeric scalar"

@@ -1019,6 +1019,15 @@ def test_mat_import_takes_a_sparse_matrix_and_a_complex_one_with_zero_imaginary_
         assert r.exit_code == 0, r.stderr
         got = tomllib.loads(r.stdout)["system"]["A"]
         np.testing.assert_array_equal(np.array(got, float), A)
+    # the sample time alike: a sparse or complex (zero imaginary part) Ts
+    for ts in (scipy.sparse.csc_matrix([[0.5]]), np.array([[0.5 + 0j]])):
+        mat = tmp_path / "ts.mat"
+        savemat(mat, {"Ad": A, "Cm": np.array([[1.0, 0.0]]), "Ts": ts})
+        r = CliRunner().invoke(
+            app, ["import", str(mat), "--A", "Ad", "--C", "Cm", "--dt-var", "Ts"]
+        )
+        assert r.exit_code == 0, r.stderr
+        assert tomllib.loads(r.stdout)["system"]["sample_time"] == 0.5
     mat = tmp_path / "imag.mat"
     savemat(mat, {"Ad": A + 1j, "Cm": np.array([[1.0, 0.0]])})
     r = CliRunner().invoke(app, ["import", str(mat), "--A", "Ad", "--C", "Cm", "--dt", "1"])
