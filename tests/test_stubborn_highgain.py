@@ -492,3 +492,52 @@ def test_substeps_are_the_steps_of_a_finer_grid() -> None:
 
     ref = solve_ivp(f, (0, 1), [1.0, 0.0], t_eval=fine.t, rtol=1e-12, atol=1e-12).y.T
     np.testing.assert_allclose(fine.x, ref, rtol=0, atol=1e-6)
+
+
+HG_FLOAT = """
+[system]
+time = "continuous"
+states = ["x1", "x2"]
+f = ["F1", "-sin(x1)"]
+C = [[1, 0]]
+[method]
+key = "stubborn"
+mode = "high-gain"
+K = [2, 1]
+lipschitz = 1
+"""
+
+
+@pytest.mark.parametrize(
+    ("f1", "warned"),
+    [
+        ("x2 - 2e16*cos(pi/2)*x2", True),  # cos(π/2) ≈ 6·10⁻¹⁷ in floats: ẋ1 ≈ −0.22·x2
+        ("x2 + (0.1 + 0.2 - 0.3)*2e16*x2", True),
+        ("x2", False),
+        ("x2 + 1e12*x1**3", False),  # a large φ_1 of x1: rounding, not a dependence
+        ("x2 + 0*x2", False),
+    ],
+)
+def test_a_plant_that_is_triangular_only_exactly_gets_a_note(f1: str, warned: bool) -> None:
+    """The triangular form is proved on the exact expressions, but simulate runs the doubles:
+    2e16·cos(π/2)·x2 is 0 exactly and −1.22·x2 in floats, and the certified design diverged
+    in simulate (|e| = 4920) with exit 0 and no word (expression-claims trial, session 39).
+    The design notes it."""
+    rep = api.design(api.load_spec_text(HG_FLOAT.replace("F1", f1), "hg.toml"))
+    assert rep.exit_code() == 0
+    said = [n for n in rep.notes if "in doubles" in n]
+    assert bool(said) is warned, said
+    if warned:
+        assert "ẋ_1 reads x2" in said[0]
+
+
+def test_the_linear_part_warning_reads_A_only_when_the_plant_is_A_plus_psi() -> None:
+    """f = (x2, −sin x1) beside A = [[0, 1], [−100, 0]]: the plant is f, A is not read, and
+    the warning "A's terms have norm ≈ 100 > L" was false (expression-claims trial, session
+    39)."""
+    text = HG_FLOAT.replace("F1", "x2").replace(
+        "C = [[1, 0]]", "A = [[0, 1], [-100, 0]]\nC = [[1, 0]]"
+    )
+    rep = api.design(api.load_spec_text(text, "fa.toml"))
+    assert rep.exit_code() == 0
+    assert not [n for n in rep.notes if "on and below its diagonal" in n]

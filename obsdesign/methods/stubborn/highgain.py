@@ -122,6 +122,9 @@ def design_params(
         f"ℓ* = 2L|P| ≤ {fmt_up(ell_star, 6)} (L = {fmt_exact(o.lipschitz)}); ℓ = {fmt_exact(ell)}",
         "ε is the user's choice (default 1): the slides give no formula for ε*",
     ]
+    floats = _float_chain_note(spec)
+    if floats is not None:
+        notes.append(floats)
     lin = _linear_part_norm(spec)
     if lin > float(o.lipschitz):
         notes.append(
@@ -144,11 +147,60 @@ def _linear_part_norm(spec: Spec) -> float:
     scaled Δ_φ at ℓ = 1 (the scaling only shrinks it for ℓ ≥ 1); 0 without A (the f form).
     Information for a warning, never a claim."""
     s = spec.system
-    if s.A is None:
+    if s.A is None or s.f is not None:
+        # with f given the plant is f (docs/spec.md) and A is not read: its terms warned
+        # "norm ≈ 100 > L" for f = (x2, −sin x1) (expression-claims trial, session 39)
         return 0.0
     A0, _ = chain(s.n)
     M = np.asarray(to_float(np.asarray(s.A.q, dtype=object) - A0), dtype=float)
     return float(np.linalg.norm(M, 2)) if M.size else 0.0
+
+
+def _float_chain_note(spec: Spec) -> str | None:
+    """A warning when the plant evaluated in doubles is not in the triangular form the exact
+    reading certified: ẋ_i must read x_{i+1} with coefficient 1 and no later state, which
+    the options check proves on the exact expressions (sympy), while ``simulate`` runs the
+    doubles. An exact zero that is not zero in doubles (2e16·cos(π/2)·x2, cos(π/2) ≈ 6·10⁻¹⁷
+    in floats) made the simulated plant ẋ1 = −0.22·x2: the certified observer diverged in
+    simulate with exit 0 and no word (expression-claims trial, session 39). Found by
+    perturbing each state at 64 seeded points of the state box (``state_bound``, else
+    [−1, 1]ⁿ); information for a note, never a claim."""
+    s = spec.system
+    n = s.n
+    if n < 2:
+        return None
+    F = _rhs(spec)
+    o: Options = spec.options
+    box = np.asarray(o.state_bound, float) if o.state_bound is not None else np.ones(n)
+    rng = np.random.default_rng(0)
+    X = rng.uniform(-1.0, 1.0, (64, n)) * box
+    u, d = np.zeros(len(s.inputs)), np.zeros(len(s.disturbances))
+    with np.errstate(all="ignore"):
+        base = F(X, u, d, 0.0)
+        for j in range(1, n):
+            step = 1e-3 * float(box[j])
+            Y = X.copy()
+            Y[:, j] += step
+            moved = F(Y, u, d, 0.0)
+            dx = (Y[:, j] - X[:, j])[:, None]
+            diff = (moved - base) / dx
+            # the rounding of f's values themselves, over the step (a large φ_i of x_1..x_i)
+            noise = 64 * np.finfo(float).eps * (np.abs(base) + np.abs(moved)) / np.abs(dx)
+            for i in range(j):
+                want = 1.0 if i == j - 1 else 0.0
+                dev = diff[:, i] - want
+                tol = 1e-6 * (1.0 + np.abs(diff[:, i])) + noise[:, i]
+                bad = ~np.isfinite(dev) | (np.abs(dev) > tol)
+                if np.any(bad & np.isfinite(base[:, i])):
+                    k = int(np.argmax(np.where(np.isfinite(dev), np.abs(dev), np.inf)))
+                    return (
+                        f"WARNING: in doubles, ẋ_{i + 1} reads {s.states[j]} with coefficient "
+                        f"≈ {float(diff[k, i]):.6g} (exactly {want:g} in the certified reading "
+                        "of the expressions): an exact zero that is not zero in floats (such as "
+                        "2e16·cos(pi/2)); the certificate is about the exact plant, and simulate "
+                        "runs the doubles"
+                    )
+    return None
 
 
 def certify(spec: Spec, params: Parameters) -> list[Claim]:
