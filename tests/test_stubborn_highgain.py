@@ -541,3 +541,13 @@ def test_the_linear_part_warning_reads_A_only_when_the_plant_is_A_plus_psi() -> 
     rep = api.design(api.load_spec_text(text, "fa.toml"))
     assert rep.exit_code() == 0
     assert not [n for n in rep.notes if "on and below its diagonal" in n]
+
+
+def test_another_C_says_to_reorder_the_states_not_to_omit_C() -> None:
+    """ "omit C or reorder the states", but C is required (expression-claims trial, 39)."""
+    from obsdesign.errors import SpecError
+
+    text = HG_FLOAT.replace("F1", "x2").replace("C = [[1, 0]]", "C = [[0, 1]]")
+    with pytest.raises(SpecError, match=r"\[system.C\].*reorder the states") as e:
+        api.load_spec_text(text, "c.toml")
+    assert "omit C" not in str(e.value)

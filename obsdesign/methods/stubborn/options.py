@@ -195,7 +195,7 @@ def parse_options(table: Table, spec: Spec) -> Options:
                 spec.file,
                 "system.C",
                 "must be [[1, 0, …, 0]] in mode = 'high-gain' (the high-gain observer measures "
-                "y = x1 of the triangular form); omit C or reorder the states",
+                "y = x1 of the triangular form): reorder the states so that y is the first",
             )
         _check_triangular(spec)
         K = table.vector("K", n=n).q
