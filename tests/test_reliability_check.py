@@ -870,11 +870,9 @@ def test_a_budget_puts_back_the_callers_own_timer(tmp_path: Path):
         signal.signal(signal.SIGALRM, old)
 
 
-def test_the_callers_timer_fires_on_time_during_a_budget(monkeypatch):
-    """A caller's 0.3 s watchdog during design(timeout=100) of a design that takes 2 s fired
-    only when the design returned (re-check trial, session 39): the timer is armed for the
-    earlier of the two deadlines, and the caller's alarm goes to the caller's handler."""
-    import signal
+def _slow_lyapunov_design(monkeypatch: Any, seconds: float) -> None:
+    """Make the lyapunov method's design take ``seconds`` more, in 0.05 s sleeps (each a
+    point where a signal's handler runs)."""
     import time
 
     from obsdesign.methods import get_method
@@ -883,9 +881,19 @@ def test_the_callers_timer_fires_on_time_during_a_budget(monkeypatch):
     real = cls.design
 
     def slow(self: Any, *a: Any, **k: Any) -> Any:
-        for _ in range(40):
+        for _ in range(round(seconds / 0.05)):
             time.sleep(0.05)
         return real(self, *a, **k)
+
+    monkeypatch.setattr(cls, "design", slow)
+
+
+def test_the_callers_timer_fires_on_time_during_a_budget(monkeypatch):
+    """A caller's 0.3 s watchdog during design(timeout=100) of a design that takes 2 s fired
+    only when the design returned (re-check trial, session 39): the timer is armed for the
+    earlier of the two deadlines, and the caller's alarm goes to the caller's handler."""
+    import signal
+    import time
 
     class Watchdog(Exception):
         pass
@@ -893,7 +901,7 @@ def test_the_callers_timer_fires_on_time_during_a_budget(monkeypatch):
     def bark(*a: Any) -> None:
         raise Watchdog
 
-    monkeypatch.setattr(cls, "design", slow)
+    _slow_lyapunov_design(monkeypatch, 2.0)
     old = signal.signal(signal.SIGALRM, bark)
     try:
         t0 = time.monotonic()
@@ -915,20 +923,9 @@ def test_a_sigalrm_from_outside_is_not_the_budgets(monkeypatch):
     import os
     import signal
     import threading
-    import time
-
-    from obsdesign.methods import get_method
-
-    cls = type(get_method("lyapunov"))
-    real = cls.design
-
-    def slow(self: Any, *a: Any, **k: Any) -> Any:
-        for _ in range(20):
-            time.sleep(0.05)
-        return real(self, *a, **k)
 
     got = []
-    monkeypatch.setattr(cls, "design", slow)
+    _slow_lyapunov_design(monkeypatch, 1.0)
     old = signal.signal(signal.SIGALRM, lambda *a: got.append(1))
     try:
         threading.Timer(0.2, lambda: os.kill(os.getpid(), signal.SIGALRM)).start()
