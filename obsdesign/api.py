@@ -305,9 +305,11 @@ def _design_budget(budget: float | None, deadline: float | None) -> Iterator[Non
     if left <= 0:
         raise SolverError(message)
     try:
-        with _time_budget(max(left, MIN_BUDGET_S)):
+        with _time_budget(max(left, MIN_BUDGET_S)) as token:
             yield
-    except SpecTimeout:
+    except SpecTimeout as e:
+        if e.args and e.args[0] is not token:
+            raise  # an outer budget's stop (design(timeout=) inside check(timeout=))
         raise SolverError(message) from None
 
 
@@ -1325,6 +1327,8 @@ def _time_budget(seconds: float | None) -> Any:
     t_start = time.monotonic()
     deadline = t_start + float(seconds)
     caller: list[float | None] = [t_start + caller_left if caller_left > 0 else None]
+    every = [caller_every]
+    token = object()  # this budget's stop (a nested budget passes an outer one's on)
 
     def arm(now: float) -> None:
         if caller[0] is not None and caller[0] < deadline:
@@ -1343,20 +1347,35 @@ def _time_budget(seconds: float | None) -> Any:
             return
         now = time.monotonic()
         if caller[0] is not None and now >= caller[0] - ALARM_SLACK_S:
-            caller[0] = caller[0] + caller_every if caller_every > 0 else None
-            arm(now)
-            _pass_alarm(old, signum, frame)
+            caller[0] = caller[0] + every[0] if every[0] > 0 else None
+            hand_over(signum, frame)
             return
         if now < deadline - ALARM_SLACK_S:
             # before either deadline: a SIGALRM from outside (kill -ALRM, a wrapper's
             # alarm) goes to the handler there was (the CLI's: "alarm clock", exit 142); the
             # budget took it for its own, "not finished within 600 s" after 0.06 s, or
             # dropped it inside an import (re-check trial, session 39)
-            _pass_alarm(old, signum, frame)
+            hand_over(signum, frame)
             return
         # not inside an import (the repeat RETIMEOUT_S later stops it)
         if not _importing(already):
-            raise SpecTimeout
+            raise SpecTimeout(token)
+
+    def hand_over(signum: int, frame: Any) -> None:
+        # the handler there was runs with the timer stopped: a watchdog that re-arms itself
+        # (setitimer / alarm in its handler) replaced the budget's deadline and was then
+        # disarmed for good (re-check trial, session 39); its new time is taken as the
+        # caller's, and the timer is armed again for the earlier deadline
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        try:
+            _pass_alarm(old, signum, frame)
+        finally:
+            left, again = signal.getitimer(signal.ITIMER_REAL)
+            now = time.monotonic()
+            if left > 0:
+                caller[0], every[0] = now + left, again
+            if not leaving[0]:
+                arm(now)
 
     # the timer starts inside the try, and the finally disarms it first: an alarm that landed
     # between starting the timer and the try (--timeout 1e-7), or in the finally before the
@@ -1366,14 +1385,14 @@ def _time_budget(seconds: float | None) -> Any:
     try:
         signal.signal(signal.SIGALRM, on_alarm)
         arm(time.monotonic())
-        yield
+        yield token
     finally:
         leaving[0] = True
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, old if old is not None else signal.SIG_DFL)
         if caller[0] is not None:
             left = max(caller[0] - time.monotonic(), MIN_BUDGET_S)
-            signal.setitimer(signal.ITIMER_REAL, left, caller_every)
+            signal.setitimer(signal.ITIMER_REAL, left, every[0])
 
 
 #: an alarm this close before a deadline is that deadline's (timer and clock granularity)

@@ -933,3 +933,55 @@ def test_a_sigalrm_from_outside_is_not_the_budgets(monkeypatch):
         assert rep.verdict == "ok" and got == [1]
     finally:
         signal.signal(signal.SIGALRM, old)
+
+
+def test_a_watchdog_that_rearms_itself_keeps_firing_and_does_not_delay_the_budget(monkeypatch):
+    """A caller's handler that re-arms its timer (setitimer / alarm in the handler) replaced
+    the budget's deadline and was then disarmed for good: no more alarms after
+    design(timeout=100), and a 0.5 s budget stopped at 2 s behind a 5 s re-arm (re-check
+    trial, session 39). The handler runs with the timer stopped; its new time is the
+    caller's."""
+    import signal
+    import time
+
+    _slow_lyapunov_design(monkeypatch, 2.0)
+    fired: list[float] = []
+    t0 = time.monotonic()
+
+    def rearm(*a: Any) -> None:
+        fired.append(time.monotonic() - t0)
+        signal.setitimer(signal.ITIMER_REAL, 0.3)
+
+    old = signal.signal(signal.SIGALRM, rearm)
+    try:
+        signal.setitimer(signal.ITIMER_REAL, 0.3)
+        api.design(SPEC, timeout=100)
+        assert len(fired) >= 4  # 0.3, 0.6, … through the 2 s design
+        assert signal.getitimer(signal.ITIMER_REAL)[0] > 0  # still armed after it
+        signal.setitimer(signal.ITIMER_REAL, 0)
+
+        def slow_rearm(*a: Any) -> None:
+            signal.setitimer(signal.ITIMER_REAL, 5.0)
+
+        signal.signal(signal.SIGALRM, slow_rearm)
+        signal.setitimer(signal.ITIMER_REAL, 0.1)
+        t1 = time.monotonic()
+        with pytest.raises(api.SolverError, match="not finished within 0.5 s"):
+            api.design(SPEC, timeout=0.5)
+        assert time.monotonic() - t1 < 1.5
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+
+
+def test_an_outer_budgets_stop_is_not_an_inner_designs_timeout(monkeypatch):
+    """design(timeout=100) inside a 1 s budget: the outer stop came out as "not finished
+    within 100 s" (re-check trial, session 39); it reaches the outer budget."""
+    import time
+
+    _slow_lyapunov_design(monkeypatch, 2.0)
+    t0 = time.monotonic()
+    with pytest.raises(api.SpecTimeout):
+        with api._time_budget(1.0):
+            api.design(SPEC, timeout=100)
+    assert time.monotonic() - t0 < 1.8
