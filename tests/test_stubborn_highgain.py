@@ -516,6 +516,9 @@ lipschitz = 1
         ("x2", False),
         ("x2 + 1e12*x1**3", False),  # a large φ_1 of x1: rounding, not a dependence
         ("x2 + 0*x2", False),
+        # through t, or away from the unit box (missed at t = 0 in [−1, 1]ⁿ: re-check, 39)
+        ("x2 - 2e16*cos(pi/2)*t*x2", True),
+        ("x2 - 2e16*cos(pi/2)*max(abs(x1) - 1, 0)*x2", True),
     ],
 )
 def test_a_plant_that_is_triangular_only_exactly_gets_a_note(f1: str, warned: bool) -> None:

@@ -171,17 +171,38 @@ def _float_chain_note(spec: Spec) -> str | None:
         return None
     F = _rhs(spec)
     o: Options = spec.options
-    box = np.asarray(o.state_bound, float) if o.state_bound is not None else np.ones(n)
     rng = np.random.default_rng(0)
+    sim = spec.simulate
+    t_end = float(sim.horizon.f) if sim is not None and sim.horizon is not None else 10.0
+    # the states in the box (state_bound, else [−1, 1]ⁿ, 10× and 1000× it), and t, u, d at
+    # random: a dependence through t·x2 or u·x2 was missed at t = 0, u = 0 (re-check, 39)
+    boxes = (
+        [np.asarray(o.state_bound, float)]
+        if o.state_bound is not None
+        else [np.ones(n), 10 * np.ones(n), 1000 * np.ones(n)]
+    )
+    for box in boxes:
+        note = _float_chain_at(s, F, rng, box, t_end)
+        if note is not None:
+            return note
+    return None
+
+
+def _float_chain_at(s: Any, F: Any, rng: Any, box: np.ndarray, t_end: float) -> str | None:
+    """:func:`_float_chain_note` on 64 seeded points of one box, t in [0, t_end], u and d
+    in [−1, 1] (one draw each: the perturbation compares F at the same t, u, d)."""
+    n = s.n
     X = rng.uniform(-1.0, 1.0, (64, n)) * box
-    u, d = np.zeros(len(s.inputs)), np.zeros(len(s.disturbances))
+    t = float(rng.uniform(0.0, t_end))
+    u = rng.uniform(-1.0, 1.0, len(s.inputs))
+    d = rng.uniform(-1.0, 1.0, len(s.disturbances))
     with np.errstate(all="ignore"):
-        base = F(X, u, d, 0.0)
+        base = F(X, u, d, t)
         for j in range(1, n):
             step = 1e-3 * float(box[j])
             Y = X.copy()
             Y[:, j] += step
-            moved = F(Y, u, d, 0.0)
+            moved = F(Y, u, d, t)
             dx = (Y[:, j] - X[:, j])[:, None]
             diff = (moved - base) / dx
             # the rounding of f's values themselves, over the step (a large φ_i of x_1..x_i)
