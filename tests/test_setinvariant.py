@@ -4,6 +4,7 @@ bad input, and property tests (Proposition 4.1) on random systems."""
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -963,3 +964,16 @@ def test_affine_dim_of_collinear_points_off_the_origin() -> None:
     assert _affine_dim(pts) == 1
     tri = [np.array([fmpq(a), fmpq(b)], dtype=object) for a, b in [(1, 1), (2, 1), (1, 2)]]
     assert _affine_dim(tri) == 2
+
+
+@pytest.mark.parametrize("lam", ["1e-17", "1e-20"])
+def test_a_tiny_lambda_is_inconclusive_not_an_internal_failure(lam: str) -> None:
+    """Example 7.1 with λ = 1e-17: the polytope's slice had no point in floats and numpy's
+    "zero-size array to reduction" was exit 3, internal failure (set-invariant trial,
+    session 39); λ = 1e-12 already gave the documented exit 4."""
+    from obsdesign.errors import InconclusiveError
+
+    spec = Path(__file__).resolve().parents[1] / "specs" / "dorea-pimenta-7-1.toml"
+    text = re.sub(r"(?m)^lambda = .*$", f"lambda = {lam}", spec.read_text(), count=1)
+    with pytest.raises(InconclusiveError, match="a float polytope computation failed"):
+        api.design(api.load_spec_text(text, "tiny.toml"))

@@ -243,6 +243,13 @@ def symmetric(
         xi = lps.delta(G, pb.B1, Dv)  # (13)
         if c is not None:
             S = po.slice_points(P, st.edges, c, -pb.eta, pb.eta)
+            if len(S) == 0:
+                # λ = 1e-17 left a polytope whose slice has no point in floats: numpy's
+                # "zero-size array to reduction" was an internal failure, exit 3 (set-invariant
+                # trial, session 39); the design reports a float computation that failed
+                raise po.PolytopeError(
+                    "the slice |c·x| ≤ η of the polytope has no point in float arithmetic"
+                )
             phi0 = (G @ pb.A @ S.T).max(axis=1)
         else:
             phi0, S = lps.phi_slice_general(G, pb.A, pb.C, pb.eta)
