@@ -2334,3 +2334,16 @@ def test_a_schedule_entry_at_a_wrong_upper_bound_of_exp_fails(tmp_path: Path) ->
     v["gamma_schedule"] = sched
     v["eps_schedule"] = [a / p["kappa"] for a in sched]
     assert _failed(_report_with(rep, v, tmp_path)) == {"gamma-schedule"}
+
+
+def test_the_schedule_checks_retry_enclosure_is_rigorous() -> None:
+    """The doubling retry of the γ-schedule check (an entry undecided at 113 bits): x = 2⁻¹⁵⁰
+    and the entry γ₁ = 1 + x with γ₀ = 2, below the rule γ₀e^x/2 = e^x > 1 + x. mpmath's
+    interval exp at 226 bits gives the upper end 1 + x exactly, which would accept the entry;
+    arb's does not, and at 452 bits the entry is refuted (putting iv.exp back on that line
+    passed every test: before-stop review, session 39)."""
+    from obsdesign.methods.searchspace import claims as ssc
+
+    x = fmpq(1, 2**150)
+    verdict, _, _ = ssc._follows(fmpq(2), 1 + x, fmpq(1, 2), x, fmpq(1), 1 + 2 * x)
+    assert verdict is False
