@@ -390,6 +390,14 @@ def _version(value: bool) -> None:
         raise typer.Exit(0)
 
 
+def _seconds(value: float) -> float:
+    """``--timeout``'s value: a number of seconds ≥ 0 or inf; nan gets its own message
+    (typer's min=0 check said "greater than or equal to 0" of nan)."""
+    if value != value or value < 0:
+        raise typer.BadParameter(f"{value} is not a number of seconds >= 0 (0 or inf: none)")
+    return value
+
+
 @app.callback()
 def _main(
     ctx: typer.Context,
@@ -461,7 +469,7 @@ def design(
         typer.Option(
             "--timeout",
             metavar="SECONDS",
-            min=0,
+            callback=_seconds,
             help="Time budget of the design and its certification (0 or inf: none, the "
             "default); past it the design stops with exit 3 and -o gets its error report.",
         ),
@@ -519,7 +527,7 @@ def _timeout_opt(unit: str) -> Any:
         typer.Option(
             "--timeout",
             metavar="SECONDS",
-            min=0,
+            callback=_seconds,
             help=f"Time budget per {unit} (0 or inf: none); a {unit} past it gets exit 3 and "
             "the others still run (on Dask too: applied in the worker). It stops a "
             f"{unit} only between imports: a budget below ~0.1 s can be overrun by the first "

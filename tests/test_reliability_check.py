@@ -985,3 +985,18 @@ def test_an_outer_budgets_stop_is_not_an_inner_designs_timeout(monkeypatch):
         with api._time_budget(1.0):
             api.design(SPEC, timeout=100)
     assert time.monotonic() - t0 < 1.8
+
+
+@pytest.mark.parametrize("cmd", ["design", "check", "sweep"])
+def test_a_nan_or_negative_timeout_is_named_as_such(tmp_path: Path, cmd: str):
+    """``--timeout nan`` got typer's "greater than or equal to 0", which nan is not less
+    than either (CLI review, session 39): the message now says it is not a number of
+    seconds; negative values too; both are exit 2 with nothing written."""
+    args = {"design": ["design", str(SPEC)], "check": ["check", str(SPEC)]}.get(
+        cmd, ["sweep", str(SPEC), "--set", "method.L=[[1],[1]]"]
+    )
+    for bad in ("nan", "-1", "-inf"):
+        res = runner.invoke(app, [*args, "--timeout", bad])
+        assert res.exit_code == 2, res.output
+        assert "is not a number of seconds >= 0" in res.output
+        assert "Traceback" not in res.output
