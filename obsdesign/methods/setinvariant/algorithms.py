@@ -137,6 +137,21 @@ def _eps_screened(
     return lps.EpsResult(eps, v)
 
 
+def centred(Dv: np.ndarray) -> np.ndarray:
+    """D's vertices less their mean c, for the general algorithm's iterations.
+
+    The paper assumes 0 ∈ D (Section III, "Ω and D are compact, convex polyhedra containing
+    the origin"); the spec may not. With D = c + D₀ the injection absorbs the offset:
+    max_i(φ_i + δ_i + G_i v) is the same with v' = v + B1·c over D₀, so ε(z) of LP (9) and the
+    stopping rule do not change, but the image Q^i = A·S(z^l) + B1·D + v^l of step 7 depends on
+    which of LP (9)'s many optimal v^l HiGHS returns, and with D off the origin that choice made
+    a rotation with D = [0.01, 0.03] diverge (ε ≈ 2.94 after 21 iterations) where D = [−0.01,
+    0.01] converges in 2 (set-invariant trial, session 39). Centring makes the iterations the
+    same for D and any translate of it. Only the float iterations use it: the final polyhedron
+    is proved exactly against the spec's own D, with v^l from LP (9) over it."""
+    return Dv - Dv.mean(axis=0) if len(Dv) else Dv
+
+
 def general(
     pb: Problem,
     lam_run: float,
@@ -159,7 +174,8 @@ def general(
     P = Vo if start is None else np.vstack([start, Vo])
     too_far = GROWTH_MAX * float(np.max(np.linalg.norm(Vo, axis=1)))
     hist = [] if history is None else history
-    Bd = pb.Dv @ pb.B1.T if pb.B1.shape[1] else np.zeros((1, pb.n))
+    Dv = centred(pb.Dv)
+    Bd = Dv @ pb.B1.T if pb.B1.shape[1] else np.zeros((1, pb.n))
     eps_l = np.inf
     st = None
     prev: tuple[np.ndarray, np.ndarray] | None = None
@@ -171,7 +187,7 @@ def general(
             return IterResult(st.G, st.V, eps_l, it - 1, False, hist, timed_out=True)
         st = nxt
         P, G = st.V, st.G
-        dl = lps.delta(G, pb.B1, pb.Dv)
+        dl = lps.delta(G, pb.B1, Dv)
         zs = lps.z_d(P, c, pb.eta)  # step 3
         try:
             phi, slices = lps.phi_at(G, pb.A, P, st.edges, c, pb.eta, zs, deadline)  # step 4a
