@@ -1000,3 +1000,33 @@ def test_a_nan_or_negative_timeout_is_named_as_such(tmp_path: Path, cmd: str):
         assert res.exit_code == 2, res.output
         assert "is not a number of seconds >= 0" in res.output
         assert "Traceback" not in res.output
+
+
+def test_an_exception_of_the_callers_alarm_handler_reaches_the_caller(monkeypatch):
+    """A caller whose watchdog's SIGALRM handler raises (its own TimeoutError) during
+    check(timeout=) / design(timeout=) gets that exception: check made it the row's exit 3
+    "internal failure: …" and went on to the next spec (session 39)."""
+    import signal
+    import time
+
+    class Watchdog(Exception):
+        pass
+
+    def bark(*a: Any) -> None:
+        raise Watchdog("caller's deadline")
+
+    old = signal.signal(signal.SIGALRM, bark)
+    try:
+        _slow_lyapunov_design(monkeypatch, 2.0)
+        for run in (
+            lambda: api.check([SPEC, SPEC], timeout=600),
+            lambda: api.design(SPEC, timeout=600),
+        ):
+            signal.setitimer(signal.ITIMER_REAL, 0.2)
+            t0 = time.monotonic()
+            with pytest.raises(Watchdog, match="caller's deadline"):
+                run()
+            assert time.monotonic() - t0 < 1.5  # stopped by it, not after the work
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
