@@ -334,24 +334,38 @@ def _error_report_on_failure(sp: Spec, out: str | Path | None, force: bool) -> I
     except Exception as e:
         code, msg = design_error(e)
         if out is not None and code != EXIT_BAD_INPUT:
-            _write_error_report(sp, out, code, msg, force)
+            _write_error_report(sp, out, code, msg, force, getattr(e, "candidate", None))
         raise
 
 
-def error_report(sp: Spec, code: int, message: str) -> Report:
+def error_report(sp: Spec, code: int, message: str, candidate: Any = None) -> Report:
     """The report of a design of ``sp`` that stopped with an error (``"verdict": "error"``,
-    no parameters, no claims): what ``design -o`` writes and ``design --format json`` prints
-    then, and what ``verify`` reports as that error.
+    no claims): what ``design -o`` writes and ``design --format json`` prints then, and what
+    ``verify`` reports as that error. Its parameters are empty, or what the design tried
+    (``candidate``, e.g. the lyapunov method's designed L), not certified and said so in a
+    note: a user can give it back in the spec (every consumer of a report refuses an error
+    report's parameters: verify, simulate, the observer export).
 
     :param sp: the spec; :param code: the error's exit code (1, 3 or 4); :param message: its
-    one-line message."""
+    one-line message; :param candidate: a :class:`Parameters` or None."""
+    params = candidate if isinstance(candidate, Parameters) else Parameters()
+    notes = (
+        [
+            "parameters: what the design tried before it stopped, NOT certified ("
+            + ", ".join(params)
+            + "); give them in the spec's [method] to check them"
+        ]
+        if len(params)
+        else []
+    )
     return Report(
         method=sp.method,
         spec=sp.text,
         spec_file=sp.file,
         spec_sha256=sp.sha256,
-        parameters=Parameters(),
+        parameters=params,
         claims=[],
+        notes=notes,
         verdict="error",
         error={"exit_code": code, "message": message},
     )
@@ -366,8 +380,10 @@ def design_error(e: Exception) -> tuple[int, str]:
     return EXIT_SOLVER, f"internal failure: {type(e).__name__}: {e}"
 
 
-def _write_error_report(sp: Spec, out: str | Path, code: int, message: str, force: bool) -> None:
-    write_atomic(out, error_report(sp, code, message).to_json(), force)
+def _write_error_report(
+    sp: Spec, out: str | Path, code: int, message: str, force: bool, candidate: Any = None
+) -> None:
+    write_atomic(out, error_report(sp, code, message, candidate).to_json(), force)
 
 
 #: claims only ``verify`` makes (never in a design report)
@@ -468,6 +484,8 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
     if sp.method != rep.method:
         raise InputError(f"{named}: method '{rep.method}' but the spec says '{sp.method}'")
     if rep.error is not None:
+        # what the stopped design tried (its candidate) is shown as "not verified"
+        rep.unverified = list(rep.parameters)
         return _replace_claims(rep, [_error_claim(rep)], time.perf_counter() - t0)
     claims: list[Claim] = []
     problems = [

@@ -602,9 +602,11 @@ def _design_error_outputs(sp: Any, e: Exception, output: Path | None, fmt: Fmt) 
     if code == EXIT_BAD_INPUT:
         return
     if fmt == Fmt.json:
-        print(api.error_report(sp, code, message).to_json())
+        print(api.error_report(sp, code, message, getattr(e, "candidate", None)).to_json())
     elif output is not None and fmt == Fmt.text:
-        _say(f"error report written to {output}")
+        tried = getattr(e, "candidate", None)
+        holds = f" (its parameters: {', '.join(tried)} tried, not certified)" if tried else ""
+        _say(f"error report written to {output}{holds}")
 
 
 @contextmanager

@@ -7,6 +7,7 @@
 from __future__ import annotations
 
 import re
+from typing import Any
 
 EXIT_OK = 0
 EXIT_INFEASIBLE = 1
@@ -82,6 +83,10 @@ class ObsdesignError(Exception):
     #: enough to say it (set by the loader and the method binding): ``check`` and ``sweep``
     #: rows of bad input name the method instead of "?"
     method_key: str | None = None
+    #: what the design tried before it stopped (a :class:`obsdesign.params.Parameters`, not
+    #: certified), written to the error report's ``parameters`` so that a user can retry
+    #: with it (the lyapunov method's designed L); None: nothing worth keeping
+    candidate: Any = None
 
     def __init__(self, message: str) -> None:
         message = one_line(message)

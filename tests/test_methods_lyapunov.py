@@ -715,6 +715,41 @@ def test_a_sensitive_closed_loop_keeps_more_bits_of_the_gain() -> None:
     assert ei.value.exit_code == 4 and "the designed gain fails" in ei.value.message
 
 
+def test_the_error_report_of_a_failed_designed_gain_holds_that_gain(tmp_path: Path) -> None:
+    """Pole placement on the ill-conditioned 8-state plant fails (exit 4): the error report
+    at -o held no L, so a user could not give it back at another rate (lyapunov trial,
+    session 38). It now holds the L tried, as "not verified", with a note; verify still
+    reports the error (exit 4), and simulate and the observer export refuse it. Given back
+    in the spec, that L is checked (exit 1: A − LC is not Schur, proved exactly)."""
+    from obsdesign.errors import InputError
+    from obsdesign.report.model import Report
+
+    path = Path(__file__).parent / "data" / "lyapunov-ill-conditioned-8state.toml"
+    text = "".join(
+        line.replace('key = "lyapunov"', 'key = "lyapunov"\ndesign = "place"')
+        for line in path.read_text().splitlines(keepends=True)
+        if not line.startswith("riccati_Q")
+    )
+    spec = tmp_path / "place.toml"
+    spec.write_text(text)
+    out = tmp_path / "r.json"
+    res = CliRunner().invoke(app, ["design", str(spec), "-o", str(out)])
+    assert res.exit_code == 4
+    assert "its parameters: L tried, not certified" in res.output
+    d = json.loads(out.read_text())
+    assert d["verdict"] == "error" and d["error"]["exit_code"] == 4
+    assert np.asarray(d["parameters"]["L"], dtype=float).shape == (8, 1)
+    assert any("NOT certified (L)" in n for n in d["notes"])
+    ver = api.verify(out)
+    assert ver.exit_code() == 4 and ver.unverified == ["L"]
+    with pytest.raises(InputError, match="no observer"):
+        Report.load(out)[0].observer_statespace()
+    L = ", ".join(f"[{float(v)!r}]" for v in np.asarray(d["parameters"]["L"]).ravel())
+    given = text.replace('design = "place"', f"L = [{L}]")
+    with pytest.raises(InfeasibleError, match="the given L does not stabilize the error"):
+        api.design(load_spec_text(given, "given.toml"))  # the user's L: exit 1, not 4
+
+
 def test_no_float_riccati_gain_takes_the_high_precision_one(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:

@@ -20,7 +20,13 @@ from obsdesign import lyap
 from obsdesign.certify.detect import Detectability, detectability, unobservable_restriction
 from obsdesign.certify.printing import fmt_exact
 from obsdesign.certify.psd import check_pd
-from obsdesign.errors import InconclusiveError, InfeasibleError, SolverError, SpecError
+from obsdesign.errors import (
+    InconclusiveError,
+    InfeasibleError,
+    ObsdesignError,
+    SolverError,
+    SpecError,
+)
 from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
 from obsdesign.methods.lyapunov.options import Options
 from obsdesign.params import Parameters
@@ -89,6 +95,9 @@ def _designed(spec: Spec, o: Options, progress: Progress | None) -> Design:
             return _design_rounded(spec, Lm, lyap.BITS, solver, how, progress)
         except InfeasibleError as e:
             first = designed_gain_failed(e, how, Lm, asked, o)
+        except InconclusiveError as e:
+            _keep_gain(e, Lm)
+            raise
     # the float Riccati gain is missing or failed the exact tests: the high-precision one
     hp = riccati_retry_hp(spec, o)
     if hp is None:
@@ -98,6 +107,17 @@ def _designed(spec: Spec, o: Options, progress: Progress | None) -> Design:
         return _design_rounded(spec, Lm, bits, solver, how, progress)
     except InfeasibleError as e2:
         raise designed_gain_failed(e2, how, Lm, asked, o) from None
+    except InconclusiveError as e3:
+        _keep_gain(e3, Lm)
+        raise
+
+
+def _keep_gain(e: ObsdesignError, Lm: fmpq_mat) -> ObsdesignError:
+    """``e`` with the designed gain it failed on as its candidate: the error report (``-o``)
+    holds that L, not certified, so that a user can give it in the spec and check it at
+    another rate or margin (an error report held no L: lyapunov trial, session 38)."""
+    e.candidate = Parameters({"L": lyap.as_array(Lm)})
+    return e
 
 
 def _lmi_fallback(
@@ -122,7 +142,9 @@ def _lmi_fallback(
     except (InconclusiveError, InfeasibleError) as e:
         # the LMI error's own hint ("omit design") cannot help once Riccati failed too
         # (lyapunov fuzz, session 38)
-        raise type(lmi_error)(f"{why}; the Riccati design failed too: {e.message}") from None
+        both = type(lmi_error)(f"{why}; the Riccati design failed too: {e.message}")
+        both.candidate = e.candidate  # the Riccati L it failed on, if any
+        raise both from None
     d.notes.insert(0, f"the LMI gain design gave no certified gain ({why}): L is the Riccati gain")
     if isinstance(d.solver, SolverResult):
         d.solver.extra.update(gain_design="lmi", lmi_fallback="riccati")
@@ -178,10 +200,11 @@ def designed_gain_failed(
             f"the float design by {how} is inaccurate on this badly conditioned plant ({big}); "
             "give L, or try another design or weights"
         )
-    return InconclusiveError(
+    err = InconclusiveError(
         f"the designed gain fails: {e.message}; yet some L succeeds ((C, A) is detectable"
         f"{also}, proved exactly): {why}"
     )
+    return _keep_gain(err, Lm)
 
 
 def _design_for(
