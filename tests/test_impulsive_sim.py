@@ -82,7 +82,9 @@ def test_template_designs() -> None:
 
 
 def test_M_choices_with_lipschitz_x() -> None:
-    """orthonormal / given / optimized M: all certify; the optimized window is not narrower."""
+    """orthonormal / given / optimized M: all certify; the optimized window is not narrower
+    in ratio T_max / T_min (what the search maximizes since session 40: the width had no
+    upper bound, see test_impulsive_soundness)."""
     A = qmat([[Q("0.2"), Q("0.005")], [Q("0.5"), -3]])
     C = qmat([[1, 0]])
     widths = {}
@@ -90,8 +92,8 @@ def test_M_choices_with_lipschitz_x() -> None:
         p = Problem(A, C, qvec([Q("0.8")]), Q(3), Q("0.1"), M, LipschitzX(Q("0.005")), "widest")
         P, _ = design_window(p)
         assert all(c.ok for c in certify_window(p, P))
-        widths[P["M_source"]] = float(P["T_max"] - P["T_min"])
-    assert widths["optimized"] >= widths["orthonormal"] - 1e-4
+        widths[P["M_source"]] = float(P["T_max"] / P["T_min"])
+    assert widths["optimized"] >= widths["orthonormal"] * (1 - 1e-3)
     assert np.isclose(widths["given"], widths["orthonormal"])
 
 

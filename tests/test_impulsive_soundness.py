@@ -1119,3 +1119,81 @@ def test_block_cross_bounds_read_a_huge_box(scale: float, slack: float) -> None:
     lit = f.literal_cross
     assert lit["o"] == pytest.approx(3, rel=1e-6) and lit["n"] == pytest.approx(5, rel=1e-6)
     assert all((v.count > 0) == (slack < 1) for v in cross), f.summary()
+
+
+def _first_row_zero_spec(M: str) -> str:
+    """The impulsive trial's 4-state plant (session 40): A's first row is 0, so C·A = 0 and
+    the coupling terms of (22) can be driven to 0 by M."""
+    return f"""
+[system]
+time = "continuous"
+A = [[0.0, 0.0, 0.0, 0.0], [0.0077549, -5.55029, 3.64544, 2.25169],
+     [-0.0175328, -3.64544, -5.55029, -1.39966], [-0.0379486, 0.959081, -0.897898, -6.2409]]
+C = [[1, 0, 0, 0]]
+states = ["x1", "x2", "x3", "x4"]
+psi = ["0", "0", "0", "0"]
+[nonlinearity]
+lipschitz_x = 0
+[method]
+key = "impulsive"
+L = [0.817636]
+alpha = 8.17636
+noise_bound = 0
+M = {M}
+"""
+
+
+def test_m_optimize_does_not_walk_to_the_edge_of_condition_22() -> None:
+    """M = "optimize" scored the window's width, unbounded where C·A = 0 (it grows like 1/κ
+    as κ → 0): on this plant the search chose an M scoring 6.6·10¹⁴ whose rounded κ_n was
+    negative, "Lemma 1 fails" (exit 1), where the orthonormal M certifies [0.0137, 0.4372]
+    with κ ≈ 7.74; on the 3-state one it certified [238048, 2070405] with κ = 1.3·10⁻⁶
+    (impulsive trial, session 40). The score is now ln(T_max / T_min): both certify with a
+    κ no smaller than half the orthonormal M's and a window no narrower in ratio."""
+    opt = api.design(load_spec_text(_first_row_zero_spec('"optimize"'), "opt.toml"))
+    orth = api.design(load_spec_text(_first_row_zero_spec('"orthonormal"'), "orth.toml"))
+    assert opt.exit_code() == 0 and orth.exit_code() == 0
+    k_opt, k_orth = (float(r.parameters.float("kappa")) for r in (opt, orth))
+    assert k_opt >= 0.5 * k_orth
+
+    def ratio(r: Any) -> float:
+        return float(r.parameters.float("T_max")) / float(r.parameters.float("T_min"))
+
+    assert ratio(opt) >= ratio(orth) * (1 - 1e-3)
+    assert api.verify(opt).exit_code() == 0
+    three = (
+        '[system]\ntime = "continuous"\nA = [[0, 0, 0], [1, -1, 0.5], [0, -0.5, -1]]\n'
+        'C = [[1, 0, 0]]\nstates = ["x1", "x2", "x3"]\npsi = ["0", "0", "0"]\n'
+        "[nonlinearity]\nlipschitz_x = 0\n"
+        '[method]\nkey = "impulsive"\nL = [0.8]\nalpha = 3\nnoise_bound = 0\nM = "optimize"\n'
+    )
+    rep = api.design(load_spec_text(three, "three.toml"))
+    assert rep.exit_code() == 0
+    assert float(rep.parameters.float("kappa")) > 0.1  # was 1.3e-6
+    assert float(rep.parameters.float("T_max")) < 100  # was 2070405
+
+
+def test_m_optimize_falls_back_to_the_orthonormal_m(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A searched M that fails the exact conditions (here: one the search is made to return,
+    with its last row nearly a copy of C's) is replaced by the orthonormal complement the
+    search started from, with a note; the design was exit 1 on the searched M alone."""
+    from obsdesign.errors import InfeasibleError
+    from obsdesign.methods.impulsive import design as dmod
+
+    def edge(p: Any, seed: int = 0, starts: int = 6) -> np.ndarray:
+        return np.array([[0.0, 1, 0, 0], [0, 0, 1, 0], [1, 0, 0, 1e-9]])
+
+    monkeypatch.setattr(dmod, "optimize_M", edge)
+    rep = api.design(load_spec_text(_first_row_zero_spec('"optimize"'), "opt.toml"))
+    assert rep.exit_code() == 0
+    assert any('M = "optimize": the searched M failed the exact conditions' in n for n in rep.notes)
+    assert rep.parameters["M_source"] == "orthonormal"
+    assert api.verify(rep).exit_code() == 0
+
+    def fails(p: Any) -> Any:
+        searched = isinstance(p.M, str) and p.M == "optimize"
+        raise dmod.Infeasible("searched M fails" if searched else "orthonormal fails")
+
+    monkeypatch.setattr(dmod, "design_window", fails)
+    with pytest.raises(InfeasibleError, match="searched M fails"):  # the searched M's error
+        api.design(load_spec_text(_first_row_zero_spec('"optimize"'), "opt.toml"))

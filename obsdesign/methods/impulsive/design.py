@@ -9,6 +9,7 @@ and is certified again, from the spec and these numbers only, by :mod:`.claims`.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from typing import Any
@@ -71,7 +72,7 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     if progress:
         progress("coordinates, κ_n, ϖ_o, κ and the window (26b)-(26c)")
     try:
-        vals, notes = design_window(o.problem)
+        vals, notes = _design_window_or_orthonormal(o.problem)
     except Infeasible as e:
         raise InfeasibleError(str(e)) from None
     params = Parameters(vals)
@@ -96,6 +97,30 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     return Design(params, solver, notes)
 
 
+def _design_window_or_orthonormal(p: Problem) -> tuple[dict[str, Any], list[str]]:
+    """:func:`design_window`; for ``M = "optimize"`` whose searched M fails the exact
+    conditions (a float optimum at the edge of (22) that the rounding of κ_n, ϖ_o and the
+    norms pushes over it), the orthonormal complement the search started from, with a note
+    (the search's M failed with "Lemma 1 fails", exit 1, where the orthonormal M certifies:
+    impulsive trial, session 40). The searched M's error is raised when both fail."""
+    try:
+        return design_window(p)
+    except (Infeasible, InconclusiveError) as e:
+        if not (isinstance(p.M, str) and p.M == "optimize"):
+            raise
+        try:
+            vals, notes = design_window(dataclasses.replace(p, M="orthonormal"))
+        except (Infeasible, InconclusiveError):
+            raise e from None
+        why = e.message if isinstance(e, InconclusiveError) else str(e)
+        notes.insert(
+            0,
+            f'M = "optimize": the searched M failed the exact conditions ({why}); '
+            "the orthonormal complement of C's rows is used",
+        )
+        return vals, notes
+
+
 # -- float evaluation (used by the M search) -------------------------------------------------
 #: relative margin below the float κ_max at which :func:`float_window` takes a given κ as
 #: admitted: the certified κ_max lies up to ~10⁻⁵ below the float one (κ_n rounded down, the
@@ -105,8 +130,17 @@ GIVEN_KAPPA_MARGIN = 1e-3
 
 
 def float_window(p: Problem, Mf: np.ndarray) -> float:
-    """Window width T_max − T_min of (26b)-(26c) in floats for a float M (``lipschitz_x``
-    data); a negative score measures how far (22) is from holding. Used only to choose M.
+    """The window of (26b)-(26c) in floats for a float M (``lipschitz_x`` data), scored
+    ln(T_max / T_min); a score below −10 measures how far (22) is from holding. Used only to
+    choose M.
+
+    The score is the ratio, not the width T_max − T_min: the width has no upper bound where
+    the coupling terms can be driven to 0 (C·A = 0), growing like 1/κ as κ → 0, so the search
+    walked to the edge of (22) — an M scoring 6.6·10¹⁴ whose κ_n was negative once rounded
+    ("Lemma 1 fails", exit 1, where the orthonormal M certifies), or a certified window
+    [238048, 2070405] with κ = 1.3·10⁻⁶ (an observer 10⁶ times slower than the orthonormal
+    M's; impulsive trial, session 40). The ratio does not depend on the time scale and
+    falls to 0 as κ → 0.
 
     ``p``: the problem; ``Mf``: a float (n−m)×n complement of the rows of C."""
     A, C = (np.asarray(to_float(x), dtype=float) for x in (p.A, p.C))
@@ -140,7 +174,9 @@ def float_window(p: Problem, Mf: np.ndarray) -> float:
     kap = _kappa_float(p, max(varpi, 0.0), coup, g, kmax)
     tmax = -2.0 * np.log1p(-g) / (max(varpi, 0.0) + kap + coup)  # (26b)
     tmin = -np.log1p(-g / float(p.alpha)) / kap  # (26c), log1p: α ≫ γ keeps its digits
-    return tmax - tmin
+    if not (tmax > 0 and tmin > 0 and np.isfinite(tmax) and np.isfinite(tmin)):
+        return -10.0
+    return max(float(np.log(tmax / tmin)), -10.0)
 
 
 def _kappa_float(p: Problem, varpi: float, coup: float, g: float, kmax: float) -> float:
@@ -152,7 +188,8 @@ def _kappa_float(p: Problem, varpi: float, coup: float, g: float, kmax: float) -
 
 
 def optimize_M(p: Problem, seed: int = 0, starts: int = 6) -> np.ndarray:
-    """Search M (float) maximizing the window width T_max − T_min of (26b)-(26c)
+    """Search M (float) maximizing the window ratio T_max / T_min of (26b)-(26c)
+    (:func:`float_window`)
     (Nelder-Mead from the orthonormal complement and ``starts`` − 1 random starts drawn with
     ``seed``). Only meaningful when the nonlinearity data transform with T (``lipschitz_x``).
 
