@@ -1784,11 +1784,25 @@ def test_problem_text_names_r_bound_and_a_given_K() -> None:
 
     from obsdesign.methods.stubborn.claims import _problem_text
 
-    o = SimpleNamespace(margin=fmpq(1, 10**6), K=None, gain_bound=fmpq(100), r_bound=fmpq(5))
+    o = SimpleNamespace(
+        margin=fmpq(1, 10**6),
+        K=None,
+        gain_bound=fmpq(100),
+        r_bound=fmpq(5),
+        scale_free_gain=False,
+    )
     t = _problem_text(o, "(1)-(3)", False)
     assert "R ⪯ r_bound·(1 − 10⁻⁶), r_bound = 5" in t and "gain_bound = 100" in t
+    assert "‖X‖₂ ≤ gain_bound·(1 − 10⁻⁶)" in t and "s·I" not in t
+    o.scale_free_gain = True  # the design's retry (session 40)
+    t = _problem_text(o, "(1)-(3)", False)
+    assert "‖X‖₂ ≤ gain_bound·s·(1 − 10⁻⁶) with P ⪰ s·I, gain_bound = 100" in t
     o = SimpleNamespace(
-        margin=fmpq(1, 10**6), K=np.array([[1.0]]), gain_bound=fmpq(100), r_bound=None
+        margin=fmpq(1, 10**6),
+        K=np.array([[1.0]]),
+        gain_bound=fmpq(100),
+        r_bound=None,
+        scale_free_gain=False,
     )
     t = _problem_text(o, "(7)-(9)", True)
     assert t.endswith("the given K") and "gain_bound" not in t and "r_bound" not in t
@@ -1976,3 +1990,36 @@ def test_the_simulated_output_has_the_D_u_term() -> None:
     )
     res = api.simulate(api.load_spec_text(text, "d.toml"))
     np.testing.assert_allclose(res.y[:, 0], res.x[:, 0] + 0.2 * 0.3, rtol=0, atol=1e-15)
+
+
+@pytest.mark.parametrize(
+    "time, a, c",
+    [("continuous", 0.5, 1000), ("discrete", 1.25, 1000), ("continuous", 0.1, 2000)],
+)
+def test_a_gain_bound_that_only_the_normalization_breaks_is_met_scale_free(
+    time: str, a: float, c: float
+) -> None:
+    """A = a, C = c ≈ 10³: with P ⪰ I, W ⪰ I the LMIs need P ≳ 10⁶, so ‖X‖₂ = ‖P K‖₂ ≳ 500
+    above the default gain_bound 100 although K ≈ 0.01 certifies; the design said "LMIs
+    infeasible for every λ tried: raise gain_bound (now 100)", exit 1 (stubborn trial,
+    session 40). It now retries with ‖X‖₂ ≤ gain_bound·s, P ⪰ s·I (still ‖K‖₂ ≤ gain_bound),
+    says so in a note and in gain_normalization, and verify agrees."""
+    text = f'[system]\ntime = "{time}"\nA = [[{a}]]\nC = [[{c}]]\n[method]\nkey = "stubborn"\n'
+    rep = api.design(api.load_spec_text(text, "s.toml"))
+    assert rep.exit_code() == 0
+    assert rep.parameters["gain_normalization"] == "scale-free"
+    assert any("designed with ‖X‖₂ ≤ gain_bound·s and P ⪰ s·I" in n for n in rep.notes)
+    K = np.asarray(to_float(rep.parameters["K"]), dtype=float)
+    assert np.linalg.norm(K, 2) <= 100
+    claims = {cl.id: cl.status for cl in rep.claims}
+    assert claims["gain-bound"] == ClaimStatus.CERTIFIED
+    assert api.verify(rep).exit_code() == 0
+
+
+def test_the_scale_free_retry_keeps_the_first_verdict_when_it_fails_too() -> None:
+    """A = 2.4, C = 1 in discrete time with gain_bound = 1: |2.4 − K| < 1 needs K > 1.4, so
+    the bound is the cause under any normalization: the retry fails and the first message
+    ("raise gain_bound") stands, exit 1."""
+    text = '[system]\ntime = "discrete"\nA = [[2.4]]\nC = [[1]]\n[method]\nkey = "stubborn"\n'
+    with pytest.raises(InfeasibleError, match="raise gain_bound"):
+        api.design(api.load_spec_text(text + "gain_bound = 1\n", "s.toml"))

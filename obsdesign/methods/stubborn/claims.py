@@ -12,6 +12,7 @@ the report's copy.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -279,6 +280,9 @@ def lambda_max_claims(spec: Spec, pr: Parameters) -> list[Claim]:
     from obsdesign.methods.stubborn.design import INFEASIBLE, Feasibility, Plant
 
     o: Options = spec.options
+    if pr.get("gain_normalization") == "scale-free":
+        # the design's retry with ‖X‖₂ ≤ gain_bound·s, P ⪰ s·I: its bracket is of that problem
+        o = replace(o, scale_free_gain=True)
     disc = spec.system.discrete
     c = Claims()
     lm = pr.exact("lambda_max", c)
@@ -356,7 +360,12 @@ def _problem_text(o: Options, eqs: str, disc: bool) -> str:
     delta = fmt_exact(o.margin) + ("" if disc else "·min(1, λ)")
     parts = [f"LMIs {eqs} with margin δ = {delta} (each ⪯ −δI; [method] margin)", "P ⪰ I, W ⪰ I"]
     if o.K is None and o.gain_bound is not None:
-        parts.append(f"‖X‖₂ ≤ gain_bound·(1 − 10⁻⁶), gain_bound = {fmt_exact(o.gain_bound)}")
+        s = "·s" if o.scale_free_gain else ""
+        parts.append(
+            f"‖X‖₂ ≤ gain_bound{s}·(1 − 10⁻⁶)"
+            + (" with P ⪰ s·I" if s else "")
+            + f", gain_bound = {fmt_exact(o.gain_bound)}"
+        )
     if o.r_bound is not None:
         parts.append(f"R ⪯ r_bound·(1 − 10⁻⁶), r_bound = {fmt_exact(o.r_bound)}")
     if o.K is not None:

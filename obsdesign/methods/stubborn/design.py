@@ -122,7 +122,13 @@ def _problem(
         cons.append(sym(Mi) >> m * np.eye(n + 1))
     if o.K is None and o.gain_bound is not None:
         gb = float(o.gain_bound) * (1 - inside)  # strictly inside: the claim checks ‖K‖₂ ≤ bound
-        cons.append(cp.bmat([[gb * np.eye(n), X], [X.T, gb * np.eye(p)]]) >> 0)
+        if o.scale_free_gain:
+            # ‖X‖₂ ≤ gb·s and P ⪰ s·I give ‖K‖₂ = ‖P⁻¹X‖₂ ≤ gb, homogeneous like the LMIs
+            sg = cp.Variable()
+            cons.append(P >> sg * np.eye(n))
+            cons.append(cp.bmat([[gb * sg * np.eye(n), X], [X.T, gb * sg * np.eye(p)]]) >> 0)
+        else:
+            cons.append(cp.bmat([[gb * np.eye(n), X], [X.T, gb * np.eye(p)]]) >> 0)
     if o.r_bound is not None:
         cons.append(R << float(o.r_bound) * (1 - inside) * np.eye(p))
     obj: Any = cp.Minimize(0)
@@ -348,8 +354,50 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
 
         vals, solver, notes = high_gain(spec, progress)
     else:
-        vals, solver, notes = design_params(spec, progress)
+        vals, solver, notes = _design_or_scale_free(spec, progress)
     return Design(Parameters(vals), solver, notes)
+
+
+def _design_or_scale_free(
+    spec: Spec, progress: Any = None
+) -> tuple[dict[str, Any], SolverResult, list[str]]:
+    """:func:`design_params`; when it ends "infeasible" with the gain bound among the bounds
+    to raise, once more with the gain bound scale-free (``Options.scale_free_gain``).
+
+    With the normalization P ⪰ I, W ⪰ I the bound ‖X‖₂ ≤ gain_bound is not scale-free: a plant
+    whose LMIs need P ≫ W (A = 0.5, C = 1000: P ≳ 10⁶ for w ≥ 1) needs ‖X‖₂ = ‖P K‖₂ ≳ 500
+    although K = 0.01 certifies, and the design said "LMIs (1)-(3) infeasible for every λ
+    tried: raise gain_bound (now 100)", exit 1 (stubborn trial, session 40). The retry bounds
+    ‖X‖₂ ≤ gain_bound·s with P ⪰ s·I, which still gives ‖K‖₂ ≤ gain_bound (the certified
+    claim) and scales with P; the report's ``gain_normalization = "scale-free"`` says which
+    problem its λ bracket is of. The first error stands when the retry fails too."""
+    from dataclasses import replace as _replace
+
+    o: Options = spec.options
+    try:
+        return design_params(spec, progress)
+    except InfeasibleError as e:
+        if o.K is not None or o.scale_free_gain or not getattr(e, "gain_bound_hint", False):
+            raise
+        first = e
+    free = _replace(spec, options=_replace(o, scale_free_gain=True))
+    if progress:
+        progress(
+            "infeasible with ‖X‖₂ ≤ gain_bound and P ⪰ I: again with ‖X‖₂ ≤ gain_bound·s, P ⪰ s·I"
+        )
+    try:
+        vals, solver, notes = design_params(free, progress)
+    except (InfeasibleError, InconclusiveError):
+        raise first from None
+    vals["gain_normalization"] = "scale-free"
+    notes.insert(
+        0,
+        f"with P ⪰ I, W ⪰ I and ‖X‖₂ ≤ gain_bound = {fmt_exact(o.gain_bound)} the solver "
+        "reports the LMIs infeasible (that bound is not scale-free: the LMIs need P ≫ W here); "
+        "designed with ‖X‖₂ ≤ gain_bound·s and P ⪰ s·I instead, which still gives "
+        "‖K‖₂ ≤ gain_bound (claim gain-bound)",
+    )
+    return vals, solver, notes
 
 
 def design_params(
@@ -779,6 +827,7 @@ def _bounds_too_tight(pl: Plant, o: Options, where: str, verdict: bool | None) -
     if o.lam is not None:
         lam_hint = "a larger λ (closer to 1)" if pl.discrete else "a smaller λ"
     hints = [h for h in (lam_hint and f"try {lam_hint}", bounds and f"raise {bounds}") if h]
+    relax_gain = o.K is None and o.gain_bound is not None
     if o.K is not None:
         # the given K may not be the obstacle: on ker C the (1,1) block of (1) does not depend
         # on K, so a λ beyond A's own decay there fails for every K (hard-case fuzzer: "the
@@ -791,6 +840,7 @@ def _bounds_too_tight(pl: Plant, o: Options, where: str, verdict: bool | None) -
         if verdict is True and pl.discrete:
             free = replace(o, gain_bound=None, r_bound=None)
             if not feasible(pl, free, 1 - 1e-6)[0]:
+                relax_gain = False  # infeasible without any bound: nothing to retry
                 _slow_mode(pl, where)
                 at = "at any λ ≤ 1 − 10⁻⁶ (the search's most lenient λ)"
                 without = f" even without {bounds} and {at}" if bounds else f" {at}"
@@ -801,7 +851,10 @@ def _bounds_too_tight(pl: Plant, o: Options, where: str, verdict: bool | None) -
                     "C = 1 has no solution): a faster sampling (A closer to I) or the "
                     "continuous-time model may help"
                 )
-    raise InfeasibleError(f"stubborn: LMIs {_refs(pl)} infeasible {where}: {why}")
+    err = InfeasibleError(f"stubborn: LMIs {_refs(pl)} infeasible {where}: {why}")
+    # the gain bound is among what to relax: the design tries it scale-free (see design())
+    err.gain_bound_hint = relax_gain  # type: ignore[attr-defined]
+    raise err
 
 
 #: a stable mode of A with |μ|² above 1 − NEAR_ONE makes a discrete `infeasible` at the

@@ -62,6 +62,11 @@ class Options:
     #: R ⪯ r_bound·I in every solve (the other way to make the best λ finite); with it the gain
     #: bound is off unless given too
     r_bound: fmpq | None = None
+    #: not a spec key: the gain bound as ‖X‖₂ ≤ gain_bound·s with P ⪰ s·I (scale-free, still
+    #: ‖K‖₂ ≤ gain_bound), the design's retry when ‖X‖₂ ≤ gain_bound with P ⪰ I, W ⪰ I is
+    #: infeasible (:func:`obsdesign.methods.stubborn.design.design`); the report says so in
+    #: its parameter ``gain_normalization``
+    scale_free_gain: bool = False
 
 
 @dataclass
