@@ -2023,3 +2023,23 @@ def test_the_scale_free_retry_keeps_the_first_verdict_when_it_fails_too() -> Non
     text = '[system]\ntime = "discrete"\nA = [[2.4]]\nC = [[1]]\n[method]\nkey = "stubborn"\n'
     with pytest.raises(InfeasibleError, match="raise gain_bound"):
         api.design(api.load_spec_text(text + "gain_bound = 1\n", "s.toml"))
+
+
+def test_the_slow_plant_search_goes_down_to_its_floor(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Below 10⁻⁶ the continuous λ search steps down by 10⁴ to LAMBDA_FLOOR = 10⁻³⁰ (docs):
+    10⁻⁶ / (10⁴)⁶ is 9.99…·10⁻³¹ in floats, so the last λ tried was 10⁻²⁶ (stubborn trial,
+    session 40)."""
+    from obsdesign.methods.stubborn import design as d
+
+    tried: list[float] = []
+
+    def never(self: Any, lam: float) -> tuple[bool, str]:
+        tried.append(lam)
+        return False, d.INFEASIBLE
+
+    monkeypatch.setattr(d.Feasibility, "__call__", never)
+    text = '[system]\ntime = "continuous"\nA = [[-1]]\nC = [[1]]\n[method]\nkey = "stubborn"\n'
+    spec = api.load_spec_text(text, "s.toml")
+    good, bad, st = d.search_lambda(d.Plant.of(spec), spec.options)
+    assert good == 0.0 and st == d.INFEASIBLE
+    assert min(tried) == pytest.approx(d.LAMBDA_FLOOR, rel=1e-9, abs=0)

@@ -27,7 +27,7 @@ class Coordinates:
     """T = [C; M], its exact inverse and Ā = T A T⁻¹ with its blocks (eqs. (9)-(10c)).
 
     ``source`` says where M came from: ``given`` (spec), ``orthonormal`` (complement of the
-    row space of C, rounded) or ``optimized`` (search that widens the window).
+    row space of C, rounded) or ``optimized`` (search that widens the window's ratio T_max / T_min).
     """
 
     T: np.ndarray

@@ -272,7 +272,7 @@ def certified_rate(Ablk: np.ndarray, qsr: QSR, theta: fmpq, rate_f: float) -> fm
 
 def coordinates_for(p: Problem) -> Coordinates:
     """T = [C; M] of eq. (9): the spec's M, the orthonormal complement of the rows of C, or
-    the M that widens the window (``optimize``), rounded to exact rationals.
+    the M that widens the window's ratio T_max / T_min (``optimize``), rounded to exact rationals.
 
     ``p``: the problem."""
     if isinstance(p.M, str):

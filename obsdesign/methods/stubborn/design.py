@@ -268,7 +268,9 @@ def search_lambda(pl: Plant, o: Options) -> tuple[float, float, str]:
                 # said "infeasible for every λ tried"; unusual-spec trial, session 24)
                 hi, st = lo, st_lo
                 lo /= LOW_STEP
-                if lo < LAMBDA_FLOOR:
+                # 10⁻⁶ / (10⁴)⁶ is 9.99…·10⁻³¹ in floats: a plain < stopped at 10⁻²⁶ (stubborn
+                # trial, session 40); the floor itself is tried
+                if lo < LAMBDA_FLOOR * (1 - 1e-9):
                     return 0.0, hi, st
                 ok, st_lo = feasible(pl, o, lo)
         lo, hi, st, known = _bisect(feas, lo, hi, st, tol)
