@@ -2043,3 +2043,38 @@ def test_the_slow_plant_search_goes_down_to_its_floor(monkeypatch: pytest.Monkey
     good, bad, st = d.search_lambda(d.Plant.of(spec), spec.options)
     assert good == 0.0 and st == d.INFEASIBLE
     assert min(tried) == pytest.approx(d.LAMBDA_FLOOR, rel=1e-9, abs=0)
+
+
+def test_the_gain_bound_retry_ends_with_k_zero(monkeypatch: pytest.MonkeyPatch) -> None:
+    """_within_gain_bound yields K scaled into ‖K‖_F ≤ gain_bound (exactly), then K = 0 with
+    X = P K rebuilt; end to end, a stable plant whose scaled candidate fails too is certified
+    with K = 0 (the fallback of session 38 that no test reached: note 39)."""
+    from dataclasses import replace
+
+    from obsdesign.methods.stubborn import design as d
+
+    text = '[system]\ntime = "continuous"\nA = [[-1]]\nC = [[1]]\n[method]\nkey = "stubborn"\n'
+    spec = api.load_spec_text(text + "gain_bound = 0.5\n", "s.toml")
+    o = spec.options
+    P = np.array([[fmpq(3)]], dtype=object)
+    K = np.array([[fmpq(2)]], dtype=object)
+    fits = list(d._within_gain_bound({"K": K, "P": P, "X": P @ K}, o))
+    assert len(fits) == 2
+    k1 = fits[0]["K"][0, 0]
+    assert 0 < k1 <= fmpq(1, 2) and k1 * k1 <= Q(o.gain_bound) ** 2
+    assert fits[0]["X"][0, 0] == 3 * k1
+    assert fits[1]["K"][0, 0] == 0 and fits[1]["X"][0, 0] == 0
+    assert list(d._within_gain_bound({"K": K, "P": P}, replace(o, gain_bound=None))) == []
+    # end to end: every candidate but K = 0 fails the gain bound (the solver's K, then the
+    # scaled one); the stable plant certifies with K = 0
+    real = d._claims.point_failures
+
+    def only_zero_gain(spec: Any, cand: dict[str, Any], l2: bool) -> list[str]:
+        if any(k != 0 for k in cand["K"].ravel()):
+            return ["gain-bound"]
+        return real(spec, cand, l2)
+
+    monkeypatch.setattr(d._claims, "point_failures", only_zero_gain)
+    rep = api.design(spec)
+    assert rep.exit_code() == 0
+    assert all(k == 0 for k in np.asarray(rep.parameters["K"]).ravel())
