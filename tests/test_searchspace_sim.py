@@ -875,3 +875,31 @@ def test_an_output_or_state_floats_cannot_evaluate_is_inconclusive(
     with pytest.raises(InconclusiveError, match="not finite in floats at t = ") as e:
         api.simulate(p)
     assert ("at t = 0 " in e.value.message) is at_t0, e.value.message
+
+
+@pytest.mark.parametrize("t0", ["1e16", "-1e308", "1e13"])
+def test_times_too_coarse_for_the_step_are_refused_as_inconclusive(t0: str) -> None:
+    """t0 = 10¹⁶ (float spacing 2 against ΔT = 0.0064): the run held u(t) over windows of
+    hundreds of periods and simulated another plant (final state (−0.75, −0.66) where the
+    spec's is (sin 6, cos 6)); t0 = −10³⁰⁸ a plant that never moved; both exit 0 with no word
+    (search-space trial, session 40). Refused before the run, exit 4, naming the spacing."""
+    from obsdesign.errors import InconclusiveError
+
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "specs" / "hernandez-garcia-example.toml").read_text()
+    sp = api.load_spec_text(text.replace("[method]\n", f"[method]\nt0 = {t0}\n", 1), "t.toml")
+    with pytest.raises(InconclusiveError, match=r"below 1024 float spacings .* of its times"):
+        api.simulate(sp)
+
+
+def test_the_time_spacing_is_that_of_the_later_end_and_of_the_substep() -> None:
+    """The check's threshold: MIN_STEP_ULPS spacings of the larger of |t0| and |t_end| (a
+    run from −10⁹ to 0 has the spacing of 10⁹), for the substep ΔT / n."""
+    ulp = float(np.spacing(1e9))
+    S._check_time_spacing(-1e9, 0.0, S.MIN_STEP_ULPS * ulp, 1)  # at the threshold: runs
+    for t0, t1 in ((-1e9, 0.0), (0.0, 1e9)):
+        with pytest.raises(InconclusiveError, match="below 1024 float spacings"):
+            S._check_time_spacing(t0, t1, S.MIN_STEP_ULPS * ulp * (1 - 1e-9), 1)
+    with pytest.raises(InconclusiveError, match="substeps"):
+        S._check_time_spacing(1e9, 1e9, 1e-6 / 8, 8)
+    S._check_time_spacing(0.0, 12.0, 1e-6, 1)

@@ -393,6 +393,8 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
             stacklevel=2,
         )
     _check_float_spacing(o, eps[min(len(eps) - 1, N // max(K, 1))] / math.sqrt(n))
+    t_end = t0 + N * dT
+    _check_time_spacing(t0, t_end, dT / (so.substeps or 1), so.substeps or 1)
     x0 = np.asarray(spec.simulate.x0.f, dtype=float).reshape(1, n)
     _warn_x0_outside_D(spec, o)
     E_lo, E_hi = o.E.lower, o.E.upper
@@ -430,6 +432,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
     _record(run, t, x[0], y, C, eps[0], 0.0, L_f, gam[0], so, 0)
     if so.substeps == 0:
         nsub, flow_err = _auto_substeps(plant, C, t, dT, nsub, eps[0])
+        _check_time_spacing(t0, t_end, dT / nsub, nsub)
     for k in range(1, N + 1):
         if left_U is None:
             left_U = _left_U(plant, o, t0, dT, k)
@@ -493,6 +496,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
                 )
             if so.substeps == 0:
                 nsub, fe = _auto_substeps(plant, C, t, dT, nsub, e_new)
+                _check_time_spacing(t0, t_end, dT / nsub, nsub)
                 flow_err = max(flow_err, fe)
         e_cur = eps[min(i, len(eps) - 1)]
         _record(run, t, x[0], y, C, e_cur, t - tau, L_f, gam[min(i, len(gam) - 1)], so, k)
@@ -743,6 +747,10 @@ def _diagnose(
 
 #: the smallest cell half-side, in float spacings of E's coordinates, that a run takes
 MIN_CELL_ULPS = 16
+#: the smallest RK4 time step, in float spacings of the times a run reaches: each time then
+#: lies within 1/2048 of a step of its value (t0 = 1.7·10⁹, a Unix time, allows steps from
+#: 2.4·10⁻⁴ s)
+MIN_STEP_ULPS = 1024
 
 
 def _check_finite(x: np.ndarray, y: Any, t: float) -> None:
@@ -773,6 +781,25 @@ def _check_float_spacing(o: Options, s: float) -> None:
             f"(up to {big[j]:.6g} in magnitude): float64 centres cannot represent the grid "
             "(translate the state so that E lies near the origin, or a larger γ⋆ / shorter "
             "horizon)"
+        )
+
+
+def _check_time_spacing(t0: float, t_end: float, step: float, nsub: int) -> None:
+    """Refuse (exit 4) a run whose RK4 step ΔT / substeps is below MIN_STEP_ULPS float
+    spacings of the times it reaches: t0 + k·ΔT then rounds by more than a step, the input
+    u(t) is held over windows of many sampling periods and the time column repeats — with
+    t0 = 10¹⁶ (spacing 2, ΔT = 0.0064) the run simulated another plant (final state
+    (−0.75, −0.66) where the spec's is (sin 6, cos 6)) and with t0 = −10³⁰⁸ a plant that never
+    moved, both exit 0 with no word (search-space trial, session 40). The space analogue is
+    :func:`_check_float_spacing`."""
+    ulp = float(np.spacing(max(abs(t0), abs(t_end))))
+    if not step >= MIN_STEP_ULPS * ulp:
+        per = f"ΔT / {nsub:,} substeps = {step:.3g}" if nsub > 1 else f"ΔT = {step:.3g}"
+        raise InconclusiveError(
+            f"the simulation's time step {per} is below {MIN_STEP_ULPS} float spacings "
+            f"({ulp:.3g}) of its times (t0 = {t0:.6g} to {t_end:.6g}): float64 times cannot "
+            "resolve it, so u(t) and the flow would be evaluated at the wrong times (set "
+            "[method] t0 nearer 0, e.g. shift the time in f, h and u)"
         )
 
 
