@@ -57,6 +57,10 @@ TABLE = [
     ("[[0,0],[0,1]] (PSD, zero leading pivot)", [[0, 0], [0, 1]], True, False),
     ("[[1,0],[0,0]]", [[1, 0], [0, 0]], True, False),
     ("[[1,0],[0,-1/10^30]]", [[1, 0], [0, F(-1, 10**30)]], False, False),
+    # the largest diagonal 0 and a negative one after it (the zero-pivot branch must look at
+    # the diagonal too: Q_n = diag(0, 1) was certified ⪯ 0 under a mutant; review 40)
+    ("diag(0, -1) (largest pivot 0)", [[0, 0], [0, -1]], False, False),
+    ("diag(-1, 0, 0)", [[-1, 0, 0], [0, 0, 0], [0, 0, 0]], False, False),
     ("[[2,1],[1,2]] (eigenvalues 1, 3)", [[2, 1], [1, 2]], True, True),
     ("[[4,2,2],[2,5,1],[2,1,6]]", [[4, 2, 2], [2, 5, 1], [2, 1, 6]], True, True),
     ("[[1,1],[1,1+2^-60]] (PD, float-singular)", [[1, 1], [1, 1 + F(1, 2**60)]], True, True),
@@ -449,3 +453,12 @@ def test_asymmetric_takes_a_flint_matrix() -> None:
     T = fmpq_mat([[2, 1], [fmpq(1) + fmpq(1, 2**100), 3]])
     r = asymmetric(T, "P")
     assert r is not None and not r.ok and r.detail == "P is not symmetric at (0, 1)"
+
+
+def test_a_negative_diagonal_behind_a_zero_pivot_is_named_as_such() -> None:
+    """diag(0, −1): the message said "zero pivot with a nonzero off-diagonal entry" though
+    the offending entry is the diagonal −1 (mutation review, session 40)."""
+    r = check_psd([[0, 0], [0, -1]])
+    assert not r.ok and "negative diagonal -1" in r.detail and "off-diagonal" not in r.detail
+    r = check_psd([[0, 1], [1, 0]])
+    assert not r.ok and "off-diagonal" in r.detail

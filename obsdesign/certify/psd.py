@@ -148,6 +148,13 @@ def check_psd(M: Any, margin: Any = 0) -> PSDResult:
                 False, float_or_inf(p), f"negative diagonal {float_or_inf(p):.6g} after elimination"
             )
         if p == 0:
+            # the largest remaining diagonal entry is 0: PSD only if the rest is all zero
+            for i in idx:
+                if a[i][i] != 0:  # below 0: the message said "off-diagonal" (session 40)
+                    v = float_or_inf(a[i][i])
+                    return PSDResult(
+                        False, v, f"negative diagonal {v:.6g} after elimination (largest 0)"
+                    )
             for i in idx:
                 for j in idx:
                     if a[i][j] != 0:
