@@ -1148,3 +1148,95 @@ def test_admissibility_reads_a_face_at_its_own_offset(case: str) -> None:
     assert res.info["max_gauge"] > 1.1
     key = "e0_in_omega" if case == "e0" else "admissible_scenario"
     assert res.info[key] is False and res.info.get("exit_code", 0) == 0
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([fmpq(1, 20), fmpq(1, 3), fmpq(2)]))
+def test_phi_exact_is_the_max_over_the_slab_by_cdd(seed: int, eta: fmpq) -> None:
+    """φ_i(z) of LP (6) with η̄ > 0, against an independent slice: cdd.gmp's vertices of
+    {G e ≤ 1, z − η̄ ≤ c·e ≤ z + η̄} (no obsdesign code), on random 2- and 3-D polytopes.
+    Dropping the edge crossings of the upper plane c·e = z + η̄ survived every test and
+    certified a factor 0.9499 where the true level is 1.0024 (Example 7.1 with η̄ = 0.05,
+    λ = 0.95; mutation review, session 40)."""
+    import cdd
+    import cdd.gmp as cddg
+
+    q = fmpq
+    rng = np.random.default_rng(seed)
+    n = 2 + seed % 2
+    pts = np.vstack([rng.integers(-20, 21, size=(10, n)), 21 * np.eye(n), -21 * np.eye(n)])
+    G, vrep = ce.po.exact_hull(np.array([[q(int(x)) for x in p] for p in pts], dtype=object))
+    Aq = np.array(
+        [[q(int(x), 7) for x in row] for row in rng.integers(-5, 6, (n, n))], dtype=object
+    )
+    cq = [q(int(x)) for x in rng.integers(-3, 4, n)]
+    if all(x == 0 for x in cq):
+        return
+    ex = _undisturbed(Aq, cq, G, eta)
+    zs, cv = ce.exact_zd(vrep.V, ex.C[0], ex.eta)
+    sl = ce._Slices(ex, G, vrep, zs, cv)
+
+    def fr(x: fmpq) -> Fraction:
+        return Fraction(int(x.p), int(x.q))
+
+    GA = [[sum((fr(G[i, k]) * fr(Aq[k, j]) for k in range(n)), Fraction(0)) for j in range(n)]
+          for i in range(len(G))]  # fmt: skip
+    for l, z in enumerate(zs):
+        rows = [[Fraction(1)] + [-fr(x) for x in G[i]] for i in range(len(G))]
+        rows.append([fr(z + eta)] + [-fr(x) for x in cq])  # c·e ≤ z + η̄
+        rows.append([-fr(z - eta)] + [fr(x) for x in cq])  # c·e ≥ z − η̄
+        p = cddg.polyhedron_from_matrix(
+            cddg.matrix_from_array(rows, rep_type=cdd.RepType.INEQUALITY)
+        )
+        verts = [[x / r[0] for x in r[1:]] for r in cddg.copy_generators(p).array if r[0] != 0]
+        phis = sl.phi_exact(l)
+        for i in range(len(G)):
+            want = max(sum((GA[i][j] * v[j] for j in range(n)), Fraction(0)) for v in verts)
+            assert fr(phis[i]) == want, (l, i)
+
+
+def test_linear_law_takes_every_vertex_of_a_non_symmetric_polytope() -> None:
+    """Proposition 7.1 on the triangle x ≥ −1, y ≥ −1, x + y ≤ 1 with A = diag(½, ¼), L = 0:
+    the factor is max over rows and vertices of G_i A e = 3/4 (row x + y at the vertex
+    (2, −1), listed last). Skipping the last vertex gave 1/2 ≤ λ = 3/5 and no test failed:
+    every linear-law test had a symmetric polytope, where a vertex's mirror stands in for it
+    (mutation review, session 40)."""
+    q = fmpq
+    ex = ce.ExactProblem(
+        A=np.array([[q(1, 2), q(0)], [q(0), q(1, 4)]], dtype=object),
+        B1=np.zeros((2, 0), dtype=object),
+        C=np.array([[q(1), q(0)]], dtype=object),
+        G0=np.zeros((0, 2), dtype=object),
+        Vo=np.zeros((0, 2), dtype=object),
+        Dv=np.zeros((0, 0), dtype=object),
+        eta=q(0),
+        lam=q(3, 5),
+    )
+    G = np.array([[q(-1), q(0)], [q(0), q(-1)], [q(1), q(1)]], dtype=object)
+    V = np.array([[q(-1), q(-1)], [q(-1), q(2)], [q(2), q(-1)]], dtype=object)
+    L = np.array([[q(0)], [q(0)]], dtype=object)
+    assert ce.linear_law(ex, G, V, L) == (False, q(3, 4))
+    assert ce.linear_law(ex, G, V[::-1], L) == (False, q(3, 4))
+
+
+def test_linear_law_bounds_the_noise_by_the_sum_of_absolute_values() -> None:
+    """Two outputs (C = I) and L = [[1, −1], [0, 0]] on the box |x|, |y| ≤ 1: the rows ±(1, 0)
+    have G_i L = ±(1, −1), so their worst noise term is (|1| + |−1|)·η̄ = 2η̄, not
+    |1 − 1|·η̄ = 0 (the mutant |Σ_k G_i L_k|·η̄ survived every test, all with one output;
+    mutation review, session 40). With A = 0 and η̄ = 1/10 the factor is 2 + 2/10."""
+    q = fmpq
+    I2 = np.array([[q(1), q(0)], [q(0), q(1)]], dtype=object)
+    ex = ce.ExactProblem(
+        A=np.array([[q(0), q(0)], [q(0), q(0)]], dtype=object),
+        B1=np.zeros((2, 0), dtype=object),
+        C=I2,
+        G0=np.zeros((0, 2), dtype=object),
+        Vo=np.zeros((0, 2), dtype=object),
+        Dv=np.zeros((0, 0), dtype=object),
+        eta=q(1, 10),
+        lam=q(21, 10),
+    )
+    G = np.array([[q(a), q(b)] for a, b in ((1, 0), (-1, 0), (0, 1), (0, -1))], dtype=object)
+    V = np.array([[q(a), q(b)] for a, b in ((1, 1), (1, -1), (-1, 1), (-1, -1))], dtype=object)
+    L = np.array([[q(1), q(-1)], [q(0), q(0)]], dtype=object)
+    assert ce.linear_law(ex, G, V, L) == (False, q(11, 5))
