@@ -618,6 +618,22 @@ def test_l2_formula_known_answer() -> None:
         assert not check_pd(-lmis.l2_gain(A, C, Bd, _q([[p]]), X, fmpq(1), False)).ok
 
 
+def test_l2_formula_known_answer_discrete() -> None:
+    """e⁺ = e/2 + d has L2 gain 1/(1 − 1/2) = 2 (γ² = 4, at z = 1): the discrete bounded-real-
+    lemma matrix certifies γ² = 4(1 + 2⁻¹⁰) with P = 2, and no P gives γ² = 4 or 3. Only the
+    continuous formula had a known answer, and the discrete one without its +I certified
+    γ² ≤ 4 on Example 4, whose true γ² is at least 4.33 (mutation review, session 40)."""
+    from obsdesign.certify.psd import check_pd
+    from obsdesign.methods.stubborn import lmis
+
+    A, C, Bd = _q([[fmpq(1, 2)]]), _q([[0]]), _q([[1]])
+    X = _q([[0]])
+    assert check_pd(-lmis.l2_gain(A, C, Bd, _q([[2]]), X, 4 * (1 + fmpq(1, 2**10)), True)).ok
+    for g in (fmpq(4), fmpq(3)):
+        for p in (fmpq(1, 100), fmpq(1, 2), fmpq(1), fmpq(2), fmpq(5, 2)):
+            assert not check_pd(-lmis.l2_gain(A, C, Bd, _q([[p]]), X, g, True)).ok
+
+
 def test_r_bound_instead_of_gain_bound() -> None:
     """r_bound alone (no gain bound) also makes the best λ finite; R ⪯ r_bound·I is certified
     and a reported R just above the bound fails exactly that claim."""

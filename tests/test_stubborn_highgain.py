@@ -554,3 +554,41 @@ def test_another_C_says_to_reorder_the_states_not_to_omit_C() -> None:
     with pytest.raises(SpecError, match=r"\[system.C\].*reorder the states") as e:
         api.load_spec_text(text, "c.toml")
     assert "omit C" not in str(e.value)
+
+
+def test_the_lyapunov_equation_checks_its_last_entry_too(rep: Report) -> None:
+    """A P whose residual E = P(A₀ − KC) + (A₀ − KC)ᵀP + I is zero but for its last entry: with
+    K = (2, 1), E₀₀ = 1 − 4p₀ − 2p₁, E₀₁ = p₀ − 2p₁ − p₂, E₁₁ = 2p₁ + 1, so p₁ = −1/2 + 2⁻⁸⁰
+    with p₀, p₂ solving the first two leaves E₁₁ = 2⁻⁷⁹ alone. Skipping E's last entry
+    survived every test (the tamper tests changed other entries; mutation review, session
+    40)."""
+    d = rep.to_dict()
+    p1 = fmpq(-1, 2) + TINY
+    p0 = (1 - 2 * p1) / 4
+    p2 = p0 - 2 * p1
+    _set(d, "P", np.array([[p0, p1], [p1, p2]], dtype=object))
+    assert "lyapunov-equation" in _failed(d)
+
+
+def test_ell_exactly_at_2L_norm_P_is_not_above_it() -> None:
+    """K = (0.6, 0.8): P = [[3/2, −1/2], [−1/2, 9/4]] has |P| = 5/2 (rational), so with L = 2
+    the bound 2L|P| is exactly 10: ℓ = 10 must fail "ℓ > 2L|P|" (ℓI − 2LP is singular, not
+    ≻ 0). A non-strict check accepted it and no test had ℓ at the bound (mutation review,
+    session 40)."""
+    text = (
+        '[system]\ntime = "continuous"\nstates = ["x1", "x2"]\nf = ["x2", "-x1 - sin(x1)"]\n'
+        'C = [[1, 0]]\n[method]\nkey = "stubborn"\nmode = "high-gain"\n'
+        "K = [0.6, 0.8]\nlipschitz = 2\nlambda = 1\nepsilon = 1\n"
+    )
+    r = api.design(api.load_spec_text(text, "hg.toml"))
+    assert r.exit_code() == 0
+    P = r.parameters["P"]
+    assert [[P[i, j] for j in range(2)] for i in range(2)] == [
+        [fmpq(3, 2), fmpq(-1, 2)],
+        [fmpq(-1, 2), fmpq(9, 4)],
+    ]
+    d = r.to_dict()
+    _set(d, "ell", fmpq(10))
+    assert "ell-bound" in _failed(d)
+    _set(d, "ell", fmpq(10) + TINY)
+    assert "ell-bound" not in _failed(d)
