@@ -241,3 +241,18 @@ def test_diag_dominance_bound_is_shown_at_or_below_the_exact_one() -> None:
     r = psd.diag_dominant_int(fmpz_mat([[3, 0], [0, 3]]), fmpq(3, 7))
     assert r is not None and Q(r.min_pivot) <= fmpq(9, 7)
     assert float(fmpq(9, 7)) > r.min_pivot  # one step below the nearest
+
+
+@pytest.mark.parametrize("scale_bits", [0, 60, 120, 200])
+def test_the_cholesky_certificate_holds_at_any_scale(scale_bits: int) -> None:
+    """[[1, 3/2], [3/2, 3]] (PD, not diagonally dominant) times 2^s: the certificate
+    F = RᵀR + S needs RᵀR subtracted at its true scale, 2^(−2k); for entries above 2¹⁰⁴ the
+    float factor's shift k is negative, a branch no test reached (the mutant 2^(−k) there
+    went unnoticed; mutation review, session 40). S = F − RᵀR must come out dominant at every
+    scale; the mutant leaves S ≈ F, not dominant, and finds no proof."""
+    s = fmpq(2) ** scale_bits
+    M = qmat([[1, fmpq(3, 2)], [fmpq(3, 2), 3]]) * s
+    F = fmpq_mat(2, 2, list(M.flat))
+    Mf = np.array([[float(x) for x in row] for row in M], dtype=float)
+    r = psd._gershgorin_certificate(F, Mf)
+    assert r is not None and r.ok and r.detail.startswith("M = RᵀR + S")
