@@ -317,3 +317,12 @@ def test_a_long_search_space_expression_splits_its_source_once_per_literal(
     api.design(api.load_spec_text(text, "long.toml"))
     literals = 2 * 30 + 1 + 5  # 0.01 and i.5 per term, 0.2, and the spec's other literals
     assert 0 < len(calls) <= 4 * literals
+
+
+@pytest.mark.parametrize("text", ["-x1 # - 100*x1^3", "x1#", "#x1", "(x1 +\n# 5\n x1)"])
+def test_a_hash_is_refused_not_read_as_a_comment(text: str) -> None:
+    """Python's parser reads '#' as a comment: f = "-u1*x1 # - 100*x1^3" was certified as the
+    plant −u1·x1 with the rest dropped (L_f ≤ 1 where the written plant has 1875; CLI trial,
+    session 40). It is bad input naming the key."""
+    with pytest.raises(SpecError, match=r"\[system\.f\[1\]\] has '#'"):
+        parse_expr(text, ["x1"], file="s.toml", key="system.f[1]")

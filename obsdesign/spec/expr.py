@@ -204,6 +204,14 @@ def parse_expr(
             f"expression is {len(text)} characters long, above the limit of "
             f"{lim.max_expr_chars} (--limit max_expr_chars=N)",
         )
+    if "#" in text:
+        # Python's parser reads '#' as a comment: "-u1*x1 # - 100*x1^3" was the certified
+        # plant -u1*x1, with the rest of the text silently dropped (CLI trial, session 40)
+        raise SpecError(
+            file,
+            key,
+            "has '#': an expression has no comments (Python would ignore everything after it)",
+        )
     depth = nesting_depth(text, stop=lim.max_expr_depth)
     if depth > lim.max_expr_depth:
         raise SpecError(file, key, _too_deep(depth))
