@@ -214,3 +214,28 @@ def test_cvxpy_logs_nothing_once_an_interrupt_is_recorded(
     monkeypatch.setattr(interrupt, "_requested", True)
     log.warning("Encountered unexpected exception importing solver HIGHS:\nSystemError()")
     assert capsys.readouterr().err == "before\n"
+
+
+def test_deferred_records_a_stop_and_raises_it_as_the_block_ends() -> None:
+    """interrupt.deferred(): the handler records a stop inside the block without raising;
+    the outermost block raises KeyboardInterrupt as it ends; a stop recorded before the
+    block is not raised again by it (session 40)."""
+    import signal
+
+    from obsdesign import interrupt
+
+    interrupt.reset()
+    ran = []
+    with pytest.raises(KeyboardInterrupt):
+        with interrupt.deferred():
+            with interrupt.deferred():
+                interrupt.handler(signal.SIGTERM, None)  # no raise here
+                ran.append("inner")
+            ran.append("outer")  # the inner block does not raise either
+    assert ran == ["inner", "outer"] and interrupt.signal_number() == signal.SIGTERM
+    with interrupt.deferred():  # recorded before: not raised again
+        pass
+    interrupt.reset()
+    with pytest.raises(KeyboardInterrupt):  # outside a block the handler raises at once
+        interrupt.handler(signal.SIGINT, None)
+    interrupt.reset()

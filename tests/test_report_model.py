@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import os
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -193,3 +194,39 @@ def test_check_float_view_agrees_with_the_float_view(value) -> None:
     assert (got is None) == (want is None)
     if want is not None:
         assert "parameter 'x'" in got and "float view" in got
+
+
+@pytest.mark.parametrize("where", ["probe", "write"])
+def test_a_stop_as_the_temp_file_appears_leaves_no_file(tmp_path: Path, where: str) -> None:
+    """A stop signal (here SIGUSR1 with the CLI's handler, interrupt.handler, which it
+    installs for SIGTERM and the other stop signals) that lands right after a temp file is
+    created: the probe of the output folder and write_via's temp file were left behind (4 of
+    25 ``design -o`` runs under SIGTERM; CLI trial, session 40). Deferred during creation and
+    cleanup, the stop is raised inside the block that removes the file."""
+    import signal
+
+    from obsdesign import interrupt
+    from obsdesign.report import model as m
+
+    real = m._temp_file
+
+    def created_then_stopped(*a: Any, **k: Any) -> tuple[int, str]:
+        out = real(*a, **k)
+        os.kill(os.getpid(), signal.SIGUSR1)  # delivered now, or held until the block ends
+        return out
+
+    old = signal.signal(signal.SIGUSR1, interrupt.handler)
+    interrupt.reset()
+    try:
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setattr(m, "_temp_file", created_then_stopped)
+            with pytest.raises(KeyboardInterrupt):
+                if where == "probe":
+                    m._probe_dir(tmp_path / "r.json")
+                else:
+                    m.write_via(tmp_path / "r.json", lambda p: p.write_text("{}"))
+    finally:
+        signal.signal(signal.SIGUSR1, old)
+        assert interrupt.requested()
+        interrupt.reset()
+    assert sorted(os.listdir(tmp_path)) == []

@@ -598,13 +598,14 @@ def _probe_dir(p: Path) -> None:
     fuzzer; a 241–255-byte name passed a short probe name and failed after the work: output
     trial, session 30)."""
     parent = p.parent if str(p.parent) else Path(".")
-    try:
-        fd, name = _temp_file(p)
-    except OSError as e:
-        raise InputError(f"{p}: cannot write in {parent} ({e.strerror})") from None
-    os.close(fd)
-    with contextlib.suppress(OSError):
-        os.unlink(name)
+    with interrupt.deferred():  # a stop between creating and removing the probe left it
+        try:
+            fd, name = _temp_file(p)
+        except OSError as e:
+            raise InputError(f"{p}: cannot write in {parent} ({e.strerror})") from None
+        os.close(fd)
+        with contextlib.suppress(OSError):
+            os.unlink(name)
 
 
 #: the longest file name (bytes) of the usual file systems (NAME_MAX)
@@ -656,9 +657,13 @@ def write_via(path: str | Path, writer: Callable[[Path], Any], force: bool = Fal
             mode = stat.S_IMODE(os.stat(p).st_mode)
         except FileNotFoundError:
             mode = _umask_mode()
-        fd, tmp = _temp_file(p, given)
-        os.close(fd)
+        tmp: str | None = None
         try:
+            # no stop between creating the temp file and the try that removes it (a stop
+            # held here is handled inside the try), nor inside that cleanup
+            with interrupt.deferred():
+                fd, tmp = _temp_file(p, given)
+                os.close(fd)
             writer(Path(tmp))
             os.chmod(tmp, mode)
             # a Ctrl-C whose KeyboardInterrupt some library swallowed (mpmath's from_float has
@@ -667,8 +672,9 @@ def write_via(path: str | Path, writer: Callable[[Path], Any], force: bool = Fal
             interrupt.check()
             os.replace(tmp, p)
         finally:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
+            with interrupt.deferred():
+                if tmp is not None and os.path.exists(tmp):
+                    os.unlink(tmp)
     except OSError as e:
         raise InputError(f"{path}: cannot write ({e.strerror or e})") from None
     return p
