@@ -689,16 +689,19 @@ def _write_into(p: Path, writer: Callable[[Path], Any], suffix: str) -> None:
     on a link to /dev/full; output trial, session 30); a format that seeks works too."""
     import shutil
 
-    fd, tmp = _temp_file(Path(tempfile.gettempdir()) / "obsdesign", suffix)
-    os.close(fd)
+    tmp: str | None = None
     try:
+        with interrupt.deferred():  # as in write_via: no stop before the cleanup is armed
+            fd, tmp = _temp_file(Path(tempfile.gettempdir()) / "obsdesign", suffix)
+            os.close(fd)
         writer(Path(tmp))
         interrupt.check()
         with open(tmp, "rb") as src, open(p, "wb") as dst:
             shutil.copyfileobj(src, dst)
     finally:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
+        with interrupt.deferred(), contextlib.suppress(OSError):
+            if tmp is not None:
+                os.unlink(tmp)
 
 
 def write_atomic(path: str | Path, text: str, force: bool = False) -> Path:
