@@ -40,7 +40,7 @@ BITS = 40
 LAMBDA_CAP = 1e6
 #: continuous time: below λ = 10⁻⁶ the search goes down by LOW_STEP a step to LAMBDA_FLOOR
 LOW_STEP = 1e4
-LAMBDA_FLOOR = 1e-30
+LAMBDA_FLOOR = 1e-26
 
 
 @dataclass
@@ -268,8 +268,8 @@ def search_lambda(pl: Plant, o: Options) -> tuple[float, float, str]:
                 # said "infeasible for every λ tried"; unusual-spec trial, session 24)
                 hi, st = lo, st_lo
                 lo /= LOW_STEP
-                # 10⁻⁶ / (10⁴)⁶ is 9.99…·10⁻³¹ in floats: a plain < stopped at 10⁻²⁶ (stubborn
-                # trial, session 40); the floor itself is tried
+                # 10⁻⁶ / (10⁴)⁵ is 9.99…·10⁻²⁷ in floats: the floor itself is tried (the
+                # docs said 10⁻³⁰, a floor a plain < never reached; stubborn trial, session 40)
                 if lo < LAMBDA_FLOOR * (1 - 1e-9):
                     return 0.0, hi, st
                 ok, st_lo = feasible(pl, o, lo)
@@ -364,7 +364,8 @@ def _design_or_scale_free(
     spec: Spec, progress: Any = None
 ) -> tuple[dict[str, Any], SolverResult, list[str]]:
     """:func:`design_params`; when it ends "infeasible" with the gain bound among the bounds
-    to raise, once more with the gain bound scale-free (``Options.scale_free_gain``).
+    to raise, or without a verdict at every λ tried (exit 4: inaccurate answers, badly scaled
+    data), once more with the gain bound scale-free (``Options.scale_free_gain``).
 
     With the normalization P ⪰ I, W ⪰ I the bound ‖X‖₂ ≤ gain_bound is not scale-free: a plant
     whose LMIs need P ≫ W (A = 0.5, C = 1000: P ≳ 10⁶ for w ≥ 1) needs ‖X‖₂ = ‖P K‖₂ ≳ 500
@@ -378,8 +379,13 @@ def _design_or_scale_free(
     o: Options = spec.options
     try:
         return design_params(spec, progress)
-    except InfeasibleError as e:
-        if o.K is not None or o.scale_free_gain or not getattr(e, "gain_bound_hint", False):
+    except (InfeasibleError, InconclusiveError) as e:
+        # exit 1 naming the gain bound, or exit 4 where no λ was found feasible without a
+        # verdict: with C ~ 10⁵ the solver's answer is "inaccurate", or the data span gate
+        # says it is no verdict, where the scale-free problem certifies (re-check trial,
+        # session 40); not the exit 4 of a margin or bound at its feasibility limit
+        named = getattr(e, "gain_bound_hint", False)
+        if o.K is not None or o.gain_bound is None or o.scale_free_gain or not named:
             raise
         first = e
     free = _replace(spec, options=_replace(o, scale_free_gain=True))
@@ -394,8 +400,13 @@ def _design_or_scale_free(
     vals["gain_normalization"] = "scale-free"
     notes.insert(
         0,
-        f"with P ⪰ I, W ⪰ I and ‖X‖₂ ≤ gain_bound = {fmt_exact(o.gain_bound)} the solver "
-        "reports the LMIs infeasible (that bound is not scale-free: the LMIs need P ≫ W here); "
+        f"with P ⪰ I, W ⪰ I and ‖X‖₂ ≤ gain_bound = {fmt_exact(o.gain_bound)} "
+        + (
+            "the solver reports the LMIs infeasible"
+            if isinstance(first, InfeasibleError)
+            else "the design gives no verdict (exit 4)"
+        )
+        + " (that bound is not scale-free: the LMIs may need P ≫ W); "
         "designed with ‖X‖₂ ≤ gain_bound·s and P ⪰ s·I instead, which still gives "
         "‖K‖₂ ≤ gain_bound (claim gain-bound)",
     )
@@ -437,12 +448,14 @@ def design_params(
         good, bad, st = search_lambda(pl, o)
         if good == (0.0 if not pl.discrete else 1.0):
             if st != INFEASIBLE:
-                raise InconclusiveError(
+                err = InconclusiveError(
                     f"stubborn: the solver found LMIs {_refs(pl)} feasible at no λ tried "
                     f"(down to {bad:g}), but did not report them infeasible there either "
                     f"(status {st}): not a verdict; a smaller [method] margin (now "
                     f"{fmt_exact(o.margin)}) or a rescaled plant may help"
                 )
+                err.gain_bound_hint = o.K is None and o.gain_bound is not None  # type: ignore[attr-defined]
+                raise err
             _unless_feasible_with_less_margin(pl, o, bad, "for every λ tried")
             _infeasible(spec, pl, o, "for every λ tried")
         best, cert = _certified_best(spec, pl, o, good)
@@ -775,12 +788,14 @@ def _infeasible(spec: Spec, pl: Plant, o: Options, where: str) -> None:
         # rescaled certificate (search-space/stubborn trial, session 31): on data this badly
         # scaled the status is no proof
         what = "A, C and the given K" if o.K is not None else "A and C"
-        raise InconclusiveError(
+        err = InconclusiveError(
             f"stubborn: the solver reports LMIs {_refs(pl)} infeasible {where}, but (C, A) is "
             f"detectable and the nonzero entries of {what} span a factor {spread:.3g} (above "
             f"{SPREAD_MAX:g}): on data this badly scaled that status is no proof of "
             "infeasibility (rescale the states or the outputs)"
         )
+        err.gain_bound_hint = o.K is None and o.gain_bound is not None  # type: ignore[attr-defined]
+        raise err
     _bounds_too_tight(pl, o, where, det.verdict)
 
 
