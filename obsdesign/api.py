@@ -921,7 +921,7 @@ def simulate(
         if rep.error is not None:
             raise InputError(
                 f"{where}: records a design that stopped with an error "
-                f"({rep.error.get('message', '')}): no parameters to simulate"
+                f"({rep.error.get('message', '')}): no certified parameters to simulate"
             )
         params = rep.parameters.traced(finite=True)
     if report is not None and rep.computed_verdict() != "ok":
@@ -1364,7 +1364,16 @@ def _time_budget(seconds: float | None) -> Any:
             # batch trial, session 35); the caller's timer is re-armed there
             return
         now = time.monotonic()
-        if caller[0] is not None and now >= caller[0] - ALARM_SLACK_S:
+        caller_due = caller[0] is not None and now >= caller[0] - ALARM_SLACK_S
+        if (caller_due or now < deadline - ALARM_SLACK_S) and _importing(already):
+            # the caller's alarm (or one from outside) waits for the import to end, as the
+            # budget's own stop does: a handler raising inside ``import cvxpy`` left it
+            # half-imported, and every later design of the process failed with "module
+            # 'cvxpy' has no attribute 'promote'" (re-check trial, session 40)
+            signal.setitimer(signal.ITIMER_REAL, IMPORT_WAIT_S)
+            return
+        if caller_due:
+            assert caller[0] is not None
             caller[0] = caller[0] + every[0] if every[0] > 0 else None
             hand_over(signum, frame)
             return
@@ -1432,6 +1441,9 @@ class _CallerAlarm(BaseException):
         super().__init__(exc)
         self.exc = exc
 
+
+#: seconds between looks at whether an import a caller's alarm waits for has ended
+IMPORT_WAIT_S = 0.01
 
 #: an alarm this close before a deadline is that deadline's (timer and clock granularity)
 ALARM_SLACK_S = 1e-3

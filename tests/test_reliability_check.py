@@ -1030,3 +1030,41 @@ def test_an_exception_of_the_callers_alarm_handler_reaches_the_caller(monkeypatc
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, old)
+
+
+def test_the_callers_alarm_waits_for_an_import_to_end(monkeypatch):
+    """A caller's alarm handler that raises inside ``import cvxpy`` (the first design of a
+    process) left cvxpy half-imported: every later design failed with "module 'cvxpy' has no
+    attribute 'promote'" (re-check trial, session 40). During a budget the caller's alarm
+    now waits for the import to end, as the budget's own stop does (an import simulated
+    here for 0.3 s)."""
+    import signal
+    import time
+
+    from obsdesign import api as api_mod
+
+    class Watchdog(Exception):
+        pass
+
+    importing = [True]
+    monkeypatch.setattr(api_mod, "_importing", lambda already: importing[0])
+    fired: list[float] = []
+
+    def bark(*a: Any) -> None:
+        fired.append(time.monotonic())
+        raise Watchdog
+
+    old = signal.signal(signal.SIGALRM, bark)
+    try:
+        signal.setitimer(signal.ITIMER_REAL, 0.05)
+        t0 = time.monotonic()
+        with pytest.raises(Watchdog), api_mod._time_budget(100):
+            while time.monotonic() - t0 < 0.3:  # "importing"
+                pass
+            importing[0] = False
+            while time.monotonic() - t0 < 3:
+                pass
+        assert len(fired) == 1 and 0.3 <= fired[0] - t0 < 1.0
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
