@@ -8,8 +8,9 @@ Checked where the input enters:
 
 - files (spec, report): a regular file (``stat`` before ``open``, so a FIFO or /dev/zero is
   refused at once) of at most ``max_file_bytes``;
-- values: a spec holds at most ``max_values`` comma-separated values (counted on the text
-  before the TOML parser runs: a 2000×2000 matrix is refused in milliseconds);
+- values: a spec holds at most ``max_values`` comma-separated values, and as many lines
+  (counted on the text before the TOML parser runs: a 2000×2000 matrix is refused in
+  milliseconds);
 - numbers: at most ``max_digits`` significant digits and a decimal exponent within
   ``±max_exponent``, checked on the text / ``Decimal`` before any conversion to a rational;
 - TOML and JSON nesting: at most ``max_depth`` levels (walked iteratively);
