@@ -224,9 +224,13 @@ def dask_client(
             # (exit 3 "missing port number"; hostile-input trial, session 24); TypeError: a
             # tls:// or ucx:// address without its setup; MemoryError: a service that answers
             # bytes read as a frame length of exabytes (an HTTP server; session 27)
-            raise InputError(
-                f"--scheduler {scheduler}: cannot connect ({type(e).__name__}: {e})"
-            ) from None
+            why = (
+                "the service there does not speak Dask's protocol (its answer read as a "
+                "message of impossible size)"
+                if isinstance(e, MemoryError)
+                else f"{type(e).__name__}: {e}"
+            )
+            raise InputError(f"--scheduler {scheduler}: cannot connect ({why})") from None
         try:
             try:
                 # a scheduler without workers took the tasks and waited forever, silently

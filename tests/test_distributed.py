@@ -6,6 +6,7 @@ One LocalCluster (2 worker processes: the ``dask_client`` fixture) is shared by 
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import subprocess
@@ -615,3 +616,37 @@ def test_an_interrupted_cluster_is_closed_with_a_bounded_wait(
     with pytest.raises(KeyboardInterrupt), distributed.dask_client(workers=1):
         pass
     assert len(waits) == 1 and isinstance(waits[0], (int, float)) and 0 < waits[0] <= 60
+
+
+def test_an_http_service_as_scheduler_is_named_as_not_dask() -> None:
+    """A service that answers HTTP at once: Dask reads its first bytes as a frame length of
+    exabytes, and the message was "cannot connect (MemoryError: Unable to allocate 3.07 EiB
+    …)" (CLI trial, session 40). It now says the service does not speak Dask's protocol."""
+    import socket
+    import threading
+
+    from obsdesign.errors import InputError
+
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen(8)
+    port = srv.getsockname()[1]
+
+    def serve() -> None:
+        while True:
+            try:
+                c, _ = srv.accept()
+            except OSError:
+                return
+            with contextlib.suppress(OSError):
+                c.sendall(b"HTTP/1.0 400 Bad Request\r\nServer: x\r\n\r\n" + b"x" * 64)
+                c.close()
+
+    threading.Thread(target=serve, daemon=True).start()
+    try:
+        with pytest.raises(InputError, match="cannot connect") as ei:
+            run_tasks(abs, [1], scheduler=f"tcp://127.0.0.1:{port}")
+    finally:
+        srv.close()
+    msg = ei.value.message
+    assert "EiB" not in msg and "Unable to allocate" not in msg, msg
