@@ -656,9 +656,16 @@ def _spec_source(spec: Any) -> tuple[str, str]:
         p = Path(spec)
         raw = read_input(p, "spec")
         try:
-            return raw.decode("utf-8"), str(p)
+            text = raw.decode("utf-8")
         except UnicodeDecodeError:
             raise InputError(f"{p}: is not UTF-8 text") from None
+        if text.startswith("\ufeff"):
+            # the loader's message (design, check, simulate): sweep said "is not valid TOML
+            # (Invalid statement …)" of the edited point (CLI trial, session 40)
+            from obsdesign.spec.loader import read_spec_text
+
+            read_spec_text(text, str(p))
+        return text, str(p)
     return spec.text, spec.file
 
 

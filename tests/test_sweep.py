@@ -792,3 +792,12 @@ def test_a_range_with_a_negative_or_zero_count_says_so(count: str) -> None:
     with pytest.raises(InputError, match="the number of values must be at least 1, got "):
         sw.parse_grid([f"method.lambda=0.96:0.97:{count}"])
     assert sw.parse_grid(["a.x=1:2:3:lin"])[0].values == sw.parse_grid(["a.x=1:2:3"])[0].values
+
+
+def test_a_spec_with_a_byte_order_mark_gets_the_loaders_message(tmp_path: Path) -> None:
+    """design, check and simulate name the BOM; sweep said "is not valid TOML (Invalid
+    statement …)" (CLI trial, session 40)."""
+    spec = tmp_path / "bom.toml"
+    spec.write_bytes(b"\xef\xbb\xbf" + SPEC.read_bytes())
+    res = CliRunner().invoke(app, ["sweep", str(spec), "--set", "method.rate=0.9"])
+    assert res.exit_code == 2 and "byte-order mark" in res.output, res.output
