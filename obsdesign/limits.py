@@ -250,10 +250,15 @@ def decimal_problem(d: Decimal) -> str | None:
 
 def int_problem(v: int) -> str | None:
     """Why an int has too many digits (None when it is fine); no decimal conversion made."""
+    lim = _current.max_digits
     bits = abs(v).bit_length()
-    if bits * 0.30103 > _current.max_digits + 1:
-        return f"has about {int(bits * 0.30103)} digits, above the limit of {_current.max_digits} (--limit max_digits=N)"
-    return None
+    # up to lim digits for sure below that many bits; else compared exactly with 10^lim (the
+    # estimate's slack of one digit let a 1001-digit integer pass the limit of 1000, and
+    # max_digits = 1 called 153 "about 2 digits"; CLI trial, session 40)
+    if (bits - 1) * 0.30103 < lim - 1 or abs(v) < 10**lim:
+        return None
+    least = max(lim + 1, int((bits - 1) * 0.30103) + 1)  # v ≥ 2^(bits − 1)
+    return f"has at least {least} digits, above the limit of {lim} (--limit max_digits=N)"
 
 
 _NUM = re.compile(

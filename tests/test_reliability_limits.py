@@ -619,3 +619,22 @@ def test_an_expression_at_the_depth_limit_is_evaluated(tmp_path: Path) -> None:
         assert sys.getrecursionlimit() == RECURSION_LIMIT + 1  # a higher limit is kept
     finally:
         sys.setrecursionlimit(old)
+
+
+def test_an_integer_one_digit_beyond_max_digits_is_refused() -> None:
+    """The bit-length estimate allowed one digit of slack: a 1001-digit integer passed the
+    limit of 1000, and max_digits = 1 called 153 "about 2 digits" (CLI trial, session 40).
+    Decided exactly now, at the limit and one past it."""
+    from obsdesign.limits import int_problem, restore, saved, set_limits
+
+    assert int_problem(10**1000 - 1) is None  # 1000 digits
+    assert "at least 1001 digits" in (int_problem(10**1000) or "")
+    assert "at least 1001 digits" in (int_problem(-(10**1000)) or "")
+    old = saved()
+    set_limits(max_digits=1)
+    try:
+        assert int_problem(9) is None
+        assert "at least 2 digits" in (int_problem(10) or "")
+        assert "at least 3 digits" in (int_problem(153) or "")
+    finally:
+        restore(old)
