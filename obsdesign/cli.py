@@ -684,7 +684,7 @@ def simulate(
         typer.Option(
             "--csv",
             metavar="FILE",
-            help="Write the trajectories as CSV: t, x_*, xhat_*, e_*, y* (run 0 of --runs).",
+            help="Write the trajectories as CSV: t, x_*, xhat_*, e_*, y* (impulsive: no y*, its y_k exists at the samples only; run 0 of --runs).",
         ),
     ] = None,
     fmt: FmtOpt = Fmt.text,
