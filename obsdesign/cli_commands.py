@@ -254,15 +254,20 @@ def _dumps(obj: Any, **kw: Any) -> str:
 def _finite(o: Any, default: Callable[[Any], Any] | None) -> Any:
     """``o`` with every non-finite float written as the string ``"nan"``, ``"inf"`` or
     ``"-inf"`` (Python's own spelling, which ``float()`` reads back), containers walked, and
-    what JSON cannot hold passed through ``default`` first."""
+    what JSON cannot hold passed through ``default`` first; strings made valid Unicode (a
+    non-UTF-8 spec file name in a row's message: :func:`obsdesign.errors.valid_text`)."""
     import math
 
-    if isinstance(o, bool) or o is None or isinstance(o, (int, str)):
+    from obsdesign.errors import valid_text
+
+    if isinstance(o, bool) or o is None or isinstance(o, int):
         return o
+    if isinstance(o, str):
+        return valid_text(o)
     if isinstance(o, float):
         return o if math.isfinite(o) else repr(o)
     if isinstance(o, dict):
-        return {k: _finite(v, default) for k, v in o.items()}
+        return {valid_text(str(k)): _finite(v, default) for k, v in o.items()}
     if isinstance(o, (list, tuple)):
         return [_finite(v, default) for v in o]
     if default is None:

@@ -54,6 +54,35 @@ def ascii_name(text: str) -> str:
     return escape_controls(text).encode("ascii", "backslashreplace").decode("ascii")
 
 
+def valid_text(text: str) -> str:
+    """``text`` as valid Unicode: a file name that is not UTF-8 reaches Python as lone
+    surrogates (``a\udcff.toml``), which no UTF-8 output can hold (``design -o`` of such a
+    spec ended with exit 3 "UnicodeEncodeError … surrogates not allowed" and no report:
+    session 40); each such byte is written as ``\xff``. Ordinary text is returned as is."""
+    try:
+        text.encode("utf-8")
+        return text
+    except UnicodeEncodeError:
+        try:
+            return text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+        except UnicodeEncodeError:  # a surrogate that is not a byte's escape (\ud800)
+            return text.encode("utf-8", "backslashreplace").decode("utf-8")
+
+
+def valid_strings(obj: Any) -> Any:
+    """``obj`` (JSON data: dicts, lists, strings, numbers) with every string and key passed
+    through :func:`valid_text`."""
+    if isinstance(obj, str):
+        return valid_text(obj)
+    if isinstance(obj, dict):
+        return {
+            valid_text(k) if isinstance(k, str) else k: valid_strings(v) for k, v in obj.items()
+        }
+    if isinstance(obj, (list, tuple)):
+        return [valid_strings(v) for v in obj]
+    return obj
+
+
 def one_line(message: str) -> str:
     """``message`` safe to print as one line: control characters (newline, ESC, …) and
     Unicode line/paragraph separators from user-given names (TOML keys, file names) are

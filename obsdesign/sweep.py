@@ -860,8 +860,12 @@ def _cell(v: Any) -> Any:
 
 def write_table(path: Path, rows: list[dict[str, Any]], force: bool = False) -> None:
     """Write ``rows`` to ``path`` atomically (CSV, JSON Lines or Parquet by suffix)."""
+    from obsdesign.errors import valid_strings
     from obsdesign.report.model import write_via
 
+    # a non-UTF-8 spec file name in the messages: written with escapes, not a
+    # UnicodeEncodeError after the sweep (session 40)
+    rows = [valid_strings(r) for r in rows]
     cols = columns(rows)
     suf = path.suffix.lower()
 

@@ -985,3 +985,33 @@ def test_a_stderr_that_cannot_take_the_error_line_keeps_the_exit_code(
         )
         assert r.returncode == code, (args, r.returncode)
     assert json.loads(out.read_text())["verdict"] == "ok"
+
+
+def test_a_spec_file_name_that_is_not_utf8_is_written_with_escapes(tmp_path: Path) -> None:
+    """A spec named with the byte 0xff reaches Python as a lone surrogate: ``design -o``
+    ended with exit 3 "UnicodeEncodeError … surrogates not allowed" and no report, and the
+    JSON of check and sweep held text no UTF-8 reader takes (session 40). The name is
+    written with escapes (``a\\xff.toml``) in the report, the rows and the tables."""
+    from typer.testing import CliRunner
+
+    from obsdesign.cli import app
+
+    src = SPEC.read_bytes()
+    raw = os.fsencode(tmp_path) + b"/a\xff.toml"
+    with open(raw, "wb") as f:
+        f.write(src)
+    spec = os.fsdecode(raw)
+    run = CliRunner().invoke
+    out = tmp_path / "r.json"
+    res = run(app, ["design", spec, "-o", str(out), "-q"])
+    assert res.exit_code == 0, res.output
+    d = json.loads(out.read_bytes().decode("utf-8"))  # strict UTF-8
+    assert d["spec_file"].endswith("a\\xff.toml")
+    assert run(app, ["verify", str(out), "-q"]).exit_code == 0
+    res = run(app, ["check", spec, "--format", "json"])
+    assert res.exit_code == 0
+    assert json.loads(res.stdout_bytes.decode("utf-8"))[0]["spec"].endswith("a\\xff.toml")
+    for name in ("s.csv", "s.jsonl"):  # a row that fails names the file in its message
+        res = run(app, ["sweep", spec, "--set", "method.nokey=1", "-o", str(tmp_path / name)])
+        assert res.exit_code == 2, res.output
+        assert "xff.toml[point 0]" in (tmp_path / name).read_bytes().decode("utf-8")

@@ -264,7 +264,18 @@ class Report:
         return observer_statespace(self, law, verify)
 
     def to_json(self) -> str:
-        return json.dumps(self.to_dict(), indent=2, ensure_ascii=False)
+        """The report as JSON text; a string that is not valid Unicode (a non-UTF-8 spec
+        file name in ``spec_file`` and the messages) written with escapes
+        (:func:`obsdesign.errors.valid_text`)."""
+        d = self.to_dict()
+        text = json.dumps(d, indent=2, ensure_ascii=False)
+        try:
+            text.encode("utf-8")
+        except UnicodeEncodeError:
+            from obsdesign.errors import valid_strings
+
+            text = json.dumps(valid_strings(d), indent=2, ensure_ascii=False)
+        return text
 
     @classmethod
     def load(cls, path: str | Path) -> tuple[Report, list[str]]:
