@@ -13,6 +13,7 @@ covered in :func:`obsdesign.lmi.solve`.
 from __future__ import annotations
 
 import sys
+import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
@@ -31,12 +32,27 @@ def handler(signum: int, frame: object) -> None:
     the interrupt, then raise KeyboardInterrupt as Python does for SIGINT, so the same
     cleanup runs (temp files removed). SIGTERM (what ``timeout`` sends) killed the process at once and left a hidden
     half-written ``.NAME.XXXX.csv`` beside the output (simulate trial, session 27)."""
-    global _requested, _signum
+    global _requested, _signum, _first_at
+    now = time.monotonic()
+    if _requested and now - _first_at < REPEAT_GRACE_S:
+        # a second stop right after the first (a double Ctrl-C, SIGTERM twice): the first's
+        # KeyboardInterrupt is on its way, and raising again could cut the cleanup it runs (a
+        # second SIGTERM as write_via's finally began skipped the temp file's removal;
+        # re-check trial, session 40); recorded only
+        return
     _requested = True
     _signum = signum
+    _first_at = now
     if _deferred:
         return  # inside :func:`deferred`: raised when the block ends
     raise KeyboardInterrupt
+
+
+#: seconds after a stop during which another stop signal is recorded but not raised again
+#: (:func:`handler`); later, one is raised again (the first may have been swallowed)
+REPEAT_GRACE_S = 1.0
+#: ``time.monotonic()`` of the recorded stop
+_first_at = 0.0
 
 
 #: depth of :func:`deferred` blocks open (the handler records but does not raise inside)

@@ -239,3 +239,26 @@ def test_deferred_records_a_stop_and_raises_it_as_the_block_ends() -> None:
     with pytest.raises(KeyboardInterrupt):  # outside a block the handler raises at once
         interrupt.handler(signal.SIGINT, None)
     interrupt.reset()
+
+
+def test_a_second_stop_right_after_the_first_is_recorded_not_raised(monkeypatch) -> None:
+    """A second SIGTERM landing as the first one's cleanup began (write_via's finally)
+    raised KeyboardInterrupt there and skipped the temp file's removal (re-check trial,
+    session 40). Within REPEAT_GRACE_S of a stop another is recorded only; after it, one is
+    raised again (the first may have been swallowed by a library)."""
+    import signal
+
+    from obsdesign import interrupt
+
+    interrupt.reset()
+    with pytest.raises(KeyboardInterrupt):
+        interrupt.handler(signal.SIGTERM, None)
+    try:
+        interrupt.handler(signal.SIGTERM, None)  # no raise: the first one is on its way
+    except KeyboardInterrupt:
+        pytest.fail("a second stop within the grace raised again")
+    assert interrupt.requested() and interrupt.signal_number() == signal.SIGTERM
+    monkeypatch.setattr(interrupt, "_first_at", interrupt._first_at - 2 * interrupt.REPEAT_GRACE_S)
+    with pytest.raises(KeyboardInterrupt):
+        interrupt.handler(signal.SIGINT, None)
+    interrupt.reset()
