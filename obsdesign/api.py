@@ -353,7 +353,14 @@ def error_report(sp: Spec, code: int, message: str, candidate: Any = None) -> Re
         [
             "parameters: what the design tried before it stopped, NOT certified ("
             + ", ".join(params)
-            + "); give them in the spec's [method] to check them"
+            + "); give them in the spec's [method] to check them ("
+            + (
+                "their float values are exact"
+                if _floats_exact(params)
+                else "the float values are rounded: the exact ones are the p/q strings of "
+                "parameters.exact; a spec takes decimals, and a p/2^k has a finite one"
+            )
+            + ")"
         ]
         if len(params)
         else []
@@ -369,6 +376,23 @@ def error_report(sp: Spec, code: int, message: str, candidate: Any = None) -> Re
         verdict="error",
         error={"exit_code": code, "message": message},
     )
+
+
+def _floats_exact(params: Parameters) -> bool:
+    """Whether every exact value of ``params`` is a double (a gain rounded to 40 bits is):
+    its float copy in the JSON is then the value itself, to copy into a spec."""
+    import numpy as np
+    from flint import fmpq
+
+    from obsdesign.certify.exact import Q
+
+    for k in params:
+        for x in np.asarray(params[k], dtype=object).ravel():
+            if isinstance(x, fmpq):
+                f = float(x)
+                if not math.isfinite(f) or Q(f) != x:
+                    return False
+    return True
 
 
 def design_error(e: Exception) -> tuple[int, str]:

@@ -739,7 +739,16 @@ def test_the_error_report_of_a_failed_designed_gain_holds_that_gain(tmp_path: Pa
     d = json.loads(out.read_text())
     assert d["verdict"] == "error" and d["error"]["exit_code"] == 4
     assert np.asarray(d["parameters"]["L"], dtype=float).shape == (8, 1)
-    assert any("NOT certified (L)" in n for n in d["notes"])
+    assert any("NOT certified (L)" in n and "float values are exact" in n for n in d["notes"])
+    # a value that is not a double: the note says the floats are rounded (lyapunov trial,
+    # session 40: the exact p/q strings are not spec input)
+    third = api.error_report(
+        api.load_spec_text(text, "p.toml"),
+        4,
+        "x",
+        Parameters({"L": np.array([[fmpq(1, 3)]] * 8, dtype=object)}),
+    )
+    assert "float values are rounded" in third.notes[0]
     ver = api.verify(out)
     assert ver.exit_code() == 4 and ver.unverified == ["L"]
     with pytest.raises(InputError, match="no observer"):
