@@ -1141,7 +1141,7 @@ def _certified_P_hp(
     from obsdesign import lyap_hp
 
     n = Am.nrows()
-    if n > lyap_hp.MAX_N and Pf is None:
+    if n > lyap_hp.DOUBLING_MAX_N and Pf is None:
         return None
     Af = mat_float(Am) if Af is None else Af
     if guide is None:
@@ -1161,10 +1161,11 @@ def _certified_P_hp(
         )
         if P is not None:
             return P
-    if n > lyap_hp.MAX_N:
+    if n > lyap_hp.DOUBLING_MAX_N:
         return None
+    solve = lyap_hp.lyapunov_P_hp if n <= lyap_hp.MAX_N else lyap_hp.lyapunov_P_doubling
     for prec in lyap_hp.PRECISIONS:
-        Pm = lyap_hp.lyapunov_P_hp(Am, r, discrete, prec)
+        Pm = solve(Am, r, discrete, prec)
         if Pm is None:
             continue
         Pm = Pm * margin_scale(mat_float(Pm), margin, Pm)

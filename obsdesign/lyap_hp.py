@@ -98,6 +98,82 @@ def lyapunov_P_hp(Acl: fmpq_mat, rate: Any, discrete: bool, prec: int) -> fmpq_m
     return (P + P.transpose()) * fmpq(1, 2)
 
 
+#: the largest state dimension the doubling solve (:func:`lyapunov_P_doubling`) is tried at,
+#: above :data:`MAX_N` (n³ work a step instead of the Kronecker system's n⁶)
+DOUBLING_MAX_N = 40
+
+#: the most squaring steps of the doubling solve (2⁶⁴ terms of the series)
+DOUBLING_STEPS = 64
+
+
+def _to_fmpq(v: Any) -> fmpq:
+    """The midpoint of an arb ball, exactly (m·2^e)."""
+    m, e = v.mid().man_exp()
+    e = int(e)
+    return fmpq(int(m) << e) if e >= 0 else fmpq(int(m), 1 << -e)
+
+
+def lyapunov_P_doubling(Acl: fmpq_mat, rate: Any, discrete: bool, prec: int) -> fmpq_mat | None:
+    """The Lyapunov-equation P with decay matrix I (as :func:`lyapunov_P_hp`), for
+    ``MAX_N < n ≤ DOUBLING_MAX_N``, by Smith's doubling at ``prec`` bits: discrete,
+    λ²P − AclᵀPAcl = I is P = λ⁻² Σ_k (Fᵀ)^k F^k with F = Acl/λ, summed as S ← S + GᵀSG,
+    G ← G² (2^j terms after j steps); continuous, FᵀP + PF = −I with F = Acl + αI goes to
+    that form by the Cayley transform G = (I − hF)⁻¹(I + hF), Q = 2h(I − hF)⁻ᵀ(I − hF)⁻¹
+    (h = 1/‖F‖_F). Eq. (4)-(6), constrained-redesign paper. A 20-state Jordan block at 1
+    with its Riccati gain (ρ(A − LC) = 0.84) was exit 4 at λ = 0.95: the float P fails the
+    exact check and the Kronecker solve stopped at 16 states (lyapunov trial, session 40).
+    None when the series does not settle in :data:`DOUBLING_STEPS` steps (a rate on or below
+    the spectrum) or a value is not finite; never a proof: the caller's exact check decides.
+
+    :param Acl: A − LC (exact); :param rate: λ or α; :param discrete: time domain;
+    :param prec: working precision in bits."""
+    from flint import arb
+
+    n = Acl.nrows()
+    r = fmpq(rate) if not isinstance(rate, fmpq) else rate
+    eye = fmpq_mat(n, n, [1 if i == j else 0 for i in range(n) for j in range(n)])
+    with ctx.workprec(prec):
+        if discrete:
+            if r == 0:
+                return None
+            G = arb_mat(Acl * (1 / r))
+            S = arb_mat(eye * (1 / (r * r)))
+        else:
+            F = Acl + eye * r
+            fro = sum((float(F[i, j]) ** 2 for i in range(n) for j in range(n)), 0.0) ** 0.5
+            hf = 1.0 / fro if 0 < fro < float("inf") else 1.0
+            if not 0 < hf < float("inf"):
+                return None
+            h = fmpq(*hf.as_integer_ratio())  # any h > 0 does: this one balances G
+            try:
+                Minv = arb_mat(eye - F * h).inv()
+            except (ZeroDivisionError, ValueError):
+                return None
+            G = Minv * arb_mat(eye + F * h)
+            S = Minv.transpose() * Minv * arb(2 * h)
+        for _ in range(DOUBLING_STEPS):
+            step = G.transpose() * S * G
+            S = (S + step).mid()
+            G = (G * G).mid()
+            big = max(abs(float(S[i, i].mid())) for i in range(n))
+            small = max(abs(float(step[i, j].mid())) for i in range(n) for j in range(n))
+            if not (big > 0 and big < float("inf")):
+                return None
+            if small <= big * 2.0 ** (-prec):
+                break
+        else:
+            return None
+        vals = []
+        for i in range(n):
+            for j in range(n):
+                v = S[i, j]
+                if not v.is_finite():
+                    return None
+                vals.append(_to_fmpq(v))
+    P = fmpq_mat(n, n, vals)
+    return (P + P.transpose()) * fmpq(1, 2)
+
+
 def lyapunov_P_exact(Acl: fmpq_mat, rate: Any, discrete: bool) -> fmpq_mat | None:
     """The Lyapunov-equation P with decay matrix exactly I, by an exact rational solve of the
     Kronecker system (python-flint ``fmpq_mat.solve``; symmetric, the solution being unique),

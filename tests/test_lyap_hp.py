@@ -68,6 +68,7 @@ def test_badly_conditioned_rate_certifies_only_through_the_fallback(monkeypatch)
     E = D - d * fmpq_mat(2, 2, [1, 0, 0, 1])
     assert E[0, 0] > 0 and E[0, 0] * E[1, 1] - E[0, 1] * E[1, 0] > 0  # Sylvester, exactly
     monkeypatch.setattr(lyap_hp, "MAX_N", 0)
+    monkeypatch.setattr(lyap_hp, "DOUBLING_MAX_N", 0)  # no high-precision solve at all
     assert lyap.certified_P(A, C, L, True, r, d, Acl=Acl) is None
     monkeypatch.undo()
     low = fmpq(1, 100)
@@ -134,10 +135,15 @@ def test_audit_spec_designs_and_verifies(tmp_path: Path) -> None:
     assert float(rep.parameters.float("lambda_best")) < 0.021
 
 
-@pytest.mark.parametrize("n", [lyap_hp.MAX_N + 1])
+@pytest.mark.parametrize("n", [lyap_hp.DOUBLING_MAX_N + 1])
 def test_beyond_max_n_no_fallback(n: int) -> None:
+    """Beyond the doubling solve's DOUBLING_MAX_N (the Kronecker solve's MAX_N before
+    session 40) there is no high-precision fallback; at MAX_N + 1 the doubling solve runs."""
     Acl = lyap.fmat(qmat(np.diag([fmpq(1, 2)] * n).tolist()))
     assert lyap._certified_P_hp(Acl, fmpq(3, 4), True, fmpq(0), None, None) is None
+    m = lyap_hp.MAX_N + 1
+    Acl = lyap.fmat(qmat(np.diag([fmpq(1, 2)] * m).tolist()))
+    assert lyap._certified_P_hp(Acl, fmpq(3, 4), True, fmpq(0), None, None) is not None
 
 
 def test_float_spectrum_far_off_does_not_skip_the_fallback(tmp_path: Path) -> None:
@@ -280,4 +286,55 @@ def test_an_exact_P_beyond_the_float_range_is_scaled_into_it() -> None:
     assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
     P = np.asarray(rep.parameters.float("P"), dtype=float)
     assert np.all(np.isfinite(P)) and np.max(np.abs(P)) > 1e300
+    assert api.verify(rep).exit_code() == 0
+
+
+def _jordan(n: int, mu: int) -> str:
+    """A discrete / continuous spec of the n-state Jordan block at mu, C = e₁."""
+    rows = ", ".join(
+        "[" + ", ".join(str(mu if i == j else int(j == i + 1)) for j in range(n)) + "]"
+        for i in range(n)
+    )
+    t = "discrete" if mu == 1 else "continuous"
+    c = ", ".join(["1"] + ["0"] * (n - 1))
+    return f'[system]\ntime = "{t}"\nA = [{rows}]\nC = [[{c}]]\n[method]\nkey = "lyapunov"\n'
+
+
+@pytest.mark.parametrize("discrete", [True, False])
+def test_the_doubling_solve_solves_the_lyapunov_equation(discrete: bool) -> None:
+    """lyapunov_P_doubling (Smith's doubling; continuous through the Cayley transform) on an
+    18-state matrix with spectral radius 0.9 / abscissa −0.1 and a rate beyond it: the exact
+    residual of λ²P − AᵀPA = I (or FᵀP + PF = −I) is below 2⁻²⁰⁰ of |P|; a rate on the wrong
+    side of the spectrum gives None."""
+    rng = np.random.default_rng(7)
+    n = 18
+    M = rng.standard_normal((n, n))
+    M *= 0.9 / np.max(np.abs(np.linalg.eigvals(M)))
+    if not discrete:
+        M = M - 1.0 * np.eye(n)  # abscissa ≤ −0.1
+    A = fmpq_mat(n, n, [Q(float(x)) for x in M.ravel()])
+    rate = fmpq(95, 100) if discrete else fmpq(1, 20)
+    P = lyap_hp.lyapunov_P_doubling(A, rate, discrete, 320)
+    assert P is not None and P == P.transpose()
+    eye = fmpq_mat(n, n, [int(i == j) for i in range(n) for j in range(n)])
+    if discrete:
+        R = P * (rate * rate) - A.transpose() * P * A - eye
+    else:
+        F = A + eye * rate
+        R = F.transpose() * P + P * F + eye
+    big = max(abs(P[i, j]) for i in range(n) for j in range(n))
+    assert max(abs(R[i, j]) for i in range(n) for j in range(n)) < big * fmpq(1, 2**200)
+    wrong = fmpq(1, 2) if discrete else fmpq(2)  # inside the spectrum
+    assert lyap_hp.lyapunov_P_doubling(A, wrong, discrete, 128) is None
+
+
+def test_a_20_state_jordan_block_certifies_beyond_the_kronecker_solve() -> None:
+    """The 20-state Jordan block at 1 (discrete, C = e₁) with its Riccati gain: "A − LC is
+    Schur (exact test) but no decay rate λ < 1 could be certified", exit 4 — the float P
+    fails the exact check and the high-precision (Kronecker) solve stopped at 16 states
+    (lyapunov trial, session 40). The doubling solve, for 16 < n ≤ 40, certifies it; the
+    rates stay exact claims and verify agrees."""
+    rep = api.design(api.load_spec_text(_jordan(20, 1), "j20.toml"))
+    assert rep.exit_code() == 0
+    assert float(rep.parameters.float("lambda_best")) < 1
     assert api.verify(rep).exit_code() == 0
