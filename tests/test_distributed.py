@@ -13,6 +13,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -389,6 +390,28 @@ def test_a_scheduler_address_without_a_port_is_bad_input() -> None:
             pass
 
 
+def _tcp_service(on_connect: Any) -> tuple[Any, int]:
+    """A TCP server on a free local port calling ``on_connect(socket)`` for each connection
+    (in a daemon thread, until the server is closed): (server socket, port)."""
+    import socket
+    import threading
+
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen(8)
+
+    def serve() -> None:
+        while True:
+            try:
+                c, _ = srv.accept()
+            except OSError:
+                return
+            on_connect(c)
+
+    threading.Thread(target=serve, daemon=True).start()
+    return srv, srv.getsockname()[1]
+
+
 def test_a_tcp_service_that_is_not_dask_is_bad_input_not_a_hang(monkeypatch) -> None:
     """--scheduler at a service that accepts TCP and never answers Dask's handshake (python3 -m
     http.server) hung forever: Client's timeout bounds the connect only (distributed trial,
@@ -397,27 +420,13 @@ def test_a_tcp_service_that_is_not_dask_is_bad_input_not_a_hang(monkeypatch) -> 
     is left half-made (one interrupted while being made deadlocked the next test's
     LocalCluster from its finalizer), so no warning either."""
     import socket
-    import threading
 
     from obsdesign import distributed
     from obsdesign.errors import InputError
 
     monkeypatch.setattr(distributed, "CONNECT_S", 2.0)
-    srv = socket.socket()
-    srv.bind(("127.0.0.1", 0))
-    srv.listen(8)
-    port = srv.getsockname()[1]
     conns: list[socket.socket] = []
-
-    def serve() -> None:
-        while True:
-            try:
-                c, _ = srv.accept()
-            except OSError:
-                return
-            conns.append(c)  # accepted, never answered
-
-    threading.Thread(target=serve, daemon=True).start()
+    srv, port = _tcp_service(conns.append)  # accepted, never answered
     t0 = time.monotonic()
     try:
         with pytest.raises(InputError, match="no Dask scheduler answered within 2 s"):
@@ -623,26 +632,15 @@ def test_an_http_service_as_scheduler_is_named_as_not_dask() -> None:
     exabytes, and the message was "cannot connect (MemoryError: Unable to allocate 3.07 EiB
     …)" (CLI trial, session 40). It now says the service does not speak Dask's protocol."""
     import socket
-    import threading
 
     from obsdesign.errors import InputError
 
-    srv = socket.socket()
-    srv.bind(("127.0.0.1", 0))
-    srv.listen(8)
-    port = srv.getsockname()[1]
+    def http(c: socket.socket) -> None:
+        with contextlib.suppress(OSError):
+            c.sendall(b"HTTP/1.0 400 Bad Request\r\nServer: x\r\n\r\n" + b"x" * 64)
+            c.close()
 
-    def serve() -> None:
-        while True:
-            try:
-                c, _ = srv.accept()
-            except OSError:
-                return
-            with contextlib.suppress(OSError):
-                c.sendall(b"HTTP/1.0 400 Bad Request\r\nServer: x\r\n\r\n" + b"x" * 64)
-                c.close()
-
-    threading.Thread(target=serve, daemon=True).start()
+    srv, port = _tcp_service(http)
     try:
         with pytest.raises(InputError, match="cannot connect") as ei:
             run_tasks(abs, [1], scheduler=f"tcp://127.0.0.1:{port}")
