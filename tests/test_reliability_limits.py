@@ -105,6 +105,18 @@ SPEC_CASES = [
         TEXT + "".join(f"[t{i}]\n" for i in range(60_000)),
         ["60", "lines", "max_values"],
     ),
+    (
+        # 40,000 parts took tomllib 19 s before its depth was seen; 4 MB, minutes (re-check
+        # trial, session 40)
+        "a dotted key of 40,000 parts",
+        TEXT + ".".join(["a"] * 40_000) + " = 1\n",
+        ["dotted key", "more than 32 parts", "max_depth"],
+    ),
+    (
+        "a table name of 40,000 quoted parts",
+        TEXT + "[" + ".".join(['"a"'] * 40_000) + "]\n",
+        ["dotted key", "max_depth"],
+    ),
 ]
 
 

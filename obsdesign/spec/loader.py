@@ -127,6 +127,19 @@ def _copy_tree(x: Any) -> Any:
     return x
 
 
+def _dotted_too_deep(text: str, depth: int) -> bool:
+    """Whether ``text`` holds a run of more than ``depth`` dot-separated key parts
+    (``a.b.c…``, bare or quoted, as a dotted key or table name), found in linear time
+    (possessive quantifiers: no backtracking on a long word); a number has one dot."""
+    import re
+
+    part = r"""(?:[A-Za-z0-9_\-]++|"[^"\n]*+"|'[^'\n]*+')"""
+    # a match starts only at the start of a chain (not inside a word, not after a dot): from
+    # inside one, every start position would rescan the rest (quadratic on 4 MB of letters)
+    start = r"(?<![A-Za-z0-9_\-.])"
+    return re.search(rf"{start}(?:{part}[ \t]*+\.[ \t]*+){{{depth},}}{part}", text) is not None
+
+
 def _parse_toml_fresh(text: str, file: str) -> dict[str, Any]:
     """:func:`_parse_toml` without the memo."""
     lim = limits()
@@ -148,6 +161,16 @@ def _parse_toml_fresh(text: str, file: str) -> dict[str, Any]:
             file,
             "",
             f"has {lines + 1} lines, above the limit of {lim.max_values} (--limit max_values=N)",
+        )
+    if _dotted_too_deep(text, lim.max_depth):
+        # a dotted key of 40,000 parts on one line (80 kB, no comma, one line) took tomllib
+        # 19 s, and 4 MB of them minutes, before the depth limit below could refuse it
+        # (re-check trial, session 40)
+        raise SpecError(
+            file,
+            "",
+            f"has a dotted key or table name of more than {lim.max_depth} parts: it is nested "
+            f"more than {lim.max_depth} levels deep (--limit max_depth=N)",
         )
     try:
         with int_digits():
