@@ -257,7 +257,9 @@ def int_problem(v: int) -> str | None:
     # max_digits = 1 called 153 "about 2 digits"; CLI trial, session 40)
     if (bits - 1) * 0.30103 < lim - 1 or abs(v) < 10**lim:
         return None
-    least = max(lim + 1, int((bits - 1) * 0.30103) + 1)  # v ≥ 2^(bits − 1)
+    # v ≥ 2^(bits − 1); 0.3010299956 < log10 2 keeps it a lower bound (0.30103 is above it:
+    # 2^13301 has 4004 digits and was "at least 4005"; re-check trial, session 40)
+    least = max(lim + 1, int((bits - 1) * 0.3010299956) + 1)
     return f"has at least {least} digits, above the limit of {lim} (--limit max_digits=N)"
 
 

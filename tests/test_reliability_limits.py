@@ -642,6 +642,8 @@ def test_an_integer_one_digit_beyond_max_digits_is_refused() -> None:
     assert int_problem(10**1000 - 1) is None  # 1000 digits
     assert "at least 1001 digits" in (int_problem(10**1000) or "")
     assert "at least 1001 digits" in (int_problem(-(10**1000)) or "")
+    # 2^13301 has 4004 digits: 0.30103 (above log10 2) said "at least 4005"
+    assert "at least 4004 digits" in (int_problem(2**13301) or "")
     old = saved()
     set_limits(max_digits=1)
     try:
