@@ -2107,3 +2107,29 @@ def test_the_gain_bound_retry_ends_with_k_zero(monkeypatch: pytest.MonkeyPatch) 
     rep = api.design(spec)
     assert rep.exit_code() == 0
     assert all(k == 0 for k in np.asarray(rep.parameters["K"]).ravel())
+
+
+def test_a_tampered_gain_normalization_fails_verify() -> None:
+    """A = [[0.5, 1], [0, 0.3]], C = [[1000, 0]]: designed with the scale-free gain bound and
+    a λ bracket of that problem. Removing gain_normalization, or giving another value, makes
+    verify re-solve and name the other problem: the bracket claim's statement differs from
+    the report's, exit 1 (the claims reading it must be seen failing; session 40)."""
+    text = (
+        '[system]\ntime = "continuous"\nA = [[0.5, 1], [0, 0.3]]\nC = [[1000, 0]]\n'
+        '[method]\nkey = "stubborn"\n'
+    )
+    rep = api.design(api.load_spec_text(text, "s.toml"))
+    assert rep.exit_code() == 0 and rep.parameters["gain_normalization"] == "scale-free"
+    assert "lambda_bracket" in rep.parameters
+    assert api.verify(rep).exit_code() == 0
+    for value in (None, "foo"):
+        d = rep.to_dict()
+        if value is None:
+            del d["parameters"]["gain_normalization"]
+        else:
+            d["parameters"]["gain_normalization"] = value
+        ver = api.verify(Report.from_dict(json.loads(json.dumps(d)))[0])
+        assert ver.exit_code() == 1
+        assert any(c.id == "report-alters:lambda-max-bracket" for c in ver.failed), [
+            c.id for c in ver.failed
+        ]
