@@ -155,6 +155,10 @@ class SimOption:
                     raise ValueError
                 v = low in ("true", "1", "yes")
             elif self.kind == "path":
+                if not text.strip():
+                    # Path("") is ".": "sampling_file=" read the working directory and said
+                    # ".: is a directory" (CLI review, session 40)
+                    raise ValueError
                 v = Path(text)
             else:
                 v = text
@@ -212,7 +216,12 @@ class SimOption:
             out = bool(f)
         elif self.kind == "str":
             out = v
-        elif self.kind == "path" and isinstance(v, (str, os.PathLike)) and "\0" not in os.fspath(v):
+        elif (
+            self.kind == "path"
+            and isinstance(v, (str, os.PathLike))
+            and "\0" not in os.fspath(v)
+            and os.fspath(v).strip()
+        ):
             out = Path(v)
         else:
             raise InputError(f"{what}: expected {_KIND[self.kind]}, got {v!r}")

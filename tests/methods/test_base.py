@@ -61,3 +61,16 @@ def test_table_schema() -> None:
         "additionalProperties": False,
         "properties": {"key": {"const": "k"}, "a": {"type": "number"}},
     }
+
+
+@pytest.mark.parametrize("text", ["", " ", "\t"])
+def test_an_empty_path_option_is_refused(text: str) -> None:
+    """``--option sampling_file=`` was Path('') = '.': '.: is a directory' (CLI review)."""
+    from obsdesign.methods.base import SimOption
+
+    opt = SimOption("sampling_file", "path", None, "a file")
+    with pytest.raises(InputError, match=r"^--option sampling_file: expected a path, got "):
+        opt.parse(text)
+    with pytest.raises(InputError, match=r"^simulate: sampling_file: expected a path"):
+        opt.check_value(text)
+    assert opt.parse("h.txt").name == "h.txt"
