@@ -2347,3 +2347,17 @@ def test_the_schedule_checks_retry_enclosure_is_rigorous() -> None:
     x = fmpq(1, 2**150)
     verdict, _, _ = ssc._follows(fmpq(2), 1 + x, fmpq(1, 2), x, fmpq(1), 1 + 2 * x)
     assert verdict is False
+
+
+def test_a_bound_beyond_the_float_range_is_named_as_such() -> None:
+    """f = −cosh(x1) on x1 ∈ [−1000, 1000] is Lipschitz with a constant past 10³⁰⁸; the
+    refusal said only "not Lipschitz/bounded" (CLI review, session 40)."""
+    from pathlib import Path
+
+    text = (Path(__file__).parents[1] / "specs" / "hernandez-garcia-pendulum.toml").read_text()
+    text = text.replace('"-sin(x1) - 0.2*x2 + u1"', '"-cosh(x1) - 0.2*x2 + u1"')
+    text = text.replace("lower = [-3, -3]", "lower = [-1000, -3]")
+    text = text.replace("upper = [3, 3]", "upper = [1000, 3]")
+    assert "cosh" in text and "-1000" in text
+    with pytest.raises(InfeasibleError, match=r"beyond the float range.*give \[method\]\.L_f"):
+        api.design(api.load_spec_text(text, "cosh.toml"))

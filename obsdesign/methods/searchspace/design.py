@@ -167,7 +167,10 @@ def constants(spec: Spec) -> Constants:
                         if k == "L_h"
                         else "f is not Lipschitz/bounded there or not defined on all of it"
                     )
-                    + f"; give [method].{k} to use your own value"
+                    # cosh(x1) on x1 ∈ [−1000, 1000] is Lipschitz with a constant past 10³⁰⁸:
+                    # "not Lipschitz" alone misled (CLI review, session 40)
+                    + ", or its bound is beyond the float range (exp, cosh or a power of a "
+                    "large argument)" + f"; give [method].{k} to use your own value"
                 )
             vals[k] = round_up_q(b.upper, o.digits)
             if vals[k] == 0 and k == "L_h":
