@@ -101,7 +101,7 @@ def _designed(spec: Spec, o: Options, progress: Progress | None) -> Design:
     # the float Riccati gain is missing or failed the exact tests: the high-precision one
     hp = riccati_retry_hp(spec, o)
     if hp is None:
-        raise first from None
+        raise _hp_outcome(first, spec, o) from None
     Lm, bits, solver, how = hp
     try:
         return _design_rounded(spec, Lm, bits, solver, how, progress)
@@ -110,6 +110,28 @@ def _designed(spec: Spec, o: Options, progress: Progress | None) -> Design:
     except InconclusiveError as e3:
         _keep_gain(e3, Lm)
         raise
+
+
+def _hp_outcome(e: InconclusiveError, spec: Spec, o: Options) -> InconclusiveError:
+    """``e`` (the float Riccati gain's failure) saying what the high-precision retry
+    (:func:`riccati_retry_hp`) did: found no gain that certifies, or did not run (more than
+    :data:`obsdesign.riccati.HP_MAX_N` states). The message read as if only the float solve
+    had run (lyapunov trial, session 40). Other designs (``place``) have no such retry.
+
+    :param e: the error to raise; :param spec: the bound spec; :param o: its options."""
+    from obsdesign.riccati import HP_MAX_N
+
+    if o.design != "riccati":
+        return e
+    n = spec.system.n
+    said = (
+        f"; the high-precision Riccati retry runs up to {HP_MAX_N} states (n = {n})"
+        if n > HP_MAX_N
+        else "; the high-precision Riccati retry found no gain that certifies either"
+    )
+    e.message = e.message + said
+    e.args = (e.message,)
+    return e
 
 
 def _keep_gain(e: ObsdesignError, Lm: fmpq_mat) -> ObsdesignError:
