@@ -848,6 +848,12 @@ def test_place_needs_observability() -> None:
     assert ei.value.exit_code == 2
     rep = api.design(load_spec_text(_designed(A, C_UO)))  # detectable: riccati works
     assert rep.exit_code() == 0
+    # not detectable: no gain of any design exists, and that verdict (exit 1) comes first
+    A_nd = np.array([[0.5, 0.0], [0.0, 1.5]])
+    for design in ("place", "riccati", "lmi"):
+        with pytest.raises(InfeasibleError, match="is not detectable") as ei:
+            api.design(load_spec_text(_designed(A_nd, C_UO, extra=f'design = "{design}"\n')))
+        assert ei.value.exit_code == 1
 
 
 @pytest.mark.parametrize(
