@@ -1337,11 +1337,15 @@ class RateResolutionError(InconclusiveError):
         self.tol, self.width, self.rate = tol, width, rate
 
     def hint(self) -> str:
-        """The spec error's wording: what was asked, what is reachable."""
+        """The spec error's wording: what was asked, what is reachable. The suggested least
+        ``rate_tol`` is the width rounded *up* (it said "≥ 2.1e-16" for a width of
+        2.109·10⁻¹⁶, a value itself refused; lyapunov review, session 41)."""
+        from obsdesign.certify.printing import fmt_up
+
         return (
             f"rate_tol = {float(self.tol):.3g} cannot be met: the best-rate bracket cannot be "
             f"narrower than {float(self.width):.3g} near the rate {float(self.rate):.6g} (the "
-            f"float resolution there); expected rate_tol ≥ {float(self.width):.2g}"
+            f"float resolution there); expected rate_tol ≥ {fmt_up(self.width, 2)}"
         )
 
 

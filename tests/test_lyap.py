@@ -1047,3 +1047,19 @@ def test_iss_mu_raises_by_ten_percent_steps_when_the_float_value_is_short(
     assert need <= mu <= need * fmpq(11, 10)
     assert 2 <= len(tried) <= 4 and mu == tried[-1]
     assert all(y > x * fmpq(109, 100) for x, y in zip(tried, tried[1:], strict=False))
+
+
+@pytest.mark.parametrize("width", [fmpq(2109, 10**19), fmpq(21, 10**17), fmpq(1, 3)])
+def test_rate_resolution_hint_suggests_a_tolerance_that_is_met(width: fmpq) -> None:
+    """The suggested least rate_tol is the width rounded up to 2 digits: it said "≥ 2.1e-16"
+    for 2.109·10⁻¹⁶, itself refused (lyapunov review, session 41); an exact 2-digit width is
+    suggested as itself."""
+    import re
+    from fractions import Fraction
+
+    e = lyap.RateResolutionError(fmpq(1, 10**20), width, fmpq(19, 20))
+    said = re.search(r"expected rate_tol ≥ (\S+)$", e.hint())
+    assert said is not None
+    got = Fraction(said.group(1))
+    assert got >= Fraction(int(width.p), int(width.q))
+    assert got <= Fraction(int(width.p), int(width.q)) * Fraction(11, 10)
