@@ -68,6 +68,26 @@ def test_checked_rows_shape_error_names_the_key() -> None:
         Table({"M": [[1, 2]]}, "t.toml", checked=True).matrix("M", rows=2, cols=2)
 
 
+@pytest.mark.parametrize("checked", [True, False])
+def test_a_flat_list_of_the_other_orientation_says_how_to_write_it(checked: bool) -> None:
+    """L = [1, 0.5] for n = 1, p = 2 (a column where a 1×2 row is expected) said only
+    "expected shape 1×2, got 2×1" (lyapunov review, session 41). Nested lists and flat lists
+    that fit neither way get no such hint."""
+    t = Table({"L": [1, Decimal("0.5")], "R": [1, 2], "M": [[1, 2]]}, "t.toml", checked=checked)
+    with pytest.raises(
+        SpecError, match=r"got 2×1 \(a flat list is read as one column: write \[\[a, b"
+    ):
+        t.matrix("L", rows=1, cols=2, vector_as="column")
+    with pytest.raises(
+        SpecError, match=r"got 1×2 \(a flat list is read as one row: write \[\[a\], \[b"
+    ):
+        t.matrix("R", rows=2, cols=1)
+    with pytest.raises(SpecError, match=r"expected shape 2×1, got 1×2$"):
+        t.matrix("M", rows=2, cols=1)
+    with pytest.raises(SpecError, match=r"expected shape 3×1, got 1×2$"):
+        t.matrix("R", rows=3, cols=1)
+
+
 @pytest.mark.parametrize("key", ["A = [[1e309]]", "B = [[-2e308]]", "Dn = [[1e400]]"])
 def test_number_beyond_the_float_range_is_bad_input(tmp_path, key: str) -> None:
     """exit 2 naming the file and key, no report (it was exit 4 with no key named)."""

@@ -251,7 +251,8 @@ class Table:
             return v
         if _is_number(v):
             v = [[v]]
-        if isinstance(v, list) and v and all(_is_number(x) for x in v):
+        flat = isinstance(v, list) and bool(v) and all(_is_number(x) for x in v)
+        if flat:
             v = [v] if vector_as == "row" else [[x] for x in v]
         if not isinstance(v, list) or not v or not all(isinstance(r, list) and r for r in v):
             empty = isinstance(v, list) and all(isinstance(r, list) and not r for r in v)
@@ -281,13 +282,7 @@ class Table:
             arr = np.empty(len(v) * len(v[0]), dtype=object)
             arr[:] = fast[0]
             arr = arr.reshape(len(v), len(v[0]))
-            if (rows is not None and arr.shape[0] != rows) or (
-                cols is not None and arr.shape[1] != cols
-            ):
-                raise self.error(
-                    k,
-                    f"expected shape {_dim(rows)}×{_dim(cols)}, got {arr.shape[0]}×{arr.shape[1]}",
-                )
+            self._shape(k, arr.shape, rows, cols, flat, vector_as)
             val = Value(arr, np.array(fast[1], dtype=float).reshape(arr.shape))
             self._no_underflow(k, val)
             return val
@@ -297,13 +292,34 @@ class Table:
                 if isinstance(x, list):
                     raise self.error(k, "expected a matrix of numbers (nested too deep)")
                 arr[i, j] = self._number(k, x)
-        if (rows is not None and arr.shape[0] != rows) or (
-            cols is not None and arr.shape[1] != cols
-        ):
-            raise self.error(
-                k, f"expected shape {_dim(rows)}×{_dim(cols)}, got {arr.shape[0]}×{arr.shape[1]}"
-            )
+        self._shape(k, arr.shape, rows, cols, flat, vector_as)
         return self._value(k, arr)
+
+    def _shape(
+        self,
+        k: str,
+        shape: tuple[int, ...],
+        rows: int | None,
+        cols: int | None,
+        flat: bool,
+        vector_as: str,
+    ) -> None:
+        """Refuse a matrix of another shape than rows×cols (None: any), naming ``k``. A flat
+        list read as a column where a row fits (or the reverse) says how to write it: L = [1,
+        0.5] for n = 1, p = 2 said only "expected shape 1×2, got 2×1" (lyapunov review,
+        session 41)."""
+        if (rows is None or shape[0] == rows) and (cols is None or shape[1] == cols):
+            return
+        hint = ""
+        if flat and (rows is None or shape[1] == rows) and (cols is None or shape[0] == cols):
+            hint = f" (a flat list is read as one {vector_as}: write " + (
+                "[[a], [b], ...] for a column)"
+                if vector_as == "row"
+                else "[[a, b, ...]] for a row)"
+            )
+        raise self.error(
+            k, f"expected shape {_dim(rows)}×{_dim(cols)}, got {shape[0]}×{shape[1]}{hint}"
+        )
 
     def _value(self, k: str, q: Any) -> Value:
         """:meth:`Value.of`, with a number beyond the float range (|x| ≥ 2^1024 after
