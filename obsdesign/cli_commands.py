@@ -90,14 +90,12 @@ def _load_spec(spec: Path) -> Any:
     if not _is_stdin(spec):
         return api.load_spec(spec)
     from obsdesign.errors import InputError
-    from obsdesign.limits import limits
+    from obsdesign.limits import values_problem
 
     text = _read_stdin("spec")
-    if text.count(",") >= limits().max_values:
-        raise InputError(
-            f"{STDIN_NAME}: holds about {text.count(',') + 1} values, above the limit of "
-            f"{limits().max_values} (--limit max_values=N)"
-        )
+    said = values_problem(text.count(","))
+    if said:
+        raise InputError(f"{STDIN_NAME}: {said}")
     return api.load_spec_text(text, STDIN_NAME)
 
 

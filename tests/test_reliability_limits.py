@@ -652,3 +652,24 @@ def test_an_integer_one_digit_beyond_max_digits_is_refused() -> None:
         assert "at least 3 digits" in (int_problem(153) or "")
     finally:
         restore(old)
+
+
+def test_the_value_limit_says_it_counted_commas_in_comments_too(tmp_path: Path) -> None:
+    """A spec of a few values with a 60,000-comma comment was refused as "holds about 60019
+    values" (docs review, session 41): the count is on the text, and the message (file,
+    stdin and in-memory text alike) says so."""
+    from obsdesign import api
+    from obsdesign.errors import SpecError
+
+    text = TEXT + "# " + "," * 60_000 + "\n"
+    spec = tmp_path / "c.toml"
+    spec.write_text(text)
+    n = text.count(",")
+    assert n >= 60_000
+    want = f"has {n} commas, above the limit of 50000 values (counted on the text, comments"
+    res = runner.invoke(app, ["design", str(spec)])
+    assert res.exit_code == 2 and want in res.output
+    res = runner.invoke(app, ["design", "-"], input=text)
+    assert res.exit_code == 2 and want in res.output
+    with pytest.raises(SpecError, match=rf"has {n} commas, .*comments and strings included"):
+        api.load_spec_text(text, "c.toml")

@@ -19,7 +19,7 @@ import numpy as np
 from obsdesign.certify.exact import qeye, qzeros
 from obsdesign.certify.psd import check_pd
 from obsdesign.errors import ObsdesignError, SpecError
-from obsdesign.limits import data_problem, int_digits, limits, read_input
+from obsdesign.limits import data_problem, int_digits, limits, read_input, values_problem
 from obsdesign.sets import Box, Ellipsoid, Polytope, SymmetricPolytope
 from obsdesign.sets.base import ConvexSet
 from obsdesign.sets.polytope import check_polytope_q
@@ -145,14 +145,9 @@ def _parse_toml_fresh(text: str, file: str) -> dict[str, Any]:
     lim = limits()
     if len(text) > lim.max_file_bytes:
         raise SpecError(file, "", f"is above the limit of {lim.max_file_bytes} bytes")
-    commas = text.count(",")
-    if commas >= lim.max_values:
-        raise SpecError(
-            file,
-            "",
-            f"holds about {commas + 1} values, above the limit of {lim.max_values} "
-            f"(--limit max_values=N)",
-        )
+    said = values_problem(text.count(","))
+    if said:
+        raise SpecError(file, "", said)
     lines = text.count("\n")
     if lines >= lim.max_values:
         # 1.6 million empty table headers (16 MiB) took tomllib 60 s and 1.7 GB before the
