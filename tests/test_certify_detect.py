@@ -415,3 +415,44 @@ def test_rational_echelon_form_and_kernel():
     A2f = fmpq_mat(A2.tolist())
     assert A2f * N2 == N2 * Au2 and N2.ncols() == 2
     assert (fmpq_mat([[0, 0, 1]]) * N2).tolist() == [[0, 0]]
+
+
+def _schur_cohn_rational(p: fmpq_poly) -> tuple[bool, str]:
+    """The rational Schur–Cohn recursion (each step made monic), as schur_stable ran it
+    until session 41: the reference of the integer one."""
+    c = [fmpq(v) for v in p.coeffs()]
+    step = 0
+    while len(c) > 1:
+        a0, ad = c[0], c[-1]
+        if abs(a0) >= abs(ad):
+            return False, (
+                f"Schur–Cohn step {step}: |a0| = {abs(a0)} >= |a_d| = {abs(ad)}, "
+                "so a root has |z| >= 1"
+            )
+        rev = c[::-1]
+        new = [ad * c[i] - a0 * rev[i] for i in range(1, len(c))]
+        c = [v / new[-1] for v in new]
+        step += 1
+    return True, f"Schur–Cohn: all {step} steps with |a0| < |a_d|"
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.lists(
+        st.fractions(min_value=-3, max_value=3, max_denominator=12), min_size=1, max_size=9
+    ).filter(lambda c: c[-1] != 0)
+)
+def test_integer_schur_cohn_agrees_with_the_rational_recursion(coeffs) -> None:
+    """Same verdict and same message as the rational recursion, on random polynomials
+    (roots inside, on and outside the unit circle; zero constant terms)."""
+    p = fmpq_poly([fmpq(c.numerator, c.denominator) for c in coeffs])
+    assert schur_stable(p) == _schur_cohn_rational(p)
+
+
+def test_integer_schur_cohn_decides_a_degree_44_product_of_close_roots() -> None:
+    """(z − 0.999)^22 (z + 0.9991)^22: stable, and decided; every root moved by 10⁻³ out of
+    the disk is not."""
+    inside = fmpq_poly([fmpq(-999, 1000), 1]) ** 22 * fmpq_poly([fmpq(9991, 10000), 1]) ** 22
+    assert schur_stable(inside)[0]
+    outside = fmpq_poly([fmpq(-1001, 1000), 1]) * inside
+    assert not schur_stable(outside)[0]
