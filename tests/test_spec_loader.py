@@ -391,3 +391,25 @@ def test_signal_counts_are_bounded_before_anything_is_allocated(line: str, key: 
     assert f"[{key}]" in str(e.value) and "--limit max_states" in str(e.value)
     ok = load_spec_text(base.format("disturbances = 100"), "ok.toml")
     assert ok.system.Bd.shape == (2, 100)
+
+
+@pytest.mark.parametrize(
+    "body, key",
+    [
+        ('type = "polytope"\nG = [[1], [-1]]\ng = [1, 1]', "sets.D.G"),
+        ('type = "box"\nlower = [-1]\nupper = [1]', "sets.D.lower"),
+        ('type = "symmetric-polytope"\nQ = [[2]]', "sets.D.Q"),
+    ],
+)
+def test_a_set_of_another_dimension_without_dim_names_dim(body: str, key: str) -> None:
+    """A 1-D disturbance set in a 2-state spec without `dim` said only "expected shape ?×2,
+    got 2×1" (set-invariant review, session 41); with dim = 1 it loads. A size error of a
+    set that gives dim says nothing about dim."""
+    with pytest.raises(SpecError, match=r"without dim, a set has the state dimension 2") as ei:
+        load_spec_text(GOOD + "\n[sets.D]\n" + body + "\n")
+    assert ei.value.key == key
+    spec = load_spec_text(GOOD + "\n[sets.D]\ndim = 1\n" + body + "\n")
+    assert spec.sets["D"].dim == 1
+    with pytest.raises(SpecError) as ei:
+        load_spec_text(GOOD + "\n[sets.D]\ndim = 3\n" + body + "\n")
+    assert "without dim" not in str(ei.value)

@@ -422,8 +422,26 @@ def _exprs(t: Table, k: str, length: int, variables: list[str], params: dict[str
 
 # -- [sets.NAME] --------------------------------------------------------------------------
 def _set(t: Table, n: int) -> ConvexSet:
-    """One ``[sets.NAME]``; its dimension is the state dimension unless ``dim`` says."""
-    n = t.int("dim", default=n, min=1)
+    """One ``[sets.NAME]``; its dimension is the state dimension unless ``dim`` says. Without
+    ``dim``, a size error names it: a 1-D disturbance polytope G = [[1], [-1]] said only
+    "[sets.D.G] expected shape ?×2, got 2×1" (set-invariant review, session 41)."""
+    if t.has("dim"):
+        return _set_of_dim(t, t.int("dim", min=1))
+    try:
+        return _set_of_dim(t, n)
+    except SpecError as e:
+        if not re.match(r"expected (shape |\d+ numbers, got)", e.expected):
+            raise  # not a size error
+        raise SpecError(
+            e.file,
+            e.key,
+            f"{e.expected} (without dim, a set has the state dimension {n}; a set of "
+            "another dimension, such as a disturbance set, gives dim)",
+        ) from None
+
+
+def _set_of_dim(t: Table, n: int) -> ConvexSet:
+    """One ``[sets.NAME]`` of dimension ``n``."""
     kind = t.str("type", choices=SET_TYPES)
     s: ConvexSet
     if kind == "box":
