@@ -326,3 +326,42 @@ def test_a_hash_is_refused_not_read_as_a_comment(text: str) -> None:
     session 40). It is bad input naming the key."""
     with pytest.raises(SpecError, match=r"\[system\.f\[1\]\] has '#'"):
         parse_expr(text, ["x1"], file="s.toml", key="system.f[1]")
+
+
+@pytest.mark.parametrize("k", [197, 198, 199, 200, 201, 4000])
+def test_depth_limit_is_one_measure_and_the_message_names_the_limit(k: int) -> None:
+    """A chain of k unary minus signs before x1 has depth k + 1: accepted up to the limit
+    (200), refused past it as "more than 200 levels". The parsed tree counted the Expression
+    wrapper and the load context, two more than the scan: 198 signs were refused as "201
+    levels", 199 as "202" and 201 as "201" (docs review, session 41)."""
+    import ast
+
+    from obsdesign.spec.expr import _tree_depth, nesting_depth
+
+    text = "-" * k + "x1"
+    if k < 1000:
+        assert _tree_depth(ast.parse(text, mode="eval")) == nesting_depth(text) == k + 1
+    if k + 1 <= 200:
+        parse_expr(text, ["x1"], {}, "f.toml", "system.f[0]")
+    else:
+        with pytest.raises(SpecError, match=r"nests more than 200 levels deep \(--limit"):
+            parse_expr(text, ["x1"], {}, "f.toml", "system.f[0]")
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.recursive(st.sampled_from(["x1", "2", "t"]), lambda e: st.one_of(
+    st.builds(lambda a: f"-{a}", e),
+    st.builds(lambda a, b: f"({a} + {b})", e, e),
+    st.builds(lambda a, b: f"{a} * {b}", e, e),
+    st.builds(lambda a, b: f"{a} ** {b}", e, e),
+    st.builds(lambda a: f"sin({a})", e),
+), max_leaves=30))  # fmt: skip
+def test_the_scan_never_reads_shallower_than_the_tree(text: str) -> None:
+    """The scan before ast.parse is never below the parsed tree's depth (it may count a
+    parenthesized operand one deeper), so an expression the scan admits is admitted by the
+    tree's check too: one limit, not two."""
+    import ast
+
+    from obsdesign.spec.expr import _tree_depth, nesting_depth
+
+    assert _tree_depth(ast.parse(text, mode="eval")) <= nesting_depth(text)

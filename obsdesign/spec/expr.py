@@ -214,7 +214,7 @@ def parse_expr(
         )
     depth = nesting_depth(text, stop=lim.max_expr_depth)
     if depth > lim.max_expr_depth:
-        raise SpecError(file, key, _too_deep(depth))
+        raise SpecError(file, key, _too_deep())
     try:
         # ``^`` is power here; Python's ^ binds looser than * and +, so rewrite it as ** first
         tree = ast.parse(text.strip().replace("^", "**"), mode="eval")
@@ -228,7 +228,7 @@ def parse_expr(
         raise SpecError(file, key, f"is not a valid expression ({e})") from None
     tree_depth = _tree_depth(tree)
     if tree_depth > lim.max_expr_depth:
-        raise SpecError(file, key, _too_deep(tree_depth))
+        raise SpecError(file, key, _too_deep())
     for m in _EXPONENT.finditer(text):
         if abs(int(m.group(1))) > lim.max_exponent:
             raise SpecError(
@@ -247,11 +247,14 @@ def parse_expr(
     return Expr(text, tree, tuple(variables), parameters, fn)
 
 
-def _too_deep(depth: int) -> str:
+def _too_deep() -> str:
+    """The refusal of an expression deeper than ``max_expr_depth``: "more than the limit",
+    as the scan stops once past it (the depth it had reached then was printed: a 201-long
+    minus chain said "201 levels", one of 199 "202"; docs review, session 41)."""
     from obsdesign.limits import limits
 
     return (
-        f"expression nests {depth} levels deep, above the limit of {limits().max_expr_depth} "
+        f"expression nests more than {limits().max_expr_depth} levels deep "
         f"(--limit max_expr_depth=N)"
     )
 
@@ -349,13 +352,20 @@ def nesting_depth(text: str, stop: int | None = None) -> int:
 
 
 def _tree_depth(tree: ast.AST) -> int:
-    """Depth of a parsed tree, walked with an explicit stack (no recursion)."""
+    """Depth of a parsed tree as :func:`nesting_depth` counts it (a name or number 1, each
+    operator, call or unary sign one more; the ``Expression`` wrapper and the load contexts
+    not counted: they made the tree 2 deeper than the scan, so a 198-long minus chain passed
+    the scan and was refused as "201 levels"; docs review, session 41), walked with an
+    explicit stack (no recursion)."""
     deepest = 0
-    stack: list[tuple[ast.AST, int]] = [(tree, 1)]
+    root = tree.body if isinstance(tree, ast.Expression) else tree
+    stack: list[tuple[ast.AST, int]] = [(root, 1)]
     while stack:
         node, d = stack.pop()
         deepest = max(deepest, d)
-        stack.extend((c, d + 1) for c in ast.iter_child_nodes(node))
+        stack.extend(
+            (c, d + 1) for c in ast.iter_child_nodes(node) if not isinstance(c, ast.expr_context)
+        )
     return deepest
 
 
