@@ -6,6 +6,7 @@ import hashlib
 import math
 import numbers
 import os
+import re
 import signal
 import sys
 import threading
@@ -980,6 +981,9 @@ def simulate(
         notes += _uncertified_design(sp, rep.parameters, where)
     left = _left_float_range(res)
     if left is not None:
+        # the plain warning says it; numpy's overflow / invalid-value warnings of the same
+        # divergence were printed beside it, four more lines (docs review, session 41)
+        notes[:] = [n for n in notes if not _FLOAT_NOISE.match(n)]
         notes.insert(0, left)
     step = _step_note(sp)
     if step is not None:
@@ -1037,6 +1041,13 @@ def _step_note(sp: Spec) -> str | None:
         f"{float(sim.horizon.f)!r}: the grid steps by dt = {float(sim.dt.f)!r} ({steps} "
         f"step{'' if k == 1 else 's'}), so that it ends at the horizon"
     )
+
+
+#: numpy's floating-point warnings as :func:`captured_warnings` words them: dropped when
+#: :func:`_left_float_range` gives the plain warning of the same divergence
+_FLOAT_NOISE = re.compile(
+    r"warning: RuntimeWarning: (overflow|invalid value|divide by zero|underflow) encountered"
+)
 
 
 def _left_float_range(res: SimResult) -> str | None:

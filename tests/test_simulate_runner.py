@@ -121,6 +121,21 @@ def test_a_diverging_trajectory_gets_a_plain_warning():
     assert not any("float range" in w for w in res.info.get("warnings", []))
 
 
+def test_a_divergence_gets_one_plain_warning_not_numpy_s_too() -> None:
+    """x1⁺ = x1² from 10 overflows at t = 9: the plain warning, and none of numpy's four
+    "overflow / invalid value encountered" lines beside it (docs review, session 41)."""
+    from obsdesign import api
+
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.5, 0], [0, 0.5]]\nC = [[0, 1]]\n'
+        'f = ["x1^2", "0.5*x2"]\n[method]\nkey = "lyapunov"\nL = [0, 0]\nlambda = 0.6\n'
+        "[simulate]\nhorizon = 20\nx0 = [10, 1]\nxhat0 = [0, 0]\n"
+    )
+    said = api.simulate(load_spec_text(text, "square.toml")).info["warnings"]
+    assert "leaves the float range at t = 9" in said[0]
+    assert not [w for w in said if "RuntimeWarning" in w], said
+
+
 def test_an_input_that_is_not_finite_is_not_called_a_divergence() -> None:
     """u = 1e308·10·t is inf from the first step: the warning blamed a divergence of the plant
     or the observer (non-finite expressions trial, session 35). One step after values far
