@@ -141,9 +141,9 @@ def test_beyond_max_n_no_fallback(n: int) -> None:
     session 40) there is no high-precision fallback; at MAX_N + 1 the doubling solve runs."""
     Acl = lyap.fmat(qmat(np.diag([fmpq(1, 2)] * n).tolist()))
     assert lyap._certified_P_hp(Acl, fmpq(3, 4), True, fmpq(0), None, None) is None
-    m = lyap_hp.MAX_N + 1
-    Acl = lyap.fmat(qmat(np.diag([fmpq(1, 2)] * m).tolist()))
-    assert lyap._certified_P_hp(Acl, fmpq(3, 4), True, fmpq(0), None, None) is not None
+    for m in (lyap_hp.MAX_N + 1, 48):  # 48: beyond the doubling's old limit of 40
+        Acl = lyap.fmat(qmat(np.diag([fmpq(1, 2)] * m).tolist()))
+        assert lyap._certified_P_hp(Acl, fmpq(3, 4), True, fmpq(0), None, None) is not None
 
 
 def test_float_spectrum_far_off_does_not_skip_the_fallback(tmp_path: Path) -> None:
