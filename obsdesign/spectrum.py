@@ -26,8 +26,8 @@ import numpy as np
 from flint import acb_mat, arb_mat, ctx, fmpq_mat
 
 #: the largest state dimension at which inaccurate float eigenvalues are redone in high
-#: precision (~1 ms at n = 8, ~15 ms at n = 24 at 128 bits)
-HP_MAX_N = 24
+#: precision (~1 ms at n = 8, ~15 ms at n = 24, ~50 ms at n = 64 at 128 bits; 24 until session 41)
+HP_MAX_N = 64
 #: working precisions of the high-precision eigenvalues, in bits
 PRECISIONS = (128, 320, 1024)
 #: float eigenvalues are taken when their error bound is at most this, relative to

@@ -219,3 +219,16 @@ def test_agree_compares_the_abscissa_too() -> None:
 def test_agree_compares_the_radius_too() -> None:
     """Kills P06 (_agree on the abscissa alone): {0.5, −1} and {0.5, −2}."""
     assert not spectrum._agree(np.array([0.5 + 0j, -1 + 0j]), np.array([0.5 + 0j, -2 + 0j]))
+
+
+def test_high_precision_eigenvalues_up_to_64_states() -> None:
+    """A 48-state Jordan block at 1/2 (defective: float eigenvalues are off by ~u^(1/48), their
+    error bound is useless) gets its eigenvalues from the exact characteristic polynomial: the
+    radius 1/2. Until session 41 the limit was 24 states, and a 64-state continuous Jordan
+    plant's search took a float abscissa of −0.0166 for −0.0483."""
+    n = 48
+    A = np.diag([0.5] * n) + np.diag([1.0] * (n - 1), 1)
+    Am = lyap.fmat(A)
+    g = spectrum.spectrum(Am, A)
+    assert g.source.startswith("roots of the exact characteristic polynomial"), g.source
+    assert abs(g.bound(True) - 0.5) < 1e-12
