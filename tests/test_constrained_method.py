@@ -273,6 +273,37 @@ def test_X0_must_be_a_box_or_polytope(specs_dir):
         load_spec_text(text, "x0.toml")
 
 
+@pytest.mark.parametrize(
+    "old, new, key",
+    [
+        # a 1-D box [-1, 1] for the 2-state plant: numpy broadcast it over both coordinates
+        # and v_min = 1.027 was certified where the 2-D box gives 0.908 (re-check trial,
+        # session 41: a false certificate)
+        ("lower = [-1, -1]\nupper = [1, 1]", "dim = 1\nlower = [-1]\nupper = [1]", "X"),
+        (
+            "lower = [-1, -1]\nupper = [1, 1]",
+            "dim = 3\nlower = [-1, -1, -1]\nupper = [1, 1, 1]",
+            "X",
+        ),
+        (
+            'type = "box"\nlower = [-1, -1]\nupper = [1, 1]',
+            'type = "polytope"\ndim = 1\nG = [[1], [-1]]\ng = [1, 1]',
+            "X",
+        ),
+    ],
+)
+def test_a_set_of_another_dimension_than_the_state_is_refused(specs_dir, old, new, key):
+    """X, X̂, X0 and X̂0 are sets of states: one of another dimension (given with dim) is
+    bad input naming the key, not a design on a broadcast set (or exit 3)."""
+    text = (specs_dir / SEC5).read_text()
+    assert text.count(old) >= 1
+    bad = text.replace(old, new, 1)
+    with pytest.raises(
+        SpecError, match=rf"\[method\.{key}\] expected a set of the state dimension 2"
+    ):
+        load_spec_text(bad, "dim.toml")
+
+
 def test_sec5_max_norm_matches_issue_estimate(specs_dir):
     """With |c| the max-norm, C_min/C_max are boxes, v_min has an exact closed form, and
     δ = 643.47, γ = 3.2434e-5 (the issue's estimate: δ ≈ 637, γ ≈ 3.3e-5)."""

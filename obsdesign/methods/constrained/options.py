@@ -242,6 +242,15 @@ def _set_ref(table: Table, key: str, spec: Spec, kinds: tuple[str, ...]) -> tupl
         raise table.error(
             key, f"expected a set of type {' or '.join(kinds)}; [sets.{name}] is {_a(S.kind)}"
         )
+    n = spec.system.n
+    if S.dim != n:
+        # X, X̂, X0 and X̂0 are sets of states: a 1-D box [−1, 1] given with dim = 1 for a
+        # 2-state plant was broadcast by numpy over both coordinates and certified v_min
+        # = 1.027 where the 2-D box gives 0.908 (a false certificate, re-check trial,
+        # session 41); other dimensions were exit 3
+        raise table.error(
+            key, f"expected a set of the state dimension {n}; [sets.{name}] has dimension {S.dim}"
+        )
     return name, S
 
 
