@@ -228,3 +228,30 @@ def test_rmse_of_errors_beyond_the_squares_range(scale: float) -> None:
         top = r.extra["per_run"]["sup_abs_error"][i]
         assert np.all(top / np.sqrt(201) <= rmse[i] * (1 + 1e-12))
         assert np.all(rmse[i] <= top * (1 + 1e-12))
+
+
+def test_a_diverging_nonlinear_run_has_a_nan_rmse_not_0() -> None:
+    """x1⁺ = x1² + d from 1 leaves the float range: its RMSE is nan (as run 0's table says),
+    not 0 — the scaled sum of squares read a nan scale as "no error" and the quantiles
+    printed RMSE 0 (re-check trial, session 41). The scaled RMSE keeps nan and inf scales."""
+    import warnings
+
+    import numpy as np
+
+    from obsdesign import api
+    from obsdesign.simulate import montecarlo as mc
+
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0]]\nBd = [[1]]\nC = [[1]]\npsi = ["x1^2"]\n'
+        '[method]\nkey = "lyapunov"\nL = [0]\n'
+        "[simulate]\nhorizon = 60\nx0 = [1]\nxhat0 = [1]\nseed = 0\n"
+        '[simulate.disturbance]\nkind = "uniform"\nbound = 0.01\n'
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = api.simulate(api.load_spec_text(text, "sq.toml"), runs=2)
+    q = res.info["quantiles"]["rmse"]["x1"]
+    assert all(np.isnan(v) for v in q.values()), q
+    sc = np.array([[[np.nan]], [[np.inf]], [[2.0]]])
+    got = mc._scaled_rmse(np.array([[[0.0]], [[0.0]], [[1.0]]]), sc, np.zeros((3, 1)), 4)
+    assert np.isnan(got[0, 0]) and got[1, 0] == np.inf and got[2, 0] == 1.0

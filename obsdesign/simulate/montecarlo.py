@@ -688,11 +688,15 @@ def _scaled_rmse(sq: np.ndarray, sc: np.ndarray, e0: np.ndarray, count: int) -> 
     :param sq, sc: the scaled sums and their scales; :param e0: the initial errors;
     :param count: the number of errors summed (K + 1)."""
     S = np.maximum(sc.max(axis=1), np.abs(e0))
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         Sd = np.where(S > 0, S, 1.0)
         rel = sc / Sd[:, None, :]
         tot = (sq * rel * rel).sum(axis=1) + (e0 / Sd) ** 2
-    return np.where(S > 0, S * np.sqrt(tot / count), 0.0)
+        out = np.where(S > 0, S * np.sqrt(tot / count), 0.0)
+    # a run whose error left the float range: its scale is nan (or inf) and so is its RMSE;
+    # it was 0 (nan > 0 is false), a diverging run's RMSE 0 in the quantiles beside a table
+    # saying nan (re-check trial, session 41)
+    return np.where(np.isfinite(S), out, S)
 
 
 def _matmul_for(rows: int, inner: int, cols: int) -> Any:
