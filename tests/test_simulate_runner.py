@@ -134,6 +134,14 @@ def test_a_divergence_gets_one_plain_warning_not_numpy_s_too() -> None:
     said = api.simulate(load_spec_text(text, "square.toml")).info["warnings"]
     assert "leaves the float range at t = 9" in said[0]
     assert not [w for w in said if "RuntimeWarning" in w], said
+    # a divide by zero that stays finite (min(1/t, 1) at t = 0) is another matter: kept
+    other = (
+        '[system]\ntime = "discrete"\nA = [[1.5]]\nC = [[1]]\npsi = ["0.001*min(1/t, 1)"]\n'
+        '[method]\nkey = "lyapunov"\nL = [1.2]\n[simulate]\nhorizon = 2000\nx0 = [1]\nxhat0 = [0]\n'
+    )
+    said = api.simulate(load_spec_text(other, "div.toml")).info["warnings"]
+    assert "leaves the float range" in said[0]
+    assert any("divide by zero" in w for w in said), said
 
 
 def test_an_input_that_is_not_finite_is_not_called_a_divergence() -> None:
