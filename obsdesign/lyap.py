@@ -1376,10 +1376,14 @@ class RateResolutionError(InconclusiveError):
         2.109·10⁻¹⁶, a value itself refused; lyapunov review, session 41)."""
         from obsdesign.certify.printing import fmt_up
 
+        # at the resolution itself the search can still run out of exact checks (a width of
+        # 2.2e-16 at λ = 0.95 did, exit 4; re-check trial, session 41): a safe value too
         return (
             f"rate_tol = {float(self.tol):.3g} cannot be met: the best-rate bracket cannot be "
             f"narrower than {float(self.width):.3g} near the rate {float(self.rate):.6g} (the "
-            f"float resolution there); expected rate_tol ≥ {fmt_up(self.width, 2)}"
+            f"float resolution there); expected rate_tol ≥ {fmt_up(self.width, 2)} (at that "
+            f"width the search may run out of exact checks: {fmt_up(self.width * 10, 1)} or "
+            "more is safe)"
         )
 
 

@@ -1058,11 +1058,33 @@ def test_rate_resolution_hint_suggests_a_tolerance_that_is_met(width: fmpq) -> N
     from fractions import Fraction
 
     e = lyap.RateResolutionError(fmpq(1, 10**20), width, fmpq(19, 20))
-    said = re.search(r"expected rate_tol ≥ (\S+)$", e.hint())
+    said = re.search(
+        r"expected rate_tol ≥ (\S+) \(at that width .*: (\S+) or more is safe\)$", e.hint()
+    )
     assert said is not None
     got = Fraction(said.group(1))
     assert got >= Fraction(int(width.p), int(width.q))
     assert got <= Fraction(int(width.p), int(width.q)) * Fraction(11, 10)
+    assert Fraction(said.group(2)) >= 10 * Fraction(int(width.p), int(width.q))
+
+
+def test_the_safe_rate_tol_of_the_refusal_is_met() -> None:
+    """Section 5's plant with its L (λ ≈ 0.95): the least width (2.2e-16) ran out of exact
+    checks (exit 4; re-check trial, session 41); the "safe" value the refusal names designs."""
+    import re
+
+    from obsdesign import api
+    from obsdesign.errors import SpecError
+
+    base = (
+        '[system]\ntime = "discrete"\nA = [[0, 1], [1, 0]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\nL = [-1.87, 1.874]\nrate_tol = {}\n'
+    )
+    with pytest.raises(SpecError) as ei:
+        api.design(api.load_spec_text(base.format("1e-30"), "rt.toml"))
+    safe = re.search(r": (\S+) or more is safe\)$", str(ei.value))
+    assert safe is not None
+    assert api.design(api.load_spec_text(base.format(safe.group(1)), "rt.toml")).exit_code() == 0
 
 
 def test_inverse_float_matches_the_exact_inverse_and_refuses_a_singular_P() -> None:
