@@ -66,6 +66,16 @@ def test_sampling_file(tmp_path: Path) -> None:
         get_method("impulsive").simulate(spec, rep.parameters, sampling_file=tmp_path / "no")
 
 
+@pytest.mark.parametrize("value", ['""', '" "', '"a\\u0000b"'])
+def test_an_empty_or_nul_sampling_file_in_the_spec_is_bad_input(tmp_path: Path, value) -> None:
+    """[simulate] sampling_file = "" was the spec's folder ("is a directory"), a NUL exit 3
+    (re-check trial, session 41): bad input naming the key, as --option sampling_file."""
+    from obsdesign.errors import SpecError
+
+    with pytest.raises(SpecError, match=r"\[simulate\.sampling_file\] expected a file path"):
+        load_spec_text(_spec3(f"\nsampling_file = {value}"), str(tmp_path / "s.toml"))
+
+
 def test_template_designs() -> None:
     """`obsdesign init impulsive` writes a spec that loads and designs, and whose declared
     Assumption 1 data hold: the falsification pass (``on_violation = "fail"``) finds no

@@ -195,7 +195,12 @@ def parse_simulate(table: Table, spec: Spec) -> SimOptions:
         raise table.error("runs", "expected at most 100,000 runs")
     sf = None
     if table.has("sampling_file"):
-        p = Path(table.str("sampling_file"))
+        text = table.str("sampling_file")
+        if not text.strip() or "\0" in text:
+            # "" was the spec's folder ("is a directory"), a NUL an internal ValueError, exit
+            # 3 (re-check trial, session 41), as for --option sampling_file
+            raise table.error("sampling_file", f"expected a file path, got {text!r}")
+        p = Path(text)
         sf = p if p.is_absolute() else Path(spec.file).resolve().parent / p
     # the bounds of ``--option rtol`` (1e-14 … 1e-2): rtol = 1 was accepted here (review)
     rtol = float(
