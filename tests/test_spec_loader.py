@@ -413,3 +413,12 @@ def test_a_set_of_another_dimension_without_dim_names_dim(body: str, key: str) -
     with pytest.raises(SpecError) as ei:
         load_spec_text(GOOD + "\n[sets.D]\ndim = 3\n" + body + "\n")
     assert "without dim" not in str(ei.value)
+
+
+def test_a_polytope_g_of_the_wrong_length_gets_no_dim_hint() -> None:
+    """g's length follows G's rows, not the dimension: "[sets.P.g] expected 4 numbers, got 3"
+    got the dim hint (re-check trial, session 41)."""
+    body = 'type = "polytope"\nG = [[1, 0], [-1, 0], [0, 1], [0, -1]]\ng = [1, 1, 1]'
+    with pytest.raises(SpecError, match=r"expected 4 numbers, got 3$") as ei:
+        load_spec_text(GOOD + "\n[sets.P]\n" + body + "\n")
+    assert ei.value.key == "sets.P.g"

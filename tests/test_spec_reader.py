@@ -203,3 +203,9 @@ def test_a_string_sibling_is_not_a_table_that_holds_the_key() -> None:
     with pytest.raises(SpecError) as e:
         sim.int("horizon")
     assert "simulte" not in str(e.value)
+
+
+def test_a_vector_of_one_number_is_named_in_the_singular() -> None:
+    """"expected 1 numbers" (re-check trial, session 41)."""
+    with pytest.raises(SpecError, match=r"\[v\] expected 1 number, got 2$"):
+        Table({"v": [1, 2]}, "t.toml").vector("v", n=1)

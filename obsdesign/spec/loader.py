@@ -430,8 +430,8 @@ def _set(t: Table, n: int) -> ConvexSet:
     try:
         return _set_of_dim(t, n)
     except SpecError as e:
-        if not re.match(r"expected (shape |\d+ numbers, got)", e.expected):
-            raise  # not a size error
+        if not re.match(r"expected (shape |\d+ numbers?, got)", e.expected) or e.key.endswith(".g"):
+            raise  # not a size error, or g's, whose length follows G's rows, not the dimension
         raise SpecError(
             e.file,
             e.key,

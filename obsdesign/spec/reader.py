@@ -234,7 +234,7 @@ class Table:
         if not isinstance(v, list) or not v or any(isinstance(x, list) for x in v):
             raise self.error(k, f"expected a non-empty list of numbers{_len(n)}")
         if n is not None and len(v) != n:
-            raise self.error(k, f"expected {n} numbers, got {len(v)}")
+            raise self.error(k, f"expected {n} number{'' if n == 1 else 's'}, got {len(v)}")
         return self._value(k, np.array([self._number(k, x) for x in v], dtype=object))
 
     def matrix(
