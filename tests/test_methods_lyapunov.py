@@ -778,13 +778,16 @@ def test_no_float_riccati_gain_takes_the_high_precision_one(
         api.design(load_spec_text(path.read_text(), str(path)))
     assert ei.value.exit_code == 4
     # the message says what the high-precision retry did (it read as if only floats ran)
-    assert str(ei.value).endswith("the high-precision Riccati retry runs up to 0 states (n = 4)")
+    assert str(ei.value).endswith(
+        "the high-precision Riccati retry runs up to 0 states (n = 4); give L, or try "
+        'design = "lmi" or other weights (riccati_Q, riccati_R)'
+    )
     monkeypatch.setattr(riccati, "HP_MAX_N", 24)
     monkeypatch.setattr(riccati, "HP_PRECISIONS", (24,))  # too coarse to give a good gain
     with pytest.raises(InconclusiveError, match="the Riccati equation gave no gain") as ei:
         api.design(load_spec_text(path.read_text(), str(path)))
-    assert str(ei.value).endswith(
-        "high-precision Riccati retry found no gain that certifies either"
+    assert "high-precision Riccati retry found no gain that certifies either; give L" in str(
+        ei.value
     )
 
 

@@ -206,6 +206,6 @@ def test_a_string_sibling_is_not_a_table_that_holds_the_key() -> None:
 
 
 def test_a_vector_of_one_number_is_named_in_the_singular() -> None:
-    """"expected 1 numbers" (re-check trial, session 41)."""
+    """ "expected 1 numbers" (re-check trial, session 41)."""
     with pytest.raises(SpecError, match=r"\[v\] expected 1 number, got 2$"):
         Table({"v": [1, 2]}, "t.toml").vector("v", n=1)

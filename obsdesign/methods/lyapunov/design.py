@@ -129,6 +129,10 @@ def _hp_outcome(e: InconclusiveError, spec: Spec, o: Options) -> InconclusiveErr
         if n > HP_MAX_N
         else "; the high-precision Riccati retry found no gain that certifies either"
     )
+    if isinstance(e, NoRiccatiGain):
+        # the designed-gain failure says what to try; this one said nothing (re-check
+        # trial, session 41)
+        said += '; give L, or try design = "lmi" or other weights (riccati_Q, riccati_R)'
     e.message = e.message + said
     e.args = (e.message,)
     return e
