@@ -977,3 +977,20 @@ def test_a_tiny_lambda_is_inconclusive_not_an_internal_failure(lam: str) -> None
     text = re.sub(r"(?m)^lambda = .*$", f"lambda = {lam}", spec.read_text(), count=1)
     with pytest.raises(InconclusiveError, match="a float polytope computation failed"):
         api.design(api.load_spec_text(text, "tiny.toml"))
+
+
+@pytest.mark.parametrize("dn", ["[1, 1]", "[[1, 0, 0], [0, 1, 0]]", "[[1, 0], [0, 2]]"])
+def test_a_noise_map_that_is_not_the_identity_is_bad_input(dn: str) -> None:
+    """Two outputs with Dn = [1, 1] (2×1: one noise channel) was an IndexError, exit 3 (shape
+    review, session 41); a 2×3 or a non-identity 2×2 Dn is the same refusal."""
+    from obsdesign.errors import SpecError
+
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.5, 0.2, 0], [0, 0.5, 0.2], [0.1, 0, 0.5]]\n'
+        f"C = [[1, 0, 0], [0, 1, 0]]\nDn = {dn}\n"
+        '[sets.omega]\ntype = "box"\nlower = [-1, -1, -1]\nupper = [1, 1, 1]\n'
+        '[method]\nkey = "set-invariant"\nomega = "omega"\neta_bar = 0\nlambda = 0.9\n'
+        'algorithm = "symmetric"\n'
+    )
+    with pytest.raises(SpecError, match=r"\[system\.Dn\] expected the identity"):
+        api.design(load_spec_text(text, "dn.toml"))

@@ -116,8 +116,11 @@ def _check_noise_map(spec: Spec) -> None:
     if s.p == 0:
         return
     Dn = np.asarray(s.Dn.q, dtype=object)
-    eye = all(Dn[i, j] == (1 if i == j else 0) for i in range(s.p) for j in range(s.p))
-    if Dn.shape != (s.p, s.p) or not eye:
+    # the shape first: a 2×1 Dn (two outputs, one noise channel) was an IndexError, exit 3
+    # (shape review, session 41)
+    square = Dn.shape == (s.p, s.p)
+    eye = square and all(Dn[i, j] == (1 if i == j else 0) for i in range(s.p) for j in range(s.p))
+    if not eye:
         raise _spec_error(
             spec,
             "system.Dn",
