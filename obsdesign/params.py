@@ -355,6 +355,26 @@ def _plain_array(x: list[Any]) -> np.ndarray | None:
     return out if np.all(np.isfinite(out)) else None
 
 
+def shaped(v: Any, shape: tuple[int | None, ...], key: str) -> np.ndarray:
+    """A report parameter ``v`` as an object array of exactly ``shape`` (None: any length on
+    that axis), else ValueError naming ``key`` (a failed ``parameters-wellformed`` claim,
+    :func:`obsdesign.api.certify`). A reshape is no check: a stubborn K of 4×2 written as 2×4
+    (its entries row-major) and a set-invariant G of 6×2 written as 2×6 were reshaped back
+    and verified with exit 0, although the matrices as written state other claims (shape
+    review, session 41).
+
+    :param v: the value (nested lists, an array); :param shape: the expected shape;
+    :param key: the parameter's name, for the message."""
+    arr = np.asarray(v, dtype=object)
+    if arr.ndim != len(shape) or any(
+        want is not None and got != want for got, want in zip(arr.shape, shape, strict=True)
+    ):
+        want_s = "×".join("?" if d is None else str(d) for d in shape) or "a scalar"
+        got_s = "×".join(str(d) for d in arr.shape) or "a scalar"
+        raise ValueError(f"parameters.{key}: expected shape {want_s}, got {got_s}")
+    return arr
+
+
 def exact_param(params: Parameters, k: str, claims: list[Any], accept_float: bool = True) -> Any:
     """The exact value of parameter ``k`` for a certificate, or None after appending a failed
     claim saying why (missing; or float-only when ``accept_float`` is False). A float-only

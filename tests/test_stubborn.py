@@ -963,9 +963,16 @@ def test_a_scalar_given_as_two_numbers_is_refused(ex1: Report, tmp_path: Path, k
     out.write_text(json.dumps(d))
     r = CliRunner().invoke(app, ["verify", str(out)])
     assert r.exit_code == 2, r.output
-    assert f"{out}: parameters.exact.{key}: expected one number, got 2" in r.output.replace(
-        "\n", ""
-    )
+    said = f"{out}: parameters.exact.{key}: expected one number, got a list of shape 2"
+    assert said in r.output.replace("\n", "")
+    # [x] and [[x]] too: read as x until session 41 (shape review)
+    f0 = d["parameters"][key][0]
+    for one in ([x], [[x]]):
+        d["parameters"]["exact"][key] = one
+        d["parameters"][key] = f0
+        out.write_text(json.dumps(d))
+        r = CliRunner().invoke(app, ["verify", str(out)])
+        assert r.exit_code == 2 and "expected one number, got a list of shape" in r.output
 
 
 def test_the_single_run_reports_the_error_from_its_recursion() -> None:
@@ -2133,3 +2140,43 @@ def test_a_tampered_gain_normalization_fails_verify() -> None:
         assert any(c.id == "report-alters:lambda-max-bracket" for c in ver.failed), [
             c.id for c in ver.failed
         ]
+
+
+@pytest.mark.parametrize(
+    "keys",
+    [("K", "X", "K_at_max"), ("P",), ("Y", "Y_at_max"), ("U",), ("lambda_bracket",)],
+)
+def test_report_matrices_of_another_shape_are_not_reshaped(ex4: Report, keys) -> None:
+    """Example 4's 4×2 K, X (and their _at_max forms) written as 2×4 with the same entries
+    row-major verified with exit 0, 13 claims certified: the check reshaped them back, while
+    A − KᵀC is not Schur (shape review, session 41: a false certificate). Every matrix of a
+    point is read at its exact shape; a flat or nested-deeper one fails parameters-wellformed."""
+    d = ex4.to_dict()
+    for k in keys:
+        ex = np.asarray(d["parameters"]["exact"][k], dtype=object)
+        fl = np.asarray(d["parameters"][k], dtype=float)
+        if ex.ndim == 2 and ex.shape[0] == ex.shape[1]:  # a square one flat (row-major)
+            new_ex, new_fl = ex.reshape(-1), fl.reshape(-1)
+        elif ex.ndim == 2:  # the other shape, the same entries row-major
+            new_ex, new_fl = ex.reshape(ex.shape[::-1]), fl.reshape(fl.shape[::-1])
+        else:  # a vector as a column
+            new_ex, new_fl = ex.reshape(-1, 1), fl.reshape(-1, 1)
+        d["parameters"]["exact"][k] = new_ex.tolist()
+        d["parameters"][k] = new_fl.tolist()
+    rep = api.verify(Report.from_dict(d)[0])
+    assert rep.exit_code() != 0
+    bad = [c for c in rep.claims if c.id == "parameters-wellformed"]
+    assert bad and "expected shape" in bad[0].detail, [(c.id, c.detail) for c in rep.failed]
+
+
+def test_high_gain_report_matrices_are_read_at_their_shape() -> None:
+    """The high-gain claims reshaped K (n×1) and P (n×n) too: a flat K or P is malformed."""
+    rep = api.design(SPECS / "astolfi-stubborn-duffing.toml")
+    assert rep.exit_code() == 0
+    for k in ("K", "P"):
+        d = rep.to_dict()
+        d["parameters"]["exact"][k] = np.asarray(d["parameters"]["exact"][k]).reshape(-1).tolist()
+        d["parameters"][k] = np.asarray(d["parameters"][k], dtype=float).reshape(-1).tolist()
+        ver = api.verify(Report.from_dict(d)[0])
+        bad = [c for c in ver.claims if c.id == "parameters-wellformed"]
+        assert ver.exit_code() != 0 and bad and f"parameters.{k}: expected shape" in bad[0].detail

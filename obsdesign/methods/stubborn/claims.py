@@ -25,21 +25,20 @@ from obsdesign.certify.psd import PSDResult, asymmetric, check_pd, check_psd
 from obsdesign.errors import InputError
 from obsdesign.methods.stubborn import lmis
 from obsdesign.methods.stubborn.options import Options
-from obsdesign.params import Parameters
+from obsdesign.params import Parameters, shaped
 from obsdesign.spec.models import Spec
 
 PAPER = "stubborn-observer slides (Astolfi, Alessandri, Zaccarian, WUDS 2017)"
 
 
-def _mat(v: Any, shape: tuple[int, int]) -> np.ndarray:
-    return qmat(np.asarray(v, dtype=object).reshape(shape))
+def _mat(v: Any, shape: tuple[int, int], key: str) -> np.ndarray:
+    """The report's matrix ``key`` of exactly ``shape`` (:func:`obsdesign.params.shaped`)."""
+    return qmat(shaped(v, shape, key))
 
 
-def _vec(v: Any, n: int) -> np.ndarray:
-    arr = np.asarray(v, dtype=object).reshape(-1)
-    if arr.size != n:
-        raise ValueError(f"expected {n} entries, got {arr.size}")
-    return np.array([Q(x) for x in arr], dtype=object)
+def _vec(v: Any, n: int, key: str) -> np.ndarray:
+    """The report's vector ``key`` of exactly n entries (a flat list)."""
+    return np.array([Q(x) for x in shaped(v, (n,), key)], dtype=object)
 
 
 def _scalar(v: Any, key: str) -> fmpq:
@@ -47,10 +46,14 @@ def _scalar(v: Any, key: str) -> fmpq:
     cut to its first entry and a report with λ = [x, anything] verified (audit)."""
     if isinstance(v, fmpq):
         return v
-    arr = np.asarray(v, dtype=object).reshape(-1)
-    if arr.size != 1:
-        raise InputError(f"report: parameters.exact.{key}: expected one number, got {arr.size}")
-    return Q(arr[0])
+    arr = np.asarray(v, dtype=object)
+    if arr.ndim != 0:
+        # [x] and [[x]] were read as x (shape review, session 41): one number is a scalar
+        raise InputError(
+            f"report: parameters.exact.{key}: expected one number, got a list of shape "
+            + "×".join(str(d) for d in arr.shape)
+        )
+    return Q(arr.item())
 
 
 def _sign(v: np.ndarray) -> PSDResult:
@@ -135,12 +138,12 @@ def _read_point(pr: Parameters, c: Claims, spec: Spec, suffix: str) -> dict[str,
     if any(v is None for v in vals.values()):
         return None
     return {
-        "K": _mat(vals["K"], (n, p)),
-        "P": _mat(vals["P"], (n, n)),
-        "U": _vec(vals["U"], p),
-        "W": _vec(vals["W"], p),
-        "Y": _mat(vals["Y"], (p, n)),
-        "R": _mat(vals["R"], (p, p)),
+        "K": _mat(vals["K"], (n, p), "K" + suffix),
+        "P": _mat(vals["P"], (n, n), "P" + suffix),
+        "U": _vec(vals["U"], p, "U" + suffix),
+        "W": _vec(vals["W"], p, "W" + suffix),
+        "Y": _mat(vals["Y"], (p, n), "Y" + suffix),
+        "R": _mat(vals["R"], (p, p), "R" + suffix),
     }
 
 
@@ -197,7 +200,7 @@ def lmi_claims(
     if pt is None or Xr is None or lam is None:
         return c
     lam = _scalar(lam, "lambda")
-    Xr = _mat(Xr, (n, p))
+    Xr = _mat(Xr, (n, p), "X")
     if o.K is not None:
         c.matches("K", pt["K"], np.asarray(o.K, dtype=object), "[method].K")
         pt["K"] = np.asarray(o.K, dtype=object)
@@ -314,7 +317,7 @@ def lambda_max_claims(spec: Spec, pr: Parameters) -> list[Claim]:
     br = pr.exact("lambda_bracket", c)
     if br is None:
         return c
-    arr = np.asarray(br, dtype=object).reshape(-1)
+    arr = shaped(br, (None,), "lambda_bracket")
     lo, hi = Q(arr[0]), Q(arr[-1])
     pair = arr.size == 2
     close = abs(hi - lo) <= o.lambda_tol * abs(lo)

@@ -34,7 +34,7 @@ from obsdesign.errors import InputError
 from obsdesign.methods.base import SolverResult, SolverStatus
 from obsdesign.methods.stubborn.claims import identity_claim
 from obsdesign.methods.stubborn.options import ELL_FACTOR, Options, SimOptions
-from obsdesign.params import Parameters
+from obsdesign.params import Parameters, shaped
 from obsdesign.simulate.budget import TimeBudget
 from obsdesign.simulate.grid import time_grid
 from obsdesign.simulate.result import SimResult
@@ -233,12 +233,12 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     if any(v is None for v in vals.values()):
         return c
     K = np.asarray(o.K, dtype=object)
-    c.matches("K", qmat(np.asarray(vals["K"], dtype=object).reshape(n, 1)), K, "[method].K")
+    c.matches("K", qmat(shaped(vals["K"], (n, 1), "K")), K, "[method].K")
     c.matches("lambda", vals["lambda"], o.lam, "[method].lambda")
     c.matches("epsilon", vals["epsilon"], o.epsilon, "[method].epsilon")
     if o.ell is not None:
         c.matches("ell", vals["ell"], o.ell, "[method].ell")
-    P = qmat(np.asarray(vals["P"], dtype=object).reshape(n, n))
+    P = qmat(shaped(vals["P"], (n, n), "P"))
     A, C = chain(n)
     Ac = A - K @ C
     E = P @ Ac + Ac.T @ P + qeye(n)
