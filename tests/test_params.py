@@ -335,3 +335,19 @@ def test_shaped_takes_the_shape_or_a_vector_and_refuses_a_transpose() -> None:
         p.shaped("G", (-1, 3))
     with pytest.raises(InputError, match="expected 2×2"):
         p.shaped("v", (2, 2))
+
+
+def test_shaped_refuses_every_other_shape() -> None:
+    """params.shaped: exactly the shape (None: any length), a named ValueError otherwise."""
+    import numpy as np
+    import pytest
+
+    from obsdesign.params import shaped
+
+    assert shaped([[1, 2], [3, 4]], (2, 2), "P").shape == (2, 2)
+    assert shaped([1, 2, 3], (None,), "b").shape == (3,)
+    for bad, shape in (([1, 2, 3, 4], (2, 2)), ([[1, 2]], (2, 1)), ([[1], [2]], (2,)), (5, (1,))):
+        with pytest.raises(ValueError, match=r"^parameters\.P: expected shape "):
+            shaped(bad, shape, "P")
+    with pytest.raises(ValueError, match="expected shape 2×2, got 1×4"):
+        shaped(np.zeros((1, 4)), (2, 2), "P")
