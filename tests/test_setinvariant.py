@@ -14,7 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from obsdesign import api
-from obsdesign.api import load_spec_text
+from obsdesign.api import load_spec, load_spec_text
 from obsdesign.certify.claim import ClaimStatus
 from obsdesign.certify.exact import Q, qmat
 from obsdesign.errors import (
@@ -994,3 +994,42 @@ def test_a_noise_map_that_is_not_the_identity_is_bad_input(dn: str) -> None:
     )
     with pytest.raises(SpecError, match=r"\[system\.Dn\] expected the identity"):
         api.design(load_spec_text(text, "dn.toml"))
+
+
+@pytest.mark.parametrize(
+    "key, how",
+    [
+        ("G", "transpose"),  # 6×2 written 2×6: verified with exit 0 (false certificate)
+        ("V", "flat"),
+        ("v_breakpoints", "transpose"),
+        ("breakpoints", "column"),
+        ("L", "transpose"),
+        ("L_admissible_vertices", "flat"),
+    ],
+)
+def test_report_matrices_of_another_shape_fail_verify(key: str, how: str) -> None:
+    """Example 7.1's report with one matrix written in another shape (the same entries
+    row-major): the checks reshaped them back, and a 6×2 G written 2×6 verified with "10
+    claims certified" — Ω ⊆ {G e ≤ 1} is false for the matrix as written (shape review,
+    session 41). Now a failed parameters-wellformed claim naming the key."""
+    from obsdesign.report.model import Report
+
+    path = Path(__file__).resolve().parents[1] / "specs" / "dorea-pimenta-7-1.toml"
+    rep = api.design(load_spec(path))
+    assert rep.exit_code() == 0
+    d = rep.to_dict()
+    ex = np.asarray(d["parameters"]["exact"][key], dtype=object)
+    fl = np.asarray(d["parameters"][key], dtype=float)
+    change = {
+        "transpose": lambda a: a.reshape(a.shape[::-1]),
+        "flat": lambda a: a.reshape(-1),
+        "column": lambda a: a.reshape(-1, 1),
+    }[how]
+    d["parameters"]["exact"][key] = change(ex).tolist()
+    d["parameters"][key] = change(fl).tolist()
+    ver = api.verify(Report.from_dict(d)[0])
+    assert ver.exit_code() != 0
+    bad = [c for c in ver.claims if c.id == "parameters-wellformed"]
+    assert bad and f"parameters.{key}: expected shape" in bad[0].detail, [
+        (c.id, c.detail) for c in ver.failed
+    ]

@@ -25,7 +25,7 @@ from flint import fmpq
 
 from obsdesign.certify.claim import Claim, Claims
 from obsdesign.certify.printing import fmt_exact
-from obsdesign.params import Parameters
+from obsdesign.params import Parameters, shaped
 from obsdesign.sets import polytope_ops as po
 from obsdesign.spec.models import Spec
 
@@ -166,8 +166,10 @@ class ExactBackend:
         """The exact value of a reported parameter (a float-only one is a failed claim)."""
         return params.exact(key, c, accept_float=False)
 
-    def matrix(self, x: Any, cols: int) -> np.ndarray:
-        return np.asarray(x, dtype=object).reshape(-1, cols)
+    def matrix(self, x: Any, shape: tuple[int | None, int], key: str) -> np.ndarray:
+        """The reported matrix ``key`` of exactly ``shape`` (rows None: any number): a 6×2 G
+        written 2×6 was reshaped back and verified (shape review, session 41)."""
+        return shaped(x, shape, key)
 
     def forms(self, G: np.ndarray, V: np.ndarray) -> tuple[bool, str, Any]:
         if self.params is not None:
@@ -211,13 +213,14 @@ class ExactBackend:
     def linear(self, G: np.ndarray, V: np.ndarray, L: np.ndarray) -> tuple[bool, Any]:
         return ce.linear_law(self.ex, G, V, L)
 
-    def gain_vertices_ok(self, G: np.ndarray, V: np.ndarray, reported: np.ndarray) -> str:
-        """'' when the reported vertices are exactly the admissible set's vertices."""
+    def gain_vertices_ok(self, G: np.ndarray, V: np.ndarray, reported: Any, width: int) -> str:
+        """'' when the reported vertices (rows of ``width`` = n·p entries) are exactly the
+        admissible set's vertices."""
         from .linear import gain_vertices
 
         verts, _ = gain_vertices(self.ex, G, V)
         want = {tuple(np.asarray(v, dtype=object).reshape(-1)) for v in verts}
-        got = [tuple(r) for r in np.asarray(reported, dtype=object).reshape(len(reported), -1)]
+        got = [tuple(r) for r in shaped(reported, (None, width), "L_admissible_vertices")]
         if len(set(got)) != len(got):
             return "a vertex is listed twice"
         if set(got) != want:
@@ -263,8 +266,9 @@ class FloatBackend:
             return None
         return np.asarray(params.float(key), dtype=float)
 
-    def matrix(self, x: Any, cols: int) -> np.ndarray:
-        return np.asarray(x, dtype=float).reshape(-1, cols)
+    def matrix(self, x: Any, shape: tuple[int | None, int], key: str) -> np.ndarray:
+        """:meth:`ExactBackend.matrix` in float64."""
+        return np.asarray(shaped(x, shape, key), dtype=float)
 
     def forms(self, G: np.ndarray, V: np.ndarray) -> tuple[bool, str, Any]:
         tol = numerical.TOL * max(1.0, float(np.abs(G).max()) if G.size else 1.0)
@@ -332,11 +336,11 @@ class FloatBackend:
         f = numerical.linear_factor(self.fl, G, V, np.asarray(L, dtype=float))
         return f <= self.lam * (1 + numerical.TOL), f
 
-    def gain_vertices_ok(self, G: np.ndarray, V: np.ndarray, reported: np.ndarray) -> str:
+    def gain_vertices_ok(self, G: np.ndarray, V: np.ndarray, reported: Any, width: int) -> str:
         """Without cdd.gmp: each reported point is admissible and a vertex (n·p independent
         active constraints), in float64; that no vertex is missing is not checked."""
         Af, bf = numerical.gain_constraints(self.fl, self.lam, G, V)
-        R = np.asarray(reported, dtype=float).reshape(len(reported), -1)
+        R = np.asarray(shaped(reported, (None, width), "L_admissible_vertices"), dtype=float)
         for x in R:
             slack = bf - Af @ x
             tol = numerical.TOL * np.maximum(1.0, np.abs(bf))
@@ -432,7 +436,7 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     V = b.read(params, "V", c)
     if G is None or V is None:
         return c
-    G, V = b.matrix(G, s.n), b.matrix(V, s.n)
+    G, V = b.matrix(G, (None, s.n), "G"), b.matrix(V, (None, s.n), "V")
     c.matches("lambda", params.get("lambda"), o.lam, "[method].lambda")
     if "L_user" in params or o.L is not None:
         c.matches("L_user", params.get("L_user"), o.L, "[method].L")
@@ -490,8 +494,8 @@ def _single_output(
     zr, vr = b.read(params, "breakpoints", c), b.read(params, "v_breakpoints", c)
     if zr is None or vr is None:
         return
-    zs = list(np.asarray(zr).reshape(-1))
-    vs = [list(r) for r in b.matrix(vr, s.n)]
+    zs = list(shaped(zr, (None,), "breakpoints"))
+    vs = [list(r) for r in b.matrix(vr, (None, s.n), "v_breakpoints")]
     if len(vs) != len(zs):
         emit("theorem-3.1", False, "breakpoints and v_breakpoints differ in length", 0, False)
         return
@@ -573,7 +577,7 @@ def _linear(
     if "L" in params:
         L = b.read(params, "L", c)
         if L is not None:
-            f = law("linear-law", b.matrix(L, s.p).reshape(s.n, s.p))
+            f = law("linear-law", b.matrix(L, (s.n, s.p), "L"))
             if "L_factor" in params:
                 fr = b.read(params, "L_factor", c)
                 if fr is not None:
@@ -588,7 +592,7 @@ def _linear(
     if "L_admissible_vertices" in params:
         Vs = b.read(params, "L_admissible_vertices", c)
         if Vs is not None:
-            why = b.gain_vertices_ok(G, V, np.asarray(Vs))
+            why = b.gain_vertices_ok(G, V, Vs, s.n * s.p)
             emit(
                 "linear-gains-vertices",
                 not why,
