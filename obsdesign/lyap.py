@@ -1198,19 +1198,38 @@ def _certified_P_hp(
     if n > lyap_hp.DOUBLING_MAX_N:
         return None
     solve = lyap_hp.lyapunov_P_hp if n <= lyap_hp.MAX_N else lyap_hp.lyapunov_P_doubling
-    for prec in lyap_hp.PRECISIONS:
+    for prec in lyap_hp.precisions(n):
         Pm = solve(Am, r, discrete, prec)
         if Pm is None:
             continue
         Pm = Pm * margin_scale(mat_float(Pm), margin, Pm)
-        P = as_array(Pm)
-        if _passes(Am, P, Pm, r, discrete, margin, memo, Af):
-            return P
+        view = _into_float_view(Pm)
+        # the P scaled into the float range first; when that loses the margin, the P itself
+        # (a true certificate the report then cannot show: exit 4 naming P, as before)
+        for cand in (view, Pm) if view is not Pm else (Pm,):
+            P = as_array(cand)
+            if _passes(Am, P, cand, r, discrete, margin, memo, Af):
+                return P
     return _certified_P_exact(Am, r, discrete, margin, memo, Af)
 
 
 #: the largest binary exponent of an entry of the exact fallback's P (a float view's margin)
 FLOAT_VIEW_BITS = 1020
+
+
+def _into_float_view(Pm: fmpq_mat) -> fmpq_mat:
+    """``Pm`` scaled down by a power of two to about 2^:data:`FLOAT_VIEW_BITS` when an entry
+    is beyond the float range (the report would have no float view of it: exit 4, "an exact
+    value lies beyond the float range"); the exact checks decide whether the margin still
+    holds (re-check trial, session 39: a 4×4 Jordan block at λ = ρ + 10⁻⁴⁰). For the exact
+    fallback's P and, since session 41, the high-precision one (at 1024 bits it reaches that
+    block too)."""
+    n = Pm.nrows()
+    top = max(
+        (Pm[i, j].p.bit_length() - Pm[i, j].q.bit_length() for i in range(n) for j in range(n)),
+        default=0,
+    )
+    return Pm * fmpq(1, 2 ** (top - FLOAT_VIEW_BITS)) if top > FLOAT_VIEW_BITS else Pm
 
 
 def _certified_P_exact(
@@ -1232,18 +1251,8 @@ def _certified_P_exact(
     most = limits().max_digits
     for bits in lyap_hp.EXACT_BITS:
         Pm = lyap_hp.round_relative(Pe, bits)
-        Pm = Pm * margin_scale(mat_float(Pm), margin, Pm)
+        Pm = _into_float_view(Pm * margin_scale(mat_float(Pm), margin, Pm))
         n = Pm.nrows()
-        # a P beyond the float range has no float view (the report is then exit 4, "an
-        # exact value lies beyond the float range"): scaled down by a power of two to about
-        # 2^1020, the exact checks deciding whether the margin still holds (re-check trial,
-        # session 39: a 4×4 Jordan block at λ = ρ + 10⁻⁴⁰)
-        top = max(
-            (Pm[i, j].p.bit_length() - Pm[i, j].q.bit_length() for i in range(n) for j in range(n)),
-            default=0,
-        )
-        if top > FLOAT_VIEW_BITS:
-            Pm = Pm * fmpq(1, 2 ** (top - FLOAT_VIEW_BITS))
         if any(
             len(str(abs(Pm[i, j].p))) > most or len(str(Pm[i, j].q)) > most
             for i in range(n)

@@ -27,6 +27,21 @@ MAX_N = 16
 #: the working precisions tried, in bits
 PRECISIONS = (128, 320)
 
+#: one more precision up to :data:`WIDE_MAX_N` states (:func:`precisions`): a 20-state
+#: dead-beat closed loop (‖A − LC‖ ≈ 1.8·10⁵, nilpotent) has Lyapunov Ps whose doubling
+#: needs it at rates whose 1/λ is not dyadic (λ = 0.09: residual 3.4 at 320 bits, 10⁻²¹²
+#: at 1024), so the best-rate search stopped at 0.0883 where 0.01 certifies (hard-plant
+#: review, session 41)
+WIDE_PRECISION = 1024
+#: the largest state dimension :data:`WIDE_PRECISION` is tried at (its cost grows as n³)
+WIDE_MAX_N = 40
+
+
+def precisions(n: int) -> tuple[int, ...]:
+    """The working precisions of the high-precision Lyapunov solve at ``n`` states."""
+    return PRECISIONS + ((WIDE_PRECISION,) if n <= WIDE_MAX_N else ())
+
+
 #: the largest state dimension the exact rational solve is tried at (n² unknowns over Q)
 EXACT_MAX_N = 8
 

@@ -86,7 +86,7 @@ def test_hp_P_at_an_infeasible_rate_fails_the_exact_check(monkeypatch) -> None:
     real = lyap_hp.lyapunov_P_hp
     monkeypatch.setattr(lyap_hp, "lyapunov_P_hp", lambda *a: calls.append(a[-1]) or real(*a))
     got = lyap._certified_P_hp(Acl, fmpq(49, 100), True, fmpq(0), None, None, zeros)
-    assert got is None and calls == list(lyap_hp.PRECISIONS)
+    assert got is None and calls == list(lyap_hp.precisions(2)) == [128, 320, 1024]
     got = lyap._certified_P_hp(Acl, fmpq(51, 100), True, fmpq(0), None, None, zeros)
     assert got is not None and calls[-1] == lyap_hp.PRECISIONS[0]
     calls.clear()
@@ -215,7 +215,9 @@ def test_the_exact_solve_certifies_where_320_bits_do_not(monkeypatch) -> None:
     """λ = 0.01 for the 6-state plant: the exact rational P (decay matrix exactly I) rounded
     to 512 relative bits passes the exact checks; without the exact fallback (EXACT_MAX_N =
     0) nothing does, as before; below the spectral radius (λ = 0.0027) nothing does either
-    (the exact P is then not ≻ 0)."""
+    (the exact P is then not ≻ 0). The 1024-bit solve (session 41) is switched off: this is
+    the exact fallback's test."""
+    monkeypatch.setattr(lyap_hp, "WIDE_MAX_N", 0)
     sp = api.load_spec(SCALES)
     s = sp.system
     L = lyap.fmat(sp.options.L)
@@ -271,11 +273,15 @@ def test_an_exact_P_beyond_the_reports_digits_is_not_taken(monkeypatch) -> None:
         reset_limits(old)
 
 
-def test_an_exact_P_beyond_the_float_range_is_scaled_into_it() -> None:
+@pytest.mark.parametrize("wide", [0, 40])
+def test_an_exact_P_beyond_the_float_range_is_scaled_into_it(monkeypatch, wide: int) -> None:
     """A 4×4 Jordan block (0.5, superdiagonal 10⁶) at λ = ½ + 10⁻⁴⁰, margin 10⁻²⁰: the exact
     fallback's P had entries beyond the float range, and the design stopped with exit 4 "an
     exact value lies beyond the float range" (re-check trial, session 39). Scaled down to
-    about 2^1020 it still passes the exact checks; the report verifies."""
+    about 2^1020 it still passes the exact checks; the report verifies. With the 1024-bit
+    solve (session 41; wide = 40) its P reaches the same block and is scaled the same way
+    (without that it was exit 4 again); wide = 0 tests the exact fallback."""
+    monkeypatch.setattr(lyap_hp, "WIDE_MAX_N", wide)
     text = (
         '[system]\ntime = "discrete"\nA = [[0.5, 1000000, 0, 0], [0, 0.5, 1000000, 0], '
         "[0, 0, 0.5, 1000000], [0, 0, 0, 0.5]]\nC = [[1, 0, 0, 0]]\n[method]\n"

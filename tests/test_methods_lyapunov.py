@@ -1626,3 +1626,21 @@ def test_a_28_state_jordan_block_gets_the_high_precision_riccati_gain(tmp_path: 
     out = tmp_path / "r.json"
     out.write_text(rep.to_json())
     assert api.verify(out).exit_code() == 0
+
+
+def test_a_dead_beat_gain_gets_its_best_rate(tmp_path: Path) -> None:
+    """A 20-state Jordan block at 1 with the dead-beat L = (C(20, k))ₖ (A − LC nilpotent,
+    ‖A − LC‖ ≈ 1.8·10⁵): the Lyapunov P at a rate whose 1/λ is not dyadic needs 1024 bits
+    (λ = 0.09: residual 3.4 at 320 bits), so the search stopped at λ = 0.0883, "not
+    certifiable", although 0.01 certifies (hard-plant review, session 41). Now the best rate
+    is within rate_tol of 0, the bracket's other end infeasible, and verify agrees."""
+    import math
+
+    L = ", ".join(str(math.comb(20, k)) for k in range(1, 21))
+    rep = api.design(load_spec_text(_jordan_spec(20) + f"L = [{L}]\n", "db20.toml"))
+    assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
+    assert rep.parameters["lambda_best"] <= fmpq(1, 1000)
+    assert rep.parameters["lambda_bracket_kind"] == "infeasible"
+    out = tmp_path / "r.json"
+    out.write_text(rep.to_json())
+    assert api.verify(out).exit_code() == 0
