@@ -1205,3 +1205,21 @@ def test_rho_below_lambda_squared_says_it_is_the_designs_rule() -> None:
     with pytest.raises(SpecError, match=r"\[method\.rho\] expected rho >= lambda² = 0\.81") as e:
         load_spec_text(text, "rho.toml")
     assert "needs" not in e.value.message and "give lambda <= √rho" in e.value.message
+
+
+def test_counts_of_one_are_singular_in_the_messages() -> None:
+    """ "1 positive numbers" and "(1 numbers)" for a 1-state plant (re-check trial, session
+    41)."""
+    from obsdesign.methods.constrained.options import _count
+
+    assert _count(1) == "1 number" and _count(3) == "3 numbers"
+    assert _count(1, "positive number") == "1 positive number"
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.5]]\nC = [[1]]\n'
+        '[sets.X]\ntype = "box"\nlower = [-1]\nupper = [1]\n'
+        '[method]\nkey = "constrained"\nL = [0.1]\nlambda = 0.9\nX = "X"\neps_min = 0.01\n'
+        '[method.c]\ntype = "box"\nlower = [-1.1]\nupper = [1.1]\n'
+        "[simulate]\nhorizon = 10\nx0 = [1]\nxhat0 = [0]\n"
+    )
+    with pytest.raises(SpecError, match=r"bounds of w = \(d, v\) \(1 number\)$"):
+        load_spec_text(text, "sg.toml")

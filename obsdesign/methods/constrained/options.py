@@ -169,7 +169,7 @@ def parse_options(table: Table, spec: Spec) -> Options:
         if nw:
             raise table.error(
                 "D",
-                f"is missing: expected a table with lower/upper bounds of w = (d, v) ({nw} numbers)",
+                f"is missing: expected a table with lower/upper bounds of w = (d, v) ({_count(nw)})",
             )
         Dl = Du = np.zeros(0, dtype=object)
     else:
@@ -189,7 +189,7 @@ def parse_options(table: Table, spec: Spec) -> Options:
     elif model.nonlinear and s.m:
         raise table.error(
             "U",
-            f"is missing: expected a table with lower/upper bounds of the input u ({s.m} numbers)",
+            f"is missing: expected a table with lower/upper bounds of the input u ({_count(s.m)})",
         )
     eps_min = table.scalar("eps_min", min=0, strict_min=True).q
     em = table.scalar("eps_max", default=None, min=0, strict_min=True)
@@ -228,6 +228,11 @@ def parse_options(table: Table, spec: Spec) -> Options:
     )
     o.model, o.U_lower, o.U_upper = model, Ul, Uh
     return o
+
+
+def _count(k: int, what: str = "number") -> str:
+    """ "k numbers", "1 number" ("1 numbers" in three messages; re-check trial, session 41)."""
+    return f"{k} {what}{'' if k == 1 else 's'}"
 
 
 def _set_ref(table: Table, key: str, spec: Spec, kinds: tuple[str, ...]) -> tuple[str, ConvexSet]:
@@ -315,7 +320,8 @@ def parse_simulate(table: Table, spec: Spec) -> SimOptions:
         out.saturation_r = table.vector("saturation_r").f
         if len(out.saturation_r) not in (1, spec.system.n) or np.any(out.saturation_r <= 0):
             raise table.error(
-                "saturation_r", f"expected a positive number or {spec.system.n} positive numbers"
+                "saturation_r",
+                f"expected a positive number or {_count(spec.system.n, 'positive number')}",
             )
     out.time_limit = parse_time_limit(table)
     return out
