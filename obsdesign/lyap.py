@@ -1135,7 +1135,8 @@ def _inverse_float(Pm: fmpq_mat) -> np.ndarray | None:
 
 
 def _lambda_min_by_inverse(Pm: fmpq_mat, fallback: float) -> float:
-    """λ_min(P) = 1/λ_max(P⁻¹) for a positive definite P, P⁻¹ exact (flint), its largest
+    """λ_min(P) = 1/λ_max(P⁻¹) for a positive definite P, P⁻¹ from :func:`_inverse_float`
+    (ball arithmetic, else exact), its largest
     eigenvalue in floats (well resolved, while P⁻¹'s smallest may not be: P⁻¹ is as
     ill-conditioned as P); a guide for :func:`margin_scale` only (for a P that is not positive
     definite it may mislead; the exact checks decide). ``fallback`` when P is singular or
