@@ -147,3 +147,47 @@ def test_a_field_that_is_not_finite_stops_its_run_not_the_solver() -> None:
     x0[1, 1] = 1e120  # below ESCAPE, but ψ is inf/inf = NaN there: frozen in interval 0
     b = simulate_hybrid(_example_field, T, np.array([0.8]), x0, xh0, H, W)
     assert b.escaped[1] and not b.valid[1, -1]
+
+
+def test_the_error_is_stepped_by_its_own_dynamics_on_an_unstable_plant() -> None:
+    """ε = ẑ − Tx is integrated itself (flow Āε, jump ε_o⁺ = (1 − L)ε_o + Lw), not read off
+    as the difference of ẑ and Tx: on a plant growing as e^{20t} that difference of two
+    numbers near 10⁶⁰ is rounding (~10⁴⁴) where ε is ~10⁻³; the impulsive simulate printed
+    final |e| = 0.0 and sup |e| ~ 10¹³² for a certified design (re-check review, session 41).
+    The reference is the error recursion alone, with matrix exponentials."""
+    from scipy.linalg import expm
+
+    A = np.array([[20.0, 0.0], [0.0, -1.0]])
+    T = np.eye(2)
+    L = 0.8
+    K = 700
+    H = np.full((1, K), 0.01)
+    x0, xh0 = np.array([[1.0, 1.0]]), np.array([[0.5, 2.0]])
+
+    def zero(X: np.ndarray) -> np.ndarray:
+        return np.zeros_like(X)
+
+    b = simulate_hybrid(
+        lambda X: X @ A.T,
+        T,
+        np.array([L]),
+        x0,
+        xh0,
+        H,
+        np.zeros((1, K, 1)),
+        dense=1,
+        rtol=1e-10,
+        atol=1e-300,
+        split=(A, zero),
+    )
+    assert not (b.escaped[0] or b.diverged[0]) and b.valid[0, -1]
+    assert abs(b.x[0, -1, 0]) > 1e59  # the plant is huge
+    Phi = expm(A * 0.01)
+    e = (xh0 - x0)[0]
+    for _k in range(K):
+        e = Phi @ e
+        ref_last = e.copy()  # the stored point at t_k is the pre-jump value
+        e[0] *= 1 - L
+    np.testing.assert_allclose(b.err[0, -1], ref_last, rtol=1e-6, atol=0)
+    np.testing.assert_allclose(b.eps[0, -1], np.linalg.norm(ref_last), rtol=1e-6)
+    assert 1e-4 < b.eps[0, -1] < 1e-2  # e_2 = e^{−7}: neither 0 nor rounding of 10⁶⁰

@@ -28,7 +28,10 @@ class HybridBatch:
     """Trajectories of N runs on per-run time grids.
 
     ``t``: (N, G) times; ``x``, ``xhat``: (N, G, n); ``eps``: (N, G) ‖ẑ − z‖ (z-coordinates,
-    the ε of (12)); ``valid``: (N, G) mask (False on padding after the horizon or after a
+    the ε of (12)); ``err``: (N, G, n) the error x̂ − x = T⁻¹ε, stepped by its own dynamics
+    (not the difference of x̂ and x: on an escaping plant that difference of two numbers near
+    10¹⁵⁰ printed final |e| = 0.0 and sup |e| ~ 10¹³² for a certified design; re-check review,
+    session 41); ``valid``: (N, G) mask (False on padding after the horizon or after a
     run stopped); ``sample_times``: (N, K) instants t_k (NaN for padding); ``diverged``:
     (N,) runs stopped because the *error* blew up (ε above ``blowup``·max(1, ε(0)) and above
     10⁻³‖z‖, or not finite); ``escaped``: (N,) runs stopped because the *plant* left the float range
@@ -40,6 +43,7 @@ class HybridBatch:
     x: np.ndarray
     xhat: np.ndarray
     eps: np.ndarray
+    err: np.ndarray
     valid: np.ndarray
     sample_times: np.ndarray
     diverged: np.ndarray
@@ -94,13 +98,20 @@ def simulate_hybrid(
     atol: float = 1e-9,
     blowup: float = 1e8,
     check: Callable[[int, int], None] | None = None,
+    split: tuple[np.ndarray, VectorField] | None = None,
 ) -> HybridBatch:
     """Run plant + observer (11) for N runs: x0, xhat0 (N, n); H (N, K) intervals (0 = padding);
     W (N, K, m) noise w_k at the sample ending interval k. ``dense`` points per interval.
     The output at a sample is y_k = C x(t_k) + w_k with C the first m rows of T = [C; M].
     ``check(k, K)`` runs before each interval k of K (a time budget may raise there).
 
-    The observer state is integrated in z-coordinates exactly as (11a) reads (ψ̄(z) = Tψ(T⁻¹z)).
+    Integrated are the plant x and the error ε = ẑ − Tx of (12) (z-coordinates), not ẑ:
+    flow ε̇ = T(f(x + T⁻¹ε) − f(x)), which with ``split`` = (A, ψ), f(x) = Ax + ψ(x) of (1a),
+    is Āε + T(ψ(x + T⁻¹ε) − ψ(x)), Ā = TAT⁻¹, its linear part free of x; jump (11b)
+    ε_o⁺ = ε_o − L(ε_o − w_k). The estimate is ẑ = Tx + ε. Stepping ẑ and differencing lost
+    every digit of ε once ‖x‖ passed 10¹⁶‖ε‖ (an unstable plant; re-check review, session
+    41). The nonlinear part ψ(x + T⁻¹ε) − ψ(x) is still a difference of doubles at x, so it
+    loses its digits there too (docs/methods/impulsive.md, "Simulation").
     """
     x0 = np.atleast_2d(np.asarray(x0, dtype=float))
     xhat0 = np.atleast_2d(np.asarray(xhat0, dtype=float))
@@ -111,19 +122,28 @@ def simulate_hybrid(
     Ti = np.linalg.inv(T)
     Ld = np.asarray(L_diag, dtype=float).reshape(1, m)
 
-    def fz(Z: np.ndarray) -> np.ndarray:
-        return f(Z @ Ti.T) @ T.T
+    if split is not None:
+        Abar = T @ np.asarray(split[0], dtype=float) @ Ti
+        psi = split[1]
+
+        def fe(X: np.ndarray, E: np.ndarray, dX: np.ndarray) -> np.ndarray:
+            return E @ Abar.T + (psi(X + E @ Ti.T) - psi(X)) @ T.T
+
+    else:
+
+        def fe(X: np.ndarray, E: np.ndarray, dX: np.ndarray) -> np.ndarray:
+            return (f(X + E @ Ti.T) - dX) @ T.T
 
     G = K * dense + 1
     t = np.zeros((N, G))
     xs = np.zeros((N, G, n))
-    zs = np.zeros((N, G, n))
+    es = np.zeros((N, G, n))
     valid = np.zeros((N, G), dtype=bool)
     X = x0.copy()
-    Z = xhat0 @ T.T
-    xs[:, 0], zs[:, 0], valid[:, 0] = X, Z, True
     with np.errstate(all="ignore"):
-        e0 = np.nan_to_num(np.linalg.norm(Z - X @ T.T, axis=1), posinf=np.inf)
+        Z = (xhat0 - x0) @ T.T  # the error ε (12), not ẑ
+        xs[:, 0], es[:, 0], valid[:, 0] = X, Z, True
+        e0 = np.nan_to_num(np.linalg.norm(Z, axis=1), posinf=np.inf)
     diverged = np.zeros(N, dtype=bool)
     with np.errstate(all="ignore"):  # a start already beyond ESCAPE (or not finite)
         escaped = ~np.all(np.isfinite(X), axis=1) | (np.abs(X).max(axis=1) > ESCAPE)
@@ -163,7 +183,8 @@ def simulate_hybrid(
                 check(k, K)
             U = u.reshape(N, 2, n)
             with np.errstate(all="ignore"):
-                d = np.stack([f(U[:, 0]), fz(U[:, 1])], axis=1)
+                dX = f(U[:, 0])
+                d = np.stack([dX, fe(U[:, 0], U[:, 1], dX)], axis=1)
                 d *= h[:, None, None]
             bad_x |= ~np.all(np.isfinite(d[:, 0]), axis=1)
             bad_z |= ~np.all(np.isfinite(d[:, 1]), axis=1)
@@ -190,21 +211,21 @@ def simulate_hybrid(
         cols = slice(1 + k * dense, 1 + (k + 1) * dense)
         t[:, cols] = tk[:, None] + h[:, None] * s_eval[None, :]
         xs[:, cols] = np.moveaxis(U[:, 0], 2, 1)
-        zs[:, cols] = np.moveaxis(U[:, 1], 2, 1)
+        es[:, cols] = np.moveaxis(U[:, 1], 2, 1)
         valid[:, cols] = active[:, None]
         X = np.where(active[:, None], U[:, 0, :, -1], X)
         Z = np.where(active[:, None], U[:, 1, :, -1], Z)
         tk = tk + h
         # jump (11b) at t_k = end of interval k, only for runs that really sampled:
-        # y_k = C x(t_k) + w_k = (T x)_o + w_k, T = [C; M] (eq. (9))
-        y = (X @ T[:m].T) + W[:, k, :]
-        Zo = Z[:, :m] - Ld * (Z[:, :m] - y)
+        # y_k = C x(t_k) + w_k = (T x)_o + w_k, T = [C; M] (eq. (9)), so in the error
+        # ε_o⁺ = ẑ_o⁺ − (Tx)_o = ε_o − L(ε_o − w_k)
+        Zo = Z[:, :m] - Ld * (Z[:, :m] - W[:, k, :])
         Z[:, :m] = np.where(active[:, None], Zo, Z[:, :m])
         sample_times[:, k] = np.where(active, tk, np.nan)
         with np.errstate(all="ignore"):
             xmax = np.abs(X).max(axis=1)
             out = ~np.all(np.isfinite(X), axis=1) | (xmax > ESCAPE)
-            e = np.linalg.norm(Z - X @ T.T, axis=1)
+            e = np.linalg.norm(Z, axis=1)
             zn = np.linalg.norm(X @ T.T, axis=1)
         big = (e > blowup * np.maximum(1.0, e0)) & (e > 1e-3 * zn)
         bad = ~out & (~np.all(np.isfinite(Z), axis=1) | big)
@@ -216,9 +237,10 @@ def simulate_hybrid(
         # the post-jump value is what the next interval starts from; the stored point at t_k
         # is the pre-jump (left-continuous) value, as in the paper.
     with np.errstate(all="ignore"):  # runs that escaped: their values are not finite
-        xhat = zs @ Ti.T
-        eps = np.linalg.norm(zs - xs @ T.T, axis=2)
-    return HybridBatch(t, xs, xhat, eps, valid, sample_times, diverged, escaped)
+        err = es @ Ti.T
+        xhat = xs + err
+        eps = np.linalg.norm(es, axis=2)
+    return HybridBatch(t, xs, xhat, eps, err, valid, sample_times, diverged, escaped)
 
 
 def simulate_one_by_one(
