@@ -98,6 +98,34 @@ def test_example_71_linear_gains(rep71):
     assert any("Proposition 7.1 with Q_I" in n for n in rep.notes)
 
 
+def test_proposition_71_notes_count_the_rows_of_G_from_1(rep71):
+    """ "Q_I = row i of G" names row i of the report's G counted from 1, as the paper counts:
+    L = A [Q_I; C]⁻¹ [0; −I] rebuilt from that row gives the printed L. The notes counted from
+    0, so "row 1" read as (−0.9, 0) gave L = (−0.7, −0.7), which is not admissible
+    (paper-reproduction review, session 42)."""
+    import re
+
+    from flint import fmpq_mat
+
+    rep, _ = rep71
+    G = np.asarray(rep.parameters["G"], dtype=object)
+    spec = load_spec_text(rep.spec, rep.spec_file)
+    A, C = spec.system.A.q, spec.system.C.q
+    notes = [n for n in rep.notes if n.startswith("Proposition 7.1 with Q_I = row")]
+    assert len(notes) >= 2
+    for note in notes:
+        m = re.match(
+            r"Proposition 7.1 with Q_I = row (\d+) of G \(counted from 1\) gives L = ≈?\[(.*)\]",
+            note,
+        )
+        assert m, note
+        i = int(m.group(1))
+        M = fmpq_mat([list(G[i - 1]), *[list(r) for r in C]])
+        L = fmpq_mat([list(r) for r in A]) * M.inv() * fmpq_mat([[0], [-1]])
+        shown = [float(v) for v in m.group(2).split(",")]
+        assert [float(L[0, 0]), float(L[1, 0])] == pytest.approx(shown, abs=1e-4)
+
+
 def test_example_71_verify_and_simulate(rep71, tmp_path):
     rep, out = rep71
     v = api.verify(out)

@@ -359,7 +359,10 @@ def polytope_params(
                     f"({vs_txt}); dimension {gs.dimension}"
                 )
             for i, Lp in gs.prop71:
-                notes.append(f"Proposition 7.1 with Q_I = row {i} of G gives L = {_vec_text(Lp)}")
+                notes.append(
+                    f"Proposition 7.1 with Q_I = row {i + 1} of G (counted from 1) gives L = "
+                    f"{_vec_text(Lp)}"
+                )
         else:
             notes.append(f"no linear law: {gs.how}")
     if o.L is not None:

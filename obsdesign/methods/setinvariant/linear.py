@@ -194,7 +194,7 @@ def admissible_gains(
         avg = sum((L for _, L in prop), np.full((n, p), fmpq(0), dtype=object)) * fmpq(1, len(prop))
         candidates.append((avg, "average of the Proposition 7.1 gains"))
         for i, L in prop:
-            candidates.append((L, f"Proposition 7.1 with Q_I = row {i}"))
+            candidates.append((L, f"Proposition 7.1 with Q_I = row {i + 1} of G (counted from 1)"))
     if res is not None:
         candidates.append((po.rationalize(res.x[:nl]).reshape(n, p), "max-margin LP point"))
     for L, how in candidates:
