@@ -953,26 +953,26 @@ def test_asymmetric_P_fails_the_l2_gain() -> None:
 
 @pytest.mark.parametrize("key", ["lambda", "lambda_max"])
 def test_a_scalar_given_as_two_numbers_is_refused(ex1: Report, tmp_path: Path, key: str) -> None:
-    """λ = [x, anything] was cut to x and verified with exit 0 (audit): exit 2 naming the
-    report and the key."""
+    """λ = [x, anything] was cut to x and verified with exit 0 (audit): a failed
+    ``parameters-wellformed`` claim naming the key, exit 1, as for a matrix of another shape
+    (it was exit 2 until session 42, the one malformed parameter that was bad input)."""
     d = ex1.to_dict()
     x = d["parameters"]["exact"][key]
     d["parameters"]["exact"][key] = [x, "12345"]
     d["parameters"][key] = [d["parameters"][key], 12345.0]
     out = tmp_path / "two.json"
-    out.write_text(json.dumps(d))
-    r = CliRunner().invoke(app, ["verify", str(out)])
-    assert r.exit_code == 2, r.output
-    said = f"{out}: parameters.exact.{key}: expected one number, got a list of shape 2"
-    assert said in r.output.replace("\n", "")
     # [x] and [[x]] too: read as x until session 41 (shape review)
     f0 = d["parameters"][key][0]
-    for one in ([x], [[x]]):
+    for one, got in (([x, "12345"], "2"), ([x], "1"), ([[x]], "1×1")):
         d["parameters"]["exact"][key] = one
         d["parameters"][key] = f0
         out.write_text(json.dumps(d))
-        r = CliRunner().invoke(app, ["verify", str(out)])
-        assert r.exit_code == 2 and "expected one number, got a list of shape" in r.output
+        r = CliRunner().invoke(app, ["verify", str(out), "--format", "json"])
+        assert r.exit_code == 1, r.output
+        claims = json.loads(r.output)["claims"]
+        bad = [c for c in claims if c["id"] == "parameters-wellformed"]
+        assert bad and bad[0]["status"] == "failed"
+        assert f"parameters.{key}: expected shape a scalar, got {got}" in bad[0]["detail"]
 
 
 def test_the_single_run_reports_the_error_from_its_recursion() -> None:

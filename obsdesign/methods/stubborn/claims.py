@@ -22,7 +22,6 @@ from obsdesign.certify.claim import Claim, Claims
 from obsdesign.certify.exact import Q, float_or_inf, qmat
 from obsdesign.certify.printing import fmt_exact, fmt_up
 from obsdesign.certify.psd import PSDResult, asymmetric, check_pd, check_psd
-from obsdesign.errors import InputError
 from obsdesign.methods.stubborn import lmis
 from obsdesign.methods.stubborn.options import Options
 from obsdesign.params import Parameters, shaped
@@ -42,18 +41,14 @@ def _vec(v: Any, n: int, key: str) -> np.ndarray:
 
 
 def _scalar(v: Any, key: str) -> fmpq:
-    """One number of the report (``key``: its name); a list of several is bad input — it was
-    cut to its first entry and a report with λ = [x, anything] verified (audit)."""
+    """One number of the report (``key``: its name), else ValueError (a failed
+    ``parameters-wellformed`` claim, exit 1, as a matrix of another shape): a list of several
+    was cut to its first entry and a report with λ = [x, anything] verified (audit); [x] and
+    [[x]] were read as x (shape review, session 41), then refused as bad input (exit 2, where
+    every other malformed parameter is a failed claim: re-check review, session 41)."""
     if isinstance(v, fmpq):
         return v
-    arr = np.asarray(v, dtype=object)
-    if arr.ndim != 0:
-        # [x] and [[x]] were read as x (shape review, session 41): one number is a scalar
-        raise InputError(
-            f"report: parameters.exact.{key}: expected one number, got a list of shape "
-            + "×".join(str(d) for d in arr.shape)
-        )
-    return Q(arr.item())
+    return Q(shaped(v, (), key).item())
 
 
 def _sign(v: np.ndarray) -> PSDResult:
