@@ -70,7 +70,7 @@ def test_a_5000_digit_schema_version_is_one_short_line(tmp_path: Path) -> None:
     assert r.exit_code == 2, r.stderr
     assert r.stderr.count("\n") == 1 and len(r.stderr) < 300
     assert "schema_version 99999999999999999999…(5000 digits)" in r.stderr
-    assert "is not supported" in r.stderr
+    assert "is not supported (this tool reads 1.x reports and writes 1.1)" in r.stderr
     bad.write_text(json.dumps(d).replace('"SV"', '"' + "9" * 5000 + '"'))  # no MINOR
     r = runner.invoke(app, ["--limit", "max_digits=10000", "verify", str(bad)])
     assert r.exit_code == 2 and r.stderr.count("\n") == 1 and len(r.stderr) < 300

@@ -542,9 +542,14 @@ def test_schema_version_is_major_dot_minor(tmp_path: Path, version: str) -> None
     p.write_text(json.dumps(d))
     res = CliRunner().invoke(app, ["verify", str(p)])
     assert res.exit_code == 2 and "schema_version must be MAJOR.MINOR" in res.output, res.output
-    d["schema_version"] = "1.1"
+    for minor in ("1.1", "1.2"):  # any 1.x is read (docs/spec.md)
+        d["schema_version"] = minor
+        p.write_text(json.dumps(d))
+        assert CliRunner().invoke(app, ["verify", str(p)]).exit_code == 0
+    d["schema_version"] = "2.1"  # the message said "(expected 1.1)" while 1.2 read
     p.write_text(json.dumps(d))
-    assert CliRunner().invoke(app, ["verify", str(p)]).exit_code == 0
+    res = CliRunner().invoke(app, ["verify", str(p)])
+    assert res.exit_code == 2 and "(this tool reads 1.x reports and writes 1.1)" in res.output
 
 
 def test_an_upper_case_spec_hash_says_so_and_a_bool_exact_value_reads_once(tmp_path: Path) -> None:

@@ -365,7 +365,8 @@ class Report:
             )
         if d["schema_version"].split(".")[0] != SCHEMA_VERSION.split(".")[0]:
             raise InputError(
-                f"{file}: schema_version {d['schema_version']} is not supported (expected {SCHEMA_VERSION})"
+                f"{file}: schema_version {d['schema_version']} is not supported (this tool reads "
+                f"{SCHEMA_VERSION.split('.')[0]}.x reports and writes {SCHEMA_VERSION})"
             )
         if not isinstance(d["spec"], str) or not isinstance(d["spec_sha256"], str):
             raise InputError(f"{file}: 'spec' must be the spec text and 'spec_sha256' its hash")
