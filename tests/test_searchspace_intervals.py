@@ -176,9 +176,14 @@ def test_sup_norm_and_range():
         ("0.31*sin(t)", "-3/10", "3/10", False, True),
         # atan(0) = 0 exactly: proved inside [0, 1.5707963] on [0, 8] (it was inconclusive,
         # the float enclosure near t = 0 reaching −5e-324); a lower bound 10⁻³⁰⁰ above 0
-        # is broken at t = 0 and never proved
+        # is broken at t = 0: proved there, at the exact point, since session 42
         ("atan(t)", "0", "1.5707963", True, False),
-        ("atan(t)", "1e-300", "1.5707963", False, False),
+        ("atan(t)", "1e-300", "1.5707963", False, True),
+        # leaves U at the horizon's end only (t = 8): proved there, at the exact point; the
+        # enclosures of the sub-intervals reaching 8 overlap U, inconclusive until session 42
+        ("floor(t)", "0", "7", False, True),
+        ("floor(t/8)", "0", "0", False, True),
+        ("floor(t/8) - 1", "-1", "-1", False, True),
     ],
 )
 def test_range_inside_exact_constants_and_proved_violations(
@@ -212,6 +217,7 @@ def test_range_inside_uses_the_exact_ends_of_the_horizon(t0, t1, lo, hi, ok) -> 
 
     got = B.range_inside([parse_expr("t", ["t"])], "t", q(t0), q(t1), [q(lo)], [q(hi)], 256)
     assert got[0] == ok
+    assert got[3] == (not ok)  # u at the end point itself is outside: proved (session 42)
 
 
 @given(st.integers(-(10**6), 10**6), st.integers(-(10**6), 10**6), st.integers(-(10**6), 10**6))

@@ -752,7 +752,38 @@ def range_inside(
             worst_left = max(worst_left, ex)
             continue
         stack.extend(parts)
+    if worst_left > 0.0 and not outside:
+        # not proved either way: u at the horizon's two ends, exactly. The enclosures of
+        # floor(t) on sub-intervals reaching t = 1 always overlap U = [0, 0], so a u that
+        # leaves U at an end point only was inconclusive, exit 4 (search-space review,
+        # session 42); at the point itself the exact enclosure is [1, 1]
+        outside = _points_outside(exprs, var, (_frac(t_lo), _frac(t_hi)), LO, HI, qparams)
     return worst_left == 0.0, worst_left, used, outside
+
+
+def _points_outside(
+    exprs: Sequence[Expr],
+    var: str,
+    points: Sequence[Fraction],
+    LO: Sequence[Fraction],
+    HI: Sequence[Fraction],
+    qparams: Sequence[dict[str, QI]],
+) -> bool:
+    """Whether some component of ``exprs`` provably leaves [LO_i, HI_i] at one of the exact
+    ``points`` of ``var``: its exact-end-point enclosure at the point
+    (:func:`~obsdesign.methods.searchspace.qintervals.evaluate_q`) lies wholly beyond a bound
+    (Remark 2.5, Hernández & García: u(t) ∈ U over the horizon)."""
+    for t in points:
+        for ex, a, z, prm in zip(exprs, LO, HI, qparams, strict=True):
+            try:
+                v = evaluate_q(
+                    ex.tree, {var: QI.point(t)}, prm, ex.source.strip().replace("^", "**")
+                )
+            except (ArithmeticError, ValueError, KeyError):
+                continue
+            if v is not None and (v.hi < a or v.lo > z):
+                return True
+    return False
 
 
 def _exact_params(ex: Expr) -> dict[str, QI]:

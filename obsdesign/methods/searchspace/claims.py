@@ -436,7 +436,8 @@ def _input_range(c: Claims, spec: Spec) -> None:
         detail=""
         if ok
         else (
-            "u leaves U: an enclosure lies wholly beyond a bound (proved)"
+            "u leaves U: an enclosure (of a constant, of a sub-interval, or of u at an end "
+            "of the horizon) lies wholly beyond a bound (proved)"
             if outside
             else (
                 f"an enclosure leaves U by up to {excess:.3g} (not proved either way)"
