@@ -1630,6 +1630,26 @@ def test_an_infeasible_answer_that_a_smaller_margin_overturns_is_exit_4() -> Non
         api.design(api.load_spec_text(_scalar_discrete("2.6"), "s.toml"))
 
 
+def test_a_solver_failure_without_bounds_is_not_infeasible_at_any_lambda() -> None:
+    """A detectable discrete plant whose C is ~10⁻³ needs a gain ≈ 1.2·10⁴: infeasible at
+    gain_bound = 100 (the solver's `infeasible`), and without any bound the solver fails
+    ("solver failure"), which was read as infeasible: "infeasible … at any λ ≤ 1 − 10⁻⁶:
+    detectability does not suffice", exit 1, though an exact witness satisfies LMIs (7)-(9)
+    at λ = 1/2 (stubborn review, session 42). Only `infeasible` is that verdict: the
+    message names the gain bound."""
+    text = (
+        '[system]\ntime = "discrete"\n'
+        "A = [[-1.0870920121814378, -0.9364996025654619], "
+        "[-1.0129275696226316, -0.48433555014060464]]\n"
+        "C = [[0.0014472801153936389, -0.0016013138916154473]]\n"
+        '[method]\nkey = "stubborn"\n'
+    )
+    with pytest.raises(InfeasibleError) as ei:
+        api.design(api.load_spec_text(text, "s.toml"))
+    assert "raise gain_bound (now 100)" in ei.value.message
+    assert "does not suffice" not in ei.value.message
+
+
 def test_a_stable_mode_near_the_unit_circle_makes_discrete_infeasible_no_verdict() -> None:
     """A = diag(0.9999999, 1.5), C = (0, 1): the unseen mode needs λ > 0.9999998, beyond the
     search's most lenient 1 − 10⁻⁶, and the design said "infeasible … at any λ < 1" (exit 1),

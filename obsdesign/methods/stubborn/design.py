@@ -856,7 +856,11 @@ def _bounds_too_tight(pl: Plant, o: Options, where: str, verdict: bool | None) -
         why = "(C, A) is detectable: " + (" or ".join(hints) or "no bound or λ to relax")
         if verdict is True and pl.discrete:
             free = replace(o, gain_bound=None, r_bound=None)
-            if not feasible(pl, free, 1 - 1e-6)[0]:
+            # only the solver's `infeasible` is a verdict: its "solver failure" on a plant
+            # feasible at λ = 1/3 by an exact witness (gain ≈ 1.2·10⁴) said "infeasible at any
+            # λ … detectability does not suffice" instead of "raise gain_bound", exit 1
+            # (stubborn review, session 42)
+            if feasible(pl, free, 1 - 1e-6)[1] == INFEASIBLE:
                 relax_gain = False  # infeasible without any bound: nothing to retry
                 _slow_mode(pl, where)
                 at = "at any λ ≤ 1 − 10⁻⁶ (the search's most lenient λ)"
