@@ -1063,9 +1063,9 @@ def test_best_rate_takes_an_infinite_rate_as_the_worst_theta(monkeypatch) -> Non
 
     def fake(A, Qm, S, R):
         t = float(Qm[0, 0])
-        return (math.inf, 0.0) if t > math.exp(3) else (-(math.log(t) ** 2), 0.0)
+        return (math.inf, 0.0, 0.0) if t > math.exp(3) else (-(math.log(t) ** 2), 0.0, 0.0)
 
-    monkeypatch.setattr(dv, "best_rate_float", fake)
+    monkeypatch.setattr(dv, "_rate_resid_scale", fake)
     monkeypatch.setattr(dv, "range_theta", lambda qsr: None)
     one = np.array([[fmpq(1)]], dtype=object)
     qsr = dv.QSR(one, np.array([[fmpq(0)]], dtype=object), -one, "test")
@@ -1197,3 +1197,25 @@ def test_m_optimize_falls_back_to_the_orthonormal_m(monkeypatch: pytest.MonkeyPa
     monkeypatch.setattr(dmod, "design_window", fails)
     with pytest.raises(InfeasibleError, match="searched M fails"):  # the searched M's error
         api.design(load_spec_text(_first_row_zero_spec('"optimize"'), "opt.toml"))
+
+
+def test_a_near_point_sector_is_not_lemma1_fails_at_a_noise_theta() -> None:
+    """A sector 7·10⁻¹⁸ wide on the unmeasured block: κ*(θ) rises to its supremum 9.1 as
+    θ → ∞ and is flat in floats from θ ≈ e¹⁰ on; the θ search followed rounding noise to
+    θ ≈ 4·10²⁰ (float rate −128, certified κ_n −1042) and the design said "Lemma 1 fails",
+    exit 1, where a certificate with κ_n = 9.09 exists (impulsive review, session 42). The
+    search now weighs κ*(θ)'s float error: κ_n ≈ 9.1 certifies, and verify agrees."""
+    from obsdesign import api
+
+    text = (
+        '[system]\ntime = "continuous"\nA = [[-1.5, -0.2], [0.03, -4.5]]\nC = [[1, 0]]\n'
+        'states = ["x1", "x2"]\npsi = ["-0.05*x1", "-0.05*x2"]\n'
+        "[nonlinearity.o]\nsector = [-0.05, -0.05]\n"
+        "[nonlinearity.n]\nsector = [-0.049888315228288321, -0.049888315228288314]\n"
+        '[method]\nkey = "impulsive"\nL = [0.8]\nalpha = 3\nnoise_bound = 0.1\n'
+        'kappa = "max"\nM = [[0, 1]]\n'
+    )
+    rep = api.design(api.load_spec_text(text, "s.toml"))
+    assert rep.exit_code() == 0
+    assert 9.09 < float(rep.parameters["kappa_n"]) <= 9.1
+    assert api.verify(rep).exit_code() == 0

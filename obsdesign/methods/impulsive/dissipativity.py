@@ -97,13 +97,25 @@ def best_rate_float(
     Ā + Āᵀ + R − (I + S)ᵀ Q⁺ (I + S) + κ I ⪯ 0, so κ* = −λ_max(Ā + Āᵀ + R − (I+S)ᵀQ⁺(I+S)).
     For Q ≺ 0 this is −λ_max(M_o) of eq. (16).
     """
+    r, resid, _ = _rate_resid_scale(Ablk, Qm, S, R)
+    return r, resid
+
+
+def _rate_resid_scale(
+    Ablk: np.ndarray, Qm: np.ndarray, S: np.ndarray, R: np.ndarray
+) -> tuple[float, float, float]:
+    """:func:`best_rate_float`'s (κ*, residual) and the size of the terms summed for κ*
+    (max |entry| of Ā + Āᵀ, R and (I + S)ᵀQ⁺(I + S)): κ* is their sum's λ_max, so its float
+    error is about one ulp of that size."""
     k = Ablk.shape[0]
     B = np.eye(k) + S
     Qp = np.linalg.pinv(Qm, rcond=1e-12)
     resid = float(np.linalg.norm((np.eye(k) - Qm @ Qp) @ B)) if k else 0.0
-    Mx = Ablk + Ablk.T + R - B.T @ Qp @ B
+    BQB = B.T @ Qp @ B
+    Mx = Ablk + Ablk.T + R - BQB
     lam = float(np.linalg.eigvalsh((Mx + Mx.T) / 2).max()) if k else -np.inf
-    return -lam, resid
+    size = max((float(np.abs(t).max(initial=0.0)) for t in (Ablk + Ablk.T, R, BQB)), default=0.0)
+    return -lam, resid, size
 
 
 def range_theta(qsr: QSR) -> fmpq | None:
@@ -139,6 +151,12 @@ def range_theta(qsr: QSR) -> fmpq | None:
     ok = all(va[c] + theta * vb[c] == 0 for va, vb in zip(N, NS, strict=True) for c in range(k))
     return theta if ok else None
 
+
+#: the weight of κ*(θ)'s float error (relative to the size of its terms) in the θ search of
+#: :func:`best_rate`: a few ulps, so that among near-equal rates the search prefers the θ
+#: whose float rate the exact rounding (:func:`~obsdesign.methods.impulsive.design.
+#: certified_rate`, first step 2⁻⁵⁰ of that size) can confirm
+ERROR_WEIGHT = 2.0**-48
 
 #: the log θ grid of :func:`best_rate`'s first look, and how far it may be moved (θ within
 #: e^±LOG_THETA_MAX: far inside the float range, θ·Q stays finite for any spec's Q)
@@ -191,8 +209,13 @@ def best_rate(Ablk: np.ndarray, qsr: QSR, optimize: bool) -> tuple[float, fmpq, 
     def neg(lt: float) -> float:
         t = float(np.exp(lt))
         with np.errstate(all="ignore"):
-            r, res = best_rate_float(Ablk, t * Qm, t * S, t * R)
-        v = -r + (1e6 * res if res > 1e-9 else 0.0)
+            r, res, size = _rate_resid_scale(Ablk, t * Qm, t * S, t * R)
+        # plus the float error of κ*(θ) (about an ulp of the terms it sums, which grow like
+        # θ): a sector 7·10⁻¹⁸ wide has κ*(θ) rising to its supremum as θ → ∞, flat in floats
+        # from θ ≈ e¹⁰ on, and the search followed rounding noise to θ ≈ 4·10²⁰, where the
+        # float rate was −128 and the certified κ_n −1042: "Lemma 1 fails", exit 1, on a
+        # design that certifies with κ_n ≈ 9.1 (impulsive review, session 42)
+        v = -r + (1e6 * res if res > 1e-9 else 0.0) + ERROR_WEIGHT * size
         # an overflowed θ (NaN or inf) is the worst value, not the first argmin: a sector
         # [0, 10¹⁶⁰] overflowed (θS)² on the whole first grid, and its NaN was taken as the
         # minimum ("I + S_n ∉ range Q_n", a false reason; non-finite expressions trial,
