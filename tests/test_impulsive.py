@@ -293,6 +293,32 @@ def test_kappa_widest_positive_for_any_alpha(gamma: float, log_alpha: float, d0:
         assert k == pytest.approx(d0 * r / (1 - r), rel=1e-6)
 
 
+def test_kappa_widest_takes_1_minus_gamma_exactly_near_1() -> None:
+    """L = 1 − 10⁻¹⁷ rounds to γ = 1.0 in floats: c₁ = −ln((1 − γ)²) was ∞, κ = 5·10⁻³²⁴ and
+    T_min = ∞, "empty window", exit 1, where κ = 0.07 certifies (impulsive review, session
+    42). From the exact γ, c₁ = 2·17·ln 10 and κ is the stationary point of the formula; the
+    spec designs and verifies."""
+    from obsdesign import api
+    from obsdesign.methods.impulsive.window import kappa_widest
+
+    g = fmpq(1) - fmpq(1, 10**17)
+    k = kappa_widest(2.0, 0.0, g, 3.0)
+    c1, c2 = 34 * np.log(10.0), -np.log1p(-1 / 3.0)
+    r = np.sqrt(c2 / c1)
+    assert k == pytest.approx(2.0 * r / (1 - r), rel=1e-12)
+    text = (
+        '[system]\ntime = "continuous"\nA = [[0, 0, 0], [1, -3, 0.5], [0, -0.5, -3]]\n'
+        'C = [[1, 0, 0]]\nstates = ["x1", "x2", "x3"]\n'
+        'psi = ["0.2*sin(x1)", "0.3*tanh(x2)", "0.3*tanh(x3)"]\n'
+        "[nonlinearity.o]\nsector = [-0.2, 0.2]\n[nonlinearity.n]\nsector = [0, 0.3]\n"
+        '[method]\nkey = "impulsive"\nL = [0.99999999999999999]\nalpha = 3\n'
+        'noise_bound = 0.1\nM = [[0, 1, 0], [0, 0, 1]]\nkappa = "widest"\n'
+    )
+    rep = api.design(api.load_spec_text(text, "s.toml"))
+    assert rep.exit_code() == 0 and float(rep.parameters["kappa"]) > 0.01
+    assert api.verify(rep).exit_code() == 0
+
+
 def test_kappa_widest_with_a_huge_alpha_designs_and_verifies(tmp_path: Path) -> None:
     """The audit's spec (α = 10¹⁶, κ = "widest"): exit 0, every claim certified (B: numerical),
     verify agrees;

@@ -179,7 +179,7 @@ def float_window(p: Problem, Mf: np.ndarray) -> float:
     return max(float(np.log(tmax / tmin)), -10.0)
 
 
-def _kappa_float(p: Problem, varpi: float, coup: float, g: float, kmax: float) -> float:
+def _kappa_float(p: Problem, varpi: float, coup: float, g: Any, kmax: float) -> float:
     if p.kappa == "max":
         return kmax * (1 - 1e-6)
     if p.kappa == "widest":
@@ -315,7 +315,7 @@ def _window(
         )
     vp = max(float(varpi), 0.0)
     if p.given_kappa is None:
-        kf = _kappa_float(p, vp, float(coupling(lam_no, lam_on, beta)), float(gamma), float(kmax))
+        kf = _kappa_float(p, vp, float(coupling(lam_no, lam_on, beta)), gamma, float(kmax))
         kappa = Q(dyadic(kf, 30))
         while kappa >= kmax:
             kappa = kappa * fmpq(1023, 1024)

@@ -33,7 +33,7 @@ def kappa_max(kappa_n: Any, lam_no: Any, lam_on: Any, beta: Any) -> fmpq:
     return Q(kappa_n) - coupling(lam_no, lam_on, beta)
 
 
-def kappa_widest(varpi_o: float, coup: float, gamma: float, alpha: float) -> float:
+def kappa_widest(varpi_o: float, coup: float, gamma: Any, alpha: float) -> float:
     """κ maximizing T_max(κ) − T_min(κ) = c₁/(D₀ + κ) − c₂/κ (26b)-(26c), D₀ = ϖ_o + coupling,
     c₁ = −ln((1−γ)²), c₂ = −ln((α − γ)/α).
 
@@ -43,9 +43,15 @@ def kappa_widest(varpi_o: float, coup: float, gamma: float, alpha: float) -> flo
     soundness audit at α = 10¹⁶). r is formed in log space (c₂ ≈ γ/α may be subnormal) and a
     κ that still underflows is returned as the smallest positive double: the caller caps it
     by the largest admissible κ, and the exact checks decide the window either way.
+    ``gamma`` may be exact (an ``fmpq``): c₁ near γ = 1 then comes from the exact 1 − γ; from
+    the float γ, L = 1 − 10⁻¹⁷ rounded to 1, c₁ = ∞ and κ = 5·10⁻³²⁴, T_min = ∞: "empty
+    window", exit 1, where κ = 0.07 certifies (impulsive review, session 42).
     """
-    c1 = -2.0 * np.log1p(-gamma)
-    c2 = -np.log1p(-gamma / alpha)
+    g = float(gamma)
+    om = 1 - Q(gamma)  # exact: 1 − γ of a γ within an ulp of 1
+    c1 = -2.0 * np.log1p(-g) if g <= 0.5 else -2.0 * np.log(float(om))
+    c2 = -np.log1p(-g / alpha)
+    gamma = g
     d0 = varpi_o + coup
     if d0 <= 0 or not c1 > 0:
         return np.inf
