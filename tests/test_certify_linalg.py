@@ -90,11 +90,11 @@ def test_norm_bound_known_answers():
 
 
 def test_norm_upper_known_values():
-    """The first candidate is f(1 + 2^-30) on a 30-bit dyadic grid, relative to the norm: an
+    """The first candidate is f(1 + 2^-30) on a 40-bit dyadic grid, relative to the norm: an
     absolute 2^-40 beside it was 90 % of the bound of a block of norm 10^-12 (re-check trial,
     session 28)."""
-    assert norm_upper(qmat([[1]])) == 1  # 1 + 2^-30 rounds to 1 on the 30-bit grid; proved
-    assert norm_upper(qmat([[2**-50]])) == F(1, 2**50)
+    assert norm_upper(qmat([[1]])) == 1 + F(1, 2**30)
+    assert norm_upper(qmat([[2**-50]])) == F(1, 2**50) * (1 + F(1, 2**30))
     assert norm_upper(qmat([[F(3, 10**12)]])) <= F(3, 10**12) * (1 + F(1, 2**20))
     assert norm_upper(qmat([[0, 0]])) == 0
     assert norm_upper(np.empty((0, 2), dtype=object)) == 0
@@ -116,7 +116,7 @@ def test_norm_upper_recovers_from_a_low_float_estimate(monkeypatch):
     """When the float norm is too low, the candidate grows by 1025/1024 per step."""
     monkeypatch.setattr(np.linalg, "norm", lambda *a, **k: 0.98)
     u = norm_upper(qmat([[1]]))
-    sched = _schedule(Q(dyadic(0.98 * (1 + 2.0**-30), 30)), 39)
+    sched = _schedule(Q(dyadic(0.98 * (1 + 2.0**-30), 40)), 39)
     first = next(i for i, v in enumerate(sched) if v >= 1)
     assert u == sched[first] and u >= 1 and sched[first - 1] < 1
 
@@ -178,3 +178,16 @@ def test_frobenius_fallback_just_above_a_square() -> None:
     X = qmat([[1 + fmpq(1, 2**100)]])
     u = _frobenius_upper(X)
     assert u > 1 and norm_bound_holds(X, u) and u == 1 + fmpq(1, 2**40)
+
+
+def test_norm_upper_of_a_norm_just_above_a_power_of_two_is_rounded_up_within_1e6() -> None:
+    """X = (1, 5·10⁻¹⁸)ᵀ (an impulsive block of a given M with an entry 10⁻¹⁷): ‖X‖ is 1 +
+    1.25·10⁻³⁵, its float 1.0; on a 30-bit grid f(1 + 2⁻³⁰) rounded back to 1, which failed,
+    and the next step (×1025/1024) gave 1.00098 — above "‖X‖ rounded up" (10⁻⁶), so the
+    design failed its own lambda_no claim, exit 1 (impulsive review, session 42)."""
+    from obsdesign.certify.linalg import not_above
+
+    X = qmat([[1], [F(5, 10**18)]])
+    u = norm_upper(X)
+    assert norm_bound_holds(X, u) and not_above(X, u)
+    assert u == 1 + F(1, 2**30)

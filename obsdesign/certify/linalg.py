@@ -73,7 +73,10 @@ def norm_upper(X: Any) -> fmpq:
         return fmpq(0)
     f = float(np.linalg.norm(to_float(X), 2))
     if f > 0.0 and math.isfinite(f):
-        u = Q(dyadic(f * (1 + 2.0**-30), 30))
+        # 40 bits: at 30 the raise of 2⁻³⁰ itself rounded away when f is a power of two (‖X‖ =
+        # 1 + 10⁻³⁴ for X = (1, 5·10⁻¹⁸)ᵀ: u = 1 failed, the next step gave 1.00098 and the
+        # impulsive design failed its own lambda_no claim, exit 1; impulsive review, session 42)
+        u = Q(dyadic(f * (1 + 2.0**-30), 40))
         for _ in range(40):
             if norm_bound_holds(X, u):
                 return u
