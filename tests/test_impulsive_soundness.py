@@ -1219,3 +1219,21 @@ def test_a_near_point_sector_is_not_lemma1_fails_at_a_noise_theta() -> None:
     assert rep.exit_code() == 0
     assert 9.09 < float(rep.parameters["kappa_n"]) <= 9.1
     assert api.verify(rep).exit_code() == 0
+
+
+def test_an_edited_M_source_label_fails_verify() -> None:
+    """M_source was read and passed on unchecked: a report of a given M edited to
+    "optimized" verified (impulsive review, session 42). It must be what the spec's
+    [method].M gives: "given" here; the shipped example (M given) verifies unedited."""
+    from obsdesign import api
+    from obsdesign.report import Report
+
+    rep = api.design(api.load_spec(ROOT / "specs" / "impulsive-sector-3state.toml"))
+    assert rep.parameters["M_source"] == "given"
+    assert api.verify(rep).exit_code() == 0
+    for label in ("optimized", "orthonormal", "Given"):
+        d = rep.to_dict()
+        d["parameters"]["M_source"] = label
+        ver = api.verify(Report.from_dict(d)[0])
+        bad = [c.id for c in ver.claims if not c.ok]
+        assert ver.exit_code() == 1 and "M_source-matches-spec" in bad, (label, bad)

@@ -75,6 +75,7 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     if any(v is None for v in P.values()):
         return c
     P["M_source"] = str(params.get("M_source", "given"))
+    _m_source_claim(c, p, P["M_source"])
     certify_window(p, P, c)
     t_ok = any(x.id == "T" and x.ok for x in c)
     if o.falsify is not None and t_ok:
@@ -108,6 +109,27 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
                 detail=fr.summary(),
             )
     return c
+
+
+def _m_source_claim(c: Claims, p: Problem, label: str) -> None:
+    """A failed ``M_source-matches-spec`` claim when the report's label of M is not one the
+    spec's ``[method] M`` gives: "given" for a matrix, "orthonormal" for "orthonormal",
+    "optimized" or "orthonormal" (the fallback of a search that failed) for "optimize". The
+    label was read and passed on unchecked: a report edited to "optimized" for a given M
+    verified (impulsive review, session 42). M itself is checked by the ``T`` claim (eq. (9))."""
+    if p.given_M is not None:
+        ok: tuple[str, ...] = ("given",)
+    elif p.M == "orthonormal":
+        ok = ("orthonormal",)
+    else:
+        ok = ("optimized", "orthonormal")
+    if label not in ok:
+        c.failed(
+            id="M_source-matches-spec",
+            statement="the report's M_source is what the spec's [method].M gives",
+            reference="spec [method].M",
+            detail=f"report says {label!r}; the spec gives " + " or ".join(map(repr, ok)),
+        )
 
 
 def _ref(where: str) -> str:
