@@ -645,8 +645,17 @@ def test_the_window_warning_names_the_outside_intervals_and_the_exact_window(
     with pytest.warns(UserWarning) as w:
         get_method("impulsive").simulate(spec, rep.parameters)
     msg = [str(x.message) for x in w if "certified window" in str(x.message)]
-    assert len(msg) == 1 and "2 of 4 sampling intervals (from 5 to 5)" in msg[0]
+    assert len(msg) == 1 and "2 of 4 sampling intervals (from 5.0 to 5.0)" in msg[0]
     assert f"T_min = {shown[0]} < t_(k+1) − t_k < T_max = {shown[1]}" in msg[0]
+    # an interval a hair below T_min is printed as the double it is (at 6 digits it read as
+    # T_min itself; impulsive review, session 42)
+    below = float(np.nextafter(float(t_min), 0.0))
+    below = float(t_min) * (1 - 1e-11) if dyadic(below) >= Q(t_min) else below
+    (tmp_path / "h.txt").write_text("\n".join([repr(below), "1.0"] * 8), encoding="utf-8")
+    with pytest.warns(UserWarning) as w:
+        get_method("impulsive").simulate(spec, rep.parameters)
+    msg = [str(x.message) for x in w if "certified window" in str(x.message)]
+    assert len(msg) == 1 and f"(from {below!r} to " in msg[0]
     (tmp_path / "h.txt").write_text("\n".join([repr(inside[0]), "1.0"] * 8), encoding="utf-8")
     with warnings.catch_warnings():
         warnings.simplefilter("error")

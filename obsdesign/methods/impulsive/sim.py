@@ -239,8 +239,10 @@ def simulate(
         # trial, session 30)
         out = used[~inside]
         warnings.warn(
+            # the doubles themselves (shortest repr): at 6 digits 0.417599999999, just below
+            # T_min = 0.4176, printed as 0.4176 (impulsive review, session 42)
             f"[simulate] {out.size:,} of {used.size:,} sampling intervals (from "
-            f"{float(out.min()):.6g} to {float(out.max()):.6g}) lie outside the certified window "
+            f"{float(out.min())!r} to {float(out.max())!r}) lie outside the certified window "
             f"T_min = {fmt_exact(params['T_min'])} < t_(k+1) − t_k < T_max = "
             f"{fmt_exact(params['T_max'])}: the runs are outside the premise of Theorems 1-2, "
             "and their decay says nothing of the certificate",
