@@ -196,19 +196,63 @@ def read_input(path: str | Path, what: str) -> bytes:
         raise InputError(f"{p}: is a directory, not a {what} file")
     if not stat.S_ISREG(st.st_mode):
         raise InputError(f"{p}: is not a regular file (refusing to read a {what} from it)")
+    kernel = _kernel_dir(p)
+    if kernel:
+        # /proc/kmsg is a "regular file" of 0 bytes whose read waits for kernel messages
+        # (and, as root, consumes them): verify of a report naming it as spec_file, or
+        # design /proc/kmsg, hung (CLI review, session 42)
+        raise InputError(f"{p}: is a kernel interface file under {kernel}, not a {what} file")
     if st.st_size > lim:
         raise InputError(
             f"{p}: {what} file is {st.st_size} bytes, above the limit of {lim} bytes "
             f"(--limit max_file_bytes=N)"
         )
-    try:
-        with open(p, "rb") as f:
-            data = f.read(lim + 1)
-    except OSError as e:
-        raise InputError(f"{p}: cannot read {what} ({e.strerror})") from None
+    data = _read_nonblocking(p, what, lim)
     if len(data) > lim:
         raise InputError(f"{p}: {what} file is above the limit of {lim} bytes")
     return data
+
+
+#: file systems of the kernel's interfaces: their files look regular but may block or change
+KERNEL_DIRS = ("/proc", "/sys")
+
+
+def _kernel_dir(p: Path) -> str:
+    """The kernel directory (:data:`KERNEL_DIRS`) that ``p`` resolves into, or ""."""
+    real = os.path.realpath(p)
+    return next((d for d in KERNEL_DIRS if real == d or real.startswith(d + "/")), "")
+
+
+def _read_nonblocking(p: Path, what: str, lim: int) -> bytes:
+    """At most ``lim`` + 1 bytes of ``p``, opened with O_NONBLOCK and checked again on the
+    open descriptor (a regular file still: the path may have been replaced since ``stat``):
+    a file whose read would wait is refused, never waited on."""
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
+    try:
+        fd = os.open(p, flags)
+    except OSError as e:
+        raise InputError(f"{p}: cannot read {what} ({e.strerror})") from None
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise InputError(f"{p}: is not a regular file (refusing to read a {what} from it)")
+        chunks: list[bytes] = []
+        got = 0
+        while got <= lim:
+            try:
+                b = os.read(fd, min(lim + 1 - got, 1 << 20))
+            except BlockingIOError:
+                raise InputError(
+                    f"{p}: cannot read {what} (its read would wait: not a plain file)"
+                ) from None
+            if not b:
+                break
+            chunks.append(b)
+            got += len(b)
+        return b"".join(chunks)
+    except OSError as e:
+        raise InputError(f"{p}: cannot read {what} ({e.strerror})") from None
+    finally:
+        os.close(fd)
 
 
 def precheck_spec(path: str | Path) -> None:

@@ -258,6 +258,43 @@ def test_spec_fifo_and_directory_are_refused(tmp_path: Path):
     assert res.exit_code == 2 and "directory" in res.output
 
 
+@pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="needs Linux /proc")
+def test_kernel_interface_files_are_not_read(tmp_path: Path) -> None:
+    """/proc/kmsg is a "regular file" of 0 bytes whose read waits for kernel messages (and
+    consumes them, as root): `design /proc/kmsg`, `verify R --spec /proc/kmsg` and the
+    verify of a report whose spec_file names it hung (CLI review, session 42). Files under
+    /proc and /sys, also through a symlink, are refused before any open; the ordinary read
+    is non-blocking besides."""
+    link = tmp_path / "s.toml"
+    link.symlink_to("/proc/self/status")
+    for path in ("/proc/self/status", str(link), "/sys/kernel/mm/transparent_hugepage/enabled"):
+        if not Path(path).exists():
+            continue
+        with pytest.raises(L.InputError, match="kernel interface file under /"):
+            L.read_input(path, "spec")
+        res = runner.invoke(app, ["design", path])
+        assert res.exit_code == 2 and "kernel interface file" in res.output
+    # the report's spec_file: not read, no note, no hang (a subprocess with a timeout: a
+    # regression would block on /proc/kmsg itself where it exists)
+    import subprocess
+    import sys
+
+    from obsdesign import api
+
+    rep = api.design(api.load_spec_text(TEXT, str(tmp_path / "t.toml")))
+    d = json.loads(rep.to_json())
+    d["spec_file"] = "/proc/kmsg"
+    out = tmp_path / "r.json"
+    out.write_text(json.dumps(d), encoding="utf-8")
+    r = subprocess.run(
+        [sys.executable, "-m", "obsdesign", "verify", "-q", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert r.returncode == 0, r.stderr
+
+
 def test_file_size_limit(tmp_path: Path):
     spec = tmp_path / "s.toml"
     spec.write_text(TEXT + "\n# " + "x" * 5000 + "\n")
