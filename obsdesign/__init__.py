@@ -20,7 +20,7 @@ def _early_interrupt(signum: int, frame: object) -> None:  # pragma: no cover - 
     exit 130, no traceback. :func:`obsdesign.cli._run` restores Python's handler when a
     command body starts, so that cleanup code (temporary files) runs on Ctrl-C."""
     try:  # stderr closed or full: the line is dropped, the code stays 130 (session 34)
-        _sys.stderr.write("obsdesign: interrupted\n")
+        _sys.stderr.write("obsdesign: error: interrupted\n")  # the wording of cli._err
         _sys.stderr.flush()
     except (OSError, ValueError, AttributeError):
         pass

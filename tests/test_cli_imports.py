@@ -231,6 +231,25 @@ def test_the_start_up_ctrl_c_exits_130_with_stderr_closed(monkeypatch: pytest.Mo
         assert e.value.code == 130
 
 
+def test_the_early_interrupt_line_is_the_one_of_every_other_interrupt(monkeypatch) -> None:
+    """Ctrl-C in the first ~0.05 s printed "obsdesign: interrupted", later the documented
+    "obsdesign: error: interrupted" (CLI review, session 42): one wording."""
+    import io
+    import sys
+
+    import obsdesign
+
+    def fake_exit(code: int) -> None:
+        raise SystemExit(code)
+
+    monkeypatch.setattr(obsdesign._os, "_exit", fake_exit)
+    err = io.StringIO()
+    monkeypatch.setattr(sys, "stderr", err)
+    with pytest.raises(SystemExit) as e:
+        obsdesign._early_interrupt(2, None)
+    assert e.value.code == 130 and err.getvalue() == "obsdesign: error: interrupted\n"
+
+
 def test_fast_float_takes_only_an_admissible_float() -> None:
     """A float below the option's min, NaN or a typed-in str goes to typer's own path."""
     from typer._click import Context
