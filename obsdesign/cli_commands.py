@@ -966,6 +966,7 @@ def _dt_seconds(text: str) -> float:
     """``import --dt``: the text read exactly first, so that a positive sample time below the
     float range is refused rather than read as 0, continuous time (``--dt 1e-400`` wrote
     ``time = "continuous"``; hostile-input trial, session 38)."""
+    import math
     from decimal import Decimal, InvalidOperation
 
     from obsdesign.errors import InputError
@@ -982,8 +983,13 @@ def _dt_seconds(text: str) -> float:
             f"--dt is {text}, a nonzero number below the float range (it would read as 0, "
             "continuous time)"
         )
-    if f == -1 and q != -1:  # only -1 itself is MATLAB's "no sample time"
-        raise InputError(f"--dt {text!r}: expected a finite number >= 0, or exactly -1")
+    # only -1 itself is MATLAB's "no sample time"; the text as typed in the message (1e999
+    # said "--dt inf"; CLI review, session 42)
+    if not (q.is_finite() and math.isfinite(f) and (f >= 0 or q == -1)):
+        raise InputError(
+            f"--dt {text!r}: expected a finite number >= 0 (0: continuous time), or exactly -1 "
+            "(discrete time with no sample time, as MATLAB's Ts = -1)"
+        )
     return f
 
 

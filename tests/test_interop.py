@@ -408,7 +408,10 @@ def test_lists_of_tables_and_missing_values() -> None:
         ({"C0": np.zeros((0, 2))}, ["--C", "C0"], "'C0' (C) is 0×2: a plant needs", True),
         ({"ts": 5e-324}, ["--dt-var", "ts"], "'ts' (the sample time) is 5e-324, a nonzero", True),
         ({}, ["--dt", "1e-320"], "--dt is 1e-320, a nonzero number below", False),
-        ({}, ["--dt", "inf"], "--dt inf: expected a finite number", False),
+        ({}, ["--dt", "inf"], "--dt 'inf': expected a finite number", False),
+        # the text as typed: 1e999 said "--dt inf" (CLI review, session 42)
+        ({}, ["--dt", "1e999"], "--dt '1e999': expected a finite number", False),
+        ({}, ["--dt", "-2"], "--dt '-2': expected a finite number >= 0", False),
         # below the float range: read as 0.0, continuous time, silently (session 38)
         ({}, ["--dt", "1e-400"], "--dt is 1e-400, a nonzero number below the float range", False),
         ({}, ["--dt", "abc"], "--dt 'abc': expected a number of seconds", False),
