@@ -1644,3 +1644,30 @@ def test_a_dead_beat_gain_gets_its_best_rate(tmp_path: Path) -> None:
     out = tmp_path / "r.json"
     out.write_text(rep.to_json())
     assert api.verify(out).exit_code() == 0
+
+
+def test_the_design_memo_is_not_used_for_a_spec_copy_with_another_A() -> None:
+    """The memo left on the spec keyed A − LC by L alone: a copy of the designed spec with
+    another A (copy.copy shares the memo) was certified with the old A − LC — decay-lmi
+    "certified" for A = [[0, 1], [3, 0]], where A − LC has an eigenvalue 2.349 > λ (API
+    review, session 42). A − LC is reused for the very same A and C arrays only."""
+    import copy
+    import dataclasses
+
+    from flint import fmpq
+
+    from obsdesign.spec.reader import Value
+
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0, 1], [1, 0]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\nL = [-1.87, 1.874]\nlambda = 0.955\niss_gain = false\n'
+    )
+    spec = api.load_spec_text(text, "s.toml")
+    rep = api.design(spec)
+    assert rep.exit_code() == 0
+    assert all(c.ok for c in api.certify(spec, rep.parameters))  # the memo's own spec
+    other = copy.copy(spec)
+    A3 = np.array([[fmpq(0), fmpq(1)], [fmpq(3), fmpq(0)]], dtype=object)
+    other.system = dataclasses.replace(spec.system, A=Value.of(A3))
+    status = {c.id: c.ok for c in api.certify(other, rep.parameters)}
+    assert status["decay-lmi"] is False and status["decay-lmi_best"] is False

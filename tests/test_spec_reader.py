@@ -209,3 +209,25 @@ def test_a_vector_of_one_number_is_named_in_the_singular() -> None:
     """ "expected 1 numbers" (re-check trial, session 41)."""
     with pytest.raises(SpecError, match=r"\[v\] expected 1 number, got 2$"):
         Table({"v": [1, 2]}, "t.toml").vector("v", n=1)
+
+
+def test_spec_arrays_are_read_only() -> None:
+    """A spec's numbers cannot be edited in place: designs keep results for the spec's data
+    (the lyapunov memo, caches) and a report embeds the spec's text, so an A edited in place
+    after a design was certified with the old A's verdicts (API review, session 42)."""
+    import numpy as np
+    import pytest
+
+    from obsdesign import api
+
+    spec = api.load_spec_text(
+        '[system]\ntime = "discrete"\nA = [[0, 1], [1, 0]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\n',
+        "s.toml",
+    )
+    for v in (spec.system.A, spec.system.C, spec.system.B, spec.system.Bd, spec.system.Dn):
+        for arr in (v.q, v.f):
+            assert isinstance(arr, np.ndarray) and not arr.flags.writeable
+            if arr.size:
+                with pytest.raises(ValueError, match="read-only"):
+                    arr.flat[0] = 3

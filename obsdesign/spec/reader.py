@@ -28,6 +28,15 @@ class Value:
     q: Any
     f: Any
 
+    def __post_init__(self) -> None:
+        # read-only: designs keep results for the spec's data (the lyapunov memo, caches),
+        # and a report embeds the spec's text; an array edited in place after loading made
+        # api.certify certify claims about A that were false for the edited A (API review,
+        # session 42). Edit the text and load it again instead.
+        for a in (self.q, self.f):
+            if isinstance(a, np.ndarray):
+                a.flags.writeable = False
+
     @classmethod
     def of(cls, q: Any) -> Value:
         if isinstance(q, fmpq):

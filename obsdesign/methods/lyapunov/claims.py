@@ -62,7 +62,8 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     A, C = s.A.q, s.C.q
     memo = lyap.memo_of(spec)  # the design's exact verdicts, same process, same inputs only
     Lq = lyap.fmat(L)
-    Acl = None if memo is None else memo.get(lyap.CLOSED_LOOP_KEY, (Lq,))
+    hit = None if memo is None else memo.get(lyap.CLOSED_LOOP_KEY, (Lq,))
+    Acl = hit[2] if hit is not None and hit[0] is A and hit[1] is C else None
     if Acl is None:
         Acl = lyap.closed_loop_fmat(A, C, Lq)
     # correctly rounded, once, for the enclosures and the bracket's proof (left to them

@@ -255,7 +255,10 @@ def _design_for(
     memo = lyap.ExactMemo()  # the exact verdicts, reused by certify in this process only
     Lm = lyap.fmat(L) if Lm is None else Lm
     Acl = lyap.closed_loop_fmat(A, C, Lm)
-    memo.put(lyap.CLOSED_LOOP_KEY, (Lm,), Acl)  # A − LC for this spec's A, C and this L
+    # A − LC for this L and these very A, C arrays (read-only: the same objects hold the
+    # same numbers); keyed by L alone, a copy of the spec given another A reused it and
+    # api.certify certified a decay LMI false for that A (API review, session 42)
+    memo.put(lyap.CLOSED_LOOP_KEY, (Lm,), (A, C, Acl))
     Af = lyap.mat_float(Acl)  # converted once: the float guide of every step below
     # the eigenvalues, a guide (float ones, or high-precision ones when those are inaccurate)
     guide = spectrum(Acl, Af)
