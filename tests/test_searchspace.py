@@ -2361,3 +2361,21 @@ def test_a_bound_beyond_the_float_range_is_named_as_such() -> None:
     assert "cosh" in text and "-1000" in text
     with pytest.raises(InfeasibleError, match=r"beyond the float range.*give \[method\]\.L_f"):
         api.design(api.load_spec_text(text, "cosh.toml"))
+
+
+def test_the_bound_caches_are_keyed_by_the_data_not_the_text() -> None:
+    """The interval bounds and proofs were cached by the spec's text: a spec object with the
+    same text and f five times larger (dataclasses.replace) was certified "L_f ≤ 1" and
+    "‖f_u‖ ≤ 3.53554" — the difference quotient along e₂ is 5 and |f(−5/2, −5/2, u = 1)|² =
+    625/2 (API review, session 42). Keyed by what the constants are computed from."""
+    text = SPEC.read_text(encoding="utf-8")
+    spec = api.load_spec_text(text, "ex.toml")
+    rep = api.design(spec)
+    assert rep.exit_code() == 0
+    f5 = api.load_spec_text(
+        text.replace('f = ["u1*x2", "-u1*x1"]', 'f = ["5*u1*x2", "-5*u1*x1"]'), "f5.toml"
+    ).system.f
+    other = dataclasses.replace(spec, system=dataclasses.replace(spec.system, f=f5))
+    status = {c.id: c.ok for c in api.certify(other, rep.parameters)}
+    assert status["L_f-bound"] is False and status["f_sup-bound"] is False
+    assert all(c.ok for c in api.certify(spec, rep.parameters))  # the designed spec: cached

@@ -67,7 +67,35 @@ def round_up_q(x: float | fmpq, digits: int) -> fmpq:
     return Q(fmt_up(Q(x), digits))
 
 
-_CACHE: dict[tuple[str, str, int, float], bounds.Bound] = {}
+_CACHE: dict[tuple[Any, ...], bounds.Bound] = {}
+
+
+def _content_key(kind: str, spec: Spec) -> tuple[Any, ...]:
+    """What the constant ``kind`` is computed from (:func:`_problem`: the expressions with
+    their parameters' exact values, the variables, the exact box) and the budget: the key of
+    the caches. They were keyed by the spec's text, and a spec object with the same text and
+    another f (``dataclasses.replace``) got the bounds of the old f certified — L_f ≤ 1 where
+    the quotient is 5 (API review, session 42)."""
+    exprs, names, diff, lo, hi = _problem(kind, spec)
+    o: Options = spec.options
+    ex_key = tuple(
+        (
+            ex.source,
+            ex.variables,
+            tuple(sorted((k, str(Q(v))) for k, v in ex.parameters.items())),
+        )
+        for ex in exprs
+    )
+    return (
+        kind,
+        ex_key,
+        tuple(names),
+        tuple(diff),
+        tuple(str(x) for x in lo),
+        tuple(str(x) for x in hi),
+        o.bound_boxes,
+        o.bound_rtol,
+    )
 
 
 def _problem(kind: str, spec: Spec) -> tuple[Any, list[str], Any, list[Any], list[Any]]:
@@ -92,7 +120,7 @@ def _compute(kind: str, spec: Spec, budget: int, rtol: float) -> bounds.Bound:
     return bounds.lipschitz(exprs, names, diff, lo, hi, budget, rtol)
 
 
-_PROOFS: dict[tuple[str, str, int, float, str], Any] = {}
+_PROOFS: dict[tuple[Any, ...], Any] = {}
 
 
 def proved_lower(kind: str, spec: Spec, val: fmpq) -> tuple[Any, Any] | None:
@@ -103,9 +131,8 @@ def proved_lower(kind: str, spec: Spec, val: fmpq) -> tuple[Any, Any] | None:
     Computed only where asked: every constant computed it at design time, 37 exact
     evaluations of each expression, and specs with many long polynomials took 77 s instead
     of 28 s (re-check trial, session 31), where only a given value below the enclosure needs
-    it. Cached per spec text and value."""
-    o: Options = spec.options
-    key = (kind, spec.text, o.bound_boxes, o.bound_rtol, str(val))
+    it. Cached per content (:func:`_content_key`) and value."""
+    key = (*_content_key(kind, spec), str(val))
     if key not in _PROOFS:
         if len(_PROOFS) > 256:
             _PROOFS.clear()
@@ -129,12 +156,12 @@ def proved_lower(kind: str, spec: Spec, val: fmpq) -> tuple[Any, Any] | None:
 
 def interval_bound(kind: str, spec: Spec) -> bounds.Bound:
     """Certified bound of ``kind`` ∈ {L_f, L_h, f_sup} on E (× U): L_f^E, L_h^E, ‖f_u‖_E of
-    Lemma 1, Lemma 2 and Theorem 1. A deterministic function of the spec text, so it is cached
-    per text (design and certify compute it once).
+    Lemma 1, Lemma 2 and Theorem 1. A deterministic function of the spec's data, so it is cached
+    per content (:func:`_content_key`; design and certify compute it once).
 
     ``kind``: which constant; ``spec``: the bound spec."""
     o: Options = spec.options
-    key = (kind, spec.text, o.bound_boxes, o.bound_rtol)
+    key = _content_key(kind, spec)
     if key not in _CACHE:
         if len(_CACHE) > 256:
             _CACHE.clear()
