@@ -1061,3 +1061,26 @@ def test_report_matrices_of_another_shape_fail_verify(key: str, how: str) -> Non
     assert bad and f"parameters.{key}: expected shape" in bad[0].detail, [
         (c.id, c.detail) for c in ver.failed
     ]
+
+
+def test_a_gain_set_with_lines_has_no_vertices_to_report() -> None:
+    """C = 0, η̄ = 0: every L gives the factor 1/2, so the admissible set of linear gains is the
+    whole plane, with no vertices; cdd's one point of it, (0, 0), was reported and certified
+    "exactly the vertices of the set of linear gains" (degenerate-sizes review, session 42).
+    No vertices are reported, and a report listing (0, 0) fails the claim."""
+    from obsdesign.report import Report
+
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.5, 0], [0, 0.5]]\nC = [[0, 0]]\n'
+        '[sets.omega]\ntype = "box"\nlower = [-1, -1]\nupper = [1, 1]\n'
+        '[method]\nkey = "set-invariant"\nomega = "omega"\neta_bar = 0\nlambda = 0.6\n'
+    )
+    rep = api.design(load_spec_text(text, "c0.toml"))
+    assert rep.exit_code() == 0
+    assert "L_admissible_vertices" not in rep.parameters
+    d = rep.to_dict()
+    d["parameters"]["L_admissible_vertices"] = [[0.0, 0.0]]
+    d["parameters"]["exact"]["L_admissible_vertices"] = [["0", "0"]]
+    ver = api.verify(Report.from_dict(d)[0])
+    bad = [c.id for c in ver.claims if not c.ok]
+    assert ver.exit_code() == 1 and "linear-gains-vertices" in bad, bad

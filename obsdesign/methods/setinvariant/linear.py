@@ -130,10 +130,15 @@ def gain_vertices(
     poly = cddg.polyhedron_from_matrix(cddg.matrix_from_array(mat, rep_type=cdd.RepType.INEQUALITY))
     gen = cddg.copy_generators(poly)
     verts: list[np.ndarray] = []
-    for idx, r in enumerate(gen.array):
-        if r[0] != 0 and idx not in gen.lin_set:
-            verts.append(np.array([po._q(x / r[0]) for x in r[1:]], dtype=object).reshape(n, p))
     has_dir = bool(gen.lin_set) or any(r[0] == 0 for r in gen.array)
+    if gen.lin_set:
+        # a set with lines has no vertices: cdd's point is only a point of a minimal face
+        # (C = 0, η̄ = 0: every L is admissible, and (0, 0) was certified "exactly the
+        # vertices of the set of linear gains"; degenerate-sizes review, session 42)
+        return verts, has_dir
+    for r in gen.array:
+        if r[0] != 0:
+            verts.append(np.array([po._q(x / r[0]) for x in r[1:]], dtype=object).reshape(n, p))
     return verts, has_dir
 
 
