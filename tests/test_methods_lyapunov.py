@@ -1671,3 +1671,23 @@ def test_the_design_memo_is_not_used_for_a_spec_copy_with_another_A() -> None:
     other.system = dataclasses.replace(spec.system, A=Value.of(A3))
     status = {c.id: c.ok for c in api.certify(other, rep.parameters)}
     assert status["decay-lmi"] is False and status["decay-lmi_best"] is False
+
+
+def test_a_certificate_beyond_the_float_range_names_the_rate_and_rate_tol() -> None:
+    """A dead-beat gain (the double integrator's Riccati gain) with rate_tol = 1e-100: the best
+    rate's P with the default margin δ = 1e-9 reaches 10⁴⁰⁰, and the design ended with the
+    report's generic "parameter 'P': integer division result too large for a float", naming
+    neither the rate nor rate_tol (degenerate-sizes review, session 42). Exit 4 naming them;
+    with margin = 0 the same rate certifies."""
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0, 1], [0, 0]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\nrate_tol = 1e-100\n'
+    )
+    with pytest.raises(InconclusiveError, match=r"P_best at lambda = 1e-100 has entries beyond"):
+        api.design(api.load_spec_text(text, "s.toml"))
+    try:
+        api.design(api.load_spec_text(text, "s.toml"))
+    except InconclusiveError as e:
+        assert "[method].rate_tol (now 1e-100)" in e.message and "margin = 0" in e.message
+    rep = api.design(api.load_spec_text(text + "margin = 0\n", "s.toml"))
+    assert rep.exit_code() == 0 and api.verify(rep).exit_code() == 0

@@ -34,6 +34,26 @@ from obsdesign.spec.models import Spec
 from obsdesign.spectrum import spectrum
 
 
+def _float_viewable(key: str, P: Any, rate: Any, name: str, o: Options) -> None:
+    """InconclusiveError (exit 4) naming the rate and what to change when an entry of the
+    certified P is beyond the float range, so that the report cannot show it. The decay LMI
+    with the margin δ (eq. (4)-(6), constrained-redesign paper) needs λ²P − (A − LC)ᵀP(A − LC)
+    ⪰ δI: at a rate near 0 (a dead-beat gain, rate_tol = 1e-100: λ = 10⁻¹⁰⁰) that P reaches
+    10⁴⁰⁰, and the design ended with the report's generic "parameter 'P': integer division
+    result too large for a float" (degenerate-sizes review, session 42)."""
+    from obsdesign.certify.exact import float_or_inf
+
+    top = max((abs(float_or_inf(x)) for x in np.asarray(P, dtype=object).ravel()), default=0.0)
+    if np.isfinite(top):
+        return
+    raise InconclusiveError(
+        f"the certificate {key} at {name} = {fmt_exact(rate)} has entries beyond the float "
+        f"range (the decay LMI with margin δ = {fmt_exact(o.margin)} needs a P that large at "
+        "that rate), so the report cannot show it: a larger [method].rate_tol (now "
+        f"{fmt_exact(o.rate_tol)}) or [method].{name}, or margin = 0"
+    )
+
+
 def rate_name(discrete: bool) -> str:
     """``lambda`` (discrete, eq. (6): ρ = λ²) or ``alpha`` (continuous), the parameter name of
     the decay rate of V (Section 5, constrained-redesign paper).
@@ -318,6 +338,8 @@ def _design_for(
     except lyap.RateResolutionError as e:
         raise SpecError(spec.file, "method.rate_tol", e.hint()) from None
     rate, P = (br.best, br.P) if known is None else known
+    for key, M, at in (("P_best", br.P, br.best), ("P", P, rate)):
+        _float_viewable(key, M, at, name, o)
     solver.extra["best_rate_exact_checks"] = br.exact_checks
     params["P"] = P
     params[name] = rate
