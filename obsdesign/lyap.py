@@ -1215,6 +1215,15 @@ def _certified_P_hp(
     return _certified_P_exact(Am, r, discrete, margin, memo, Af)
 
 
+def beyond_float(M: Any) -> bool:
+    """Whether some entry of the exact matrix ``M`` (e.g. a certified P of eq. (4)-(6),
+    constrained-redesign paper) is beyond the float range: a report cannot show its float
+    view (a rate near 0 with a margin δ > 0 needs P ~ δ/λ^(2k))."""
+    from obsdesign.certify.exact import float_or_inf
+
+    return any(not math.isfinite(float_or_inf(x)) for x in np.asarray(M, dtype=object).ravel())
+
+
 #: the largest binary exponent of an entry of the exact fallback's P (a float view's margin)
 FLOAT_VIEW_BITS = 1020
 

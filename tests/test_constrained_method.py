@@ -1223,3 +1223,27 @@ def test_counts_of_one_are_singular_in_the_messages() -> None:
     )
     with pytest.raises(SpecError, match=r"bounds of w = \(d, v\) \(1 number\)$"):
         load_spec_text(text, "sg.toml")
+
+
+@pytest.mark.parametrize("key", ["rate_tol", "lambda"])
+def test_a_certificate_beyond_the_float_range_names_the_keys(key: str) -> None:
+    """A − LC = 0 with rate_tol = 1e-300 (or λ = 1e-300): the P of the decay LMI with the
+    default margin is beyond the float range, and the design ended with the report's generic
+    "integer division result too large for a float", naming no key (degenerate-sizes review,
+    session 42). Exit 4 naming the key to change and margin = 0."""
+    from obsdesign.errors import InconclusiveError
+
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.5]]\nC = [[1]]\n'
+        '[sets.X]\ntype = "box"\nlower = [-1]\nupper = [1]\n'
+        '[method]\nkey = "constrained"\nL = [0.5]\nX = "X"\n'
+        f"{key} = 1e-300\neps_min = 0.01\n"
+        '[method.c]\ntype = "box"\nlower = [-1.1]\nupper = [1.1]\n'
+        "[method.D]\nlower = [-3]\nupper = [3]\n"
+    )
+    with pytest.raises(InconclusiveError) as ei:
+        api.design(api.load_spec_text(text, "s.toml"))
+    msg = ei.value.message
+    assert "P at λ = 1e-300 has entries beyond the float range" in msg
+    assert "[method].lambda" in msg and "margin = 0" in msg
+    assert ("[method].rate_tol (now 1e-300)" in msg) == (key == "rate_tol")

@@ -85,6 +85,7 @@ def lyapunov_data(spec: Spec) -> LyapData:
             raise SpecError(spec.file, "method.rate_tol", e.hint()) from None
         lam, P = br.best, br.P
         bracket = (br.other, br.kind)
+
         if o.rho is not None and Q(o.rho) < lam * lam:
             # ρ ≥ λ² is needed (eq. (6)); with λ given this is a spec check, with λ omitted
             # it is known only now: it ran on to μ of eq. (5) and ended "inconclusive"
@@ -114,6 +115,19 @@ def lyapunov_data(spec: Spec) -> LyapData:
             raise InconclusiveError(
                 f"decay rate λ = {float(lam):g} holds in floats but the exact check failed"
             )
+    if lyap.beyond_float(P):
+        # A − LC = 0 with rate_tol = 1e-300: the report's generic "integer division result
+        # too large for a float" named no key (degenerate-sizes review, session 42)
+        which = (
+            f"a larger [method].rate_tol (now {fmt_exact(o.rate_tol)}) or [method].lambda"
+            if o.lam is None
+            else "a larger [method].lambda"
+        )
+        raise InconclusiveError(
+            f"the certificate P at λ = {fmt_exact(lam)} has entries beyond the float range "
+            f"(the decay LMI with margin δ = {fmt_exact(o.margin)} needs a P that large at "
+            f"that rate), so the report cannot show it: {which}, or margin = 0"
+        )
     rho = Q(o.rho) if o.rho is not None else lam * lam
     Acl = lyap.closed_loop(A, C, o.L)
     mu = lyap.iss_mu(Acl, lyap.error_input(s.Bd.q, s.Dn.q, o.L), P, rho)

@@ -41,16 +41,17 @@ def _float_viewable(key: str, P: Any, rate: Any, name: str, o: Options) -> None:
     ⪰ δI: at a rate near 0 (a dead-beat gain, rate_tol = 1e-100: λ = 10⁻¹⁰⁰) that P reaches
     10⁴⁰⁰, and the design ended with the report's generic "parameter 'P': integer division
     result too large for a float" (degenerate-sizes review, session 42)."""
-    from obsdesign.certify.exact import float_or_inf
-
-    top = max((abs(float_or_inf(x)) for x in np.asarray(P, dtype=object).ravel()), default=0.0)
-    if np.isfinite(top):
+    if not lyap.beyond_float(P):
         return
+    which = (
+        f"a larger [method].{name}"
+        if o.rate is not None
+        else f"a larger [method].rate_tol (now {fmt_exact(o.rate_tol)}) or [method].{name}"
+    )
     raise InconclusiveError(
         f"the certificate {key} at {name} = {fmt_exact(rate)} has entries beyond the float "
         f"range (the decay LMI with margin δ = {fmt_exact(o.margin)} needs a P that large at "
-        "that rate), so the report cannot show it: a larger [method].rate_tol (now "
-        f"{fmt_exact(o.rate_tol)}) or [method].{name}, or margin = 0"
+        f"that rate), so the report cannot give its float view: {which}, or margin = 0"
     )
 
 
@@ -338,7 +339,7 @@ def _design_for(
     except lyap.RateResolutionError as e:
         raise SpecError(spec.file, "method.rate_tol", e.hint()) from None
     rate, P = (br.best, br.P) if known is None else known
-    for key, M, at in (("P_best", br.P, br.best), ("P", P, rate)):
+    for key, M, at in (("P", P, rate), ("P_best", br.P, br.best)):
         _float_viewable(key, M, at, name, o)
     solver.extra["best_rate_exact_checks"] = br.exact_checks
     params["P"] = P
