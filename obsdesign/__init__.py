@@ -12,7 +12,6 @@ from __future__ import annotations
 import _signal  # the C module: ``signal`` itself spends milliseconds building its enums
 import os as _os
 import sys as _sys
-from typing import TYPE_CHECKING, Any
 
 
 def _early_interrupt(signum: int, frame: object) -> None:  # pragma: no cover - timing
@@ -42,6 +41,10 @@ elif _signal.getsignal(_signal.SIGINT) is _signal.default_int_handler and _os.pa
     _sys.argv[0] if _sys.argv else ""
 ) in ("obsdesign", "cli.py", "-m"):  # "-m": ``python -m obsdesign`` importing this package
     _signal.signal(_signal.SIGINT, _early_interrupt)
+
+# after the handler: ``typing`` takes milliseconds to import, and a Ctrl-C there printed a
+# traceback ending in this file (re-check review, session 42)
+from typing import TYPE_CHECKING, Any  # noqa: E402
 
 __version__ = "0.1.0"
 
