@@ -1250,8 +1250,10 @@ def spec_files(paths: list[str | Path] | str | Path) -> list[Path]:
     if isinstance(paths, (str, Path)):
         paths = [paths]
     out: list[Path] = []
+    from obsdesign.limits import kernel_dir
+
     for p in map(Path, paths):
-        if p.is_dir():
+        if p.is_dir() and not kernel_dir(p):  # /proc, /sys: one row saying so (not walked)
             out += _toml_files(p)
         else:
             out.append(p)

@@ -186,6 +186,13 @@ def read_input(path: str | Path, what: str) -> bytes:
         raise InputError(f"{p}: no such {what} file") from None
     except OSError as e:
         raise InputError(f"{p}: cannot read {what} ({e.strerror})") from None
+    kernel = kernel_dir(p)
+    if kernel:
+        # /proc/kmsg is a "regular file" of 0 bytes whose read waits for kernel messages
+        # (and, as root, consumes them): verify of a report naming it as spec_file, or
+        # design /proc/kmsg, hung (CLI review, session 42); `check /proc` walked the
+        # process table, a row per unreadable folder (re-check review, session 42)
+        raise InputError(f"{p}: is under {kernel} (the kernel's interface), not a {what} file")
     if stat.S_ISDIR(st.st_mode):
         try:
             os.scandir(p).close()
@@ -196,12 +203,6 @@ def read_input(path: str | Path, what: str) -> bytes:
         raise InputError(f"{p}: is a directory, not a {what} file")
     if not stat.S_ISREG(st.st_mode):
         raise InputError(f"{p}: is not a regular file (refusing to read a {what} from it)")
-    kernel = _kernel_dir(p)
-    if kernel:
-        # /proc/kmsg is a "regular file" of 0 bytes whose read waits for kernel messages
-        # (and, as root, consumes them): verify of a report naming it as spec_file, or
-        # design /proc/kmsg, hung (CLI review, session 42)
-        raise InputError(f"{p}: is a kernel interface file under {kernel}, not a {what} file")
     if st.st_size > lim:
         raise InputError(
             f"{p}: {what} file is {st.st_size} bytes, above the limit of {lim} bytes "
@@ -217,7 +218,7 @@ def read_input(path: str | Path, what: str) -> bytes:
 KERNEL_DIRS = ("/proc", "/sys")
 
 
-def _kernel_dir(p: Path) -> str:
+def kernel_dir(p: Path) -> str:
     """The kernel directory (:data:`KERNEL_DIRS`) that ``p`` resolves into, or ""."""
     real = os.path.realpath(p)
     return next((d for d in KERNEL_DIRS if real == d or real.startswith(d + "/")), "")

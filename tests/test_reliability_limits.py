@@ -270,10 +270,16 @@ def test_kernel_interface_files_are_not_read(tmp_path: Path) -> None:
     for path in ("/proc/self/status", str(link), "/sys/kernel/mm/transparent_hugepage/enabled"):
         if not Path(path).exists():
             continue
-        with pytest.raises(L.InputError, match="kernel interface file under /"):
+        with pytest.raises(L.InputError, match="is under /(proc|sys) \\(the kernel.s interface\\)"):
             L.read_input(path, "spec")
         res = runner.invoke(app, ["design", path])
-        assert res.exit_code == 2 and "kernel interface file" in res.output
+        assert res.exit_code == 2 and "the kernel's interface" in res.output
+    # `check /proc` is one row saying so, not a walk of the process table (a row per
+    # unreadable folder: re-check review, session 42)
+    res = runner.invoke(app, ["check", "/proc", "--format", "json"])
+    (row,) = json.loads(res.stdout)
+    assert res.exit_code == 2 and row["code"] == 2
+    assert row["message"] == "/proc: is under /proc (the kernel's interface), not a spec file"
     # the report's spec_file: not read, no note, no hang (a subprocess with a timeout: a
     # regression would block on /proc/kmsg itself where it exists)
     import subprocess
