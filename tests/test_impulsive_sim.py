@@ -749,3 +749,12 @@ def test_the_error_metrics_of_a_growing_plant_are_the_errors_own(tmp_path: Path)
     assert max(m["sup_abs_error"].values()) < 10
     assert m["quantiles"]["final_error_norm"]["max"] < 2 * m["ball_radius"]
     assert 0 < m["noise_free_final_eps_max"] < 1e-2 and m["noise_free_decay"]  # from 2.4
+    # the open-loop run's error blows up (L = 0, x₁ unstable) and stops: said, with when
+    # (its final ε is the one at the stop; re-check review, session 42)
+    stop = m["open_loop_stopped_at"]
+    assert stop is not None and 0 < stop < 3
+    ok = get_method("impulsive").simulate(
+        load_spec_text(_spec3(), str(tmp_path / "s.toml")),
+        api.design(load_spec_text(_spec3(), str(tmp_path / "s.toml"))).parameters,
+    )
+    assert ok.metrics()["open_loop_stopped_at"] is None

@@ -277,6 +277,14 @@ def simulate(
             and not clean.diverged.any()
         ),
         "open_loop_final_eps": float(open_.eps[0, np.nonzero(open_.valid[0])[0][-1]]),
+        # where the open-loop run stopped before the horizon (its error blew up, or the plant
+        # left the float range), its "final" ε is the one at that stop: the same 3.5·10⁸ was
+        # printed for horizons 3 and 11.5 without a word (re-check review, session 42)
+        "open_loop_stopped_at": (
+            float(open_.t[0, np.nonzero(open_.valid[0])[0][-1]])
+            if bool(open_.diverged[0] or open_.escaped[0])
+            else None
+        ),
     }
     info["quantiles"] = run_quantiles(noisy, list(spec.system.states))
     res = SimResult(
