@@ -1084,3 +1084,51 @@ def test_a_gain_set_with_lines_has_no_vertices_to_report() -> None:
     ver = api.verify(Report.from_dict(d)[0])
     bad = [c.id for c in ver.claims if not c.ok]
     assert ver.exit_code() == 1 and "linear-gains-vertices" in bad, bad
+
+
+def test_a_nan_float_bracket_is_evaluated_exactly_not_skipped() -> None:
+    """An injection value (M, M) with M = 1e308 at z = 0 (a tampered report, its table
+    recomputed exactly) made G v = 10M − 10M = inf − inf = NaN in the float pre-screen: every
+    comparison with NaN is False, no breakpoint was evaluated exactly, the factor fell back to
+    0 and verify certified theorem-3.1 and contractivity-value = 0, exit 0, for a true level of
+    20M + 1/2 ≈ 2·10³⁰⁹ (statement-vs-check review, session 42). Now exit 1, theorem-3.1
+    failed."""
+    from fractions import Fraction as F
+
+    from obsdesign.report import Report
+
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0.5, 0], [0, 0.5]]\nC = [[10000, 0]]\n'
+        '[sets.omega]\ntype = "symmetric-polytope"\nQ = [[10, 10], [10, -10]]\n'
+        '[method]\nkey = "set-invariant"\nomega = "omega"\neta_bar = 0\nlambda = 0.9\n'
+        'algorithm = "none"\nlinear_law = false\n'
+    )
+    rep = api.design(load_spec_text(text, "diamond.toml"))
+    assert rep.exit_code() == 0
+    d = json.loads(rep.to_json())
+    p, ex = d["parameters"], d["parameters"]["exact"]
+    zs = [F(z) for z in ex["breakpoints"]]
+    vs = [[F(x) for x in r] for r in ex["v_breakpoints"]]
+    vs[zs.index(0)] = [F(1e308), F(1e308)]
+    Ls = [[(vs[j + 1][k] - vs[j][k]) / (zs[j + 1] - zs[j]) for k in range(2)] for j in range(2)]
+    ws = [[vs[j][k] - zs[j] * Ls[j][k] for k in range(2)] for j in range(2)]
+    for key, M in (("v_breakpoints", vs), ("L_pieces", Ls), ("w_pieces", ws)):
+        ex[key] = [[str(x) for x in r] for r in M]
+        p[key] = [[float(x) for x in r] for r in M]
+    ex["contractivity"], p["contractivity"] = "0", 0.0
+    ver = api.verify(Report.from_dict(d)[0])
+    bad = [c.id for c in ver.claims if not c.ok]
+    assert ver.exit_code() == 1 and "theorem-3.1" in bad and "contractivity-value" in bad, bad
+
+
+def test_omega_contained_with_a_nan_float_product_is_exact() -> None:
+    """G_0 v = 1e308·2 + 1e308·2 overflows to inf, and so does the prefilter's tolerance:
+    max − tol = inf − inf = NaN compared False with every entry, no candidate was left (max
+    of an empty sequence, an internal error) — the float prefilter must not decide anything
+    then; the exact maximum over all pairs is 4·10³⁰⁸, so Ω ⊄ {G e ≤ 1}."""
+    from obsdesign.methods.setinvariant.certificate import omega_contained
+
+    G = np.array([[fmpq(10**308), fmpq(10**308)], [fmpq(1), fmpq(0)]], dtype=object)
+    V = np.array([[fmpq(2), fmpq(2)]], dtype=object)
+    ok, m = omega_contained(G, V)
+    assert not ok and m == 4 * 10**308

@@ -18,6 +18,7 @@ so a skipped entry is provably below the bound.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 from fractions import Fraction
@@ -26,6 +27,7 @@ from itertools import product
 import numpy as np
 from flint import fmpq
 
+from obsdesign.certify.exact import float_or_inf
 from obsdesign.errors import InconclusiveError, SolverError
 from obsdesign.sets import polytope_ops as po
 
@@ -85,9 +87,13 @@ def omega_contained(G: np.ndarray, Vo: np.ndarray) -> tuple[bool, fmpq]:
     (far above the float error of any entry), so the exact max over those pairs is the
     exact max."""
     Gf, Vf = po.qfloat(G), po.qfloat(Vo)
-    M = Gf @ Vf.T
-    tol = _FILTER * float((np.abs(Gf) @ np.abs(Vf).T).max()) + 1e-300
-    cand = np.argwhere(M >= M.max() - tol)
+    with np.errstate(all="ignore"):
+        M = Gf @ Vf.T
+        tol = _FILTER * float((np.abs(Gf) @ np.abs(Vf).T).max()) + 1e-300
+    if np.all(np.isfinite(M)) and math.isfinite(tol):
+        cand = np.argwhere(M >= M.max() - tol)
+    else:  # inf − inf = NaN compares False: every pair exactly (statement-vs-check review)
+        cand = np.argwhere(np.ones(M.shape, dtype=bool))
     m = max(po.qdot(G[i], Vo[j]) for i, j in cand)
     return m <= 1, m
 
@@ -505,8 +511,11 @@ def theorem31(
             raise BudgetExceeded(sum(e is not None for e in eps_l))
         v = vs_use[l]
         up, low = fl_rows[l]
-        thr = min(lamf, float(low.max()))
-        rows = np.nonzero(up >= thr)[0]  # every row that can reach the level or λ
+        top = float(low.max())
+        thr = min(lamf, top) if math.isfinite(top) else -math.inf
+        # every row that can reach the level or λ; a NaN bound (inf − inf in floats) is
+        # a row to evaluate, never one to skip
+        rows = np.nonzero(~(up < thr))[0]
         ph = sl.phi_exact(l, rows)
         e = max(ph[i] + po.qdot(G[i], v) + dl[i] for i in ph)
         # the exact LP only helps where the float LP says ε(z) <= λ and rounding broke it;
@@ -519,20 +528,28 @@ def theorem31(
         eps_l[l] = e
         out_vs[l] = list(v)
 
+    # The float brackets decide only where they are numbers: an injection value of 1e308
+    # made G v = inf − inf = NaN, every comparison with it False, no breakpoint was evaluated
+    # exactly and the factor fell back to 0 — a tampered report with a true factor of
+    # 2·10³⁰⁹ verified (statement-vs-check review, session 42). NaN counts as "may exceed".
     # 1. every breakpoint whose level may exceed λ (where the exact LP may replace v^l)
-    for l in np.nonzero(hi > lamf)[0]:
+    for l in np.nonzero(~(hi <= lamf))[0]:
         exact_at(int(l))
     # 2. every breakpoint whose level may reach the largest: the certified factor is exact;
     #    the others are provably below it (and below λ)
     floor = max(
-        [float(e) for e in eps_l if e is not None]
-        + [float(lo[l]) for l in range(nz) if eps_l[l] is None],
-        default=0.0,
+        [float_or_inf(e) for e in eps_l if e is not None]
+        + [float(lo[l]) for l in range(nz) if eps_l[l] is None and math.isfinite(lo[l])],
+        default=-math.inf,
     )
     for l in range(nz):
-        if eps_l[l] is None and hi[l] >= floor:
+        if eps_l[l] is None and not hi[l] < floor:
             exact_at(l)
     done = [l for l in range(nz) if eps_l[l] is not None]
+    if nz and not done:  # (every level bracketed below another: impossible; never factor 0)
+        for l in range(nz):
+            exact_at(l)
+        done = list(range(nz))
     worst = max(done, key=lambda k: eps_l[k]) if done else 0
     factor = eps_l[worst] if done else fmpq(0)
     return Theorem31Result(

@@ -24,6 +24,7 @@ import numpy as np
 from flint import fmpq
 
 from obsdesign.certify.claim import Claim, Claims
+from obsdesign.certify.exact import float_or_inf
 from obsdesign.certify.printing import fmt_exact
 from obsdesign.params import Parameters, shaped
 from obsdesign.sets import polytope_ops as po
@@ -232,7 +233,9 @@ class ExactBackend:
 
     def leq(self, x: Any, bound: Any) -> tuple[bool, bool]:
         """(x <= bound exactly, the same inequality in float64)."""
-        return bool(x <= bound), bool(float(x) <= float(bound))
+        # float_or_inf: an exact factor past the float range (a tampered injection value of
+        # 1e308 gives 2·10³⁰⁹) is a failed claim, not an OverflowError (exit 4)
+        return bool(x <= bound), bool(float_or_inf(x) <= float_or_inf(bound))
 
     def margin(self, bound: Any, x: Any) -> Any:
         """The exact slack bound − x (negative when the claim fails)."""
@@ -247,7 +250,8 @@ class ExactBackend:
         if "/" not in d and len(d) <= 24:
             return d
         t = str(x)
-        return f"{t} ≈ {float(x):.12g}" if len(t) <= 24 else f"≈ {float(x):.12g}"
+        f = float_or_inf(x)
+        return f"{t} ≈ {f:.12g}" if len(t) <= 24 else f"≈ {f:.12g}"
 
 
 class FloatBackend:
