@@ -339,8 +339,9 @@ def _design_for(
     except lyap.RateResolutionError as e:
         raise SpecError(spec.file, "method.rate_tol", e.hint()) from None
     rate, P = (br.best, br.P) if known is None else known
-    for key, M, at in (("P", P, rate), ("P_best", br.P, br.best)):
-        _float_viewable(key, M, at, name, o)
+    _float_viewable("P", P, rate, name, o)
+    if br.P is not P:
+        _float_viewable("P_best", br.P, br.best, name, o)
     solver.extra["best_rate_exact_checks"] = br.exact_checks
     params["P"] = P
     params[name] = rate
