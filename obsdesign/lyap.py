@@ -142,8 +142,8 @@ class ExactMemo:
         return hit[1]
 
 
-#: the :class:`ExactMemo` key of A − LC: the matrix L compared exactly, the value (A, C,
-#: A − LC) used only for the very same (read-only) A and C arrays
+#: the :class:`ExactMemo` key of A − LC: the matrix L compared exactly, the value (copies of
+#: A and C, A − LC) used only for A and C with exactly these entries
 CLOSED_LOOP_KEY = ("closed-loop",)
 
 #: the attribute of a bound spec under which the design leaves its :class:`ExactMemo`

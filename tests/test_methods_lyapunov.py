@@ -1675,6 +1675,15 @@ def test_the_design_memo_is_not_used_for_a_spec_copy_with_another_A() -> None:
     other.system = dataclasses.replace(spec.system, A=Value.of(A3))
     status = {c.id: c.ok for c in api.certify(other, rep.parameters)}
     assert status["decay-lmi"] is False and status["decay-lmi_best"] is False
+    # the same array object edited despite read-only (its flag set back by hand): the memo
+    # compares entries, not identity (re-check review, session 42)
+    A = spec.system.A.q
+    for a in (A.base, A):
+        if a is not None:
+            a.flags.writeable = True
+    A[1, 0] = fmpq(3)
+    status = {c.id: c.ok for c in api.certify(spec, rep.parameters)}
+    assert status["decay-lmi"] is False and status["decay-lmi_best"] is False
 
 
 def test_a_certificate_beyond_the_float_range_names_the_rate_and_rate_tol() -> None:

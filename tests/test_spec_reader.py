@@ -225,9 +225,17 @@ def test_spec_arrays_are_read_only() -> None:
         '[method]\nkey = "lyapunov"\n',
         "s.toml",
     )
-    for v in (spec.system.A, spec.system.C, spec.system.B, spec.system.Bd, spec.system.Dn):
+    import copy
+    import pickle
+
+    values = (spec.system.A, spec.system.C, spec.system.B, spec.system.Bd, spec.system.Dn)
+    copies = [copy.deepcopy(v) for v in values] + [pickle.loads(pickle.dumps(values[1]))]
+    for v in (*values, *copies):
         for arr in (v.q, v.f):
             assert isinstance(arr, np.ndarray) and not arr.flags.writeable
+            # the array it views too: A edited through ``.base`` kept the design's verdicts
+            # (re-check review, session 42); deep copies and pickles were writable
+            assert arr.base is None or not arr.base.flags.writeable
             if arr.size:
                 with pytest.raises(ValueError, match="read-only"):
                     arr.flat[0] = 3

@@ -34,8 +34,13 @@ class Value:
         # api.certify certify claims about A that were false for the edited A (API review,
         # session 42). Edit the text and load it again instead.
         for a in (self.q, self.f):
-            if isinstance(a, np.ndarray):
-                a.flags.writeable = False
+            while isinstance(a, np.ndarray):  # the array and every array it views: a
+                a.flags.writeable = False  # write through ``.base`` edited A as well
+                a = a.base
+
+    def __reduce__(self) -> tuple[Any, tuple[Any, Any]]:
+        # copies (copy.deepcopy, pickle) are made through __init__, so read-only as well
+        return (Value, (self.q, self.f))
 
     @classmethod
     def of(cls, q: Any) -> Value:

@@ -63,7 +63,7 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     memo = lyap.memo_of(spec)  # the design's exact verdicts, same process, same inputs only
     Lq = lyap.fmat(L)
     hit = None if memo is None else memo.get(lyap.CLOSED_LOOP_KEY, (Lq,))
-    Acl = hit[2] if hit is not None and hit[0] is A and hit[1] is C else None
+    Acl = hit[2] if hit is not None and _same(hit[0], A) and _same(hit[1], C) else None
     if Acl is None:
         Acl = lyap.closed_loop_fmat(A, C, Lq)
     # correctly rounded, once, for the enclosures and the bracket's proof (left to them
@@ -99,6 +99,12 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     if o.iss_gain:
         iss_claim(c, A, C, L, s.Bd.q, s.Dn.q, P, rate, mu, s.discrete)
     return list(c)
+
+
+def _same(a: np.ndarray, b: Any) -> bool:
+    """Whether the exact arrays ``a`` and ``b`` have the same shape and entries."""
+    b = np.asarray(b, dtype=object)
+    return a.shape == b.shape and bool(np.all(a == b))
 
 
 def _unless_asymmetric(P: Any, name: str) -> tuple[PSDResult, bool] | None:

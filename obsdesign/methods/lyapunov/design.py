@@ -276,10 +276,12 @@ def _design_for(
     memo = lyap.ExactMemo()  # the exact verdicts, reused by certify in this process only
     Lm = lyap.fmat(L) if Lm is None else Lm
     Acl = lyap.closed_loop_fmat(A, C, Lm)
-    # A − LC for this L and these very A, C arrays (read-only: the same objects hold the
-    # same numbers); keyed by L alone, a copy of the spec given another A reused it and
-    # api.certify certified a decay LMI false for that A (API review, session 42)
-    memo.put(lyap.CLOSED_LOOP_KEY, (Lm,), (A, C, Acl))
+    # A − LC for this L and A, C with these very entries (copies, compared entry by entry
+    # in certify: 0.8 ms at n = 100); keyed by L alone, a copy of the spec given another A
+    # reused it and api.certify certified a decay LMI false for that A, and so did an A
+    # edited through its writable base array after identity was checked (API and re-check
+    # reviews, session 42)
+    memo.put(lyap.CLOSED_LOOP_KEY, (Lm,), (A.copy(), C.copy(), Acl))
     Af = lyap.mat_float(Acl)  # converted once: the float guide of every step below
     # the eigenvalues, a guide (float ones, or high-precision ones when those are inaccurate)
     guide = spectrum(Acl, Af)
