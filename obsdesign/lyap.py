@@ -618,10 +618,20 @@ def iss_mu(
     r = Q(rho)
     S = np.asarray(iss_matrix(Acl, Bw[:, :0], P, r, 0, discrete), dtype=float)
     with np.errstate(over="ignore", invalid="ignore"):  # a non-finite G is OverflowError below
-        if discrete:
-            G = Bf.T @ Pf @ Bf + Bf.T @ Pf @ Af @ np.linalg.solve(S, Af.T @ Pf @ Bf)
-        else:
-            G = Bf.T @ Pf @ np.linalg.solve(S, Pf @ Bf)
+        try:
+            if discrete:
+                G = Bf.T @ Pf @ Bf + Bf.T @ Pf @ Af @ np.linalg.solve(S, Af.T @ Pf @ Bf)
+            else:
+                G = Bf.T @ Pf @ np.linalg.solve(S, Pf @ Bf)
+        except np.linalg.LinAlgError:
+            # S singular in floats: ρ = λ² = 10⁻⁶⁰⁰ underflows to 0 (constrained, A − LC
+            # nilpotent, λ = 1e-300, margin = 0: exit 3 "Singular matrix"; re-check review,
+            # session 42)
+            raise InconclusiveError(
+                "the ISS gain μ of eq. (5): S = ρP − (A − LC)ᵀP(A − LC) is singular in floats "
+                f"(ρ = {float(r):.3g}): a rate this close to 0 leaves the float range; a larger "
+                "decay rate"
+            ) from None
     # G/2 + Gᵀ/2, not (G + Gᵀ)/2: the sum overflowed for entries above 9e307, half the float
     # range, and a μ ≈ 9.96e307 that certifies was refused (re-check trial, session 29)
     H = G / 2 + G.T / 2

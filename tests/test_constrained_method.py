@@ -1245,5 +1245,17 @@ def test_a_certificate_beyond_the_float_range_names_the_keys(key: str) -> None:
         api.design(api.load_spec_text(text, "s.toml"))
     msg = ei.value.message
     assert "P at λ = 1e-300 has entries beyond the float range" in msg
-    assert "[method].lambda" in msg and "margin = 0" in msg
+    # not "margin = 0": with it the design reaches μ of eq. (5), whose S = λ²P − … is then
+    # singular in floats (exit 4 saying so; it was exit 3; re-check review, session 42)
+    assert "[method].lambda" in msg and "margin = 0" not in msg
+    nil = (  # A − LC = [[0, 1], [0, 0]], nilpotent
+        '[system]\ntime = "discrete"\nA = [[0, 1], [1, 0]]\nC = [[1, 0]]\n'
+        '[sets.X]\ntype = "box"\nlower = [-1, -1]\nupper = [1, 1]\n'
+        '[method]\nkey = "constrained"\nL = [0, 1]\nX = "X"\nmargin = 0\n'
+        f"{key} = 1e-300\neps_min = 0.01\n"
+        '[method.c]\ntype = "box"\nlower = [-1.1, -1.1]\nupper = [1.1, 1.1]\n'
+        "[method.D]\nlower = [-3]\nupper = [3]\n"
+    )
+    with pytest.raises(InconclusiveError, match=r"S = ρP − \(A − LC\)ᵀP\(A − LC\) is singular"):
+        api.design(api.load_spec_text(nil, "s.toml"))
     assert ("[method].rate_tol (now 1e-300)" in msg) == (key == "rate_tol")

@@ -1704,3 +1704,10 @@ def test_a_certificate_beyond_the_float_range_names_the_rate_and_rate_tol() -> N
         assert "[method].rate_tol (now 1e-100)" in e.message and "margin = 0" in e.message
     rep = api.design(api.load_spec_text(text + "margin = 0\n", "s.toml"))
     assert rep.exit_code() == 0 and api.verify(rep).exit_code() == 0
+    # with λ = 0.5 asked, P_best (at the best rate, which rate_tol sets) is the one beyond:
+    # rate_tol is named, not lambda (re-check review, session 42)
+    with pytest.raises(InconclusiveError) as ei:
+        api.design(api.load_spec_text(text + "lambda = 0.5\n", "s.toml"))
+    msg = ei.value.message
+    assert "P_best at lambda_best = 1e-100" in msg and "rate_tol (now 1e-100)" in msg
+    assert "[method].lambda" not in msg

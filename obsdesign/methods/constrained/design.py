@@ -126,7 +126,7 @@ def lyapunov_data(spec: Spec) -> LyapData:
         raise InconclusiveError(
             f"the certificate P at λ = {fmt_exact(lam)} has entries beyond the float range "
             f"(the decay LMI with margin δ = {fmt_exact(o.margin)} needs a P that large at "
-            f"that rate), so the report cannot show it: {which}, or margin = 0"
+            f"that rate), so the report cannot show it: {which}"
         )
     rho = Q(o.rho) if o.rho is not None else lam * lam
     Acl = lyap.closed_loop(A, C, o.L)

@@ -43,13 +43,18 @@ def _float_viewable(key: str, P: Any, rate: Any, name: str, o: Options) -> None:
     result too large for a float" (degenerate-sizes review, session 42)."""
     if not lyap.beyond_float(P):
         return
+    # P is at the asked rate when one is given, P_best at the best one, which rate_tol sets
+    # (the P_best message said "a larger [method].lambda" with λ given; re-check review)
+    asked = key == "P" and o.rate is not None
     which = (
         f"a larger [method].{name}"
-        if o.rate is not None
-        else f"a larger [method].rate_tol (now {fmt_exact(o.rate_tol)}) or [method].{name}"
+        if asked
+        else f"a larger [method].rate_tol (now {fmt_exact(o.rate_tol)})"
+        + ("" if o.rate is not None else f" or [method].{name}")
     )
+    at = name if key == "P" else f"{name}_best"
     raise InconclusiveError(
-        f"the certificate {key} at {name} = {fmt_exact(rate)} has entries beyond the float "
+        f"the certificate {key} at {at} = {fmt_exact(rate)} has entries beyond the float "
         f"range (the decay LMI with margin δ = {fmt_exact(o.margin)} needs a P that large at "
         f"that rate), so the report cannot give its float view: {which}, or margin = 0"
     )
