@@ -1053,6 +1053,8 @@ def _dyadic_certified(
     """The float P rounded to ``bits`` (53: the floats themselves), symmetrized, when it passes
     both exact checks of eq. (4)-(6) (constrained-redesign paper, Astolfi et al., NOLCOS 2019)
     — P − δI ≻ 0 and the decay matrix − δI ≻ 0 — else None."""
+    if not np.all(np.isfinite(Pf)):  # P scaled for a margin of 1e307 overflowed: no float P
+        return None  # (it raised "cannot round a non-finite number", exit 3; re-check review)
     Pm, _ = dyadic_fmat(Pf, bits)
     Pm = Pm if Pm == Pm.transpose() else _sym(Pm)
     P = as_array(Pm)

@@ -1304,7 +1304,7 @@ def test_a_report_with_no_float_view_is_exit_4_in_every_output_mode(tmp_path, fl
     p.write_text(_TINY_RATE)
     with pytest.raises(
         InconclusiveError,
-        match=r"certificate P at lambda = 1e-300 .*a larger \[method\]\.lambda, or margin = 0",
+        match=r"certificate P at lambda = 1e-300 .*a smaller \[method\]\.margin .*a larger \[method\]\.lambda",
     ):
         api.design(p)
     res = CliRunner().invoke(app, ["design", str(p), *flags])
@@ -1701,7 +1701,9 @@ def test_a_certificate_beyond_the_float_range_names_the_rate_and_rate_tol() -> N
     try:
         api.design(api.load_spec_text(text, "s.toml"))
     except InconclusiveError as e:
-        assert "[method].rate_tol (now 1e-100)" in e.message and "margin = 0" in e.message
+        assert (
+            "[method].rate_tol (now 1e-100)" in e.message and "margin = 0 is allowed" in e.message
+        )
     rep = api.design(api.load_spec_text(text + "margin = 0\n", "s.toml"))
     assert rep.exit_code() == 0 and api.verify(rep).exit_code() == 0
     # with λ = 0.5 asked, P_best (at the best rate, which rate_tol sets) is the one beyond:
@@ -1711,3 +1713,17 @@ def test_a_certificate_beyond_the_float_range_names_the_rate_and_rate_tol() -> N
     msg = ei.value.message
     assert "P_best at lambda_best = 1e-100" in msg and "rate_tol (now 1e-100)" in msg
     assert "[method].lambda" not in msg
+
+
+def test_a_huge_margin_is_exit_4_naming_the_margin() -> None:
+    """margin = 1e307: the float P scaled for that margin overflows; it was exit 3 "cannot
+    round a non-finite number" (re-check review, session 42). Exit 4, the margin named."""
+    text = (
+        '[system]\ntime = "continuous"\nA = [[-1, 0], [0, -1]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\nL = [0, 0]\nalpha = 0.5\nmargin = 1e307\n'
+        "iss_gain = true\n"
+    )
+    with pytest.raises(
+        InconclusiveError, match=r"margin δ = 1e\+?307.*a smaller \[method\]\.margin"
+    ):
+        api.design(api.load_spec_text(text, "s.toml"))

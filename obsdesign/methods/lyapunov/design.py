@@ -56,7 +56,8 @@ def _float_viewable(key: str, P: Any, rate: Any, name: str, o: Options) -> None:
     raise InconclusiveError(
         f"the certificate {key} at {at} = {fmt_exact(rate)} has entries beyond the float "
         f"range (the decay LMI with margin δ = {fmt_exact(o.margin)} needs a P that large at "
-        f"that rate), so the report cannot give its float view: {which}, or margin = 0"
+        "that rate), so the report cannot give its float view: a smaller [method].margin "
+        f"(margin = 0 is allowed), or {which}"
     )
 
 
