@@ -28,19 +28,22 @@ def _early_interrupt(signum: int, frame: object) -> None:  # pragma: no cover - 
 
 # Installed here, the first obsdesign code the console script runs (``from obsdesign.cli
 # import main`` imports this package first). Only Python's own start-up before any obsdesign
-# code (the interpreter, site.py and the .pth files of site-packages) can still show a
-# traceback on Ctrl-C: no package code runs there.
+# code (the interpreter, site.py and the .pth files of site-packages) and the few bytecodes of
+# this file above the ``if`` (three C-module imports, a def, a constant) can still show a
+# traceback on Ctrl-C.
 #: set (to "1") in the environment of the Dask worker processes the command line starts
 #: (:func:`obsdesign.distributed.client`): they ignore Ctrl-C, which the terminal sends to the
 #: whole process group, and the command that started them shuts them down; with the handler
 #: below each printed its own "obsdesign: interrupted" (outsider trial, session 22)
 WORKER_ENV = "OBSDESIGN_DASK_WORKER"
-if _os.environ.get(WORKER_ENV) == "1":
-    _signal.signal(_signal.SIGINT, _signal.SIG_IGN)
-elif _signal.getsignal(_signal.SIGINT) is _signal.default_int_handler and _os.path.basename(
+# the handler first, then the worker's override: the environment lookup before it left a
+# window where a Ctrl-C printed a traceback ending in this file (re-check review, session 42)
+if _signal.getsignal(_signal.SIGINT) is _signal.default_int_handler and _os.path.basename(
     _sys.argv[0] if _sys.argv else ""
 ) in ("obsdesign", "cli.py", "-m"):  # "-m": ``python -m obsdesign`` importing this package
     _signal.signal(_signal.SIGINT, _early_interrupt)
+if _os.environ.get(WORKER_ENV) == "1":
+    _signal.signal(_signal.SIGINT, _signal.SIG_IGN)
 
 # after the handler: ``typing`` takes milliseconds to import, and a Ctrl-C there printed a
 # traceback ending in this file (re-check review, session 42)

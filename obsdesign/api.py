@@ -31,7 +31,7 @@ from obsdesign.errors import (
     ascii_name,
     one_line,
 )
-from obsdesign.limits import ensure_recursion_limit, limits, max_states_for
+from obsdesign.limits import ensure_recursion_limit, kernel_dir, limits, max_states_for
 from obsdesign.methods import get_method, method_keys
 from obsdesign.methods.base import Method, Progress
 from obsdesign.params import Parameters, same_bits
@@ -1250,8 +1250,6 @@ def spec_files(paths: list[str | Path] | str | Path) -> list[Path]:
     if isinstance(paths, (str, Path)):
         paths = [paths]
     out: list[Path] = []
-    from obsdesign.limits import kernel_dir
-
     for p in map(Path, paths):
         if p.is_dir() and not kernel_dir(p):  # /proc, /sys: one row saying so (not walked)
             out += _toml_files(p)
@@ -1302,7 +1300,9 @@ def _toml_files(root: Path) -> list[Path]:
             except OSError:
                 real_dir = any_dir = False
             if real_dir:
-                if not e.name.startswith("."):
+                # /proc and /sys inside the tree (`check /`): not walked, a row per
+                # unreadable process folder (re-check review, session 42)
+                if not e.name.startswith(".") and not kernel_dir(Path(e.path)):
                     stack.append(Path(e.path))
             elif e.name.endswith(".toml") and not any_dir:
                 found.append(Path(e.path))

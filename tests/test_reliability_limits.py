@@ -280,6 +280,20 @@ def test_kernel_interface_files_are_not_read(tmp_path: Path) -> None:
     (row,) = json.loads(res.stdout)
     assert res.exit_code == 2 and row["code"] == 2
     assert row["message"] == "/proc: is under /proc (the kernel's interface), not a spec file"
+    # nor walked inside a tree (`check /` listed a row per unreadable /proc/N folder):
+    # a folder resolving into a kernel directory is skipped (faked here for tmp_path/kern)
+    from obsdesign import api as api_mod
+
+    (tmp_path / "tree" / "kern" / "x").mkdir(parents=True)
+    (tmp_path / "tree" / "kern" / "x" / "a.toml").write_text(TEXT)
+    (tmp_path / "tree" / "b.toml").write_text(TEXT)
+    real = api_mod.kernel_dir
+    try:
+        api_mod.kernel_dir = lambda q: "/proc" if Path(q).name == "kern" else real(q)
+        found = [f.name for f in api_mod.spec_files(tmp_path / "tree")]
+    finally:
+        api_mod.kernel_dir = real
+    assert found == ["b.toml"]
     # the report's spec_file: not read, no note, no hang (a subprocess with a timeout: a
     # regression would block on /proc/kmsg itself where it exists)
     import subprocess
