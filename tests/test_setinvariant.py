@@ -1132,3 +1132,40 @@ def test_omega_contained_with_a_nan_float_product_is_exact() -> None:
     V = np.array([[fmpq(2), fmpq(2)]], dtype=object)
     ok, m = omega_contained(G, V)
     assert not ok and m == 4 * 10**308
+
+
+def test_an_overflowing_slice_product_is_no_proof() -> None:
+    """A report's polytope with a vertex p* = (T, −T), T = 10²⁹⁹, where G_i A p* = (K + 1)T −
+    KT = T/2 exactly: the float product overflowed to −inf (the sign of the first overflowing
+    term), its bound was NaN, p* was never evaluated exactly and φ_i came from the smallest
+    point: verify certified theorem-3.1 at ≈ 0.5 for a true level of 10²⁹⁹ (float pre-screen
+    review, session 42). Rows whose float products are not finite now keep every candidate."""
+    from fractions import Fraction as F
+
+    from obsdesign.report import Report
+
+    K, T = 10**10, F(10**299)
+    text = (
+        f'[system]\ntime = "discrete"\nA = [[{K}, {K + 1}], [0, 0]]\nC = [[1, 1]]\n'
+        '[sets.omega]\ntype = "symmetric-polytope"\nQ = [[1, 0], [0, 1]]\n'
+        '[method]\nkey = "set-invariant"\nomega = "omega"\neta_bar = 0\nlambda = 0.9\n'
+        'algorithm = "none"\nlinear_law = false\n'
+    )
+    d = json.loads(api.design(load_spec_text(text, "s.toml")).to_json())
+    p, ex = d["parameters"], d["parameters"]["exact"]
+    G = [[F(0), F(1)], [F(-1), F(0)], [(T + 1) / (2 * T), (T - 1) / (2 * T)]]
+    G.append([-(T - 1) / (2 * T), -(T + 1) / (2 * T)])
+    V = [[F(-1), F(1)], [F(1), F(1)], [T, -T], [F(-1), F(-1)]]
+    zs = [F(-2), F(0), F(2)]
+    vs = [[F(2 * K + 1), F(0)], [F(0), F(0)], [F(-(2 * K + 1)), F(0)]]
+    Ls = [[(vs[j + 1][k] - vs[j][k]) / (zs[j + 1] - zs[j]) for k in range(2)] for j in range(2)]
+    ws = [[vs[j][k] - zs[j] * Ls[j][k] for k in range(2)] for j in range(2)]
+    for key, M in (("G", G), ("V", V), ("v_breakpoints", vs), ("L_pieces", Ls), ("w_pieces", ws)):
+        ex[key] = [[str(x) for x in r] for r in M]
+        p[key] = [[float(x) for x in r] for r in M]
+    ex["breakpoints"], p["breakpoints"] = [str(z) for z in zs], [float(z) for z in zs]
+    p["facets"], p["vertices"] = 4, 4
+    ex["contractivity"], p["contractivity"] = str((T + 1) / (2 * T)), 0.5
+    ver = api.verify(Report.from_dict(d)[0])
+    status = {c.id: c.ok for c in ver.claims}
+    assert ver.exit_code() == 1 and status["theorem-3.1"] is False, status

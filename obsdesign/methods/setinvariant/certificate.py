@@ -319,10 +319,18 @@ class _Slices:
             low = np.full(m, -np.inf)
             prec = err <= _PRECISE
 
+            # rows whose float products are not all finite carry no information: an overflow
+            # gives an infinity of either sign (−inf for a true +10²⁹⁹), and a max over the
+            # others is then a finite number below the truth (float pre-screen review,
+            # session 42): such a row gets up = +inf, low = −inf
+            blind = np.zeros(m, dtype=bool)
+
             def cmax(cols: np.ndarray) -> np.ndarray:  # max_j c_ij over the columns (or -inf)
                 if not cols.any():
                     return np.full(m, -np.inf)
-                return (self.GAf @ S[cols].T).max(axis=1)
+                M = self.GAf @ S[cols].T
+                blind[:] |= ~np.all(np.isfinite(M), axis=1)
+                return M.max(axis=1)
 
             if prec.any():
                 Sp, Dp = np.abs(S[prec]), np.abs(dirs[prec])
@@ -335,10 +343,14 @@ class _Slices:
             if len(loose):
                 cen = self.GAf @ S[loose].T
                 rad = self._rad(l, slice(None), loose)
+                blind |= ~np.all(np.isfinite(cen) & np.isfinite(rad), axis=1)
                 up = np.maximum(up, (cen + rad).max(axis=1))
                 ls = sure[loose]
                 if ls.any():
                     low = np.maximum(low, (cen[:, ls] - rad[:, ls]).max(axis=1))
+            blind |= ~np.isfinite(up) | np.isnan(low)
+            up = np.where(blind, np.inf, up)
+            low = np.where(blind, -np.inf, low)
             self._bounds[l] = (up, low)
         return self._bounds[l]
 
@@ -352,7 +364,17 @@ class _Slices:
         out = {}
         for r, i in enumerate(rows):
             best = None
-            for j in np.nonzero(up[r] >= phi_low[i])[0]:
+            # a float bound that is not a number decides nothing: G_i A p of a vertex near
+            # 1e299 overflowed to an infinity of the wrong sign (−inf for +T/2), its bound was
+            # NaN or −inf, the point was skipped and φ_i taken from the smallest one — verify
+            # certified theorem-3.1 for a true level of 5·10²⁹⁸ (float pre-screen review,
+            # session 42): such a row keeps every candidate
+            row = up[r]
+            if np.all(np.isfinite(row)) and math.isfinite(phi_low[i]) or phi_low[i] == -np.inf:
+                keep = ~(row < phi_low[i]) | ~np.isfinite(row)
+            else:
+                keep = np.ones(len(row), dtype=bool)
+            for j in np.nonzero(keep)[0]:
                 p = self._exact_point(l, self._cand(l, int(j)))
                 if p is not None:
                     val = po.qdot(self.GA[i], p)
@@ -513,9 +535,9 @@ def theorem31(
         up, low = fl_rows[l]
         top = float(low.max())
         thr = min(lamf, top) if math.isfinite(top) else -math.inf
-        # every row that can reach the level or λ; a NaN bound (inf − inf in floats) is
-        # a row to evaluate, never one to skip
-        rows = np.nonzero(~(up < thr))[0]
+        # every row that can reach the level or λ; a bound that is not a finite number (inf
+        # − inf, or an overflow to an infinity of the wrong sign) is a row to evaluate
+        rows = np.nonzero(~(up < thr) | ~np.isfinite(up))[0]
         ph = sl.phi_exact(l, rows)
         e = max(ph[i] + po.qdot(G[i], v) + dl[i] for i in ph)
         # the exact LP only helps where the float LP says ε(z) <= λ and rounding broke it;
@@ -533,7 +555,8 @@ def theorem31(
     # exactly and the factor fell back to 0 — a tampered report with a true factor of
     # 2·10³⁰⁹ verified (statement-vs-check review, session 42). NaN counts as "may exceed".
     # 1. every breakpoint whose level may exceed λ (where the exact LP may replace v^l)
-    for l in np.nonzero(~(hi <= lamf))[0]:
+    # (an overflow may also give an infinity of the wrong sign: −inf is no proof either)
+    for l in np.nonzero(~(hi <= lamf) | ~np.isfinite(hi))[0]:
         exact_at(int(l))
     # 2. every breakpoint whose level may reach the largest: the certified factor is exact;
     #    the others are provably below it (and below λ)
@@ -543,7 +566,7 @@ def theorem31(
         default=-math.inf,
     )
     for l in range(nz):
-        if eps_l[l] is None and not hi[l] < floor:
+        if eps_l[l] is None and not (math.isfinite(hi[l]) and hi[l] < floor):
             exact_at(l)
     done = [l for l in range(nz) if eps_l[l] is not None]
     if nz and not done:  # (every level bracketed below another: impossible; never factor 0)
