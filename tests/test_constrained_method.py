@@ -1259,3 +1259,22 @@ def test_a_certificate_beyond_the_float_range_names_the_keys(key: str) -> None:
     with pytest.raises(InconclusiveError, match=r"S = ρP − \(A − LC\)ᵀP\(A − LC\) is singular"):
         api.design(api.load_spec_text(nil, "s.toml"))
     assert ("[method].rate_tol (now 1e-300)" in msg) == (key == "rate_tol")
+
+
+def test_an_inclusion_whose_float_norm_overflows_is_false_not_undecided() -> None:
+    """X̂ = [−1e80, 1e80]² with the Section 5 box map and ε_max = 100: |c| ≈ 1.4·10¹⁶⁰ at X̂'s
+    corners overflowed in floats and the float estimate from below dropped those points and
+    said 0, so the failed inclusion read "undecided", exit 4 (float pre-screen review, session
+    42). In float64 |c| = inf > ε_max as well: exit 1."""
+    text = (TSPECS.parent.parent / "specs" / "constrained-redesign-sec5.toml").read_text(
+        encoding="utf-8"
+    )
+    text = text.replace(
+        "[method]\n",
+        '[sets.Xh]\ntype = "box"\nlower = [-1e80, -1e80]\nupper = [1e80, 1e80]\n\n[method]\n',
+        1,
+    ).replace('key = "constrained"\n', 'key = "constrained"\nXhat = "Xh"\neps_max = 100\n', 1)
+    rep = api.design(api.load_spec_text(text, "s.toml"))
+    bad = {c.id: c.float_ok for c in rep.claims if not c.ok}
+    assert rep.exit_code() == 1, bad
+    assert bad.get("Xhat-in-Cmax") is False

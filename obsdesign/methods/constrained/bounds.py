@@ -521,5 +521,8 @@ def sup_norm_c_float_lower(
         pts = X
     with np.errstate(all="ignore"):
         vals = np.asarray(cm.norm_c(pts), dtype=float)
-    vals = vals[np.isfinite(vals)]
+    # +inf is kept: |c| overflowed at a point of the set, so in float64 the inclusion fails
+    # there (dropping it made X̂ = [−1e80, 1e80]², |c| ≈ 1.4e160 > ε_max = 100, "undecided",
+    # exit 4 instead of 1; float pre-screen review, session 42); only NaN says nothing
+    vals = vals[~np.isnan(vals)]
     return float(vals.max()) if vals.size else 0.0
