@@ -775,6 +775,18 @@ def sweep(
         sw.write_table(output, rows, force)
     if plot is not None:
         _write_plot(plot, lambda tmp: sw.plot_sweep(rows, axes, y or "", tmp, x), force)
+        gaps = sw.missing_y(rows, y or "")
+        if gaps:  # ok rows without a value: gaps that are not failures (sweep review)
+            from obsdesign.errors import one_line
+
+            sys.stderr.write(
+                one_line(
+                    f"obsdesign: warning: {gaps} ok row(s) have no value of --y {y} (the "
+                    "method gives none there, e.g. alpha in discrete time, mu without "
+                    "iss_gain): gaps in the plot, not failures"
+                )
+                + "\n"
+            )
     if fmt == Fmt.json:
         print(_dumps(rows, indent=2, ensure_ascii=False, default=_jsonable))
         return sw.exit_code(rows)

@@ -933,6 +933,31 @@ def plot_groups(
     return groups
 
 
+def _x_codes(rows: list[dict[str, Any]], x: str) -> list[tuple[float, Any]]:
+    """(x as a number, exit code) of the rows whose x is a number."""
+    out = []
+    for r in rows:
+        try:
+            out.append((float(r[x]), r.get("exit_code")))
+        except (TypeError, ValueError, KeyError):
+            continue
+    return out
+
+
+def missing_y(rows: list[dict[str, Any]], y: str) -> int:
+    """How many ok rows (exit 0) have no number in column ``y`` (gaps of the plot that are
+    not failures: alpha of a discrete-time spec, mu where iss_gain is false)."""
+    n = 0
+    for r in rows:
+        if r.get("exit_code") != 0:
+            continue
+        try:
+            float(r[y])
+        except (TypeError, ValueError, KeyError):
+            n += 1
+    return n
+
+
 def plot_sweep(
     rows: list[dict[str, Any]], axes: list[Axis], y: str, path: Path, x: str | None = None
 ) -> None:
@@ -960,7 +985,10 @@ def plot_sweep(
         # gap at an end of the range was simply off the axis (the README's sweep showed
         # 0.96 … 0.99 of 0.90 … 0.99, nothing said six points failed; outsider trial,
         # session 29)
-        bad = sorted({p[0] for pts in groups.values() for p in pts if math.isnan(p[1])})
+        # the rows with exit ≠ 0 only: an ok row without a value of y (alpha of a discrete
+        # spec, mu with iss_gain = false) is a gap, not a failure — all four ok rows of a
+        # sweep were marked "not ok" (sweep review, session 42)
+        bad = sorted({xv for xv, code in _x_codes(rows, x) if code != 0})
         xs = [p[0] for pts in groups.values() for p in pts]
         if bad:
             ax.plot(

@@ -801,3 +801,31 @@ def test_a_spec_with_a_byte_order_mark_gets_the_loaders_message(tmp_path: Path) 
     spec.write_bytes(b"\xef\xbb\xbf" + SPEC.read_bytes())
     res = CliRunner().invoke(app, ["sweep", str(spec), "--set", "method.rate=0.9"])
     assert res.exit_code == 2 and "byte-order mark" in res.output, res.output
+
+
+def test_ok_rows_without_a_value_are_gaps_not_failures(monkeypatch, tmp_path) -> None:
+    """--y alpha of a discrete-time spec (no alpha), or mu where iss_gain = false: every ok
+    row was marked × "not ok (a row with exit ≠ 0)" (sweep review, session 42). Only rows
+    with exit ≠ 0 are marked; the CLI warns that the ok rows without a value are gaps."""
+    from obsdesign.simulate import plot as splot
+
+    figs = []
+    monkeypatch.setattr(splot, "save_figure", lambda fig, path, **kw: figs.append(fig))
+    rows = [
+        {"a": 0.1, "exit_code": 0},
+        {"a": 0.2, "y": 2.0, "exit_code": 0},
+        {"a": 0.3, "exit_code": 1},
+    ]
+    sw.plot_sweep(rows, [sw.Axis("a", ("0.1", "0.2", "0.3"))], "y", tmp_path / "p.png")
+    (ax,) = figs[0].axes
+    marks = [ln for ln in ax.get_lines() if ln.get_label().startswith("not ok")]
+    assert len(marks) == 1 and list(marks[0].get_xdata()) == [0.3]
+    assert sw.missing_y(rows, "y") == 1
+    lyap = ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+    res = CliRunner().invoke(
+        app,
+        ["sweep", str(lyap), "--set", "method.lambda=[0.96, 0.97]", "--plot",
+         str(tmp_path / "q.png"), "--y", "alpha", "-q"],
+    )  # fmt: skip
+    assert res.exit_code == 0, res.output
+    assert "2 ok row(s) have no value of --y alpha" in res.stderr
