@@ -354,6 +354,10 @@ def test_check_junit_refusals_do_not_suggest_force(tmp_path: Path) -> None:
         assert "refusing" in res.output and "--force" not in res.output, res.output
     res = runner.invoke(app, ["design", str(SPEC), "-o", "/dev/null"])
     assert res.exit_code == 2 and "(--force writes into it)" in res.output
+    # the checked folder itself as --junit: "is a directory", as any folder (it said "is the
+    # input file itself"; sweep and check review, session 42)
+    res = runner.invoke(app, ["check", str(tmp_path), "--junit", str(tmp_path)])
+    assert res.exit_code == 2 and f"{tmp_path}: is a directory" in res.output, res.output
 
 
 def test_a_folder_that_cannot_be_listed_does_not_end_the_search(

@@ -564,6 +564,8 @@ def _check_output(path: str | Path, force: bool, inputs: tuple[Path, ...]) -> No
             same = os.path.samefile(p, i)
         except OSError:
             same = False
+        if same and stat.S_ISDIR(lst.st_mode):  # `check d --junit d`: a folder, as any other
+            raise InputError(f"{p}: is a directory")
         if same and not force:
             raise InputError(f"{p}: is the input file itself; refusing to overwrite it (--force)")
     if stat.S_ISLNK(lst.st_mode) and not force:
