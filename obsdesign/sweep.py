@@ -206,8 +206,12 @@ def _split_list(key: str, spec: str) -> list[str]:
     if quote or depth:
         raise InputError(f"--set {key}: unbalanced brackets or quotes in {spec!r}")
     last = "".join(cur).strip()
-    if last or items:
+    if last:  # a trailing comma ends the list, as TOML allows ([0.96,] was "empty item")
         items.append(last)
+    elif not items:
+        pass
+    elif not items[-1]:
+        items.append(last)  # ",," at the end: an empty item, refused below
     if any(not it for it in items):
         raise InputError(f"--set {key}: empty item in {spec!r}")
     return items

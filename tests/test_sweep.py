@@ -829,3 +829,13 @@ def test_ok_rows_without_a_value_are_gaps_not_failures(monkeypatch, tmp_path) ->
     )  # fmt: skip
     assert res.exit_code == 0, res.output
     assert "2 ok row(s) have no value of --y alpha" in res.stderr
+
+
+def test_a_trailing_comma_ends_a_value_list_as_in_toml() -> None:
+    """`--set 'method.lambda=[0.96,]'` was "empty item" although TOML reads [0.96,] as [0.96]
+    (sweep review, session 42); empty items elsewhere stay refused."""
+    assert sw.parse_axis("method.lambda=[0.96,]").values == ("0.96",)
+    assert sw.parse_axis("method.lambda=[0.96, 0.97,]").values == ("0.96", "0.97")
+    for bad in ("[0.96,,]", "[,]", "[0.96,,0.97]"):
+        with pytest.raises(InputError, match="empty item"):
+            sw.parse_axis(f"method.lambda={bad}")
