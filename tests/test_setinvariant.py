@@ -1169,3 +1169,55 @@ def test_an_overflowing_slice_product_is_no_proof() -> None:
     ver = api.verify(Report.from_dict(d)[0])
     status = {c.id: c.ok for c in ver.claims}
     assert ver.exit_code() == 1 and status["theorem-3.1"] is False, status
+
+
+def test_subnormal_entries_of_GA_widen_the_slice_prescreen() -> None:
+    """G A with subnormal entries (A = 1.5·10⁻²³ I, a polygon scaled to ~10³⁰⁰): rounding them
+    to doubles is an absolute error of up to 2⁻¹⁰⁷⁵ (25 % relative), which the relative slack
+    did not cover; the float order of a slice's two ends reversed, the true maximizer was
+    skipped, and a tampered report (injection chosen to put the computed level exactly at λ)
+    certified theorem-3.1 at 0.9 for an exact 0.9 + 4.75·10⁻²⁵ (re-check review, session 42).
+    Built as the review built it; now exit 1."""
+    from fractions import Fraction as F
+
+    from obsdesign.report import Report
+
+    u, a, lam = F(1, 2**1074), F(15, 10**24), F(9, 10)
+    X = a / (3 * u)
+    text = (
+        '[system]\ntime = "discrete"\nA = [[1.5e-23, 0], [0, 1.5e-23]]\nC = [[1.1, 1]]\n'
+        '[sets.omega]\ntype = "symmetric-polytope"\nQ = [[1, 0], [0, 1]]\n'
+        '[method]\nkey = "set-invariant"\nomega = "omega"\neta_bar = 0\nlambda = 0.9\n'
+        'algorithm = "none"\nlinear_law = false\n'
+    )
+    Bp, Cp, Dp = (F(0), F(11, 10)), (F(8, 10), F(1)), (F(12, 10), F(-1))
+    t, s = F(305, 1000) / F(1835, 1000), F(153, 100) / F(386, 100)
+    C1 = (Bp[0] + t * (Cp[0] - Bp[0]), Bp[1] + t * (Cp[1] - Bp[1]))
+    C2 = (Cp[0] + s * (Dp[0] - Cp[0]), Cp[1] + s * (Dp[1] - Cp[1]))
+    V = [(X * x, X * y) for x, y in [(F(-1), F(1)), Bp, C1, C2, Dp, (F(-1), F(-1))]]
+
+    def facet(p, q):  # the row g with g·p = g·q = 1
+        det = p[0] * q[1] - q[0] * p[1]
+        return ((q[1] - p[1]) / det, (p[0] - q[0]) / det)
+
+    G = [facet(V[k], V[(k + 1) % len(V)]) for k in range(len(V))]
+    c = (F(11, 10), F(1))
+    zs = sorted({c[0] * v[0] + c[1] * v[1] for v in V})
+    zstar = c[0] * V[1][0] + c[1] * V[1][1]
+    phi_float_max = a * (G[2][0] * X)  # the level the pre-screen kept: the point (X, 0)
+    q = ((C1[0] + C2[0]) / 2 * X, (C1[1] + C2[1]) / 2 * X)  # G_2 q = 1
+    vstar = ((lam - phi_float_max) * q[0], (lam - phi_float_max) * q[1])
+    vs = [list(vstar) if z == zstar else [F(0), F(0)] for z in zs]
+    Ls = [[(vs[j + 1][k] - vs[j][k]) / (zs[j + 1] - zs[j]) for k in range(2)] for j in range(5)]
+    ws = [[vs[j][k] - zs[j] * Ls[j][k] for k in range(2)] for j in range(5)]
+    d = json.loads(api.design(load_spec_text(text, "s.toml")).to_json())
+    p, ex = d["parameters"], d["parameters"]["exact"]
+    for key, M in (("G", G), ("V", V), ("v_breakpoints", vs), ("L_pieces", Ls), ("w_pieces", ws)):
+        ex[key] = [[str(x) for x in r] for r in M]
+        p[key] = [[float(x) for x in r] for r in M]
+    ex["breakpoints"], p["breakpoints"] = [str(z) for z in zs], [float(z) for z in zs]
+    p["facets"], p["vertices"] = len(G), len(V)
+    ex["contractivity"], p["contractivity"] = str(lam), float(lam)
+    ver = api.verify(Report.from_dict(d)[0])
+    status = {c.id: c.ok for c in ver.claims}
+    assert ver.exit_code() == 1 and status["theorem-3.1"] is False, status

@@ -139,6 +139,24 @@ def _weight_error(
     return np.minimum(out, 1.0)
 
 
+#: the spacing of the subnormal doubles: the absolute error of rounding an exact value
+#: below 2⁻¹⁰²² to a double (its relative error is then not 2⁻⁵³ but up to 25 %)
+_SUBNORMAL_ULP = 2.0**-1074
+
+
+def _subnormal_slack(aGA: np.ndarray, aP: np.ndarray) -> np.ndarray:
+    """The error of G_i A p from rounding subnormal entries of G A and of p to doubles, which
+    the relative slack ``_FILTER`` does not cover: (rows, points) ``2⁻¹⁰⁷⁴ (|p|₁ + |G_i A|₁)``
+    (the entries' rounding errors are at most half of that each). G A ≈ 2.6·2⁻¹⁰⁷⁴ rounded
+    to 3·2⁻¹⁰⁷⁴ times a vertex near 10³⁰⁰ reversed the float order of a slice's two ends, the
+    true maximizer was skipped and a tampered report certified theorem-3.1 at 0.9 for an
+    exact 0.9 + 4.75·10⁻²⁵ (re-check review, session 42).
+
+    :param aGA: |G A| (rows, n); :param aP: |p| per point (points, n)."""
+    with np.errstate(over="ignore"):
+        return _SUBNORMAL_ULP * (aP.sum(axis=1)[None, :] + aGA.sum(axis=1)[:, None])
+
+
 class _Slices:
     """Slices of {G e <= 1} at each z^l: float candidates, exact points on demand.
 
@@ -289,6 +307,7 @@ class _Slices:
         GA, aGA = self.GAf[rows], self.absGA[rows]
         rad = np.abs(GA @ D.T) * err[cols][None, :]
         rad += _FILTER * (aGA @ (np.abs(S) + np.abs(D)).T) + 1e-300
+        rad += _subnormal_slack(aGA, np.abs(S) + np.abs(D))
         return rad
 
     def cand_up(self, l: int, rows: np.ndarray) -> np.ndarray:
@@ -336,6 +355,7 @@ class _Slices:
                 Sp, Dp = np.abs(S[prec]), np.abs(dirs[prec])
                 r = (err[prec][:, None] * Dp + _FILTER * (Sp + Dp)).max(axis=0)
                 radp = self.absGA @ r + 1e-300
+                radp += _subnormal_slack(self.absGA, (Sp + Dp).max(axis=0)[None, :])[:, 0]
                 sure_max = cmax(prec & sure)
                 up = np.maximum(sure_max, cmax(prec & ~sure)) + radp
                 low = sure_max - radp
