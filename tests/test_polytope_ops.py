@@ -633,3 +633,19 @@ def test_incidences_prefilter_margin_scales_with_the_terms() -> None:
         _, _, on, bad = _incidences(G, P)
         assert on == [{0}]
         assert bad == [(0, 1)]
+
+
+def test_incidences_evaluate_a_nan_float_pair_exactly() -> None:
+    """A pair whose float product is NaN (inf − inf: other BLAS, or numpy's einsum, give it
+    where OpenBLAS's matmul gives ±inf) compared False with the threshold and was never
+    evaluated exactly: a point violating a row went unseen (float pre-screen reviews, session
+    42). Here the caller's float image of the point holds the NaN; the exact test finds the
+    violation G_0 p = 2 > 1."""
+    from obsdesign.sets import polytope_ops as po
+
+    G = np.array([[fmpq(1), fmpq(1)], [fmpq(-1), fmpq(0)]], dtype=object)
+    P = np.array([[fmpq(1), fmpq(1)]], dtype=object)
+    pv, pd = po._scaled(P)
+    Pf = np.array([[np.nan, 1.0]])
+    _, _, _, bad = po._incidences(G, P, (Pf, pv, pd))
+    assert (0, 0) in bad

@@ -890,8 +890,13 @@ def _incidences(
     ``pts``: (floats, scaled vectors, denominators) of P when already computed."""
     Pf, pv, pd = pts if pts is not None else (qfloat(P), *_scaled(P))
     Gf = qfloat(G)
-    M = Gf @ Pf.T
-    near = np.argwhere(M >= 1 - (1e-9 * (np.abs(Gf) @ np.abs(Pf).T) + 1e-300))
+    with np.errstate(all="ignore"):
+        M = Gf @ Pf.T
+        thr = 1 - (1e-9 * (np.abs(Gf) @ np.abs(Pf).T) + 1e-300)
+    # NaN (inf − inf: other BLAS and numpy's einsum give it where OpenBLAS's matmul gives
+    # ±inf) is a pair to evaluate exactly, never one to skip (float pre-screen reviews,
+    # session 42)
+    near = np.argwhere(~(M < thr))
     gv, gd = _scaled(G)
     on: list[set[int]] = [set() for _ in range(len(G))]
     bad = []
