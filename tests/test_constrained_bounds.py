@@ -877,10 +877,13 @@ def test_set_points_of_a_box_are_its_vertices_all_or_sampled() -> None:
     assert set(np.unique(pts)) == {-1.0, 1.0}
 
 
-def test_the_float_estimate_skips_values_that_are_not_finite() -> None:
-    """Mutation review 30 (sup_norm_c_float_lower: the isfinite filter dropped; 0 for no
-    finite value made inf): a |c| that overflows at some points is no evidence (the largest
-    finite one counts), and none finite is 0 — undecided, never a refutation."""
+def test_the_float_estimate_skips_nan_and_keeps_an_overflowing_norm() -> None:
+    """Mutation review 30 (sup_norm_c_float_lower: the filter dropped; 0 for no value): NaN
+    is no evidence and none at all is 0 — undecided, never a refutation. +inf counts since
+    session 42: the norm is taken scaled, so an infinite |c| is a component (φ_i⁺)² beyond
+    the float range, the inclusion false at that point (X̂ = [−1e80, 1e80]², ε_max = 100 was
+    "undecided", exit 4; float pre-screen review); a representable |c| ≈ 1.4e160 from
+    components near 1e80² is not inf."""
 
     class Stub:
         affine = False
@@ -892,8 +895,17 @@ def test_the_float_estimate_skips_values_that_are_not_finite() -> None:
             return np.resize(np.asarray(self.vals, float), len(pts))
 
     X = _box(-np.ones(2), np.ones(2))
-    assert B.sup_norm_c_float_lower(Stub([1.0, np.nan, 2.0, np.inf]), X) == 2.0
-    assert B.sup_norm_c_float_lower(Stub([np.nan, np.inf, -np.inf, np.nan]), X) == 0.0
+    assert B.sup_norm_c_float_lower(Stub([1.0, np.nan, 2.0, np.inf]), X) == np.inf
+    assert B.sup_norm_c_float_lower(Stub([1.0, np.nan, 2.0, 1.5]), X) == 2.0
+    assert B.sup_norm_c_float_lower(Stub([np.nan, np.nan]), X) == 0.0
+
+    class Comp(Stub):  # components c_i = 1e160: |c| = 1.41e160, representable
+        norm = "euclidean"
+
+        def c(self, pts):
+            return np.full((len(pts), 2), 1e160)
+
+    assert B.sup_norm_c_float_lower(Comp([np.inf]), X) == pytest.approx(2**0.5 * 1e160)
 
 
 def _psd2(M: np.ndarray) -> bool:

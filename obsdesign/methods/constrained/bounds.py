@@ -520,9 +520,23 @@ def sup_norm_c_float_lower(
     else:
         pts = X
     with np.errstate(all="ignore"):
-        vals = np.asarray(cm.norm_c(pts), dtype=float)
-    # +inf is kept: |c| overflowed at a point of the set, so in float64 the inclusion fails
-    # there (dropping it made X̂ = [−1e80, 1e80]², |c| ≈ 1.4e160 > ε_max = 100, "undecided",
-    # exit 4 instead of 1; float pre-screen review, session 42); only NaN says nothing
+        vals = np.asarray(_norm_c_scaled(cm, pts), dtype=float)
+    # +inf is kept: with the norm taken scaled (no overflow of c_i² for c_i ~ 1e160), an
+    # infinite |c| means a component c_i = (φ_i⁺)² beyond the float range, so the inclusion
+    # fails at that point of the set (dropping it made X̂ = [−1e80, 1e80]², |c| ≈ 1.4e160 >
+    # ε_max = 100, "undecided", exit 4 instead of 1; float pre-screen review, session 42);
+    # only NaN says nothing
     vals = vals[~np.isnan(vals)]
     return float(vals.max()) if vals.size else 0.0
+
+
+def _norm_c_scaled(cm: Any, pts: np.ndarray) -> np.ndarray:
+    """|c| at the points, the Euclidean norm taken scaled
+    (:func:`obsdesign.simulate.result.norms`): ``norm_c``'s squares overflowed for components
+    near 10¹⁶⁰ and made a representable |c| infinite."""
+    c = getattr(cm, "c", None)
+    if c is None or getattr(cm, "norm", "euclidean") == "max":
+        return np.asarray(cm.norm_c(pts), dtype=float)
+    from obsdesign.simulate.result import norms
+
+    return norms(np.asarray(c(pts), dtype=float))
