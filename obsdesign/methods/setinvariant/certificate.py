@@ -146,15 +146,17 @@ _SUBNORMAL_ULP = 2.0**-1074
 
 def _subnormal_slack(aGA: np.ndarray, aP: np.ndarray) -> np.ndarray:
     """The error of G_i A p from rounding subnormal entries of G A and of p to doubles, which
-    the relative slack ``_FILTER`` does not cover: (rows, points) ``2⁻¹⁰⁷⁴ (|p|₁ + |G_i A|₁)``
-    (the entries' rounding errors are at most half of that each). G A ≈ 2.6·2⁻¹⁰⁷⁴ rounded
+    the relative slack ``_FILTER`` does not cover: (rows, points) ``2·2⁻¹⁰⁷⁴ (|p|₁ + |G_i A|₁)``
+    (the entries' rounding errors are at most half an ulp each, a float crossing point's
+    coordinates up to two: twice that, so the slack keeps a margin of its own; re-check
+    review, session 42). G A ≈ 2.6·2⁻¹⁰⁷⁴ rounded
     to 3·2⁻¹⁰⁷⁴ times a vertex near 10³⁰⁰ reversed the float order of a slice's two ends, the
     true maximizer was skipped and a tampered report certified theorem-3.1 at 0.9 for an
     exact 0.9 + 4.75·10⁻²⁵ (re-check review, session 42).
 
     :param aGA: |G A| (rows, n); :param aP: |p| per point (points, n)."""
     with np.errstate(over="ignore"):
-        return _SUBNORMAL_ULP * (aP.sum(axis=1)[None, :] + aGA.sum(axis=1)[:, None])
+        return 2 * _SUBNORMAL_ULP * (aP.sum(axis=1)[None, :] + aGA.sum(axis=1)[:, None])
 
 
 class _Slices:
