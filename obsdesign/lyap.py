@@ -28,7 +28,7 @@ import numpy as np
 from flint import fmpq, fmpq_mat, fmpq_poly, fmpz, fmpz_mat
 
 from obsdesign.certify.detect import hurwitz_stable, schur_stable
-from obsdesign.certify.exact import Q, dyadic, qeye, symmetrize
+from obsdesign.certify.exact import Q, dyadic, float_or_inf, qeye, symmetrize
 from obsdesign.certify.psd import check_pd_fast, check_psd, negative_direction, to_fmpq_mat
 from obsdesign.errors import InconclusiveError, InfeasibleError
 from obsdesign.spectrum import Spectrum, spectrum
@@ -1034,7 +1034,9 @@ def certified_P(
         return P
     c = margin_scale(Pf, margin)
     if c != 1:  # the margin asks for a larger P (its decay matrix is c·I)
-        P = _dyadic_certified(Am, Pf * float(c), bits, r, discrete, margin, memo, Af)
+        # float_or_inf: a margin of 1e308 makes c itself overflow (the float P is then
+        # infinite and skipped below; it raised OverflowError, the generic exit-4 text)
+        P = _dyadic_certified(Am, Pf * float_or_inf(c), bits, r, discrete, margin, memo, Af)
         if P is not None:
             return P
     return _certified_P_hp(Am, r, discrete, margin, memo, Af, guide, Pf if bits < 53 else None)
@@ -1205,7 +1207,7 @@ def _certified_P_hp(
         return None
     if Pf is not None:
         P = _dyadic_certified(
-            Am, Pf * float(margin_scale(Pf, margin)), 53, r, discrete, margin, memo, Af
+            Am, Pf * float_or_inf(margin_scale(Pf, margin)), 53, r, discrete, margin, memo, Af
         )
         if P is not None:
             return P
@@ -1349,7 +1351,7 @@ class _Forecast:
         wp = np.linalg.eigvalsh(Pf)
         wm = np.linalg.eigvalsh(M)
         if m > 0 and (wp[0] <= m or wm[0] <= m):  # certified_P scales P for the margin
-            c = float(margin_scale(Pf, self.m))
+            c = float_or_inf(margin_scale(Pf, self.m))
             wp, wm = wp * c, wm * c
         return bool(
             wp[0] - m > gap * abs(wp[-1]) and wm[0] - m > gap * max(abs(wm[-1]), abs(wm[0]), 1.0)

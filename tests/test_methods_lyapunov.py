@@ -1727,3 +1727,17 @@ def test_a_huge_margin_is_exit_4_naming_the_margin() -> None:
         InconclusiveError, match=r"margin δ = 1e\+?307.*a smaller \[method\]\.margin"
     ):
         api.design(api.load_spec_text(text, "s.toml"))
+
+
+def test_a_margin_whose_scale_factor_overflows_names_the_margin() -> None:
+    """margin = 1e308: the scale factor for the margin itself overflowed before the float P
+    did, and the design ended with the generic "integer division result too large for a
+    float" (re-check review, session 42). Exit 4 naming the margin."""
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0, 1], [1, 0]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\nL = [-1.87, 1.874]\nlambda = 0.955\nmargin = 1e308\n'
+    )
+    with pytest.raises(
+        InconclusiveError, match=r"margin δ = 1e\+?308.*a smaller \[method\]\.margin"
+    ):
+        api.design(api.load_spec_text(text, "s.toml"))
