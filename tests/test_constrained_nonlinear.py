@@ -209,6 +209,8 @@ def test_v_max_breve_rests_on_inequality_5() -> None:
     assert _claim(rep, "iss-bound").status is ClaimStatus.NUMERICAL
     assert _claim(rep, "v_max_breve-bound").status is ClaimStatus.NUMERICAL
     assert rep.exit_code() == 0
+    # the bound is proved for disturbances in D only, and says so (statement audit, session 43)
+    assert "w_k ∈ D" in _claim(rep, "v_max_breve-bound").statement
 
 
 def test_the_sampled_inequality_5_is_scaled_by_the_spec_not_the_report() -> None:

@@ -343,7 +343,10 @@ def _breve(
         return
     vbr, tb = Q(vr), Q(tr)
     ref = v_max_breve(P, rho, mu, o.X0, o.Xhat0, W)
-    statement = f"V(x̂_k − x_k) ≤ v̆_max ≤ {fmt_up(vbr, 8)} for all k along solutions from X0 × X̂0"
+    statement = (
+        f"V(x̂_k − x_k) ≤ v̆_max ≤ {fmt_up(vbr, 8)} for all k along solutions from X0 × X̂0"
+        " with every w_k ∈ D"
+    )
     check = "exact: v̆_max ≥ max V(x̂0 − x0) over X0 × X̂0 + μ max|w|²/(1 − ρ), ρ < 1"
     ok = vbr >= ref and rho < 1
     detail = f"recomputed bound ≤ {fmt_up(ref, 10)}"
