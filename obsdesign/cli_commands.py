@@ -992,7 +992,7 @@ def _dt_seconds(text: str) -> float:
         ) from None
     if q.is_finite() and q > 0 and f == 0:
         raise InputError(
-            f"--dt is {text}, a nonzero number below the float range (it would read as 0, "
+            f"--dt {text!r}: a nonzero number below the float range (it would read as 0, "
             "continuous time)"
         )
     # only -1 itself is MATLAB's "no sample time"; the text as typed in the message (1e999

@@ -413,7 +413,7 @@ def test_lists_of_tables_and_missing_values() -> None:
         ({}, ["--dt", "1e999"], "--dt '1e999': expected a finite number", False),
         ({}, ["--dt", "-2"], "--dt '-2': expected a finite number >= 0", False),
         # below the float range: read as 0.0, continuous time, silently (session 38)
-        ({}, ["--dt", "1e-400"], "--dt is 1e-400, a nonzero number below the float range", False),
+        ({}, ["--dt", "1e-400"], "--dt '1e-400': a nonzero number below the float range", False),
         ({}, ["--dt", "abc"], "--dt 'abc': expected a number of seconds", False),
     ],
 )
