@@ -74,9 +74,21 @@ def error_method(e: ObsdesignError) -> str | None:
 
 
 def _bind(spec: Spec) -> Spec:
-    """:func:`bind`."""
+    """:func:`bind`. A bound spec whose system or a set was replaced since its options were
+    parsed (``copy.copy(spec)`` then ``spec.system = …``) is bound again, on a copy: the
+    impulsive options hold A and C of the system they were parsed from, and a copy with
+    another A was certified (and designed, exit 0) for the old one while ``simulate`` ran the
+    new one (API review, session 43)."""
     if spec.options is not None:
-        return spec
+        if spec.bound_to is None or _same_objects(spec.bound_to, spec.binding()):
+            return spec
+        import copy
+
+        spec = copy.copy(spec)
+        spec.options = None
+        if spec.simulate is not None:
+            spec.simulate = copy.copy(spec.simulate)
+            spec.simulate.options = None
     mt = spec.method_table
     assert mt is not None
     if spec.method not in method_keys():
@@ -118,7 +130,17 @@ def _bind(spec: Spec) -> Spec:
         st = spec.simulate.table
         spec.simulate.options = m.parse_simulate(st, spec)
         st.done()
+    spec.bound_to = spec.binding()
     return spec
+
+
+def _same_objects(a: tuple[Any, ...], b: tuple[Any, ...]) -> bool:
+    """The same objects in the same order (identity, not equality: arrays of a spec compare
+    elementwise)."""
+    return len(a) == len(b) and all(
+        x is y or (isinstance(x, tuple) and isinstance(y, tuple) and _same_objects(x, y))
+        for x, y in zip(a, b, strict=True)
+    )
 
 
 def load_spec(path: str | Path) -> Spec:

@@ -1237,3 +1237,27 @@ def test_an_edited_M_source_label_fails_verify() -> None:
         ver = api.verify(Report.from_dict(d)[0])
         bad = [c.id for c in ver.claims if not c.ok]
         assert ver.exit_code() == 1 and "M_source-matches-spec" in bad, (label, bad)
+
+
+def test_a_copied_spec_with_another_system_is_bound_to_that_system() -> None:
+    """The impulsive options hold A and C of the system they were parsed from: a copy of the
+    3-state spec with A = diag(0, 1, 1) (spec.system replaced) had every exact claim certified
+    for the old A — Ā, κ_n ≥ 5.39999, Lemma 1's ISS — and designed with exit 0, while
+    ``simulate`` ran the new A, whose (A, C) is not even detectable (API review, session 43).
+    The copy is bound again to its own system."""
+    import copy
+    import dataclasses
+
+    from obsdesign.errors import InfeasibleError
+    from obsdesign.spec.reader import Value
+
+    spec, rep = designed("3state")
+    other = copy.copy(spec)
+    A = np.array([[fmpq(int(i == j and i > 0)) for j in range(3)] for i in range(3)], dtype=object)
+    other.system = dataclasses.replace(spec.system, A=Value.of(A))
+    failed = {c.id for c in api.certify(other, rep.parameters) if not c.ok}
+    assert {"Abar", "kappa_n", "lambda_no", "lambda_on"} <= failed
+    with pytest.raises(InfeasibleError, match="Lemma 1 fails"):
+        api.design(other)
+    assert all(c.ok for c in api.certify(spec, rep.parameters))  # the original: unchanged
+    assert spec.options.problem.A is spec.system.A.q

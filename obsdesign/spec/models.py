@@ -122,6 +122,15 @@ class Spec:
     simulate: SimulateSpec | None
     tables: dict[str, Table] = field(default_factory=dict)
     method_table: Table | None = None
+    #: what ``options`` were parsed from (:func:`obsdesign.api.bind`): the system and sets
+    #: objects; a spec whose system or a set was replaced since (``copy.copy`` then
+    #: ``spec.system = …``, ``dataclasses.replace``) is bound again
+    bound_to: tuple[Any, ...] | None = field(default=None, repr=False, compare=False)
+
+    def binding(self) -> tuple[Any, ...]:
+        """The objects the method's options are parsed from: the system and every set (by
+        identity; see ``bound_to``)."""
+        return (self.system, *sorted(self.sets.items(), key=lambda kv: kv[0]))
 
     def set(self, name: str) -> ConvexSet:
         return self.sets[name]
