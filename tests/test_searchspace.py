@@ -2379,3 +2379,24 @@ def test_the_bound_caches_are_keyed_by_the_data_not_the_text() -> None:
     status = {c.id: c.ok for c in api.certify(other, rep.parameters)}
     assert status["L_f-bound"] is False and status["f_sup-bound"] is False
     assert all(c.ok for c in api.certify(spec, rep.parameters))  # the designed spec: cached
+
+
+def test_the_bound_caches_are_keyed_by_the_parsed_expression_not_its_source() -> None:
+    """The caches were keyed by each expression's source while the bounds are computed from
+    its parsed tree: an Expr whose source was edited in place ("1.2*u1*x2", tree of "u1*x2")
+    stored L_f = 1 under the new text, and a later spec with f = 1.2·u1·x2 was certified
+    "L_f ≤ 1" (the quotient along e₂ is 6/5; API review, session 43). Keyed by the tree, and
+    an Expr is frozen."""
+    import dataclasses
+
+    text = SPEC.read_text(encoding="utf-8")
+    assert 'f = ["u1*x2", "-u1*x1"]' in text
+    spec = api.load_spec_text(text, "ex.toml")
+    ex = spec.system.f[0]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        ex.source = "1.2*u1*x2"  # type: ignore[misc]
+    object.__setattr__(ex, "source", "1.2*u1*x2")  # past the guard, as the review did
+    api.design(spec)
+    other = text.replace('f = ["u1*x2", "-u1*x1"]', 'f = ["1.2*u1*x2", "-u1*x1"]')
+    rep = api.design(api.load_spec_text(other, "f12.toml"))
+    assert Q(rep.parameters["L_f"]) >= Q(6) / 5

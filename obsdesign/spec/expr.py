@@ -112,9 +112,13 @@ _FORBIDDEN = {
 }
 
 
-@dataclass
+@dataclass(frozen=True)
 class Expr:
-    """A checked expression: evaluate it vectorized, differentiate it exactly (sympy)."""
+    """A checked expression: evaluate it vectorized, differentiate it exactly (sympy).
+
+    Frozen: ``source``, the parsed ``tree`` and the compiled callable belong together (an
+    in-place ``source`` edit left the tree and the callable of the old text; API review,
+    session 43)."""
 
     source: str
     tree: ast.Expression

@@ -13,6 +13,7 @@ continuous systems with controls" (paper 004):
 
 from __future__ import annotations
 
+import ast
 import math
 import time
 from dataclasses import dataclass
@@ -78,9 +79,12 @@ def _content_key(kind: str, spec: Spec) -> tuple[Any, ...]:
     the quotient is 5 (API review, session 42)."""
     exprs, names, diff, lo, hi = _problem(kind, spec)
     o: Options = spec.options
+    # the tree, which the bounds are computed from: keyed by ``source`` alone, an Expr whose
+    # source was edited in place (its tree unchanged) stored the old f's bounds under the new
+    # text, and a later spec with that text was certified with them (API review, session 43)
     ex_key = tuple(
         (
-            ex.source,
+            ast.dump(ex.tree),
             ex.variables,
             tuple(sorted((k, str(Q(v))) for k, v in ex.parameters.items())),
         )
