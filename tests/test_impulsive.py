@@ -299,6 +299,7 @@ def test_kappa_widest_takes_1_minus_gamma_exactly_near_1() -> None:
     42). From the exact γ, c₁ = 2·17·ln 10 and κ is the stationary point of the formula; the
     spec designs and verifies."""
     from obsdesign import api
+    from obsdesign.errors import ObsdesignError
     from obsdesign.methods.impulsive.window import kappa_widest
 
     g = fmpq(1) - fmpq(1, 10**17)
@@ -317,6 +318,19 @@ def test_kappa_widest_takes_1_minus_gamma_exactly_near_1() -> None:
     rep = api.design(api.load_spec_text(text, "s.toml"))
     assert rep.exit_code() == 0 and float(rep.parameters["kappa"]) > 0.01
     assert api.verify(rep).exit_code() == 0
+    # 1 − γ = 10⁻³³⁰ is 0.0 as a float: κ = 5·10⁻³²⁴ and "empty window", exit 1, where
+    # kappa = "max" ends with exit 4 (β = 10⁶⁶⁰ beyond a report); the same exit now
+    # (re-check review, session 43)
+    g = fmpq(1) - fmpq(1, 10**330)
+    c1 = 660 * np.log(10.0)
+    r = np.sqrt(c2 / c1)
+    assert kappa_widest(2.0, 0.0, g, 3.0) == pytest.approx(2.0 * r / (1 - r), rel=1e-12)
+    L = "0." + "9" * 330
+    for kappa in ('"widest"', '"max"'):
+        t = text.replace("0.99999999999999999", L).replace('"widest"', kappa)
+        with pytest.raises(ObsdesignError, match="beyond the float range.*'beta'") as ei:
+            api.design(api.load_spec_text(t, "s.toml"))
+        assert ei.value.exit_code == 4
 
 
 def test_kappa_widest_with_a_huge_alpha_designs_and_verifies(tmp_path: Path) -> None:

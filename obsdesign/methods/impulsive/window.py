@@ -7,6 +7,7 @@ in the safe direction: T_max down, T_min up, the radius of B up.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -49,7 +50,13 @@ def kappa_widest(varpi_o: float, coup: float, gamma: Any, alpha: float) -> float
     """
     g = float(gamma)
     om = 1 - Q(gamma)  # exact: 1 − γ of a γ within an ulp of 1
-    c1 = -2.0 * np.log1p(-g) if g <= 0.5 else -2.0 * np.log(float(om))
+    if g <= 0.5:
+        c1 = -2.0 * np.log1p(-g)
+    elif om > 0:  # the logarithm of the exact ratio: 1 − γ = 10⁻³³⁰ is 0.0 as a float, and
+        # c₁ = ∞ gave κ = 5·10⁻³²⁴, "empty window" (re-check review, session 43)
+        c1 = -2.0 * (math.log(int(om.p)) - math.log(int(om.q)))
+    else:
+        c1 = np.inf
     c2 = -np.log1p(-g / alpha)
     gamma = g
     d0 = varpi_o + coup
