@@ -594,6 +594,7 @@ def iss_mu(
     discrete: bool = True,
     strict: bool = False,
     rel: float = 1e-9,
+    remedy: str = "give a larger [method].lambda (or [method].rate_tol when λ is the best rate)",
 ) -> fmpq:
     """Smallest ISS gain μ (rounded up, then certified exactly) for the given ρ.
 
@@ -609,7 +610,8 @@ def iss_mu(
 
     :param Acl, Bw, P, rho, discrete: as in :func:`iss_matrix`;
     :param strict: certify the block matrix ≻ 0 (``check_pd``) instead of ⪰ 0 (``check_psd``);
-    :param rel: the relative step above the float μ.
+    :param rel: the relative step above the float μ;
+    :param remedy: what the message of a float-singular S tells the user to change.
     Returns μ (0 when B_w has no column). Raises :class:`InconclusiveError` when no μ certifies.
     """
     if Bw.shape[1] == 0:
@@ -629,8 +631,7 @@ def iss_mu(
             # session 42)
             raise InconclusiveError(
                 "the ISS gain μ of eq. (5): S = ρP − (A − LC)ᵀP(A − LC) is singular in floats "
-                f"(ρ = {float(r):.3g}): a rate this close to 0 leaves the float range; a larger "
-                "decay rate"
+                f"(ρ = {float(r):.3g}): a rate this close to 0 leaves the float range; " + remedy
             ) from None
     # G/2 + Gᵀ/2, not (G + Gᵀ)/2: the sum overflowed for entries above 9e307, half the float
     # range, and a μ ≈ 9.96e307 that certifies was refused (re-check trial, session 29)

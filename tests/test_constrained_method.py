@@ -1256,8 +1256,14 @@ def test_a_certificate_beyond_the_float_range_names_the_keys(key: str) -> None:
         '[method.c]\ntype = "box"\nlower = [-1.1, -1.1]\nupper = [1.1, 1.1]\n'
         "[method.D]\nlower = [-3]\nupper = [3]\n"
     )
-    with pytest.raises(InconclusiveError, match=r"S = ρP − \(A − LC\)ᵀP\(A − LC\) is singular"):
+    with pytest.raises(
+        InconclusiveError, match=r"S = ρP − \(A − LC\)ᵀP\(A − LC\) is singular"
+    ) as e2:
         api.design(api.load_spec_text(nil, "s.toml"))
+    # the key to change (the message named none and ended mid-sentence; session 43)
+    assert e2.value.message.endswith(
+        "a larger [method].lambda (or [method].rate_tol when λ is the best rate)"
+    )
     assert ("[method].rate_tol (now 1e-300)" in msg) == (key == "rate_tol")
 
 

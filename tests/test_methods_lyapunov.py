@@ -1741,3 +1741,21 @@ def test_a_margin_whose_scale_factor_overflows_names_the_margin() -> None:
         InconclusiveError, match=r"margin δ = 1e\+?308.*a smaller \[method\]\.margin"
     ):
         api.design(api.load_spec_text(text, "s.toml"))
+
+
+def test_a_float_singular_iss_block_names_the_keys_to_change() -> None:
+    """λ = 1e-300 with margin = 0 and the ISS gain: S = λ²P − (A − LC)ᵀP(A − LC) is singular
+    in floats (ρ = 0), exit 4 — whose message named no key and ended "a larger decay rate"
+    (re-check review, session 43). It names [method].lambda and iss_gain = false, and with
+    iss_gain = false the same rate certifies."""
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0, 1], [1, 0]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\nL = [0, 1]\nmargin = 0\nlambda = 1e-300\niss_gain = true\n'
+    )
+    with pytest.raises(InconclusiveError, match=r"is singular in floats") as ei:
+        api.design(api.load_spec_text(text, "s.toml"))
+    assert ei.value.exit_code == 4
+    assert "a larger [method].lambda" in ei.value.message
+    assert ei.value.message.endswith("or iss_gain = false (no ISS gain)")
+    rep = api.design(api.load_spec_text(text.replace("iss_gain = true", "iss_gain = false"), "s"))
+    assert rep.exit_code() == 0

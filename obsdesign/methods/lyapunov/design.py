@@ -362,7 +362,18 @@ def _design_for(
         rho = lyap.decay_factor(rate, s.discrete)
         # 10⁻⁶ above the float μ: the verified float check decides it (lyap.iss_mu)
         params["mu"] = lyap.iss_mu(
-            lyap.as_array(Acl), Bw, P, rho, s.discrete, strict=True, rel=ISS_MU_REL
+            lyap.as_array(Acl),
+            Bw,
+            P,
+            rho,
+            s.discrete,
+            strict=True,
+            rel=ISS_MU_REL,
+            # the message named no key and ended mid-sentence (re-check review, session 43)
+            remedy=(
+                f"give a larger [method].{name} (or [method].rate_tol when {name} is the best "
+                "rate), or iss_gain = false (no ISS gain)"
+            ),
         )
     why = (
         "no P ≻ 0 gives strict decay there (proved exactly, see the bracket claim)"
