@@ -358,6 +358,11 @@ def test_check_junit_refusals_do_not_suggest_force(tmp_path: Path) -> None:
     # input file itself"; sweep and check review, session 42)
     res = runner.invoke(app, ["check", str(tmp_path), "--junit", str(tmp_path)])
     assert res.exit_code == 2 and f"{tmp_path}: is a directory" in res.output, res.output
+    # and through a symbolic link to it (re-check review, session 43)
+    link = tmp_path.parent / f"{tmp_path.name}-link"
+    link.symlink_to(tmp_path)
+    res = runner.invoke(app, ["check", str(tmp_path), "--junit", str(link)])
+    assert res.exit_code == 2 and f"{link}: is a directory" in res.output, res.output
 
 
 def test_a_folder_that_cannot_be_listed_does_not_end_the_search(

@@ -564,7 +564,9 @@ def _check_output(path: str | Path, force: bool, inputs: tuple[Path, ...]) -> No
             same = os.path.samefile(p, i)
         except OSError:
             same = False
-        if same and stat.S_ISDIR(lst.st_mode):  # `check d --junit d`: a folder, as any other
+        # `check d --junit d`: a folder, as any other; through a link to it too (it said "is
+        # the input file itself"; re-check review, session 43)
+        if same and os.path.isdir(p):
             raise InputError(f"{p}: is a directory")
         if same and not force:
             raise InputError(f"{p}: is the input file itself; refusing to overwrite it (--force)")
