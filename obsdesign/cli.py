@@ -893,7 +893,8 @@ def _output_problem(args: list[str]) -> str | None:
         bare = value.rstrip("/" + os.sep)
         folder = value.endswith(("/", os.sep)) or value.endswith(("/.", os.sep + "."))
         if folder and bare.strip("." + "/" + os.sep):
-            return f"{value}: names a folder (trailing '/'); outputs are files"
+            end = "'/.'" if value.endswith(("/.", os.sep + ".")) else "'/'"
+            return f"{value}: names a folder (trailing {end}); outputs are files"
     return None
 
 

@@ -640,6 +640,9 @@ def test_an_output_named_with_a_trailing_slash_is_refused(tmp_path: Path) -> Non
     ):
         r = _cli(*args, cwd=tmp_path)
         assert r.returncode == 2 and "names a folder (trailing '/'); outputs are files" in r.stderr
+    # a name ending in "/." is quoted as such (it said "trailing '/'"; session 43)
+    r = _cli("design", str(SPEC), "-o", "out/.", cwd=tmp_path)
+    assert r.returncode == 2 and "out/.: names a folder (trailing '/.')" in r.stderr, r.stderr
     for arg in ("-o=", "-o=out.json"):  # click read "=out.json" as the file name
         r = _cli("design", str(SPEC), arg, cwd=tmp_path)
         assert r.returncode == 2 and "write -o FILE or --output=FILE" in r.stderr
