@@ -239,3 +239,18 @@ def test_spec_arrays_are_read_only() -> None:
             if arr.size:
                 with pytest.raises(ValueError, match="read-only"):
                     arr.flat[0] = 3
+
+
+def test_value_of_leaves_the_callers_array_writable() -> None:
+    """``Value.of(arr)`` froze the caller's own object array in place (re-check review,
+    session 43): the Value holds a read-only copy."""
+    import numpy as np
+    from flint import fmpq
+
+    from obsdesign.spec.reader import Value
+
+    arr = np.array([[fmpq(1), fmpq(2)]], dtype=object)
+    v = Value.of(arr)
+    assert arr.flags.writeable and not v.q.flags.writeable
+    arr[0, 0] = fmpq(5)
+    assert v.q[0, 0] == 1

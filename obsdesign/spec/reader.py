@@ -46,7 +46,9 @@ class Value:
     def of(cls, q: Any) -> Value:
         if isinstance(q, fmpq):
             return cls(q, float(to_float(q)))
-        arr = np.asarray(q, dtype=object)
+        # a copy: the Value is read-only, and the caller's own array was frozen in place
+        # with it (re-check review, session 43)
+        arr = np.array(q, dtype=object)
         return cls(arr, np.asarray(to_float(arr), dtype=float).reshape(arr.shape))
 
     @property
