@@ -592,3 +592,24 @@ def test_ell_exactly_at_2L_norm_P_is_not_above_it() -> None:
     assert "ell-bound" in _failed(d)
     _set(d, "ell", fmpq(10) + TINY)
     assert "ell-bound" not in _failed(d)
+
+
+def test_ell_below_1_fails_its_claim_however_far_above_2L_norm_P() -> None:
+    """f = (x₂, x₁/100), L = 1/100: the design's ℓ = 1; a report edited to ℓ = 1/20 (still
+    above 2L|P|) verified with exit 0, while the error matrix [[−1/10, 1], [3/400, 0]] has
+    the eigenvalue +1/20 — the observer diverges (statement audit, session 43). Below 1 the
+    scaling by ℓ enlarges the scaled Δ_φ, and L, declared at ℓ = 1, no longer bounds it:
+    ℓ ≥ 1 is part of the claim; ℓ = 1 exactly passes."""
+    text = (
+        '[system]\ntime = "continuous"\nstates = ["x1", "x2"]\nf = ["x2", "0.01*x1"]\n'
+        'C = [[1, 0]]\n[method]\nkey = "stubborn"\nmode = "high-gain"\n'
+        "K = [2, 1]\nlipschitz = 0.01\nlambda = 1\nepsilon = 1\n"
+    )
+    r = api.design(api.load_spec_text(text, "hg.toml"))
+    assert r.exit_code() == 0 and Q(r.parameters["ell"]) == 1
+    assert api.verify(r).exit_code() == 0
+    d = r.to_dict()
+    _set(d, "ell", fmpq(1, 20))
+    assert "ell-bound" in _failed(d)
+    _set(d, "ell", fmpq(1) - fmpq(1, 10**30))
+    assert "ell-bound" in _failed(d)

@@ -273,9 +273,10 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         ),
         (
             "ell-bound",
-            f"ℓ = {fmt_exact(ell)} > 2L|P| (the high-gain observer converges when L bounds "
-            "the scaled Δ_φ, φ = ẋ − A₀x: the spec's declaration)",
-            "exact LDLᵀ of ℓ·I − 2L·P (≻ 0; |P| = λ_max(P) for P ≻ 0)",
+            f"ℓ = {fmt_exact(ell)} ≥ 1 and ℓ > 2L|P| (the high-gain observer converges when L "
+            "bounds the scaled Δ_φ, φ = ẋ − A₀x: the spec's declaration)",
+            "ℓ ≥ 1 exactly (below 1 the scaling enlarges Δ_φ and L, declared at ℓ = 1, no "
+            "longer bounds it); exact LDLᵀ of ℓ·I − 2L·P (≻ 0; |P| = λ_max(P) for P ≻ 0)",
             ell,
             check_pd,
         ),
@@ -285,6 +286,15 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         if cid == "ell-star-bound" and res.ok:
             res = _pinned(res, ell_star, P, L)
             check += "; ℓ* is 2L|P| rounded up: ℓ*/(1 + 10⁻⁶)·I − 2L·P is not ≻ 0"
+        if cid == "ell-bound" and v < 1:
+            # a report's ℓ = 1/20 with 2L|P| below it verified, exit 0, for an observer
+            # whose error grows as e^{t/20} (statement audit, session 43)
+            res = dataclasses.replace(
+                res,
+                ok=False,
+                detail=f"ℓ = {fmt_exact(v)} < 1: L, declared for the scaled Δ_φ at ℓ = 1, does "
+                "not bound it at this ℓ",
+            )
         c.checked(
             id=cid,
             statement=statement,
