@@ -15,6 +15,7 @@ from obsdesign.api import load_spec, load_spec_text
 from obsdesign.certify.claim import ClaimStatus
 from obsdesign.errors import SpecError
 from obsdesign.methods.setinvariant import numerical
+from obsdesign.params import Parameters
 from obsdesign.sets import polytope_ops as po
 from obsdesign.sets.polytope import check_polytope_q, vertices_exact
 
@@ -291,3 +292,24 @@ def test_float_stage_keeps_the_new_vertices_of_a_small_omega(nogmp):
     assert all(c.status == ClaimStatus.NUMERICAL for c in rep.claims)
     assert _rows_up_to_sign(1e-9 * rep.parameters.float("G")) == _rows_up_to_sign(Q2)
     assert abs(rep.parameters.float("contractivity") - 0.9) <= 1e-9
+
+
+def test_without_gmp_the_gain_vertices_claim_says_what_it_checks(monkeypatch):
+    """Without cdd.gmp the reported gain vertices are checked one by one, not enumerated: an
+    exact report with one of Example 7.1's two vertices dropped verified (numerical, as it
+    must) while the claim said "exact vertex enumeration (cdd.gmp)" and "1 vertices, exactly
+    those of the admissible set", and linear-law said "certified factor" (statement audit,
+    session 43)."""
+    assert po.HAVE_GMP
+    rep = api.design(SPEC71)
+    V = rep.parameters["L_admissible_vertices"]
+    assert len(V) == 2
+    params = Parameters(dict(rep.parameters))
+    params["L_admissible_vertices"] = V[:1]
+    monkeypatch.setattr(po, "HAVE_GMP", False)
+    claims = {c.id: c for c in api.certify(load_spec(SPEC71), params)}
+    vc = claims["linear-gains-vertices"]
+    assert vc.status == ClaimStatus.NUMERICAL
+    assert "exact vertex enumeration" not in vc.check and "not checked" in vc.check
+    assert "exactly those" not in vc.detail and "1 reported points" in vc.detail
+    assert "certified" not in claims["linear-law"].detail
