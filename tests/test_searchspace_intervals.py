@@ -184,6 +184,10 @@ def test_sup_norm_and_range():
         ("floor(t)", "0", "7", False, True),
         ("floor(t/8)", "0", "0", False, True),
         ("floor(t/8) - 1", "-1", "-1", False, True),
+        # U's bounds and u on opposite sides near ±1e308: the excess overflowed the float
+        # range, exit 4 for both (float pre-screen review, session 43)
+        ("1e308 + 1e307*sin(t)", "-1.7e308", "1.7e308", True, False),
+        ("1.7e308*sin(t)", "1e308", "1.7e308", False, True),
     ],
 )
 def test_range_inside_exact_constants_and_proved_violations(
@@ -1208,3 +1212,12 @@ def test_an_arb_end_is_kept_only_when_it_is_that_float() -> None:
     assert not IV._is(arb(1) / 3, 1 / 3)
     assert not IV._is(arb(2) ** -1075, 0.0)
     assert not IV._is(arb(2) ** 1100, math.inf)
+
+
+def test_range_inside_stops_at_a_proved_violation() -> None:
+    """u = floor(10 t) against U = [0, 0] on [1/10, 3/10]: the first enclosure lies wholly
+    above U (proved), and the bisection still used all 4,096 sub-intervals of its budget
+    (re-check review, session 43). It stops there."""
+    u = [parse_expr("floor(10*t)", ["t"])]
+    ok, _, used, out = B.range_inside(u, "t", fmpq(1, 10), fmpq(3, 10), [Q(0)], [Q(0)], 4096)
+    assert (ok, out) == (False, True) and used < 64

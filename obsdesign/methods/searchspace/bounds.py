@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from obsdesign.certify.exact import float_or_inf
 from obsdesign.methods.searchspace.intervals import (
     ZERO,
     Dual,
@@ -727,7 +728,10 @@ def range_inside(
                     lo_k, hi_k = max(lo_k, q.lo), min(hi_k, q.hi)
             below = a - lo_k
             above = hi_k - z
-            worst = max(worst, float(below), float(above))
+            # ±inf past the float range: U = [−1.7e308, 1.7e308] and u near 1e308 made the
+            # difference overflow, exit 4 for a range proved inside (float pre-screen
+            # review, session 43)
+            worst = max(worst, float_or_inf(below), float_or_inf(above))
             if below > 0 or above > 0:
                 worst = max(worst, 1e-300)
             out = out or hi_k < a or lo_k > z
@@ -744,7 +748,11 @@ def range_inside(
         b = stack.pop()
         used += 1
         ex, out = excess(b)
-        outside = outside or out
+        if out:  # proved outside: the claim fails whatever the other sub-intervals give
+            # (it went on bisecting to the budget; re-check review, session 43)
+            outside = True
+            worst_left = max(worst_left, ex)
+            break
         if ex <= 0.0:
             continue
         parts = _split(b, [1.0])
