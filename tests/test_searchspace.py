@@ -2400,3 +2400,26 @@ def test_the_bound_caches_are_keyed_by_the_parsed_expression_not_its_source() ->
     other = text.replace('f = ["u1*x2", "-u1*x1"]', 'f = ["1.2*u1*x2", "-u1*x1"]')
     rep = api.design(api.load_spec_text(other, "f12.toml"))
     assert Q(rep.parameters["L_f"]) >= Q(6) / 5
+
+
+@pytest.mark.parametrize(
+    ("key", "value"),
+    [
+        ("L_h", fmpq(1, 2**1074)),
+        ("f_sup", fmpq(1, 2**1074)),
+        ("f_sup", -fmpq(1, 2**1074)),
+        ("L_f", -fmpq(int(1.7976931348623157e308))),
+        ("dtau", -fmpq(10**308)),
+    ],
+)
+def test_forged_extreme_constants_fail_their_claims_not_the_run(key: str, value: fmpq) -> None:
+    """A report with L_h = 2⁻¹⁰⁷⁴ stopped verify with "a number is beyond the float range"
+    (ΔT's rule ≈ 10³²² as a float) and one with L_f = −1.8e308 with "beyond exact
+    arithmetic" (e^(L_f Δτ)), both exit 4 blaming the spec, where a forged constant is a
+    failed claim, exit 1 (float pre-screen review, session 43)."""
+    spec = api.load_spec(SPEC)
+    rep = api.design(spec)
+    params = Parameters(dict(rep.parameters))
+    params[key] = value
+    claims = api.certify(spec, params)
+    assert any(not c.ok for c in claims)

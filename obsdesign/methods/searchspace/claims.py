@@ -19,7 +19,7 @@ from flint import fmpq
 
 from obsdesign.certify import interval as ivq
 from obsdesign.certify.claim import Claim, Claims
-from obsdesign.certify.exact import Q
+from obsdesign.certify.exact import Q, float_or_inf
 from obsdesign.certify.printing import fmt_down, fmt_exact, fmt_up
 from obsdesign.methods.searchspace import bounds
 from obsdesign.methods.searchspace.design import (
@@ -97,7 +97,7 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         passed=bool(L_h < kappa < 2 * L_h),
         margin=min(kappa - L_h, 2 * L_h - kappa),
         detail="" if L_h < kappa < 2 * L_h else _by("κ leaves (L_h, 2L_h)", kappa, L_h, 2 * L_h),
-        float_ok=float(L_h) < float(kappa) < 2 * float(L_h),
+        float_ok=float_or_inf(L_h) < float_or_inf(kappa) < 2 * float_or_inf(L_h),
     )
     c.exact(
         id="gamma0-above-star",
@@ -107,7 +107,7 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         passed=bool(o.gamma0 >= g_star),
         margin=o.gamma0 - g_star,
         detail="" if o.gamma0 >= g_star else f"γ₀ is below γ⋆ by {fmt_up(g_star - o.gamma0)}",
-        float_ok=float(o.gamma0) >= float(g_star),
+        float_ok=float_or_inf(o.gamma0) >= float_or_inf(g_star),
     )
     rule = o.alpha * g_star / (2 * L_h * F)
     c.exact(
@@ -118,7 +118,7 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         passed=bool(dT == rule),
         margin=dT - rule,
         detail="" if dT == rule else f"the rule gives {fmt_exact(rule)}",
-        float_ok=float(dT) == float(rule),
+        float_ok=float_or_inf(dT) == float_or_inf(rule),
     )
     g_min = min([*gam, g_star])
     lemma1 = g_min / (2 * L_h * F)
@@ -133,7 +133,7 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         passed=bool(dT < lemma1),
         margin=lemma1 - dT,
         detail="" if dT < lemma1 else f"ΔT exceeds γ/(2 L_h ‖f_u‖) = {fmt_down(lemma1)} (α ≥ 1?)",
-        float_ok=float(dT) < float(lemma1),
+        float_ok=float_or_inf(dT) < float_or_inf(lemma1),
     )
     k_int = K.q == 1 and K >= 1
     c.exact(
@@ -144,7 +144,7 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         passed=bool(k_int and dtau == K * dT),
         margin=dtau - K * dT,
         detail="" if (k_int and dtau == K * dT) else "Δτ ≠ KΔT or K is not a positive integer",
-        float_ok=float(dtau) == float(K) * float(dT),
+        float_ok=float_or_inf(dtau) == float_or_inf(K) * float_or_inf(dT),
     )
     ratio = kappa / L_h
     bits = K_bits(dT * L_f)
@@ -235,7 +235,7 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         passed=bool(es == g_star / kappa),
         margin=es - g_star / kappa,
         detail="" if es == g_star / kappa else f"γ⋆/κ = {fmt_exact(g_star / kappa)}",
-        float_ok=float(es) == float(g_star) / float(kappa),
+        float_ok=float_or_inf(es) == float_or_inf(g_star / kappa),
     )
     return c
 
@@ -305,6 +305,12 @@ def _schedule(c: Claims, gam: list[fmpq], g_star: fmpq, L_f: fmpq, dtau: fmpq) -
             f"L_f Δτ = {fmt_up(x)} ≥ 1, so e^(L_f Δτ)/2 ≥ (1 + L_f Δτ)/2 ≥ 1: γ⋆ is not a fixed "
             "point of the rule (Δτ too long)"
         )
+        e_hi = e_lo = fmpq(0)
+    elif x < 0:
+        # a (forged) negative L_f or Δτ: no Lipschitz constant and no time step; e^x of
+        # L_f = −1.8e308 stopped verify with "beyond exact arithmetic", exit 4 (float
+        # pre-screen review, session 43)
+        bad = f"L_f Δτ = {fmt_exact(x)} < 0: L_f and Δτ must be ≥ 0"
         e_hi = e_lo = fmpq(0)
     else:
         e_hi, e_lo = exp_upper(x), exp_lower(x)
@@ -583,7 +589,7 @@ def _constant(c: Claims, spec: Spec, k: str, val: fmpq) -> None:
                     else "the interval bound"
                 )
             ),
-            float_ok=b.finite and float(val) >= b.upper and not refuted,
+            float_ok=b.finite and float_or_inf(val) >= b.upper and not refuted,
         )
     else:
         c.numerical(
