@@ -37,6 +37,7 @@ from obsdesign.methods.base import Method, Progress
 from obsdesign.params import Parameters, same_bits
 from obsdesign.report.model import TOP_KEYS, Report, check_output, write_atomic
 from obsdesign.spec import Spec, read_spec, read_spec_text
+from obsdesign.spec.frozen import freeze_arrays
 
 if TYPE_CHECKING:  # the simulation modules load with the first simulate
     from obsdesign.simulate.result import SimResult
@@ -81,6 +82,7 @@ def _bind(spec: Spec) -> Spec:
     new one (API review, session 43)."""
     if spec.options is not None:
         if spec.bound_to is None or _same_objects(spec.bound_to, spec.binding()):
+            freeze_arrays((spec.sets, spec.options))  # copies (deepcopy, pickle) too
             return spec
         import copy
 
@@ -131,6 +133,7 @@ def _bind(spec: Spec) -> Spec:
         spec.simulate.options = m.parse_simulate(st, spec)
         st.done()
     spec.bound_to = spec.binding()
+    freeze_arrays((spec.sets, spec.options))
     return spec
 
 
