@@ -381,6 +381,14 @@ def test_gamma_bounds(sec5, tmp_path, key, cid) -> None:
     assert_only(sec5, tmp_path, {cid}, {key: ok}, {key: bad})
 
 
+def test_a_zero_gamma_fails_its_claims_not_the_parse(sec5) -> None:
+    """γ = 0 in a report: θ-covers divided by γ ε_min² before gamma-bound could refuse it, and
+    the only failed claim read "parameters-wellformed: parse / ZeroDivisionError" (statement
+    audit, session 43). Now θ-covers fails saying why; nothing is a parse failure."""
+    failed = failed_ids(tamper(sec5, gamma=fmpq(0)))
+    assert "theta-covers" in failed and "parameters-wellformed" not in failed
+
+
 def test_lambda_min_bound(sec5, tmp_path) -> None:
     P, ell = p_exact(sec5, "P"), p_exact(sec5, "lambda_min_P")
     ok, bad = bisect(ell, ell * 2, lambda x: bool(check_psd(P - qeye(2) * x)))

@@ -396,10 +396,23 @@ def _theta_covers(
     :param eps_min: ε_min; :param where: the paper reference."""
     sym = {"theta": "θ", "theta_breve": "θ̆"}[key]
     ratio = f"({top_label} − v_min)/(γ ε_min²)"
+    statement = f"{sym} = {_int_or_exact(theta)} ≥ {ratio}"
+    if not gamma * eps_min**2 > 0:
+        # a (forged) γ ≤ 0 divided by zero here, before gamma-bound could say so: the claim
+        # read "parse / ZeroDivisionError" (statement audit, session 43)
+        c.exact(
+            id=f"{key}-covers",
+            statement=statement,
+            reference=_ref(where),
+            check=f"exact rational comparison; {sym} an integer",
+            passed=False,
+            detail=f"γ ε_min² = {fmt_exact(gamma * eps_min**2)} is not > 0: no step lowers V",
+        )
+        return
     need = max(top - v_min, fmpq(0)) / (gamma * eps_min**2)
     c.exact(
         id=f"{key}-covers",
-        statement=f"{sym} = {_int_or_exact(theta)} ≥ {ratio}",
+        statement=statement,
         reference=_ref(where),
         check=f"exact rational comparison; {sym} an integer",
         passed=theta >= need and _is_int(theta),
