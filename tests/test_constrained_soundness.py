@@ -1396,3 +1396,44 @@ def test_a_false_cmin_inclusion_is_refuted_by_a_faces_support() -> None:
     assert sum(max(p, 0) ** 4 for p in phi) <= F("2.906e4") ** 2
     lo, hi = (F("-1440.85876021"), F("-763.10600421")), (F("985.474705836"), F("673.156614686"))
     assert any(v < a or v > b for v, a, b in zip(x, lo, hi, strict=True))
+
+
+def _exact_outside(E: list[list[str]], x: list[fmpq]) -> bool:
+    """xᵀEx > 1 exactly (a centred ellipsoid X̂)."""
+    Eq = [[Q(v) for v in r] for r in E]
+    return sum(x[i] * Eq[i][j] * x[j] for i in range(2) for j in range(2)) > 1
+
+
+def test_ellipsoid_map_witness_along_the_generalized_axes() -> None:
+    """Q = [[2, −2], [−2, 3]], r = 45, ε_min = 0.011 (not a rational square, so the failed
+    outer-set test is not a proof) against the disk X̂ = {0.03|x|² ≤ 1}: (8, 156/25) lies in
+    C_min and outside X̂, along the eigenvector of Q's smallest eigenvalue; ±e_i and X̂'s own
+    axes (E = 0.03 I: any) missed it, exit 4 for an inclusion false by 4× (statement audit,
+    session 43). The generalized eigenvectors of (E, Q) find it."""
+    cm = ellipsoid_map(_q([[2, -2], [-2, 3]]), Q(45))
+    eps = Q("0.011")
+    E = [["0.03", "0"], ["0", "0.03"]]
+    xh = Ellipsoid(_q(E), np.array([fmpq(0)] * 2, dtype=object))
+    assert not CL.cmin_in_xhat(cm, eps, xh)[0]
+    w = CL.cmin_witness(cm, eps, xh)
+    assert w is not None and cm.norm_c_sq_q(w) <= eps**2 and _exact_outside(E, list(w))
+
+
+@pytest.mark.parametrize("kind", ["polytope", "box"])
+def test_affine_map_witness_at_a_slab_vertex(kind: str) -> None:
+    """|x_i| ≤ 1 (a polytope map, or the box map (19)), Euclidean norm, ε_min = 1/2, against
+    X̂ = {10⁻⁴x₁² + 0.37x₂² ≤ 1}: (1, 17/10) lies in C_min and outside X̂; the segments from
+    the outer set's centre towards its corners stay inside X̂, exit 4 "neither proved nor
+    refuted" (statement audit, session 43). The vertices of the slabs {φ_i ≤ t, φ_j ≤ 0}
+    refute it."""
+    if kind == "polytope":
+        G = _q([[1, 0], [-1, 0], [0, 1], [0, -1]])
+        cm = polytope_map(G, np.array([fmpq(1)] * 4, dtype=object), "euclidean")
+    else:
+        cm = box_map(np.array([-1.0, -1.0]), np.array([1.0, 1.0]))
+    eps = Q("0.5")
+    E = [["0.0001", "0"], ["0", "0.37"]]
+    xh = Ellipsoid(_q(E), np.array([fmpq(0)] * 2, dtype=object))
+    assert not CL.cmin_in_xhat(cm, eps, xh)[0]
+    w = CL.cmin_witness(cm, eps, xh)
+    assert w is not None and cm.norm_c_sq_q(w) <= eps**2 and _exact_outside(E, list(w))

@@ -24,7 +24,7 @@ from mpmath import iv
 from obsdesign import lyap
 from obsdesign.certify.claim import Claim, Claims, ClaimStatus
 from obsdesign.certify.exact import Q, dyadic, qeye, to_float
-from obsdesign.certify.interval import sqrt_upper, upper
+from obsdesign.certify.interval import sqrt_lower, sqrt_upper, upper
 from obsdesign.certify.linalg import ROUNDED_UP_REL
 from obsdesign.certify.printing import (
     fmt_down,
@@ -863,7 +863,27 @@ def cmin_witness(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet) -> np.ndarray
         x = _last_in_cmin(cm, e2, p, v - p, fmpq(1))
         if not contains_q(Xhat, x):
             return _short_witness(x, cm, e2, Xhat)
-    return _face_witness(cm, eps_min, Xhat, p, e2)
+    w = _slab_witness(cm, eps_min, Xhat, e2)
+    return w if w is not None else _face_witness(cm, eps_min, Xhat, p, e2)
+
+
+def _slab_witness(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet, e2: fmpq) -> np.ndarray | None:
+    """:func:`cmin_witness` for an affine map by the vertices of the slabs {φ_i ≤ t,
+    φ_j ≤ 0 for j ≠ i}, t ≤ √ε_min rational: only c_i is nonzero there, so they lie in C_min
+    (each is checked exactly, |c|² ≤ ε_min²); one outside X̂ refutes C_min ⊂ X̂. The segments
+    from the outer set's centre miss them: a polytope map |x_i| ≤ 1 with ε_min = 1/2 against
+    X̂ = {10⁻⁴x₁² + 0.37x₂² ≤ 1} has (1, 17/10) in C_min and outside X̂, and the failed
+    inclusion was exit 4, "neither proved nor refuted" (statement audit, session 43)."""
+    t = sqrt_lower(Q(eps_min))
+    for i in range(len(cm.h_q)):
+        h = np.array([hj + (t if j == i else 0) for j, hj in enumerate(cm.h_q)], dtype=object)
+        V, bounded = vertices_exact(cm.G_q, h)
+        if not bounded or len(V) > WITNESS_VERTICES:
+            continue
+        for v in V:
+            if cm.norm_c_sq_q(v) <= e2 and not contains_q(Xhat, v):
+                return np.asarray(v, dtype=object)
+    return None
 
 
 def _face_witness(
@@ -918,8 +938,23 @@ def _ellipsoid_map_witness(cm: ConstraintMap, eps_min: Any, Xhat: ConvexSet) -> 
         Qinv = B.qinv(cm.Q_q)
         dirs += [Qinv @ G[j] for j in range(G.shape[0])]
     elif isinstance(Xhat, Ellipsoid):
-        _, vecs = np.linalg.eigh(np.asarray(Xhat.E, dtype=float))
-        dirs += [np.array([Q(float(v)) for v in vecs[:, k]], dtype=object) for k in range(n)]
+        import scipy.linalg as sl
+
+        Ef, Qf = np.asarray(Xhat.E, dtype=float), np.asarray(to_float(cm.Q_q), dtype=float)
+        axes = [np.linalg.eigh(Ef)[1]]
+        # the directions of the largest xᵀEx on {xᵀQx = R}: the generalized eigenvectors of
+        # (E, Q) (Q = [[2, −2], [−2, 3]] against a disk X̂: E's own axes missed C_min's far
+        # point, exit 4 for an inclusion false by 4× (statement audit, session 43))
+        try:
+            axes.append(sl.eigh(Ef, Qf)[1])
+        except (np.linalg.LinAlgError, ValueError):
+            pass
+        dirs += [
+            np.array([Q(float(v)) for v in vecs[:, k]], dtype=object)
+            for vecs in axes
+            for k in range(n)
+            if np.all(np.isfinite(vecs[:, k]))
+        ]
         if any(x != 0 for x in Xhat.center_q):
             dirs.append(np.array(Xhat.center_q, dtype=object))
     e2 = Q(eps_min) ** 2
