@@ -1168,7 +1168,11 @@ def test_the_search_cap_is_said_with_the_right_side_and_no_bracket() -> None:
     stops at its cap. Continuous time: 'best λ ≥ 524288', no bracket; discrete time, where the
     best λ is the smallest, the note said '≥ 1e-06' — it is '≤'. Both say the search stopped at
     its cap, and every claim is still certified."""
-    for time, A, side, at in (("continuous", 1, "≥", "524288"), ("discrete", 2, "≤", "1e-06")):
+    # the bound rounded outward: "≤ 1e-06" was below the certified 1.0000003e-6 (session 43)
+    for time, A, side, at in (
+        ("continuous", 1, "≥", "524288"),
+        ("discrete", 2, "≤", "0.00000100001"),
+    ):
         text = (
             f'[system]\ntime = "{time}"\nA = [[{A}]]\nC = [[1]]\n[method]\nkey = "stubborn"\n'
             "gain_bound = 10\n"
@@ -2200,3 +2204,18 @@ def test_high_gain_report_matrices_are_read_at_their_shape() -> None:
         ver = api.verify(Report.from_dict(d)[0])
         bad = [c for c in ver.claims if c.id == "parameters-wellformed"]
         assert ver.exit_code() != 0 and bad and f"parameters.{k}: expected shape" in bad[0].detail
+
+
+def test_the_best_lambda_note_at_the_search_cap_rounds_its_bound_outward() -> None:
+    """Discrete A = 0, C = 1: the best λ is the search's cap; the note said "best λ ≤ 1e-06"
+    for a certified λ_max = 1.0000003·10⁻⁶ (the bound printed below the value it bounds) and
+    "λ = 1/1e+06" (statement audit, session 43)."""
+    import re
+
+    text = '[system]\ntime = "discrete"\nA = [[0]]\nC = [[1]]\n[method]\nkey = "stubborn"\n'
+    rep = api.design(api.load_spec_text(text, "d1.toml"))
+    note = next(n for n in rep.notes if n.startswith("best λ"))
+    m = re.match(r"best λ ≤ ([0-9.e+-]+) ", note)
+    assert m is not None, note
+    assert Q(m.group(1)) >= Q(rep.parameters["lambda_max"])
+    assert "cap λ = 1e-06" in note and "1/1e" not in note

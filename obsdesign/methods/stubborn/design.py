@@ -24,7 +24,7 @@ import numpy as np
 from flint import fmpq
 
 from obsdesign.certify.exact import Q, dyadic, symmetrize, to_float
-from obsdesign.certify.printing import fmt_exact
+from obsdesign.certify.printing import fmt_down, fmt_exact, fmt_up
 from obsdesign.errors import InconclusiveError, InfeasibleError, SolverError
 from obsdesign.lmi import overflow, solve
 from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
@@ -472,10 +472,17 @@ def design_params(
         # at a search cap the best λ is only bounded on one side: ≥ in continuous time (the
         # LMIs held up to the cap, and may for every λ, e.g. C invertible), ≤ in discrete
         # time, where the best λ is the smallest (the note said ≥: outsider trial, session 22)
-        cap = f"{LAMBDA_CAP:g}" if not pl.discrete else f"1/{LAMBDA_CAP:g}"
+        cap = f"{LAMBDA_CAP:g}" if not pl.discrete else f"{1 / LAMBDA_CAP:g}"
+        # the one-sided bound rounded in its own direction: "≤ 1e-06" printed a certified
+        # 1.0000003·10⁻⁶, and the cap read "λ = 1/1e+06" (statement audit, session 43)
+        shown = (
+            f"{float(best):.6g}"
+            if other is not None
+            else (fmt_up(best, 6) if pl.discrete else fmt_down(best, 6))
+        )
         notes.append(
             f"best λ {'≈' if other is not None else ('≤' if pl.discrete else '≥')} "
-            f"{float(best):.6g} (certified there"
+            f"{shown} (certified there"
             + (
                 f"; solver: {st} at {float(bad):.6g})"
                 if other is not None
