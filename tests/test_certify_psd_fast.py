@@ -256,3 +256,15 @@ def test_the_cholesky_certificate_holds_at_any_scale(scale_bits: int) -> None:
     Mf = np.array([[float(x) for x in row] for row in M], dtype=float)
     r = psd._gershgorin_certificate(F, Mf)
     assert r is not None and r.ok and r.detail.startswith("M = RᵀR + S")
+
+
+def test_the_integer_tests_refuse_a_rational_matrix() -> None:
+    """check_pd_int and diag_dominant_int truncated an fmpq_mat's entries: [[2, 29/10],
+    [29/10, 4]] (determinant −41/100) was "≻ 0" as [[2, 2], [2, 4]], and I + (99/100)·S with
+    λ_min = −0.98 was "diagonally dominant" (primitives review, session 43). A TypeError."""
+    from flint import fmpq_mat
+
+    bad = fmpq_mat([[2, fmpq(29, 10)], [fmpq(29, 10), 4]])
+    for f in (psd.check_pd_int, psd.diag_dominant_int, psd.fraction_free_int):
+        with pytest.raises(TypeError, match="fmpz_mat"):
+            f(bad)

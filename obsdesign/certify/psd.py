@@ -266,6 +266,12 @@ def _positive_scale(Z: Any, scale: Any) -> Any:
     Z square and symmetric, scale > 0 (ValueError otherwise: a caller's error, never a
     verdict; found by the session-17 review, where a non-symmetric Z or a scale ≤ 0 gave
     a wrong "≻ 0")."""
+    from flint import fmpz_mat
+
+    if not isinstance(Z, fmpz_mat):
+        # an fmpq_mat was truncated entry by entry (int(29/10) = 2) and [[2, 29/10],
+        # [29/10, 4]], not ≻ 0, was proved ≻ 0 (primitives review, session 43)
+        raise TypeError(f"expected an integer matrix (flint fmpz_mat), got {type(Z).__name__}")
     c = Q(scale)
     if c <= 0:
         raise ValueError("scale must be positive")
@@ -523,8 +529,10 @@ def check_pd_int(Z: Any, scale: Any = 1) -> tuple[PSDResult, np.ndarray | None]:
     :param Z: square symmetric integer matrix; :param scale: the positive factor (exact).
     Returns the verdict and the float matrix it used (H, a positive multiple of fl(M), so its
     eigenvalues have the signs of M's), None when it made none."""
-    from flint import fmpq, fmpq_mat
+    from flint import fmpq, fmpq_mat, fmpz_mat
 
+    if not isinstance(Z, fmpz_mat):  # see _positive_scale: fractions were truncated
+        raise TypeError(f"expected an integer matrix (flint fmpz_mat), got {type(Z).__name__}")
     c = Q(scale)
     if c <= 0:
         raise ValueError("scale must be positive")
