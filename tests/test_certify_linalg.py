@@ -191,3 +191,12 @@ def test_norm_upper_of_a_norm_just_above_a_power_of_two_is_rounded_up_within_1e6
     u = norm_upper(X)
     assert norm_bound_holds(X, u) and not_above(X, u)
     assert u == 1 + F(1, 2**30)
+
+
+def test_norm_upper_of_entries_beyond_the_float_range() -> None:
+    """X = [[10⁴⁰⁰, 1]]: the float norm raised OverflowError (an impulsive spec with such a
+    block was exit 4) where the exact Frobenius bound holds (primitives review, session 43)."""
+    X = np.array([[fmpq(10**400), fmpq(1)]], dtype=object)
+    u = norm_upper(X)
+    assert u >= 0 and u * u >= fmpq(10**800) + 1
+    assert u <= fmpq(10**400) * (1 + fmpq(1, 2**30))

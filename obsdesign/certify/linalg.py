@@ -71,7 +71,12 @@ def norm_upper(X: Any) -> fmpq:
         return fmpq(0)
     if all(v == 0 for v in X.flat):
         return fmpq(0)
-    f = float(np.linalg.norm(to_float(X), 2))
+    try:
+        f = float(np.linalg.norm(to_float(X), 2))
+    except OverflowError:  # an entry beyond the float range (10⁴⁰⁰): the exact bound below
+        # (it raised, exit 4 for an impulsive spec the Frobenius bound certifies; primitives
+        # review, session 43)
+        f = math.inf
     if f > 0.0 and math.isfinite(f):
         # 40 bits: at 30 the raise of 2⁻³⁰ itself rounded away when f is a power of two (‖X‖ =
         # 1 + 10⁻³⁴ for X = (1, 5·10⁻¹⁸)ᵀ: u = 1 failed, the next step gave 1.00098 and the
