@@ -1576,9 +1576,22 @@ def best_rate(
             hi = cand
     if P is None:
         what = "λ < 1" if discrete else "α > 0"
+        # the stability margin below the finest candidate names rate_tol: A = −1e-150·I said
+        # only "no decay rate could be certified", where rate_tol = 1e-151 certifies (float
+        # pre-screen review, session 43)
+        gap = (1 - abs(bound)) if discrete else -bound
+        finest = float(grid) / 10**12
+        hint = (
+            f"; its stability margin ({'1 − ρ(A − LC)' if discrete else '−max Re eig(A − LC)'}"
+            f" ≈ {gap:.3g}) is below the search's finest candidate, {finest:.3g} from the "
+            f"limit on the grid of rate_tol = {float(tol_q):.3g}: give a [method].rate_tol "
+            f"below {gap:.1g}"
+            if 0 < gap < finest
+            else ""
+        )
         raise InconclusiveError(
             f"A − LC is {'Schur' if discrete else 'Hurwitz'} (exact test) but no decay rate "
-            f"{what} could be certified"
+            f"{what} could be certified{hint}"
         )
     while hi - lo > tol_q:
         # the midpoint through float64 (as the search always did: same candidates, same result)

@@ -1759,3 +1759,18 @@ def test_a_float_singular_iss_block_names_the_keys_to_change() -> None:
     assert ei.value.message.endswith("or iss_gain = false (no ISS gain)")
     rep = api.design(api.load_spec_text(text.replace("iss_gain = true", "iss_gain = false"), "s"))
     assert rep.exit_code() == 0
+
+
+def test_a_stability_margin_below_the_rate_grid_names_rate_tol() -> None:
+    """A = diag(−1e-150, −2e-150), L = 0: every candidate rate of the rate_tol grid is above
+    α_best ≈ 1e-150, and the exit 4 said only "no decay rate α > 0 could be certified" (float
+    pre-screen review, session 43). It names rate_tol, and a rate_tol below the margin
+    certifies."""
+    text = (
+        '[system]\ntime = "continuous"\nA = [[-1e-150, 0], [0, -2e-150]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\nL = [0, 0]\n'
+    )
+    with pytest.raises(InconclusiveError, match=r"give a \[method\]\.rate_tol below 1e-150"):
+        api.design(api.load_spec_text(text, "s.toml"))
+    rep = api.design(api.load_spec_text(text + "rate_tol = 1e-151\n", "s.toml"))
+    assert rep.exit_code() == 0
