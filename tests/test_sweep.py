@@ -466,13 +466,29 @@ def test_set_key_multiline_span_is_not_fooled_by_a_key_named_like_the_old_span_k
     assert tomllib.loads(out) == {"m": {"v": 7, "w": 3, "obsdesign-sweep-value-span": 4, "z": [5]}}
 
 
-def test_a_point_past_the_timeout_gets_its_row_and_the_others_keep_theirs() -> None:
+def test_a_point_past_the_timeout_gets_its_row_and_the_others_keep_theirs(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
     """One hanging point cost every row of a sweep (hostile-input trial, session 24):
     ``timeout`` bounds each point as ``check --timeout`` does each spec; the slow point is
-    exit 3 "not finished", the fast one keeps its row."""
+    exit 3 "not finished", the fast one keeps its row. The second point's design hangs (a
+    stand-in: the nested-sin input that used to take seconds, its input range bisected to the
+    whole budget, is now refuted at once — session 43)."""
+    import time
+
+    from obsdesign import api as _api
+
     spec = Path(__file__).resolve().parents[1] / "specs" / "hernandez-garcia-example.toml"
-    slow = "sin(" * 10 + "t" + ")" * 10
-    grid = [f'system.u=[["t/3 - floor(t/3)"], ["{slow}"]]']
+    real = _api.design
+
+    def hangs(sp, *a, **k):  # noqa: ANN001, ANN002, ANN003, ANN202
+        if "[point 1]" in str(getattr(sp, "file", "")):
+            while True:
+                time.sleep(0.05)
+        return real(sp, *a, **k)
+
+    monkeypatch.setattr(_api, "design", hangs)
+    grid = ['system.u=[["t/3 - floor(t/3)"], ["t/4 - floor(t/4)"]]']
     rows = sw.sweep_rows(spec, grid, timeout=1.0)
     assert [r["exit_code"] for r in rows] == [0, 3]
     assert rows[1]["message"].startswith("not finished within 1 s")
