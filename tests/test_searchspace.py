@@ -2423,3 +2423,20 @@ def test_forged_extreme_constants_fail_their_claims_not_the_run(key: str, value:
     params[key] = value
     claims = api.certify(spec, params)
     assert any(not c.ok for c in claims)
+
+
+def test_two_literals_of_one_double_do_not_share_their_bounds() -> None:
+    """1.00000000000000000 and 1.00000000000000009 are one double but two exact values: keyed
+    by the parsed tree alone, the second spec got the first's bounds in the same process and
+    `check` certified L_f = 1 where the coefficient is exactly 10 (re-check review, session
+    43). The key holds the source too."""
+    text = SPEC.read_text(encoding="utf-8")
+    old = 'f = ["u1*x2", "-u1*x1"]'
+    assert old in text
+
+    def spec(lit: str) -> str:
+        return text.replace(old, f'f = ["(1 + ({lit} - 1)*100000000000000000)*u1*x2", "-u1*x1"]')
+
+    one = api.design(api.load_spec_text(spec("1.00000000000000000"), "a.toml"))
+    ten = api.design(api.load_spec_text(spec("1.00000000000000009"), "b.toml"))
+    assert Q(one.parameters["L_f"]) < 2 and Q(ten.parameters["L_f"]) >= 10

@@ -79,11 +79,15 @@ def _content_key(kind: str, spec: Spec) -> tuple[Any, ...]:
     the quotient is 5 (API review, session 42)."""
     exprs, names, diff, lo, hi = _problem(kind, spec)
     o: Options = spec.options
-    # the tree, which the bounds are computed from: keyed by ``source`` alone, an Expr whose
-    # source was edited in place (its tree unchanged) stored the old f's bounds under the new
-    # text, and a later spec with that text was certified with them (API review, session 43)
+    # the tree and the source, which the bounds are computed from (the structure from the
+    # tree, each decimal literal's exact value from the source): keyed by ``source`` alone, an
+    # Expr whose source was edited in place (its tree unchanged) stored the old f's bounds
+    # under the new text (API review, session 43); by the tree alone, 1.00000000000000000 and
+    # 1.00000000000000009 (one double, two exact values) shared their bounds, and `check` of
+    # two such specs certified L_f = 1 where the quotient is 10 (re-check review, session 43)
     ex_key = tuple(
         (
+            ex.source,
             ast.dump(ex.tree),
             ex.variables,
             tuple(sorted((k, str(Q(v))) for k, v in ex.parameters.items())),
