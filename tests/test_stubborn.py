@@ -232,7 +232,13 @@ def test_tamper_gain_bound(ex1: Report) -> None:
     assert b * b < n2
     d["spec"] = d["spec"].replace("gain_bound = 100", f"gain_bound = {float(b)!r}")
     d["spec_sha256"] = hashlib.sha256(d["spec"].encode()).hexdigest()
-    assert _failed(d) == {"gain-bound", "gain_bound-matches-spec", "lambda-max-certified"}
+    # and the solver's problem, with the smaller bound, is no longer feasible at λ_max
+    assert _failed(d) == {
+        "gain-bound",
+        "gain_bound-matches-spec",
+        "lambda-max-certified",
+        "lambda-max-bracket",
+    }
 
 
 @pytest.mark.parametrize("name", sorted(EXPECTED))
@@ -1059,11 +1065,22 @@ def test_simulate_time_limit_key_is_read_and_checked() -> None:
 
 # -- mutation review 20: conditions that no test decided before --------------------------
 def _always_infeasible(monkeypatch: pytest.MonkeyPatch) -> None:
-    """The far end's solver answer forced to 'infeasible': the side conditions of the bracket
-    must decide on their own (a solver that says infeasible anywhere must not widen them)."""
+    """The far end's solver answer forced to 'infeasible' (the near end, re-solved since
+    session 43, to 'optimal': the first solve of each verify is the far end's): the side
+    conditions of the bracket must decide on their own (a solver that says infeasible
+    anywhere must not widen them)."""
     from obsdesign.methods.stubborn import design as dz
 
-    monkeypatch.setattr(dz, "Feasibility", lambda pl, o: lambda lam: (False, dz.INFEASIBLE))
+    def feasibility(pl: Any, o: Any) -> Any:
+        calls: list[float] = []
+
+        def solve(lam: float) -> tuple[bool, str]:
+            calls.append(lam)
+            return (False, dz.INFEASIBLE) if len(calls) == 1 else (True, "optimal")
+
+        return solve
+
+    monkeypatch.setattr(dz, "Feasibility", feasibility)
 
 
 def _bracket_claim(d: dict[str, Any]) -> Any:
@@ -2219,3 +2236,32 @@ def test_the_best_lambda_note_at_the_search_cap_rounds_its_bound_outward() -> No
     assert m is not None, note
     assert Q(m.group(1)) >= Q(rep.parameters["lambda_max"])
     assert "cap λ = 1e-06" in note and "1/1e" not in note
+
+
+def test_the_bracket_near_end_is_re_solved_too() -> None:
+    """A = −1, C = 1, r_bound = 10: every point of the solver's problem (P ⪰ I, R ⪯ r_bound)
+    has λ < R/P − 2 ≤ 12. The λ_max certificate scaled by 1/100 (the LMIs are homogeneous, so
+    it still certifies them) with λ_max = 512 and the bracket [512, 1024] verified, exit 0,
+    saying the problem's best λ lies in [512, 1024] (stubborn review, session 43): the near
+    end is re-solved as the far end is."""
+    from obsdesign.methods.stubborn.claims import lambda_max_claims
+    from obsdesign.params import Parameters
+
+    text = (
+        '[system]\ntime = "continuous"\nA = [[-1]]\nC = [[1]]\n'
+        '[method]\nkey = "stubborn"\nr_bound = 10\n'
+    )
+    spec = api.load_spec_text(text, "scalar.toml")
+    rep = api.design(spec)
+    assert rep.exit_code() == 0
+    ok = {c.id: c.ok for c in lambda_max_claims(spec, rep.parameters)}
+    assert ok["lambda-max-bracket"] and ok["lambda-max-certified"]
+    p = Parameters(dict(rep.parameters))
+    s = fmpq(1, 100)
+    for k in ("P", "U", "W", "Y"):
+        p[f"{k}_at_max"] = np.asarray(rep.parameters[f"{k}_at_max"], dtype=object) * s
+    p["lambda_max"] = fmpq(512)
+    p["lambda_bracket"] = np.array([fmpq(512), fmpq(1024)], dtype=object)
+    ok = {c.id: c.ok for c in lambda_max_claims(spec, p)}
+    assert ok["lambda-max-certified"]  # the LMIs do hold at 512 with the scaled point
+    assert not ok["lambda-max-bracket"]
