@@ -422,3 +422,22 @@ def test_a_polytope_g_of_the_wrong_length_gets_no_dim_hint() -> None:
     with pytest.raises(SpecError, match=r"expected 4 numbers, got 3$") as ei:
         load_spec_text(GOOD + "\n[sets.P]\n" + body + "\n")
     assert ei.value.key == "sets.P.g"
+
+
+def test_a_system_field_cannot_be_assigned_in_place() -> None:
+    """``spec.system.A = …`` kept the System object, so the API's binding check saw the same
+    system and the impulsive options certified claims of the old A (re-check review, session
+    43). System is frozen: a field assignment raises; a replaced system is bound again."""
+    import dataclasses
+
+    import pytest
+
+    from obsdesign import api
+
+    spec = api.load_spec_text(
+        '[system]\ntime = "discrete"\nA = [[0.5]]\nC = [[1]]\n[method]\nkey = "lyapunov"\n',
+        "s.toml",
+    )
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        spec.system.A = spec.system.C  # type: ignore[misc]
+    assert spec.system.m == 0 and spec.system.nd == 0 and spec.system.nv == 1

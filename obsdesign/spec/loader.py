@@ -7,6 +7,7 @@ upper, E symmetric positive definite); every error names the file and the TOML k
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import re
 import tomllib
@@ -378,10 +379,13 @@ def _system(t: Table) -> System:
         raise t.error("psi", "is the additive term of A x + psi: A is missing")
     exact = sys.exact_parameters()
     x_u_d_t = [*sys.states, *sys.inputs, *sys.disturbances, "t"]
-    sys.f = _exprs(t, "f", n, x_u_d_t, exact)
-    sys.psi = _exprs(t, "psi", n, x_u_d_t, exact)
-    sys.h = _exprs(t, "h", p, [*sys.states, *sys.inputs, *sys.noises, "t"], exact)
-    sys.u_signal = _exprs(t, "u", m, ["t"], exact)
+    sys = dataclasses.replace(  # System is frozen
+        sys,
+        f=_exprs(t, "f", n, x_u_d_t, exact),
+        psi=_exprs(t, "psi", n, x_u_d_t, exact),
+        h=_exprs(t, "h", p, [*sys.states, *sys.inputs, *sys.noises, "t"], exact),
+        u_signal=_exprs(t, "u", m, ["t"], exact),
+    )
     t.done()
     return sys
 

@@ -11,7 +11,7 @@ from obsdesign.spec.reader import Table, Value
 from obsdesign.spec.signals import Signal
 
 
-@dataclass
+@dataclass(frozen=True)
 class System:
     """``[system]``: the one home of the plant.
 
@@ -48,7 +48,11 @@ class System:
     nv: int = field(init=False)
 
     def __post_init__(self) -> None:
-        self.m, self.nd, self.nv = self.B.shape[1], self.Bd.shape[1], self.Dn.shape[1]
+        # frozen: a field assigned in place (spec.system.A = …) kept the object, so the
+        # binding check saw the same system and the impulsive options certified the old A
+        # (re-check review, session 43); replace the system (dataclasses.replace) instead
+        for k, v in (("m", self.B.shape[1]), ("nd", self.Bd.shape[1]), ("nv", self.Dn.shape[1])):
+            object.__setattr__(self, k, v)
 
     @property
     def discrete(self) -> bool:
