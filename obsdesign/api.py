@@ -82,7 +82,7 @@ def _bind(spec: Spec) -> Spec:
     new one (API review, session 43)."""
     if spec.options is not None:
         if spec.bound_to is None or _same_objects(spec.bound_to, spec.binding()):
-            freeze_arrays((spec.sets, spec.options))  # copies (deepcopy, pickle) too
+            freeze_arrays((spec.sets, spec.options, spec.simulate))  # copies (deepcopy, pickle) too
             return spec
         import copy
 
@@ -133,7 +133,7 @@ def _bind(spec: Spec) -> Spec:
         spec.simulate.options = m.parse_simulate(st, spec)
         st.done()
     spec.bound_to = spec.binding()
-    freeze_arrays((spec.sets, spec.options))
+    freeze_arrays((spec.sets, spec.options, spec.simulate))
     return spec
 
 

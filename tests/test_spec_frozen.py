@@ -58,3 +58,8 @@ def test_set_and_option_arrays_of_a_bound_spec_are_read_only() -> None:
     api.bind(other)
     with pytest.raises(ValueError, match="read-only"):
         other.options.cmap.G_q[0, 0] = fmpq(5)
+    # the [simulate] scenario too (its noise bound was writable; re-check review, session 43)
+    sim = api.load_spec(SPECS / "impulsive-sector-3state.toml").simulate
+    assert isinstance(sim.noise.bound, np.ndarray)
+    with pytest.raises(ValueError, match="read-only"):
+        sim.noise.bound[0] = 5.0
