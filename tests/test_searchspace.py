@@ -2440,3 +2440,15 @@ def test_two_literals_of_one_double_do_not_share_their_bounds() -> None:
     one = api.design(api.load_spec_text(spec("1.00000000000000000"), "a.toml"))
     ten = api.design(api.load_spec_text(spec("1.00000000000000009"), "b.toml"))
     assert Q(one.parameters["L_f"]) < 2 and Q(ten.parameters["L_f"]) >= 10
+
+
+@pytest.mark.parametrize("key", ["L_f", "L_h", "f_sup", "kappa"])
+def test_a_zero_constant_fails_a_claim_that_says_so(key: str) -> None:
+    """A report's L_f, L_h, f_sup or κ = 0: the rules divide by them, and the only failed
+    claim read "parameters-wellformed: ZeroDivisionError" (re-check review, session 43)."""
+    spec = api.load_spec(SPEC)
+    rep = api.design(spec)
+    params = Parameters(dict(rep.parameters))
+    params[key] = fmpq(0)
+    failed = {c.id: c.detail for c in api.certify(spec, params) if not c.ok}
+    assert set(failed) == {"constants-positive"} and f"{key} = 0" in failed["constants-positive"]

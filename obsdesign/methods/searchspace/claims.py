@@ -72,6 +72,19 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     L_f, L_h, F, kappa = v["L_f"], v["L_h"], v["f_sup"], v["kappa"]
     g_star, dT, dtau = v["gamma_star"], v["dT"], v["dtau"]
     K = v["K"]
+    # the rules divide by these (ΔT by L_h‖f_u‖, ε by κ, K by L_f): a (forged) 0 made the only
+    # failed claim "parse / ZeroDivisionError" (re-check and search-space reviews, session 43)
+    zero = [k for k in ("L_f", "L_h", "f_sup", "kappa") if not v[k] > 0]
+    if zero:
+        c.exact(
+            id="constants-positive",
+            statement="L_f^E, L_h^E, ‖f_u‖_E and κ are > 0 (Theorem 1's rules divide by them)",
+            reference=f"Theorem 1, {PAPER}",
+            check="exact sign",
+            passed=False,
+            detail=", ".join(f"{k} = {fmt_exact(v[k])}" for k in zero) + " (must be > 0)",
+        )
+        return c
 
     # what the spec fixes, compared exactly
     for k in ("L_f", "L_h", "f_sup", "kappa"):
