@@ -997,7 +997,9 @@ def _dt_seconds(text: str) -> float:
         )
     # only -1 itself is MATLAB's "no sample time"; the text as typed in the message (1e999
     # said "--dt inf"; CLI review, session 42)
-    if not (q.is_finite() and math.isfinite(f) and (f >= 0 or q == -1)):
+    # the sign of the exact value: −1e-400 rounds to −0.0, which passed "f >= 0" and wrote
+    # continuous time (re-check review, session 43)
+    if not (q.is_finite() and math.isfinite(f) and (q >= 0 or q == -1)):
         raise InputError(
             f"--dt {text!r}: expected a finite number >= 0 (0: continuous time), or exactly -1 "
             "(discrete time with no sample time, as MATLAB's Ts = -1)"

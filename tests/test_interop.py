@@ -412,6 +412,8 @@ def test_lists_of_tables_and_missing_values() -> None:
         # the text as typed: 1e999 said "--dt inf" (CLI review, session 42)
         ({}, ["--dt", "1e999"], "--dt '1e999': expected a finite number", False),
         ({}, ["--dt", "-2"], "--dt '-2': expected a finite number >= 0", False),
+        # −1e-400 rounds to −0.0: it passed as continuous time (session 43)
+        ({}, ["--dt", "-1e-400"], "--dt '-1e-400': expected a finite number >= 0", False),
         # below the float range: read as 0.0, continuous time, silently (session 38)
         ({}, ["--dt", "1e-400"], "--dt '1e-400': a nonzero number below the float range", False),
         ({}, ["--dt", "abc"], "--dt 'abc': expected a number of seconds", False),
