@@ -29,6 +29,7 @@ from obsdesign.api import load_spec_text
 from obsdesign.certify.claim import Claims
 from obsdesign.certify.exact import Q, qmat
 from obsdesign.cli import app
+from obsdesign.errors import SpecError
 from obsdesign.methods.impulsive.claims import _ball
 from obsdesign.methods.impulsive.core import BlockData
 from obsdesign.methods.impulsive.dissipativity import QSR
@@ -1261,3 +1262,23 @@ def test_a_copied_spec_with_another_system_is_bound_to_that_system() -> None:
         api.design(other)
     assert all(c.ok for c in api.certify(spec, rep.parameters))  # the original: unchanged
     assert spec.options.problem.A is spec.system.A.q
+
+
+def test_assumption1_data_no_nonlinearity_satisfies_are_refused() -> None:
+    """[nonlinearity.o] Q = R = −1, S = 0 reads −φ² − ε² ≥ 0, which no function satisfies at
+    ε ≠ 0: the design certified a window (vacuously: "given the declared data") for an
+    observer whose error grows (spectral radius 2.93 over a sampling interval; impulsive
+    review, session 43). R − SᵀQ⁻¹S ⪰ 0 is required (exit 2 naming the key); R = 0, the
+    smallest satisfiable R for Q = −1, S = 0, loads."""
+    text = SPEC3.read_text(encoding="utf-8")
+    old = "[nonlinearity.o]\nsector = [-0.2, 0.2]"
+    assert old in text
+    bad = text.replace(old, "[nonlinearity.o]\nQ = [[-1]]\nS = [[0]]\nR = [[-1]]")
+    with pytest.raises(SpecError, match=r"\[nonlinearity\.o\.R\].*hold for no nonlinearity"):
+        load_spec_text(bad, "vac.toml")
+    load_spec_text(bad.replace("R = [[-1]]", "R = [[0]]"), "edge.toml")
+    # with S: R − S²/Q = R + S² for Q = −1; S = 1/2 makes R = −1/4 the edge
+    edge = text.replace(old, "[nonlinearity.o]\nQ = [[-1]]\nS = [[0.5]]\nR = [[-0.25]]")
+    load_spec_text(edge, "edge.toml")
+    with pytest.raises(SpecError, match="hold for no nonlinearity"):
+        load_spec_text(edge.replace("R = [[-0.25]]", "R = [[-0.2500001]]"), "vac.toml")

@@ -17,7 +17,7 @@ import numpy as np
 from flint import fmpq
 
 from obsdesign.certify.exact import Q, qvec
-from obsdesign.certify.linalg import qrank
+from obsdesign.certify.linalg import qinv, qrank
 from obsdesign.certify.printing import fmt_exact
 from obsdesign.certify.psd import check_pd, check_psd
 from obsdesign.errors import SpecError
@@ -161,7 +161,28 @@ def _assumption1(nl: Table, table: Table, Mv: Any, m: int, n: int) -> BlockData 
         )
     if not check_psd(-q_n.Q):
         raise tn.error("Q", "expected Q_n negative semidefinite (Assumption 1 needs Q_n ⪯ 0)")
+    for t, q, name in ((to, q_o, "o"), (tn, q_n, "n")):
+        _satisfiable(t, q, name)
     return BlockData(q_o, q_n, l_on, l_no)
+
+
+def _satisfiable(t: Table, q: QSR, name: str) -> None:
+    """Refuse given (Q, S, R) that no nonlinearity satisfies: with Q ≺ 0 the largest supply
+    φᵀQφ + 2φᵀSε + εᵀRε over φ is εᵀ(R − SᵀQ⁻¹S)ε (at φ = −Q⁻¹Sε), so unless R − SᵀQ⁻¹S ⪰ 0
+    some error ε has a negative supply for every φ, and the certificate holds only vacuously:
+    Q = R = −1, S = 0 designed and verified a window for an observer that diverges (impulsive
+    review, session 43). A sector or Lipschitz block always passes; a singular Q_n is not
+    checked (the supply is then unbounded above in φ along its kernel, or not)."""
+    if not t.has("Q") or not check_pd(-q.Q):
+        return
+    G = q.R - q.S.T @ qinv(q.Q) @ q.S
+    if not check_psd(G):
+        raise t.error(
+            "R",
+            f"Assumption 1's data of block {name} hold for no nonlinearity: R − SᵀQ⁻¹S is not "
+            "⪰ 0, so for some error ε every φ gives φᵀQφ + 2φᵀSε + εᵀRε < 0 (the certificate "
+            "would hold only vacuously)",
+        )
 
 
 def _falsify(nl: Table, n: int) -> FalsifySpec | None:
