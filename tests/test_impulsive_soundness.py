@@ -1282,3 +1282,41 @@ def test_assumption1_data_no_nonlinearity_satisfies_are_refused() -> None:
     load_spec_text(edge, "edge.toml")
     with pytest.raises(SpecError, match="hold for no nonlinearity"):
         load_spec_text(edge.replace("R = [[-0.25]]", "R = [[-0.2500001]]"), "vac.toml")
+
+
+ORTH = """[system]
+time = "continuous"
+A = [[-1, 0.5, 0.2], [0.3, -4, 0.1], [0.1, 0.2, -5]]
+C = [[1, 0, 0]]
+states = ["x1", "x2", "x3"]
+psi = ["0.1*sin(x1)", "0.1*sin(x2)", "0.1*sin(x3)"]
+[nonlinearity]
+lipschitz_x = 0.1
+[method]
+key = "impulsive"
+L = [0.5]
+alpha = 2
+noise_bound = 0.01
+M = "orthonormal"
+"""
+
+
+def test_an_orthonormal_label_needs_an_orthonormal_M() -> None:
+    """A report with M = [[0.3, 1, 0], [0, 0, 1]] (T, Ā and every bound recomputed for it)
+    labelled M_source = "orthonormal" verified, exit 0: another observer than the spec's
+    orthonormal complement (impulsive review, session 43). The label's M must be orthonormal
+    and orthogonal to C's rows (up to its 20-bit rounding)."""
+    from obsdesign.methods.impulsive.claims import _m_source_claim
+
+    spec = load_spec_text(ORTH, "orth.toml")
+    rep = api.design(spec)
+    assert rep.exit_code() == 0 and rep.parameters["M_source"] == "orthonormal"
+    p = spec.options.problem
+    c = Claims()
+    _m_source_claim(c, p, "orthonormal", rep.parameters["T"])
+    assert not list(c)
+    forged = qmat([[1, 0, 0], ["0.3", 1, 0], [0, 0, 1]])
+    _m_source_claim(c, p, "orthonormal", forged)
+    (claim,) = list(c)
+    assert claim.id == "M_source-matches-spec" and not claim.ok
+    assert "not the orthonormal complement" in claim.detail

@@ -16,13 +16,14 @@ keeps the statement true (:func:`fmt_up` for upper bounds, :func:`fmt_down` for 
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
 from flint import fmpq
 
 from obsdesign.certify.claim import Claim, Claims
-from obsdesign.certify.exact import Q
+from obsdesign.certify.exact import Q, to_float
 from obsdesign.certify.linalg import ROUNDED_UP_REL, norm_bound_holds, not_above
 from obsdesign.certify.printing import fmt_down, fmt_exact, fmt_up
 from obsdesign.certify.psd import check_pd, check_psd
@@ -75,7 +76,7 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     if any(v is None for v in P.values()):
         return c
     P["M_source"] = str(params.get("M_source", "given"))
-    _m_source_claim(c, p, P["M_source"])
+    _m_source_claim(c, p, P["M_source"], P["T"])
     certify_window(p, P, c)
     t_ok = any(x.id == "T" and x.ok for x in c)
     if o.falsify is not None and t_ok:
@@ -111,25 +112,59 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     return c
 
 
-def _m_source_claim(c: Claims, p: Problem, label: str) -> None:
+def _m_source_claim(c: Claims, p: Problem, label: str, T: Any) -> None:
     """A failed ``M_source-matches-spec`` claim when the report's label of M is not one the
     spec's ``[method] M`` gives: "given" for a matrix, "orthonormal" for "orthonormal",
     "optimized" or "orthonormal" (the fallback of a search that failed) for "optimize". The
     label was read and passed on unchecked: a report edited to "optimized" for a given M
-    verified (impulsive review, session 42). M itself is checked by the ``T`` claim (eq. (9))."""
+    verified (impulsive review, session 42). M itself is checked by the ``T`` claim (eq. (9));
+    an "orthonormal" M must be the orthonormal complement of C's rows up to its rounding to
+    :data:`~obsdesign.methods.impulsive.coordinates.M_BITS` bits (checked in floats with a
+    tolerance of 10⁻⁴): M = [[0.3, 1, 0], [0, 0, 1]] labelled "orthonormal" verified, another
+    observer than the spec's (impulsive review, session 43)."""
     if p.given_M is not None:
         ok: tuple[str, ...] = ("given",)
     elif p.M == "orthonormal":
         ok = ("orthonormal",)
     else:
         ok = ("optimized", "orthonormal")
+    detail = ""
     if label not in ok:
+        detail = f"report says {label!r}; the spec gives " + " or ".join(map(repr, ok))
+    elif label == "orthonormal":
+        off = _orthonormal_defect(T, p.m)
+        if not off <= ORTHONORMAL_TOL:
+            detail = (
+                f"M_source is 'orthonormal' but M is not the orthonormal complement of C's rows "
+                f"(max |[MMᵀ − I, CMᵀ/‖C‖]| ≈ {off:.3g} > {ORTHONORMAL_TOL:g})"
+            )
+    if detail:
         c.failed(
             id="M_source-matches-spec",
             statement="the report's M_source is what the spec's [method].M gives",
             reference="spec [method].M",
-            detail=f"report says {label!r}; the spec gives " + " or ".join(map(repr, ok)),
+            detail=detail,
         )
+
+
+#: how far an "orthonormal" M may be from orthonormal and orthogonal to C (its entries are
+#: rounded to 20 bits; :func:`_m_source_claim`)
+ORTHONORMAL_TOL = 1e-4
+
+
+def _orthonormal_defect(T: Any, m: int) -> float:
+    """max |MMᵀ − I| and max |CMᵀ|/‖C‖ for T = [C; M] (floats; inf when not finite)."""
+    Tf = np.asarray(to_float(np.asarray(T, dtype=object)), dtype=float)
+    if Tf.ndim != 2 or not np.all(np.isfinite(Tf)):
+        return math.inf
+    C, M = Tf[:m], Tf[m:]
+    nC = float(np.linalg.norm(C, 2)) or 1.0
+    with np.errstate(all="ignore"):
+        d = max(
+            float(np.max(np.abs(M @ M.T - np.eye(M.shape[0])), initial=0.0)),
+            float(np.max(np.abs(C @ M.T), initial=0.0)) / nC,
+        )
+    return d if math.isfinite(d) else math.inf
 
 
 def _ref(where: str) -> str:
