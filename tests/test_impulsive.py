@@ -780,3 +780,21 @@ def test_ssd_statements_name_the_scaling_they_hold_for() -> None:
     assert theta == 5 and nsd(theta) and not nsd(F(1))
     (st,) = [c.statement for c in rep.claims if c.id == "kappa_n"]
     assert re.search(r"θ_n·\(−R_n, −S_nᵀ, −Q_n\)-ssd\(κ_n\) with θ_n = [0-9./]+ and κ_n ≥ ", st), st
+
+
+def test_the_alpha_gamma_refusal_prints_both_exactly() -> None:
+    """L = 0.80000002, α = 0.80000001: the refusal read "expected α > γ = 0.8, got 0.8"
+    (impulsive review, session 43); both values are printed exactly."""
+    from obsdesign import api
+    from obsdesign.errors import SpecError
+
+    text = (
+        '[system]\ntime = "continuous"\nA = [[0, 0, 0], [1, -3, 0.5], [0, -0.5, -3]]\n'
+        'C = [[1, 0, 0]]\nstates = ["x1", "x2", "x3"]\n'
+        'psi = ["0.2*sin(x1)", "0.3*tanh(x2)", "0.3*tanh(x3)"]\n'
+        "[nonlinearity.o]\nsector = [-0.2, 0.2]\n[nonlinearity.n]\nsector = [0, 0.3]\n"
+        '[method]\nkey = "impulsive"\nL = [0.80000002]\nalpha = 0.80000001\n'
+        "noise_bound = 0.1\nM = [[0, 1, 0], [0, 0, 1]]\n"
+    )
+    with pytest.raises(SpecError, match=r"γ = 0\.80000002 \(Theorem 2\), got 0\.80000001"):
+        api.load_spec_text(text, "s.toml")

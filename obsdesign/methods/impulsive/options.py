@@ -97,7 +97,9 @@ def parse_options(table: Table, spec: Spec) -> Options:
     alpha = table.scalar("alpha", min=0, strict_min=True).q
     if not alpha > gamma:
         raise table.error(
-            "alpha", f"expected α > γ = {float(gamma):g} (Theorem 2), got {float(alpha):g}"
+            # exact values: "expected α > γ = 0.8, got 0.8" for α = 0.8 − 10⁻¹⁰ (review, 43)
+            "alpha",
+            f"expected α > γ = {fmt_exact(gamma)} (Theorem 2), got {fmt_exact(alpha)}",
         )
     w_bar = table.scalar("noise_bound", min=0).q
     Mv: Any = "orthonormal"
