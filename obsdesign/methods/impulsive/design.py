@@ -19,7 +19,7 @@ from flint import fmpq
 
 from obsdesign.certify.exact import Q, dyadic, float_or_inf, to_float
 from obsdesign.certify.linalg import norm_upper
-from obsdesign.certify.printing import fmt_exact
+from obsdesign.certify.printing import fmt_down, fmt_exact, fmt_up
 from obsdesign.certify.psd import check_pd, check_psd
 from obsdesign.errors import InconclusiveError, InfeasibleError
 from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
@@ -308,10 +308,14 @@ def _window(
         )
     kmax = kappa_max(kappa_n, lam_no, lam_on, beta)
     if kmax <= 0:
+        # "with the certified bounds", enough digits to show the shortfall: it read "fails
+        # for every κ > 0: κ_n = 5.4 ≤ … = 5.4" for a feasible spec whose κ_n, rounded down
+        # by 5·10⁻⁹, lost the proof (impulsive review, session 43)
         raise Infeasible(
-            f"condition (22) fails for every κ > 0: κ_n = {float(kappa_n):.6g} ≤ λ*_no + β λ*_on = "
-            f"{float(lam_no):.6g} + {float(beta):.6g}·{float(lam_on):.6g} = "
-            f"{float(coupling(lam_no, lam_on, beta)):.6g} (short by {float(-kmax):.4g})"
+            f"condition (22) fails for every κ > 0 with the certified bounds: κ_n = "
+            f"{fmt_down(kappa_n, 12)} ≤ λ*_no + β λ*_on = {fmt_up(lam_no, 12)} + "
+            f"{fmt_up(beta, 12)}·{fmt_up(lam_on, 12)} = "
+            f"{fmt_up(coupling(lam_no, lam_on, beta), 12)} (short by {float(-kmax):.4g})"
         )
     vp = max(float(varpi), 0.0)
     if p.given_kappa is None:
