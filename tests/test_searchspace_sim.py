@@ -903,3 +903,41 @@ def test_the_time_spacing_is_that_of_the_later_end_and_of_the_substep() -> None:
     with pytest.raises(InconclusiveError, match="substeps"):
         S._check_time_spacing(1e9, 1e9, 1e-6 / 8, 8)
     S._check_time_spacing(0.0, 12.0, 1e-6, 1)
+
+
+def test_a_true_state_leaving_E_is_warned(tmp_path: Path) -> None:
+    """f = 1.26·sat(x1) − 0.146·x1 drives x from −0.36 past E = [−3, 3] at t ≈ 3.05: the run
+    ended with a final error 15 times ε⋆ and said so only in an info line (search-space
+    review, session 43). It warns, naming E and the time."""
+    text = """[system]
+time = "continuous"
+states = ["x1"]
+f = ["1.26*sat(x1) - 0.146307*x1"]
+h = ["tanh(x1)"]
+u = ["0.5 + 0.5*cos(3*t)"]
+[method]
+key = "search-space"
+alpha = 0.9
+gamma_star = 0.2
+gamma0 = 0.8
+[method.E]
+lower = [-3.0]
+upper = [3.0]
+[method.D]
+lower = [-0.5]
+upper = [0.5]
+[method.U]
+lower = [-1]
+upper = [1]
+[simulate]
+horizon = 5
+x0 = [-0.3603]
+xhat0 = [0]
+max_centres = 200000
+"""
+    sp, rep = _load(text, tmp_path)
+    assert rep.exit_code() == 0
+    res = api.simulate(sp, rep)
+    said = " ".join(res.info.get("warnings", []))
+    assert "the true state leaves E = [-3, 3] at t = 3.0" in said
+    assert 3.0 < res.info["left_E_at"] < 3.1

@@ -508,7 +508,7 @@ def simulate(spec: Spec, params: Parameters, progress: bool = False, **kw: Any) 
     if bar is not None:
         bar(None, 0)
     res = _result(spec, run, params, steps, secs, nsub, flow_err, left_E, so)
-    _outside_the_design(res, o, t0, N * dT, left_U)
+    _outside_the_design(res, o, t0, N * dT, left_U, left_E)
     return res
 
 
@@ -599,12 +599,26 @@ def _left_U(plant: Plant, o: Options, t0: float, dT: float, k: int) -> float | N
 
 
 def _outside_the_design(
-    res: SimResult, o: Options, t0: float, span: float, left_U: float | None
+    res: SimResult,
+    o: Options,
+    t0: float,
+    span: float,
+    left_U: float | None,
+    left_E: float | None = None,
 ) -> None:
     """Warn (and record in ``info``) when the run leaves what the design certified: u left U
-    (``left_U_at``), or the run goes past ``[method] horizon`` (``past_horizon``), where the
-    input range was checked (search-space paper, Hernández & García, Lemmas 1-2 hold for
+    (``left_U_at``), the true state left E (``left_E_at``: the cell holding it may then be
+    discarded; it was an info line only, beside a final error 15 times ε⋆ — search-space
+    review, session 43), or the run goes past ``[method] horizon`` (``past_horizon``), where
+    the input range was checked (search-space paper, Hernández & García, Lemmas 1-2 hold for
     the constants on E × U)."""
+    if left_E is not None:
+        warnings.warn(
+            f"[simulate] the true state leaves E = {o.E.describe()} at t = {left_E:.6g}: the "
+            "constants on E (and the paper's assumption that x stays in E) do not hold after "
+            "it, so neither do the observer's bounds",
+            stacklevel=3,
+        )
     if left_U is not None:
         res.info["left_U_at"] = left_U
         warnings.warn(
