@@ -1282,6 +1282,16 @@ def test_assumption1_data_no_nonlinearity_satisfies_are_refused() -> None:
     load_spec_text(edge, "edge.toml")
     with pytest.raises(SpecError, match="hold for no nonlinearity"):
         load_spec_text(edge.replace("R = [[-0.25]]", "R = [[-0.2500001]]"), "vac.toml")
+    # a singular Q_n passed the Q ≺ 0 test unchecked: Q = diag(−1, 0), S = diag(0, −1),
+    # R = diag(−1000, 0) has supply −φ₁² − 1000 at ε = (1, 0) for every φ, and designed and
+    # verified a window for an observer with an eigenvalue +5 (tamper review, session 43)
+    old_n = "[nonlinearity.n]\nsector = [0, 0.3]"
+    assert old_n in text
+    sing = "[nonlinearity.n]\nQ = [[-1, 0], [0, 0]]\nS = [[0, 0], [0, -1]]\nR = [[{r}, 0], [0, 0]]"
+    with pytest.raises(SpecError, match=r"\[nonlinearity\.n\.R\].*hold for no nonlinearity"):
+        load_spec_text(text.replace(old_n, sing.format(r=-1000)), "vac.toml")
+    # R₁₁ = 0 is satisfiable (φ = 0 at ε = (1, 0); along ε₂ the supply is unbounded above)
+    load_spec_text(text.replace(old_n, sing.format(r=0)), "edge.toml")
 
 
 ORTH = """[system]

@@ -9,6 +9,7 @@ optional falsification box ``[nonlinearity.falsify]``.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -17,7 +18,7 @@ import numpy as np
 from flint import fmpq
 
 from obsdesign.certify.exact import Q, qvec
-from obsdesign.certify.linalg import qinv, qrank
+from obsdesign.certify.linalg import qrank
 from obsdesign.certify.printing import fmt_exact
 from obsdesign.certify.psd import check_pd, check_psd
 from obsdesign.errors import SpecError
@@ -169,21 +170,42 @@ def _assumption1(nl: Table, table: Table, Mv: Any, m: int, n: int) -> BlockData 
 
 
 def _satisfiable(t: Table, q: QSR, name: str) -> None:
-    """Refuse given (Q, S, R) that no nonlinearity satisfies: with Q ≺ 0 the largest supply
-    φᵀQφ + 2φᵀSε + εᵀRε over φ is εᵀ(R − SᵀQ⁻¹S)ε (at φ = −Q⁻¹Sε), so unless R − SᵀQ⁻¹S ⪰ 0
-    some error ε has a negative supply for every φ, and the certificate holds only vacuously:
-    Q = R = −1, S = 0 designed and verified a window for an observer that diverges (impulsive
-    review, session 43). A sector or Lipschitz block always passes; a singular Q_n is not
-    checked (the supply is then unbounded above in φ along its kernel, or not)."""
-    if not t.has("Q") or not check_pd(-q.Q):
+    """Refuse given (Q, S, R), Q ⪯ 0, that no nonlinearity satisfies. The largest supply
+    φᵀQφ + 2φᵀSε + εᵀRε over φ is +∞ when Sε leaves the range of Q, else εᵀRε − vᵀQv for any
+    v with Qv = Sε (at φ = −v; εᵀ(R − SᵀQ⁻¹S)ε for Q ≺ 0). So the data hold for some φ at
+    every ε iff εᵀRε − vᵀQv ≥ 0 on the subspace {(ε, v) : Qv = Sε}: checked exactly, on an
+    integer basis of that null space. Q = R = −1, S = 0 designed and verified a window,
+    vacuously, for an observer that diverges (impulsive review, session 43); a singular Q_n
+    (Q = diag(−1, 0), S = diag(0, −1), R = diag(−1000, 0)) still did (tamper review). A sector
+    or Lipschitz block always passes."""
+    if not t.has("Q"):
         return
-    G = q.R - q.S.T @ qinv(q.Q) @ q.S
+    from flint import fmpz_mat
+
+    k = q.k
+    M = np.hstack([-np.asarray(q.S, dtype=object), np.asarray(q.Q, dtype=object)])  # k × 2k
+    rows = []
+    for r in M:  # each row times its denominators' lcm: the same null space, over Z
+        d = 1
+        for v in r:
+            d = d * int(Q(v).q) // math.gcd(d, int(Q(v).q))
+        rows.append([int(Q(v) * d) for v in r])
+    X, nullity = fmpz_mat(rows).nullspace()
+    if nullity == 0:
+        return
+    W = np.array([[fmpq(int(X[i, j])) for j in range(nullity)] for i in range(2 * k)], dtype=object)
+    F = np.zeros((2 * k, 2 * k), dtype=object)
+    F[:] = fmpq(0)
+    F[:k, :k] = np.asarray(q.R, dtype=object)
+    F[k:, k:] = -np.asarray(q.Q, dtype=object)
+    G = W.T @ F @ W
+    G = (G + G.T) * fmpq(1, 2)  # the quadratic form's symmetric part (R given symmetric)
     if not check_psd(G):
         raise t.error(
             "R",
-            f"Assumption 1's data of block {name} hold for no nonlinearity: R − SᵀQ⁻¹S is not "
-            "⪰ 0, so for some error ε every φ gives φᵀQφ + 2φᵀSε + εᵀRε < 0 (the certificate "
-            "would hold only vacuously)",
+            f"Assumption 1's data of block {name} hold for no nonlinearity: for some error ε "
+            "every φ gives φᵀQφ + 2φᵀSε + εᵀRε < 0 (R − SᵀQ⁺S is not ⪰ 0 where Sε lies in the "
+            "range of Q), so the certificate would hold only vacuously",
         )
 
 
