@@ -2452,3 +2452,25 @@ def test_a_zero_constant_fails_a_claim_that_says_so(key: str) -> None:
     params[key] = fmpq(0)
     failed = {c.id: c.detail for c in api.certify(spec, params) if not c.ok}
     assert set(failed) == {"constants-positive"} and f"{key} = 0" in failed["constants-positive"]
+
+
+def test_each_expression_is_bounded_with_its_own_parameters() -> None:
+    """f = (k·u1·x2, −u1·x1) assembled from two specs' expressions (k = 10 in the first, k = 1
+    in the second): the interval bounds merged the expressions' parameter dicts, the last
+    winning, and certified L_f = 1 and ‖f_u‖ ≤ 3.53554 for an f whose first component is
+    10·u1·x2 (API review, session 43). Each expression is bounded with its own."""
+    import copy
+    import dataclasses
+
+    text = SPEC.read_text(encoding="utf-8")
+    old = 'f = ["u1*x2", "-u1*x1"]'
+    assert old in text
+    with_k = text.replace(old, 'f = ["k*u1*x2", "-u1*x1"]').replace(
+        "[method]", "[system.parameters]\nk = KVALUE\n\n[method]", 1
+    )
+    a = api.load_spec_text(with_k.replace("KVALUE", "1"), "a.toml")
+    b = api.load_spec_text(with_k.replace("KVALUE", "10"), "b.toml")
+    mix = copy.copy(a)
+    mix.system = dataclasses.replace(a.system, f=[b.system.f[0], a.system.f[1]])
+    rep = api.design(mix)
+    assert Q(rep.parameters["L_f"]) >= 10

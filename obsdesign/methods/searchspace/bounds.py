@@ -80,14 +80,13 @@ class Bound:
 Box = tuple[I, ...]
 
 
-def _params(exprs: Sequence[Expr]) -> dict[str, I]:
-    out: dict[str, I] = {}
-    for ex in exprs:
-        for k, v in ex.parameters.items():
-            from obsdesign.certify.exact import Q
+def _params(ex: Expr) -> dict[str, I]:
+    """The expression's own parameters as point intervals (each expression its own: one dict
+    merged over all of them, the last value winning, bounded f = (k·u1·x2, −u1·x1) with the
+    k of the other component, and certified L_f = 1 for k = 10; API review, session 43)."""
+    from obsdesign.certify.exact import Q
 
-            out[k] = I.of_q(Q(v))
-    return out
+    return {k: I.of_q(Q(v)) for k, v in ex.parameters.items()}
 
 
 def _enclose(
@@ -100,10 +99,10 @@ def _enclose(
             I(1.0, 1.0) if (d == name) else ZERO for d in diff
         )  # unit vector for a differentiation variable
         env[name] = Dual(iv, g)
-    params = _params(exprs)
     # the text the tree was parsed from (spec.expr rewrites ^ as **): exact decimal literals
     return [
-        evaluate(ex.tree, env, params, nd, ex.source.strip().replace("^", "**")) for ex in exprs
+        evaluate(ex.tree, env, _params(ex), nd, ex.source.strip().replace("^", "**"))
+        for ex in exprs
     ]
 
 
