@@ -804,3 +804,25 @@ def test_the_alpha_gamma_refusal_prints_both_exactly() -> None:
     )
     with pytest.raises(SpecError, match=r"γ = 0\.80000002 \(Theorem 2\), got 0\.80000001"):
         api.load_spec_text(text, "s.toml")
+
+
+@pytest.mark.parametrize(
+    ("kappa", "hint"), [('"max"', ", another M may help"), ("0.3", "another κ or M may help")]
+)
+def test_an_empty_window_names_kappa_only_when_it_is_given(kappa: str, hint: str) -> None:
+    """With κ = "max" no other κ opens the window (T_max/T_min = (c₁/c₂)·κ/(D₀ + κ) grows with
+    κ): "another κ or M may help" sent the user to κ = 0.05 … 0.71, all empty too (census
+    review, session 43). A given κ keeps the hint."""
+    from obsdesign import api
+    from obsdesign.errors import InfeasibleError
+
+    text = (
+        '[system]\ntime = "continuous"\nA = [[0.04, 0.18], [1.88, -2.99]]\n'
+        'C = [[1.56, 0.32]]\nstates = ["x1", "x2"]\npsi = ["0.05*sin(x1)", "0.02*tanh(x2)"]\n'
+        "[nonlinearity]\nlipschitz_x = 0.13\n"
+        '[method]\nkey = "impulsive"\nL = [0.54]\nalpha = 3.01\nnoise_bound = 0.07\n'
+        f'M = "orthonormal"\nkappa = {kappa}\n'
+    )
+    with pytest.raises(InfeasibleError, match="empty window") as ei:
+        api.design(api.load_spec_text(text, "s.toml"))
+    assert ei.value.message.endswith(hint)

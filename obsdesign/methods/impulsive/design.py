@@ -367,7 +367,10 @@ def _window(
             f"{float_or_inf(T_max):.6g} "
             f"(κ = {float(kappa):.6g}); a larger α lowers T_min (26c); another L changes "
             "both ends (γ = min L_ii raises T_min and the numerator of (26b), β = 1/(1 − γ)² "
-            "its denominator), another κ or M may help"
+            "its denominator), "
+            # with κ = "max" / "widest" no other κ opens it (T_max/T_min grows with κ, and
+            # "widest" maximizes the width): only M (census review, session 43)
+            + ("another κ or M may help" if p.given_kappa is not None else "another M may help")
         )
     return kmax, kappa, varpi, T_min_r, T_max_r
 
