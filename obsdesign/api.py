@@ -762,6 +762,18 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     The generic contract runs first: each of the method's ``required_params`` must be
     present (a failed ``<key>-present`` claim otherwise). Malformed parameters give a failed
     ``parameters-wellformed`` claim, never an exception."""
+    # a path, a dict or a Report was a bare AttributeError from deep inside (API review,
+    # session 43); design, verify and simulate name the argument alike
+    if not isinstance(spec, Spec):
+        raise InputError(
+            f"certify: spec must be a Spec (api.load_spec / load_spec_text), got "
+            f"{type(spec).__name__}"
+        )
+    if not isinstance(params, Parameters):
+        raise InputError(
+            f"certify: params must be Parameters (a report's .parameters), got "
+            f"{type(params).__name__}"
+        )
     sp = bind(spec)
     m = get_method(sp.method)
     claims: list[Claim] = []

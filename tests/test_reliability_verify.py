@@ -363,6 +363,12 @@ def test_api_arguments_of_the_wrong_type_are_input_errors(tmp_path: Path) -> Non
         api.verify(out, spec=7)  # type: ignore[arg-type]
     with pytest.raises(InputError, match="report: expected a path or a Report, got .* int"):
         api.simulate(SPEC, report=5)  # type: ignore[arg-type]
+    # certify took a path, a dict or a Report to a bare AttributeError (API review, 43)
+    rep = api.design(SPEC)
+    with pytest.raises(InputError, match="certify: spec must be a Spec .* got PosixPath"):
+        api.certify(SPEC, rep.parameters)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="certify: params must be Parameters .* got Report"):
+        api.certify(api.load_spec(SPEC), rep)  # type: ignore[arg-type]
     with pytest.raises(
         InputError,
         match=r"simulate: run: not an option of method 'lyapunov' \(did you mean 'runs'\?\) "
