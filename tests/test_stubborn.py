@@ -2265,3 +2265,31 @@ def test_the_bracket_near_end_is_re_solved_too() -> None:
     ok = {c.id: c.ok for c in lambda_max_claims(spec, p)}
     assert ok["lambda-max-certified"]  # the LMIs do hold at 512 with the scaled point
     assert not ok["lambda-max-bracket"]
+
+
+def test_an_honest_near_end_is_proved_by_its_own_certificate() -> None:
+    """Since the near end was re-solved, a cold Clarabel solve at the rounded λ_max answered
+    "optimal_inaccurate" for this random discrete plant and the design failed its own
+    lambda-max-bracket claim, exit 1 — though the λ_max certificate lies strictly inside the
+    solver's problem (re-check review, session 43). That point is checked exactly first."""
+    text = (
+        '[system]\ntime = "discrete"\n'
+        "A = [[0.291, 0.3233, -0.3233], [-1.6328, 0.3395, 0.2102], [-1.1397, 0.6224, -0.5658]]\n"
+        "C = [[0.1, -0.18, 0.2], [-1.61, 1.81, -0.6]]\n"
+        '[method]\nkey = "stubborn"\ncriterion = "K"\n'
+    )
+    rep = api.design(api.load_spec_text(text, "d.toml"))
+    (claim,) = [c for c in rep.claims if c.id == "lambda-max-bracket"]
+    assert claim.ok and "certificate lies in the problem (exact)" in claim.detail, claim.detail
+    assert rep.exit_code() == 0
+    # the exact check refuses a point outside the problem: the same certificate scaled by
+    # 1/100 still meets the homogeneous LMIs, not P ⪰ I, w ≥ 1 or the margin
+    from obsdesign.certify.claim import Claims
+    from obsdesign.methods.stubborn.claims import _in_problem, _read_point
+
+    spec = api.load_spec_text(text, "d.toml")
+    pt = _read_point(rep.parameters, Claims(), spec, "_at_max")
+    lm = Q(rep.parameters["lambda_max"])
+    assert pt is not None and _in_problem(spec, spec.options, pt, lm)
+    small = {k: (v if k == "K" else v * fmpq(1, 100)) for k, v in pt.items()}
+    assert not _in_problem(spec, spec.options, small, lm)
