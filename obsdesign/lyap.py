@@ -1581,12 +1581,20 @@ def best_rate(
         # pre-screen review, session 43)
         gap = (1 - abs(bound)) if discrete else -bound
         finest = float(grid) / 10**12
+        name = "1 − ρ(A − LC)" if discrete else "−max Re eig(A − LC)"
+        where = (
+            f"is below the search's finest candidate, {finest:.3g} from the limit on the grid "
+            f"of rate_tol = {float(tol_q):.3g}"
+        )
         hint = (
-            f"; its stability margin ({'1 − ρ(A − LC)' if discrete else '−max Re eig(A − LC)'}"
-            f" ≈ {gap:.3g}) is below the search's finest candidate, {finest:.3g} from the "
-            f"limit on the grid of rate_tol = {float(tol_q):.3g}: give a [method].rate_tol "
+            f"; its stability margin ({name} ≈ {gap:.3g}) {where}: give a [method].rate_tol "
             f"below {gap:.1g}"
             if 0 < gap < finest
+            # below the float resolution (A = 0.99999999999999999 is 1.0 as a float): no
+            # estimate, the same remedy (re-check review, session 43)
+            else f"; its stability margin ({name}) is 0 in floats and {where}: give a "
+            "smaller [method].rate_tol"
+            if gap <= 0
             else ""
         )
         raise InconclusiveError(

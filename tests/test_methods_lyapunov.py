@@ -1774,3 +1774,11 @@ def test_a_stability_margin_below_the_rate_grid_names_rate_tol() -> None:
         api.design(api.load_spec_text(text, "s.toml"))
     rep = api.design(api.load_spec_text(text + "rate_tol = 1e-151\n", "s.toml"))
     assert rep.exit_code() == 0
+    # discrete, a margin below the float resolution (A = 1 − 10⁻¹⁷ is 1.0 as a float): the
+    # hint was missing (re-check review, session 43)
+    disc = '[system]\ntime = "discrete"\nA = [[0.99999999999999999]]\nC = [[1]]\n[method]\nkey = "lyapunov"\nL = [[0]]\n'
+    with pytest.raises(
+        InconclusiveError, match=r"is 0 in floats .* a smaller \[method\]\.rate_tol"
+    ):
+        api.design(api.load_spec_text(disc, "d.toml"))
+    assert api.design(api.load_spec_text(disc + "rate_tol = 1e-6\n", "d.toml")).exit_code() == 0
