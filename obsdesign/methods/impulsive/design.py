@@ -302,9 +302,12 @@ def _window(
     lam_on: λ*_no, λ*_on; :param gamma, beta: of L; :param lam_Mo: λ_max(M_o) (float, for the
     note); :param notes: the design's notes (Assumption 2's note is added)."""
     if not kappa_n > lam_no:
+        # "with the certified bounds" and 12 digits: "κ_n = 5 ≤ λ*_no = 5" read as a plain
+        # failure where the exact κ_n = 5 > λ*_no (re-check review, session 43)
         raise Infeasible(
-            f"Lemma 1 fails: κ_n = {float(kappa_n):.6g} ≤ λ*_no = ‖Ā_no‖ + ℓ_no = "
-            f"{float(lam_no):.6g} (short by {float(lam_no - kappa_n):.4g}); try another M"
+            f"Lemma 1 fails with the certified bounds: κ_n = {fmt_down(kappa_n, 12)} ≤ λ*_no = "
+            f"‖Ā_no‖ + ℓ_no = {fmt_up(lam_no, 12)} (short by {float(lam_no - kappa_n):.4g}); "
+            "try another M"
         )
     kmax = kappa_max(kappa_n, lam_no, lam_on, beta)
     if kmax <= 0:
