@@ -828,3 +828,20 @@ def test_an_empty_window_names_kappa_only_when_it_is_given(kappa: str, hint: str
     with pytest.raises(InfeasibleError, match="empty window") as ei:
         api.design(api.load_spec_text(text, "s.toml"))
     assert ei.value.message.endswith(hint)
+
+
+@pytest.mark.parametrize("C", ["[[1e-13, 0, 0]]", "[[1, 0, 0], [1, 1e-13, 0]]"])
+def test_the_orthonormal_complement_has_n_minus_m_rows(C: str) -> None:
+    """‖C‖ < 1e-12, or a singular value of C below 1e-12·σ_max: the complement's float rank
+    cut-off gave M a row too many, and the design stopped with "T = [C; M] is singular",
+    exit 3 (re-check review, session 43). C has full row rank exactly: M has n − m rows."""
+    from obsdesign import api
+
+    text = (
+        '[system]\ntime = "continuous"\nA = [[-3, 0, 0], [0, -3, 0], [0, 0, -3]]\n'
+        f'C = {C}\npsi = ["0", "0", "0"]\n[nonlinearity]\nlipschitz_x = 0\n'
+        '[method]\nkey = "impulsive"\nL = [' + ", ".join(["0.8"] * C.count("[", 1)) + "]\n"
+        "alpha = 3\nnoise_bound = 0.1\n"
+    )
+    rep = api.design(api.load_spec_text(text, "c.toml"))
+    assert rep.exit_code() == 0 and api.verify(rep).exit_code() == 0

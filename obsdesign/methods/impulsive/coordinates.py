@@ -98,9 +98,11 @@ def orthonormal_complement(C: np.ndarray) -> np.ndarray:
     inflated by a badly conditioned T.
     """
     C = np.asarray(C, dtype=float)
-    _, s, vt = np.linalg.svd(C)
-    r = int(np.sum(s > 1e-12 * max(1.0, s.max(initial=0.0))))
-    return vt[r:, :]
+    _, _, vt = np.linalg.svd(C)
+    # C has full row rank m (checked exactly on load): the complement has n − m rows. A float
+    # rank with a relative cut-off gave M a row too many for ‖C‖ < 1e-12 or an ill-conditioned
+    # C, and "T = [C; M] is singular", exit 3 (re-check review, session 43)
+    return vt[C.shape[0] :, :]
 
 
 def rational_M(Mf: np.ndarray) -> np.ndarray:
