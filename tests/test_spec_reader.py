@@ -254,3 +254,18 @@ def test_value_of_leaves_the_callers_array_writable() -> None:
     assert arr.flags.writeable and not v.q.flags.writeable
     arr[0, 0] = fmpq(5)
     assert v.q[0, 0] == 1
+
+
+def test_value_of_a_float_array_holds_exact_rationals() -> None:
+    """``Value.of(np.array([[0.1]]))`` kept Python floats as the "exact" part: three methods
+    then stopped with a bare TypeError (API review, session 43). Each float is read at its
+    exact binary value."""
+    import numpy as np
+    from flint import fmpq
+
+    from obsdesign.spec.reader import Value
+
+    v = Value.of(np.array([[0.1, 2]]))
+    assert all(isinstance(x, fmpq) for x in v.q.flat)
+    assert v.q[0, 0] == fmpq(3602879701896397, 36028797018963968) and v.q[0, 1] == 2
+    assert v.f[0, 0] == 0.1

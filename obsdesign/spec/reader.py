@@ -49,6 +49,10 @@ class Value:
         # a copy: the Value is read-only, and the caller's own array was frozen in place
         # with it (re-check review, session 43)
         arr = np.array(q, dtype=object)
+        if not all(isinstance(v, fmpq) for v in arr.flat):
+            # floats and ints as their exact values: Python floats kept as the "exact" part
+            # were a bare TypeError in three methods (API review, session 43)
+            arr = np.array([Q(v) for v in arr.flat], dtype=object).reshape(arr.shape)
         return cls(arr, np.asarray(to_float(arr), dtype=float).reshape(arr.shape))
 
     @property
