@@ -1592,8 +1592,12 @@ def best_rate(
             if 0 < gap < finest
             # below the float resolution (A = 0.99999999999999999 is 1.0 as a float): no
             # estimate, the same remedy (re-check review, session 43)
+            # rate_tol cannot go below ~2.3e-16: past that, only a given rate helps (A = 1 −
+            # 1e-40 looped on the hint; re-check review, session 43)
             else f"; its stability margin ({name}) is 0 in floats and {where}: give a "
-            "smaller [method].rate_tol"
+            f"smaller [method].rate_tol, or a rate [method].{'lambda' if discrete else 'alpha'}"
+            " itself (written with enough digits) when the margin is below the float "
+            "resolution"
             if gap <= 0
             else ""
         )
