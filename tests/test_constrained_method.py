@@ -1284,3 +1284,16 @@ def test_an_inclusion_whose_float_norm_overflows_is_false_not_undecided() -> Non
     bad = {c.id: c.float_ok for c in rep.claims if not c.ok}
     assert rep.exit_code() == 1, bad
     assert bad.get("Xhat-in-Cmax") is False
+
+
+def test_the_lambda_bracket_names_the_discrete_time_test() -> None:
+    """The constrained method is discrete-time: its lambda-bracket check said "exact Routh
+    test", the continuous-time test (random-plant review, session 43)."""
+    from obsdesign import api
+
+    spec = Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5.toml"
+    text = spec.read_text(encoding="utf-8")
+    lines = [ln for ln in text.splitlines() if not ln.startswith("lambda = ")]
+    rep = api.design(api.load_spec_text("\n".join(lines) + "\n", "best.toml"))
+    (claim,) = [c for c in rep.claims if c.id == "lambda-bracket"]
+    assert "Schur–Cohn" in claim.check and "Routh" not in claim.check

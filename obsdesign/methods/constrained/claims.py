@@ -465,8 +465,8 @@ def _linear_claims(c: Claims, spec: Spec, P: Any, rho: fmpq, mu: fmpq, lam: fmpq
 
 def _lambda_bracket(c: Claims, spec: Spec, params: Parameters, lam: fmpq) -> None:
     """Best λ, bracketed (Section 5 of the constrained-redesign paper, Astolfi et al., NOLCOS
-    2019): at λ_infeasible no P ≻ 0 makes λ²P − (A−LC)ᵀP(A−LC) ≻ 0 (exact Routh test of the
-    spectral radius), and λ − λ_infeasible ≤ rate_tol."""
+    2019): at λ_infeasible no P ≻ 0 makes λ²P − (A−LC)ᵀP(A−LC) ≻ 0 (exact inertia certificate or
+    Schur–Cohn test of Acl/λ), and λ − λ_infeasible ≤ rate_tol."""
     o: Options = spec.options
     s = spec.system
     other = params.exact("lambda_infeasible", c)
@@ -482,7 +482,10 @@ def _lambda_bracket(c: Claims, spec: Spec, params: Parameters, lam: fmpq) -> Non
             f"is best to within {fmt_exact(o.rate_tol)}"
         ),
         reference=_ref("Section 5"),
-        check="exact Routh test (Acl/λ Schur ⟺ some P ≻ 0); exact bracket width",
+        # discrete time: an exact inertia certificate or the Schur–Cohn test (it said
+        # "Routh", the continuous-time test; random-plant review, session 43)
+        check="exact Lyapunov inertia certificate or Schur–Cohn test (Acl/λ Schur ⟺ some "
+        "P ≻ 0); exact bracket width",
         passed=not feasible and 0 <= width <= Q(o.rate_tol),
         detail=f"bracket width {fmt_up(width, 6)}"
         + ("; λ_infeasible is feasible" if feasible else ""),
