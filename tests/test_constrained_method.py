@@ -158,6 +158,12 @@ def test_gamma_just_above_its_bound_says_by_how_much() -> None:
 
     assert _over(Q("1.000001"), 1) == "1e-06 (relative) above it"
     assert _over(17, Q("2.3965e-05")) == "7.09e+05× too large"
+    # the refusal says which bound: the relative excess is over the certified γ, which lies
+    # below (24) itself ("above it" read as the excess over (24); session 43)
+    sp = _spec("gamma = 0.00002396505031790019468897047")
+    with pytest.raises(InfeasibleError) as e:
+        api.design(sp)
+    assert "(relative) above that certified γ" in str(e.value), str(e.value)
 
 
 def test_gamma_uncertified_is_failed_claim():
