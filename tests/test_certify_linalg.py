@@ -200,3 +200,5 @@ def test_norm_upper_of_entries_beyond_the_float_range() -> None:
     u = norm_upper(X)
     assert u >= 0 and u * u >= fmpq(10**800) + 1
     assert u <= fmpq(10**400) * (1 + fmpq(1, 2**30))
+    # proved by the exact check, which refuses a bound below √(10⁸⁰⁰ + 1)
+    assert norm_bound_holds(X, u) and not norm_bound_holds(X, fmpq(10**400))
