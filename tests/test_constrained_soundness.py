@@ -1404,6 +1404,15 @@ def _exact_outside(E: list[list[str]], x: list[fmpq]) -> bool:
     return sum(x[i] * Eq[i][j] * x[j] for i in range(2) for j in range(2)) > 1
 
 
+def _refuted_by_a_witness(cm: Any, eps: fmpq, E: list[list[str]]) -> None:
+    """C_min ⊂ {xᵀEx ≤ 1} fails its outer-set test and the witness search finds a point of
+    C_min outside it, both checked exactly here."""
+    xh = Ellipsoid(_q(E), np.array([fmpq(0)] * 2, dtype=object))
+    assert not CL.cmin_in_xhat(cm, eps, xh)[0]
+    w = CL.cmin_witness(cm, eps, xh)
+    assert w is not None and cm.norm_c_sq_q(w) <= eps**2 and _exact_outside(E, list(w))
+
+
 def test_ellipsoid_map_witness_along_the_generalized_axes() -> None:
     """Q = [[2, −2], [−2, 3]], r = 45, ε_min = 0.011 (not a rational square, so the failed
     outer-set test is not a proof) against the disk X̂ = {0.03|x|² ≤ 1}: (8, 156/25) lies in
@@ -1413,10 +1422,7 @@ def test_ellipsoid_map_witness_along_the_generalized_axes() -> None:
     cm = ellipsoid_map(_q([[2, -2], [-2, 3]]), Q(45))
     eps = Q("0.011")
     E = [["0.03", "0"], ["0", "0.03"]]
-    xh = Ellipsoid(_q(E), np.array([fmpq(0)] * 2, dtype=object))
-    assert not CL.cmin_in_xhat(cm, eps, xh)[0]
-    w = CL.cmin_witness(cm, eps, xh)
-    assert w is not None and cm.norm_c_sq_q(w) <= eps**2 and _exact_outside(E, list(w))
+    _refuted_by_a_witness(cm, eps, E)
 
 
 @pytest.mark.parametrize("kind", ["polytope", "box"])
@@ -1433,7 +1439,4 @@ def test_affine_map_witness_at_a_slab_vertex(kind: str) -> None:
         cm = box_map(np.array([-1.0, -1.0]), np.array([1.0, 1.0]))
     eps = Q("0.5")
     E = [["0.0001", "0"], ["0", "0.37"]]
-    xh = Ellipsoid(_q(E), np.array([fmpq(0)] * 2, dtype=object))
-    assert not CL.cmin_in_xhat(cm, eps, xh)[0]
-    w = CL.cmin_witness(cm, eps, xh)
-    assert w is not None and cm.norm_c_sq_q(w) <= eps**2 and _exact_outside(E, list(w))
+    _refuted_by_a_witness(cm, eps, E)
