@@ -417,6 +417,38 @@ def test_theta_covers(sec5, tmp_path) -> None:
     assert failed_ids(tamper(sec5, theta=t + fmpq(1, 2))) == {"theta-covers"}
 
 
+def test_singular_P_fails_P_invertible_and_keeps_the_other_claims(sec5: Report) -> None:
+    """Statement review 44: a report's P = [[1, 1], [1, 1]] (singular) was one
+    'parameters-wellformed / ZeroDivisionError: matrix is singular' claim in place of every
+    claim (P⁻¹ of the level sets); now P-invertible fails beside P-positive-definite, and
+    the claims computed before it stay."""
+    failed = failed_ids(tamper(sec5, P=[[1, 1], [1, 1]]))
+    assert {"P-positive-definite", "P-invertible"} <= failed
+    assert "parameters-wellformed" not in failed
+
+
+def test_rho_one_fails_v_max_breve_bound_not_the_parse() -> None:
+    """Statement review 44: with ρ from the report (ρ omitted, λ² by the design), ρ = 1
+    divided by 1 − ρ = 0 in v̆_max and failed as 'parameters-wellformed /
+    ZeroDivisionError' instead of v_max_breve-bound (ρ ≥ 1: no finite v̆_max)."""
+    text = variant(
+        add='X0 = "X0"\nXhat0 = "Xhat0"',
+        replace=[
+            ("rho = 0.955\n", ""),
+            (
+                "[method]",
+                '[sets.X0]\ntype = "box"\nlower = [-1, -1]\nupper = [-0.9, -0.9]\n\n'
+                '[sets.Xhat0]\ntype = "box"\nlower = [0.9, 0.9]\nupper = [1, 1]\n\n[method]',
+            ),
+        ],
+    )
+    rep = _design(text)
+    assert rep.exit_code() == 0 and "v_max_breve" in rep.parameters
+    failed = failed_ids(tamper(rep, rho=1))
+    assert {"rho-is-lambda-squared", "v_max_breve-bound"} <= failed
+    assert "parameters-wellformed" not in failed
+
+
 def test_breve_claims(breve, tmp_path) -> None:
     p = breve.parameters
     vb, tb, vmax = p["v_max_breve"], p["theta_breve"], p["v_max"]

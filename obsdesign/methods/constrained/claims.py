@@ -25,7 +25,7 @@ from obsdesign import lyap
 from obsdesign.certify.claim import Claim, Claims, ClaimStatus
 from obsdesign.certify.exact import Q, dyadic, qeye, to_float
 from obsdesign.certify.interval import sqrt_lower, sqrt_upper, upper
-from obsdesign.certify.linalg import ROUNDED_UP_REL
+from obsdesign.certify.linalg import ROUNDED_UP_REL, qrank
 from obsdesign.certify.printing import (
     fmt_down,
     fmt_exact,
@@ -165,6 +165,16 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         check="exact LDLᵀ over Q",
         result=check_pd(P, o.margin),
     )
+    if c[-1].status is ClaimStatus.FAILED and qrank(P) < len(P):
+        # the level sets of eqs. (13), (15), (21) use P⁻¹: a singular P was one
+        # 'parameters-wellformed / ZeroDivisionError' claim in place of every claim (review)
+        c.failed(
+            id="P-invertible",
+            statement="P is invertible (the level sets of eqs. (13), (15), (21) use P⁻¹)",
+            reference=_ref("eq. (4)"),
+            detail="P is singular: the claims built from P (eq. (5)-(22)) are not checked",
+        )
+        return c
     if o.model is not None and o.model.nonlinear:
         # sampled up to the v_max bound recomputed from the spec, never the report's v_max: a
         # tampered v_max of 10⁶ moved the samples off a known violation and verify accepted
@@ -342,14 +352,20 @@ def _breve(
     if vr is None or tr is None:
         return
     vbr, tb = Q(vr), Q(tr)
-    ref = v_max_breve(P, rho, mu, o.X0, o.Xhat0, W)
+    # ρ ≥ 1: the induction ρ v̆ + μ|d|² ≤ v̆ has no finite v̆ (a report's ρ = 1 was a
+    # 'parameters-wellformed / ZeroDivisionError' claim in place of every claim; review)
+    ref = v_max_breve(P, rho, mu, o.X0, o.Xhat0, W) if rho < 1 else None
     statement = (
         f"V(x̂_k − x_k) ≤ v̆_max ≤ {fmt_up(vbr, 8)} for all k along solutions from X0 × X̂0"
         " with every w_k ∈ D"
     )
     check = "exact: v̆_max ≥ max V(x̂0 − x0) over X0 × X̂0 + μ max|w|²/(1 − ρ), ρ < 1"
-    ok = vbr >= ref and rho < 1
-    detail = f"recomputed bound ≤ {fmt_up(ref, 10)}"
+    ok = ref is not None and vbr >= ref
+    detail = (
+        f"recomputed bound ≤ {fmt_up(ref, 10)}"
+        if ref is not None
+        else f"ρ = {fmt_exact(rho)} ≥ 1: no finite bound (1 − ρ ≤ 0)"
+    )
     # the bound holds along solutions only where (5) does: it is certified only with a
     # certified iss-bound (the sampled one of expression-defined maps, or a failed exact one,
     # left it certified and false; constrained trial, session 24)
