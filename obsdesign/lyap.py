@@ -7,7 +7,7 @@ x⁺ = A x + B u + Bd d, y = C x + D u + Dn v: the error e = x̂ − x obeys
 
 (ė = … in continuous time). This is the linear case of the quadratic Lyapunov function
 V(e) = eᵀ P e of eq. (4) and the dissipation inequality V(Δ(x, e, w)) ≤ β(V(e), w) of eq. (5)
-with β(v, w) = ρ v + μ |w|² (eq. (6)-(7)), ρ = λ², as in Section 5 of Astolfi, Bernard,
+with β(v, w) = ρ v + μ |w|² (eq. (6)), ρ = λ², as in Section 5 of Astolfi, Bernard,
 Postoyan, Marconi, "Redesign of discrete-time nonlinear observers with state estimate
 constraints guaranteed in prescribed convex set", NOLCOS 2019 (the "constrained-redesign
 paper"). Continuous time uses the analogue V̇ ≤ −2α V + μ |w|².

@@ -539,7 +539,7 @@ def _convexity(c: Claims, cm: ConstraintMap) -> None:
     if cm.affine:
         statement, lemma, check = (
             "each c_i = max(g_iᵀx − h_i, 0)² is convex",
-            "Lemma 2",
+            "Lemma 2" if cm.kind == "box" else "Lemma 2's argument for the polytope map",
             "by construction (affine φ_i)",
         )
         passed, detail = True, f"{cm.n_c} components"

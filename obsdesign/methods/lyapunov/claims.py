@@ -356,7 +356,7 @@ def iss_claim(
     discrete: bool,
 ) -> Claim:
     """The ISS inequality V(e⁺) ≤ λ²V(e) + μ|w|² (continuous: V̇ ≤ −2αV + μ|w|²) for
-    w = (d, v) entering as B_w = [−Bd, L Dn]: eq. (5) with β(v, w) = ρv + μ|w|², eq. (6)-(7),
+    w = (d, v) entering as B_w = [−Bd, L Dn]: eq. (5) with β(v, w) = ρv + μ|w|², eq. (6),
     Section 5 of the constrained-redesign paper (Astolfi et al., NOLCOS 2019); the block
     matrix is checked ≻ 0 exactly. μ is printed exactly, and rounded up beside it.
 
