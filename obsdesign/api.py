@@ -133,6 +133,7 @@ def _bind(spec: Spec) -> Spec:
         spec.simulate.options = m.parse_simulate(st, spec)
         st.done()
     spec.bound_to = spec.binding()
+    spec.bound_options = (spec.options, dict(getattr(spec.options, "__dict__", {})))
     freeze_arrays((spec.sets, spec.options, spec.simulate))
     return spec
 
@@ -187,6 +188,21 @@ def _spec(spec: str | Path | Spec) -> Spec:
     if isinstance(spec, Spec):
         return bind(spec)
     return load_spec(_path_arg(spec, "spec", "a Spec"))
+
+
+def _text_describes(sp: Spec) -> None:
+    """Refuse (InputError, exit 2) a spec whose objects are no longer the ones its text was
+    read into: a report embeds ``sp.text`` and its hash, and its claims must be true for
+    them. A replaced system (``dataclasses.replace``), an assigned ``spec.text`` or option
+    field, or a set put into the ``sets`` dict that ``copy.copy`` shares with the original
+    designed exit 0 with claims false for the embedded text (API review, session 44)."""
+    changed = sp.changed_since_read()
+    if changed is not None:
+        raise InputError(
+            f"{sp.file}: {changed} of the spec object was replaced or edited after "
+            "loading, and a report embeds the spec's text, which no longer describes it: "
+            "edit the text and load it again (api.load_spec_text)"
+        )
 
 
 def _path_arg(value: Any, name: str, other: str = "") -> Any:
@@ -269,6 +285,7 @@ def design(
     budget = budget_seconds(timeout)
     t0 = time.perf_counter()
     sp = _spec(spec)
+    _text_describes(sp)
     t1 = time.perf_counter()
     m = get_method(sp.method)
     notes: list[str] = []

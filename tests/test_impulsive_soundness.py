@@ -29,7 +29,8 @@ from obsdesign.api import load_spec_text
 from obsdesign.certify.claim import Claims
 from obsdesign.certify.exact import Q, qmat
 from obsdesign.cli import app
-from obsdesign.errors import SpecError
+from obsdesign.errors import InputError, SpecError
+from obsdesign.methods import get_method
 from obsdesign.methods.impulsive.claims import _ball
 from obsdesign.methods.impulsive.core import BlockData
 from obsdesign.methods.impulsive.dissipativity import QSR
@@ -1259,6 +1260,9 @@ def test_a_copied_spec_with_another_system_is_bound_to_that_system() -> None:
     failed = {c.id for c in api.certify(other, rep.parameters) if not c.ok}
     assert {"Abar", "kappa_n", "lambda_no", "lambda_on"} <= failed
     with pytest.raises(InfeasibleError, match="Lemma 1 fails"):
+        get_method("impulsive").design(api.bind(other), None)
+    # api.design refuses the copy: a report would embed the text of the old A (session 44)
+    with pytest.raises(InputError, match=r"\[system\] of the spec object was replaced"):
         api.design(other)
     assert all(c.ok for c in api.certify(spec, rep.parameters))  # the original: unchanged
     assert spec.options.problem.A is spec.system.A.q

@@ -23,7 +23,8 @@ from obsdesign.certify.claim import Claims, ClaimStatus
 from obsdesign.certify.exact import Q
 from obsdesign.certify.interval import iv
 from obsdesign.cli import app
-from obsdesign.errors import InfeasibleError, SpecError
+from obsdesign.errors import InfeasibleError, InputError, SpecError
+from obsdesign.methods import get_method
 from obsdesign.methods.searchspace import claims as C
 from obsdesign.methods.searchspace import design as D
 from obsdesign.params import Parameters
@@ -2472,5 +2473,9 @@ def test_each_expression_is_bounded_with_its_own_parameters() -> None:
     b = api.load_spec_text(with_k.replace("KVALUE", "10"), "b.toml")
     mix = copy.copy(a)
     mix.system = dataclasses.replace(a.system, f=[b.system.f[0], a.system.f[1]])
-    rep = api.design(mix)
-    assert Q(rep.parameters["L_f"]) >= 10
+    # api.design refuses the copy (its text says k = 1 throughout; API review, session 44):
+    # the method layer designs it, and api.certify checks its bounds
+    d = get_method("search-space").design(api.bind(mix), None)
+    assert Q(d.parameters["L_f"]) >= 10
+    with pytest.raises(InputError, match=r"\[system\] of the spec object was replaced"):
+        api.design(mix)

@@ -63,3 +63,63 @@ def test_set_and_option_arrays_of_a_bound_spec_are_read_only() -> None:
     assert isinstance(sim.noise.bound, np.ndarray)
     with pytest.raises(ValueError, match="read-only"):
         sim.noise.bound[0] = 5.0
+
+
+def _mutations() -> list:
+    """(name, edit of a loaded spec in place, the part the refusal names)."""
+    import dataclasses
+
+    from obsdesign.sets import Box
+    from obsdesign.spec.reader import Value
+
+    def system(sp):
+        sp.system = dataclasses.replace(sp.system, A=Value.of([[0, 1], [0.99, 0]]))
+
+    def text(sp):
+        sp.text = sp.text.replace("[method]", "# edited\n[method]")
+
+    def option_field(sp):
+        sp.options.rate = fmpq(99, 100)
+
+    def options(sp):
+        sp.options = copy.copy(sp.options)
+
+    def method(sp):
+        sp.method = "stubborn"
+
+    def shared_sets(sp):  # a copy shares the sets dict: the original changes
+        other = copy.copy(sp)
+        other.sets["Y"] = Box(np.array([-2.0, -2.0]), np.array([2.0, 2.0]))
+
+    return [
+        ("system", system, r"\[system\]"),
+        ("text", text, "text"),
+        ("option field", option_field, r"\[method\] option 'rate'"),
+        ("options", options, r"\[method\] options"),
+        ("method", method, r"\[method\] key"),
+        ("shared sets", shared_sets, r"\[sets\]"),
+    ]
+
+
+@pytest.mark.parametrize(("name", "edit", "named"), _mutations(), ids=[m[0] for m in _mutations()])
+def test_design_refuses_a_spec_changed_after_loading(name, edit, named) -> None:
+    """A report embeds the spec's text: a system replaced, the text or an option assigned, or a
+    set put into the sets dict a copy shares with the original designed exit 0 with claims
+    false for the embedded text (API review, session 44). Refused, exit 2, naming the part."""
+    from obsdesign.errors import InputError
+
+    sp = api.load_spec(SPECS / "constrained-redesign-sec5-lyapunov.toml")
+    sp.options.rate = sp.options.rate  # the same object again: nothing changed
+    assert api.design(sp).exit_code() == 0
+    edit(sp)
+    with pytest.raises(InputError, match=named) as e:
+        api.design(sp)
+    assert e.value.exit_code == 2 and "load it again" in str(e.value)
+
+
+def test_unchanged_copies_design() -> None:
+    """Copies (shallow, deep, pickled) of an unchanged spec are the same value: designed."""
+    sp = api.load_spec(SPECS / "constrained-redesign-sec5-lyapunov.toml")
+    for other in (copy.copy(sp), copy.deepcopy(sp), pickle.loads(pickle.dumps(sp))):
+        assert api.design(other).exit_code() == 0
+

@@ -90,6 +90,7 @@ def _spec(data: dict[str, Any], text: str, file: str) -> Spec:
     if sim is not None:
         spec.simulate = _simulate(sim, system)
     root.done()
+    spec.origin = spec.read_state()
     return spec
 
 

@@ -130,6 +130,46 @@ class Spec:
     #: objects; a spec whose system or a set was replaced since (``copy.copy`` then
     #: ``spec.system = …``, ``dataclasses.replace``) is bound again
     bound_to: tuple[Any, ...] | None = field(default=None, repr=False, compare=False)
+    #: what ``text`` describes: :meth:`read_state` as the loader built it, and after binding
+    #: the options object with its fields (``api.bind``); ``api.design`` refuses a spec that
+    #: differs from it, since the report embeds ``text`` (API review, session 44)
+    origin: tuple[Any, ...] | None = field(default=None, repr=False, compare=False)
+    bound_options: tuple[Any, dict[str, Any]] | None = field(
+        default=None, repr=False, compare=False
+    )
+
+    def read_state(self) -> tuple[tuple[str, Any], ...]:
+        """The fields read from the text, each as an object (compared by identity): what a
+        replaced system or set, an edited text or method key, or a set put into a shared
+        ``sets`` dict (``copy.copy`` shares it) changes."""
+        return (
+            ("text", self.text),
+            ("sha256", self.sha256),
+            ("[system]", self.system),
+            ("[sets]", tuple(sorted(self.sets.items(), key=lambda kv: kv[0]))),
+            ("[method] key", self.method),
+            ("[method]", self.method_table),
+            ("[simulate]", self.simulate),
+            ("tables", tuple(self.tables.items())),
+        )
+
+    def changed_since_read(self) -> str | None:
+        """What differs from what the text describes (``None``: nothing, or a spec not made
+        by the loader): the name of the first field replaced since loading, or the options
+        (replaced, or a field of them assigned) since binding."""
+        if self.origin is not None:
+            for (name, was), (_, now) in zip(self.origin, self.read_state(), strict=True):
+                if not _same(was, now):
+                    return name
+        if self.bound_options is not None:
+            o, fields = self.bound_options
+            now_fields = getattr(self.options, "__dict__", {})
+            if self.options is not o or now_fields.keys() != fields.keys():
+                return "[method] options"
+            for k, v in fields.items():
+                if not _same(v, now_fields[k]):
+                    return f"[method] option {k!r}"
+        return None
 
     def binding(self) -> tuple[Any, ...]:
         """The objects the method's options are parsed from: the system and every set (by
@@ -138,3 +178,16 @@ class Spec:
 
     def set(self, name: str) -> ConvexSet:
         return self.sets[name]
+
+
+def _same(a: Any, b: Any) -> bool:
+    """Identity, through tuples (the sets and tables as (name, object) pairs); equal values
+    of one immutable scalar type count as the same (a pickle does not keep the identity of
+    an int or a float: every unpickled set-invariant spec was refused)."""
+    if a is b:
+        return True
+    if isinstance(a, tuple) and isinstance(b, tuple):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
+    if type(a) is type(b) and isinstance(a, (bool, int, float, complex, str, bytes)):
+        return bool(a == b) or (a != a and b != b)  # NaN is itself
+    return False
