@@ -123,3 +123,36 @@ def test_unchanged_copies_design() -> None:
     for other in (copy.copy(sp), copy.deepcopy(sp), pickle.loads(pickle.dumps(sp))):
         assert api.design(other).exit_code() == 0
 
+
+def _with_k() -> str:
+    text = (SPECS / "hernandez-garcia-example.toml").read_text(encoding="utf-8")
+    old = 'f = ["u1*x2", "-u1*x1"]'
+    assert old in text
+    return text.replace(old, 'f = ["k*u1*x2", "-u1*x1"]').replace(
+        "[method]", "[system.parameters]\nk = 10\n\n[method]", 1
+    )
+
+
+def test_expression_and_system_parameters_are_read_only() -> None:
+    """``spec.system.f[0].parameters["k"] = 1`` designed a report certified for k = 1 (L_f = 1)
+    whose embedded text says k = 10 (re-check review, session 44): refused, in copies too."""
+    sp = api.load_spec_text(_with_k(), "k.toml")
+    for other in (sp, copy.deepcopy(sp), pickle.loads(pickle.dumps(sp))):
+        for d in (other.system.parameters, other.system.f[0].parameters):
+            with pytest.raises(TypeError, match="read-only"):
+                d["k"] = 1
+            with pytest.raises(TypeError, match="read-only"):
+                d.update(k=1)
+        assert other.system.f[0](x1=0.0, x2=1.0, u1=1.0) == 10.0
+
+
+def test_specs_with_expressions_pickle_and_design() -> None:
+    """Every spec with an expression failed to pickle (its compiled callable is a closure;
+    API review, session 44); an unpickled spec (ints and floats in its options are new
+    objects) designs as the original."""
+    sp = api.load_spec_text(_with_k(), "k.toml")
+    back = pickle.loads(pickle.dumps(sp))
+    assert back.system.f[0].source == "k*u1*x2"
+    a, b = api.design(sp), api.design(back)
+    assert b.exit_code() == a.exit_code() == 0
+    assert b.parameters["L_f"] == a.parameters["L_f"]

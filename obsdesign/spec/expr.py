@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from obsdesign.errors import SpecError
+from obsdesign.spec.frozen import ReadOnlyDict
 
 
 def source_segment(src: str | None, node: ast.AST) -> str | None:
@@ -125,6 +126,17 @@ class Expr:
     variables: tuple[str, ...]
     parameters: dict[str, Any]
     _fn: Fn = field(repr=False, default=lambda env: 0.0)
+
+    def __post_init__(self) -> None:
+        # read-only: the parameters belong to the source text as the tree does (session 44)
+        if not isinstance(self.parameters, ReadOnlyDict):
+            object.__setattr__(self, "parameters", ReadOnlyDict(self.parameters))
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        """Pickled as its source (and variables, parameters), compiled again when loaded: the
+        compiled callable is a closure, and every spec with an expression failed to pickle
+        ("Can't pickle local object"; API review, session 44)."""
+        return (parse_expr, (self.source, self.variables, dict(self.parameters)))
 
     def __call__(self, **values: Any) -> Any:
         """Evaluate with variables given by name (arrays broadcast: a batch at once)."""

@@ -41,3 +41,19 @@ def freeze_arrays(obj: Any) -> None:
             stack.extend(x)
         elif isinstance(x, dict):
             stack.extend(x.values())
+
+
+class ReadOnlyDict(dict):  # type: ignore[type-arg]
+    """A dict that refuses every in-place change (``TypeError``), and copies and pickles as
+    itself: an expression's ``parameters`` edited in place (``f[0].parameters["k"] = 1``)
+    designed a report certified for k = 1 whose embedded text said k = 10 (re-check review,
+    session 44)."""
+
+    def _refuse(self, *args: Any, **kwargs: Any) -> None:
+        raise TypeError("a spec's parameters are read-only (edit the spec text and load it again)")
+
+    __setitem__ = __delitem__ = clear = pop = popitem = setdefault = update = _refuse  # type: ignore[assignment]
+    __ior__ = _refuse  # type: ignore[assignment]
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (ReadOnlyDict, (dict(self),))

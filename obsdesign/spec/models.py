@@ -7,6 +7,7 @@ from typing import Any
 
 from obsdesign.sets.base import ConvexSet
 from obsdesign.spec.expr import Expr
+from obsdesign.spec.frozen import ReadOnlyDict
 from obsdesign.spec.reader import Table, Value
 from obsdesign.spec.signals import Signal
 
@@ -53,6 +54,8 @@ class System:
         # (re-check review, session 43); replace the system (dataclasses.replace) instead
         for k, v in (("m", self.B.shape[1]), ("nd", self.Bd.shape[1]), ("nv", self.Dn.shape[1])):
             object.__setattr__(self, k, v)
+        if not isinstance(self.parameters, ReadOnlyDict):  # as each Expr's (session 44)
+            object.__setattr__(self, "parameters", ReadOnlyDict(self.parameters))
 
     @property
     def discrete(self) -> bool:
