@@ -2267,6 +2267,37 @@ def test_the_bracket_near_end_is_re_solved_too() -> None:
     assert not ok["lambda-max-bracket"]
 
 
+def test_scale_free_gain_holds_between_its_two_candidates_and_not_past_them() -> None:
+    """The scale-free gain constraint ‖X‖₂ ≤ g·s with P ⪰ s·I (some s > 0), proved exactly:
+    ‖X‖₂ = 1.9·g with λ_min(P) = 2 holds; ‖X‖₂ = 2·g·(1 + 2⁻⁴⁰) does not (the smallest
+    false margin: no s has both), nor does a bound g ≤ 0."""
+    from obsdesign.methods.stubborn.claims import _scale_free_gain_holds
+
+    P = np.diag([fmpq(2), fmpq(3)]).astype(object)
+    g = fmpq(1, 3)
+    assert _scale_free_gain_holds(P, np.array([[g * fmpq(19, 10)], [0]], dtype=object), g)
+    over = g * 2 * (1 + fmpq(1, 2**40))
+    assert not _scale_free_gain_holds(P, np.array([[over], [0]], dtype=object), g)
+    assert not _scale_free_gain_holds(P, np.array([[fmpq(0)], [0]], dtype=object), fmpq(0))
+
+
+def test_a_scale_free_near_end_is_proved_by_its_own_certificate() -> None:
+    """The exact near-end check skipped the scale-free gain normalization (P ⪰ s·I, ‖X‖₂ ≤
+    gain_bound·s), so such designs fell back on the cold re-solve, which answered
+    "optimal_inaccurate" for this plant: exit 1 on its own lambda-max-bracket (re-check
+    review, session 44)."""
+    text = (
+        '[system]\ntime = "continuous"\n'
+        "A = [[-0.486, -0.123, 0.652], [-1.336, -0.418, -0.927], [-0.359, -1.11, -0.397]]\n"
+        "C = [[1.87, -1.9, 1.49], [0.28, 1.26, -0.99]]\n"
+        '[method]\nkey = "stubborn"\ncriterion = "K"\ngain_bound = 0.5\nr_bound = 0.5\n'
+    )
+    rep = api.design(api.load_spec_text(text, "sf.toml"))
+    (claim,) = [c for c in rep.claims if c.id == "lambda-max-bracket"]
+    assert "certificate lies in the problem (exact)" in claim.detail, claim.detail
+    assert claim.status is not ClaimStatus.FAILED and rep.exit_code() == 0
+
+
 def test_an_honest_near_end_is_proved_by_its_own_certificate() -> None:
     """Since the near end was re-solved, a cold Clarabel solve at the rounded λ_max answered
     "optimal_inaccurate" for this random discrete plant and the design failed its own

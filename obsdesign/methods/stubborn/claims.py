@@ -370,12 +370,12 @@ def _in_problem(spec: Spec, o: Options, pt: dict[str, Any], lam: fmpq) -> bool:
     problem (:func:`obsdesign.methods.stubborn.design._problem`, :func:`_problem_text`),
     exactly: LMIs (1)-(3) / (7)-(9) each ⪯ −δI (δ of :func:`design.margin_at`, as the exact
     rational of the float the solver used), P ⪰ I, w ≥ 1, u ≥ δ, R ⪰ δI, ‖X‖₂ ≤
-    gain_bound·(1 − 10⁻⁶), R ⪯ r_bound·(1 − 10⁻⁶)·I. The scale-free variant is left to the
-    solver (False here)."""
+    gain_bound·(1 − 10⁻⁶), R ⪯ r_bound·(1 − 10⁻⁶)·I. The scale-free variant's ‖X‖₂ ≤
+    gain_bound·s·(1 − 10⁻⁶) with P ⪰ s·I is proved by :func:`_scale_free_gain_holds` (it was
+    left to the solver, whose cold re-solve answered optimal_inaccurate at honest points:
+    re-check review, session 44)."""
     from obsdesign.methods.stubborn.design import BOUND_INSIDE, Plant, margin_at
 
-    if o.scale_free_gain:
-        return False
     s = spec.system
     A, C, disc = s.A.q, s.C.q, s.discrete
     P, K, u, w, Y, R = (pt[k] for k in ("P", "K", "U", "W", "Y", "R"))
@@ -401,11 +401,39 @@ def _in_problem(spec: Spec, o: Options, pt: dict[str, Any], lam: fmpq) -> bool:
         return False
     if o.K is None and o.gain_bound is not None:
         g = Q(o.gain_bound) * inside
-        if not check_psd(_scaled_eye(p, g * g) - X.T @ X):
+        if o.scale_free_gain:
+            if not _scale_free_gain_holds(P, X, g):
+                return False
+        elif not check_psd(_scaled_eye(p, g * g) - X.T @ X):
             return False
     if o.r_bound is not None and not check_psd(_scaled_eye(p, Q(o.r_bound) * inside) - R):
         return False
     return True
+
+
+def _scale_free_gain_holds(P: np.ndarray, X: np.ndarray, g: fmpq) -> bool:
+    """Whether some s > 0 has P ⪰ s·I and ‖X‖₂ ≤ g·s (the scale-free gain constraint of
+    ``design._problem``, g = gain_bound·(1 − 10⁻⁶)), proved exactly at two candidates: s
+    just below λ_min(P) and s just above ‖X‖₂/g (floats, rounded to dyadics by 2⁻³⁰ relative
+    away from the bound they approach). Any s between the two works; False when neither
+    candidate is proved (a point with no room is left to the solver's re-solve).
+
+    :param P, X: the exact point (X = P K); :param g: the exact bound factor."""
+    from obsdesign.certify.exact import dyadic, to_float
+
+    n, p = P.shape[0], X.shape[1]
+    Pf, Xf = (np.asarray(to_float(M), dtype=float) for M in (P, X))
+    if not (np.all(np.isfinite(Pf)) and np.all(np.isfinite(Xf))) or g <= 0:
+        return False
+    lo = float(np.linalg.eigvalsh((Pf + Pf.T) / 2)[0])
+    nx = float(np.linalg.norm(Xf, 2)) / float(g)
+    for sf in (lo * (1 - 2.0**-30), nx * (1 + 2.0**-30)):
+        if not (math.isfinite(sf) and sf > 0):
+            continue
+        sq = dyadic(sf, 40)
+        if check_psd(P - _scaled_eye(n, sq)) and check_psd(_scaled_eye(p, (g * sq) ** 2) - X.T @ X):
+            return True
+    return False
 
 
 def _problem_text(o: Options, eqs: str, disc: bool) -> str:
