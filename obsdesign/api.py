@@ -160,7 +160,15 @@ def load_spec(path: str | Path) -> Spec:
 
 def load_spec_text(text: str, file: str = "<spec>") -> Spec:
     """Parse spec ``text`` and bind its method (see :func:`bind`); ``file`` names it in
-    error messages."""
+    error messages (a path is taken as its str)."""
+    import os
+
+    if isinstance(file, os.PathLike):
+        # a Path kept as the spec's file made the report unwritable (a bare TypeError from
+        # json, and the error report too; API review, session 44)
+        file = os.fspath(file)
+    if not isinstance(file, str):
+        raise InputError(f"load_spec_text: file must be a str naming the spec, got {file!r}")
     if not isinstance(text, str):
         # bytes, None or a Spec reached the reader's str methods: a bare TypeError or
         # AttributeError (API trial, session 33)

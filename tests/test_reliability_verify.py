@@ -334,6 +334,23 @@ def test_a_report_read_from_json_and_edited_in_memory_is_verified_as_edited(good
     assert _failed(api.verify(rep)) == {"parameters-consistent"}
 
 
+def test_load_spec_text_takes_a_path_as_the_file_name(tmp_path: Path) -> None:
+    """``load_spec_text(text, Path(...))`` kept the Path as the spec's file: ``design(out=)``
+    was a bare TypeError (json cannot write a Path) and the error report could not be
+    written either, so ``out`` kept an earlier run's report of another spec (API review,
+    session 44). The path is taken as its str; a file name of another type is refused."""
+    from obsdesign.errors import InputError
+
+    text = SPEC.read_text("utf-8")
+    out = tmp_path / "r.json"
+    sp = api.load_spec_text(text, tmp_path / "named.toml")
+    assert sp.file == str(tmp_path / "named.toml")
+    assert api.design(sp, out=out).exit_code() == 0
+    assert api.verify(out).exit_code() == 0
+    with pytest.raises(InputError, match="file must be a str"):
+        api.load_spec_text(text, 7)  # type: ignore[arg-type]
+
+
 def test_api_arguments_of_the_wrong_type_are_input_errors(tmp_path: Path) -> None:
     """``load_spec_text(bytes | None)``, ``design(123)``, ``verify({})`` and
     ``simulate(spec, bogus=3)`` raised bare TypeError / AttributeError from deep in the
