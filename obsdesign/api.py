@@ -33,7 +33,7 @@ from obsdesign.errors import (
 )
 from obsdesign.limits import ensure_recursion_limit, kernel_dir, limits, max_states_for
 from obsdesign.methods import get_method, method_keys
-from obsdesign.methods.base import Method, Progress
+from obsdesign.methods.base import INT_MAX, Method, Progress
 from obsdesign.params import Parameters, same_bits
 from obsdesign.report.model import TOP_KEYS, Report, check_output, write_atomic
 from obsdesign.spec import Spec, read_spec, read_spec_text
@@ -957,6 +957,8 @@ def simulate(
     if r is not None and (isinstance(r, bool) or not isinstance(r, numbers.Integral) or r < 1):
         # runs=0 ran once (``runs or 1``) while the CLI refuses --runs 0 (outsider trial)
         raise InputError(f"runs: expected a whole number of runs, at least 1, got {r!r}")
+    if r is not None and r > INT_MAX:  # 10**400: a bare OverflowError (API review, session 44)
+        raise InputError(f"runs: expected at most 2^63 − 1 runs, got {r}")
     if sp.simulate is None:
         raise InputError(f"{sp.file}: [simulate] is missing: nothing to simulate")
     check_sim_memory(sp, kwargs)

@@ -476,6 +476,18 @@ def test_the_api_refuses_a_run_count_below_one_or_not_whole(runs: object) -> Non
     assert api.simulate(spec, runs=np.int64(2)).metrics()["runs"] == 2
 
 
+def test_the_api_refuses_a_run_count_past_64_bits() -> None:
+    """``simulate(spec, runs=10**400)`` was a bare OverflowError (exit 3 from the CLI; API
+    review, session 44): refused by name, exit 2."""
+    from obsdesign import api
+    from obsdesign.errors import InputError
+
+    spec = Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+    for runs in (2**63, 10**400):
+        with pytest.raises(InputError, match="runs: expected at most 2"):
+            api.simulate(spec, runs=runs)
+
+
 _SCALE_SPEC = """[system]
 time = "discrete"
 A = [[0, 1], [1, 0]]

@@ -124,6 +124,10 @@ class SummaryField:
             object.__setattr__(self, "param", self.label)
 
 
+#: the largest integer a simulate option or run count takes (a 64-bit count)
+INT_MAX = 2**63 - 1
+
+
 @dataclass(frozen=True)
 class SimOption:
     """A ``simulate --option KEY=VALUE`` key: its type, default, range and help.
@@ -172,6 +176,10 @@ class SimOption:
         how the message quotes it)."""
         if self.choices is not None and v not in self.choices:
             raise InputError(f"{what}: expected one of {', '.join(self.choices)}, got {shown}")
+        if self.kind == "int" and self.name != "seed" and abs(v) > INT_MAX:  # numpy takes any seed
+            # max_centres = 10**400 reached a float conversion: exit 4 blaming the spec's
+            # numbers (API review, session 44)
+            raise InputError(f"{what}: expected an integer of at most 2^63 − 1, got {number}")
         if self.min is not None and v < self.min:
             raise InputError(f"{what}: expected a value >= {self.min:g}, got {number}")
         if self.max is not None and v > self.max:

@@ -74,3 +74,20 @@ def test_an_empty_path_option_is_refused(text: str) -> None:
     with pytest.raises(InputError, match=r"^simulate: sampling_file: expected a path"):
         opt.check_value(text)
     assert opt.parse("h.txt").name == "h.txt"
+
+
+def test_an_int_option_past_64_bits_is_refused_but_a_seed_is_not() -> None:
+    """``max_centres = 10**400`` reached a float conversion (exit 4 blaming the spec) and
+    ``runs = 10**400`` a bare OverflowError (API review, session 44): an int option above
+    2^63 − 1 is refused by name; 2^63 − 1 itself passes, and a seed takes any size."""
+    from obsdesign.methods.base import INT_MAX, SimOption
+
+    opt = SimOption("max_centres", "int", None, "a cap", 1)
+    assert opt.parse(str(INT_MAX)) == INT_MAX == opt.check_value(INT_MAX)
+    for bad in (str(INT_MAX + 1), str(10**400)):
+        with pytest.raises(InputError, match="max_centres: expected an integer of at most 2"):
+            opt.parse(bad)
+    with pytest.raises(InputError, match="simulate: max_centres: expected an integer of at"):
+        opt.check_value(INT_MAX + 1)
+    seed = SimOption("seed", "int", 0, "a seed")
+    assert seed.check_value(10**400) == 10**400
