@@ -355,6 +355,31 @@ def _columns(M: Any, rows: int, name: str, what: str) -> np.ndarray:
     raise InputError(f"{name} has shape {arr.shape}: expected {rows} rows ({what})")
 
 
+def _time_of(dt: Any) -> tuple[str, float | None]:
+    """``time`` and ``sample_time`` of a system's ``dt``: None or 0 continuous, True discrete
+    without a sample time, > 0 discrete with it. The sign is the exact value's: a Fraction
+    or Decimal below the float range (1/10⁴⁰⁰) read as 0.0, continuous time, and −1/10⁴⁰⁰
+    as −0.0 passed (API review, session 44); such a dt is refused."""
+    import math
+
+    if dt is None:
+        return "continuous", None
+    if dt is True:
+        return "discrete", None
+    try:
+        zero, positive, f = bool(dt == 0), bool(dt > 0), float(dt)
+    except (TypeError, ValueError, ArithmeticError):
+        zero = positive = False
+        f = math.nan
+    if zero:
+        return "continuous", None
+    if positive and math.isfinite(f) and f > 0:
+        return "discrete", f
+    if positive and f == 0:
+        raise InputError(f"dt {dt!r} is positive but below the float range (it would read as 0)")
+    raise InputError(f"dt must be 0, True or a finite positive number, got {dt!r}")
+
+
 def spec_text_from_statespace(
     sys: Any,
     method: str = "lyapunov",
@@ -382,14 +407,7 @@ def spec_text_from_statespace(
     column), else InputError. A boolean is written as ``true`` / ``false`` wherever it sits
     (never as 1 / 0 beside a float), so the spec refuses it where a number belongs."""
     A, B, C, D, dt = _matrices(sys)
-    if dt is None or (dt is not True and float(dt) == 0):
-        time, sample_time = "continuous", None
-    elif dt is True:
-        time, sample_time = "discrete", None
-    elif float(dt) > 0:
-        time, sample_time = "discrete", float(dt)
-    else:
-        raise InputError(f"dt must be 0, True or positive, got {dt!r}")
+    time, sample_time = _time_of(dt)
     system: dict[str, Any] = {"time": time, "A": A, "C": C}
     if B.size and np.any(B != 0):
         system["B"] = B

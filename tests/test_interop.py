@@ -1059,3 +1059,32 @@ def test_mat_import_reads_matlabs_ts_minus_one_as_discrete_time_without_a_sample
         bad = ["--dt", "-1.00000000000000001"]
         r = CliRunner().invoke(app, ["import", str(mat), "--A", "Ad", "--C", "Cm", *bad])
         assert r.exit_code == 2 and "exactly -1" in r.stderr
+
+
+@pytest.mark.parametrize(
+    ("dt", "match"),
+    [
+        (Fraction(1, 10**400), "positive but below the float range"),
+        (Decimal("1e-400"), "positive but below the float range"),
+        (Decimal("-1e-400"), "finite positive number"),
+        (Fraction(-1, 10**400), "finite positive number"),
+        (float("inf"), "finite positive number"),
+        (float("nan"), "finite positive number"),
+        (Decimal("NaN"), "finite positive number"),
+    ],
+)
+def test_a_dt_is_signed_by_its_exact_value(dt: object, match: str) -> None:
+    """dt = 1/10⁴⁰⁰ read as 0.0 and wrote a continuous-time spec; −1/10⁴⁰⁰ as −0.0 passed
+    (API review, session 44): the sign is the exact value's, and a dt of no float is
+    refused; Fraction(0) and Decimal('0') are continuous time, 1/3 discrete."""
+    from obsdesign.errors import InputError
+    from obsdesign.interop import spec_text_from_statespace
+
+    A, B, C, D = [[-0.5, 1], [0, -0.5]], [[0], [0]], [[1, 0]], [[0]]
+    with pytest.raises(InputError, match=match):
+        spec_text_from_statespace((A, B, C, D, dt), "lyapunov")
+    for zero in (Fraction(0), Decimal("0"), Decimal("-0")):
+        text = spec_text_from_statespace((A, B, C, D, zero), "lyapunov")
+        assert 'time = "continuous"' in text
+    text = spec_text_from_statespace((A, B, C, D, Fraction(1, 3)), "lyapunov")
+    assert 'time = "discrete"' in text and "sample_time = 0.3333333333333333" in text
