@@ -79,7 +79,15 @@ def _bind(spec: Spec) -> Spec:
     parsed (``copy.copy(spec)`` then ``spec.system = …``) is bound again, on a copy: the
     impulsive options hold A and C of the system they were parsed from, and a copy with
     another A was certified (and designed, exit 0) for the old one while ``simulate`` ran the
-    new one (API review, session 43)."""
+    new one (API review, session 43). A spec whose method key was assigned is refused: its
+    ``[method]`` table and options are the loaded method's, and ``certify`` checked a report
+    of one method against the other's contract (API review, session 44)."""
+    was = dict(spec.origin).get("[method] key") if spec.origin is not None else None
+    if was is not None and spec.method != was:
+        raise InputError(
+            f"{spec.file}: spec.method was assigned {spec.method!r}, but its [method] table is "
+            f"for {was!r}: edit the text's [method] key and load it again"
+        )
     if spec.options is not None:
         if spec.bound_to is None or _same_objects(spec.bound_to, spec.binding()):
             freeze_arrays((spec.sets, spec.options, spec.simulate))  # copies (deepcopy, pickle) too

@@ -96,7 +96,7 @@ def _mutations() -> list:
         ("text", text, "text"),
         ("option field", option_field, r"\[method\] option 'rate'"),
         ("options", options, r"\[method\] options"),
-        ("method", method, r"\[method\] key"),
+        ("method", method, "spec.method was assigned 'stubborn', but its .method. table is for"),
         ("shared sets", shared_sets, r"\[sets\]"),
     ]
 
@@ -156,3 +156,17 @@ def test_specs_with_expressions_pickle_and_design() -> None:
     a, b = api.design(sp), api.design(back)
     assert b.exit_code() == a.exit_code() == 0
     assert b.parameters["L_f"] == a.parameters["L_f"]
+
+
+def test_certify_refuses_a_spec_whose_method_key_was_assigned() -> None:
+    """``spec.method = "constrained"`` on a lyapunov spec: ``certify`` checked the lyapunov
+    report against the constrained contract (its options still lyapunov's), and ``design``
+    was a bare AttributeError (API review, session 44). Refused by every API call."""
+    from obsdesign.errors import InputError
+
+    sp = api.load_spec(SPECS / "constrained-redesign-sec5-lyapunov.toml")
+    rep = api.design(sp)
+    sp.method = "constrained"
+    for call in (lambda: api.certify(sp, rep.parameters), lambda: api.simulate(sp, rep)):
+        with pytest.raises(InputError, match="spec.method was assigned 'constrained'"):
+            call()
