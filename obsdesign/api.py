@@ -984,8 +984,15 @@ def simulate(
                 f"method '{sp.method}' does not distribute its simulation runs on Dask: "
                 "run it without --workers/--scheduler (its runs, if any, run in this process)"
             )
-        if batches is not None and batches < 1:
-            raise InputError(f"batches: expected a positive number, got {batches}")
+        if batches is not None and (
+            isinstance(batches, bool)
+            or not isinstance(batches, numbers.Integral)
+            or not 1 <= batches <= INT_MAX
+        ):
+            # 2.5 was a bare TypeError and True one batch (API review, session 44)
+            raise InputError(
+                f"batches: expected a whole number from 1 to 2^63 − 1, got {batches!r}"
+            )
         so = sp.simulate.options
         if kwargs.get("runs") is None and all(
             getattr(so, k, None) is None for k in ("runs", "initial_error")

@@ -116,6 +116,14 @@ def test_the_single_scenario_is_not_distributed() -> None:
     assert api.simulate(SPEC, batches=2, runs=1).info["runs"] == 1
 
 
+@pytest.mark.parametrize("batches", [0, 2.5, True, 2**63])
+def test_a_batch_count_is_a_whole_number_from_one(batches: object) -> None:
+    """``batches=2.5`` was a bare TypeError and ``batches=True`` one batch (API review,
+    session 44): refused by name, exit 2, before any run."""
+    with pytest.raises(InputError, match="batches: expected a whole number from 1"):
+        api.simulate(SPEC, batches=batches, runs=2)
+
+
 def test_workers_without_dask_say_how_to_install(monkeypatch, spec_and_report):
     path, _, _ = spec_and_report
     monkeypatch.setattr(distributed, "dask_available", lambda: False)
