@@ -1409,11 +1409,21 @@ def budget_seconds(timeout: Any, name: str = "timeout") -> float | None:
     NaN and −10⁻⁹ ran without a limit, "1" was a TypeError and True one second; re-check
     trial, session 35).
 
-    :param timeout: the budget given; :param name: how the error message names it."""
+    :param timeout: the budget given; :param name: how the error message names it. A
+    Decimal and a 0-d numpy array are numbers too, as simulate's ``time_limit`` takes them
+    (API review, session 44)."""
+    import decimal
     import numbers
+    from fractions import Fraction
+
+    import numpy as np
 
     if timeout is None:
         return None
+    if isinstance(timeout, np.ndarray) and timeout.ndim == 0 and timeout.dtype.kind in "iuf":
+        timeout = timeout.item()
+    if isinstance(timeout, decimal.Decimal) and timeout.is_finite():
+        timeout = Fraction(timeout)
     if isinstance(timeout, bool) or not isinstance(timeout, numbers.Real):
         raise InputError(
             f"{name} must be a number of seconds (0 or None: no limit), got "

@@ -201,6 +201,17 @@ def test_budget_seconds_keeps_a_real_budget_and_drops_no_budget() -> None:
     assert api.budget_seconds(Fraction(1, 10**400)) == api.MIN_BUDGET_S
     with pytest.raises(InputError):
         api.budget_seconds(-(10**400))
+    # API review, session 44: a Decimal and a 0-d array were refused (simulate's time_limit
+    # takes them); a Decimal NaN or a negative one is still refused
+    from decimal import Decimal
+
+    import numpy as np
+
+    assert api.budget_seconds(Decimal("2.5")) == 2.5 == api.budget_seconds(np.array(2.5))
+    assert api.budget_seconds(Decimal("1e-400")) == api.MIN_BUDGET_S
+    for bad in (Decimal("NaN"), Decimal("-1"), np.array(True)):
+        with pytest.raises(InputError):
+            api.budget_seconds(bad)
 
 
 def test_a_spec_named_twice_gets_one_row(tmp_path: Path) -> None:
