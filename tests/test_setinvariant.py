@@ -1221,3 +1221,53 @@ def test_subnormal_entries_of_GA_widen_the_slice_prescreen() -> None:
     ver = api.verify(Report.from_dict(d)[0])
     status = {c.id: c.ok for c in ver.claims}
     assert ver.exit_code() == 1 and status["theorem-3.1"] is False, status
+
+
+NO_LINEAR_LAW = """[system]
+time = "discrete"
+A = [[1.44, -0.0457, -1.02, 1.51], [-0.112, 1.16, 0.879, 0.843], [0.225, -0.843, 0.267, -0.165], [-0.738, 0.738, 2.6, -0.808]]
+C = [[0, 0, 0, 1], [1, 0, 0, 0], [0, 0, 1, 0]]
+B1 = [-0.17, 0.6, 0.27, -0.56]
+
+[sets.omega]
+type = "symmetric-polytope"
+Q = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1], [0.5, 0.25, -0.38, -0.15]]
+
+[sets.D]
+type = "box"
+dim = 1
+lower = [-0.071]
+upper = [0.071]
+
+[method]
+key = "set-invariant"
+omega = "omega"
+disturbance = "D"
+eta_bar = 0
+lambda = 0.8
+algorithm = "symmetric"
+max_iterations = 60
+time_limit = 90
+mirror = true
+
+[simulate]
+horizon = 20
+x0 = [0, 0, 0, 0]
+xhat0 = [0.077, 0.13, -0.16, 0.27]
+time_limit = 60
+"""
+
+
+def test_simulate_of_a_spec_whose_design_has_no_linear_gain_exits_1(tmp_path: Path) -> None:
+    """Three outputs, λ = 0.8: the design finds no admissible linear gain (exit 1), and
+    ``simulate SPEC`` said "the report has no linear gain L", exit 2 (bad input), although
+    no report was given (census, session 44): exit 1, the design's own infeasibility."""
+    p = tmp_path / "nolaw.toml"
+    p.write_text(NO_LINEAR_LAW, encoding="utf-8")
+    from typer.testing import CliRunner
+
+    from obsdesign.cli import app
+
+    r = CliRunner().invoke(app, ["simulate", str(p)])
+    assert r.exit_code == 1, r.output
+    assert "found no admissible linear gain" in r.output and "give [method] L" in r.output

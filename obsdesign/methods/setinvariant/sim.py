@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from obsdesign.errors import InputError
+from obsdesign.errors import InfeasibleError, InputError
 from obsdesign.params import Parameters
 from obsdesign.sets import Box
 from obsdesign.sets import polytope_ops as po
@@ -43,7 +43,14 @@ def make_law(spec: Spec, params: Parameters, law: str | None) -> Any:
         if "L" in params:
             return laws.LinearLaw(params.shaped("L", (s.n, s.p)))
         if spec.options.L is None:
-            raise InputError("the report has no linear gain L and the spec gives none")
+            # the design's own infeasibility (its linear-law claim failed): exit 1, as the
+            # README says for simulate SPEC; it was exit 2 naming a report that no one gave
+            # (census, session 44)
+            raise InfeasibleError(
+                "no linear injection to simulate: the design found no admissible linear gain "
+                "L (its report has none) and [method] L is not given; give [method] L, or "
+                "another lambda"
+            )
         return laws.LinearLaw(po.qfloat(spec.options.L).reshape(s.n, s.p))
     if law == "online-lp":
         if s.p != 1:
