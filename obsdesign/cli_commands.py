@@ -56,6 +56,26 @@ def _inputs(*paths: Path | None) -> tuple[Path, ...]:
     return tuple(out)
 
 
+def _sim_input_files(sp: Any, option: list[str] | None) -> list[Path]:
+    """The files a simulation reads besides spec and report: path-valued ``[simulate]``
+    options of the method (the impulsive ``sampling_file``, relative to the spec) and
+    path-valued ``--option KEY=PATH``. ``simulate --csv samp.csv`` overwrote the sampling
+    file it read, exit 0 (CLI review, session 44)."""
+    from obsdesign import api
+
+    out: list[Path] = []
+    so = getattr(sp.simulate, "options", None) if sp.simulate is not None else None
+    for v in getattr(so, "__dict__", {}).values():
+        if isinstance(v, Path):
+            out.append(v)
+    kinds = {o.name: o.kind for o in api.method(sp.method).sim_options}
+    for item in option or []:
+        k, eq, v = item.partition("=")
+        if eq and kinds.get(k.strip()) == "path" and v.strip():
+            out.append(Path(v.strip()))
+    return out
+
+
 def _read_stdin(what: str) -> str:
     """Standard input as text, within ``max_file_bytes`` (``-`` in place of a path)."""
     from obsdesign.errors import InputError
@@ -837,6 +857,11 @@ def simulate(
     if csv is not None:
         check_output(csv, force, _inputs(spec, report))
     sp = _load_spec(spec)
+    files = _sim_input_files(sp, option)
+    if files:  # the scenario's own input files (impulsive sampling_file) are inputs too
+        _check_plot(plot, force, _inputs(spec, report, *files))
+        if csv is not None:
+            check_output(csv, force, _inputs(spec, report, *files))
     steps = (
         api.sim_grid_steps(sp)
         if plot is not None and sp.simulate is not None and api.method(sp.method).sim_grid_from_dt

@@ -1015,3 +1015,30 @@ def test_a_spec_file_name_that_is_not_utf8_is_written_with_escapes(tmp_path: Pat
         res = run(app, ["sweep", spec, "--set", "method.nokey=1", "-o", str(tmp_path / name)])
         assert res.exit_code == 2, res.output
         assert "xff.toml[point 0]" in (tmp_path / name).read_bytes().decode("utf-8")
+
+
+def test_force_never_overwrites_the_spec(spec: Path) -> None:
+    """``design s.toml -o s.toml --force`` replaced the spec with its report; an input of the
+    run is refused even with --force (the brief: never overwrite the spec; session 44)."""
+    before = spec.read_bytes()
+    res = runner.invoke(app, ["design", str(spec), "-o", str(spec), "--force"])
+    _refused(res, "input file itself", "even with --force")
+    assert spec.read_bytes() == before
+
+
+def test_simulate_never_overwrites_the_sampling_file_it_reads(tmp_path: Path) -> None:
+    """``simulate s.toml --csv samp.csv`` with ``[simulate] sampling_file = "samp.csv"`` (or
+    ``--option sampling_file=samp.csv``) replaced the sampling intervals it had read with the
+    trajectory, exit 0 (CLI review, session 44): refused, exit 2, the file kept."""
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "specs" / "schaum-impulsive-example.toml").read_text(encoding="utf-8")
+    assert "\nseed = 1\n" in text
+    spec = tmp_path / "s.toml"
+    spec.write_text(text.replace("\nseed = 1\n", '\nseed = 1\nsampling_file = "samp.csv"\n'))
+    samp = tmp_path / "samp.csv"
+    samp.write_text("0.8\n" * 100)
+    before = samp.read_bytes()
+    for extra in ([], ["--force"], ["--option", f"sampling_file={samp}"]):
+        res = runner.invoke(app, ["simulate", str(spec), "-q", "--csv", str(samp), *extra])
+        _refused(res, "input file itself")
+        assert samp.read_bytes() == before

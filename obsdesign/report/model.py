@@ -514,7 +514,7 @@ def check_output(
     path: str | Path, force: bool = False, inputs: tuple[Path, ...] = (), forceable: bool = True
 ) -> None:
     """Refuse (:class:`InputError`, one line) an output path that would destroy something:
-    one of ``inputs`` (the spec itself), a symbolic link, an existing file that is not a
+    one of ``inputs`` (the spec itself; always, ``force`` or not), a symbolic link, an existing file that is not a
     regular file (device, FIFO, socket), a write-protected file, or a ``.toml`` name, new
     or existing (no output is TOML), unless ``force``; a
     directory, a path given for two outputs, or a directory that cannot take a new file
@@ -568,8 +568,12 @@ def _check_output(path: str | Path, force: bool, inputs: tuple[Path, ...]) -> No
         # the input file itself"; re-check review, session 43)
         if same and os.path.isdir(p):
             raise InputError(f"{p}: is a directory")
-        if same and not force:
-            raise InputError(f"{p}: is the input file itself; refusing to overwrite it (--force)")
+        if same:
+            # never, not even with --force: an input (the spec, the report, a sampling file)
+            # is what the run reads (the brief: never overwrite the spec; session 44)
+            raise InputError(
+                f"{p}: is the input file itself; refusing to overwrite it (even with --force)"
+            )
     if stat.S_ISLNK(lst.st_mode) and not force:
         raise InputError(
             f"{p}: is a symbolic link; refusing to replace it (--force writes through it)"
