@@ -528,7 +528,7 @@ def check_output(
     except InputError as e:
         if forceable:
             raise
-        raise InputError(re.sub(r" \(--force[^)]*\)$", "", str(e))) from None
+        raise InputError(re.sub(r" \((even with )?--force[^)]*\)$", "", str(e))) from None
 
 
 def _check_output(path: str | Path, force: bool, inputs: tuple[Path, ...]) -> None:
