@@ -1472,3 +1472,11 @@ def test_affine_map_witness_at_a_slab_vertex(kind: str) -> None:
     eps = Q("0.5")
     E = [["0.0001", "0"], ["0", "0.37"]]
     _refuted_by_a_witness(cm, eps, E)
+
+
+def test_a_report_without_the_spec_lambda_fails_lambda_present(sec5: Report) -> None:
+    """λ given in the spec: a report with ``lambda`` removed verified, 16 claims certified,
+    while removing ``rho`` or ``L`` (also fixed by the spec) fails (tamper review, session
+    44). Now ``lambda-present`` fails too."""
+    assert "lambda-present" in failed_ids(tamper(sec5, **{"lambda": None}))
+    assert "rho-present" in failed_ids(tamper(sec5, rho=None))

@@ -136,8 +136,11 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
     else:
         if o.lam is not None:
             lam = Q(o.lam)
-            if "lambda" in params:
-                c.matches("lambda", params.exact("lambda", c), lam, "[method].lambda")
+            # required, as rho and L are when the spec fixes them (a report without it
+            # verified; tamper review, session 44)
+            lr = params.exact("lambda", c)
+            if lr is not None:
+                c.matches("lambda", lr, lam, "[method].lambda")
         else:
             lr = params.exact("lambda", c)
             lam = None if lr is None else Q(lr)
