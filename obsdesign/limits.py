@@ -37,6 +37,10 @@ from typing import Any
 
 from obsdesign.errors import InputError
 
+#: the largest integer a spec key, a simulate option or a run count takes (a 64-bit count;
+#: a seed takes any size); larger ones reached float conversions (session 44)
+INT_MAX = 2**63 - 1
+
 
 @dataclass(frozen=True)
 class Limits:

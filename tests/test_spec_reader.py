@@ -269,3 +269,16 @@ def test_value_of_a_float_array_holds_exact_rationals() -> None:
     assert all(isinstance(x, fmpq) for x in v.q.flat)
     assert v.q[0, 0] == fmpq(3602879701896397, 36028797018963968) and v.q[0, 1] == 2
     assert v.f[0, 0] == 0.1
+
+
+def test_an_integer_key_past_64_bits_is_refused_but_a_seed_is_not() -> None:
+    """``[simulate] runs = 10**400`` was exit 3 (OverflowError in the memory estimate) and a
+    discrete ``horizon`` of 400 digits exit 4 naming no key (CLI review, session 44): an
+    integer key above 2^63 − 1 is refused naming it; 2^63 − 1 passes; a seed takes any size."""
+    from obsdesign.limits import INT_MAX
+
+    t = Table({"runs": INT_MAX, "horizon": INT_MAX + 1, "seed": 10**400}, "s.toml", "simulate")
+    assert t.int("runs", min=1) == INT_MAX
+    with pytest.raises(SpecError, match=r"\[simulate.horizon\] expected an integer of at most 2"):
+        t.int("horizon", min=1)
+    assert t.int("seed") == 10**400

@@ -42,6 +42,7 @@ from types import ModuleType
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from obsdesign.errors import InputError
+from obsdesign.limits import INT_MAX
 
 if TYPE_CHECKING:
     from obsdesign.certify.claim import Claim
@@ -122,10 +123,6 @@ class SummaryField:
     def __post_init__(self) -> None:
         if not self.param:
             object.__setattr__(self, "param", self.label)
-
-
-#: the largest integer a simulate option or run count takes (a 64-bit count)
-INT_MAX = 2**63 - 1
 
 
 @dataclass(frozen=True)

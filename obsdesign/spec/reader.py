@@ -16,7 +16,7 @@ from flint import fmpq
 
 from obsdesign.certify.exact import Q, to_float
 from obsdesign.errors import SpecError
-from obsdesign.limits import decimal_problem, int_problem
+from obsdesign.limits import INT_MAX, decimal_problem, int_problem
 
 _MISSING: Any = object()
 
@@ -202,6 +202,10 @@ class Table:
             raise self.error(k, f"expected an integer, got {_tname(v)}")
         if min is not None and v < min:
             raise self.error(k, f"expected an integer >= {min}, got {v}")
+        if k != "seed" and abs(v) > INT_MAX:  # numpy takes a seed of any size
+            # runs = 10**400 reached a float conversion (exit 3), a discrete horizon of 400
+            # digits exit 4 naming no key (CLI review, session 44)
+            raise self.error(k, f"expected an integer of at most 2^63 − 1, got {v}")
         return v
 
     def scalar(
