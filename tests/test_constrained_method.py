@@ -1303,3 +1303,13 @@ def test_the_lambda_bracket_names_the_discrete_time_test() -> None:
     rep = api.design(api.load_spec_text("\n".join(lines) + "\n", "best.toml"))
     (claim,) = [c for c in rep.claims if c.id == "lambda-bracket"]
     assert "Schur–Cohn" in claim.check and "Routh" not in claim.check
+
+
+@pytest.mark.parametrize("c", ["1e308", "-1e308"])
+def test_a_closed_loop_past_the_float_range_is_decided_exactly(c: str) -> None:
+    """C = [[1e308, 0]]: A − LC overflowed to inf in floats and eigvals raised LinAlgError,
+    exit 3 (CLI review, session 44). The exact Schur–Cohn test decides: not Schur, exit 1."""
+    text = variant(replace=[("C = [[1, 0]]", f"C = [[{c}, 0]]")])
+    assert f"C = [[{c}, 0]]" in text
+    with pytest.raises(InfeasibleError, match="A − LC is not Schur"):
+        api.design(load_spec_text(text, "c.toml"))

@@ -7,6 +7,7 @@ Order: Lyapunov data (P, ρ, μ; Assumption 2) → X̂ → v_max (13) → ε_max
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -65,8 +66,12 @@ def lyapunov_data(spec: Spec) -> LyapData:
     if o.P is not None:
         return LyapData(o.P, Q(o.rho), Q(o.mu), None)
     A, C = s.A.q, s.C.q
-    Acl_f = s.A.f - np.asarray(o.L, dtype=float) @ s.C.f
-    rad = float(np.max(np.abs(np.linalg.eigvals(Acl_f))))
+    with np.errstate(over="ignore", invalid="ignore"):
+        Acl_f = s.A.f - np.asarray(o.L, dtype=float) @ s.C.f
+    # A − LC past the float range (C = 1e308): no float radius, the exact test decides (eigvals
+    # raised LinAlgError, exit 3; CLI review, session 44)
+    finite = bool(np.all(np.isfinite(Acl_f)))
+    rad = float(np.max(np.abs(np.linalg.eigvals(Acl_f)))) if finite else math.inf
     if rad >= 1:
         # the float radius only raises the question; the exact test decides (a Jordan block
         # at 0.99999 has float radius 1.00017 and was refused, while lyapunov certified
