@@ -390,12 +390,25 @@ def _version(value: bool) -> None:
         raise typer.Exit(0)
 
 
-def _seconds(value: float) -> float:
+def _seconds(value: str | float) -> float:
     """``--timeout``'s value: a number of seconds ≥ 0 or inf; nan gets its own message
-    (typer's min=0 check said "greater than or equal to 0" of nan)."""
-    if value != value or value < 0:
+    (typer's min=0 check said "greater than or equal to 0" of nan). The text is read
+    exactly first: ``1e-400`` read as 0.0 (no limit) and ``-1e-400`` as −0.0 passed (CLI
+    review, session 44); a positive budget below the float range is the smallest one."""
+    import math
+    from decimal import Decimal, InvalidOperation
+
+    if isinstance(value, (int, float)):  # the default
+        q = Decimal(value)
+    else:
+        try:
+            q = Decimal(value.strip())
+        except InvalidOperation:
+            raise typer.BadParameter(f"{value!r} is not a number of seconds") from None
+    if q.is_nan() or (q < 0 and not q.is_zero()):
         raise typer.BadParameter(f"{value} is not a number of seconds >= 0 (0 or inf: none)")
-    return value
+    f = float(q)
+    return math.ulp(0.0) if f == 0 and q > 0 else abs(f)
 
 
 @app.callback()
@@ -469,7 +482,7 @@ def design(
         typer.Option(
             "--timeout",
             metavar="SECONDS",
-            callback=_seconds,
+            parser=_seconds,
             help="Time budget of the design and its certification (0 or inf: none, the "
             "default); past it the design stops with exit 3 and -o gets its error report.",
         ),
@@ -527,7 +540,7 @@ def _timeout_opt(unit: str) -> Any:
         typer.Option(
             "--timeout",
             metavar="SECONDS",
-            callback=_seconds,
+            parser=_seconds,
             help=f"Time budget per {unit} (0 or inf: none); a {unit} past it gets exit 3 and "
             "the others still run (on Dask too: applied in the worker). It stops a "
             f"{unit} only between imports: a budget below ~0.1 s can be overrun by the first "

@@ -1015,11 +1015,19 @@ def test_a_nan_or_negative_timeout_is_named_as_such(tmp_path: Path, cmd: str):
     args = {"design": ["design", str(SPEC)], "check": ["check", str(SPEC)]}.get(
         cmd, ["sweep", str(SPEC), "--set", "method.L=[[1],[1]]"]
     )
-    for bad in ("nan", "-1", "-inf"):
+    for bad in ("nan", "-1", "-inf", "-1e-400"):
         res = runner.invoke(app, [*args, "--timeout", bad])
         assert res.exit_code == 2, res.output
         assert "is not a number of seconds >= 0" in res.output
         assert "Traceback" not in res.output
+
+
+def test_a_positive_timeout_below_the_float_range_is_the_smallest_budget() -> None:
+    """``--timeout 1e-400`` read as 0.0, no limit, and ran the whole design (CLI review,
+    session 44): it is the smallest budget, exit 3 at once; ``-0`` is no limit."""
+    res = runner.invoke(app, ["design", str(SPEC), "-q", "--timeout", "1e-400"])
+    assert res.exit_code == 3 and "not finished within" in res.output, res.output
+    assert runner.invoke(app, ["design", str(SPEC), "-q", "--timeout", "-0"]).exit_code == 0
 
 
 def test_an_exception_of_the_callers_alarm_handler_reaches_the_caller(monkeypatch):
