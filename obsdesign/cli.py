@@ -478,15 +478,15 @@ def design(
     quiet: QuietOpt = False,
     width: WidthOpt = None,
     timeout: Annotated[
-        float,
+        str,  # read as text (exactly), made seconds by the callback
         typer.Option(
             "--timeout",
             metavar="SECONDS",
-            parser=_seconds,
+            callback=_seconds,
             help="Time budget of the design and its certification (0 or inf: none, the "
             "default); past it the design stops with exit 3 and -o gets its error report.",
         ),
-    ] = 0.0,
+    ] = "0",
 ) -> None:
     """Design the observer of SPEC, certify every claim, and print (or write) the report.
 
@@ -494,7 +494,9 @@ def design(
     inconclusive, or error when the design stopped with an error), so it is never stale;
     bad input (exit 2) writes nothing."""
 
-    _run(lambda cmd: cmd.design(spec, output, fmt, plot, force, quiet, timeout), quiet, width)
+    _run(
+        lambda cmd: cmd.design(spec, output, fmt, plot, force, quiet, float(timeout)), quiet, width
+    )
 
 
 @app.command()
@@ -536,11 +538,11 @@ WorkersOpt = Annotated[
 def _timeout_opt(unit: str) -> Any:
     """``--timeout SECONDS`` of ``check`` (per spec) and ``sweep`` (per point)."""
     return Annotated[
-        float,
+        str,  # read as text (exactly), made seconds by the callback
         typer.Option(
             "--timeout",
             metavar="SECONDS",
-            parser=_seconds,
+            callback=_seconds,
             help=f"Time budget per {unit} (0 or inf: none); a {unit} past it gets exit 3 and "
             "the others still run (on Dask too: applied in the worker). It stops a "
             f"{unit} only between imports: a budget below ~0.1 s can be overrun by the first "
@@ -580,7 +582,7 @@ def check(
     width: WidthOpt = None,
     workers: WorkersOpt = None,
     scheduler: SchedulerOpt = None,
-    timeout: SpecTimeoutOpt = 600.0,
+    timeout: SpecTimeoutOpt = "600",
 ) -> None:
     """Design and verify every spec; one row per spec; non-zero exit if any fails.
 
@@ -589,7 +591,11 @@ def check(
     The last line (text and md) is the verdict, e.g. "checked: 13 specs, 13 ok, 0 failed;
     149 claims certified, 8 numerical, 0 failed"."""
 
-    _run(lambda cmd: cmd.check(paths, fmt, junit, quiet, workers, scheduler, timeout), quiet, width)
+    _run(
+        lambda cmd: cmd.check(paths, fmt, junit, quiet, workers, scheduler, float(timeout)),
+        quiet,
+        width,
+    )
 
 
 @app.command()
@@ -645,7 +651,7 @@ def sweep(
     ] = False,
     quiet: QuietOpt = False,
     width: WidthOpt = None,
-    timeout: PointTimeoutOpt = 600.0,
+    timeout: PointTimeoutOpt = "600",
 ) -> None:
     """Design and verify SPEC at every point of a grid of spec keys; one row per point.
 
@@ -667,7 +673,7 @@ def sweep(
             scheduler,
             force,
             quiet,
-            timeout,
+            float(timeout),
         ),
         quiet,
         width,

@@ -3,8 +3,8 @@
 typer ≥ 0.2x coerces every command-line value through a pydantic ``TypeAdapter`` built per
 parameter when a command runs; importing pydantic and building the adapters costs ~150 ms of
 a ~0.5 s cold ``obsdesign design``. :class:`FastParam` coerces the values of the plain types
-this CLI declares (a str, a Path, a decimal int within min/max, an enum member or its name,
-a float default)
+this CLI declares (a str, a Path, a decimal int within min/max, an enum member or its name;
+``--timeout`` is a str read by its callback since session 44, so no float option is left)
 to what pydantic gives; anything else, and every value typer would refuse, goes through
 typer's own adapter, so results and error messages are typer's. Installed by
 :func:`obsdesign.cli._fast_runtime_param`.
@@ -42,15 +42,6 @@ def fast_leaf(ann: Any, info: Any, value: Any, param: Any, ctx: Any) -> Any:
         if (info.min is not None and value < info.min) or (
             info.max is not None and value > info.max
         ):
-            return SLOW
-        return value
-    if ann is float and type(value) is float and not info.clamp:
-        # a float default (``design --timeout`` 0.0): typer coerces defaults too, and a
-        # float option took the cold design through pydantic; a typed-in value is a str
-        # and takes typer's own path (its parsing and messages)
-        if value != value or (info.min is not None and value < info.min):
-            return SLOW
-        if info.max is not None and value > info.max:
             return SLOW
         return value
     if isinstance(ann, type) and issubclass(ann, Enum):
