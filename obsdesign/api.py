@@ -1330,7 +1330,11 @@ def spec_files(paths: list[str | Path] | str | Path) -> list[Path]:
         paths = [paths]
     out: list[Path] = []
     for p in map(Path, paths):
-        if p.is_dir() and not kernel_dir(p):  # /proc, /sys: one row saying so (not walked)
+        try:
+            folder = p.is_dir()
+        except OSError:  # a name too long: its own row says so (exit 3, no rows; session 44)
+            folder = False
+        if folder and not kernel_dir(p):  # /proc, /sys: one row saying so (not walked)
             out += _toml_files(p)
         else:
             out.append(p)

@@ -1096,3 +1096,16 @@ def test_the_callers_alarm_waits_for_an_import_to_end(monkeypatch):
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, old)
+
+
+def test_a_name_too_long_is_one_row_not_the_whole_check(tmp_path: Path) -> None:
+    """``check good.toml <300-character name>.toml`` was exit 3 "internal failure: OSError:
+    File name too long" with no row at all (``is_dir`` raised ENAMETOOLONG; CLI review,
+    session 44): the long name is a file whose row fails, and the good spec keeps its row."""
+    good = tmp_path / "good.toml"
+    shutil.copy(SPEC, good)
+    long = tmp_path / ("a" * 300 + ".toml")
+    assert api.spec_files([good, long]) == [good, long]
+    res = runner.invoke(app, ["check", str(good), str(long), "--format", "json"])
+    rows = json.loads(res.stdout)
+    assert res.exit_code == 2 and [r["code"] for r in rows] == [0, 2], res.output
