@@ -1714,6 +1714,25 @@ def _error_row(path: Path, method_key: str, code: int, t0: float, message: str) 
     return CheckRow(str(path), method_key, code, 0, 0, 0, "", t, one_line(message))
 
 
+def _verify_own(rep: Report) -> Report:
+    """``verify`` of a report this process just designed, through its JSON data, with
+    ``max_digits`` raised to the report's longest exact integer (up to the limit's ceiling):
+    its exact values are the tool's own, and a valid spec (a set-invariant Q entry 1e-300)
+    was a row "exit 2 bad input, [parameters.exact…] has more than 1000 digits" (CLI review,
+    session 44)."""
+    from obsdesign.limits import CEILINGS, exact_digits, limits, restore, saved, set_limits
+
+    d = rep.to_dict()
+    need = exact_digits(d.get("parameters", {}).get("exact", {}))
+    state = saved()
+    try:
+        if limits().max_digits < need <= CEILINGS["max_digits"]:
+            set_limits(max_digits=need)
+        return verify(Report.from_dict(d)[0])
+    finally:
+        restore(state)
+
+
 def _check_one(path: Path, t0: float, seen: list[str]) -> CheckRow:
     """:func:`check_one` without the time budget; ``seen[0]`` becomes the spec's method once it
     is loaded (the budget's row names it: a spec stopped by ``--timeout`` showed "?")."""
@@ -1722,7 +1741,7 @@ def _check_one(path: Path, t0: float, seen: list[str]) -> CheckRow:
         sp = load_spec(path)
         method_key = seen[0] = sp.method
         rep = design(sp)
-        ver = verify(Report.from_dict(rep.to_dict())[0])
+        ver = _verify_own(rep)
         code = ver.exit_code()
         counts = ver.status_counts()
         msg = "; ".join(f"{c.id}: {c.detail}" for c in ver.failed)

@@ -584,7 +584,30 @@ def design(
         _say(f"report written to {output}")
     if output is not None:
         _warn_above_read_limit(output)
+        _warn_above_digit_limit(rep, output)
     return rep.exit_code()
+
+
+def _warn_above_digit_limit(rep: Any, output: Path) -> None:
+    """A warning on stderr (also with -q) when the report holds an exact value longer than
+    ``max_digits``: a set-invariant design with a Q entry of 1e-300 exited 0 with a report
+    (4471-digit vertices) that its own ``verify`` refused as bad input, exit 2 (CLI review,
+    session 44). The report is right; reading it takes a raised limit, which the warning
+    names."""
+    from obsdesign.errors import one_line
+    from obsdesign.limits import exact_digits, limits
+
+    need = exact_digits(rep.to_dict().get("parameters", {}).get("exact", {}))
+    lim = limits().max_digits
+    if need > lim:
+        sys.stderr.write(
+            one_line(
+                f"obsdesign: warning: {output} holds exact values of {need:,} digits, above "
+                f"max_digits = {lim:,}, the most verify reads: verify it with 'obsdesign "
+                f"--limit max_digits={need} verify {output}'"
+            )
+            + "\n"
+        )
 
 
 def _warn_above_read_limit(output: Path) -> None:

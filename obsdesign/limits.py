@@ -309,6 +309,25 @@ def decimal_problem(d: Decimal) -> str | None:
     return None
 
 
+def exact_digits(obj: Any) -> int:
+    """The most decimal digits of an integer in the exact strings (``"p/q"``) under ``obj``
+    (a report's ``parameters.exact``: nested dicts and lists). A design's exact values can
+    be longer than ``max_digits`` allows a report read back (a set-invariant Q entry 1e-300
+    gave 4471-digit vertices; CLI review, session 44)."""
+    best = 0
+    stack = [obj]
+    while stack:
+        x = stack.pop()
+        if isinstance(x, str):
+            for part in x.split("/"):
+                best = max(best, len(part.strip().lstrip("+-")))
+        elif isinstance(x, dict):
+            stack.extend(x.values())
+        elif isinstance(x, (list, tuple)):
+            stack.extend(x)
+    return best
+
+
 def int_problem(v: int) -> str | None:
     """Why an int has too many digits (None when it is fine); no decimal conversion made."""
     lim = _current.max_digits

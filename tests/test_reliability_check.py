@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import warnings
 from pathlib import Path
@@ -1109,3 +1110,29 @@ def test_a_name_too_long_is_one_row_not_the_whole_check(tmp_path: Path) -> None:
     res = runner.invoke(app, ["check", str(good), str(long), "--format", "json"])
     rows = json.loads(res.stdout)
     assert res.exit_code == 2 and [r["code"] for r in rows] == [0, 2], res.output
+
+
+def test_a_report_with_long_exact_values_is_checked_and_its_design_warns(tmp_path: Path) -> None:
+    """A Q entry of 1e-300 in the Dórea–Pimenta 7.2 spec gives exact values of ~2,200 digits:
+    ``design -o`` exited 0 silently with a report its own ``verify`` refused as bad input
+    (max_digits = 1000), and ``check`` made the valid spec a row "exit 2 bad input" (CLI
+    review, session 44). check verifies its own report with the digit limit raised to it;
+    design warns with the --limit that verifies the file, and that limit does."""
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "specs" / "dorea-pimenta-7-2.toml").read_text(encoding="utf-8")
+    assert "[0.2681, 0.7595, -0.0851]" in text
+    spec = tmp_path / "q.toml"
+    spec.write_text(text.replace("[0.2681, 0.7595, -0.0851]", "[1e-300, 0.7595, -0.0851]"))
+    res = runner.invoke(app, ["check", str(spec), "-q"])
+    assert res.exit_code == 0, res.output
+    out = tmp_path / "q.json"
+    res = runner.invoke(app, ["design", str(spec), "-q", "-o", str(out)])
+    assert res.exit_code == 0
+    m = re.search(r"verify it with 'obsdesign --limit max_digits=(\d+) verify", res.stderr)
+    assert m and int(m.group(1)) > 1000, res.stderr
+    assert runner.invoke(app, ["verify", str(out), "-q"]).exit_code == 2
+    need = m.group(1)
+    ok = runner.invoke(app, ["--limit", f"max_digits={need}", "verify", str(out), "-q"])
+    assert ok.exit_code == 0, ok.output
+    short = runner.invoke(app, ["--limit", f"max_digits={int(need) - 1}", "verify", str(out)])
+    assert short.exit_code == 2
