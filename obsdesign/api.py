@@ -1714,7 +1714,7 @@ def _error_row(path: Path, method_key: str, code: int, t0: float, message: str) 
     return CheckRow(str(path), method_key, code, 0, 0, 0, "", t, one_line(message))
 
 
-def _verify_own(rep: Report) -> Report:
+def verify_own(rep: Report) -> Report:
     """``verify`` of a report this process just designed, through its JSON data, with
     ``max_digits`` raised to the report's longest exact integer (up to the limit's ceiling):
     its exact values are the tool's own, and a valid spec (a set-invariant Q entry 1e-300)
@@ -1741,7 +1741,7 @@ def _check_one(path: Path, t0: float, seen: list[str]) -> CheckRow:
         sp = load_spec(path)
         method_key = seen[0] = sp.method
         rep = design(sp)
-        ver = _verify_own(rep)
+        ver = verify_own(rep)
         code = ver.exit_code()
         counts = ver.status_counts()
         msg = "; ".join(f"{c.id}: {c.detail}" for c in ver.failed)

@@ -855,3 +855,20 @@ def test_a_trailing_comma_ends_a_value_list_as_in_toml() -> None:
     for bad in ("[0.96,,]", "[,]", "[0.96,,0.97]"):
         with pytest.raises(InputError, match="empty item"):
             sw.parse_axis(f"method.lambda={bad}")
+
+
+def test_a_point_with_long_exact_values_is_verified_with_its_own_digit_limit(
+    tmp_path: Path,
+) -> None:
+    """A sweep row verifies its own report as check does (``api.verify_own``): a Q entry of
+    1e-300 made ~2,200-digit exact values, and the row was "exit 2 bad input" (CLI review,
+    session 44)."""
+    from obsdesign import api
+
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "specs" / "dorea-pimenta-7-2.toml").read_text(encoding="utf-8")
+    assert "[0.2681, 0.7595, -0.0851]" in text and "lambda = 1\n" in text
+    spec = tmp_path / "q.toml"
+    spec.write_text(text.replace("[0.2681, 0.7595, -0.0851]", "[1e-300, 0.7595, -0.0851]"))
+    rows = api.sweep(spec, ["method.lambda=1:1:1"])
+    assert list(rows["exit_code"]) == [0], rows.to_dict("records")
