@@ -17,7 +17,9 @@ EXIT_INCONCLUSIVE = 4
 
 
 #: runs of digits at least this long are shortened in messages
-_LONG_DIGITS = re.compile(r"\d{100,}")
+#: a run of 100 or more digits, also grouped by thousands separators (``{n:,}`` printed a
+#: 400-digit theta_m whole: CLI review, session 44)
+_LONG_DIGITS = re.compile(r"\d{100,}|\d{1,3}(?:,\d{3}){33,}")
 
 
 def _escape_char(c: str) -> str:
@@ -83,6 +85,12 @@ def valid_strings(obj: Any) -> Any:
     return obj
 
 
+def _shorten_digits(m: re.Match[str]) -> str:
+    """A long digit run as its first 20 digits and its length (separators dropped)."""
+    digits = m[0].replace(",", "")
+    return f"{digits[:20]}…({len(digits)} digits)"
+
+
 def one_line(message: str) -> str:
     """``message`` safe to print as one line: control characters (newline, ESC, …) and
     Unicode line/paragraph separators from user-given names (TOML keys, file names) are
@@ -92,7 +100,7 @@ def one_line(message: str) -> str:
     around "…(N characters)…" (a 5-million-character TOML key was echoed whole;
     hostile-input trial, session 24). Idempotent on ordinary text."""
     out = escape_controls(message)
-    out = _LONG_DIGITS.sub(lambda m: f"{m[0][:20]}…({len(m[0])} digits)", out)
+    out = _LONG_DIGITS.sub(_shorten_digits, out)
     if len(out) > MAX_LINE:
         cut = len(out) - MAX_LINE // 2 - MAX_LINE // 4
         out = f"{out[: MAX_LINE // 2]}…({cut} characters)…{out[-(MAX_LINE // 4) :]}"

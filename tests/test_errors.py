@@ -135,3 +135,16 @@ def test_invisible_format_characters_and_look_alike_names_are_shown_escaped(
     assert r.exit_code == 0, r.output
     assert "\\u0420" in r.stdout and "mu\\u200b" in r.stdout
     assert "\u0420" not in r.stdout + r.stderr and "\u200b" not in r.stdout + r.stderr
+
+
+def test_one_line_shortens_a_digit_run_grouped_by_thousands() -> None:
+    """``{n:,}`` printed a 400-digit theta_m whole, 533 characters of digits and commas (CLI
+    review, session 44): shortened like a plain run; 99 grouped digits stay whole."""
+    from obsdesign.errors import one_line
+
+    assert one_line(f"theta_m = {10**400 - 1:,} steps") == (
+        "theta_m = 99999999999999999999…(400 digits) steps"
+    )
+    short = f"{10**98:,}"  # 99 digits in 33 groups
+    assert one_line(short) == short
+    assert one_line(f"{10**99:,}") == "10000000000000000000…(100 digits)"
