@@ -124,6 +124,10 @@ def test_consistency_lost_is_diagnosed(tmp_path):
     sp, rep = _load(text, tmp_path)
     with pytest.raises(ConsistencyLost, match=r"consistency lost.*x0 = \[1\.5, 0\.0\] is not in D"):
         api.simulate(sp, rep)
+    # near the float limit: np.round(x0, 6) multiplied by 10⁶ and printed inf (session 44)
+    sp, rep = _load(text.replace("x0 = [1.5, 0]", "x0 = [1e308, 0]"), tmp_path)
+    with pytest.raises(ConsistencyLost, match=r"x0 = \[1e\+308, 0\.0\] is not in D"):
+        api.simulate(sp, rep)
 
 
 def test_cli_simulate_option_and_cap(tmp_path):

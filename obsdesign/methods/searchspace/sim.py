@@ -715,7 +715,9 @@ def _diagnose(
     msg = [f"consistency lost: every centre was discarded by {where}."]
     x0 = run.x[0] if run.x else x
     if not np.all(o.D.contains(x0)):
-        msg.append(f"x0 = {np.round(x0, 6).tolist()} is not in D = {o.D.describe()}.")
+        # %.6g, not np.round: round(1e308, 6) multiplies by 10⁶ and printed inf (session 44)
+        shown = ", ".join(repr(float(f"{float(v):.6g}")) for v in np.ravel(x0))
+        msg.append(f"x0 = [{shown}] is not in D = {o.D.describe()}.")
     outside = _centre_outside_E(cells if ctx is None else ctx[0], x, o)
     if outside is not None and ctx is None:
         msg.append(outside)
