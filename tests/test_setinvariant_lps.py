@@ -46,6 +46,20 @@ def test_a_huge_disturbance_gain_is_inconclusive_not_a_solver_failure() -> None:
     assert "(A, C, B1, the sets) or the growth of the iterates under A" in e.value.message
 
 
+@pytest.mark.parametrize("entry", ["9007199254740993", "1e15"])
+def test_a_highs_failure_on_wide_data_is_inconclusive(entry: str) -> None:
+    """A = [[0.7, 2^53 + 1], [−0.7, 0.7]] in Dórea–Pimenta 7.1: HiGHS answered "status not
+    recognized" after every retry and the design was exit 3, an internal failure (CLI review,
+    session 44). With right-hand sides past 10¹² the failure is the data's: exit 4."""
+    text = (ROOT / "specs" / "dorea-pimenta-7-1.toml").read_text()
+    old = "A = [[0.7, 0.7], [-0.7, 0.7]]"
+    assert old in text
+    spec = api.load_spec_text(text.replace(old, f"A = [[0.7, {entry}], [-0.7, 0.7]]"), "t.toml")
+    with pytest.raises(InconclusiveError, match=r"HiGHS failed on LP \(9\).*too large") as e:
+        api.design(spec)
+    assert e.value.exit_code == 4
+
+
 def test_failing_highs_stops_at_the_deadline(monkeypatch: pytest.MonkeyPatch) -> None:
     """A HiGHS that keeps failing (status 4 after 100 ms each call) on a 64-block LP (9):
     the split-and-retry stops at the budget (Timeout) instead of about 2·64·3 calls; every

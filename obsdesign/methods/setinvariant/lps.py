@@ -125,6 +125,12 @@ def lp_in_range(A: np.ndarray, b: np.ndarray) -> bool:
     return bool(np.isfinite(a) and np.isfinite(r) and a <= HIGHS_MATRIX_MAX and r < HIGHS_INFINITY)
 
 
+#: a right-hand side of LP (9) beyond which a HiGHS failure is put down to the data (its
+#: gauge values are O(1) for a polyhedron near Ω; 10¹² is past HiGHS's feasibility
+#: tolerance 10⁻⁷ by more than the 53 bits of a double)
+WIDE_RHS = 1e12
+
+
 def check_lp_range(A: np.ndarray, b: np.ndarray, what: str) -> None:
     """Raise InconclusiveError (exit 4) when the float LP ``what`` has data that HiGHS would
     read as infinite, or no finite data at all, instead of its "Model error" (exit 3).
@@ -174,6 +180,15 @@ def _eps_block(
         res = _linprog(cost, A_ub, b_ub, method, deadline)
     if res.status != 0:
         check_deadline(deadline)  # stopped by the time limit: the budget's, not a failure
+        r = float(np.max(np.abs(b_ub), initial=0.0))
+        if r > WIDE_RHS:
+            # A = [[0.7, 2^53 + 1], [−0.7, 0.7]]: HiGHS "status not recognized", exit 3 as an
+            # internal failure, where it is data beyond the float design (CLI review, 44)
+            raise InconclusiveError(
+                f"HiGHS failed on LP (9) ({res.message}) with right-hand sides up to {r:.3g}: "
+                "the spec's numbers (A, C, B1, the sets) or the growth of the iterates under "
+                "A are too large for the float design"
+            )
         raise SolverError(f"HiGHS failed on LP (9): {res.message}")
     v = res.x[: nz * n].reshape(nz, n) * s
     eps = (phi + dlt[None, :] + v @ G.T).max(axis=1)
