@@ -988,6 +988,16 @@ def _encodable(stream: Any) -> None:
             pass
 
 
+def _dash_file(arg: str) -> str:
+    """An argument that names the file '-' (``./-``, ``.//-``) as its absolute path: typer
+    makes it ``Path("-")``, the very value that means stdin, and ``design ./-`` read stdin
+    (a terminal: it waited) instead of the file (CLI review, session 44). Only the literal
+    ``-`` is stdin."""
+    if arg != "-" and arg.endswith("-") and os.path.normpath(arg) == "-":
+        return os.path.join(os.getcwd(), "-")
+    return arg
+
+
 def main() -> None:
     """Console-script entry point. Click's own usage errors (an unknown option, a missing
     argument, a bad option value) become one line, like every other bad input: "obsdesign:
@@ -1021,6 +1031,7 @@ def main() -> None:
             after = f" after {sys.argv[empty - 1]!r}" if empty > 1 else ""
         _err(f"an empty argument{after} (an unset shell variable?): give a path or a value")
         sys.exit(2)
+    sys.argv[1:] = [_dash_file(a) for a in sys.argv[1:]]
     try:
         rv = app(standalone_mode=False, prog_name="obsdesign")
     except KeyboardInterrupt:  # pragma: no cover - Ctrl-C outside a command body

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import re
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -525,3 +526,24 @@ def test_messages_name_the_papers_as_the_docs_do(tmp_path: Path) -> None:
     )
     refs = {c["reference"] for c in json.loads(r.output)["claims"]}
     assert r.exit_code == 0 and refs and not [x for x in refs if "paper 0" in x], refs
+
+
+def test_dot_slash_dash_is_the_file_named_dash_not_stdin(tmp_path: Path) -> None:
+    """``design ./-`` read stdin, the spec piped in, and never the file ``-`` (typer made it
+    ``Path("-")``, the value that means stdin; CLI review, session 44). Only the literal ``-``
+    is stdin."""
+    root = Path(__file__).resolve().parents[1] / "specs"
+    shutil.copy(root / "schaum-impulsive-example.toml", tmp_path / "-")
+    piped = (root / "constrained-redesign-sec5-lyapunov.toml").read_text(encoding="utf-8")
+    run = [sys.executable, "-m", "obsdesign", "design"]
+    for arg, method in (("./-", "impulsive"), (".//-", "impulsive"), ("-", "lyapunov")):
+        r = subprocess.run(
+            [*run, arg, "--format", "json"],
+            input=piped,
+            capture_output=True,
+            text=True,
+            cwd=tmp_path,
+            timeout=300,
+        )
+        assert r.returncode == 0, r.stderr
+        assert json.loads(r.stdout)["method"] == method, arg
