@@ -945,3 +945,18 @@ max_centres = 200000
     said = " ".join(res.info.get("warnings", []))
     assert "the true state leaves E = [-3, 3] at t = 3.0" in said
     assert 3.0 < res.info["left_E_at"] < 3.1
+
+
+def test_recover_refuses_a_ball_beyond_the_cap_before_enumerating_it() -> None:
+    """An initial state of −1e16 made η/ε ≈ 7·10³, and ``recover`` listed the (2R + 1)ⁿ grid
+    offsets first: 2.4 GB, MemoryError (exit 3); past 10⁹⁹ "int too large" (exit 4); neither
+    time_limit nor max_sim_bytes stopped it (CLI review, session 44). MemoryCap now, at once,
+    with the ball's least cell count; a ball that fits still recovers."""
+    C = np.zeros((1, 2))
+    for eta in (1e4, 1e100, 1e300, float("inf")):
+        with pytest.raises(MemoryCap, match="the refinement needs"):
+            recover(C, eta, 0.5, 200_000)
+    # the smallest refusal: ⌊η/(s√2)⌋² just above the cap (η/(s√2) = 448, 448² > 200,000)
+    with pytest.raises(MemoryCap, match="at least 200,704 live centres"):
+        recover(C, 448 * 0.5 * math.sqrt(2) * (1 + 1e-9), 0.5, 200_000)
+    assert len(recover(C, 10.0, 0.5, 200_000)) > 0

@@ -271,6 +271,33 @@ def cover_box(lo: np.ndarray, hi: np.ndarray, s: float) -> np.ndarray:
     return grid * (2 * s)
 
 
+def _ball_fits(eta: float, s: float, n: int, cap: int) -> None:
+    """:class:`MemoryCap` before :func:`recover` enumerates the (2R + 1)ⁿ grid offsets of a
+    ball B(c, η) in cells of half-side s: when the ball alone meets more than ``cap`` cells
+    (a cube of half-side η/√n inside it meets at least ⌊η/(s√n)⌋ⁿ), or when the offsets
+    are more than max(4·cap, 2²⁰). An initial state of −1e16 gave a ball that the offsets'
+    list filled 2.4 GB with (MemoryError, exit 3; past 10⁹⁹ "int too large", exit 4), and
+    neither time_limit nor max_sim_bytes stopped it (CLI review, session 44)."""
+    why = None
+    if not (math.isfinite(eta) and math.isfinite(s) and s > 0):
+        why = f"a search radius η = {eta:.3g} for cells of half-side {s:.3g}"
+    else:
+        per = eta / (s * math.sqrt(n))
+        least = math.floor(per) ** n
+        if least > cap:
+            why = f"at least {least:,} live centres (η/ε ≈ {eta / (2 * s):.3g} per state)"
+        else:
+            offs = (2 * math.ceil((eta + s) / (2 * s) + 0.5) + 1) ** n
+            if offs > max(4 * cap, 1 << 20):
+                why = f"{offs:,} grid offsets per centre (η/ε ≈ {eta / (2 * s):.3g} per state)"
+    if why is not None:
+        raise MemoryCap(
+            f"the refinement needs {why}, above the memory cap max_centres = {cap:,}: the "
+            "error bound grew past what the grid can cover (a state far outside D?); raise "
+            "max_centres, or start from a smaller D or a larger γ₀"
+        )
+
+
 def recover(
     C: np.ndarray,
     eta: float,
@@ -283,6 +310,7 @@ def recover(
     :class:`~obsdesign.simulate.budget.TimeExceeded` past ``budget`` (checked per chunk of rows)."""
     n = C.shape[1]
     eta = eta * (1 + INFLATE) + INFLATE * s
+    _ball_fits(eta, s, n, cap)
     R = math.ceil((eta + s) / (2 * s) + 0.5)
     offs = np.array(list(itertools.product(range(-R, R + 1), repeat=n)), dtype=np.int64)
     base = np.rint(C / (2 * s)).astype(np.int64)
