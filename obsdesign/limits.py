@@ -206,7 +206,7 @@ def read_input(path: str | Path, what: str) -> bytes:
             ) from None
         raise InputError(f"{p}: is a directory, not a {what} file")
     if not stat.S_ISREG(st.st_mode):
-        raise InputError(f"{p}: is not a regular file (refusing to read a {what} from it)")
+        raise InputError(f"{p}: is not a regular file (refusing to read a {what} file from it)")
     if st.st_size > lim:
         raise InputError(
             f"{p}: {what} file is {st.st_size} bytes, above the limit of {lim} bytes "
@@ -239,7 +239,7 @@ def _read_nonblocking(p: Path, what: str, lim: int) -> bytes:
         raise InputError(f"{p}: cannot read {what} ({e.strerror})") from None
     try:
         if not stat.S_ISREG(os.fstat(fd).st_mode):
-            raise InputError(f"{p}: is not a regular file (refusing to read a {what} from it)")
+            raise InputError(f"{p}: is not a regular file (refusing to read a {what} file from it)")
         chunks: list[bytes] = []
         got = 0
         while got <= lim:

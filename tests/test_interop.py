@@ -1088,3 +1088,15 @@ def test_a_dt_is_signed_by_its_exact_value(dt: object, match: str) -> None:
         assert 'time = "continuous"' in text
     text = spec_text_from_statespace((A, B, C, D, Fraction(1, 3)), "lyapunov")
     assert 'time = "discrete"' in text and "sample_time = 0.3333333333333333" in text
+
+
+def test_import_of_a_fifo_names_a_matlab_file(tmp_path: Path) -> None:
+    """``import ff.mat`` (a FIFO) said "refusing to read a MATLAB from it" (CLI review,
+    session 44): "a MATLAB file"."""
+    import os
+
+    fifo = tmp_path / "ff.mat"
+    os.mkfifo(fifo)
+    r = CliRunner().invoke(app, ["import", str(fifo), "--A", "A", "--C", "C"])
+    assert r.exit_code == 2
+    assert "is not a regular file (refusing to read a MATLAB file from it)" in r.output
