@@ -1041,8 +1041,15 @@ def main() -> None:
         _quiet_broken_pipe_exit()
     except OSError as e:
         # click's own output (--help, --version, usage) to a full stdout: a traceback and
-        # exit 1 (re-check trial, session 30); a command's OS errors are handled in _run
-        _err(_stdout_error(e).message)
+        # exit 1 (re-check trial, session 30); a command's OS errors are handled in _run.
+        # An error naming a file is that file's (--install-completion into a read-only
+        # home said "stdout: cannot write"; CLI review, session 44)
+        if e.filename is not None:
+            from obsdesign.errors import one_line
+
+            _err(one_line(f"{e.filename}: cannot write ({e.strerror or e})"))
+        else:
+            _err(_stdout_error(e).message)
         sys.exit(2)
     except Exception as e:
         kind = _click_kind(e)

@@ -547,3 +547,30 @@ def test_dot_slash_dash_is_the_file_named_dash_not_stdin(tmp_path: Path) -> None
         )
         assert r.returncode == 0, r.stderr
         assert json.loads(r.stdout)["method"] == method, arg
+
+
+def test_an_os_error_naming_a_file_outside_a_command_names_that_file(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
+) -> None:
+    """``--install-completion`` into a read-only home said "stdout: cannot write (Read-only
+    file system)" (CLI review, session 44): an OS error with a file name names the file; one
+    without (stdout full) still says stdout."""
+    import errno
+
+    from obsdesign import cli
+
+    for exc, want in (
+        (OSError(errno.EROFS, "Read-only file system", "/home/u/.bashrc"), "/home/u/.bashrc"),
+        (OSError(errno.ENOSPC, "No space left on device"), "stdout: cannot write"),
+    ):
+
+        def boom(*a: object, _e: OSError = exc, **k: object) -> None:
+            raise _e
+
+        monkeypatch.setattr(cli, "app", boom)
+        monkeypatch.setattr(sys, "argv", ["obsdesign", "--install-completion"])
+        with pytest.raises(SystemExit) as e:
+            cli.main()
+        assert e.value.code == 2
+        err = capsys.readouterr().err
+        assert err.startswith(f"obsdesign: error: {want}"), err
