@@ -1719,7 +1719,10 @@ def verify_own(rep: Report) -> Report:
     ``max_digits`` raised to the report's longest exact integer (up to the limit's ceiling):
     its exact values are the tool's own, and a valid spec (a set-invariant Q entry 1e-300)
     was a row "exit 2 bad input, [parameters.exact…] has more than 1000 digits" (CLI review,
-    session 44)."""
+    session 44).
+
+    :param rep: a report :func:`design` returned in this process (not one read from a file:
+    the raised limit is for the tool's own numbers)."""
     from obsdesign.limits import CEILINGS, exact_digits, limits, restore, saved, set_limits
 
     d = rep.to_dict()
