@@ -125,6 +125,16 @@ class SummaryField:
             object.__setattr__(self, "param", self.label)
 
 
+def _nonzero_text(text: str) -> bool:
+    """Whether a number's text is exactly nonzero (``1e-400``, which floats read as 0)."""
+    from decimal import Decimal, InvalidOperation
+
+    try:
+        return not Decimal(text.strip().replace("_", "")).is_zero()
+    except InvalidOperation:
+        return False
+
+
 @dataclass(frozen=True)
 class SimOption:
     """A ``simulate --option KEY=VALUE`` key: its type, default, range and help.
@@ -150,6 +160,12 @@ class SimOption:
                 v = float(text)
                 if not math.isfinite(v):
                     raise ValueError
+                if v == 0 and _nonzero_text(text):
+                    # gamma=1e-400 said "expected a positive number, got 0.0" (CLI review,
+                    # session 44); -1e-400 passed a min = 0 as −0.0
+                    raise InputError(
+                        f"{what}: {text.strip()} is below the float range (it would read as 0)"
+                    )
             elif self.kind == "bool":
                 low = text.strip().lower()
                 if low not in ("true", "false", "1", "0", "yes", "no"):

@@ -91,3 +91,17 @@ def test_an_int_option_past_64_bits_is_refused_but_a_seed_is_not() -> None:
         opt.check_value(INT_MAX + 1)
     seed = SimOption("seed", "int", 0, "a seed")
     assert seed.check_value(10**400) == 10**400
+
+
+def test_a_float_option_below_the_float_range_is_named_as_such() -> None:
+    """``--option gamma=1e-400`` said "expected a positive number, got 0.0" (CLI review,
+    session 44): the text is exactly nonzero, and the refusal says it reads as 0; 0 and -0
+    themselves stay zero."""
+    from obsdesign.methods.base import SimOption
+
+    opt = SimOption("gamma", "float", None, "a gain")
+    for text in ("1e-400", "-1e-400", " 2E-330 "):
+        with pytest.raises(InputError, match="is below the float range"):
+            opt.parse(text)
+    assert opt.parse("0") == 0.0 and opt.parse("-0.0") == 0.0
+    assert opt.parse("5e-324") == 5e-324
