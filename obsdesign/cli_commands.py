@@ -76,6 +76,25 @@ def _sim_input_files(sp: Any, option: list[str] | None) -> list[Path]:
     return out
 
 
+def _sweep_sim_files(tasks: list[Any], option: list[str] | None) -> list[Path]:
+    """:func:`_sim_input_files` of every point of a sweep whose spec loads (a point that does
+    not is its own row's bad input); none when the method reads no file."""
+    from obsdesign import api
+    from obsdesign.errors import ObsdesignError
+    from obsdesign.sweep import point_text
+
+    out: list[Path] = []
+    for t in tasks:
+        try:
+            sp = api.load_spec_text(point_text(t.text, t.values, t.file), t.file)
+        except ObsdesignError:
+            continue
+        if not any(o.kind == "path" for o in api.method(sp.method).sim_options):
+            return []
+        out += [f for f in _sim_input_files(sp, option) if f not in out]
+    return out
+
+
 def _read_stdin(what: str) -> str:
     """Standard input as text, within ``max_file_bytes`` (``-`` in place of a path)."""
     from obsdesign.errors import InputError
@@ -790,6 +809,14 @@ def sweep(
         src = types.SimpleNamespace(text=_read_stdin("spec"), file=STDIN_NAME)
     axes = sw.parse_grid(sets)
     _, tasks = sw.plan(src, sets, simulate, _kv(option or []))
+    if simulate and (output is not None or plot is not None):
+        # the points' scenario files (impulsive sampling_file, also one --set per point):
+        # sweep --simulate -o samp.csv wrote the table over it, exit 0 (re-check review, 44)
+        files = _sweep_sim_files(tasks, option)
+        if files:
+            if output is not None:
+                sw.check_output_path(output, force, _inputs(spec, *files))
+            _check_plot(plot, force, _inputs(spec, output, *files))
     cols = None
     if plot is not None:
         cols = sw.expected_columns(tasks[0].text, axes, simulate)

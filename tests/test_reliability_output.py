@@ -1042,3 +1042,12 @@ def test_simulate_never_overwrites_the_sampling_file_it_reads(tmp_path: Path) ->
         res = runner.invoke(app, ["simulate", str(spec), "-q", "--csv", str(samp), *extra])
         _refused(res, "input file itself")
         assert samp.read_bytes() == before
+    # sweep --simulate reads it at every point: -o onto it wrote the table over it (re-check
+    # review, session 44), also when a --set names it
+    plain = tmp_path / "plain.toml"
+    plain.write_text(text)  # no sampling_file: a --set names it for every point
+    for spec_, extra in ((spec, []), (plain, ["--set", 'simulate.sampling_file="samp.csv"'])):
+        sweep = ["sweep", str(spec_), "--set", "method.alpha=3:3.1:2", "--simulate", "-q"]
+        res = runner.invoke(app, [*sweep, "-o", str(samp), *extra])
+        _refused(res, "input file itself")
+        assert samp.read_bytes() == before
