@@ -611,7 +611,8 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
                     0,
                     False,
                     f"the recomputed claims give '{got}'",
-                    float_ok=False,
+                    # 'ok' against an inconclusive recomputation is inconclusive (session 44)
+                    float_ok=rep.verdict == "ok" and got == "inconclusive",
                 )
             )
     unknown = sorted(set(rep.extra_keys) - set(TOP_KEYS))
@@ -763,7 +764,16 @@ def compare_claims(reported: list[Claim], fresh: list[Claim]) -> list[Claim]:
         if c.status != f.status:
             what.append(f"status {c.status.value} vs recomputed {f.status.value}")
         if what:
-            out.append(_diff_claim(f"report-alters:{cid}", "; ".join(what)))
+            # a claim the report passed that the recomputation fails only inconclusively (a
+            # solver re-solve answering "inaccurate") leaves the difference inconclusive too:
+            # exit 4, not 1 (tamper review, session 44)
+            unsure = (
+                c.statement == f.statement
+                and f.status is ClaimStatus.FAILED
+                and f.float_ok
+                and c.status is not ClaimStatus.FAILED
+            )
+            out.append(_diff_claim(f"report-alters:{cid}", "; ".join(what), unsure))
     for cid, mine in by_id.items():
         for f in mine[seen.get(cid, 0) :]:
             out.append(
@@ -776,7 +786,7 @@ def compare_claims(reported: list[Claim], fresh: list[Claim]) -> list[Claim]:
     return out
 
 
-def _diff_claim(cid: str, detail: str) -> Claim:
+def _diff_claim(cid: str, detail: str, float_ok: bool = False) -> Claim:
     return exact_claim(
         cid,
         "the report's claim list is the recomputed one",
@@ -785,7 +795,7 @@ def _diff_claim(cid: str, detail: str) -> Claim:
         0,
         False,
         detail,
-        float_ok=False,
+        float_ok=float_ok,
     )
 
 

@@ -2324,3 +2324,30 @@ def test_an_honest_near_end_is_proved_by_its_own_certificate() -> None:
     assert pt is not None and _in_problem(spec, spec.options, pt, lm)
     small = {k: (v if k == "K" else v * fmpq(1, 100)) for k, v in pt.items()}
     assert not _in_problem(spec, spec.options, small, lm)
+
+
+def test_an_inaccurate_re_solve_at_the_far_end_is_inconclusive_not_failed(
+    ex1: Report, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A cold re-solve at the bracket's far end answering "infeasible_inaccurate" failed
+    lambda-max-bracket and verify was exit 1, "NOT verified", for a true statement (tamper
+    review, session 44): inconclusive now, exit 4, the claim and the differences it makes in
+    the comparison float-ok; an answer of "optimal" there is still a refutation, exit 1."""
+    from obsdesign.methods.stubborn import design as sd
+
+    assert api.verify(ex1).exit_code() == 0
+    real = sd.Feasibility.__call__
+    far = float(ex1.parameters["lambda_bracket"][-1])
+
+    def answer(status: str):
+        def call(self, lam):
+            return (False, status) if lam == far else real(self, lam)
+
+        return call
+
+    monkeypatch.setattr(sd.Feasibility, "__call__", answer("infeasible_inaccurate"))
+    ver = api.verify(ex1)
+    assert ver.exit_code() == 4, [(c.id, c.detail) for c in ver.failed]
+    assert {c.id for c in ver.failed} >= {"lambda-max-bracket", "report-verdict"}
+    monkeypatch.setattr(sd.Feasibility, "__call__", answer("optimal"))
+    assert api.verify(ex1).exit_code() == 1
