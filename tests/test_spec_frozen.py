@@ -170,3 +170,22 @@ def test_certify_refuses_a_spec_whose_method_key_was_assigned() -> None:
     for call in (lambda: api.certify(sp, rep.parameters), lambda: api.simulate(sp, rep)):
         with pytest.raises(InputError, match="spec.method was assigned 'constrained'"):
             call()
+
+
+def test_an_expression_read_under_raised_limits_unpickles_under_the_defaults() -> None:
+    """Expressions pickle as their source and are parsed again when loaded: under a Dask
+    worker's default limits, a spec read with --limit max_expr_chars=20000 failed to
+    deserialize and ``simulate --workers 2`` ended exit 3 after 60 s (re-check review,
+    session 44). The source was checked once; loading it takes any size."""
+    from obsdesign.limits import restore, saved, set_limits
+
+    text = _with_k().replace('"k*u1*x2"', '"k*u1*x2 + ' + "0" * 12_000 + '*x1"')
+    state = saved()
+    try:
+        set_limits(max_expr_chars=20_000)
+        data = pickle.dumps(api.load_spec_text(text, "long.toml"))
+    finally:
+        restore(state)
+    back = pickle.loads(data)  # the default limit, 10,000 characters
+    assert len(back.system.f[0].source) > 12_000
+    assert back.system.f[0](x1=1.0, x2=1.0, u1=1.0) == 10.0

@@ -136,7 +136,7 @@ class Expr:
         """Pickled as its source (and variables, parameters), compiled again when loaded: the
         compiled callable is a closure, and every spec with an expression failed to pickle
         ("Can't pickle local object"; API review, session 44)."""
-        return (parse_expr, (self.source, self.variables, dict(self.parameters)))
+        return (_rebuild_expr, (self.source, self.variables, dict(self.parameters)))
 
     def __call__(self, **values: Any) -> Any:
         """Evaluate with variables given by name (arrays broadcast: a batch at once)."""
@@ -194,6 +194,34 @@ class Expr:
             return np.stack([np.broadcast_to(p(**vals), X.shape[:-1]) for p in parts], axis=-1)
 
         return J
+
+
+def _rebuild_expr(text: str, variables: tuple[str, ...], parameters: dict[str, Any]) -> Expr:
+    """An unpickled :class:`Expr`: its source was checked when it was first parsed, so the
+    input limits of the process that loads it (a Dask worker's defaults) do not apply — a
+    spec read with ``--limit max_expr_chars=20000`` failed to deserialize on the workers of
+    ``simulate --workers 2`` (re-check review, session 44)."""
+    from obsdesign.limits import (
+        CEILINGS,
+        ensure_recursion_limit,
+        limits,
+        restore,
+        saved,
+        set_limits,
+    )
+
+    state = saved()
+    try:
+        lim = limits()
+        set_limits(
+            max_expr_chars=max(lim.max_expr_chars, len(text)),
+            max_expr_depth=max(lim.max_expr_depth, CEILINGS["max_expr_depth"]),
+            max_exponent=max(lim.max_exponent, CEILINGS["max_exponent"]),
+        )
+        ensure_recursion_limit()
+        return parse_expr(text, variables, parameters)
+    finally:
+        restore(state)
 
 
 def parse_expr(
