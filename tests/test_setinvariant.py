@@ -1271,3 +1271,22 @@ def test_simulate_of_a_spec_whose_design_has_no_linear_gain_exits_1(tmp_path: Pa
     r = CliRunner().invoke(app, ["simulate", str(p)])
     assert r.exit_code == 1, r.output
     assert "found no admissible linear gain" in r.output and "give [method] L" in r.output
+
+
+def test_law_linear_where_the_design_makes_no_linear_law_is_bad_input(tmp_path: Path) -> None:
+    """``simulate --option law=linear`` of Dórea–Pimenta 7.1 with linear_law = false (and no
+    L) said the design "found no admissible linear gain", exit 1, though it never looks for
+    one (re-check review, session 44; the census fix made every missing L exit 1): exit 2,
+    naming the law."""
+    from typer.testing import CliRunner
+
+    from obsdesign.cli import app
+
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "specs" / "dorea-pimenta-7-1.toml").read_text(encoding="utf-8")
+    assert "L = [-0.7, -0.2212]" in text
+    p = tmp_path / "nolin.toml"
+    p.write_text(text.replace("L = [-0.7, -0.2212]", "linear_law = false"), encoding="utf-8")
+    r = CliRunner().invoke(app, ["simulate", str(p), "-q", "--option", "law=linear"])
+    assert r.exit_code == 2, r.output
+    assert "law 'linear' needs a linear gain" in r.output

@@ -42,6 +42,14 @@ def make_law(spec: Spec, params: Parameters, law: str | None) -> Any:
         # the designed L, else the spec's [method].L (never the report's copy of it)
         if "L" in params:
             return laws.LinearLaw(params.shaped("L", (s.n, s.p)))
+        searched = spec.options.linear_law and s.p == s.n - 1  # Proposition 7.1's gains
+        if spec.options.L is None and not searched:
+            # law=linear where the design makes no linear law (p = 1 with n > 2, or
+            # linear_law = false): the option is the problem (re-check review, session 44)
+            raise InputError(
+                "law 'linear' needs a linear gain: the design computes one only for p = n − 1 "
+                "outputs with linear_law = true; give [method] L, or another law"
+            )
         if spec.options.L is None:
             # the design's own infeasibility (its linear-law claim failed): exit 1, as the
             # README says for simulate SPEC; it was exit 2 naming a report that no one gave
