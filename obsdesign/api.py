@@ -38,6 +38,7 @@ from obsdesign.params import Parameters, same_bits
 from obsdesign.report.model import TOP_KEYS, Report, check_output, write_atomic
 from obsdesign.spec import Spec, read_spec, read_spec_text
 from obsdesign.spec.frozen import freeze_arrays
+from obsdesign.spec.models import option_parts
 
 if TYPE_CHECKING:  # the simulation modules load with the first simulate
     from obsdesign.simulate.result import SimResult
@@ -141,7 +142,7 @@ def _bind(spec: Spec) -> Spec:
         spec.simulate.options = m.parse_simulate(st, spec)
         st.done()
     spec.bound_to = spec.binding()
-    spec.bound_options = (spec.options, dict(getattr(spec.options, "__dict__", {})))
+    spec.bound_options = (spec.options, option_parts(spec.options))
     freeze_arrays((spec.sets, spec.options, spec.simulate))
     return spec
 

@@ -189,3 +189,24 @@ def test_an_expression_read_under_raised_limits_unpickles_under_the_defaults() -
     back = pickle.loads(data)  # the default limit, 10,000 characters
     assert len(back.system.f[0].source) > 12_000
     assert back.system.f[0](x1=1.0, x2=1.0, u1=1.0) == 10.0
+
+
+def test_design_refuses_a_nested_option_or_an_expression_tree_edited_in_place() -> None:
+    """``sp.options.problem.w_bar = 0`` (a field of a nested options object) certified a ball
+    radius of 0 for a spec whose noise bound is 0.1, and an expression's tree edited in place
+    (u1*x2 made 0.2*x2) certified f_sup = 2.55 for an f whose bound is 3.54 (re-check review,
+    session 44): both refused, exit 2, naming the part."""
+    import ast
+
+    from obsdesign.errors import InputError
+
+    sp = api.load_spec(SPECS / "schaum-impulsive-example.toml")
+    sp.options.problem.w_bar = fmpq(0)
+    with pytest.raises(InputError, match=r"\[method\] option 'problem.w_bar' of the spec"):
+        api.design(sp)
+    sp = api.load_spec(SPECS / "hernandez-garcia-example.toml")
+    assert api.design(sp).exit_code() == 0
+    f0 = sp.system.f[0]
+    f0.tree.body.left = ast.copy_location(ast.Constant(0.2), f0.tree.body.left)
+    with pytest.raises(InputError, match=r"\[system.f\]\[0\] expression of the spec object"):
+        api.design(sp)

@@ -126,11 +126,20 @@ class Expr:
     variables: tuple[str, ...]
     parameters: dict[str, Any]
     _fn: Fn = field(repr=False, default=lambda env: 0.0)
+    #: ``ast.dump`` of the tree as parsed (:meth:`intact`)
+    _dump: str = field(repr=False, default="", compare=False)
 
     def __post_init__(self) -> None:
         # read-only: the parameters belong to the source text as the tree does (session 44)
         if not isinstance(self.parameters, ReadOnlyDict):
             object.__setattr__(self, "parameters", ReadOnlyDict(self.parameters))
+        object.__setattr__(self, "_dump", ast.dump(self.tree))
+
+    def intact(self) -> bool:
+        """Whether the tree is still the one parsed from ``source``: an AST is mutable, and a
+        node edited in place (``u1*x2`` made ``0.2*x2``) designed claims for another f while
+        the compiled callable and the text kept the old one (re-check review, session 44)."""
+        return ast.dump(self.tree) == self._dump
 
     def __reduce__(self) -> tuple[Any, ...]:
         """Pickled as its source (and variables, parameters), compiled again when loaded: the

@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
+
+import numpy as np
 
 from obsdesign.sets.base import ConvexSet
 from obsdesign.spec.expr import Expr
@@ -137,7 +140,7 @@ class Spec:
     #: the options object with its fields (``api.bind``); ``api.design`` refuses a spec that
     #: differs from it, since the report embeds ``text`` (API review, session 44)
     origin: tuple[Any, ...] | None = field(default=None, repr=False, compare=False)
-    bound_options: tuple[Any, dict[str, Any]] | None = field(
+    bound_options: tuple[Any, list[tuple[str, Any]]] | None = field(
         default=None, repr=False, compare=False
     )
 
@@ -165,13 +168,19 @@ class Spec:
                 if not _same(was, now):
                     return name
         if self.bound_options is not None:
-            o, fields = self.bound_options
-            now_fields = getattr(self.options, "__dict__", {})
-            if self.options is not o or now_fields.keys() != fields.keys():
+            o, parts = self.bound_options
+            if self.options is not o:
                 return "[method] options"
-            for k, v in fields.items():
-                if not _same(v, now_fields[k]):
+            now = option_parts(o)
+            if [k for k, _ in now] != [k for k, _ in parts]:
+                return "[method] options"
+            for (k, v), (_, w) in zip(parts, now, strict=True):
+                if not _same(v, w):
                     return f"[method] option {k!r}"
+        for name in ("f", "psi", "h", "u_signal"):
+            for i, e in enumerate(getattr(self.system, name) or ()):
+                if not e.intact():  # its tree edited in place (re-check review, session 44)
+                    return f"[system.{name}][{i}] expression"
         return None
 
     def binding(self) -> tuple[Any, ...]:
@@ -181,6 +190,38 @@ class Spec:
 
     def set(self, name: str) -> ConvexSet:
         return self.sets[name]
+
+
+def option_parts(obj: Any) -> list[tuple[str, Any]]:
+    """Every part of a method's options as (path, object): the fields, and within them the
+    fields of nested dataclasses, list and tuple items and dict values (numpy arrays, which
+    are read-only, and expressions, which check themselves, are leaves). ``api.design``
+    compares them by identity with those at binding: a field of a nested object assigned
+    (the impulsive ``options.problem.w_bar = 0``) designed exit 0 with claims false for the
+    embedded text (re-check review, session 44)."""
+    out: list[tuple[str, Any]] = []
+    stack: list[tuple[str, Any, int]] = [("", obj, 0)]
+    while stack:
+        path, x, depth = stack.pop()
+        if depth > 8 or isinstance(x, (np.ndarray, Expr, str, bytes)):
+            continue
+        if dataclasses.is_dataclass(x) and not isinstance(x, type):
+            items = [(f.name, getattr(x, f.name, None)) for f in dataclasses.fields(x)]
+        elif isinstance(x, (list, tuple)):
+            items = [(str(i), v) for i, v in enumerate(x)]
+            out.append((f"{path}#len", len(x)))
+        elif isinstance(x, dict):
+            items = [(str(k), v) for k, v in x.items()]
+            out.append((f"{path}#len", len(x)))
+        elif hasattr(x, "__dict__") and depth == 0:
+            items = list(vars(x).items())
+        else:
+            continue
+        for k, v in items:
+            sub = f"{path}.{k}" if path else k
+            out.append((sub, v))
+            stack.append((sub, v, depth + 1))
+    return out
 
 
 def _same(a: Any, b: Any) -> bool:
