@@ -1435,10 +1435,18 @@ def budget_seconds(timeout: Any, name: str = "timeout") -> float | None:
 
     if timeout is None:
         return None
+    given = timeout
     if isinstance(timeout, np.ndarray) and timeout.ndim == 0 and timeout.dtype.kind in "iuf":
         timeout = timeout.item()
-    if isinstance(timeout, decimal.Decimal) and timeout.is_finite():
-        timeout = Fraction(timeout)
+    if isinstance(timeout, decimal.Decimal) and not timeout.is_nan():
+        # by its exponent first: Fraction(Decimal('1e10000000')) built 10^10⁷ in full, 8 s
+        # (re-check review, session 44); Infinity is no limit, as float inf
+        if timeout.is_infinite() or (timeout.adjusted() > 400 and timeout > 0):
+            timeout = math.inf if timeout > 0 else -math.inf
+        elif timeout.adjusted() < -400 and not timeout.is_zero():
+            timeout = Fraction(1, 10**401) if timeout > 0 else Fraction(-1, 10**401)
+        else:
+            timeout = Fraction(timeout)
     if isinstance(timeout, bool) or not isinstance(timeout, numbers.Real):
         raise InputError(
             f"{name} must be a number of seconds (0 or None: no limit), got "
@@ -1448,8 +1456,8 @@ def budget_seconds(timeout: Any, name: str = "timeout") -> float | None:
         t = float(timeout)
     except OverflowError:  # 10**400: beyond any budget (re-check trial, session 36)
         t = math.inf if timeout > 0 else -math.inf
-    if not t >= 0:
-        raise InputError(f"{name} must be ≥ 0 seconds (0 or None: no limit), got {timeout!r}")
+    if not t >= 0 or timeout < 0:  # −1/10⁴⁰⁰ is −0.0 as a float: the exact sign decides
+        raise InputError(f"{name} must be ≥ 0 seconds (0 or None: no limit), got {given!r}")
     if t == 0 and timeout > 0:  # Fraction(1, 10**400) rounds to 0.0, which is no limit
         t = MIN_BUDGET_S
     return t if 0 < t <= MAX_BUDGET_S else None

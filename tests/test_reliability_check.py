@@ -213,6 +213,18 @@ def test_budget_seconds_keeps_a_real_budget_and_drops_no_budget() -> None:
     for bad in (Decimal("NaN"), Decimal("-1"), np.array(True)):
         with pytest.raises(InputError):
             api.budget_seconds(bad)
+    # re-check review, session 44: Decimal('1e10000000') built 10^10⁷ in full (8 s), and
+    # Infinity was refused; a negative value below the float range passed as −0.0
+    import time
+
+    t0 = time.perf_counter()
+    assert api.budget_seconds(Decimal("1e999999999")) is None
+    assert time.perf_counter() - t0 < 1.0
+    assert api.budget_seconds(Decimal("Infinity")) is None
+    assert api.budget_seconds(Decimal("1e-999999999")) == api.MIN_BUDGET_S
+    for bad in (Decimal("-1e-999999999"), Fraction(-1, 10**400), Decimal("-Infinity")):
+        with pytest.raises(InputError, match="must be ≥ 0 seconds"):
+            api.budget_seconds(bad)
 
 
 def test_a_spec_named_twice_gets_one_row(tmp_path: Path) -> None:
