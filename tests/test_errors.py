@@ -137,14 +137,14 @@ def test_invisible_format_characters_and_look_alike_names_are_shown_escaped(
     assert "\u0420" not in r.stdout + r.stderr and "\u200b" not in r.stdout + r.stderr
 
 
-def test_one_line_shortens_a_digit_run_grouped_by_thousands() -> None:
-    """``{n:,}`` printed a 400-digit theta_m whole, 533 characters of digits and commas (CLI
-    review, session 44): shortened like a plain run; 99 grouped digits stay whole."""
-    from obsdesign.errors import one_line
+def test_count_text_shortens_a_long_count_and_one_line_keeps_lists() -> None:
+    """``{n:,}`` printed a 400-digit theta_m whole (CLI review, session 44): counts go through
+    ``count_text``; one_line's pattern for grouped digits also caught a list of 3-digit
+    numbers ("100,101,…" became "10010110210310410510…(120 digits)": re-check review), so
+    a list is kept as given."""
+    from obsdesign.errors import count_text, one_line
 
-    assert one_line(f"theta_m = {10**400 - 1:,} steps") == (
-        "theta_m = 99999999999999999999…(400 digits) steps"
-    )
-    short = f"{10**98:,}"  # 99 digits in 33 groups
-    assert one_line(short) == short
-    assert one_line(f"{10**99:,}") == "10000000000000000000…(100 digits)"
+    assert count_text(10**400 - 1) == "99999999999999999999…(400 digits)"
+    assert count_text(1234567) == "1,234,567" and count_text(-(10**120)).startswith("-1000")
+    listed = ",".join(str(k) for k in range(100, 140))
+    assert one_line(f"--set method.lambda={listed}") == f"--set method.lambda={listed}"

@@ -12,7 +12,7 @@ import numpy as np
 
 from obsdesign.certify.exact import Q, to_float
 from obsdesign.certify.printing import fmt_down
-from obsdesign.errors import InputError
+from obsdesign.errors import InputError, count_text
 from obsdesign.methods.constrained import bounds as B
 from obsdesign.methods.constrained.design import xhat_set
 from obsdesign.methods.constrained.observer import (
@@ -202,7 +202,7 @@ def simulate(
         # theta_m = 1e30 with the paper's uncertified γ = 17 ran past 120 s with memory
         # growing (CLI fuzzer): a budget above θ, or any with an uncertified γ, may be spent
         raise InputError(
-            f"{spec.file}: [simulate] theta_m = {max(thetas):,} refining steps per sample "
+            f"{spec.file}: [simulate] theta_m = {count_text(max(thetas))} refining steps per sample "
             f"over {N:,} samples is above {MAX_REFINING_STEPS:,} steps in all (a smaller "
             "theta_m or horizon; a budget up to θ with a certified γ is not bounded here)"
         )

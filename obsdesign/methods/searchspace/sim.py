@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 
 from obsdesign.certify.printing import fmt_exact
-from obsdesign.errors import InconclusiveError, InfeasibleError, InputError
+from obsdesign.errors import InconclusiveError, InfeasibleError, InputError, count_text
 from obsdesign.limits import limits
 from obsdesign.methods.searchspace.options import Options, SimOptions
 from obsdesign.params import Parameters
@@ -285,11 +285,11 @@ def _ball_fits(eta: float, s: float, n: int, cap: int) -> None:
         per = eta / (s * math.sqrt(n))
         least = math.floor(per) ** n
         if least > cap:
-            why = f"at least {least:,} live centres (η/ε ≈ {eta / (2 * s):.3g} per state)"
+            why = f"at least {count_text(least)} live centres (η/ε ≈ {eta / (2 * s):.3g} per state)"
         else:
             offs = (2 * math.ceil((eta + s) / (2 * s) + 0.5) + 1) ** n
             if offs > max(4 * cap, 1 << 20):
-                why = f"{offs:,} grid offsets per centre (η/ε ≈ {eta / (2 * s):.3g} per state)"
+                why = f"{count_text(offs)} grid offsets per centre (η/ε ≈ {eta / (2 * s):.3g} per state)"
     if why is not None:
         raise MemoryCap(
             f"the refinement needs {why}, above the memory cap max_centres = {cap:,}: the "
