@@ -994,7 +994,10 @@ def _dash_file(arg: str) -> str:
     (a terminal: it waited) instead of the file (CLI review, session 44). Only the literal
     ``-`` is stdin."""
     if arg != "-" and arg.endswith("-") and os.path.normpath(arg) == "-":
-        return os.path.join(os.getcwd(), "-")
+        try:
+            return os.path.join(os.getcwd(), "-")
+        except OSError:  # the working folder removed: a traceback (re-check review, 44)
+            return arg
     return arg
 
 

@@ -574,3 +574,23 @@ def test_an_os_error_naming_a_file_outside_a_command_names_that_file(
         assert e.value.code == 2
         err = capsys.readouterr().err
         assert err.startswith(f"obsdesign: error: {want}"), err
+
+
+def test_dot_slash_dash_in_a_removed_folder_is_no_traceback(tmp_path: Path) -> None:
+    """``./-`` is made absolute from the working folder; with that folder removed,
+    os.getcwd() raised FileNotFoundError before the error handling: a traceback, exit 1
+    (re-check review, session 44). One line, no traceback."""
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    code = (
+        "import os, sys; os.chdir(sys.argv[1]); os.rmdir(sys.argv[1]); "
+        "sys.argv = ['obsdesign', 'design', './-']; from obsdesign.cli import main; main()"
+    )
+    r = subprocess.run(
+        [sys.executable, "-c", code, str(gone)],
+        input="",
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert "Traceback" not in r.stderr and r.returncode == 2, r.stderr
