@@ -420,11 +420,13 @@ def test_theta_covers(sec5, tmp_path) -> None:
 def test_singular_P_fails_P_invertible_and_keeps_the_other_claims(sec5: Report) -> None:
     """Statement review 44: a report's P = [[1, 1], [1, 1]] (singular) was one
     'parameters-wellformed / ZeroDivisionError: matrix is singular' claim in place of every
-    claim (P⁻¹ of the level sets); now P-invertible fails beside P-positive-definite, and
-    the claims computed before it stay."""
-    failed = failed_ids(tamper(sec5, P=[[1, 1], [1, 1]]))
-    assert {"P-positive-definite", "P-invertible"} <= failed
-    assert "parameters-wellformed" not in failed
+    claim (P⁻¹ of the level sets); now P-claims-checked fails beside P-positive-definite,
+    and the claims computed before it stay. An indefinite or negative definite P was one
+    'ComplexResult' claim (re-check review, session 44): the same."""
+    for P in ([[1, 1], [1, 1]], [[1, 0], [0, -1]], [[-1, 0], [0, -1]]):
+        failed = failed_ids(tamper(sec5, P=P))
+        assert {"P-positive-definite", "P-claims-checked"} <= failed, P
+        assert "parameters-wellformed" not in failed
 
 
 def test_rho_one_fails_v_max_breve_bound_not_the_parse() -> None:

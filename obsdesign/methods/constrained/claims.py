@@ -84,6 +84,19 @@ def expected_params(o: Options) -> set[str]:
     return keys
 
 
+def _P_unusable(P: Any) -> str | None:
+    """Why no claim can be built from a report's P (None: they can): singular, or its
+    symmetric part not positive definite (V(e) = eᵀPe has no bounded level sets). An
+    asymmetric P with a positive definite symmetric part goes on, and
+    :func:`_fail_if_asymmetric` fails the claims built from P itself."""
+    if qrank(P) < len(P):
+        return "P is singular"
+    sym = (np.asarray(P, dtype=object) + np.asarray(P, dtype=object).T) * fmpq(1, 2)
+    if not check_pd(sym).ok:
+        return "P is not positive definite (V(e) = eᵀPe has no bounded level sets)"
+    return None
+
+
 def _ref(where: str) -> str:
     return f"{where}, {REF}"
 
@@ -168,14 +181,16 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         check="exact LDLᵀ over Q",
         result=check_pd(P, o.margin),
     )
-    if c[-1].status is ClaimStatus.FAILED and qrank(P) < len(P):
-        # the level sets of eqs. (13), (15), (21) use P⁻¹: a singular P was one
-        # 'parameters-wellformed / ZeroDivisionError' claim in place of every claim (review)
+    why = _P_unusable(P) if c[-1].status is ClaimStatus.FAILED else None
+    if why is not None:
+        # the level sets of eqs. (13), (15), (21) use P⁻¹ and square roots of P's forms: a
+        # singular P was one 'parameters-wellformed / ZeroDivisionError' claim in place of
+        # every claim, an indefinite one 'ComplexResult' (statement and re-check reviews 44)
         c.failed(
-            id="P-invertible",
-            statement="P is invertible (the level sets of eqs. (13), (15), (21) use P⁻¹)",
+            id="P-claims-checked",
+            statement="the claims built from P (eqs. (5)-(22): P⁻¹, level sets of V) are checked",
             reference=_ref("eq. (4)"),
-            detail="P is singular: the claims built from P (eq. (5)-(22)) are not checked",
+            detail=f"not checked: {why}",
         )
         return c
     if o.model is not None and o.model.nonlinear:
