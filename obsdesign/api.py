@@ -517,7 +517,7 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
         d = report.to_dict()
         if report.raw_parameters is not None and _unchanged_since_read(report, d):
             d["parameters"] = report.raw_parameters  # as read: floats compared bit for bit
-        rep, problems = Report.from_dict(d)
+        rep, problems = _from_memory(d)
         rep.extra_keys = list(report.extra_keys)
     else:
         rep, problems = Report.load(_path_arg(report, "report", "a Report"))
@@ -1024,7 +1024,7 @@ def simulate(
         notes += _uncertified_design(sp, params)
     else:
         rep, problems = (
-            Report.from_dict(report.to_dict())
+            _from_memory(report.to_dict())
             if isinstance(report, Report)
             else Report.load(_path_arg(report, "report", "a Report"))
         )
@@ -1733,26 +1733,32 @@ def _error_row(path: Path, method_key: str, code: int, t0: float, message: str) 
     return CheckRow(str(path), method_key, code, 0, 0, 0, "", t, one_line(message))
 
 
-def verify_own(rep: Report) -> Report:
-    """``verify`` of a report this process just designed, through its JSON data, with
-    ``max_digits`` raised to the report's longest exact integer (up to the limit's ceiling):
-    its exact values are the tool's own, and a valid spec (a set-invariant Q entry 1e-300)
-    was a row "exit 2 bad input, [parameters.exact…] has more than 1000 digits" (CLI review,
-    session 44).
-
-    :param rep: a report :func:`design` returned in this process (not one read from a file:
-    the raised limit is for the tool's own numbers)."""
+def _from_memory(d: dict[str, Any]) -> tuple[Report, list[str]]:
+    """A Report object's JSON data read back (``Report.from_dict``) with ``max_digits``
+    raised to its longest exact integer (up to the limit's ceiling): the input limits guard
+    files and streams, and an object in memory already holds its numbers. A valid spec (a
+    set-invariant Q entry 1e-300, ~2,200-digit exact values) was "exit 2 bad input" for
+    ``verify(design(spec))``, ``simulate(spec, design(spec))`` and a check or sweep row
+    (CLI and re-check reviews, session 44)."""
     from obsdesign.limits import CEILINGS, exact_digits, limits, restore, saved, set_limits
 
-    d = rep.to_dict()
-    need = exact_digits(d.get("parameters", {}).get("exact", {}))
+    params = d.get("parameters")
+    need = exact_digits(params.get("exact", {})) if isinstance(params, dict) else 0
     state = saved()
     try:
         if limits().max_digits < need <= CEILINGS["max_digits"]:
             set_limits(max_digits=need)
-        return verify(Report.from_dict(d)[0])
+        return Report.from_dict(d)
     finally:
         restore(state)
+
+
+def verify_own(rep: Report) -> Report:
+    """``verify`` of a report this process just designed, through its JSON data (as a file
+    would carry it), with ``max_digits`` raised to its own exact values (:func:`_from_memory`).
+
+    :param rep: a report :func:`design` returned in this process."""
+    return verify(_from_memory(rep.to_dict())[0])
 
 
 def _check_one(path: Path, t0: float, seen: list[str]) -> CheckRow:

@@ -1148,3 +1148,9 @@ def test_a_report_with_long_exact_values_is_checked_and_its_design_warns(tmp_pat
     assert ok.exit_code == 0, ok.output
     short = runner.invoke(app, ["--limit", f"max_digits={int(need) - 1}", "verify", str(out)])
     assert short.exit_code == 2
+    # in memory, the report's own numbers are read as they are: verify(design(spec)) and
+    # simulate(spec, design(spec)) were "exit 2 bad input" (re-check review, session 44)
+    sp = api.load_spec(spec)
+    rep = api.design(sp)
+    assert api.verify(rep).exit_code() == 0
+    assert api.simulate(sp, rep).metrics()
