@@ -982,6 +982,17 @@ def _float_P(
     floats: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
 ) -> Any:
     Af, Cf, Lf = floats or tuple(np.asarray(x, dtype=float) for x in (A, C, L))
+    if Cf.size:
+        with np.errstate(all="ignore"):
+            overflow = not np.all(np.isfinite(Af - Lf @ Cf))
+        if overflow and A.dtype == object:
+            # L·C past the float range while A − LC is small exactly (A = diag(5e307, 0.5),
+            # C = [[1e308, 0], [1.5e308, 0]], L = [[2, −1], [0, 0]]: A − LC = diag(0, 0.5)):
+            # the float problem from the exact closed loop, rounded (re-check review, 44)
+            Acl = mat_float(closed_loop_fmat(A, C, L))
+            if np.all(np.isfinite(Acl)):
+                n = Acl.shape[0]
+                Af, Cf, Lf = Acl, np.zeros((0, n)), np.zeros((n, 0))
     try:
         Pf = lyapunov_P(Af, Cf, Lf, float(r), discrete)
     except (np.linalg.LinAlgError, ValueError):

@@ -1784,3 +1784,34 @@ def test_a_stability_margin_below_the_rate_grid_names_rate_tol() -> None:
     ):
         api.design(api.load_spec_text(disc, "d.toml"))
     assert api.design(api.load_spec_text(disc + "rate_tol = 1e-6\n", "d.toml")).exit_code() == 0
+
+
+_OVERFLOW = """[system]
+time = "discrete"
+A = [[5e307, 0], [0, 0.5]]
+C = [[1e308, 0], [1.5e308, 0]]
+[method]
+key = "lyapunov"
+L = [[2, -1], [0, 0]]
+"""
+
+
+def test_a_gain_whose_float_product_overflows_is_certified_from_the_exact_loop() -> None:
+    """L·C past the float range while A − LC = diag(0, 0.5) exactly: the float P came from
+    A − L·C in doubles (inf), exit 4 "holds in floats but the exact check failed", and the
+    doubles' note was an internal failure (re-check review, session 44). The float problem
+    is made from the exact closed loop, rounded; the report certifies and verifies, and
+    says the doubles cannot run it."""
+    from obsdesign import api
+
+    rep = api.design(api.load_spec_text(_OVERFLOW, "o.toml"))
+    assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
+    assert api.verify(rep).exit_code() == 0
+    assert any("formed in doubles overflows" in n for n in rep.notes), rep.notes
+    text = _OVERFLOW.replace('key = "lyapunov"', 'key = "constrained"\nX = "X"\neps_min = 0.01')
+    text += '[method.c]\ntype = "box"\nlower = [-1.1, -1.1]\nupper = [1.1, 1.1]\n'
+    text += "[method.D]\nlower = [-3, -3]\nupper = [3, 3]\n"
+    text = text.replace(
+        "[method]", '[sets.X]\ntype = "box"\nlower = [-1, -1]\nupper = [1, 1]\n[method]'
+    )
+    assert api.design(api.load_spec_text(text, "c.toml")).exit_code() == 0

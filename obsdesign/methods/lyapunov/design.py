@@ -424,7 +424,17 @@ def _float_gain_note(
     size = max(1.0, float(np.max(np.abs(guide.w)))) if guide.w.size else 1.0
     if guide.source == FLOAT_SOURCE and margin > 10 * FLOAT_TOL * size * scale:
         return None
-    verdict = lyap.float_realization(Af_plant - Lf @ Cf, s.discrete, rate)
+    with np.errstate(all="ignore"):
+        Ao = Af_plant - Lf @ Cf
+    if not np.all(np.isfinite(Ao)):
+        # L·C past the float range, A − LC small exactly (re-check review, session 44): an
+        # internal failure, ValueError "not a finite number", before
+        return (
+            "warning: A − LC formed in doubles overflows (L·C is beyond the float range): the "
+            "certificate is about the exact A − LC (parameters.exact.L); simulate and "
+            "observer_statespace(), which use doubles, cannot run this observer"
+        )
+    verdict = lyap.float_realization(Ao, s.discrete, rate)
     if verdict == "ok":
         return None
     what = "is not stable" if verdict == "unstable" else "is stable but slower than the rate"
