@@ -4,6 +4,7 @@ literal Definition 7 and the "consistency lost" diagnosis."""
 
 from __future__ import annotations
 
+import itertools
 import math
 import warnings
 from pathlib import Path
@@ -960,3 +961,25 @@ def test_recover_refuses_a_ball_beyond_the_cap_before_enumerating_it() -> None:
     with pytest.raises(MemoryCap, match="at least 200,704 live centres"):
         recover(C, 448 * 0.5 * math.sqrt(2) * (1 + 1e-9), 0.5, 200_000)
     assert len(recover(C, 10.0, 0.5, 200_000)) > 0
+
+
+def test_ball_offsets_list_only_what_can_meet_the_ball() -> None:
+    """At n = 5 a ball meeting about 1.5 million cells (η/ε ≈ 11.4) was refused under
+    max_centres = 2,000,000: its offset cube has 27⁵ = 14.3 million rows, above 4·cap
+    (re-check review, session 44). The offsets are pruned axis by axis; every offset the
+    exact test keeps for some centre is among them."""
+    from obsdesign.methods.searchspace.sim import ball_offsets
+
+    offs = ball_offsets(11.4, 0.5, 5, 8_000_000)
+    assert 1_000_000 < len(offs) < 27**5 // 4
+    rng = np.random.default_rng(7)
+    for n, eta, s in ((1, 2.3, 0.25), (2, 1.7, 0.3), (3, 0.9, 0.2)):
+        got = {tuple(k) for k in ball_offsets(eta, s, n, 10**7)}
+        R = math.ceil((eta + s) / (2 * s) + 0.5)
+        cube = np.array(list(itertools.product(range(-R, R + 1), repeat=n)))
+        for c in rng.uniform(-3, 3, size=(20, n)):
+            base = np.rint(c / (2 * s))
+            g = (base + cube) * (2 * s)
+            d = np.maximum(np.abs(c - g) - s, 0.0)
+            hit = cube[(d * d).sum(axis=1) <= eta * eta]
+            assert {tuple(k) for k in hit} <= got

@@ -272,30 +272,60 @@ def cover_box(lo: np.ndarray, hi: np.ndarray, s: float) -> np.ndarray:
 
 
 def _ball_fits(eta: float, s: float, n: int, cap: int) -> None:
-    """:class:`MemoryCap` before :func:`recover` enumerates the (2R + 1)ⁿ grid offsets of a
-    ball B(c, η) in cells of half-side s: when the ball alone meets more than ``cap`` cells
-    (a cube of half-side η/√n inside it meets at least ⌊η/(s√n)⌋ⁿ), or when the offsets
-    are more than max(4·cap, 2²⁰). An initial state of −1e16 gave a ball that the offsets'
-    list filled 2.4 GB with (MemoryError, exit 3; past 10⁹⁹ "int too large", exit 4), and
-    neither time_limit nor max_sim_bytes stopped it (CLI review, session 44)."""
+    """:class:`MemoryCap` before :func:`recover` lists the grid offsets of a ball B(c, η) in
+    cells of half-side s, when the ball alone meets more than ``cap`` cells (a cube of
+    half-side η/√n inside it meets at least ⌊η/(s√n)⌋ⁿ). An initial state of −1e16 gave a
+    ball whose (2R + 1)ⁿ offsets filled 2.4 GB (MemoryError, exit 3; past 10⁹⁹ "int too
+    large", exit 4), and neither time_limit nor max_sim_bytes stopped it (CLI review,
+    session 44); :func:`ball_offsets` lists only the offsets that can meet the ball."""
     why = None
     if not (math.isfinite(eta) and math.isfinite(s) and s > 0):
         why = f"a search radius η = {eta:.3g} for cells of half-side {s:.3g}"
     else:
-        per = eta / (s * math.sqrt(n))
-        least = math.floor(per) ** n
+        least = math.floor(eta / (s * math.sqrt(n))) ** n
         if least > cap:
             why = f"at least {count_text(least)} live centres (η/ε ≈ {eta / (2 * s):.3g} per state)"
-        else:
-            offs = (2 * math.ceil((eta + s) / (2 * s) + 0.5) + 1) ** n
-            if offs > max(4 * cap, 1 << 20):
-                why = f"{count_text(offs)} grid offsets per centre (η/ε ≈ {eta / (2 * s):.3g} per state)"
     if why is not None:
         raise MemoryCap(
             f"the refinement needs {why}, above the memory cap max_centres = {cap:,}: the "
             "error bound grew past what the grid can cover (a state far outside D?); raise "
             "max_centres, or start from a smaller D or a larger γ₀"
         )
+
+
+def ball_offsets(eta: float, s: float, n: int, most: int) -> np.ndarray:
+    """The integer offsets k (rows) of the cells of half-side s around the grid point nearest
+    a centre c that can meet B(c, η): with |c − 2s·base| ≤ s per coordinate, the cell
+    2s(base + k) is at least max(0, (|k_i| − 1)·2s) away from c along axis i, and a k whose
+    squares of those sum past η² cannot meet the ball (the exact test in :func:`recover`
+    decides the rest). Built axis by axis, so that only the offsets that pass are listed:
+    the whole cube (2R + 1)ⁿ refused balls of 0.8–1.9 million cells at n = 5 below
+    max_centres (re-check review, session 44). :class:`MemoryCap` past ``most`` offsets.
+
+    :param eta: the ball's radius; :param s: the cells' half-side; :param n: the dimension;
+    :param most: the most offsets listed."""
+    R = math.ceil((eta + s) / (2 * s) + 0.5)
+    r = np.arange(-R, R + 1, dtype=np.int64)
+    gap = np.maximum(np.abs(r) - 1, 0).astype(float) * (2 * s)
+    per = gap * gap
+    reach = eta * eta * (1 + 1e-9) + 1e-300
+    offs = np.zeros((1, 0), dtype=np.int64)
+    acc = np.zeros(1)
+    for _ in range(n):
+        new = acc[:, None] + per[None, :]
+        keep = new <= reach
+        count = int(np.count_nonzero(keep))
+        if count > most:
+            raise MemoryCap(
+                f"the refinement needs more than {count_text(most)} grid offsets per centre "
+                f"(η/ε ≈ {eta / (2 * s):.3g} per state), above 4·max_centres: the error bound "
+                "grew past what the grid can cover; raise max_centres, or start from a "
+                "smaller D or a larger γ₀"
+            )
+        i, j = np.nonzero(keep)
+        offs = np.concatenate([offs[i], r[j][:, None]], axis=1)
+        acc = new[keep]
+    return offs
 
 
 def recover(
@@ -311,8 +341,7 @@ def recover(
     n = C.shape[1]
     eta = eta * (1 + INFLATE) + INFLATE * s
     _ball_fits(eta, s, n, cap)
-    R = math.ceil((eta + s) / (2 * s) + 0.5)
-    offs = np.array(list(itertools.product(range(-R, R + 1), repeat=n)), dtype=np.int64)
+    offs = ball_offsets(eta, s, n, 4 * cap)
     base = np.rint(C / (2 * s)).astype(np.int64)
     step = max(1, (1 << 20) // len(offs))
     keys: list[np.ndarray] = []
