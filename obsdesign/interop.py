@@ -367,7 +367,11 @@ def _time_of(dt: Any) -> tuple[str, float | None]:
     if dt is True:
         return "discrete", None
     try:
-        zero, positive, f = bool(dt == 0), bool(dt > 0), float(dt)
+        zero, positive = bool(dt == 0), bool(dt > 0)
+        try:
+            f = float(dt)
+        except OverflowError:  # Fraction(10**400): beyond the float range, not "not positive"
+            f = math.inf
     except (TypeError, ValueError, ArithmeticError):
         zero = positive = False
         f = math.nan
@@ -377,6 +381,8 @@ def _time_of(dt: Any) -> tuple[str, float | None]:
         return "discrete", f
     if positive and f == 0:
         raise InputError(f"dt {dt!r} is positive but below the float range (it would read as 0)")
+    if positive and not math.isfinite(f):
+        raise InputError(f"dt {dt!r} is beyond the float range")
     raise InputError(f"dt must be 0, True or a finite positive number, got {dt!r}")
 
 

@@ -349,6 +349,9 @@ def test_load_spec_text_takes_a_path_as_the_file_name(tmp_path: Path) -> None:
     assert api.verify(out).exit_code() == 0
     with pytest.raises(InputError, match="file must be a str"):
         api.load_spec_text(text, 7)  # type: ignore[arg-type]
+    from obsdesign.spec import read_spec_text  # the spec layer takes a Path too (session 44)
+
+    assert read_spec_text(text, tmp_path / "raw.toml").file == str(tmp_path / "raw.toml")
 
 
 def test_api_arguments_of_the_wrong_type_are_input_errors(tmp_path: Path) -> None:

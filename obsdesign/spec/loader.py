@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
+import os
 import re
 import tomllib
 from decimal import Decimal
@@ -51,6 +52,8 @@ def read_spec_text(text: str, file: str = "<spec>") -> Spec:
 
     Returns a :class:`Spec` whose ``method_table`` (and ``simulate.table``) are raw: the API
     binds the method, which reads its own keys."""
+    if isinstance(file, os.PathLike):  # a Path kept as the file made reports unwritable
+        file = os.fspath(file)  # (re-check review, session 44; api.load_spec_text did it)
     if text.startswith("\ufeff"):  # tomllib said "Invalid statement (line 1, column 1)"
         raise SpecError(
             file,
