@@ -210,3 +210,20 @@ def test_design_refuses_a_nested_option_or_an_expression_tree_edited_in_place() 
     f0.tree.body.left = ast.copy_location(ast.Constant(0.2), f0.tree.body.left)
     with pytest.raises(InputError, match=r"\[system.f\]\[0\] expression of the spec object"):
         api.design(sp)
+
+
+def test_design_refuses_a_system_list_edited_in_place() -> None:
+    """System is frozen, its lists are not: ``f[0] = <another expression>`` or a state
+    renamed in place designed claims for another plant than the text's (API reviews,
+    sessions 43-44): refused, exit 2."""
+    from obsdesign.errors import InputError
+
+    sp = api.load_spec(SPECS / "hernandez-garcia-example.toml")
+    other = api.load_spec_text(_with_k(), "k.toml").system.f[0]
+    sp.system.f[0] = other
+    with pytest.raises(InputError, match="expressions or state names of the spec object"):
+        api.design(sp)
+    sp = api.load_spec(SPECS / "constrained-redesign-sec5-lyapunov.toml")
+    sp.system.states[0] = "renamed"
+    with pytest.raises(InputError, match="expressions or state names"):
+        api.design(sp)

@@ -152,6 +152,14 @@ class Spec:
             ("text", self.text),
             ("sha256", self.sha256),
             ("[system]", self.system),
+            # its lists too: System is frozen, its lists are not (f[0] = another Expr)
+            (
+                "[system] expressions or state names",
+                tuple(
+                    tuple(getattr(self.system, k) or ())
+                    for k in ("states", "f", "psi", "h", "u_signal")
+                ),
+            ),
             ("[sets]", tuple(sorted(self.sets.items(), key=lambda kv: kv[0]))),
             ("[method] key", self.method),
             ("[method]", self.method_table),
