@@ -613,20 +613,10 @@ def _warn_above_digit_limit(rep: Any, output: Path) -> None:
     (4471-digit vertices) that its own ``verify`` refused as bad input, exit 2 (CLI review,
     session 44). The report is right; reading it takes a raised limit, which the warning
     names."""
-    from obsdesign.errors import one_line
-    from obsdesign.limits import exact_digits, limits
+    from obsdesign.limits import exact_digits
 
     need = exact_digits(rep.to_dict().get("parameters", {}).get("exact", {}))
-    lim = limits().max_digits
-    if need > lim:
-        sys.stderr.write(
-            one_line(
-                f"obsdesign: warning: {output} holds exact values of {need:,} digits, above "
-                f"max_digits = {lim:,}, the most verify reads: verify it with 'obsdesign "
-                f"--limit max_digits={need} verify {output}'"
-            )
-            + "\n"
-        )
+    _warn_limit(output, f"holds exact values of {need:,} digits", "max_digits", need)
 
 
 def _warn_above_read_limit(output: Path) -> None:
@@ -635,20 +625,26 @@ def _warn_above_read_limit(output: Path) -> None:
     18.9 MB report that its own ``verify`` then refused as bad input, exit 2 (re-check trial,
     session 31). The report is right; reading it takes a raised limit, which the warning
     names."""
-    from obsdesign.errors import one_line
-    from obsdesign.limits import limits
 
     try:
         size = os.path.getsize(output)
     except OSError:  # written through a link to a device, or gone since: nothing to say
         return
-    lim = limits().max_file_bytes
-    if size > lim:
+    _warn_limit(output, f"is {size:,} bytes", "max_file_bytes", size)
+
+
+def _warn_limit(output: Path, what: str, key: str, need: int) -> None:
+    """The warning of a written report that ``verify`` reads only with ``--limit key=need``
+    (when ``need`` is above the limit in force); ``what`` says how the report exceeds it."""
+    from obsdesign.errors import one_line
+    from obsdesign.limits import limits
+
+    lim = getattr(limits(), key)
+    if need > lim:
         sys.stderr.write(
             one_line(
-                f"obsdesign: warning: {output} is {size:,} bytes, above max_file_bytes = "
-                f"{lim:,}, the most verify reads: verify it with 'obsdesign --limit "
-                f"max_file_bytes={size} verify {output}'"
+                f"obsdesign: warning: {output} {what}, above {key} = {lim:,}, the most verify "
+                f"reads: verify it with 'obsdesign --limit {key}={need} verify {output}'"
             )
             + "\n"
         )
