@@ -613,8 +613,18 @@ def _warn_above_digit_limit(rep: Any, output: Path) -> None:
     (4471-digit vertices) that its own ``verify`` refused as bad input, exit 2 (CLI review,
     session 44). The report is right; reading it takes a raised limit, which the warning
     names."""
-    from obsdesign.limits import exact_digits
+    import re
 
+    from obsdesign.limits import exact_digits, limits
+
+    try:  # a scan of the written text first: the walk below only when a run is that long
+        if not stat.S_ISREG(os.stat(output).st_mode):  # a FIFO or device (--force)
+            return
+        text = Path(output).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return
+    if re.search(rf"\d{{{limits().max_digits + 1}}}", text) is None:
+        return
     need = exact_digits(rep.to_dict().get("parameters", {}).get("exact", {}))
     _warn_limit(output, f"holds exact values of {need:,} digits", "max_digits", need)
 

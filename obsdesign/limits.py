@@ -319,8 +319,9 @@ def exact_digits(obj: Any) -> int:
     while stack:
         x = stack.pop()
         if isinstance(x, str):
-            for part in x.split("/"):
-                best = max(best, len(part.strip().lstrip("+-")))
+            if len(x) > best:  # a part is never longer than the string
+                for part in x.split("/"):
+                    best = max(best, len(part.strip().lstrip("+-")))
         elif isinstance(x, dict):
             stack.extend(x.values())
         elif isinstance(x, (list, tuple)):
