@@ -612,8 +612,12 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
                     0,
                     False,
                     f"the recomputed claims give '{got}'",
-                    # 'ok' against an inconclusive recomputation is inconclusive (session 44)
-                    float_ok=rep.verdict == "ok" and got == "inconclusive",
+                    # 'ok' against a recomputation left inconclusive only by a solver's
+                    # inaccurate re-solve is inconclusive (session 44); any other 'ok' over a
+                    # failed claim is a tampered verdict (re-check review: exit 4 for it)
+                    float_ok=rep.verdict == "ok"
+                    and got == "inconclusive"
+                    and all(cl.extra.get("solver_inaccurate") for cl in fresh if not cl.ok),
                 )
             )
     unknown = sorted(set(rep.extra_keys) - set(TOP_KEYS))
@@ -771,7 +775,7 @@ def compare_claims(reported: list[Claim], fresh: list[Claim]) -> list[Claim]:
             unsure = (
                 c.statement == f.statement
                 and f.status is ClaimStatus.FAILED
-                and f.float_ok
+                and bool(f.extra.get("solver_inaccurate"))
                 and c.status is not ClaimStatus.FAILED
             )
             out.append(_diff_claim(f"report-alters:{cid}", "; ".join(what), unsure))

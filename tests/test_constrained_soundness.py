@@ -1482,3 +1482,23 @@ def test_a_report_without_the_spec_lambda_fails_lambda_present(sec5: Report) -> 
     44). Now ``lambda-present`` fails too."""
     assert "lambda-present" in failed_ids(tamper(sec5, **{"lambda": None}))
     assert "rho-present" in failed_ids(tamper(sec5, rho=None))
+
+
+def test_a_report_relabelling_an_undecided_claim_certified_fails_verify() -> None:
+    """A design whose one claim is undecided (exit 4) relabelled certified with verdict "ok":
+    verify gave exit 4 once the stubborn solver allowance (an inaccurate re-solve is not a
+    refutation) was applied to every float-ok claim (re-check review, session 44); it holds
+    only for a solver's inaccurate answer, and this tampered report fails, exit 1."""
+    text = ELLIPSOID_XHAT_AT_EPS_MAX.replace("E0", "0.25")
+    rep = _design(text)
+    assert rep.exit_code() == 4
+    d = json.loads(rep.to_json())
+    for c in d["claims"]:
+        if c["status"] == "failed":
+            c["status"], c["detail"] = "certified", "all checks passed"
+    d["verdict"] = "ok"
+    tampered, problems = Report.from_dict(d)
+    assert not problems and api.verify(tampered).exit_code() == 1
+    d["claims"] = json.loads(rep.to_json())["claims"]  # the verdict alone changed
+    only_verdict, _ = Report.from_dict(d)
+    assert api.verify(only_verdict).exit_code() == 1

@@ -372,6 +372,7 @@ def lambda_max_claims(spec: Spec, pr: Parameters) -> list[Claim]:
             cl,
             float_ok=True,
             detail=cl.detail + "; the solver's answer is inaccurate there: not refuted",
+            extra={**cl.extra, "solver_inaccurate": True},
         )
     return c
 
