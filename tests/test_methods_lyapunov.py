@@ -1808,6 +1808,12 @@ def test_a_gain_whose_float_product_overflows_is_certified_from_the_exact_loop()
     assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
     assert api.verify(rep).exit_code() == 0
     assert any("formed in doubles overflows" in n for n in rep.notes), rep.notes
+    # simulate says the same, exit 4 (it was an internal failure, exit 3: re-check review)
+    from obsdesign.errors import InconclusiveError
+
+    sim = _OVERFLOW + "[simulate]\nhorizon = 5\nx0 = [1, 1]\nxhat0 = [0, 0]\n"
+    with pytest.raises(InconclusiveError, match="formed in doubles overflows"):
+        api.simulate(api.load_spec_text(sim, "s.toml"))
     text = _OVERFLOW.replace('key = "lyapunov"', 'key = "constrained"\nX = "X"\neps_min = 0.01')
     text += '[method.c]\ntype = "box"\nlower = [-1.1, -1.1]\nupper = [1.1, 1.1]\n'
     text += "[method.D]\nlower = [-3, -3]\nupper = [3, 3]\n"

@@ -180,11 +180,18 @@ def _warn_float_gain(spec: Spec, params: Parameters, L: Any) -> None:
         return
     key = "lambda" if s.discrete else "alpha"
     rate = params.exact(key, [], accept_float=True) if key in params else None
-    verdict = float_realization(
-        np.asarray(s.A.f, float) - np.asarray(L, float) @ np.asarray(s.C.f, float),
-        s.discrete,
-        rate,
-    )
+    with np.errstate(all="ignore"):
+        Ao = np.asarray(s.A.f, float) - np.asarray(L, float) @ np.asarray(s.C.f, float)
+    if not np.all(np.isfinite(Ao)):
+        from obsdesign.errors import InconclusiveError
+
+        # the design says so in a note; simulate was an internal failure (re-check, 44)
+        raise InconclusiveError(
+            "A − LC formed in doubles overflows (L·C is beyond the float range): the "
+            "certificate is about the exact A − LC, and a simulation in doubles cannot run "
+            "this observer"
+        )
+    verdict = float_realization(Ao, s.discrete, rate)
     if verdict == "ok":
         return
     what = (
