@@ -222,6 +222,10 @@ def test_budget_seconds_keeps_a_real_budget_and_drops_no_budget() -> None:
     assert time.perf_counter() - t0 < 1.0
     assert api.budget_seconds(Decimal("Infinity")) is None
     assert api.budget_seconds(Decimal("1e-999999999")) == api.MIN_BUDGET_S
+    t0 = time.perf_counter()
+    with pytest.raises(InputError, match="must be ≥ 0 seconds"):
+        api.budget_seconds(Decimal("-1e100000000"))  # built 10^10⁸ before (re-check review)
+    assert time.perf_counter() - t0 < 1.0
     for bad in (Decimal("-1e-999999999"), Fraction(-1, 10**400), Decimal("-Infinity")):
         with pytest.raises(InputError, match="must be ≥ 0 seconds"):
             api.budget_seconds(bad)
