@@ -228,6 +228,13 @@ class SimOption:
             f = float(v) if number else math.nan
         except (OverflowError, ValueError):
             f = math.nan
+        if self.kind == "float" and number and f == 0 and not isinstance(v, float):
+            try:
+                tiny = v != 0  # an exact value (Decimal, Fraction) that floats read as 0
+            except (ArithmeticError, TypeError):
+                tiny = False
+            if tiny:  # gamma=Decimal('1e-400') said "got 0.0" (re-check review, session 44)
+                raise InputError(f"{what}: {v!r} is below the float range (it would read as 0)")
         whole = isinstance(v, numbers.Integral) and not isinstance(v, (bool, np.bool_))
         if self.kind == "int" and (whole or (number and math.isfinite(f) and f == int(f))):
             out: Any = int(v) if whole else int(f)

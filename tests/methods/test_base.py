@@ -105,3 +105,11 @@ def test_a_float_option_below_the_float_range_is_named_as_such() -> None:
             opt.parse(text)
     assert opt.parse("0") == 0.0 and opt.parse("-0.0") == 0.0
     assert opt.parse("5e-324") == 5e-324
+    # a typed value from the API too (re-check review, session 44)
+    from decimal import Decimal
+    from fractions import Fraction
+
+    for v in (Decimal("1e-400"), Fraction(1, 10**400)):
+        with pytest.raises(InputError, match="simulate: gamma: .* is below the float range"):
+            opt.check_value(v)
+    assert opt.check_value(Decimal("0")) == 0.0 and opt.check_value(0.5) == 0.5
