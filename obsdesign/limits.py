@@ -224,7 +224,10 @@ KERNEL_DIRS = ("/proc", "/sys")
 
 def kernel_dir(p: Path) -> str:
     """The kernel directory (:data:`KERNEL_DIRS`) that ``p`` resolves into, or ""."""
-    real = os.path.realpath(p)
+    try:
+        real = os.path.realpath(p)
+    except OSError:  # a relative path in a removed working folder (re-check review, 44)
+        real = os.path.abspath(p) if os.path.isabs(p) else str(p)
     return next((d for d in KERNEL_DIRS if real == d or real.startswith(d + "/")), "")
 
 

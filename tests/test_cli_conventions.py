@@ -582,6 +582,7 @@ def test_dot_slash_dash_in_a_removed_folder_is_no_traceback(tmp_path: Path) -> N
     (re-check review, session 44). One line, no traceback."""
     gone = tmp_path / "gone"
     gone.mkdir()
+    (tmp_path / "gone2").mkdir()
     code = (
         "import os, sys; os.chdir(sys.argv[1]); os.rmdir(sys.argv[1]); "
         "sys.argv = ['obsdesign', 'design', './-']; from obsdesign.cli import main; main()"
@@ -594,3 +595,9 @@ def test_dot_slash_dash_in_a_removed_folder_is_no_traceback(tmp_path: Path) -> N
         timeout=120,
     )
     assert "Traceback" not in r.stderr and r.returncode == 2, r.stderr
+    assert "the working folder no longer exists" in r.stderr
+    # check of a relative file there was an internal failure, exit 3 (realpath; re-check)
+    code = code.replace("'design', './-'", "'check', './x.toml'")
+    again = [sys.executable, "-c", code, str(tmp_path / "gone2")]
+    r = subprocess.run(again, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2 and "the working folder no longer exists" in r.stderr, r.stderr
