@@ -1360,7 +1360,10 @@ def spec_files(paths: list[str | Path] | str | Path) -> list[Path]:
     first: dict[str, int] = {}
     unique: list[Path | None] = []
     for f in out:
-        key = os.path.realpath(f)
+        try:
+            key = os.path.realpath(f)
+        except OSError:  # a relative path in a removed working folder (re-check review, 44)
+            key = str(f)
         i = first.get(key)
         if i is None or (os.path.islink(unique[i] or f) and not os.path.islink(f)):
             if i is not None:
@@ -1445,7 +1448,7 @@ def budget_seconds(timeout: Any, name: str = "timeout") -> float | None:
     if isinstance(timeout, decimal.Decimal) and not timeout.is_nan():
         # by its exponent first: Fraction(Decimal('1e10000000')) built 10^10⁷ in full, 8 s
         # (re-check review, session 44); Infinity is no limit, as float inf
-        if timeout.is_infinite() or timeout.adjusted() > 400:  # −1e100000000 too (re-check)
+        if timeout.is_infinite() or (timeout.adjusted() > 400 and not timeout.is_zero()):
             timeout = math.inf if timeout > 0 else -math.inf
         elif timeout.adjusted() < -400 and not timeout.is_zero():
             timeout = Fraction(1, 10**401) if timeout > 0 else Fraction(-1, 10**401)

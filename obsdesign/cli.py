@@ -998,7 +998,7 @@ def _dash_file(arg: str) -> str:
             return os.path.join(os.getcwd(), "-")
         except OSError:  # the working folder removed: a traceback (re-check review, 44),
             # and returning ./- read stdin (it is Path("-") to typer)
-            _err(f"{arg}: cannot read (the working folder no longer exists)")
+            _err(f"{arg}: cannot read (the working folder no longer exists: cd to one)")
             sys.exit(2)
     return arg
 
@@ -1035,13 +1035,6 @@ def main() -> None:
         else:
             after = f" after {sys.argv[empty - 1]!r}" if empty > 1 else ""
         _err(f"an empty argument{after} (an unset shell variable?): give a path or a value")
-        sys.exit(2)
-    try:
-        os.getcwd()
-    except OSError:
-        # a removed working folder: relative paths resolve nowhere, and realpath raised
-        # deep in check (exit 3) or ./- read stdin (re-check review, session 44)
-        _err("the working folder no longer exists: cd to an existing folder")
         sys.exit(2)
     sys.argv[1:] = [_dash_file(a) for a in sys.argv[1:]]
     try:

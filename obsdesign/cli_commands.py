@@ -623,7 +623,9 @@ def _warn_above_digit_limit(rep: Any, output: Path) -> None:
         text = Path(output).read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError):
         return
-    if re.search(rf"\d{{{limits().max_digits + 1}}}", text) is None:
+    # each digit run tried from its start only (a lookbehind): tried from every position the
+    # search was quadratic in a run's length, 1 s for one 20,000-digit value (re-check, 44)
+    if re.search(rf"(?<![0-9])[0-9]{{{limits().max_digits + 1}}}", text) is None:
         return
     need = exact_digits(rep.to_dict().get("parameters", {}).get("exact", {}))
     _warn_limit(output, f"holds exact values of {need:,} digits", "max_digits", need)

@@ -699,3 +699,23 @@ def test_an_output_option_given_twice_is_refused(tmp_path: Path) -> None:
         r = _cli(*args, cwd=tmp_path)
         assert r.returncode == 2 and f"{name} is given twice; give each output once" in r.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+def test_the_digit_warning_scan_is_linear_in_a_long_digit_run(tmp_path: Path) -> None:
+    """design -o looks for a digit run longer than max_digits in the written text: the search
+    tried each run from every position, quadratic in its length (about 1 s for one
+    20,000-digit value; re-check review, session 44); from each run's start only now."""
+    import time
+
+    from obsdesign.cli_commands import _warn_above_digit_limit
+
+    out = tmp_path / "r.json"
+    out.write_text('{"a": "' + "/".join(["7" * 999] * 2000) + '"}')
+
+    class _Rep:
+        def to_dict(self) -> dict:
+            return {"parameters": {"exact": {"x": "1"}}}
+
+    t0 = time.perf_counter()
+    _warn_above_digit_limit(_Rep(), out)  # runs of 999 digits: below the limit of 1,000
+    assert time.perf_counter() - t0 < 2.0

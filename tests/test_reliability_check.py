@@ -222,6 +222,8 @@ def test_budget_seconds_keeps_a_real_budget_and_drops_no_budget() -> None:
     assert time.perf_counter() - t0 < 1.0
     assert api.budget_seconds(Decimal("Infinity")) is None
     assert api.budget_seconds(Decimal("1e-999999999")) == api.MIN_BUDGET_S
+    for zero in ("0E+500", "-0E+500", "0E+401"):  # zeros, whatever the exponent (re-check)
+        assert api.budget_seconds(Decimal(zero)) is None
     t0 = time.perf_counter()
     with pytest.raises(InputError, match="must be ≥ 0 seconds"):
         api.budget_seconds(Decimal("-1e100000000"))  # built 10^10⁸ before (re-check review)
