@@ -104,8 +104,23 @@ def check_workers(workers: int | None, scheduler: str | None) -> None:
             f"--scheduler: expected an address such as tcp://HOST:8786 (schemes: "
             f"{', '.join(SCHEMES)}), got {scheduler!r}"
         )
+    if scheduler is not None:
+        _check_port(scheduler)
     if workers is not None or scheduler is not None:
         _require_dask()
+
+
+def _check_port(scheduler: str) -> None:
+    """Refuse (exit 2) a TCP-family address whose port is outside 1–65535: distributed retried
+    tcp://127.0.0.1:99999 until the :data:`CONNECT_S` probe gave up, 20 s later, blaming the
+    service (CLI review 44)."""
+    scheme, location = scheduler.split("://", 1)
+    if scheme not in ("tcp", "tls", "ws", "wss") or ":" not in location:
+        return
+    port = location.rsplit(":", 1)[1].split("/", 1)[0]
+    digits = port.lstrip("0")
+    if port.isascii() and port.isdigit() and (len(digits) > 5 or not 0 < int(digits or 0) <= 65535):
+        raise InputError(f"--scheduler {scheduler}: port {port} is outside 1-65535")
 
 
 def _quiet_logs() -> None:

@@ -379,6 +379,20 @@ def test_an_unknown_scheduler_scheme_is_bad_input() -> None:
     check_workers(None, "tcp://127.0.0.1:8786")  # no connection is made here
 
 
+@pytest.mark.parametrize("port", ["99999", "0", "00000", "9" * 5000])
+def test_a_scheduler_port_out_of_range_is_bad_input_at_once(port: str) -> None:
+    """``--scheduler tcp://127.0.0.1:99999`` waited the whole CONNECT_S probe (20 s) and then
+    blamed the service (CLI review 44): a port outside 1-65535 is refused before any
+    connection, naming the port; ports in range and IPv6 hosts pass."""
+    from obsdesign.distributed import check_workers
+    from obsdesign.errors import InputError
+
+    with pytest.raises(InputError, match=r"port .* is outside 1-65535"):
+        check_workers(None, f"tcp://127.0.0.1:{port}")
+    for ok in ("tcp://127.0.0.1:65535", "tls://[::1]:1", "tcp://host:08786", "inproc://x:99999"):
+        check_workers(None, ok)
+
+
 def test_a_scheduler_address_without_a_port_is_bad_input() -> None:
     """``--scheduler tcp://`` raised distributed's ValueError "missing port number" (exit 3;
     hostile-input trial, session 24): exit 2 naming the option."""
