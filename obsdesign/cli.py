@@ -1003,6 +1003,22 @@ def _dash_file(arg: str) -> str:
     return arg
 
 
+def _completion_extra(args: list[str]) -> str | None:
+    """The error for ``--install-completion`` / ``--show-completion`` given with anything
+    else: typer's flags take no value and act at once, so ``--install-completion tcsh``
+    installed bash completion, exit 0, the shell name silently dropped (CLI review 44)."""
+    flags = [a for a in args if a in ("--install-completion", "--show-completion")]
+    others = [a for a in args if a not in flags]
+    if not flags or not others:
+        return None
+    from obsdesign.errors import one_line
+
+    return one_line(
+        f"{flags[0]} takes no argument (got {others[0]!r}): it acts for the shell it runs in "
+        "(bash, zsh, fish or PowerShell); run it alone from that shell"
+    )
+
+
 def main() -> None:
     """Console-script entry point. Click's own usage errors (an unknown option, a missing
     argument, a bad option value) become one line, like every other bad input: "obsdesign:
@@ -1035,6 +1051,10 @@ def main() -> None:
         else:
             after = f" after {sys.argv[empty - 1]!r}" if empty > 1 else ""
         _err(f"an empty argument{after} (an unset shell variable?): give a path or a value")
+        sys.exit(2)
+    completion = _completion_extra(sys.argv[1:])
+    if completion is not None:
+        _err(completion)
         sys.exit(2)
     sys.argv[1:] = [_dash_file(a) for a in sys.argv[1:]]
     try:

@@ -576,6 +576,34 @@ def test_an_os_error_naming_a_file_outside_a_command_names_that_file(
         assert err.startswith(f"obsdesign: error: {want}"), err
 
 
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["--install-completion", "tcsh"],
+        ["--show-completion", "nushell"],
+        ["design", "x.toml", "--show-completion"],
+    ],
+)
+def test_a_completion_flag_with_anything_else_is_bad_input(
+    argv: list[str], monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
+) -> None:
+    """``--install-completion tcsh`` installed bash completion, exit 0, the shell name
+    silently dropped (CLI review 44): typer's completion flags take no value and act at once,
+    so anything given with them is refused before they run, naming it."""
+    from obsdesign import cli
+
+    ran: list[object] = []
+    monkeypatch.setattr(cli, "app", lambda *a, **k: ran.append(a))
+    monkeypatch.setattr(sys, "argv", ["obsdesign", *argv])
+    with pytest.raises(SystemExit) as e:
+        cli.main()
+    assert e.value.code == 2 and not ran
+    err = capsys.readouterr().err
+    other = next(a for a in argv if not a.endswith("-completion"))
+    assert err.startswith("obsdesign: error: --") and repr(other) in err, err
+    assert err.count("\n") == 1
+
+
 def test_dot_slash_dash_in_a_removed_folder_is_no_traceback(tmp_path: Path) -> None:
     """``./-`` is made absolute from the working folder; with that folder removed,
     os.getcwd() raised FileNotFoundError before the error handling: a traceback, exit 1
