@@ -334,13 +334,16 @@ def _progress() -> Callable[[str], None]:
     return show
 
 
-def _print_report(rep: Any, fmt: Fmt) -> None:
+def _print_report(rep: Any, fmt: Fmt) -> str | None:
+    """Print a report in ``fmt``: the JSON text printed for ``--format json``, else None."""
     from obsdesign.report.render import render_markdown, render_text
 
     if sys.stderr.isatty() and fmt == Fmt.text:
         sys.stderr.write("\r\033[K")
     if fmt == Fmt.json:
-        print(rep.to_json())
+        text = rep.to_json()
+        print(text)
+        return text
     elif fmt == Fmt.md:
         sys.stdout.write(render_markdown(rep))
     else:
@@ -593,8 +596,9 @@ def design(
         except Exception as e:
             _design_error_outputs(sp, e, output, fmt)
             raise
-    if not quiet or fmt == Fmt.json:
-        _print_report(rep, fmt)
+    printed = _print_report(rep, fmt) if not quiet or fmt == Fmt.json else None
+    if printed is not None and output is None:
+        _warn_printed_report(rep, printed)
     if plot is not None:
         _write_plot(plot, lambda tmp: api.plot_design(sp, rep.parameters, tmp, atomic=False), force)
         if fmt == Fmt.text:
@@ -613,22 +617,38 @@ def _warn_above_digit_limit(rep: Any, output: Path) -> None:
     (4471-digit vertices) that its own ``verify`` refused as bad input, exit 2 (CLI review,
     session 44). The report is right; reading it takes a raised limit, which the warning
     names."""
-    import re
-
-    from obsdesign.limits import exact_digits, limits
-
     try:  # a scan of the written text first: the walk below only when a run is that long
         if not stat.S_ISREG(os.stat(output).st_mode):  # a FIFO or device (--force)
             return
         text = Path(output).read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError):
         return
+    _warn_digits(rep, text, output)
+
+
+def _warn_digits(rep: Any, text: str, where: Path | str) -> None:
+    """The max_digits warning for a report's JSON ``text`` written to ``where``: a scan of the
+    text first, the walk of the report's exact values only when a digit run is that long."""
+    import re
+
+    from obsdesign.limits import exact_digits, limits
+
     # each digit run tried from its start only (a lookbehind): tried from every position the
     # search was quadratic in a run's length, 1 s for one 20,000-digit value (re-check, 44)
     if re.search(rf"(?<![0-9])[0-9]{{{limits().max_digits + 1}}}", text) is None:
         return
     need = exact_digits(rep.to_dict().get("parameters", {}).get("exact", {}))
-    _warn_limit(output, f"holds exact values of {need:,} digits", "max_digits", need)
+    _warn_limit(where, f"holds exact values of {need:,} digits", "max_digits", need)
+
+
+def _warn_printed_report(rep: Any, text: str) -> None:
+    """``design --format json`` without ``-o``: the warnings ``-o`` gives for a report that
+    ``verify`` reads only under a raised limit, for the report printed (a saved copy of it
+    was refused by verify, exit 2, with no word at design time; CLI review 44)."""
+    where = "the report printed"
+    size = len(text.encode()) + 1  # print's newline
+    _warn_limit(where, f"is {size:,} bytes", "max_file_bytes", size)
+    _warn_digits(rep, text, where)
 
 
 def _warn_above_read_limit(output: Path) -> None:
@@ -645,9 +665,10 @@ def _warn_above_read_limit(output: Path) -> None:
     _warn_limit(output, f"is {size:,} bytes", "max_file_bytes", size)
 
 
-def _warn_limit(output: Path, what: str, key: str, need: int) -> None:
+def _warn_limit(output: Path | str, what: str, key: str, need: int) -> None:
     """The warning of a written report that ``verify`` reads only with ``--limit key=need``
-    (when ``need`` is above the limit in force); ``what`` says how the report exceeds it."""
+    (when ``need`` is above the limit in force); ``what`` says how the report exceeds it;
+    ``output`` is its file, or "the report printed" (verified as a saved FILE)."""
     from obsdesign.errors import one_line
     from obsdesign.limits import limits
 
@@ -656,7 +677,8 @@ def _warn_limit(output: Path, what: str, key: str, need: int) -> None:
         sys.stderr.write(
             one_line(
                 f"obsdesign: warning: {output} {what}, above {key} = {lim:,}, the most verify "
-                f"reads: verify it with 'obsdesign --limit {key}={need} verify {output}'"
+                f"reads: verify it with 'obsdesign --limit {key}={need} verify "
+                f"{output if isinstance(output, Path) else 'FILE'}'"
             )
             + "\n"
         )

@@ -549,6 +549,21 @@ def test_design_warns_when_its_report_is_above_the_read_limit(tmp_path: Path) ->
     assert v.exit_code == 0, v.output
     r = CliRunner().invoke(app, ["design", str(spec), "-q", "-o", str(out), "--force"])
     assert r.exit_code == 0 and "warning" not in r.stderr
+    # --format json without -o: the report printed gets the warning (CLI review 44), its
+    # size that of the saved stdout
+    r = CliRunner().invoke(
+        app, ["--limit", "max_file_bytes=3000", "design", str(spec), "--format", "json"]
+    )
+    saved = tmp_path / "saved.json"
+    saved.write_text(r.stdout, encoding="utf-8")
+    size = saved.stat().st_size
+    assert r.exit_code == 0 and size > 3000
+    assert f"the report printed is {size:,} bytes, above max_file_bytes = 3,000" in r.stderr
+    assert f"--limit max_file_bytes={size} verify FILE" in r.stderr
+    v = CliRunner().invoke(app, ["--limit", f"max_file_bytes={size}", "verify", str(saved)])
+    assert v.exit_code == 0, v.output
+    r = CliRunner().invoke(app, ["design", str(spec), "--format", "json"])
+    assert r.exit_code == 0 and "warning" not in r.stderr
 
 
 def test_debug_shows_the_traceback_and_keeps_the_exit_code(tmp_path: Path) -> None:

@@ -1154,6 +1154,19 @@ def test_a_report_with_long_exact_values_is_checked_and_its_design_warns(tmp_pat
     assert ok.exit_code == 0, ok.output
     short = runner.invoke(app, ["--limit", f"max_digits={int(need) - 1}", "verify", str(out)])
     assert short.exit_code == 2
+    # --format json without -o warned of nothing, and its saved stdout was refused by verify
+    # (CLI review 44): the printed report gets the same warning, its file called FILE
+    res = runner.invoke(app, ["design", str(spec), "--format", "json"])
+    assert res.exit_code == 0
+    assert (
+        f"the report printed holds exact values of {int(need):,} digits" in res.stderr
+        and f"verify it with 'obsdesign --limit max_digits={need} verify FILE'" in res.stderr
+    ), res.stderr
+    saved = tmp_path / "saved.json"
+    saved.write_text(res.stdout, encoding="utf-8")
+    assert (
+        runner.invoke(app, ["--limit", f"max_digits={need}", "verify", str(saved)]).exit_code == 0
+    )
     # in memory, the report's own numbers are read as they are: verify(design(spec)) and
     # simulate(spec, design(spec)) were "exit 2 bad input" (re-check review, session 44)
     sp = api.load_spec(spec)
