@@ -1079,10 +1079,11 @@ def import_mat(
     return 0
 
 
-def _dt_seconds(text: str) -> float:
-    """``import --dt``: the text read exactly first, so that a positive sample time below the
-    float range is refused rather than read as 0, continuous time (``--dt 1e-400`` wrote
-    ``time = "continuous"``; hostile-input trial, session 38)."""
+def _dt_seconds(text: str) -> Any:
+    """``import --dt``: the text read exactly (a Decimal), so that a positive sample time below
+    the float range is refused rather than read as 0, continuous time (``--dt 1e-400`` wrote
+    ``time = "continuous"``; hostile-input trial, session 38), and the spec holds the value
+    typed (``--dt 0.1000000000000000000001`` was written as 0.1; re-check review 44)."""
     import math
     from decimal import Decimal, InvalidOperation
 
@@ -1109,7 +1110,7 @@ def _dt_seconds(text: str) -> float:
             f"--dt {text!r}: expected a finite number >= 0 (0: continuous time), or exactly -1 "
             "(discrete time with no sample time, as MATLAB's Ts = -1)"
         )
-    return f
+    return -1.0 if q == -1 else q
 
 
 def methods(fmt: Fmt) -> int:

@@ -355,7 +355,7 @@ def _columns(M: Any, rows: int, name: str, what: str) -> np.ndarray:
     raise InputError(f"{name} has shape {arr.shape}: expected {rows} rows ({what})")
 
 
-def _time_of(dt: Any) -> tuple[str, float | None]:
+def _time_of(dt: Any) -> tuple[str, float | Decimal | None]:
     """``time`` and ``sample_time`` of a system's ``dt``: None or 0 continuous, True discrete
     without a sample time, > 0 discrete with it. The sign is the exact value's: a Fraction
     or Decimal below the float range (1/10⁴⁰⁰) read as 0.0, continuous time, and −1/10⁴⁰⁰
@@ -378,7 +378,13 @@ def _time_of(dt: Any) -> tuple[str, float | None]:
     if zero:
         return "continuous", None
     if positive and math.isfinite(f) and f > 0:
-        return "discrete", f
+        # an exact dt (a Decimal, a Fraction with a decimal form) is written as it is: import
+        # --dt 0.1000000000000000000001 wrote the nearest double, 0.1 (re-check review, 44)
+        try:
+            q = _exact(dt) if isinstance(dt, (Decimal, Fraction)) else None
+        except InputError:  # Fraction(1, 3): no decimal form, written as its double
+            q = None
+        return "discrete", (f if q is None or q == Decimal(f) else q)
     if positive and f == 0:
         raise InputError(f"dt {dt!r} is positive but below the float range (it would read as 0)")
     if positive and not math.isfinite(f):
@@ -677,7 +683,7 @@ def spec_text_from_mat(
     path: str | Path,
     names: Mapping[str, str | None],
     method: str = "lyapunov",
-    dt: float | None = None,
+    dt: float | Decimal | None = None,
     dt_name: str | None = None,
 ) -> str:
     """Spec text from the matrices of a MATLAB ``.mat`` file: ``names`` maps ``A``, ``B``,
@@ -816,7 +822,7 @@ def spec_text_from_mat(
     if dt is not None and 0 < dt < np.finfo(float).tiny:
         # written as sample_time = 5e-324, then refused by the spec loader (session 28)
         raise InputError(
-            f"{given} is {dt!r}, a nonzero number below the float range (subnormal), which a "
+            f"{given} is {_num(dt)}, a nonzero number below the float range (subnormal), which a "
             "spec refuses: rescale time"
         )
     # D without B: the inputs enter y only (the spec had D with no input and was refused)

@@ -1101,3 +1101,33 @@ def test_import_of_a_fifo_names_a_matlab_file(tmp_path: Path) -> None:
     r = CliRunner().invoke(app, ["import", str(fifo), "--A", "A", "--C", "C"])
     assert r.exit_code == 2
     assert "is not a regular file (refusing to read a MATLAB file from it)" in r.output
+
+
+def test_an_exact_dt_is_written_as_given(tmp_path: Path) -> None:
+    """``import --dt 0.1000000000000000000001`` wrote ``sample_time = 0.1``, the nearest
+    double (re-check review, session 44): an exact dt (the --dt text, a Decimal, a Fraction
+    with a decimal form) is written as it is, and the spec reads it back exactly; a float,
+    and a Fraction with no decimal form, are written as their double."""
+    from scipy.io import savemat
+
+    from obsdesign import api
+    from obsdesign.interop import spec_text_from_statespace
+
+    A, B, C, D = [[0.5, 1], [0, 0.8]], [[0], [0]], [[1, 0]], [[0]]
+    for dt, want in (
+        (Decimal("0.1000000000000000000001"), "0.1000000000000000000001"),
+        (Fraction(1, 8), "0.125"),
+        (Decimal("1E+5"), "100000"),
+        (0.1, "0.1"),
+        (Fraction(1, 3), "0.3333333333333333"),
+    ):
+        text = spec_text_from_statespace((A, B, C, D, dt), "lyapunov")
+        assert f"sample_time = {want}\n" in text, text
+        st = api.load_spec_text(text, "s.toml").system.sample_time
+        assert st is not None and Fraction(str(st.q)) == Fraction(want)
+    mat = tmp_path / "p.mat"
+    savemat(mat, {"A": np.array(A, dtype=float), "C": np.array(C, dtype=float)})
+    r = CliRunner().invoke(app, ["import", str(mat), "--dt", "0.1000000000000000000001"])
+    assert r.exit_code == 0 and "sample_time = 0.1000000000000000000001\n" in r.stdout, r.output
+    r = CliRunner().invoke(app, ["import", str(mat), "--dt", "1e-310"])
+    assert r.exit_code == 2 and "--dt is 1e-310, a nonzero number below" in r.stderr, r.output
