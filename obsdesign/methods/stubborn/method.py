@@ -46,7 +46,7 @@ class Stubborn(Method):
             "observer",
             "str",
             "stubborn",
-            "observer of the single run",
+            "observer of the single run (the outlier study compares all four)",
             choices=("stubborn", "luenberger", "standard"),
         ),
         SimOption("time_limit", "float", None, "seconds the simulation may run", min=1e-3),
