@@ -225,12 +225,44 @@ def _print_sweep(rows: list[dict[str, Any]], fmt: Fmt) -> None:
 
     from obsdesign.report.render import console, esc
 
+    cells = [[_sweep_cell(r.get(c)) for c in cols] for r in rows]
+    # every column whole at its widest (header and values), the message at least
+    # CHECK_RESULT_MIN, and the borders: below that rich folded headers and values mid-word
+    # ("metho / d.lam / bda", "faile / d" at --width 40; CLI review 44) or cropped the
+    # table, so each point is then a paragraph of key=value items, wrapped at spaces
+    widths = [
+        CHECK_RESULT_MIN if c == "message" else max(len(c), *(len(x[i]) for x in cells))
+        for i, c in enumerate(cols)
+    ]
+    con = console()
+    if cells and con.width < 3 * len(cols) + 1 + sum(widths):
+        import textwrap
+
+        from rich.text import Text
+
+        def para(text: str) -> None:  # wrapped at spaces, indented by 2, no trailing blanks
+            w = max(con.width - 2, 8)
+            for line in textwrap.wrap(text, w, break_on_hyphens=False) or [""]:
+                con.print(Text("  " + line), soft_wrap=True)
+
+        con.print("[bold]obsdesign sweep[/]")
+        for x in cells:
+            named = dict(zip(cols, x, strict=True))
+            con.print(Text(f"point {named.get('point', '')}"), overflow="fold")
+            para(
+                "  ".join(
+                    f"{c}={v}" for c, v in named.items() if v and c not in ("point", "message")
+                )
+            )
+            if named.get("message"):
+                para(named["message"])
+        return
     t = Table(title="obsdesign sweep")
     for c in cols:
         t.add_column(esc(c), overflow="fold")
-    for r in rows:
-        t.add_row(*(esc(_sweep_cell(r.get(c))) for c in cols))
-    console().print(t)
+    for x in cells:
+        t.add_row(*(esc(v) for v in x))
+    con.print(t)
 
 
 def _sweep_cell(v: Any) -> str:

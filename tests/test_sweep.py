@@ -872,3 +872,35 @@ def test_a_point_with_long_exact_values_is_verified_with_its_own_digit_limit(
     spec.write_text(text.replace("[0.2681, 0.7595, -0.0851]", "[1e-300, 0.7595, -0.0851]"))
     rows = api.sweep(spec, ["method.lambda=1:1:1"])
     assert list(rows["exit_code"]) == [0], rows.to_dict("records")
+
+
+@pytest.mark.parametrize("width", [40, 60, 100, 200])
+def test_a_narrow_sweep_table_is_a_paragraph_a_point_with_every_value_whole(width: int) -> None:
+    """At --width 40 the table folded headers and values mid-word ("metho / d.lam / bda",
+    "faile / d"; CLI review 44) and at 100 with --simulate it squeezed or cropped columns:
+    when the columns cannot all be whole, each point is a paragraph of key=value items
+    wrapped at spaces, every value whole and on one line; a wide terminal keeps the table."""
+    r = runner.invoke(
+        app, ["sweep", str(SPEC), "--set", "method.lambda=[0.9, 0.96]", "--width", str(width)]
+    )
+    assert r.exit_code == 1, r.output
+    lines = [x for x in r.stdout.splitlines() if not x.startswith("swept: ")]
+    assert all(len(x) <= width for x in lines), r.stdout
+    if width >= 200:
+        assert any("┃ point ┃ method.lambda ┃ verdict ┃" in x for x in lines), r.stdout
+        return
+    assert all(x == x.rstrip() for x in lines), r.stdout
+    text = " ".join(x.strip() for x in lines)
+    for item in (
+        "method.lambda=0.9 ",
+        "verdict=failed",
+        "exit_code=1",
+        "method.lambda=0.96",
+        "verdict=ok",
+        "certified=6",
+        "lambda_best=0.9501",
+        "mu=≈2.48428e+07",
+    ):
+        assert item in text, (item, r.stdout)
+    assert [x for x in lines if x.startswith("point ")] == ["point 0", "point 1"]
+    assert "spectral radius ≈ 0.95" in text
