@@ -791,6 +791,34 @@ def test_no_float_riccati_gain_takes_the_high_precision_one(
     )
 
 
+def test_an_extreme_rate_is_named_as_the_reason_the_riccati_gain_failed() -> None:
+    """λ = 1e-300 asked of a 2-state plant was exit 4 blaming the Riccati solver ("too far
+    from generalized Schur form") and suggesting other weights (lyapunov review 43): the
+    message names the rate's scaling of A as the reason and what to try instead; a rate
+    the float solve handles (λ = 1e-3) still designs."""
+    from obsdesign.errors import InconclusiveError
+    from obsdesign.methods.lyapunov.design import _extreme_rate
+
+    text = (
+        '[system]\ntime = "discrete"\nA = [[0, 1], [1, 0]]\nC = [[1, 0]]\n'
+        '[method]\nkey = "lyapunov"\nlambda = {lam}\n'
+    )
+    with pytest.raises(InconclusiveError, match="the Riccati equation gave no gain") as ei:
+        api.design(load_spec_text(text.format(lam="1e-300"), "x.toml"))
+    msg = str(ei.value)
+    assert "the rate λ = 1e-300 scales A by 1/λ (entries near 1e+300)" in msg, msg
+    assert 'try design = "place"' in msg and "other weights" not in msg, msg
+    assert api.design(load_spec_text(text.format(lam="1e-3"), "x.toml")).exit_code() == 0
+    A = np.array([[0.0, 1.0], [1.0, 0.0]])
+    assert _extreme_rate(A, True, 1.01e-100) == "" and _extreme_rate(A, True, 1e-100) != ""
+    assert (
+        _extreme_rate(A, True, None) == "" and _extreme_rate(np.zeros((2, 2)), True, 1e-300) == ""
+    )
+    assert _extreme_rate(A, False, 1e99) == "" and "shifts A by 1e+100·I" in _extreme_rate(
+        A, False, -1e100
+    )
+
+
 @pytest.mark.parametrize(
     ("man", "exp", "bits", "want"),
     [

@@ -71,7 +71,10 @@ def rate_name(discrete: bool) -> str:
 
 class NoRiccatiGain(InconclusiveError):
     """The float Riccati solvers gave no finite gain although (C, A) is detectable (exit 4,
-    unless the high-precision solve gives one)."""
+    unless the high-precision solve gives one). ``hinted``: its message already says what to
+    try (an extreme rate, :func:`_extreme_rate`)."""
+
+    hinted = False
 
 
 def design(spec: Spec, progress: Progress | None = None) -> Design:
@@ -156,7 +159,7 @@ def _hp_outcome(e: InconclusiveError, spec: Spec, o: Options) -> InconclusiveErr
         if n > HP_MAX_N
         else "; the high-precision Riccati retry found no gain that certifies either"
     )
-    if isinstance(e, NoRiccatiGain):
+    if isinstance(e, NoRiccatiGain) and not e.hinted:
         # the designed-gain failure says what to try; this one said nothing (re-check
         # trial, session 41)
         said += '; give L, or try design = "lmi" or other weights (riccati_Q, riccati_R)'
@@ -735,10 +738,45 @@ def design_gain(
             break
         last = "non-finite gain"
     else:
-        raise NoRiccatiGain(
-            f"the Riccati equation gave no gain ({last}) although (C, A) is {det.reason}"
+        extreme = _extreme_rate(A, s.discrete, target)
+        err = NoRiccatiGain(
+            f"the Riccati equation gave no gain ({last}) although (C, A) is {det.reason}" + extreme
         )
+        err.hinted = bool(extreme)
+        raise err
     return _riccati_result(Lf, are, s.discrete, weights, shift, _time.perf_counter() - t0)
+
+
+#: the ratio of the asked rate's shift to the plant's scale past which the float Riccati
+#: equation of :func:`riccati_gain` is hopeless in double precision
+EXTREME_SHIFT = 1e100
+
+
+def _extreme_rate(A: np.ndarray, discrete: bool, target: float | None) -> str:
+    """The reason a Riccati gain failed when the asked rate is extreme for the plant: the
+    discrete shift divides A by λ (λ = 1e-300 made entries near 1e300 and the failure blamed
+    the Riccati solver alone: lyapunov review 43), the continuous one adds αI to A. Empty
+    when the rate is not extreme.
+
+    :param A: float plant; :param discrete: time domain; :param target: the asked rate."""
+    if target is None:
+        return ""
+    scale = float(np.max(np.abs(A))) if A.size else 0.0
+    with np.errstate(all="ignore"):
+        ratio = scale / target if discrete else abs(target) / max(scale, 1e-300)
+    if discrete and target > 0 and not ratio < EXTREME_SHIFT:
+        return (
+            f" — the rate λ = {target:.6g} scales A by 1/λ (entries near {ratio:.3g}), past "
+            'what a double-precision Riccati solve can do: give L, try design = "place", '
+            "or ask a larger rate"
+        )
+    if not discrete and not ratio < EXTREME_SHIFT:
+        return (
+            f" — the rate {target:.6g} shifts A by {abs(target):.3g}·I, {ratio:.3g} times its "
+            "entries, past what a double-precision Riccati solve can do: give L, try design = "
+            '"place", or ask a rate nearer the plant\'s'
+        )
+    return ""
 
 
 def _riccati_result(
