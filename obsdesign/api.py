@@ -695,7 +695,11 @@ def _unchanged_since_read(report: Report, d: dict[str, Any]) -> bool:
     import numpy as np
 
     try:
-        as_read, _ = Report.from_dict({**d, "parameters": report.raw_parameters})
+        # read as the object itself was read: with max_digits raised to its exact values
+        # (:func:`_from_memory`) — under the normal limits a report with long exact values
+        # was always "edited", and a float tampered beside them was never compared as read:
+        # exit 0 in memory, exit 1 from the file (re-check review 45)
+        as_read, _ = _from_memory({**d, "parameters": report.raw_parameters})
     except Exception:  # noqa: BLE001 — unreadable as read: verify what the object holds
         return False
     a, b = as_read.parameters, report.parameters

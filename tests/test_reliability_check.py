@@ -1167,6 +1167,28 @@ def test_a_report_with_long_exact_values_is_checked_and_its_design_warns(tmp_pat
     assert (
         runner.invoke(app, ["--limit", f"max_digits={need}", "verify", str(saved)]).exit_code == 0
     )
+    # a float one ulp off beside the long exact values, the report loaded under the raised
+    # limit: verify of the file was exit 1, of the object read from it exit 0 (its as-read
+    # comparison re-read it under the normal limits and took it for edited; re-check 45)
+    import math
+
+    from obsdesign.limits import restore, set_limits
+    from obsdesign.limits import saved as saved_limits
+    from obsdesign.report.model import Report
+
+    d = json.loads(out.read_text(encoding="utf-8"))
+    d["parameters"]["contractivity"] = math.nextafter(d["parameters"]["contractivity"], 2.0)
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(d), encoding="utf-8")
+    state = saved_limits()
+    set_limits(max_digits=int(need))
+    try:
+        loaded, problems = Report.load(bad)
+        assert not problems and api.verify(bad).exit_code() == 1
+    finally:
+        restore(state)
+    ver = api.verify(loaded)
+    assert ver.exit_code() == 1 and [c.id for c in ver.failed] == ["parameters-consistent"]
     # in memory, the report's own numbers are read as they are: verify(design(spec)) and
     # simulate(spec, design(spec)) were "exit 2 bad input" (re-check review, session 44)
     sp = api.load_spec(spec)
