@@ -9,8 +9,14 @@ DEBS   := libcdd-dev libgmp-dev
 
 install: $(VENV)/.installed
 
+# besides DEBS, what a fresh Debian lacks to build pycddlib (no Linux wheel: pip compiles it)
+# and make the virtualenv: a C toolchain, the Python headers, ensurepip (docs review 45)
 $(VENV)/.debs:
-	@dpkg -s $(DEBS) >/dev/null 2>&1 || { $(SUDO) apt-get update -qq && $(SUDO) DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $(DEBS); }
+	@need="$(DEBS)"; \
+	command -v cc >/dev/null 2>&1 || need="$$need build-essential"; \
+	$(PYTHON) -c 'import os, sys, sysconfig; sys.exit(not os.path.exists(os.path.join(sysconfig.get_paths()["include"], "Python.h")))' || need="$$need python3-dev"; \
+	$(PYTHON) -c 'import ensurepip' 2>/dev/null || need="$$need python3-venv"; \
+	dpkg -s $$need >/dev/null 2>&1 || { $(SUDO) apt-get update -qq && $(SUDO) DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$need; }
 	@[ -d $(VENV) ] || $(PYTHON) -m venv $(VENV)
 	@touch $@
 

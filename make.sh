@@ -1,0 +1,11 @@
+#!/bin/sh
+# `make`, installed first when this machine has none (a fresh Debian has no make; the
+# Makefile then installs everything else): sh make.sh run | test | bench | ...
+set -e
+cd "$(dirname "$0")"
+if ! command -v make >/dev/null 2>&1; then
+    if [ "$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi
+    $SUDO apt-get update -qq
+    $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq make
+fi
+exec make "$@"

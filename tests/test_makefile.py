@@ -1,0 +1,106 @@
+"""The set-up commands of the README (``sh make.sh run`` / ``test``) on a machine that lacks
+what they need: ``make.sh`` installs make, the Makefile's first step the Debian packages that
+building pycddlib and the virtualenv take (docs review 45: a fresh Debian has no make, no C
+compiler, no Python headers and no ensurepip; pycddlib has no Linux wheel). Run with stub
+commands on a PATH of their own: nothing is installed."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _stubs(tmp_path: Path, scripts: dict[str, str], real: tuple[str, ...]) -> Path:
+    """A folder of stub commands (``scripts``: name → shell body) and links to the ``real``
+    commands named; it is the whole PATH of the run."""
+    bin_ = tmp_path / "bin"
+    bin_.mkdir()
+    for name, body in scripts.items():
+        f = bin_ / name
+        f.write_text(f"#!/bin/sh\n{body}\n")
+        f.chmod(0o755)
+    for name in real:
+        where = shutil.which(name)
+        assert where is not None, name
+        (bin_ / name).symlink_to(where)
+    return bin_
+
+
+@pytest.mark.skipif(shutil.which("make") is None, reason="needs make for the Makefile run")
+def test_the_first_step_installs_compiler_headers_and_venv_when_missing(tmp_path: Path) -> None:
+    """No cc on PATH, a Python without headers or ensurepip, libcdd-dev not installed: the
+    one apt-get install names every package; with all present, apt-get is not run."""
+    log = tmp_path / "apt.log"
+    venv = tmp_path / "venv"
+    python = 'case "$1" in -m) mkdir -p "$3";; *) exit 1;; esac'
+    bin_ = _stubs(
+        tmp_path,
+        {
+            "dpkg": "exit 1",
+            "apt-get": f'echo "$@" >> {log}',
+            "python": python,
+            "sudo": 'exec "$@"',
+        },
+        ("id", "touch", "mkdir"),
+    )
+    env = {"PATH": str(bin_), "HOME": str(tmp_path)}
+    make = shutil.which("make")
+    assert make is not None
+    args = [make, "-s", "-C", str(ROOT), f"VENV={venv}", f"PYTHON={bin_ / 'python'}"]
+    r = subprocess.run([*args, f"{venv}/.debs"], env=env, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    lines = log.read_text().splitlines()
+    assert lines[0] == "update -qq", lines
+    assert lines[1].split()[-5:] == [
+        "libcdd-dev",
+        "libgmp-dev",
+        "build-essential",
+        "python3-dev",
+        "python3-venv",
+    ], lines
+    assert (venv / ".debs").exists()
+    # everything present (dpkg knows the packages, cc exists, the Python has both): no apt
+    (venv / ".debs").unlink()
+    log.unlink()
+    (bin_ / "dpkg").write_text("#!/bin/sh\nexit 0\n")
+    (bin_ / "cc").write_text("#!/bin/sh\nexit 0\n")
+    (bin_ / "cc").chmod(0o755)
+    (bin_ / "python").write_text('#!/bin/sh\ncase "$1" in -m) mkdir -p "$3";; *) exit 0;; esac\n')
+    r = subprocess.run([*args, f"{venv}/.debs"], env=env, capture_output=True, text=True)
+    assert r.returncode == 0 and not log.exists(), r.stderr
+
+
+def test_make_sh_installs_make_when_missing_then_runs_it(tmp_path: Path) -> None:
+    """``sh make.sh test`` with no make on PATH: apt-get installs make (the stub puts one on
+    PATH), then make runs with the arguments given; with make present, no apt-get."""
+    log = tmp_path / "calls.log"
+    bin_ = _stubs(
+        tmp_path,
+        {
+            "apt-get": (
+                f'echo "apt-get $*" >> {log}\n'
+                f'[ "$1" = install ] && printf \'#!/bin/sh\\necho "make $*" >> {log}\\n\' '
+                f"> {tmp_path}/bin/make && chmod +x {tmp_path}/bin/make\nexit 0"
+            ),
+            "sudo": 'exec "$@"',
+        },
+        ("id", "env", "dirname", "printf", "chmod"),
+    )
+    env = {"PATH": str(bin_), "HOME": str(tmp_path)}
+    sh = shutil.which("sh")
+    assert sh is not None
+    r = subprocess.run([sh, str(ROOT / "make.sh"), "test"], env=env, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    calls = log.read_text().splitlines()
+    assert calls[0] == "apt-get update -qq" and calls[1].startswith("apt-get install"), calls
+    assert calls[1].split()[-1] == "make" and calls[2] == "make test", calls
+    log.unlink()
+    r = subprocess.run([sh, str(ROOT / "make.sh"), "run"], env=env, capture_output=True, text=True)
+    assert r.returncode == 0 and log.read_text().splitlines() == ["make run"], r.stderr
+    assert os.access(ROOT / "make.sh", os.R_OK)
