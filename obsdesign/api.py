@@ -776,11 +776,15 @@ def compare_claims(reported: list[Claim], fresh: list[Claim]) -> list[Claim]:
             # a claim the report passed that the recomputation fails only inconclusively (a
             # solver re-solve answering "inaccurate") leaves the difference inconclusive too:
             # exit 4, not 1 (tamper review, session 44)
+            # Only a report that says what an honest one says when the re-solve is accurate:
+            # such a claim is a solver check, "numerical" when it passes — a report that
+            # relabelled it "certified" and moved its far end to draw an inaccurate answer
+            # was exit 4, not 1 (re-check review 45)
             unsure = (
                 c.statement == f.statement
                 and f.status is ClaimStatus.FAILED
                 and bool(f.extra.get("solver_inaccurate"))
-                and c.status is not ClaimStatus.FAILED
+                and c.status is ClaimStatus.NUMERICAL
             )
             out.append(_diff_claim(f"report-alters:{cid}", "; ".join(what), unsure))
     for cid, mine in by_id.items():

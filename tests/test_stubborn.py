@@ -2356,3 +2356,17 @@ def test_an_inaccurate_re_solve_at_the_far_end_is_inconclusive_not_failed(
     for refuting in ("optimal", "optimal_inaccurate", "solver_error"):
         monkeypatch.setattr(sd.Feasibility, "__call__", answer(refuting))
         assert api.verify(ex1).exit_code() == 1, refuting
+    # the claim relabelled "certified" (it is a solver check, numerical when it passes):
+    # exit 1 whatever the far end's re-solve answers — with an inaccurate answer there it was
+    # exit 4 (re-check review 45: a far end moved by 10⁻¹² draws that answer)
+    d = ex1.to_dict()
+    for c in d["claims"]:
+        if c["id"] == "lambda-max-bracket":
+            assert c["status"] == "numerical"
+            c["status"] = "certified"
+    relabelled, _ = Report.from_dict(d)
+    monkeypatch.setattr(sd.Feasibility, "__call__", answer("infeasible_inaccurate"))
+    ver = api.verify(relabelled)
+    assert ver.exit_code() == 1, [(c.id, c.float_ok) for c in ver.failed]
+    alters = next(c for c in ver.failed if c.id == "report-alters:lambda-max-bracket")
+    assert not alters.float_ok
