@@ -106,6 +106,16 @@ def check_workers(workers: int | None, scheduler: str | None) -> None:
         )
     if scheduler is not None:
         _check_port(scheduler)
+    if workers is not None:
+        try:
+            os.getcwd()
+        except FileNotFoundError:
+            # the Nanny processes start with multiprocessing's spawn, which needs the working
+            # folder: exit 3 "Nanny failed to start" (re-check review 45)
+            raise InputError(
+                "the working folder no longer exists: cd to an existing folder (--workers "
+                "starts its processes there)"
+            ) from None
     if workers is not None or scheduler is not None:
         _require_dask()
 

@@ -393,6 +393,22 @@ def test_a_scheduler_port_out_of_range_is_bad_input_at_once(port: str) -> None:
         check_workers(None, ok)
 
 
+def test_workers_in_a_removed_working_folder_is_bad_input(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``check --workers 2`` in a removed working folder was exit 3 "Nanny failed to start"
+    (multiprocessing's spawn reads the working folder; re-check review 45): exit 2 saying
+    so, before any process starts; a --scheduler (no local processes) is not refused."""
+    from obsdesign import distributed as dist
+    from obsdesign.errors import InputError
+
+    def gone() -> str:
+        raise FileNotFoundError(2, "No such file or directory")
+
+    monkeypatch.setattr(dist.os, "getcwd", gone)
+    with pytest.raises(InputError, match="the working folder no longer exists"):
+        dist.check_workers(2, None)
+    dist.check_workers(None, "tcp://127.0.0.1:8786")
+
+
 def test_a_scheduler_address_without_a_port_is_bad_input() -> None:
     """``--scheduler tcp://`` raised distributed's ValueError "missing port number" (exit 3;
     hostile-input trial, session 24): exit 2 naming the option."""
