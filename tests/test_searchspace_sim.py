@@ -983,3 +983,32 @@ def test_ball_offsets_list_only_what_can_meet_the_ball() -> None:
             d = np.maximum(np.abs(c - g) - s, 0.0)
             hit = cube[(d * d).sum(axis=1) <= eta * eta]
             assert {tuple(k) for k in hit} <= got
+
+
+def test_recover_far_from_the_origin_keeps_every_cell_the_full_cube_keeps(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """At |c|/s ≈ 10¹⁰ the double quotient rint(c/2s) put a centre near a cell boundary
+    1.03·s from its grid point, past the s the pruning assumed, and recover dropped cells
+    that meet the ball exactly (re-check review 45: 4 of 76 in one case). The offsets are
+    widened by the centres' measured excess: recover's cells equal the full cube's on such
+    cases, near and far from the origin."""
+    rng = np.random.default_rng(11)
+    real = S.ball_offsets
+
+    def cube(eta: float, s: float, n: int, most: int, excess: float = 0.0) -> np.ndarray:
+        R = math.ceil((eta + s + excess) / (2 * s) + 1.5)
+        return np.array(list(itertools.product(range(-R, R + 1), repeat=n)), dtype=np.int64)
+
+    for lo in (1e3, 1e7, 1e9, 1e10):
+        for _ in range(60):
+            n = int(rng.integers(1, 4))
+            s = float(rng.uniform(0.1, 3))
+            b = rng.integers(int(lo), int(lo * 100), n).astype(float) * 2
+            C = ((b + 1) * s + rng.uniform(-3e-4, 3e-4, n) * s)[None, :]
+            eta = 2 * s * int(rng.integers(1, 3)) * (1 - float(10 ** rng.uniform(-9, -4)))
+            monkeypatch.setattr(S, "ball_offsets", real)
+            pruned = {tuple(r) for r in recover(C, eta, s, 10**6)}
+            monkeypatch.setattr(S, "ball_offsets", cube)
+            full = {tuple(r) for r in recover(C, eta, s, 10**6)}
+            assert pruned == full, (lo, n, s, eta, C.tolist())

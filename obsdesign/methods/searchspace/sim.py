@@ -293,7 +293,7 @@ def _ball_fits(eta: float, s: float, n: int, cap: int) -> None:
         )
 
 
-def ball_offsets(eta: float, s: float, n: int, most: int) -> np.ndarray:
+def ball_offsets(eta: float, s: float, n: int, most: int, excess: float = 0.0) -> np.ndarray:
     """The integer offsets k (rows) of the cells of half-side s around the grid point nearest
     a centre c that can meet B(c, η): with |c − 2s·base| ≤ s per coordinate, the cell
     2s(base + k) is at least max(0, (|k_i| − 1)·2s) away from c along axis i, and a k whose
@@ -302,11 +302,16 @@ def ball_offsets(eta: float, s: float, n: int, most: int) -> np.ndarray:
     the whole cube (2R + 1)ⁿ refused balls of 0.8–1.9 million cells at n = 5 below
     max_centres (re-check review, session 44). :class:`MemoryCap` past ``most`` offsets.
 
+    ``excess``: how far past s a centre may lie from its nearest grid point in doubles (its
+    ``rint(c/2s)`` rounds the quotient: at |c|/s ≈ 10¹⁰ a centre near a cell boundary was
+    1.03·s from it, and cells that meet its ball were pruned; re-check review 45): every gap
+    is that much smaller.
+
     :param eta: the ball's radius; :param s: the cells' half-side; :param n: the dimension;
-    :param most: the most offsets listed."""
-    R = math.ceil((eta + s) / (2 * s) + 0.5)
+    :param most: the most offsets listed; :param excess: the centres' distance past s."""
+    R = math.ceil((eta + s + excess) / (2 * s) + 0.5)
     r = np.arange(-R, R + 1, dtype=np.int64)
-    gap = np.maximum(np.abs(r) - 1, 0).astype(float) * (2 * s)
+    gap = np.maximum(np.maximum(np.abs(r) - 1, 0).astype(float) * (2 * s) - excess, 0.0)
     per = gap * gap
     reach = eta * eta * (1 + 1e-9) + 1e-300
     offs = np.zeros((1, 0), dtype=np.int64)
@@ -341,8 +346,12 @@ def recover(
     n = C.shape[1]
     eta = eta * (1 + INFLATE) + INFLATE * s
     _ball_fits(eta, s, n, cap)
-    offs = ball_offsets(eta, s, n, 4 * cap)
     base = np.rint(C / (2 * s)).astype(np.int64)
+    # how far past s the centres are from their grid points as the hit test below computes
+    # them (in doubles), with the rounding of the grid points themselves
+    far = float(np.max(np.abs(C - base * (2 * s)), initial=0.0)) - s
+    excess = max(far, 0.0) + 4 * np.finfo(float).eps * float(np.max(np.abs(C), initial=0.0))
+    offs = ball_offsets(eta, s, n, 4 * cap, excess)
     step = max(1, (1 << 20) // len(offs))
     keys: list[np.ndarray] = []
     total = 0
