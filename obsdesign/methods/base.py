@@ -236,11 +236,22 @@ class SimOption:
             if tiny:  # gamma=Decimal('1e-400') said "got 0.0" (re-check review, session 44)
                 raise InputError(f"{what}: {v!r} is below the float range (it would read as 0)")
         whole = isinstance(v, numbers.Integral) and not isinstance(v, (bool, np.bool_))
-        if self.kind == "int" and (whole or (number and math.isfinite(f) and f == int(f))):
+
+        def exactly(g: int) -> bool:
+            # the value itself, not its double: seed=Decimal('1E-400') ran with seed 0 and
+            # Fraction(10**20 + 1, 10**20) with seed 1 (re-check review 45)
+            try:
+                return bool(v == g)
+            except (ArithmeticError, TypeError):
+                return False
+
+        if self.kind == "int" and (
+            whole or (number and math.isfinite(f) and f == int(f) and exactly(int(f)))
+        ):
             out: Any = int(v) if whole else int(f)
         elif self.kind == "float" and number and math.isfinite(f):
             out = f
-        elif self.kind == "bool" and number and f in (0.0, 1.0):
+        elif self.kind == "bool" and number and f in (0.0, 1.0) and exactly(int(f)):
             out = bool(f)
         elif self.kind == "str":
             out = v

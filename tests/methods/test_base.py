@@ -113,3 +113,28 @@ def test_a_float_option_below_the_float_range_is_named_as_such() -> None:
         with pytest.raises(InputError, match="simulate: gamma: .* is below the float range"):
             opt.check_value(v)
     assert opt.check_value(Decimal("0")) == 0.0 and opt.check_value(0.5) == 0.5
+
+
+def test_an_int_or_bool_option_takes_an_exact_value_only_when_it_is_whole() -> None:
+    """``seed=Decimal('1E-400')`` ran with seed 0 and ``Fraction(10**20 + 1, 10**20)`` with
+    seed 1: the double of the value was whole, the value not (re-check review 45). The value
+    itself must be whole (1 or 0 for a true/false option); 3.0, Decimal('3'), Fraction(6, 2)
+    and numpy integers and floats that are whole still pass."""
+    from decimal import Decimal
+    from fractions import Fraction
+
+    import numpy as np
+
+    from obsdesign.methods.base import SimOption
+
+    seed = SimOption("seed", "int", 0, "a seed")
+    flag = SimOption("plot", "bool", False, "a flag")
+    for v in (Decimal("1E-400"), Fraction(10**20 + 1, 10**20), Decimal("2.0000000000000000001")):
+        with pytest.raises(InputError, match="simulate: seed: expected an integer"):
+            seed.check_value(v)
+    for v in (Decimal("1.0000000000000000001"), Fraction(10**20 + 1, 10**20)):
+        with pytest.raises(InputError, match="simulate: plot: expected"):
+            flag.check_value(v)
+    for v, want in ((3.0, 3), (Decimal("3"), 3), (Fraction(6, 2), 3), (np.float32(3), 3)):
+        assert seed.check_value(v) == want
+    assert flag.check_value(Decimal("1")) is True and flag.check_value(np.bool_(False)) is False
