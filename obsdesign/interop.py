@@ -541,10 +541,13 @@ def observer_statespace(report: Any, law: str | None = None, verify: bool = Fals
 
     def linear(G: np.ndarray, sign: float, rate: Any = None) -> Any:
         # x̂' = A x̂ + B u + sign·G (y − C x̂ − D u)
+        from obsdesign.lyap import float_closed_loop
+
         G = np.asarray(G, float).reshape(n, p)
-        Ao = A - sign * G @ C
+        Ao = float_closed_loop(A, sign * G, C, "observer_statespace(), in doubles,")
         _check_float_realization(Ao, s.discrete, rate, where)
-        Bo = np.hstack([B - sign * G @ D, sign * G])
+        with np.errstate(all="ignore"):
+            Bo = np.hstack([B - sign * G @ D, sign * G])
         return ct.ss(
             Ao,
             Bo,

@@ -913,6 +913,27 @@ def rate_feasible(
     return rate_feasibility(Acl, rate, discrete, memo, Af)[0]
 
 
+def float_closed_loop(A: np.ndarray, G: np.ndarray, C: np.ndarray, who: str) -> np.ndarray:
+    """A − G·C formed in doubles, the observer's error matrix as a simulation or an exported
+    state-space system runs it (the linear observer of Section 5, constrained-redesign paper);
+    :class:`~obsdesign.errors.InconclusiveError` (exit 4) when it overflows: a certificate
+    about the exact A − LC can stand where G·C is past the float range (re-check reviews 44,
+    45: simulate was an internal failure, ``observer_statespace()`` a bare ValueError).
+
+    :param A, G, C: float matrices; :param who: what cannot run it ("a simulation in
+    doubles")."""
+    with np.errstate(all="ignore"):
+        Ao = np.asarray(A, float) - np.asarray(G, float) @ np.asarray(C, float)
+    if not np.all(np.isfinite(Ao)):
+        from obsdesign.errors import InconclusiveError
+
+        raise InconclusiveError(
+            "A − LC formed in doubles overflows (L·C is beyond the float range): the "
+            f"certificate is about the exact A − LC, and {who} cannot run this observer"
+        )
+    return Ao
+
+
 def float_realization(Ao: np.ndarray, discrete: bool, rate: Any = None) -> str:
     """How the closed-loop matrix in doubles ``Ao`` (A − LC formed in floats: what a user
     deploys and what ``simulate`` steps) stands to the certificate, which is about the exact

@@ -1831,14 +1831,22 @@ def test_a_gain_whose_float_product_overflows_is_certified_from_the_exact_loop()
     is made from the exact closed loop, rounded; the report certifies and verifies, and
     says the doubles cannot run it."""
     from obsdesign import api
+    from obsdesign.errors import InconclusiveError
 
     rep = api.design(api.load_spec_text(_OVERFLOW, "o.toml"))
     assert rep.exit_code() == 0, [(c.id, c.detail) for c in rep.failed]
     assert api.verify(rep).exit_code() == 0
     assert any("formed in doubles overflows" in n for n in rep.notes), rep.notes
+    # numpy's own overflow warnings were notes too (re-check review 45), also in continuous
+    # time; observer_statespace() was a bare ValueError "not a finite number: -inf"
+    ct = _OVERFLOW.replace('"discrete"', '"continuous"').replace("0.5]]", "-0.5]]")
+    ct = ct.replace("L = [[2,", "L = [[2.00000000000000000001,")  # A − LC = diag(−1e288, −0.5)
+    for r in (rep, api.design(api.load_spec_text(ct, "ct.toml"))):
+        assert r.exit_code() == 0 and not any("RuntimeWarning" in n for n in r.notes), r.notes
+        pytest.importorskip("control")
+        with pytest.raises(InconclusiveError, match="observer_statespace\\(\\), in doubles"):
+            r.observer_statespace()
     # simulate says the same, exit 4 (it was an internal failure, exit 3: re-check review)
-    from obsdesign.errors import InconclusiveError
-
     sim = _OVERFLOW + "[simulate]\nhorizon = 5\nx0 = [1, 1]\nxhat0 = [0, 0]\n"
     with pytest.raises(InconclusiveError, match="formed in doubles overflows"):
         api.simulate(api.load_spec_text(sim, "s.toml"))

@@ -421,9 +421,13 @@ def _float_gain_note(
     Lf = np.asarray(to_float(np.asarray(L, dtype=object)), dtype=float)  # the report's doubles
     Af_plant, Cf = np.asarray(s.A.f, float), np.asarray(s.C.f, float)
     margin = float(rate) - bound if s.discrete else -bound - float(rate)
-    scale = 1.0 + (np.linalg.norm(Af_plant) + np.linalg.norm(Lf) * np.linalg.norm(Cf)) / max(
-        float(np.linalg.norm(Af)), np.finfo(float).tiny
-    )
+    # the guide overflows where L·C does (‖C‖ = inf): numpy's warnings were report notes
+    # ("RuntimeWarning: overflow encountered in dot"; re-check review 45); a nan scale takes
+    # the exact check below
+    with np.errstate(all="ignore"):
+        scale = 1.0 + (np.linalg.norm(Af_plant) + np.linalg.norm(Lf) * np.linalg.norm(Cf)) / max(
+            float(np.linalg.norm(Af)), np.finfo(float).tiny
+        )
     size = max(1.0, float(np.max(np.abs(guide.w)))) if guide.w.size else 1.0
     if guide.source == FLOAT_SOURCE and margin > 10 * FLOAT_TOL * size * scale:
         return None
