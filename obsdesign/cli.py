@@ -998,7 +998,8 @@ def _dash_file(arg: str) -> str:
             return os.path.join(os.getcwd(), "-")
         except OSError:  # the working folder removed: a traceback (re-check review, 44),
             # and returning ./- read stdin (it is Path("-") to typer)
-            _err(f"{arg}: cannot read (the working folder no longer exists: cd to one)")
+            # an input or an output (-o ./-): "cannot read" was wrong for the latter (45)
+            _err(f"{arg}: cannot use (the working folder no longer exists: cd to one)")
             sys.exit(2)
     return arg
 

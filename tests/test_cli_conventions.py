@@ -623,7 +623,7 @@ def test_dot_slash_dash_in_a_removed_folder_is_no_traceback(tmp_path: Path) -> N
         timeout=120,
     )
     assert "Traceback" not in r.stderr and r.returncode == 2, r.stderr
-    assert "the working folder no longer exists" in r.stderr
+    assert "./-: cannot use (the working folder no longer exists" in r.stderr, r.stderr
     # check of a relative file there was an internal failure, exit 3 (realpath; re-check):
     # its row says so; a command with an absolute path still runs (--version, here)
     code = code.replace("'design', './-'", "'check', './x.toml'")

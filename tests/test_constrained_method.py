@@ -1313,3 +1313,13 @@ def test_a_closed_loop_past_the_float_range_is_decided_exactly(c: str) -> None:
     assert f"C = [[{c}, 0]]" in text
     with pytest.raises(InfeasibleError, match="A − LC is not Schur"):
         api.design(load_spec_text(text, "c.toml"))
+
+
+def test_the_best_rate_note_names_the_discrete_time_test(specs_dir) -> None:
+    """The note of a best-rate design said "(exact Routh test)", the continuous-time test,
+    where its lambda-bracket claim names Schur–Cohn, the one that ran (re-check review 45)."""
+    text = (specs_dir / "constrained-redesign-sec5.toml").read_text(encoding="utf-8")
+    assert "lambda = 0.955\n" in text
+    rep = api.design(api.load_spec_text(text.replace("lambda = 0.955\n", ""), "best.toml"))
+    note = next(n for n in rep.notes if n.startswith("λ: the best certified rate"))
+    assert "(exact Schur–Cohn test)" in note and "Routh" not in note, note

@@ -255,8 +255,9 @@ def design_params(spec: Spec) -> tuple[dict[str, Any], list[str]]:
     if ld.lam_other is not None and ld.other_kind == lyap.INFEASIBLE:
         params["lambda_infeasible"] = ld.lam_other
         notes.append(
-            "λ: the best certified rate; no P ≻ 0 exists at λ_infeasible (exact Routh test), "
-            f"bracket width ≤ rate_tol = {o.rate_tol}"
+            "λ: the best certified rate; no P ≻ 0 exists at λ_infeasible "
+            f"({lyap.stability_test(spec.system.discrete)}), bracket width ≤ rate_tol = "
+            f"{o.rate_tol}"
         )
     elif ld.lam_other is not None:
         notes.append(
