@@ -124,3 +124,39 @@ def test_the_schema_ties_simulate_keys_to_the_method(spec: str, foreign: str) ->
         jsonschema.validate(tomllib.loads(bad), api.schema())
     with pytest.raises(SpecError):
         api.load_spec_text(bad, "foreign.toml")
+
+
+def test_a_simulate_key_of_several_methods_is_checked_by_the_spec_methods_rule() -> None:
+    """Every method's [simulate] rules went into one dict, the last method's winning:
+    search-space ``substeps = 0`` (its documented default) was refused by the schema and
+    impulsive ``runs = 200000`` accepted, the tool doing the opposite (docs review 45). Each
+    method's branch carries its own rules; the falsification's ``samples`` has the tool's
+    maximum too."""
+    from obsdesign.errors import SpecError
+    from obsdesign.methods.impulsive.options import MAX_SAMPLES
+
+    schema = api.schema()
+    branches = {
+        b["if"]["properties"]["method"]["properties"]["key"]["const"]: b for b in schema["allOf"]
+    }
+    for m in api.methods():
+        own = branches[m.key]["then"]["properties"]["simulate"]["properties"]
+        assert own == m.simulate_schema(), m.key
+    root = SPECS[0].parent
+    ss = (root / "hernandez-garcia-example.toml").read_text(encoding="utf-8")
+    ok = ss.replace("\n[simulate]\n", "\n[simulate]\nsubsteps = 0\n", 1)
+    jsonschema.validate(tomllib.loads(ok), schema)
+    api.load_spec_text(ok, "ss.toml")
+    imp = (root / "schaum-impulsive-example.toml").read_text(encoding="utf-8")
+    assert "\nruns = 20\n" in imp
+    for text in (
+        imp.replace("\nruns = 20\n", "\nruns = 200000\n", 1),
+        imp.replace("samples = 20000\n", f"samples = {MAX_SAMPLES + 1}\n", 1),
+    ):
+        with pytest.raises(jsonschema.ValidationError):
+            jsonschema.validate(tomllib.loads(text), schema)
+        with pytest.raises(SpecError):
+            api.load_spec_text(text, "imp.toml")
+    text = imp.replace("samples = 20000\n", f"samples = {MAX_SAMPLES}\n", 1)
+    jsonschema.validate(tomllib.loads(text), schema)
+    api.load_spec_text(text, "imp.toml")

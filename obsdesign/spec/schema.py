@@ -93,7 +93,9 @@ def _nonlinearity() -> dict[str, Any]:
                 "properties": {
                     "lower": VEC,
                     "upper": VEC,
-                    "samples": {"type": "integer", "minimum": 10},
+                    # impulsive.options.MAX_SAMPLES (this layer imports no method; a test
+                    # ties the two): 2,000,000 validated, the tool refused it (docs review 45)
+                    "samples": {"type": "integer", "minimum": 10, "maximum": 1_000_000},
                     "seed": {"type": "integer", "minimum": 0},
                     "on_violation": {"enum": ["fail", "warn"]},
                 },
@@ -128,16 +130,18 @@ def expression_keys(schema: dict[str, Any]) -> list[str]:
 def spec_schema(
     method_schemas: list[dict[str, Any]],
     simulate_keys: dict[str, Any] | None = None,
-    simulate_own: dict[str, list[str]] | None = None,
+    simulate_own: dict[str, dict[str, Any]] | None = None,
 ) -> dict[str, Any]:
     """The JSON schema (draft 2020-12) of a spec file.
 
     ``method_schemas`` are the methods' ``[method]`` schemas and ``simulate_keys`` the union of
-    their own ``[simulate]`` keys; ``simulate_own`` maps each method key to the names of its
-    own ``[simulate]`` keys, so that a spec of one method with another's key is refused by the
-    schema as by the tool (a lyapunov spec with theta_m validated, then design said exit 2;
-    outsider trial, session 29). The caller (the API) collects them, so this layer imports no
-    method."""
+    their own ``[simulate]`` keys; ``simulate_own`` maps each method key to its own
+    ``[simulate]`` keys and their schemas, so that a spec of one method with another's key is
+    refused by the schema as by the tool (a lyapunov spec with theta_m validated, then design
+    said exit 2; outsider trial, session 29), and a key two methods share is checked by the
+    rule of the spec's method (the last method's rule applied to every method's spec:
+    search-space ``substeps = 0`` was refused, impulsive ``runs = 200000`` accepted; docs
+    review 45). The caller (the API) collects them, so this layer imports no method."""
 
     sets = {
         "oneOf": [
@@ -180,7 +184,12 @@ def spec_schema(
                 },
             },
             "then": {
-                "properties": {"simulate": {"propertyNames": {"enum": [*common, *sorted(own)]}}}
+                "properties": {
+                    "simulate": {
+                        "propertyNames": {"enum": [*common, *sorted(own)]},
+                        "properties": dict(sorted(own.items())),
+                    }
+                }
             },
         }
         for k, own in (simulate_own or {}).items()
