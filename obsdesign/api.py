@@ -1045,6 +1045,16 @@ def simulate(
         where = "report" if isinstance(report, Report) else str(report)
         if problems:
             raise InputError(f"{where}: {problems[0]}")
+        # what verify refuses first, refused here too: a report of another method, or whose
+        # embedded spec is not the one its spec_sha256 names, ran with exit 0 (tamper
+        # review 45)
+        if rep.method != sp.method:
+            raise InputError(f"{where}: method {rep.method!r} but the spec says '{sp.method}'")
+        if hashlib.sha256(str(rep.spec).encode("utf-8")).hexdigest() != rep.spec_sha256:
+            raise InputError(
+                f"{where}: its embedded spec is not the one its spec_sha256 names (edited "
+                "after the design?): obsdesign verify fails it"
+            )
         if rep.error is not None:
             raise InputError(
                 f"{where}: records a design that stopped with an error "

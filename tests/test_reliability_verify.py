@@ -606,3 +606,27 @@ def test_an_upper_case_spec_hash_says_so_and_a_bool_exact_value_reads_once(tmp_p
     p.write_text(json.dumps(d))
     res = CliRunner().invoke(app, ["verify", str(p)])
     assert res.exit_code == 2 and f"parameters.exact.{key}: not an exact value (True)" in res.output
+
+
+def test_simulate_refuses_a_report_verify_refuses_first(tmp_path: Path) -> None:
+    """``simulate SPEC --report R`` compared only the spec's sha256 with the report's: a report
+    whose method was edited (verify: exit 2), or whose embedded spec text was replaced
+    (verify: exit 1, spec-hash), ran with exit 0 (tamper review 45). Both are bad input for
+    simulate now, naming the report; the honest report runs."""
+    rep = api.design(SPEC)
+    good = tmp_path / "good.json"
+    good.write_text(rep.to_json(), encoding="utf-8")
+    r = CliRunner().invoke(app, ["simulate", str(SPEC), "--report", str(good), "-q"])
+    assert r.exit_code == 0, r.output
+    other = (SPEC.parent / "constrained-redesign-sec5.toml").read_text(encoding="utf-8")
+    for edit, want in (
+        (lambda d: d.update(method="stubborn"), "method 'stubborn' but the spec says 'lyapunov'"),
+        (lambda d: d.update(spec=other), "its embedded spec is not the one its spec_sha256 names"),
+    ):
+        d = json.loads(rep.to_json())
+        edit(d)
+        bad = tmp_path / "bad.json"
+        bad.write_text(json.dumps(d), encoding="utf-8")
+        assert CliRunner().invoke(app, ["verify", str(bad), "-q"]).exit_code in (1, 2)
+        r = CliRunner().invoke(app, ["simulate", str(SPEC), "--report", str(bad), "-q"])
+        assert r.exit_code == 2 and want in r.stderr and str(bad) in r.stderr, r.output
