@@ -312,36 +312,14 @@ def _kv(items: list[str]) -> dict[str, str]:
 
 
 def _dumps(obj: Any, **kw: Any) -> str:
-    """``json.dumps`` of :func:`_finite` ``obj``, so the text is valid JSON: a non-finite
+    """``json.dumps`` of :func:`obsdesign.errors.json_safe` ``obj``, so the text is valid JSON: a non-finite
     metric printed as ``NaN`` / ``Infinity``, which JSON has not (independent simulate
     review). json loads only on the paths that print JSON."""
     import json
 
-    return json.dumps(_finite(obj, kw.pop("default", None)), allow_nan=False, **kw)
+    from obsdesign.errors import json_safe
 
-
-def _finite(o: Any, default: Callable[[Any], Any] | None) -> Any:
-    """``o`` with every non-finite float written as the string ``"nan"``, ``"inf"`` or
-    ``"-inf"`` (Python's own spelling, which ``float()`` reads back), containers walked, and
-    what JSON cannot hold passed through ``default`` first; strings made valid Unicode (a
-    non-UTF-8 spec file name in a row's message: :func:`obsdesign.errors.valid_text`)."""
-    import math
-
-    from obsdesign.errors import valid_text
-
-    if isinstance(o, bool) or o is None or isinstance(o, int):
-        return o
-    if isinstance(o, str):
-        return valid_text(o)
-    if isinstance(o, float):
-        return o if math.isfinite(o) else repr(o)
-    if isinstance(o, dict):
-        return {valid_text(str(k)): _finite(v, default) for k, v in o.items()}
-    if isinstance(o, (list, tuple)):
-        return [_finite(v, default) for v in o]
-    if default is None:
-        return o
-    return _finite(default(o), None)
+    return json.dumps(json_safe(obj, kw.pop("default", None)), allow_nan=False, **kw)
 
 
 def _jsonable(o: Any) -> Any:

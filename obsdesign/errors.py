@@ -7,6 +7,7 @@
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from typing import Any
 
 EXIT_OK = 0
@@ -181,3 +182,27 @@ class InconclusiveError(ObsdesignError):
     """A candidate was found but the exact check could not certify it."""
 
     exit_code = EXIT_INCONCLUSIVE
+
+
+def json_safe(o: Any, default: Callable[[Any], Any] | None = None) -> Any:
+    """``o`` with every non-finite float written as the string ``"nan"``, ``"inf"`` or
+    ``"-inf"`` (Python's own spelling, which ``float()`` reads back), containers walked, and
+    what JSON cannot hold passed through ``default`` first; strings made valid Unicode (a
+    non-UTF-8 spec file name in a row's message: :func:`valid_text`). JSON has no NaN or
+    Infinity: a non-finite metric (independent simulate review) or a report's unread 1e400
+    (tamper review 45) was printed as such, which strict readers refuse."""
+    import math
+
+    if isinstance(o, bool) or o is None or isinstance(o, int):
+        return o
+    if isinstance(o, str):
+        return valid_text(o)
+    if isinstance(o, float):
+        return o if math.isfinite(o) else repr(o)
+    if isinstance(o, dict):
+        return {valid_text(str(k)): json_safe(v, default) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [json_safe(v, default) for v in o]
+    if default is None:
+        return o
+    return json_safe(default(o), None)

@@ -630,3 +630,27 @@ def test_simulate_refuses_a_report_verify_refuses_first(tmp_path: Path) -> None:
         assert CliRunner().invoke(app, ["verify", str(bad), "-q"]).exit_code in (1, 2)
         r = CliRunner().invoke(app, ["simulate", str(SPEC), "--report", str(bad), "-q"])
         assert r.exit_code == 2 and want in r.stderr and str(bad) in r.stderr, r.output
+
+
+def test_verify_json_output_is_strict_json_whatever_the_report_holds(tmp_path: Path) -> None:
+    """A report with 1e400 (valid JSON, read as inf) or NaN in an unread parameter, its tool
+    or its timings: verify --format json printed Infinity / NaN, which strict JSON readers
+    refuse (tamper review 45). Non-finite values are written as their text; a report of the
+    tool's own is written unchanged."""
+    rep = api.design(SPEC)
+    plain = json.loads(rep.to_json())
+    assert json.loads(rep.to_json(), parse_constant=_refuse) == plain
+    text = rep.to_json().replace('"parameters": {', '"parameters": {\n"odd_extra": 1e400,', 1)
+    text = text.replace('"timings": {', '"timings": {"odd": NaN, ', 1)
+    assert "1e400" in text and "NaN" in text
+    bad = tmp_path / "bad.json"
+    bad.write_text(text, encoding="utf-8")
+    r = CliRunner().invoke(app, ["verify", str(bad), "--format", "json"])
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.stdout, parse_constant=_refuse)
+    assert out["parameters"]["odd_extra"] == "inf"
+
+
+def _refuse(c: str) -> Any:
+    """json's parse_constant for a strict reader: NaN and ±Infinity are not JSON."""
+    raise ValueError(f"not JSON: {c}")

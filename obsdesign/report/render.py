@@ -232,10 +232,7 @@ def render_text(report: Report, title: str = "") -> None:
         # 60 cropped the whole table: rich measures a column's minimum by its longest word,
         # and a forced minimum on the id column then left no room; re-check, session 27)
         words = (
-            w
-            for cl in claims
-            for t in (cl.statement, cl.check, cl.detail)
-            for w in esc(t).split()
+            w for cl in claims for t in (cl.statement, cl.check, cl.detail) for w in esc(t).split()
         )
         prose = max(24, max((len(w) for w in words), default=0) + 8)  # + "detail: "
         id_w = max(4, min(id_w, out.width - 7 - prose))
