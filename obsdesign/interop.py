@@ -613,11 +613,13 @@ def _check_float_realization(Ao: np.ndarray, discrete: bool, rate: Any, where: s
             stacklevel=3,
         )
         return
+    # no word on the certificate itself: with verify=False the report's claims are taken as
+    # stored, and a tampered unstable gain was said to be certified (tamper review 45)
     raise InconclusiveError(
         f"{where}: the observer matrix in doubles (A − LC rounded) is not "
-        f"{'Schur' if discrete else 'Hurwitz'}: the certificate holds for the exact gain "
-        "(report parameters.exact), and this ill-conditioned observer has no float64 "
-        "realization that keeps it; no observer is offered"
+        f"{'Schur' if discrete else 'Hurwitz'}: no observer is offered (a report's "
+        "certificate is about the exact gain, parameters.exact, which an ill-conditioned "
+        "observer's doubles can lose; obsdesign verify checks whether the report's claims hold)"
     )
 
 

@@ -970,6 +970,20 @@ def test_an_observer_with_no_float_realization_is_not_offered() -> None:
     assert rep.exit_code() == 0
     with pytest.raises(InconclusiveError, match="not Schur"):
         rep.observer_statespace()
+    # a report whose L was replaced by an unstable one, read without verify: the refusal
+    # said "the certificate holds for the exact gain", which no certificate backs (tamper
+    # review 45); it says what verify is for instead
+    from obsdesign.report.model import Report
+
+    shipped = api.design(api.load_spec(ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml"))
+    d = shipped.to_dict()
+    d["parameters"]["L"] = [1.0, 5.0]
+    d["parameters"]["exact"]["L"] = ["1", "5"]
+    tampered, _ = Report.from_dict(d)
+    with pytest.raises(InconclusiveError, match="not Schur") as ei:
+        tampered.observer_statespace()
+    assert "holds for the exact gain" not in str(ei.value)
+    assert "obsdesign verify checks whether the report's claims hold" in str(ei.value)
     rep8 = api.design(api.load_spec(data / "lyapunov-ill-conditioned-8state.toml"))
     assert rep8.exit_code() == 0
     with pytest.warns(UserWarning, match="does not keep the certified rate"):
