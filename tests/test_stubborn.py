@@ -2370,3 +2370,23 @@ def test_an_inaccurate_re_solve_at_the_far_end_is_inconclusive_not_failed(
     assert ver.exit_code() == 1, [(c.id, c.float_ok) for c in ver.failed]
     alters = next(c for c in ver.failed if c.id == "report-alters:lambda-max-bracket")
     assert not alters.float_ok
+
+
+def test_no_lambda_found_names_the_bounds_in_force() -> None:
+    """A 3-state plant with r_bound = 12.9: the solver found the LMIs feasible at no λ and
+    answered infeasible_inaccurate; exit 4 suggested a smaller margin or a rescaled plant,
+    while r_bound = 1000 certifies (census review 45; also gain_bound at its default 100).
+    The message names the bounds in force beside the margin."""
+    from obsdesign.errors import InconclusiveError
+
+    text = (
+        '[system]\ntime = "continuous"\n'
+        "A = [[-0.105, 0.201, 0.11], [0.101, 0.177, -0.091], [0.146, 0.466, 0.135]]\n"
+        "C = [[1.188, -0.866, -0.449]]\n"
+        '[method]\nkey = "stubborn"\nr_bound = 12.9\ncriterion = "R"\n'
+    )
+    with pytest.raises(InconclusiveError, match="feasible at no λ tried") as ei:
+        api.design(api.load_spec_text(text, "s021.toml"))
+    assert "a larger r_bound (now 12.9)" in str(ei.value), str(ei.value)
+    ok = api.design(api.load_spec_text(text.replace("12.9", "1000"), "s021.toml"))
+    assert ok.exit_code() == 0

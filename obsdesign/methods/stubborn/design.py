@@ -452,7 +452,9 @@ def design_params(
                     f"stubborn: the solver found LMIs {_refs(pl)} feasible at no λ tried "
                     f"(down to {bad:g}), but did not report them infeasible there either "
                     f"(status {st}): not a verdict; a smaller [method] margin (now "
-                    f"{fmt_exact(o.margin)}) or a rescaled plant may help"
+                    f"{fmt_exact(o.margin)}), "
+                    + (f"a larger {_bounds_text(o)}, " if _bounds_text(o) else "")
+                    + "or a rescaled plant may help"
                 )
                 err.gain_bound_hint = o.K is None and o.gain_bound is not None  # type: ignore[attr-defined]
                 raise err
@@ -769,6 +771,16 @@ def _unless_feasible_with_less_margin(pl: Plant, o: Options, lam: float, where: 
         )
 
 
+def _bounds_text(o: Options) -> str:
+    """The design's bounds in force, "gain_bound (now 100), r_bound (now 12.9)" (empty when
+    none): the gain bound applies in full mode only (redesign keeps the given K)."""
+    return ", ".join(
+        f"{k} (now {fmt_exact(v)})"
+        for k, v in (("gain_bound", o.gain_bound if o.K is None else None), ("r_bound", o.r_bound))
+        if v is not None
+    )
+
+
 def _infeasible(spec: Spec, pl: Plant, o: Options, where: str) -> None:
     """Say why: (C, A) not detectable (necessary for the LMIs; in continuous time also
     sufficient, the slides' Proposition), or the bounds of the design (gain bound, given K,
@@ -839,12 +851,7 @@ def _unstable_gain(pl: Plant, where: str) -> None:
 def _bounds_too_tight(pl: Plant, o: Options, where: str, verdict: bool | None) -> None:
     """Exit 1 naming the bounds of the design to relax (the solver's `infeasible` on
     well-scaled data of a detectable plant)."""
-    # the gain bound applies in full mode only (redesign keeps the given K)
-    bounds = ", ".join(
-        f"{k} (now {fmt_exact(v)})"
-        for k, v in (("gain_bound", o.gain_bound if o.K is None else None), ("r_bound", o.r_bound))
-        if v is not None
-    )
+    bounds = _bounds_text(o)
     # λ: the decay asked of V, λ·V in (1) (larger is harder) but λ·P in (7), where a
     # λ closer to 1 is weaker (random-spec fuzzer: the discrete hint said "smaller")
     lam_hint = ""
