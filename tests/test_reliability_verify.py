@@ -654,3 +654,24 @@ def test_verify_json_output_is_strict_json_whatever_the_report_holds(tmp_path: P
 def _refuse(c: str) -> Any:
     """json's parse_constant for a strict reader: NaN and ±Infinity are not JSON."""
     raise ValueError(f"not JSON: {c}")
+
+
+def test_verify_with_spec_checks_the_embedded_spec_too(tmp_path: Path) -> None:
+    """A report whose embedded spec had its A edited (spec_sha256 left as designed):
+    ``verify R`` failed spec-hash, but ``verify R --spec SPEC`` hashed only the file and
+    said ok, its JSON output embedding the edited plant (re-check review 45). Both fail
+    spec-hash now; the honest report verifies either way."""
+    rep = api.design(SPEC)
+    good = tmp_path / "good.json"
+    good.write_text(rep.to_json(), encoding="utf-8")
+    assert api.verify(good, spec=SPEC).exit_code() == 0
+    d = json.loads(rep.to_json())
+    assert "A = [[0, 1], [1, 0]]" in d["spec"]
+    d["spec"] = d["spec"].replace("A = [[0, 1], [1, 0]]", "A = [[0, 1], [1, 0.5]]")
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(d), encoding="utf-8")
+    for kw in ({}, {"spec": SPEC}):
+        ver = api.verify(bad, **kw)
+        assert ver.exit_code() == 1 and [c.id for c in ver.failed] == ["spec-hash"], kw
+    detail = api.verify(bad, spec=SPEC).failed[0].detail
+    assert detail.startswith("the embedded spec has sha256"), detail
