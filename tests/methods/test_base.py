@@ -137,4 +137,11 @@ def test_an_int_or_bool_option_takes_an_exact_value_only_when_it_is_whole() -> N
             flag.check_value(v)
     for v, want in ((3.0, 3), (Decimal("3"), 3), (Fraction(6, 2), 3), (np.float32(3), 3)):
         assert seed.check_value(v) == want
+    # whole exact values past 2^53 are whole (their doubles are not the value: Decimal(2^60
+    # + 1) was refused, re-check review 45), and a seed of True is no integer
+    for v in (Decimal(2**60 + 1), Fraction(2**60 + 1), Decimal("1E+30"), Decimal("-0")):
+        assert seed.check_value(v) == int(v)
+    for v in (True, np.True_, Decimal("1E+999999999"), Decimal("Infinity")):
+        with pytest.raises(InputError, match="simulate: seed: expected an integer"):
+            seed.check_value(v)
     assert flag.check_value(Decimal("1")) is True and flag.check_value(np.bool_(False)) is False
