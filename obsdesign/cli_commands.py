@@ -230,20 +230,21 @@ def _print_sweep(rows: list[dict[str, Any]], fmt: Fmt) -> None:
     # CHECK_RESULT_MIN, and the borders: below that rich folded headers and values mid-word
     # ("metho / d.lam / bda", "faile / d" at --width 40; CLI review 44) or cropped the
     # table, so each point is then a paragraph of key=value items, wrapped at spaces
+    # in terminal cells, not characters: a CJK value is two cells a character (re-check 45)
+    from rich.cells import cell_len
+
     widths = [
-        CHECK_RESULT_MIN if c == "message" else max(len(c), *(len(x[i]) for x in cells))
+        CHECK_RESULT_MIN if c == "message" else max(cell_len(c), *(cell_len(x[i]) for x in cells))
         for i, c in enumerate(cols)
     ]
     con = console()
     if cells and con.width < 3 * len(cols) + 1 + sum(widths):
-        import textwrap
-
         from rich.text import Text
 
         def para(text: str) -> None:  # wrapped at spaces, indented by 2, no trailing blanks
-            w = max(con.width - 2, 8)
-            for line in textwrap.wrap(text, w, break_on_hyphens=False) or [""]:
-                con.print(Text("  " + line), soft_wrap=True)
+            for line in Text(text).wrap(con, max(con.width - 2, 8), overflow="fold"):
+                line.rstrip()
+                con.print(Text("  ") + line, soft_wrap=True)
 
         con.print("[bold]obsdesign sweep[/]")
         for x in cells:

@@ -904,3 +904,29 @@ def test_a_narrow_sweep_table_is_a_paragraph_a_point_with_every_value_whole(widt
         assert item in text, (item, r.stdout)
     assert [x for x in lines if x.startswith("point ")] == ["point 0", "point 1"]
     assert "spectral radius ≈ 0.95" in text
+
+
+def test_a_wide_character_value_is_measured_in_terminal_cells() -> None:
+    """A CJK swept title (two cells a character) was measured in characters: at --width 170
+    the table folded it mid-value, and the paragraphs were 56 cells wide at --width 40
+    (re-check review 45). Widths are terminal cells now: no line wider than --width."""
+    from rich.cells import cell_len
+
+    title = "日本語のタイトル" * 3
+    for width in (40, 100, 170):
+        r = runner.invoke(
+            app,
+            [
+                "sweep",
+                str(SPEC),
+                "--set",
+                f'title=["{title}"]',
+                "--set",
+                "method.lambda=[0.955, 0.9]",
+                "--width",
+                str(width),
+            ],
+        )
+        lines = [x for x in r.stdout.splitlines() if not x.startswith("swept: ")]
+        assert r.exit_code == 1 and all(cell_len(x) <= width for x in lines), (width, r.stdout)
+        assert title in "".join(x.strip() for x in lines).replace("title=", ""), r.stdout
