@@ -384,7 +384,8 @@ def _time_of(dt: Any) -> tuple[str, float | Decimal | None]:
             q = _exact(dt) if isinstance(dt, (Decimal, Fraction)) else None
         except InputError:  # Fraction(1, 3): no decimal form, written as its double
             q = None
-        return "discrete", (f if q is None or q == Decimal(f) else q)
+        # q even when it is a double's value: 0.1's double written "0.1" read back as 1/10
+        return "discrete", (f if q is None else q)
     if positive and f == 0:
         raise InputError(f"dt {dt!r} is positive but below the float range (it would read as 0)")
     if positive and not math.isfinite(f):

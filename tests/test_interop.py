@@ -1134,6 +1134,9 @@ def test_an_exact_dt_is_written_as_given(tmp_path: Path) -> None:
         (Decimal("1E+5"), "100000"),
         (0.1, "0.1"),
         (Fraction(1, 3), "0.3333333333333333"),
+        # the exact value of 0.1's double, given exactly: written in full (it was "0.1",
+        # read back as 1/10; re-check review 45)
+        (Fraction(0.1), str(Decimal(0.1))),
     ):
         text = spec_text_from_statespace((A, B, C, D, dt), "lyapunov")
         assert f"sample_time = {want}\n" in text, text
