@@ -194,7 +194,7 @@ def spec_schema(
         }
         for k, own in (simulate_own or {}).items()
     ]
-    return {
+    schema = {
         "$schema": "https://json-schema.org/draft/2020-12/schema",
         "title": "obsdesign spec",
         **({"allOf": per_method} if per_method else {}),
@@ -258,7 +258,12 @@ def spec_schema(
                 "required": ["horizon", "x0", "xhat0"],
                 "additionalProperties": False,
                 "properties": {
-                    "horizon": {**NUM, "description": "samples (discrete) or seconds (continuous)"},
+                    "horizon": {
+                        **NUM,
+                        "exclusiveMinimum": 0,
+                        "description": "samples (discrete: an integer ≥ 1) or seconds "
+                        "(continuous)",
+                    },
                     "dt": {**NUM, "exclusiveMinimum": 0},
                     "x0": VEC,
                     "xhat0": VEC,
@@ -271,3 +276,27 @@ def spec_schema(
             },
         },
     }
+    return _capped_integers(schema)
+
+
+#: the largest integer a spec key takes (obsdesign.limits.INT_MAX; a seed takes any size)
+_INT_MAX = 2**63 - 1
+
+
+def _capped_integers(node: Any, key: str = "") -> Any:
+    """``node`` with ``"maximum": 2^63 − 1`` on every integer schema that has no maximum,
+    but a seed's: the tool refuses larger integers by name (session 44), and the schema
+    accepted them (re-check review 45)."""
+    if isinstance(node, list):
+        return [_capped_integers(x, key) for x in node]
+    if not isinstance(node, dict):
+        return node
+    out = {}
+    for k, v in node.items():
+        if k == "properties" and isinstance(v, dict):
+            out[k] = {name: _capped_integers(x, name) for name, x in v.items()}
+        else:
+            out[k] = _capped_integers(v, key)
+    if out.get("type") == "integer" and "maximum" not in out and key != "seed":
+        out["maximum"] = _INT_MAX
+    return out

@@ -419,7 +419,10 @@ def simulate_schema() -> dict[str, Any]:
         },
         "gamma": {**NUM, "exclusiveMinimum": 0, "description": "simulation-only γ"},
         "saturation_r": {
-            "anyOf": [NUM, VEC],
+            "anyOf": [
+                {**NUM, "exclusiveMinimum": 0},
+                {**VEC, "items": {**NUM, "exclusiveMinimum": 0}, "maxItems": 2},
+            ],
             "description": "level r of the saturated observer (29)",
         },
         "time_limit": TIME_LIMIT_SCHEMA,
