@@ -16,8 +16,9 @@ $(VENV)/.debs:
 	command -v cc >/dev/null 2>&1 || need="$$need build-essential"; \
 	$(PYTHON) -c 'import os, sys, sysconfig; sys.exit(not os.path.exists(os.path.join(sysconfig.get_paths()["include"], "Python.h")))' || need="$$need python3-dev"; \
 	$(PYTHON) -c 'import ensurepip' 2>/dev/null || need="$$need python3-venv"; \
-	dpkg -s $$need >/dev/null 2>&1 || { $(SUDO) apt-get update -qq && $(SUDO) DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$need; }
-	@[ -d $(VENV) ] || $(PYTHON) -m venv $(VENV)
+	dpkg -s $$need >/dev/null 2>&1 || { $(SUDO) apt-get update -qq && $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$need; }
+	@# a .venv without pip (left by a venv made before python3-venv was there) is made again
+	@$(PY) -m pip --version >/dev/null 2>&1 || $(PYTHON) -m venv --clear $(VENV)
 	@touch $@
 
 $(VENV)/.installed: $(VENV)/.debs pyproject.toml

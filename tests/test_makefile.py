@@ -38,7 +38,8 @@ def test_the_first_step_installs_compiler_headers_and_venv_when_missing(tmp_path
     one apt-get install names every package; with all present, apt-get is not run."""
     log = tmp_path / "apt.log"
     venv = tmp_path / "venv"
-    python = 'case "$1" in -m) mkdir -p "$3";; *) exit 1;; esac'
+    # `python -m venv [--clear] DIR` makes DIR; every other use fails (no headers, no ensurepip)
+    python = 'case "$1" in -m) for a; do d=$a; done; mkdir -p "$d";; *) exit 1;; esac'
     bin_ = _stubs(
         tmp_path,
         {
@@ -47,7 +48,7 @@ def test_the_first_step_installs_compiler_headers_and_venv_when_missing(tmp_path
             "python": python,
             "sudo": 'exec "$@"',
         },
-        ("id", "touch", "mkdir"),
+        ("id", "touch", "mkdir", "env"),
     )
     env = {"PATH": str(bin_), "HOME": str(tmp_path)}
     make = shutil.which("make")
@@ -71,7 +72,9 @@ def test_the_first_step_installs_compiler_headers_and_venv_when_missing(tmp_path
     (bin_ / "dpkg").write_text("#!/bin/sh\nexit 0\n")
     (bin_ / "cc").write_text("#!/bin/sh\nexit 0\n")
     (bin_ / "cc").chmod(0o755)
-    (bin_ / "python").write_text('#!/bin/sh\ncase "$1" in -m) mkdir -p "$3";; *) exit 0;; esac\n')
+    (bin_ / "python").write_text(
+        '#!/bin/sh\ncase "$1" in -m) for a; do d=$a; done; mkdir -p "$d";; *) exit 0;; esac\n'
+    )
     r = subprocess.run([*args, f"{venv}/.debs"], env=env, capture_output=True, text=True)
     assert r.returncode == 0 and not log.exists(), r.stderr
 
@@ -104,3 +107,35 @@ def test_make_sh_installs_make_when_missing_then_runs_it(tmp_path: Path) -> None
     r = subprocess.run([sh, str(ROOT / "make.sh"), "run"], env=env, capture_output=True, text=True)
     assert r.returncode == 0 and log.read_text().splitlines() == ["make run"], r.stderr
     assert os.access(ROOT / "make.sh", os.R_OK)
+
+
+@pytest.mark.skipif(shutil.which("make") is None, reason="needs make for the Makefile run")
+def test_a_virtualenv_without_pip_is_made_again(tmp_path: Path) -> None:
+    """A .venv left without pip (made before python3-venv was installed: ensurepip failed)
+    was kept by ``[ -d .venv ]`` and the next step failed, "No module named pip" (re-check
+    review 45): it is made again with --clear; a working one is left alone."""
+    log = tmp_path / "venv.log"
+    venv = tmp_path / "venv"
+    (venv / "bin").mkdir(parents=True)
+    bin_ = _stubs(
+        tmp_path,
+        {
+            "dpkg": "exit 0",
+            "cc": "exit 0",
+            "python": f'case "$1" in -m) echo "$*" >> {log};; *) exit 0;; esac',
+        },
+        ("id", "touch", "mkdir", "env"),
+    )
+    env = {"PATH": str(bin_), "HOME": str(tmp_path)}
+    make = shutil.which("make")
+    assert make is not None
+    args = [make, "-s", "-C", str(ROOT), f"VENV={venv}", f"PYTHON={bin_ / 'python'}"]
+    for pip_ok, want in ((False, [f"-m venv --clear {venv}"]), (True, [])):
+        (venv / "bin" / "python").write_text(f"#!/bin/sh\nexit {0 if pip_ok else 1}\n")
+        (venv / "bin" / "python").chmod(0o755)
+        log.unlink(missing_ok=True)
+        (venv / ".debs").unlink(missing_ok=True)
+        r = subprocess.run([*args, f"{venv}/.debs"], env=env, capture_output=True, text=True)
+        assert r.returncode == 0, r.stderr
+        got = log.read_text().splitlines() if log.exists() else []
+        assert got == want, (pip_ok, got)
