@@ -200,7 +200,9 @@ def _table(name: str, data: Mapping[str, Any]) -> list[str]:
                 raise InputError(f"[{name}] {k}: {e}") from None
     out = lines + [""]
     for k, v in subs:
-        out += _table(f"{name}.{k}", v)
+        # a sub-table's name quoted as a key is: "my noise" wrote invalid TOML, and a name
+        # with a dot or a bracket made other tables, or injected some (API review 45)
+        out += _table(f"{name}.{_key(k)}", v)
     return out
 
 
@@ -439,7 +441,7 @@ def spec_text_from_statespace(
     head = [f"title = {_value(title)}", ""] if title else []
     lines = head + _table("system", system)
     for name, s in (sets or {}).items():
-        lines += _table(f"sets.{name}", s)
+        lines += _table(f"sets.{_key(name)}", s)
     if nonlinearity:
         lines += _table("nonlinearity", nonlinearity)
     lines += _table("method", {"key": method, **options})

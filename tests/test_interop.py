@@ -1148,3 +1148,23 @@ def test_an_exact_dt_is_written_as_given(tmp_path: Path) -> None:
     assert r.exit_code == 0 and "sample_time = 0.1000000000000000000001\n" in r.stdout, r.output
     r = CliRunner().invoke(app, ["import", str(mat), "--dt", "1e-310"])
     assert r.exit_code == 2 and "--dt is 1e-310, a nonzero number below" in r.stderr, r.output
+
+
+def test_table_names_are_quoted_keys() -> None:
+    """A set named "X.hat" was written [sets.X.hat] (a nested table), a [simulate] sub-table
+    "my noise" made invalid TOML, and a name holding "]\\n[simulate]..." injected tables
+    (API review 45): each name is one quoted key; the text is valid TOML with exactly the
+    tables given."""
+    from obsdesign.interop import spec_text_from_statespace
+
+    A, B, C, D = [[0.5, 1], [0, 0.5]], [[0], [0]], [[1, 0]], [[0]]
+    box = {"type": "box", "lower": [-1, -1], "upper": [1, 1]}
+    evil = "X]\n[simulate]\nhorizon = 7\n[sets.X"
+    text = spec_text_from_statespace(
+        (A, B, C, D, True),
+        sets={"X.hat": box, evil: box},
+        simulate={"horizon": 5, "x0": [0, 0], "xhat0": [0, 0], "my noise": {"kind": "zero"}},
+    )
+    doc = tomllib.loads(text)
+    assert set(doc["sets"]) == {"X.hat", evil}
+    assert doc["simulate"]["horizon"] == 5 and "my noise" in doc["simulate"]
