@@ -16,7 +16,7 @@ from collections.abc import Callable, Iterable, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from obsdesign.certify.claim import Claim, ClaimStatus, exact_claim
 from obsdesign.errors import (
@@ -271,6 +271,27 @@ def captured_warnings(notes: list[str]) -> Iterator[None]:
                     notes.append(text)
 
 
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def _numpy_defaults(fn: F) -> F:
+    """Run ``fn`` under numpy's default floating-point error handling (warn; underflow
+    ignored): a caller's ``np.seterr(all="raise")`` made designs raise a bare
+    FloatingPointError where an underflow is expected, and simulations in ``nextafter``
+    (API review 45). The caller's setting is back when ``fn`` returns."""
+    import functools
+
+    @functools.wraps(fn)
+    def run(*args: Any, **kwargs: Any) -> Any:
+        import numpy as np
+
+        with np.errstate(divide="warn", over="warn", under="ignore", invalid="warn"):
+            return fn(*args, **kwargs)
+
+    return run  # type: ignore[return-value]
+
+
+@_numpy_defaults
 def design(
     spec: str | Path | Spec,
     out: str | Path | None = None,
@@ -488,6 +509,7 @@ def _hash_mismatch(where: str, sha: str, stored: str) -> str:
     return f"{where} has sha256 {sha[:12]}…, the report was made from {stored[:12]}…"
 
 
+@_numpy_defaults
 def verify(report: str | Path | Report, spec: str | Path | None = None) -> Report:
     """Re-check a report from the spec and the parameters alone, and compare it with what
     the report claims.
@@ -818,6 +840,7 @@ def _diff_claim(cid: str, detail: str, float_ok: bool = False) -> Claim:
     )
 
 
+@_numpy_defaults
 def certify(spec: Spec, params: Parameters) -> list[Claim]:
     """Every claim of the spec's method recomputed from the spec and ``params`` alone.
 
@@ -951,6 +974,7 @@ def _sim_part(method: Any) -> Any:
         return None
 
 
+@_numpy_defaults
 def simulate(
     spec: str | Path | Spec,
     report: str | Path | Report | None = None,
@@ -1834,6 +1858,7 @@ def _check_one(path: Path, t0: float, seen: list[str]) -> CheckRow:
         return _error_row(path, method_key, EXIT_SOLVER, t0, msg)
 
 
+@_numpy_defaults
 def check(
     paths: list[str | Path] | str | Path,
     on_start: Any = None,
@@ -1952,6 +1977,7 @@ def _as_shown(message: str, path: str, shown: str) -> str:
     return message.replace(escape_controls(path), escape_controls(shown))
 
 
+@_numpy_defaults
 def sweep(
     spec: str | Path | Spec,
     grid: list[str] | dict[str, Any],
@@ -2004,6 +2030,7 @@ def schema() -> dict[str, Any]:
     return spec_schema([m.options_schema() for m in ms], sim, own)
 
 
+@_numpy_defaults
 def plot_design(
     spec: str | Path | Spec, params: Parameters, path: str | Path, atomic: bool = True
 ) -> Any:
@@ -2019,6 +2046,7 @@ def plot_design(
     return _plot_to(path, lambda p: draw(sp, params, p), atomic)
 
 
+@_numpy_defaults
 def plot_simulation(
     spec: str | Path | Spec, result: SimResult, path: str | Path, atomic: bool = True
 ) -> Any:

@@ -730,3 +730,29 @@ def test_the_value_limit_says_it_counted_commas_in_comments_too(tmp_path: Path) 
     assert res.exit_code == 2 and want in res.output
     with pytest.raises(SpecError, match=rf"has {n} commas, .*comments and strings included"):
         api.load_spec_text(text, "c.toml")
+
+
+def test_a_callers_numpy_error_setting_neither_breaks_nor_leaks() -> None:
+    """A caller running numpy with ``np.seterr(all="raise")`` (a common debugging setting):
+    designing the Dórea–Pimenta 7.1 spec raised a bare FloatingPointError on an expected
+    underflow, simulating it and the Schaum example one in nextafter (API review 45). The
+    API runs under numpy's defaults and gives the caller's setting back."""
+    import numpy as np
+
+    from obsdesign import api
+
+    root = Path(__file__).resolve().parents[1] / "specs"
+    old = np.seterr(all="raise")
+    try:
+        rep = api.design(root / "dorea-pimenta-7-1.toml")
+        assert rep.exit_code() == 0 and api.verify(rep).exit_code() == 0
+        api.simulate(api.load_spec(root / "dorea-pimenta-7-1.toml"), rep)
+        api.simulate(api.load_spec(root / "schaum-impulsive-example.toml"))
+        assert np.geterr() == {
+            "divide": "raise",
+            "over": "raise",
+            "under": "raise",
+            "invalid": "raise",
+        }
+    finally:
+        np.seterr(**old)
