@@ -868,7 +868,9 @@ def certify(spec: Spec, params: Parameters) -> list[Claim]:
         claims += m.certify(sp, params)
     except ObsdesignError:
         raise
-    except (KeyError, ValueError, TypeError, IndexError, ZeroDivisionError, AttributeError) as e:
+    except (KeyError, ValueError, TypeError, IndexError, ArithmeticError, AttributeError) as e:
+        # ArithmeticError: ZeroDivisionError, and OverflowError of a 10**400 entry read as a
+        # float (a set-invariant G: a bare OverflowError; API review 45)
         claims.append(
             exact_claim(
                 "parameters-wellformed",

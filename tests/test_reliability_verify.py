@@ -675,3 +675,20 @@ def test_verify_with_spec_checks_the_embedded_spec_too(tmp_path: Path) -> None:
         assert ver.exit_code() == 1 and [c.id for c in ver.failed] == ["spec-hash"], kw
     detail = api.verify(bad, spec=SPEC).failed[0].detail
     assert detail.startswith("the embedded spec has sha256"), detail
+
+
+def test_a_parameter_past_the_float_range_is_a_failed_claim_not_an_exception() -> None:
+    """A set-invariant G with an entry of 10**400: api.certify, documented as never raising
+    for malformed parameters, raised a bare OverflowError converting it to a float (API
+    review 45). It is the failed parameters-wellformed claim."""
+    from obsdesign.params import Parameters
+
+    sp = api.load_spec(SPEC.parent / "dorea-pimenta-7-1.toml")
+    rep = api.design(sp)
+    p = Parameters(dict(rep.parameters.items()))
+    G = p["G"].copy()
+    G.flat[-1] = 10**400
+    p["G"] = G
+    claims = api.certify(sp, p)
+    bad = [c for c in claims if c.status is ClaimStatus.FAILED]
+    assert [c.id for c in bad] == ["parameters-wellformed"] and "OverflowError" in bad[0].detail
