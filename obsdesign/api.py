@@ -536,7 +536,7 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
     ensure_recursion_limit()
     t0 = time.perf_counter()
     if isinstance(report, Report):
-        d = report.to_dict()
+        d = report_dict(report)
         if report.raw_parameters is not None and _unchanged_since_read(report, d):
             d["parameters"] = report.raw_parameters  # as read: floats compared bit for bit
         rep, problems = _from_memory(d)
@@ -1068,7 +1068,7 @@ def simulate(
         notes += _uncertified_design(sp, params)
     else:
         rep, problems = (
-            _from_memory(report.to_dict())
+            _from_memory(report_dict(report))
             if isinstance(report, Report)
             else Report.load(_path_arg(report, "report", "a Report"))
         )
@@ -1788,6 +1788,25 @@ def _error_row(path: Path, method_key: str, code: int, t0: float, message: str) 
     :func:`obsdesign.errors.one_line`), no claims."""
     t = time.perf_counter() - t0
     return CheckRow(str(path), method_key, code, 0, 0, 0, "", t, one_line(message))
+
+
+def report_dict(report: Report) -> dict[str, Any]:
+    """``report.to_dict()`` of a Report object given to the API, a malformed one (built or
+    edited by hand: parameters a plain dict, an exact array holding None or nan, claims as
+    dicts, an int key) an :class:`InputError` naming what failed — bare TypeErrors and
+    AttributeErrors escaped verify and simulate (API review 45)."""
+    try:
+        d = report.to_dict()
+        odd = [k for k in report.parameters if not isinstance(k, str)]
+        odd += [k for k in report.extra_keys if not isinstance(k, str)]
+        if odd:
+            raise TypeError(f"a key that is not a string: {odd[0]!r}")
+    except (TypeError, ValueError, AttributeError, ArithmeticError, KeyError) as e:
+        raise InputError(
+            f"report: not a well-formed Report object ({type(e).__name__}: {e}); a report "
+            "read by Report.load or returned by design has this form"
+        ) from None
+    return d
 
 
 def _from_memory(d: dict[str, Any]) -> tuple[Report, list[str]]:

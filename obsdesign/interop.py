@@ -490,13 +490,13 @@ def observer_statespace(report: Any, law: str | None = None, verify: bool = Fals
     import hashlib
     import warnings
 
-    from obsdesign.api import load_spec_text
+    from obsdesign.api import load_spec_text, report_dict
     from obsdesign.report.model import Report
 
     ct = _control()
     where = "report" if isinstance(report, Report) else str(report)
     report, problems = (
-        Report.from_dict(report.to_dict()) if isinstance(report, Report) else Report.load(report)
+        Report.from_dict(report_dict(report)) if isinstance(report, Report) else Report.load(report)
     )
     if problems:
         raise InputError(f"{where}: {problems[0]}")

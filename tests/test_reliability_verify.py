@@ -692,3 +692,38 @@ def test_a_parameter_past_the_float_range_is_a_failed_claim_not_an_exception() -
     claims = api.certify(sp, p)
     bad = [c for c in claims if c.status is ClaimStatus.FAILED]
     assert [c.id for c in bad] == ["parameters-wellformed"] and "OverflowError" in bad[0].detail
+
+
+def test_a_malformed_report_object_is_bad_input_for_verify_and_simulate() -> None:
+    """Report objects built or edited by hand — parameters a plain dict, claims as dicts, an
+    exact array holding None, an int parameter key, extra_keys that are not strings — made
+    api.verify and api.simulate raise bare TypeErrors and AttributeErrors (API review 45):
+    an InputError (exit 2) naming the report."""
+    import dataclasses
+
+    import numpy as np
+
+    from obsdesign.errors import InputError
+    from obsdesign.params import Parameters
+
+    sp = api.load_spec(SPEC)
+    rep = api.design(sp)
+    L = np.array(rep.parameters["L"], dtype=object)
+    L.flat[-1] = None
+    odd = {
+        "parameters=dict": dataclasses.replace(rep, parameters=dict(rep.parameters.items())),
+        "claims=dicts": dataclasses.replace(rep, claims=[c.to_dict() for c in rep.claims]),
+        "None in L": dataclasses.replace(
+            rep, parameters=Parameters({**dict(rep.parameters.items()), "L": L})
+        ),
+        "int key": dataclasses.replace(
+            rep, parameters=Parameters({**dict(rep.parameters.items()), 1: 0.5})
+        ),
+        "extra_keys": dataclasses.replace(rep, extra_keys=[1, None]),
+    }
+    for name, r in odd.items():
+        for call in (lambda r=r: api.verify(r), lambda r=r: api.simulate(sp, r)):
+            with pytest.raises(InputError, match="report: not a well-formed Report object"):
+                call()
+        assert name
+    assert api.verify(rep).exit_code() == 0

@@ -261,8 +261,7 @@ def spec_schema(
                     "horizon": {
                         **NUM,
                         "exclusiveMinimum": 0,
-                        "description": "samples (discrete: an integer ≥ 1) or seconds "
-                        "(continuous)",
+                        "description": "samples (discrete: an integer ≥ 1) or seconds (continuous)",
                     },
                     "dt": {**NUM, "exclusiveMinimum": 0},
                     "x0": VEC,
