@@ -264,8 +264,17 @@ def parse_grid(grid: Sequence[str] | dict[str, Any]) -> list[Axis]:
                 v = _py_literal(v, k)
             texts.append(f"{k}={v}")
         grid = texts
+    elif isinstance(grid, str):
+        grid = [grid]  # one KEY=VALUES text, not its characters
+    else:
+        # a generator is true even when empty: an empty one swept one unswept point, ok
+        # (API review 45)
+        grid = list(grid)
     if not grid:
         raise InputError("sweep: no --set KEY=VALUES given (nothing to sweep)")
+    bad = next((t for t in grid if not isinstance(t, str)), None)
+    if bad is not None:
+        raise InputError(f"sweep: expected KEY=VALUES texts (or a dict), got {bad!r}")
     return [parse_axis(t) for t in grid]
 
 
@@ -669,7 +678,13 @@ def _spec_source(spec: Any) -> tuple[str, str]:
 
             read_spec_text(text, str(p))
         return text, str(p)
-    return spec.text, spec.file
+    text, file = getattr(spec, "text", None), getattr(spec, "file", None)
+    if not isinstance(text, str) or not isinstance(file, str):
+        # sweep(123, ...) was a bare AttributeError (API review 45)
+        raise InputError(
+            f"sweep: spec must be a path or a Spec (api.load_spec), got {type(spec).__name__}"
+        )
+    return text, file
 
 
 def plan(

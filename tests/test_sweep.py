@@ -930,3 +930,18 @@ def test_a_wide_character_value_is_measured_in_terminal_cells() -> None:
         lines = [x for x in r.stdout.splitlines() if not x.startswith("swept: ")]
         assert r.exit_code == 1 and all(cell_len(x) <= width for x in lines), (width, r.stdout)
         assert title in "".join(x.strip() for x in lines).replace("title=", ""), r.stdout
+
+
+def test_the_api_names_a_bad_spec_or_grid_argument() -> None:
+    """sweep(123, ...) was a bare AttributeError, and an empty generator as the grid swept one
+    unswept point with verdict ok where [] is refused (API review 45): both are InputErrors;
+    a non-empty generator and one KEY=VALUES text sweep."""
+    for spec in (123, {"a": 1}):
+        with pytest.raises(InputError, match="sweep: spec must be a path or a Spec"):
+            sw.sweep_rows(spec, {"method.lambda": [0.96]})
+    for grid in ([], (t for t in []), [3]):
+        with pytest.raises(InputError, match="sweep: (no --set|expected KEY=VALUES)"):
+            sw.sweep_rows(SPEC, grid)
+    rows = sw.sweep_rows(SPEC, (t for t in ["method.lambda=[0.96, 0.97]"]))
+    assert [r["exit_code"] for r in rows] == [0, 0]
+    assert len(sw.sweep_rows(SPEC, "method.lambda=0.96")) == 1
