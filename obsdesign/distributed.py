@@ -231,6 +231,11 @@ def dask_client(
     connected to ``scheduler``, else one on a new ``LocalCluster`` of ``workers`` processes
     with one thread each. What this function starts, it closes (also on Ctrl-C)."""
     if client is not None:
+        if not callable(getattr(client, "submit", None)):
+            # client=object() was a bare AttributeError (API review 45)
+            raise InputError(
+                f"client: expected a dask.distributed.Client, got {type(client).__name__}"
+            )
         yield client
         return
     _require_dask()

@@ -655,3 +655,24 @@ initial_error = "E0"
     sp = load_spec_text(text.replace("RUNS", str(runs)), "far.toml")
     with pytest.raises(TimeExceeded, match=where):
         api.simulate(sp, api.design(sp))
+
+
+def test_span_and_client_keywords_are_checked() -> None:
+    """simulate(spec, span="ab") and span=(0.5, 2.5) were bare TypeErrors, client=object() a
+    bare AttributeError (API review 45): InputErrors naming the keyword; a span of numpy
+    integers still runs."""
+    import numpy as np
+
+    from obsdesign import api
+    from obsdesign.errors import InputError
+
+    spec = api.load_spec(
+        Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+    )
+    for span in ("ab", (0.5, 2.5), (True, 2), (0, 1, 2)):
+        with pytest.raises(InputError, match="span: expected a pair of whole numbers"):
+            api.simulate(spec, runs=5, span=span)
+    with pytest.raises(InputError, match="client: expected a dask.distributed.Client"):
+        api.simulate(spec, runs=3, client=object())
+    res = api.simulate(spec, runs=5, span=(np.int64(1), np.int64(3)))
+    assert res.info["span"] == [1, 3]

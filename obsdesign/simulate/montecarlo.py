@@ -32,6 +32,7 @@ calls from its ``parse_simulate``.
 
 from __future__ import annotations
 
+import numbers
 import warnings
 from dataclasses import dataclass
 from typing import Any
@@ -419,7 +420,14 @@ def study(
     sim, s = _need(spec), spec.system
     if runs < 1:
         raise InputError(f"runs: expected at least 1, got {runs}")
-    first, last = span if span is not None else (0, runs)
+    if span is not None and not (
+        isinstance(span, (tuple, list))
+        and len(span) == 2
+        and all(isinstance(v, numbers.Integral) and not isinstance(v, bool) for v in span)
+    ):
+        # span="ab" or (0.5, 2.5) were bare TypeErrors (API review 45)
+        raise InputError(f"span: expected a pair of whole numbers (a, b), got {span!r}")
+    first, last = (int(span[0]), int(span[1])) if span is not None else (0, runs)
     if not 0 <= first < last <= runs:
         raise InputError(f"span: expected 0 <= a < b <= {runs}, got ({first}, {last})")
     if initial_error is not None and initial_error not in spec.sets:
