@@ -2060,11 +2060,26 @@ def plot_design(
     :func:`obsdesign.report.model.write_via`), or with ``atomic=False`` straight into
     ``path`` (for a caller that made it a temp file, FIFO or device itself)."""
     sp = _spec(spec)
+    if not isinstance(params, Parameters):  # a plain dict was a bare AttributeError (45)
+        raise InputError(
+            f"plot_design: params must be Parameters (a report's .parameters), got "
+            f"{type(params).__name__}"
+        )
     m = get_method(sp.method)
     if m.plot_design is None:
         raise InputError(f"method '{sp.method}' has no design plot")
     draw = m.plot_design
-    return _plot_to(path, lambda p: draw(sp, params, p), atomic)
+
+    def drawn(p: Path) -> Any:
+        try:
+            return draw(sp, params, p)
+        except (KeyError, IndexError) as e:  # Parameters() was a bare KeyError 'G' (45)
+            raise InputError(
+                f"plot_design: the parameters are not a design of this spec (missing "
+                f"{type(e).__name__}: {e})"
+            ) from None
+
+    return _plot_to(path, drawn, atomic)
 
 
 @_numpy_defaults
@@ -2073,7 +2088,14 @@ def plot_simulation(
 ) -> Any:
     """The method's simulation plot of ``spec`` and ``result`` written to ``path``, or the
     generic one (estimation error over time); ``atomic`` as for :func:`plot_design`."""
+    from obsdesign.simulate.result import SimResult
+
     sp = _spec(spec)
+    if not isinstance(result, SimResult):
+        raise InputError(
+            f"plot_simulation: result must be a SimResult (api.simulate), got "
+            f"{type(result).__name__}"
+        )
     m = get_method(sp.method)
     if m.plot_simulation is not None:
         method_draw = m.plot_simulation
@@ -2114,13 +2136,33 @@ def _largest_finite(result: SimResult) -> float:
     return best
 
 
+def check_plot_path(path: str | Path, force: bool = False, inputs: tuple[Path, ...] = ()) -> Path:
+    """``path`` as a plot file, or an :class:`InputError`: an unknown format (by its suffix,
+    :data:`obsdesign.formats.PLOT_SUFFIXES`) or a path
+    :func:`obsdesign.report.model.check_output` refuses (a folder, a link, a device, one of
+    ``inputs``, unless ``force`` where that helps). The API's plots wrote through a link and
+    said "Format 'tmp' is not supported" for a folder or a name without suffix (API review
+    45); the command line's --plot is checked by the same function."""
+    from obsdesign.formats import PLOT_SUFFIXES
+
+    p = Path(_path_arg(path, "plot path"))
+    if p.suffix.lower() not in PLOT_SUFFIXES:
+        raise InputError(
+            f"{p}: unknown plot format {p.suffix or '(no suffix)'!r} "
+            f"(expected one of {', '.join(PLOT_SUFFIXES)})"
+        )
+    check_output(p, force, inputs)
+    return p
+
+
 def _plot_to(path: str | Path, draw: Callable[[Path], Any], atomic: bool) -> Any:
-    """``draw(path)``, through a temp file and a rename when ``atomic``."""
+    """``draw(path)``, through a temp file and a rename when ``atomic`` (the path checked by
+    :func:`check_plot_path` first)."""
     if not atomic:
         return draw(Path(path))
     from obsdesign.report.model import write_via
 
-    return write_via(path, draw)
+    return write_via(check_plot_path(path), draw)
 
 
 __all__ = [

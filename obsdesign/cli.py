@@ -91,20 +91,6 @@ _state = {"debug": False}
 #: ``-`` in place of a spec (or report) path: read it from standard input
 STDIN = "-"
 STDIN_NAME = "<stdin>"
-#: plot formats (matplotlib's savefig, by the file suffix)
-PLOT_SUFFIXES = (
-    ".png",
-    ".svg",
-    ".svgz",
-    ".pdf",
-    ".eps",
-    ".ps",
-    ".jpg",
-    ".jpeg",
-    ".tif",
-    ".tiff",
-    ".webp",
-)
 
 
 class Fmt(StrEnum):

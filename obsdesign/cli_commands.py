@@ -16,7 +16,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-from obsdesign.cli import PLOT_SUFFIXES, STDIN, STDIN_NAME, Fmt
+from obsdesign.cli import STDIN, STDIN_NAME, Fmt
 
 #: -q/--quiet of the running command (kept here, not in :mod:`obsdesign.cli`: run as
 #: ``python obsdesign/cli.py`` that module is ``__main__`` and this one imports a copy)
@@ -170,15 +170,9 @@ def _check_plot(path: Path | None, force: bool, inputs: tuple[Path, ...] = ()) -
     :func:`obsdesign.report.model.check_output` refuses (exit 2)."""
     if path is None:
         return
-    from obsdesign.errors import InputError
-    from obsdesign.report.model import check_output
+    from obsdesign.api import check_plot_path
 
-    if path.suffix.lower() not in PLOT_SUFFIXES:
-        raise InputError(
-            f"{path}: unknown plot format {path.suffix or '(no suffix)'!r} "
-            f"(expected one of {', '.join(PLOT_SUFFIXES)})"
-        )
-    check_output(path, force, inputs)
+    check_plot_path(path, force, inputs)
 
 
 def _write_plot(path: Path, draw: Callable[[Path], Any], force: bool) -> None:

@@ -35,3 +35,37 @@ def test_a_title_with_dollars_plots_as_written(tmp_path: Path, spec: str) -> Non
     r = CliRunner().invoke(app, ["simulate", str(s), "-q", "--plot", str(png)])
     assert r.exit_code == 0, r.output
     assert png.stat().st_size > 1000
+
+
+def test_the_api_plots_check_their_path_and_arguments(tmp_path: Path) -> None:
+    """api.plot_design / plot_simulation checked nothing (API review 45): a folder or a name
+    without suffix said "Format 'tmp' is not supported", an int path was a bare TypeError,
+    a plain dict of parameters an AttributeError, Parameters() a KeyError, and a symbolic
+    link was replaced by a regular file. Each is an InputError now, the link kept; a plot to
+    a new .png is written."""
+    from obsdesign import api
+    from obsdesign.errors import InputError
+    from obsdesign.params import Parameters
+
+    spec = api.load_spec(Path(__file__).resolve().parents[1] / "specs" / "dorea-pimenta-7-1.toml")
+    rep = api.design(spec)
+    (tmp_path / "target.png").write_bytes(b"target")
+    (tmp_path / "link.png").symlink_to(tmp_path / "target.png")
+    for path, match in (
+        (tmp_path, "unknown plot format"),
+        (tmp_path / "noext", "unknown plot format"),
+        (3, "plot path: expected a path"),
+        (tmp_path / "link.png", "symbolic link"),
+    ):
+        with pytest.raises(InputError, match=match):
+            api.plot_design(spec, rep.parameters, path)
+    assert (tmp_path / "target.png").read_bytes() == b"target"
+    assert (tmp_path / "link.png").is_symlink()
+    with pytest.raises(InputError, match="params must be Parameters"):
+        api.plot_design(spec, dict(rep.parameters.items()), tmp_path / "a.png")
+    with pytest.raises(InputError, match="not a design of this spec"):
+        api.plot_design(spec, Parameters(), tmp_path / "a.png")
+    with pytest.raises(InputError, match="result must be a SimResult"):
+        api.plot_simulation(spec, {"t": []}, tmp_path / "s.png")
+    api.plot_design(spec, rep.parameters, tmp_path / "ok.png")
+    assert (tmp_path / "ok.png").stat().st_size > 0
