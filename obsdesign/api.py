@@ -660,8 +660,26 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
         moved = _named_file_differs(rep.spec_file, sha)
         if moved:
             notes.append(moved)
+    other = _other_tool(rep.tool)
+    if other:
+        notes.append(other)
     rep.notes += notes
     return _replace_claims(rep, claims, time.perf_counter() - t0)
+
+
+def _other_tool(tool: Any) -> str | None:
+    """A note when the report's ``tool`` is not this obsdesign's name and version: verify's
+    output kept the input's tool field (any name or version, or ``{}``) beside the claims
+    this tool recomputed, and nothing said which one verified (tamper review 45)."""
+    from obsdesign import __version__
+
+    t = tool if isinstance(tool, dict) else {}
+    if t.get("name") == "obsdesign" and t.get("version") == __version__:
+        return None
+    return (
+        f"verified by obsdesign {__version__}; the report's tool field names the tool that "
+        "made it, as the report states it (not verified)"
+    )
 
 
 def _named_file_differs(spec_file: str, sha: str) -> str | None:

@@ -727,3 +727,27 @@ def test_a_malformed_report_object_is_bad_input_for_verify_and_simulate() -> Non
                 call()
         assert name
     assert api.verify(rep).exit_code() == 0
+
+
+def test_verify_says_which_tool_verified_a_report_of_another_tool() -> None:
+    """verify's output kept the input report's tool field — any name or version, or {} —
+    beside the claims this tool recomputed, with no word of which tool verified (tamper
+    review 45): a note says so when the field is not this obsdesign's; the tool's own
+    reports get no such note."""
+    from obsdesign import __version__
+
+    rep = api.design(SPEC)
+    assert not any(n.startswith("verified by obsdesign") for n in api.verify(rep).notes)
+    for tool in (
+        {},
+        {"name": "obsdesign", "version": "9.9"},
+        {"name": "other", "version": __version__},
+    ):
+        d = json.loads(rep.to_json())
+        d["tool"] = tool
+        r, _ = Report.from_dict(d)
+        ver = api.verify(r)
+        assert ver.exit_code() == 0
+        assert f"verified by obsdesign {__version__}; the report's tool field" in " ".join(
+            ver.notes
+        )
