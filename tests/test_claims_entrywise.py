@@ -54,27 +54,7 @@ TINY = fmpq(1, 2**80)
 #: impulsive with ``lipschitz_x`` data (no shipped spec uses it; the plant of
 #: tests/test_impulsive_soundness.py): M is free and the design takes T = I, so
 #: ‖C‖ = ‖M‖ = ‖P_o‖ = ‖P_n‖ = 1 exactly
-LIPSCHITZ_X = """title = "impulsive, lipschitz_x data"
-[system]
-time = "continuous"
-A = [[0.2, 0.005], [0.5, -3]]
-C = [[1, 0]]
-states = ["x1", "x2"]
-psi = ["0.005*sin(x2)", "0"]
-[nonlinearity]
-lipschitz_x = 0.005
-[nonlinearity.falsify]
-lower = [-2, -2]
-upper = [2, 2]
-samples = 2000
-on_violation = "fail"
-[method]
-key = "impulsive"
-L = [0.8]
-alpha = 3
-noise_bound = 0.1
-kappa = "widest"
-"""
+LIPSCHITZ_X = (ROOT / "tests" / "specs" / "impulsive-lipschitz-x.toml").read_text(encoding="utf-8")
 
 Design = tuple[Spec, Report]
 

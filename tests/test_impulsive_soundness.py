@@ -45,27 +45,8 @@ K = Q("1.9822152")  # the sector ±k of ψ̃_o in the shipped example
 TINY = fmpq(1, 2**100)
 runner = CliRunner()
 
-LIPSCHITZ = """title = "impulsive, lipschitz_x data"
-[system]
-time = "continuous"
-A = [[0.2, 0.005], [0.5, -3]]
-C = [[1, 0]]
-states = ["x1", "x2"]
-psi = ["0.005*sin(x2)", "0"]
-[nonlinearity]
-lipschitz_x = 0.005
-[nonlinearity.falsify]
-lower = [-2, -2]
-upper = [2, 2]
-samples = 2000
-on_violation = "fail"
-[method]
-key = "impulsive"
-L = [0.8]
-alpha = 3
-noise_bound = 0.1
-kappa = "widest"
-"""
+#: impulsive with ``lipschitz_x`` data (also tests/test_claims_entrywise.py)
+LIPSCHITZ = (ROOT / "tests" / "specs" / "impulsive-lipschitz-x.toml").read_text(encoding="utf-8")
 
 
 def example_text(**method: str) -> str:
