@@ -1819,6 +1819,15 @@ def report_dict(report: Report) -> dict[str, Any]:
         odd += [k for k in report.extra_keys if not isinstance(k, str)]
         if odd:
             raise TypeError(f"a key that is not a string: {odd[0]!r}")
+        # the spec text is hashed as UTF-8: a lone surrogate ("\ud800") was a bare
+        # UnicodeEncodeError (a file with one is refused when read; re-check review 45)
+        str(d.get("spec", "")).encode("utf-8")
+        str(d.get("spec_file", "")).encode("utf-8")
+    except UnicodeEncodeError:
+        raise InputError(
+            "report: holds a string that is not valid Unicode (a lone surrogate such as "
+            "\\ud800) in its spec or spec_file"
+        ) from None
     except (TypeError, ValueError, AttributeError, ArithmeticError, KeyError) as e:
         raise InputError(
             f"report: not a well-formed Report object ({type(e).__name__}: {e}); a report "

@@ -202,3 +202,17 @@ def test_the_schema_refuses_the_values_every_loader_refuses() -> None:
     big_seed = text.replace("\n[simulate]\n", f"\n[simulate]\nseed = {2**70}\n", 1)
     jsonschema.validate(tomllib.loads(big_seed), schema)
     api.load_spec_text(big_seed, "seed.toml")
+
+
+def test_the_schema_takes_a_saturation_level_per_state() -> None:
+    """The cap of session 45 limited constrained saturation_r to 2 entries: a 3-state spec
+    with one level per state designs but was invalid under the schema (re-check review 45).
+    Any number of positive levels is valid; the count (1 or n) is the tool's cross-key check."""
+    doc = tomllib.loads(api.template("constrained"))
+    doc.setdefault("simulate", {})["saturation_r"] = [2.0, 2.0, 2.0]
+    errs = [
+        e
+        for e in jsonschema.Draft202012Validator(api.schema()).iter_errors(doc)
+        if "saturation_r" in "/".join(map(str, e.absolute_path))
+    ]
+    assert not errs, [e.message for e in errs]

@@ -421,7 +421,7 @@ def simulate_schema() -> dict[str, Any]:
         "saturation_r": {
             "anyOf": [
                 {**NUM, "exclusiveMinimum": 0},
-                {**VEC, "items": {**NUM, "exclusiveMinimum": 0}, "maxItems": 2},
+                {**VEC, "items": {**NUM, "exclusiveMinimum": 0}},
             ],
             "description": "level r of the saturated observer (29)",
         },
