@@ -983,6 +983,32 @@ def _check_sim_keywords(method: Any, kwargs: dict[str, Any]) -> None:
             kwargs[k] = declared[k].check_value(kwargs[k])
 
 
+def _whole_runs(r: Any) -> int:
+    """``runs`` of :func:`simulate` as an int from 1 to 2^63 − 1, taken as the integer
+    options take theirs: a whole int, float, Decimal, Fraction or 0-d array (runs = 3.0 and
+    Decimal(3) were refused while seed took them; re-check review 45), never a bool; runs=0
+    ran once (``runs or 1``) while the CLI refuses --runs 0 (outsider trial); 10**400 was a
+    bare OverflowError (API review, session 44)."""
+    import math
+
+    from obsdesign.errors import value_text
+    from obsdesign.methods.base import _exact_integer
+
+    v = r.item() if type(r).__name__ == "ndarray" and getattr(r, "ndim", 1) == 0 else r
+    n: int | None = None
+    if isinstance(v, numbers.Integral) and not isinstance(v, bool) and type(v).__name__ != "bool_":
+        n = int(v)
+    elif isinstance(v, float) and math.isfinite(v) and v == int(v):
+        n = int(v)
+    elif type(v).__name__ not in ("bool", "bool_"):
+        n = _exact_integer(v)
+    if n is None or n < 1:
+        raise InputError(f"runs: expected a whole number of runs, at least 1, got {value_text(r)}")
+    if n > INT_MAX:
+        raise InputError(f"runs: expected at most 2^63 − 1 runs, got {value_text(n)}")
+    return n
+
+
 def _sim_part(method: Any) -> Any:
     """The method's ``sim`` module, or None when it has none (a module it imports that is
     missing is raised, as :meth:`Method.simulate` raises it)."""
@@ -1035,11 +1061,8 @@ def simulate(
         )
     kwargs = {**get_method(sp.method).parse_sim_options(options or {}), **kwargs}
     r = kwargs.get("runs")
-    if r is not None and (isinstance(r, bool) or not isinstance(r, numbers.Integral) or r < 1):
-        # runs=0 ran once (``runs or 1``) while the CLI refuses --runs 0 (outsider trial)
-        raise InputError(f"runs: expected a whole number of runs, at least 1, got {r!r}")
-    if r is not None and r > INT_MAX:  # 10**400: a bare OverflowError (API review, session 44)
-        raise InputError(f"runs: expected at most 2^63 − 1 runs, got {r}")
+    if r is not None:
+        kwargs["runs"] = r = _whole_runs(r)
     if sp.simulate is None:
         raise InputError(f"{sp.file}: [simulate] is missing: nothing to simulate")
     check_sim_memory(sp, kwargs)
@@ -1063,8 +1086,10 @@ def simulate(
             or not 1 <= batches <= INT_MAX
         ):
             # 2.5 was a bare TypeError and True one batch (API review, session 44)
+            from obsdesign.errors import value_text
+
             raise InputError(
-                f"batches: expected a whole number from 1 to 2^63 − 1, got {batches!r}"
+                f"batches: expected a whole number from 1 to 2^63 − 1, got {value_text(batches)}"
             )
         so = sp.simulate.options
         if kwargs.get("runs") is None and all(

@@ -34,7 +34,7 @@ from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from typing import Any, TypeVar
 
-from obsdesign.errors import InputError
+from obsdesign.errors import InputError, value_text
 
 T = TypeVar("T")
 R = TypeVar("R")
@@ -87,11 +87,14 @@ def check_workers(workers: int | None, scheduler: str | None) -> None:
             f"--scheduler: expected an address such as tcp://HOST:8786, got {scheduler!r}"
         )
     if workers is not None and workers < 1:
-        raise InputError(f"--workers: expected a positive number of processes, got {workers}")
+        raise InputError(
+            f"--workers: expected a positive number of processes, got {value_text(workers)}"
+        )
     if workers is not None and workers > MAX_LOCAL_WORKERS:
         # 100,000 local processes were still starting after 120 s (CLI fuzzer)
         raise InputError(
-            f"--workers: {workers} processes on this machine is above {MAX_LOCAL_WORKERS} "
+            f"--workers: {value_text(workers)} processes on this machine is above "
+            f"{MAX_LOCAL_WORKERS} "
             f"(4 × its {os.cpu_count() or 1} CPUs, at least 64); for more, start a Dask "
             "cluster and give --scheduler"
         )

@@ -206,3 +206,12 @@ def json_safe(o: Any, default: Callable[[Any], Any] | None = None) -> Any:
     if default is None:
         return o
     return json_safe(default(o), None)
+
+
+def value_text(v: Any) -> str:
+    """``repr(v)`` for a message, an integer of 100 digits or more as :func:`count_text`
+    shortens it: repr of an int past Python's 4,300-digit limit is itself a ValueError
+    (``seed=10**4301`` was a bare ValueError from the message; re-check review 45)."""
+    if isinstance(v, int) and not isinstance(v, bool) and abs(v) >= 10**99:
+        return count_text(v)
+    return repr(v)

@@ -463,10 +463,11 @@ def test_a_thin_set_that_a_run_cannot_draw_from_is_named(monkeypatch) -> None:
         api.simulate(sp)
 
 
-@pytest.mark.parametrize("runs", [0, -3, 2.0, True])
+@pytest.mark.parametrize("runs", [0, -3, 2.5, True])
 def test_the_api_refuses_a_run_count_below_one_or_not_whole(runs: object) -> None:
     """``simulate(spec, runs=0)`` ran once (``runs or 1``) while the CLI refuses ``--runs 0``
-    (outsider trial, session 22): a run count is a whole number ≥ 1 (numpy integers too)."""
+    (outsider trial, session 22): a run count is a whole number ≥ 1 (numpy integers too;
+    since session 45 also a whole float such as 2.0, as the integer options take theirs)."""
     from obsdesign import api
     from obsdesign.errors import InputError
 
@@ -676,3 +677,34 @@ def test_span_and_client_keywords_are_checked() -> None:
         api.simulate(spec, runs=3, client=object())
     res = api.simulate(spec, runs=5, span=(np.int64(1), np.int64(3)))
     assert res.info["span"] == [1, 3]
+
+
+def test_runs_take_whole_values_as_the_integer_options_do_and_huge_ints_are_named() -> None:
+    """runs = Decimal(3), Fraction(3), 3.0 and a 0-d array were refused while seed took them,
+    and an int past Python's 4,300-digit text limit (seed, runs, span, batches) was a bare
+    ValueError from the message itself (re-check review 45). runs take whole values of any
+    real type, never a bool; a huge int is named by its digit count; a huge seed runs."""
+    from decimal import Decimal
+    from fractions import Fraction
+
+    from obsdesign import api
+    from obsdesign.errors import InputError
+
+    spec = api.load_spec(
+        Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+    )
+    for runs in (Decimal(3), Fraction(3), 3.0, np.array(3), np.int64(3)):
+        assert api.simulate(spec, runs=runs).info["runs"] == 3
+    for runs in (True, 2.5, Decimal("3.5"), 0, "3x"):
+        with pytest.raises(InputError, match="runs: expected a whole number of runs"):
+            api.simulate(spec, runs=runs)
+    with pytest.raises(
+        InputError, match="runs: expected at most 2.63 − 1 runs, got a number of about 4301 digits"
+    ):
+        api.simulate(spec, runs=10**4301)
+    with pytest.raises(InputError, match=r"span: expected 0 <= a < b <= 4, got \(0, a number of"):
+        api.simulate(spec, runs=4, span=(0, 10**5000))
+    imp = api.load_spec(
+        spec.file.replace("constrained-redesign-sec5-lyapunov", "schaum-impulsive-example")
+    )
+    assert api.simulate(imp, runs=2, seed=10**4301).info["runs"] == 2

@@ -41,7 +41,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING, Any, ClassVar
 
-from obsdesign.errors import InputError
+from obsdesign.errors import InputError, value_text
 from obsdesign.limits import INT_MAX
 
 if TYPE_CHECKING:
@@ -273,11 +273,13 @@ class SimOption:
         ):
             out = Path(v)
         else:
-            raise InputError(f"{what}: expected {_KIND[self.kind]}, got {v!r}")
+            raise InputError(f"{what}: expected {_KIND[self.kind]}, got {value_text(v)}")
         if self.kind in ("int", "float"):
-            self._in_range(what, out, repr(v), repr(v))
+            self._in_range(what, out, value_text(v), value_text(v))
         elif self.choices is not None and out not in self.choices:
-            raise InputError(f"{what}: expected one of {', '.join(self.choices)}, got {v!r}")
+            raise InputError(
+                f"{what}: expected one of {', '.join(self.choices)}, got {value_text(v)}"
+            )
         return out
 
 

@@ -429,7 +429,11 @@ def study(
         raise InputError(f"span: expected a pair of whole numbers (a, b), got {span!r}")
     first, last = (int(span[0]), int(span[1])) if span is not None else (0, runs)
     if not 0 <= first < last <= runs:
-        raise InputError(f"span: expected 0 <= a < b <= {runs}, got ({first}, {last})")
+        from obsdesign.errors import value_text
+
+        raise InputError(
+            f"span: expected 0 <= a < b <= {runs}, got ({value_text(first)}, {value_text(last)})"
+        )
     if initial_error is not None and initial_error not in spec.sets:
         raise InputError(f"{spec.file}: initial_error = {initial_error!r} is not in [sets]")
     eset = spec.sets[initial_error] if initial_error is not None else None
