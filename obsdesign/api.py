@@ -2105,12 +2105,17 @@ def schema() -> dict[str, Any]:
 
 @_numpy_defaults
 def plot_design(
-    spec: str | Path | Spec, params: Parameters, path: str | Path, atomic: bool = True
+    spec: str | Path | Spec,
+    params: Parameters,
+    path: str | Path,
+    atomic: bool = True,
+    force: bool = False,
 ) -> Any:
     """The method's design plot of ``spec`` with ``params`` (a report's parameters), written
     to ``path`` (InputError when the method has none): atomically (temp file and rename,
     :func:`obsdesign.report.model.write_via`), or with ``atomic=False`` straight into
-    ``path`` (for a caller that made it a temp file, FIFO or device itself)."""
+    ``path`` (for a caller that made it a temp file, FIFO or device itself). ``force``: as
+    ``--force`` of ``--plot`` (a write-protected file or a link replaced)."""
     sp = _spec(spec)
     if not isinstance(params, Parameters):  # a plain dict was a bare AttributeError (45)
         raise InputError(
@@ -2131,15 +2136,20 @@ def plot_design(
                 f"{type(e).__name__}: {e})"
             ) from None
 
-    return _plot_to(path, drawn, atomic)
+    return _plot_to(path, drawn, atomic, force)
 
 
 @_numpy_defaults
 def plot_simulation(
-    spec: str | Path | Spec, result: SimResult, path: str | Path, atomic: bool = True
+    spec: str | Path | Spec,
+    result: SimResult,
+    path: str | Path,
+    atomic: bool = True,
+    force: bool = False,
 ) -> Any:
     """The method's simulation plot of ``spec`` and ``result`` written to ``path``, or the
-    generic one (estimation error over time); ``atomic`` as for :func:`plot_design`."""
+    generic one (estimation error over time); ``atomic`` and ``force`` as for
+    :func:`plot_design`."""
     from obsdesign.simulate.result import SimResult
 
     sp = _spec(spec)
@@ -2161,7 +2171,7 @@ def plot_simulation(
             return plot_result(result, p, title=sp.title or sp.file)
 
     try:
-        return _plot_to(path, draw, atomic)
+        return _plot_to(path, draw, atomic, force)
     except (ValueError, OverflowError) as e:
         # matplotlib's tick locator fails on data near the float limit (x0 = 1.7e308, or a
         # run that diverges there): "internal failure: arange: cannot compute length", exit 3
@@ -2207,14 +2217,16 @@ def check_plot_path(path: str | Path, force: bool = False, inputs: tuple[Path, .
     return p
 
 
-def _plot_to(path: str | Path, draw: Callable[[Path], Any], atomic: bool) -> Any:
+def _plot_to(
+    path: str | Path, draw: Callable[[Path], Any], atomic: bool, force: bool = False
+) -> Any:
     """``draw(path)``, through a temp file and a rename when ``atomic`` (the path checked by
-    :func:`check_plot_path` first)."""
+    :func:`check_plot_path` first, ``force`` as its)."""
     if not atomic:
         return draw(Path(path))
     from obsdesign.report.model import write_via
 
-    return write_via(check_plot_path(path), draw)
+    return write_via(check_plot_path(path, force), draw, force)
 
 
 __all__ = [

@@ -69,3 +69,12 @@ def test_the_api_plots_check_their_path_and_arguments(tmp_path: Path) -> None:
         api.plot_simulation(spec, {"t": []}, tmp_path / "s.png")
     api.plot_design(spec, rep.parameters, tmp_path / "ok.png")
     assert (tmp_path / "ok.png").stat().st_size > 0
+    # a write-protected file: refused, and replaced with force=True (the API had no force
+    # while the check said "(--force)"; re-check review 45)
+    ro = tmp_path / "ro.png"
+    ro.write_bytes(b"old")
+    ro.chmod(0o444)
+    with pytest.raises(InputError, match="write-protected"):
+        api.plot_design(spec, rep.parameters, ro)
+    api.plot_design(spec, rep.parameters, ro, force=True)
+    assert ro.read_bytes() != b"old"
