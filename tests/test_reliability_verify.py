@@ -725,7 +725,9 @@ def test_a_malformed_report_object_is_bad_input_for_verify_and_simulate() -> Non
     }
     for name, r in odd.items():
         for call in (lambda r=r: api.verify(r), lambda r=r: api.simulate(sp, r)):
-            with pytest.raises(InputError, match="report: (not a well-formed|holds a string)"):
+            with pytest.raises(
+                InputError, match="report: (not a well-formed|its spec holds a string)"
+            ):
                 call()
         assert name
     assert api.verify(rep).exit_code() == 0
