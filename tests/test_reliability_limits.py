@@ -756,3 +756,19 @@ def test_a_callers_numpy_error_setting_neither_breaks_nor_leaks() -> None:
         }
     finally:
         np.seterr(**old)
+
+
+def test_an_exponent_past_the_decimal_readers_range_is_bad_input() -> None:
+    """``0.1e+99999999999999999999`` in a spec was exit 3 "internal failure: InvalidOperation"
+    naming no file (Decimal's own exponent range; CLI review 45): exit 2 naming the file,
+    line and key; an exponent of 10^18 − 1 was already refused so."""
+    from obsdesign import api
+    from obsdesign.errors import SpecError
+
+    base = '[system]\ntime = "discrete"\nA = [[{a}]]\nC = [[1]]\n[method]\nkey = "lyapunov"\n'
+    for a in ("0.1e+99999999999999999999", "1e-99999999999999999999", "1e999999999999999999"):
+        with pytest.raises(
+            SpecError, match=r"h\.toml: \[(line 3, key A|system\.A\[0\]\[0\])\] has .*exponent"
+        ) as ei:
+            api.load_spec_text(base.format(a=a), "h.toml")
+        assert ei.value.exit_code == 2

@@ -187,6 +187,14 @@ def _parse_toml_fresh(text: str, file: str) -> dict[str, Any]:
         ) from None
     except ValueError:  # an integer beyond Python's int-string limit (4300 digits)
         raise SpecError(file, _long_number_line(text), _too_many_digits()) from None
+    except ArithmeticError:
+        # decimal.InvalidOperation: an exponent past Decimal's own range (0.1e+10^20) was
+        # exit 3 "internal failure: InvalidOperation" naming no file (CLI review 45)
+        raise SpecError(
+            file,
+            _line_of(text, r"[eE][+-]?[\d_]{19,}"),
+            f"has a number whose exponent is beyond ±{limits().max_exponent} (max_exponent)",
+        ) from None
     bad = data_problem(data)
     if bad is not None:
         raise SpecError(file, bad[0], bad[1])
@@ -199,7 +207,12 @@ def _too_many_digits() -> str:
 
 def _long_number_line(text: str) -> str:
     """'line N (key K)' of the first run of digits longer than the digit limit."""
-    m = re.search(r"\d[\d_]{" + str(limits().max_digits) + ",}", text)
+    return _line_of(text, r"\d[\d_]{" + str(limits().max_digits) + ",}")
+
+
+def _line_of(text: str, pattern: str) -> str:
+    """'line N, key K' of the first match of ``pattern`` in ``text`` ('' when none)."""
+    m = re.search(pattern, text)
     if m is None:
         return ""
     line_no = text.count("\n", 0, m.start()) + 1
