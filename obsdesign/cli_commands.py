@@ -217,9 +217,12 @@ def _print_sweep(rows: list[dict[str, Any]], fmt: Fmt) -> None:
         return
     from rich.table import Table
 
+    from obsdesign.errors import escape_controls
     from obsdesign.report.render import console, esc
 
-    cells = [[_sweep_cell(r.get(c)) for c in cols] for r in rows]
+    # control characters as escapes in both layouts: the paragraphs printed an ESC colour
+    # sequence of a swept value raw, and a newline broke them (CLI review 45)
+    cells = [[escape_controls(_sweep_cell(r.get(c))) for c in cols] for r in rows]
     # every column whole at its widest (header and values), the message at least
     # CHECK_RESULT_MIN, and the borders: below that rich folded headers and values mid-word
     # ("metho / d.lam / bda", "faile / d" at --width 40; CLI review 44) or cropped the

@@ -945,3 +945,25 @@ def test_the_api_names_a_bad_spec_or_grid_argument() -> None:
     rows = sw.sweep_rows(SPEC, (t for t in ["method.lambda=[0.96, 0.97]"]))
     assert [r["exit_code"] for r in rows] == [0, 0]
     assert len(sw.sweep_rows(SPEC, "method.lambda=0.96")) == 1
+
+
+@pytest.mark.parametrize("width", [40, 250])
+def test_control_characters_of_a_swept_value_are_escapes_in_both_layouts(width: int) -> None:
+    """The paragraph layout printed a swept title's ESC colour sequence raw (it reached the
+    terminal) and its newline broke the paragraph (CLI review 45); the table escaped them.
+    Both layouts print them as escapes now."""
+    r = runner.invoke(
+        app,
+        [
+            "sweep",
+            str(SPEC),
+            "--set",
+            'title=["red \\u001b[31mX\\u001b[0m and\\nnew"]',
+            "--set",
+            "method.lambda=[0.96]",
+            "--width",
+            str(width),
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    assert "\x1b" not in r.stdout and "red \\x1b[31mX\\x1b[0m and\\nnew" in r.stdout, r.stdout
