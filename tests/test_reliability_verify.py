@@ -755,3 +755,17 @@ def test_verify_says_which_tool_verified_a_report_of_another_tool() -> None:
         assert f"verified by obsdesign {__version__}; the report's tool field" in " ".join(
             ver.notes
         )
+
+
+def test_the_not_verified_note_names_at_most_fifty_parameters() -> None:
+    """A report with 100,000 unread parameters made verify's "not verified" note ~14,000
+    lines (CLI review 45): it names the first NOTE_NAMES and counts the rest."""
+    rep = api.design(SPEC)
+    d = json.loads(rep.to_json())
+    d["parameters"].update({f"extra_{i}": i for i in range(60)})
+    r, _ = Report.from_dict(d)
+    ver = api.verify(r)
+    note = next(n for n in ver.notes if n.startswith("not verified (no check reads them"))
+    unread = len(ver.unverified)
+    assert unread > api.NOTE_NAMES == 50
+    assert note.endswith(f" and {unread - 50:,} more") and "extra_59" not in note, note

@@ -219,3 +219,5 @@ def test_a_report_with_thousands_of_claims_prints_the_failed_ones_and_counts_the
     rep.parameters = Parameters({f"extra{i}": float(i) for i in range(20)})
     out = _rendered(monkeypatch, rep)
     assert "… 8 more parameters not shown (--format json or md lists every one)" in out
+    # the rows past the cap are not built (100,000 parameters took 54 s; CLI review 45)
+    assert len(render._param_rows(rep, 3)) == 3 and len(render._param_rows(rep)) == 20
