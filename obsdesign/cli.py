@@ -994,16 +994,34 @@ def _completion_extra(args: list[str]) -> str | None:
     """The error for ``--install-completion`` / ``--show-completion`` given with anything
     else: typer's flags take no value and act at once, so ``--install-completion tcsh``
     installed bash completion, exit 0, the shell name silently dropped (CLI review 44)."""
-    flags = [a for a in args if a in ("--install-completion", "--show-completion")]
-    others = [a for a in args if a not in flags]
-    if not flags or not others:
+    before = args[: args.index("--")] if "--" in args else args  # after --: file names
+    flags = [a for a in before if a in ("--install-completion", "--show-completion")]
+    if not flags:
         return None
     from obsdesign.errors import one_line
 
-    return one_line(
-        f"{flags[0]} takes no argument (got {others[0]!r}): it acts for the shell it runs in "
-        "(bash, zsh, fish or PowerShell); run it alone from that shell"
-    )
+    others = [a for a in args if a not in flags]
+    if others or len(flags) > 1:
+        # --install-completion --show-completion together installed silently (CLI review 45)
+        got = others[0] if others else flags[1]
+        return one_line(
+            f"{flags[0]} takes no argument (got {got!r}): it acts for the shell it runs in "
+            "(bash, zsh, fish or PowerShell); run it alone from that shell"
+        )
+    # typer says "Shell sh not supported." and exits 1, the code of a failed claim (CLI
+    # review 45): the shell is looked at first, exit 2 naming it
+    try:
+        from typer._completion_shared import _get_shell_name
+
+        shell = _get_shell_name()
+    except Exception:  # noqa: BLE001 - typer's private helper moved: typer decides
+        return None
+    if shell not in ("bash", "zsh", "fish", "powershell", "pwsh"):
+        return one_line(
+            f"{flags[0]}: the shell here is {shell or 'unknown'!r}; completion is for bash, "
+            "zsh, fish and PowerShell: run it from one of them"
+        )
+    return None
 
 
 def main() -> None:

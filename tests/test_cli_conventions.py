@@ -582,6 +582,7 @@ def test_an_os_error_naming_a_file_outside_a_command_names_that_file(
         ["--install-completion", "tcsh"],
         ["--show-completion", "nushell"],
         ["design", "x.toml", "--show-completion"],
+        ["--install-completion", "--show-completion"],  # installed silently (CLI review 45)
     ],
 )
 def test_a_completion_flag_with_anything_else_is_bad_input(
@@ -599,9 +600,43 @@ def test_a_completion_flag_with_anything_else_is_bad_input(
         cli.main()
     assert e.value.code == 2 and not ran
     err = capsys.readouterr().err
-    other = next(a for a in argv if not a.endswith("-completion"))
+    other = next((a for a in argv if not a.endswith("-completion")), argv[1])
     assert err.startswith("obsdesign: error: --") and repr(other) in err, err
     assert err.count("\n") == 1
+
+
+def test_completion_is_for_its_shells_and_a_file_after_dash_dash_is_a_file(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
+) -> None:
+    """From sh, typer said "Shell sh not supported." and exited 1, a failed claim's code
+    (the install variant on stdout); a spec file named ``--show-completion`` given after
+    ``--`` was refused as the flag (CLI review 45). The shell is named, exit 2; after ``--``
+    the name is a file's; from bash the flag runs."""
+    import typer._completion_shared as shared
+
+    from obsdesign import cli
+
+    ran: list[object] = []
+    monkeypatch.setattr(cli, "app", lambda *a, **k: ran.append(a))
+    for shell, argv, code in (
+        ("sh", ["--show-completion"], 2),
+        (None, ["--install-completion"], 2),
+        ("bash", ["--show-completion"], None),
+        ("sh", ["design", "--", "--show-completion"], None),
+    ):
+        monkeypatch.setattr(shared, "_get_shell_name", lambda s=shell: s)
+        monkeypatch.setattr(sys, "argv", ["obsdesign", *argv])
+        ran.clear()
+        if code is None:
+            with pytest.raises(SystemExit):
+                cli.main()
+            assert ran, argv
+            continue
+        with pytest.raises(SystemExit) as e:
+            cli.main()
+        assert e.value.code == 2 and not ran
+        err = capsys.readouterr().err
+        assert f"the shell here is {shell or 'unknown'!r}" in err, err
 
 
 def test_dot_slash_dash_in_a_removed_folder_is_no_traceback(tmp_path: Path) -> None:
