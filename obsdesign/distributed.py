@@ -130,9 +130,15 @@ def _check_port(scheduler: str) -> None:
     scheme, location = scheduler.split("://", 1)
     if scheme not in ("tcp", "tls", "ws", "wss") or ":" not in location:
         return
-    port = location.rsplit(":", 1)[1].split("/", 1)[0]
+    host_port = location.split("/", 1)[0]
+    if host_port.endswith("]") or ":" not in host_port:  # [::1] with no port: Dask says so
+        return
+    port = host_port.rsplit(":", 1)[1]
+    if not (port.isascii() and port.isdigit()):
+        # -1, +99999, 9_9999 passed to the 20 s probe (CLI review 45)
+        raise InputError(f"--scheduler {scheduler}: port {port!r} is not a number from 1 to 65535")
     digits = port.lstrip("0")
-    if port.isascii() and port.isdigit() and (len(digits) > 5 or not 0 < int(digits or 0) <= 65535):
+    if len(digits) > 5 or not 0 < int(digits or 0) <= 65535:
         raise InputError(f"--scheduler {scheduler}: port {port} is outside 1-65535")
 
 

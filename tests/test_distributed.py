@@ -389,7 +389,18 @@ def test_a_scheduler_port_out_of_range_is_bad_input_at_once(port: str) -> None:
 
     with pytest.raises(InputError, match=r"port .* is outside 1-65535"):
         check_workers(None, f"tcp://127.0.0.1:{port}")
-    for ok in ("tcp://127.0.0.1:65535", "tls://[::1]:1", "tcp://host:08786", "inproc://x:99999"):
+    # signs, underscores and other non-digits too (they waited the probe: CLI review 45)
+    for bad in ("-1", "+99999", "9_9999", "８７８６", "x"):
+        with pytest.raises(InputError, match=r"is not a number from 1 to 65535"):
+            check_workers(None, f"tcp://127.0.0.1:{bad}")
+    for ok in (
+        "tcp://127.0.0.1:65535",
+        "tls://[::1]:1",
+        "tcp://host:08786",
+        "inproc://x:99999",
+        "tcp://[::1]",
+        "tcp://host:8786/path",
+    ):
         check_workers(None, ok)
 
 
