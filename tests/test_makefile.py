@@ -139,3 +139,24 @@ def test_a_virtualenv_without_pip_is_made_again(tmp_path: Path) -> None:
         assert r.returncode == 0, r.stderr
         got = log.read_text().splitlines() if log.exists() else []
         assert got == want, (pip_ok, got)
+
+
+def test_a_dry_run_without_make_installs_nothing(tmp_path: Path) -> None:
+    """``sh make.sh -n test`` on a machine without make ran apt-get to install make before
+    the dry run (CLI review 45): exit 2 saying so, apt-get never called."""
+    log = tmp_path / "calls.log"
+    bin_ = _stubs(
+        tmp_path,
+        {"apt-get": f'echo "apt-get $*" >> {log}', "sudo": 'exec "$@"'},
+        ("id", "env", "dirname"),
+    )
+    sh = shutil.which("sh")
+    assert sh is not None
+    for flag in ("-n", "--dry-run"):
+        r = subprocess.run(
+            [sh, str(ROOT / "make.sh"), flag, "test"],
+            env={"PATH": str(bin_), "HOME": str(tmp_path)},
+            capture_output=True,
+            text=True,
+        )
+        assert r.returncode == 2 and "a dry run" in r.stderr and not log.exists(), r.stderr
