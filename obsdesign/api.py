@@ -1437,6 +1437,16 @@ class CheckRow:
     claims: list[dict[str, Any]] = field(default_factory=list)
 
 
+def _empty_folder(p: Path) -> bool:
+    """Whether ``p`` is a readable folder (not under /proc or /sys) with no spec file under
+    it: :func:`spec_files` gives such a folder as itself, a row of check's saying so (`check
+    EMPTY good.toml` dropped it and said ok; CLI review 45)."""
+    try:
+        return p.is_dir() and not kernel_dir(p) and os.access(p, os.R_OK) and not _toml_files(p)
+    except OSError:
+        return False
+
+
 def spec_files(paths: list[str | Path] | str | Path) -> list[Path]:
     """Expand the folders among ``paths`` to their ``*.toml`` files, subfolders included (sorted; hidden
     folders skipped); keep files as given, each file once (by its real path). One path (a
@@ -1452,7 +1462,9 @@ def spec_files(paths: list[str | Path] | str | Path) -> list[Path]:
         except OSError:  # a name too long: its own row says so (exit 3, no rows; session 44)
             folder = False
         if folder and not kernel_dir(p):  # /proc, /sys: one row saying so (not walked)
-            out += _toml_files(p)
+            # a folder with no spec is a row of its own saying so: `check EMPTY good.toml`
+            # dropped it and said ok, while `check EMPTY` is exit 2 (CLI review 45)
+            out += _toml_files(p) or [p]
         else:
             out.append(p)
     # one row per file: "check d d/ d/a.toml" checked and counted d's specs twice (outsider
@@ -1822,6 +1834,10 @@ def check_one(path: Path, timeout: float | None = None) -> CheckRow:
     timeout = budget_seconds(timeout)
     t0 = time.perf_counter()
     seen = ["?"]  # the method, once the spec is loaded
+    if _empty_folder(path):
+        return _error_row(
+            path, "?", EXIT_BAD_INPUT, t0, f"{path}: a folder with no spec files (*.toml)"
+        )
     try:
         with _time_budget(timeout):
             return _check_one(path, t0, seen)
@@ -1980,7 +1996,7 @@ def check(
         # refused '' (re-check trial, session 34)
         raise InputError("check: an empty path (an unset variable?): give a file or folder")
     files = spec_files(paths)
-    if not files:
+    if not files or all(_empty_folder(f) for f in files):
         raise InputError(f"no spec files (*.toml) in {', '.join(map(str, paths))}")
     if workers is None and scheduler is None and client is None:
         rows = []

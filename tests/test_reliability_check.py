@@ -325,9 +325,13 @@ def test_a_very_deep_folder_costs_no_other_row(tmp_path: Path) -> None:
     shutil.copy(SPEC, good / "s.toml")
     _deep_folder(tmp_path / "deep", 1100)
     try:
-        res = runner.invoke(app, ["check", str(good), str(tmp_path / "deep"), "-q"])
-        assert res.exit_code == 0, res.output
-        assert api.spec_files([good, tmp_path / "deep"]) == [good / "s.toml"]
+        res = runner.invoke(app, ["check", str(good), str(tmp_path / "deep"), "--format", "json"])
+        # the good spec keeps its row; the deep folder, holding no spec, is a row of its own
+        # saying so since session 45 (an empty folder beside a spec was dropped silently)
+        rows = json.loads(res.stdout)
+        assert [r["code"] for r in rows] == [0, 2], res.output
+        assert rows[1]["message"].endswith("a folder with no spec files (*.toml)")
+        assert api.spec_files([good, tmp_path / "deep"]) == [good / "s.toml", tmp_path / "deep"]
     finally:
         _remove_deep_folder(tmp_path / "deep")
     assert not (tmp_path / "deep").exists()
@@ -1195,3 +1199,22 @@ def test_a_report_with_long_exact_values_is_checked_and_its_design_warns(tmp_pat
     rep = api.design(sp)
     assert api.verify(rep).exit_code() == 0
     assert api.simulate(sp, rep).metrics()
+
+
+def test_an_empty_folder_beside_a_spec_is_a_row_saying_so(tmp_path: Path) -> None:
+    """``check EMPTY good.toml`` dropped the empty folder and said ok, exit 0, while ``check
+    EMPTY`` alone is exit 2 "no spec files" (CLI review 45): the folder is a row of its
+    own, exit 2, saying it holds no spec; alone it is still the one-line refusal."""
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    good = tmp_path / "good.toml"
+    shutil.copy(SPEC, good)
+    rows = api.check([empty, good])
+    assert [r.code for r in rows] == [2, 0]
+    assert rows[0].message == f"{empty}: a folder with no spec files (*.toml)"
+    res = runner.invoke(app, ["check", str(empty), str(good), "-q"])
+    assert res.exit_code == 2
+    from obsdesign.errors import InputError
+
+    with pytest.raises(InputError, match="no spec files"):
+        api.check([empty])
