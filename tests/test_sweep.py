@@ -967,3 +967,13 @@ def test_control_characters_of_a_swept_value_are_escapes_in_both_layouts(width: 
     )
     assert r.exit_code == 0, r.output
     assert "\x1b" not in r.stdout and "red \\x1b[31mX\\x1b[0m and\\nnew" in r.stdout, r.stdout
+
+
+def test_a_swept_value_past_the_float_range_is_its_literal() -> None:
+    """A swept 1e400 was recorded as inf in the rows (text, json, csv), a real inf point's
+    look (CLI review 45): the cell is the literal as written; inf itself stays inf."""
+    assert sw._value("1e400") == "1e400" and sw._value("-1e400") == "-1e400"
+    assert sw._value("inf") == float("inf") and sw._value("0.5") == 0.5
+    rows = sw.sweep_rows(SPEC, ["method.lambda=[1e400, 0.96]"])
+    assert rows[0]["method.lambda"] == "1e400" and rows[0]["exit_code"] == 2
+    assert rows[1]["method.lambda"] == 0.96 and rows[1]["exit_code"] == 0
