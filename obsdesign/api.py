@@ -2233,6 +2233,8 @@ def check_plot_path(path: str | Path, force: bool = False, inputs: tuple[Path, .
     from obsdesign.formats import PLOT_SUFFIXES
 
     p = Path(_path_arg(path, "plot path"))
+    if p.is_dir():  # "is a directory", not "unknown plot format" (CLI review 45)
+        check_output(p, force, inputs)
     if p.suffix.lower() not in PLOT_SUFFIXES:
         raise InputError(
             f"{p}: unknown plot format {p.suffix or '(no suffix)'!r} "

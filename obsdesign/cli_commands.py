@@ -1113,6 +1113,8 @@ def _dt_seconds(text: str) -> Any:
     # said "--dt inf"; CLI review, session 42)
     # the sign of the exact value: −1e-400 rounds to −0.0, which passed "f >= 0" and wrote
     # continuous time (re-check review, session 43)
+    if q.is_finite() and not math.isfinite(f):
+        raise InputError(f"--dt {text!r}: beyond the float range")  # it said "not finite" (45)
     if not (q.is_finite() and math.isfinite(f) and (q >= 0 or q == -1)):
         raise InputError(
             f"--dt {text!r}: expected a finite number >= 0 (0: continuous time), or exactly -1 "

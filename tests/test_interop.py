@@ -409,8 +409,9 @@ def test_lists_of_tables_and_missing_values() -> None:
         ({"ts": 5e-324}, ["--dt-var", "ts"], "'ts' (the sample time) is 5e-324, a nonzero", True),
         ({}, ["--dt", "1e-320"], "--dt is 1e-320, a nonzero number below", False),
         ({}, ["--dt", "inf"], "--dt 'inf': expected a finite number", False),
-        # the text as typed: 1e999 said "--dt inf" (CLI review, session 42)
-        ({}, ["--dt", "1e999"], "--dt '1e999': expected a finite number", False),
+        # the text as typed: 1e999 said "--dt inf" (CLI review, session 42), and "expected a
+        # finite number" of a finite text past the float range (CLI review 45)
+        ({}, ["--dt", "1e999"], "--dt '1e999': beyond the float range", False),
         ({}, ["--dt", "-2"], "--dt '-2': expected a finite number >= 0", False),
         # −1e-400 rounds to −0.0: it passed as continuous time (session 43)
         ({}, ["--dt", "-1e-400"], "--dt '-1e-400': expected a finite number >= 0", False),
@@ -1148,6 +1149,9 @@ def test_an_exact_dt_is_written_as_given(tmp_path: Path) -> None:
     assert r.exit_code == 0 and "sample_time = 0.1000000000000000000001\n" in r.stdout, r.output
     r = CliRunner().invoke(app, ["import", str(mat), "--dt", "1e-310"])
     assert r.exit_code == 2 and "--dt is 1e-310, a nonzero number below" in r.stderr, r.output
+    # past the float range it said "expected a finite number" (CLI review 45)
+    r = CliRunner().invoke(app, ["import", str(mat), "--dt", "1e400"])
+    assert r.exit_code == 2 and "--dt '1e400': beyond the float range" in r.stderr, r.output
 
 
 def test_table_names_are_quoted_keys() -> None:

@@ -52,7 +52,7 @@ def test_the_api_plots_check_their_path_and_arguments(tmp_path: Path) -> None:
     (tmp_path / "target.png").write_bytes(b"target")
     (tmp_path / "link.png").symlink_to(tmp_path / "target.png")
     for path, match in (
-        (tmp_path, "unknown plot format"),
+        (tmp_path, "is a directory"),  # it said "unknown plot format" (CLI review 45)
         (tmp_path / "noext", "unknown plot format"),
         (3, "plot path: expected a path"),
         (tmp_path / "link.png", "symbolic link"),
