@@ -2233,7 +2233,11 @@ def check_plot_path(path: str | Path, force: bool = False, inputs: tuple[Path, .
     from obsdesign.formats import PLOT_SUFFIXES
 
     p = Path(_path_arg(path, "plot path"))
-    if p.is_dir():  # "is a directory", not "unknown plot format" (CLI review 45)
+    try:
+        folder = p.is_dir()
+    except OSError:  # a name too long, a folder not searchable: check_output names it
+        folder = False
+    if folder:  # "is a directory", not "unknown plot format" (CLI review 45)
         check_output(p, force, inputs)
     if p.suffix.lower() not in PLOT_SUFFIXES:
         raise InputError(

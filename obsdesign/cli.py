@@ -994,7 +994,10 @@ def _completion_extra(args: list[str]) -> str | None:
     """The error for ``--install-completion`` / ``--show-completion`` given with anything
     else: typer's flags take no value and act at once, so ``--install-completion tcsh``
     installed bash completion, exit 0, the shell name silently dropped (CLI review 44)."""
-    before = args[: args.index("--")] if "--" in args else args  # after --: file names
+    # after `--` an argument is a file name, but only once a command came before it: with
+    # none, click reads `-- --install-completion` as the flag (re-check review 45)
+    cut = args.index("--") if "--" in args else len(args)
+    before = args[:cut] if any(not a.startswith("-") for a in args[:cut]) else args
     flags = [a for a in before if a in ("--install-completion", "--show-completion")]
     if not flags:
         return None

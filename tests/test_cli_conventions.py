@@ -583,6 +583,7 @@ def test_an_os_error_naming_a_file_outside_a_command_names_that_file(
         ["--show-completion", "nushell"],
         ["design", "x.toml", "--show-completion"],
         ["--install-completion", "--show-completion"],  # installed silently (CLI review 45)
+        ["--", "--install-completion"],  # no command before --: click reads the flag (45)
     ],
 )
 def test_a_completion_flag_with_anything_else_is_bad_input(

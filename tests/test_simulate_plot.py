@@ -56,6 +56,8 @@ def test_the_api_plots_check_their_path_and_arguments(tmp_path: Path) -> None:
         (tmp_path / "noext", "unknown plot format"),
         (3, "plot path: expected a path"),
         (tmp_path / "link.png", "symbolic link"),
+        # a name too long was a bare OSError from is_dir (re-check review 45)
+        (tmp_path / ("a" * 300 + ".png"), "cannot write"),
     ):
         with pytest.raises(InputError, match=match):
             api.plot_design(spec, rep.parameters, path)
