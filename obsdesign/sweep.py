@@ -951,6 +951,10 @@ def plot_groups(
             yv = float(r[y]) if r.get(y) is not None and r.get("exit_code") == 0 else math.nan
         except (TypeError, ValueError, KeyError):
             continue
+        if not math.isfinite(xv):
+            # a swept 1e400 or inf has no place on the axis: matplotlib's limits were an
+            # internal failure, exit 3, no table (re-check review 45)
+            continue
         groups.setdefault(g, []).append((xv, yv))
     return groups
 
@@ -960,9 +964,11 @@ def _x_codes(rows: list[dict[str, Any]], x: str) -> list[tuple[float, Any]]:
     out = []
     for r in rows:
         try:
-            out.append((float(r[x]), r.get("exit_code")))
+            xv = float(r[x])
         except (TypeError, ValueError, KeyError):
             continue
+        if math.isfinite(xv):  # as in _groups: no place on the axis
+            out.append((xv, r.get("exit_code")))
     return out
 
 

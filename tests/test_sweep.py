@@ -977,3 +977,28 @@ def test_a_swept_value_past_the_float_range_is_its_literal() -> None:
     rows = sw.sweep_rows(SPEC, ["method.lambda=[1e400, 0.96]"])
     assert rows[0]["method.lambda"] == "1e400" and rows[0]["exit_code"] == 2
     assert rows[1]["method.lambda"] == 0.96 and rows[1]["exit_code"] == 0
+
+
+def test_a_plot_skips_swept_values_past_the_float_range(tmp_path: Path) -> None:
+    """sweep --plot with a swept 1e400 or inf was exit 3 "Axis limits cannot be NaN or Inf",
+    no table and no plot, the sweep's own exit 2 lost (re-check review 45): such an x has no
+    place on the axis and is left out; the plot is written and the exit code is the rows'."""
+    out = tmp_path / "p.png"
+    r = runner.invoke(
+        app,
+        [
+            "sweep",
+            str(SPEC),
+            "--set",
+            "method.lambda=[0.96, 0.97, 1e400]",
+            "--plot",
+            str(out),
+            "--y",
+            "certified",
+        ],
+    )
+    assert r.exit_code == 2 and out.stat().st_size > 0, r.output
+    groups = sw.plot_groups(
+        [{"a": 1e400, "y": 1, "exit_code": 0}, {"a": 0.5, "y": 2, "exit_code": 0}], [], "a", "y"
+    )
+    assert groups == {(): [(0.5, 2.0)]}
