@@ -4,12 +4,20 @@
 set -e
 cd "$(dirname "$0")"
 if ! command -v make >/dev/null 2>&1; then
+    # a dry run (-n, in a cluster such as -sn, --dry-run / --just-print / --recon and their
+    # abbreviations, or n in MAKEFLAGS' flag letters) installs nothing (re-check review 45)
+    flags=${MAKEFLAGS%% *}
+    case "$flags" in -*|'') ;; *n*) set -- -n "$@";; esac
     for a in "$@"; do
         case "$a" in
-            -n|--dry-run|--just-print|--recon)
-                echo "make.sh: make is not installed; a dry run ($a) installs nothing" >&2
-                exit 2;;
+            --dry*|--just*|--rec*) dry=$a;;
+            --*) ;;
+            -*n*) dry=$a;;
         esac
+        if [ -n "${dry:-}" ]; then
+            echo "make.sh: make is not installed; a dry run ($dry) installs nothing" >&2
+            exit 2
+        fi
     done
     if [ "$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi
     $SUDO apt-get update -qq

@@ -152,11 +152,21 @@ def test_a_dry_run_without_make_installs_nothing(tmp_path: Path) -> None:
     )
     sh = shutil.which("sh")
     assert sh is not None
-    for flag in ("-n", "--dry-run"):
+    # clusters and abbreviations too (-sn, --dry; re-check review 45), and MAKEFLAGS=n
+    for flags, makeflags in (
+        (["-n"], ""),
+        (["--dry-run"], ""),
+        (["-sn"], ""),
+        (["-nk"], ""),
+        (["--dry"], ""),
+        (["--just"], ""),
+        ([], "n"),
+        ([], "sn --jobserver-auth=3,4"),
+    ):
         r = subprocess.run(
-            [sh, str(ROOT / "make.sh"), flag, "test"],
-            env={"PATH": str(bin_), "HOME": str(tmp_path)},
+            [sh, str(ROOT / "make.sh"), *flags, "test"],
+            env={"PATH": str(bin_), "HOME": str(tmp_path), "MAKEFLAGS": makeflags},
             capture_output=True,
             text=True,
         )
-        assert r.returncode == 2 and "a dry run" in r.stderr and not log.exists(), r.stderr
+        assert r.returncode == 2 and "a dry run" in r.stderr and not log.exists(), (flags, r.stderr)
