@@ -476,8 +476,10 @@ def _float_says(v: float, lit: str) -> bool:
     """Is the shortest repr of ``v`` the same number as the TOML float literal ``lit``?"""
     try:
         return Decimal(repr(v)) == Decimal(lit.strip().replace("_", ""))
-    except ArithmeticError:  # decimal.InvalidOperation: a literal Decimal does not read
-        return True
+    except ArithmeticError:
+        # decimal.InvalidOperation: an exponent past Decimal's range (0.9e-10^20 read as
+        # 0.0, a real zero's look; re-check review 45): the literal is kept
+        return False
 
 
 def _row_head(task: PointTask) -> dict[str, Any]:

@@ -973,6 +973,8 @@ def test_a_swept_value_past_the_float_range_is_its_literal() -> None:
     """A swept 1e400 was recorded as inf in the rows (text, json, csv), a real inf point's
     look (CLI review 45): the cell is the literal as written; inf itself stays inf."""
     assert sw._value("1e400") == "1e400" and sw._value("-1e400") == "-1e400"
+    # an exponent past Decimal's own range read as 0.0 (re-check review 45)
+    assert sw._value("0.9e-100000000000000000000") == "0.9e-100000000000000000000"
     assert sw._value("inf") == float("inf") and sw._value("0.5") == 0.5
     rows = sw.sweep_rows(SPEC, ["method.lambda=[1e400, 0.96]"])
     assert rows[0]["method.lambda"] == "1e400" and rows[0]["exit_code"] == 2
