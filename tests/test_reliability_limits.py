@@ -765,10 +765,15 @@ def test_an_exponent_past_the_decimal_readers_range_is_bad_input() -> None:
     from obsdesign import api
     from obsdesign.errors import SpecError
 
-    base = '[system]\ntime = "discrete"\nA = [[{a}]]\nC = [[1]]\n[method]\nkey = "lyapunov"\n'
+    # line 1 reads like such a number in a string and a comment: the number's own line and
+    # key are named, not the title (re-check review 45)
+    base = (
+        'title = "e99999999999999999999"  # 1e99999999999999999999\n'
+        '[system]\ntime = "discrete"\nA = [[{a}]]\nC = [[1]]\n[method]\nkey = "lyapunov"\n'
+    )
     for a in ("0.1e+99999999999999999999", "1e-99999999999999999999", "1e999999999999999999"):
         with pytest.raises(
-            SpecError, match=r"h\.toml: \[(line 3, key A|system\.A\[0\]\[0\])\] has .*exponent"
+            SpecError, match=r"h\.toml: \[(line 4, key A|system\.A\[0\]\[0\])\] has .*exponent"
         ) as ei:
             api.load_spec_text(base.format(a=a), "h.toml")
         assert ei.value.exit_code == 2
