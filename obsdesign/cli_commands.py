@@ -1101,6 +1101,12 @@ def _dt_seconds(text: str) -> Any:
         q = Decimal(text.strip().replace("_", ""))
         f = float(q)
     except (InvalidOperation, ValueError):
+        import re
+
+        m = re.fullmatch(r"\s*[+-]?[\d_]*\.?[\d_]*[eE]([+-]?)[\d_]+\s*", text)
+        if m is not None:  # an exponent past Decimal's range: "expected a number" (45)
+            where = "below" if m.group(1) == "-" else "beyond"
+            raise InputError(f"--dt {text!r}: {where} the float range") from None
         raise InputError(
             f"--dt {text!r}: expected a number of seconds (0: continuous time)"
         ) from None
