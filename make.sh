@@ -11,7 +11,7 @@ if ! command -v make >/dev/null 2>&1; then
     for a in "$@"; do
         case "$a" in
             --dry*|--just*|--rec*) dry=$a;;
-            --*) ;;
+            --*|-*/*|-*=*) ;;  # a long option, or an option with a path or value (-I/usr/n)
             -*n*) dry=$a;;
         esac
         if [ -n "${dry:-}" ]; then

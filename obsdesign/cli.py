@@ -388,6 +388,8 @@ def _seconds(value: str | float) -> float:
         q = Decimal(value)
     else:
         try:
+            if not value.isascii():  # Decimal reads Arabic-Indic digits; --limit does not (45)
+                raise InvalidOperation
             q = Decimal(value.strip())
         except InvalidOperation:
             raise typer.BadParameter(f"{value!r} is not a number of seconds") from None

@@ -1098,6 +1098,8 @@ def _dt_seconds(text: str) -> Any:
     from obsdesign.errors import InputError
 
     try:
+        if not text.isascii():  # Decimal reads Arabic-Indic digits; --limit does not (45)
+            raise InvalidOperation
         q = Decimal(text.strip().replace("_", ""))
         f = float(q)
     except (InvalidOperation, ValueError):

@@ -415,6 +415,8 @@ def test_lists_of_tables_and_missing_values() -> None:
         # an exponent past Decimal's own range said "expected a number" (re-check 45)
         ({}, ["--dt", "1e100000000000000000000"], "beyond the float range", False),
         ({}, ["--dt", "1e-100000000000000000000"], "below the float range", False),
+        # Arabic-Indic digits: Decimal read them, --limit refuses them (CLI review 45)
+        ({}, ["--dt", "٠٫١"], "expected a number of seconds", False),
         ({}, ["--dt", "-2"], "--dt '-2': expected a finite number >= 0", False),
         # −1e-400 rounds to −0.0: it passed as continuous time (session 43)
         ({}, ["--dt", "-1e-400"], "--dt '-1e-400': expected a finite number >= 0", False),

@@ -170,3 +170,11 @@ def test_a_dry_run_without_make_installs_nothing(tmp_path: Path) -> None:
             text=True,
         )
         assert r.returncode == 2 and "a dry run" in r.stderr and not log.exists(), (flags, r.stderr)
+    # an option with a path holding an n is no dry run: make is installed (CLI review 45)
+    r = subprocess.run(
+        [sh, str(ROOT / "make.sh"), "-I/usr/include/n", "test"],
+        env={"PATH": str(bin_), "HOME": str(tmp_path), "MAKEFLAGS": ""},
+        capture_output=True,
+        text=True,
+    )
+    assert "a dry run" not in r.stderr and log.read_text().startswith("apt-get update"), r.stderr

@@ -1051,6 +1051,9 @@ def test_a_positive_timeout_below_the_float_range_is_the_smallest_budget() -> No
     res = runner.invoke(app, ["design", str(SPEC), "-q", "--timeout", "1e-400"])
     assert res.exit_code == 3 and "not finished within" in res.output, res.output
     assert runner.invoke(app, ["design", str(SPEC), "-q", "--timeout", "-0"]).exit_code == 0
+    # Arabic-Indic digits: Decimal read them, --limit refuses them (CLI review 45)
+    res = runner.invoke(app, ["design", str(SPEC), "-q", "--timeout", "٥"])
+    assert res.exit_code == 2 and "is not a number of seconds" in res.output, res.output
 
 
 def test_an_exception_of_the_callers_alarm_handler_reaches_the_caller(monkeypatch):
