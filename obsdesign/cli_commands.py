@@ -936,6 +936,13 @@ def simulate(
     from obsdesign import api
     from obsdesign.report.model import check_output
 
+    if report is not None and _is_stdin(report):
+        from obsdesign.errors import InputError
+
+        # it said "-: no such report file" (CLI review 45); the spec may come from stdin
+        raise InputError(
+            "--report -: a report is read from a file, not from stdin (use ./- for a file named -)"
+        )
     if workers is not None or scheduler is not None:
         from obsdesign.distributed import check_workers
 

@@ -734,3 +734,13 @@ def test_the_digit_warning_scan_is_linear_in_a_long_digit_run(tmp_path: Path) ->
     t0 = time.perf_counter()
     _warn_above_digit_limit(_Rep(), out)  # runs of 999 digits: below the limit of 1,000
     assert time.perf_counter() - t0 < 2.0
+
+
+def test_simulate_report_dash_says_reports_are_files() -> None:
+    """``simulate SPEC --report -`` said "-: no such report file" (CLI review 45): a report is
+    read from a file, not stdin, and the message says so (./- names a file called -)."""
+    spec = Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+    r = CliRunner().invoke(app, ["simulate", str(spec), "--report", "-"], input="")
+    assert (
+        r.exit_code == 2 and "--report -: a report is read from a file, not from stdin" in r.stderr
+    )
