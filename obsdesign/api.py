@@ -495,6 +495,11 @@ def _write_error_report(
 VERIFY_ONLY = ("spec-hash", "parameters-consistent", "report-verdict")
 
 
+def _plain(text: str) -> str:
+    """``text`` with a leading byte-order mark dropped and CRLF / CR line endings as LF."""
+    return text.removeprefix("\ufeff").replace("\r\n", "\n").replace("\r", "\n")
+
+
 def _hash_mismatch(where: str, sha: str, stored: str) -> str:
     """The spec-hash claim's detail: both hashes' first 12 digits, and why they differ where
     those look the same — the stored hash in upper case, or differing further on, showed two
@@ -566,6 +571,14 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
             sha, file, spec = embedded, "", None
     if sha != rep.spec_sha256:
         where = f"spec {file}" if spec is not None else "the embedded spec"
+        detail = _hash_mismatch(where, sha, rep.spec_sha256)
+        if spec is not None and _plain(text) == _plain(str(rep.spec)) and text != rep.spec:
+            # a copy converted to CRLF or given a BOM said only "sha256 differs" (CLI
+            # review 45)
+            detail += (
+                "; the file and the report's embedded spec differ only in line endings or a "
+                "byte-order mark (the file was converted after the design?)"
+            )
         claims = [
             exact_claim(
                 "spec-hash",
@@ -574,7 +587,7 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
                 "sha256",
                 0,
                 False,
-                _hash_mismatch(where, sha, rep.spec_sha256),
+                detail,
                 float_ok=False,
             )
         ]

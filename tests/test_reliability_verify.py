@@ -769,3 +769,22 @@ def test_the_not_verified_note_names_at_most_fifty_parameters() -> None:
     unread = len(ver.unverified)
     assert unread > api.NOTE_NAMES == 50
     assert note.endswith(f" and {unread - 50:,} more") and "extra_59" not in note, note
+
+
+def test_verify_with_a_crlf_copy_of_the_spec_says_why_the_hash_differs(tmp_path: Path) -> None:
+    """``verify R --spec COPY`` with COPY the spec converted to CRLF (or given a BOM) said only
+    that the sha256 differs (CLI review 45): the detail says the two differ only in line
+    endings or a byte-order mark; an edited copy gets no such words."""
+    rep = api.design(SPEC)
+    text = SPEC.read_text(encoding="utf-8")
+    for name, copied in (
+        ("crlf.toml", text.replace("\n", "\r\n")),
+        ("bom.toml", "\ufeff" + text),
+        ("edited.toml", text.replace("lambda = 0.955", "lambda = 0.96")),
+    ):
+        p = tmp_path / name
+        p.write_bytes(copied.encode("utf-8"))
+        ver = api.verify(rep, spec=p)
+        assert ver.exit_code() == 1 and [c.id for c in ver.failed] == ["spec-hash"]
+        said = "differ only in line endings or a byte-order mark" in ver.failed[0].detail
+        assert said == (name != "edited.toml"), (name, ver.failed[0].detail)
