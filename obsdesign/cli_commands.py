@@ -905,12 +905,26 @@ def sweep(
     line = f"swept: {pts}, {ok} ok, {len(rows) - ok} not ok"
     if rows and ok < len(rows):
         line += f" (worst exit {sw.exit_code(rows)})"
+    if fmt == Fmt.text:  # wrapped at the table width as the table is (session 45's note)
+        line = _wrapped(line)
     print(f"\n**{line}**" if fmt == Fmt.md and not quiet else line)
     if output is not None and fmt == Fmt.text:
         _say(f"table written to {output}")
     if plot is not None and fmt == Fmt.text:
         _say(f"plot written to {plot}")
     return sw.exit_code(rows)
+
+
+def _wrapped(line: str) -> str:
+    """``line`` folded at spaces to the text tables' width (:func:`render.width`; the
+    terminal's when that leaves it to rich)."""
+    import shutil
+    import textwrap
+
+    from obsdesign.report.render import MIN_WIDTH, width
+
+    w = width() or max(MIN_WIDTH, shutil.get_terminal_size().columns)
+    return textwrap.fill(line, w, break_long_words=False, break_on_hyphens=False)
 
 
 #: grid points of a run that ``simulate --plot`` draws at most

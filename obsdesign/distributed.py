@@ -27,7 +27,6 @@ import functools
 import logging
 import numbers
 import os
-import sys
 import time
 import uuid
 from collections.abc import Callable, Iterator, Sequence
@@ -553,7 +552,6 @@ def progress_bar(total: int, label: str, quiet: bool = False) -> Iterator[Callab
     if quiet or total <= 0:
         yield lambda failed: None
         return
-    from rich.console import Console
     from rich.progress import (
         BarColumn,
         MofNCompleteColumn,
@@ -563,6 +561,8 @@ def progress_bar(total: int, label: str, quiet: bool = False) -> Iterator[Callab
         TimeRemainingColumn,
     )
 
+    from obsdesign.report.render import stderr_console
+
     bar = Progress(
         TextColumn("{task.description}"),
         BarColumn(),
@@ -571,7 +571,7 @@ def progress_bar(total: int, label: str, quiet: bool = False) -> Iterator[Callab
         TimeElapsedColumn(),
         TextColumn("ETA"),
         TimeRemainingColumn(),
-        console=Console(file=sys.stderr),
+        console=stderr_console(),
         transient=False,
     )
     task = bar.add_task(label, total=total, failures=0)

@@ -1004,3 +1004,25 @@ def test_a_plot_skips_swept_values_past_the_float_range(tmp_path: Path) -> None:
         [{"a": 1e400, "y": 1, "exit_code": 0}, {"a": 0.5, "y": 2, "exit_code": 0}], [], "a", "y"
     )
     assert groups == {(): [(0.5, 2.0)]}
+
+
+def test_width_folds_the_progress_bar_and_the_summary_line(tmp_path: Path):
+    """--width 40 holds for the progress bar on stderr and the "swept:" line: the bar took
+    the terminal's (or rich's) width and the line ran past the table's (session 45's note)."""
+    import os
+    import subprocess
+    import sys
+
+    from rich.cells import cell_len
+
+    env = dict(os.environ, COLUMNS="200")
+    cmd = [sys.executable, "-m", "obsdesign", "sweep", str(SPEC)]
+    cmd += ["--set", "method.lambda=[0.9, 1.5]", "--width", "40"]
+    r = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=tmp_path, timeout=120)
+    assert r.returncode == 2, r.stderr
+    bar = [x for x in r.stderr.splitlines() if "failures" in x]
+    assert bar and all(cell_len(x) <= 40 for x in bar), r.stderr
+    out = r.stdout.splitlines()
+    k = next(i for i, x in enumerate(out) if x.startswith("swept: "))
+    assert out[k:] == ["swept: 2 points, 0 ok, 2 not ok (worst", "exit 2)"]
+    assert all(cell_len(x) <= 40 for x in out), r.stdout

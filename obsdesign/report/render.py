@@ -120,6 +120,16 @@ def set_width(n: int | None) -> None:
     _WIDTH["width"] = n
 
 
+def stderr_console() -> Any:
+    """A rich console on stderr for progress bars, ``--width`` columns wide when given (else
+    rich's own: the terminal's, or COLUMNS) — the bars ignored --width (session 45's note)."""
+    import sys
+
+    from rich.console import Console
+
+    return Console(file=sys.stderr, width=_WIDTH["width"])
+
+
 def width() -> int | None:
     """The table width: ``--width`` if given, else ``COLUMNS`` if set to a positive number,
     else the terminal's width (None: rich asks the terminal) when stdout is a terminal, else

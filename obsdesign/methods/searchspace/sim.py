@@ -906,15 +906,16 @@ def _centre_outside_E(C: np.ndarray | None, x: np.ndarray, o: Options) -> str | 
 def _progress(on: bool, N: int) -> Any:
     if not on:
         return None
-    from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn
+
+    from obsdesign.report.render import stderr_console
 
     # on stderr: on stdout it came before --format json's JSON (simulate trial, session 27)
     p = Progress(
         TextColumn("observer"),
         BarColumn(),
         TextColumn("{task.fields[live]} centres"),
-        console=Console(stderr=True),
+        console=stderr_console(),
     )
     task = p.add_task("run", total=N, live=0)
     p.start()
