@@ -478,7 +478,8 @@ def observer_statespace(report: Any, law: str | None = None, verify: bool = Fals
     (:data:`LINEAR`), a ``control.NonlinearIOSystem`` for set-invariant's piecewise-affine
     injection (``law="interpolated"`` or ``"time-varying"``; the default for one output when
     the report has a breakpoint table is still the linear law when it has one: pass ``law``
-    to choose). Continuous-time plants give continuous-time observers, discrete ones
+    to choose; the linear law's gain is the spec's ``[method].L`` when given, else the
+    designed L, as ``simulate``'s ``law=linear``). Continuous-time plants give continuous-time observers, discrete ones
     discrete (``dt`` = ``sample_time``, else True).
 
     The report's claims are not recomputed unless ``verify`` (then a report that

@@ -121,7 +121,10 @@ def test_set_invariant_linear_and_piecewise_observers():
     sp = api.load_spec(ROOT / "specs" / "dorea-pimenta-7-1.toml")
     A, B, C = sp.system.A.f, sp.system.B.f, sp.system.C.f
     obs = observer_statespace(rep, law="linear")
-    L = np.asarray(rep.parameters.float("L"), float).reshape(2, 1)
+    # the spec's [method].L (reported as L_user), as simulate's law=linear runs it; the
+    # design's midpoint L was exported in its place (papers review 46)
+    L = np.asarray(rep.parameters.float("L_user"), float).reshape(2, 1)
+    assert not np.allclose(L, np.asarray(rep.parameters.float("L"), float).reshape(2, 1))
     np.testing.assert_allclose(obs.A, A + L @ C, rtol=0, atol=1e-15)  # x̂⁺ = A x̂ − L z
     nl = observer_statespace(rep, law="interpolated")
     assert isinstance(nl, control.NonlinearIOSystem) and not isinstance(nl, control.StateSpace)

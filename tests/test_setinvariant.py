@@ -142,9 +142,23 @@ def test_example_71_verify_and_simulate(rep71, tmp_path):
 
     png = get_method("set-invariant").plot_simulation(spec, res, tmp_path / "fig1.png")
     assert png.exists() and png.stat().st_size > 1000
-    # the paper's linear gain gives a trajectory in the polyhedron too
+    # the paper's linear gain (the spec's [method].L, Fig. 1's law) gives a trajectory in the
+    # polyhedron too; it is the gain simulated, not the design's midpoint L = [-0.7, -49/255]
+    # that ran in its place (papers review 46): e⁺ = A e + B1 d + L (C e + η), eq. (3)
     res2 = api.simulate(spec, out, law="linear")
     assert res2.info["error_in_polyhedron"]
+    assert res2.info["linear_gain"] == "[method].L of the spec"
+    from obsdesign.simulate.runner import signals
+
+    s, L = spec.system, np.array([[-0.7], [-0.2212]])
+    e = res2.extra["e_paper"]
+    _, d, eta = signals(spec, np.arange(len(e)))
+    want = [e[0]]
+    for k in range(len(e) - 1):
+        z = s.C.f @ want[-1] + s.Dn.f @ eta[k]
+        want.append(s.A.f @ want[-1] + s.Bd.f @ d[k] + L @ z)
+    np.testing.assert_allclose(e, np.array(want), rtol=0, atol=1e-12)
+    assert e[2][1] == pytest.approx(-1.4424, abs=5e-5)  # the design's midpoint L: -1.384314
     # the law is named as the option names it (it printed the class, LinearLaw: docs audit)
     assert res.info["law"] == "interpolated" and res2.info["law"] == "linear"
 

@@ -46,7 +46,7 @@ class SetInvariant(Method):
             "str",
             None,
             "injection law: interpolated (eq. (12), default with one output), time-varying "
-            "(eq. (10)), online-lp (LP (9) at each step) or linear (v = L z)",
+            "(eq. (10)), online-lp (LP (9) at each step) or linear (v = L z: the spec's [method].L when given, else the designed L)",
             choices=LAWS,
         ),
         SimOption("time_limit", "float", None, "seconds the simulation may run", min=1e-3),

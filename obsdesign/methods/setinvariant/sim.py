@@ -27,7 +27,8 @@ from .problem import build
 
 
 def make_law(spec: Spec, params: Parameters, law: str | None) -> Any:
-    """The runtime injection law named ``law`` (default: the table for one output, else L)."""
+    """The runtime injection law named ``law`` (default: the table for one output, else L;
+    ``linear``: the spec's ``[method].L`` when given, else the designed L)."""
     s = spec.system
     lam = float(spec.options.lam)
     if law is None:
@@ -39,27 +40,29 @@ def make_law(spec: Spec, params: Parameters, law: str | None) -> Any:
         v = params.shaped("v_breakpoints", (len(z), s.n))
         return laws.PiecewiseAffineLaw(z, v, lam, law)
     if law == "linear":
-        # the designed L, else the spec's [method].L (never the report's copy of it)
+        # the spec's [method].L (never the report's copy of it) when given — the gain the
+        # user asked to certify, Fig. 1's law in Example 7.1 of the paper — else the designed
+        # L: the designed one ran in its place without a word (papers review 46)
+        if spec.options.L is not None:
+            return laws.LinearLaw(po.qfloat(spec.options.L).reshape(s.n, s.p))
         if "L" in params:
             return laws.LinearLaw(params.shaped("L", (s.n, s.p)))
         searched = spec.options.linear_law and s.p == s.n - 1  # Proposition 7.1's gains
-        if spec.options.L is None and not searched:
+        if not searched:
             # law=linear where the design makes no linear law (p = 1 with n > 2, or
             # linear_law = false): the option is the problem (re-check review, session 44)
             raise InputError(
                 "law 'linear' needs a linear gain: the design computes one only for p = n − 1 "
                 "outputs with linear_law = true; give [method] L, or another law"
             )
-        if spec.options.L is None:
-            # the design's own infeasibility (its linear-law claim failed): exit 1, as the
-            # README says for simulate SPEC; it was exit 2 naming a report that no one gave
-            # (census, session 44)
-            raise InfeasibleError(
-                "no linear injection to simulate: the design found no admissible linear gain "
-                "L (its report has none) and [method] L is not given; give [method] L, or "
-                "another lambda"
-            )
-        return laws.LinearLaw(po.qfloat(spec.options.L).reshape(s.n, s.p))
+        # the design's own infeasibility (its linear-law claim failed): exit 1, as the
+        # README says for simulate SPEC; it was exit 2 naming a report that no one gave
+        # (census, session 44)
+        raise InfeasibleError(
+            "no linear injection to simulate: the design found no admissible linear gain "
+            "L (its report has none) and [method] L is not given; give [method] L, or "
+            "another lambda"
+        )
     if law == "online-lp":
         if s.p != 1:
             # LP (9) is posed on the slices {e ∈ Ω : |c e − z| ≤ η̄} of a scalar output z
@@ -74,6 +77,11 @@ def make_law(spec: Spec, params: Parameters, law: str | None) -> Any:
     raise InputError(
         f"unknown law {law!r}: expected interpolated, time-varying, online-lp or linear"
     )
+
+
+def _gain_source(spec: Spec) -> str:
+    """Which L the linear law ran (:func:`make_law`): the spec's or the design's."""
+    return "[method].L of the spec" if spec.options.L is not None else "the design's L"
 
 
 def _admissible(spec: Spec, d: np.ndarray, v: np.ndarray) -> bool:
@@ -172,6 +180,7 @@ def simulate(
         {
             # the option's name (it printed the class: LinearLaw, OnlineLPLaw; docs audit)
             "law": name,
+            **({"linear_gain": _gain_source(spec)} if name == "linear" else {}),
             "max_gauge": float(gauge.max()),
             "error_in_polyhedron": inside,
             "e0_in_omega": e0_in,
