@@ -758,3 +758,25 @@ def test_the_error_metrics_of_a_growing_plant_are_the_errors_own(tmp_path: Path)
         api.design(load_spec_text(_spec3(), str(tmp_path / "s.toml"))).parameters,
     )
     assert ok.metrics()["open_loop_stopped_at"] is None
+
+
+def test_fig4_without_injection_needs_an_estimate_in_the_attractors_basin() -> None:
+    """Paper 001, Fig. 4: without measurement injection "the observer and system trajectories
+    converge to different equilibrium states". The shipped x̂(0) = (0, 0.5) does not show it:
+    plant (from (1, 1)) and open-loop observer both tend to the origin, ‖ε‖ ≈ 0.002 at t = 30;
+    from x̂(0) = (−1, −1) the observer goes to the attractor (−2/3, −2) while the plant goes to
+    the origin: e → (2/3, 2), and ε = T e with T = [C; M] = [[1, 0], [−3, 1]] → (2/3, 0),
+    ‖ε‖ → 2/3 (papers review 46; docs/methods/impulsive.md)."""
+    import re
+
+    text = (ROOT / "specs" / "schaum-impulsive-example.toml").read_text(encoding="utf-8")
+    text = re.sub(r"horizon = 60\b", "horizon = 30", text.replace("runs = 20", "runs = 1"))
+    got = {}
+    for xh in ("[0, 0.5]", "[-1, -1]"):
+        sp = load_spec_text(text.replace("xhat0 = [0, 0.5]", f"xhat0 = {xh}"), "fig4.toml")
+        assert sp.simulate.xhat0.f.tolist() == eval(xh)
+        info = get_method("impulsive").simulate(sp, api.design(sp).parameters).info
+        assert info["runs_ending_in_ball"] == 1  # with injection, either way
+        got[xh] = info["open_loop_final_eps"]
+    assert got["[0, 0.5]"] < 0.01
+    assert got["[-1, -1]"] == pytest.approx(2 / 3, abs=0.01)
