@@ -142,7 +142,9 @@ def test_simulate_metrics_and_plot(tmp_path: Path):
     # of the paper's 21.611; every other digit of the row matches (docs/methods/lyapunov.md,
     # "Reproduced numbers"; docs/methods/constrained.md, Table 1)
     assert m["sup_abs_estimate"]["x2"] == pytest.approx(21.610486, abs=1e-6)
-    assert abs(m["sup_abs_estimate"]["x2"] - 21.611) < 5e-4 + 2e-5
+    # not reproduced at the printed precision (a widened tolerance read as a match: papers
+    # review 46)
+    assert round(m["sup_abs_estimate"]["x2"], 3) == 21.610 != 21.611
     assert png.exists() and png.stat().st_size > 1000
 
 

@@ -83,7 +83,8 @@ def test_example_71_Q2_iterations_and_vertices(rep71):
 def test_example_71_linear_gains(rep71):
     """Two rows of Q² tie in Ω ∩ ker C: the Prop. 7.1 gains are the ends of the admissible
     segment L = [−0.7, l2], l2 ∈ [−7/15, 7/85] (≈ [−0.4667, 0.0824]); the paper's
-    L = [−0.7, −0.2212] lies inside and certifies."""
+    L = [−0.7, −0.2212] lies inside and certifies, but is not reproduced: it is neither end
+    nor the midpoint −49/255 (docs/methods/set-invariant.md; papers review 46)."""
     rep, _ = rep71
     p = rep.parameters
     L = np.asarray(p["L"]).reshape(-1)
@@ -92,7 +93,8 @@ def test_example_71_linear_gains(rep71):
     ends = sorted(V[:, 1])
     assert ends == [fmpq(-7, 15), fmpq(7, 85)]
     assert all(v == fmpq(-7, 10) for v in V[:, 0])
-    assert ends[0] < L[1] < ends[1]
+    assert ends[0] < L[1] < ends[1] and L[1] == fmpq(-49, 255)
+    assert all(round(float(v), 4) != -0.2212 for v in (*ends, L[1]))
     user = next(c for c in rep.claims if c.id == "linear-law-user")
     assert user.status == ClaimStatus.CERTIFIED
     assert any("Proposition 7.1 with Q_I" in n for n in rep.notes)
