@@ -1011,7 +1011,6 @@ def _whole_runs(r: Any) -> int:
     Decimal(3) were refused while seed took them; re-check review 45), never a bool; runs=0
     ran once (``runs or 1``) while the CLI refuses --runs 0 (outsider trial); 10**400 was a
     bare OverflowError (API review, session 44)."""
-    import math
 
     from obsdesign.errors import value_text
     from obsdesign.methods.base import _exact_integer
@@ -1020,8 +1019,14 @@ def _whole_runs(r: Any) -> int:
     n: int | None = None
     if isinstance(v, numbers.Integral) and not isinstance(v, bool) and type(v).__name__ != "bool_":
         n = int(v)
-    elif isinstance(v, float) and math.isfinite(v) and v == int(v):
-        n = int(v)
+    elif isinstance(v, numbers.Real) and hasattr(v, "as_integer_ratio") and not isinstance(v, bool):
+        # a float or any numpy float (float32, float16, longdouble: np.float32(3) was refused
+        # while np.float64(3) was taken; re-check review 46), its value exactly
+        try:
+            a, b = v.as_integer_ratio()
+        except (OverflowError, ValueError):  # inf, nan
+            a, b = 0, 0
+        n = a if b == 1 else None
     elif type(v).__name__ not in ("bool", "bool_"):
         n = _exact_integer(v)
     if n is None or n < 1:

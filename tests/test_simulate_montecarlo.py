@@ -693,9 +693,11 @@ def test_runs_take_whole_values_as_the_integer_options_do_and_huge_ints_are_name
     spec = api.load_spec(
         Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5-lyapunov.toml"
     )
-    for runs in (Decimal(3), Fraction(3), 3.0, np.array(3), np.int64(3)):
+    # every numpy float too (np.float32(3) was refused beside np.float64(3); re-check review 46)
+    wholes = (np.float32(3), np.float16(3), np.longdouble(3), np.array(np.float32(3)))
+    for runs in (Decimal(3), Fraction(3), 3.0, np.array(3), np.int64(3), *wholes):
         assert api.simulate(spec, runs=runs).info["runs"] == 3
-    for runs in (True, 2.5, Decimal("3.5"), 0, "3x"):
+    for runs in (True, 2.5, Decimal("3.5"), 0, "3x", np.float32(2.5), np.longdouble("inf")):
         with pytest.raises(InputError, match="runs: expected a whole number of runs"):
             api.simulate(spec, runs=runs)
     with pytest.raises(
