@@ -221,3 +221,27 @@ def test_a_report_with_thousands_of_claims_prints_the_failed_ones_and_counts_the
     assert "… 8 more parameters not shown (--format json or md lists every one)" in out
     # the rows past the cap are not built (100,000 parameters took 54 s; CLI review 45)
     assert len(render._param_rows(rep, 3)) == 3 and len(render._param_rows(rep)) == 20
+
+
+def test_the_capped_parameter_table_shows_the_verified_parameters_first(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """600 unread parameters before L and P: the 500-row table showed only them, "not
+    verified", and hid every parameter the checks read (re-check review 46). Cut to the cap,
+    the verified parameters come first in report order, then the unread ones."""
+    from obsdesign.params import Parameters
+
+    monkeypatch.setattr(render, "TEXT_MAX_ROWS", 12)
+    rep = api.design(SPEC)
+    real = dict(rep.parameters.items())
+    pad = {f"a{i:04d}": float(i) for i in range(20)}
+    rep.parameters = Parameters({**pad, **real})
+    rep.unverified = list(pad)
+    rows = render._param_rows(rep, 12)
+    want = [*real, *pad][:12]
+    assert [r[0] for r in rows] == want
+    assert all(r[2] != "not verified" for r in rows[: len(real)])
+    out = _rendered(monkeypatch, rep)
+    assert all(f"\n{k} " in out or f" {k} " in out for k in list(real)[:3]), out
+    # under the cap: report order, unchanged
+    assert [r[0] for r in render._param_rows(rep)] == [*pad, *real]

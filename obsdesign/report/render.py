@@ -48,15 +48,19 @@ def _sides(method: str) -> dict[str, str]:
 
 
 def _param_rows(report: Report, most: int | None = None) -> list[tuple[str, str, str]]:
-    """(name, value, form) of the report's parameters, the first ``most`` of them (all when
+    """(name, value, form) of the report's parameters, at most ``most`` of them (all when
     None): 100,000 parameters took 54 s, each row built and looked up in a list (CLI review
-    45)."""
+    45). Cut to ``most``, the verified parameters come first, in report order: 600 unread
+    parameters before L and P filled the table and hid every verified one (re-check review
+    46)."""
     rows = []
     sides = _sides(report.method)
     unverified = set(report.unverified)
-    for i, k in enumerate(report.parameters):
-        if most is not None and i >= most:
-            break
+    keys = list(report.parameters)
+    if most is not None and len(keys) > most:
+        keys = [k for k in keys if k not in unverified] + [k for k in keys if k in unverified]
+        keys = keys[:most]
+    for k in keys:
         raw = report.parameters[k]
         # a rounded number is marked "≈" (a certified α = 2.16666655 showed as "2.16667",
         # a proven-infeasible rate: rendering trial, session 27); a one-sided bound is
