@@ -184,7 +184,8 @@ def test_the_schema_refuses_the_values_every_loader_refuses() -> None:
         ),
         "constrained-redesign-sec5.toml": (
             "\n[simulate]\n",
-            ["saturation_r = 0", "saturation_r = [1, -1]"],
+            # theta_m past 2^63 − 1: the schema refused it and the loader took it (re-check 46)
+            ["saturation_r = 0", "saturation_r = [1, -1]", "theta_m = [10, 9223372036854775808]"],
         ),
     }
     for name, (anchor, bad_lines) in cases.items():
@@ -216,3 +217,32 @@ def test_the_schema_takes_a_saturation_level_per_state() -> None:
         if "saturation_r" in "/".join(map(str, e.absolute_path))
     ]
     assert not errs, [e.message for e in errs]
+
+
+def test_the_schema_and_the_reader_agree_on_one_number_bounds_and_empty_windows() -> None:
+    """A vector key the reader takes as one number (a 1-D box bound, the outlier amplitudes)
+    was invalid under the schema, and windows = [] was valid though the reader refuses it
+    (re-check review 46)."""
+    from obsdesign.errors import SpecError
+
+    schema = api.schema()
+    root = SPECS[0].parent
+    ss = (root / "hernandez-garcia-example.toml").read_text(encoding="utf-8")
+    st = (root / "astolfi-stubborn-example1.toml").read_text(encoding="utf-8")
+    co = (root / "constrained-redesign-sec5.toml").read_text(encoding="utf-8")
+    good = [
+        ss.replace("lower = [0]\nupper = [1]", "lower = 0\nupper = 1"),
+        st.replace("amplitudes = [0.1, 1, 10, 100, 1000]", "amplitudes = 5"),
+        co.replace("[method.D]\nlower = [-3]\nupper = [3]", "[method.D]\nlower = -3\nupper = 3"),
+    ]
+    for text in good:
+        assert text not in (ss, st, co)
+        jsonschema.validate(tomllib.loads(text), schema)
+        api.load_spec_text(text, "one.toml")
+    ly = (root / "constrained-redesign-sec5-lyapunov.toml").read_text(encoding="utf-8")
+    bad = ly.replace("windows = [{ start = 151, stop = 153, value = [3] }]", "windows = []")
+    assert bad != ly
+    with pytest.raises(jsonschema.ValidationError):
+        jsonschema.validate(tomllib.loads(bad), schema)
+    with pytest.raises(SpecError):
+        api.load_spec_text(bad, "w.toml")

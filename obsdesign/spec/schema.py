@@ -10,6 +10,10 @@ from typing import Any
 
 NUM: dict[str, Any] = {"type": "number"}
 VEC: dict[str, Any] = {"type": "array", "items": NUM, "minItems": 1}
+#: a vector key the reader also takes as one number (a box bound, a list of amplitudes: a
+#: scalar is a vector of length 1 — of the set's dimension, a rule across keys that the
+#: schema does not state); VEC refused lower = -3 of a 1-D box the tool takes (re-check 46)
+BOUND: dict[str, Any] = {"anyOf": [NUM, VEC]}
 MAT: dict[str, Any] = {
     "description": "a list of rows; a flat list is one row (one column for B, Bd, Dn, L)",
     "anyOf": [NUM, VEC, {"type": "array", "items": VEC, "minItems": 1}],
@@ -32,6 +36,7 @@ def _signal() -> dict[str, Any]:
             "value": VEC,
             "windows": {
                 "type": "array",
+                "minItems": 1,  # windows = [] is refused by the reader (re-check review 46)
                 "items": {
                     "type": "object",
                     "required": ["start", "stop", "value"],
@@ -91,8 +96,8 @@ def _nonlinearity() -> dict[str, Any]:
                 "description": "sample pairs in the box [lower, upper] to look for a "
                 "violation of the bound (a numerical check, not a certificate)",
                 "properties": {
-                    "lower": VEC,
-                    "upper": VEC,
+                    "lower": BOUND,
+                    "upper": BOUND,
                     # impulsive.options.MAX_SAMPLES (this layer imports no method; a test
                     # ties the two): 2,000,000 validated, the tool refused it (docs review 45)
                     "samples": {"type": "integer", "minimum": 10, "maximum": 1_000_000},
@@ -148,7 +153,12 @@ def spec_schema(
             {
                 "type": "object",
                 "required": ["type", "lower", "upper"],
-                "properties": {"type": {"const": "box"}, "lower": VEC, "upper": VEC, "dim": DIM},
+                "properties": {
+                    "type": {"const": "box"},
+                    "lower": BOUND,
+                    "upper": BOUND,
+                    "dim": DIM,
+                },
                 "additionalProperties": False,
             },
             {

@@ -10,7 +10,8 @@ from flint import fmpq
 
 from obsdesign.certify.exact import Q
 from obsdesign.certify.psd import check_pd
-from obsdesign.errors import SpecError
+from obsdesign.errors import SpecError, value_text
+from obsdesign.limits import INT_MAX
 from obsdesign.methods.base import table_schema
 from obsdesign.methods.constrained.cmap import (
     KINDS,
@@ -312,6 +313,11 @@ def parse_simulate(table: Table, spec: Spec) -> SimOptions:
             isinstance(x, int) and not isinstance(x, bool) and x >= 0 for x in vals
         ):
             raise table.error("theta_m", "expected a non-negative integer or a list of them")
+        big = [x for x in vals if x > INT_MAX]
+        if big:  # as every integer key (the schema said so and the loader took it; re-check 46)
+            raise table.error(
+                "theta_m", f"expected integers of at most 2^63 − 1, got {value_text(big[0])}"
+            )
         table.mark("theta_m")
         out.theta_m = [int(x) for x in vals]
     g = table.scalar("gamma", default=None, min=0, strict_min=True)
@@ -356,13 +362,13 @@ def _short_up(t: fmpq) -> fmpq:
 
 def options_schema(key: str) -> dict[str, Any]:
     """JSON schema of ``[method]`` (the shared NUM / VEC / MAT / EXPRS fragments)."""
-    from obsdesign.spec.schema import EXPRS, MAT, NUM, VEC
+    from obsdesign.spec.schema import BOUND, EXPRS, MAT, NUM, VEC
 
     bounds = {
         "type": "object",
         "required": ["lower", "upper"],
         "additionalProperties": False,
-        "properties": {"lower": VEC, "upper": VEC},
+        "properties": {"lower": BOUND, "upper": BOUND},
     }
     return table_schema(
         key,
@@ -389,8 +395,8 @@ def options_schema(key: str) -> dict[str, Any]:
                 "properties": {
                     "type": {"enum": list(KINDS)},
                     "norm": {"enum": ["euclidean", "max"]},
-                    "lower": VEC,
-                    "upper": VEC,
+                    "lower": BOUND,
+                    "upper": BOUND,
                     "G": MAT,
                     "h": VEC,
                     "Q": MAT,

@@ -224,7 +224,9 @@ def options_schema(key: str) -> dict[str, Any]:
     """JSON schema of ``[method]``."""
     num = {"type": "number"}
     pos = {"type": "number", "exclusiveMinimum": 0}
-    vec = {"type": "array", "items": num}
+    vec = {
+        "anyOf": [num, {"type": "array", "items": num, "minItems": 1}]
+    }  # a scalar: one coordinate
     box = {
         "anyOf": [
             {"type": "string"},

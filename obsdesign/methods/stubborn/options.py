@@ -346,7 +346,12 @@ def simulate_schema() -> dict[str, Any]:
     return {
         "noise_std": {**num, "minimum": 0},
         "outlier_rate": {**num, "minimum": 0, "maximum": 1},
-        "amplitudes": {"type": "array", "items": {**num, "minimum": 0}, "minItems": 1},
+        "amplitudes": {  # one number is a list of one (the reader's vector)
+            "anyOf": [
+                {**num, "minimum": 0},
+                {"type": "array", "items": {**num, "minimum": 0}, "minItems": 1},
+            ]
+        },
         "runs": {"type": "integer", "minimum": 1},
         "sigma0": {**num, "minimum": 0},
         "impulse_time": {**num, "minimum": 0},
