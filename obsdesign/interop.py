@@ -543,13 +543,18 @@ def observer_statespace(report: Any, law: str | None = None, verify: bool = Fals
     inputs, outputs = _names("u", m) + _names("y", p), _names("xhat", n)
     name = f"obsdesign-{report.method}"
 
-    def linear(G: np.ndarray, sign: float, rate: Any = None) -> Any:
-        # x̂' = A x̂ + B u + sign·G (y − C x̂ − D u)
+    def linear(G: np.ndarray, sign: float, rate: Any = None, key: str | None = None) -> Any:
+        # x̂' = A x̂ + B u + sign·G (y − C x̂ − D u); key: the report parameter holding G
+        # exactly (None: the spec's [method].L)
         from obsdesign.lyap import float_closed_loop
 
         G = np.asarray(G, float).reshape(n, p)
         Ao = float_closed_loop(A, sign * G, C, "observer_statespace(), in doubles,")
-        _check_float_realization(Ao, s.discrete, rate, where)
+
+        def exact_loop() -> Any:
+            return _exact_loop(sp, params, key, sign)
+
+        _check_float_realization(Ao, s.discrete, rate, where, exact_loop)
         with np.errstate(all="ignore"):
             Bo = np.hstack([B - sign * G @ D, sign * G])
         return ct.ss(
@@ -569,7 +574,7 @@ def observer_statespace(report: Any, law: str | None = None, verify: bool = Fals
     if report.method == "lyapunov":
         key = "lambda" if s.discrete else "alpha"
         rate = params.exact(key, [], accept_float=True) if key in params else None
-        return linear(_named(params.shaped, "L", (n, p), where), +1.0, rate)
+        return linear(_named(params.shaped, "L", (n, p), where), +1.0, rate, "L")
     if report.method == "stubborn":
         if getattr(sp.options, "mode", None) == "high-gain" or not s.linear:
             # A + psi in mode high-gain passed the f / h test above and returned the linear
@@ -580,33 +585,67 @@ def observer_statespace(report: Any, law: str | None = None, verify: bool = Fals
                 "with psi) runs the nonlinearity and the high-gain injection: it is not a "
                 "linear state-space system and is not offered as a python-control system"
             )
-        return linear(_named(params.shaped, "K", (n, p), where), +1.0)
+        return linear(_named(params.shaped, "K", (n, p), where), +1.0, key="K")
     if report.method == "set-invariant":
         use = law or ("linear" if "L" in params or sp.options.L is not None else "interpolated")
         if use == "linear":
             from obsdesign.methods.setinvariant.sim import make_law
 
-            return linear(make_law(sp, params, "linear").L, -1.0)
+            key = None if sp.options.L is not None else "L"  # make_law's choice
+            return linear(make_law(sp, params, "linear").L, -1.0, key=key)
         return _setinvariant_nonlinear(ct, sp, params, use, A, B, C, D, dt, inputs, outputs, name)
     raise InputError(_NOT_LINEAR.format(method=report.method, linear=", ".join(LINEAR)))
 
 
-def _check_float_realization(Ao: np.ndarray, discrete: bool, rate: Any, where: str) -> None:
+def _exact_loop(sp: Any, params: Any, key: str | None, sign: float) -> Any:
+    """A − sign·G·C in exact arithmetic, G the exact gain (report parameter ``key``, or the
+    spec's ``[method].L`` for None), or None when an exact value is not at hand."""
+    from obsdesign.lyap import exact_closed_loop
+
+    G = sp.options.L if key is None else params.exact(key, [], accept_float=True)
+    if G is None:
+        return None
+    G = np.asarray(G, dtype=object)
+    return exact_closed_loop(sp.system.A.q, G if sign > 0 else -G, sp.system.C.q)
+
+
+def _check_float_realization(
+    Ao: np.ndarray, discrete: bool, rate: Any, where: str, exact_loop: Any = None
+) -> None:
     """The exported observer matrix (A − LC formed in doubles, the realization the user
     takes away) checked exactly: every eigenvalue within the certified ``rate`` (lyapunov's
     λ or α; None: stability, |z| < 1 or Re z < 0), by :func:`obsdesign.lyap.float_realization`
     on the doubles' exact values. The certificate is about the exact gain: on an
     ill-conditioned plant (ρ(A − LC) = 0.647 certified) the doubles gave ρ = 3.5, an
     unstable observer handed over with no word (interop trial, session 39). Unstable: an
-    :class:`InconclusiveError`; stable but slower than ``rate``: a ``UserWarning``."""
+    :class:`InconclusiveError`; stable but slower than ``rate``: a ``UserWarning`` — unless
+    ``exact_loop()`` (A − LC of the exact gain) fails too: the gain itself is unstable
+    (:class:`InputError`, its claims cannot hold) or slower (a warning saying so)."""
     import warnings
 
     from obsdesign.certify.exact import Q
     from obsdesign.errors import InconclusiveError
-    from obsdesign.lyap import float_realization
+    from obsdesign.lyap import exact_within, float_realization, stability_test
 
     verdict = float_realization(Ao, discrete, rate)
     if verdict == "ok":
+        return
+    Aex = exact_loop() if exact_loop is not None else None
+    if Aex is not None and not exact_within(Aex, discrete, rate if verdict == "slower" else None):
+        # the exact gain itself: the doubles were blamed for an L edited to an unstable or
+        # slower gain, exit 4, while verify says the report's claims fail (tamper review 46)
+        what = (
+            f"is not {'Schur' if discrete else 'Hurwitz'} ({stability_test(discrete)})"
+            if verdict == "unstable"
+            else f"does not keep the certified rate {float(Q(rate)):.6g}"
+        )
+        text = (
+            f"{where}: the observer matrix A − LC of the report's exact gain {what}: the "
+            "report's claims cannot hold for it (obsdesign verify says which fail)"
+        )
+        if verdict == "unstable":
+            raise InputError(text + "; no observer is offered")
+        warnings.warn(text, UserWarning, stacklevel=3)
         return
     if verdict == "slower":
         warnings.warn(

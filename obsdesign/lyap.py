@@ -953,6 +953,32 @@ def float_realization(Ao: np.ndarray, discrete: bool, rate: Any = None) -> str:
     return "unstable"
 
 
+def exact_closed_loop(A: Any, G: Any, C: Any) -> Any:
+    """A − G·C in exact arithmetic (object arrays of fmpq; the observer's error matrix of
+    Section 5, constrained-redesign paper) from exact entries (spec values, report exact
+    parameters), or None when one is not a number (a malformed report is refused elsewhere).
+
+    :param A, G, C: n×n, n×p, p×n arrays of exact numbers."""
+    to_q = np.vectorize(Q, otypes=[object])
+    try:
+        Aq, Cq = to_q(np.asarray(A, dtype=object)), to_q(np.asarray(C, dtype=object))
+        Gq = to_q(np.asarray(G, dtype=object)).reshape(Aq.shape[0], Cq.shape[0])
+    except (ValueError, TypeError, ArithmeticError):
+        return None
+    return Aq - Gq @ Cq
+
+
+def exact_within(Acl: Any, discrete: bool, rate: Any = None) -> bool:
+    """Whether the exact closed loop ``Acl`` (A − LC of a report's exact gain) keeps ``rate``
+    (None: stability), decided by :func:`rate_feasibility` — the check behind a float
+    realization that fails, to tell a gain that is itself too slow or unstable (the report's
+    claims cannot hold) from doubles that lose a certified gain (tamper review 46).
+
+    :param Acl: exact matrix; :param discrete: time domain; :param rate: exact rate or None."""
+    unit = Q(1) if discrete else Q(0)
+    return bool(rate_feasibility(Acl, unit if rate is None else rate, discrete)[0])
+
+
 def stability_test(discrete: bool) -> str:
     """The name of the exact polynomial test behind :func:`rate_feasible` when the inertia
     certificate does not decide (for messages and claims).

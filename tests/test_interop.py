@@ -989,10 +989,20 @@ def test_an_observer_with_no_float_realization_is_not_offered() -> None:
     d["parameters"]["L"] = [1.0, 5.0]
     d["parameters"]["exact"]["L"] = ["1", "5"]
     tampered, _ = Report.from_dict(d)
-    with pytest.raises(InconclusiveError, match="not Schur") as ei:
+    # ... and that gain is itself unstable, exactly: not the doubles' fault (exit 4 said
+    # they lost a certificate; tamper review 46) — bad input, its claims cannot hold
+    with pytest.raises(InputError, match="exact gain is not Schur") as ei:
         tampered.observer_statespace()
-    assert "holds for the exact gain" not in str(ei.value)
-    assert "obsdesign verify checks whether the report's claims hold" in str(ei.value)
+    assert "holds for the exact gain" not in str(ei.value) and ei.value.exit_code == 2
+    assert "the report's claims cannot hold for it" in str(ei.value)
+    res = api.simulate(ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml", tampered)
+    assert any("in doubles and for the exact gain alike" in w for w in res.info["warnings"])
+    # a stable gain slower than the report's λ = 0.955 (ρ = 0.96): a warning naming the gain
+    d["parameters"]["L"] = [-1.46, 1.48]
+    d["parameters"]["exact"]["L"] = ["-73/50", "37/25"]
+    slower, _ = Report.from_dict(d)
+    with pytest.warns(UserWarning, match="exact gain does not keep the certified rate 0.955"):
+        slower.observer_statespace()
     rep8 = api.design(api.load_spec(data / "lyapunov-ill-conditioned-8state.toml"))
     assert rep8.exit_code() == 0
     with pytest.warns(UserWarning, match="does not keep the certified rate"):

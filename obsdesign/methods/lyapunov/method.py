@@ -171,7 +171,7 @@ def _warn_float_gain(spec: Spec, params: Parameters, L: Any) -> None:
     in floats."""
     import warnings
 
-    from obsdesign.lyap import float_closed_loop, float_realization
+    from obsdesign.lyap import exact_closed_loop, exact_within, float_closed_loop, float_realization
 
     s = spec.system
     if s.A is None or s.C is None:
@@ -186,6 +186,18 @@ def _warn_float_gain(spec: Spec, params: Parameters, L: Any) -> None:
     what = (
         "is not stable" if verdict == "unstable" else "is stable but slower than the certified rate"
     )
+    Lq = params.exact("L", [], accept_float=True) if "L" in params else None
+    Aex = None if Lq is None else exact_closed_loop(s.A.q, Lq, s.C.q)
+    if Aex is not None and not exact_within(Aex, s.discrete, rate if verdict == "slower" else None):
+        # the gain itself, not its doubles: an L edited to an unstable gain was blamed on the
+        # doubles (tamper review 46)
+        warnings.warn(
+            f"the simulated observer's A − LC {what}, in doubles and for the exact gain "
+            "alike: the report's claims cannot hold for it (obsdesign verify says which fail)",
+            UserWarning,
+            stacklevel=2,
+        )
+        return
     warnings.warn(
         f"the simulated observer's A − LC in doubles {what}: the certificate is about the "
         "exact gain (report parameters.exact), which doubles do not hold on this "
