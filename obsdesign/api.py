@@ -1143,7 +1143,16 @@ def simulate(
             else Report.load(_path_arg(report, "report", "a Report"))
         )
         if rep.spec_sha256 != sp.sha256:
-            raise InputError(f"{sp.file}: the report was made from another spec (sha256 differs)")
+            why = ""
+            if isinstance(rep.spec, str) and _plain(sp.text) == _plain(rep.spec) != sp.text:
+                # as verify --spec says it (tamper review 46)
+                why = (
+                    "; the two differ only in line endings or a byte-order mark: was the file "
+                    "converted after the design?"
+                )
+            raise InputError(
+                f"{sp.file}: the report was made from another spec (sha256 differs){why}"
+            )
         where = "report" if isinstance(report, Report) else str(report)
         if problems:
             raise InputError(f"{where}: {problems[0]}")

@@ -788,3 +788,23 @@ def test_verify_with_a_crlf_copy_of_the_spec_says_why_the_hash_differs(tmp_path:
         assert ver.exit_code() == 1 and [c.id for c in ver.failed] == ["spec-hash"]
         said = "differ only in line endings or a byte-order mark" in ver.failed[0].detail
         assert said == (name != "edited.toml"), (name, ver.failed[0].detail)
+
+
+def test_simulate_with_a_crlf_copy_of_the_spec_says_why_the_hash_differs(tmp_path: Path) -> None:
+    """``simulate COPY --report R`` with COPY the spec converted to CRLF said only that the
+    sha256 differs, while verify --spec says why (tamper review 46); an edited copy gets no
+    such words. Both are exit 2."""
+    from obsdesign.errors import InputError
+
+    rep = api.design(SPEC)
+    text = SPEC.read_text(encoding="utf-8")
+    for name, copied in (
+        ("crlf.toml", text.replace("\n", "\r\n")),
+        ("edited.toml", text.replace("lambda = 0.955", "lambda = 0.96")),
+    ):
+        p = tmp_path / name
+        p.write_bytes(copied.encode("utf-8"))
+        with pytest.raises(InputError, match="made from another spec") as ei:
+            api.simulate(p, rep)
+        said = "differ only in line endings or a byte-order mark" in str(ei.value)
+        assert said == (name == "crlf.toml") and ei.value.exit_code == 2, str(ei.value)
