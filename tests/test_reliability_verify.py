@@ -189,6 +189,10 @@ def test_bad_verdict_value_is_refused(good, tmp_path: Path, verdict):
         ("constrained-redesign-sec5.toml", "v_min"),
         ("constrained-redesign-sec5-lyapunov.toml", "P"),
         ("astolfi-stubborn-example4.toml", "K"),
+        # set-invariant's copy of the spec's λ: 1.0 is exactly 1, and a float-only λ was
+        # compared by its double and verified (tamper review 46)
+        ("dorea-pimenta-7-2.toml", "lambda"),
+        ("dorea-pimenta-7-1.toml", "L_user"),
     ],
 )
 def test_verify_refuses_a_parameter_whose_exact_value_was_removed(
