@@ -864,7 +864,8 @@ _SAME_OUTPUT = {"-o": "--output", "--plot-epsilon": "--plot"}
 def _output_uses(args: list[str]) -> list[tuple[str, str, str]]:
     """(option as written, its canonical name, its value) for each use of an output option
     (:data:`OUTPUT_OPTIONS`) before ``--``: ``--opt VALUE`` (the value is skipped, so a value
-    that reads like an option is not one), ``--opt=VALUE`` and the glued ``-oVALUE``."""
+    that reads like an option is not one), ``--opt=VALUE``, the glued ``-oVALUE`` and a
+    cluster of short options ending in o (``-qo VALUE``, ``-qoVALUE``)."""
     uses = []
     i = 0
     while i < len(args):
@@ -878,8 +879,16 @@ def _output_uses(args: list[str]) -> list[tuple[str, str, str]]:
             continue
         if a.startswith("--") and eq and name in OUTPUT_OPTIONS:
             uses.append((name, _SAME_OUTPUT.get(name, name), val))
-        elif a.startswith("-o") and not a.startswith("--") and len(a) > 2:
-            uses.append(("-o", "--output", a[2:]))
+        elif a.startswith("-") and not a.startswith("--") and "o" in a[1:]:
+            # a cluster of short options, as click reads it: flags (-q) up to the o, whose
+            # value is the rest of the word or the next word — -qo a.json -o b.json wrote
+            # only b.json, and -qo out.json/ passed the checks (CLI review 46)
+            rest = a[a.index("o", 1) + 1 :]
+            if rest:
+                uses.append(("-o", "--output", rest))
+            elif i + 1 < len(args):
+                uses.append(("-o", "--output", args[i + 1]))
+                i += 1
         i += 1
     return uses
 
@@ -897,6 +906,12 @@ def _output_problem(args: list[str]) -> str | None:
             shown = {"--output": "-o/--output", "--plot": "--plot/--plot-epsilon"}.get(key, key)
             return f"{shown} is given twice; give each output once"
         seen.add(key)
+        if value.startswith("-") and value != "-":
+            # -o -q wrote a file named -q: the file name was forgotten (CLI review 46)
+            return (
+                f"{written} {value}: the file name reads like an option (was it left out?); "
+                f"write ./{value} for a file of that name"
+            )
         bare = value.rstrip("/" + os.sep)
         folder = value.endswith(("/", os.sep)) or value.endswith(("/.", os.sep + "."))
         if folder and bare.strip("." + "/" + os.sep):

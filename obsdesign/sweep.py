@@ -862,6 +862,8 @@ def check_output_path(path: Path, force: bool, inputs: tuple[Path, ...]) -> None
     path :func:`obsdesign.report.model.check_output` refuses."""
     from obsdesign.report.model import check_output
 
+    if str(path) == "-":  # design's words for it, not "unknown table format" (CLI review 46)
+        check_output(path, force, inputs)
     suf = path.suffix.lower()
     if suf not in OUTPUT_SUFFIXES:
         raise InputError(

@@ -708,6 +708,10 @@ def test_an_output_option_given_twice_is_refused(tmp_path: Path) -> None:
         (["design", str(SPEC), "-o", "a.json", "--output", "b.json"], "-o/--output"),
         (["simulate", str(SPEC), "--csv=a.csv", "--csv", "b.csv"], "--csv"),
         (["design", str(SPEC), "-oa.json", "-o", "b.json"], "-o/--output"),
+        # short options clustered with -o: only "-o…" at a word's start was seen, and
+        # -qo a.json -o b.json wrote b.json alone (CLI review 46)
+        (["design", str(SPEC), "-qo", "a.json", "-o", "b.json"], "-o/--output"),
+        (["design", str(SPEC), "-qoa.json", "--output=b.json"], "-o/--output"),
         (
             ["design", str(SPEC), "--plot", "a.png", "--plot-epsilon", "b.png"],
             "--plot/--plot-epsilon",
@@ -746,3 +750,19 @@ def test_simulate_report_dash_says_reports_are_files() -> None:
     assert (
         r.exit_code == 2 and "--report -: a report is read from a file, not from stdin" in r.stderr
     )
+
+
+def test_clustered_and_option_like_output_values_are_checked(tmp_path: Path) -> None:
+    """-qo out.json/ wrote out.json and -qo=x.json a file named '=x.json', while -q -o … was
+    refused; -o -q wrote a file named -q; sweep -o - said 'unknown table format' (CLI review
+    46). Each is exit 2 with nothing written."""
+    lam = "method.lambda=[0.96]"
+    for args, said in (
+        (["design", str(SPEC), "-qo", "out.json/"], "out.json/: names a folder"),
+        (["design", str(SPEC), "-qo=x.json"], "-o=x.json: write -o FILE or --output=FILE"),
+        (["design", str(SPEC), "-o", "-q"], "-o -q: the file name reads like an option"),
+        (["sweep", str(SPEC), "--set", lam, "-o", "-"], "-: outputs go to files, not to stdout"),
+    ):
+        r = _cli(*args, cwd=tmp_path)
+        assert r.returncode == 2 and said in r.stderr, (args, r.stderr)
+    assert list(tmp_path.iterdir()) == []
