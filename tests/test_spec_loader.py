@@ -441,3 +441,23 @@ def test_a_system_field_cannot_be_assigned_in_place() -> None:
     with pytest.raises(dataclasses.FrozenInstanceError):
         spec.system.A = spec.system.C  # type: ignore[misc]
     assert spec.system.m == 0 and spec.system.nd == 0 and spec.system.nv == 1
+
+
+def test_spec_text_with_a_lone_surrogate_is_bad_input(tmp_path) -> None:
+    """A non-UTF-8 byte in a shell argument reaches Python as a lone surrogate: sweep --set
+    title=["\\xff"] was a row with exit 3 'internal failure: UnicodeEncodeError', and
+    load_spec_text a bare UnicodeEncodeError at the spec's hash (CLI review 46). Exit 2,
+    naming the file and the line."""
+    import json
+
+    from obsdesign import api
+
+    with pytest.raises(SpecError, match=r"x\.toml: line 2: holds a character that is not valid"):
+        api.load_spec_text('# a\ntitle = "\udcff"\n[system]\nA = [[1]]\nC = [[1]]\n', "x.toml")
+    spec = Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+    r = CliRunner().invoke(
+        app, ["sweep", str(spec), "--set", 'title=["\udcff"]', "--format", "json"]
+    )
+    rows = json.loads(r.stdout)
+    assert r.exit_code == 2 and rows[0]["exit_code"] == 2, r.output
+    assert "not valid Unicode" in rows[0]["message"]

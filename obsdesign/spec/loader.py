@@ -61,6 +61,18 @@ def read_spec_text(text: str, file: str = "<spec>") -> Spec:
             "starts with a byte-order mark (U+FEFF, 'UTF-8 with BOM'): TOML is UTF-8 without "
             "one; save the file as plain UTF-8",
         )
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError as e:
+        # a lone surrogate (a non-UTF-8 byte passed through a shell argument, sweep --set
+        # title=["\xff"]) was a bare UnicodeEncodeError at the hash, exit 3 (CLI review 46)
+        line = text.count("\n", 0, e.start) + 1
+        raise SpecError(
+            file,
+            "",
+            f"line {line}: holds a character that is not valid Unicode "
+            f"({ascii(text[e.start : e.end])}, a byte that is not UTF-8?); the spec is UTF-8 text",
+        ) from None
     data = _parse_toml(text, file)
     method = data.get("method")
     declared = method.get("key") if isinstance(method, dict) else None
