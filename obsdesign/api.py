@@ -45,8 +45,19 @@ if TYPE_CHECKING:  # the simulation modules load with the first simulate
 
 
 # -- binding a spec to its method ----------------------------------------------------------
+def _flag(v: Any, name: str) -> bool:
+    """A true/false argument of the API: a bool (numpy's too), else an :class:`InputError`
+    — force='no' was true, and design overwrote a spec it refuses to replace without force
+    (CLI review 46)."""
+    if type(v).__name__ in ("bool", "bool_"):
+        return bool(v)
+    raise InputError(f"{name}: expected True or False, got {v!r}"[:300])
+
+
 def method(key: str) -> Method:
     """The method object for ``key``; :class:`InputError` (with a suggestion) if unknown."""
+    if not isinstance(key, str):  # api.method(5) was a bare TypeError (CLI review 46)
+        raise InputError(f"expected a method key (a text), got {type(key).__name__}")
     if key not in method_keys():
         raise InputError(
             f"unknown method '{key}'{_did_you_mean(key, method_keys())} "
@@ -318,6 +329,7 @@ def design(
     ``"verdict": "error"`` and the error, which ``verify`` reports as such. Bad input (exit 2)
     writes nothing and leaves ``out`` untouched."""
     ensure_recursion_limit()
+    force = _flag(force, "force")
     if out is not None:
         check_output(_path_arg(out, "out"), force, inputs=_spec_inputs(spec))
     budget = budget_seconds(timeout)
@@ -2259,6 +2271,7 @@ def check_plot_path(path: str | Path, force: bool = False, inputs: tuple[Path, .
     45); the command line's --plot is checked by the same function."""
     from obsdesign.formats import PLOT_SUFFIXES
 
+    force = _flag(force, "force")
     p = Path(_path_arg(path, "plot path"))
     try:
         folder = p.is_dir()
@@ -2280,6 +2293,7 @@ def _plot_to(
 ) -> Any:
     """``draw(path)``, through a temp file and a rename when ``atomic`` (the path checked by
     :func:`check_plot_path` first, ``force`` as its)."""
+    atomic, force = _flag(atomic, "atomic"), _flag(force, "force")
     if not atomic:
         return draw(Path(path))
     from obsdesign.report.model import write_via

@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 import numbers
 import re
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from decimal import Decimal, localcontext
 from fractions import Fraction
 from pathlib import Path
@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from obsdesign.errors import InputError, SpecError
+from obsdesign.limits import INT_MAX
 
 #: methods whose designed observer is linear (a control.StateSpace)
 LINEAR = ("lyapunov", "set-invariant", "stubborn")
@@ -113,6 +114,12 @@ def _num(x: Any) -> str:
     if isinstance(x, (bool, np.bool_)):
         return "true" if x else "false"
     if isinstance(x, (int, np.integer)):
+        if abs(int(x)) > INT_MAX:  # the spec refuses it, and past 4,300 digits str() raised
+            from obsdesign.errors import value_text
+
+            raise InputError(
+                f"cannot write {value_text(int(x))} into a spec: integers are at most 2^63 − 1"
+            )
         return str(int(x))
     q = _exact(x)
     if q is not None:
@@ -421,6 +428,63 @@ def spec_text_from_statespace(
     exactly; B and Bd must have n rows and D p×m (a vector is one column, D's one row or
     column), else InputError. A boolean is written as ``true`` / ``false`` wherever it sits
     (never as 1 / 0 beside a float), so the spec refuses it where a number belongs."""
+    args = {"sets": sets, "nonlinearity": nonlinearity, "simulate": simulate, **options}
+    for name, v in args.items():
+        _nesting_check(name, v)
+    try:
+        return _spec_text(sys, method, title, states, sets, nonlinearity, simulate, Bd, options)
+    except RecursionError:
+        raise InputError("a value nested too deeply to be written into a spec") from None
+
+
+def _nesting_check(name: str, value: Any) -> None:
+    """Refuse ``value`` nested deeper than the spec reader's ``max_depth`` (walked
+    iteratively): mappings or lists thousands deep were a bare RecursionError, or — under a
+    raised recursion limit — written into a spec no reader takes (CLI review 46)."""
+    from obsdesign.limits import limits
+
+    most = limits().max_depth
+    stack = [(value, 1)]
+    while stack:
+        v, depth = stack.pop()
+        if isinstance(v, Mapping):
+            items: Any = v.values()
+        elif isinstance(v, (list, tuple)) or (isinstance(v, np.ndarray) and v.dtype == object):
+            items = v
+        else:
+            continue
+        if depth > most:
+            raise InputError(
+                f"{name}: nested more than {most} levels deep, past what a spec may hold "
+                "(--limit max_depth)"
+            )
+        stack.extend((x, depth + 1) for x in items)
+
+
+def _spec_text(
+    sys: Any,
+    method: str,
+    title: str | None,
+    states: Any,
+    sets: Any,
+    nonlinearity: Any,
+    simulate: Any,
+    Bd: Any,
+    options: dict[str, Any],
+) -> str:
+    """:func:`spec_text_from_statespace`'s body."""
+    for what, v in (("sets", sets), ("nonlinearity", nonlinearity), ("simulate", simulate)):
+        if v is not None and not isinstance(v, Mapping):
+            raise InputError(f"{what}: expected a mapping of keys to values, got {_tname(v)}")
+    if states is not None and (
+        isinstance(states, (str, bytes))
+        or not isinstance(states, Sequence)
+        or not all(isinstance(x, str) for x in states)
+    ):
+        # states=5 was a bare TypeError (CLI review 46)
+        raise InputError(f"states: expected a list of state names (texts), got {_tname(states)}")
+    if not isinstance(method, str):
+        raise InputError(f"method: expected a method key (a text), got {_tname(method)}")
     A, B, C, D, dt = _matrices(sys)
     time, sample_time = _time_of(dt)
     system: dict[str, Any] = {"time": time, "A": A, "C": C}
@@ -448,6 +512,10 @@ def spec_text_from_statespace(
     if simulate:
         lines += _table("simulate", simulate)
     return "\n".join(lines).rstrip("\n") + "\n"
+
+
+def _tname(v: Any) -> str:
+    return type(v).__name__
 
 
 def spec_from_statespace(sys: Any, method: str = "lyapunov", **options: Any) -> Any:
@@ -489,11 +557,17 @@ def observer_statespace(report: Any, law: str | None = None, verify: bool = Fals
     other than ok gives a ``UserWarning``. A report with L edited to an unstable gain gave
     an observer with no word (sweep, import and check trial, session 28)."""
     import hashlib
+    import os
     import warnings
 
     from obsdesign.api import load_spec_text, report_dict
     from obsdesign.report.model import Report
 
+    if not isinstance(report, (Report, str, os.PathLike)):
+        # None was a bare TypeError from the path handling (CLI review 46)
+        raise InputError(f"report: expected a Report or the path of one, got {_tname(report)}")
+    if law is not None and not isinstance(law, str):
+        raise InputError(f"law: expected a law name (a text), got {_tname(law)}")
     ct = _control()
     where = "report" if isinstance(report, Report) else str(report)
     report, problems = (
@@ -520,6 +594,13 @@ def observer_statespace(report: Any, law: str | None = None, verify: bool = Fals
         )
     if report.method not in LINEAR:
         raise InputError(_NOT_LINEAR.format(method=report.method, linear=", ".join(LINEAR)))
+    if law not in (None, "linear") and report.method != "set-invariant":
+        # law="online-lp" with a lyapunov report was dropped without a word, while
+        # set-invariant refuses a law it does not know (CLI review 46)
+        raise InputError(
+            f"law {law!r}: the {report.method} observer is linear and has no other law; "
+            "law is for set-invariant reports"
+        )
     sp = load_spec_text(report.spec, report.spec_file or "<report>")
     s, params = sp.system, report.parameters
     if s.A is None or s.C is None:

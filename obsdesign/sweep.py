@@ -268,8 +268,14 @@ def parse_grid(grid: Sequence[str] | dict[str, Any]) -> list[Axis]:
         grid = [grid]  # one KEY=VALUES text, not its characters
     else:
         # a generator is true even when empty: an empty one swept one unswept point, ok
-        # (API review 45)
-        grid = list(grid)
+        # (API review 45); None or 5 were bare TypeErrors (CLI review 46)
+        try:
+            grid = list(grid)
+        except TypeError:
+            raise InputError(
+                f"sweep: expected KEY=VALUES texts (or a dict) as the grid, got "
+                f"{type(grid).__name__}"
+            ) from None
     if not grid:
         raise InputError("sweep: no --set KEY=VALUES given (nothing to sweep)")
     bad = next((t for t in grid if not isinstance(t, str)), None)
@@ -767,7 +773,9 @@ def sweep_rows(
     """One row per grid point, in grid order (see the module docstring); ``on_row(row)`` is
     called as each row arrives (completion order); ``timeout``: seconds per point (on Dask
     too: applied in the worker), past which the point's row is exit 3."""
-    _, tasks = plan(spec, grid, simulate, options, timeout)
+    if type(simulate).__name__ not in ("bool", "bool_"):  # 'no' simulated (CLI review 46)
+        raise InputError(f"simulate: expected True or False, got {simulate!r}"[:300])
+    _, tasks = plan(spec, grid, bool(simulate), options, timeout)
 
     def lost(task: PointTask, message: str) -> dict[str, Any]:
         return failure_row(task, EXIT_SOLVER, message, task_method(task))

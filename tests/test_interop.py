@@ -1190,3 +1190,39 @@ def test_table_names_are_quoted_keys() -> None:
     doc = tomllib.loads(text)
     assert set(doc["sets"]) == {"X.hat", evil}
     assert doc["simulate"]["horizon"] == 5 and "my noise" in doc["simulate"]
+
+
+def test_bad_arguments_of_the_interop_functions_are_bad_input() -> None:
+    """Values nested thousands deep (RecursionError), states=5 (TypeError), an integer past
+    Python's 4,300-digit text limit (ValueError), observer_statespace(None) (TypeError) were
+    bare exceptions, and a law given with a lyapunov report was dropped without a word (CLI
+    review 46). Each is an InputError now."""
+    ss = ([[0, 1], [1, 0]], [[0], [1]], [[1, 0]], [[0]], 1)
+    deep: dict = {}
+    cur = deep
+    for _ in range(3000):
+        cur["a"] = {}
+        cur = cur["a"]
+    deep_list: list = []
+    cur_l = deep_list
+    for _ in range(3000):
+        cur_l.append([])
+        cur_l = cur_l[0]
+    cases = (
+        (lambda: spec_text_from_statespace(ss, sets={"X": deep}), "sets: nested more than"),
+        (lambda: spec_text_from_statespace(ss, simulate=deep), "simulate: nested more than"),
+        (lambda: spec_text_from_statespace(ss, L=deep_list), "L: nested more than"),
+        (lambda: spec_text_from_statespace(ss, states=5), "states: expected a list"),
+        (lambda: spec_text_from_statespace(ss, states="x1"), "states: expected a list"),
+        (lambda: spec_text_from_statespace(ss, simulate=5), "simulate: expected a mapping"),
+        (lambda: spec_text_from_statespace(ss, horizon=10**5000), "about 5000 digits"),
+        (lambda: spec_text_from_statespace(ss, horizon=2**63), "at most 2.63 − 1"),
+        (lambda: observer_statespace(None), "expected a Report or the path of one"),
+    )
+    for call, said in cases:
+        with pytest.raises(InputError, match=said):
+            call()
+    rep = api.design(api.load_spec(ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml"))
+    with pytest.raises(InputError, match="law 'online-lp': the lyapunov observer is linear"):
+        observer_statespace(rep, law="online-lp")
+    assert observer_statespace(rep, law="linear").A.shape == (2, 2)

@@ -1026,3 +1026,14 @@ def test_width_folds_the_progress_bar_and_the_summary_line(tmp_path: Path):
     k = next(i for i, x in enumerate(out) if x.startswith("swept: "))
     assert out[k:] == ["swept: 2 points, 0 ok, 2 not ok (worst", "exit 2)"]
     assert all(cell_len(x) <= 40 for x in out), r.stdout
+
+
+def test_the_sweep_api_refuses_a_grid_or_simulate_flag_of_another_type() -> None:
+    """sweep(spec, None) and sweep(spec, 5) were bare TypeErrors, and simulate='no' simulated
+    every point (CLI review 46)."""
+    for grid in (None, 5):
+        with pytest.raises(InputError, match="as the grid, got"):
+            sw.sweep(SPEC, grid)
+    for flag in ("no", 1, None):
+        with pytest.raises(InputError, match="simulate: expected True or False"):
+            sw.sweep(SPEC, ["method.lambda=0.97"], simulate=flag)
