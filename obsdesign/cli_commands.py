@@ -462,6 +462,22 @@ def _json_only(v: Any) -> bool:
     return isinstance(v, dict) and bool(v) and all(isinstance(x, dict) for x in v.values())
 
 
+def _metric_text(v: Any) -> str:
+    """A metric's value in the text and Markdown output: yes / no for a truth value, none
+    for a missing one, a flat mapping as ``key = value, …``, a list item by item — Python's
+    reprs (None, True, {'standard': 1.28…}) were printed as they were (CLI review 46; JSON
+    keeps null, true and the objects)."""
+    if type(v).__name__ in ("bool", "bool_"):  # numpy's too
+        return "yes" if v else "no"
+    if v is None:
+        return "none"
+    if isinstance(v, dict):
+        return ", ".join(f"{k} = {_metric_text(x)}" for k, x in v.items())
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_metric_text(x) for x in v) + "]"
+    return str(v)
+
+
 def _metrics_markdown(m: dict[str, Any]) -> str:
     lines = ["| state | sup \\|e_i\\| | RMSE | sup \\|x̂_i\\| |", "| --- | --- | --- | --- |"]
     for st, v in m["sup_abs_error"].items():
@@ -479,7 +495,7 @@ def _metrics_markdown(m: dict[str, Any]) -> str:
             # (outsider trial, session 22): a fenced block keeps its rows
             lines += [f"- {_md_cell(k)}:", "", "```", v.strip("\n"), "```", ""]
         elif k not in (*_MAIN_METRICS, "quantiles"):
-            lines.append(f"- {_md_cell(k)}: {_md_cell(v)}")
+            lines.append(f"- {_md_cell(k)}: {_md_cell(_metric_text(v))}")
     head, rows = _quantile_rows(m.get("quantiles"))
     if rows:
         lines += ["", "| quantiles | " + " | ".join(head) + " |", "| --- " * (len(head) + 1) + "|"]
@@ -564,7 +580,7 @@ def _print_metrics(m: dict[str, Any]) -> None:
             # each line escaped (escaped whole, its newlines printed as "\n": simulate trial)
             c.print("\n".join(esc(line) for line in f"{k}: {v}".split("\n")), soft_wrap=True)
         elif k not in (*_MAIN_METRICS, "quantiles"):
-            c.print(esc(f"{k}: {v}"))
+            c.print(esc(f"{k}: {_metric_text(v)}"))
     head, rows = _quantile_rows(m.get("quantiles"))
     if rows:
         q = Table(title=f"quantiles over {m.get('runs', 'the')} runs")

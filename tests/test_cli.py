@@ -766,3 +766,23 @@ def test_clustered_and_option_like_output_values_are_checked(tmp_path: Path) -> 
         r = _cli(*args, cwd=tmp_path)
         assert r.returncode == 2 and said in r.stderr, (args, r.stderr)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_simulate_text_and_markdown_print_metrics_in_words_not_python_reprs() -> None:
+    """simulate printed Python's reprs: "open_loop_stopped_at: None", "e0_in_omega: True",
+    "rmse_error_norm: {'standard': 1.28…, 'stubborn': 1.23…}" (CLI review 46): yes / no,
+    none, and key = value items; --format json keeps true, null and the objects."""
+    import numpy as np
+
+    from obsdesign.cli_commands import _metric_text
+
+    assert _metric_text(True) == "yes" and _metric_text(np.bool_(False)) == "no"
+    assert _metric_text(None) == "none" and _metric_text([0.5, None]) == "[0.5, none]"
+    assert _metric_text({"standard": 1.5, "stubborn": 2}) == "standard = 1.5, stubborn = 2"
+    spec = str(SPEC.parent / "dorea-pimenta-7-1.toml")
+    for fmt in ("text", "md"):
+        r = CliRunner().invoke(app, ["simulate", spec, "--format", fmt])
+        assert r.exit_code == 0 and "e0_in_omega: yes" in r.stdout, r.stdout
+        assert "True" not in r.stdout and "None" not in r.stdout
+    r = CliRunner().invoke(app, ["simulate", spec, "--format", "json"])
+    assert json.loads(r.stdout)["e0_in_omega"] is True
