@@ -786,3 +786,13 @@ def test_simulate_text_and_markdown_print_metrics_in_words_not_python_reprs() ->
         assert "True" not in r.stdout and "None" not in r.stdout
     r = CliRunner().invoke(app, ["simulate", spec, "--format", "json"])
     assert json.loads(r.stdout)["e0_in_omega"] is True
+
+
+def test_output_to_dev_stdout_on_a_pipe_with_force_writes_into_it(tmp_path: Path) -> None:
+    """-o /dev/stdout --force with stdout a pipe: the link's realpath is "pipe:[…]", a name
+    that does not exist, and the whole design ran before exit 2 "cannot write (No such file
+    or directory)" (CLI review 46). The report goes into the pipe, as into a named FIFO."""
+    r = _cli("design", str(SPEC), "-o", "/dev/stdout", "--force", "-q", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["verdict"] == "ok"
+    assert list(tmp_path.iterdir()) == []

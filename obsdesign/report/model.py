@@ -676,6 +676,16 @@ def write_via(path: str | Path, writer: Callable[[Path], Any], force: bool = Fal
     given = p.suffix  # the name written picks the format, not a link's target (session 30)
     try:
         if force and p.is_symlink():
+            try:  # what the link leads to, followed as open() follows it
+                st = os.stat(p)
+            except OSError:
+                st = None
+            if st is not None and (stat.S_ISFIFO(st.st_mode) or stat.S_ISCHR(st.st_mode)):
+                # /dev/stdout or /dev/fd/N on a pipe: its realpath is "pipe:[…]", a name
+                # that does not exist, and the design ran before "cannot write (No such
+                # file or directory)" (CLI review 46); write into the given path
+                _write_into(p, writer, given)
+                return p
             p = Path(os.path.realpath(p))
         if force and p.exists() and not p.is_file() and not p.is_dir():
             _write_into(p, writer, given)  # a FIFO or a device: write into it, never replace
