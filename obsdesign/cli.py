@@ -857,15 +857,35 @@ GLOBAL_OPTIONS = ("--limit", "--debug", "--version")
 OUTPUT_OPTIONS = ("-o", "--output", "--plot", "--plot-epsilon", "--junit", "--csv")
 
 
-#: the output options that are names of one option (-o / --output, --plot / --plot-epsilon)
+#: the options that take one value, once (a test ties this to the commands' own options):
+#: given twice, click kept the last without a word — verify --spec a --spec b checked b
+#: only, --timeout 0.001 --timeout 0 ran unbounded (CLI review 46)
+SINGLE_OPTIONS = (
+    *OUTPUT_OPTIONS,
+    *("--spec", "--report", "--format", "--timeout", "--width", "--workers", "--scheduler"),
+    *("--runs", "--study", "--x", "--y", "--method"),
+    *("--A", "--B", "--Bd", "--C", "--D", "--dt", "--dt-var"),
+)
+
+#: the options that take a value and may be repeated
+REPEATED_OPTIONS = ("--set", "--option", "--limit")
+
+#: the options that are names of one option (-o / --output, --plot / --plot-epsilon)
 _SAME_OUTPUT = {"-o": "--output", "--plot-epsilon": "--plot"}
 
 
 def _output_uses(args: list[str]) -> list[tuple[str, str, str]]:
     """(option as written, its canonical name, its value) for each use of an output option
-    (:data:`OUTPUT_OPTIONS`) before ``--``: ``--opt VALUE`` (the value is skipped, so a value
-    that reads like an option is not one), ``--opt=VALUE``, the glued ``-oVALUE`` and a
-    cluster of short options ending in o (``-qo VALUE``, ``-qoVALUE``)."""
+    (:data:`OUTPUT_OPTIONS`), as :func:`_option_uses`."""
+    return [u for u in _option_uses(args) if u[0] in OUTPUT_OPTIONS]
+
+
+def _option_uses(args: list[str]) -> list[tuple[str, str, str]]:
+    """(option as written, its canonical name, its value) for each use of an option that
+    takes one value (:data:`SINGLE_OPTIONS`) before ``--``: ``--opt VALUE`` (the value of
+    every option that takes one is skipped, so a value that reads like an option is not
+    one), ``--opt=VALUE``, the glued ``-oVALUE`` and a cluster of short options ending in o
+    (``-qo VALUE``, ``-qoVALUE``)."""
     uses = []
     i = 0
     while i < len(args):
@@ -873,11 +893,14 @@ def _output_uses(args: list[str]) -> list[tuple[str, str, str]]:
         if a == "--":
             break
         name, eq, val = a.partition("=")
-        if a in OUTPUT_OPTIONS and i + 1 < len(args):
+        if a in REPEATED_OPTIONS:
+            i += 2
+            continue
+        if a in SINGLE_OPTIONS and i + 1 < len(args):
             uses.append((a, _SAME_OUTPUT.get(a, a), args[i + 1]))
             i += 2
             continue
-        if a.startswith("--") and eq and name in OUTPUT_OPTIONS:
+        if a.startswith("--") and eq and name in SINGLE_OPTIONS:
             uses.append((name, _SAME_OUTPUT.get(name, name), val))
         elif a.startswith("-") and not a.startswith("--") and "o" in a[1:]:
             # a cluster of short options, as click reads it: flags (-q) up to the o, whose
@@ -894,12 +917,18 @@ def _output_uses(args: list[str]) -> list[tuple[str, str, str]]:
 
 
 def _output_problem(args: list[str]) -> str | None:
-    """The one-line error for an output option used badly, or None: given twice (click kept
+    """The one-line error for an option that takes one value given twice (click kept the
+    last; CLI review 46), or for an output option used badly, or None: given twice (click kept
     the last: ``-o a.json -o b.json`` wrote b.json alone), a name that ends in a slash or in
     "/." (pathlib dropped it and wrote out.json), or ``-o=FILE`` (click read a file named
     "=FILE") — hostile-input trial and re-checks, session 38."""
     seen: set[str] = set()
-    for written, key, value in _output_uses(args):
+    for written, key, value in _option_uses(args):
+        if written not in OUTPUT_OPTIONS:
+            if key in seen:
+                return f"{key} is given twice; give it once (the last one would be used alone)"
+            seen.add(key)
+            continue
         if written == "-o" and value.startswith("="):
             return f"-o{value}: write -o FILE or --output=FILE (-o= names a file starting with '=')"
         if key in seen:

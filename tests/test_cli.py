@@ -796,3 +796,32 @@ def test_output_to_dev_stdout_on_a_pipe_with_force_writes_into_it(tmp_path: Path
     assert r.returncode == 0, r.stderr
     assert json.loads(r.stdout)["verdict"] == "ok"
     assert list(tmp_path.iterdir()) == []
+
+
+def test_an_option_that_takes_one_value_given_twice_is_refused(tmp_path: Path) -> None:
+    """click keeps the last of a repeated option: verify --spec a --spec b checked b only,
+    --timeout 0.001 --timeout 0 ran unbounded, --format md --format json printed JSON (CLI
+    review 46). Exit 2 for every option that takes one value; --set, --option and --limit
+    repeat. The table of such options is the commands' own."""
+    import typer.main
+
+    from obsdesign.cli import REPEATED_OPTIONS, SINGLE_OPTIONS
+
+    group = typer.main.get_command(app)
+    single, repeated = set(), set()
+    for params in [group.params, *(c.params for c in group.commands.values())]:  # type: ignore[attr-defined]
+        for p in params:
+            if p.param_type_name == "option" and not p.is_flag:
+                (repeated if p.multiple else single).update(p.opts + p.secondary_opts)
+    assert single == set(SINGLE_OPTIONS) and repeated == set(REPEATED_OPTIONS)
+    for args, name in (
+        (["verify", "r.json", "--spec", "a.toml", "--spec", "b.toml"], "--spec"),
+        (["design", str(SPEC), "--timeout", "0.001", "--timeout=0"], "--timeout"),
+        (["design", str(SPEC), "--format", "md", "--format", "json"], "--format"),
+        (["simulate", str(SPEC), "--runs", "2", "--runs", "3"], "--runs"),
+    ):
+        r = _cli(*args, cwd=tmp_path)
+        assert r.returncode == 2 and f"{name} is given twice; give it once" in r.stderr, r.stderr
+    # a value that reads like a repeated option is a value: --y --x is the column "--x"
+    r = _cli("sweep", str(SPEC), "--set", "method.lambda=[0.97]", "--y", "--x", "--x", "a")
+    assert "given twice" not in r.stderr
