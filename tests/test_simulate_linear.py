@@ -244,3 +244,23 @@ def test_an_overflowing_plant_leaves_a_decoupled_error_finite() -> None:
     np.testing.assert_allclose(res.e, e, rtol=1e-12, atol=1e-300)
     m = res.metrics()
     assert m["sup_abs_error"] == {"x1": 1.0, "x2": 1.0} and m["final_error_norm"] == 0.0
+
+
+def test_an_observer_unstable_in_doubles_is_said_so_not_blamed_on_dt() -> None:
+    """A certified 12-state design (‖L‖ ≈ 2.5·10¹¹): exp of the joint system over the default
+    dt is not finite because A − LC in doubles is not Hurwitz; simulate was exit 2 blaming
+    "[simulate] dt = 0.01", and a smaller dt gave NaN (census 46). Exit 4 naming A − LC in
+    doubles; the design and its verify stand."""
+    from pathlib import Path
+
+    import pytest
+
+    from obsdesign import api
+    from obsdesign.errors import InconclusiveError
+
+    spec = api.load_spec(Path(__file__).parent / "specs" / "lyapunov-float-unstable-12state.toml")
+    rep = api.design(spec)
+    assert rep.exit_code() == 0 and api.verify(rep).exit_code() == 0
+    with pytest.raises(InconclusiveError, match="A − LC formed in doubles is not Hurwitz") as e:
+        api.simulate(spec, rep)
+    assert "dt" not in str(e.value).split("not Hurwitz")[0] and e.value.exit_code == 4

@@ -102,6 +102,20 @@ def joint_system(spec: Spec, L: np.ndarray, error: bool = False) -> JointSystem:
     with np.errstate(all="ignore"):
         F = expm(aug * dt)
     if not np.all(np.isfinite(F)):
+        from obsdesign.lyap import float_realization
+
+        Acl = A - LC
+        if not np.all(np.isfinite(Acl)) or float_realization(Acl, False) == "unstable":
+            # the observer in doubles, not dt: a certified 12-state design with ‖L‖ ≈ 2.5e11
+            # was exit 2 blaming the default dt, and a smaller dt gave NaN (census 46)
+            from obsdesign.errors import InconclusiveError
+
+            raise InconclusiveError(
+                f"{spec.file}: A − LC formed in doubles is not Hurwitz (decided exactly on "
+                "the doubles), and exp of the observer over dt is not finite: a simulation in "
+                "doubles cannot run this observer; the certificate is about the exact gain "
+                "(report parameters.exact)"
+            )
         # horizon 1e50 (dt = horizon / 1000) printed NaN metrics and "the plant or the
         # observer diverges" for a stable plant and observer (independent simulate review)
         raise InputError(

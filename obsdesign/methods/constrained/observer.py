@@ -82,7 +82,11 @@ class Refiner:
                 p = G @ x - h
                 np.maximum(p, 0.0, out=p)
                 p2 = p * p
-                nc2 = float(p2.max()) ** 2 if cm.norm == "max" else float(p2 @ p2)
+                # numpy's square: a plant past 1e77 made Python's float power raise
+                # OverflowError, exit 4 "too large", where the Euclidean norm gives inf and
+                # stops the refinement (census 46)
+                with np.errstate(over="ignore"):
+                    nc2 = float(np.square(p2.max()) if cm.norm == "max" else p2 @ p2)
                 if not (lo2 < nc2 <= hi2):
                     break
                 x = x - Pg @ (G.T @ (2.0 * p2 * p))
