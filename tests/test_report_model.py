@@ -230,3 +230,17 @@ def test_a_stop_as_the_temp_file_appears_leaves_no_file(tmp_path: Path, where: s
         assert interrupt.requested()
         interrupt.reset()
     assert sorted(os.listdir(tmp_path)) == []
+
+
+def test_a_report_with_a_byte_order_mark_gets_a_sentence(tmp_path: Path) -> None:
+    """A report file starting with a UTF-8 BOM said Python's hint "Unexpected UTF-8 BOM
+    (decode using utf-8-sig)" (tamper review 46); it says what a spec with one is told."""
+    from obsdesign import api
+    from obsdesign.errors import InputError
+
+    spec = Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+    p = tmp_path / "bom.json"
+    p.write_text("\ufeff" + api.design(api.load_spec(spec)).to_json(), encoding="utf-8")
+    with pytest.raises(InputError, match="starts with a byte-order mark") as e:
+        api.verify(p)
+    assert "utf-8-sig" not in str(e.value)

@@ -461,3 +461,17 @@ def test_spec_text_with_a_lone_surrogate_is_bad_input(tmp_path) -> None:
     rows = json.loads(r.stdout)
     assert r.exit_code == 2 and rows[0]["exit_code"] == 2, r.output
     assert "not valid Unicode" in rows[0]["message"]
+
+
+def test_a_report_given_as_a_spec_is_named_as_a_report(tmp_path) -> None:
+    """check or design given a report (JSON), named directly or saved as .toml in a checked
+    folder, said only "is not valid TOML (Invalid statement (at line 1, column 1))" (tamper
+    review 46): it says the file is a report, which verify reads. Other bad TOML unchanged."""
+    from obsdesign import api
+
+    spec = Path(__file__).resolve().parents[1] / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+    text = api.design(api.load_spec(spec)).to_json()
+    with pytest.raises(SpecError, match=r"r\.toml: is an obsdesign report \(JSON\), not a spec"):
+        load_spec_text(text, "r.toml")
+    with pytest.raises(SpecError, match="is not valid TOML"):
+        load_spec_text('{"a": 1}', "j.toml")

@@ -307,6 +307,13 @@ class Report:
         last of two ``"verdict"`` or ``"parameters"`` copies (session 27)."""
         from obsdesign.limits import int_digits, limits
 
+        if text.startswith("\ufeff"):
+            # json said "Unexpected UTF-8 BOM (decode using utf-8-sig)", a hint for Python
+            # programmers; as the spec loader says it (tamper review 46)
+            raise InputError(
+                f"{name}: starts with a byte-order mark (U+FEFF, 'UTF-8 with BOM'): a report is "
+                "UTF-8 without one; save the file as plain UTF-8"
+            )
         try:
             with int_digits():
                 d = json.loads(text, object_pairs_hook=_unique_keys)

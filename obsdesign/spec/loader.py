@@ -47,6 +47,13 @@ def read_spec(path: str | Path) -> Spec:
     return read_spec_text(text, str(p))
 
 
+def _looks_like_report(text: str) -> bool:
+    """Whether ``text`` reads as the start of an obsdesign report: a JSON object whose first
+    keys are a report's (``schema_version``, ``tool``)."""
+    head = text.lstrip()[:400]
+    return head.startswith("{") and '"schema_version"' in head and '"spec_sha256"' in text
+
+
 def read_spec_text(text: str, file: str = "<spec>") -> Spec:
     """Parse and validate the generic parts of spec text; ``file`` is used in error messages.
 
@@ -188,6 +195,12 @@ def _parse_toml_fresh(text: str, file: str) -> dict[str, Any]:
         with int_digits():
             data = tomllib.loads(text, parse_float=Decimal)
     except tomllib.TOMLDecodeError as e:
+        if _looks_like_report(text):
+            # check or design given a report said only "Invalid statement (line 1)" (tamper
+            # review 46)
+            raise SpecError(
+                file, "", "is an obsdesign report (JSON), not a spec: obsdesign verify reads it"
+            ) from None
         raise SpecError(file, "", f"is not valid TOML ({e})") from None
     except RecursionError:
         raise SpecError(
