@@ -244,3 +244,32 @@ def test_a_report_with_a_byte_order_mark_gets_a_sentence(tmp_path: Path) -> None
     with pytest.raises(InputError, match="starts with a byte-order mark") as e:
         api.verify(p)
     assert "utf-8-sig" not in str(e.value)
+
+
+@pytest.mark.parametrize(("flag", "word"), [("+a", "append-only"), ("+i", "immutable")])
+def test_an_append_only_or_immutable_output_is_refused_before_any_work(
+    tmp_path: Path, flag: str, word: str
+) -> None:
+    """os.access allows writing to an append-only file (chattr +a), but a rename cannot
+    replace it: sweep, check and design did all their work, then exit 2 "cannot write
+    (Operation not permitted)" and the rows were lost (CLI review 46). Refused up front, even
+    with --force (the flag is the file's own). Skipped where chattr does not work (tmpfs,
+    no CAP_LINUX_IMMUTABLE)."""
+    import shutil
+    import subprocess
+
+    from obsdesign.errors import InputError
+    from obsdesign.report.model import check_output
+
+    out = tmp_path / "out.json"
+    out.write_text("{}", encoding="utf-8")
+    chattr = shutil.which("chattr")
+    if chattr is None or subprocess.run([chattr, flag, str(out)]).returncode != 0:
+        pytest.skip("chattr is not available here")
+    try:
+        for force in (False, True):
+            with pytest.raises(InputError, match=f"out.json: is {word}: it cannot be replaced"):
+                check_output(out, force, ())
+    finally:
+        subprocess.run([chattr, "-" + flag[1:], str(out)], check=True)
+    check_output(out, False, ())  # a plain file again

@@ -617,6 +617,13 @@ def _check_output(path: str | Path, force: bool, inputs: tuple[Path, ...]) -> No
         # no output of this tool is TOML: an existing .toml is somebody's spec (check --junit
         # x/.hidden/s.toml replaced a spec the run skipped: session 26)
         raise InputError(f"{p}: is a spec file (.toml); refusing to replace it (--force)")
+    if stat.S_ISREG(st.st_mode):
+        # before the write-protection test: an immutable file is that too, and --force
+        # cannot replace it either
+        real = Path(os.path.realpath(p)) if stat.S_ISLNK(lst.st_mode) else p
+        fixed = _inode_fixed(real)
+        if fixed:
+            raise InputError(f"{p}: is {fixed}: it cannot be replaced (chattr -a / -i)")
     protected = not os.access(p, os.W_OK) or not st.st_mode & 0o222  # (root ignores access)
     if stat.S_ISREG(st.st_mode) and protected and not force:
         raise InputError(f"{p}: is write-protected; refusing to replace it (--force)")
@@ -624,6 +631,38 @@ def _check_output(path: str | Path, force: bool, inputs: tuple[Path, ...]) -> No
         # through a link (--force) the file written is the target's (a link in a writable
         # folder to /proc/version ran every point, then failed: output trial, session 30)
         _probe_dir(Path(os.path.realpath(p)) if stat.S_ISLNK(lst.st_mode) else p)
+
+
+#: Linux inode flags (FS_IOC_GETFLAGS) that forbid replacing a file by a rename
+_FS_IOC_GETFLAGS = 0x80086601
+_FS_APPEND_FL, _FS_IMMUTABLE_FL = 0x20, 0x10
+
+
+def _inode_fixed(p: Path) -> str | None:
+    """ "append-only" or "immutable" when the file's inode flags (chattr +a / +i) forbid a
+    rename over it, else None (unknown: None). ``os.access`` allows writing to an append-only
+    file, and sweep, check and design did all their work before "cannot write (Operation not
+    permitted)" (CLI review 46)."""
+    if not sys.platform.startswith("linux"):
+        return None
+    import array
+    import fcntl
+
+    try:
+        fd = os.open(p, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOFOLLOW", 0))
+    except OSError:
+        return None
+    try:
+        buf = array.array("l", [0])
+        fcntl.ioctl(fd, _FS_IOC_GETFLAGS, buf, True)
+    except OSError:  # a file system without inode flags (tmpfs, NFS)
+        return None
+    finally:
+        os.close(fd)
+    flags = buf[0]
+    if flags & _FS_IMMUTABLE_FL:
+        return "immutable"
+    return "append-only" if flags & _FS_APPEND_FL else None
 
 
 def _probe_dir(p: Path) -> None:
