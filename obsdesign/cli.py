@@ -204,8 +204,21 @@ def _run(fn: Callable[[Any], int], quiet: bool = False, width: int | None = None
         _quiet_broken_pipe()
     except OSError as e:
         _err(_stdout_error(e).message)
+        _drop_stdout()
         raise typer.Exit(_stdout_error(e).exit_code) from None
     raise typer.Exit(code)
+
+
+def _drop_stdout() -> None:
+    """Point stdout's descriptor at /dev/null once its error is reported: the bytes left in
+    Python's buffer made the flush at exit fail again, "Exception ignored … OSError" and exit
+    120 — on any machine without PYTHONUNBUFFERED (fresh-Debian review 46)."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError, AttributeError):
+        pass
 
 
 #: the program names of the console script's own process (``obsdesign``, ``python -m
@@ -352,11 +365,7 @@ def _quiet_broken_pipe() -> None:
     """The reader of stdout went away (``obsdesign schema | head -1``): stop quietly with
     exit 141, as a process killed by SIGPIPE would (stdout is pointed at /dev/null so that
     Python's own flush at exit does not complain)."""
-    try:
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-    except (OSError, ValueError):
-        pass
+    _drop_stdout()
     raise typer.Exit(141) from None
 
 
@@ -1129,6 +1138,7 @@ def main() -> None:
             _err(one_line(f"{e.filename}: cannot write ({e.strerror or e})"))
         else:
             _err(_stdout_error(e).message)
+            _drop_stdout()
         sys.exit(2)
     except Exception as e:
         kind = _click_kind(e)
@@ -1174,6 +1184,14 @@ def main() -> None:
             except (OSError, ValueError, AttributeError):
                 pass
         os._exit(code)
+    try:  # what is still buffered (--version, click's help): its errors as a command's
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _quiet_broken_pipe_exit()
+    except OSError as e:
+        _err(_stdout_error(e).message)
+        _drop_stdout()
+        sys.exit(2)
     sys.exit(code)
 
 
