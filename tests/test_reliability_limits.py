@@ -767,13 +767,23 @@ def test_an_exponent_past_the_decimal_readers_range_is_bad_input() -> None:
 
     # line 1 reads like such a number in a string and a comment: the number's own line and
     # key are named, not the title (re-check review 45)
+    # ... nor an apostrophe in a title, a multi-line title or a comment inside an array (a
+    # line scan counting quotes was fooled by each; re-check review 46)
     base = (
-        'title = "e99999999999999999999"  # 1e99999999999999999999\n'
-        '[system]\ntime = "discrete"\nA = [[{a}]]\nC = [[1]]\n[method]\nkey = "lyapunov"\n'
+        'title = "it\'s e99999999999999999999"  # 1e99999999999999999999\n'
+        'description = """\nx = 1e99999999999999999999\n"""\n'
+        '[system]\ntime = "discrete"\nA = [[{a}]]\nC = [  # 1e99999999999999999999\n [1]]\n'
+        '[method]\nkey = "lyapunov"\n'
     )
-    for a in ("0.1e+99999999999999999999", "1e-99999999999999999999", "1e999999999999999999"):
+    cases = (
+        "0.1e+99999999999999999999",
+        "1e-99999999999999999999",
+        "1e999999999999999999",
+        "100e999999999999999999",  # 18 digits, past Decimal's range once normalized
+    )
+    for a in cases:
         with pytest.raises(
-            SpecError, match=r"h\.toml: \[(line 4, key A|system\.A\[0\]\[0\])\] has .*exponent"
+            SpecError, match=r"h\.toml: \[(line 7, key A|system\.A\[0\]\[0\])\] has .*exponent"
         ) as ei:
             api.load_spec_text(base.format(a=a), "h.toml")
         assert ei.value.exit_code == 2

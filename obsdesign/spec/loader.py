@@ -217,7 +217,8 @@ def _parse_toml_fresh(text: str, file: str) -> dict[str, Any]:
         # exit 3 "internal failure: InvalidOperation" naming no file (CLI review 45)
         raise SpecError(
             file,
-            _line_of(text, r"[eE][+-]?[\d_]{19,}"),
+            # 18 digits: 100e999999999999999999 is past Decimal's range once normalized
+            _line_of(text, r"[eE][+-]?[\d_]{18,}"),
             f"has a number whose exponent is beyond ±{limits().max_exponent} (max_exponent)",
         ) from None
     bad = data_problem(data)
@@ -236,16 +237,36 @@ def _long_number_line(text: str) -> str:
 
 
 def _line_of(text: str, pattern: str) -> str:
-    """'line N, key K' of the first match of ``pattern`` in ``text`` outside comments and
-    quoted strings ('' when none): a title holding "e" and 19 digits was named in place of
-    the number on line 32 (re-check review 45). A scan line by line, quotes counted."""
-    for line_no, line in enumerate(text.splitlines(), 1):
-        for m in re.finditer(pattern, line):
-            before = line[: m.start()]
-            if "#" in before or (before.count('"') + before.count("'")) % 2:
+    """'line N, key K' of the first match of ``pattern`` in a value of ``text``, outside
+    comments and strings ('' when none), found with the statement lexer
+    (:mod:`obsdesign.spec.tomltext`): a title holding "e" and 19 digits was named in place of
+    the number on line 32 (re-check review 45), and a line scan with quotes counted took an
+    apostrophe in a title, or a multi-line title, for a value (re-check review 46)."""
+    from obsdesign.spec.tomltext import statements, string_end
+
+    rx = re.compile(pattern)
+    for st in statements(text):
+        if st.kind != "keyval":
+            continue
+        i, end = st.value_start, st.value_end
+        while i < end:
+            c = text[i]
+            if c in "\"'":
+                i = string_end(text, i)
                 continue
-            k = re.match(r"\s*([A-Za-z0-9_.\"'-]+)\s*=", line)
-            return f"line {line_no}" + (f", key {k.group(1)}" if k else "")
+            if c == "#":
+                nl = text.find("\n", i, end)
+                i = end if nl < 0 else nl
+                continue
+            stop = i
+            while stop < end and text[stop] not in "\"'#":
+                stop += 1
+            m = rx.search(text, i, stop)
+            if m is not None:
+                line = text.count("\n", 0, m.start()) + 1
+                key = ".".join(st.key) if st.key else ""
+                return f"line {line}" + (f", key {key}" if key else "")
+            i = stop
     return ""
 
 
