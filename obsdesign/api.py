@@ -2277,8 +2277,9 @@ def check_plot_path(path: str | Path, force: bool = False, inputs: tuple[Path, .
         folder = p.is_dir()
     except OSError:  # a name too long, a folder not searchable: check_output names it
         folder = False
-    if folder:  # "is a directory", not "unknown plot format" (CLI review 45)
-        check_output(p, force, inputs)
+    if folder or str(path) == "-":  # "is a directory" or "outputs go to files", not
+        # "unknown plot format" (CLI reviews 45, 46)
+        check_output(str(path) if str(path) == "-" else p, force, inputs)
     if p.suffix.lower() not in PLOT_SUFFIXES:
         raise InputError(
             f"{p}: unknown plot format {p.suffix or '(no suffix)'!r} "

@@ -762,6 +762,7 @@ def test_clustered_and_option_like_output_values_are_checked(tmp_path: Path) -> 
         (["design", str(SPEC), "-qo=x.json"], "-o=x.json: write -o FILE or --output=FILE"),
         (["design", str(SPEC), "-o", "-q"], "-o -q: the file name reads like an option"),
         (["sweep", str(SPEC), "--set", lam, "-o", "-"], "-: outputs go to files, not to stdout"),
+        (["design", str(SPEC), "--plot", "-"], "-: outputs go to files, not to stdout"),
     ):
         r = _cli(*args, cwd=tmp_path)
         assert r.returncode == 2 and said in r.stderr, (args, r.stderr)
