@@ -729,6 +729,15 @@ def _named_file_differs(spec_file: str, sha: str) -> str | None:
         return None
     p = Path(spec_file)
     try:
+        if not p.is_file() and "\\x" in spec_file:
+            # a name that is not UTF-8 is written with each such byte as \xNN
+            # (errors.valid_text): look the file up by its bytes (re-check review 46)
+            raw_name = re.sub(
+                r"\\x([89a-fA-F][0-9a-fA-F])",
+                lambda m: chr(0xDC00 + int(m.group(1), 16)),
+                spec_file,
+            )
+            p = Path(raw_name)
         if not p.is_file():
             return None
         raw = read_input(p, "spec")

@@ -812,3 +812,20 @@ def test_simulate_with_a_crlf_copy_of_the_spec_says_why_the_hash_differs(tmp_pat
             api.simulate(p, rep)
         said = "differ only in line endings or a byte-order mark" in str(ei.value)
         assert said == (name == "crlf.toml") and ei.value.exit_code == 2, str(ei.value)
+
+
+def test_the_differs_note_finds_a_spec_whose_name_is_not_utf8(tmp_path: Path) -> None:
+    """A report names a spec file whose name is not UTF-8 with each such byte as \\xNN; the
+    note "that file differs" looked up that text, found no file, and said nothing after the
+    file was edited (re-check review 46). The name is read back to its bytes."""
+    import os
+
+    name = tmp_path / os.fsdecode(b"b\xffd.toml")
+    name.write_text(SPEC.read_text(encoding="utf-8"), encoding="utf-8")
+    out = tmp_path / "r.json"
+    api.design(api.load_spec(name), out=out)
+    assert "\\xff" in json.loads(out.read_text(encoding="utf-8"))["spec_file"]
+    assert not [n for n in api.verify(out).notes if "differs from it" in n]
+    with open(name, "a", encoding="utf-8") as f:
+        f.write("# edited\n")
+    assert [n for n in api.verify(out).notes if "differs from it" in n]
