@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 import numbers
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from decimal import Decimal, localcontext
 from fractions import Fraction
 from pathlib import Path
@@ -31,7 +31,6 @@ from typing import Any
 import numpy as np
 
 from obsdesign.errors import InputError, SpecError
-from obsdesign.limits import INT_MAX
 
 #: methods whose designed observer is linear (a control.StateSpace)
 LINEAR = ("lyapunov", "set-invariant", "stubborn")
@@ -114,13 +113,15 @@ def _num(x: Any) -> str:
     if isinstance(x, (bool, np.bool_)):
         return "true" if x else "false"
     if isinstance(x, (int, np.integer)):
-        if abs(int(x)) > INT_MAX:  # the spec refuses it, and past 4,300 digits str() raised
+        try:  # any size the spec reader takes (a seed, an exact matrix entry)
+            return str(int(x))
+        except ValueError:  # past Python's int-string limit: a bare ValueError (CLI review 46)
             from obsdesign.errors import value_text
 
             raise InputError(
-                f"cannot write {value_text(int(x))} into a spec: integers are at most 2^63 − 1"
-            )
-        return str(int(x))
+                f"cannot write {value_text(int(x))} into a spec (past Python's 4,300-digit "
+                "limit for integer text)"
+            ) from None
     q = _exact(x)
     if q is not None:
         if q == q.to_integral_value() and abs(q) < 10**18:
@@ -476,13 +477,18 @@ def _spec_text(
     for what, v in (("sets", sets), ("nonlinearity", nonlinearity), ("simulate", simulate)):
         if v is not None and not isinstance(v, Mapping):
             raise InputError(f"{what}: expected a mapping of keys to values, got {_tname(v)}")
-    if states is not None and (
-        isinstance(states, (str, bytes))
-        or not isinstance(states, Sequence)
-        or not all(isinstance(x, str) for x in states)
-    ):
-        # states=5 was a bare TypeError (CLI review 46)
-        raise InputError(f"states: expected a list of state names (texts), got {_tname(states)}")
+    if states is not None:
+        # any iterable of names (a list, a tuple, a numpy array, a generator); states=5 was
+        # a bare TypeError (CLI review 46)
+        try:
+            items = None if isinstance(states, (str, bytes)) else list(states)
+        except TypeError:
+            items = None
+        if items is None or not all(isinstance(x, str) for x in items):
+            raise InputError(
+                f"states: expected a list of state names (texts), got {_tname(states)}"
+            )
+        states = [str(x) for x in items]
     if not isinstance(method, str):
         raise InputError(f"method: expected a method key (a text), got {_tname(method)}")
     A, B, C, D, dt = _matrices(sys)
@@ -624,9 +630,12 @@ def observer_statespace(report: Any, law: str | None = None, verify: bool = Fals
     inputs, outputs = _names("u", m) + _names("y", p), _names("xhat", n)
     name = f"obsdesign-{report.method}"
 
-    def linear(G: np.ndarray, sign: float, rate: Any = None, key: str | None = None) -> Any:
+    def linear(
+        G: np.ndarray, sign: float, rate: Any = None, key: str | None = None, strict: bool = True
+    ) -> Any:
         # x̂' = A x̂ + B u + sign·G (y − C x̂ − D u); key: the report parameter holding G
-        # exactly (None: the spec's [method].L)
+        # exactly (None: the spec's [method].L); strict: the certificate implies asymptotic
+        # stability (set-invariant with λ = 1 proves invariance only: ρ ≤ 1)
         from obsdesign.lyap import float_closed_loop
 
         G = np.asarray(G, float).reshape(n, p)
@@ -635,7 +644,8 @@ def observer_statespace(report: Any, law: str | None = None, verify: bool = Fals
         def exact_loop() -> Any:
             return _exact_loop(sp, params, key, sign)
 
-        _check_float_realization(Ao, s.discrete, rate, where, exact_loop)
+        if strict:
+            _check_float_realization(Ao, s.discrete, rate, where, exact_loop)
         with np.errstate(all="ignore"):
             Bo = np.hstack([B - sign * G @ D, sign * G])
         return ct.ss(
@@ -673,7 +683,10 @@ def observer_statespace(report: Any, law: str | None = None, verify: bool = Fals
             from obsdesign.methods.setinvariant.sim import make_law
 
             key = None if sp.options.L is not None else "L"  # make_law's choice
-            return linear(make_law(sp, params, "linear").L, -1.0, key=key)
+            # λ = 1 certifies an invariant polytope, ρ(A + LC) ≤ 1, not a stable observer:
+            # such a certified, verified report was refused as unstable (re-check review 46)
+            strict = sp.options.lam < 1
+            return linear(make_law(sp, params, "linear").L, -1.0, key=key, strict=strict)
         return _setinvariant_nonlinear(ct, sp, params, use, A, B, C, D, dt, inputs, outputs, name)
     raise InputError(_NOT_LINEAR.format(method=report.method, linear=", ".join(LINEAR)))
 

@@ -1216,13 +1216,45 @@ def test_bad_arguments_of_the_interop_functions_are_bad_input() -> None:
         (lambda: spec_text_from_statespace(ss, states="x1"), "states: expected a list"),
         (lambda: spec_text_from_statespace(ss, simulate=5), "simulate: expected a mapping"),
         (lambda: spec_text_from_statespace(ss, horizon=10**5000), "about 5000 digits"),
-        (lambda: spec_text_from_statespace(ss, horizon=2**63), "at most 2.63 − 1"),
         (lambda: observer_statespace(None), "expected a Report or the path of one"),
     )
     for call, said in cases:
         with pytest.raises(InputError, match=said):
             call()
+    # any integer the reader takes is written: a seed of any size, an exact entry past 2^63
+    # (refused for a while by session 46's check; re-check review 46)
+    text = spec_text_from_statespace(ss, L=[2**70, 0], simulate={"seed": 2**80, "horizon": 5})
+    assert f"L = [{2**70}, 0]" in text and f"seed = {2**80}" in text
+    # states as any sequence of names: a numpy array or a tuple (re-check review 46)
+    for names in (np.array(["p", "v"]), ("p", "v")):
+        assert 'states = ["p", "v"]' in spec_text_from_statespace(ss, states=names)
     rep = api.design(api.load_spec(ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml"))
     with pytest.raises(InputError, match="law 'online-lp': the lyapunov observer is linear"):
         observer_statespace(rep, law="online-lp")
     assert observer_statespace(rep, law="linear").A.shape == (2, 2)
+
+
+def test_a_set_invariant_observer_with_lambda_1_is_exported() -> None:
+    """λ = 1 certifies an invariant polytope, ρ(A + LC) ≤ 1: the rotation below with L = 0 is
+    certified and verifies, and observer_statespace refused it as "the report's claims
+    cannot hold" (the export was held to strict stability; re-check review 46)."""
+    text = """
+[system]
+time = "discrete"
+A = [[0, -1], [1, 0]]
+C = [[1, 0]]
+[sets.omega]
+type = "symmetric-polytope"
+Q = [[1, 0], [0, 1]]
+[method]
+key = "set-invariant"
+omega = "omega"
+eta_bar = 0
+lambda = 1
+algorithm = "symmetric"
+L = [0, 0]
+"""
+    rep = api.design(api.load_spec_text(text, "rot.toml"))
+    assert rep.exit_code() == 0 and api.verify(rep).exit_code() == 0
+    obs = observer_statespace(rep, law="linear")
+    np.testing.assert_array_equal(obs.A, [[0.0, -1.0], [1.0, 0.0]])
