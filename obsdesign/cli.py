@@ -180,6 +180,10 @@ def _run(fn: Callable[[Any], int], quiet: bool = False, width: int | None = None
         if _state["debug"]:
             raise
         _err(e.message)
+        if e.message.startswith("stdout: cannot write"):
+            # what stdout still buffers would fail main's flush: the line printed twice
+            # without PYTHONUNBUFFERED (re-check review 46)
+            _drop_stdout()
         raise typer.Exit(e.exit_code) from None
     except typer.Exit:
         _settle(owned)

@@ -822,7 +822,16 @@ def test_force_through_a_dangling_link_creates_no_folders(spec: Path, tmp_path: 
 
 
 @pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full")
-@pytest.mark.parametrize("args", [["schema"], ["init", "lyapunov"], ["methods"]])
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["schema"],
+        ["init", "lyapunov"],
+        ["methods"],
+        # a command's text output: the line was printed twice when buffered (re-check 46)
+        ["design", str(Path(__file__).resolve().parents[1] / "specs" / "dorea-pimenta-7-1.toml")],
+    ],
+)
 def test_a_full_disk_on_stdout_is_exit_2(args: list[str]) -> None:
     """``obsdesign schema > /dev/full`` (no space left) was exit 3 "internal failure:
     OSError" (output trial, session 30): an OS error writing stdout is bad output, exit 2
