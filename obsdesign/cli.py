@@ -887,14 +887,9 @@ REPEATED_OPTIONS = ("--set", "--option", "--limit")
 _SAME_OUTPUT = {"-o": "--output", "--plot-epsilon": "--plot"}
 
 
-def _output_uses(args: list[str]) -> list[tuple[str, str, str]]:
-    """(option as written, its canonical name, its value) for each use of an output option
-    (:data:`OUTPUT_OPTIONS`), as :func:`_option_uses`."""
-    return [u for u in _option_uses(args) if u[0] in OUTPUT_OPTIONS]
-
-
-def _option_uses(args: list[str]) -> list[tuple[str, str, str]]:
-    """(option as written, its canonical name, its value) for each use of an option that
+def _option_uses(args: list[str]) -> list[tuple[str, str, str, bool]]:
+    """(option as written, its canonical name, its value, whether the value is a word of its
+    own) for each use of an option that
     takes one value (:data:`SINGLE_OPTIONS`) before ``--``: ``--opt VALUE`` (the value of
     every option that takes one is skipped, so a value that reads like an option is not
     one), ``--opt=VALUE``, the glued ``-oVALUE`` and a cluster of short options ending in o
@@ -910,20 +905,20 @@ def _option_uses(args: list[str]) -> list[tuple[str, str, str]]:
             i += 2
             continue
         if a in SINGLE_OPTIONS and i + 1 < len(args):
-            uses.append((a, _SAME_OUTPUT.get(a, a), args[i + 1]))
+            uses.append((a, _SAME_OUTPUT.get(a, a), args[i + 1], True))
             i += 2
             continue
         if a.startswith("--") and eq and name in SINGLE_OPTIONS:
-            uses.append((name, _SAME_OUTPUT.get(name, name), val))
+            uses.append((name, _SAME_OUTPUT.get(name, name), val, False))
         elif a.startswith("-") and not a.startswith("--") and "o" in a[1:]:
             # a cluster of short options, as click reads it: flags (-q) up to the o, whose
             # value is the rest of the word or the next word — -qo a.json -o b.json wrote
             # only b.json, and -qo out.json/ passed the checks (CLI review 46)
             rest = a[a.index("o", 1) + 1 :]
             if rest:
-                uses.append(("-o", "--output", rest))
+                uses.append(("-o", "--output", rest, False))
             elif i + 1 < len(args):
-                uses.append(("-o", "--output", args[i + 1]))
+                uses.append(("-o", "--output", args[i + 1], True))
                 i += 1
         i += 1
     return uses
@@ -936,7 +931,7 @@ def _output_problem(args: list[str]) -> str | None:
     "/." (pathlib dropped it and wrote out.json), or ``-o=FILE`` (click read a file named
     "=FILE") — hostile-input trial and re-checks, session 38."""
     seen: set[str] = set()
-    for written, key, value in _option_uses(args):
+    for written, key, value, separate in _option_uses(args):
         if written not in OUTPUT_OPTIONS:
             if key in seen:
                 return f"{key} is given twice; give it once (the last one would be used alone)"
@@ -948,7 +943,7 @@ def _output_problem(args: list[str]) -> str | None:
             shown = {"--output": "-o/--output", "--plot": "--plot/--plot-epsilon"}.get(key, key)
             return f"{shown} is given twice; give each output once"
         seen.add(key)
-        if value.startswith("-") and value != "-":
+        if separate and value.startswith("-") and value != "-":
             # -o -q wrote a file named -q: the file name was forgotten (CLI review 46)
             return (
                 f"{written} {value}: the file name reads like an option (was it left out?); "

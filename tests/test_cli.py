@@ -767,6 +767,10 @@ def test_clustered_and_option_like_output_values_are_checked(tmp_path: Path) -> 
         r = _cli(*args, cwd=tmp_path)
         assert r.returncode == 2 and said in r.stderr, (args, r.stderr)
     assert list(tmp_path.iterdir()) == []
+    # a value glued to its option cannot have been forgotten: written (re-check review 46)
+    for args, name in ((["--output=-r.json"], "-r.json"), (["-o-s.json"], "-s.json")):
+        r = _cli("design", str(SPEC), "-q", *args, cwd=tmp_path)
+        assert r.returncode == 0 and (tmp_path / name).is_file(), r.stderr
 
 
 def test_simulate_text_and_markdown_print_metrics_in_words_not_python_reprs() -> None:
