@@ -273,3 +273,26 @@ def test_an_append_only_or_immutable_output_is_refused_before_any_work(
     finally:
         subprocess.run([chattr, "-" + flag[1:], str(out)], check=True)
     check_output(out, False, ())  # a plain file again
+
+
+def test_an_append_only_folder_is_refused_before_any_work(tmp_path: Path) -> None:
+    """A folder with chattr +a takes new files but no rename or removal: the probe file and
+    the finished temp file were left in it, and the refusal came after the work (re-check
+    review 46). Refused up front, nothing left."""
+    import shutil
+    import subprocess
+
+    from obsdesign.errors import InputError
+    from obsdesign.report.model import check_output
+
+    folder = tmp_path / "ad"
+    folder.mkdir()
+    chattr = shutil.which("chattr")
+    if chattr is None or subprocess.run([chattr, "+a", str(folder)]).returncode != 0:
+        pytest.skip("chattr is not available here")
+    try:
+        with pytest.raises(InputError, match="the folder is append-only"):
+            check_output(folder / "r.json", False, ())
+        assert list(folder.iterdir()) == []
+    finally:
+        subprocess.run([chattr, "-a", str(folder)], check=True)

@@ -649,7 +649,7 @@ def _inode_fixed(p: Path) -> str | None:
     import fcntl
 
     try:
-        fd = os.open(p, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOFOLLOW", 0))
+        fd = os.open(p, os.O_RDONLY | os.O_NONBLOCK)
     except OSError:
         return None
     try:
@@ -673,6 +673,11 @@ def _probe_dir(p: Path) -> None:
     fuzzer; a 241–255-byte name passed a short probe name and failed after the work: output
     trial, session 30)."""
     parent = p.parent if str(p.parent) else Path(".")
+    fixed = _inode_fixed(parent)
+    if fixed:
+        # a folder with chattr +a takes new files but no rename or removal: the probe file
+        # and the finished temp file were left in it, after the work (re-check review 46)
+        raise InputError(f"{p}: cannot write in {parent}: the folder is {fixed} (chattr -a / -i)")
     with interrupt.deferred():  # a stop between creating and removing the probe left it
         try:
             fd, name = _temp_file(p)
