@@ -553,11 +553,7 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
     ensure_recursion_limit()
     t0 = time.perf_counter()
     if isinstance(report, Report):
-        d = report_dict(report)
-        if report.raw_parameters is not None and _unchanged_since_read(report, d):
-            d["parameters"] = report.raw_parameters  # as read: floats compared bit for bit
-        rep, problems = _from_memory(d)
-        rep.extra_keys = list(report.extra_keys)
+        rep, problems = object_report(report)
     else:
         rep, problems = Report.load(_path_arg(report, "report", "a Report"))
     if spec is not None:
@@ -1159,7 +1155,7 @@ def simulate(
         notes += _uncertified_design(sp, params)
     else:
         rep, problems = (
-            _from_memory(report_dict(report))
+            object_report(report)
             if isinstance(report, Report)
             else Report.load(_path_arg(report, "report", "a Report"))
         )
@@ -1932,6 +1928,21 @@ def report_dict(report: Report) -> dict[str, Any]:
             "read by Report.load or returned by design has this form"
         ) from None
     return d
+
+
+def object_report(report: Report) -> tuple[Report, list[str]]:
+    """A Report object given to the API read back as its file would be: its JSON data
+    (:func:`report_dict`), with the parameters as read when they are unchanged since (floats
+    compared bit for bit), under :func:`_from_memory`'s limits; returns the report and its
+    float/exact inconsistencies. verify, simulate and observer_statespace read objects this
+    one way: simulate and the export dropped the parameters as read, and a float edited in
+    the file ran without a word where verify fails it (API review 46)."""
+    d = report_dict(report)
+    if report.raw_parameters is not None and _unchanged_since_read(report, d):
+        d["parameters"] = report.raw_parameters  # as read: floats compared bit for bit
+    rep, problems = _from_memory(d)
+    rep.extra_keys = list(report.extra_keys)
+    return rep, problems
 
 
 def _from_memory(d: dict[str, Any]) -> tuple[Report, list[str]]:

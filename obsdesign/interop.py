@@ -566,7 +566,7 @@ def observer_statespace(report: Any, law: str | None = None, verify: bool = Fals
     import os
     import warnings
 
-    from obsdesign.api import load_spec_text, report_dict
+    from obsdesign.api import load_spec_text, object_report
     from obsdesign.report.model import Report
 
     if not isinstance(report, (Report, str, os.PathLike)):
@@ -576,9 +576,7 @@ def observer_statespace(report: Any, law: str | None = None, verify: bool = Fals
         raise InputError(f"law: expected a law name (a text), got {_tname(law)}")
     ct = _control()
     where = "report" if isinstance(report, Report) else str(report)
-    report, problems = (
-        Report.from_dict(report_dict(report)) if isinstance(report, Report) else Report.load(report)
-    )
+    report, problems = object_report(report) if isinstance(report, Report) else Report.load(report)
     if problems:
         raise InputError(f"{where}: {problems[0]}")
     if report.error is not None:

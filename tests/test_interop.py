@@ -1258,3 +1258,36 @@ L = [0, 0]
     assert rep.exit_code() == 0 and api.verify(rep).exit_code() == 0
     obs = observer_statespace(rep, law="linear")
     np.testing.assert_array_equal(obs.A, [[0.0, -1.0], [1.0, 0.0]])
+
+
+def test_report_objects_are_read_as_verify_reads_them(tmp_path: Path) -> None:
+    """A loaded report whose float L was edited in the file (the exact L untouched): verify
+    of the object fails it, while observer_statespace(verify=True) and simulate of the same
+    object ran — both re-read the object without the parameters as read (API review 46).
+    And an object with exact values past max_digits (a set-invariant Q entry 1e-300) was
+    refused by observer_statespace only, verify and simulate taking it."""
+    import warnings
+
+    from obsdesign.report.model import Report
+
+    spec = ROOT / "specs" / "constrained-redesign-sec5-lyapunov.toml"
+    good = tmp_path / "good.json"
+    api.design(spec, out=good)
+    d = json.loads(good.read_text(encoding="utf-8"))
+    d["parameters"]["L"] = [[5.0], [5.0]]
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(d), encoding="utf-8")
+    rep, problems = Report.load(bad)
+    assert problems and api.verify(rep).exit_code() == 1
+    with pytest.raises(InputError, match="float value differs from its exact value"):
+        observer_statespace(rep, verify=True)
+    with pytest.raises(InputError, match="float value differs from its exact value"):
+        api.simulate(spec, rep)
+    text = (ROOT / "specs" / "dorea-pimenta-7-2.toml").read_text(encoding="utf-8")
+    long = text.replace("[0.2681, 0.7595, -0.0851]", "[1e-300, 0.7595, -0.0851]")
+    assert long != text
+    r = api.design(api.load_spec_text(long, "q.toml"))
+    assert r.exit_code() == 0 and api.verify(r).exit_code() == 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert observer_statespace(r, law="interpolated") is not None
