@@ -1952,7 +1952,7 @@ def _from_memory(d: dict[str, Any]) -> tuple[Report, list[str]]:
     set-invariant Q entry 1e-300, ~2,200-digit exact values) was "exit 2 bad input" for
     ``verify(design(spec))``, ``simulate(spec, design(spec))`` and a check or sweep row
     (CLI and re-check reviews, session 44)."""
-    from obsdesign.limits import CEILINGS, exact_digits, limits, restore, saved, set_limits
+    from obsdesign.limits import CEILINGS, exact_digits, raised
 
     try:  # the common case: within the limits, no walk of the exact strings
         return Report.from_dict(d)
@@ -1961,13 +1961,10 @@ def _from_memory(d: dict[str, Any]) -> tuple[Report, list[str]]:
             raise
     params = d.get("parameters")
     need = exact_digits(params.get("exact", {})) if isinstance(params, dict) else 0
-    state = saved()
-    try:
-        if limits().max_digits < need <= CEILINGS["max_digits"]:
-            set_limits(max_digits=need)
+    # raised for this thread only: raising the process's limits and restoring them, two
+    # threads left them raised for good (API review 46)
+    with raised(max_digits=min(need, CEILINGS["max_digits"])):
         return Report.from_dict(d)
-    finally:
-        restore(state)
 
 
 def verify_own(rep: Report) -> Report:

@@ -30,6 +30,7 @@ import stat
 import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass, fields, replace
 from decimal import Decimal
 from pathlib import Path
@@ -96,9 +97,36 @@ def ensure_recursion_limit() -> None:
         sys.setrecursionlimit(RECURSION_LIMIT)
 
 
+#: a context's own raised limits (:func:`raised`): the API raised the process-wide limits
+#: for one object and restored them, and two threads doing so left them raised for the whole
+#: process — a 1500-digit number then passed max_digits = 1000 (API review 46)
+_RAISED: ContextVar[Limits | None] = ContextVar("obsdesign_raised_limits", default=None)
+
+
 def limits() -> Limits:
-    """The limits in force."""
-    return _current
+    """The limits in force (in this thread or task: :func:`raised` ones first)."""
+    own = _RAISED.get()
+    return own if own is not None else _current
+
+
+@contextmanager
+def raised(**values: int) -> Iterator[None]:
+    """The limits with ``values`` in force for this thread or task only, within the block
+    (each no lower than the limit in force)."""
+    now = limits()
+    token = _RAISED.set(replace(now, **{k: max(v, getattr(now, k)) for k, v in values.items()}))
+    try:
+        yield
+    finally:
+        _RAISED.reset(token)
+
+
+def _checked_value(k: str, v: Any) -> int:
+    """A limit's value: a whole number ≥ 1 (a float, a string or None was a bare TypeError or
+    broke every later design; API review 46)."""
+    if type(v).__name__ in ("bool", "bool_") or not isinstance(v, int) or v < 1:
+        raise InputError(f"--limit {k}: expected a whole number ≥ 1, got {v!r}"[:200])
+    return int(v)
 
 
 def set_limits(**values: int) -> Limits:
@@ -109,7 +137,8 @@ def set_limits(**values: int) -> Limits:
     for k, v in values.items():
         if k not in known:
             raise InputError(f"--limit {k}: unknown limit (known: {', '.join(sorted(known))})")
-        _check_ceiling(k, v)
+        values[k] = _checked_value(k, v)
+        _check_ceiling(k, values[k])
     _current = replace(_current, **values)
     _overridden.update(values)
     return old
@@ -144,16 +173,22 @@ def reset_limits(old: Limits | None = None) -> None:
     """Back to ``old`` (or to the defaults)."""
     global _current
     _current = old if old is not None else Limits()
-    if old is None:
-        _overridden.clear()
+    # overridden: what differs from the defaults — reset_limits(set_limits(max_states=200))
+    # kept max_states marked overridden, and the per-method caps gave way to 100 for the rest
+    # of the process (API review 46)
+    defaults = Limits()
+    _overridden.clear()
+    _overridden.update(
+        f.name for f in fields(Limits) if getattr(_current, f.name) != getattr(defaults, f.name)
+    )
 
 
 def max_states_for(key: str, declared: int | None = None) -> int:
     """The state-dimension limit of method ``key``: ``--limit max_states`` when given, else
     the method's declared ``max_states``, else :data:`METHOD_MAX_STATES`, else the default."""
     if "max_states" in _overridden:
-        return _current.max_states
-    return int(declared or METHOD_MAX_STATES.get(key, _current.max_states))
+        return limits().max_states
+    return int(declared or METHOD_MAX_STATES.get(key, limits().max_states))
 
 
 def parse_limit(text: str) -> tuple[str, int]:
@@ -183,7 +218,7 @@ def read_input(path: str | Path, what: str) -> bytes:
     ``max_file_bytes``. Anything else is an :class:`InputError` naming the path; checked
     with ``stat`` before ``open`` so a FIFO, a device or /dev/zero is refused at once."""
     p = Path(path)
-    lim = _current.max_file_bytes
+    lim = limits().max_file_bytes
     try:
         st = os.stat(p)
     except FileNotFoundError:
@@ -279,7 +314,7 @@ def values_problem(commas: int) -> str | None:
     values with a 60,000-comma comment was refused as "holds about 60019 values" (docs
     review, session 41); the message says what was counted. One wording for the three
     places that count (the file pre-check, the loader, stdin)."""
-    lim = _current.max_values
+    lim = limits().max_values
     if commas < lim:
         return None
     return (
@@ -293,7 +328,7 @@ def decimal_problem(d: Decimal) -> str | None:
     """Why a Decimal is too big to convert to a rational (None when it is fine)."""
     if not d.is_finite():
         return None
-    lim = _current
+    lim = limits()
     text = str(d)
     if "E" not in text and len(text) <= min(lim.max_digits, lim.max_exponent):
         # plain notation: the digits and |exponent| are at most the length (exactly the
@@ -334,7 +369,7 @@ def exact_digits(obj: Any) -> int:
 
 def int_problem(v: int) -> str | None:
     """Why an int has too many digits (None when it is fine); no decimal conversion made."""
-    lim = _current.max_digits
+    lim = limits().max_digits
     bits = abs(v).bit_length()
     # up to lim digits for sure below that many bits; else compared exactly with 10^lim (the
     # estimate's slack of one digit let a 1001-digit integer pass the limit of 1000, and
@@ -357,7 +392,7 @@ _FRAC = re.compile(r"^\s*[+-]?(\d+)\s*/\s*[+-]?(\d+)\s*$")
 def number_text_problem(s: str) -> str | None:
     """Why the text of an exact number ("p/q" or a decimal) is too big to convert (None when
     fine or when it is not a number at all: the converter then says so)."""
-    lim = _current
+    lim = limits()
     if len(s) <= min(lim.max_digits, lim.max_exponent) and "e" not in s and "E" not in s:
         # no exponent: digits ≤ length (the verdict below, without the regexes; a 100-state
         # report has 2×10⁴ exact strings)
@@ -393,7 +428,7 @@ def int_digits() -> Iterator[None]:
     int-string limit (4300 by default); the digit count is then checked by the walker."""
     get = getattr(sys, "get_int_max_str_digits", None)
     old = get() if get is not None else 0
-    need = _current.max_digits + 1
+    need = limits().max_digits + 1
     if get is None or old == 0 or old >= need:
         yield
         return
@@ -474,7 +509,7 @@ def data_problem(data: Any, exact_strings: bool = False) -> tuple[str, str] | No
     The entries of a list are checked in the list's own loop (a 100-state report has 2×10⁴
     exact strings: one stack frame each cost more than the checks); dicts and nested lists
     are walked iteratively, depth first."""
-    lim = _current
+    lim = limits()
     max_depth = lim.max_depth
     short = min(lim.max_digits, lim.max_exponent)
     stack: list[tuple[_Node, Any, int]] = [(None, data, 0)]

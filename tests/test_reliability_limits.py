@@ -787,3 +787,47 @@ def test_an_exponent_past_the_decimal_readers_range_is_bad_input() -> None:
         ) as ei:
             api.load_spec_text(base.format(a=a), "h.toml")
         assert ei.value.exit_code == 2
+
+
+def test_raised_limits_hold_in_their_own_thread_only() -> None:
+    """The API raised the process's limits for one Report object and restored them: two
+    threads doing so left max_digits raised for good, and a 1500-digit number then passed
+    (API review 46). A raise holds in its own thread (context) and block only."""
+    import threading
+
+    from obsdesign.limits import limits, raised
+
+    base = limits().max_digits
+    inside: list[int] = []
+    go, done = threading.Event(), threading.Event()
+
+    def other() -> None:
+        go.wait(10)
+        inside.append(limits().max_digits)  # while the main thread is inside its raise
+        done.set()
+
+    t = threading.Thread(target=other)
+    t.start()
+    with raised(max_digits=base + 5000):
+        assert limits().max_digits == base + 5000
+        go.set()
+        assert done.wait(10)
+    t.join(10)
+    assert inside == [base] and limits().max_digits == base
+
+
+def test_set_limits_takes_whole_numbers_and_reset_clears_what_it_restores() -> None:
+    """set_limits("5000"), None, 5000.5, 0 and -1 were a bare TypeError or accepted (and
+    broke every later design); reset_limits(old) kept max_states marked overridden, so the
+    per-method caps gave way to 100 for the rest of the process (API review 46)."""
+    from obsdesign.errors import InputError
+    from obsdesign.limits import max_states_for, reset_limits, set_limits
+
+    for bad in ("5000", None, 5000.5, 0, -1, True):
+        with pytest.raises(InputError, match="expected a whole number ≥ 1"):
+            set_limits(max_digits=bad)
+    before = max_states_for("set-invariant")
+    old = set_limits(max_states=200)
+    assert max_states_for("set-invariant") == 200
+    reset_limits(old)
+    assert max_states_for("set-invariant") == before

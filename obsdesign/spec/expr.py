@@ -217,27 +217,17 @@ def _rebuild_expr(text: str, variables: tuple[str, ...], parameters: dict[str, A
     input limits of the process that loads it (a Dask worker's defaults) do not apply — a
     spec read with ``--limit max_expr_chars=20000`` failed to deserialize on the workers of
     ``simulate --workers 2`` (re-check review, session 44)."""
-    from obsdesign.limits import (
-        CEILINGS,
-        ensure_recursion_limit,
-        limits,
-        restore,
-        saved,
-        set_limits,
-    )
+    from obsdesign.limits import CEILINGS, ensure_recursion_limit, raised
 
-    state = saved()
-    try:
-        lim = limits()
-        set_limits(
-            max_expr_chars=max(lim.max_expr_chars, len(text)),
-            max_expr_depth=max(lim.max_expr_depth, CEILINGS["max_expr_depth"]),
-            max_exponent=max(lim.max_exponent, CEILINGS["max_exponent"]),
-        )
+    # raised for this thread only (the process's limits, raised and restored, could be left
+    # raised by two threads; API review 46)
+    with raised(
+        max_expr_chars=len(text),
+        max_expr_depth=CEILINGS["max_expr_depth"],
+        max_exponent=CEILINGS["max_exponent"],
+    ):
         ensure_recursion_limit()
         return parse_expr(text, variables, parameters)
-    finally:
-        restore(state)
 
 
 def parse_expr(
