@@ -696,6 +696,12 @@ def _spec_source(spec: Any) -> tuple[str, str]:
         raise InputError(
             f"sweep: spec must be a path or a Spec (api.load_spec), got {type(spec).__name__}"
         )
+    if hasattr(spec, "changed_since_read"):
+        # the points are the text's: an object edited after loading (its system replaced)
+        # swept its text, every row ok, where design refuses it (API review 46)
+        from obsdesign.api import _text_describes
+
+        _text_describes(spec)
     return text, file
 
 

@@ -1037,3 +1037,17 @@ def test_the_sweep_api_refuses_a_grid_or_simulate_flag_of_another_type() -> None
     for flag in ("no", 1, None):
         with pytest.raises(InputError, match="simulate: expected True or False"):
             sw.sweep(SPEC, ["method.lambda=0.97"], simulate=flag)
+
+
+def test_a_spec_object_edited_after_loading_is_refused_by_sweep() -> None:
+    """sweep() of a Spec whose system was replaced after loading swept its text, every row
+    ok, while design refuses the object (API review 46). Refused the same way."""
+    import dataclasses
+
+    from obsdesign import api
+
+    sp = api.load_spec(SPEC)
+    sp.system = dataclasses.replace(sp.system, A=sp.system.C)
+    with pytest.raises(InputError, match="was replaced or edited after loading"):
+        sw.sweep(sp, ["method.lambda=[0.97]"])
+    assert sw.sweep(api.load_spec(SPEC), ["method.lambda=[0.97]"]) is not None
