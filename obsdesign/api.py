@@ -71,6 +71,8 @@ def bind(spec: Spec) -> Spec:
     ``[simulate]`` keys into ``spec.simulate.options``; check the generic contract (linear
     model present where the method needs it, no table the method does not read). An error
     carries the spec's method key (``ObsdesignError.method_key``)."""
+    if not isinstance(spec, Spec):  # bind(None): a bare AttributeError (API review 46)
+        raise InputError(f"bind: expected a Spec (api.load_spec), got {type(spec).__name__}")
     try:
         return _bind(spec)
     except ObsdesignError as e:
@@ -247,6 +249,26 @@ def _path_arg(value: Any, name: str, other: str = "") -> Any:
     raise InputError(f"{name}: expected a path{also}, got a value of type {type(value).__name__}")
 
 
+def _callback(f: Any, name: str) -> Any:
+    """``f`` when it is None or a callable that takes one argument, else an
+    :class:`InputError`: design(progress=5) and check(on_row=5) were bare TypeErrors after
+    the work began, and design(out=…) wrote them as the tool's "internal failure" (API
+    review 46)."""
+    if f is None:
+        return f
+    import inspect
+
+    try:
+        inspect.signature(f).bind(None)
+        return f
+    except TypeError:
+        pass
+    except ValueError:  # a builtin without a signature: taken as it is
+        if callable(f):
+            return f
+    raise InputError(f"{name}: expected a function of one argument, got {f!r}"[:200])
+
+
 def _did_you_mean(word: str, known: list[str]) -> str:
     import difflib
 
@@ -330,6 +352,7 @@ def design(
     writes nothing and leaves ``out`` untouched."""
     ensure_recursion_limit()
     force = _flag(force, "force")
+    progress = _callback(progress, "progress")
     if out is not None:
         check_output(_path_arg(out, "out"), force, inputs=_spec_inputs(spec))
     budget = budget_seconds(timeout)
@@ -1497,10 +1520,15 @@ def spec_files(paths: list[str | Path] | str | Path) -> list[Path]:
     string or a Path) is one path:
     ``check("specs/")`` iterated the string's characters, and its "/" searched the whole
     file system (outsider trial, session 22)."""
-    if isinstance(paths, (str, Path)):
+    if isinstance(paths, (str, os.PathLike)):
         paths = [paths]
+    if isinstance(paths, (bytes, Mapping)) or not isinstance(paths, Iterable):
+        # spec_files(None): a bare TypeError (API review 46), as check refuses it
+        raise InputError(
+            f"spec_files: expected a path or a list of paths, got {type(paths).__name__}"
+        )
     out: list[Path] = []
-    for p in map(Path, paths):
+    for p in (Path(_path_arg(x, "spec_files")) for x in paths):
         try:
             folder = p.is_dir()
         except OSError:  # a name too long: its own row says so (exit 3, no rows; session 44)
@@ -1876,6 +1904,7 @@ def check_one(path: Path, timeout: float | None = None) -> CheckRow:
     the row is exit 3 "not finished" (one spec that hung cost every row: CLI fuzzer); read
     by :func:`budget_seconds` (a bad one is an :class:`InputError`, not a row)."""
     timeout = budget_seconds(timeout)
+    path = Path(_path_arg(path, "check_one"))  # a str was a bare AttributeError (API review 46)
     t0 = time.perf_counter()
     seen = ["?"]  # the method, once the spec is loaded
     if _empty_folder(path):
@@ -2032,6 +2061,7 @@ def check(
     (:mod:`obsdesign.distributed`): the rows are the serial run's (but ``seconds``).
     ``on_row(row)`` is called as each row arrives."""
     timeout = budget_seconds(timeout)
+    on_start, on_row = _callback(on_start, "on_start"), _callback(on_row, "on_row")
     if type(paths).__name__ == "ndarray" and getattr(paths, "ndim", 1) == 0:
         paths = paths.item()  # type: ignore[union-attr]  # one path in a 0-d array
     if isinstance(paths, (str, os.PathLike)):
@@ -2313,6 +2343,9 @@ def _plot_to(
     :func:`check_plot_path` first, ``force`` as its)."""
     atomic, force = _flag(atomic, "atomic"), _flag(force, "force")
     if not atomic:
+        # None or "" were a bare TypeError / IsADirectoryError (API review 46)
+        if not str(_path_arg(path, "plot path")):
+            raise InputError("plot path: an empty path (an unset variable?)")
         return draw(Path(path))
     from obsdesign.report.model import write_via
 

@@ -572,6 +572,9 @@ def observer_statespace(report: Any, law: str | None = None, verify: bool = Fals
     if not isinstance(report, (Report, str, os.PathLike)):
         # None was a bare TypeError from the path handling (CLI review 46)
         raise InputError(f"report: expected a Report or the path of one, got {_tname(report)}")
+    if not isinstance(report, Report) and "\0" in os.fspath(report):
+        # open() said "embedded null byte", a bare ValueError (API review 46)
+        raise InputError(f"report: a path with a NUL character: {os.fspath(report)!r}")
     if law is not None and not isinstance(law, str):
         raise InputError(f"law: expected a law name (a text), got {_tname(law)}")
     ct = _control()

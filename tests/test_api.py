@@ -41,3 +41,35 @@ def test_a_method_key_that_is_not_a_text_is_bad_input() -> None:
         with pytest.raises(InputError, match="expected a method key"):
             api.method(bad)
     assert api.method("lyapunov").key == "lyapunov"
+
+
+def test_callbacks_and_paths_of_other_types_are_bad_input(tmp_path: Path) -> None:
+    """design(progress=5), check(on_row=5) were bare TypeErrors after the work began (and
+    design(out=…) wrote them as the tool's "internal failure"); bind(None), check_one(None),
+    spec_files(None), a NUL in observer_statespace's path and plot_simulation(…, None,
+    atomic=False) were bare exceptions; check_one took only a Path (API review 46)."""
+    from obsdesign.interop import observer_statespace
+
+    out = tmp_path / "r.json"
+    for bad in (5, "x", lambda: None):
+        with pytest.raises(InputError, match="progress: expected a function of one argument"):
+            api.design(SPEC, out=out, progress=bad)
+    assert not out.exists()
+    with pytest.raises(InputError, match="on_row: expected a function of one argument"):
+        api.check(SPEC, on_row=5)
+    seen: list[str] = []
+    assert api.check(SPEC, on_start=lambda p: seen.append(str(p)))[0].code == 0
+    assert seen == [str(SPEC)]
+    for call, said in (
+        (lambda: api.bind(None), "bind: expected a Spec"),
+        (lambda: api.check_one(None), "check_one: expected a path"),
+        (lambda: api.spec_files(None), "spec_files: expected a path or a list of paths"),
+        (lambda: observer_statespace("a\0b"), "a path with a NUL character"),
+    ):
+        with pytest.raises(InputError, match=said):
+            call()
+    assert api.check_one(str(SPEC)).code == 0
+    res = api.simulate(SPEC)
+    for bad in (None, ""):
+        with pytest.raises(InputError, match="plot path"):
+            api.plot_simulation(SPEC, res, bad, atomic=False)
