@@ -1240,3 +1240,19 @@ def test_linear_law_bounds_the_noise_by_the_sum_of_absolute_values() -> None:
     V = np.array([[q(a), q(b)] for a, b in ((1, 1), (1, -1), (-1, 1), (-1, -1))], dtype=object)
     L = np.array([[q(1), q(-1)], [q(0), q(0)]], dtype=object)
     assert ce.linear_law(ex, G, V, L) == (False, q(11, 5))
+
+
+def test_the_strict_retry_goes_on_past_the_float_lps_accuracy() -> None:
+    """λ = 1 and delta_tol = 1e-9: the one retry with the hull scaled by λ/(1 + Δδ) was judged
+    by the float LP (9) alone, ended "converged", and the exact factor was 1.0000000208 > λ
+    — design exit 1 with converged = true (census 46). The retry goes on with a margin twice
+    the float-vs-exact gap, and the design is certified."""
+    from pathlib import Path
+
+    from obsdesign import api
+
+    spec = api.load_spec(Path(__file__).parent / "specs" / "setinvariant-float-gap.toml")
+    rep = api.design(spec)
+    assert rep.exit_code() == 0, [c.detail for c in rep.failed]
+    assert any("is still above λ" in n and "iterating again" in n for n in rep.notes)
+    assert api.verify(rep).exit_code() == 0
