@@ -593,7 +593,11 @@ def _run_point(task: PointTask, t0: float, seen: list[str]) -> dict[str, Any]:
         row["seconds"] = round(time.perf_counter() - t0, 4)
         return row
     except ObsdesignError as e:
-        row = failure_row(task, e.exit_code, e.message, method or api.error_method(e) or "")
+        # the spec's key when the error left none (a value past the reader's range: the
+        # row's method was "" beside the others' "lyapunov"; CLI review 46)
+        row = failure_row(
+            task, e.exit_code, e.message, method or api.error_method(e) or task_method(task)
+        )
     except Exception as e:  # noqa: BLE001 - one row per point, whatever happened in it
         row = failure_row(task, EXIT_SOLVER, f"internal failure: {type(e).__name__}: {e}", method)
     row["seconds"] = round(time.perf_counter() - t0, 4)

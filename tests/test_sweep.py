@@ -1051,3 +1051,11 @@ def test_a_spec_object_edited_after_loading_is_refused_by_sweep() -> None:
     with pytest.raises(InputError, match="was replaced or edited after loading"):
         sw.sweep(sp, ["method.lambda=[0.97]"])
     assert sw.sweep(api.load_spec(SPEC), ["method.lambda=[0.97]"]) is not None
+
+
+def test_a_point_past_the_readers_range_names_the_spec_method() -> None:
+    """A swept value past Decimal's range (1e999999999): its row's method was "" while every
+    other bad-input row names the spec's method (CLI review 46)."""
+    rows = sw.sweep_rows(SPEC, ["method.lambda=[1e999999999, 0.97]"])
+    assert [r["exit_code"] for r in rows] == [2, 0]
+    assert [r["method"] for r in rows] == ["lyapunov", "lyapunov"]
