@@ -34,8 +34,11 @@ def _escape_char(c: str) -> str:
 def escape_controls(text: str) -> str:
     """``text`` with control characters (newline, ESC, …) and Unicode line/paragraph
     separators written as escapes (``\\n``, ``\\x1b``), everything else as it is: for
-    user-given names in tables and progress lines (:func:`one_line` for messages)."""
-    return _CONTROLS.sub(lambda m: _escape_char(m[0]), text)
+    user-given names in tables and progress lines (:func:`one_line` for messages). A byte of
+    a file name that is not UTF-8 (a lone surrogate) is written ``\\xNN`` as in reports
+    (:func:`valid_text`): error lines showed ``\\udcff`` where the JSON showed ``\\xff`` (CLI
+    review 46)."""
+    return _CONTROLS.sub(lambda m: _escape_char(m[0]), valid_text(text))
 
 
 #: the characters of Unicode categories Cc, Zl and Zp, and the bidirectional controls of Cf

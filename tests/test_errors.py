@@ -148,3 +148,16 @@ def test_count_text_shortens_a_long_count_and_one_line_keeps_lists() -> None:
     assert count_text(1234567) == "1,234,567" and count_text(-(10**120)).startswith("-1000")
     listed = ",".join(str(k) for k in range(100, 140))
     assert one_line(f"--set method.lambda={listed}") == f"--set method.lambda={listed}"
+
+
+def test_a_byte_that_is_not_utf8_is_written_as_in_reports() -> None:
+    """A file name's byte that is not UTF-8 reaches Python as a lone surrogate: error lines
+    and JUnit names showed it as \\udcff, reports and check's JSON as \\xff (CLI review
+    46). One spelling, \\xff, everywhere."""
+    from obsdesign.errors import escape_controls, one_line, valid_text
+
+    name = "b\udcffd.toml"
+    assert valid_text(name) == "b\\xffd.toml"
+    assert one_line(f"{name}: no such spec file") == "b\\xffd.toml: no such spec file"
+    assert escape_controls(name) == "b\\xffd.toml"
+    assert escape_controls("plain\nname") == "plain\\nname"
