@@ -399,8 +399,20 @@ def _check_edit_parsed(old: str, new: str, parts: list[str], literal: str, file:
                 f"{file}: [{key}] has a number with more than {limits().max_digits} digits "
                 "(--limit max_digits=N)"
             ) from None
+        node: Any = before
+        for p in parts:
+            node = node.get(p) if isinstance(node, dict) else None
+        if isinstance(node, dict):
+            # tomllib's "Cannot overwrite a value (at line 15, column 8)" named a line of
+            # the text as edited, not the user's (CLI review 46)
+            raise InputError(
+                f"{file}: cannot set {key} = {literal}: [{key}] is a table; --set sets a "
+                f"value in it ({key}.NAME=VALUES)"
+            ) from None
+        # the position is in the text as edited, which the user never saw (CLI review 46)
+        why = re.sub(r"\s*\(at line \d+, column \d+\)", "", str(e))
         raise InputError(
-            f"{file}: cannot set {key} = {literal} ({e}"
+            f"{file}: cannot set {key} = {literal} ({why}"
             + (_immutable_hint(before, parts) if "immutable" in str(e) else "")
             + ")"
         ) from None

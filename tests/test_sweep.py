@@ -1059,3 +1059,14 @@ def test_a_point_past_the_readers_range_names_the_spec_method() -> None:
     rows = sw.sweep_rows(SPEC, ["method.lambda=[1e999999999, 0.97]"])
     assert [r["exit_code"] for r in rows] == [2, 0]
     assert [r["method"] for r in rows] == ["lyapunov", "lyapunov"]
+
+
+def test_set_of_a_table_or_into_an_array_says_so_without_tomllib_positions() -> None:
+    """--set method=1 said tomllib's "Cannot overwrite a value (at line 15, column 8)" and
+    --set system.A.0=1 "(at line 13, column 8)": positions in the text as edited, not the
+    user's (CLI review 46). A table is named as one; positions are dropped."""
+    with pytest.raises(InputError, match=r"cannot set method = 1: \[method\] is a table") as e:
+        sw.plan(SPEC, ["method=1"])
+    with pytest.raises(InputError, match="system.A is an array") as e2:
+        sw.plan(SPEC, ["system.A.0=1"])
+    assert "at line" not in str(e.value) and "at line" not in str(e2.value)
