@@ -1503,6 +1503,12 @@ class CheckRow:
     #: spec stopped before any claim): the JUnit XML of ``check --junit`` has one testcase each
     claims: list[dict[str, Any]] = field(default_factory=list)
 
+    def __post_init__(self) -> None:
+        # to 0.1 ms as sweep's rows: check --format json printed 0.000980008000624366 (CLI
+        # review 46)
+        if isinstance(self.seconds, float):
+            self.seconds = round(self.seconds, 4)
+
 
 def _empty_folder(p: Path) -> bool:
     """Whether ``p`` is a readable folder (not under /proc or /sys) with no spec file under

@@ -73,3 +73,11 @@ def test_callbacks_and_paths_of_other_types_are_bad_input(tmp_path: Path) -> Non
     for bad in (None, ""):
         with pytest.raises(InputError, match="plot path"):
             api.plot_simulation(SPEC, res, bad, atomic=False)
+
+
+def test_check_rows_give_seconds_to_a_tenth_of_a_millisecond() -> None:
+    """check --format json printed seconds as 0.000980008000624366 while sweep rounds to 4
+    places (CLI review 46)."""
+    row = api.check(SPEC)[0]
+    assert row.seconds == round(row.seconds, 4)
+    assert api.CheckRow("s", "m", 0, 0, 0, 0, "", 0.000980008000624366).seconds == 0.001
