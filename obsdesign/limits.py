@@ -124,7 +124,10 @@ def raised(**values: int) -> Iterator[None]:
 def _checked_value(k: str, v: Any) -> int:
     """A limit's value: a whole number ≥ 1 (a float, a string or None was a bare TypeError or
     broke every later design; API review 46)."""
-    if type(v).__name__ in ("bool", "bool_") or not isinstance(v, int) or v < 1:
+    import numbers
+
+    # any integer type (numpy's too, as the rest of the API takes them), never a bool
+    if type(v).__name__ in ("bool", "bool_") or not isinstance(v, numbers.Integral) or v < 1:
         raise InputError(f"--limit {k}: expected a whole number ≥ 1, got {v!r}"[:200])
     return int(v)
 

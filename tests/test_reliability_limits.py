@@ -826,6 +826,9 @@ def test_set_limits_takes_whole_numbers_and_reset_clears_what_it_restores() -> N
     for bad in ("5000", None, 5000.5, 0, -1, True):
         with pytest.raises(InputError, match="expected a whole number ≥ 1"):
             set_limits(max_digits=bad)
+    import numpy as np
+
+    reset_limits(set_limits(max_digits=np.int64(5000)))  # numpy's integers are integers
     before = max_states_for("set-invariant")
     old = set_limits(max_states=200)
     assert max_states_for("set-invariant") == 200

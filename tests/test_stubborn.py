@@ -1995,8 +1995,8 @@ def test_slides_rmse_tables_are_not_reproduced_and_examples_1_2_agree(ex1: Repor
     ≈ 2 / 5 at 1000 (slides 18.01 / 29.97). With the slides' own K and an outlier rate of 0.05
     (our guess, fitted to that row, not the slides' statement) the 1000 column comes within
     10 % of the printed one at this test's dt = 2 ms (an outlier per integration step, held for
-    dt: the RMSE scales with √dt, and at the shipped 1 ms it is 12.1 / 20.1, 33 % below; the
-    fit is of rate/dt, papers review 46), while the 0.1 column stays ≈ 0.03: the base level is not
+    dt: at the shipped 1 ms it is 12.1 / 20.1, 33 % below; what is fitted is rate·dt, papers
+    and docs reviews 46), while the 0.1 column stays ≈ 0.03: the base level is not
     explained. Example 2 differs from Example 1 only in u, which the error does not see, so
     its table is Example 1's (to rounding), where the slides' two tables differ slightly."""
     from obsdesign.methods.stubborn import sim

@@ -239,6 +239,13 @@ def test_the_schema_and_the_reader_agree_on_one_number_bounds_and_empty_windows(
         assert text not in (ss, st, co)
         jsonschema.validate(tomllib.loads(text), schema)
         api.load_spec_text(text, "one.toml")
+    one_state = (
+        '[system]\ntime = "discrete"\nA = [[0.5]]\nC = [[1]]\n[method]\nkey = "lyapunov"\n'
+        'L = [0.2]\n[sets.E0]\ntype = "ellipsoid"\nE = [[1]]\ncenter = 0\n[simulate]\n'
+        'horizon = 5\nx0 = 1\nxhat0 = 0\n[simulate.noise]\nkind = "constant"\nvalue = 3\n'
+    )  # x0, xhat0, a signal's value, an ellipsoid's center as one number (docs review 46)
+    jsonschema.validate(tomllib.loads(one_state), schema)
+    api.load_spec_text(one_state, "one.toml")
     ly = (root / "constrained-redesign-sec5-lyapunov.toml").read_text(encoding="utf-8")
     bad = ly.replace("windows = [{ start = 151, stop = 153, value = [3] }]", "windows = []")
     assert bad != ly

@@ -10,9 +10,10 @@ from typing import Any
 
 NUM: dict[str, Any] = {"type": "number"}
 VEC: dict[str, Any] = {"type": "array", "items": NUM, "minItems": 1}
-#: a vector key the reader also takes as one number (a box bound, a list of amplitudes: a
-#: scalar is a vector of length 1 — of the set's dimension, a rule across keys that the
-#: schema does not state); VEC refused lower = -3 of a 1-D box the tool takes (re-check 46)
+#: a vector key the reader also takes as one number (a box bound, x0, a signal's value, an
+#: ellipsoid's center, the amplitudes: a scalar is a vector of length 1 — of the set's or
+#: plant's dimension, a rule across keys that the schema does not state); VEC refused
+#: lower = -3 of a 1-D box the tool takes (re-check and docs reviews 46)
 BOUND: dict[str, Any] = {"anyOf": [NUM, VEC]}
 MAT: dict[str, Any] = {
     "description": "a list of rows; a flat list is one row (one column for B, Bd, Dn, L)",
@@ -33,14 +34,14 @@ def _signal() -> dict[str, Any]:
         "required": ["kind"],
         "properties": {
             "kind": {"enum": ["zero", "constant", "windows", "uniform", "outliers", "sequence"]},
-            "value": VEC,
+            "value": BOUND,
             "windows": {
                 "type": "array",
                 "minItems": 1,  # windows = [] is refused by the reader (re-check review 46)
                 "items": {
                     "type": "object",
                     "required": ["start", "stop", "value"],
-                    "properties": {"start": NUM, "stop": NUM, "value": VEC},
+                    "properties": {"start": NUM, "stop": NUM, "value": BOUND},
                     "description": "value on start <= k <= stop (inclusive)",
                 },
             },
@@ -179,7 +180,12 @@ def spec_schema(
                 "type": "object",
                 "required": ["type", "E"],
                 "description": "{x : (x-c)' E (x-c) <= 1}, E symmetric positive definite",
-                "properties": {"type": {"const": "ellipsoid"}, "E": MAT, "center": VEC, "dim": DIM},
+                "properties": {
+                    "type": {"const": "ellipsoid"},
+                    "E": MAT,
+                    "center": BOUND,
+                    "dim": DIM,
+                },
                 "additionalProperties": False,
             },
         ]
@@ -274,8 +280,8 @@ def spec_schema(
                         "description": "samples (discrete: an integer ≥ 1) or seconds (continuous)",
                     },
                     "dt": {**NUM, "exclusiveMinimum": 0},
-                    "x0": VEC,
-                    "xhat0": VEC,
+                    "x0": BOUND,
+                    "xhat0": BOUND,
                     "seed": {"type": "integer", "minimum": 0},
                     "u": _signal(),
                     "disturbance": _signal(),
