@@ -23,6 +23,7 @@ is an :class:`InputError` that says how to install it (exit 2).
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import logging
 import numbers
@@ -353,21 +354,14 @@ def _limits_state() -> tuple[Any, tuple[str, ...]]:
 
 
 def _call(fn: Callable[[T], R], state: tuple[Any, tuple[str, ...]], item: T) -> R:
-    """Run ``fn(item)`` in a worker with the caller's limits in force (restored after)."""
+    """Run ``fn(item)`` in a worker with the caller's limits in force, for this task's
+    thread only (:func:`obsdesign.limits.applied`)."""
     from obsdesign import limits as lim
 
     values, overridden = state
-    old = lim.limits()
-    old_over = set(lim._overridden)
-    lim.reset_limits()
-    if overridden:
-        lim.set_limits(**{k: getattr(values, k) for k in overridden})
-    try:
+    given = {k: getattr(values, k) for k in overridden}
+    with lim.applied(dataclasses.replace(lim.Limits(), **given), frozenset(overridden)):
         return fn(item)
-    finally:
-        lim.reset_limits(old)
-        lim._overridden.clear()
-        lim._overridden.update(old_over)
 
 
 def _call_many(

@@ -100,13 +100,22 @@ def ensure_recursion_limit() -> None:
 #: a context's own raised limits (:func:`raised`): the API raised the process-wide limits
 #: for one object and restored them, and two threads doing so left them raised for the whole
 #: process — a 1500-digit number then passed max_digits = 1000 (API review 46)
-_RAISED: ContextVar[Limits | None] = ContextVar("obsdesign_raised_limits", default=None)
+_RAISED: ContextVar[tuple[Limits, frozenset[str]] | None] = ContextVar(
+    "obsdesign_raised_limits", default=None
+)
 
 
 def limits() -> Limits:
-    """The limits in force (in this thread or task: :func:`raised` ones first)."""
+    """The limits in force (in this thread or task: :func:`raised` / :func:`applied` ones
+    first)."""
     own = _RAISED.get()
-    return own if own is not None else _current
+    return own[0] if own is not None else _current
+
+
+def _overridden_now() -> frozenset[str] | set[str]:
+    """The limit names given explicitly, in this thread or task (:func:`applied`) first."""
+    own = _RAISED.get()
+    return own[1] if own is not None else _overridden
 
 
 @contextmanager
@@ -114,7 +123,21 @@ def raised(**values: int) -> Iterator[None]:
     """The limits with ``values`` in force for this thread or task only, within the block
     (each no lower than the limit in force)."""
     now = limits()
-    token = _RAISED.set(replace(now, **{k: max(v, getattr(now, k)) for k, v in values.items()}))
+    new = replace(now, **{k: max(v, getattr(now, k)) for k, v in values.items()})
+    token = _RAISED.set((new, frozenset(_overridden_now())))
+    try:
+        yield
+    finally:
+        _RAISED.reset(token)
+
+
+@contextmanager
+def applied(values: Limits, overridden: frozenset[str] | set[str]) -> Iterator[None]:
+    """``values`` (with ``overridden``, the names given explicitly) in force for this thread
+    or task only, within the block: a Dask task runs with its caller's limits — reset and set
+    process-wide, two tasks in the threads of one worker undid each other's, and a row under
+    --limit max_digits=2000 was refused at 1000 (re-check review 46)."""
+    token = _RAISED.set((values, frozenset(overridden)))
     try:
         yield
     finally:
@@ -142,9 +165,16 @@ def set_limits(**values: int) -> Limits:
             raise InputError(f"--limit {k}: unknown limit (known: {', '.join(sorted(known))})")
         values[k] = _checked_value(k, v)
         _check_ceiling(k, values[k])
+    _GIVEN[id(old)] = (old, frozenset(_overridden))  # for reset_limits(old)
+    while len(_GIVEN) > 64:
+        _GIVEN.pop(next(iter(_GIVEN)))
     _current = replace(_current, **values)
     _overridden.update(values)
     return old
+
+
+#: the names given explicitly when each Limits that set_limits returned was in force
+_GIVEN: dict[int, tuple[Limits, frozenset[str]]] = {}
 
 
 def saved() -> tuple[Limits, frozenset[str]]:
@@ -176,20 +206,25 @@ def reset_limits(old: Limits | None = None) -> None:
     """Back to ``old`` (or to the defaults)."""
     global _current
     _current = old if old is not None else Limits()
-    # overridden: what differs from the defaults — reset_limits(set_limits(max_states=200))
-    # kept max_states marked overridden, and the per-method caps gave way to 100 for the rest
-    # of the process (API review 46)
-    defaults = Limits()
+    # overridden: as when ``old`` was in force (set_limits returned it), else what differs
+    # from the defaults — reset_limits(set_limits(max_states=200)) kept max_states marked
+    # overridden, and the per-method caps gave way to 100 for the rest of the process (API
+    # review 46); an explicit max_states = 100 stays given (re-check review 46)
+    known = _GIVEN.get(id(old)) if old is not None else None
     _overridden.clear()
-    _overridden.update(
-        f.name for f in fields(Limits) if getattr(_current, f.name) != getattr(defaults, f.name)
-    )
+    if known is not None and known[0] is old:
+        _overridden.update(known[1])
+    else:
+        defaults = Limits()
+        _overridden.update(
+            f.name for f in fields(Limits) if getattr(_current, f.name) != getattr(defaults, f.name)
+        )
 
 
 def max_states_for(key: str, declared: int | None = None) -> int:
     """The state-dimension limit of method ``key``: ``--limit max_states`` when given, else
     the method's declared ``max_states``, else :data:`METHOD_MAX_STATES`, else the default."""
-    if "max_states" in _overridden:
+    if "max_states" in _overridden_now():
         return limits().max_states
     return int(declared or METHOD_MAX_STATES.get(key, limits().max_states))
 

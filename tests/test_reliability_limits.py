@@ -834,3 +834,55 @@ def test_set_limits_takes_whole_numbers_and_reset_clears_what_it_restores() -> N
     assert max_states_for("set-invariant") == 200
     reset_limits(old)
     assert max_states_for("set-invariant") == before
+
+
+def test_dask_tasks_in_one_workers_threads_keep_their_own_limits() -> None:
+    """A Dask task ran with its caller's limits by resetting and setting the worker process's:
+    two tasks in the threads of one worker undid each other's, and a row under --limit
+    max_digits=2000 was refused at 1000 (re-check review 46). Each task's limits hold in its
+    own thread."""
+    import threading
+
+    from obsdesign.distributed import _call
+    from obsdesign.limits import Limits, limits, max_states_for
+
+    a_in, b_in, a_read = threading.Event(), threading.Event(), threading.Event()
+    seen: dict[str, tuple[int, int]] = {}
+
+    def task_a(_: object) -> None:
+        a_in.set()
+        assert b_in.wait(10)  # B is inside its task now
+        seen["a"] = (limits().max_digits, max_states_for("set-invariant"))
+        a_read.set()
+
+    def task_b(_: object) -> None:
+        b_in.set()
+        assert a_read.wait(10)
+        seen["b"] = (limits().max_digits, max_states_for("set-invariant"))
+
+    raised = Limits(max_digits=2000, max_states=100)
+    ta = threading.Thread(target=_call, args=(task_a, (raised, ("max_digits", "max_states")), 0))
+    ta.start()
+    assert a_in.wait(10)
+    tb = threading.Thread(target=_call, args=(task_b, (Limits(), ()), 0))
+    tb.start()
+    ta.join(10)
+    tb.join(10)
+    assert seen == {"a": (2000, 100), "b": (Limits().max_digits, 12)}
+    assert limits() == Limits()
+
+
+def test_reset_limits_keeps_an_explicit_limit_equal_to_its_default() -> None:
+    """set_limits(max_states=100) lifts set-invariant's own cap of 12; a later save/restore
+    pair (old = set_limits(...); reset_limits(old)) dropped it, the value being the default
+    (re-check review 46)."""
+    from obsdesign.limits import max_states_for, reset_limits, set_limits
+
+    first = set_limits(max_states=100)
+    try:
+        assert max_states_for("set-invariant") == 100
+        reset_limits(set_limits(max_digits=5000))
+        assert max_states_for("set-invariant") == 100
+    finally:
+        reset_limits(first)
+    assert max_states_for("set-invariant") == 12
