@@ -647,6 +647,8 @@ def observer_statespace(report: Any, law: str | None = None, verify: bool = Fals
 
         if strict:
             _check_float_realization(Ao, s.discrete, rate, where, exact_loop)
+        else:
+            _check_invariant_gain(exact_loop(), where)
         with np.errstate(all="ignore"):
             Bo = np.hstack([B - sign * G @ D, sign * G])
         return ct.ss(
@@ -702,6 +704,23 @@ def _exact_loop(sp: Any, params: Any, key: str | None, sign: float) -> Any:
         return None
     G = np.asarray(G, dtype=object)
     return exact_closed_loop(sp.system.A.q, G if sign > 0 else -G, sp.system.C.q)
+
+
+def _check_invariant_gain(Aex: Any, where: str) -> None:
+    """For a certificate of invariance only (set-invariant with λ = 1: ρ(A + LC) ≤ 1): refuse
+    an exact gain whose A + LC has an eigenvalue clearly outside the unit disk — no P ≻ 0
+    decays at the rate 1 + 2⁻⁴⁰, decided exactly — as the report's claims cannot hold for it.
+    With λ = 1 no check ran, and an L edited to a gain with eigenvalue 10.65 was exported
+    without a word while verify fails it (re-check review 46). ``Aex`` None: not at hand."""
+    from obsdesign.certify.exact import Q
+    from obsdesign.lyap import exact_within
+
+    if Aex is not None and not exact_within(Aex, True, Q(1) + Q(1) / 2**40):
+        raise InputError(
+            f"{where}: the observer matrix of the report's exact gain has an eigenvalue outside "
+            "the unit disk: the report's invariance claims cannot hold for it (obsdesign "
+            "verify says which fail); no observer is offered"
+        )
 
 
 def _check_float_realization(

@@ -1258,6 +1258,19 @@ L = [0, 0]
     assert rep.exit_code() == 0 and api.verify(rep).exit_code() == 0
     obs = observer_statespace(rep, law="linear")
     np.testing.assert_array_equal(obs.A, [[0.0, -1.0], [1.0, 0.0]])
+    # ... but not a gain edited to an unstable one: with λ = 1 no check ran, and it was
+    # exported without a word (re-check review 46)
+    from obsdesign.report.model import Report
+
+    d = rep.to_dict()
+    d["spec"] = d["spec"].replace("L = [0, 0]", "L = [5, 5]")
+    import hashlib
+
+    d["spec_sha256"] = hashlib.sha256(d["spec"].encode()).hexdigest()
+    bad, _ = Report.from_dict(d)
+    assert api.verify(bad).exit_code() == 1
+    with pytest.raises(InputError, match="eigenvalue outside the unit disk"):
+        observer_statespace(bad, law="linear")
 
 
 def test_report_objects_are_read_as_verify_reads_them(tmp_path: Path) -> None:
