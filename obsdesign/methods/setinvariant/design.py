@@ -257,7 +257,10 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
         run.stage = _final_of(r, data, single, lam, dl, o)
     res = run.stage.res
     if single and o.strict and run.converged and res is not None and not res.ok:
-        if o.algorithm != "none" and float(res.factor) <= lam * (1 + 2 * dd):
+        # within 2Δδ of λ, or within the float LP's accuracy (~1e-8) for a tiny Δδ: the
+        # retry never started at delta_tol ≤ 5e-9 with the factor 2e-8 above λ (re-check
+        # review 46)
+        if o.algorithm != "none" and float(res.factor) <= lam * (1 + max(2 * dd, 1e-7)):
             if not sym_failed or o.fallback == "general":
                 run.notes.append(
                     f"certified factor {float(res.factor):.9g} > λ: iterating with the hull "
@@ -268,7 +271,7 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
                 # factor 2·10⁻⁸ above λ = 1 at delta_tol = 1e-9, below what the LP resolves
                 # (census 46)
                 margin = dd
-                for _ in range(3):
+                for tries_left in (2, 1, 0):
                     V0 = po.qfloat(run.stage.vrep.V) if data.ex is not None else run.stage.vrep.V
                     r = al.general(
                         fl, lam / (1 + margin), lam * (1 - 1e-12), o.max_iterations, o.mirror,
@@ -279,7 +282,7 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
                     run.iterations, run.converged = r.iterations, r.converged
                     run.stage = _final_of(r, data, single, lam, dl, o)
                     res = run.stage.res
-                    if not run.converged or res is None or res.ok:
+                    if not run.converged or res is None or res.ok or not tries_left:
                         break
                     gap = float(res.factor) / float(lam) - 1
                     margin = max(2 * margin, 2 * gap)
