@@ -1526,6 +1526,8 @@ def spec_files(paths: list[str | Path] | str | Path) -> list[Path]:
     string or a Path) is one path:
     ``check("specs/")`` iterated the string's characters, and its "/" searched the whole
     file system (outsider trial, session 22)."""
+    if type(paths).__name__ == "ndarray" and getattr(paths, "ndim", 1) == 0:
+        paths = paths.item()  # type: ignore[union-attr]  # one path in a 0-d array, as check
     if isinstance(paths, (str, os.PathLike)):
         paths = [paths]
     if isinstance(paths, (bytes, Mapping)) or not isinstance(paths, Iterable):
@@ -1533,8 +1535,12 @@ def spec_files(paths: list[str | Path] | str | Path) -> list[Path]:
         raise InputError(
             f"spec_files: expected a path or a list of paths, got {type(paths).__name__}"
         )
+    given = [_path_arg(x, "spec_files") for x in paths]
+    if any(os.fspath(x) == "" for x in given):
+        # '' is '.' to pathlib: the working folder was walked (re-check review 46)
+        raise InputError("spec_files: an empty path (an unset variable?): give a file or folder")
     out: list[Path] = []
-    for p in (Path(_path_arg(x, "spec_files")) for x in paths):
+    for p in map(Path, given):
         try:
             folder = p.is_dir()
         except OSError:  # a name too long: its own row says so (exit 3, no rows; session 44)
@@ -2349,9 +2355,12 @@ def _plot_to(
     :func:`check_plot_path` first, ``force`` as its)."""
     atomic, force = _flag(atomic, "atomic"), _flag(force, "force")
     if not atomic:
-        # None or "" were a bare TypeError / IsADirectoryError (API review 46)
-        if not str(_path_arg(path, "plot path")):
+        # None, "", Path("") or a folder were a bare TypeError / IsADirectoryError (API and
+        # re-check reviews 46)
+        if not os.fspath(_path_arg(path, "plot path")):
             raise InputError("plot path: an empty path (an unset variable?)")
+        if Path(path).is_dir():
+            raise InputError(f"{path}: is a directory")
         return draw(Path(path))
     from obsdesign.report.model import write_via
 

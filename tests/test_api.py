@@ -73,6 +73,13 @@ def test_callbacks_and_paths_of_other_types_are_bad_input(tmp_path: Path) -> Non
     for bad in (None, ""):
         with pytest.raises(InputError, match="plot path"):
             api.plot_simulation(SPEC, res, bad, atomic=False)
+    # Path(""), a folder; spec_files of a 0-d array and of "" (re-check review 46)
+    for bad in (Path(""), tmp_path):
+        with pytest.raises(InputError, match="is a directory|empty path"):
+            api.plot_simulation(SPEC, res, bad, atomic=False)
+    assert api.spec_files(np.array(str(SPEC))) == [SPEC]
+    with pytest.raises(InputError, match="spec_files: an empty path"):
+        api.spec_files([""])
 
 
 def test_check_rows_give_seconds_to_a_tenth_of_a_millisecond() -> None:
