@@ -151,7 +151,7 @@ def _checked_value(k: str, v: Any) -> int:
 
     # any integer type (numpy's too, as the rest of the API takes them), never a bool
     if type(v).__name__ in ("bool", "bool_") or not isinstance(v, numbers.Integral) or v < 1:
-        raise InputError(f"--limit {k}: expected a whole number ≥ 1, got {v!r}"[:200])
+        raise InputError(f"limit {k}: expected a whole number ≥ 1, got {v!r}"[:200])
     return int(v)
 
 
