@@ -202,15 +202,22 @@ def _run(fn: Callable[[Any], int], quiet: bool = False, width: int | None = None
     finally:
         if isinstance(sys.stdout, _Stdout):
             sys.stdout = sys.stdout.wrapped
+    raise typer.Exit(_flushed(code))
+
+
+def _flushed(code: int) -> int:
+    """``code`` once what stdout still buffers is written, else the exit code of the failure,
+    said once: 141 for a closed pipe (quietly), 2 for any other OS error."""
     try:
         sys.stdout.flush()
+        return code
     except BrokenPipeError:
-        _quiet_broken_pipe()
+        _drop_stdout()
+        return 141
     except OSError as e:
         _err(_stdout_error(e).message)
         _drop_stdout()
-        raise typer.Exit(_stdout_error(e).exit_code) from None
-    raise typer.Exit(code)
+        return int(_stdout_error(e).exit_code)
 
 
 def _drop_stdout() -> None:
@@ -1183,15 +1190,8 @@ def main() -> None:
             except (OSError, ValueError, AttributeError):
                 pass
         os._exit(code)
-    try:  # what is still buffered (--version, click's help): its errors as a command's
-        sys.stdout.flush()
-    except BrokenPipeError:
-        _quiet_broken_pipe_exit()
-    except OSError as e:
-        _err(_stdout_error(e).message)
-        _drop_stdout()
-        sys.exit(2)
-    sys.exit(code)
+    # what is still buffered (--version, click's help): its errors as a command's
+    sys.exit(_flushed(code))
 
 
 if __name__ == "__main__":
