@@ -162,9 +162,10 @@ def set_limits(**values: int) -> Limits:
     known = {f.name for f in fields(Limits)}
     for k, v in values.items():
         if k not in known:
-            raise InputError(f"--limit {k}: unknown limit (known: {', '.join(sorted(known))})")
+            # "limit", not the CLI's "--limit": parse_limit checks --limit first (re-check 46)
+            raise InputError(f"limit {k}: unknown limit (known: {', '.join(sorted(known))})")
         values[k] = _checked_value(k, v)
-        _check_ceiling(k, values[k])
+        _check_ceiling(k, values[k], prefix="limit")
     _GIVEN[id(old)] = (old, frozenset(_overridden))  # for reset_limits(old)
     while len(_GIVEN) > 64:
         _GIVEN.pop(next(iter(_GIVEN)))
@@ -191,13 +192,13 @@ def restore(state: tuple[Limits, frozenset[str]]) -> None:
     _overridden.update(state[1])
 
 
-def _check_ceiling(k: str, v: int, shown: str | None = None) -> None:
+def _check_ceiling(k: str, v: int, shown: str | None = None, prefix: str = "--limit") -> None:
     """An :class:`InputError` when ``v`` is above the limit's :data:`CEILINGS` entry
     (``shown``: the value as the user wrote it, else ``v``)."""
     cap = CEILINGS.get(k)
     if cap is not None and v > cap:
         raise InputError(
-            f"--limit {k}: at most {cap} (above it one value can take minutes or exhaust "
+            f"{prefix} {k}: at most {cap} (above it one value can take minutes or exhaust "
             f"Python's recursion), got {shown if shown is not None else v}"
         )
 

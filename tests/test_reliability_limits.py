@@ -824,8 +824,13 @@ def test_set_limits_takes_whole_numbers_and_reset_clears_what_it_restores() -> N
     from obsdesign.limits import max_states_for, reset_limits, set_limits
 
     for bad in ("5000", None, 5000.5, 0, -1, True):
-        with pytest.raises(InputError, match="expected a whole number ≥ 1"):
+        with pytest.raises(InputError, match="^limit max_digits: expected a whole number ≥ 1"):
             set_limits(max_digits=bad)
+    # the API's refusals name the limit, not the CLI's --limit (re-check review 46)
+    with pytest.raises(InputError, match="^limit max_digit: unknown limit"):
+        set_limits(max_digit=5)
+    with pytest.raises(InputError, match="^limit max_digits: at most 100000"):
+        set_limits(max_digits=200000)
     import numpy as np
 
     reset_limits(set_limits(max_digits=np.int64(5000)))  # numpy's integers are integers
