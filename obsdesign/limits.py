@@ -28,6 +28,7 @@ import os
 import re
 import stat
 import sys
+import weakref
 from collections.abc import Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -166,16 +167,19 @@ def set_limits(**values: int) -> Limits:
             raise InputError(f"limit {k}: unknown limit (known: {', '.join(sorted(known))})")
         values[k] = _checked_value(k, v)
         _check_ceiling(k, values[k], prefix="limit")
-    _GIVEN[id(old)] = (old, frozenset(_overridden))  # for reset_limits(old)
-    while len(_GIVEN) > 64:
-        _GIVEN.pop(next(iter(_GIVEN)))
+    # for reset_limits(old), while old lives (no count cap: a 64-entry table forgot a saved
+    # Limits after 64 calls; re-check review 46)
+    if id(old) not in _GIVEN:
+        weakref.finalize(old, _GIVEN.pop, id(old), None)
+    _GIVEN[id(old)] = (weakref.ref(old), frozenset(_overridden))
     _current = replace(_current, **values)
     _overridden.update(values)
     return old
 
 
-#: the names given explicitly when each Limits that set_limits returned was in force
-_GIVEN: dict[int, tuple[Limits, frozenset[str]]] = {}
+#: the names given explicitly when each Limits that set_limits returned was in force, by
+#: the object's id while it lives
+_GIVEN: dict[int, tuple[weakref.ref[Limits], frozenset[str]]] = {}
 
 
 def saved() -> tuple[Limits, frozenset[str]]:
@@ -213,7 +217,7 @@ def reset_limits(old: Limits | None = None) -> None:
     # review 46); an explicit max_states = 100 stays given (re-check review 46)
     known = _GIVEN.get(id(old)) if old is not None else None
     _overridden.clear()
-    if known is not None and known[0] is old:
+    if known is not None and known[0]() is old:
         _overridden.update(known[1])
     else:
         defaults = Limits()

@@ -888,6 +888,11 @@ def test_reset_limits_keeps_an_explicit_limit_equal_to_its_default() -> None:
         assert max_states_for("set-invariant") == 100
         reset_limits(set_limits(max_digits=5000))
         assert max_states_for("set-invariant") == 100
+        saved = set_limits(max_digits=5000)  # and after many set_limits calls (a 64-entry
+        for _ in range(100):  # table forgot it; re-check review 46)
+            set_limits(max_digits=4000)
+        reset_limits(saved)
+        assert max_states_for("set-invariant") == 100
     finally:
         reset_limits(first)
     assert max_states_for("set-invariant") == 12

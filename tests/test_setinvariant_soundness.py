@@ -1261,3 +1261,31 @@ def test_the_strict_retry_goes_on_past_the_float_lps_accuracy(delta_tol: str) ->
     again = any("is still above λ" in n and "iterating again" in n for n in rep.notes)
     assert again == (delta_tol == "1e-09")  # at 5e-9 the first retry is enough
     assert api.verify(rep).exit_code() == 0
+
+
+def test_a_strict_retry_out_of_time_leaves_the_finished_polyhedron(monkeypatch) -> None:
+    """The strict retry's own time-budget stop replaced a finished exit-1 design (the factor
+    6.7e-8 above λ, its polyhedron and notes) by exit 3 with no polyhedron (re-check review
+    46): the polyhedron before the retry is reported, with a note."""
+    from pathlib import Path
+
+    from obsdesign import api
+    from obsdesign.errors import SolverError
+    from obsdesign.methods.setinvariant import design as des
+
+    calls = []
+    real = des.al.general
+
+    def general(*a, **k):  # the strict retry (it stops at λ(1 − 1e-12)) runs out of time
+        if abs(float(a[2]) - (1 - 1e-12)) < 1e-15:
+            calls.append(1)
+            raise SolverError("not converged within 1 s ([method] time_limit)")
+        return real(*a, **k)
+
+    monkeypatch.setattr(des.al, "general", general)
+    spec = api.load_spec(Path(__file__).parent / "specs" / "setinvariant-float-gap.toml")
+    rep = api.design(spec)
+    assert rep.exit_code() == 1 and rep.error is None and "G" in rep.parameters
+    assert [c.id for c in rep.failed] == ["theorem-3.1"]
+    assert any("the strict retry ran out of the time budget" in n for n in rep.notes)
+    assert len(calls) == 1

@@ -270,19 +270,34 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
                 # one try judged by the float LP (9) alone ended "converged" with the exact
                 # factor 2·10⁻⁸ above λ = 1 at delta_tol = 1e-9, below what the LP resolves
                 # (census 46)
+                # the best finished polyhedron stands when a retry runs out of the time budget
+                # or ends worse: a retry's timeout replaced an exit-1 report by exit 3 with no
+                # polyhedron (re-check review 46)
+                best = (run.stage, run.iterations, run.converged)
                 margin = dd
                 for tries_left in (2, 1, 0):
                     V0 = po.qfloat(run.stage.vrep.V) if data.ex is not None else run.stage.vrep.V
-                    r = al.general(
-                        fl, lam / (1 + margin), lam * (1 - 1e-12), o.max_iterations, o.mirror,
-                        start=V0, progress=progress, it0=run.iterations, history=hist,
-                        deadline=dl,
-                    )  # fmt: skip
-                    _budget(r, o, run)
-                    run.iterations, run.converged = r.iterations, r.converged
-                    run.stage = _final_of(r, data, single, lam, dl, o)
-                    res = run.stage.res
-                    if not run.converged or res is None or res.ok or not tries_left:
+                    try:
+                        r = al.general(
+                            fl, lam / (1 + margin), lam * (1 - 1e-12), o.max_iterations,
+                            o.mirror, start=V0, progress=progress, it0=run.iterations,
+                            history=hist, deadline=dl,
+                        )  # fmt: skip
+                        _budget(r, o, run)
+                        stage = _final_of(r, data, single, lam, dl, o)
+                    except SolverError:
+                        run.notes.append(
+                            "the strict retry ran out of the time budget ([method] time_limit):"
+                            " the best polyhedron before it is reported"
+                        )
+                        break
+                    run.iterations, run.converged, run.stage = r.iterations, r.converged, stage
+                    res = stage.res
+                    if not run.converged or res is None or res.ok:
+                        break
+                    if res.factor < best[0].res.factor:
+                        best = (run.stage, run.iterations, run.converged)
+                    if not tries_left:
                         break
                     gap = float(res.factor) / float(lam) - 1
                     margin = max(2 * margin, 2 * gap)
@@ -291,6 +306,14 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
                         f"{gap:.3g} relative, more than delta_tol = {dd:g}: the float LP's "
                         f"accuracy): iterating again with the margin {margin:.3g}"
                     )
+                res = run.stage.res
+                if res is None or not (run.converged and res.ok):
+                    if best[0] is not run.stage:
+                        run.notes.append(
+                            "the strict retries did not certify λ: the polyhedron with the "
+                            "lowest certified factor is reported"
+                        )
+                    run.stage, run.iterations, run.converged = best
     return run
 
 
