@@ -2361,7 +2361,18 @@ def _plot_to(
             raise InputError("plot path: an empty path (an unset variable?)")
         if Path(path).is_dir():
             raise InputError(f"{path}: is a directory")
-        return draw(Path(path))
+        from obsdesign.formats import PLOT_SUFFIXES
+
+        p = Path(path)
+        if p.suffix.lower() not in PLOT_SUFFIXES:  # matplotlib's bare ValueError (re-check 46)
+            raise InputError(
+                f"{p}: unknown plot format {p.suffix or '(no suffix)'!r} "
+                f"(expected one of {', '.join(PLOT_SUFFIXES)})"
+            )
+        try:
+            return draw(p)
+        except OSError as e:  # a missing folder, /proc: a bare FileNotFoundError (re-check 46)
+            raise InputError(f"{p}: cannot write ({e.strerror or e})") from None
     from obsdesign.report.model import write_via
 
     return write_via(check_plot_path(path, force), draw, force)

@@ -77,6 +77,9 @@ def test_callbacks_and_paths_of_other_types_are_bad_input(tmp_path: Path) -> Non
     for bad in (Path(""), tmp_path):
         with pytest.raises(InputError, match="is a directory|empty path"):
             api.plot_simulation(SPEC, res, bad, atomic=False)
+    for bad, said in ((tmp_path / "no" / "x.png", "cannot write"), (tmp_path / "x.zz", "unknown")):
+        with pytest.raises(InputError, match=said):  # bare exceptions (re-check review 46)
+            api.plot_simulation(SPEC, res, bad, atomic=False)
     assert api.spec_files(np.array(str(SPEC))) == [SPEC]
     with pytest.raises(InputError, match="spec_files: an empty path"):
         api.spec_files([""])
