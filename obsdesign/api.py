@@ -765,10 +765,17 @@ def _named_file_differs(spec_file: str, sha: str) -> str | None:
     have = hashlib.sha256(raw).hexdigest()
     if have == sha:
         return None
+    # a name with bytes that are not UTF-8 is shown with \xNN, which a shell does not read
+    # back as the byte (re-check review 46)
+    odd = (
+        " (its name holds bytes that are not UTF-8, written \\xNN here)"
+        if p.name != Path(spec_file).name
+        else ""
+    )
     return (
         f"the spec embedded in the report was verified, not the file {spec_file}: that file "
         f"differs from it (sha256 {have[:12]}… here, {sha[:12]}… embedded); "
-        f"'obsdesign verify REPORT --spec {spec_file}' checks the report against the file"
+        f"'obsdesign verify REPORT --spec {spec_file}' checks the report against the file{odd}"
     )
 
 

@@ -828,4 +828,5 @@ def test_the_differs_note_finds_a_spec_whose_name_is_not_utf8(tmp_path: Path) ->
     assert not [n for n in api.verify(out).notes if "differs from it" in n]
     with open(name, "a", encoding="utf-8") as f:
         f.write("# edited\n")
-    assert [n for n in api.verify(out).notes if "differs from it" in n]
+    notes = [n for n in api.verify(out).notes if "differs from it" in n]
+    assert notes and "holds bytes that are not UTF-8" in notes[0]
