@@ -400,8 +400,15 @@ def _check_edit_parsed(old: str, new: str, parts: list[str], literal: str, file:
                 "(--limit max_digits=N)"
             ) from None
         node: Any = before
-        for p in parts:
+        for i, p in enumerate(parts):
             node = node.get(p) if isinstance(node, dict) else None
+            if i < len(parts) - 1 and node is not None and not isinstance(node, (dict, list)):
+                # a key under a number (method.lambda.x=1): "Cannot overwrite a value" alone
+                # (re-check review 46)
+                above = ".".join(parts[: i + 1])
+                raise InputError(
+                    f"{file}: cannot set {key} = {literal}: [{above}] is a value, not a table"
+                ) from None
         if isinstance(node, dict):
             # tomllib's "Cannot overwrite a value (at line 15, column 8)" named a line of
             # the text as edited, not the user's (CLI review 46)

@@ -1070,3 +1070,5 @@ def test_set_of_a_table_or_into_an_array_says_so_without_tomllib_positions() -> 
     with pytest.raises(InputError, match="system.A is an array") as e2:
         sw.plan(SPEC, ["system.A.0=1"])
     assert "at line" not in str(e.value) and "at line" not in str(e2.value)
+    with pytest.raises(InputError, match=r"\[method.lambda\] is a value, not a table"):
+        sw.plan(SPEC, ["method.lambda.x=1"])
