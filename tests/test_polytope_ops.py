@@ -649,3 +649,83 @@ def test_incidences_evaluate_a_nan_float_pair_exactly() -> None:
     Pf = np.array([[np.nan, 1.0]])
     _, _, _, bad = po._incidences(G, P, (Pf, pv, pd))
     assert (0, 0) in bad
+
+
+def _old_edges(simplices: np.ndarray, remap: np.ndarray) -> np.ndarray:
+    """The edges as computed before session 47 (pairs sorted with np.unique(axis=0))."""
+    S = remap[np.asarray(simplices, dtype=int)]
+    k = S.shape[1]
+    pairs = [np.sort(S[:, [a, b]], axis=1) for a in range(k) for b in range(a + 1, k)]
+    E = np.vstack(pairs) if pairs else np.zeros((0, 2), dtype=int)
+    E = E[(E[:, 0] >= 0) & (E[:, 0] != E[:, 1])]
+    return np.unique(E, axis=0) if len(E) else E.reshape(0, 2)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 10**6), st.integers(2, 5), st.integers(6, 40), st.integers(1, 50))
+def test_edges_by_int_keys_are_the_pair_sort(seed, n, k, block) -> None:
+    """The edges of a triangulation as one int64 key per pair, made in blocks (session 47:
+    ``np.unique(axis=0)`` took 48 s on a 9-cube's triangulation) are the pairs the row sort
+    gave, in the same order, for any block size; ``check`` runs once per block."""
+    rng = np.random.default_rng(seed)
+    P = rng.standard_normal((k, n))
+    from scipy.spatial import ConvexHull
+
+    h = ConvexHull(P)
+    remap = np.full(len(P), -1, dtype=int)
+    remap[h.vertices] = np.arange(len(h.vertices))
+    calls = []
+    old = po.BLOCK_ENTRIES
+    po.BLOCK_ENTRIES = block * n * (n - 1) // 2  # a simplex of the boundary: n points
+    try:
+        E = po._edges_from_simplices(h.simplices, remap, lambda: calls.append(1))
+    finally:
+        po.BLOCK_ENTRIES = old
+    assert np.array_equal(E, _old_edges(h.simplices, remap))
+    assert len(calls) == -(-len(h.simplices) // block)
+
+
+def test_a_long_qhull_run_sees_the_budget_and_is_left_behind(monkeypatch) -> None:
+    """A qhull run on a large input runs in a thread while the caller looks at the budget
+    every POLL_S s: the budget's exception ends the call at once (qhull cannot be stopped;
+    inline, a 9-state set-invariant design with time_limit = 10 ran 132 s and ignored
+    SIGTERM, session 47). Small inputs run inline; qhull's result and error come back."""
+    import threading
+
+    import scipy.spatial
+
+    release = threading.Event()
+    started = threading.Event()
+
+    def slow(points, qhull_options=None):  # stands in for a qhull run of minutes
+        started.set()
+        release.wait(30)
+        raise AssertionError("the abandoned run was waited for")
+
+    class Budget(Exception):
+        pass
+
+    looks = []
+
+    def check() -> None:
+        looks.append(threading.current_thread() is threading.main_thread())
+        if len(looks) == 3:
+            raise Budget
+
+    monkeypatch.setattr(po, "POLL_S", 0.01)
+    monkeypatch.setattr(scipy.spatial, "ConvexHull", slow)
+    big = np.random.default_rng(0).standard_normal((po.THREAD_MIN_COORDS // 4 + 1, 4))
+    with pytest.raises(Budget):
+        po._qhull(big, check)
+    assert started.is_set() and looks == [True, True, True]
+    release.set()
+    monkeypatch.undo()
+    h = po._qhull(big, check=lambda: None)  # the real qhull, in a thread
+    assert len(h.vertices) >= 5
+
+    def fails(points, qhull_options=None):
+        raise scipy.spatial.QhullError("QH6154 initial simplex is flat")
+
+    monkeypatch.setattr(scipy.spatial, "ConvexHull", fails)
+    with pytest.raises(po._QhullFailed, match="QH6154"):  # qhull's error comes back
+        po._qhull(big, check=lambda: None)

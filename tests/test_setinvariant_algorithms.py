@@ -60,3 +60,35 @@ def test_translating_d_leaves_the_iterations_alone(shift: int, k: int, seed: int
     assert r0.iterations == r1.iterations
     assert [h["eps"] for h in r1.history] == [h["eps"] for h in r0.history]
     np.testing.assert_array_equal(r1.G, r0.G)
+
+
+def _rows(rows: list[list[int]]) -> str:
+    return "[" + ", ".join("[" + ", ".join(map(str, r)) + "]" for r in rows) + "]"
+
+
+_EYE10 = [[int(i == j) for j in range(10)] for i in range(10)]
+CUBE10 = (
+    f'[system]\ntime = "discrete"\nA = {_rows(_EYE10)}\nC = {_rows(_EYE10[:9])}\n'
+    f'[sets.omega]\ntype = "box"\ndim = 10\nlower = {[-1] * 10}\nupper = {[1] * 10}\n'
+    '[method]\nkey = "set-invariant"\nomega = "omega"\nlambda = 1\ntime_limit = 1\n'
+    f"L = {_rows([[0] * 9] * 10)}\n"
+)
+
+
+def test_the_first_hull_is_held_to_the_time_budget() -> None:
+    """The first iteration's hull was exempt from ``time_limit`` (so that a run always had a
+    polyhedron): on the 10-cube (A = I, λ = 1) it ran past 11 minutes for a 1 s budget
+    (re-check review 46). It is now stopped by the budget, exit 3 saying the first hull did
+    not finish."""
+    from obsdesign.errors import SolverError
+
+    spec = load_spec_text(CUBE10, "cube10.toml")
+    try:
+        rep = api.design(spec)
+    except SolverError as e:
+        msg = e.message
+    else:
+        msg = rep.error or ""
+        assert rep.exit_code() == 3, rep.notes
+    assert "within 1 s ([method] time_limit) / 0 iterations" in msg, msg
+    assert "the first hull of" in msg and "did not finish" in msg, msg

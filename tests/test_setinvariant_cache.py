@@ -167,7 +167,7 @@ def test_time_budget_refuses_with_reason() -> None:
     sp = api.load_spec_text(SEED0.replace("max_iterations = 60", "time_limit = 1e-9"), "t.toml")
     with pytest.raises(
         SolverError,
-        match=r"not converged within 1e-09 s .* / 0 iterations: no iteration finished with",
+        match=r"not converged within 1e-09 s .* / 0 iterations: the first hull of 8 points did",
     ):
         api.design(sp)
     rep = api.design(api.load_spec_text(SEED0, "s0.toml"))  # the default budget: converges
@@ -328,14 +328,19 @@ def test_time_budget_inside_the_hull_and_the_point_screening(monkeypatch):
 
     def hull(P, with_edges=True, check=None):
         calls.append(check is not None)
-        if check is not None:  # the budget runs out inside this hull
+        if len(calls) == stop_at:  # the budget runs out inside this hull
             raise Timeout
-        return real(P, with_edges)
+        return real(P, with_edges, check)
 
     monkeypatch.setattr(po, "hull", hull)
+    stop_at = 2
     r = al.general(fl, 0.9604, 0.9604, 60, True, deadline=1e18)
-    assert calls == [False, True]  # the first hull unchecked (a polyhedron to report)
-    assert r.timed_out and r.iterations == 1 and not r.converged
+    assert calls == [True, True]  # the first hull is checked too (session 47)
+    assert r.timed_out and r.iterations == 1 and not r.converged and len(r.G)
+    calls.clear()
+    stop_at = 1  # in the first hull: no polyhedron (algorithms._unfinished)
+    r = al.general(fl, 0.9604, 0.9604, 60, True, deadline=1e18)
+    assert r.timed_out and r.iterations == 0 and r.G.shape == (0, 3) and len(r.P) == 8
     monkeypatch.undo()
     G = fl.G0
     with pytest.raises(Timeout):
@@ -380,3 +385,28 @@ def test_lp9_on_the_merged_float_rows_then_on_all_rows_where_tight():
     calls.clear()
     again = ce.theorem31(tight, G, v_solver=solver, vrep=vrep, v_rows=Gm)
     assert calls == [len(Gm), len(G)] and again.ok and again.factor <= merged.factor
+
+
+def test_budget_message_says_how_far_the_run_got() -> None:
+    """The three ends of a run stopped by the budget: in its first hull (no polyhedron), in
+    its first iteration's LPs (a hull, no ε), after an iteration (its ε)."""
+    from obsdesign.methods.setinvariant import algorithms as al
+    from obsdesign.methods.setinvariant.design import _budget, _Run
+    from obsdesign.methods.setinvariant.problem import build
+
+    sp = api.load_spec_text(SEED0, "s0.toml")
+    fl = build(sp).fl
+    run = _Run(None, 0, True)
+    ends = {
+        "the first hull of 8 points did not finish": al._unfinished(np.ones((8, 3)), 0, []),
+        "no iteration finished, 6 facets": al.IterResult(
+            fl.G0, fl.G0, np.inf, 0, False, timed_out=True
+        ),
+        "last ε ≈ 0.97 > λ = 0.9604 with 6 facets": al.IterResult(
+            fl.G0, fl.G0, 0.97, 3, False, timed_out=True
+        ),
+    }
+    for said, r in ends.items():
+        with pytest.raises(SolverError, match=r"within \d+ s .* iterations: .*") as e:
+            _budget(r, sp.options, run)
+        assert said in e.value.message, e.value.message

@@ -104,26 +104,78 @@ class _QhullFailed(Exception):
     """qhull failed with and without joggled input (message: qhull's)."""
 
 
-def _qhull(points: np.ndarray) -> ConvexHull:
+#: inputs of at least this many coordinates (points × dimension) run qhull in a helper thread
+#: (:func:`_qhull`); below it qhull takes about a millisecond and a thread would cost a tenth
+THREAD_MIN_COORDS = 1000
+#: seconds between two looks at the budget and the signals while qhull runs in its thread
+POLL_S = 0.05
+
+
+def _qhull(points: np.ndarray, check: Callable[[], None] | None = None) -> ConvexHull:
     """qhull with default options, then with joggled input if the default run fails
-    (raises :class:`_QhullFailed` when both fail). scipy.spatial is imported here."""
+    (raises :class:`_QhullFailed` when both fail). scipy.spatial is imported here.
+
+    An input of :data:`THREAD_MIN_COORDS` coordinates or more runs in a daemon thread while
+    this thread waits in slices of :data:`POLL_S` s and calls ``check()`` between them (a
+    time budget may raise): qhull releases the GIL but cannot be stopped, and inline it held
+    the caller for its whole run — a 9-state set-invariant design with ``time_limit = 10``
+    ran 132 s, 83 of them in one qhull call, and ignored SIGTERM meanwhile (Python runs
+    signal handlers between bytecodes of the main thread; re-check review 46). On a timeout
+    or a stop the thread is abandoned: it finishes in the background (a CLI run exits
+    without waiting for it; an API caller's process keeps one core busy until it ends)."""
     from scipy.spatial import ConvexHull, QhullError
 
-    try:
-        return ConvexHull(points)
-    except QhullError:
+    def run() -> ConvexHull:
         try:
-            return ConvexHull(points, qhull_options="QJ")
-        except QhullError as exc:
-            raise _QhullFailed(str(exc)) from exc
+            return ConvexHull(points)
+        except QhullError:
+            try:
+                return ConvexHull(points, qhull_options="QJ")
+            except QhullError as exc:
+                raise _QhullFailed(str(exc)) from exc
+
+    if np.size(points) < THREAD_MIN_COORDS:
+        return run()
+    return _in_thread(run, check)
 
 
-def _rhs1_hull(P: np.ndarray, failed: str, origin: str) -> tuple[ConvexHull, np.ndarray]:
+def _in_thread(fn: Callable[[], Any], check: Callable[[], None] | None) -> Any:
+    """``fn()`` run in a daemon thread; this thread waits for it in slices of
+    :data:`POLL_S` s, calling ``check()`` between slices (what it raises is raised here,
+    the thread abandoned); signal handlers run during the waits. ``fn``'s exception is
+    re-raised here."""
+    import threading
+
+    box: dict[str, Any] = {}
+
+    def target() -> None:
+        try:
+            box["value"] = fn()
+        except BaseException as exc:  # handed to the waiting thread
+            box["error"] = exc
+
+    th = threading.Thread(target=target, name="obsdesign-qhull", daemon=True)
+    th.start()
+    while True:
+        th.join(POLL_S)
+        if not th.is_alive():
+            break
+        if check is not None:
+            check()
+    if "error" in box:
+        raise box["error"]
+    return box["value"]
+
+
+def _rhs1_hull(
+    P: np.ndarray, failed: str, origin: str, check: Callable[[], None] | None = None
+) -> tuple[ConvexHull, np.ndarray]:
     """qhull of ``P`` and its facets as rows ``a`` with ``a·x = 1`` (which needs the origin
     strictly inside). PolytopeError ``failed`` (with qhull's message) when qhull fails,
-    ``origin`` when a facet passes through or beyond the origin."""
+    ``origin`` when a facet passes through or beyond the origin. ``check``: see
+    :func:`_qhull`."""
     try:
-        h = _qhull(P)
+        h = _qhull(P, check)
     except _QhullFailed as exc:
         raise PolytopeError(f"{failed} ({exc})") from exc
     eq = h.equations
@@ -167,15 +219,31 @@ def outward_fix(
     return G / m[:, None]
 
 
-def _edges_from_simplices(simplices: np.ndarray, remap: np.ndarray) -> np.ndarray:
-    """All pairs of vertices that share a simplex of the triangulation (vectorized);
-    ``remap`` maps point indices to vertex indices (-1 for non-vertices)."""
-    S = remap[np.asarray(simplices, dtype=int)]
-    k = S.shape[1]
-    pairs = [np.sort(S[:, [a, b]], axis=1) for a in range(k) for b in range(a + 1, k)]
-    E = np.vstack(pairs) if pairs else np.zeros((0, 2), dtype=int)
-    E = E[(E[:, 0] >= 0) & (E[:, 0] != E[:, 1])]
-    return np.unique(E, axis=0) if len(E) else E.reshape(0, 2)
+def _edges_from_simplices(
+    simplices: np.ndarray, remap: np.ndarray, check: Callable[[], None] | None = None
+) -> np.ndarray:
+    """All pairs of vertices that share a simplex of the triangulation (vectorized), sorted;
+    ``remap`` maps point indices to vertex indices (-1 for non-vertices). Each pair is one
+    int64 key ``a·m + b`` (a 1-D sort: ``np.unique(axis=0)`` on the pairs took 48 s for the
+    26 million pairs of a triangulated 9-cube), made in blocks of :data:`BLOCK_ENTRIES`
+    pairs with ``check()`` between blocks (a time budget may raise)."""
+    S = remap[np.asarray(simplices, dtype=np.int64)]
+    k = S.shape[1] if S.ndim == 2 else 0
+    m = np.int64(max(1, int(remap.max(initial=-1)) + 1))
+    step = max(1, BLOCK_ENTRIES // max(1, k * (k - 1) // 2))
+    keys: list[np.ndarray] = []
+    for s in range(0, len(S), step):
+        if check is not None:
+            check()
+        B = S[s : s + step]
+        for a in range(k):
+            for b in range(a + 1, k):
+                lo, hi = np.minimum(B[:, a], B[:, b]), np.maximum(B[:, a], B[:, b])
+                ok = (lo >= 0) & (lo != hi)
+                keys.append(np.unique(lo[ok] * m + hi[ok]))
+        keys = [np.unique(np.concatenate(keys))]
+    K = np.unique(np.concatenate(keys)) if keys else np.zeros(0, dtype=np.int64)
+    return np.stack([K // m, K % m], axis=1).astype(int)
 
 
 def hull(
@@ -185,7 +253,8 @@ def hull(
 
     Returns the extreme points, the triangulation edges (a superset of the edges) and the
     canonical, outward-fixed H-form (one row per facet, right-hand side 1). ``check()`` runs
-    before qhull and between the blocks of :func:`outward_fix` (a time budget may raise).
+    before qhull, while a large qhull run waits (:func:`_qhull`) and between the blocks of
+    the edges and of :func:`outward_fix` (a time budget may raise).
     """
     P = np.asarray(points, dtype=float)
     n = P.shape[1]
@@ -197,12 +266,16 @@ def hull(
     if check is not None:
         check()
     h, rows = _rhs1_hull(
-        P, "the points are not full-dimensional", "the origin is not interior to the hull"
+        P, "the points are not full-dimensional", "the origin is not interior to the hull", check
     )
     remap = np.full(len(P), -1, dtype=int)
     remap[h.vertices] = np.arange(len(h.vertices))
     V = P[h.vertices]
-    edges = _edges_from_simplices(h.simplices, remap) if with_edges else np.zeros((0, 2), dtype=int)
+    edges = (
+        _edges_from_simplices(h.simplices, remap, check)
+        if with_edges
+        else np.zeros((0, 2), dtype=int)
+    )
     G, _ = merge_rows(rows)
     return HullState(V, edges, outward_fix(G, P, check))
 

@@ -180,10 +180,15 @@ def _budget(r: al.IterResult, o: Options, run: _Run) -> None:
             f"({eps_vs_lam('last ε', r.eps, o.lam)}); stopped there, not converged"
         )
     if r.timed_out:
-        last = eps_vs_lam("last ε", r.eps, o.lam) if np.isfinite(r.eps) else "no iteration finished"
+        if not len(r.G):  # stopped in its first hull (algorithms._unfinished)
+            last = f"the first hull of {len(r.P)} points did not finish"
+        elif np.isfinite(r.eps):
+            last = eps_vs_lam("last ε", r.eps, o.lam) + f" with {len(r.G)} facets"
+        else:
+            last = f"no iteration finished, {len(r.G)} facets"
         raise SolverError(
             f"not converged within {o.time_limit:g} s ([method] time_limit) / {r.iterations} "
-            f"iterations: {last} with {len(r.G)} facets (raise time_limit, or a larger λ or Δδ)"
+            f"iterations: {last} (raise time_limit, or a larger λ or Δδ)"
         )
 
 
