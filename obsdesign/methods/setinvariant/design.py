@@ -192,6 +192,88 @@ def _budget(r: al.IterResult, o: Options, run: _Run) -> None:
         )
 
 
+def _strict_retries(
+    run: _Run,
+    data: Data,
+    single: bool,
+    lam: float,
+    dd: float,
+    dl: float,
+    o: Options,
+    progress: Progress | None,
+) -> None:
+    """The strict continuation: up to three runs of the general algorithm scaled by
+    λ/(1 + margin) from the last polyhedron, the margin at least twice the last
+    float-vs-exact gap (one try judged by the float LP (9) alone ended "converged" with the
+    exact factor 2·10⁻⁸ above λ = 1 at delta_tol = 1e-9, below what the LP resolves: census
+    46). The first retry that converges with its factor certified ≤ λ is reported. Otherwise
+    the finished polyhedron with the lowest certified factor stands, with its iteration count
+    and history: a retry that ran out of the time budget, failed in a solver or a hull,
+    reached ``max_iterations`` or diverged is dropped with a note saying which (a retry's
+    timeout replaced an exit-1 report by exit 3 with no polyhedron, and a retry's unfinished
+    exact check did so still, with its history and a "diverges" note left in the report:
+    re-check reviews 46, 47)."""
+    fl, hist = data.fl, run.history
+    best = (run.stage, run.iterations, run.converged, len(hist))
+    margin = dd
+    for tries_left in (2, 1, 0):
+        V0 = po.qfloat(run.stage.vrep.V) if data.ex is not None else run.stage.vrep.V
+        try:
+            r = al.general(
+                fl, lam / (1 + margin), lam * (1 - 1e-12), o.max_iterations, o.mirror,
+                start=V0, progress=progress, it0=run.iterations, history=hist, deadline=dl,
+            )  # fmt: skip
+            _budget(r, o, _Run(run.stage, run.iterations, run.converged))  # raises past dl
+            if not r.converged:
+                how = (
+                    "diverges" + (f" ({r.why})" if r.why else "")
+                    if r.diverged
+                    else f"reached its max_iterations = {o.max_iterations}"
+                )
+                run.notes.append(
+                    f"the strict retry {how} after {r.iterations} iterations in all, not "
+                    "converged: the best polyhedron before it is reported"
+                )
+                break
+            stage = final_stage(data, r.P, single, lam, dl, o)
+        except (SolverError, InfeasibleError) as e:
+            run.notes.append(
+                f"the strict retry stopped ({e.message}): the best polyhedron before it is "
+                "reported"
+            )
+            break
+        except po.PolytopeError as e:
+            run.notes.append(
+                f"the strict retry stopped (a float polytope computation failed: {e}): the "
+                "best polyhedron before it is reported"
+            )
+            break
+        run.iterations, run.converged, run.stage = r.iterations, r.converged, stage
+        res = stage.res
+        if res is not None and res.ok:
+            return
+        if res is None:  # no exact result (cannot happen with the exact data that started it)
+            break
+        if res.factor < best[0].res.factor:
+            best = (run.stage, run.iterations, run.converged, len(hist))
+        if not tries_left:
+            break
+        gap = float(res.factor) / float(lam) - 1
+        margin = max(2 * margin, 2 * gap)
+        run.notes.append(
+            f"the exact factor {float(res.factor):.12g} is still above λ (by {gap:.3g} "
+            f"relative, more than delta_tol = {dd:g}: the float LP's accuracy): iterating "
+            f"again with the margin {margin:.3g}"
+        )
+    if best[0] is not run.stage:
+        run.notes.append(
+            "the strict retries did not certify λ: the polyhedron with the lowest certified "
+            "factor is reported"
+        )
+    run.stage, run.iterations, run.converged, kept = best
+    del hist[kept:]  # the dropped retries' iterations
+
+
 def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
     """The algorithm of the spec: symmetric C_K^∞ (Section VI; condition (14)), general
     (Section V; stopping rule ε^i ≤ λ(1 + Δδ)) or none (Ω itself); the symmetric-to-general
@@ -278,47 +360,7 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
                 # the best finished polyhedron stands when a retry runs out of the time budget
                 # or ends worse: a retry's timeout replaced an exit-1 report by exit 3 with no
                 # polyhedron (re-check review 46)
-                best = (run.stage, run.iterations, run.converged)
-                margin = dd
-                for tries_left in (2, 1, 0):
-                    V0 = po.qfloat(run.stage.vrep.V) if data.ex is not None else run.stage.vrep.V
-                    try:
-                        r = al.general(
-                            fl, lam / (1 + margin), lam * (1 - 1e-12), o.max_iterations,
-                            o.mirror, start=V0, progress=progress, it0=run.iterations,
-                            history=hist, deadline=dl,
-                        )  # fmt: skip
-                        _budget(r, o, run)
-                        stage = _final_of(r, data, single, lam, dl, o)
-                    except SolverError:
-                        run.notes.append(
-                            "the strict retry ran out of the time budget ([method] time_limit):"
-                            " the best polyhedron before it is reported"
-                        )
-                        break
-                    run.iterations, run.converged, run.stage = r.iterations, r.converged, stage
-                    res = stage.res
-                    if not run.converged or res is None or res.ok:
-                        break
-                    if res.factor < best[0].res.factor:
-                        best = (run.stage, run.iterations, run.converged)
-                    if not tries_left:
-                        break
-                    gap = float(res.factor) / float(lam) - 1
-                    margin = max(2 * margin, 2 * gap)
-                    run.notes.append(
-                        f"the exact factor {float(res.factor):.12g} is still above λ (by "
-                        f"{gap:.3g} relative, more than delta_tol = {dd:g}: the float LP's "
-                        f"accuracy): iterating again with the margin {margin:.3g}"
-                    )
-                res = run.stage.res
-                if res is None or not (run.converged and res.ok):
-                    if best[0] is not run.stage:
-                        run.notes.append(
-                            "the strict retries did not certify λ: the polyhedron with the "
-                            "lowest certified factor is reported"
-                        )
-                    run.stage, run.iterations, run.converged = best
+                _strict_retries(run, data, single, lam, dd, dl, o, progress)
     return run
 
 
