@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import math
 import numbers
@@ -2244,8 +2245,9 @@ def plot_design(
     """The method's design plot of ``spec`` with ``params`` (a report's parameters), written
     to ``path`` (InputError when the method has none): atomically (temp file and rename,
     :func:`obsdesign.report.model.write_via`), or with ``atomic=False`` straight into
-    ``path`` (for a caller that made it a temp file, FIFO or device itself). ``force``: as
-    ``--force`` of ``--plot`` (a write-protected file or a link replaced)."""
+    ``path`` (for a caller that made it a temp file, FIFO or device itself: a path without
+    a suffix gets PNG; a file this call created is removed when the write fails). ``force``:
+    as ``--force`` of ``--plot`` (a write-protected file or a link replaced)."""
     sp = _spec(spec)
     if not isinstance(params, Parameters):  # a plain dict was a bare AttributeError (45)
         raise InputError(
@@ -2366,20 +2368,37 @@ def _plot_to(
         # re-check reviews 46)
         if not os.fspath(_path_arg(path, "plot path")):
             raise InputError("plot path: an empty path (an unset variable?)")
-        if Path(path).is_dir():
-            raise InputError(f"{path}: is a directory")
         from obsdesign.formats import PLOT_SUFFIXES
 
         p = Path(path)
-        if p.suffix.lower() not in PLOT_SUFFIXES:  # matplotlib's bare ValueError (re-check 46)
+        try:
+            if p.is_dir():
+                raise InputError(f"{path}: is a directory")
+            existed = p.exists() or p.is_symlink()
+        except OSError as e:  # a name too long: a bare OSError (re-check review 47)
+            raise InputError(f"{p}: cannot write ({e.strerror or e})") from None
+        # a present suffix must be a plot format (matplotlib's bare ValueError: re-check 46);
+        # none is matplotlib's default, PNG: mkstemp names and devices have none, and they are
+        # what atomic=False is for (refused for a while: re-check review 47)
+        if p.suffix and p.suffix.lower() not in PLOT_SUFFIXES:
             raise InputError(
-                f"{p}: unknown plot format {p.suffix or '(no suffix)'!r} "
-                f"(expected one of {', '.join(PLOT_SUFFIXES)})"
+                f"{p}: unknown plot format {p.suffix!r} (expected one of "
+                f"{', '.join(PLOT_SUFFIXES)}, or no suffix for PNG)"
             )
         try:
             return draw(p)
-        except OSError as e:  # a missing folder, /proc: a bare FileNotFoundError (re-check 46)
-            raise InputError(f"{p}: cannot write ({e.strerror or e})") from None
+        except BaseException as e:
+            # a file this call made is not left half-written (a write that failed part-way
+            # left 20,000 bytes: re-check review 47); one the caller made is theirs to drop
+            partial = ""
+            if not existed and p.is_file() and not p.is_symlink():
+                with contextlib.suppress(OSError):
+                    p.unlink()
+            elif p.is_file():
+                partial = "; the file may hold part of a plot"
+            if isinstance(e, OSError):  # a missing folder, /proc: a bare FileNotFoundError
+                raise InputError(f"{p}: cannot write ({e.strerror or e}){partial}") from None
+            raise
     from obsdesign.report.model import write_via
 
     return write_via(check_plot_path(path, force), draw, force)

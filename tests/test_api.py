@@ -91,3 +91,36 @@ def test_check_rows_give_seconds_to_a_tenth_of_a_millisecond() -> None:
     row = api.check(SPEC)[0]
     assert row.seconds == round(row.seconds, 4)
     assert api.CheckRow("s", "m", 0, 0, 0, 0, "", 0.000980008000624366).seconds == 0.001
+
+
+def test_unchecked_plots_write_temp_names_and_devices_and_leave_no_part(tmp_path: Path) -> None:
+    """atomic=False is for a path the caller made (a mkstemp name, a device): those have no
+    suffix and were refused as "unknown plot format '(no suffix)'"; a name too long was a
+    bare OSError; a write that failed part-way left a half-written file (re-check review
+    47). No suffix writes PNG; a file the call made is removed on failure."""
+    import errno
+    import os
+    import tempfile
+
+    res = api.simulate(SPEC)
+    fd, tmp = tempfile.mkstemp(dir=tmp_path)
+    os.close(fd)
+    api.plot_simulation(SPEC, res, tmp, atomic=False)
+    assert Path(tmp).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    api.plot_simulation(SPEC, res, os.devnull, atomic=False)
+    with pytest.raises(InputError, match="cannot write"):
+        api.plot_simulation(SPEC, res, tmp_path / ("n" * 300 + ".png"), atomic=False)
+    with pytest.raises(InputError, match=r"unknown plot format '\.gif'"):
+        api.plot_simulation(SPEC, res, tmp_path / "x.gif", atomic=False)
+
+    def half(p: Path) -> None:  # a disk that fills up part-way
+        p.write_bytes(b"\x89PNG" + b"0" * 100)
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    new = tmp_path / "new.png"
+    with pytest.raises(InputError, match="No space left on device"):
+        api._plot_to(new, half, atomic=False)
+    assert not new.exists()
+    with pytest.raises(InputError, match="the file may hold part of a plot"):
+        api._plot_to(tmp, half, atomic=False)  # the caller's own file stays
+    assert Path(tmp).exists()

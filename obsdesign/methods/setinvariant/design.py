@@ -238,8 +238,7 @@ def _strict_retries(
             stage = final_stage(data, r.P, single, lam, dl, o)
         except (SolverError, InfeasibleError) as e:
             run.notes.append(
-                f"the strict retry stopped ({e.message}): the best polyhedron before it is "
-                "reported"
+                f"the strict retry stopped ({e.message}): the best polyhedron before it is reported"
             )
             break
         except po.PolytopeError as e:
