@@ -442,14 +442,14 @@ def _main(
     _state["debug"] = debug
     if limit:
         from obsdesign.errors import ObsdesignError
-        from obsdesign.limits import parse_limit, restore, saved, set_limits
+        from obsdesign.limits import parse_limits, restore, saved, set_limits
 
         # for this command only: in one process (CliRunner, an embedding program) the next
         # command ran under them (a test's max_file_bytes failed 46 later tests; session 32)
         before = saved()
         ctx.call_on_close(lambda: restore(before))
         try:
-            set_limits(**dict(parse_limit(x) for x in limit))
+            set_limits(**parse_limits(limit))
         except ObsdesignError as e:
             _err(e.message)
             raise typer.Exit(e.exit_code) from None

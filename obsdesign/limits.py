@@ -255,6 +255,19 @@ def parse_limit(text: str) -> tuple[str, int]:
     return k, int(num) * mult
 
 
+def parse_limits(texts: list[str]) -> dict[str, int]:
+    """Every ``--limit KEY=VALUE`` of a command (:func:`parse_limit` each); a key given twice
+    is an InputError, as for ``--option`` and ``--set`` (the last one was used without a
+    word: re-check review 47)."""
+    out: dict[str, int] = {}
+    for text in texts:
+        k, v = parse_limit(text)
+        if k in out:
+            raise InputError(f"--limit {k} is given twice ({out[k]}, {v}): give it once")
+        out[k] = v
+    return out
+
+
 # -- files ----------------------------------------------------------------------------------
 def read_input(path: str | Path, what: str) -> bytes:
     """The bytes of an input file: a regular file (symlinks followed) of at most

@@ -177,6 +177,13 @@ def test_limits_are_overridable(tmp_path: Path):
     assert res.exit_code == 2 and "unknown limit" in res.output
     res = runner.invoke(app, ["--limit", "max_digits=-3", "design", str(spec)])
     assert res.exit_code == 2 and "positive integer" in res.output
+    # one key twice: the last one was used without a word (re-check review 47)
+    twice = ["--limit", "max_digits=3000", "--limit", "max_digits=3", "design", str(spec)]
+    res = runner.invoke(app, twice)
+    assert res.exit_code == 2, res.output
+    assert "--limit max_digits is given twice (3000, 3): give it once" in res.output
+    both = ["--limit", "max_digits=3000", "--limit", "max_depth=50", "design", str(spec)]
+    assert runner.invoke(app, both).exit_code != 2  # two keys: both set
 
 
 @pytest.mark.parametrize("key", ["max_digits", "max_exponent", "max_depth", "max_expr_depth"])
