@@ -766,17 +766,25 @@ def _named_file_differs(spec_file: str, sha: str) -> str | None:
     have = hashlib.sha256(raw).hexdigest()
     if have == sha:
         return None
-    # a name with bytes that are not UTF-8 is shown with \xNN, which a shell does not read
-    # back as the byte (re-check review 46)
-    odd = (
-        " (its name holds bytes that are not UTF-8, written \\xNN here)"
-        if p.name != Path(spec_file).name
-        else ""
-    )
+    # the command quoted for a shell (a space split it in two, an apostrophe left a quote
+    # open, "$(…)" ran when pasted, and the name comes from the report, which may be anyone's:
+    # re-check review 47); a path with bytes that are not UTF-8 (in any part: the folder's
+    # were missed, re-check review 47) is shown with \xNN, which bash reads back as the bytes
+    # inside $'…' (re-check review 46)
+    if str(p) != spec_file:
+        arg = "$'" + spec_file.replace("'", "\\'") + "'"
+        odd = (
+            " (its path holds bytes that are not UTF-8, written \\xNN here: bash reads them "
+            "back inside $'…')"
+        )
+    else:
+        import shlex
+
+        arg, odd = shlex.quote(spec_file), ""
     return (
         f"the spec embedded in the report was verified, not the file {spec_file}: that file "
         f"differs from it (sha256 {have[:12]}… here, {sha[:12]}… embedded); "
-        f"'obsdesign verify REPORT --spec {spec_file}' checks the report against the file{odd}"
+        f'"obsdesign verify REPORT --spec {arg}" checks the report against the file{odd}'
     )
 
 

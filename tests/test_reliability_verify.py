@@ -233,7 +233,7 @@ def test_a_spec_file_that_differs_from_the_embedded_spec_is_named(tmp_path: Path
     assert moved(out) == []
     spec.write_text(SPEC.read_text(encoding="utf-8") + "# edited\n", encoding="utf-8")
     (note,) = moved(out)
-    assert f"not the file {spec}" in note and f"--spec {spec}'" in note
+    assert f"not the file {spec}" in note and f'--spec {spec}" checks' in note
     assert api.verify(out).exit_code() == 0  # a note, not a verdict
     r = CliRunner().invoke(app, ["verify", str(out)])
     assert r.exit_code == 0 and "differs from it" in r.output
@@ -830,3 +830,34 @@ def test_the_differs_note_finds_a_spec_whose_name_is_not_utf8(tmp_path: Path) ->
         f.write("# edited\n")
     notes = [n for n in api.verify(out).notes if "differs from it" in n]
     assert notes and "holds bytes that are not UTF-8" in notes[0]
+
+
+@pytest.mark.parametrize(
+    "name",
+    [b"my spec.toml", b"it's.toml", b"$(echo hi).toml", b"d\xff/s.toml", b"e\xfe/'x y.toml"],
+)
+def test_the_differs_note_gives_a_command_a_shell_reads_back(tmp_path: Path, name: bytes) -> None:
+    """The note's "obsdesign verify REPORT --spec FILE" named the file unquoted: a space
+    split it, an apostrophe left a quote open, "$(…)" ran when pasted (the name comes from
+    the report); a folder whose name is not UTF-8 got no hint (re-check review 47). The
+    argument, as bash reads it, is the file's path, byte for byte."""
+    import os
+    import re
+    import shutil
+    import subprocess
+
+    path = tmp_path / os.fsdecode(name)
+    path.parent.mkdir(exist_ok=True)
+    path.write_text(SPEC.read_text(encoding="utf-8"), encoding="utf-8")
+    out = tmp_path / "r.json"
+    api.design(api.load_spec(path), out=out)
+    with open(path, "a", encoding="utf-8") as f:
+        f.write("# edited\n")
+    (note,) = [n for n in api.verify(out).notes if "differs from it" in n]
+    arg = re.search(r'"obsdesign verify REPORT --spec (.*)" checks', note).group(1)
+    assert ("not UTF-8" in note) == (b"\xff" in name or b"\xfe" in name)
+    bash = shutil.which("bash")
+    if bash is None:  # pragma: no cover - Debian has bash
+        pytest.skip("no bash to read the command back")
+    got = subprocess.run([bash, "-c", f"printf %s {arg}"], capture_output=True, check=True)
+    assert got.stdout == os.fsencode(path)
