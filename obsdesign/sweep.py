@@ -330,7 +330,18 @@ def set_key(text: str, key: str, literal: str, file: str = "<spec>") -> str:
     from a lexer (:mod:`obsdesign.spec.tomltext`); the result is parsed and compared with
     the original: exactly that key changed, or :class:`InputError`."""
     parts = tuple(key.split("."))
+    original = text
     stmts = tomltext.statements(text)
+    aot = next((s.key for s in stmts if s.kind == "aot" and s.key == parts[: len(s.key)]), None)
+    if aot is not None:  # [[simulate.noise.windows]] (re-check review 47)
+        if len(aot) < len(parts):
+            whole = ".".join(aot)
+            raise InputError(
+                f"{file}: cannot set {key}: [[{whole}]] is an array of tables: --set replaces "
+                f"it whole, e.g. --set '{whole}=[{{ ... }}, ...]'"
+            )
+        text = _without_aot(text, stmts, aot)
+        stmts = tomltext.statements(text)
     owner = _tables(stmts)
     new_text = None
     for j in range(len(parts) - 1, -1, -1):  # the value: [a.b] c = ..., [a] b.c = ..., a.b.c
@@ -355,8 +366,31 @@ def set_key(text: str, key: str, literal: str, file: str = "<spec>") -> str:
             break
     if new_text is None:
         new_text = f"{'.'.join(parts)} = {literal}\n" + text
-    _check_edit(text, new_text, list(parts), literal, file)
+    _check_edit(original, new_text, list(parts), literal, file)
     return new_text
+
+
+def _without_aot(text: str, stmts: list[tomltext.Statement], key: tuple[str, ...]) -> str:
+    """``text`` without the array of tables ``[[key]]``: each ``[[key]]`` header through the
+    statements and sub-tables (``[key.sub]``) that follow it, up to the next header outside
+    ``key``. ``--set key=[...]`` then adds the key as an inline array (``windows`` written as
+    ``[[simulate.noise.windows]]`` was refused with the advice to write an inline table as a
+    [table]; re-check review 47)."""
+    cut: list[tuple[int, int]] = []
+    at: int | None = None
+    for s in stmts:
+        if s.kind in ("table", "aot"):
+            inside = s.key is not None and s.key[: len(key)] == key
+            if at is not None and not inside:
+                cut.append((at, s.start))
+                at = None
+            if at is None and s.kind == "aot" and s.key == key:
+                at = s.start
+    if at is not None:
+        cut.append((at, len(text)))
+    for a, b in reversed(cut):
+        text = text[:a] + text[b:]
+    return text
 
 
 def _check_edit(old: str, new: str, parts: list[str], literal: str, file: str) -> None:

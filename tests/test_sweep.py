@@ -1072,3 +1072,48 @@ def test_set_of_a_table_or_into_an_array_says_so_without_tomllib_positions() -> 
     assert "at line" not in str(e.value) and "at line" not in str(e2.value)
     with pytest.raises(InputError, match=r"\[method.lambda\] is a value, not a table"):
         sw.plan(SPEC, ["method.lambda.x=1"])
+
+
+AOT = """[simulate.noise]  # the output disturbance
+kind = "windows"
+
+[[simulate.noise.windows]]
+start = 151
+stop = 153
+value = [3]
+
+[simulate.noise.windows.sub]
+x = 1
+
+[[simulate.noise.windows]]
+start = 160
+stop = 161
+value = [1]
+
+[method]
+key = "lyapunov"
+"""
+
+
+def test_set_key_replaces_an_array_of_tables_whole() -> None:
+    """windows written as [[simulate.noise.windows]] (the spec loader takes it) could not be
+    swept: "an inline table holds it: write it as a [table]", wrong advice, and a key under
+    it said tomllib's bare "Cannot overwrite a value" (re-check review 47). The whole key
+    replaces every [[...]] block and its sub-tables; a key under it names the array."""
+    new = sw.set_key(AOT, "simulate.noise.windows", "[{ start = 1, stop = 2, value = [3] }]")
+    got = tomllib.loads(new)
+    assert got["simulate"]["noise"] == {
+        "kind": "windows",
+        "windows": [{"start": 1, "stop": 2, "value": [3]}],
+    }
+    assert got["method"] == {"key": "lyapunov"} and "[[" not in new
+    for sub in ("simulate.noise.windows.0.start", "simulate.noise.windows.sub.x"):
+        with pytest.raises(InputError, match=r"\[\[simulate\.noise\.windows\]\] is an array of"):
+            sw.set_key(AOT, sub, "3")
+    # the table that holds it, and a sibling key, are edited as before
+    assert (
+        tomllib.loads(sw.set_key(AOT, "simulate.noise.kind", '"none"'))["simulate"]["noise"][
+            "windows"
+        ][1]["start"]
+        == 160
+    )
