@@ -273,7 +273,7 @@ def test_time_budget_stops_a_long_exact_hull(monkeypatch):
     """Issue 12 item 2: a budget of 1 s on an exact hull that cdd.gmp needs a minute for
     (150 points on the 4-sphere, the incidence proof switched off) is refused within the
     budget plus the child's start and kill."""
-    monkeypatch.setattr(po, "_float_facets", lambda P: None)
+    monkeypatch.setattr(po, "_float_facets", lambda P, check=None: None)
     P = _sphere4(150)
     t0 = time.perf_counter()
     with pytest.raises(po.HullTimeout):
@@ -729,3 +729,14 @@ def test_a_long_qhull_run_sees_the_budget_and_is_left_behind(monkeypatch) -> Non
     monkeypatch.setattr(scipy.spatial, "ConvexHull", fails)
     with pytest.raises(po._QhullFailed, match="QH6154"):  # qhull's error comes back
         po._qhull(big, check=lambda: None)
+
+
+def test_the_exact_hulls_float_facets_look_at_the_budget() -> None:
+    """The float hull's facets made exact (one exact solve per simplex of qhull's
+    triangulation: ~10⁵ for a 9-cube) ran with no look at the deadline: a past deadline
+    still gave the hull (session 47). Now HullTimeout, and with no deadline the hull."""
+    P = _sphere4(60)
+    with pytest.raises(po.HullTimeout):
+        po.exact_hull(P, deadline=time.perf_counter() - 1.0)
+    G, vrep = po.exact_hull(P)
+    assert len(vrep.V) == 60 and len(G) > 60

@@ -213,7 +213,7 @@ def test_time_budget_stops_the_exact_hull_of_the_final_stage(monkeypatch):
     )
     S = np.random.default_rng(7).normal(size=(150, 4))
     P = 3 * S / np.linalg.norm(S, axis=1)[:, None]
-    monkeypatch.setattr(po, "_float_facets", lambda P: None)
+    monkeypatch.setattr(po, "_float_facets", lambda P, check=None: None)
     t0 = time.perf_counter()
     with pytest.raises(
         SolverError, match=r"exact certificate not finished within 1 s .*exact hull"

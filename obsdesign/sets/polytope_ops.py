@@ -800,27 +800,39 @@ def _cdd_hull_bounded(
     return Gq, idx, [tuple(e) for e in edges]
 
 
-def _float_facets(P: np.ndarray) -> np.ndarray | None:
+def _float_facets(P: np.ndarray, check: Callable[[], None] | None = None) -> np.ndarray | None:
     """Exact candidate facet rows of ``conv(P)`` from the float hull (qhull): the exact
     hyperplane ``a·p = 1`` through the n points of each simplex of qhull's triangulated
     boundary, duplicates merged, sorted (canonical). None when qhull fails. The rows are
-    only candidates: :func:`hull_certificate` decides."""
+    only candidates: :func:`hull_certificate` decides. ``check()`` runs while qhull runs
+    (:func:`_qhull`) and every 256 simplices (a time budget may raise: a triangulated
+    9-cube has ~10⁵ simplices, one exact solve each)."""
     from flint import fmpq_mat
 
     n = P.shape[1]
     try:
-        h = _qhull(qfloat(P))
+        h = _qhull(qfloat(P), check)
     except _QhullFailed:
         return None
     rows: dict[tuple, list[fmpq]] = {}
     one = fmpq_mat(n, 1, [1] * n)
-    for s in np.asarray(h.simplices, dtype=int):
+    for i, s in enumerate(np.asarray(h.simplices, dtype=int)):
+        if check is not None and not i % 256:
+            check()
         try:
             a = fmpq_mat([list(P[j]) for j in s]).solve(one).entries()
         except ZeroDivisionError:  # a flat simplex (joggled or coplanar input)
             continue
         rows.setdefault(tuple((x.p, x.q) for x in a), a)  # (fmpq hashes slowly)
     return np.array(sorted(rows.values()), dtype=object).reshape(len(rows), n)
+
+
+def _past(deadline: float) -> None:
+    """:class:`HullTimeout` past ``deadline`` (a ``time.perf_counter()`` value)."""
+    import time
+
+    if time.perf_counter() > deadline:
+        raise HullTimeout(0.0)
 
 
 def exact_hull(P: np.ndarray, deadline: float | None = None) -> tuple[np.ndarray, ExactVRep]:
@@ -835,11 +847,11 @@ def exact_hull(P: np.ndarray, deadline: float | None = None) -> tuple[np.ndarray
     rounded from floats would split them into clusters.
 
     ``deadline``: a ``time.perf_counter()`` value; with it, a cdd.gmp run on more than
-    :data:`CHILD_MIN_POINTS` points runs in a child process killed at the deadline
-    (:class:`HullTimeout`)."""
+    :data:`CHILD_MIN_POINTS` points runs in a child process killed at the deadline, and the
+    float hull's qhull run and exact facets look at it (:class:`HullTimeout`)."""
     P = distinct_rows(np.asarray(P, dtype=object))
     n = P.shape[1]
-    G = _float_facets(P) if n >= 2 else None
+    G = _float_facets(P, None if deadline is None else lambda: _past(deadline)) if n >= 2 else None
     if G is not None and len(G):
         cert = hull_certificate(G, P)
         if isinstance(cert, str):  # qhull merged near-coplanar points: repair, then decide
