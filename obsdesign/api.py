@@ -393,6 +393,7 @@ def design(
             "certify_s": round(t3 - t2, 4),
         },
         notes=[*d.notes, *notes],
+        read_limits=sp.read_limits,
     )
     report.verdict = report.computed_verdict()
     if out is not None:
@@ -492,6 +493,7 @@ def error_report(sp: Spec, code: int, message: str, candidate: Any = None) -> Re
         notes=notes,
         verdict="error",
         error={"exit_code": code, "message": message},
+        read_limits=sp.read_limits,
     )
 
 
@@ -628,7 +630,8 @@ def verify(report: str | Path | Report, spec: str | Path | None = None) -> Repor
     if rep.method not in method_keys():
         raise InputError(f"{named}: unknown method '{rep.method}'")
     try:
-        sp = load_spec_text(text, file)
+        with _read_limits_of(rep if spec is None else None):
+            sp = load_spec_text(text, file)
     except SpecError as e:
         if spec is not None or not isinstance(report, (str, Path)):
             raise
@@ -1999,7 +2002,22 @@ def object_report(report: Report) -> tuple[Report, list[str]]:
         d["parameters"] = report.raw_parameters  # as read: floats compared bit for bit
     rep, problems = _from_memory(d)
     rep.extra_keys = list(report.extra_keys)
+    rep.read_limits = report.read_limits
     return rep, problems
+
+
+def _read_limits_of(rep: Report | None) -> contextlib.AbstractContextManager[None]:
+    """The input limits raised (this thread only) to those ``rep``'s spec was read under, for
+    re-reading its embedded spec (``Report.read_limits``: a report object this process
+    designed); no change for a report read from a file or None."""
+    from dataclasses import fields
+
+    from obsdesign.limits import Limits, raised
+
+    lim = None if rep is None else rep.read_limits
+    if not isinstance(lim, Limits):
+        return contextlib.nullcontext()
+    return raised(**{f.name: getattr(lim, f.name) for f in fields(Limits)})
 
 
 def _from_memory(d: dict[str, Any]) -> tuple[Report, list[str]]:
@@ -2029,7 +2047,9 @@ def verify_own(rep: Report) -> Report:
     would carry it), with ``max_digits`` raised to its own exact values (:func:`_from_memory`).
 
     :param rep: a report :func:`design` returned in this process."""
-    return verify(_from_memory(rep.to_dict())[0])
+    own = _from_memory(rep.to_dict())[0]
+    own.read_limits = rep.read_limits
+    return verify(own)
 
 
 def _check_one(path: Path, t0: float, seen: list[str]) -> CheckRow:

@@ -124,3 +124,38 @@ def test_unchecked_plots_write_temp_names_and_devices_and_leave_no_part(tmp_path
     with pytest.raises(InputError, match="the file may hold part of a plot"):
         api._plot_to(tmp, half, atomic=False)  # the caller's own file stays
     assert Path(tmp).exists()
+
+
+def test_a_report_object_is_verified_under_the_limits_its_spec_was_read_under() -> None:
+    """A spec read under max_digits = 3000 (a 1404-digit λ), designed after the limits were
+    reset (or in a spawned process), gave design exit 0 and verify exit 2 for the same
+    object: the embedded spec was re-read under the defaults (API review 46). A report
+    object carries the limits its spec was read under (never into its file: a file is read
+    under the limits in force)."""
+    import dataclasses
+    import pickle
+
+    from obsdesign.errors import ObsdesignError, SpecError
+    from obsdesign.limits import limits, reset_limits, set_limits
+    from obsdesign.report.model import Report
+
+    text = SPEC.read_text(encoding="utf-8").replace(
+        "lambda = 0.955", "lambda = 0.955" + "0" * 1400 + "1"
+    )
+    old = set_limits(max_digits=3000)
+    try:
+        sp = api.load_spec_text(text, "long.toml")
+    finally:
+        reset_limits(old)
+    assert limits().max_digits == 1000
+    rep = api.design(sp)
+    assert rep.exit_code() == 0 and api.verify(rep).exit_code() == 0
+    assert api.verify(pickle.loads(pickle.dumps(rep))).exit_code() == 0  # a process's hand-off
+    assert limits().max_digits == 1000  # raised for the call only
+    with pytest.raises(ObsdesignError, match="1000"):  # a file: read under today's limits
+        api.verify(Report.from_dict(rep.to_dict())[0])
+    rep.spec_file = "long.toml"  # an object re-read under today's limits: the spec alone
+    bare = dataclasses.replace(rep, read_limits=None)
+    with pytest.raises(SpecError, match="above the limit of 1000"):
+        api.verify(bare)
+    assert "read_limits" not in rep.to_json()

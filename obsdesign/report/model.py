@@ -164,6 +164,10 @@ class Report:
     raw_parameters: dict[str, Any] | None = field(default=None, repr=False)
     #: top-level keys of the JSON that are not report keys (``verify`` notes them)
     extra_keys: list[str] = field(default_factory=list)
+    #: in memory only (never written): the input limits the spec was read under when this
+    #: process designed it (``Spec.read_limits``); ``verify`` of this object re-reads the
+    #: embedded spec with them raised. None for a report read from a file
+    read_limits: Any = field(default=None, repr=False, compare=False)
 
     # -- verdict ----------------------------------------------------------------------------
     @property

@@ -113,6 +113,7 @@ def _spec(data: dict[str, Any], text: str, file: str) -> Spec:
         spec.simulate = _simulate(sim, system)
     root.done()
     spec.origin = spec.read_state()
+    spec.read_limits = limits()
     return spec
 
 

@@ -143,6 +143,12 @@ class Spec:
     bound_options: tuple[Any, list[tuple[str, Any]]] | None = field(
         default=None, repr=False, compare=False
     )
+    #: the input limits (:class:`obsdesign.limits.Limits`) in force when the loader read
+    #: ``text``: ``verify`` of a report object designed from this spec re-reads the embedded
+    #: text with them raised, as the object was accepted under them (a spec read under
+    #: ``max_digits = 3000``, designed after the limits were reset or in a spawned process,
+    #: gave design exit 0 and verify exit 2; API review 46)
+    read_limits: Any = field(default=None, repr=False, compare=False)
 
     def read_state(self) -> tuple[tuple[str, Any], ...]:
         """The fields read from the text, each as an object (compared by identity): what a
