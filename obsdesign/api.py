@@ -1598,11 +1598,19 @@ def _toml_files(root: Path) -> list[Path]:
     An explicit walk with a stack: ``Path.rglob`` recursed once per level, so a folder 1,100
     levels deep stopped ``check`` with exit 3 (RecursionError) and no row at all; and it
     matched a folder named ``v1.toml``, a failed "spec" row in a tree of good specs (sweep,
-    import and check trial, session 28)."""
+    import and check trial, session 28). Each folder's real path is its parent's and its own
+    name (a subfolder walked is never a link): resolving every folder's path again took 22 s,
+    quadratic in the depth, for that folder (session 47)."""
+    from obsdesign.limits import kernel_dir_of_real
+
     found: list[Path] = []
-    stack = [root]
+    try:
+        top = os.path.realpath(root)
+    except OSError:  # a relative path in a removed working folder
+        top = os.path.abspath(root)
+    stack = [(root, top)]
     while stack:
-        d = stack.pop()
+        d, real = stack.pop()
         try:
             with os.scandir(d) as it:
                 entries = list(it)
@@ -1620,8 +1628,9 @@ def _toml_files(root: Path) -> list[Path]:
             if real_dir:
                 # /proc and /sys inside the tree (`check /`): not walked, a row per
                 # unreadable process folder (re-check review, session 42)
-                if not e.name.startswith(".") and not kernel_dir(Path(e.path)):
-                    stack.append(Path(e.path))
+                sub = os.path.join(real, e.name)
+                if not e.name.startswith(".") and not kernel_dir_of_real(sub):
+                    stack.append((Path(e.path), sub))
             elif e.name.endswith(".toml") and not any_dir:
                 found.append(Path(e.path))
     return sorted(found)

@@ -319,6 +319,13 @@ def kernel_dir(p: Path) -> str:
         real = os.path.realpath(p)
     except OSError:  # a relative path in a removed working folder (re-check review, 44)
         real = os.path.abspath(p) if os.path.isabs(p) else str(p)
+    return kernel_dir_of_real(real)
+
+
+def kernel_dir_of_real(real: str) -> str:
+    """The kernel directory (:data:`KERNEL_DIRS`) that the resolved path ``real`` lies in,
+    or "" (:func:`kernel_dir` without the resolving: a folder walk extends its parent's real
+    path by each real subfolder's name instead of resolving every path again)."""
     return next((d for d in KERNEL_DIRS if real == d or real.startswith(d + "/")), "")
 
 

@@ -289,18 +289,27 @@ def test_kernel_interface_files_are_not_read(tmp_path: Path) -> None:
     assert row["message"] == "/proc: is under /proc (the kernel's interface), not a spec file"
     # nor walked inside a tree (`check /` listed a row per unreadable /proc/N folder):
     # a folder resolving into a kernel directory is skipped (faked here for tmp_path/kern)
+    # (the walk extends each folder's real path by its subfolders' names: session 47)
     from obsdesign import api as api_mod
 
     (tmp_path / "tree" / "kern" / "x").mkdir(parents=True)
     (tmp_path / "tree" / "kern" / "x" / "a.toml").write_text(TEXT)
     (tmp_path / "tree" / "b.toml").write_text(TEXT)
-    real = api_mod.kernel_dir
+    real = L.kernel_dir_of_real
+    seen: list[str] = []
+
+    def faked(r: str) -> str:
+        seen.append(r)
+        return "/proc" if os.path.basename(r) == "kern" else real(r)
+
     try:
-        api_mod.kernel_dir = lambda q: "/proc" if Path(q).name == "kern" else real(q)
+        L.kernel_dir_of_real = faked
         found = [f.name for f in api_mod.spec_files(tmp_path / "tree")]
     finally:
-        api_mod.kernel_dir = real
+        L.kernel_dir_of_real = real
     assert found == ["b.toml"]
+    top = os.path.realpath(tmp_path / "tree")  # the tree given, then its one subfolder
+    assert seen == [top, os.path.join(top, "kern")]
     # the report's spec_file: not read, no note, no hang (a subprocess with a timeout: a
     # regression would block on /proc/kmsg itself where it exists)
     import subprocess
