@@ -272,10 +272,20 @@ def pd_int(Pm: fmpq_mat, margin: Any) -> Any:
     constrained-redesign paper, Astolfi et al., NOLCOS 2019: V = eᵀPe positive definite).
 
     :param Pm: P (exact); :param margin: δ ≥ 0 (exact)."""
-    from obsdesign.certify.psd import check_pd_int
+    from obsdesign.certify.psd import (
+        _square_symmetric,
+        check_pd_int,
+        common_denominator,
+        too_costly,
+    )
 
-    Z, D = Pm.numer_denom()
-    return check_pd_int(*_minus_margin(Z, D, margin))[0]
+    early = _square_symmetric(Pm)  # before the common denominator (see :func:`decay_pd`)
+    if early is not None:
+        return early
+    got = common_denominator(Pm)
+    if got is None:
+        return too_costly("P")
+    return check_pd_int(*_minus_margin(*got, margin))[0]
 
 
 def _minus_margin(Z: fmpz_mat, D: Any, margin: Any) -> tuple[fmpz_mat, fmpq]:
@@ -423,9 +433,11 @@ def decay_pd(
     positive multiple of it), as :func:`obsdesign.certify.psd.check_pd_fast_float`."""
     from obsdesign.certify.psd import (
         check_pd_int,
+        common_denominator,
         diag_dominant_int,
         fflu_cheap,
         fraction_free_int,
+        too_costly,
     )
     from obsdesign.certify.vchol import int_to_float
 
@@ -441,6 +453,9 @@ def decay_pd(
     hit = _enclosure_pd(Am, Pm, Q(rate), discrete, Q(margin), Af, Pf)
     if hit is not None:
         return hit
+    for M, what in ((Am, "A − LC"), (Pm, "P")):  # decay_int's common denominators
+        if common_denominator(M) is None:
+            return too_costly(what), None
     Z, D = decay_int(Am, Pm, rate, discrete)
     return check_pd_int(*_minus_margin(Z, D, margin))
 

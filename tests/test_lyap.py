@@ -1113,3 +1113,47 @@ def test_inverse_float_matches_the_exact_inverse_and_refuses_a_singular_P() -> N
         assert np.max(np.abs(got - want)) <= 2.0**-50 * np.max(np.abs(want))
     S = fmpq_mat(2, 2, [1, 2, 2, 4])
     assert lyap._inverse_float(S) is None
+
+
+def _long_denominators(n: int, bits: int, negative: bool = False) -> fmpq_mat:
+    """A symmetric n×n matrix near 2I whose entries each have their own odd denominator of
+    ``bits`` bits (a hostile report's P), its (0, 0) entry −1 when ``negative``."""
+    import random
+
+    rnd = random.Random(n)
+    M = fmpq_mat(n, n)
+    for i in range(n):
+        for j in range(i, n):
+            q = rnd.getrandbits(bits) | (1 << (bits - 1)) | 1
+            M[i, j] = M[j, i] = fmpq(2 * q if i == j else 1, q)
+    if negative:
+        M[0, 0] = -1
+    return M
+
+
+def test_exact_checks_refuse_a_common_denominator_too_long_to_form() -> None:
+    """A report's P with distinct long denominators was put over their common denominator
+    (10⁵-10⁶ digits): verify ran for minutes, used > 20 GB or aborted in GMP
+    (responsiveness review 47). Past MAX_DENOMINATOR_BITS the check is not made and fails
+    ("not decided"); below it, and for a design's dyadic matrices, the verdict is exact."""
+    from obsdesign.certify import psd
+
+    bits = 3000  # within max_digits (~900 digits); 36 distinct ones: 108,000 bits
+    bad = _long_denominators(8, bits, negative=True)
+    assert psd.common_denominator(bad) is None
+    r = lyap.pd_int(bad, 0)
+    assert not r.ok and r.path == "costly" and "not decided" in r.detail
+    A = fmpq_mat(8, 8, [fmpq(1, 2) if i == j else 0 for i in range(8) for j in range(8)])
+    d, _ = lyap.decay_pd(A, bad, fmpq(9, 10), True, 0)
+    assert not d.ok and d.path == "costly"
+    assert psd._fraction_free(bad).path == "costly"
+    few = _long_denominators(4, 200, negative=True)  # 10 × 200 bits: decided exactly
+    assert psd.common_denominator(few) == few.numer_denom()
+    r = lyap.pd_int(few, 0)
+    assert not r.ok and r.path != "costly"
+    assert lyap.pd_int(_long_denominators(4, 200), 0).ok
+    dy = fmpq_mat(8, 8, [fmpq(k, 2 ** (k % 900)) for k in range(64)])  # dyadic: small lcm
+    assert psd.common_denominator(dy) == dy.numer_denom()
+    skew = _long_denominators(8, bits)  # one asymmetric pair: refused before any lcm
+    skew[0, 1] = skew[0, 1] + 1
+    assert lyap.pd_int(skew, 0).path == "symmetry"

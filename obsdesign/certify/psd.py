@@ -195,7 +195,45 @@ PATHS = {
     "the margin raised by e, the final inequality checked exactly over Q",
     "symmetry": "exact: symmetry of the rational matrix",
     "empty": "empty matrix",
+    "costly": "not decided: the entries' common denominator is too long for an exact check",
 }
+
+
+#: the most bits the common denominator of a matrix's entries may have where an exact check
+#: puts them over it (:func:`common_denominator`): a report's P with 10⁴ distinct 30- to
+#: 600-digit denominators had one of 10⁵-10⁶ digits, and the integer check over it took
+#: minutes and > 20 GB, or aborted in GMP (responsiveness review 47); a design's matrices
+#: are dyadic or decimal (a few thousand bits at most)
+MAX_DENOMINATOR_BITS = 1 << 16
+
+
+def common_denominator(F: Any) -> tuple[Any, Any] | None:
+    """``F.numer_denom()`` (Z, D with F = Z/D) for an ``fmpq_mat``, or None when the least
+    common multiple of its entries' denominators has more than :data:`MAX_DENOMINATOR_BITS`
+    bits (found without forming a larger one)."""
+    from flint import fmpz
+
+    qs = {x.q for x in F.entries()}
+    if sum(q.bit_length() for q in qs) > MAX_DENOMINATOR_BITS:
+        lcm = fmpz(1)
+        for q in qs:
+            lcm = lcm * q // lcm.gcd(q)
+            if lcm.bit_length() > MAX_DENOMINATOR_BITS:
+                return None
+    return F.numer_denom()
+
+
+def too_costly(what: str) -> PSDResult:
+    """The failed verdict of a check not made: ``what``'s entries have no common denominator
+    of at most :data:`MAX_DENOMINATOR_BITS` bits (:func:`common_denominator`)."""
+    return PSDResult(
+        False,
+        float("nan"),
+        f"not decided: the entries of {what} have no common denominator of at most "
+        f"{MAX_DENOMINATOR_BITS} bits (an exact check over it would take minutes and "
+        "gigabytes; a design never makes such a matrix)",
+        "costly",
+    )
 
 
 def check_text(r: PSDResult) -> str:
@@ -232,7 +270,10 @@ def _fraction_free(F: Any) -> PSDResult:
     """Exact LDLᵀ verdict on a symmetric ``fmpq_mat`` by Bareiss elimination over Z."""
     from flint import fmpq
 
-    Z, D = F.numer_denom()  # F = Z / D, D > 0: Z ≻ 0 iff F ≻ 0
+    got = common_denominator(F)  # F = Z / D, D > 0: Z ≻ 0 iff F ≻ 0
+    if got is None:
+        return too_costly("the matrix")
+    Z, D = got
     return fraction_free_int(Z, fmpq(1) / fmpq(D))
 
 
