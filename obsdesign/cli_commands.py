@@ -603,7 +603,7 @@ def design(
     """The body of ``obsdesign design`` (see :func:`obsdesign.cli.design`)."""
     _precheck(spec)  # before the heavy imports: an oversized spec is refused at once
     from obsdesign import api
-    from obsdesign.errors import InputError
+    from obsdesign.errors import InputError, SolverError
     from obsdesign.report.model import check_output
 
     _distinct_outputs(output, plot)
@@ -611,12 +611,27 @@ def design(
         check_output(output, force, _inputs(spec))
     _check_plot(plot, force, _inputs(spec, output))
     progress = _progress() if fmt == Fmt.text and not quiet else None
-    sp = _load_spec(spec)
+    # --timeout covers reading the spec: a polytope set's exact vertices are found there
+    # (8-60 s past --timeout 2; responsiveness review 47)
+    import time
+
+    budget = api.budget_seconds(timeout)
+    deadline = None if budget is None else time.monotonic() + budget
+    try:
+        with api._design_budget(budget, deadline):
+            sp = _load_spec(spec)
+    except SolverError as e:  # the budget ran out while the spec was read: name it
+        from obsdesign.errors import valid_text
+
+        raise SolverError(
+            f"{STDIN_NAME if _is_stdin(spec) else valid_text(str(spec))}: {e.message} "
+            "(reading the spec)"
+        ) from None
     if plot is not None and api.method(sp.method).plot_design is None:
         raise InputError(f"--plot: method '{sp.method}' has no design plot")
     with _naming_the_spec(sp.file):
         try:
-            rep = api.design(sp, output, progress=progress, force=force, timeout=timeout)
+            rep = api.design_within(sp, output, progress, force, budget, deadline)
         except Exception as e:
             _design_error_outputs(sp, e, output, fmt)
             raise

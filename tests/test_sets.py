@@ -845,3 +845,79 @@ def test_escalated_rounds_stay_within_a_bounded_size(monkeypatch: pytest.MonkeyP
     with pytest.raises(Exception, match="no volume"):
         P.sample(Counted(), 2000)  # type: ignore[arg-type]
     assert max(sizes) <= max(8000, base.SAMPLE_MAX_ROUND) and sum(sizes) == 64 * 8000
+
+
+def _cube_rows(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The n-cube [-1, 1]ⁿ as {G x <= g}, exact (2ⁿ vertices)."""
+    from flint import fmpq
+
+    G = [[fmpq(s) if j == i else fmpq(0) for j in range(n)] for s in (1, -1) for i in range(n)]
+    return np.array(G, dtype=object), np.array([fmpq(1)] * (2 * n), dtype=object)
+
+
+def test_exact_vertices_in_many_dimensions_come_from_a_child_process(monkeypatch) -> None:
+    """From CHILD_MIN_DIM dimensions the exact enumeration runs in a child process (one C call
+    of minutes for a 17-cube held the interpreter: --timeout and SIGTERM waited; responsiveness
+    review 47): the same vertices and boundedness as in this process, an unbounded set too."""
+    from obsdesign.sets import polytope as pt
+    from obsdesign.sets import polytope_ops as po
+
+    G, g = _cube_rows(8)
+    V, bounded = pt.vertices_exact(G, g)
+    W, same = pt._vertices_exact(G, g)
+    assert bounded and same and len(V) == 256
+    assert sorted(map(tuple, V)) == sorted(map(tuple, W))
+    Vh, b2 = pt.vertices_exact(G[:12], g[:12])  # four faces dropped: unbounded
+    assert not b2 and (len(Vh), not pt._vertices_exact(G[:12], g[:12])[1]) == (16, True)
+    calls = []
+    real = po.in_child
+    monkeypatch.setattr(po, "in_child", lambda *a: calls.append(a[0]) or real(*a))
+    pt.vertices_exact(*_cube_rows(3))  # small: in this process
+    pt.vertices_exact(G, g)
+    assert calls == ["vertices"]
+
+
+def test_a_budget_stops_a_long_exact_enumeration_and_its_child() -> None:
+    """A time budget's stop reaches the wait for the child (a 17-cube: minutes of cdd.gmp),
+    which is killed; an unused polytope of a spec read under design --timeout 1 is exit 3
+    within the budget, naming the spec (it ran 12 s to minutes and then exit 0)."""
+    import os
+    import time
+
+    from typer.testing import CliRunner
+
+    from obsdesign import api
+    from obsdesign.cli import app
+    from obsdesign.sets import polytope as pt
+
+    def children() -> set[int]:
+        me = str(os.getpid())
+        out = set()
+        for d in os.listdir("/proc"):
+            if d.isdigit():
+                try:
+                    with open(f"/proc/{d}/stat") as f:
+                        if f.read().rsplit(")", 1)[1].split()[1] == me:
+                            out.add(int(d))
+                except OSError:
+                    pass
+        return out
+
+    before = children()
+    with pytest.raises(api.SpecTimeout):
+        with api._time_budget(0.5):
+            pt.vertices_exact(*_cube_rows(17))
+    time.sleep(0.2)
+    assert children() <= before  # the child was killed and reaped
+    n = 17
+    rows = lambda M: "[" + ", ".join("[" + ", ".join(map(str, r)) + "]" for r in M) + "]"  # noqa: E731
+    eye = [[int(i == j) for j in range(n)] for i in range(n)]
+    G, _ = _cube_rows(n)
+    text = (
+        f'[system]\ntime = "discrete"\nA = {rows([[0.5 * v for v in r] for r in eye])}\n'
+        f'C = {rows(eye[:1])}\n[sets.E]\ntype = "polytope"\nG = {rows(G)}\n'
+        f'g = {[1] * (2 * n)}\n[method]\nkey = "lyapunov"\nlambda = 0.6\n'
+    )
+    res = CliRunner().invoke(app, ["design", "-", "--timeout", "1", "-q"], input=text)
+    assert res.exit_code == 3, res.output
+    assert "not finished within 1 s" in res.output and "(reading the spec)" in res.output

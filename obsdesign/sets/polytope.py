@@ -20,14 +20,46 @@ from obsdesign.certify.exact import Q, float_or_inf, frac, to_float
 from obsdesign.sets import polytope_ops as po
 from obsdesign.sets.base import ConvexSet, float_view
 
+#: exact vertex enumerations in this many dimensions or more run in a child process
+#: (:func:`vertices_exact`): the count of vertices can grow as 2ⁿ (a 17-cube written as a
+#: polytope has 131,072; cdd.gmp took 7.5 s at n = 16 and minutes at 17), and the one C call
+#: holds the interpreter, so neither ``design --timeout`` nor SIGTERM / Ctrl-C could stop it
+#: (72-89 s against --timeout 5, 28 s to answer SIGTERM; responsiveness review 47). Starting
+#: the child costs 0.2-0.9 s, about what an enumeration at this size costs anyway
+CHILD_MIN_DIM = 8
+
 
 def vertices_exact(G_q: np.ndarray, g_q: np.ndarray) -> tuple[np.ndarray, bool]:
     """Exact vertices of {G x <= g} by cdd.gmp; returns (vertices (k, n) of fmpq, bounded).
+    From :data:`CHILD_MIN_DIM` dimensions on, in a child process that this one waits for in
+    Python (a time budget's alarm, SIGTERM or Ctrl-C stop the wait, and the child is killed).
 
     Raises :class:`~obsdesign.sets.polytope_ops.PolytopeError` when cdd.gmp is not available
     (:data:`~obsdesign.sets.polytope_ops.HAVE_GMP` is False)."""
     if not po.HAVE_GMP:
         raise po.PolytopeError("cdd.gmp is not available: exact vertex enumeration is disabled")
+    if np.asarray(G_q).ndim == 2 and np.asarray(G_q).shape[1] >= CHILD_MIN_DIM:
+        rows = [[(int(Q(x).p), int(Q(x).q)) for x in r] for r in np.asarray(G_q, dtype=object)]
+        rhs = [(int(Q(x).p), int(Q(x).q)) for x in np.asarray(g_q, dtype=object).reshape(-1)]
+        verts, bounded = po.in_child("vertices", (rows, rhs))
+        n = np.asarray(G_q).shape[1]
+        V = np.array([[fmpq(a, b) for a, b in r] for r in verts], dtype=object)
+        return V.reshape(len(verts), n), bounded
+    return _vertices_exact(G_q, g_q)
+
+
+def _vertices_child(payload: tuple[list, list]) -> tuple[list, bool]:
+    """:func:`_vertices_exact` of the integer pairs ``payload`` (rows of G, entries of g),
+    as integer pairs: the child process's side of :func:`vertices_exact`."""
+    rows, rhs = payload
+    G = np.array([[fmpq(a, b) for a, b in r] for r in rows], dtype=object)
+    g = np.array([fmpq(a, b) for a, b in rhs], dtype=object)
+    V, bounded = _vertices_exact(G.reshape(len(rows), -1), g)
+    return [[(int(x.p), int(x.q)) for x in r] for r in V], bounded
+
+
+def _vertices_exact(G_q: np.ndarray, g_q: np.ndarray) -> tuple[np.ndarray, bool]:
+    """:func:`vertices_exact` in this process."""
     import cdd
     import cdd.gmp
 

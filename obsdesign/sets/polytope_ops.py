@@ -748,6 +748,90 @@ def _child() -> None:  # pragma: no cover - runs in the child process (tested th
     sys.stdout.flush()
 
 
+def _child_task(name: str) -> Callable[[Any], Any]:
+    """The function a child process of :func:`in_child` runs for the task ``name``."""
+    if name == "vertices":
+        from obsdesign.sets.polytope import _vertices_child
+
+        return _vertices_child
+    raise ValueError(f"unknown child task {name!r}")
+
+
+def _task_child() -> None:  # pragma: no cover - runs in the child process (tested through it)
+    """Body of the child process of :func:`in_child`: the task named in ``argv[2]`` on the
+    pickled payload from stdin, its pickled result (or PolytopeError's message) to stdout;
+    dies with its parent (PR_SET_PDEATHSIG), as :func:`_child`."""
+    import os
+    import pickle
+    import sys
+
+    try:
+        import ctypes
+        import signal
+
+        ctypes.CDLL(None).prctl(1, int(signal.SIGKILL))  # PR_SET_PDEATHSIG
+        if os.getppid() != int(sys.argv[1]):
+            os._exit(1)
+    except (OSError, AttributeError, ValueError, IndexError):
+        pass
+    payload = pickle.load(sys.stdin.buffer)
+    try:
+        out: Any = ("ok", _child_task(sys.argv[2])(payload))
+    except PolytopeError as e:
+        out = ("error", str(e))
+    pickle.dump(out, sys.stdout.buffer)
+    sys.stdout.flush()
+
+
+#: seconds between two looks at the thread's stop while :func:`in_child` waits
+CHILD_POLL_S = 0.2
+
+
+def in_child(task: str, payload: Any) -> Any:
+    """The task ``task`` (:func:`_child_task`) on ``payload`` in a child process, which this
+    process waits for in Python, in slices of :data:`CHILD_POLL_S` s: a time budget's alarm
+    or asynchronous stop, SIGTERM or Ctrl-C end the wait (the exception is raised here) and
+    the child is killed; it also dies with this process. A PolytopeError in the child is
+    raised here; a child that fails otherwise is a PolytopeError naming its last words."""
+    import os
+    import pickle
+    import subprocess
+    import sys
+
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    code = (
+        f"import sys; sys.path.insert(0, {root!r}); "
+        "from obsdesign.sets.polytope_ops import _task_child; _task_child()"
+    )
+    proc = subprocess.Popen(
+        [sys.executable, "-P", "-c", code, str(os.getpid()), task],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    data: bytes | None = pickle.dumps(payload)
+    try:
+        while True:
+            try:
+                out, err = proc.communicate(data, timeout=CHILD_POLL_S)
+                break
+            except subprocess.TimeoutExpired:
+                data = None  # the input is remembered by the first call
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    if proc.returncode != 0 or not out:
+        msg = err.decode(errors="replace").strip().splitlines()
+        raise PolytopeError(
+            f"the {task} child process failed ({msg[-1] if msg else proc.returncode})"
+        )
+    res = pickle.loads(out)
+    if res[0] == "error":
+        raise PolytopeError(res[1])
+    return res[1]
+
+
 def _cdd_hull_bounded(
     P: np.ndarray, deadline: float
 ) -> tuple[np.ndarray, list[int], list[tuple[int, int]]]:
