@@ -740,3 +740,46 @@ def test_the_exact_hulls_float_facets_look_at_the_budget() -> None:
         po.exact_hull(P, deadline=time.perf_counter() - 1.0)
     G, vrep = po.exact_hull(P)
     assert len(vrep.V) == 60 and len(G) > 60
+
+
+def test_a_high_dimensional_qhull_run_is_a_child_the_budget_kills() -> None:
+    """From CHILD_MIN_DIM dimensions a large qhull run goes to a child process: abandoned in a
+    thread, a 9-cube's first hull ran on for minutes beside the next rows of a check (Dask
+    review 47). The child's hull is the one made here; the budget's check stops the wait and
+    the child is killed."""
+    import os
+    import time
+
+    rng = np.random.default_rng(1)
+    P = rng.standard_normal((po.THREAD_MIN_COORDS // po.CHILD_MIN_DIM + 1, po.CHILD_MIN_DIM))
+    here = po._qhull_here(P)
+    there = po._qhull(P, check=lambda: None)
+    assert isinstance(there, po._ChildHull)
+    assert np.array_equal(np.sort(there.vertices), np.sort(here.vertices))
+    assert np.allclose(np.sort(there.equations, axis=0), np.sort(here.equations, axis=0))
+
+    class Budget(Exception):
+        pass
+
+    def stop() -> None:
+        raise Budget
+
+    mine = str(os.getpid())
+
+    def children() -> int:
+        n = 0
+        for d in os.listdir("/proc"):
+            if d.isdigit():
+                try:
+                    with open(f"/proc/{d}/stat") as f:
+                        n += f.read().rsplit(")", 1)[1].split()[1] == mine
+                except OSError:
+                    pass
+        return n
+
+    before = children()
+    big = rng.standard_normal((3000, 9))  # qhull: minutes
+    t0 = time.perf_counter()
+    with pytest.raises(Budget):
+        po._qhull(big, stop)
+    assert children() <= before and time.perf_counter() - t0 < 60

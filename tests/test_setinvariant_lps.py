@@ -176,3 +176,19 @@ def test_slice_of_ker_C_does_not_depend_on_the_scale_of_C() -> None:
     phi1, S1 = lps.phi_slice_general(G, A, C, 0.0)
     phis, Ss = lps.phi_slice_general(G, A, 1e-13 * C, 0.0)
     assert np.allclose(phis, phi1) and np.allclose(np.abs(Ss @ C.T), 0.0, atol=1e-12)
+
+
+def test_a_phi_table_too_large_is_refused_by_name(monkeypatch) -> None:
+    """A 7-state design reached 949,004 facets and 4,834 breakpoints: LP (6)'s table was an
+    internal failure, MemoryError for 34.2 GiB (session 47). It is a SolverError naming the
+    size."""
+    from obsdesign.errors import SolverError
+    from obsdesign.methods.setinvariant import lps
+
+    monkeypatch.setattr(lps, "PHI_MAX_BYTES", 8 * 3 * 5)
+    G, A, V = np.eye(3), np.eye(3), np.eye(3)
+    c = np.array([1.0, 0.0, 0.0])
+    with pytest.raises(SolverError, match=r"3 facets with 6 breakpoints: LP \(6\)'s table"):
+        lps.phi_at(G, A, V, np.zeros((0, 2), dtype=int), c, 0.0, np.arange(6.0))
+    out, _ = lps.phi_at(G, A, V, np.zeros((0, 2), dtype=int), c, 0.0, np.arange(5.0) / 10)
+    assert out.shape == (5, 3)

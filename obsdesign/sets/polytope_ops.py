@@ -123,20 +123,68 @@ def _qhull(points: np.ndarray, check: Callable[[], None] | None = None) -> Conve
     signal handlers between bytecodes of the main thread; re-check review 46). On a timeout
     or a stop the thread is abandoned: it finishes in the background (a CLI run exits
     without waiting for it; an API caller's process keeps one core busy until it ends)."""
-    from scipy.spatial import ConvexHull, QhullError
 
     def run() -> ConvexHull:
-        try:
-            return ConvexHull(points)
-        except QhullError:
-            try:
-                return ConvexHull(points, qhull_options="QJ")
-            except QhullError as exc:
-                raise _QhullFailed(str(exc)) from exc
+        return _qhull_here(points)
 
     if np.size(points) < THREAD_MIN_COORDS:
         return run()
+    if np.ndim(points) == 2 and np.shape(points)[1] >= CHILD_MIN_DIM:
+        return _qhull_in_child(np.asarray(points, dtype=float), check)
     return _in_thread(run, check)
+
+
+#: qhull runs on :data:`THREAD_MIN_COORDS` coordinates or more in this many dimensions or more
+#: run in a child process (:func:`in_child`), killed when the budget stops them: abandoned
+#: in a thread, they ran on for minutes beside the rows that came next — a 9-cube's first hull
+#: made a good spec after it in ``check --timeout 2.3`` exit 3 (Dask review 47). Below this
+#: dimension qhull takes seconds at most, and the child's start (0.2-0.9 s) would cost more
+CHILD_MIN_DIM = 7
+
+
+@dataclass
+class _ChildHull:
+    """What this module reads of a ConvexHull, as a child process returned it."""
+
+    equations: np.ndarray
+    vertices: np.ndarray
+    simplices: np.ndarray
+    neighbors: np.ndarray
+
+
+def _qhull_child(points: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The child process's side of :func:`_qhull_in_child` (raises PolytopeError when qhull
+    fails with and without joggled input)."""
+    try:
+        h = _qhull_here(points)  # not _qhull: a child of its own, and so on
+    except _QhullFailed as e:
+        raise PolytopeError(f"qhull: {e}") from None
+    return h.equations, h.vertices, h.simplices, h.neighbors
+
+
+def _qhull_in_child(points: np.ndarray, check: Callable[[], None] | None) -> _ChildHull:
+    """:func:`_qhull` in a child process (``check()`` between waits; what it raises ends the
+    wait and the child); :class:`_QhullFailed` when qhull failed there."""
+    try:
+        eq, ve, si, nb = in_child("qhull", points, check)
+    except PolytopeError as e:
+        if str(e).startswith("qhull: "):
+            raise _QhullFailed(str(e)[7:]) from None
+        raise
+    return _ChildHull(eq, ve, si, nb)
+
+
+def _qhull_here(points: np.ndarray) -> ConvexHull:
+    """:func:`_qhull` in this thread."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    try:
+        return ConvexHull(points)
+    except QhullError:
+        try:
+            return ConvexHull(points, qhull_options="QJ")
+        except QhullError as exc:
+            raise _QhullFailed(str(exc)) from exc
 
 
 def _in_thread(fn: Callable[[], Any], check: Callable[[], None] | None) -> Any:
@@ -754,6 +802,8 @@ def _child_task(name: str) -> Callable[[Any], Any]:
         from obsdesign.sets.polytope import _vertices_child
 
         return _vertices_child
+    if name == "qhull":
+        return _qhull_child
     raise ValueError(f"unknown child task {name!r}")
 
 
@@ -787,12 +837,13 @@ def _task_child() -> None:  # pragma: no cover - runs in the child process (test
 CHILD_POLL_S = 0.2
 
 
-def in_child(task: str, payload: Any) -> Any:
+def in_child(task: str, payload: Any, check: Callable[[], None] | None = None) -> Any:
     """The task ``task`` (:func:`_child_task`) on ``payload`` in a child process, which this
-    process waits for in Python, in slices of :data:`CHILD_POLL_S` s: a time budget's alarm
-    or asynchronous stop, SIGTERM or Ctrl-C end the wait (the exception is raised here) and
-    the child is killed; it also dies with this process. A PolytopeError in the child is
-    raised here; a child that fails otherwise is a PolytopeError naming its last words."""
+    process waits for in Python, in slices of :data:`CHILD_POLL_S` s (``check()`` between
+    them): what ``check`` raises, a time budget's alarm or asynchronous stop, SIGTERM or
+    Ctrl-C end the wait (the exception is raised here) and the child is killed; it also dies
+    with this process. A PolytopeError in the child is raised here; a child that fails
+    otherwise is a PolytopeError naming its last words."""
     import os
     import pickle
     import subprocess
@@ -817,6 +868,8 @@ def in_child(task: str, payload: Any) -> Any:
                 break
             except subprocess.TimeoutExpired:
                 data = None  # the input is remembered by the first call
+                if check is not None:
+                    check()
     finally:
         if proc.poll() is None:
             proc.kill()

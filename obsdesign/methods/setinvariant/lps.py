@@ -44,6 +44,10 @@ def z_d(V: np.ndarray, c: np.ndarray, eta: float) -> np.ndarray:
     return z[np.concatenate([[True], np.diff(z) > tol])]
 
 
+#: the largest table of φ(z) values (breakpoints × facets, float64) :func:`phi_at` makes
+PHI_MAX_BYTES = 2 * 1024**3
+
+
 def phi_at(
     G: np.ndarray,
     A: np.ndarray,
@@ -55,7 +59,16 @@ def phi_at(
     deadline: float | None = None,
 ) -> tuple[np.ndarray, list[np.ndarray]]:
     """φ(z) of LP (6) for each z in ``zs`` (rows), and the slice points used for each z
-    (:class:`Timeout` past ``deadline``, checked every 32 slices)."""
+    (:class:`Timeout` past ``deadline``, checked every 32 slices). A table of φ larger than
+    :data:`PHI_MAX_BYTES` is a SolverError saying so (a 7-state design reached 949,004 facets
+    and 4,834 breakpoints: an internal failure, MemoryError for 34.2 GiB; session 47)."""
+    need = 8 * len(zs) * len(G)
+    if need > PHI_MAX_BYTES:
+        raise SolverError(
+            f"the polyhedron grew to {len(G):,} facets with {len(zs):,} breakpoints: LP (6)'s "
+            f"table would take {need / 2**30:.1f} GiB (at most {PHI_MAX_BYTES / 2**30:g}; a "
+            "larger λ or Δδ, or fewer states)"
+        )
     GA = G @ A
     out = np.empty((len(zs), len(G)))
     slices = []
