@@ -742,6 +742,27 @@ def test_simulate_time_limit_stops_the_run(rep71, law, monkeypatch, slow_clock) 
         api.load_spec_text(text.replace("[simulate]", "[simulate]\ntime_limit = -1", 1))
 
 
+def test_simulate_time_limit_is_looked_at_every_step(rep71, monkeypatch) -> None:
+    """The budget was looked at every 1,024 steps, each online-lp step an LP: time_limit = 3
+    ran 55 s (responsiveness review 47). It is looked at every step."""
+    from pathlib import Path
+
+    from obsdesign.errors import SolverError
+    from obsdesign.simulate.budget import TimeBudget
+
+    _, out = rep71
+    spec = api.load_spec(Path(__file__).resolve().parents[1] / "specs" / "dorea-pimenta-7-1.toml")
+    looks = []
+
+    def expired(self) -> bool:  # the deadline passes at the third look
+        looks.append(1)
+        return len(looks) >= 3
+
+    monkeypatch.setattr(TimeBudget, "expired", expired)
+    with pytest.raises(SolverError, match=r"the online-lp law at step 2 of 17"):
+        api.simulate(spec, out, law="online-lp", time_limit=999)
+
+
 @pytest.mark.parametrize("law", ["online-lp", "interpolated", "time-varying"])
 def test_one_output_laws_with_two_outputs_are_input_errors(law: str) -> None:
     """p = n − 1 = 2 (outsider trial, session 22): `--option law=online-lp` crashed inside
