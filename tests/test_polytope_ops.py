@@ -783,3 +783,22 @@ def test_a_high_dimensional_qhull_run_is_a_child_the_budget_kills() -> None:
     with pytest.raises(Budget):
         po._qhull(big, stop)
     assert children() <= before and time.perf_counter() - t0 < 60
+
+
+def test_exact_h_to_v_in_many_dimensions_is_the_same_from_a_child() -> None:
+    """From H_TO_V_CHILD_DIM dimensions exact_h_to_v runs in a child process (Ω's vertices of an
+    8-state set-invariant spec: 150 s in one cdd.gmp call, deaf to SIGTERM; responsiveness
+    review 47): the same vertices, in the same order, and edges; errors come back."""
+    from fractions import Fraction
+
+    n = po.H_TO_V_CHILD_DIM
+    rng = np.random.default_rng(5)
+    G = np.vstack([np.eye(n), -np.eye(n), rng.integers(-3, 4, (4, n))])
+    Gq = np.array([[fmpq(int(x)) for x in r] for r in G], dtype=object)
+    g = np.array([Fraction(3, 2)] * len(G), dtype=object)
+    here = po._exact_h_to_v(Gq, g)
+    there = po.exact_h_to_v(Gq, g)
+    assert there.edges == here.edges and there.V.shape == here.V.shape
+    assert all(a == b for a, b in zip(there.V.ravel(), here.V.ravel(), strict=True))
+    with pytest.raises(po.PolytopeError, match="unbounded"):
+        po.exact_h_to_v(Gq[:n])

@@ -410,3 +410,28 @@ def test_budget_message_says_how_far_the_run_got() -> None:
         with pytest.raises(SolverError, match=r"within \d+ s .* iterations: .*") as e:
             _budget(r, sp.options, run)
         assert said in e.value.message, e.value.message
+
+
+def test_omegas_exact_vertices_are_held_to_the_time_budget(monkeypatch) -> None:
+    """Ω's exact vertices (a child process from 8 states) were found before the budget
+    started: an 8-state spec ran 150 s against time_limit = 5 (responsiveness review 47).
+    The budget starts with the design; past it, Ω's enumeration is not started and the
+    design stops (exit 3) saying so; within it, the vertices are those found in-process."""
+    import time
+
+    from obsdesign.methods.setinvariant import problem
+    from obsdesign.methods.setinvariant.budget import Timeout
+    from obsdesign.sets import polytope_ops as po
+
+    monkeypatch.setattr(po, "H_TO_V_CHILD_DIM", 2)  # Ω of SEED0 (3 states) in a child
+    problem._omega_vertices.cache_clear()
+    G0 = problem.omega_rows(api.load_spec_text(SEED0, "s0.toml").sets["omega"])
+    with pytest.raises(Timeout):
+        problem.omega_vertices(G0, time.perf_counter() - 1)
+    V = problem.omega_vertices(G0, time.perf_counter() + 60)
+    assert sorted(map(tuple, V)) == sorted(map(tuple, po._exact_h_to_v(G0).V))
+    problem._omega_vertices.cache_clear()
+    sp = api.load_spec_text(SEED0.replace("max_iterations = 60", "time_limit = 1e-9"), "t.toml")
+    with pytest.raises(SolverError, match="Ω's exact vertices were not found"):
+        api.design(sp)
+    problem._omega_vertices.cache_clear()

@@ -24,7 +24,9 @@ converted to rationals and proved.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass
 from fractions import Fraction
 from typing import TYPE_CHECKING, Any
@@ -545,11 +547,47 @@ class ExactVRep:
     edges: list[tuple[int, int]]
 
 
+#: :func:`exact_h_to_v` in this many dimensions or more runs in a child process (as
+#: :func:`obsdesign.sets.polytope.vertices_exact`): Ω's exact vertices and edges of an
+#: 8-state set-invariant spec took 150 s in one cdd.gmp call, deaf to SIGTERM for 42 s
+#: (responsiveness review 47)
+H_TO_V_CHILD_DIM = 8
+
+
+def _qpairs(M: np.ndarray) -> list[list[tuple[int, int]]]:
+    """An exact matrix as rows of (numerator, denominator) pairs (for a child process)."""
+    from obsdesign.certify.exact import Q
+
+    return [[(int(Q(x).p), int(Q(x).q)) for x in r] for r in np.asarray(M, dtype=object)]
+
+
+def _h_to_v_child(payload: tuple[list, list | None]) -> tuple[list, list]:
+    """The child process's side of :func:`exact_h_to_v`."""
+    rows, rhs = payload
+    G = np.array([[fmpq(a, b) for a, b in r] for r in rows], dtype=object)
+    g = None if rhs is None else np.array([fmpq(a, b) for a, b in rhs], dtype=object)
+    rep = _exact_h_to_v(G.reshape(len(rows), -1), g)
+    return _qpairs(rep.V), [tuple(e) for e in rep.edges]
+
+
 def exact_h_to_v(G: np.ndarray, g: np.ndarray | None = None) -> ExactVRep:
-    """Exact vertices and edges of ``{e : G e <= g}`` (``g`` defaults to 1) by cdd.gmp.
+    """Exact vertices and edges of ``{e : G e <= g}`` (``g`` defaults to 1) by cdd.gmp; from
+    :data:`H_TO_V_CHILD_DIM` dimensions on in a child process that this one waits for in
+    Python (stop signals and a time budget's alarm end the wait and the child).
 
     Raises PolytopeError if it is empty, unbounded (ray or line) or not full-dimensional.
     """
+    G = np.asarray(G, dtype=object)
+    if G.ndim == 2 and G.shape[1] >= H_TO_V_CHILD_DIM:
+        rhs = None if g is None else [r[0] for r in _qpairs(np.asarray(g).reshape(-1, 1))]
+        V, edges = in_child("h_to_v", (_qpairs(G), rhs))
+        Vq = np.array([[fmpq(a, b) for a, b in r] for r in V], dtype=object)
+        return ExactVRep(Vq.reshape(len(V), G.shape[1]), [tuple(e) for e in edges])
+    return _exact_h_to_v(G, g)
+
+
+def _exact_h_to_v(G: np.ndarray, g: np.ndarray | None = None) -> ExactVRep:
+    """:func:`exact_h_to_v` in this process."""
     cdd, cddg = _require_gmp()
     G = np.asarray(G, dtype=object)
     k, n = G.shape
@@ -804,6 +842,8 @@ def _child_task(name: str) -> Callable[[Any], Any]:
         return _vertices_child
     if name == "qhull":
         return _qhull_child
+    if name == "h_to_v":
+        return _h_to_v_child
     raise ValueError(f"unknown child task {name!r}")
 
 
@@ -836,6 +876,22 @@ def _task_child() -> None:  # pragma: no cover - runs in the child process (test
 #: seconds between two looks at the thread's stop while :func:`in_child` waits
 CHILD_POLL_S = 0.2
 
+#: the check :func:`in_child` calls between waits when given none (:func:`child_check`)
+_CHILD_CHECK: ContextVar[Callable[[], None] | None] = ContextVar(
+    "obsdesign_child_check", default=None
+)
+
+
+@contextmanager
+def child_check(check: Callable[[], None]) -> Iterator[None]:
+    """``check`` called between the waits of every :func:`in_child` inside the block (for a
+    caller whose time budget is a deadline, not a signal: set-invariant's ``time_limit``)."""
+    token = _CHILD_CHECK.set(check)
+    try:
+        yield
+    finally:
+        _CHILD_CHECK.reset(token)
+
 
 def in_child(task: str, payload: Any, check: Callable[[], None] | None = None) -> Any:
     """The task ``task`` (:func:`_child_task`) on ``payload`` in a child process, which this
@@ -849,6 +905,10 @@ def in_child(task: str, payload: Any, check: Callable[[], None] | None = None) -
     import subprocess
     import sys
 
+    if check is None:
+        check = _CHILD_CHECK.get()
+    if check is not None:
+        check()  # no child started past the budget
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     code = (
         f"import sys; sys.path.insert(0, {root!r}); "

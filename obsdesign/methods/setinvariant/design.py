@@ -30,6 +30,7 @@ from obsdesign.spec.models import Spec
 from . import algorithms as al
 from . import certificate as ce
 from . import laws, lps, memo, numerical, scaling
+from .budget import Timeout
 from .linear import admissible_gains
 from .options import Options
 from .problem import Data, build, check_detectable
@@ -273,7 +274,9 @@ def _strict_retries(
     del hist[kept:]  # the dropped retries' iterations
 
 
-def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
+def _iterate(
+    spec: Spec, data: Data, progress: Progress | None, deadline: float | None = None
+) -> _Run:
     """The algorithm of the spec: symmetric C_K^∞ (Section VI; condition (14)), general
     (Section V; stopping rule ε^i ≤ λ(1 + Δδ)) or none (Ω itself); the symmetric-to-general
     fallback (Example 7.2) and the strict continuation until the certified factor is ≤ λ."""
@@ -281,7 +284,8 @@ def _iterate(spec: Spec, data: Data, progress: Progress | None) -> _Run:
     fl = data.fl
     single = spec.system.p == 1
     lam, dd = float(o.lam), float(o.delta_tol)
-    dl = time.perf_counter() + o.time_limit  # the budget of the whole design
+    # the budget of the whole design (from its start: ``deadline``)
+    dl = deadline if deadline is not None else time.perf_counter() + o.time_limit
     run = _Run(Stage(np.zeros((0, fl.n)), None, None), 0, True)
     hist = run.history
     sym_failed = False
@@ -471,10 +475,18 @@ def design(spec: Spec, progress: Progress | None = None) -> Design:
     o: Options = spec.options
     t0 = time.perf_counter()
     try:
-        data = build(spec)
+        # one budget from here: Ω's exact vertices (a child process from 8 states) count
+        deadline = time.perf_counter() + o.time_limit
+        try:
+            data = build(spec, deadline)
+        except Timeout:
+            raise SolverError(
+                f"not converged within {o.time_limit:g} s ([method] time_limit) / 0 "
+                "iterations: Ω's exact vertices were not found (raise time_limit)"
+            ) from None
         check_detectable(spec.system.A.q, spec.system.C.q, o.lam)
         work, s = scaling.scaled(data)
-        run = _iterate(spec, work, progress)
+        run = _iterate(spec, work, progress, deadline)
         found = run.stage  # in the design's coordinates
         if s is not None:
             _unscale(run, s)

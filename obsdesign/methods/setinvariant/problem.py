@@ -71,14 +71,30 @@ def _omega_vertices(rows: tuple[tuple[fmpq, ...], ...]) -> np.ndarray:
     return po.exact_h_to_v(np.array(rows, dtype=object)).V
 
 
-def omega_vertices(G0: np.ndarray) -> np.ndarray:
+def omega_vertices(G0: np.ndarray, deadline: float | None = None) -> np.ndarray:
     """Exact vertices of Ω = {G0 e <= 1} (cdd.gmp), computed once per Ω and process (the
-    design and its certify both build the problem); a copy, keyed by the exact rows."""
-    return _omega_vertices(tuple(tuple(r) for r in np.asarray(G0, dtype=object))).copy()
+    design and its certify both build the problem); a copy, keyed by the exact rows.
+    ``deadline`` (``time.perf_counter()``): an enumeration in a child process (8+ states) is
+    stopped past it (:class:`~.budget.Timeout`): Ω's vertices of an 8-state spec took 150 s
+    against ``time_limit = 5`` (responsiveness review 47)."""
+    key = tuple(tuple(r) for r in np.asarray(G0, dtype=object))
+    if deadline is None:
+        return _omega_vertices(key).copy()
+    with _deadline(deadline):  # looked at only while a child enumerates (a cache miss)
+        return _omega_vertices(key).copy()
 
 
-def build(spec: Spec) -> Data:
-    """Float and exact data of the spec (the options were validated by parse_options)."""
+def _deadline(deadline: float) -> Any:
+    """The budget's check for the child processes of :mod:`obsdesign.sets.polytope_ops`
+    started inside the block (:data:`obsdesign.sets.polytope_ops.CHILD_CHECK`)."""
+    from .budget import check_deadline
+
+    return po.child_check(lambda: check_deadline(deadline))
+
+
+def build(spec: Spec, deadline: float | None = None) -> Data:
+    """Float and exact data of the spec (the options were validated by parse_options);
+    ``deadline``: as for :func:`omega_vertices`."""
     o = spec.options
     s = spec.system
     G0 = omega_rows(spec.sets[o.omega])
@@ -94,7 +110,7 @@ def build(spec: Spec) -> Data:
             ),
             None,
         )
-    Vo = omega_vertices(G0)
+    Vo = omega_vertices(G0, deadline)
     D = o.D
     Dv = disturbance_vertices(D, s.nd)
     B1 = np.asarray(s.Bd.q, dtype=object).reshape(s.n, s.nd)
