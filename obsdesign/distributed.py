@@ -497,21 +497,32 @@ def run_tasks(
 NO_WORKERS_S = 60.0
 
 
+#: worker states that take tasks (a worker without a ``status`` counts as one)
+WORKING = frozenset({"running", "init"})
+
+
 class _Workers:
-    """The scheduler's worker count, asked at most once a second, and since when it is 0."""
+    """The scheduler's count of workers that take tasks, asked at most once a second, and
+    since when it is 0. A paused worker (Dask pauses one past 80 % of its memory limit) takes
+    none: counted as one, a cluster of paused workers left ``check --scheduler`` waiting
+    forever with no word (Dask review 47)."""
 
     def __init__(self, client: Any) -> None:
         self.client = client
         self.asked = 0.0
         self.none_since: float | None = None
+        self.paused = 0
 
     def gone_for(self) -> float:
-        """Seconds the scheduler has had no worker (0 while it has one)."""
+        """Seconds the scheduler has had no worker that takes tasks (0 while it has one)."""
         now = time.monotonic()
         if now - self.asked >= 1.0:
             self.asked = now
             try:
-                n = len(self.client.scheduler_info().get("workers", {}))
+                workers = self.client.scheduler_info().get("workers", {})
+                states = [str(w.get("status", "running")) for w in workers.values()]
+                n = sum(st in WORKING for st in states)
+                self.paused = sum(st == "paused" for st in states)
             except Exception:  # noqa: BLE001 - a scheduler that went away: as_completed says so
                 n = 1
             self.none_since = None if n else (self.none_since or now)
@@ -532,6 +543,13 @@ def _arrivals(ac: Any, watch: _Workers) -> Iterator[Any]:
             yield from batch
             continue
         if watch.gone_for() > NO_WORKERS_S:
+            if watch.paused:
+                raise SolverError(
+                    f"the Dask scheduler's {watch.paused} worker(s) have been paused for "
+                    f"{NO_WORKERS_S:g} s (Dask pauses a worker past 80 % of its memory "
+                    "limit): the rows not done are lost (give the workers more memory, "
+                    "--memory-limit, and run again)"
+                )
             raise SolverError(
                 f"the Dask scheduler has had no worker for {NO_WORKERS_S:g} s: the rows not "
                 "done are lost (start workers and run again)"

@@ -510,6 +510,8 @@ def test_a_run_whose_workers_are_all_gone_stops() -> None:
             return []
 
     class Gone:
+        paused = 0
+
         def gone_for(self) -> float:
             return distributed.NO_WORKERS_S + 1
 
@@ -517,6 +519,34 @@ def test_a_run_whose_workers_are_all_gone_stops() -> None:
         next(distributed._arrivals(Never(), Gone()))  # type: ignore[arg-type]
     got = list(distributed._arrivals(_Ready([1, 2]), Gone()))  # type: ignore[arg-type]
     assert got == [1, 2]
+    Gone.paused = 2
+    with pytest.raises(SolverError, match=r"2 worker\(s\) have been paused for 60 s"):
+        next(distributed._arrivals(Never(), Gone()))  # type: ignore[arg-type]
+
+
+def test_paused_workers_are_no_workers() -> None:
+    """Workers Dask paused (past 80 % of their memory limit) take no task, but were counted:
+    check --scheduler on such a cluster waited forever with no word (Dask review 47)."""
+    from obsdesign import distributed
+
+    class Client:
+        def __init__(self, states: list[str | None]) -> None:
+            self.states = states
+
+        def scheduler_info(self) -> dict:
+            return {
+                "workers": {
+                    f"w{i}": ({} if st is None else {"status": st})
+                    for i, st in enumerate(self.states)
+                }
+            }
+
+    w = distributed._Workers(Client(["paused", "paused"]))
+    w.gone_for()
+    assert w.none_since is not None and w.paused == 2
+    for states in (["paused", "running"], [None], ["init"]):
+        w = distributed._Workers(Client(states))
+        assert w.gone_for() == 0.0 and w.none_since is None
 
 
 class _Ready:
