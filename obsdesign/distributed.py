@@ -464,6 +464,7 @@ def run_tasks(
                 try:
                     got = fut.result()
                 except Exception as e:  # noqa: BLE001 - KilledWorker, or fn raised
+                    _scheduler_gone(e)
                     if not single and b - a > 1:  # again item by item: only the bad one is lost
                         for i in range(a, b):
                             f = c.submit(
@@ -491,6 +492,22 @@ def run_tasks(
             c.cancel(futures)
             raise
     return results
+
+
+def _scheduler_gone(e: Exception) -> None:
+    """A SolverError (exit 3, one message for the run) when a task's future was cancelled:
+    this code cancels none while it waits, so the scheduler went away (killed, restarted).
+    Each row not done was an exit-3 row of its own, "internal failure: FutureCancelledError
+    … cancelled for reason: unknown", blaming the specs (Dask review 47)."""
+    from concurrent.futures import CancelledError
+
+    from obsdesign.errors import SolverError
+
+    if isinstance(e, CancelledError):
+        raise SolverError(
+            "the Dask scheduler went away (its tasks were cancelled): the rows not done are "
+            "lost (restart it and run again)"
+        ) from None
 
 
 #: seconds a run may go on with no worker at all before it stops

@@ -719,3 +719,17 @@ def test_an_http_service_as_scheduler_is_named_as_not_dask() -> None:
         srv.close()
     msg = ei.value.message
     assert "EiB" not in msg and "Unable to allocate" not in msg, msg
+
+
+def test_a_scheduler_that_went_away_stops_the_run_with_one_message() -> None:
+    """A scheduler killed mid-run made each row not done an exit-3 row of its own,
+    "internal failure: FutureCancelledError … cancelled for reason: unknown" (Dask review
+    47): a cancelled future stops the run, exit 3, once; other failures are rows."""
+    from distributed.client import FutureCancelledError
+
+    from obsdesign import distributed
+    from obsdesign.errors import SolverError
+
+    with pytest.raises(SolverError, match="the Dask scheduler went away"):
+        distributed._scheduler_gone(FutureCancelledError("obsdesign-x-0-3", "unknown"))
+    distributed._scheduler_gone(RuntimeError("a worker's own failure"))  # a row: no raise
