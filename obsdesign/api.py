@@ -1727,10 +1727,18 @@ def _time_budget(seconds: float | None) -> Any:
     if not seconds or not seconds <= MAX_BUDGET_S:
         yield
         return
+    from obsdesign.deadline import until
+
     if threading.current_thread() is not threading.main_thread():
-        with _thread_budget(float(seconds)):
+        with _thread_budget(float(seconds)), until(float(seconds)):
             yield
         return
+    with until(float(seconds)):
+        yield from _main_thread_budget(float(seconds))
+
+
+def _main_thread_budget(seconds: float) -> Iterator[Any]:
+    """:func:`_time_budget` in the main thread (by SIGALRM)."""
 
     already = _initializing()  # the caller's own imports (a check run at module level)
     leaving = [False]

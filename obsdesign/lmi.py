@@ -56,9 +56,9 @@ def solve(problem: Any, solvers: tuple[str, ...] = SOLVERS) -> SolveResult:
             with warnings.catch_warnings():  # "solution may be inaccurate": we read the status
                 warnings.simplefilter("ignore", UserWarning)
                 if name == "SCS":
-                    _solve_scs(problem)
+                    _solve_scs(problem, time_limit(name))
                 else:
-                    problem.solve(solver=name)
+                    problem.solve(solver=name, **time_limit(name))
         except cp.error.SolverError as e:
             last = f"{name}: {e}"
             continue
@@ -87,14 +87,32 @@ def overflow(e: ValueError) -> None:
         ) from e
 
 
-def _solve_scs(problem: Any) -> None:
+#: each solver's own time-limit setting (seconds), given what is left of the time budget in
+#: force (:mod:`obsdesign.deadline`): one Clarabel solve of a 24-state stubborn LMI ran 25 s
+#: past ``design --timeout 5``, the budget's alarm waiting for it (responsiveness review 47)
+TIME_LIMIT_OPTION = {"CLARABEL": "time_limit", "SCS": "time_limit_secs"}
+
+
+def time_limit(name: str) -> dict[str, float]:
+    """``{option: seconds}`` for solver ``name`` under a time budget (at least 10 ms: a
+    solver stopped by its limit returns, and the budget's own stop follows), else {}."""
+    from obsdesign.deadline import seconds_left
+
+    left = seconds_left()
+    option = TIME_LIMIT_OPTION.get(name)
+    if left is None or option is None:
+        return {}
+    return {option: max(left, 0.01)}
+
+
+def _solve_scs(problem: Any, opts: dict[str, float] | None = None) -> None:
     """``problem.solve(solver="SCS")`` through cvxpy's documented steps (get_problem_data,
     solve_via_data, unpack_results), so that SCS's raw status can be read: SCS replaces the
     SIGINT handler while it iterates and, on Ctrl-C, stops with status "interrupted", which
     cvxpy reports as a solver error, so the interrupt would be lost (and the next solver
     tried). That status raises KeyboardInterrupt here."""
     data, chain, inverse = problem.get_problem_data(solver="SCS")
-    raw = chain.solve_via_data(problem, data)
+    raw = chain.solve_via_data(problem, data, solver_opts=dict(opts or {}))
     info = raw.get("info", {}) if isinstance(raw, dict) else {}
     if info.get("status_val") == -5 or info.get("status") == "interrupted":  # SCS_SIGINT
         raise KeyboardInterrupt

@@ -34,6 +34,7 @@ from obsdesign.certify.printing import (
     fmt_value_up,
 )
 from obsdesign.certify.psd import asymmetric, check_pd, check_psd
+from obsdesign.lmi import time_limit
 from obsdesign.methods.constrained import bounds as B
 from obsdesign.methods.constrained import dual as D
 from obsdesign.methods.constrained.cmap import ConstraintMap
@@ -945,7 +946,7 @@ def _face_witness(
     for j in range(G.shape[0]):
         prob = cp.Problem(cp.Maximize(Gf[j] @ x), cons)
         try:
-            prob.solve(solver=cp.CLARABEL)
+            prob.solve(solver=cp.CLARABEL, **time_limit("CLARABEL"))
         except (cp.error.SolverError, ValueError, ArithmeticError):
             continue
         if x.value is None or not np.all(np.isfinite(x.value)):

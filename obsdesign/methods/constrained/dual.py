@@ -25,6 +25,7 @@ import numpy as np
 from flint import fmpq, fmpq_mat, fmpz
 
 from obsdesign.certify.exact import Q, to_float
+from obsdesign.lmi import time_limit
 
 #: y_i below this fraction of max y are dropped before the exact correction (the solver's
 #: zeros are ~1e-10, not 0)
@@ -195,7 +196,7 @@ def float_multipliers(
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # "Solution may be inaccurate": checked exactly
-            prob.solve(solver=cp.CLARABEL)
+            prob.solve(solver=cp.CLARABEL, **time_limit("CLARABEL"))
     except (cp.error.SolverError, ValueError, ArithmeticError):
         return None
     if z.value is None or not np.all(np.isfinite(z.value)):

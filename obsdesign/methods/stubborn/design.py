@@ -26,7 +26,7 @@ from flint import fmpq
 from obsdesign.certify.exact import Q, dyadic, symmetrize, to_float
 from obsdesign.certify.printing import fmt_down, fmt_exact, fmt_up
 from obsdesign.errors import InconclusiveError, InfeasibleError, SolverError
-from obsdesign.lmi import overflow, solve
+from obsdesign.lmi import overflow, solve, time_limit
 from obsdesign.methods.base import Design, Progress, SolverResult, SolverStatus
 from obsdesign.methods.stubborn import claims as _claims
 from obsdesign.methods.stubborn.detect import detectability
@@ -185,7 +185,7 @@ def solve_cold(prob: Any) -> tuple[bool, str]:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)
-            prob.solve(solver="CLARABEL", warm_start=False)
+            prob.solve(solver="CLARABEL", warm_start=False, **time_limit("CLARABEL"))
     except cp.error.SolverError as e:
         return False, f"solver failure ({e})"
     except ValueError as e:
