@@ -167,7 +167,7 @@ def test_time_budget_refuses_with_reason() -> None:
     sp = api.load_spec_text(SEED0.replace("max_iterations = 60", "time_limit = 1e-9"), "t.toml")
     with pytest.raises(
         SolverError,
-        match=r"not converged within 1e-09 s .* / 0 iterations: the first hull of 8 points did",
+        match=r"not converged within 1e-09 s .* / 0 iterations: the budget was used up before",
     ):
         api.design(sp)
     rep = api.design(api.load_spec_text(SEED0, "s0.toml"))  # the default budget: converges
@@ -399,6 +399,10 @@ def test_budget_message_says_how_far_the_run_got() -> None:
     run = _Run(None, 0, True)
     ends = {
         "the first hull of 8 points did not finish": al._unfinished(np.ones((8, 3)), 0, []),
+        # a continuation begun past the budget (after a long exact check): no hull ran
+        "0 iterations: the budget was used up before this run began": al._unfinished(
+            np.ones((8, 3)), 0, [], spent=True
+        ),
         "no iteration finished, 6 facets": al.IterResult(
             fl.G0, fl.G0, np.inf, 0, False, timed_out=True
         ),
@@ -435,3 +439,26 @@ def test_omegas_exact_vertices_are_held_to_the_time_budget(monkeypatch) -> None:
     with pytest.raises(SolverError, match="Ω's exact vertices were not found"):
         api.design(sp)
     problem._omega_vertices.cache_clear()
+
+
+def test_the_merged_hull_and_the_eps_profile_look_at_the_budget() -> None:
+    """The float hull of the exact points (LP (9)'s rows) ran 49-56 s unchecked on the
+    9-cube, and the ε profile of a note ran minutes and to 24 GB (re-check review 47): both
+    stop past the deadline."""
+    import time
+
+    from obsdesign.methods.setinvariant import design as des
+    from obsdesign.methods.setinvariant import lps
+    from obsdesign.methods.setinvariant.budget import Timeout
+    from obsdesign.methods.setinvariant.problem import build
+
+    data = build(api.load_spec_text(SEED0, "s0.toml"))
+    Pq = data.ex.Vo
+    past = time.perf_counter() - 1
+    with pytest.raises(Timeout):
+        des._merged(Pq, past)
+    assert des._merged(Pq) is not None
+    fl = data.fl
+    with pytest.raises(Timeout):
+        lps.epsilon_profile(fl.G0, fl.A, fl.B1, fl.C[0], fl.Dv, fl.eta, deadline=past)
+    assert len(lps.epsilon_profile(fl.G0, fl.A, fl.B1, fl.C[0], fl.Dv, fl.eta)[1])

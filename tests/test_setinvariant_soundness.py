@@ -1292,7 +1292,7 @@ def test_a_strict_retry_out_of_time_leaves_the_finished_polyhedron(monkeypatch) 
     assert len(calls) == 1
 
 
-@pytest.mark.parametrize("how", ["max_iterations", "diverges", "hull"])
+@pytest.mark.parametrize("how", ["max_iterations", "diverges", "hull", "lp-range"])
 def test_a_strict_retry_that_fails_otherwise_leaves_the_finished_polyhedron(
     monkeypatch, how: str
 ) -> None:
@@ -1305,7 +1305,7 @@ def test_a_strict_retry_that_fails_otherwise_leaves_the_finished_polyhedron(
     from pathlib import Path
 
     from obsdesign import api
-    from obsdesign.errors import SolverError
+    from obsdesign.errors import InconclusiveError, SolverError
     from obsdesign.methods.setinvariant import design as des
     from obsdesign.sets import polytope_ops as po
 
@@ -1317,6 +1317,8 @@ def test_a_strict_retry_that_fails_otherwise_leaves_the_finished_polyhedron(
             retry.append(1)
             if how == "hull":
                 raise po.PolytopeError("the points are not full-dimensional")
+            if how == "lp-range":  # exit 4 with no polyhedron (re-check review 47)
+                raise InconclusiveError("LP (9) is out of a float LP's range")
             r = real(*a[:3], 1, *a[4:], **k)  # one iteration (it needs two)
             return dataclasses.replace(r, converged=False, diverged=how == "diverges")
         return real(*a, **k)
@@ -1337,6 +1339,7 @@ def test_a_strict_retry_that_fails_otherwise_leaves_the_finished_polyhedron(
         "max_iterations": "the strict retry reached its max_iterations",
         "diverges": "the strict retry diverges",
         "hull": "the strict retry stopped (a float polytope computation failed",
+        "lp-range": "the strict retry stopped (LP (9) is out of a float LP's range)",
     }[how]
     assert any(n.startswith(said) for n in rep.notes), rep.notes
     assert not any(n.startswith("the general algorithm diverges") for n in rep.notes)

@@ -109,10 +109,15 @@ def _hull(P: np.ndarray, deadline: float | None) -> po.HullState:
     return po.hull(P, check=lambda: check_deadline(deadline))
 
 
-def _unfinished(P: np.ndarray, it: int, hist: list) -> IterResult:
+def _unfinished(P: np.ndarray, it: int, hist: list, spent: bool = False) -> IterResult:
     """The run stopped by the budget in its first hull (of the points ``P``): no polyhedron
-    (``G`` has no rows), ``it`` iterations done, ε unknown (inf)."""
-    return IterResult(np.zeros((0, P.shape[1])), P, np.inf, it, False, hist, timed_out=True)
+    (``G`` has no rows), ``it`` iterations done, ε unknown (inf); ``spent``: the budget was
+    used up before the run began (a continuation after a long exact check: "the first hull
+    … did not finish" named a hull that never started; re-check review 47)."""
+    why = "the budget was used up before this run began" if spent else ""
+    return IterResult(
+        np.zeros((0, P.shape[1])), P, np.inf, it, False, hist, timed_out=True, why=why
+    )
 
 
 def _eps_screened(
@@ -188,12 +193,13 @@ def general(
     eps_l = np.inf
     st = None
     prev: tuple[np.ndarray, np.ndarray] | None = None
+    spent = deadline is not None and time.perf_counter() > deadline
     for it in range(it0 + 1, it0 + max_iter + 1):
         try:
             nxt = _hull(P, deadline)
         except Timeout:  # the budget ran out in the hull of the grown cloud
             if st is None:
-                return _unfinished(P, it - 1, hist)
+                return _unfinished(P, it - 1, hist, spent)
             return IterResult(st.G, st.V, eps_l, it - 1, False, hist, timed_out=True)
         st = nxt
         P, G = st.V, st.G
@@ -258,12 +264,13 @@ def symmetric(
     hist = [] if history is None else history
     eps = np.inf
     st = None
+    spent = deadline is not None and time.perf_counter() > deadline
     for it in range(it0 + 1, it0 + max_iter + 1):
         try:
             nxt = _hull(P, deadline)
         except Timeout:  # the budget ran out in the hull of the grown cloud
             if st is None:
-                return _unfinished(P, it - 1, hist)
+                return _unfinished(P, it - 1, hist, spent)
             return IterResult(st.G, st.V, eps, it - 1, False, hist, timed_out=True)
         st = nxt
         P, G = st.V, st.G

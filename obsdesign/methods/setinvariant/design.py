@@ -30,7 +30,7 @@ from obsdesign.spec.models import Spec
 from . import algorithms as al
 from . import certificate as ce
 from . import laws, lps, memo, numerical, scaling
-from .budget import Timeout
+from .budget import Timeout, check_deadline
 from .linear import admissible_gains
 from .options import Options
 from .problem import Data, build, check_detectable
@@ -93,8 +93,16 @@ def final_stage(
     if not single:
         return Stage(Gq, vrep, None)
     try:
+        v_rows = _merged(Pq, deadline)
+    except Timeout:
+        raise SolverError(
+            f"exact certificate not finished within {limit}: the float hull of the "
+            f"{len(Pq)} exact points (for LP (9)) was stopped (raise time_limit, or a larger λ "
+            "or Δδ for a smaller polyhedron)"
+        ) from None
+    try:
         res = ce.theorem31(
-            ex, Gq, v_solver=lps.eps_batch, vrep=vrep, deadline=deadline, v_rows=_merged(Pq)
+            ex, Gq, v_solver=lps.eps_batch, vrep=vrep, deadline=deadline, v_rows=v_rows
         )
     except ce.BudgetExceeded as e:
         raise SolverError(
@@ -145,12 +153,14 @@ def _final_of(
         ) from None
 
 
-def _merged(Pq: np.ndarray) -> np.ndarray | None:
+def _merged(Pq: np.ndarray, deadline: float | None = None) -> np.ndarray | None:
     """The float hull's rows of the exact points (near-coplanar facets merged: 492 rows
     where the exact hull has 548 on a random 3-state system), for LP (9); None if qhull
-    fails."""
+    fails. The budget is looked at inside the hull (:class:`~.budget.Timeout` past
+    ``deadline``: the 9-cube's ran 49-56 s with none; re-check review 47)."""
+    check = None if deadline is None else (lambda: check_deadline(deadline))
     try:
-        return po.hull(po.qfloat(Pq), with_edges=False).G
+        return po.hull(po.qfloat(Pq), with_edges=False, check=check).G
     except po.PolytopeError:
         return None
 
@@ -182,7 +192,7 @@ def _budget(r: al.IterResult, o: Options, run: _Run) -> None:
         )
     if r.timed_out:
         if not len(r.G):  # stopped in its first hull (algorithms._unfinished)
-            last = f"the first hull of {len(r.P)} points did not finish"
+            last = r.why or f"the first hull of {len(r.P)} points did not finish"
         elif np.isfinite(r.eps):
             last = eps_vs_lam("last ε", r.eps, o.lam) + f" with {len(r.G)} facets"
         else:
@@ -237,7 +247,9 @@ def _strict_retries(
                 )
                 break
             stage = final_stage(data, r.P, single, lam, dl, o)
-        except (SolverError, InfeasibleError) as e:
+        except (SolverError, InfeasibleError, InconclusiveError) as e:
+            # InconclusiveError: an LP beyond HiGHS's range in a retry ended the design with
+            # exit 4 and no polyhedron (re-check review 47)
             run.notes.append(
                 f"the strict retry stopped ({e.message}): the best polyhedron before it is reported"
             )
@@ -302,7 +314,15 @@ def _iterate(
         res = run.stage.res
         if r.converged and single and res is not None and not res.ok:
             sym_failed = True
-            _, epsz = lps.epsilon_profile(r.G, fl.A, fl.B1, fl.C[0], fl.Dv, fl.eta)
+            try:
+                _, epsz = lps.epsilon_profile(r.G, fl.A, fl.B1, fl.C[0], fl.Dv, fl.eta, deadline=dl)
+            except Timeout:
+                raise SolverError(
+                    f"not converged within {o.time_limit:g} s ([method] time_limit) / "
+                    f"{r.iterations} iterations: the symmetric C_K^∞ meets condition (14) but "
+                    "not Theorem 3.1, and its ε profile was not finished (raise time_limit, or "
+                    "a larger λ or Δδ)"
+                ) from None
             sym_eps = float(np.max(epsz))
             run.extra.update(
                 symmetric_G=run.stage.G,

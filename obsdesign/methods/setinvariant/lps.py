@@ -239,13 +239,16 @@ def epsilon_profile(
     Dv: np.ndarray,
     eta: float,
     zs: np.ndarray | None = None,
+    deadline: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """(z, ε(z)) for a polytope: at Z_d, or at the given ``zs`` (Fig. 2 of the paper)."""
+    """(z, ε(z)) for a polytope: at Z_d, or at the given ``zs`` (Fig. 2 of the paper);
+    :class:`Timeout` past ``deadline`` (a 6-state design's note ran minutes and to 24 GB
+    with none; re-check review 47)."""
     st = po.h_to_v(G)
     if zs is None:
         zs = z_d(st.V, c, eta)
-    phi, _ = phi_at(G, A, st.V, st.edges, c, eta, zs)
-    return zs, eps_batch(G, phi, delta(G, B1, Dv)).eps
+    phi, _ = phi_at(G, A, st.V, st.edges, c, eta, zs, deadline)
+    return zs, eps_batch(G, phi, delta(G, B1, Dv), deadline=deadline).eps
 
 
 def phi_slice_general(
