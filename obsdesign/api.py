@@ -371,7 +371,8 @@ def design_within(
 ) -> Report:
     """:func:`design` with its arguments checked and its time budget given as ``budget``
     seconds (for the message) ending at ``deadline`` (``time.monotonic()``; None: no limit):
-    the command line reads the spec under the same budget first."""
+    the command line reads the spec under the same budget first. ``spec``, ``out``,
+    ``progress`` and ``force`` as for :func:`design`."""
     t0 = time.perf_counter()
     # the budget covers reading the spec too: a polytope set's exact vertex enumeration
     # there took 8-60 s outside --timeout 2 (responsiveness review 47); a spec not read
@@ -793,7 +794,16 @@ def _named_file_differs(spec_file: str, sha: str) -> str | None:
     # were missed, re-check review 47) is shown with \xNN, which bash reads back as the bytes
     # inside $'…' (re-check review 46)
     if str(p) != spec_file:
-        arg = "$'" + spec_file.replace("'", "\\'") + "'"
+        # from the path's own bytes: the shown text cannot tell a backslash in the name from
+        # an escape (a folder "a\\tb" read back as a TAB; re-check review 47)
+        arg = (
+            "$'"
+            + "".join(
+                chr(b) if 32 <= b < 127 and b not in (39, 92) else f"\\x{b:02x}"
+                for b in os.fsencode(p)
+            )
+            + "'"
+        )
         odd = (
             " (its path holds bytes that are not UTF-8, written \\xNN here: bash reads them "
             "back inside $'…')"
@@ -1624,8 +1634,9 @@ def _toml_files(root: Path) -> list[Path]:
     found: list[Path] = []
     try:
         top = os.path.realpath(root)
-    except OSError:  # a relative path in a removed working folder
-        top = os.path.abspath(root)
+    except OSError:  # a relative path in a removed working folder: abspath fails too (as
+        # limits.kernel_dir; an internal failure, exit 3, for a while: re-check review 47)
+        top = os.path.abspath(root) if os.path.isabs(root) else os.fspath(root)
     stack = [(root, top)]
     while stack:
         d, real = stack.pop()

@@ -338,7 +338,8 @@ def set_key(text: str, key: str, literal: str, file: str = "<spec>") -> str:
             whole = ".".join(aot)
             raise InputError(
                 f"{file}: cannot set {key}: [[{whole}]] is an array of tables: --set replaces "
-                f"it whole, e.g. --set '{whole}=[{{ ... }}, ...]'"
+                f"it whole, e.g. --set '{whole}=[[{{ ... }}, ...]]' (one point: the outer brackets "
+                "list the swept values)"
             )
         text = _without_aot(text, stmts, aot)
         stmts = tomltext.statements(text)

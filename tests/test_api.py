@@ -159,3 +159,14 @@ def test_a_report_object_is_verified_under_the_limits_its_spec_was_read_under() 
     with pytest.raises(SpecError, match="above the limit of 1000"):
         api.verify(bare)
     assert "read_limits" not in rep.to_json()
+
+
+def test_spec_files_in_a_removed_working_folder_is_the_folder_itself(tmp_path, monkeypatch) -> None:
+    """``check .`` in a working folder removed since: exit 3 "internal failure:
+    FileNotFoundError" for a while (the folder walk's real path; re-check review 47); the
+    folder is its own row, as before."""
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    monkeypatch.chdir(gone)
+    gone.rmdir()
+    assert api.spec_files(".") == [Path(".")]

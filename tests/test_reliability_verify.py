@@ -834,7 +834,14 @@ def test_the_differs_note_finds_a_spec_whose_name_is_not_utf8(tmp_path: Path) ->
 
 @pytest.mark.parametrize(
     "name",
-    [b"my spec.toml", b"it's.toml", b"$(echo hi).toml", b"d\xff/s.toml", b"e\xfe/'x y.toml"],
+    [
+        b"my spec.toml",
+        b"it's.toml",
+        b"$(echo hi).toml",
+        b"d\xff/s.toml",
+        b"e\xfe/'x y.toml",
+        b"a\\tb/s\xff.toml",  # a backslash in the folder's name: read back as a TAB (47)
+    ],
 )
 def test_the_differs_note_gives_a_command_a_shell_reads_back(tmp_path: Path, name: bytes) -> None:
     """The note's "obsdesign verify REPORT --spec FILE" named the file unquoted: a space
@@ -855,7 +862,7 @@ def test_the_differs_note_gives_a_command_a_shell_reads_back(tmp_path: Path, nam
         f.write("# edited\n")
     (note,) = [n for n in api.verify(out).notes if "differs from it" in n]
     arg = re.search(r'"obsdesign verify REPORT --spec (.*)" checks', note).group(1)
-    assert ("not UTF-8" in note) == (b"\xff" in name or b"\xfe" in name)
+    assert ("not UTF-8" in note) == (b"\xff" in name or b"\xfe" in name), note
     bash = shutil.which("bash")
     if bash is None:  # pragma: no cover - Debian has bash
         pytest.skip("no bash to read the command back")

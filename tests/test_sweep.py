@@ -1108,8 +1108,12 @@ def test_set_key_replaces_an_array_of_tables_whole() -> None:
     }
     assert got["method"] == {"key": "lyapunov"} and "[[" not in new
     for sub in ("simulate.noise.windows.0.start", "simulate.noise.windows.sub.x"):
-        with pytest.raises(InputError, match=r"\[\[simulate\.noise\.windows\]\] is an array of"):
+        with pytest.raises(
+            InputError, match=r"\[\[simulate\.noise\.windows\]\] is an array of"
+        ) as e:
             sw.set_key(AOT, sub, "3")
+        # the advice is one point (outer brackets list the swept values; re-check review 47)
+        assert "--set 'simulate.noise.windows=[[{ ... }, ...]]'" in str(e.value)
     # the table that holds it, and a sibling key, are edited as before
     assert (
         tomllib.loads(sw.set_key(AOT, "simulate.noise.kind", '"none"'))["simulate"]["noise"][
