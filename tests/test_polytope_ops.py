@@ -305,7 +305,7 @@ def test_child_dies_with_its_parent():
             except OSError:
                 continue
             if (
-                any(b"from obsdesign.sets.polytope_ops import _child; _child()" in c for c in cmd)
+                any(b"import _task_child; _task_child()" in c for c in cmd)
                 and str(pid).encode() in cmd
             ):
                 out.append(int(d))

@@ -806,32 +806,12 @@ def _pack(P: np.ndarray) -> list[list[tuple[int, int]]]:
     return [[(int(x.p), int(x.q)) for x in row] for row in np.asarray(P, dtype=object)]
 
 
-def _child() -> None:  # pragma: no cover - runs in the child process (tested through it)
-    """Body of the child process of :func:`_cdd_hull_bounded`: read the pickled points from
-    stdin, write the pickled hull (or the PolytopeError's message) to stdout. Linux: dies
-    with its parent (PR_SET_PDEATHSIG), so a killed parent leaves no cdd run behind."""
-    import os
-    import pickle
-    import sys
-
-    try:
-        import ctypes
-        import signal
-
-        ctypes.CDLL(None).prctl(1, int(signal.SIGKILL))  # PR_SET_PDEATHSIG
-        if os.getppid() != int(sys.argv[1]):  # the parent died before prctl
-            os._exit(1)
-    except (OSError, AttributeError, ValueError, IndexError):
-        pass
-    rows = pickle.load(sys.stdin.buffer)
+def _cdd_hull_child(rows: list[list[tuple[int, int]]]) -> tuple[Any, list[int], Any]:
+    """The child process's side of :func:`_cdd_hull_bounded`: :func:`_cdd_hull` of the
+    points given as integer pairs, the rows as integer pairs."""
     P = np.array([[fmpq(a, b) for a, b in r] for r in rows], dtype=object)
-    try:
-        G, idx, edges = _cdd_hull(P)
-        out: Any = ("ok", _pack(G), idx, edges)
-    except PolytopeError as e:
-        out = ("error", str(e))
-    pickle.dump(out, sys.stdout.buffer)
-    sys.stdout.flush()
+    G, idx, edges = _cdd_hull(P)
+    return _pack(G), idx, edges
 
 
 def _child_task(name: str) -> Callable[[Any], Any]:
@@ -844,13 +824,15 @@ def _child_task(name: str) -> Callable[[Any], Any]:
         return _qhull_child
     if name == "h_to_v":
         return _h_to_v_child
+    if name == "cdd_hull":
+        return _cdd_hull_child
     raise ValueError(f"unknown child task {name!r}")
 
 
 def _task_child() -> None:  # pragma: no cover - runs in the child process (tested through it)
     """Body of the child process of :func:`in_child`: the task named in ``argv[2]`` on the
     pickled payload from stdin, its pickled result (or PolytopeError's message) to stdout;
-    dies with its parent (PR_SET_PDEATHSIG), as :func:`_child`."""
+    dies with its parent (PR_SET_PDEATHSIG: a killed parent leaves no cdd or qhull run behind)."""
     import os
     import pickle
     import sys
@@ -909,6 +891,9 @@ def in_child(task: str, payload: Any, check: Callable[[], None] | None = None) -
         check = _CHILD_CHECK.get()
     if check is not None:
         check()  # no child started past the budget
+    # -P: the working folder is not put on the child's import path (a cdd.py or numpy.py
+    # where `obsdesign check` runs replaced the real module in the child, whose results are
+    # trusted; batch trial, session 39); obsdesign itself from where this process has it
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     code = (
         f"import sys; sys.path.insert(0, {root!r}); "
@@ -948,53 +933,26 @@ def in_child(task: str, payload: Any, check: Callable[[], None] | None = None) -
 def _cdd_hull_bounded(
     P: np.ndarray, deadline: float
 ) -> tuple[np.ndarray, list[int], list[tuple[int, int]]]:
-    """:func:`_cdd_hull` in a child process that is killed at ``deadline`` (a
-    ``time.perf_counter()`` value): raises :class:`HullTimeout` then. The cdd.gmp call
-    cannot be interrupted inside the calling process; a child can. The child is also
-    killed when the caller is interrupted (Ctrl-C: KeyboardInterrupt) or raises, and dies
-    with this process (daemon-like: PR_SET_PDEATHSIG on Linux)."""
-    import os
-    import pickle
-    import subprocess
-    import sys
+    """:func:`_cdd_hull` in a child process (:func:`in_child`) that is killed at ``deadline``
+    (a ``time.perf_counter()`` value, looked at every :data:`CHILD_POLL_S` s): raises
+    :class:`HullTimeout` then. The cdd.gmp call cannot be interrupted inside the calling
+    process; a child can. The child is also killed when the caller is interrupted (Ctrl-C:
+    KeyboardInterrupt) or raises, and dies with this process (PR_SET_PDEATHSIG on Linux);
+    it runs with ``-P`` (a cdd.py or numpy.py where `obsdesign check` runs replaced the real
+    module in the child, whose hull is trusted; batch trial, session 39)."""
     import time
 
     left = deadline - time.perf_counter()
     if left <= 0:
         raise HullTimeout(0.0)
-    # -P: the working folder is not put on the child's import path (a cdd.py or numpy.py
-    # where `obsdesign check` runs replaced the real module in the child, whose hull is
-    # trusted; batch trial, session 39); obsdesign itself from where this process has it
-    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-    code = (
-        f"import sys; sys.path.insert(0, {root!r}); "
-        "from obsdesign.sets.polytope_ops import _child; _child()"
-    )
-    proc = subprocess.Popen(
-        [sys.executable, "-P", "-c", code, str(os.getpid())],
-        stdin=subprocess.PIPE,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-    )
-    try:
-        out, err = proc.communicate(pickle.dumps(_pack(P)), timeout=left)
-    except subprocess.TimeoutExpired:
-        raise HullTimeout(left) from None
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
-    if proc.returncode != 0 or not out:
-        msg = err.decode(errors="replace").strip().splitlines()
-        raise PolytopeError(
-            f"the exact hull's child process failed ({msg[-1] if msg else proc.returncode})"
-        )
-    res = pickle.loads(out)
-    if res[0] == "error":
-        raise PolytopeError(res[1])
-    _, G, idx, edges = res
+
+    def check() -> None:
+        if time.perf_counter() > deadline:
+            raise HullTimeout(left)
+
+    G, idx, edges = in_child("cdd_hull", _pack(P), check)
     Gq = np.array([[fmpq(a, b) for a, b in r] for r in G], dtype=object).reshape(-1, P.shape[1])
-    return Gq, idx, [tuple(e) for e in edges]
+    return Gq, list(idx), [tuple(e) for e in edges]
 
 
 def _float_facets(P: np.ndarray, check: Callable[[], None] | None = None) -> np.ndarray | None:
