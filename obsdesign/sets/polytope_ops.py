@@ -920,10 +920,23 @@ def in_child(task: str, payload: Any, check: Callable[[], None] | None = None) -
             proc.kill()
             proc.communicate()
     if proc.returncode != 0 or not out:
+        # not the polytope's fault: a child killed (the OOM killer) or failing otherwise was
+        # a PolytopeError, which set-invariant reports as numerically inconclusive, exit 4,
+        # blaming the spec's sets (re-check review 47c); a SolverError, exit 3, naming it
+        import signal
+
+        from obsdesign.errors import SolverError
+
+        rc = proc.returncode
         msg = err.decode(errors="replace").strip().splitlines()
-        raise PolytopeError(
-            f"the {task} child process failed ({msg[-1] if msg else proc.returncode})"
-        )
+        if rc is not None and rc < 0:
+            try:
+                how = f"was killed by {signal.Signals(-rc).name}"
+            except ValueError:
+                how = f"was killed by signal {-rc}"
+        else:
+            how = f"failed ({msg[-1] if msg else rc})"
+        raise SolverError(f"the {task} child process {how} (an internal failure, not the spec's)")
     res = pickle.loads(out)
     if res[0] == "error":
         raise PolytopeError(res[1])
