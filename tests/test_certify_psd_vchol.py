@@ -270,3 +270,42 @@ def test_int_to_float_of_zero_and_empty_matrices() -> None:
     assert s == 0 and H.shape == (0, 0)
     H, s = vchol.int_to_float(fmpz_mat(1, 2, [3, -5]))
     assert s == 2 and H.tolist() == [[0.75, -1.25]]
+
+
+@pytest.mark.parametrize("fflu_max_n", [None, 0])
+def test_to_float_entry_by_entry_is_correctly_rounded_with_distinct_denominators(
+    monkeypatch, fflu_max_n
+) -> None:
+    """to_float went through one common denominator (264,000 digits for 10⁴ distinct
+    30-digit ones: 15 s, 3 GB; responsiveness review 47); entry by entry it is the same
+    correctly rounded copy. And the smallest false margin still fails: P with distinct long
+    denominators whose smallest eigenvalue is −2⁻²⁰⁰ is not proved positive definite."""
+    import random
+    from fractions import Fraction
+
+    from obsdesign import lyap
+
+    if fflu_max_n is not None:  # the verified float Cholesky and the integer check decide
+        monkeypatch.setattr(lyap, "FFLU_MAX_N", fflu_max_n)
+    rnd = random.Random(47)
+    n = 6
+    F = fmpq_mat(n, n)
+    for i in range(n):
+        for j in range(i, n):
+            q = rnd.getrandbits(100) | 1
+            F[i, j] = F[j, i] = fmpq(rnd.getrandbits(90) * (2 if i == j else 1), q)
+    H = to_float(F)
+    for i in range(n):
+        for j in range(n):
+            x = F[i, j]
+            assert H[i, j] == float(Fraction(int(x.p), int(x.q)))
+    # v = e₁ − e₂: vᵀPv = P₁₁ − 2P₁₂ + P₂₂ set to −2⁻²⁰⁰, the smallest false margin here
+    P = fmpq_mat(n, n, [fmpq(int(i == j) * 2) for i in range(n) for j in range(n)])
+    q = fmpq(1, rnd.getrandbits(100) | 1)
+    P[0, 1] = P[1, 0] = fmpq(2) + q
+    P[0, 0] = fmpq(1) + q
+    P[1, 1] = 2 * P[0, 1] - P[0, 0] - fmpq(1, 2**200)  # vᵀPv = −2⁻²⁰⁰ exactly
+    r = lyap.pd_verdict(P, 0, None, P, to_float(P))
+    assert not r.ok
+    P[1, 1] = 2 * P[0, 1] - P[0, 0] + 1  # then vᵀPv = 1: decided the other way
+    assert lyap.pd_verdict(P, 0, None, P, to_float(P)).ok
